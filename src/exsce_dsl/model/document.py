@@ -1,0 +1,77 @@
+"""A specification as written: files, their imports and declarations."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+
+from exsce_dsl.errors import ExsceError, SourceLocation
+from exsce_dsl.model.environment import Environment
+from exsce_dsl.model.robots import RobotType
+from exsce_dsl.model.scenario import Scenario
+from exsce_dsl.model.tasks import Task
+
+Declaration = RobotType | Environment | Task | Scenario
+
+
+@dataclass(frozen=True)
+class Import:
+    path: str
+    location: SourceLocation | None = field(default=None, compare=False, repr=False)
+
+
+@dataclass(frozen=True)
+class Document:
+    """One ``.exsce`` file: what it imports and what it declares, in order."""
+
+    path: str
+    imports: tuple[Import, ...]
+    declarations: tuple[Declaration, ...]
+
+
+@dataclass(frozen=True)
+class Specification:
+    """A root file with everything it imports, checked and resolved."""
+
+    root: str
+    documents: tuple[Document, ...]
+    """The root document first, then the imported ones."""
+
+    def declarations(self) -> Iterator[Declaration]:
+        for document in self.documents:
+            yield from document.declarations
+
+    @property
+    def scenarios(self) -> tuple[Scenario, ...]:
+        return tuple(d for d in self.declarations() if isinstance(d, Scenario))
+
+    @property
+    def environments(self) -> tuple[Environment, ...]:
+        return tuple(d for d in self.declarations() if isinstance(d, Environment))
+
+    @property
+    def tasks(self) -> tuple[Task, ...]:
+        return tuple(d for d in self.declarations() if isinstance(d, Task))
+
+    @property
+    def robot_types(self) -> tuple[RobotType, ...]:
+        return tuple(d for d in self.declarations() if isinstance(d, RobotType))
+
+    @property
+    def root_document(self) -> Document:
+        return self.documents[0]
+
+    def scenario(self, scenario_id: str | None = None) -> Scenario:
+        """The scenario with this id, or the root file's only scenario."""
+        if scenario_id is not None:
+            for s in self.scenarios:
+                if s.id == scenario_id:
+                    return s
+            raise ExsceError(f"no scenario '{scenario_id}' in {self.root}")
+        own = [d for d in self.root_document.declarations if isinstance(d, Scenario)]
+        if len(own) != 1:
+            found = ", ".join(s.id for s in own) or "none"
+            raise ExsceError(
+                f"{self.root} declares {len(own)} scenarios ({found}); name one with --scenario"
+            )
+        return own[0]

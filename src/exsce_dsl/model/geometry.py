@@ -1,0 +1,52 @@
+"""Positions, orientations and named poses, in SI units (metres, radians)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from exsce_dsl.errors import SourceLocation
+
+
+@dataclass(frozen=True)
+class Position:
+    x: float
+    y: float
+    z: float = 0.0
+    unit: str = field(default="m", compare=False)
+    """How the author wrote it (m, cm, mm); only the formatter looks at it."""
+
+    def distance_to(self, other: Position) -> float:
+        return math.dist((self.x, self.y, self.z), (other.x, other.y, other.z))
+
+
+@dataclass(frozen=True)
+class Orientation:
+    roll: float = 0.0
+    pitch: float = 0.0
+    yaw: float = 0.0
+    unit: str = field(default="rad", compare=False)
+    """How the author wrote it (rad, deg); only the formatter looks at it."""
+
+    @property
+    def is_planar(self) -> bool:
+        return self.roll == 0.0 and self.pitch == 0.0
+
+
+@dataclass(frozen=True)
+class Pose:
+    """A named pose of an environment, or a waypoint given by coordinates.
+
+    ``area`` is the id of the area that holds it (``None`` for coordinate
+    waypoints, which belong to their task).  A use of a declared pose with
+    another heading is a ``Pose`` with the same id and another orientation.
+    """
+
+    id: str
+    position: Position
+    orientation: Orientation = Orientation()
+    area: str | None = None
+    location: SourceLocation | None = field(default=None, compare=False, repr=False)
+
+    def with_orientation(self, orientation: Orientation) -> Pose:
+        return Pose(self.id, self.position, orientation, self.area, self.location)

@@ -1,0 +1,27 @@
+"""Robot types (hardware facts) and the robots of a scenario's fleet."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from exsce_dsl.errors import SourceLocation
+from exsce_dsl.model.geometry import Pose
+
+
+@dataclass(frozen=True)
+class RobotType:
+    """Hardware facts that similarity uses; unknown facts are ``None``."""
+
+    id: str
+    base: str | None = None
+    torso: bool | None = None
+    location: SourceLocation | None = field(default=None, compare=False, repr=False)
+
+
+@dataclass(frozen=True)
+class Robot:
+    id: str
+    type: RobotType
+    namespace: str
+    start_pose: Pose | None = None
+    location: SourceLocation | None = field(default=None, compare=False, repr=False)
