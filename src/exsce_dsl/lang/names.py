@@ -1,0 +1,29 @@
+"""What an id may look like, the same rule the grammar's ``Name`` uses.
+
+Every id that reaches an IRI, a file path or generated code passes through
+here, so the grammar and the importers agree on it.
+"""
+
+from __future__ import annotations
+
+import re
+
+#: Words of the language that cannot be ids (also those reserved for
+#: acceptance criteria, metrics and derivations).  Keep in step with
+#: ``grammar/common.tx``; a test checks that they agree.
+KEYWORDS: frozenset[str] = frozenset(
+    """import robot type base torso yes no environment map world from package path
+    file area pose at facing rpy obstacle size model task subtask visit source scenario
+    in robots namespace starts mission parallel sequential does then acceptance feature
+    given when and but each stays below above is increasing decreasing invariant within
+    std of baseline by before after during derive remove add swap reverse substitute
+    replace reassign move metric oracle relation monitor topic""".split()
+)
+
+NAME_PATTERN = r"[A-Za-z_][A-Za-z0-9_]*(?:-[A-Za-z0-9_]+)*"
+_NAME_RE = re.compile(NAME_PATTERN)
+
+
+def is_valid_name(text: str) -> bool:
+    """True if ``text`` can be written as an id in the DSL."""
+    return bool(_NAME_RE.fullmatch(text)) and text not in KEYWORDS
