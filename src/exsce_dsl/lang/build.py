@@ -1,0 +1,464 @@
+"""Build the semantic model from parse trees, resolving every reference.
+
+References are resolved here rather than by textX so that *every* unknown
+name is reported (with a did-you-mean), not only the first one.  Checks that
+need the whole scenario live in :mod:`exsce_dsl.lang.checks`.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from exsce_dsl.errors import Diagnostic, SourceLocation, SpecError
+from exsce_dsl.lang.checks import check_environment_map, check_scenario
+from exsce_dsl.lang.loader import load_files
+from exsce_dsl.lang.parser import ParsedFile
+from exsce_dsl.lang.suggest import did_you_mean
+from exsce_dsl.model import (
+    Area,
+    Assignment,
+    Document,
+    Environment,
+    Import,
+    MapModel,
+    Mission,
+    MissionType,
+    Obstacle,
+    Orientation,
+    Pose,
+    Position,
+    Robot,
+    RobotType,
+    RosResource,
+    Scenario,
+    Specification,
+    Subtask,
+    Task,
+    WorldModel,
+)
+
+_LENGTH_SCALE = {None: 1.0, "m": 1.0, "cm": 0.01, "mm": 0.001}
+
+_KIND_WORDS = {
+    "RobotType": "robot type",
+    "Environment": "environment",
+    "Task": "task",
+    "Scenario": "scenario",
+}
+
+
+@dataclass
+class Analysis:
+    """What :func:`analyse` found: the model if it is valid, and every diagnostic."""
+
+    spec: Specification | None
+    diagnostics: list[Diagnostic] = field(default_factory=list)
+
+    @property
+    def errors(self) -> list[Diagnostic]:
+        return [d for d in self.diagnostics if d.severity == "error"]
+
+
+def load_spec(path: str | Path, overlay: Mapping[str, str] | None = None) -> Specification:
+    """Parse, resolve and check a specification; raise :class:`SpecError` listing every error."""
+    analysis = analyse(path, overlay)
+    if analysis.errors or analysis.spec is None:
+        raise SpecError(analysis.errors or analysis.diagnostics)
+    return analysis.spec
+
+
+def analyse(path: str | Path, overlay: Mapping[str, str] | None = None) -> Analysis:
+    """Like :func:`load_spec`, but return diagnostics instead of raising (for editors and ``check``)."""
+    files, diagnostics = load_files(path, overlay)
+    builder = _Builder(files)
+    spec = builder.build() if files else None
+    diagnostics.extend(builder.diagnostics)
+    unique = sorted(set(diagnostics), key=lambda d: (d.location or SourceLocation("", 0, 0), d.message))
+    has_errors = any(d.severity == "error" for d in unique)
+    return Analysis(None if has_errors else spec, unique)
+
+
+@dataclass
+class _Declared:
+    obj: Any
+    file: ParsedFile
+    name_location: SourceLocation
+
+
+class _Builder:
+    def __init__(self, files: list[ParsedFile]) -> None:
+        self.files = files
+        self.diagnostics: list[Diagnostic] = []
+        self.declared: dict[str, dict[str, _Declared]] = {k: {} for k in _KIND_WORDS}
+        self.robot_types: dict[str, RobotType] = {}
+        self.environments: dict[str, Environment] = {}
+        self.tasks: dict[str, Task] = {}
+        self.scenarios: dict[str, Scenario] = {}
+        # pose id -> the environments declaring it, with the pose
+        self.poses: dict[str, list[tuple[str, Pose]]] = {}
+        self.task_refs: dict[str, list[tuple[str, SourceLocation]]] = {}
+
+    # ---------------------------------------------------------------- helpers
+    def error(self, message: str, location: SourceLocation | None, code: str = "semantic") -> None:
+        self.diagnostics.append(Diagnostic(message, location, code=code))
+
+    def warning(self, message: str, location: SourceLocation | None) -> None:
+        self.diagnostics.append(Diagnostic(message, location, severity="warning", code="semantic"))
+
+    @staticmethod
+    def name_span(pf: ParsedFile, obj: Any) -> SourceLocation:
+        """The span of ``obj.name`` inside the text of ``obj``."""
+        pattern = re.compile(rf"(?<![\w-]){re.escape(obj.name)}(?![\w-])")
+        match = pattern.search(pf.text, obj._tx_position, obj._tx_position_end)
+        if match is None:
+            return pf.span(obj)
+        return pf.lines.span(match.start(), match.end())
+
+    # ------------------------------------------------------------------ build
+    def build(self) -> Specification:
+        for pf in self.files:
+            for decl in pf.tree.declarations:
+                self._declare(pf, decl)
+        for name, d in self.declared["RobotType"].items():
+            self.robot_types[name] = self._robot_type(d)
+        for name, d in self.declared["Environment"].items():
+            self.environments[name] = self._environment(d)
+        for name, d in self.declared["Task"].items():
+            task = self._task(d)
+            if task is not None:
+                self.tasks[name] = task
+        for name, d in self.declared["Scenario"].items():
+            scenario = self._scenario(d)
+            if scenario is not None:
+                self.scenarios[name] = scenario
+        for env in self.environments.values():
+            self.diagnostics.extend(check_environment_map(env))
+        for scenario in self.scenarios.values():
+            self.diagnostics.extend(check_scenario(scenario))
+        return Specification(self.files[0].path, tuple(self._document(pf) for pf in self.files))
+
+    def _declare(self, pf: ParsedFile, decl: Any) -> None:
+        kind = decl.__class__.__name__
+        table = self.declared[kind]
+        where = self.name_span(pf, decl)
+        first = table.get(decl.name)
+        if first is not None:
+            self.error(
+                f"duplicate {_KIND_WORDS[kind]} '{decl.name}' (first declared at {first.name_location})",
+                where,
+            )
+            return
+        table[decl.name] = _Declared(decl, pf, where)
+
+    def _document(self, pf: ParsedFile) -> Document:
+        imports = tuple(Import(i.path, pf.span(i)) for i in pf.tree.imports)
+        tables: dict[str, Mapping[str, Any]] = {
+            "RobotType": self.robot_types,
+            "Environment": self.environments,
+            "Task": self.tasks,
+            "Scenario": self.scenarios,
+        }
+        declarations = []
+        for decl in pf.tree.declarations:
+            kind = decl.__class__.__name__
+            declared = self.declared[kind].get(decl.name)
+            built = tables[kind].get(decl.name)
+            if built is not None and declared is not None and declared.obj is decl:
+                declarations.append(built)
+        return Document(pf.path, imports, tuple(declarations))
+
+    # ------------------------------------------------------------ robot types
+    def _robot_type(self, d: _Declared) -> RobotType:
+        base: str | None = None
+        torso: bool | None = None
+        seen: set[str] = set()
+        for fact in d.obj.facts:
+            kind = fact.__class__.__name__
+            if kind in seen:
+                word = "base" if kind == "BaseFact" else "torso"
+                self.error(f"robot type '{d.obj.name}' states its {word} twice", d.file.span(fact))
+            seen.add(kind)
+            if kind == "BaseFact":
+                base = fact.base
+            else:
+                torso = fact.torso == "yes"
+        return RobotType(d.obj.name, base, torso, d.name_location)
+
+    # ----------------------------------------------------------- environments
+    def _environment(self, d: _Declared) -> Environment:
+        pf, env = d.file, d.obj
+        map_model: MapModel | None = None
+        world: WorldModel | None = None
+        areas: list[Area] = []
+        obstacles: list[Obstacle] = []
+        pose_seen: dict[str, SourceLocation] = {}
+        area_seen: dict[str, SourceLocation] = {}
+        obstacle_seen: dict[str, SourceLocation] = {}
+        for member in env.members:
+            kind = member.__class__.__name__
+            if kind == "MapModel":
+                if map_model is not None:
+                    self.error(f"environment '{env.name}' has two maps", pf.span(member))
+                    continue
+                file = None
+                if member.file:
+                    file = str(Path(pf.path).parent / member.file)
+                map_model = MapModel(member.name, _ros(member.source), file, pf.span(member))
+            elif kind == "WorldModel":
+                if world is not None:
+                    self.error(f"environment '{env.name}' has two worlds", pf.span(member))
+                    continue
+                world = WorldModel(member.name, _ros(member.source), pf.span(member))
+            elif kind == "Area":
+                where = self.name_span(pf, member)
+                if member.name in area_seen:
+                    self.error(
+                        f"duplicate area '{member.name}' in environment '{env.name}' "
+                        f"(first declared at {area_seen[member.name]})",
+                        where,
+                    )
+                    continue
+                area_seen[member.name] = where
+                poses = []
+                for decl in member.poses:
+                    pwhere = self.name_span(pf, decl)
+                    if decl.name in pose_seen:
+                        self.error(
+                            f"duplicate pose '{decl.name}' in environment '{env.name}' "
+                            f"(first declared at {pose_seen[decl.name]})",
+                            pwhere,
+                        )
+                        continue
+                    pose_seen[decl.name] = pwhere
+                    pose = Pose(
+                        decl.name,
+                        _position(decl.position),
+                        _orientation(decl.orientation),
+                        member.name,
+                        pwhere,
+                    )
+                    poses.append(pose)
+                    self.poses.setdefault(decl.name, []).append((env.name, pose))
+                areas.append(Area(member.name, tuple(poses), where))
+            else:  # Obstacle
+                where = self.name_span(pf, member)
+                if member.name in obstacle_seen:
+                    self.error(
+                        f"duplicate obstacle '{member.name}' in environment '{env.name}' "
+                        f"(first declared at {obstacle_seen[member.name]})",
+                        where,
+                    )
+                    continue
+                obstacle_seen[member.name] = where
+                size = None
+                if member.sx is not None:
+                    dims = [member.sx, member.sy] + ([member.sz] if member.sz is not None else [])
+                    size = tuple(_length(v) for v in dims)
+                pose = Pose(
+                    member.name, _position(member.position), _orientation(member.orientation), None, where
+                )
+                obstacles.append(Obstacle(member.name, pose, member.model or None, size, where))
+        return Environment(env.name, map_model, world, tuple(areas), tuple(obstacles), d.name_location)
+
+    # ------------------------------------------------------------------ tasks
+    def _task(self, d: _Declared) -> Task | None:
+        pf, task = d.file, d.obj
+        subtasks: list[Subtask] = []
+        ok = True
+        coordinate_count = 0
+        for number, sub in enumerate(task.subtasks, start=1):
+            waypoints: list[Pose] = []
+            for visit in sub.visits:
+                for wp in visit.waypoints:
+                    if wp.__class__.__name__ == "CoordinateWaypoint":
+                        coordinate_count += 1
+                        waypoints.append(
+                            Pose(
+                                f"{task.name}-w{coordinate_count:03d}",
+                                _position(wp.position),
+                                _orientation(wp.orientation),
+                                None,
+                                pf.span(wp),
+                            )
+                        )
+                        continue
+                    pose = self._pose_use(pf, wp, self._task_pose_candidates())
+                    if pose is None:
+                        ok = False
+                    else:
+                        waypoints.append(pose)
+            if not sub.visits and sub.__class__.__name__ == "Subtask":
+                self.error(f"subtask {number} of task '{task.name}' has no waypoints", pf.span(sub))
+                ok = False
+            subtasks.append(Subtask(tuple(waypoints), pf.span(sub)))
+        if not task.subtasks:
+            self.error(f"task '{task.name}' has no waypoints; add 'visit <pose>'", d.name_location)
+            ok = False
+        if not ok:
+            return None
+        return Task(task.name, tuple(subtasks), _ros(task.source), d.name_location)
+
+    def _task_pose_candidates(self) -> dict[str, Pose | None]:
+        """Pose ids a task may name: unambiguous ones map to their pose."""
+        table: dict[str, Pose | None] = {}
+        for pose_id, found in self.poses.items():
+            distinct = {(p.position, p.orientation) for _, p in found}
+            table[pose_id] = found[0][1] if len(distinct) == 1 else None
+        return table
+
+    def _pose_use(self, pf: ParsedFile, use: Any, table: Mapping[str, Pose | None]) -> Pose | None:
+        name = use.pose.name
+        where = pf.span(use.pose)
+        if name not in table:
+            self.error(f"unknown pose '{name}'{did_you_mean(name, table)}", where, code="reference")
+            return None
+        pose = table[name]
+        if pose is None:
+            envs = ", ".join(sorted(e for e, _ in self.poses[name]))
+            self.error(
+                f"pose '{name}' is declared differently in environments {envs}; "
+                "a task cannot tell which one it means",
+                where,
+                code="reference",
+            )
+            return None
+        loc = pf.span(use)
+        if use.orientation is not None:
+            return Pose(pose.id, pose.position, _orientation(use.orientation), pose.area, loc)
+        return Pose(pose.id, pose.position, pose.orientation, pose.area, loc)
+
+    # -------------------------------------------------------------- scenarios
+    def _scenario(self, d: _Declared) -> Scenario | None:
+        pf, sc = d.file, d.obj
+        ok = True
+        env = self.environments.get(sc.environment.name)
+        if env is None:
+            self.error(
+                f"unknown environment '{sc.environment.name}'"
+                f"{did_you_mean(sc.environment.name, self.environments)}",
+                pf.span(sc.environment),
+                code="reference",
+            )
+            ok = False
+        env_poses: dict[str, Pose | None] = {p.id: p for p in env.poses()} if env else {}
+
+        robots: list[Robot] = []
+        robot_seen: dict[str, SourceLocation] = {}
+        for decl in sc.robots:
+            where = self.name_span(pf, decl)
+            if decl.name in robot_seen:
+                self.error(
+                    f"duplicate robot '{decl.name}' in scenario '{sc.name}' "
+                    f"(first declared at {robot_seen[decl.name]})",
+                    where,
+                )
+                ok = False
+                continue
+            robot_seen[decl.name] = where
+            rtype = self.robot_types.get(decl.type.name)
+            if rtype is None:
+                self.error(
+                    f"unknown robot type '{decl.type.name}'{did_you_mean(decl.type.name, self.robot_types)}",
+                    pf.span(decl.type),
+                    code="reference",
+                )
+                ok = False
+            start = None
+            if decl.start is not None and env is not None:
+                if decl.start.pose.name not in env_poses and decl.start.pose.name in self.poses:
+                    self.error(
+                        f"start pose '{decl.start.pose.name}' of robot '{decl.name}' is not in "
+                        f"environment '{env.id}'",
+                        pf.span(decl.start.pose),
+                        code="reference",
+                    )
+                    ok = False
+                else:
+                    start = self._pose_use(pf, decl.start, env_poses)
+                    ok = ok and start is not None
+            namespace = decl.namespace if decl.namespace else decl.name
+            if rtype is not None:
+                robots.append(Robot(decl.name, rtype, namespace, start, where))
+
+        mission = self._mission(pf, sc, robot_seen)
+        if mission is None or env is None or not ok:
+            return None
+        used: list[Task] = []
+        for entry in mission.allocation:
+            task = self.tasks.get(entry.task)
+            if task is None:
+                return None  # reported where the task is declared or referenced
+            if task not in used:
+                used.append(task)
+        return Scenario(sc.name, env, tuple(robots), mission, tuple(used), d.name_location)
+
+    def _mission(self, pf: ParsedFile, sc: Any, fleet: Mapping[str, SourceLocation]) -> Mission | None:
+        m = sc.mission
+        if m is None:
+            self.error(
+                f"scenario '{sc.name}' has no mission; add 'mission <id> parallel {{ ... }}'",
+                self.name_span(pf, sc),
+            )
+            return None
+        allocation: list[Assignment] = []
+        ok = True
+        for line in m.assignments:
+            robot = line.robot.name
+            if robot not in fleet:
+                self.error(
+                    f"robot '{robot}' is not in the fleet of scenario '{sc.name}'{did_you_mean(robot, fleet)}",
+                    pf.span(line.robot),
+                    code="reference",
+                )
+                ok = False
+            for ref in line.tasks:
+                if ref.name not in self.declared["Task"]:
+                    self.error(
+                        f"unknown task '{ref.name}'{did_you_mean(ref.name, self.declared['Task'])}",
+                        pf.span(ref),
+                        code="reference",
+                    )
+                    ok = False
+                allocation.append(Assignment(robot, ref.name, pf.span(ref)))
+        if not m.assignments:
+            self.error(f"mission '{m.name}' allocates no task", self.name_span(pf, m))
+            ok = False
+        if not ok:
+            return None
+        return Mission(m.name, MissionType(m.kind), tuple(allocation), self.name_span(pf, m))
+
+
+def _ros(source: Any) -> RosResource | None:
+    if source is None:
+        return None
+    return RosResource(source.package, source.path or None)
+
+
+def _length(length: Any) -> float:
+    return float(length.value) * _LENGTH_SCALE[length.unit or None]
+
+
+def _position(pos: Any) -> Position:
+    unit = pos.x.unit or "m"
+    z = _length(pos.z) if pos.z is not None else 0.0
+    return Position(_length(pos.x), _length(pos.y), z, unit)
+
+
+def _angle(angle: Any) -> float:
+    value = float(angle.value)
+    return math.radians(value) if angle.unit == "deg" else value
+
+
+def _orientation(orientation: Any) -> Orientation:
+    if orientation is None:
+        return Orientation()
+    unit = orientation.yaw.unit or "rad"
+    if orientation.__class__.__name__ == "Facing":
+        return Orientation(0.0, 0.0, _angle(orientation.yaw), unit)
+    return Orientation(_angle(orientation.roll), _angle(orientation.pitch), _angle(orientation.yaw), unit)
+

@@ -1,0 +1,147 @@
+"""Semantic checks on built scenarios and environments.
+
+Each check returns diagnostics instead of raising, so that one pass reports
+every problem it finds.
+"""
+
+from __future__ import annotations
+
+import re
+from functools import lru_cache
+from pathlib import Path
+
+from exsce_dsl.errors import Diagnostic, ExsceError
+from exsce_dsl.lang.occupancy import FREE, OUTSIDE, OccupancyGrid, load_occupancy_grid
+from exsce_dsl.model import Environment, Pose, Scenario
+
+# ROS graph resource names (namespaces): letters, digits, _ and / separators.
+_ROS_NAMESPACE = re.compile(r"/?[A-Za-z][A-Za-z0-9_]*(/[A-Za-z][A-Za-z0-9_]*)*")
+
+
+def check_scenario(scenario: Scenario) -> list[Diagnostic]:
+    found: list[Diagnostic] = []
+    env = scenario.environment
+    env_pose_ids = {p.id for p in env.poses()}
+    busy = {a.robot for a in scenario.mission.allocation}
+
+    namespaces: dict[str, str] = {}
+    starts: dict[str, str] = {}
+    for robot in scenario.robots:
+        if not _ROS_NAMESPACE.fullmatch(robot.namespace):
+            found.append(
+                Diagnostic(
+                    f"namespace '{robot.namespace}' of robot '{robot.id}' is not a valid ROS name",
+                    robot.location,
+                )
+            )
+        if robot.namespace in namespaces:
+            found.append(
+                Diagnostic(
+                    f"robots '{namespaces[robot.namespace]}' and '{robot.id}' share the namespace "
+                    f"'{robot.namespace}'; their topics would mix",
+                    robot.location,
+                )
+            )
+        namespaces.setdefault(robot.namespace, robot.id)
+        if robot.start_pose is None:
+            if robot.id in busy:
+                found.append(
+                    Diagnostic(
+                        f"robot '{robot.id}' has tasks in mission '{scenario.mission.id}' but no start "
+                        "pose; add 'starts at <pose>'",
+                        robot.location,
+                    )
+                )
+        else:
+            other = starts.get(robot.start_pose.id)
+            if other is not None:
+                found.append(
+                    Diagnostic(
+                        f"robots '{other}' and '{robot.id}' both start at '{robot.start_pose.id}'",
+                        robot.start_pose.location or robot.location,
+                    )
+                )
+            starts.setdefault(robot.start_pose.id, robot.id)
+        if robot.id not in busy:
+            found.append(
+                Diagnostic(
+                    f"robot '{robot.id}' has no task in mission '{scenario.mission.id}'",
+                    robot.location,
+                    severity="warning",
+                )
+            )
+
+    for entry in scenario.mission.allocation:
+        task = scenario.task(entry.task)
+        if task is None:
+            continue
+        for waypoint in task.waypoints():
+            if waypoint.area is not None and waypoint.id not in env_pose_ids:
+                found.append(
+                    Diagnostic(
+                        f"task '{task.id}' visits pose '{waypoint.id}', which is not in environment "
+                        f"'{env.id}' of scenario '{scenario.id}'",
+                        entry.location,
+                    )
+                )
+        if env.map is not None and env.map.file is not None:
+            grid = _grid_or_none(env.map.file)
+            if grid is not None:
+                for waypoint in task.waypoints():
+                    if waypoint.area is None:
+                        problem = _pose_problem(grid, waypoint, env.map.name)
+                        if problem:
+                            found.append(Diagnostic(problem, waypoint.location))
+    return found
+
+
+def check_environment_map(env: Environment) -> list[Diagnostic]:
+    """Every declared pose and obstacle must lie in the free space of a known map."""
+    if env.map is None or env.map.file is None:
+        return []
+    try:
+        grid = _grid(env.map.file)
+    except ExsceError as exc:
+        return [Diagnostic(exc.message, env.map.location)]
+    found = []
+    for pose in env.poses():
+        problem = _pose_problem(grid, pose, env.map.name)
+        if problem:
+            found.append(Diagnostic(problem, pose.location))
+    for obstacle in env.obstacles:
+        if grid.state_at(obstacle.pose.position.x, obstacle.pose.position.y) == OUTSIDE:
+            found.append(
+                Diagnostic(
+                    f"obstacle '{obstacle.id}' is outside the map '{env.map.name}'{_bounds(grid)}",
+                    obstacle.location,
+                )
+            )
+    return found
+
+
+def _pose_problem(grid: OccupancyGrid, pose: Pose, map_name: str) -> str | None:
+    x, y = pose.position.x, pose.position.y
+    state = grid.state_at(x, y)
+    if state == FREE:
+        return None
+    where = f"pose '{pose.id}' at ({x:g}, {y:g})"
+    if state == OUTSIDE:
+        return f"{where} is outside the map '{map_name}'{_bounds(grid)}"
+    return f"{where} is in {state} space of the map '{map_name}', not in free space"
+
+
+def _bounds(grid: OccupancyGrid) -> str:
+    x0, x1, y0, y1 = grid.bounds()
+    return f" (x from {x0:.2f} to {x1:.2f}, y from {y0:.2f} to {y1:.2f})"
+
+
+@lru_cache(maxsize=8)
+def _grid(path: str) -> OccupancyGrid:
+    return load_occupancy_grid(Path(path))
+
+
+def _grid_or_none(path: str) -> OccupancyGrid | None:
+    try:
+        return _grid(path)
+    except ExsceError:
+        return None

@@ -1,0 +1,114 @@
+"""Occupancy grids in ROS map_server format (a YAML file beside a PGM image).
+
+Used to check that poses lie in free space; the simulator reuses it later.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from exsce_dsl.errors import ExsceError
+
+FREE, OCCUPIED, UNKNOWN, OUTSIDE = "free", "occupied", "unknown", "outside"
+
+
+@dataclass(frozen=True)
+class OccupancyGrid:
+    """``cells`` is row 0 = the top of the image, as map_server reads it."""
+
+    cells: np.ndarray  # uint8 grey levels, shape (height, width)
+    resolution: float
+    origin: tuple[float, float, float]
+    occupied_thresh: float
+    free_thresh: float
+    negate: bool
+
+    @property
+    def height(self) -> int:
+        return int(self.cells.shape[0])
+
+    @property
+    def width(self) -> int:
+        return int(self.cells.shape[1])
+
+    def bounds(self) -> tuple[float, float, float, float]:
+        """(x_min, x_max, y_min, y_max) of the grid in the map frame (origin yaw 0)."""
+        ox, oy, _ = self.origin
+        return ox, ox + self.width * self.resolution, oy, oy + self.height * self.resolution
+
+    def state_at(self, x: float, y: float) -> str:
+        """free, occupied, unknown or outside, by map_server's thresholds."""
+        ox, oy, yaw = self.origin
+        dx, dy = x - ox, y - oy
+        if yaw:
+            c, s = math.cos(-yaw), math.sin(-yaw)
+            dx, dy = c * dx - s * dy, s * dx + c * dy
+        col = math.floor(dx / self.resolution)
+        row_from_bottom = math.floor(dy / self.resolution)
+        if not (0 <= col < self.width and 0 <= row_from_bottom < self.height):
+            return OUTSIDE
+        grey = int(self.cells[self.height - 1 - row_from_bottom, col])
+        occupancy = grey / 255.0 if self.negate else (255 - grey) / 255.0
+        if occupancy > self.occupied_thresh:
+            return OCCUPIED
+        if occupancy < self.free_thresh:
+            return FREE
+        return UNKNOWN
+
+
+def load_occupancy_grid(yaml_path: Path) -> OccupancyGrid:
+    """Read a map_server YAML and its PGM image (binary P5 or ASCII P2)."""
+    try:
+        meta = yaml.safe_load(yaml_path.read_text(encoding="utf-8"))
+    except (OSError, yaml.YAMLError) as exc:
+        raise ExsceError(f"cannot read map file {yaml_path}: {exc}") from None
+    if not isinstance(meta, dict) or "image" not in meta or "resolution" not in meta:
+        raise ExsceError(f"map file {yaml_path} is not a map_server YAML (needs image, resolution)")
+    image = yaml_path.parent / str(meta["image"])
+    origin = [float(v) for v in (meta.get("origin") or [0.0, 0.0, 0.0])] + [0.0, 0.0, 0.0]
+    return OccupancyGrid(
+        cells=_read_pgm(image),
+        resolution=float(meta["resolution"]),
+        origin=(origin[0], origin[1], origin[2]),
+        occupied_thresh=float(meta.get("occupied_thresh", 0.65)),
+        free_thresh=float(meta.get("free_thresh", 0.196)),
+        negate=bool(meta.get("negate", 0)),
+    )
+
+
+def _read_pgm(path: Path) -> np.ndarray:
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise ExsceError(f"cannot read map image {path}: {exc.strerror}") from None
+    magic = data[:2]
+    if magic not in (b"P5", b"P2"):
+        raise ExsceError(f"map image {path} is not a PGM file (only PGM maps are supported)")
+    fields: list[bytes] = []
+    pos = 2
+    while len(fields) < 3:
+        while pos < len(data) and data[pos : pos + 1].isspace():
+            pos += 1
+        if data[pos : pos + 1] == b"#":
+            pos = data.index(b"\n", pos) + 1
+            continue
+        start = pos
+        while pos < len(data) and not data[pos : pos + 1].isspace():
+            pos += 1
+        fields.append(data[start:pos])
+    width, height, maxval = (int(f) for f in fields)
+    if magic == b"P2":
+        values = np.array(data[pos:].split(), dtype=np.int64)
+    else:
+        pos += 1  # the single whitespace after maxval
+        dtype = np.uint8 if maxval < 256 else np.dtype(">u2")
+        values = np.frombuffer(data, dtype=dtype, count=width * height, offset=pos).astype(np.int64)
+    if values.size != width * height:
+        raise ExsceError(f"map image {path} is truncated")
+    scaled = values * 255 // maxval if maxval != 255 else values
+    return scaled.astype(np.uint8).reshape(height, width)
