@@ -121,14 +121,12 @@ def compile_command(spec: str, fmt: str, output: str | None, scenario_id: str | 
 @click.argument("specs", nargs=-1, required=True, type=click.Path(dir_okay=False))
 @click.option("--check", "check_only", is_flag=True, help="Change nothing; exit 1 if a file would change.")
 @click.option("--diff", "show_diff", is_flag=True, help="Print what would change as a unified diff.")
-@click.option("--drop-comments", is_flag=True, help="Format files with comments too (comments are not kept).")
 @reports_errors
-def fmt(specs: tuple[str, ...], check_only: bool, show_diff: bool, drop_comments: bool) -> None:
+def fmt(specs: tuple[str, ...], check_only: bool, show_diff: bool) -> None:
     """Rewrite SPEC files in canonical form.
 
     The formatter prints the checked model, so a file must be valid to be
-    formatted.  It does not keep comments yet: it refuses to rewrite a file
-    that has some unless --drop-comments is given.
+    formatted.  Comments stay before the element that follows them.
 
     \b
     Example:
@@ -136,13 +134,15 @@ def fmt(specs: tuple[str, ...], check_only: bool, show_diff: bool, drop_comments
     """
     from exsce_dsl.lang.build import load_spec
     from exsce_dsl.lang.formatter import format_spec_document
+    from exsce_dsl.lang.lexical import comments
     from exsce_dsl.lang.loader import display_path
 
     changed = []
     for spec_path in specs:
         spec = load_spec(spec_path)
         original = Path(spec_path).read_text(encoding="utf-8")
-        formatted = format_spec_document(spec, display_path(spec_path))
+        path = display_path(spec_path)
+        formatted = format_spec_document(spec, path, comments(original, path))
         if formatted == original:
             continue
         changed.append(spec_path)
@@ -152,20 +152,12 @@ def fmt(specs: tuple[str, ...], check_only: bool, show_diff: bool, drop_comments
                 fromfile=spec_path, tofile=f"{spec_path} (formatted)")), nl=False)
         if check_only:
             click.echo(f"would reformat {spec_path}", err=True)
-        elif _has_comments(original) and not drop_comments:
-            raise ExsceError(f"{spec_path} has comments, which the formatter does not keep; "
-                             "rerun with --drop-comments to format it anyway")
         else:
             Path(spec_path).write_text(formatted, encoding="utf-8")
             click.echo(f"reformatted {spec_path}", err=True)
     if check_only and changed:
         sys.exit(1)
 
-
-def _has_comments(text: str) -> bool:
-    from exsce_dsl.lang.lexical import has_comments
-
-    return has_comments(text)
 
 
 @main.command(name="import")

@@ -8,10 +8,15 @@ printing is idempotent.  Comments are not part of the model and are not kept.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping
+import os
+from collections.abc import Iterable, Mapping, Sequence
 from decimal import Decimal
 
+from exsce_dsl.errors import SourceLocation
+from exsce_dsl.lang.lexical import Comment
+
 from exsce_dsl.model import (
+    Assignment,
     Document,
     Environment,
     Orientation,
@@ -25,15 +30,20 @@ from exsce_dsl.model import (
 )
 
 INDENT = "  "
+
+# A line of output and the source location of what it prints (to place comments).
+Line = tuple[str, SourceLocation | None]
 _LENGTH_UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001}
 
 
-def format_spec_document(spec: Specification, path: str | None = None) -> str:
+def format_spec_document(
+    spec: Specification, path: str | None = None, comments: Sequence[Comment] = ()
+) -> str:
     """The canonical text of one file of ``spec`` (the root file by default)."""
     document = spec.root_document if path is None else next(
         d for d in spec.documents if d.path == path
     )
-    return format_document(document, declared_poses(spec.environments))
+    return format_document(document, declared_poses(spec.environments), comments)
 
 
 def declared_poses(environments: Iterable[Environment]) -> dict[str, Pose]:
@@ -41,10 +51,14 @@ def declared_poses(environments: Iterable[Environment]) -> dict[str, Pose]:
     return {p.id: p for env in environments for p in env.poses()}
 
 
-def format_document(document: Document, poses: Mapping[str, Pose]) -> str:
-    blocks: list[str] = []
+def format_document(
+    document: Document, poses: Mapping[str, Pose], comments: Sequence[Comment] = ()
+) -> str:
+    """``comments`` (from :func:`exsce_dsl.lang.lexical.comments`) are kept before the
+    element that follows them, or at the end of the line they end."""
+    blocks: list[list[Line]] = []
     if document.imports:
-        blocks.append("\n".join(f"import {_string(i.path)}" for i in document.imports))
+        blocks.append([(f"import {_string(i.path)}", i.location) for i in document.imports])
     for decl in document.declarations:
         if isinstance(decl, RobotType):
             blocks.append(_robot_type(decl))
@@ -54,42 +68,71 @@ def format_document(document: Document, poses: Mapping[str, Pose]) -> str:
             blocks.append(_task(decl, poses))
         else:
             blocks.append(_scenario(decl, poses))
-    return "\n\n".join(blocks) + "\n"
+    lines: list[Line] = []
+    for block in blocks:
+        if lines:
+            lines.append(("", None))
+        lines.extend(block)
+    return _with_comments(lines, [c for c in comments if c.file == document.path])
 
 
-def _robot_type(rtype: RobotType) -> str:
-    facts = []
+def _with_comments(lines: list[Line], comments: Sequence[Comment]) -> str:
+    pending = sorted(comments, key=lambda c: (c.line, c.column))
+    out: list[str] = []
+    for text, loc in lines:
+        if loc is not None and pending:
+            indent = text[: len(text) - len(text.lstrip())]
+            last_line = None
+            while pending and pending[0].line < loc.line:
+                comment = pending.pop(0)
+                out.append(indent + comment.text)
+                last_line = comment.line + comment.text.count("\n")
+            if last_line is not None and last_line < loc.line - 1:
+                out.append("")  # keep a comment apart from what follows, as written
+            trailing = [c for c in pending if c.line == loc.line]
+            for comment in trailing:
+                pending.remove(comment)
+                text += "  " + comment.text
+        out.append(text)
+    out.extend(c.text for c in pending)
+    return "\n".join(out) + "\n"
+
+
+def _robot_type(rtype: RobotType) -> list[Line]:
+    facts: list[Line] = []
     if rtype.base is not None:
-        facts.append(f"{INDENT}base {rtype.base}")
+        facts.append((f"{INDENT}base {rtype.base}", None))
     if rtype.torso is not None:
-        facts.append(f"{INDENT}torso {'yes' if rtype.torso else 'no'}")
+        facts.append((f"{INDENT}torso {'yes' if rtype.torso else 'no'}", None))
     if not facts:
-        return f"robot type {rtype.id} {{ }}"
-    return "\n".join([f"robot type {rtype.id} {{", *facts, "}"])
+        return [(f"robot type {rtype.id} {{ }}", rtype.location)]
+    return [(f"robot type {rtype.id} {{", rtype.location), *facts, ("}", None)]
 
 
-def _environment(env: Environment) -> str:
-    lines = [f"environment {env.id} {{"]
-    models = []
+def _environment(env: Environment) -> list[Line]:
+    sections: list[list[Line]] = []
+    models: list[Line] = []
     if env.map is not None:
         text = f"{INDENT}map {env.map.name}{_from(env.map.source)}"
         if env.map.file is not None:
             text += f" file {_string(_relative_map_file(env))}"
-        models.append(text)
+        models.append((text, env.map.location))
     if env.world is not None:
-        models.append(f"{INDENT}world {env.world.name}{_from(env.world.source)}")
-    sections = ["\n".join(models)] if models else []
+        models.append((f"{INDENT}world {env.world.name}{_from(env.world.source)}", env.world.location))
+    if models:
+        sections.append(models)
     for area in env.areas:
-        body = [f"{INDENT}area {area.id} {{"]
+        body: list[Line] = [(f"{INDENT}area {area.id} {{", area.location)]
         for pose in area.poses:
-            body.append(
+            body.append((
                 f"{INDENT * 2}pose {pose.id} at {_position(pose.position)}"
-                f"{_orientation(pose.orientation, declared=Orientation())}"
-            )
-        body.append(f"{INDENT}}}")
-        sections.append("\n".join(body))
+                f"{_orientation(pose.orientation, declared=Orientation())}",
+                pose.location,
+            ))
+        body.append((f"{INDENT}}}", None))
+        sections.append(body)
     if env.obstacles:
-        obstacles = []
+        obstacles: list[Line] = []
         for ob in env.obstacles:
             text = f"{INDENT}obstacle {ob.id}"
             if ob.model is not None:
@@ -98,63 +141,64 @@ def _environment(env: Environment) -> str:
             text += _orientation(ob.pose.orientation, declared=Orientation())
             if ob.size is not None:
                 text += " size (" + ", ".join(_number(v) for v in ob.size) + ")"
-            obstacles.append(text)
-        sections.append("\n".join(obstacles))
-    lines.append("\n\n".join(sections))
-    lines.append("}")
-    return "\n".join(line for line in lines if line)
+            obstacles.append((text, ob.location))
+        sections.append(obstacles)
+    lines: list[Line] = [(f"environment {env.id} {{", env.location)]
+    for i, section in enumerate(sections):
+        if i:
+            lines.append(("", None))
+        lines.extend(section)
+    lines.append(("}", None))
+    return lines
 
 
 def _relative_map_file(env: Environment) -> str:
-    """The map file as written: builders store it joined to the file's folder."""
+    """The map file as written: the builder stores it joined to the file's folder."""
     assert env.map is not None and env.map.file is not None
     if env.location is None:
         return env.map.file
-    import os
-
     return os.path.relpath(env.map.file, os.path.dirname(env.location.file) or ".")
 
 
-def _task(task: Task, poses: Mapping[str, Pose]) -> str:
-    lines = [f"task {task.id} {{"]
+def _task(task: Task, poses: Mapping[str, Pose]) -> list[Line]:
+    lines: list[Line] = [(f"task {task.id} {{", task.location)]
     if task.source is not None:
-        lines.append(f"{INDENT}source{_ros(task.source)}")
+        lines.append((f"{INDENT}source{_ros(task.source)}", None))
     if len(task.subtasks) == 1:
-        lines.extend(f"{INDENT}visit {_waypoint(w, poses)}" for w in task.subtasks[0].waypoints)
+        lines.extend((f"{INDENT}visit {_waypoint(w, poses)}", w.location) for w in task.subtasks[0].waypoints)
     else:
         for sub in task.subtasks:
-            lines.append(f"{INDENT}subtask {{")
-            lines.extend(f"{INDENT * 2}visit {_waypoint(w, poses)}" for w in sub.waypoints)
-            lines.append(f"{INDENT}}}")
-    lines.append("}")
-    return "\n".join(lines)
+            lines.append((f"{INDENT}subtask {{", sub.location))
+            lines.extend((f"{INDENT * 2}visit {_waypoint(w, poses)}", w.location) for w in sub.waypoints)
+            lines.append((f"{INDENT}}}", None))
+    lines.append(("}", None))
+    return lines
 
 
-def _scenario(sc: Scenario, poses: Mapping[str, Pose]) -> str:
-    lines = [f"scenario {sc.id} in {sc.environment.id} {{", f"{INDENT}robots {{"]
+def _scenario(sc: Scenario, poses: Mapping[str, Pose]) -> list[Line]:
+    lines: list[Line] = [(f"scenario {sc.id} in {sc.environment.id} {{", sc.location), (f"{INDENT}robots {{", None)]
     for robot in sc.robots:
         text = f"{INDENT * 2}{robot.id}: {robot.type.id}"
         if robot.namespace != robot.id:
             text += f" namespace {_string(robot.namespace)}"
         if robot.start_pose is not None:
             text += f" starts at {_pose_use(robot.start_pose, poses)}"
-        lines.append(text)
-    lines.append(f"{INDENT}}}")
+        lines.append((text, robot.location))
+    lines.append((f"{INDENT}}}", None))
     m = sc.mission
-    lines.append(f"{INDENT}mission {m.id} {m.type.value} {{")
-    run: list[str] = []
-    robot = None
+    lines.append((f"{INDENT}mission {m.id} {m.type.value} {{", m.location))
+    runs: list[list[Assignment]] = []
     for entry in m.allocation:
-        if entry.robot != robot and run:
-            lines.append(f"{INDENT * 2}{robot} does {' then '.join(run)}")
-            run = []
-        robot = entry.robot
-        run.append(entry.task)
-    if run:
-        lines.append(f"{INDENT * 2}{robot} does {' then '.join(run)}")
-    lines.append(f"{INDENT}}}")
-    lines.append("}")
-    return "\n".join(lines)
+        if runs and runs[-1][0].robot == entry.robot:
+            runs[-1].append(entry)
+        else:
+            runs.append([entry])
+    for run in runs:
+        tasks = " then ".join(e.task for e in run)
+        lines.append((f"{INDENT * 2}{run[0].robot} does {tasks}", run[0].location))
+    lines.append((f"{INDENT}}}", None))
+    lines.append(("}", None))
+    return lines
 
 
 def _waypoint(pose: Pose, poses: Mapping[str, Pose]) -> str:

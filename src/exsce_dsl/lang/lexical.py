@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass
+
+from exsce_dsl.lang.locations import LineIndex
 
 # A string literal, or a comment; strings come first so `"//"` is not a comment.
 _TOKEN = re.compile(r'"(?:\\.|[^"\\])*"|//[^\n]*|/\*.*?\*/', re.DOTALL)
@@ -10,3 +13,22 @@ _TOKEN = re.compile(r'"(?:\\.|[^"\\])*"|//[^\n]*|/\*.*?\*/', re.DOTALL)
 
 def has_comments(text: str) -> bool:
     return any(not m.group().startswith('"') for m in _TOKEN.finditer(text))
+
+
+@dataclass(frozen=True)
+class Comment:
+    file: str
+    line: int
+    column: int
+    text: str
+
+
+def comments(text: str, path: str) -> list[Comment]:
+    """Every comment of ``text``, with where it starts."""
+    index = LineIndex(path, text)
+    found = []
+    for match in _TOKEN.finditer(text):
+        if not match.group().startswith('"'):
+            line, col = index.line_col(match.start())
+            found.append(Comment(path, line, col, match.group().rstrip()))
+    return found

@@ -1,0 +1,506 @@
+"""Import of the method's YAML format: a scenario file and the task files it names.
+
+The method described a scenario in one YAML file whose allocation names each task by
+ROS package and path (``pkg``, ``file_path``). Here those files are found on disk,
+read, and turned into the semantic model, split the way a person would write the
+``.exsce`` files: one document per robot type, one for the environment, one per task
+and one for the scenario. The environment's areas are not in the method's files: they
+are rebuilt from the poses the scenario uses, the area being the pose id's prefix
+before its last ``-`` (``classroom_c025-w001`` is in ``classroom_c025``).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import yaml
+
+from exsce_dsl.errors import ImportFormatError, SourceLocation
+from exsce_dsl.lang.names import KEYWORDS, is_valid_name
+from exsce_dsl.model import (
+    Area,
+    Assignment,
+    Document,
+    Environment,
+    Import,
+    MapModel,
+    Mission,
+    MissionType,
+    Orientation,
+    Pose,
+    Position,
+    Robot,
+    RobotType,
+    RosResource,
+    Scenario,
+    Subtask,
+    Task,
+    WorldModel,
+)
+
+#: Hardware facts of the robot types the method used (PAL Robotics): base, torso.
+KNOWN_ROBOT_TYPES: Mapping[str, tuple[str, bool]] = {
+    "tiago": ("pmb2", True),
+    "pmb2": ("pmb2", False),
+    "omni_base": ("omni_base", False),
+}
+
+#: The area of a pose whose id has no ``-`` (so no area prefix).
+UNASSIGNED_AREA = "unassigned"
+
+_Key = str | int
+
+
+def import_scenario_yaml(path: Path, task_search_path: Sequence[Path] = ()) -> tuple[Document, ...]:
+    """Read a scenario YAML file and the task files it names, as ``.exsce`` documents.
+
+    Each task file is looked for, in every folder D of [the scenario's folder,
+    *task_search_path], at D/pkg/file_path, then D/file_path, then as any file under D
+    with the same name (sorted, first wins). The documents come back with paths
+    relative to the scenario document, which is first.
+    """
+    scenario_file = _YamlFile.read(path)
+    root = scenario_file.root_node()
+    finder = _TaskFinder([path.parent, *task_search_path])
+
+    scenario_id = root.get("id").ident("scenario")
+    robots_node = root.get("robots")
+    environment_node = root.get("environment")
+    mission_node = root.get("mission")
+
+    # Robots and their types, in the order of the YAML list.
+    robot_types: dict[str, RobotType] = {}
+    robot_rows: list[tuple[_Node, str, RobotType, str]] = []
+    for entry in robots_node.items_of_list():
+        robot_id = entry.get("robot_id").ident("robot")
+        if any(robot_id == row[1] for row in robot_rows):
+            raise entry.error(f"robot '{robot_id}' is listed twice")
+        type_id = entry.get("robot_type").ident("robot type")
+        if type_id not in robot_types:
+            base, torso = KNOWN_ROBOT_TYPES.get(type_id, (None, None))
+            robot_types[type_id] = RobotType(type_id, base, torso, entry.location)
+        namespace = entry.get("robot_namespace").text()
+        robot_rows.append((entry, robot_id, robot_types[type_id], namespace))
+    robot_ids = [row[1] for row in robot_rows]
+
+    # Start poses, keyed by robot.
+    read_starts: dict[str, Pose] = {}
+    starts = environment_node.opt("robots")
+    for robot_id, entry in starts.items_of_mapping() if starts else ():
+        if robot_id not in robot_ids:
+            raise entry.error(
+                f"start pose for robot '{robot_id}', which is not in the robots list "
+                f"({', '.join(robot_ids)})"
+            )
+        read_starts[robot_id] = _read_pose(entry.get("start_pose"))
+
+    # What else the scenario file says, checked before any task file is read.
+    environment_id = environment_node.get("id").ident("environment")
+    map_model = _read_map(environment_node)
+    world_model = _read_world(environment_node)
+    mission_id = mission_node.get("id").ident("mission")
+    mission_type = _mission_type(mission_node.get("type"))
+
+    # The allocation, and each task once, in order of first use.
+    tasks: dict[str, Task] = {}
+    allocation: list[Assignment] = []
+    for entry in mission_node.get("allocation").items_of_list():
+        robot_node = entry.get("robot")
+        robot_id = robot_node.ident("robot")
+        if robot_id not in robot_ids:
+            raise robot_node.error(
+                f"allocation names robot '{robot_id}', which is not in the robots list "
+                f"({', '.join(robot_ids)})"
+            )
+        source = RosResource(entry.get("pkg").text(), entry.get("file_path").text())
+        task_id = _task_id_of(entry.get("file_path"))
+        known = tasks.get(task_id)
+        if known is None:
+            task_file = finder.find(entry)
+            tasks[task_id] = _read_task(_YamlFile.read(task_file), task_id, source)
+        elif known.source != source:
+            raise entry.error(
+                f"task '{task_id}' comes from package {source.package} path {source.path} "
+                f"here, but from package {_describe(known.source)} at {known.location}; "
+                "tasks are named after their file, so two files cannot share a name"
+            )
+        allocation.append(Assignment(robot_id, task_id, entry.location))
+
+    # Every pose used, declared once where it first occurs.
+    poses = _PoseTable()
+    start_poses: dict[str, Pose] = {}
+    for _, robot_id, _, _ in robot_rows:
+        if robot_id in read_starts:
+            start_poses[robot_id] = poses.add(read_starts[robot_id])
+    for task in tasks.values():
+        for waypoint in task.waypoints():
+            poses.add(waypoint)
+
+    environment = Environment(
+        id=environment_id,
+        map=map_model,
+        world=world_model,
+        areas=poses.areas(),
+        location=environment_node.location,
+    )
+    robots = tuple(
+        Robot(robot_id, robot_type, namespace, start_poses.get(robot_id), entry.location)
+        for entry, robot_id, robot_type, namespace in robot_rows
+    )
+    mission = Mission(
+        id=mission_id,
+        type=mission_type,
+        allocation=tuple(allocation),
+        location=mission_node.location,
+    )
+    scenario = Scenario(
+        scenario_id, environment, robots, mission, tuple(tasks.values()), root.location
+    )
+
+    parts: list[Document] = [
+        *(Document(f"robots/{t.id}.exsce", (), (t,)) for t in robot_types.values()),
+        Document(f"environments/{environment.id}.exsce", (), (environment,)),
+        *(Document(f"tasks/{t.id}.exsce", (), (t,)) for t in tasks.values()),
+    ]
+    main = Document(f"{scenario_id}.exsce", tuple(Import(d.path) for d in parts), (scenario,))
+    return (main, *parts)
+
+
+def import_task_yaml(
+    path: Path, task_id: str | None = None, *, source: RosResource | None = None
+) -> Task:
+    """Read one task file of the method. The task id defaults to the file's name
+    without ``.yaml``; each waypoint's area is its id's prefix (see the module)."""
+    file = _YamlFile.read(path)
+    if task_id is None:
+        task_id = _strip_yaml_suffix(path.name)
+        _check_name(task_id, "task", f"the name of file {path}", file.root_node())
+    elif not is_valid_name(task_id):
+        raise ImportFormatError(
+            f"task id '{task_id}' is not a valid exsce id: {_why_not_a_name(task_id)}"
+        )
+    return _read_task(file, task_id, source)
+
+
+# -- reading YAML with positions -------------------------------------------------------
+
+
+class _YamlFile:
+    """A YAML file read twice: as data with ``yaml.safe_load``, and as a node tree
+    (composed by the same safe loader) that only serves line and column numbers."""
+
+    def __init__(self, name: str, data: object, tree: yaml.Node | None) -> None:
+        self.name = name
+        self.data = data
+        self.tree = tree
+
+    @classmethod
+    def read(cls, path: Path) -> _YamlFile:
+        try:
+            text = path.read_text(encoding="utf-8")
+        except OSError as e:
+            raise ImportFormatError(f"cannot read {path}: {e.strerror or e}") from e
+        try:
+            data = yaml.safe_load(text)
+            tree = yaml.compose(text, Loader=yaml.SafeLoader)
+        except yaml.YAMLError as e:
+            mark = getattr(e, "problem_mark", None)
+            location = _location(str(path), mark) if mark is not None else None
+            problem = getattr(e, "problem", None) or str(e)
+            raise ImportFormatError(f"not valid YAML: {problem}", location) from e
+        return cls(str(path), data, tree)
+
+    def root_node(self) -> _Node:
+        return _Node(self, (), self.data)
+
+    def location(self, keys: tuple[_Key, ...]) -> SourceLocation:
+        """Where the value at ``keys`` starts, or the nearest enclosing value."""
+        node = self.tree
+        if node is None:
+            return SourceLocation(self.name, 1, 1)
+        for key in keys:
+            child = _child(node, key)
+            if child is None:
+                break
+            node = child
+        return _location(self.name, node.start_mark, node.end_mark)
+
+
+def _child(node: yaml.Node, key: _Key) -> yaml.Node | None:
+    if isinstance(node, yaml.MappingNode) and isinstance(key, str):
+        return next((v for k, v in node.value if getattr(k, "value", None) == key), None)
+    if isinstance(node, yaml.SequenceNode) and isinstance(key, int) and key < len(node.value):
+        child: yaml.Node = node.value[key]
+        return child
+    return None
+
+
+def _location(file: str, start: yaml.Mark, end: yaml.Mark | None = None) -> SourceLocation:
+    if end is None:
+        return SourceLocation(file, start.line + 1, start.column + 1)
+    return SourceLocation(file, start.line + 1, start.column + 1, end.line + 1, end.column + 1)
+
+
+@dataclass(frozen=True)
+class _Node:
+    """A value of a YAML file with the keys that lead to it, for error messages."""
+
+    file: _YamlFile
+    keys: tuple[_Key, ...]
+    value: object
+
+    @property
+    def where(self) -> str:
+        text = ""
+        for key in self.keys:
+            text += f"[{key}]" if isinstance(key, int) else f".{key}" if text else key
+        return text or "the top level"
+
+    @property
+    def location(self) -> SourceLocation:
+        return self.file.location(self.keys)
+
+    def error(self, message: str) -> ImportFormatError:
+        return ImportFormatError(message, self.location)
+
+    def _mapping(self) -> Mapping[object, object]:
+        if not isinstance(self.value, Mapping):
+            raise self.error(
+                f"{self.where} should be a mapping of keys to values, not {_kind(self.value)}"
+            )
+        return self.value
+
+    def get(self, key: str) -> _Node:
+        """The value of a required key."""
+        mapping = self._mapping()
+        if key not in mapping:
+            raise self.error(f"missing key '{key}' in {self.where}")
+        return _Node(self.file, (*self.keys, key), mapping[key])
+
+    def opt(self, key: str) -> _Node | None:
+        """The value of an optional key; ``None`` when absent or empty."""
+        mapping = self._mapping()
+        if mapping.get(key) is None:
+            return None
+        return _Node(self.file, (*self.keys, key), mapping[key])
+
+    def items_of_mapping(self) -> Iterator[tuple[str, _Node]]:
+        for key, value in self._mapping().items():
+            yield str(key), _Node(self.file, (*self.keys, str(key)), value)
+
+    def items_of_list(self) -> Iterator[_Node]:
+        if not isinstance(self.value, list):
+            raise self.error(f"{self.where} should be a list, not {_kind(self.value)}")
+        for i, value in enumerate(self.value):
+            yield _Node(self.file, (*self.keys, i), value)
+
+    def text(self) -> str:
+        if not isinstance(self.value, str):
+            raise self.error(f"{self.where} should be text, not {_kind(self.value)}")
+        return self.value
+
+    def number(self) -> float:
+        if isinstance(self.value, bool) or not isinstance(self.value, int | float):
+            raise self.error(f"{self.where} should be a number, not {_kind(self.value)}")
+        return float(self.value)
+
+    def ident(self, what: str) -> str:
+        """Text that must be a valid exsce id (it becomes a name in the DSL)."""
+        if isinstance(self.value, bool) or not isinstance(self.value, str | int | float):
+            raise self.error(f"{self.where} should be a {what} id, not {_kind(self.value)}")
+        text = str(self.value)
+        _check_name(text, what, self.where, self)
+        return text
+
+
+def _kind(value: object) -> str:
+    if value is None:
+        return "nothing"
+    if isinstance(value, Mapping):
+        return "a mapping"
+    if isinstance(value, list):
+        return "a list"
+    return f"{type(value).__name__} {value!r}"
+
+
+def _check_name(text: str, what: str, where: str, node: _Node) -> None:
+    if not is_valid_name(text):
+        raise node.error(
+            f"{what} id '{text}' ({where}) is not a valid exsce id: {_why_not_a_name(text)}"
+        )
+
+
+def _why_not_a_name(text: str) -> str:
+    rule = (
+        "an id is letters, digits and '_', starting with a letter or '_', "
+        "with single '-' between parts"
+    )
+    if not text:
+        return "it is empty"
+    if text in KEYWORDS:
+        return f"'{text}' is a word of the exsce language"
+    bad = next((c for c in text if not (c.isascii() and (c.isalnum() or c in "_-"))), None)
+    if bad is not None:
+        return f"it contains {bad!r}; {rule}"
+    if not (text[0].isalpha() or text[0] == "_"):
+        return f"it starts with {text[0]!r}; {rule}"
+    return rule
+
+
+# -- finding and reading task files -----------------------------------------------------
+
+
+class _TaskFinder:
+    def __init__(self, folders: Sequence[Path]) -> None:
+        self.folders = list(dict.fromkeys(folders))
+        self._by_name: dict[Path, dict[str, list[Path]]] = {}
+
+    def find(self, entry: _Node) -> Path:
+        package = entry.get("pkg").text()
+        file_path = entry.get("file_path").text()
+        name = Path(file_path).name
+        for folder in self.folders:
+            for candidate in (folder / package / file_path, folder / file_path):
+                if candidate.is_file():
+                    return candidate
+            found = self._files_named(folder).get(name)
+            if found:
+                return found[0]
+        tried = ", ".join(str(f) for f in self.folders)
+        raise entry.get("file_path").error(
+            f"task file '{file_path}' of package '{package}' not found: looked for "
+            f"D/{package}/{file_path}, D/{file_path} and any file named '{name}' under D, "
+            f"for each folder D of the task search path [{tried}]; "
+            "add the folder that holds it to the task search path"
+        )
+
+    def _files_named(self, folder: Path) -> dict[str, list[Path]]:
+        """Every file under ``folder`` by name, each list sorted; listed once per folder."""
+        index = self._by_name.get(folder)
+        if index is None:
+            index = {}
+            for parent, dirs, files in os.walk(folder):
+                dirs.sort()
+                for file in sorted(files):
+                    index.setdefault(file, []).append(Path(parent) / file)
+            for paths in index.values():
+                paths.sort()
+            self._by_name[folder] = index
+        return index
+
+
+def _strip_yaml_suffix(name: str) -> str:
+    for suffix in (".yaml", ".yml"):
+        if name.endswith(suffix):
+            return name[: -len(suffix)]
+    return name
+
+
+def _task_id_of(file_path: _Node) -> str:
+    task_id = _strip_yaml_suffix(Path(file_path.text()).name)
+    _check_name(task_id, "task", f"the name of file {file_path.text()}", file_path)
+    return task_id
+
+
+def _read_task(file: _YamlFile, task_id: str, source: RosResource | None) -> Task:
+    root = file.root_node()
+    subtasks = tuple(
+        Subtask(
+            tuple(_read_pose(w) for w in entry.get("waypoints").items_of_list()),
+            entry.location,
+        )
+        for entry in root.get("task").items_of_list()
+    )
+    return Task(task_id, subtasks, source, root.location)
+
+
+def _read_pose(node: _Node) -> Pose:
+    """A pose as the method wrote it: id, x, y, and optionally z, roll, pitch, yaw."""
+    pose_id = node.get("id").ident("pose")
+
+    def coordinate(key: str) -> float:
+        value = node.opt(key)
+        return value.number() if value is not None else 0.0
+
+    position = Position(node.get("x").number(), node.get("y").number(), coordinate("z"))
+    orientation = Orientation(coordinate("roll"), coordinate("pitch"), coordinate("yaw"))
+    return Pose(pose_id, position, orientation, _area_of(pose_id, node), node.location)
+
+
+def _area_of(pose_id: str, node: _Node) -> str:
+    if "-" not in pose_id:
+        return UNASSIGNED_AREA
+    area = pose_id.rsplit("-", 1)[0]
+    _check_name(area, "area", f"the part of pose id '{pose_id}' before its last '-'", node)
+    return area
+
+
+class _PoseTable:
+    """The poses of an environment, each declared where it first occurs."""
+
+    def __init__(self) -> None:
+        self._poses: dict[str, Pose] = {}
+
+    def add(self, pose: Pose) -> Pose:
+        first = self._poses.setdefault(pose.id, pose)
+        if first.position != pose.position:
+            raise ImportFormatError(
+                f"pose '{pose.id}' is at {_xyz(pose.position)} here but at "
+                f"{_xyz(first.position)} in {first.location}; a pose id names one place",
+                pose.location,
+            )
+        return pose
+
+    def areas(self) -> tuple[Area, ...]:
+        by_area: dict[str, list[Pose]] = {}
+        for pose in self._poses.values():
+            by_area.setdefault(pose.area or UNASSIGNED_AREA, []).append(pose)
+        return tuple(Area(area, tuple(poses)) for area, poses in by_area.items())
+
+
+def _xyz(p: Position) -> str:
+    return f"({p.x}, {p.y}, {p.z})"
+
+
+def _describe(source: RosResource | None) -> str:
+    return f"{source.package} path {source.path}" if source else "(none)"
+
+
+# -- the rest of a scenario --------------------------------------------------------------
+
+
+def _mission_type(node: _Node) -> MissionType:
+    text = node.text()
+    try:
+        return MissionType(text)
+    except ValueError:
+        kinds = " or ".join(t.value for t in MissionType)
+        raise node.error(f"mission type '{text}' is not {kinds}") from None
+
+
+def _model(environment: _Node, key: str, name_key: str) -> tuple[str, RosResource | None, _Node]:
+    node = environment.get("models").get(key)
+    name = node.get(name_key).ident(f"{key} model")
+    package = node.opt("pkg")
+    path = node.opt("relative_path")
+    source = RosResource(package.text(), path.text() if path else None) if package else None
+    return name, source, node
+
+
+def _read_map(environment: _Node) -> MapModel | None:
+    models = environment.opt("models")
+    if models is None or models.opt("map") is None:
+        return None
+    name, source, node = _model(environment, "map", "map_name")
+    return MapModel(name, source, location=node.location)
+
+
+def _read_world(environment: _Node) -> WorldModel | None:
+    models = environment.opt("models")
+    if models is None or models.opt("gazebo_world") is None:
+        return None
+    name, source, node = _model(environment, "gazebo_world", "model_name")
+    return WorldModel(name, source, node.location)

@@ -1,0 +1,299 @@
+"""Every namespace, prefix and identifier rule of exsce's PROV, in one place.
+
+The namespaces are those of the method's published models; the base one
+(``exsce:``) is configurable, and every namespace of the method that lives
+under it moves with it.  The robot-schema and ROS namespaces are fixed.
+
+Identifiers follow the published models, with two deliberate differences
+where the published rule loses information:
+
+* pose and orientation ids write each angle with two decimals only when that
+  is exact, and otherwise with Python's shortest round-trip form
+  (:func:`format_angle`), so that two different poses never share an id;
+* task ids are the DSL task ids (``task:delivery_a``), not the task file's
+  basename (``task:delivery_a.yaml``), which collides across environments.
+
+This module is free of prov and rdflib: it deals in prefix names, IRIs and
+local names (strings), so that every layer can share it.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass
+from typing import NamedTuple
+
+from exsce_dsl.errors import ExsceError
+from exsce_dsl.model.geometry import Orientation, Pose
+
+DEFAULT_NAMESPACE = "https://www.sesame-project.org/scenarios/"
+"""The method's base namespace, ``exsce:``."""
+
+ROBOT_SCHEMA = "https://robot-schema.org/"
+ROS_WIKI = "http://wiki.ros.org/"
+PROV_NAMESPACE = "http://www.w3.org/ns/prov#"
+XSD_NAMESPACE = "http://www.w3.org/2001/XMLSchema#"
+
+# The fixed prefix names, as published.
+EXSCE = "exsce"
+MISSION = "mission"
+ENV = "env"
+ROBOT = "robot"
+TASK = "task"
+POSE = "pose"
+POINT = "point"
+ORIENTATION = "orientation"
+ORACLE = "oracle"
+GEOM = "geom"
+COORD = "coord"
+ANGLE = "angle"
+ROS = "ros"
+
+STANDARD_PREFIXES = frozenset({"prov", "xsd", "xsi", "rdf", "rdfs", "owl", "xml"})
+"""Prefix names that PROV and RDF tools bind themselves."""
+
+RESERVED_PREFIXES = frozenset(
+    {EXSCE, MISSION, ENV, ROBOT, TASK, POSE, POINT, ORIENTATION, ORACLE}
+    | {GEOM, COORD, ANGLE, ROS}
+    | STANDARD_PREFIXES
+)
+"""Prefix names no per-element namespace may take."""
+
+
+class Term(NamedTuple):
+    """A name in one of the fixed namespaces: ``Term("geom", "Pose")`` is ``geom:Pose``."""
+
+    prefix: str
+    local: str
+
+    def __str__(self) -> str:
+        return f"{self.prefix}:{self.local}"
+
+
+# Types (values of prov:type).
+PROV_PLAN = Term("prov", "Plan")
+PROV_PRIMARY_SOURCE = Term("prov", "PrimarySource")
+PROV_SOFTWARE_AGENT = Term("prov", "SoftwareAgent")
+CONCRETE_SCENARIO = Term(EXSCE, "ConcreteScenario")
+MISSION_TYPE_VALUE = Term(EXSCE, "mission")
+ENVIRONMENT_TYPE = Term(EXSCE, "environment")
+MAP_TYPE = Term(EXSCE, "map")
+ROBOT_TYPE_VALUE = Term(EXSCE, "robot")
+OBSTACLE_TYPE = Term(EXSCE, "obstacle")
+GEOM_POSE = Term(GEOM, "Pose")
+GEOM_POINT = Term(GEOM, "Point")
+GEOM_EULER_ANGLES = Term(GEOM, "EulerAngles")
+ROS_OCCUPANCY_GRID = Term(ROS, "OccupancyGrid")
+ROS_PARAMETER_SERVER = Term(ROS, "Parameter_Server")
+ROS_GAZEBO_MODEL = Term(ROS, "GazeboModel")
+
+# Attributes.
+MISSION_TYPE = Term(EXSCE, "missionType")
+SCENARIO_ATTR = Term(EXSCE, "scenario")
+ROBOT_TYPE = Term(EXSCE, "robotType")
+BASE_TYPE = Term(EXSCE, "baseType")
+TORSO = Term(EXSCE, "torso")
+OBSTACLE_MODEL = Term(EXSCE, "model")
+OBSTACLE_SIZE = Term(EXSCE, "size")
+GEOM_AXES = Term(GEOM, "axes")
+COORD_X = Term(COORD, "x")
+COORD_Y = Term(COORD, "y")
+COORD_Z = Term(COORD, "z")
+ANGLE_ROLL = Term(ANGLE, "roll")
+ANGLE_PITCH = Term(ANGLE, "pitch")
+ANGLE_YAW = Term(ANGLE, "yaw")
+ROS_PKG = Term(ROS, "pkg")
+ROS_RELATIVE_PATH = Term(ROS, "relative_path")
+ROS_NAMESPACE = Term(ROS, "namespace")
+
+
+@dataclass(frozen=True)
+class Namespaces:
+    """The namespace IRIs of one project, all but the fixed ones under ``base``."""
+
+    base: str = DEFAULT_NAMESPACE
+
+    def __post_init__(self) -> None:
+        if not re.fullmatch(r"[A-Za-z][A-Za-z0-9+.\-]*:[^\s<>\"{}|\\^`]*[/#]", self.base):
+            raise ExsceError(
+                f"namespace '{self.base}' is not an absolute IRI ending in '/' or '#'"
+            )
+
+    @property
+    def fixed(self) -> dict[str, str]:
+        """Prefix name → IRI of every fixed namespace, in the published order."""
+        base = self.base
+        return {
+            EXSCE: base,
+            MISSION: f"{base}missions/",
+            ENV: f"{base}environments/",
+            ROBOT: f"{base}robots/",
+            TASK: f"{base}tasks/",
+            POSE: f"{base}tasks/waypoints/",
+            POINT: f"{base}tasks/points/",
+            ORIENTATION: f"{base}tasks/orientation/",
+            ORACLE: f"{base}oracles/",
+            GEOM: ROBOT_SCHEMA,
+            COORD: f"{ROBOT_SCHEMA}coordinates/",
+            ANGLE: f"{ROBOT_SCHEMA}rotation/",
+            ROS: ROS_WIKI,
+        }
+
+    def iri(self, term: Term) -> str:
+        """The full IRI of a term of a fixed (or the prov) namespace."""
+        if term.prefix == "prov":
+            return PROV_NAMESPACE + term.local
+        return self.fixed[term.prefix] + term.local
+
+    # Per-element namespaces: the names an element's parts live in.
+
+    def of_scenario(self, scenario_id: str) -> str:
+        return f"{self.base}{scenario_id}/"
+
+    def of_mission(self, mission_id: str) -> str:
+        return f"{self.base}missions/{mission_id}/"
+
+    def of_environment(self, environment_id: str) -> str:
+        return f"{self.base}environments/{environment_id}/"
+
+    def of_robot(self, robot_id: str) -> str:
+        return f"{self.base}robots/{robot_id}/"
+
+    def of_subtask(self, task_id: str, index: int) -> str:
+        return f"{self.base}tasks/{subtask_name(task_id, index)}/"
+
+
+# Local names.  Each function returns the part after the prefix.
+
+
+def format_angle(value: float) -> str:
+    """An angle as it appears in pose and orientation ids.
+
+    Two decimals where that is exact (``0.0 → 0.00``, ``2.27 → 2.27``), as the
+    method writes them; otherwise the shortest form that reads back as the same
+    float (``0.925 → 0.925``), where the method rounded and merged poses.
+    """
+    value = float(value)
+    if value == 0.0:
+        value = 0.0  # no separate id for -0.0
+    if round(value, 2) == value:
+        return f"{value:.2f}"
+    return repr(value)
+
+
+def orientation_name(orientation: Orientation) -> str:
+    """``R<roll>_P<pitch>_Y<yaw>``, the local name in ``orientation:``."""
+    return (
+        f"R{format_angle(orientation.roll)}"
+        f"_P{format_angle(orientation.pitch)}"
+        f"_Y{format_angle(orientation.yaw)}"
+    )
+
+
+def pose_name(pose: Pose) -> str:
+    """``<pose id>-R.._P.._Y..``, the local name in ``pose:``."""
+    return f"{pose.id}-{orientation_name(pose.orientation)}"
+
+
+def point_name(pose: Pose) -> str:
+    """The local name in ``point:``: the pose id (its position, whatever its heading)."""
+    return pose.id
+
+
+def subtask_name(task_id: str, index: int) -> str:
+    """``<task>-subtask_NNN`` (1-based), in ``task:``; also its own namespace's name."""
+    return f"{task_id}-subtask_{index:03d}"
+
+
+def subtask_role(index: int) -> str:
+    return f"subtask_{index:03d}"
+
+
+def waypoint_relation_name(index: int) -> str:
+    """``w_NNN`` (1-based), in the subtask's namespace: the waypoint derivation's id."""
+    return f"w_{index:03d}"
+
+
+def allocation_name(robot_id: str, index: int) -> str:
+    """``<robot>-task_NN`` (1-based per robot), in the mission's namespace."""
+    return f"{robot_id}-task_{index:02d}"
+
+
+def start_pose_relation_name(robot_id: str) -> str:
+    """``<robot>-start-pose``, in the scenario's namespace."""
+    return f"{robot_id}-start-pose"
+
+
+def map_entity_name(map_name: str) -> str:
+    """``<map>_map``, in the environment's namespace."""
+    return f"{map_name}_map"
+
+
+def obstacle_pose_relation_name(obstacle_id: str) -> str:
+    """``<obstacle>-pose``, in the environment's namespace."""
+    return f"{obstacle_id}-pose"
+
+
+def bundle_name(element_id: str) -> str:
+    """``<id>_bundle``: the bundle of a scenario, environment, area, robot or task."""
+    return f"{element_id}_bundle"
+
+
+# Prefix names.
+
+_PREFIX_RE = re.compile(r"[A-Za-z](?:[A-Za-z0-9_.\-]*[A-Za-z0-9_\-])?")
+
+
+def is_valid_prefix(name: str) -> bool:
+    """True if ``name`` can be a prefix in PROV-N, PROV-XML, Turtle and SPARQL."""
+    return bool(_PREFIX_RE.fullmatch(name)) and not name.lower().startswith("xml")
+
+
+class PrefixTable:
+    """Prefix names for the namespaces of one document.
+
+    The fixed prefixes are taken first.  A per-element namespace asks for its
+    element's id as prefix name (``tiago1:``); when that name is taken by
+    another namespace (a robot called ``pose``) or cannot be a prefix, it gets
+    ``<id>_<kind>`` (``pose_robot:``), then ``<id>_<kind>2`` and so on.  Prefix
+    names are cosmetic: the IRIs never change.  A namespace keeps one prefix
+    name in the whole document.
+    """
+
+    def __init__(self, namespaces: Namespaces) -> None:
+        self._iri_of: dict[str, str] = {}
+        self._prefix_of: dict[str, str] = {}
+        for name in sorted(STANDARD_PREFIXES):
+            self._iri_of[name] = ""
+        for prefix, iri in namespaces.fixed.items():
+            self._iri_of[prefix] = iri
+            self._prefix_of[iri] = prefix
+
+    def prefix(self, preferred: str, iri: str, kind: str) -> str:
+        """The prefix name of ``iri``, taking ``preferred`` if it is free."""
+        known = self._prefix_of.get(iri)
+        if known is not None:
+            return known
+        for candidate in self._candidates(preferred, kind):
+            if candidate not in self._iri_of and is_valid_prefix(candidate):
+                self._iri_of[candidate] = iri
+                self._prefix_of[iri] = candidate
+                return candidate
+        raise AssertionError("unreachable: the candidates never run out")
+
+    @staticmethod
+    def _candidates(preferred: str, kind: str) -> Iterator[str]:
+        yield preferred
+        stem = next(
+            s for s in (f"{preferred}_{kind}", f"{kind}_{preferred}", kind) if is_valid_prefix(s)
+        )
+        yield stem
+        n = 2
+        while True:
+            yield f"{stem}{n}"
+            n += 1
+
+    def items(self) -> Mapping[str, str]:
+        """Prefix name → IRI of every namespace named so far (not the standard ones)."""
+        return {p: iri for p, iri in self._iri_of.items() if iri}
