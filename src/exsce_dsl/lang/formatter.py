@@ -224,24 +224,31 @@ def _orientation(o: Orientation, declared: Orientation, always: bool = False) ->
 
 def _angle(value: float, unit: str) -> str:
     if unit == "deg":
-        return f"{_number(round(math.degrees(value), 10))} deg"
+        degrees = float(_number(round(math.degrees(value), 10)))
+        if math.radians(degrees) == value:  # print in degrees only when it reads back exactly
+            return f"{_number(degrees)} deg"
     return _number(value)
 
 
 def _position(p: Position) -> str:
-    unit = p.unit if p.unit in _LENGTH_UNITS else "m"
-    scale = _LENGTH_UNITS[unit]
     values = [p.x, p.y] + ([p.z] if p.z != 0.0 else [])
-    suffix = "" if unit == "m" else f" {unit}"
-    return "(" + ", ".join(_number(round(v / scale, 10) if scale != 1.0 else v) + suffix for v in values) + ")"
+    scale = _LENGTH_UNITS.get(p.unit, 1.0)
+    if scale != 1.0:
+        scaled = [float(_number(round(v / scale, 10))) for v in values]
+        if all(s * scale == v for s, v in zip(scaled, values, strict=True)):
+            return "(" + ", ".join(f"{_number(s)} {p.unit}" for s in scaled) + ")"
+    return "(" + ", ".join(_number(v) for v in values) + ")"
 
 
 def _number(value: float) -> str:
-    """Shortest text that reads back as the same float, never in exponent form."""
-    text = format(Decimal(repr(float(value))), "f")
-    if "." not in text:
-        text += ".0"
-    return text
+    """Shortest text that reads back as the same float (always with a decimal point)."""
+    text = repr(float(value))
+    mantissa, _, exponent = text.partition("e")
+    if exponent and abs(int(exponent)) <= 6:
+        text, mantissa, exponent = format(Decimal(text), "f"), "", ""
+    if exponent:
+        return (mantissa if "." in mantissa else mantissa + ".0") + "e" + exponent
+    return text if "." in text else text + ".0"
 
 
 def _string(text: str) -> str:

@@ -131,10 +131,9 @@ def import_scenario_yaml(path: Path, task_search_path: Sequence[Path] = ()) -> t
 
     # Every pose used, declared once where it first occurs.
     poses = _PoseTable()
-    start_poses: dict[str, Pose] = {}
-    for _, robot_id, _, _ in robot_rows:
+    for robot_id in robot_ids:
         if robot_id in read_starts:
-            start_poses[robot_id] = poses.add(read_starts[robot_id])
+            poses.add(read_starts[robot_id])
     for task in tasks.values():
         for waypoint in task.waypoints():
             poses.add(waypoint)
@@ -147,7 +146,7 @@ def import_scenario_yaml(path: Path, task_search_path: Sequence[Path] = ()) -> t
         location=environment_node.location,
     )
     robots = tuple(
-        Robot(robot_id, robot_type, namespace, start_poses.get(robot_id), entry.location)
+        Robot(robot_id, robot_type, namespace, read_starts.get(robot_id), entry.location)
         for entry, robot_id, robot_type, namespace in robot_rows
     )
     mission = Mission(
@@ -444,7 +443,7 @@ class _PoseTable:
     def __init__(self) -> None:
         self._poses: dict[str, Pose] = {}
 
-    def add(self, pose: Pose) -> Pose:
+    def add(self, pose: Pose) -> None:
         first = self._poses.setdefault(pose.id, pose)
         if first.position != pose.position:
             raise ImportFormatError(
@@ -452,7 +451,6 @@ class _PoseTable:
                 f"{_xyz(first.position)} in {first.location}; a pose id names one place",
                 pose.location,
             )
-        return pose
 
     def areas(self) -> tuple[Area, ...]:
         by_area: dict[str, list[Pose]] = {}

@@ -116,9 +116,7 @@ class Namespaces:
 
     def __post_init__(self) -> None:
         if not re.fullmatch(r"[A-Za-z][A-Za-z0-9+.\-]*:[^\s<>\"{}|\\^`]*[/#]", self.base):
-            raise ExsceError(
-                f"namespace '{self.base}' is not an absolute IRI ending in '/' or '#'"
-            )
+            raise ExsceError(f"namespace '{self.base}' is not an absolute IRI ending in '/' or '#'")
 
     @property
     def fixed(self) -> dict[str, str]:
