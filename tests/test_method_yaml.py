@@ -561,3 +561,26 @@ def test_imported_documents_format_and_load_back_to_the_same_scenario(tmp_path: 
         target.parent.mkdir(parents=True, exist_ok=True)
         target.write_text(format_document(document, poses), encoding="utf-8")
     assert load_spec(tmp_path / "scenario_c.exsce").scenario() == scenario
+
+
+def test_area_is_the_pose_id_up_to_its_first_dash(tmp_path: Path) -> None:
+    """The method's corridor poses are `right_long_corridor-point-0`: area `right_long_corridor`."""
+    task_file = tmp_path / "corridor.yaml"
+    task_file.write_text(
+        "task:\n  - waypoints:\n"
+        "    - {id: right_long_corridor-point-0, x: 51.12, y: 39.44, yaw: 0.0}\n"
+        "    - {id: classroom_c025-w001, x: 1.0, y: 2.0}\n"
+    )
+    task = import_task_yaml(task_file)
+    assert [w.area for w in task.waypoints()] == ["right_long_corridor", "classroom_c025"]
+
+
+def test_imported_task_files_check_on_their_own(tmp_path: Path) -> None:
+    from exsce_dsl.lang.build import analyse
+    from exsce_dsl.lang.writer import write_documents
+
+    documents = import_fixture("scenario_c")
+    written = write_documents(documents, tmp_path)
+    for path in written:
+        analysis = analyse(path)
+        assert analysis.errors == [], (path, analysis.errors)

@@ -162,7 +162,11 @@ def import_scenario_yaml(path: Path, task_search_path: Sequence[Path] = ()) -> t
     parts: list[Document] = [
         *(Document(f"robots/{t.id}.exsce", (), (t,)) for t in robot_types.values()),
         Document(f"environments/{environment.id}.exsce", (), (environment,)),
-        *(Document(f"tasks/{t.id}.exsce", (), (t,)) for t in tasks.values()),
+        # a task names poses, so its file imports the environment that declares them
+        *(
+            Document(f"tasks/{t.id}.exsce", (Import(f"../environments/{environment.id}.exsce"),), (t,))
+            for t in tasks.values()
+        ),
     ]
     main = Document(f"{scenario_id}.exsce", tuple(Import(d.path) for d in parts), (scenario,))
     return (main, *parts)
@@ -432,8 +436,10 @@ def _read_pose(node: _Node) -> Pose:
 def _area_of(pose_id: str, node: _Node) -> str:
     if "-" not in pose_id:
         return UNASSIGNED_AREA
-    area = pose_id.rsplit("-", 1)[0]
-    _check_name(area, "area", f"the part of pose id '{pose_id}' before its last '-'", node)
+    # The method names poses <area>-<point>: `classroom_c025-w001`, and also
+    # `right_long_corridor-point-0`, so the area ends at the first '-'.
+    area = pose_id.split("-", 1)[0]
+    _check_name(area, "area", f"the part of pose id '{pose_id}' before its first '-'", node)
     return area
 
 
