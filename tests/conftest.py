@@ -19,12 +19,21 @@ def run_exscec(*args: str, cwd: Path | None = None) -> subprocess.CompletedProce
     """Run the real ``exscec`` console script of this environment."""
     exe = Path(sys.executable).with_name("exscec")
     return subprocess.run(
-        [str(exe), *args], cwd=cwd, capture_output=True, text=True, timeout=120,
+        [str(exe), *args],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+        timeout=120,
         env={**os.environ, "COLUMNS": "120"},
     )
 
 
-def write_map(folder: Path, name: str = "map", size: int = 100, occupied: tuple[int, int, int, int] | None = None) -> Path:
+def write_map(
+    folder: Path,
+    name: str = "map",
+    size: int = 100,
+    occupied: tuple[int, int, int, int] | None = None,
+) -> Path:
     """A map_server map of ``size``² cells of 5 cm, origin (0, 0); ``occupied`` = (x0, y0, x1, y1) cells."""
     grid = np.full((size, size), 254, dtype=np.uint8)
     if occupied is not None:

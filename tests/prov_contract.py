@@ -100,9 +100,7 @@ def _map_iris(found: Records, rename: Callable[[str], str]) -> Records:
         return Record(
             r.kind,
             rename(r.identifier) if r.identifier else None,
-            frozenset(
-                (name, ("iri", rename(v[1])) if v[0] == "iri" else v) for name, v in r.attributes
-            ),
+            frozenset((name, ("iri", rename(v[1])) if v[0] == "iri" else v) for name, v in r.attributes),
         )
 
     return {rename(bundle): frozenset(map(record, rs)) for bundle, rs in found.items()}
@@ -111,8 +109,7 @@ def _map_iris(found: Records, rename: Callable[[str], str]) -> Records:
 def _map_values(found: Records, change: Callable[[Record, str, Value], Value]) -> Records:
     return {
         bundle: frozenset(
-            replace(r, attributes=frozenset((n, change(r, n, v)) for n, v in r.attributes))
-            for r in rs
+            replace(r, attributes=frozenset((n, change(r, n, v)) for n, v in r.attributes)) for r in rs
         )
         for bundle, rs in found.items()
     }
@@ -197,12 +194,8 @@ def robot_facts_added(found: Records, scenario: Scenario, base: str) -> Records:
     added: dict[str, dict[str, Value]] = {}
     for robot in scenario.robots:
         parts = names.of_robot(robot.id)
-        added[names.fixed[ids.ROBOT] + robot.id] = {
-            names.iri(ids.ROBOT_TYPE): ("string", robot.type.id)
-        }
-        added[parts + "software-config"] = {
-            names.iri(ids.ROS_NAMESPACE): ("string", robot.namespace)
-        }
+        added[names.fixed[ids.ROBOT] + robot.id] = {names.iri(ids.ROBOT_TYPE): ("string", robot.type.id)}
+        added[parts + "software-config"] = {names.iri(ids.ROS_NAMESPACE): ("string", robot.namespace)}
         hardware: dict[str, Value] = {}
         if robot.type.base is not None:
             hardware[names.iri(ids.BASE_TYPE)] = ("string", robot.type.base)
@@ -231,9 +224,7 @@ PUBLISHED_FLAWS: tuple[Normalisation, ...] = (
 """Each deliberate difference between exsce's PROV and the published models."""
 
 
-def normalised_published(
-    path: Path, scenario: Scenario, base: str = ids.DEFAULT_NAMESPACE
-) -> Records:
+def normalised_published(path: Path, scenario: Scenario, base: str = ids.DEFAULT_NAMESPACE) -> Records:
     """The records of a published model, with every flaw of :data:`PUBLISHED_FLAWS` undone."""
     found = load_records(path)
     found.pop("", None)  # the published documents hold nothing outside their bundles

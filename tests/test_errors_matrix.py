@@ -6,11 +6,10 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from conftest import write_map
 
 from exsce_dsl.errors import SourceLocation
 from exsce_dsl.lang.build import analyse
-
-from conftest import write_map
 
 SCENARIO = """\
 import "env.exsce"
@@ -67,28 +66,180 @@ CASES = [
     ("syntax-missing-colon", "scenario.exsce", "r1: tiago", "r1 tiago", 11, 8, "expected ':'"),
     ("syntax-missing-number", "tasks.exsce", "facing 0.5", "facing", 9, 1, "expected a number"),
     ("syntax-bad-keyword", "env.exsce", "area room_b", "aera room_b", 9, 3, "expected"),
-    ("unknown-robot-type", "scenario.exsce", "r2: tiago", "r2: tiagp", 12, 9, "unknown robot type 'tiagp'; did you mean 'tiago'?"),
-    ("unknown-start-pose", "scenario.exsce", "at room_a-p2", "at room_a-p3", 12, 25, "unknown pose 'room_a-p3'; did you mean"),
-    ("unknown-task", "scenario.exsce", "then go_home_1", "then go_hom_1", 15, 23, "unknown task 'go_hom_1'; did you mean 'go_home_1'?"),
-    ("robot-not-in-fleet", "scenario.exsce", "r2 does go_b", "r3 does go_b", 16, 5, "robot 'r3' is not in the fleet"),
-    ("unknown-environment", "scenario.exsce", "in env1", "in env2", 9, 16, "unknown environment 'env2'; did you mean 'env1'?"),
+    (
+        "unknown-robot-type",
+        "scenario.exsce",
+        "r2: tiago",
+        "r2: tiagp",
+        12,
+        9,
+        "unknown robot type 'tiagp'; did you mean 'tiago'?",
+    ),
+    (
+        "unknown-start-pose",
+        "scenario.exsce",
+        "at room_a-p2",
+        "at room_a-p3",
+        12,
+        25,
+        "unknown pose 'room_a-p3'; did you mean",
+    ),
+    (
+        "unknown-task",
+        "scenario.exsce",
+        "then go_home_1",
+        "then go_hom_1",
+        15,
+        23,
+        "unknown task 'go_hom_1'; did you mean 'go_home_1'?",
+    ),
+    (
+        "robot-not-in-fleet",
+        "scenario.exsce",
+        "r2 does go_b",
+        "r3 does go_b",
+        16,
+        5,
+        "robot 'r3' is not in the fleet",
+    ),
+    (
+        "unknown-environment",
+        "scenario.exsce",
+        "in env1",
+        "in env2",
+        9,
+        16,
+        "unknown environment 'env2'; did you mean 'env1'?",
+    ),
     ("duplicate-robot", "scenario.exsce", "r2: tiago", "r1: tiago", 12, 5, "duplicate robot 'r1'"),
-    ("no-start-pose", "scenario.exsce", "r2: tiago starts at room_a-p2", "r2: tiago", 12, 5, "robot 'r2' has tasks in mission 'm1' but no start pose"),
-    ("shared-namespace", "scenario.exsce", "r2: tiago starts", 'r2: tiago namespace "r1" starts', 12, 5, "share the namespace 'r1'"),
-    ("same-start-pose", "scenario.exsce", "at room_a-p2", "at room_a-p1", 12, 25, "both start at 'room_a-p1'"),
-    ("empty-mission", "scenario.exsce", "    r1 does go_b then go_home_1\n    r2 does go_b\n", "", 14, 11, "mission 'm1' allocates no task"),
-    ("duplicate-robot-type", "scenario.exsce", "scenario s1", "robot type tiago { }\n\nscenario s1", 9, 12, "duplicate robot type 'tiago' (first declared at scenario.exsce:4:12)"),
-    ("invalid-namespace", "scenario.exsce", 'namespace "r1"', 'namespace "r 1"', 11, 5, "not a valid ROS name"),
-    ("duplicate-pose", "env.exsce", "pose room_a-p2", "pose room_a-p1", 6, 10, "duplicate pose 'room_a-p1' in environment 'env1' (first declared at env.exsce:5:10)"),
+    (
+        "no-start-pose",
+        "scenario.exsce",
+        "r2: tiago starts at room_a-p2",
+        "r2: tiago",
+        12,
+        5,
+        "robot 'r2' has tasks in mission 'm1' but no start pose",
+    ),
+    (
+        "shared-namespace",
+        "scenario.exsce",
+        "r2: tiago starts",
+        'r2: tiago namespace "r1" starts',
+        12,
+        5,
+        "share the namespace 'r1'",
+    ),
+    (
+        "same-start-pose",
+        "scenario.exsce",
+        "at room_a-p2",
+        "at room_a-p1",
+        12,
+        25,
+        "both start at 'room_a-p1'",
+    ),
+    (
+        "empty-mission",
+        "scenario.exsce",
+        "    r1 does go_b then go_home_1\n    r2 does go_b\n",
+        "",
+        14,
+        11,
+        "mission 'm1' allocates no task",
+    ),
+    (
+        "duplicate-robot-type",
+        "scenario.exsce",
+        "scenario s1",
+        "robot type tiago { }\n\nscenario s1",
+        9,
+        12,
+        "duplicate robot type 'tiago' (first declared at scenario.exsce:4:12)",
+    ),
+    (
+        "invalid-namespace",
+        "scenario.exsce",
+        'namespace "r1"',
+        'namespace "r 1"',
+        11,
+        5,
+        "not a valid ROS name",
+    ),
+    (
+        "duplicate-pose",
+        "env.exsce",
+        "pose room_a-p2",
+        "pose room_a-p1",
+        6,
+        10,
+        "duplicate pose 'room_a-p1' in environment 'env1' (first declared at env.exsce:5:10)",
+    ),
     ("duplicate-area", "env.exsce", "area room_b", "area room_a", 9, 8, "duplicate area 'room_a'"),
-    ("pose-outside-map", "env.exsce", "(3.0, 3.0)", "(30.0, 3.0)", 10, 10, "pose 'room_b-p1' at (30, 3) is outside the map 'env1' (x from 0.00 to 5.00"),
-    ("pose-in-occupied-cell", "env.exsce", "(3.0, 3.0)", "(4.2, 4.2)", 10, 10, "is in occupied space of the map 'env1'"),
+    (
+        "pose-outside-map",
+        "env.exsce",
+        "(3.0, 3.0)",
+        "(30.0, 3.0)",
+        10,
+        10,
+        "pose 'room_b-p1' at (30, 3) is outside the map 'env1' (x from 0.00 to 5.00",
+    ),
+    (
+        "pose-in-occupied-cell",
+        "env.exsce",
+        "(3.0, 3.0)",
+        "(4.2, 4.2)",
+        10,
+        10,
+        "is in occupied space of the map 'env1'",
+    ),
     ("missing-map-file", "env.exsce", '"map.yaml"', '"nomap.yaml"', 2, 3, "cannot read map file"),
-    ("unknown-waypoint", "tasks.exsce", "visit room_b-p1", "visit room_b-p9", 4, 9, "unknown pose 'room_b-p9'; did you mean 'room_b-p1'?"),
-    ("empty-task", "tasks.exsce", "  visit room_a-p1 facing 0.5\n", "", 7, 6, "task 'go_home_1' has no waypoints"),
-    ("empty-subtask", "tasks.exsce", "  visit room_b-p1\n", "  subtask { visit room_b-p1 }\n  subtask { }\n", 5, 3, "subtask 2 of task 'go_b' has no waypoints"),
-    ("duplicate-task", "tasks.exsce", "task go_home_1", "task go_b", 7, 6, "duplicate task 'go_b' (first declared at tasks.exsce:3:6)"),
-    ("missing-import", "scenario.exsce", '"tasks.exsce"', '"taskz.exsce"', 2, 1, "imported file 'taskz.exsce' not found"),
+    (
+        "unknown-waypoint",
+        "tasks.exsce",
+        "visit room_b-p1",
+        "visit room_b-p9",
+        4,
+        9,
+        "unknown pose 'room_b-p9'; did you mean 'room_b-p1'?",
+    ),
+    (
+        "empty-task",
+        "tasks.exsce",
+        "  visit room_a-p1 facing 0.5\n",
+        "",
+        7,
+        6,
+        "task 'go_home_1' has no waypoints",
+    ),
+    (
+        "empty-subtask",
+        "tasks.exsce",
+        "  visit room_b-p1\n",
+        "  subtask { visit room_b-p1 }\n  subtask { }\n",
+        5,
+        3,
+        "subtask 2 of task 'go_b' has no waypoints",
+    ),
+    (
+        "duplicate-task",
+        "tasks.exsce",
+        "task go_home_1",
+        "task go_b",
+        7,
+        6,
+        "duplicate task 'go_b' (first declared at tasks.exsce:3:6)",
+    ),
+    (
+        "missing-import",
+        "scenario.exsce",
+        '"tasks.exsce"',
+        '"taskz.exsce"',
+        2,
+        1,
+        "imported file 'taskz.exsce' not found",
+    ),
 ]
 
 
@@ -115,7 +266,11 @@ def test_error_is_reported_at_its_line_and_column(in_tmp: Path, case: tuple) -> 
     analysis = analyse("scenario.exsce")
     assert analysis.spec is None
     found = [(d.location, d.message) for d in analysis.errors]
-    at = [msg for loc, msg in found if loc is not None and (loc.file, loc.line, loc.column) == (file, line, column)]
+    at = [
+        msg
+        for loc, msg in found
+        if loc is not None and (loc.file, loc.line, loc.column) == (file, line, column)
+    ]
     assert any(words in msg for msg in at), f"wanted {words!r} at {file}:{line}:{column}, got {found}"
 
 

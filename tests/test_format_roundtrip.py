@@ -6,6 +6,7 @@ import math
 from pathlib import Path
 
 import pytest
+from conftest import EXAMPLES
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -31,8 +32,6 @@ from exsce_dsl.model import (
     Subtask,
     Task,
 )
-
-from conftest import EXAMPLES
 
 EXAMPLE_FILES = sorted(EXAMPLES.rglob("*.exsce"))
 
@@ -117,7 +116,7 @@ def _orientations(draw: st.DrawFn) -> Orientation:
 @st.composite
 def _positions(draw: st.DrawFn) -> Position:
     if draw(st.booleans()):
-        x, y, z = (draw(st.integers(-10**6, 10**6)) for _ in range(3))
+        x, y, z = (draw(st.integers(-(10**6), 10**6)) for _ in range(3))
         return Position(x * 0.01, y * 0.01, z * 0.01 if draw(st.booleans()) else 0.0, "cm")
     z = draw(_coordinates) if draw(st.booleans()) else 0.0
     return Position(draw(_coordinates), draw(_coordinates), z)
@@ -127,7 +126,9 @@ def _positions(draw: st.DrawFn) -> Position:
 def documents(draw: st.DrawFn) -> Document:
     ids = draw(st.lists(_names, min_size=15, max_size=20, unique=True))
     area_ids, pose_ids, other = ids[:2], ids[2:7], ids[7:]
-    poses = [Pose(p, draw(_positions()), draw(_orientations()), area_ids[i % 2]) for i, p in enumerate(pose_ids)]
+    poses = [
+        Pose(p, draw(_positions()), draw(_orientations()), area_ids[i % 2]) for i, p in enumerate(pose_ids)
+    ]
     areas = tuple(Area(a, tuple(p for p in poses if p.area == a)) for a in area_ids)
     env = Environment(other[0], areas=areas)
     rtype = RobotType(other[1], draw(st.none() | _names), draw(st.none() | st.booleans()))
@@ -144,10 +145,18 @@ def documents(draw: st.DrawFn) -> Document:
         tasks.append(Task(t, tuple(subtasks), source if draw(st.booleans()) else None))
     robots = (
         Robot(other[4], rtype, "ns_" + other[4].replace("-", "_"), poses[0]),
-        Robot(other[5], rtype, "ns_" + other[5].replace("-", "_"), poses[1].with_orientation(Orientation(0, 0, 1.0))),
+        Robot(
+            other[5],
+            rtype,
+            "ns_" + other[5].replace("-", "_"),
+            poses[1].with_orientation(Orientation(0, 0, 1.0)),
+        ),
     )
     allocation = tuple(
-        Assignment(draw(st.sampled_from([r.id for r in robots])), draw(st.sampled_from([t.id for t in tasks])))
+        Assignment(
+            draw(st.sampled_from([r.id for r in robots])),
+            draw(st.sampled_from([t.id for t in tasks])),
+        )
         for _ in range(draw(st.integers(1, 5)))
     ) + tuple(Assignment(r.id, tasks[0].id) for r in robots)
     first_use = list(dict.fromkeys(a.task for a in allocation))

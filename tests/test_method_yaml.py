@@ -141,12 +141,8 @@ def test_scenario_c_environment() -> None:
 
     assert environment == Environment(
         "brsu_building_c_with_doors",
-        map=MapModel(
-            "brsu_building_c_with_doors", RosResource("floorplan-DSL-environments", "maps/")
-        ),
-        world=WorldModel(
-            "brsu_building_c_with_doors", RosResource("floorplan-DSL-environments", "worlds/")
-        ),
+        map=MapModel("brsu_building_c_with_doors", RosResource("floorplan-DSL-environments", "maps/")),
+        world=WorldModel("brsu_building_c_with_doors", RosResource("floorplan-DSL-environments", "worlds/")),
         areas=(
             # start poses first (as the scenario gives them: yaw 0), then task waypoints
             Area(
@@ -188,12 +184,8 @@ def test_scenario_c_tasks_carry_their_own_headings() -> None:
         (
             Subtask(
                 (
-                    Pose(
-                        "classroom_c022-w001", C022_W001, Orientation(yaw=2.269), "classroom_c022"
-                    ),
-                    Pose(
-                        "classroom_c018-w001", C018_W001, Orientation(yaw=-0.641), "classroom_c018"
-                    ),
+                    Pose("classroom_c022-w001", C022_W001, Orientation(yaw=2.269), "classroom_c022"),
+                    Pose("classroom_c018-w001", C018_W001, Orientation(yaw=-0.641), "classroom_c018"),
                 )
             ),
         ),
@@ -228,11 +220,7 @@ def test_import_task_yaml_names_the_task_after_its_file() -> None:
     task = import_task_yaml(TASKS / "navigate_home_2.yaml")
     assert task == Task(
         "navigate_home_2",
-        (
-            Subtask(
-                (Pose("classroom_c025-w002", C025_W002, Orientation(yaw=0.925), "classroom_c025"),)
-            ),
-        ),
+        (Subtask((Pose("classroom_c025-w002", C025_W002, Orientation(yaw=0.925), "classroom_c025"),)),),
     )
     assert import_task_yaml(TASKS / "navigate_home_2.yaml", "home").id == "home"
 
@@ -405,9 +393,7 @@ def test_missing_task_file_names_the_file_and_the_search_path() -> None:
         ("config/tasks/t.yaml", "config/tasks/t.v2.yaml", "task id 't.v2'"),
     ],
 )
-def test_invalid_id_says_which_id_in_which_file(
-    old: str, new: str, expected: str, tmp_path: Path
-) -> None:
+def test_invalid_id_says_which_id_in_which_file(old: str, new: str, expected: str, tmp_path: Path) -> None:
     scenario = write(tmp_path / "small.yaml", SMALL_SCENARIO.replace(old, new))
     write(tmp_path / "config" / "tasks" / "t.yaml", SMALL_TASK.format(pose="lab-p2", x=1.0))
     with pytest.raises(ImportFormatError, match="is not a valid exsce id") as caught:
@@ -447,15 +433,11 @@ def test_same_pose_with_another_heading_is_no_conflict(tmp_path: Path) -> None:
 
 
 def test_missing_key_names_the_key_and_where(tmp_path: Path) -> None:
-    scenario = write(
-        tmp_path / "small.yaml", SMALL_SCENARIO.replace("    robot_namespace: r1\n", "")
-    )
+    scenario = write(tmp_path / "small.yaml", SMALL_SCENARIO.replace("    robot_namespace: r1\n", ""))
     write(tmp_path / "config" / "tasks" / "t.yaml", SMALL_TASK.format(pose="lab-p1", x=1.0))
     with pytest.raises(ImportFormatError) as caught:
         import_scenario_yaml(scenario)
-    assert str(caught.value) == (
-        f"{scenario}:18:5: error: missing key 'robot_namespace' in robots[0]"
-    )
+    assert str(caught.value) == (f"{scenario}:18:5: error: missing key 'robot_namespace' in robots[0]")
 
 
 def test_missing_key_in_a_task_file(tmp_path: Path) -> None:

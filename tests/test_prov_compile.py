@@ -179,8 +179,7 @@ def test_a_task_bundle_written_out_by_hand() -> None:
         "entity(task:delivery_a, [prov:type='prov:Plan', ros:pkg=\"metamorphic_testing\", "
         'ros:relative_path="config/tasks/delivery_a.yaml"])',
         "entity(task:delivery_a-subtask_001, [prov:type='prov:Plan'])",
-        "wasDerivedFrom(task:delivery_a, task:delivery_a-subtask_001, -, -, -, "
-        '[prov:role="subtask_001"])',
+        'wasDerivedFrom(task:delivery_a, task:delivery_a-subtask_001, -, -, -, [prov:role="subtask_001"])',
         "wasDerivedFrom(delivery_a-subtask_001:w_001; task:delivery_a-subtask_001, "
         'pose:classroom_c022-w001-R0.00_P0.00_Y2.269, -, -, -, [prov:role="waypoint"])',
         "wasDerivedFrom(delivery_a-subtask_001:w_002; task:delivery_a-subtask_001, "
@@ -315,9 +314,7 @@ def prefix_of(document: ProvDocument, iri: str) -> set[str]:
 
 
 def renamed(scenario: Scenario, robot_ids: dict[str, str], scenario_id: str) -> Scenario:
-    robots = tuple(
-        Robot(robot_ids[r.id], r.type, r.namespace, r.start_pose) for r in scenario.robots
-    )
+    robots = tuple(Robot(robot_ids[r.id], r.type, r.namespace, r.start_pose) for r in scenario.robots)
     allocation = tuple(Assignment(robot_ids[a.robot], a.task) for a in scenario.mission.allocation)
     mission = Mission(scenario.mission.id, scenario.mission.type, allocation)
     return Scenario(scenario_id, scenario.environment, robots, mission, scenario.tasks)
@@ -370,9 +367,7 @@ def test_the_base_namespace_is_configurable() -> None:
     document = compile_scenario(scenario_c(), namespace=base)
     ours = records(through_json(document))
     assert base + "scenario_c_bundle" in ours
-    assert base + "tasks/waypoints/classroom_c025-w001-R0.00_P0.00_Y0.00" in serialize(
-        document, "nq"
-    )
+    assert base + "tasks/waypoints/classroom_c025-w001-R0.00_P0.00_Y0.00" in serialize(document, "nq")
     assert "sesame-project" not in serialize(document, "nq")
     theirs = normalised_published(SCENARIOS / "scenario_c.prov.json", scenario_c())
     assert len(ours) == len(theirs)
@@ -423,23 +418,18 @@ def test_a_start_pose_without_area_goes_in_the_scenario_bundle() -> None:
 def test_a_sequential_mission_and_a_task_without_source() -> None:
     document = compile_scenario(small_scenario())
     scenario = bundle_provn(document, EXSCE["small_bundle"])
-    assert "entity(mission:m, [prov:type='exsce:mission', exsce:missionType=\"sequential\"])" in (
-        scenario
-    )
+    assert "entity(mission:m, [prov:type='exsce:mission', exsce:missionType=\"sequential\"])" in (scenario)
     assert "entity(task:t1, [prov:type='prov:Plan'])" in bundle_provn(document, TASK["t1_bundle"])
 
 
 def test_obstacles_are_members_of_the_environment_derived_from_their_pose() -> None:
-    box = Obstacle(
-        "box1", Pose("box1", Position(1.0, 1.0), Orientation(yaw=0.3)), "box", (0.5, 0.5, 1.0)
-    )
+    box = Obstacle("box1", Pose("box1", Position(1.0, 1.0), Orientation(yaw=0.3)), "box", (0.5, 0.5, 1.0))
     base = small_scenario()
     environment = Environment("building", areas=base.environment.areas, obstacles=(box,))
     document = compile_scenario(small_scenario(environment=environment))
     lines = bundle_provn(document, ENV["building_bundle"])
     assert (
-        "entity(building:box1, [prov:type='exsce:obstacle', exsce:model=\"box\", "
-        'exsce:size="0.5 0.5 1.0"])'
+        'entity(building:box1, [prov:type=\'exsce:obstacle\', exsce:model="box", exsce:size="0.5 0.5 1.0"])'
     ) in lines
     assert "hadMember(env:building, building:box1)" in lines
     assert (
@@ -498,9 +488,7 @@ def every_format(document: ProvDocument) -> dict[str, str]:
 
 
 def test_compiling_twice_gives_the_same_text_in_every_format() -> None:
-    assert every_format(compile_scenario(scenario_c())) == every_format(
-        compile_scenario(scenario_c())
-    )
+    assert every_format(compile_scenario(scenario_c())) == every_format(compile_scenario(scenario_c()))
 
 
 def test_the_text_does_not_depend_on_the_process() -> None:
@@ -631,9 +619,7 @@ def odd_document() -> ProvDocument:
     bundle.entity(ex["odd.local."], {"prov:type": "plain-type"})
     bundle.activity(ex["run"], when, when, {"prov:type": ex["Run"]})
     bundle.agent(ex["robot"])
-    bundle.usage(
-        ex["run"], ex["e"], when, identifier=ex["u1"], other_attributes={"prov:role": "in"}
-    )
+    bundle.usage(ex["run"], ex["e"], when, identifier=ex["u1"], other_attributes={"prov:role": "in"})
     bundle.generation(ex["odd.local."], ex["run"], when)
     bundle.association(ex["run"], ex["robot"], ex["e"])
     bundle.start(ex["run"], ex["e"], None, when)
@@ -645,9 +631,7 @@ def odd_document() -> ProvDocument:
     bundle.invalidation(ex["e"], ex["run"])
     bundle.specialization(ex["e"], ex["odd.local."])
     bundle.alternate(ex["e"], ex["odd.local."])
-    bundle.derivation(
-        ex["e"], ex["odd.local."], other_attributes={"prov:type": PROV_NAMES["Revision"]}
-    )
+    bundle.derivation(ex["e"], ex["odd.local."], other_attributes={"prov:type": PROV_NAMES["Revision"]})
     document.entity(ex["top"])
     return document
 
@@ -714,9 +698,7 @@ def large_scenario(robots: int = 100, poses: int = 2000, tasks: int = 500) -> Sc
         )
         areas.append(Area(f"room{a}", area_poses))
         all_poses.extend(area_poses)
-    environment = Environment(
-        "big", MapModel("big", RosResource("pkg", "maps/")), areas=tuple(areas)
-    )
+    environment = Environment("big", MapModel("big", RosResource("pkg", "maps/")), areas=tuple(areas))
     task_list = tuple(
         Task(
             f"task{t}",
@@ -735,13 +717,9 @@ def large_scenario(robots: int = 100, poses: int = 2000, tasks: int = 500) -> Sc
         )
         for t in range(tasks)
     )
-    robot_list = tuple(
-        Robot(f"r{r}", TIAGO, f"r{r}", start_pose=all_poses[r]) for r in range(robots)
-    )
+    robot_list = tuple(Robot(f"r{r}", TIAGO, f"r{r}", start_pose=all_poses[r]) for r in range(robots))
     allocation = tuple(Assignment(f"r{t % robots}", f"task{t}") for t in range(tasks))
-    return Scenario(
-        "big", environment, robot_list, Mission("m", MissionType.PARALLEL, allocation), task_list
-    )
+    return Scenario("big", environment, robot_list, Mission("m", MissionType.PARALLEL, allocation), task_list)
 
 
 def test_a_large_scenario_compiles_and_reads_back() -> None:

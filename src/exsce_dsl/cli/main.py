@@ -45,7 +45,10 @@ def reports_errors(func: F) -> F:
         except Exception as exc:  # a bug of ours: say so briefly, trace with --debug
             if _State.debug:
                 raise
-            click.echo(f"internal error: {type(exc).__name__}: {exc} (run with --debug for a traceback)", err=True)
+            click.echo(
+                f"internal error: {type(exc).__name__}: {exc} (run with --debug for a traceback)",
+                err=True,
+            )
             sys.exit(1)
 
     return wrapper  # type: ignore[return-value]
@@ -97,9 +100,21 @@ def check(specs: tuple[str, ...]) -> None:
 
 @main.command(name="compile")
 @click.argument("spec", type=click.Path(dir_okay=False))
-@click.option("-f", "--format", "fmt", type=click.Choice(PROV_FORMATS), default="provn", show_default=True,
-              help="PROV-N, PROV-JSON, PROV-XML, or PROV-O as Turtle, TriG, N-Quads or JSON-LD.")
-@click.option("-o", "--output", type=click.Path(dir_okay=False, writable=True), help="Write here instead of stdout.")
+@click.option(
+    "-f",
+    "--format",
+    "fmt",
+    type=click.Choice(PROV_FORMATS),
+    default="provn",
+    show_default=True,
+    help="PROV-N, PROV-JSON, PROV-XML, or PROV-O as Turtle, TriG, N-Quads or JSON-LD.",
+)
+@click.option(
+    "-o",
+    "--output",
+    type=click.Path(dir_okay=False, writable=True),
+    help="Write here instead of stdout.",
+)
 @click.option("--scenario", "scenario_id", help="Which scenario, when the file declares several.")
 @reports_errors
 def compile_command(spec: str, fmt: str, output: str | None, scenario_id: str | None) -> None:
@@ -147,9 +162,17 @@ def fmt(specs: tuple[str, ...], check_only: bool, show_diff: bool) -> None:
             continue
         changed.append(spec_path)
         if show_diff:
-            click.echo("".join(difflib.unified_diff(
-                original.splitlines(keepends=True), formatted.splitlines(keepends=True),
-                fromfile=spec_path, tofile=f"{spec_path} (formatted)")), nl=False)
+            click.echo(
+                "".join(
+                    difflib.unified_diff(
+                        original.splitlines(keepends=True),
+                        formatted.splitlines(keepends=True),
+                        fromfile=spec_path,
+                        tofile=f"{spec_path} (formatted)",
+                    )
+                ),
+                nl=False,
+            )
         if check_only:
             click.echo(f"would reformat {spec_path}", err=True)
         else:
@@ -159,13 +182,25 @@ def fmt(specs: tuple[str, ...], check_only: bool, show_diff: bool) -> None:
         sys.exit(1)
 
 
-
 @main.command(name="import")
 @click.argument("yaml_file", type=click.Path(exists=True, dir_okay=False))
-@click.option("-o", "--output", "out_dir", type=click.Path(file_okay=False), default=".", show_default=True,
-              help="Folder to write the .exsce files to.")
-@click.option("-t", "--tasks", "task_dirs", multiple=True, type=click.Path(exists=True, file_okay=False),
-              help="Folder to search for the task files the scenario names (repeatable).")
+@click.option(
+    "-o",
+    "--output",
+    "out_dir",
+    type=click.Path(file_okay=False),
+    default=".",
+    show_default=True,
+    help="Folder to write the .exsce files to.",
+)
+@click.option(
+    "-t",
+    "--tasks",
+    "task_dirs",
+    multiple=True,
+    type=click.Path(exists=True, file_okay=False),
+    help="Folder to search for the task files the scenario names (repeatable).",
+)
 @click.option("--force", is_flag=True, help="Overwrite existing files.")
 @reports_errors
 def import_command(yaml_file: str, out_dir: str, task_dirs: tuple[str, ...], force: bool) -> None:
@@ -188,10 +223,23 @@ def import_command(yaml_file: str, out_dir: str, task_dirs: tuple[str, ...], for
 
 @main.command(name="export")
 @click.argument("spec", type=click.Path(dir_okay=False))
-@click.option("--to", "target", type=click.Choice(["yaml"]), default="yaml", show_default=True,
-              help="The format to write.")
-@click.option("-o", "--output", "out_dir", type=click.Path(file_okay=False), default=".", show_default=True,
-              help="Folder to write to.")
+@click.option(
+    "--to",
+    "target",
+    type=click.Choice(["yaml"]),
+    default="yaml",
+    show_default=True,
+    help="The format to write.",
+)
+@click.option(
+    "-o",
+    "--output",
+    "out_dir",
+    type=click.Path(file_okay=False),
+    default=".",
+    show_default=True,
+    help="Folder to write to.",
+)
 @click.option("--scenario", "scenario_id", help="Which scenario, when the file declares several.")
 @reports_errors
 def export_command(spec: str, target: str, out_dir: str, scenario_id: str | None) -> None:
@@ -215,4 +263,3 @@ def _write(text: str, output: str | None) -> None:
     else:
         Path(output).write_text(text, encoding="utf-8")
         click.echo(f"wrote {output}", err=True)
-

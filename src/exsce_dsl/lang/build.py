@@ -260,7 +260,11 @@ class _Builder:
                     dims = [member.sx, member.sy] + ([member.sz] if member.sz is not None else [])
                     size = tuple(_length(v) for v in dims)
                 pose = Pose(
-                    member.name, _position(member.position), _orientation(member.orientation), None, where
+                    member.name,
+                    _position(member.position),
+                    _orientation(member.orientation),
+                    None,
+                    where,
                 )
                 obstacles.append(Obstacle(member.name, pose, member.model or None, size, where))
         return Environment(env.name, map_model, world, tuple(areas), tuple(obstacles), d.name_location)
@@ -411,7 +415,8 @@ class _Builder:
             robot = line.robot.name
             if robot not in fleet:
                 self.error(
-                    f"robot '{robot}' is not in the fleet of scenario '{sc.name}'{did_you_mean(robot, fleet)}",
+                    f"robot '{robot}' is not in the fleet of scenario '{sc.name}'"
+                    f"{did_you_mean(robot, fleet)}",
                     pf.span(line.robot),
                     code="reference",
                 )
@@ -461,4 +466,3 @@ def _orientation(orientation: Any) -> Orientation:
     if orientation.__class__.__name__ == "Facing":
         return Orientation(0.0, 0.0, _angle(orientation.yaw), unit)
     return Orientation(_angle(orientation.roll), _angle(orientation.pitch), _angle(orientation.yaw), unit)
-

@@ -14,7 +14,6 @@ from decimal import Decimal
 
 from exsce_dsl.errors import SourceLocation
 from exsce_dsl.lang.lexical import Comment
-
 from exsce_dsl.model import (
     Assignment,
     Document,
@@ -40,9 +39,7 @@ def format_spec_document(
     spec: Specification, path: str | None = None, comments: Sequence[Comment] = ()
 ) -> str:
     """The canonical text of one file of ``spec`` (the root file by default)."""
-    document = spec.root_document if path is None else next(
-        d for d in spec.documents if d.path == path
-    )
+    document = spec.root_document if path is None else next(d for d in spec.documents if d.path == path)
     return format_document(document, declared_poses(spec.environments), comments)
 
 
@@ -51,9 +48,7 @@ def declared_poses(environments: Iterable[Environment]) -> dict[str, Pose]:
     return {p.id: p for env in environments for p in env.poses()}
 
 
-def format_document(
-    document: Document, poses: Mapping[str, Pose], comments: Sequence[Comment] = ()
-) -> str:
+def format_document(document: Document, poses: Mapping[str, Pose], comments: Sequence[Comment] = ()) -> str:
     """``comments`` (from :func:`exsce_dsl.lang.lexical.comments`) are kept before the
     element that follows them, or at the end of the line they end."""
     blocks: list[list[Line]] = []
@@ -124,11 +119,13 @@ def _environment(env: Environment) -> list[Line]:
     for area in env.areas:
         body: list[Line] = [(f"{INDENT}area {area.id} {{", area.location)]
         for pose in area.poses:
-            body.append((
-                f"{INDENT * 2}pose {pose.id} at {_position(pose.position)}"
-                f"{_orientation(pose.orientation, declared=Orientation())}",
-                pose.location,
-            ))
+            body.append(
+                (
+                    f"{INDENT * 2}pose {pose.id} at {_position(pose.position)}"
+                    f"{_orientation(pose.orientation, declared=Orientation())}",
+                    pose.location,
+                )
+            )
         body.append((f"{INDENT}}}", None))
         sections.append(body)
     if env.obstacles:
@@ -176,7 +173,10 @@ def _task(task: Task, poses: Mapping[str, Pose]) -> list[Line]:
 
 
 def _scenario(sc: Scenario, poses: Mapping[str, Pose]) -> list[Line]:
-    lines: list[Line] = [(f"scenario {sc.id} in {sc.environment.id} {{", sc.location), (f"{INDENT}robots {{", None)]
+    lines: list[Line] = [
+        (f"scenario {sc.id} in {sc.environment.id} {{", sc.location),
+        (f"{INDENT}robots {{", None),
+    ]
     for robot in sc.robots:
         text = f"{INDENT * 2}{robot.id}: {robot.type.id}"
         if robot.namespace != robot.id:

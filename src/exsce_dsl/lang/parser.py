@@ -97,7 +97,7 @@ def _token_at(text: str, line: int, col: int) -> str:
     lines = text.splitlines()
     if line > len(lines):
         return "the end of the file"
-    rest = lines[line - 1][col - 1:].strip()
+    rest = lines[line - 1][col - 1 :].strip()
     if not rest:
         return "the end of the line" if line < len(lines) else "the end of the file"
     token = rest.split()[0]

@@ -28,7 +28,11 @@ def _check_whole_spec(model: Any, metamodel: Any) -> None:
         loc = first.location
         raise TextXSemanticError(
             first.message
-            + (f" (and {len(analysis.errors) - 1} more; see 'exscec check')" if len(analysis.errors) > 1 else ""),
+            + (
+                f" (and {len(analysis.errors) - 1} more; see 'exscec check')"
+                if len(analysis.errors) > 1
+                else ""
+            ),
             line=loc.line if loc else None,
             col=loc.column if loc else None,
             filename=loc.file if loc else path,
@@ -66,28 +70,52 @@ def _generate(model: Any, output_path: str | None, overwrite: bool, fmt: str, su
 
 
 @generator("exsce", "provn")
-def provn_generator(metamodel: Any, model: Any, output_path: str | None, overwrite: bool,
-                    debug: bool, **custom_args: Any) -> None:
+def provn_generator(
+    metamodel: Any,
+    model: Any,
+    output_path: str | None,
+    overwrite: bool,
+    debug: bool,
+    **custom_args: Any,
+) -> None:
     "exsce scenario to PROV-N"
     _generate(model, output_path, overwrite, "provn", ".provn")
 
 
 @generator("exsce", "provjson")
-def provjson_generator(metamodel: Any, model: Any, output_path: str | None, overwrite: bool,
-                       debug: bool, **custom_args: Any) -> None:
+def provjson_generator(
+    metamodel: Any,
+    model: Any,
+    output_path: str | None,
+    overwrite: bool,
+    debug: bool,
+    **custom_args: Any,
+) -> None:
     "exsce scenario to PROV-JSON"
     _generate(model, output_path, overwrite, "json", ".prov.json")
 
 
 @generator("exsce", "provxml")
-def provxml_generator(metamodel: Any, model: Any, output_path: str | None, overwrite: bool,
-                      debug: bool, **custom_args: Any) -> None:
+def provxml_generator(
+    metamodel: Any,
+    model: Any,
+    output_path: str | None,
+    overwrite: bool,
+    debug: bool,
+    **custom_args: Any,
+) -> None:
     "exsce scenario to PROV-XML"
     _generate(model, output_path, overwrite, "xml", ".prov.xml")
 
 
 @generator("exsce", "trig")
-def trig_generator(metamodel: Any, model: Any, output_path: str | None, overwrite: bool,
-                     debug: bool, **custom_args: Any) -> None:
+def trig_generator(
+    metamodel: Any,
+    model: Any,
+    output_path: str | None,
+    overwrite: bool,
+    debug: bool,
+    **custom_args: Any,
+) -> None:
     "exsce scenario to PROV-O (TriG, one named graph per bundle)"
     _generate(model, output_path, overwrite, "trig", ".trig")

@@ -18,7 +18,7 @@ def closest(name: str, candidates: Iterable[str], cutoff: float = 0.6) -> str | 
         cand = candidate.lower()
         score = SequenceMatcher(None, lowered, cand).ratio()
         if len(cand) > len(lowered):
-            tail = cand[-(len(lowered) + 1):]
+            tail = cand[-(len(lowered) + 1) :]
             score = max(score, SequenceMatcher(None, lowered, tail).ratio() - 0.05)
         if score > best_score or (score == best_score and best is not None and candidate < best):
             best, best_score = candidate, score

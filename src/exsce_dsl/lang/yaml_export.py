@@ -34,8 +34,7 @@ def scenario_to_yaml(scenario: Scenario) -> dict[str, Any]:
             "id": scenario.mission.id,
             "type": scenario.mission.type.value,
             "allocation": [
-                {"robot": a.robot, **_task_reference(scenario, a.task)}
-                for a in scenario.mission.allocation
+                {"robot": a.robot, **_task_reference(scenario, a.task)} for a in scenario.mission.allocation
             ],
         },
         "environment": {
@@ -66,11 +65,7 @@ def task_to_yaml(task: Task) -> dict[str, Any]:
                 "make the waypoint planar to export it",
                 waypoint.location,
             )
-    return {
-        "task": [
-            {"waypoints": [_waypoint(w) for w in subtask.waypoints]} for subtask in task.subtasks
-        ]
-    }
+    return {"task": [{"waypoints": [_waypoint(w) for w in subtask.waypoints]} for subtask in task.subtasks]}
 
 
 def export_yaml(scenario: Scenario, out_dir: Path) -> list[Path]:
@@ -99,9 +94,7 @@ def export_yaml(scenario: Scenario, out_dir: Path) -> list[Path]:
     for relative, content in files.items():
         target = out_dir.joinpath(*relative.parts)
         target.parent.mkdir(parents=True, exist_ok=True)
-        target.write_text(
-            yaml.safe_dump(content, sort_keys=False, allow_unicode=True), encoding="utf-8"
-        )
+        target.write_text(yaml.safe_dump(content, sort_keys=False, allow_unicode=True), encoding="utf-8")
         written.append(target)
     return written
 

@@ -92,8 +92,7 @@ def import_scenario_yaml(path: Path, task_search_path: Sequence[Path] = ()) -> t
     for robot_id, entry in starts.items_of_mapping() if starts else ():
         if robot_id not in robot_ids:
             raise entry.error(
-                f"start pose for robot '{robot_id}', which is not in the robots list "
-                f"({', '.join(robot_ids)})"
+                f"start pose for robot '{robot_id}', which is not in the robots list ({', '.join(robot_ids)})"
             )
         read_starts[robot_id] = _read_pose(entry.get("start_pose"))
 
@@ -155,9 +154,7 @@ def import_scenario_yaml(path: Path, task_search_path: Sequence[Path] = ()) -> t
         allocation=tuple(allocation),
         location=mission_node.location,
     )
-    scenario = Scenario(
-        scenario_id, environment, robots, mission, tuple(tasks.values()), root.location
-    )
+    scenario = Scenario(scenario_id, environment, robots, mission, tuple(tasks.values()), root.location)
 
     parts: list[Document] = [
         *(Document(f"robots/{t.id}.exsce", (), (t,)) for t in robot_types.values()),
@@ -172,9 +169,7 @@ def import_scenario_yaml(path: Path, task_search_path: Sequence[Path] = ()) -> t
     return (main, *parts)
 
 
-def import_task_yaml(
-    path: Path, task_id: str | None = None, *, source: RosResource | None = None
-) -> Task:
+def import_task_yaml(path: Path, task_id: str | None = None, *, source: RosResource | None = None) -> Task:
     """Read one task file of the method. The task id defaults to the file's name
     without ``.yaml``; each waypoint's area is its id's prefix (see the module)."""
     file = _YamlFile.read(path)
@@ -182,9 +177,7 @@ def import_task_yaml(
         task_id = _strip_yaml_suffix(path.name)
         _check_name(task_id, "task", f"the name of file {path}", file.root_node())
     elif not is_valid_name(task_id):
-        raise ImportFormatError(
-            f"task id '{task_id}' is not a valid exsce id: {_why_not_a_name(task_id)}"
-        )
+        raise ImportFormatError(f"task id '{task_id}' is not a valid exsce id: {_why_not_a_name(task_id)}")
     return _read_task(file, task_id, source)
 
 
@@ -271,9 +264,7 @@ class _Node:
 
     def _mapping(self) -> Mapping[object, object]:
         if not isinstance(self.value, Mapping):
-            raise self.error(
-                f"{self.where} should be a mapping of keys to values, not {_kind(self.value)}"
-            )
+            raise self.error(f"{self.where} should be a mapping of keys to values, not {_kind(self.value)}")
         return self.value
 
     def get(self, key: str) -> _Node:
@@ -331,16 +322,11 @@ def _kind(value: object) -> str:
 
 def _check_name(text: str, what: str, where: str, node: _Node) -> None:
     if not is_valid_name(text):
-        raise node.error(
-            f"{what} id '{text}' ({where}) is not a valid exsce id: {_why_not_a_name(text)}"
-        )
+        raise node.error(f"{what} id '{text}' ({where}) is not a valid exsce id: {_why_not_a_name(text)}")
 
 
 def _why_not_a_name(text: str) -> str:
-    rule = (
-        "an id is letters, digits and '_', starting with a letter or '_', "
-        "with single '-' between parts"
-    )
+    rule = "an id is letters, digits and '_', starting with a letter or '_', with single '-' between parts"
     if not text:
         return "it is empty"
     if text in KEYWORDS:

@@ -1,7 +1,14 @@
 """The semantic model: plain, immutable dataclasses, free of textX, rdflib and prov."""
 
 from exsce_dsl.model.document import Declaration, Document, Import, Specification
-from exsce_dsl.model.environment import Area, Environment, MapModel, Obstacle, RosResource, WorldModel
+from exsce_dsl.model.environment import (
+    Area,
+    Environment,
+    MapModel,
+    Obstacle,
+    RosResource,
+    WorldModel,
+)
 from exsce_dsl.model.geometry import Orientation, Pose, Position
 from exsce_dsl.model.robots import Robot, RobotType
 from exsce_dsl.model.scenario import Assignment, Mission, MissionType, Scenario

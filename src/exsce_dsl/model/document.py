@@ -71,7 +71,5 @@ class Specification:
         own = [d for d in self.root_document.declarations if isinstance(d, Scenario)]
         if len(own) != 1:
             found = ", ".join(s.id for s in own) or "none"
-            raise ExsceError(
-                f"{self.root} declares {len(own)} scenarios ({found}); name one with --scenario"
-            )
+            raise ExsceError(f"{self.root} declares {len(own)} scenarios ({found}); name one with --scenario")
         return own[0]

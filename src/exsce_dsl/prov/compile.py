@@ -147,9 +147,7 @@ class _BundleWriter:
     test keeps the two equal.
     """
 
-    def __init__(
-        self, compiler: _ScenarioCompiler, identifier: QualifiedName, checked: bool = False
-    ) -> None:
+    def __init__(self, compiler: _ScenarioCompiler, identifier: QualifiedName, checked: bool = False) -> None:
         self._compiler = compiler
         self.bundle: ProvBundle = compiler.document.bundle(identifier)
         self._checked = checked
@@ -225,9 +223,7 @@ class _BundleWriter:
         identifier: QualifiedName | None = None,
     ) -> None:
         if self._checked:
-            self.bundle.derivation(
-                generated, used, identifier=identifier, other_attributes=attributes
-            )
+            self.bundle.derivation(generated, used, identifier=identifier, other_attributes=attributes)
         else:
             self._add(
                 ProvDerivation,
@@ -293,9 +289,7 @@ class _ScenarioCompiler:
         """:func:`~exsce_dsl.prov.identifiers.pose_name`, each orientation formatted once."""
         name = self._orientation_names.get(pose.orientation)
         if name is None:
-            name = self._orientation_names[pose.orientation] = ids.orientation_name(
-                pose.orientation
-            )
+            name = self._orientation_names[pose.orientation] = ids.orientation_name(pose.orientation)
         return f"{pose.id}-{name}"
 
     def _bundle(
@@ -469,14 +463,10 @@ class _ScenarioCompiler:
             w.derivation(plan_id, task_id, primary_source)
 
     def _environment_bundle(self, environment: Environment, loose_poses: list[Pose]) -> None:
-        w = self._bundle(
-            ids.ENV, environment.id, f"environment '{environment.id}'", environment.location
-        )
+        w = self._bundle(ids.ENV, environment.id, f"environment '{environment.id}'", environment.location)
         t = w.term
         env_id = w.fixed(ids.ENV)[environment.id]
-        parts = w.of_element(
-            environment.id, self.names.of_environment(environment.id), "environment"
-        )
+        parts = w.of_element(environment.id, self.names.of_environment(environment.id), "environment")
         w.entity(env_id, {PROV_TYPE: t(ids.ENVIRONMENT_TYPE)})
         members: list[tuple[QualifiedName, QualifiedName]] = []
         if environment.map is not None:
@@ -548,15 +538,11 @@ class _ScenarioCompiler:
         task_id = task_ns[task.id]
         w.entity(task_id, {PROV_TYPE: t(ids.PROV_PLAN), **self._ros(w, task.source)})
         plan_type = {PROV_TYPE: t(ids.PROV_PLAN)}
-        subtask_ids = [
-            task_ns[ids.subtask_name(task.id, i)] for i in range(1, len(task.subtasks) + 1)
-        ]
+        subtask_ids = [task_ns[ids.subtask_name(task.id, i)] for i in range(1, len(task.subtasks) + 1)]
         for subtask_id in subtask_ids:
             w.entity(subtask_id, plan_type)
         waypoint_role = {PROV_ROLE: WAYPOINT_ROLE}
-        for index, (subtask, subtask_id) in enumerate(
-            zip(task.subtasks, subtask_ids, strict=True), start=1
-        ):
+        for index, (subtask, subtask_id) in enumerate(zip(task.subtasks, subtask_ids, strict=True), start=1):
             w.derivation(task_id, subtask_id, {PROV_ROLE: ids.subtask_role(index)})
             relations = w.of_element(
                 ids.subtask_name(task.id, index), self.names.of_subtask(task.id, index), "subtask"

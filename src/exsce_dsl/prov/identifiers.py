@@ -283,9 +283,7 @@ class PrefixTable:
     @staticmethod
     def _candidates(preferred: str, kind: str) -> Iterator[str]:
         yield preferred
-        stem = next(
-            s for s in (f"{preferred}_{kind}", f"{kind}_{preferred}", kind) if is_valid_prefix(s)
-        )
+        stem = next(s for s in (f"{preferred}_{kind}", f"{kind}_{preferred}", kind) if is_valid_prefix(s))
         yield stem
         n = 2
         while True:

@@ -262,9 +262,7 @@ def _statements(triples: Iterable[_Triple], spell: _Spelling, indent: str) -> st
     more = f" ;\n{indent}    "
     for subject, predicates in subjects.items():
         parts = [
-            ("a" if p == _RDF_TYPE else spell.short(p))
-            + " "
-            + ", ".join(spell.short(o) for o in objects)
+            ("a" if p == _RDF_TYPE else spell.short(p)) + " " + ", ".join(spell.short(o) for o in objects)
             for p, objects in predicates.items()
         ]
         blocks.append(f"{indent}{spell.short(subject)} {more.join(parts)} .\n")
@@ -369,9 +367,7 @@ _RELATIONS: dict[QualifiedName, _RelationForm] = {
         _p("activity"),
         (_p("atTime"),),
     ),
-    PROV_USAGE: _RelationForm(
-        _p("used"), _p("qualifiedUsage"), _p("Usage"), _p("entity"), (_p("atTime"),)
-    ),
+    PROV_USAGE: _RelationForm(_p("used"), _p("qualifiedUsage"), _p("Usage"), _p("entity"), (_p("atTime"),)),
     PROV_COMMUNICATION: _RelationForm(
         _p("wasInformedBy"), _p("qualifiedCommunication"), _p("Communication"), _p("activity")
     ),
@@ -552,9 +548,7 @@ def _bundle_quads(bundle: ProvBundle, graph: URIRef | None, terms: _Terms) -> It
             yield from _relation_quads(record, graph, terms)
 
 
-def _attribute_quads(
-    subject: Node, attributes: Any, graph: URIRef | None, terms: _Terms
-) -> Iterator[_Quad]:
+def _attribute_quads(subject: Node, attributes: Any, graph: URIRef | None, terms: _Terms) -> Iterator[_Quad]:
     for name, value in attributes:
         if value is None:
             continue

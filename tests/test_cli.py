@@ -1,0 +1,132 @@
+"""The real ``exscec`` command, run in a temporary folder."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import yaml
+
+from conftest import EXAMPLES, FIXTURES, run_exscec
+
+SCENARIO_C = EXAMPLES / "brsu_building_c" / "scenario_c.exsce"
+
+
+def _copy_examples(tmp: Path) -> Path:
+    shutil.copytree(EXAMPLES / "brsu_building_c", tmp / "bc")
+    return tmp / "bc"
+
+
+def test_help_lists_the_commands_with_examples() -> None:
+    result = run_exscec("--help")
+    assert result.returncode == 0
+    for command in ("check", "compile", "fmt", "import", "export"):
+        assert command in result.stdout
+    compile_help = run_exscec("compile", "--help").stdout
+    assert "Example:" in compile_help and "provn" in compile_help
+
+
+def test_compile_prints_prov_n_of_scenario_c() -> None:
+    result = run_exscec("compile", str(SCENARIO_C))
+    assert result.returncode == 0, result.stderr
+    out = result.stdout
+    assert out.startswith("document\n")
+    assert "bundle exsce:scenario_c_bundle" in out
+    assert "entity(mission:mission_c, [prov:type='exsce:mission', exsce:missionType=\"parallel\"])" in out
+    assert "wasDerivedFrom(mission_c:tiago1-task_02, task:navigate_home_1" in out
+    assert "pose:classroom_c025-w001-R0.00_P0.00_Y0.925" in out
+    assert out.rstrip().endswith("endDocument")
+
+
+def test_compile_writes_prov_json_to_a_file(in_tmp: Path) -> None:
+    result = run_exscec("compile", str(SCENARIO_C), "-f", "json", "-o", "c.json")
+    assert result.returncode == 0, result.stderr
+    bundles = json.loads((in_tmp / "c.json").read_text())["bundle"]
+    assert "exsce:scenario_c_bundle" in bundles
+    assert "robot:tiago2_bundle" in bundles
+
+
+def test_check_reports_every_error_as_file_line_col_and_exits_1(in_tmp: Path) -> None:
+    folder = _copy_examples(in_tmp)
+    text = (folder / "scenario_c.exsce").read_text()
+    text = text.replace("tiago2: tiago", "tiago2: tiagoo").replace("then navigate_home_1", "")
+    text = text.replace("tiago1 does navigate_home_1", "tiago3 does navigate_home_1")
+    (folder / "scenario_c.exsce").write_text(text)
+    result = run_exscec("check", "bc/scenario_c.exsce")
+    assert result.returncode == 1
+    assert "Traceback" not in result.stderr
+    lines = result.stderr.splitlines()
+    assert "bc/scenario_c.exsce:9:13: error: unknown robot type 'tiagoo'; did you mean 'tiago'?" in lines
+    assert any(line.startswith("bc/scenario_c.exsce:14:5: error: robot 'tiago3' is not in the fleet") for line in lines)
+    assert "bc/scenario_c.exsce: 2 errors" in lines
+
+
+def test_syntax_error_is_worded_and_has_no_traceback(in_tmp: Path) -> None:
+    (in_tmp / "bad.exsce").write_text("robot type tiago {\n  base\n}\n")
+    result = run_exscec("compile", "bad.exsce")
+    assert result.returncode == 1
+    assert result.stderr.strip() == "bad.exsce:3:1: error: expected a name, found '}'"
+    assert result.stdout == ""
+
+
+def test_debug_shows_the_traceback(in_tmp: Path) -> None:
+    (in_tmp / "bad.exsce").write_text("robot type tiago {\n  base\n}\n")
+    result = run_exscec("--debug", "compile", "bad.exsce")
+    assert result.returncode == 1
+    assert "Traceback" in result.stderr
+
+
+def test_usage_errors_exit_2(in_tmp: Path) -> None:
+    assert run_exscec("compile").returncode == 2
+    assert run_exscec("compile", str(SCENARIO_C), "-f", "dot").returncode == 2
+
+
+def test_missing_file_is_an_error_not_a_crash(in_tmp: Path) -> None:
+    result = run_exscec("check", "nope.exsce")
+    assert result.returncode == 1
+    assert "cannot read nope.exsce" in result.stderr
+    assert "Traceback" not in result.stderr
+
+
+def test_fmt_check_and_rewrite(in_tmp: Path) -> None:
+    folder = _copy_examples(in_tmp)
+    assert run_exscec("fmt", "--check", "bc/scenario_c.exsce").returncode == 0
+    messy = (folder / "scenario_c.exsce").read_text().replace("  robots {", "robots{   ")
+    (folder / "scenario_c.exsce").write_text("// keep me\n" + messy)
+    result = run_exscec("fmt", "--check", "bc/scenario_c.exsce")
+    assert result.returncode == 1 and "would reformat bc/scenario_c.exsce" in result.stderr
+    assert run_exscec("fmt", "bc/scenario_c.exsce").returncode == 0
+    assert (folder / "scenario_c.exsce").read_text() == "// keep me\n" + (SCENARIO_C.read_text())
+
+
+def test_import_then_compile_and_export(in_tmp: Path) -> None:
+    result = run_exscec(
+        "import", str(FIXTURES / "scenarios" / "scenario_d.yaml"), "-t", str(FIXTURES / "tasks"), "-o", "spec"
+    )
+    assert result.returncode == 0, result.stderr
+    assert (in_tmp / "spec" / "scenario_d.exsce").is_file()
+    assert (in_tmp / "spec" / "tasks" / "delivery_b.exsce").is_file()
+    assert run_exscec("check", "spec/scenario_d.exsce").returncode == 0
+    again = run_exscec("import", str(FIXTURES / "scenarios" / "scenario_d.yaml"), "-t", str(FIXTURES / "tasks"), "-o", "spec")
+    assert again.returncode == 1 and "use --force" in again.stderr
+    exported = run_exscec("export", "spec/scenario_d.exsce", "--to", "yaml", "-o", "out")
+    assert exported.returncode == 0, exported.stderr
+    data = yaml.safe_load((in_tmp / "out" / "scenarios" / "scenario_d.yaml").read_text())
+    assert data["mission"]["type"] == "sequential"
+    assert [a["file_path"] for a in data["mission"]["allocation"]] == [
+        "config/tasks/delivery_a.yaml",
+        "config/tasks/delivery_b.yaml",
+        "config/tasks/navigate_home_1.yaml",
+    ]
+
+
+def test_textx_knows_the_language() -> None:
+    import subprocess
+    import sys
+
+    textx = Path(sys.executable).with_name("textx")
+    languages = subprocess.run([str(textx), "list-languages"], capture_output=True, text=True)
+    assert "exsce (*.exsce)" in languages.stdout + languages.stderr
+    checked = subprocess.run([str(textx), "check", str(SCENARIO_C)], capture_output=True, text=True)
+    assert checked.returncode == 0 and "OK" in checked.stdout + checked.stderr
