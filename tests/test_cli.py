@@ -58,7 +58,10 @@ def test_check_reports_every_error_as_file_line_col_and_exits_1(in_tmp: Path) ->
     assert "Traceback" not in result.stderr
     lines = result.stderr.splitlines()
     assert "bc/scenario_c.exsce:9:13: error: unknown robot type 'tiagoo'; did you mean 'tiago'?" in lines
-    assert any(line.startswith("bc/scenario_c.exsce:14:5: error: robot 'tiago3' is not in the fleet") for line in lines)
+    assert any(
+        line.startswith("bc/scenario_c.exsce:14:5: error: robot 'tiago3' is not in the fleet")
+        for line in lines
+    )
     assert "bc/scenario_c.exsce: 2 errors" in lines
 
 
@@ -108,7 +111,9 @@ def test_import_then_compile_and_export(in_tmp: Path) -> None:
     assert (in_tmp / "spec" / "scenario_d.exsce").is_file()
     assert (in_tmp / "spec" / "tasks" / "delivery_b.exsce").is_file()
     assert run_exscec("check", "spec/scenario_d.exsce").returncode == 0
-    again = run_exscec("import", str(FIXTURES / "scenarios" / "scenario_d.yaml"), "-t", str(FIXTURES / "tasks"), "-o", "spec")
+    again = run_exscec(
+        "import", str(FIXTURES / "scenarios" / "scenario_d.yaml"), "-t", str(FIXTURES / "tasks"), "-o", "spec"
+    )
     assert again.returncode == 1 and "use --force" in again.stderr
     exported = run_exscec("export", "spec/scenario_d.exsce", "--to", "yaml", "-o", "out")
     assert exported.returncode == 0, exported.stderr

@@ -6,10 +6,11 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from conftest import write_map
 
 from exsce_dsl.errors import SourceLocation
 from exsce_dsl.lang.build import analyse
+
+from conftest import write_map
 
 SCENARIO = """\
 import "env.exsce"
@@ -64,7 +65,15 @@ FILES = {"scenario.exsce": SCENARIO, "env.exsce": ENV, "tasks.exsce": TASKS}
 # (id, file, text to replace, replacement, line, column, words the message must hold)
 CASES = [
     ("syntax-missing-colon", "scenario.exsce", "r1: tiago", "r1 tiago", 11, 8, "expected ':'"),
-    ("syntax-missing-number", "tasks.exsce", "facing 0.5", "facing", 9, 1, "expected a number"),
+    (
+        "syntax-missing-angle",
+        "tasks.exsce",
+        "facing 0.5",
+        "facing",
+        9,
+        1,
+        "expected an angle (a number, in rad unless followed by deg), found '}'",
+    ),
     ("syntax-bad-keyword", "env.exsce", "area room_b", "aera room_b", 9, 3, "expected"),
     (
         "unknown-robot-type",

@@ -6,7 +6,6 @@ import math
 from pathlib import Path
 
 import pytest
-from conftest import EXAMPLES
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -32,6 +31,8 @@ from exsce_dsl.model import (
     Subtask,
     Task,
 )
+
+from conftest import EXAMPLES
 
 EXAMPLE_FILES = sorted(EXAMPLES.rglob("*.exsce"))
 

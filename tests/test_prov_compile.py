@@ -20,7 +20,6 @@ from prov.constants import PROV as PROV_NAMES
 from prov.constants import XSD_DECIMAL
 from prov.model import Literal as ProvLiteral
 from prov.model import ProvDocument
-from prov_contract import differences, normalised_published, records
 from rdflib import RDF, Dataset, Graph, Literal, Namespace, URIRef
 from rdflib.compare import isomorphic
 
@@ -55,6 +54,8 @@ from exsce_dsl.prov.identifiers import (
     orientation_name,
     pose_name,
 )
+
+from prov_contract import differences, normalised_published, records
 
 MODELS = Path(__file__).parent / "fixtures" / "hbrs-sesame-models"
 SCENARIOS = MODELS / "scenarios"

@@ -43,6 +43,7 @@ from exsce_dsl.model import (
 )
 
 _LENGTH_SCALE = {None: 1.0, "m": 1.0, "cm": 0.01, "mm": 0.001}
+_QUANTITY = re.compile(r"(\S+?)\s*(mm|cm|m|rad|deg)?")
 
 _KIND_WORDS = {
     "RobotType": "robot type",
@@ -101,7 +102,7 @@ class _Builder:
         self.scenarios: dict[str, Scenario] = {}
         # pose id -> the environments declaring it, with the pose
         self.poses: dict[str, list[tuple[str, Pose]]] = {}
-        self.task_refs: dict[str, list[tuple[str, SourceLocation]]] = {}
+        self.task_poses: dict[str, Pose | None] = {}
 
     # ---------------------------------------------------------------- helpers
     def error(self, message: str, location: SourceLocation | None, code: str = "semantic") -> None:
@@ -113,11 +114,15 @@ class _Builder:
     @staticmethod
     def name_span(pf: ParsedFile, obj: Any) -> SourceLocation:
         """The span of ``obj.name`` inside the text of ``obj``."""
-        pattern = re.compile(rf"(?<![\w-]){re.escape(obj.name)}(?![\w-])")
-        match = pattern.search(pf.text, obj._tx_position, obj._tx_position_end)
-        if match is None:
-            return pf.span(obj)
-        return pf.lines.span(match.start(), match.end())
+        text, name, end = pf.text, obj.name, obj._tx_position_end
+        start = text.find(name, obj._tx_position, end)
+        while start >= 0:  # the first whole-word occurrence (`t` in `task t` is not the one in `task`)
+            before = text[start - 1] if start else " "
+            after = text[start + len(name)] if start + len(name) < len(text) else " "
+            if not (before.isalnum() or before in "_-") and not (after.isalnum() or after in "_-"):
+                return pf.lines.span(start, start + len(name))
+            start = text.find(name, start + 1, end)
+        return pf.span(obj)
 
     # ------------------------------------------------------------------ build
     def build(self) -> Specification:
@@ -128,6 +133,7 @@ class _Builder:
             self.robot_types[name] = self._robot_type(d)
         for name, d in self.declared["Environment"].items():
             self.environments[name] = self._environment(d)
+        self.task_poses = self._task_pose_candidates()
         for name, d in self.declared["Task"].items():
             task = self._task(d)
             if task is not None:
@@ -291,7 +297,7 @@ class _Builder:
                             )
                         )
                         continue
-                    pose = self._pose_use(pf, wp, self._task_pose_candidates())
+                    pose = self._pose_use(pf, wp, self.task_poses)
                     if pose is None:
                         ok = False
                     else:
@@ -392,14 +398,13 @@ class _Builder:
         mission = self._mission(pf, sc, robot_seen)
         if mission is None or env is None or not ok:
             return None
-        used: list[Task] = []
+        used: dict[str, Task] = {}
         for entry in mission.allocation:
             task = self.tasks.get(entry.task)
             if task is None:
                 return None  # reported where the task is declared or referenced
-            if task not in used:
-                used.append(task)
-        return Scenario(sc.name, env, tuple(robots), mission, tuple(used), d.name_location)
+            used.setdefault(task.id, task)
+        return Scenario(sc.name, env, tuple(robots), mission, tuple(used.values()), d.name_location)
 
     def _mission(self, pf: ParsedFile, sc: Any, fleet: Mapping[str, SourceLocation]) -> Mission | None:
         m = sc.mission
@@ -444,25 +449,33 @@ def _ros(source: Any) -> RosResource | None:
     return RosResource(source.package, source.path or None)
 
 
-def _length(length: Any) -> float:
-    return float(length.value) * _LENGTH_SCALE[length.unit or None]
+def _quantity(text: str) -> tuple[float, str | None]:
+    """Number and unit of a ``Length`` or ``Angle`` token such as ``150 cm`` or ``-0.5``."""
+    match = _QUANTITY.fullmatch(text)
+    assert match is not None, text  # the grammar only lets such tokens through
+    return float(match.group(1)), match.group(2)
+
+
+def _length(text: str) -> float:
+    value, unit = _quantity(text)
+    return value * _LENGTH_SCALE[unit]
 
 
 def _position(pos: Any) -> Position:
-    unit = pos.x.unit or "m"
+    unit = _quantity(pos.x)[1] or "m"
     z = _length(pos.z) if pos.z is not None else 0.0
     return Position(_length(pos.x), _length(pos.y), z, unit)
 
 
-def _angle(angle: Any) -> float:
-    value = float(angle.value)
-    return math.radians(value) if angle.unit == "deg" else value
+def _angle(text: str) -> float:
+    value, unit = _quantity(text)
+    return math.radians(value) if unit == "deg" else value
 
 
 def _orientation(orientation: Any) -> Orientation:
     if orientation is None:
         return Orientation()
-    unit = orientation.yaw.unit or "rad"
+    unit = _quantity(orientation.yaw)[1] or "rad"
     if orientation.__class__.__name__ == "Facing":
         return Orientation(0.0, 0.0, _angle(orientation.yaw), unit)
     return Orientation(_angle(orientation.roll), _angle(orientation.pitch), _angle(orientation.yaw), unit)

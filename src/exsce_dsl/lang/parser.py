@@ -26,6 +26,8 @@ _RULE_WORDS = {
     "INT": "a number",
     "STRING": "a quoted string",
     "EOF": "the end of the file",
+    "Length": "a length (a number, in m unless followed by cm or mm)",
+    "Angle": "an angle (a number, in rad unless followed by deg)",
 }
 
 
