@@ -1,0 +1,1 @@
+"""The provenance store: named graphs per PROV bundle, SPARQL, typed queries."""
