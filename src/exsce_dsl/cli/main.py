@@ -1,57 +1,15 @@
-"""``exscec``: the command line, a thin click layer over the library."""
+"""``exscec``: the command line, a thin click layer over the library.
+
+The group lives here; each family of commands is a module of its own that
+adds its commands to :data:`main`.
+"""
 
 from __future__ import annotations
-
-import difflib
-import functools
-import sys
-from collections.abc import Callable
-from pathlib import Path
-from typing import Any, TypeVar
 
 import click
 
 from exsce_dsl import __version__
-from exsce_dsl.errors import ExsceError
-
-F = TypeVar("F", bound=Callable[..., Any])
-
-PROV_FORMATS = ("provn", "json", "xml", "ttl", "trig", "nq", "jsonld")
-
-
-class _State:
-    debug = False
-
-
-def _print_diagnostics(diagnostics: Any) -> None:
-    for d in diagnostics:
-        click.echo(str(d), err=True)
-
-
-def reports_errors(func: F) -> F:
-    """Turn library errors into ``file:line:col: error: message`` and exit status 1."""
-
-    @functools.wraps(func)
-    def wrapper(*args: Any, **kwargs: Any) -> Any:
-        try:
-            return func(*args, **kwargs)
-        except ExsceError as exc:
-            if _State.debug:
-                raise
-            _print_diagnostics(exc.diagnostics)
-            sys.exit(1)
-        except (click.ClickException, click.exceptions.Exit, click.Abort, SystemExit):
-            raise
-        except Exception as exc:  # a bug of ours: say so briefly, trace with --debug
-            if _State.debug:
-                raise
-            click.echo(
-                f"internal error: {type(exc).__name__}: {exc} (run with --debug for a traceback)",
-                err=True,
-            )
-            sys.exit(1)
-
-    return wrapper  # type: ignore[return-value]
+from exsce_dsl.cli.common import State
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -68,198 +26,14 @@ def main(debug: bool) -> None:
       exscec check examples/scenario_c/scenario_c.exsce
       exscec compile examples/scenario_c/scenario_c.exsce -f provn
     """
-    _State.debug = debug
+    State.debug = debug
 
 
-@main.command()
-@click.argument("specs", nargs=-1, required=True, type=click.Path(dir_okay=False))
-@reports_errors
-def check(specs: tuple[str, ...]) -> None:
-    """Parse and check SPEC files; report every error found, not only the first.
+def _register() -> None:
+    from exsce_dsl.cli import spec_commands
 
-    \b
-    Example:
-      exscec check examples/scenario_c/scenario_c.exsce
-    """
-    from exsce_dsl.lang.build import analyse
-
-    failed = False
-    for spec in specs:
-        analysis = analyse(spec)
-        _print_diagnostics(analysis.diagnostics)
-        if analysis.errors or analysis.spec is None:
-            failed = True
-            count = len(analysis.errors)
-            click.echo(f"{spec}: {count} error{'s' if count != 1 else ''}", err=True)
-        else:
-            n = len(analysis.spec.scenarios)
-            click.echo(f"{spec}: ok ({n} scenario{'s' if n != 1 else ''})", err=True)
-    if failed:
-        sys.exit(1)
+    for command in spec_commands.COMMANDS:
+        main.add_command(command)
 
 
-@main.command(name="compile")
-@click.argument("spec", type=click.Path(dir_okay=False))
-@click.option(
-    "-f",
-    "--format",
-    "fmt",
-    type=click.Choice(PROV_FORMATS),
-    default="provn",
-    show_default=True,
-    help="PROV-N, PROV-JSON, PROV-XML, or PROV-O as Turtle, TriG, N-Quads or JSON-LD.",
-)
-@click.option(
-    "-o",
-    "--output",
-    type=click.Path(dir_okay=False, writable=True),
-    help="Write here instead of stdout.",
-)
-@click.option("--scenario", "scenario_id", help="Which scenario, when the file declares several.")
-@reports_errors
-def compile_command(spec: str, fmt: str, output: str | None, scenario_id: str | None) -> None:
-    """Compile a scenario to W3C PROV (bundles per scenario, environment, area, robot and task).
-
-    \b
-    Example:
-      exscec compile examples/scenario_c/scenario_c.exsce -f json -o scenario_c.prov.json
-    """
-    from exsce_dsl.lang.build import load_spec
-    from exsce_dsl.prov import compile_scenario, serialize
-
-    scenario = load_spec(spec).scenario(scenario_id)
-    text = serialize(compile_scenario(scenario), fmt)
-    _write(text, output)
-
-
-@main.command()
-@click.argument("specs", nargs=-1, required=True, type=click.Path(dir_okay=False))
-@click.option("--check", "check_only", is_flag=True, help="Change nothing; exit 1 if a file would change.")
-@click.option("--diff", "show_diff", is_flag=True, help="Print what would change as a unified diff.")
-@reports_errors
-def fmt(specs: tuple[str, ...], check_only: bool, show_diff: bool) -> None:
-    """Rewrite SPEC files in canonical form.
-
-    The formatter prints the checked model, so a file must be valid to be
-    formatted.  Comments stay before the element that follows them.
-
-    \b
-    Example:
-      exscec fmt --check examples/**/*.exsce
-    """
-    from exsce_dsl.lang.build import load_spec
-    from exsce_dsl.lang.formatter import format_spec_document
-    from exsce_dsl.lang.lexical import comments
-    from exsce_dsl.lang.loader import display_path
-
-    changed = []
-    for spec_path in specs:
-        spec = load_spec(spec_path)
-        original = Path(spec_path).read_text(encoding="utf-8")
-        path = display_path(spec_path)
-        formatted = format_spec_document(spec, path, comments(original, path))
-        if formatted == original:
-            continue
-        changed.append(spec_path)
-        if show_diff:
-            click.echo(
-                "".join(
-                    difflib.unified_diff(
-                        original.splitlines(keepends=True),
-                        formatted.splitlines(keepends=True),
-                        fromfile=spec_path,
-                        tofile=f"{spec_path} (formatted)",
-                    )
-                ),
-                nl=False,
-            )
-        if check_only:
-            click.echo(f"would reformat {spec_path}", err=True)
-        else:
-            Path(spec_path).write_text(formatted, encoding="utf-8")
-            click.echo(f"reformatted {spec_path}", err=True)
-    if check_only and changed:
-        sys.exit(1)
-
-
-@main.command(name="import")
-@click.argument("yaml_file", type=click.Path(exists=True, dir_okay=False))
-@click.option(
-    "-o",
-    "--output",
-    "out_dir",
-    type=click.Path(file_okay=False),
-    default=".",
-    show_default=True,
-    help="Folder to write the .exsce files to.",
-)
-@click.option(
-    "-t",
-    "--tasks",
-    "task_dirs",
-    multiple=True,
-    type=click.Path(exists=True, file_okay=False),
-    help="Folder to search for the task files the scenario names (repeatable).",
-)
-@click.option("--force", is_flag=True, help="Overwrite existing files.")
-@reports_errors
-def import_command(yaml_file: str, out_dir: str, task_dirs: tuple[str, ...], force: bool) -> None:
-    """Import a scenario in the method's YAML format (with its task files) as .exsce files.
-
-    Task files are found by their ROS package and path under each --tasks
-    folder (and the scenario's own folder), or by file name.
-
-    \b
-    Example:
-      exscec import scenario_c.yaml -t config/tasks -o specs/
-    """
-    from exsce_dsl.lang.method_yaml import import_scenario_yaml
-    from exsce_dsl.lang.writer import write_documents
-
-    documents = import_scenario_yaml(Path(yaml_file), [Path(d) for d in task_dirs])
-    for path in write_documents(documents, Path(out_dir), overwrite=force):
-        click.echo(f"wrote {path}", err=True)
-
-
-@main.command(name="export")
-@click.argument("spec", type=click.Path(dir_okay=False))
-@click.option(
-    "--to",
-    "target",
-    type=click.Choice(["yaml"]),
-    default="yaml",
-    show_default=True,
-    help="The format to write.",
-)
-@click.option(
-    "-o",
-    "--output",
-    "out_dir",
-    type=click.Path(file_okay=False),
-    default=".",
-    show_default=True,
-    help="Folder to write to.",
-)
-@click.option("--scenario", "scenario_id", help="Which scenario, when the file declares several.")
-@reports_errors
-def export_command(spec: str, target: str, out_dir: str, scenario_id: str | None) -> None:
-    """Export a scenario to the method's YAML scenario and task files.
-
-    \b
-    Example:
-      exscec export examples/scenario_c/scenario_c.exsce --to yaml -o out/
-    """
-    from exsce_dsl.lang.build import load_spec
-    from exsce_dsl.lang.method_yaml import export_yaml
-
-    scenario = load_spec(spec).scenario(scenario_id)
-    for path in export_yaml(scenario, Path(out_dir)):
-        click.echo(f"wrote {path}", err=True)
-
-
-def _write(text: str, output: str | None) -> None:
-    if output is None:
-        click.echo(text, nl=not text.endswith("\n"))
-    else:
-        Path(output).write_text(text, encoding="utf-8")
-        click.echo(f"wrote {output}", err=True)
+_register()

@@ -1,0 +1,60 @@
+"""What every exscec command shares: error reporting, output."""
+
+from __future__ import annotations
+
+import functools
+import sys
+from collections.abc import Callable, Iterable
+from pathlib import Path
+from typing import Any, TypeVar
+
+import click
+
+from exsce_dsl.errors import Diagnostic, ExsceError
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+
+class State:
+    """Options of the group that commands need (set by ``exscec --debug``)."""
+
+    debug = False
+
+
+def print_diagnostics(diagnostics: Iterable[Diagnostic]) -> None:
+    for d in diagnostics:
+        click.echo(str(d), err=True)
+
+
+def reports_errors(func: F) -> F:
+    """Turn library errors into ``file:line:col: error: message`` and exit status 1."""
+
+    @functools.wraps(func)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        try:
+            return func(*args, **kwargs)
+        except ExsceError as exc:
+            if State.debug:
+                raise
+            print_diagnostics(exc.diagnostics)
+            sys.exit(1)
+        except (click.ClickException, click.exceptions.Exit, click.Abort, SystemExit):
+            raise
+        except Exception as exc:  # a bug of ours: say so briefly, trace with --debug
+            if State.debug:
+                raise
+            click.echo(
+                f"internal error: {type(exc).__name__}: {exc} (run with --debug for a traceback)", err=True
+            )
+            sys.exit(1)
+
+    return wrapper  # type: ignore[return-value]
+
+
+def write_text(text: str, output: str | None) -> None:
+    """Print ``text``, or write it to ``output`` and say so on stderr."""
+    if output is None:
+        click.echo(text, nl=not text.endswith("\n"))
+    else:
+        Path(output).write_text(text, encoding="utf-8")
+        click.echo(f"wrote {output}", err=True)
