@@ -33,7 +33,7 @@ def values_block(bindings: Bindings) -> str:
     for name, value in sorted(bindings.items()):
         if not _VARIABLE.fullmatch(name):
             raise StoreError(f"not a SPARQL variable name: {name!r}")
-        terms: Sequence[Term] = value if isinstance(value, (list, tuple)) else (value,)  # type: ignore[assignment]
+        terms: Sequence[Term] = value if isinstance(value, (list, tuple)) else (value,)
         blocks.append(f"VALUES ?{name} {{ {' '.join(term_text(t) for t in terms)} }}")
     return " ".join(blocks)
 
