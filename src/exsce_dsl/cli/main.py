@@ -23,8 +23,8 @@ def main(debug: bool) -> None:
 
     \b
     Example:
-      exscec check examples/scenario_c/scenario_c.exsce
-      exscec compile examples/scenario_c/scenario_c.exsce -f provn
+      exscec check examples/brsu_building_c/scenario_c.exsce
+      exscec compile examples/brsu_building_c/scenario_c.exsce -f provn
     """
     State.debug = debug
 
