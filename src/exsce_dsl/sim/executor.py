@@ -1,0 +1,359 @@
+"""Play a scenario: who drives where and when, as the waypoint dispatcher would.
+
+Each robot's allocated tasks are run subtask by subtask (one dispatcher goal
+per subtask, one status per waypoint).  In a ``parallel`` mission the robots
+start together and each runs its own tasks in order; in a ``sequential``
+mission an allocation entry starts when the previous one has finished.
+The result keeps the ground truth (the path each robot drove), which tests
+compare metrics against.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+import random
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from exsce_dsl.errors import ExsceError
+from exsce_dsl.model import MissionType, Pose, Scenario
+from exsce_dsl.sim.motion import DT, Limits, Trajectory, drive
+from exsce_dsl.sim.planner import PlanningGrid
+
+
+class GoalStatus(enum.IntEnum):
+    """actionlib_msgs/GoalStatus values."""
+
+    PENDING = 0
+    ACTIVE = 1
+    PREEMPTED = 2
+    SUCCEEDED = 3
+    ABORTED = 4
+
+
+@dataclass(frozen=True)
+class Fault:
+    """A deliberate fault: ``overspeed:R``, ``slow:R``, ``skip-waypoint:R[:N]``, ``near-collision``."""
+
+    kind: str
+    robot: str | None = None
+    index: int = 1
+
+    KINDS = ("overspeed", "slow", "skip-waypoint", "near-collision")
+
+    @classmethod
+    def parse(cls, text: str) -> Fault:
+        kind, _, rest = text.partition(":")
+        if kind not in cls.KINDS:
+            raise ExsceError(f"unknown fault '{kind}'; known faults: {', '.join(cls.KINDS)}")
+        robot, _, index = rest.partition(":")
+        if kind in ("overspeed", "slow", "skip-waypoint") and not robot:
+            raise ExsceError(f"fault '{kind}' needs a robot: {kind}:<robot>")
+        try:
+            n = int(index) if index else 1
+        except ValueError:
+            raise ExsceError(f"fault '{text}': '{index}' is not a waypoint number") from None
+        return cls(kind, robot or None, n)
+
+
+@dataclass(frozen=True)
+class Action:
+    """One waypoint goal: the ground truth of a path segment."""
+
+    robot: str
+    task_number: int  # per robot, from 1 (the method's task_NN)
+    task: str
+    subtask_number: int
+    waypoint_number: int
+    start_pose: Pose
+    goal: Pose
+    start: float  # seconds from the run's start
+    end: float
+    status: GoalStatus
+    path_length: float
+
+
+@dataclass(frozen=True)
+class GoalEvent:
+    """A dispatcher transition: the whole status list of one goal (subtask) at time ``t``."""
+
+    t: float
+    robot: str
+    goal_key: str
+    waypoint_ids: tuple[str, ...]
+    statuses: tuple[GoalStatus, ...]
+    final: bool  # the goal is over: a result is published too
+
+
+@dataclass
+class Timeline:
+    """A robot's motion and dispatcher events over the whole run."""
+
+    robot: str
+    parts: list[Trajectory] = field(default_factory=list)
+    samples: int = 0
+    yaw: float = 0.0
+    x: float = 0.0
+    y: float = 0.0
+
+    def append(self, part: Trajectory) -> None:
+        if len(part):
+            self.parts.append(part)
+            self.samples += len(part)
+            self.x, self.y, self.yaw = float(part.x[-1]), float(part.y[-1]), float(part.yaw[-1])
+
+    def wait_until(self, sample: int) -> None:
+        if sample > self.samples:
+            self.append(Trajectory.hold(self.x, self.y, self.yaw, sample - self.samples))
+
+    @property
+    def now(self) -> float:
+        return self.samples * DT
+
+
+@dataclass(frozen=True)
+class Execution:
+    """What the executor did: trajectories on one clock, events and ground truth."""
+
+    trajectories: dict[str, Trajectory]
+    events: list[GoalEvent]
+    actions: list[Action]
+    duration: float
+
+
+def execute(
+    scenario: Scenario,
+    grid: PlanningGrid,
+    seed: int,
+    faults: tuple[Fault, ...] = (),
+    limits: Limits | None = None,
+) -> Execution:
+    limits = limits or Limits()
+    rng = random.Random(seed)
+    robots = {r.id: r for r in scenario.robots}
+    for fault in faults:
+        if fault.robot is not None and fault.robot not in robots:
+            raise ExsceError(
+                f"fault '{fault.kind}' names robot '{fault.robot}', which is not in {scenario.id}"
+            )
+    timelines: dict[str, Timeline] = {}
+    for robot in scenario.robots:
+        if robot.start_pose is None:
+            continue
+        tl = Timeline(robot.id)
+        tl.x, tl.y, tl.yaw = (
+            robot.start_pose.position.x,
+            robot.start_pose.position.y,
+            robot.start_pose.orientation.yaw,
+        )
+        tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, int(rng.uniform(0.5, 1.0) * 50)))
+        timelines[robot.id] = tl
+    speed = {r: limits.max_speed * rng.uniform(0.9, 1.0) * _speed_factor(r, faults) for r in timelines}
+    skip = {(f.robot, f.index) for f in faults if f.kind == "skip-waypoint"}
+    events: list[GoalEvent] = []
+    actions: list[Action] = []
+    last_pose = {r.id: r.start_pose for r in scenario.robots if r.start_pose is not None}
+    task_numbers: dict[str, int] = {}
+    waypoint_counts: dict[str, int] = {}
+    if any(f.kind == "near-collision" for f in faults):
+        _near_collision(scenario, timelines, grid, limits)
+
+    for entry in scenario.mission.allocation:
+        tl = timelines[entry.robot]
+        if scenario.mission.type is MissionType.SEQUENTIAL:
+            start = max(t.samples for t in timelines.values())
+            tl.wait_until(start)
+        task = scenario.task(entry.task)
+        assert task is not None
+        task_numbers[entry.robot] = task_numbers.get(entry.robot, 0) + 1
+        robot_limits = Limits(speed[entry.robot], limits.max_accel, limits.max_turn_rate)
+        for s_number, subtask in enumerate(task.subtasks, start=1):
+            ids = tuple(w.id for w in subtask.waypoints)
+            key = f"{entry.robot}-task_{task_numbers[entry.robot]:02d}-subtask_{s_number:03d}"
+            statuses = [GoalStatus.PENDING] * len(ids)
+            tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, 10))
+            events.append(GoalEvent(tl.now, entry.robot, key, ids, tuple(statuses), False))
+            for w_number, goal in enumerate(subtask.waypoints, start=1):
+                waypoint_counts[entry.robot] = waypoint_counts.get(entry.robot, 0) + 1
+                statuses[w_number - 1] = GoalStatus.ACTIVE
+                start_t = tl.now
+                events.append(GoalEvent(start_t, entry.robot, key, ids, tuple(statuses), False))
+                previous = last_pose[entry.robot]
+                if (entry.robot, waypoint_counts[entry.robot]) in skip:
+                    tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, 25))
+                    status, length = GoalStatus.ABORTED, 0.0
+                else:
+                    path = grid.plan((tl.x, tl.y), (goal.position.x, goal.position.y))
+                    length = sum(math.dist(path[i], path[i + 1]) for i in range(len(path) - 1))
+                    tl.append(drive(path, tl.yaw, goal.orientation.yaw, robot_limits))
+                    status = GoalStatus.SUCCEEDED
+                    last_pose[entry.robot] = goal
+                statuses[w_number - 1] = status
+                actions.append(
+                    Action(
+                        entry.robot,
+                        task_numbers[entry.robot],
+                        task.id,
+                        s_number,
+                        w_number,
+                        previous,
+                        goal,
+                        start_t,
+                        tl.now,
+                        status,
+                        length,
+                    )
+                )
+                last = w_number == len(ids)
+                events.append(GoalEvent(tl.now, entry.robot, key, ids, tuple(statuses), last))
+                tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, int(rng.uniform(0.2, 0.6) * 50)))
+    trajectories = {r: Trajectory.concat(t.parts) for r, t in timelines.items()}
+    if not any(f.kind == "near-collision" for f in faults):
+        trajectories, events, actions = _give_way(scenario, trajectories, events, actions)
+    end = max(len(t) for t in trajectories.values()) + 50
+    trajectories = {
+        r: Trajectory.concat(
+            [t, Trajectory.hold(float(t.x[-1]), float(t.y[-1]), float(t.yaw[-1]), end - len(t))]
+        )
+        for r, t in trajectories.items()
+    }
+    events.sort(key=lambda e: (e.t, e.robot))
+    return Execution(trajectories, events, actions, end * DT)
+
+
+SAFE_DISTANCE = 1.5  # metres between robot centres that robots keep when they can
+MAX_WAIT = 10.0  # seconds a robot waits before it goes on (a real planner would detour)
+RAMP = 1.2  # seconds to go from full progress to standing still (keeps accelerations bounded)
+
+
+def _give_way(
+    scenario: Scenario, trajectories: dict[str, Trajectory], events: list[GoalEvent], actions: list[Action]
+) -> tuple[dict[str, Trajectory], list[GoalEvent], list[Action]]:
+    """Right of way by fleet order, replayed on the trajectories (paths unchanged, clocks warped).
+
+    Each robot advances along its own trajectory at a rate between -1 (backing up
+    the way it came) and 1 (as planned); the rate changes gradually.  A robot about
+    to come closer than SAFE_DISTANCE to a robot listed before it slows to a stop;
+    a robot that a robot with right of way drives towards backs up.
+    """
+    order = [r.id for r in scenario.robots if r.id in trajectories]
+    if len(order) < 2:
+        return trajectories, events, actions
+    position = {r: 0.0 for r in order}  # fractional sample index along the robot's own trajectory
+    rate = {r: 1.0 for r in order}
+    waited = {r: 0 for r in order}
+    last = {r: len(trajectories[r]) - 1 for r in order}
+    shown: dict[str, list[float]] = {r: [] for r in order}
+    previous: dict[str, tuple[float, float]] = {}
+    step = DT / RAMP
+
+    def at(r: str, p: float) -> tuple[float, float]:
+        tr, k = trajectories[r], min(int(p), last[r])
+        k1, f = min(k + 1, last[r]), p - k
+        return (float(tr.x[k] + f * (tr.x[k1] - tr.x[k])), float(tr.y[k] + f * (tr.y[k1] - tr.y[k])))
+
+    for _ in range(10 * sum(last.values()) + 10):  # bounded: robots finish or stop waiting
+        if all(position[r] >= last[r] for r in order):
+            break
+        placed: dict[str, tuple[float, float]] = {}
+        for r in order:
+            here = at(r, position[r])
+            look = at(r, min(position[r] + 1.0 + rate[r] * RAMP / DT / 2, last[r]))  # where braking would end
+            threatened = any(
+                math.dist(p, here) < SAFE_DISTANCE
+                and math.dist(p, here) < math.dist(previous.get(h, p), here)
+                for h, p in placed.items()
+            )
+            blocked = any(
+                math.dist(look, p) < SAFE_DISTANCE and math.dist(look, p) < math.dist(here, p)
+                for p in placed.values()
+            )
+            if not (threatened or blocked):
+                target, waited[r] = 1.0, 0
+            elif waited[r] < MAX_WAIT / DT:  # give way
+                target = -1.0 if threatened and position[r] > 0 else 0.0
+                waited[r] += 1
+            else:  # waited long enough: go on until the conflict is over
+                target = 1.0
+            rate[r] = min(rate[r] + step, target) if target > rate[r] else max(rate[r] - step, target)
+            position[r] = min(max(position[r] + rate[r], 0.0), float(last[r]))
+            shown[r].append(position[r])
+            placed[r] = at(r, position[r])
+        previous = placed
+    new_index = {}
+    for r in order:
+        tr = trajectories[r]
+        p = np.asarray(shown[r])
+        k = np.minimum(p.astype(np.int64), last[r])
+        k1 = np.minimum(k + 1, last[r])
+        f = p - k
+        speed_scale = np.diff(p, prepend=0.0)  # progress per sample: -1..1
+        trajectories[r] = Trajectory(
+            tr.x[k] + f * (tr.x[k1] - tr.x[k]),
+            tr.y[k] + f * (tr.y[k1] - tr.y[k]),
+            tr.yaw[k] + f * (tr.yaw[k1] - tr.yaw[k]),
+            speed_scale * tr.v[k1],
+            speed_scale * tr.w[k1],
+        )
+        # original sample -> first new sample that reached it
+        first = np.searchsorted(np.maximum.accumulate(p), np.arange(last[r] + 2), side="left")
+        new_index[r] = np.minimum(first, len(p))
+
+    def moved(robot: str, t: float) -> float:
+        k = min(int(round(t / DT)), len(new_index[robot]) - 1)
+        return float(new_index[robot][k]) * DT
+
+    events = [
+        GoalEvent(moved(e.robot, e.t), e.robot, e.goal_key, e.waypoint_ids, e.statuses, e.final)
+        for e in events
+    ]
+    actions = [
+        Action(
+            a.robot,
+            a.task_number,
+            a.task,
+            a.subtask_number,
+            a.waypoint_number,
+            a.start_pose,
+            a.goal,
+            moved(a.robot, a.start),
+            moved(a.robot, a.end),
+            a.status,
+            a.path_length,
+        )
+        for a in actions
+    ]
+    return trajectories, events, actions
+
+
+def _speed_factor(robot: str, faults: tuple[Fault, ...]) -> float:
+    factor = 1.0
+    for f in faults:
+        if f.robot == robot and f.kind == "overspeed":
+            factor *= 1.0 / 0.6 * 1.4 / 0.95  # well over 1 m/s whatever the seeded speed
+        if f.robot == robot and f.kind == "slow":
+            factor *= 0.5
+    return factor
+
+
+def _near_collision(
+    scenario: Scenario, timelines: dict[str, Timeline], grid: PlanningGrid, limits: Limits
+) -> None:
+    """The second robot first drives next to the first one, which waits at its start."""
+    robots = [r for r in scenario.robots if r.id in timelines]
+    if len(robots) < 2:
+        raise ExsceError("fault 'near-collision' needs a scenario with two robots")
+    first, second = timelines[robots[0].id], timelines[robots[1].id]
+    target = (first.x + 0.05, first.y)
+    path = grid.plan((second.x, second.y), (first.x, first.y))
+    path[-1] = target
+    leg = drive(path, second.yaw, second.yaw, limits)
+    second.append(leg)
+    first.wait_until(second.samples + 100)
+    back = drive(list(reversed(path)), second.yaw, second.yaw, limits)
+    second.append(back)
+
+
+__all__ = ["Action", "Execution", "Fault", "GoalEvent", "GoalStatus", "execute", "np"]
