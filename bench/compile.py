@@ -22,7 +22,8 @@ import tracemalloc
 from pathlib import Path
 
 from exsce_dsl.lang.build import load_spec
-from exsce_dsl.prov import compile_scenario, serialize
+from exsce_dsl.prov import compile_scenario
+from exsce_dsl.rdf import serialize
 
 ROBOTS, AREAS, POSES_PER_AREA, TASKS, TASKS_PER_ROBOT = 100, 50, 40, 500, 5
 

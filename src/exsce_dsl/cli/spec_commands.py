@@ -19,20 +19,28 @@ PROV_FORMATS = ("provn", "json", "xml", "ttl", "trig", "nq", "jsonld")
 def check(specs: tuple[str, ...]) -> None:
     """Parse and check SPEC files; report every error found, not only the first.
 
+    After the language's own checks pass, each scenario is compiled and its
+    PROV-O validated against exsce's SHACL shapes; a violation is reported
+    at the DSL element it concerns.
+
     \b
     Example:
       exscec check examples/scenario_c/scenario_c.exsce
     """
     from exsce_dsl.lang.build import analyse
+    from exsce_dsl.rdf.shacl import check_spec_shapes
 
     failed = False
     for spec in specs:
         analysis = analyse(spec)
-        print_diagnostics(analysis.diagnostics)
-        if analysis.errors or analysis.spec is None:
+        diagnostics = list(analysis.diagnostics)
+        if not analysis.errors and analysis.spec is not None:
+            diagnostics.extend(check_spec_shapes(analysis.spec))
+        print_diagnostics(diagnostics)
+        errors = sum(d.severity == "error" for d in diagnostics)
+        if errors or analysis.spec is None:
             failed = True
-            count = len(analysis.errors)
-            click.echo(f"{spec}: {count} error{'s' if count != 1 else ''}", err=True)
+            click.echo(f"{spec}: {errors} error{'s' if errors != 1 else ''}", err=True)
         else:
             n = len(analysis.spec.scenarios)
             click.echo(f"{spec}: ok ({n} scenario{'s' if n != 1 else ''})", err=True)
@@ -58,19 +66,46 @@ def check(specs: tuple[str, ...]) -> None:
     help="Write here instead of stdout.",
 )
 @click.option("--scenario", "scenario_id", help="Which scenario, when the file declares several.")
+@click.option(
+    "--store",
+    "store_url",
+    is_flag=False,
+    flag_value="",
+    default=None,
+    metavar="[URL]",
+    help="Also add the scenario to the store (alone: the default store, $EXSCE_STORE or .exsce/store); "
+    "then PROV is printed only with -f or -o.",
+)
+@click.option("--replace", is_flag=True, help="With --store: replace a changed scenario, keeping a revision.")
 @reports_errors
-def compile_command(spec: str, fmt: str, output: str | None, scenario_id: str | None) -> None:
+def compile_command(
+    spec: str, fmt: str, output: str | None, scenario_id: str | None, store_url: str | None, replace: bool
+) -> None:
     """Compile a scenario to W3C PROV (bundles per scenario, environment, area, robot and task).
 
     \b
     Example:
       exscec compile examples/scenario_c/scenario_c.exsce -f json -o scenario_c.prov.json
+      exscec compile examples/scenario_c/scenario_c.exsce --store
     """
     from exsce_dsl.lang.build import load_spec
-    from exsce_dsl.prov import compile_scenario, serialize
+    from exsce_dsl.prov import compile_scenario
+    from exsce_dsl.rdf import serialize
 
     scenario = load_spec(spec).scenario(scenario_id)
-    text = serialize(compile_scenario(scenario), fmt)
+    document = compile_scenario(scenario)
+    if store_url is not None:
+        from exsce_dsl.cli.store_commands import add_to_store
+
+        add_to_store(document, store_url or None, replace)
+        fmt_given = (
+            click.get_current_context().get_parameter_source("fmt") != click.core.ParameterSource.DEFAULT
+        )
+        if output is None and not fmt_given:
+            return
+    elif replace:
+        raise click.UsageError("--replace goes with --store")
+    text = serialize(document, fmt)
     write_text(text, output)
 
 

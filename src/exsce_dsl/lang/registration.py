@@ -50,8 +50,11 @@ def exsce_language() -> Any:
 
 
 def _generate(model: Any, output_path: str | None, overwrite: bool, fmt: str, suffix: str) -> None:
+    # `lang` sits below `prov` and `rdf`: this entry point (called by textX, not
+    # by the layers below) imports them when it runs, never at import time.
     from exsce_dsl.lang.build import load_spec
-    from exsce_dsl.prov import compile_scenario, serialize
+    from exsce_dsl.prov import compile_scenario
+    from exsce_dsl.rdf import serialize
 
     source = Path(model._tx_filename)
     try:

@@ -97,8 +97,8 @@ __all__ = ["compile_scenario"]
 START_POSE_ROLE = "start_pose"
 WAYPOINT_ROLE = "waypoint"
 OBSTACLE_POSE_ROLE = "obstacle_pose"
-SOFTWARE_CONFIG = "software-config"
-HARDWARE_CONFIG = "hardware-config"
+SOFTWARE_CONFIG = ids.SOFTWARE_CONFIG
+HARDWARE_CONFIG = ids.HARDWARE_CONFIG
 EULER_AXES = "sxyz"
 
 # Records of one bundle are attribute maps keyed by qualified name.
@@ -453,7 +453,7 @@ class _ScenarioCompiler:
                 continue
             robot_parts = w.of_element(robot.id, names.of_robot(robot.id), "robot")
             w.derivation(
-                robot_parts["gazebo_model"],
+                robot_parts[ids.GAZEBO_MODEL],
                 self._pose_id(w, robot.start_pose),
                 role_scenario,
                 identifier=scenario_ns[ids.start_pose_relation_name(robot.id)],
@@ -472,14 +472,14 @@ class _ScenarioCompiler:
         if environment.map is not None:
             map_model: MapModel = environment.map
             map_id = parts[ids.map_entity_name(map_model.name)]
-            grid_id, metadata_id = parts["occupancy_grid"], parts["metadata"]
+            grid_id, metadata_id = parts[ids.OCCUPANCY_GRID], parts[ids.MAP_METADATA]
             w.entity(map_id, {PROV_TYPE: t(ids.MAP_TYPE), **self._ros(w, map_model.source)})
             w.entity(grid_id, {PROV_TYPE: t(ids.ROS_OCCUPANCY_GRID)})
             w.entity(metadata_id, {PROV_TYPE: t(ids.ROS_PARAMETER_SERVER)})
             members += [(map_id, grid_id), (map_id, metadata_id), (env_id, map_id)]
         if environment.world is not None:
             world: WorldModel = environment.world
-            world_id = parts["gazebo_world"]
+            world_id = parts[ids.GAZEBO_WORLD]
             w.entity(world_id, {PROV_TYPE: t(ids.ROS_GAZEBO_MODEL), **self._ros(w, world.source)})
             members.append((env_id, world_id))
         obstacles = []
@@ -516,7 +516,7 @@ class _ScenarioCompiler:
         robot_id = w.fixed(ids.ROBOT)[robot.id]
         parts = w.of_element(robot.id, self.names.of_robot(robot.id), "robot")
         software, hardware = parts[SOFTWARE_CONFIG], parts[HARDWARE_CONFIG]
-        model = parts["gazebo_model"]
+        model = parts[ids.GAZEBO_MODEL]
         w.entity(robot_id, {PROV_TYPE: t(ids.ROBOT_TYPE_VALUE), t(ids.ROBOT_TYPE): robot.type.id})
         w.entity(software, {PROV_TYPE: SOFTWARE_CONFIG, t(ids.ROS_NAMESPACE): robot.namespace})
         hardware_facts: _Attributes = {PROV_TYPE: HARDWARE_CONFIG}
@@ -526,7 +526,7 @@ class _ScenarioCompiler:
             hardware_facts[t(ids.TORSO)] = bool(robot.type.torso)
         w.entity(hardware, hardware_facts)
         w.entity(model, {PROV_TYPE: t(ids.ROS_GAZEBO_MODEL)})
-        w.agent(parts["agent"], {PROV_TYPE: t(ids.PROV_SOFTWARE_AGENT)})
+        w.agent(parts[ids.ROBOT_AGENT], {PROV_TYPE: t(ids.PROV_SOFTWARE_AGENT)})
         w.member(robot_id, model)
         w.member(robot_id, software)
         w.member(robot_id, hardware)

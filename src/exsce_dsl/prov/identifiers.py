@@ -49,6 +49,9 @@ GEOM = "geom"
 COORD = "coord"
 ANGLE = "angle"
 ROS = "ros"
+RUN = "run"
+TOPIC = "topic"
+HOTSPOT = "hotspot"
 
 STANDARD_PREFIXES = frozenset({"prov", "xsd", "xsi", "rdf", "rdfs", "owl", "xml"})
 """Prefix names that PROV and RDF tools bind themselves."""
@@ -56,6 +59,7 @@ STANDARD_PREFIXES = frozenset({"prov", "xsd", "xsi", "rdf", "rdfs", "owl", "xml"
 RESERVED_PREFIXES = frozenset(
     {EXSCE, MISSION, ENV, ROBOT, TASK, POSE, POINT, ORIENTATION, ORACLE}
     | {GEOM, COORD, ANGLE, ROS}
+    | {RUN, TOPIC, HOTSPOT}
     | STANDARD_PREFIXES
 )
 """Prefix names no per-element namespace may take."""
@@ -108,6 +112,21 @@ ROS_RELATIVE_PATH = Term(ROS, "relative_path")
 ROS_NAMESPACE = Term(ROS, "namespace")
 
 
+# Local names of an element's parts, in the element's own namespace.
+GAZEBO_MODEL = "gazebo_model"
+"""``<robot>:gazebo_model``, the robot's simulation model."""
+ROBOT_AGENT = "agent"
+"""``<robot>:agent``, the software agent that is the robot."""
+SOFTWARE_CONFIG = "software-config"
+HARDWARE_CONFIG = "hardware-config"
+"""``<robot>:software-config`` and ``<robot>:hardware-config``; also their ``prov:type`` strings."""
+OCCUPANCY_GRID = "occupancy_grid"
+MAP_METADATA = "metadata"
+"""``<environment>:occupancy_grid`` and ``<environment>:metadata``, the map's members."""
+GAZEBO_WORLD = "gazebo_world"
+"""``<environment>:gazebo_world``, the simulator's world model."""
+
+
 @dataclass(frozen=True)
 class Namespaces:
     """The namespace IRIs of one project, all but the fixed ones under ``base``."""
@@ -136,6 +155,9 @@ class Namespaces:
             COORD: f"{ROBOT_SCHEMA}coordinates/",
             ANGLE: f"{ROBOT_SCHEMA}rotation/",
             ROS: ROS_WIKI,
+            RUN: f"{base}runs/",
+            TOPIC: f"{base}topics/",
+            HOTSPOT: f"{base}hotspots/",
         }
 
     def iri(self, term: Term) -> str:
@@ -160,6 +182,10 @@ class Namespaces:
 
     def of_subtask(self, task_id: str, index: int) -> str:
         return f"{self.base}tasks/{subtask_name(task_id, index)}/"
+
+    def of_run(self, run_uuid: str) -> str:
+        """The namespace of a run's parts: ``<base>runs/run_<uuid>/``."""
+        return f"{self.base}runs/{run_name(run_uuid)}/"
 
 
 # Local names.  Each function returns the part after the prefix.
@@ -236,6 +262,118 @@ def obstacle_pose_relation_name(obstacle_id: str) -> str:
 def bundle_name(element_id: str) -> str:
     """``<id>_bundle``: the bundle of a scenario, environment, area, robot or task."""
     return f"{element_id}_bundle"
+
+
+# Runs, metrics, oracles and derivations (the run-time PROV of the method).
+
+RUN_TYPE = Term(EXSCE, "run")
+"""The run activity's type; the same name is the ``exsce:run`` attribute (the run's uuid)."""
+RUN_ATTR = Term(EXSCE, "run")
+TASK_EXECUTION_TYPE = Term(EXSCE, "task_execution")
+ACTION_TYPE = Term(EXSCE, "action")
+OUTPUT_METRIC_TYPE = Term(EXSCE, "output_metric")
+TOPIC_COLLECTION_TYPE = Term(EXSCE, "topic")
+HOTSPOT_TYPE_VALUE = Term(EXSCE, "hotspot")
+ORACLE_TYPE_VALUE = Term(EXSCE, "oracle")
+TRANSFORM_TYPE = Term(EXSCE, "transform")
+GENERATION_TYPE = Term(EXSCE, "generation")
+ROS_BAGS = Term(ROS, "Bags")
+ROS_TOPICS = Term(ROS, "Topics")
+
+FILE_PATH = Term(EXSCE, "file_path")
+ROBOT_ATTR = Term(EXSCE, "robot")
+STATUS = Term(EXSCE, "status")
+UNIT = Term(EXSCE, "unit")
+METRIC_ATTR = Term(EXSCE, "metric")
+"""On a ``violation_duration`` value: the safety metric whose limit was violated."""
+VIOLATIONS = Term(EXSCE, "violations")
+DURATION = Term(EXSCE, "duration")
+METRIC_TYPE = Term(RUN, "metricType")
+HOTSPOT_TYPE = Term(HOTSPOT, "type")
+ORACLE_METRIC = Term(ORACLE, "metric")
+ORACLE_ROBOT = Term(ORACLE, "robot")
+ORACLE_RELATIONSHIP = Term(ORACLE, "relationship")
+ORACLE_PACKAGE = Term(ORACLE, "package")
+ORACLE_KIND = Term(ORACLE, "type")
+ORACLE_VALUE = Term(ORACLE, "value")
+ORACLE_LIMIT = Term(ORACLE, "limit")
+ORACLE_DELTA = Term(ORACLE, "delta")
+ORACLE_TOLERANCE = Term(ORACLE, "tolerance")
+TRANSFORM_ATTR = Term(EXSCE, "transform")
+STEP = Term(EXSCE, "step")
+
+PARAMETER_SERVER = "parameter-server"
+"""``<run>:parameter-server``, the saved parameters the run used."""
+GOAL_ROLE = "goal"
+TOPIC_ROLE = "topic"
+HOTSPOTS_BUNDLE = "hotspots_bundle"
+GENERATION = "generation"
+GENERATION_BUNDLE = "scenario_generation"
+
+_SAFE_NAME = re.compile(r"[A-Za-z0-9_](?:[A-Za-z0-9_.\-]*[A-Za-z0-9_\-])?")
+
+
+def check_name(name: str, what: str) -> str:
+    """``name`` if it can be a local name and a part of an IRI as it is; else an ExsceError."""
+    if not _SAFE_NAME.fullmatch(name):
+        raise ExsceError(
+            f"{what} '{name}' cannot be part of an identifier; use letters, digits, '_', '-' and '.'"
+        )
+    return name
+
+
+def run_name(run_uuid: str) -> str:
+    """``run_<uuid>``, in ``run:``: the run activity; ``run_<uuid>_bundle`` is its bundle."""
+    return f"run_{check_name(run_uuid, 'run uuid')}"
+
+
+def run_prefix(run_uuid: str) -> str:
+    """The preferred prefix name of a run's namespace: ``run_`` and the uuid's first eight characters."""
+    return f"run_{run_uuid[:8]}"
+
+
+def task_execution_name(robot_id: str, allocation: int) -> str:
+    """``<robot>-task_NN``, in the run's namespace: the robot's NN-th task (1-based)."""
+    return allocation_name(robot_id, allocation)
+
+
+def action_name(robot_id: str, allocation: int, subtask: int, waypoint: int) -> str:
+    """``<robot>-task_NN-subtask_NNN-w_NNN``, in the run's namespace: one waypoint goal."""
+    task = allocation_name(robot_id, allocation)
+    return f"{task}-{subtask_role(subtask)}-{waypoint_relation_name(waypoint)}"
+
+
+def topic_name(topic: str) -> str:
+    """The local name in ``topic:`` of a ROS topic: the absolute name without its first ``/``."""
+    if not topic.startswith("/") or topic == "/" or "//" in topic or any(c.isspace() for c in topic):
+        raise ExsceError(f"'{topic}' is not an absolute ROS topic name (such as '/tiago1/nav_vel')")
+    return topic[1:]
+
+
+def metric_value_name(metric: str, subject: str | None) -> str:
+    """``<subject>-<metric>`` (subject: a robot or an action's name), or ``<metric>`` for the mission."""
+    check_name(metric, "metric")
+    return metric if subject is None else f"{subject}-{metric}"
+
+
+def topics_collection_name(metric: str, robot_id: str | None) -> str:
+    """``<robot>-<metric>-topics`` (``<metric>-topics`` for the mission): the topics a metric used."""
+    return f"{metric_value_name(metric, robot_id)}-topics"
+
+
+def hotspot_name(metric: str, robot_id: str | None, index: int) -> str:
+    """``[<robot>-]<metric>-hotspot_NNN`` (1-based), in the run's namespace."""
+    return f"{metric_value_name(metric, robot_id)}-hotspot_{index:03d}"
+
+
+def oracle_name(metric: str, robot_id: str | None) -> str:
+    """``<robot>-<metric>`` or ``<metric>`` (mission), in the judged scenario's namespace."""
+    return metric_value_name(metric, robot_id)
+
+
+def transformation_step_name(index: int, transformation: str) -> str:
+    """``step_NN-<transformation>`` (1-based), in the new scenario's namespace."""
+    return f"step_{index:02d}-{check_name(transformation, 'transformation')}"
 
 
 # Prefix names.

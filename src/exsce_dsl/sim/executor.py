@@ -173,8 +173,9 @@ def execute(
             ids = tuple(w.id for w in subtask.waypoints)
             key = f"{entry.robot}-task_{task_numbers[entry.robot]:02d}-subtask_{s_number:03d}"
             statuses = [GoalStatus.PENDING] * len(ids)
-            tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, 10))
-            events.append(GoalEvent(tl.now, entry.robot, key, ids, tuple(statuses), False))
+            tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, 5))
+            events.append(GoalEvent(tl.now, entry.robot, key, ids, tuple(statuses), False))  # goal accepted
+            tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, 5))  # the dispatcher activates its first waypoint
             for w_number, goal in enumerate(subtask.waypoints, start=1):
                 waypoint_counts[entry.robot] = waypoint_counts.get(entry.robot, 0) + 1
                 statuses[w_number - 1] = GoalStatus.ACTIVE

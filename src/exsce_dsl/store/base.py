@@ -4,16 +4,21 @@ Two implementations: :class:`exsce_dsl.store.embedded.EmbeddedStore`
 (pyoxigraph in a project folder, the default) and
 :class:`exsce_dsl.store.remote.RemoteStore` (any SPARQL 1.1 endpoint, through
 the SPARQL 1.1 Protocol and the Graph Store Protocol).
+:func:`exsce_dsl.store.open.open_store` picks one from a store URL.
 
 Terms are pyoxigraph terms (``NamedNode``, ``Literal``, ``BlankNode``)
 everywhere in this layer; callers outside ``store`` get plain Python values
 from the typed query functions in :mod:`exsce_dsl.store.queries`.
+
+Blank nodes follow SPARQL's ``INSERT DATA``: each :meth:`Store.write` makes
+fresh blank nodes, one per label (a label names the same node in every graph
+of one write), so two writes never share a blank node.
 """
 
 from __future__ import annotations
 
 import abc
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence, Set
 from dataclasses import dataclass
 
 from pyoxigraph import BlankNode, Literal, NamedNode, Quad
@@ -27,6 +32,23 @@ Bindings = Mapping[str, Term | Sequence[Term]]
 
 class StoreError(ExsceError):
     """The store cannot do what was asked (unreachable, locked, refused, conflicting)."""
+
+
+class StoreLockedError(StoreError):
+    """An embedded store's folder is open in another process (RocksDB allows one)."""
+
+    def __init__(self, message: str, path: str) -> None:
+        super().__init__(message)
+        self.path = path
+
+
+class StoreConflictError(StoreError):
+    """A document differs from what the store holds under the same names."""
+
+    def __init__(self, message: str, graphs: Sequence[str]) -> None:
+        super().__init__(message)
+        self.graphs = tuple(graphs)
+        """The names of the graphs that differ."""
 
 
 @dataclass(frozen=True)
@@ -54,15 +76,33 @@ class GraphSet:
         return sum(len(q) for q in self.graphs.values())
 
 
+Replace = bool | Set[str]
+"""Which graphs a write empties first: all of them (True), none (False), or those named."""
+
+
+def replaced_names(graphs: GraphSet, replace: Replace) -> list[str]:
+    """The graphs of ``graphs`` that ``replace`` says to empty first, in order."""
+    if replace is True:
+        return list(graphs.graphs)
+    if replace is False:
+        return []
+    return [name for name in graphs.graphs if name in replace]
+
+
 class Store(abc.ABC):
     """A dataset of named graphs (one per PROV bundle) that answers SPARQL."""
 
+    location: str = "a store"
+    """Where the store is, for messages: a folder, ``memory:``, or the endpoint's URL."""
+
     @abc.abstractmethod
-    def write(self, graphs: GraphSet, *, replace: bool = False) -> None:
+    def write(self, graphs: GraphSet, *, replace: Replace = False) -> None:
         """Add all of ``graphs`` in one transaction: all of them or none.
 
-        With ``replace``, each named graph is emptied first (in the same
-        transaction); otherwise the quads are added to what the graph holds.
+        With ``replace`` (True, or a set of graph names), those named graphs
+        are emptied first, in the same transaction; the others get the quads
+        added to what they hold.  Writing is one bulk operation, never one
+        call per quad.
         """
 
     @abc.abstractmethod
@@ -77,7 +117,8 @@ class Store(abc.ABC):
         """Run a SPARQL Update atomically."""
 
     @abc.abstractmethod
-    def graph_names(self) -> set[str]: ...
+    def graph_names(self) -> set[str]:
+        """The names of the named graphs that hold at least one quad."""
 
     @abc.abstractmethod
     def graph(self, name: str) -> list[Quad]:
@@ -87,6 +128,48 @@ class Store(abc.ABC):
     def remove_graphs(self, names: Sequence[str]) -> None:
         """Drop these named graphs, in one transaction."""
 
+    def graphs(self, names: Sequence[str]) -> dict[str, list[Quad]]:
+        """The quads of each of these named graphs (blank nodes consistent across them)."""
+        return {name: self.graph(name) for name in names}
+
+    def graph_sizes(self) -> dict[str, int]:
+        """Named graph → number of quads in it."""
+        rows = self.select("SELECT ?g (COUNT(*) AS ?n) WHERE { GRAPH ?g { ?s ?p ?o } } GROUP BY ?g")
+        sizes = {}
+        for g, n in rows.rows:
+            if isinstance(g, NamedNode) and isinstance(n, Literal):
+                sizes[g.value] = int(n.value)
+        return sizes
+
+    def quads(self) -> list[Quad]:
+        """Every quad of every named graph (the default graph is left out)."""
+        rows = self.select("SELECT ?s ?p ?o ?g WHERE { GRAPH ?g { ?s ?p ?o } }")
+        found = []
+        for s, p, o, g in rows.rows:
+            if isinstance(s, (NamedNode, BlankNode)) and isinstance(p, NamedNode) and o is not None:
+                if isinstance(g, NamedNode):
+                    found.append(Quad(s, p, o, g))
+        return found
+
+    def export(self, fmt: str = "trig") -> bytes:
+        """Every named graph as TriG (``trig``, with exsce's prefixes) or N-Quads (``nq``)."""
+        from pyoxigraph import RdfFormat, serialize
+
+        from exsce_dsl.prov.identifiers import PROV_NAMESPACE, XSD_NAMESPACE, Namespaces
+
+        if fmt == "trig":
+            prefixes = {"prov": PROV_NAMESPACE, "xsd": XSD_NAMESPACE, **Namespaces().fixed}
+            data = serialize(self.quads(), format=RdfFormat.TRIG, prefixes=prefixes)
+        elif fmt == "nq":
+            data = serialize(self.quads(), format=RdfFormat.N_QUADS)
+        else:
+            raise StoreError(f"cannot export as '{fmt}'; expected trig or nq")
+        return data or b""
+
+    def clear(self) -> None:
+        """Remove everything, in one transaction."""
+        self.update("DROP ALL")
+
     def close(self) -> None:  # noqa: B027 - optional for stores without resources
         """Release the store (files, connections)."""
 
@@ -95,3 +178,6 @@ class Store(abc.ABC):
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+    def __repr__(self) -> str:
+        return f"<{type(self).__name__} {self.location}>"

@@ -1,56 +1,250 @@
-"""The embedded store: Oxigraph (pyoxigraph) in a folder on disk, or in memory."""
+"""The embedded store: Oxigraph (pyoxigraph) in a folder on disk, or in memory.
+
+Atomicity: pyoxigraph runs each ``extend`` and each ``update`` call in one
+transaction (all or nothing), but ``remove_graph`` is a call of its own.  So a
+write that only adds is one ``extend`` of every quad, and a write that
+replaces graphs is one SPARQL Update request (``DROP SILENT GRAPH`` for each,
+then one ``INSERT DATA``), which Oxigraph also runs as one transaction.  The
+quads are collected and checked before the store is touched.
+
+A folder holds a RocksDB database, which one process at a time may open; a
+second one gets :class:`~exsce_dsl.store.base.StoreLockedError`, naming the
+process that holds it when the system says (Linux).  The folder is created on
+the first write: reading a store that does not exist yet finds it empty.
+"""
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
 from pathlib import Path
 
-from pyoxigraph import NamedNode, Quad, QuerySolutions
+from pyoxigraph import BlankNode, NamedNode, Quad, QueryBoolean, QuerySolutions
 from pyoxigraph import Store as OxStore
 
-from exsce_dsl.store.base import Bindings, GraphSet, Rows, Store, StoreError
-from exsce_dsl.store.sparql import bind
+from exsce_dsl.store.base import (
+    Bindings,
+    GraphSet,
+    Replace,
+    Rows,
+    Store,
+    StoreError,
+    StoreLockedError,
+    replaced_names,
+)
+from exsce_dsl.store.sparql import bind, checked_quads, graph_node, write_update
 
 
 class EmbeddedStore(Store):
     """``path=None`` keeps the data in memory (tests, benchmarks)."""
 
-    def __init__(self, path: Path | None = None) -> None:
-        try:
-            self._store = OxStore(str(path)) if path is not None else OxStore()
-        except OSError as exc:
-            raise StoreError(f"cannot open the store at {path}: {exc}") from None
-        self.path = path
+    def __init__(self, path: Path | str | None = None) -> None:
+        self.path = Path(path) if path is not None else None
+        self.location = str(path) if path is not None else "memory:"
+        self._store: OxStore | None = None
+        self._empty: OxStore | None = None
+        if self.path is None:
+            self._store = OxStore()
+        elif self.path.exists():
+            self._open()
 
-    def write(self, graphs: GraphSet, *, replace: bool = False) -> None:
-        if replace:
-            for name in graphs.graphs:
-                self._store.remove_graph(NamedNode(name))
-        self._store.extend([q for quads in graphs.graphs.values() for q in quads])
+    # -- opening -------------------------------------------------------------
+
+    def _open(self) -> OxStore:
+        assert self.path is not None
+        path = self.path
+        if path.exists() and not path.is_dir():
+            raise StoreError(f"cannot open the store at {path}: it is a file, not a store folder")
+        if path.is_dir() and any(path.iterdir()) and not (path / "CURRENT").exists():
+            raise StoreError(
+                f"cannot open the store at {path}: the folder is not empty and holds no Oxigraph store"
+            )
+        try:
+            path.mkdir(parents=True, exist_ok=True)
+            self._store = OxStore(str(path))
+        except OSError as exc:
+            if "lock" in str(exc).lower():
+                raise StoreLockedError(_locked_message(path, exc), str(path)) from None
+            raise StoreError(f"cannot open the store at {path}: {exc}") from None
+        self._empty = None
+        return self._store
+
+    def _reader(self) -> OxStore:
+        """The store to read from: an empty one while the folder does not exist yet."""
+        if self._store is not None:
+            return self._store
+        if self.path is not None and self.path.exists():  # made since, or reopened after close()
+            return self._open()
+        if self._empty is None:
+            self._empty = OxStore()
+        return self._empty
+
+    def _writer(self) -> OxStore:
+        return self._store if self._store is not None else self._open()
+
+    # -- writing -------------------------------------------------------------
+
+    def write(self, graphs: GraphSet, *, replace: Replace = False) -> None:
+        replaced = replaced_names(graphs, replace)
+        if replaced:
+            text = write_update(graphs, replace)
+            if text:
+                self._run_update(self._writer(), text)
+            return
+        quads = _with_fresh_blank_nodes(graphs)
+        if not quads:
+            return
+        try:
+            self._writer().extend(quads)
+        except OSError as exc:
+            raise StoreError(f"cannot write to the store at {self.location}: {exc}") from None
+
+    def update(self, update: str, bindings: Bindings | None = None) -> None:
+        self._run_update(self._writer(), bind(update, bindings))
+
+    def _run_update(self, store: OxStore, text: str) -> None:
+        try:
+            store.update(text)
+        except SyntaxError as exc:
+            raise StoreError(f"invalid SPARQL update: {exc}") from None
+        except (OSError, RuntimeError, ValueError) as exc:
+            raise StoreError(f"the update failed on the store at {self.location}: {exc}") from None
+
+    def remove_graphs(self, names: Sequence[str]) -> None:
+        if not names or self._store is None:
+            return
+        text = " ;\n".join(f"DROP SILENT GRAPH {graph_node(name)}" for name in names)
+        self._run_update(self._store, text)
+
+    def clear(self) -> None:
+        if self._store is not None:
+            self._run_update(self._store, "DROP ALL")
+
+    # -- reading -------------------------------------------------------------
+
+    def query(self, query: str, bindings: Bindings | None = None) -> object:
+        """The raw pyoxigraph answer (solutions, boolean or triples), for the endpoint."""
+        try:
+            return self._reader().query(bind(query, bindings))
+        except SyntaxError as exc:
+            raise StoreError(f"invalid SPARQL query: {exc}") from None
+        except (OSError, RuntimeError, ValueError) as exc:
+            raise StoreError(f"the query failed on the store at {self.location}: {exc}") from None
 
     def select(self, query: str, bindings: Bindings | None = None) -> Rows:
-        result = self._store.query(bind(query, bindings))
+        result = self.query(query, bindings)
         if not isinstance(result, QuerySolutions):
             raise StoreError("not a SELECT query")
         variables = tuple(v.value for v in result.variables)
-        return Rows(variables, tuple(tuple(solution[v] for v in variables) for solution in result))
+        try:
+            rows = tuple(tuple(solution[v] for v in variables) for solution in result)
+        except (OSError, RuntimeError, ValueError) as exc:
+            raise StoreError(f"the query failed on the store at {self.location}: {exc}") from None
+        return Rows(variables, rows)
 
     def ask(self, query: str, bindings: Bindings | None = None) -> bool:
-        return bool(self._store.query(bind(query, bindings)))
-
-    def update(self, update: str, bindings: Bindings | None = None) -> None:
-        self._store.update(bind(update, bindings))
+        result = self.query(query, bindings)
+        if not isinstance(result, QueryBoolean):
+            raise StoreError("not an ASK query")
+        return bool(result)
 
     def graph_names(self) -> set[str]:
-        return {g.value for g in self._store.named_graphs() if isinstance(g, NamedNode)}
+        store = self._reader()
+        return {
+            g.value
+            for g in store.named_graphs()
+            if isinstance(g, NamedNode) and next(iter(store.quads_for_pattern(None, None, None, g)), None)
+        }
 
     def graph(self, name: str) -> list[Quad]:
-        return list(self._store.quads_for_pattern(None, None, None, NamedNode(name)))
+        return list(self._reader().quads_for_pattern(None, None, None, graph_node(name)))
 
-    def remove_graphs(self, names: Sequence[str]) -> None:
-        for name in names:
-            self._store.remove_graph(NamedNode(name))
+    def graph_sizes(self) -> dict[str, int]:
+        store = self._reader()
+        sizes = {}
+        for g in store.named_graphs():
+            if isinstance(g, NamedNode):
+                n = sum(1 for _ in store.quads_for_pattern(None, None, None, g))
+                if n:
+                    sizes[g.value] = n
+        return sizes
+
+    def quads(self) -> list[Quad]:
+        return [q for q in self._reader() if isinstance(q.graph_name, NamedNode)]
+
+    @property
+    def oxigraph(self) -> OxStore:
+        """The pyoxigraph store itself (created if it does not exist yet), for the endpoint."""
+        return self._writer()
 
     def close(self) -> None:
-        self._store.flush() if self.path is not None else None
+        """Flush and release the folder, so that another process may open it."""
+        if self._store is not None and self.path is not None:
+            try:
+                self._store.flush()
+            except OSError:  # pragma: no cover - nothing more to do on the way out
+                pass
+        self._store = None
+        self._empty = None
 
+
+def _with_fresh_blank_nodes(graphs: GraphSet) -> list[Quad]:
+    """The quads of ``graphs``, each in its graph, with a new blank node for each label."""
+    fresh: dict[str, BlankNode] = {}
+
+    def renamed(node: BlankNode) -> BlankNode:
+        found = fresh.get(node.value)
+        if found is None:
+            found = fresh[node.value] = BlankNode()
+        return found
+
+    quads = []
+    for name, graph_quads in graphs.graphs.items():
+        graph = graph_node(name)
+        for q in checked_quads(graph_quads, name):
+            s, o = q.subject, q.object
+            if isinstance(s, BlankNode):
+                s = renamed(s)
+            elif not isinstance(o, BlankNode) and q.graph_name == graph:
+                quads.append(q)  # as it is: most quads
+                continue
+            if isinstance(o, BlankNode):
+                o = renamed(o)
+            quads.append(Quad(s, q.predicate, o, graph))
+    return quads
+
+
+def _locked_message(path: Path, exc: OSError) -> str:
+    holder = lock_holder(path)
+    if "current process" in str(exc):
+        who = "this process has it open already (close the other EmbeddedStore first)"
+    elif holder is not None:
+        who = f"it is open in {holder}"
+    else:
+        who = "another process has it open"
+    return (
+        f"the store at {path} is in use: {who}.  An embedded store can be opened by one "
+        "process at a time: stop that process, or point --store at a SPARQL endpoint "
+        "(for example `exscec serve` over this store)"
+    )
+
+
+def lock_holder(path: Path) -> str | None:
+    """``pid N (command)`` of the process holding the store's RocksDB lock, if the system tells."""
+    try:
+        inode = os.stat(path / "LOCK").st_ino
+        with open("/proc/locks", encoding="ascii") as locks:
+            lines = locks.read().splitlines()
+    except OSError:
+        return None
+    for line in lines:
+        fields = [f for f in line.split() if f != "->"]
+        # "1: POSIX  ADVISORY  WRITE 12345 08:01:1234567 0 EOF"
+        if len(fields) >= 6 and fields[5].rsplit(":", 1)[-1] == str(inode):
+            pid = fields[4]
+            try:
+                command = Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode().strip()
+            except OSError:
+                command = ""
+            return f"pid {pid} ({command[:120]})" if command else f"pid {pid}"
+    return None

@@ -1,0 +1,358 @@
+"""Benchmark: writing runs into the store, and the segment-metric query, against rdflib.
+
+Builds N synthetic runs shaped like the method's (two robots, ten path segments
+each, every metric per segment, per robot and for the mission, the bag's
+topics, a few hotspots) as PROV documents through ``compile_run``, writes them
+through the real write path (``exsce_dsl.store.writing.add_prov``: PROV → quads →
+one transaction per run) into an embedded on-disk store, and, for N ≤ 1,000,
+into an rdflib in-memory ``Dataset`` in the same process.  Then it times the
+segment query (mean and standard deviation of distance_travelled on one
+segment over every run of the scenario) on both.
+
+    python bench/store.py                 # N = 100, 1,000 and 10,000
+    python bench/store.py --sizes 100,1000
+
+Prints figures; never a unit test.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import gc
+import math
+import random
+import resource
+import sys
+import tempfile
+import time
+import uuid
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+from prov.model import ProvDocument
+from pyoxigraph import BlankNode, NamedNode
+from pyoxigraph import Literal as OxLiteral
+from pyoxigraph import Store as OxStore
+from rdflib import BNode, Dataset, Graph, URIRef
+from rdflib import Literal as RdfLiteral
+from rdflib.term import Node
+
+from exsce_dsl.model import (
+    Area,
+    Assignment,
+    Environment,
+    Mission,
+    MissionType,
+    Orientation,
+    Pose,
+    Position,
+    Robot,
+    RobotType,
+    Scenario,
+    Subtask,
+    Task,
+)
+from exsce_dsl.model.runs import (
+    Action,
+    ActionId,
+    Bag,
+    Hotspot,
+    MetricScope,
+    MetricValue,
+    Run,
+    TaskExecution,
+)
+from exsce_dsl.prov import compile_scenario
+from exsce_dsl.prov.identifiers import pose_name
+from exsce_dsl.prov.run import compile_run
+from exsce_dsl.rdf import to_quads
+from exsce_dsl.store.embedded import EmbeddedStore
+from exsce_dsl.store.queries import query as library_query
+from exsce_dsl.store.queries import segment_metric
+from exsce_dsl.store.sparql import bind
+from exsce_dsl.store.writing import add_prov
+
+ROBOTS = ("tiago1", "tiago2")
+WAYPOINTS_PER_TASK = 5
+TASKS_PER_ROBOT = 2
+SEGMENT_METRICS = ("task_duration", "distance_travelled", "distance_to_obstacles", "max_velocity")
+ROBOT_METRICS = (*SEGMENT_METRICS, "waypoints_visited", "violation_duration")
+MISSION_METRICS = ("mission_duration", "distance_between_robots", "violation_duration")
+TOPICS = {
+    "task_duration": ("waypoint_dispatcher/feedback",),
+    "waypoints_visited": ("waypoint_dispatcher/result",),
+    "distance_travelled": ("distance_travelled",),
+    "distance_to_obstacles": ("scan",),
+    "max_velocity": ("nav_vel",),
+    "violation_duration": ("nav_vel",),
+}
+MISSION_TOPICS = {
+    "mission_duration": "waypoint_dispatcher/feedback",
+    "distance_between_robots": "robot_pose",
+    "violation_duration": "robot_pose",
+}
+BATCH = 100
+"""Runs compiled and written before the next ones are made (memory stays flat)."""
+
+
+# -- the synthetic scenario and its runs ------------------------------------------
+
+
+def synthetic_scenario() -> Scenario:
+    """Two tiagos, each with two tasks of five waypoints, in one room of 24 poses."""
+    poses = tuple(
+        Pose(f"room-w{i:03d}", Position(float(i % 6), float(i // 6), 0.0), Orientation(0.0, 0.0, 0.0), "room")
+        for i in range(1, 25)
+    )
+    environment = Environment("bench_building", areas=(Area("room", poses),))
+    tiago = RobotType("tiago", base="pmb2", torso=True)
+    robots = tuple(
+        Robot(robot, tiago, robot, start_pose=poses[n]) for n, robot in enumerate(ROBOTS)
+    )
+    tasks = []
+    allocation = []
+    for r, robot in enumerate(ROBOTS):
+        for k in range(TASKS_PER_ROBOT):
+            first = 2 + r * 10 + k * WAYPOINTS_PER_TASK
+            waypoints = poses[first : first + WAYPOINTS_PER_TASK]
+            task_id = f"task_{robot}_{k + 1}"
+            tasks.append(Task(task_id, (Subtask(waypoints),)))
+            allocation.append(Assignment(robot, task_id))
+    mission = Mission("bench_mission", MissionType.PARALLEL, tuple(allocation))
+    return Scenario("bench_scenario", environment, robots, mission, tuple(tasks))
+
+
+def synthetic_run(scenario: Scenario, rng: random.Random, number: int) -> Run:
+    start = datetime.datetime(2024, 1, 1) + datetime.timedelta(minutes=10 * number)
+    tasks: list[TaskExecution] = []
+    metrics: list[MetricValue] = []
+    clock = start
+    topics: list[str] = []
+    for robot in scenario.robots:
+        ns = f"/{robot.namespace}"
+        robot_topics = {m: tuple(f"{ns}/{t}" for t in names) for m, names in TOPICS.items()}
+        topics += [f"{ns}/{t}" for t in ("waypoint_dispatcher/feedback", "waypoint_dispatcher/result",
+                                         "distance_travelled", "scan", "nav_vel", "robot_pose")]
+        previous = robot.start_pose
+        assert previous is not None
+        for k, task_id in enumerate(scenario.mission.tasks_of(robot.id), start=1):
+            task = scenario.task(task_id)
+            assert task is not None
+            actions = []
+            for w, goal in enumerate(task.waypoints(), start=1):
+                begin, clock = clock, clock + datetime.timedelta(seconds=rng.uniform(5, 20))
+                action = Action(ActionId(robot.id, k, 1, w), previous, goal, start=begin, end=clock)
+                actions.append(action)
+                for metric in SEGMENT_METRICS:
+                    metrics.append(
+                        MetricValue(metric, MetricScope.SEGMENT, rng.uniform(0.1, 20.0),
+                                    robot_topics[metric], action=action.id)
+                    )
+                previous = goal
+            tasks.append(TaskExecution(robot.id, k, tuple(actions)))
+        for metric in ROBOT_METRICS:
+            metrics.append(
+                MetricValue(metric, MetricScope.ROBOT, rng.uniform(0.0, 100.0), robot_topics[metric],
+                            robot=robot.id,
+                            safety_metric="max_velocity" if metric == "violation_duration" else None)
+            )
+    for metric, topic in MISSION_TOPICS.items():
+        metrics.append(
+            MetricValue(metric, MetricScope.MISSION, rng.uniform(0.0, 300.0),
+                        tuple(f"/{r}/{topic}" for r in ROBOTS),
+                        safety_metric="distance_between_robots" if metric == "violation_duration" else None)
+        )
+    hotspots = tuple(
+        Hotspot("max_velocity", Position(rng.uniform(0, 6), rng.uniform(0, 4)), rng.randint(1, 5),
+                rng.uniform(0.1, 3.0), robot=ROBOTS[i % 2])
+        for i in range(rng.randint(0, 3))
+    )
+    run_uuid = str(uuid.UUID(int=rng.getrandbits(128), version=4))
+    bag = Bag(f"{start:%Y-%m-%dT%H-%M-%S}_bench_run-{run_uuid[:8]}.bag", tuple(topics))
+    return Run(run_uuid, scenario.id, start, clock, bag, tuple(tasks), tuple(metrics), hotspots)
+
+
+def synthetic_runs(scenario: Scenario, count: int, seed: int = 1) -> Iterator[Run]:
+    rng = random.Random(seed)
+    for number in range(count):
+        yield synthetic_run(scenario, rng, number)
+
+
+# -- measuring ---------------------------------------------------------------------
+
+
+def percentile(samples: list[float], q: float) -> float:
+    ordered = sorted(samples)
+    return ordered[min(len(ordered) - 1, max(0, math.ceil(q * len(ordered)) - 1))]
+
+
+def timed(call: Callable[[], object], repeat: int) -> list[float]:
+    call()  # warm up
+    samples = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        call()
+        samples.append(time.perf_counter() - t0)
+    return samples
+
+
+def peak_memory_mb() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+def rdflib_quads(document: ProvDocument) -> list[tuple[Node, Node, Node, URIRef]]:
+    """The document's quads as rdflib terms (the same mapping, ``exsce_dsl.rdf.to_quads``)."""
+    fresh: dict[str, BNode] = {}
+
+    def term(t: object) -> Node:
+        if isinstance(t, NamedNode):
+            return URIRef(t.value)
+        if isinstance(t, BlankNode):
+            return fresh.setdefault(t.value, BNode())
+        assert isinstance(t, OxLiteral)
+        if t.language:
+            return RdfLiteral(t.value, lang=t.language)
+        return RdfLiteral(t.value, datatype=URIRef(t.datatype.value))
+
+    found = []
+    for q in to_quads(document):
+        assert isinstance(q.graph_name, NamedNode)
+        found.append((term(q.subject), term(q.predicate), term(q.object), URIRef(q.graph_name.value)))
+    return found
+
+
+class Figures:
+    def __init__(self) -> None:
+        self.triples = 0
+        self.compile = 0.0
+        self.write = 0.0
+        self.rdflib = 0.0
+
+
+def write_runs(store: EmbeddedStore, dataset: Dataset | None, scenario: Scenario, size: int) -> Figures:
+    """Compile and write ``size`` runs, ``BATCH`` at a time (only a batch is in memory at once)."""
+    figures = Figures()
+    runs = synthetic_runs(scenario, size)
+    while batch := [run for _, run in zip(range(BATCH), runs, strict=False)]:
+        for run in batch:
+            t0 = time.perf_counter()
+            document = compile_run(run, scenario)
+            t1 = time.perf_counter()
+            figures.triples += add_prov(store, document).statements
+            t2 = time.perf_counter()
+            figures.compile += t1 - t0
+            figures.write += t2 - t1
+            if dataset is not None:
+                add_to_rdflib(dataset, document)
+                figures.rdflib += time.perf_counter() - t2
+        del batch
+        gc.collect()
+    return figures
+
+
+def add_to_rdflib(dataset: Dataset, document: ProvDocument) -> None:
+    graphs: dict[URIRef, Graph] = {}
+    quads = []
+    for s, p, o, name in rdflib_quads(document):
+        graph = graphs.get(name)
+        if graph is None:
+            graph = graphs[name] = dataset.graph(name)
+        quads.append((s, p, o, graph))
+    dataset.addN(quads)  # type: ignore[arg-type]
+
+
+def raw_oxigraph_insert(scenario: Scenario, folder: Path) -> float:
+    """Quads/s of pyoxigraph's own transactional insert (``Store.extend``) into a folder, one
+    run at a time: the floor under any write path."""
+    quads = [to_quads(compile_run(run, scenario)) for run in synthetic_runs(scenario, BATCH, seed=7)]
+    raw = OxStore(str(folder))
+    t0 = time.perf_counter()
+    for run_quads in quads:
+        raw.extend(run_quads)
+    raw.flush()
+    return sum(map(len, quads)) / (time.perf_counter() - t0)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument("--sizes", default="100,1000,10000", help="numbers of runs, comma separated")
+    parser.add_argument("--repeat", type=int, default=50, help="timed queries per store")
+    parser.add_argument("--rdflib-max", type=int, default=1000, help="largest N also written to rdflib")
+    options = parser.parse_args()
+    sizes = [int(s) for s in options.sizes.split(",") if s]
+
+    scenario = synthetic_scenario()
+    start_pose = scenario.robots[0].start_pose
+    first_task = scenario.task(scenario.mission.tasks_of(ROBOTS[0])[0])
+    assert start_pose is not None and first_task is not None
+    goal_pose = next(first_task.waypoints())
+    query = library_query("segment_metric_of_scenario")
+    given = {
+        "metric": ["distance_travelled"],
+        "start": [pose_name(start_pose)],
+        "goal": [pose_name(goal_pose)],
+        "scenario": [scenario.id],
+    }
+    bindings = query.bindings(given)
+    rdflib_text = bind(query.sparql(), bindings)
+    segment = f"{pose_name(start_pose)} -> {pose_name(goal_pose)}"
+    print(f"segment {segment} (robot {ROBOTS[0]}), distance_travelled,")
+    print(f"over every run of the scenario; python {sys.version.split()[0]}, batches of {BATCH} runs")
+    with tempfile.TemporaryDirectory(prefix="exsce-bench-") as folder:
+        print(f"pyoxigraph's own on-disk insert (Store.extend, a run per transaction): "
+              f"{raw_oxigraph_insert(scenario, Path(folder) / 'raw'):,.0f} quads/s\n")
+
+    for size in sizes:
+        with tempfile.TemporaryDirectory(prefix="exsce-bench-") as folder:
+            store = EmbeddedStore(Path(folder) / "store")
+            add_prov(store, compile_scenario(scenario))
+            dataset = Dataset() if size <= options.rdflib_max else None
+            if dataset is not None:
+                add_to_rdflib(dataset, compile_scenario(scenario))
+            figures = write_runs(store, dataset, scenario, size)
+            total = figures.compile + figures.write
+            print(f"N = {size:,} runs, {figures.triples:,} triples ({figures.triples / size:,.0f} a run)")
+            print(
+                f"  write, embedded Oxigraph on disk: {total:,.1f} s = "
+                f"{figures.triples / total:,.0f} triples/s (compile_run {figures.compile:,.1f} s; "
+                f"add_prov, PROV → quads → store: {figures.write:,.1f} s)"
+            )
+            if dataset is not None:
+                rdflib_total = figures.compile + figures.rdflib
+                rate = figures.triples / rdflib_total
+                print(f"  write, rdflib Dataset in memory:  {rdflib_total:,.1f} s = {rate:,.0f} triples/s")
+
+            def on_oxigraph(store: EmbeddedStore = store) -> object:
+                assert start_pose is not None
+                return segment_metric(
+                    store, "distance_travelled", start_pose, goal_pose, scenario=scenario.id
+                )
+
+            answer = on_oxigraph()
+            samples = timed(on_oxigraph, options.repeat)
+            p50, p95 = percentile(samples, 0.5), percentile(samples, 0.95)
+            timing = f"p50 {p50 * 1e3:,.2f} ms, p95 {p95 * 1e3:,.2f} ms"
+            print(f"  segment query, Oxigraph: {timing}   {answer}")
+            if dataset is not None:
+
+                def on_rdflib(dataset: Dataset = dataset) -> object:
+                    return list(dataset.query(rdflib_text))
+
+                rows = on_rdflib()
+                rdf_samples = timed(on_rdflib, max(3, min(options.repeat, 10)))
+                r50, r95 = percentile(rdf_samples, 0.5), percentile(rdf_samples, 0.95)
+                shown = [tuple(str(v) for v in row) for row in rows]  # type: ignore[union-attr]
+                timing = f"p50 {r50 * 1e3:,.2f} ms, p95 {r95 * 1e3:,.2f} ms"
+                print(f"  segment query, rdflib:   {timing}   {shown}")
+                print(f"  Oxigraph / rdflib: {r50 / p50:,.0f}× faster at p50")
+            print(f"  peak memory so far: {peak_memory_mb():,.0f} MB\n")
+            store.close()
+            del dataset
+            gc.collect()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,265 @@
+"""Commands that ask the store: ``query`` (the query library), ``sparql`` (any SPARQL), ``runs``."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import re
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import click
+from pyoxigraph import BlankNode, NamedNode
+
+from exsce_dsl.cli.common import reports_errors, write_text
+from exsce_dsl.cli.store_commands import store_option
+from exsce_dsl.errors import ExsceError
+from exsce_dsl.store.base import Rows, Term
+
+FORMATS = ("table", "json", "csv")
+_XSD_STRING = "http://www.w3.org/2001/XMLSchema#string"
+_PREFIX_DECLARATION = re.compile(r"^\s*PREFIX\s+([A-Za-z][\w.-]*)?:", re.IGNORECASE | re.MULTILINE)
+_KIND_AFTER_PROLOGUE = re.compile(
+    r"^(?:\s|#[^\n]*\n|(?:PREFIX|BASE)\s[^\n]*\n)*\s*(SELECT|ASK|CONSTRUCT|DESCRIBE)\b", re.IGNORECASE
+)
+
+
+def format_option(func: Any) -> Any:
+    return click.option(
+        "-f",
+        "--format",
+        "fmt",
+        type=click.Choice(FORMATS),
+        default="table",
+        show_default=True,
+        help="Aligned columns, SPARQL 1.1 results JSON, or SPARQL 1.1 results CSV.",
+    )(func)
+
+
+def output_option(func: Any) -> Any:
+    return click.option(
+        "-o", "--output", type=click.Path(dir_okay=False, writable=True), help="Write here instead of stdout."
+    )(func)
+
+
+# -- writing answers -------------------------------------------------------------
+
+
+def results_json(rows: Rows) -> str:
+    """SPARQL 1.1 Query Results JSON."""
+
+    def term(t: Term) -> dict[str, str]:
+        if isinstance(t, NamedNode):
+            return {"type": "uri", "value": t.value}
+        if isinstance(t, BlankNode):
+            return {"type": "bnode", "value": t.value}
+        found = {"type": "literal", "value": t.value}
+        if t.language:
+            found["xml:lang"] = t.language
+        elif t.datatype.value != _XSD_STRING:
+            found["datatype"] = t.datatype.value
+        return found
+
+    bindings = [
+        {v: term(t) for v, t in zip(rows.variables, row, strict=True) if t is not None} for row in rows.rows
+    ]
+    answer = {"head": {"vars": list(rows.variables)}, "results": {"bindings": bindings}}
+    return json.dumps(answer, indent=2) + "\n"
+
+
+def results_csv(rows: Rows) -> str:
+    """SPARQL 1.1 Query Results CSV: lexical forms, CRLF line ends."""
+    out = io.StringIO()
+    writer = csv.writer(out, lineterminator="\r\n")
+    writer.writerow(rows.variables)
+    for row in rows.rows:
+        writer.writerow([_csv_text(t) for t in row])
+    return out.getvalue()
+
+
+def _csv_text(t: Term | None) -> str:
+    if t is None:
+        return ""
+    return f"_:{t.value}" if isinstance(t, BlankNode) else t.value
+
+
+def results_table(rows: Rows, prefixes: Mapping[str, str]) -> str:
+    """Aligned columns, IRIs shortened with the library's prefixes, literals as their text."""
+    namespaces = sorted(((iri, p) for p, iri in prefixes.items()), key=lambda item: -len(item[0]))
+
+    def show(t: Term | None) -> str:
+        if t is None:
+            return ""
+        if isinstance(t, NamedNode):
+            for iri, prefix in namespaces:
+                if t.value.startswith(iri) and len(t.value) > len(iri):
+                    return f"{prefix}:{t.value[len(iri) :]}"
+            return f"<{t.value}>"
+        if isinstance(t, BlankNode):
+            return f"_:{t.value}"
+        return t.value
+
+    cells = [list(rows.variables)] + [[show(t) for t in row] for row in rows.rows]
+    if not rows.variables:
+        return ""
+    widths = [max(len(line[i]) for line in cells) for i in range(len(rows.variables))]
+    lines = ["  ".join(c.ljust(w) for c, w in zip(line, widths, strict=True)).rstrip() for line in cells]
+    lines.insert(1, "  ".join("-" * w for w in widths))
+    return "\n".join(lines) + "\n"
+
+
+def render(rows: Rows, fmt: str) -> str:
+    from exsce_dsl.store.queries import standard_prefixes
+
+    if fmt == "json":
+        return results_json(rows)
+    if fmt == "csv":
+        return results_csv(rows)
+    return results_table(rows, standard_prefixes())
+
+
+def _parameters(pairs: Sequence[str]) -> dict[str, list[str]]:
+    given: dict[str, list[str]] = {}
+    for pair in pairs:
+        name, sep, value = pair.partition("=")
+        if not sep or not name:
+            raise click.UsageError(f"a parameter is NAME=VALUE, not {pair!r}")
+        given.setdefault(name.strip(), []).append(value)
+    return given
+
+
+# -- commands ---------------------------------------------------------------------
+
+
+@click.command(name="query")
+@click.argument("name", required=False)
+@click.option(
+    "-p", "--param", "params", multiple=True, metavar="NAME=VALUE", help="A parameter; repeat for lists."
+)
+@click.option("--list", "list_queries", is_flag=True, help="List the queries with what each answers.")
+@format_option
+@output_option
+@store_option
+@reports_errors
+def query_command(
+    name: str | None,
+    params: tuple[str, ...],
+    list_queries: bool,
+    fmt: str,
+    output: str | None,
+    store_url: str | None,
+) -> None:
+    """Run a query of the library by NAME, its parameters given with -p.
+
+    Parameters are bound as RDF terms, never pasted into the query.  A
+    parameter that takes a list (runs) is given once per value.
+
+    \b
+    Examples:
+      exscec query --list
+      exscec query runs -p scenario=scenario_c
+      exscec query segment_metric_of_scenario -p scenario=scenario_c -p metric=distance_travelled \\
+          -p start=classroom_c025-w001-R0.00_P0.00_Y0.00 -p goal=classroom_c022-w001-R0.00_P0.00_Y2.269
+      exscec query mission_metric_stats -p metric=mission_duration -p run=UUID1 -p run=UUID2 -f json
+    """
+    from exsce_dsl.store.queries import query, query_names, run_query
+
+    if list_queries:
+        lines = []
+        for known in query_names():
+            q = query(known)
+            lines.append(f"{known}{' (update)' if q.is_update else ''}: {q.description}")
+            for p in q.parameters:
+                mark = (" (one or more)" if p.many else "") + (" (optional)" if p.optional else "")
+                lines.append(f"    -p {p.name}=<{p.kind}>{mark}  {p.description}")
+        write_text("\n".join(lines) + "\n", output)
+        return
+    if name is None:
+        raise click.UsageError("name a query (exscec query --list shows them)")
+    from exsce_dsl.store.open import open_store
+
+    library_query = query(name)
+    given = _parameters(params)
+    library_query.bindings(given)  # check the parameters before opening the store
+    with open_store(store_url) as store:
+        rows = run_query(store, name, given)
+    if library_query.is_update:
+        click.echo(f"{name}: done", err=True)
+        return
+    write_text(render(rows, fmt), output)
+
+
+@click.command(name="sparql")
+@click.argument("text", metavar="QUERY")
+@format_option
+@output_option
+@store_option
+@reports_errors
+def sparql_command(text: str, fmt: str, output: str | None, store_url: str | None) -> None:
+    """Run a SPARQL SELECT or ASK QUERY (or @FILE to read it from a file).
+
+    The library's prefixes (exsce:, run:, pose:, prov:, xsd:...) are declared
+    for you unless the query declares them itself.  Every PROV bundle is a
+    named graph: match with GRAPH ?g { ... }.
+
+    \b
+    Examples:
+      exscec sparql 'SELECT ?run WHERE { GRAPH ?g { ?r a exsce:run ; exsce:run ?run } }'
+      exscec sparql @my-query.rq -f csv
+    """
+    from exsce_dsl.store.open import open_store
+    from exsce_dsl.store.queries import standard_prefixes
+
+    if text.startswith("@"):
+        path = Path(text[1:])
+        try:
+            text = path.read_text(encoding="utf-8")
+        except OSError as exc:
+            raise ExsceError(f"cannot read the query from {path}: {exc.strerror or exc}") from None
+    declared = {m.group(1) or "" for m in _PREFIX_DECLARATION.finditer(text)}
+    prologue = "".join(
+        f"PREFIX {p}: <{iri}>\n" for p, iri in standard_prefixes().items() if p not in declared
+    )
+    kind = _KIND_AFTER_PROLOGUE.match(text)
+    verb = kind.group(1).upper() if kind else ""
+    if verb not in ("SELECT", "ASK"):
+        raise ExsceError("exscec sparql runs SELECT and ASK queries")
+    with open_store(store_url) as store:
+        if verb == "ASK":
+            answer = store.ask(prologue + text)
+            if fmt == "json":
+                write_text(json.dumps({"head": {}, "boolean": answer}) + "\n", output)
+            else:
+                write_text(("true" if answer else "false") + "\n", output)
+            return
+        rows = store.select(prologue + text)
+    write_text(render(rows, fmt), output)
+
+
+@click.command(name="runs")
+@click.argument("scenario", required=False)
+@format_option
+@output_option
+@store_option
+@reports_errors
+def runs_command(scenario: str | None, fmt: str, output: str | None, store_url: str | None) -> None:
+    """List the runs of SCENARIO (of every scenario without one), oldest first.
+
+    \b
+    Example:
+      exscec runs scenario_c
+    """
+    from exsce_dsl.store.open import open_store
+    from exsce_dsl.store.queries import run_query
+
+    given = {} if scenario is None else {"scenario": scenario}
+    with open_store(store_url) as store:
+        rows = run_query(store, "runs", given)
+    write_text(render(rows, fmt), output)
+    if fmt == "table":
+        click.echo(f"{len(rows)} run{'s' if len(rows) != 1 else ''}", err=True)
+
+
+COMMANDS = [query_command, sparql_command, runs_command]

@@ -1,0 +1,126 @@
+"""Commands on runs: simulate (bags from the kinematic executor) and ingest (bags into the store)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import click
+
+from exsce_dsl.cli.common import reports_errors
+
+
+@click.command()
+@click.argument("spec", type=click.Path(dir_okay=False))
+@click.option("--runs", "-n", default=1, show_default=True, type=click.IntRange(1), help="How many runs.")
+@click.option(
+    "-o",
+    "--output",
+    "out_dir",
+    type=click.Path(file_okay=False),
+    default="runs",
+    show_default=True,
+    help="Folder for the bags.",
+)
+@click.option(
+    "--format",
+    "fmt",
+    type=click.Choice(["ros1", "ros2", "mcap"]),
+    default="ros1",
+    show_default=True,
+    help="ROS 1 .bag, ROS 2 sqlite3 or MCAP.",
+)
+@click.option("--seed", default=0, show_default=True, type=int, help="Same seed, same bytes.")
+@click.option(
+    "--fault",
+    "faults",
+    multiple=True,
+    metavar="KIND[:ROBOT[:N]]",
+    help="overspeed:R, slow:R, skip-waypoint:R[:N], near-collision (repeatable).",
+)
+@click.option("--scenario", "scenario_id", help="Which scenario, when the file declares several.")
+@reports_errors
+def simulate(
+    spec: str, runs: int, out_dir: str, fmt: str, seed: int, faults: tuple[str, ...], scenario_id: str | None
+) -> None:
+    """Play a scenario with the kinematic executor and write one bag per run.
+
+    Robots plan around the occupied cells of the environment's map, drive
+    with bounded speed and acceleration and seeded noise, and the bag holds
+    robot_pose, scan, nav_vel, distance_travelled and the waypoint
+    dispatcher's feedback and result per robot namespace.
+
+    \b
+    Example:
+      exscec simulate examples/brsu_building_c/scenario_c.exsce --runs 3 -o runs/
+      exscec simulate examples/brsu_building_c/scenario_c.exsce --fault overspeed:tiago1
+    """
+    from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.sim.executor import Fault
+    from exsce_dsl.sim.run import simulate as play
+
+    scenario = load_spec(spec).scenario(scenario_id)
+    parsed = tuple(Fault.parse(f) for f in faults)
+    with click.progressbar(length=runs, label=f"simulating {scenario.id}", file=sys.stderr) as bar:
+        for run in play(scenario, Path(out_dir), runs, fmt, seed, parsed):
+            bar.update(1)
+            click.echo(
+                f"\nwrote {run.bag} ({run.messages} messages, {run.execution.duration:.1f} s)", err=True
+            )
+
+
+@click.command()
+@click.argument("bags", nargs=-1, required=True, type=click.Path())
+@click.option(
+    "--scenario",
+    "spec",
+    required=True,
+    type=click.Path(dir_okay=False),
+    help="The .exsce file of the scenario the bags are runs of.",
+)
+@click.option("--scenario-id", help="Which scenario, when the file declares several.")
+@click.option(
+    "--jobs", "-j", default=1, show_default=True, type=click.IntRange(1), help="Bags analysed in parallel."
+)
+@click.option("--store", "store_url", envvar="EXSCE_STORE", help="Store URL (default: .exsce/store).")
+@reports_errors
+def ingest(
+    bags: tuple[str, ...], spec: str, scenario_id: str | None, jobs: int, store_url: str | None
+) -> None:
+    """Compute the metrics of bags and add each run's provenance to the store.
+
+    Each bag is one transaction: a bag that cannot be used is reported and
+    nothing of it is written, and the other bags still ingest.  A bag already
+    ingested (same content) is skipped.  Exits 1 if any bag failed.
+
+    \b
+    Example:
+      exscec ingest runs/*.bag --scenario examples/brsu_building_c/scenario_c.exsce
+    """
+    from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.runs.ingest import IngestResult, ingest_bags
+    from exsce_dsl.store.open import open_store
+
+    scenario = load_spec(spec).scenario(scenario_id)
+    paths = [Path(b) for b in bags]
+    with (
+        open_store(store_url) as store,
+        click.progressbar(length=len(paths), label="ingesting", file=sys.stderr) as bar,
+    ):
+
+        def shown(result: IngestResult) -> None:
+            bar.update(1)
+            click.echo(f"\n{'error: ' if result.failed else ''}{result.message}", err=True)
+            for problem in result.problems:
+                click.echo(f"warning: {result.bag}: {problem}", err=True)
+
+        results = ingest_bags(paths, scenario, store, jobs, shown)
+    done = sum(r.status == "ingested" for r in results)
+    skipped = sum(r.status == "skipped" for r in results)
+    failed = sum(r.failed for r in results)
+    click.echo(f"{done} ingested, {skipped} skipped, {failed} failed", err=True)
+    if failed:
+        sys.exit(1)
+
+
+COMMANDS = [simulate, ingest]

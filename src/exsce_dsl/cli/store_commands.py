@@ -1,0 +1,273 @@
+"""Commands on the store: ``store info|graphs|export|clear`` and ``serve``."""
+
+from __future__ import annotations
+
+import ipaddress
+import secrets
+from collections.abc import Callable
+from typing import Any, TypeVar
+
+import click
+
+from exsce_dsl.cli.common import reports_errors, write_text
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+STORE_HELP = (
+    "The store: a folder (embedded Oxigraph), memory:, or a SPARQL endpoint's URL "
+    "(http(s)://..., or oxigraph+, fuseki+, graphdb+, virtuoso+, neptune+http(s)://...). "
+    "Default: $EXSCE_STORE, else .exsce/store."
+)
+
+
+def store_option(func: F) -> F:
+    """``--store URL``, passed to the command as ``store_url`` (None: the default store)."""
+    return click.option("--store", "store_url", metavar="URL", help=STORE_HELP)(func)
+
+
+def add_to_store(document: Any, store_url: str | None, replace: bool) -> None:
+    """Add a compiled PROV document to the store and say what changed (on stderr)."""
+    from exsce_dsl.store.open import open_store
+    from exsce_dsl.store.writing import add_prov
+
+    with open_store(store_url) as store:
+        report = add_prov(store, document, replace=replace)
+    click.echo(report.summary(), err=True)
+
+
+@click.group(name="store")
+def store_group() -> None:
+    """Look at and manage the provenance store.
+
+    Each PROV bundle is a named graph.  The default store is the embedded
+    Oxigraph store of the current folder (.exsce/store); --store or
+    EXSCE_STORE point at another folder or at a SPARQL 1.1 endpoint
+    (docs/stores.md).
+
+    \b
+    Example:
+      exscec store graphs
+      exscec store export -f trig -o everything.trig
+    """
+
+
+@store_group.command(name="info")
+@store_option
+@reports_errors
+def info(store_url: str | None) -> None:
+    """Say what the store is and how much it holds.
+
+    \b
+    Example:
+      exscec store info --store oxigraph+http://127.0.0.1:7878
+    """
+    from exsce_dsl.store.embedded import EmbeddedStore
+    from exsce_dsl.store.open import open_store
+    from exsce_dsl.store.remote import RemoteStore
+    from exsce_dsl.store.writing import is_revision
+
+    with open_store(store_url) as store:
+        sizes = store.graph_sizes()
+        if isinstance(store, EmbeddedStore):
+            if store.path is None:
+                kind = "embedded Oxigraph, in memory"
+            elif store.path.exists():
+                kind = "embedded Oxigraph"
+            else:
+                kind = "embedded Oxigraph, not created yet (made on the first write)"
+        elif isinstance(store, RemoteStore) and store.served_by is not None:
+            server = f"exscec serve (pid {store.served_by}) at {store.url}"
+            kind = f"embedded Oxigraph, held by {server}, read through it"
+        else:
+            kind = "SPARQL 1.1 endpoint"
+        revisions = sum(1 for name in sizes if is_revision(name))
+        click.echo(f"store:      {store.location} ({kind})")
+        click.echo(f"graphs:     {len(sizes) - revisions} (+ {revisions} revisions)")
+        click.echo(f"statements: {sum(sizes.values())}")
+
+
+@store_group.command(name="graphs")
+@store_option
+@reports_errors
+def graphs(store_url: str | None) -> None:
+    """List the named graphs with their number of statements.
+
+    \b
+    Example:
+      exscec store graphs
+    """
+    from exsce_dsl.store.open import open_store
+
+    with open_store(store_url) as store:
+        sizes = store.graph_sizes()
+    width = max((len(str(n)) for n in sizes.values()), default=1)
+    for name in sorted(sizes):
+        click.echo(f"{sizes[name]:>{width}}  {name}")
+    click.echo(
+        f"{len(sizes)} graph{'s' if len(sizes) != 1 else ''}, {sum(sizes.values())} statements", err=True
+    )
+
+
+@store_group.command(name="export")
+@store_option
+@click.option(
+    "-f",
+    "--format",
+    "fmt",
+    type=click.Choice(["trig", "nq"]),
+    default="trig",
+    show_default=True,
+    help="TriG or N-Quads (both keep the named graphs).",
+)
+@click.option(
+    "-o", "--output", type=click.Path(dir_okay=False, writable=True), help="Write here, not to stdout."
+)
+@reports_errors
+def export(store_url: str | None, fmt: str, output: str | None) -> None:
+    """Write every named graph of the store as TriG or N-Quads.
+
+    \b
+    Example:
+      exscec store export -f nq -o store.nq
+    """
+    from exsce_dsl.store.open import open_store
+
+    with open_store(store_url) as store:
+        data = store.export(fmt)
+    write_text(data.decode("utf-8"), output)
+
+
+@store_group.command(name="clear")
+@store_option
+@click.confirmation_option("--yes", prompt="Remove every graph from the store?", help="Do not ask.")
+@reports_errors
+def clear(store_url: str | None) -> None:
+    """Remove everything from the store, in one transaction.
+
+    \b
+    Example:
+      exscec store clear --yes
+    """
+    from exsce_dsl.store.open import open_store
+
+    with open_store(store_url) as store:
+        count = len(store.graph_names())
+        store.clear()
+    click.echo(f"{store.location}: removed {count} graph{'s' if count != 1 else ''}", err=True)
+
+
+@click.command()
+@store_option
+@click.option(
+    "--bind",
+    default="127.0.0.1:7878",
+    show_default=True,
+    metavar="HOST:PORT",
+    help="Where to listen (port 0: any free port).",
+)
+@click.option("--allow-updates", is_flag=True, help="Accept SPARQL updates (with the bearer token).")
+@click.option(
+    "--token",
+    envvar="EXSCE_STORE_TOKEN",
+    metavar="TOKEN",
+    help="The bearer token updates need (default: $EXSCE_STORE_TOKEN, else a new one, printed once).",
+)
+@click.option("--union-default-graph", is_flag=True, help="Queries without GRAPH see every named graph.")
+@click.option("--log", "log_requests", is_flag=True, help="Print each request on stderr.")
+@reports_errors
+def serve(
+    store_url: str | None,
+    bind: str,
+    allow_updates: bool,
+    token: str | None,
+    union_default_graph: bool,
+    log_requests: bool,
+) -> None:
+    """Serve the store as a SPARQL 1.1 Protocol endpoint, read-only unless told.
+
+    Queries: GET or POST /query (results as JSON, XML, CSV or TSV; graphs as
+    Turtle or N-Triples), and a query page at /.  With --allow-updates, POST
+    /update takes SPARQL updates that carry `Authorization: Bearer TOKEN`.
+    While it runs, the server holds the store; other exscec commands on the
+    same store go through it (writes only with --allow-updates and
+    EXSCE_STORE_TOKEN set to the token).
+
+    \b
+    Example:
+      exscec serve --bind 127.0.0.1:7878
+      curl 'http://127.0.0.1:7878/query?query=ASK%7B%7D'
+    """
+    from exsce_dsl.store.embedded import EmbeddedStore
+    from exsce_dsl.store.open import open_store
+    from exsce_dsl.store.remote import RemoteStore
+    from exsce_dsl.store.server import SparqlServer, make_server, run_server
+
+    host, port = _parse_bind(bind)
+    store = open_store(store_url)
+    if isinstance(store, RemoteStore):
+        if store.served_by is not None:
+            raise click.ClickException(
+                f"{store.location}: the store is served already (pid {store.served_by})"
+            )
+        raise click.UsageError(
+            f"{store.location} is a SPARQL endpoint already; exscec serve serves an embedded store"
+        )
+    assert isinstance(store, EmbeddedStore)
+    if not allow_updates:
+        token = None
+    elif not token:
+        token = secrets.token_urlsafe(24)
+        click.echo(
+            f"updates need this bearer token: {token}  (exscec commands: EXSCE_STORE_TOKEN={token})", err=True
+        )
+    if not _is_loopback(host):
+        click.echo(
+            f"warning: listening on {host}: other machines can reach this endpoint"
+            + (" and, with the token, change the store" if token else ""),
+            err=True,
+        )
+
+    def log(line: str) -> None:
+        click.echo(line, err=True)
+
+    server = make_server(
+        store,
+        host,
+        port,
+        token=token,
+        union_default_graph=union_default_graph,
+        log=log if log_requests else None,
+    )
+
+    def ready(server: SparqlServer) -> None:
+        click.echo(f"{server.url}/")
+        mode = "updates with a bearer token" if token else "read-only"
+        click.echo(f"serving {store.location} at {server.url}/ ({mode}); Ctrl-C to stop", err=True)
+
+    run_server(server, on_ready=ready)
+
+
+def _parse_bind(bind: str) -> tuple[str, int]:
+    host, sep, port_text = bind.rpartition(":")
+    if not sep:
+        host, port_text = "", bind
+    host = host.strip("[]") or "127.0.0.1"
+    try:
+        port = int(port_text)
+    except ValueError:
+        raise click.BadParameter(f"expected HOST:PORT, got {bind!r}", param_hint="--bind") from None
+    if not 0 <= port <= 65535:
+        raise click.BadParameter(f"port {port} is out of range", param_hint="--bind")
+    return host, port
+
+
+def _is_loopback(host: str) -> bool:
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False
+
+
+COMMANDS = [store_group, serve]

@@ -1,0 +1,170 @@
+"""Runs: one execution of a scenario, what each robot did, and the metrics of its bag.
+
+A run is what ingestion of a bag file fills in and what :func:`exsce_dsl.prov.run.compile_run`
+writes as PROV:
+
+* the robots' **task executions**, one per entry of the mission's allocation that a
+  robot started, numbered per robot from 1 as in the allocation
+  (``tiago1-task_01``), each made of **actions**: one waypoint goal each, started at the
+  robot's previous pose and ended at the goal pose;
+* **metric values** computed from the bag's topics, for the whole mission, for each
+  robot, and for each path segment (one action), so that segments can be queried and
+  recombined later;
+* **hotspots**: places where a safety metric's limit was violated.
+"""
+
+from __future__ import annotations
+
+import datetime
+import enum
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+from exsce_dsl.errors import ExsceError
+from exsce_dsl.model.geometry import Pose, Position
+
+
+class ActionStatus(enum.Enum):
+    """How a waypoint goal ended (the dispatcher's final goal status)."""
+
+    SUCCEEDED = "SUCCEEDED"
+    ABORTED = "ABORTED"
+
+
+class MetricScope(enum.Enum):
+    """What a metric value covers."""
+
+    MISSION = "mission"
+    """The whole run, all robots (``mission_duration``, ``distance_between_robots``)."""
+    ROBOT = "robot"
+    """One robot over the whole run (``task_duration``, ``waypoints_visited``...)."""
+    SEGMENT = "segment"
+    """One robot on one path segment: one action, from its start pose to its goal."""
+
+
+@dataclass(frozen=True)
+class ActionId:
+    """Which action: the robot, its task (1-based per robot), the subtask and waypoint (1-based)."""
+
+    robot: str
+    allocation: int
+    subtask: int
+    waypoint: int
+
+    def __post_init__(self) -> None:
+        if min(self.allocation, self.subtask, self.waypoint) < 1:
+            raise ExsceError(f"action numbers count from 1: {self}")
+
+
+@dataclass(frozen=True)
+class Action:
+    """One waypoint goal of a robot: from ``start_pose`` (where it was) to ``goal_pose``."""
+
+    id: ActionId
+    start_pose: Pose
+    goal_pose: Pose
+    status: ActionStatus = ActionStatus.SUCCEEDED
+    start: datetime.datetime | None = None
+    """When the goal became active."""
+    end: datetime.datetime | None = None
+    """When the goal reached its final status."""
+
+    @property
+    def robot(self) -> str:
+        return self.id.robot
+
+
+@dataclass(frozen=True)
+class TaskExecution:
+    """A robot executing the ``allocation``-th task the mission gives it (1-based)."""
+
+    robot: str
+    allocation: int
+    actions: tuple[Action, ...]
+
+    def __post_init__(self) -> None:
+        for action in self.actions:
+            if action.id.robot != self.robot or action.id.allocation != self.allocation:
+                raise ExsceError(
+                    f"action {action.id} is not part of task {self.allocation} of robot '{self.robot}'"
+                )
+
+
+@dataclass(frozen=True)
+class Bag:
+    """The bag file a run recorded: its file name, where it was, and the topics it holds."""
+
+    file_name: str
+    topics: tuple[str, ...] = ()
+    path: str | None = None
+
+
+@dataclass(frozen=True)
+class MetricValue:
+    """One value of a metric, computed from ``topics`` of the run's bag.
+
+    ``robot`` is ``None`` for mission values; a segment value names its ``action``
+    (and its robot is the action's).  ``safety_metric`` says which safety metric a
+    ``violation_duration`` is about (e.g. ``max_velocity``).
+    """
+
+    metric: str
+    scope: MetricScope
+    value: float
+    topics: tuple[str, ...] = ()
+    robot: str | None = None
+    action: ActionId | None = None
+    unit: str | None = None
+    safety_metric: str | None = None
+
+    def __post_init__(self) -> None:
+        scope = self.scope
+        if scope is MetricScope.SEGMENT:
+            if self.action is None:
+                raise ExsceError(f"the segment value of '{self.metric}' names no action")
+            if self.robot is None:
+                object.__setattr__(self, "robot", self.action.robot)
+            elif self.robot != self.action.robot:
+                raise ExsceError(
+                    f"the segment value of '{self.metric}' is for robot '{self.robot}' "
+                    f"but its action is robot '{self.action.robot}'s"
+                )
+        elif self.action is not None:
+            raise ExsceError(f"a {scope.value} value of '{self.metric}' cannot name an action")
+        if scope is MetricScope.ROBOT and self.robot is None:
+            raise ExsceError(f"the robot value of '{self.metric}' names no robot")
+        if scope is MetricScope.MISSION and self.robot is not None:
+            raise ExsceError(f"the mission value of '{self.metric}' cannot be for robot '{self.robot}'")
+
+
+@dataclass(frozen=True)
+class Hotspot:
+    """A place where the limit of a safety ``metric`` was violated: how often and how long."""
+
+    metric: str
+    position: Position
+    violations: int
+    duration: float
+    """Seconds of violation there."""
+    robot: str | None = None
+
+
+@dataclass(frozen=True)
+class Run:
+    """One execution of scenario ``scenario``, identified by its ``uuid``."""
+
+    uuid: str
+    scenario: str
+    start: datetime.datetime
+    end: datetime.datetime
+    bag: Bag
+    tasks: tuple[TaskExecution, ...] = ()
+    """In the order the robots started them."""
+    metrics: tuple[MetricValue, ...] = ()
+    hotspots: tuple[Hotspot, ...] = ()
+    parameters: str | None = None
+    """The file the run's ROS parameters were saved to, if any."""
+
+    def actions(self) -> Iterator[Action]:
+        for task in self.tasks:
+            yield from task.actions

@@ -1,0 +1,113 @@
+"""Compile the oracles of a scenario into W3C PROV, in the method's shape (report Listings 16, 17, 36).
+
+:func:`compile_oracles` writes one bundle, ``oracle:<scenario>_bundle``, with, for
+each metric (and robot) that has oracles:
+
+* the oracle activity ``<scenario>:[<robot>-]<metric>`` (``prov:type=exsce:oracle``,
+  ``oracle:metric``, ``oracle:robot`` for a robot's metric, ``exsce:scenario``);
+* ``used(oracle, topic:<topic>, [prov:role="topic"])`` for each topic the metric is
+  computed from (the topics declared as ``ros:Topics`` entities);
+* one usage of the scenario whose runs it compares against, per oracle type:
+  ``used(<scenario>:<oracle>-baseline; oracle, exsce:<base>, [oracle:relationship,
+  oracle:type, oracle:value, oracle:limit, oracle:delta, oracle:tolerance,
+  oracle:package])`` (``-metamorphic`` for a metamorphic one).
+
+Where exsce differs from the method, on purpose:
+
+* the oracles have a bundle of their own, not the scenario's: the scenario bundle
+  is compiled from the specification and may be replaced in the store without
+  losing the baselines learnt from runs;
+* the activity says which scenario it judges (``exsce:scenario``), where the
+  method's queries matched the oracle's identifier against the scenario id as text;
+* a mission oracle has no ``oracle:robot`` (the method wrote the string ``"None"``);
+* the usages of the base scenario have identifiers (one baseline and one
+  metamorphic usage per oracle), so that a baseline can be updated in place;
+* every number is an ``xsd:double`` (the method wrote ``xsd:float`` and, for
+  ``waypoints_visited``, an integer).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from prov.constants import PROV_ROLE, PROV_TYPE
+from prov.identifier import QualifiedName
+from prov.model import ProvDocument
+
+from exsce_dsl.errors import ExsceError
+from exsce_dsl.model.oracles import Oracle
+from exsce_dsl.prov import identifiers as ids
+from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, Namespaces
+from exsce_dsl.prov.records import Attributes, DocumentWriter
+
+__all__ = ["compile_oracles"]
+
+
+def compile_oracles(
+    scenario_id: str,
+    oracles: Sequence[Oracle],
+    namespace: str = DEFAULT_NAMESPACE,
+    *,
+    checked: bool = False,
+) -> ProvDocument:
+    """The PROV document of the oracles that judge runs of scenario ``scenario_id``."""
+    if not oracles:
+        raise ExsceError(f"scenario '{scenario_id}' has no oracles to write")
+    names = Namespaces(namespace)
+    writer = DocumentWriter(names, checked)
+    for prefix in (ids.EXSCE, ids.ORACLE, ids.ROS, ids.TOPIC):
+        writer.document_namespace(prefix)
+    ids.check_name(scenario_id, "scenario id")
+    bundle_ns = writer.document_namespace(ids.ORACLE)
+    w = writer.bundle(bundle_ns[ids.bundle_name(scenario_id)], f"the oracles of '{scenario_id}'")
+    t = w.term
+    parts = w.of_element(scenario_id, names.of_scenario(scenario_id), "scenario")
+    exsce, topic_ns = w.fixed(ids.EXSCE), w.fixed(ids.TOPIC)
+
+    groups: dict[tuple[str, str | None], list[Oracle]] = {}
+    for oracle in oracles:
+        groups.setdefault((oracle.metric, oracle.robot), []).append(oracle)
+
+    topic_type = {PROV_TYPE: t(ids.ROS_TOPICS)}
+    declared: set[QualifiedName] = set()
+    topic_role = {PROV_ROLE: ids.TOPIC_ROLE}
+    for (metric, robot), group in groups.items():
+        name = ids.oracle_name(metric, robot)
+        activity = parts[name]
+        writer.claim(activity, f"the oracle of '{metric}'" + (f" of robot '{robot}'" if robot else ""))
+        facts: Attributes = {
+            PROV_TYPE: t(ids.ORACLE_TYPE_VALUE),
+            t(ids.ORACLE_METRIC): metric,
+            t(ids.SCENARIO_ATTR): scenario_id,
+        }
+        if robot is not None:
+            facts[t(ids.ORACLE_ROBOT)] = robot
+        w.activity(activity, facts)
+        topics = dict.fromkeys(topic for oracle in group for topic in oracle.topics)
+        for topic in topics:
+            topic_id = topic_ns[ids.topic_name(topic)]
+            if topic_id not in declared:
+                declared.add(topic_id)
+                w.entity(topic_id, topic_type)
+            w.used(activity, topic_id, topic_role)
+        for oracle in group:
+            usage = parts[f"{name}-{oracle.type.value}"]
+            whose = f" of '{robot}'" if robot else ""
+            writer.claim(usage, f"the {oracle.type.value} oracle of '{metric}'{whose}")
+            relation: Attributes = {
+                t(ids.ORACLE_RELATIONSHIP): oracle.relation,
+                t(ids.ORACLE_KIND): oracle.type.value,
+            }
+            for term, value in (
+                (ids.ORACLE_VALUE, oracle.value),
+                (ids.ORACLE_LIMIT, oracle.limit),
+                (ids.ORACLE_DELTA, oracle.delta),
+                (ids.ORACLE_TOLERANCE, oracle.tolerance),
+            ):
+                if value is not None:
+                    relation[t(term)] = float(value)
+            if oracle.package is not None:
+                relation[t(ids.ORACLE_PACKAGE)] = oracle.package
+            base = exsce[ids.check_name(oracle.base_scenario, "base scenario id")]
+            w.used(activity, base, relation, identifier=usage)
+    return writer.document

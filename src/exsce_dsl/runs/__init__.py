@@ -1,0 +1,1 @@
+"""Runs: bag files in, metrics and run provenance out."""

@@ -1,0 +1,328 @@
+"""The method's metrics, computed as array work over a run's topics.
+
+Every metric is computed for the whole run (mission or robot) and, where it
+makes sense, for each path segment.  A metric whose topic is missing from the
+bag is *missing* (no value, and a problem is reported), never 0.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from exsce_dsl.model.geometry import Position
+from exsce_dsl.model.runs import ActionId, Hotspot, MetricScope, MetricValue
+from exsce_dsl.runs.bagdata import BagData, Series
+from exsce_dsl.runs.segments import Segment
+
+HOTSPOT_RADIUS = 1.0  # metres: violations closer than this to a hotspot belong to it
+
+
+@dataclass(frozen=True)
+class SafetyLimits:
+    """The method's baseline safety limits (an oracle may set others)."""
+
+    max_velocity: float = 1.0
+    distance_to_obstacles: float = 0.1
+    distance_between_robots: float = 0.1
+
+
+def robot_topics(ns: str) -> dict[str, str]:
+    ns = ns.strip("/")
+    return {
+        "pose": f"/{ns}/robot_pose",
+        "scan": f"/{ns}/scan",
+        "vel": f"/{ns}/nav_vel",
+        "distance": f"/{ns}/distance_travelled",
+        "feedback": f"/{ns}/waypoint_dispatcher/feedback",
+        "result": f"/{ns}/waypoint_dispatcher/result",
+    }
+
+
+def _window(series: Series, start: float, end: float) -> slice:
+    return slice(int(np.searchsorted(series.t, start, "left")), int(np.searchsorted(series.t, end, "right")))
+
+
+def _durations(t: np.ndarray) -> np.ndarray:
+    """How long each sample holds: until the next one (the last holds one median period)."""
+    if len(t) < 2:
+        return np.zeros(len(t))
+    gaps = np.diff(t)
+    period = float(np.median(gaps))
+    held: np.ndarray = np.minimum(np.append(gaps, period), 2 * period)
+    return held
+
+
+@dataclass
+class RobotSignals:
+    """A robot's decoded topics, as the metrics need them."""
+
+    robot: str
+    topics: dict[str, str]
+    pose: Series | None
+    scan: Series | None
+    vel: Series | None
+    distance: Series | None
+
+    @classmethod
+    def from_bag(cls, robot: str, ns: str, bag: BagData) -> RobotSignals:
+        topics = robot_topics(ns)
+        return cls(
+            robot,
+            topics,
+            bag.series.get(topics["pose"]),
+            bag.series.get(topics["scan"]),
+            bag.series.get(topics["vel"]),
+            bag.series.get(topics["distance"]),
+        )
+
+    def speed(self) -> np.ndarray:
+        assert self.vel is not None
+        speed: np.ndarray = np.hypot(self.vel.fields["lx"], self.vel.fields["ly"])
+        return speed
+
+    def nearest_obstacle(self) -> np.ndarray:
+        """Per scan, the smallest valid range (NaN when no beam is valid)."""
+        assert self.scan is not None
+        ranges = self.scan.fields["ranges"].astype(np.float64)
+        low = self.scan.fields["range_min"][:, None]
+        high = self.scan.fields["range_max"][:, None]
+        valid = np.isfinite(ranges) & (ranges >= low) & (ranges <= high)
+        masked = np.where(valid, ranges, np.inf)
+        nearest = masked.min(axis=1)
+        result: np.ndarray = np.where(np.isfinite(nearest), nearest, np.nan)
+        return result
+
+    def travelled_between(self, start: float, end: float) -> tuple[float, str] | None:
+        """Metres between two instants: from the cumulative topic, else integrated poses."""
+        if self.distance is not None and len(self.distance):
+            d = self.distance
+            values = np.interp([start, end], d.t, d.fields["data"])
+            return float(values[1] - values[0]), self.topics["distance"]
+        if self.pose is not None and len(self.pose) > 1:
+            w = _window(self.pose, start, end)
+            x, y = self.pose.fields["x"][w], self.pose.fields["y"][w]
+            return float(np.hypot(np.diff(x), np.diff(y)).sum()), self.topics["pose"]
+        return None
+
+    def position_at(self, times: np.ndarray) -> np.ndarray:
+        assert self.pose is not None
+        return np.column_stack(
+            [
+                np.interp(times, self.pose.t, self.pose.fields["x"]),
+                np.interp(times, self.pose.t, self.pose.fields["y"]),
+            ]
+        )
+
+
+def compute_metrics(
+    signals: Sequence[RobotSignals],
+    actions: Sequence[Segment],
+    results: dict[str, int | None],
+    limits: SafetyLimits,
+    problems: list[str],
+) -> tuple[list[MetricValue], list[Hotspot]]:
+    """Every metric of DESIGN §1 for a run. ``results``: robot → waypoints SUCCEEDED (None: no topic)."""
+    values: list[MetricValue] = []
+    hotspots: list[Hotspot] = []
+    # (segment, became active, reached its final status) of every action that ended
+    done = [(a, a.start, a.end) for a in actions if a.start is not None and a.end is not None]
+    mission_start = min((s for _, s, _ in done), default=0.0)
+    mission_end = max((e for _, _, e in done), default=0.0)
+    if done:
+        values.append(
+            MetricValue(
+                "mission_duration",
+                MetricScope.MISSION,
+                mission_end - mission_start,
+                tuple(s.topics["feedback"] for s in signals),
+                unit="s",
+            )
+        )
+    for sig in signals:
+        mine = [(a, s, e) for a, s, e in done if a.robot == sig.robot]
+        feedback = (sig.topics["feedback"],)
+        if not mine:
+            problems.append(f"robot '{sig.robot}' started no waypoint goal: its metrics are missing")
+            continue
+        start, end = min(s for _, s, _ in mine), max(e for _, _, e in mine)
+        values.append(
+            MetricValue("task_duration", MetricScope.ROBOT, end - start, feedback, sig.robot, unit="s")
+        )
+        visited = results.get(sig.robot)
+        if visited is None:
+            problems.append(
+                f"topic {sig.topics['result']} is missing: waypoints_visited of '{sig.robot}' is missing"
+            )
+        else:
+            values.append(
+                MetricValue(
+                    "waypoints_visited", MetricScope.ROBOT, float(visited), (sig.topics["result"],), sig.robot
+                )
+            )
+        windows: list[tuple[Segment | None, float, float]] = [(None, start, end), *mine]
+        for action, a_start, a_end in windows:
+            aid = (
+                None
+                if action is None
+                else ActionId(sig.robot, action.allocation, action.subtask, action.waypoint)
+            )
+            scope = MetricScope.ROBOT if action is None else MetricScope.SEGMENT
+            robot = sig.robot if action is None else None
+            if action is not None:
+                values.append(MetricValue("task_duration", scope, a_end - a_start, feedback, robot, aid, "s"))
+            travelled = sig.travelled_between(a_start, a_end)
+            if travelled is not None:
+                values.append(
+                    MetricValue("distance_travelled", scope, travelled[0], (travelled[1],), robot, aid, "m")
+                )
+            if sig.scan is not None and len(sig.scan):
+                w = _window(sig.scan, a_start, a_end)
+                nearest = sig.nearest_obstacle()[w]
+                if np.isfinite(nearest).any():
+                    values.append(
+                        MetricValue(
+                            "distance_to_obstacles",
+                            scope,
+                            float(np.nanmin(nearest)),
+                            (sig.topics["scan"],),
+                            robot,
+                            aid,
+                            "m",
+                        )
+                    )
+            if sig.vel is not None and len(sig.vel):
+                w = _window(sig.vel, a_start, a_end)
+                speed = sig.speed()[w]
+                if len(speed):
+                    values.append(
+                        MetricValue(
+                            "max_velocity", scope, float(speed.max()), (sig.topics["vel"],), robot, aid, "m/s"
+                        )
+                    )
+        for name, topic, times, hold, over in _safety_signals(sig, limits, start, end):
+            values.append(
+                MetricValue(
+                    "violation_duration",
+                    MetricScope.ROBOT,
+                    float(hold[over].sum()),
+                    (topic,),
+                    sig.robot,
+                    unit="s",
+                    safety_metric=name,
+                )
+            )
+            if over.any() and sig.pose is not None:
+                where = sig.position_at(times[over])
+                hotspots.extend(
+                    Hotspot(name, Position(float(c[0]), float(c[1])), n, d, sig.robot)
+                    for c, n, d in _cluster(where, hold[over])
+                )
+        for key in ("pose", "scan", "vel", "distance"):
+            if getattr(sig, key) is None and key != "distance":
+                problems.append(
+                    f"topic {sig.topics[key]} is missing: the metrics it feeds are missing for '{sig.robot}'"
+                )
+    if done:
+        values.extend(_between_robots(signals, mission_start, mission_end, limits, hotspots, problems))
+    return values, hotspots
+
+
+SafetySignal = tuple[str, str, np.ndarray, np.ndarray, np.ndarray]
+"""(safety metric, topic, sample times, sample durations, violating samples)."""
+
+
+def _safety_signals(sig: RobotSignals, limits: SafetyLimits, start: float, end: float) -> list[SafetySignal]:
+    found: list[SafetySignal] = []
+    if sig.vel is not None and len(sig.vel):
+        w = _window(sig.vel, start, end)
+        t = sig.vel.t[w]
+        found.append(
+            ("max_velocity", sig.topics["vel"], t, _durations(t), sig.speed()[w] > limits.max_velocity)
+        )
+    if sig.scan is not None and len(sig.scan):
+        w = _window(sig.scan, start, end)
+        t = sig.scan.t[w]
+        nearest = np.nan_to_num(sig.nearest_obstacle()[w], nan=np.inf)
+        found.append(
+            (
+                "distance_to_obstacles",
+                sig.topics["scan"],
+                t,
+                _durations(t),
+                nearest < limits.distance_to_obstacles,
+            )
+        )
+    return found
+
+
+def _cluster(points: np.ndarray, durations: np.ndarray) -> list[tuple[np.ndarray, int, float]]:
+    """Greedy spatial clustering: a point joins the first centre within HOTSPOT_RADIUS."""
+    centres: list[list[float]] = []
+    members: list[list[int]] = []
+    for i, p in enumerate(points):
+        for k, c in enumerate(centres):
+            if np.hypot(p[0] - c[0], p[1] - c[1]) <= HOTSPOT_RADIUS:
+                members[k].append(i)
+                c[:] = points[members[k]].mean(axis=0)
+                break
+        else:
+            centres.append([float(p[0]), float(p[1])])
+            members.append([i])
+    return [(np.asarray(c), len(m), float(durations[m].sum())) for c, m in zip(centres, members, strict=True)]
+
+
+def _between_robots(
+    signals: Sequence[RobotSignals],
+    start: float,
+    end: float,
+    limits: SafetyLimits,
+    hotspots: list[Hotspot],
+    problems: list[str],
+) -> list[MetricValue]:
+    """Minimum pairwise distance, the second robot's poses interpolated at the first one's times."""
+    posed = [s for s in signals if s.pose is not None and len(s.pose) > 1]
+    if len(posed) < 2:
+        if len(signals) >= 2:
+            problems.append("robot_pose of fewer than two robots: distance_between_robots is missing")
+        return []
+    nearest = np.inf
+    violation = 0.0
+    topics: list[str] = []
+    for i, a in enumerate(posed):
+        for b in posed[i + 1 :]:
+            assert a.pose is not None and b.pose is not None
+            w = _window(a.pose, max(start, b.pose.t[0]), min(end, b.pose.t[-1]))
+            t = a.pose.t[w]
+            if len(t) == 0:
+                continue
+            pa = np.column_stack([a.pose.fields["x"][w], a.pose.fields["y"][w]])
+            pb = b.position_at(t)
+            gap = np.hypot(*(pa - pb).T)
+            nearest = min(nearest, float(gap.min()))
+            over = gap < limits.distance_between_robots
+            hold = _durations(t)
+            violation += float(hold[over].sum())
+            topics += [a.topics["pose"], b.topics["pose"]]
+            if over.any():
+                mid = (pa[over] + pb[over]) / 2
+                hotspots.extend(
+                    Hotspot("distance_between_robots", Position(float(c[0]), float(c[1])), n, d)
+                    for c, n, d in _cluster(mid, hold[over])
+                )
+    if not np.isfinite(nearest):
+        return []
+    unique = tuple(dict.fromkeys(topics))
+    return [
+        MetricValue("distance_between_robots", MetricScope.MISSION, nearest, unique, unit="m"),
+        MetricValue(
+            "violation_duration",
+            MetricScope.MISSION,
+            violation,
+            unique,
+            unit="s",
+            safety_metric="distance_between_robots",
+        ),
+    ]

@@ -1,0 +1,119 @@
+"""Path segments from the waypoint dispatcher's goal statuses.
+
+Each robot's dispatcher runs one goal per subtask, with one status per
+waypoint that moves PENDING → ACTIVE → SUCCEEDED/ABORTED.  An action (a path
+segment) is one waypoint from the update where it became ACTIVE to the one
+where it reached a final status; it starts at the robot's previous pose.
+Goals are matched, in order, to the subtasks the mission allocates to the
+robot: a bag whose waypoint ids differ is from another scenario.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from exsce_dsl.errors import ExsceError
+from exsce_dsl.model import Pose, Scenario
+from exsce_dsl.runs.bagdata import StatusUpdate
+
+ACTIVE, SUCCEEDED = 1, 3
+FINAL = {2: "PREEMPTED", 3: "SUCCEEDED", 4: "ABORTED", 5: "REJECTED", 8: "RECALLED", 9: "LOST"}
+
+
+class SegmentError(ExsceError):
+    """The dispatcher's statuses do not fit the scenario."""
+
+
+@dataclass(frozen=True)
+class Segment:
+    robot: str
+    allocation: int  # the robot's n-th task, from 1
+    task: str
+    subtask: int
+    waypoint: int
+    start_pose: Pose
+    goal: Pose
+    start: float | None  # became ACTIVE (seconds since the epoch); None if never
+    end: float | None  # reached a final status
+    status: str  # SUCCEEDED, ABORTED, ... or NOT_STARTED
+
+
+def segments(scenario: Scenario, robot: str, updates: list[StatusUpdate]) -> list[Segment]:
+    """The actions of ``robot`` in a run, from its dispatcher feedback ``updates`` (time order)."""
+    plan = _planned_goals(scenario, robot)
+    goals = _split_goals(updates)
+    if len(goals) > len(plan):
+        raise SegmentError(
+            f"robot '{robot}' ran {len(goals)} dispatcher goals but scenario '{scenario.id}' "
+            f"gives it {len(plan)} subtasks: the bag is from another scenario"
+        )
+    out: list[Segment] = []
+    robot_decl = scenario.robot(robot)
+    previous = robot_decl.start_pose if robot_decl is not None else None
+    for index, (allocation, task, subtask, poses) in enumerate(plan):
+        history = goals[index] if index < len(goals) else []
+        ids = tuple(p.id for p in poses)
+        if history and history[0].waypoints != ids:
+            raise SegmentError(
+                f"robot '{robot}': goal {index + 1} has waypoints {', '.join(history[0].waypoints)}, "
+                f"but task '{task}' subtask {subtask} visits {', '.join(ids)}: "
+                "the bag is from another scenario"
+            )
+        for w, goal in enumerate(poses):
+            start = next((u.t for u in history if u.statuses[w] == ACTIVE), None)
+            final = next(((u.t, u.statuses[w]) for u in history if u.statuses[w] in FINAL), None)
+            status = FINAL[final[1]] if final else ("ACTIVE" if start is not None else "NOT_STARTED")
+            assert previous is not None  # the checks ensure robots with tasks have a start pose
+            out.append(
+                Segment(
+                    robot,
+                    allocation,
+                    task,
+                    subtask,
+                    w + 1,
+                    previous,
+                    goal,
+                    start,
+                    final[0] if final else None,
+                    status,
+                )
+            )
+            if status == "SUCCEEDED":
+                previous = goal
+    return out
+
+
+def _planned_goals(scenario: Scenario, robot: str) -> list[tuple[int, str, int, tuple[Pose, ...]]]:
+    plan = []
+    allocation = 0
+    for entry in scenario.mission.allocation:
+        if entry.robot != robot:
+            continue
+        allocation += 1
+        task = scenario.task(entry.task)
+        assert task is not None
+        for s, subtask in enumerate(task.subtasks, start=1):
+            plan.append((allocation, task.id, s, subtask.waypoints))
+    return plan
+
+
+def _split_goals(updates: list[StatusUpdate]) -> list[list[StatusUpdate]]:
+    """Group updates by goal: a new goal starts when the goal id or the waypoint list changes."""
+    goals: list[list[StatusUpdate]] = []
+    for update in updates:
+        current = goals[-1] if goals else None
+        same = (
+            current is not None
+            and current[-1].goal == update.goal
+            and current[-1].waypoints == update.waypoints
+        )
+        restarted = (
+            current is not None
+            and all(s == 0 for s in update.statuses)
+            and any(s != 0 for s in current[-1].statuses)
+        )
+        if same and not restarted:
+            current.append(update)  # type: ignore[union-attr]
+        else:
+            goals.append([update])
+    return goals

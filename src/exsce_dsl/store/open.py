@@ -1,0 +1,165 @@
+"""Open a store from a store URL (what ``--store`` and ``EXSCE_STORE`` hold).
+
+==========================================  =====================================================
+``--store``                                  the store
+==========================================  =====================================================
+(nothing)                                    ``$EXSCE_STORE``, else ``.exsce/store`` in the current
+                                             folder (embedded; the folder is made on the first write)
+``path/to/folder``, ``file:path``            an embedded store in that folder
+``memory:``                                  an embedded store in memory, empty, gone at exit
+``http(s)://host/path``                      a SPARQL 1.1 endpoint; queries go to that URL
+``...?update=URL&gsp=URL``                   ... with its update and Graph Store Protocol URLs
+                                             (``form=1``: URL-encoded requests; ``auth=digest``)
+``oxigraph+http://host:7878``                Oxigraph server (also ``exsce+`` for ``exscec serve``)
+``fuseki+http://host:3030/dataset``          Apache Jena Fuseki
+``graphdb+http://host:7200/repositories/r``  GraphDB
+``virtuoso+http://host:8890``                Virtuoso
+``neptune+https://cluster:8182``             Amazon Neptune
+==========================================  =====================================================
+
+Without ``update=``, a URL ending in ``/query`` updates at the sibling
+``/update`` (Oxigraph, Fuseki, ``exscec serve``) and any other URL updates at
+itself (``/sparql`` of Virtuoso, Neptune, ``exscec serve``).  Credentials:
+``EXSCE_STORE_TOKEN`` (a bearer token), or ``user:password@`` in the URL.
+
+An embedded store folder opens in one process at a time.  When it is held by
+a running ``exscec serve`` (its ``<folder>.serve.json`` names a live process),
+the store is reached through that server instead: queries always work;
+writes work when the server allows updates and ``EXSCE_STORE_TOKEN`` holds its
+token, and otherwise fail saying which server holds the store and what to do.
+"""
+
+from __future__ import annotations
+
+import os
+import urllib.parse
+from dataclasses import dataclass
+from pathlib import Path
+
+from exsce_dsl.store.base import Store, StoreError, StoreLockedError
+from exsce_dsl.store.embedded import EmbeddedStore
+from exsce_dsl.store.remote import RemoteStore
+
+__all__ = ["DEFAULT_STORE", "PRESETS", "STORE_ENV", "TOKEN_ENV", "Preset", "open_store", "store_url"]
+
+DEFAULT_STORE = Path(".exsce") / "store"
+"""The project's embedded store, relative to the current folder."""
+STORE_ENV = "EXSCE_STORE"
+TOKEN_ENV = "EXSCE_STORE_TOKEN"
+
+
+@dataclass(frozen=True)
+class Preset:
+    """Where an endpoint flavour puts its services, relative to the URL given."""
+
+    query: str
+    update: str
+    gsp: str | None = None
+    form: bool = False
+    strip: tuple[str, ...] = ()
+    """Endpoint suffixes to take off the URL given, to find the base."""
+
+
+PRESETS: dict[str, Preset] = {
+    "oxigraph": Preset("/query", "/update", "/store", strip=("/query", "/update", "/store")),
+    "exsce": Preset("/query", "/update", "/store", strip=("/query", "/update", "/sparql", "/store")),
+    "fuseki": Preset("/query", "/update", "/data", strip=("/query", "/sparql", "/update", "/data")),
+    "graphdb": Preset("", "/statements", "/rdf-graphs/service", strip=("/statements",)),
+    "virtuoso": Preset("/sparql", "/sparql", "/sparql-graph-crud", form=True, strip=("/sparql",)),
+    "neptune": Preset("/sparql", "/sparql", "/sparql/gsp/", form=True, strip=("/sparql",)),
+}
+
+
+def store_url(url: str | None = None) -> str:
+    """The store URL in force: ``url``, else ``$EXSCE_STORE``, else ``.exsce/store``."""
+    return url or os.environ.get(STORE_ENV) or str(DEFAULT_STORE)
+
+
+def open_store(url: str | None = None, *, token: str | None = None, timeout: float = 60.0) -> Store:
+    """The store ``url`` names (see the module's table); ``token`` defaults to ``$EXSCE_STORE_TOKEN``."""
+    spec = store_url(url).strip()
+    token = token or os.environ.get(TOKEN_ENV) or None
+    if spec == "memory:":
+        return EmbeddedStore(None)
+    scheme, sep, rest = spec.partition("://")
+    if sep and "+" in scheme:
+        flavour, _, protocol = scheme.partition("+")
+        preset = PRESETS.get(flavour.lower())
+        if preset is None:
+            known = ", ".join(f"{name}+http://..." for name in PRESETS)
+            raise StoreError(f"unknown kind of store '{flavour}' in {spec!r}; known: {known}")
+        return _preset_store(preset, f"{protocol}://{rest}", token, timeout)
+    if sep and scheme.lower() in ("http", "https"):
+        return _endpoint_store(spec, token, timeout)
+    if sep and scheme.lower() != "file":
+        raise StoreError(f"cannot open a store at {spec!r}: expected a folder, memory:, or an http(s):// URL")
+    if spec.startswith("file:"):
+        spec = urllib.parse.unquote(urllib.parse.urlsplit(spec).path)
+    return _embedded_store(Path(spec), token, timeout)
+
+
+def _endpoint_store(url: str, token: str | None, timeout: float) -> RemoteStore:
+    parts = urllib.parse.urlsplit(url)
+    params = urllib.parse.parse_qsl(parts.query, keep_blank_values=True)
+    own = {"update", "gsp", "store", "form", "auth"}
+    options = {name: value for name, value in params if name in own}
+    query_url = urllib.parse.urlunsplit(
+        parts._replace(query=urllib.parse.urlencode([(n, v) for n, v in params if n not in own]))
+    )
+    update_url = options.get("update")
+    if update_url is None:
+        path = parts.path.rstrip("/")
+        update_url = query_url
+        if path.endswith("/query"):
+            update_url = urllib.parse.urlunsplit(
+                parts._replace(path=path[: -len("query")] + "update", query="")
+            )
+    return RemoteStore(
+        query_url,
+        update_url=update_url,
+        gsp_url=options.get("gsp") or options.get("store"),
+        token=token,
+        timeout=timeout,
+        form=options.get("form", "0").lower() in ("1", "true", "yes"),
+        digest=options.get("auth", "").lower() == "digest",
+    )
+
+
+def _preset_store(preset: Preset, url: str, token: str | None, timeout: float) -> RemoteStore:
+    parts = urllib.parse.urlsplit(url)
+    base = parts.path.rstrip("/")
+    for suffix in preset.strip:
+        if base.endswith(suffix):
+            base = base[: -len(suffix)]
+            break
+
+    def at(path: str) -> str:
+        return urllib.parse.urlunsplit(parts._replace(path=base + path))
+
+    return RemoteStore(
+        at(preset.query),
+        update_url=at(preset.update),
+        gsp_url=at(preset.gsp) if preset.gsp is not None else None,
+        token=token,
+        timeout=timeout,
+        form=preset.form,
+    )
+
+
+def _embedded_store(path: Path, token: str | None, timeout: float) -> Store:
+    try:
+        return EmbeddedStore(path)
+    except StoreLockedError:
+        from exsce_dsl.store.server import read_serve_info
+
+        info = read_serve_info(path)
+        if info is None or not info.is_alive():
+            raise
+        mode = "updates allowed" if info.updates else "read-only"
+        label = f"the store {path} (held by exscec serve, pid {info.pid}, {mode}, at {info.url})"
+        store = RemoteStore(
+            info.query_url, update_url=info.update_url, token=token, timeout=timeout, label=label
+        )
+        store.location = str(path)
+        store.served_by = info.pid
+        return store

@@ -1,0 +1,191 @@
+"""The query library: SPARQL files shipped in this package, loaded by name.
+
+Each ``NAME.rq`` (a query) or ``NAME.ru`` (an update) starts with comment lines:
+the first says in one line what it answers (``exscec query --list`` shows it),
+and each parameter has a line of its own::
+
+    # The runs of a scenario, oldest first.
+    #
+    # ?scenario  scenario?  the scenario, by id (all runs without it)
+
+``kind`` says how a value given as text becomes an RDF term (:data:`KINDS`); a
+``+`` after it means the parameter takes one value or more (a ``VALUES`` list),
+a ``?`` that it may be left out, ``*`` both.  A parameter that may be left out
+is written so that the query is right either way.
+
+The files use the prefixes of :meth:`Query.prologue` without declaring them
+(``exsce:``, ``run:``, ``pose:``... of the project's base namespace, and
+``prov:``, ``xsd:``, ``rdf:``, ``rdfs:``), so one file serves any base
+namespace.  Parameters are bound by :func:`exsce_dsl.store.sparql.bind`, as
+``VALUES`` of RDF terms: never pasted into the text.
+
+Every ``GRAPH ?g`` block of a query that reads the current state leaves out
+revision graphs (``FILTER(!CONTAINS(STR(?g), "revision="))``; see
+:mod:`exsce_dsl.store.writing`).
+"""
+
+from __future__ import annotations
+
+import functools
+import re
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from importlib.resources import files
+
+from pyoxigraph import Literal, NamedNode
+
+from exsce_dsl.errors import ExsceError
+from exsce_dsl.lang.suggest import did_you_mean
+from exsce_dsl.prov import identifiers as ids
+from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, Namespaces
+from exsce_dsl.store.base import Bindings, Term
+
+__all__ = ["KINDS", "Parameter", "Query", "query", "query_names", "standard_prefixes"]
+
+_XSD_DOUBLE = NamedNode(ids.XSD_NAMESPACE + "double")
+
+
+def _iri(names: Namespaces, prefix: str, local: str, what: str) -> NamedNode:
+    try:
+        return NamedNode(names.fixed[prefix] + local)
+    except ValueError:
+        raise ExsceError(f"{what} '{local}' cannot be part of an IRI") from None
+
+
+def _double(names: Namespaces, text: str) -> Literal:
+    try:
+        number = float(text)
+    except ValueError:
+        raise ExsceError(f"'{text}' is not a number") from None
+    return Literal(repr(number), datatype=_XSD_DOUBLE)
+
+
+KINDS: Mapping[str, Callable[[Namespaces, str], Term]] = {
+    "scenario": lambda names, text: _iri(names, ids.EXSCE, text, "scenario id"),
+    "pose": lambda names, text: _iri(names, ids.POSE, text, "pose"),
+    "id": lambda names, text: Literal(text),
+    "run": lambda names, text: Literal(text),
+    "robot": lambda names, text: Literal(text),
+    "metric": lambda names, text: Literal(text),
+    "string": lambda names, text: Literal(text),
+    "double": _double,
+}
+"""How a parameter's text becomes a term: ``scenario`` → ``exsce:<id>``, ``pose`` →
+``pose:<pose name>`` (``classroom_c025-w001-R0.00_P0.00_Y0.00``), ``double`` → an
+``xsd:double``, and ``id``, ``run`` (a uuid), ``robot``, ``metric``, ``string`` → a
+plain literal."""
+
+
+@dataclass(frozen=True)
+class Parameter:
+    name: str
+    kind: str
+    many: bool = False
+    optional: bool = False
+    description: str = ""
+
+    def term(self, text: str, names: Namespaces) -> Term:
+        return KINDS[self.kind](names, text)
+
+
+@dataclass(frozen=True)
+class Query:
+    """One file of the library."""
+
+    name: str
+    description: str
+    text: str
+    """The SPARQL as written (comments included), without the prologue."""
+    parameters: tuple[Parameter, ...]
+    is_update: bool
+
+    def sparql(self, namespace: str = DEFAULT_NAMESPACE) -> str:
+        """The text to run: the prologue of prefixes, then the query."""
+        return prologue(namespace) + self.text
+
+    def parameter(self, name: str) -> Parameter:
+        for p in self.parameters:
+            if p.name == name:
+                return p
+        known = ", ".join(p.name for p in self.parameters) or "none"
+        raise ExsceError(f"query '{self.name}' has no parameter '{name}' (its parameters: {known})")
+
+    def bindings(self, given: Mapping[str, Sequence[str]], namespace: str = DEFAULT_NAMESPACE) -> Bindings:
+        """Terms for parameters given as text (name → values), checked against the declarations."""
+        names = Namespaces(namespace)
+        found: dict[str, Term | Sequence[Term]] = {}
+        for name, values in given.items():
+            parameter = self.parameter(name)
+            if not parameter.many and len(values) > 1:
+                raise ExsceError(f"parameter '{name}' of query '{self.name}' takes one value")
+            terms = [parameter.term(v, names) for v in values]
+            found[name] = terms if parameter.many else terms[0]
+        missing = [p.name for p in self.parameters if not p.optional and p.name not in given]
+        if missing:
+            raise ExsceError(f"query '{self.name}' needs {', '.join(missing)} (give each with -p NAME=VALUE)")
+        return found
+
+
+_PARAMETER_LINE = re.compile(r"#\s*\?([A-Za-z_][A-Za-z0-9_]*)\s+([a-z]+)([+?*]?)\s*(.*)")
+
+
+def _parse(name: str, text: str, is_update: bool) -> Query:
+    description = ""
+    parameters = []
+    for line in text.splitlines():
+        stripped = line.strip()
+        if not stripped:
+            continue
+        if not stripped.startswith("#"):
+            break
+        match = _PARAMETER_LINE.fullmatch(stripped)
+        if match:
+            pname, kind, mark, about = match.groups()
+            if kind not in KINDS:
+                raise ExsceError(f"query '{name}': parameter ?{pname} has an unknown kind '{kind}'")
+            parameters.append(Parameter(pname, kind, mark in ("+", "*"), mark in ("?", "*"), about))
+        elif not description and stripped.lstrip("#").strip():
+            description = stripped.lstrip("#").strip()
+    return Query(name, description, text, tuple(parameters), is_update)
+
+
+@functools.lru_cache(maxsize=1)
+def _library() -> dict[str, Query]:
+    found = {}
+    for entry in files("exsce_dsl.store.queries").iterdir():
+        filename = entry.name
+        for suffix, is_update in ((".rq", False), (".ru", True)):
+            if filename.endswith(suffix):
+                name = filename[: -len(suffix)]
+                found[name] = _parse(name, entry.read_text(encoding="utf-8"), is_update)
+    return dict(sorted(found.items()))
+
+
+def query_names() -> tuple[str, ...]:
+    """The names of the library's queries and updates, sorted."""
+    return tuple(_library())
+
+
+def query(name: str) -> Query:
+    """The query called ``name`` (an ExsceError naming the known ones otherwise)."""
+    found = _library().get(name)
+    if found is None:
+        hint = did_you_mean(name, _library())
+        raise ExsceError(f"no query called '{name}'{hint} (`exscec query --list` shows them all)")
+    return found
+
+
+def standard_prefixes(namespace: str = DEFAULT_NAMESPACE) -> dict[str, str]:
+    """The prefixes every library query may use: exsce's namespaces, PROV, XSD, RDF, RDFS."""
+    return {
+        "prov": ids.PROV_NAMESPACE,
+        "xsd": ids.XSD_NAMESPACE,
+        "rdf": "http://www.w3.org/1999/02/22-rdf-syntax-ns#",
+        "rdfs": "http://www.w3.org/2000/01/rdf-schema#",
+        **Namespaces(namespace).fixed,
+    }
+
+
+@functools.lru_cache(maxsize=8)
+def prologue(namespace: str = DEFAULT_NAMESPACE) -> str:
+    return "".join(f"PREFIX {p}: <{iri}>\n" for p, iri in standard_prefixes(namespace).items())

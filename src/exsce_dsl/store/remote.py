@@ -1,0 +1,270 @@
+"""A store on any SPARQL 1.1 endpoint, over HTTP (standard library only).
+
+* Queries: SPARQL 1.1 Protocol, ``POST`` with ``application/sparql-query``
+  (or URL-encoded ``query=``, for endpoints that want a form), answers read as
+  SPARQL JSON results into pyoxigraph terms.
+* Updates: ``POST`` with ``application/sparql-update`` (or ``update=``).  A
+  :meth:`RemoteStore.write` is *one* update request (``DROP SILENT GRAPH`` for
+  each replaced graph, then one ``INSERT DATA`` with a ``GRAPH`` block per
+  graph), so it is all or nothing wherever the endpoint runs a request in one
+  transaction (Oxigraph, Fuseki, GraphDB, Neptune; see ``docs/stores.md`` for
+  Virtuoso).  Writes are never split: a write bigger than the endpoint accepts
+  fails, whole, with the endpoint's message.
+* Reading one graph: the Graph Store Protocol (``GET ?graph=``) when a GSP URL
+  is known, else a ``CONSTRUCT``.
+
+Authentication: a bearer token (``token``; ``exscec serve`` and
+token-protected gateways), or a user and password (HTTP Basic, sent with
+every request, or HTTP Digest).
+"""
+
+from __future__ import annotations
+
+import base64
+import socket
+import urllib.error
+import urllib.parse
+import urllib.request
+from collections.abc import Sequence
+from typing import Any
+
+from pyoxigraph import (
+    BlankNode,
+    NamedNode,
+    Quad,
+    QueryBoolean,
+    QueryResultsFormat,
+    QuerySolutions,
+    RdfFormat,
+    parse,
+    parse_query_results,
+)
+
+from exsce_dsl import __version__
+from exsce_dsl.store.base import Bindings, GraphSet, Replace, Rows, Store, StoreError
+from exsce_dsl.store.sparql import bind, graph_node, term_text, write_update
+
+RESULTS_JSON = "application/sparql-results+json"
+N_TRIPLES = "application/n-triples"
+
+
+class RemoteStore(Store):
+    """A SPARQL 1.1 endpoint: ``url`` answers queries, ``update_url`` (default: ``url``) updates.
+
+    ``gsp_url`` is the Graph Store Protocol service (``.../store`` for
+    Oxigraph, ``.../data`` for Fuseki), used to read whole graphs.  ``form``
+    sends queries and updates URL-encoded (Virtuoso, Neptune).  A ``user``
+    and ``password`` (or ``user:password@`` in the URL) go as HTTP Basic
+    credentials, or Digest with ``digest`` (Virtuoso's ``/sparql-auth``).  ``label``
+    names the store in error messages (default: the URL).
+    """
+
+    served_by: int | None = None
+    """The pid of the ``exscec serve`` that this store reaches a project's folder through, if so."""
+
+    def __init__(
+        self,
+        url: str,
+        *,
+        update_url: str | None = None,
+        gsp_url: str | None = None,
+        token: str | None = None,
+        user: str | None = None,
+        password: str | None = None,
+        timeout: float = 60.0,
+        form: bool = False,
+        digest: bool = False,
+        label: str | None = None,
+    ) -> None:
+        url, url_user, url_password = _split_credentials(url)
+        self.url = url
+        self.update_url = _split_credentials(update_url)[0] if update_url else url
+        self.gsp_url = _split_credentials(gsp_url)[0] if gsp_url else None
+        self.location = url
+        self.label = label or f"the SPARQL endpoint {url}"
+        self.timeout = timeout
+        self.form = form
+        self._headers = {"User-Agent": f"exsce/{__version__}"}
+        user = user if user is not None else url_user
+        password = password if password is not None else url_password
+        handlers: list[urllib.request.BaseHandler] = []
+        if token:
+            self._headers["Authorization"] = f"Bearer {token}"
+        elif user is not None and digest:
+            manager = urllib.request.HTTPPasswordMgrWithDefaultRealm()
+            for endpoint in (self.url, self.update_url, self.gsp_url):
+                if endpoint is not None:
+                    manager.add_password(None, endpoint, user, password or "")
+            handlers.append(urllib.request.HTTPDigestAuthHandler(manager))
+        elif user is not None:
+            credentials = f"{user}:{password or ''}".encode()
+            self._headers["Authorization"] = "Basic " + base64.b64encode(credentials).decode("ascii")
+        self._opener = urllib.request.build_opener(*handlers)
+
+    # -- HTTP ----------------------------------------------------------------
+
+    def _request(
+        self,
+        url: str,
+        *,
+        data: bytes | None = None,
+        content_type: str | None = None,
+        accept: str | None = None,
+        method: str | None = None,
+        missing_ok: bool = False,
+    ) -> tuple[bytes, str]:
+        """The body and Content-Type of the answer; a StoreError naming the URL on failure."""
+        headers = dict(self._headers)
+        if content_type:
+            headers["Content-Type"] = content_type
+        if accept:
+            headers["Accept"] = accept
+        request = urllib.request.Request(url, data=data, headers=headers, method=method)
+        shown = url.split("?", 1)[0]
+        try:
+            with self._opener.open(request, timeout=self.timeout) as answer:
+                return answer.read(), answer.headers.get("Content-Type", "")
+        except urllib.error.HTTPError as exc:
+            if missing_ok and exc.code == 404:
+                return b"", ""
+            raise StoreError(self._refusal(shown, exc)) from None
+        except urllib.error.URLError as exc:
+            raise StoreError(f"cannot reach {self.label} ({shown}): {_reason(exc.reason)}") from None
+        except TimeoutError:
+            raise StoreError(f"{self.label} ({shown}) did not answer within {self.timeout:g} s") from None
+        except OSError as exc:
+            raise StoreError(f"cannot talk to {self.label} ({shown}): {exc}") from None
+
+    def _refusal(self, url: str, exc: urllib.error.HTTPError) -> str:
+        try:
+            body = exc.read().decode("utf-8", "replace").strip()
+        except OSError:
+            body = ""
+        detail = " ".join(body.split())[:600]
+        base = urllib.parse.urlsplit(url)
+        where = "" if f"{base.scheme}://{base.netloc}" in self.label else f" ({url})"
+        message = f"{self.label}{where} answered {exc.code} {exc.reason}"
+        if detail:
+            message += f": {detail}"
+        if exc.code == 401 and "Authorization" not in self._headers:
+            message += (
+                "; the endpoint wants credentials: set EXSCE_STORE_TOKEN to its bearer token, "
+                "or put user:password@ in the store URL"
+            )
+        elif exc.code == 413:
+            message += "; the request is larger than the endpoint accepts (writes are never split)"
+        return message
+
+    def _post_sparql(self, url: str, kind: str, text: str, accept: str | None) -> tuple[bytes, str]:
+        if self.form:
+            data = urllib.parse.urlencode({kind: text}).encode("utf-8")
+            return self._request(
+                url, data=data, content_type="application/x-www-form-urlencoded", accept=accept
+            )
+        return self._request(
+            url, data=text.encode("utf-8"), content_type=f"application/sparql-{kind}", accept=accept
+        )
+
+    def _query(self, query: str, bindings: Bindings | None) -> QuerySolutions | QueryBoolean:
+        body, content_type = self._post_sparql(self.url, "query", bind(query, bindings), RESULTS_JSON)
+        try:
+            format_ = QueryResultsFormat.from_media_type(content_type.split(";")[0].strip() or RESULTS_JSON)
+            return parse_query_results(body, format=format_ or QueryResultsFormat.JSON)
+        except (SyntaxError, ValueError) as exc:
+            start = body[:200].decode("utf-8", "replace")
+            raise StoreError(
+                f"{self.label} did not answer with SPARQL results ({content_type or 'no Content-Type'}): "
+                f"{exc}; the answer began {start!r}"
+            ) from None
+
+    # -- Store ---------------------------------------------------------------
+
+    def select(self, query: str, bindings: Bindings | None = None) -> Rows:
+        result = self._query(query, bindings)
+        if not isinstance(result, QuerySolutions):
+            raise StoreError("not a SELECT query")
+        variables = tuple(v.value for v in result.variables)
+        return Rows(variables, tuple(tuple(solution[v] for v in variables) for solution in result))
+
+    def ask(self, query: str, bindings: Bindings | None = None) -> bool:
+        result = self._query(query, bindings)
+        if not isinstance(result, QueryBoolean):
+            raise StoreError("not an ASK query")
+        return bool(result)
+
+    def update(self, update: str, bindings: Bindings | None = None) -> None:
+        self._post_sparql(self.update_url, "update", bind(update, bindings), None)
+
+    def write(self, graphs: GraphSet, *, replace: Replace = False) -> None:
+        text = write_update(graphs, replace)
+        if text:
+            self._post_sparql(self.update_url, "update", text, None)
+
+    def remove_graphs(self, names: Sequence[str]) -> None:
+        if names:
+            self.update(" ;\n".join(f"DROP SILENT GRAPH {graph_node(name)}" for name in names))
+
+    def graph_names(self) -> set[str]:
+        rows = self.select("SELECT DISTINCT ?g WHERE { GRAPH ?g { ?s ?p ?o } }")
+        return {g.value for (g,) in rows.rows if isinstance(g, NamedNode)}
+
+    def graph(self, name: str) -> list[Quad]:
+        graph = graph_node(name)
+        if self.gsp_url is not None:
+            separator = "&" if "?" in self.gsp_url else "?"
+            url = f"{self.gsp_url}{separator}{urllib.parse.urlencode({'graph': name})}"
+            body, content_type = self._request(url, accept=N_TRIPLES, missing_ok=True)
+        else:
+            query = f"CONSTRUCT {{ ?s ?p ?o }} WHERE {{ GRAPH {term_text(graph)} {{ ?s ?p ?o }} }}"
+            body, content_type = self._post_sparql(
+                self.url, "query", query, f"{N_TRIPLES}, text/turtle;q=0.9"
+            )
+        if not body.strip():
+            return []
+        format_ = RdfFormat.from_media_type(content_type.split(";")[0].strip()) or RdfFormat.N_TRIPLES
+        try:
+            return [Quad(t.subject, t.predicate, t.object, graph) for t in parse(body, format=format_)]
+        except (SyntaxError, ValueError) as exc:
+            raise StoreError(
+                f"{self.label} sent graph <{name}> as unreadable {content_type}: {exc}"
+            ) from None
+
+    def graphs(self, names: Sequence[str]) -> dict[str, list[Quad]]:
+        found: dict[str, list[Quad]] = {name: [] for name in names}
+        if not names:
+            return found
+        values = " ".join(term_text(graph_node(name)) for name in names)
+        rows = self.select(f"SELECT ?g ?s ?p ?o WHERE {{ VALUES ?g {{ {values} }} GRAPH ?g {{ ?s ?p ?o }} }}")
+        for g, s, p, o in rows.rows:
+            if not (isinstance(g, NamedNode) and isinstance(p, NamedNode) and o is not None):
+                continue
+            if isinstance(s, (NamedNode, BlankNode)):
+                found.setdefault(g.value, []).append(Quad(s, p, o, g))
+        return found
+
+
+def _split_credentials(url: str) -> tuple[str, str | None, str | None]:
+    """The URL without ``user:password@``, and the user and password it held."""
+    parts = urllib.parse.urlsplit(url)
+    if parts.scheme not in ("http", "https") or not parts.netloc:
+        raise StoreError(f"not an http(s) URL of a SPARQL endpoint: {url!r}")
+    if parts.username is None:
+        return url, None, None
+    host = parts.hostname or ""
+    if ":" in host:
+        host = f"[{host}]"
+    netloc = f"{host}:{parts.port}" if parts.port else host
+    bare = urllib.parse.urlunsplit(parts._replace(netloc=netloc))
+    user = urllib.parse.unquote(parts.username)
+    password = urllib.parse.unquote(parts.password) if parts.password is not None else None
+    return bare, user, password
+
+
+def _reason(reason: Any) -> str:
+    if isinstance(reason, ConnectionRefusedError):
+        return "connection refused (is the server running, and on this host and port?)"
+    if isinstance(reason, socket.gaierror):
+        return f"unknown host ({reason})"
+    if isinstance(reason, (TimeoutError, socket.timeout)):
+        return "timed out"
+    return str(reason)

@@ -1,0 +1,125 @@
+"""Real SPARQL servers for the store tests: ``oxigraph serve`` and ``exscec serve``.
+
+Each runs as a child process on 127.0.0.1 at a free port, is waited for until
+it answers, and is stopped (SIGTERM, then SIGKILL) afterwards.
+"""
+
+from __future__ import annotations
+
+import os
+import select
+import signal
+import socket
+import subprocess
+import sys
+import time
+import urllib.error
+import urllib.request
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+BIN = Path(sys.executable).parent
+STARTUP_SECONDS = 20.0
+
+
+def free_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+def wait_until_answering(url: str, process: subprocess.Popen[str], timeout: float = STARTUP_SECONDS) -> None:
+    deadline = time.monotonic() + timeout
+    while True:
+        if process.poll() is not None:
+            raise RuntimeError(f"the server stopped with status {process.returncode}")
+        try:
+            with urllib.request.urlopen(url, timeout=2) as answer:
+                answer.read()
+                return
+        except urllib.error.HTTPError:
+            return  # it answers
+        except OSError:
+            if time.monotonic() > deadline:
+                raise RuntimeError(f"{url} did not answer within {timeout} s") from None
+            time.sleep(0.05)
+
+
+def stop(process: subprocess.Popen[str]) -> int:
+    if process.poll() is None:
+        process.send_signal(signal.SIGTERM)
+        try:
+            process.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait(timeout=10)
+    for stream in (process.stdout, process.stderr):
+        if stream is not None:
+            stream.close()
+    return process.returncode
+
+
+@dataclass
+class Server:
+    url: str
+    process: subprocess.Popen[str]
+
+
+@contextmanager
+def oxigraph_server(location: Path) -> Iterator[Server]:
+    """``oxigraph serve --location LOCATION --bind 127.0.0.1:PORT`` (three tries at a free port)."""
+    last: Exception | None = None
+    for _ in range(3):
+        port = free_port()
+        process = subprocess.Popen(
+            [str(BIN / "oxigraph"), "serve", "--location", str(location), "--bind", f"127.0.0.1:{port}"],
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        url = f"http://127.0.0.1:{port}"
+        try:
+            wait_until_answering(url + "/", process)
+        except RuntimeError as exc:
+            stop(process)
+            last = exc
+            continue
+        try:
+            yield Server(url, process)
+        finally:
+            stop(process)
+        return
+    raise RuntimeError(f"oxigraph serve did not start: {last}")
+
+
+def start_exscec_serve(*args: str, cwd: Path | None = None, env: dict[str, str] | None = None) -> Server:
+    """``exscec serve --bind 127.0.0.1:0 ARGS``, its URL read from the first line it prints."""
+    process = subprocess.Popen(
+        [str(BIN / "exscec"), "serve", "--bind", "127.0.0.1:0", *args],
+        cwd=cwd,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env={**os.environ, **(env or {})},
+    )
+    assert process.stdout is not None
+    ready, _, _ = select.select([process.stdout], [], [], STARTUP_SECONDS)
+    line = process.stdout.readline().strip() if ready else ""
+    if not line.startswith("http://"):
+        process.kill()
+        _, error = process.communicate(timeout=10)
+        raise RuntimeError(f"exscec serve did not start: {line!r} {error}")
+    url = line.rstrip("/")
+    wait_until_answering(url + "/", process)
+    return Server(url, process)
+
+
+@contextmanager
+def exscec_serve(*args: str, cwd: Path | None = None, env: dict[str, str] | None = None) -> Iterator[Server]:
+    server = start_exscec_serve(*args, cwd=cwd, env=env)
+    try:
+        yield server
+    finally:
+        stop(server.process)

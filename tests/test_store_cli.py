@@ -1,0 +1,88 @@
+"""The real ``exscec`` on stores: compile --store, store info|graphs|export|clear."""
+
+from __future__ import annotations
+
+import shutil
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from pyoxigraph import RdfFormat, parse
+
+from conftest import EXAMPLES, run_exscec
+from store_servers import Server, oxigraph_server
+
+SCENARIO_C = EXAMPLES / "brsu_building_c" / "scenario_c.exsce"
+
+
+@pytest.fixture(scope="module")
+def oxigraph(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
+    with oxigraph_server(tmp_path_factory.mktemp("oxigraph")) as server:
+        yield server
+
+
+def test_compile_adds_to_the_project_store_and_store_commands_show_it(in_tmp: Path) -> None:
+    added = run_exscec("compile", str(SCENARIO_C), "--store")
+    assert added.returncode == 0, added.stderr
+    assert added.stdout == ""  # no PROV printed unless -f or -o
+    assert added.stderr.strip() == ".exsce/store: added 14 graphs (377 statements written)"
+    again = run_exscec("compile", str(SCENARIO_C), "--store", "-f", "nq")
+    assert again.returncode == 0 and "no change" in again.stderr and again.stdout.count(" .\n") == 377
+
+    info = run_exscec("store", "info")
+    assert info.returncode == 0, info.stderr
+    assert info.stdout.splitlines() == [
+        "store:      .exsce/store (embedded Oxigraph)",
+        "graphs:     14 (+ 0 revisions)",
+        "statements: 377",
+    ]
+    graphs = run_exscec("store", "graphs")
+    assert "https://www.sesame-project.org/scenarios/scenario_c_bundle" in graphs.stdout
+    assert len(graphs.stdout.splitlines()) == 14 and "14 graphs, 377 statements" in graphs.stderr
+
+    exported = run_exscec("store", "export", "-f", "nq", "-o", "all.nq")
+    assert exported.returncode == 0, exported.stderr
+    quads = list(parse((in_tmp / "all.nq").read_bytes(), format=RdfFormat.N_QUADS))
+    assert len(quads) == 377 and len({q.graph_name for q in quads}) == 14
+    trig = run_exscec("store", "export")
+    assert len(list(parse(trig.stdout, format=RdfFormat.TRIG))) == 377
+
+    refused = run_exscec("store", "clear")  # asks; no answer on stdin
+    assert refused.returncode != 0
+    cleared = run_exscec("store", "clear", "--yes")
+    assert cleared.returncode == 0 and "removed 14 graphs" in cleared.stderr
+    assert run_exscec("store", "graphs").stdout == ""
+
+
+def test_compile_to_a_sparql_endpoint_refuses_a_changed_scenario_then_replaces_it(
+    in_tmp: Path, oxigraph: Server
+) -> None:
+    shutil.copytree(EXAMPLES / "brsu_building_c", in_tmp / "bc")
+    url = f"oxigraph+{oxigraph.url}"
+    assert run_exscec("compile", "bc/scenario_c.exsce", "--store", url).returncode == 0
+    spec = in_tmp / "bc" / "scenario_c.exsce"
+    spec.write_text(spec.read_text().replace("tiago2 does navigate_home_2", "tiago1 does navigate_home_2"))
+    refused = run_exscec("compile", "bc/scenario_c.exsce", "--store", url)
+    assert refused.returncode == 1
+    lines = refused.stderr.splitlines()
+    assert lines[0] == (
+        f"error: {oxigraph.url}/query already holds another version of scenario exsce:scenario_c: 1 graph differs"
+    )
+    assert lines[1].startswith("  exsce:scenario_c_bundle: mission:mission_c differs")
+    replaced = run_exscec("compile", "bc/scenario_c.exsce", "--store", url, "--replace")
+    assert replaced.returncode == 0, replaced.stderr
+    assert "replaced 1 graph" in replaced.stderr and "exsce:scenario_c_bundle?revision=1" in replaced.stderr
+    info = run_exscec("store", "info", "--store", url)
+    assert "graphs:     14 (+ 1 revisions)" in info.stdout and "SPARQL 1.1 endpoint" in info.stdout
+
+
+def test_an_unreachable_endpoint_is_named(in_tmp: Path) -> None:
+    from store_servers import free_port
+
+    url = f"http://127.0.0.1:{free_port()}/sparql"
+    result = run_exscec("store", "graphs", "--store", url)
+    assert result.returncode == 1
+    assert (
+        f"cannot reach the SPARQL endpoint {url}" in result.stderr and "connection refused" in result.stderr
+    )
+    assert "Traceback" not in result.stderr

@@ -1,0 +1,67 @@
+"""SPARQL text: where parameters go, and the one update that writes graphs."""
+
+from __future__ import annotations
+
+import pytest
+from pyoxigraph import BlankNode, Literal, NamedNode, Quad, Store
+
+from exsce_dsl.store.base import GraphSet, StoreError
+from exsce_dsl.store.sparql import bind, where_group, write_update
+
+
+@pytest.mark.parametrize(
+    ("query", "before"),
+    [
+        ("ASK { ?s ?p ?o }", "ASK {"),
+        ("SELECT * { ?s ?p ?o }", "SELECT * {"),
+        ("select * from <http://g> where { ?s ?p ?o }", "select * from <http://g> where {"),
+        ("SELECT * WHERE { { SELECT ?s WHERE { ?s ?p ?o } } }", "SELECT * WHERE {"),
+        ("CONSTRUCT { ?s ?p ?o } { ?s ?p ?o }", "CONSTRUCT { ?s ?p ?o } {"),
+        ("CONSTRUCT { ?s ?p ?o } WHERE { ?s ?p ?o }", "CONSTRUCT { ?s ?p ?o } WHERE {"),
+        ("DESCRIBE ?s WHERE { ?s ?p ?o }", "DESCRIBE ?s WHERE {"),
+        (
+            "DELETE { ?s ?p ?o } INSERT { ?s ?p 1 } WHERE { ?s ?p ?o }",
+            "DELETE { ?s ?p ?o } INSERT { ?s ?p 1 } WHERE {",
+        ),
+        (
+            "PREFIX ex: <http://x/WHERE#>\n# WHERE { in a comment\nSELECT (\"WHERE {\" AS ?w) ('}' AS ?z) ?where { ?where ex:WHERE ?o }",
+            "PREFIX ex: <http://x/WHERE#>\n# WHERE { in a comment\nSELECT (\"WHERE {\" AS ?w) ('}' AS ?z) ?where {",
+        ),
+        ('SELECT ("""a " } { """ AS ?x) WHERE { ?s ?p ?o }', 'SELECT ("""a " } { """ AS ?x) WHERE {'),
+    ],
+)
+def test_the_where_group_is_found_by_tokens(query: str, before: str) -> None:
+    at = where_group(query)
+    assert at is not None and query[: at + 1] == before
+
+
+def test_an_update_without_a_where_group_takes_no_parameters() -> None:
+    assert where_group("INSERT DATA { <http://a> <http://b> <http://c> }") is None
+    with pytest.raises(StoreError, match="WHERE"):
+        bind("INSERT DATA { <http://a> <http://b> ?o }", {"o": Literal("x")})
+
+
+def test_bound_queries_run_and_blank_nodes_are_refused() -> None:
+    store = Store()
+    text = bind(
+        "SELECT ?o # a comment with WHERE {\nWHERE { }", {"o": [Literal("}"), NamedNode("http://a#b")]}
+    )
+    assert [str(s["o"]) for s in store.query(text)] == ['"}"', "<http://a#b>"]  # type: ignore[union-attr]
+    with pytest.raises(StoreError, match="blank nodes"):
+        bind("ASK {}", {"o": BlankNode()})
+
+
+def test_one_update_drops_the_replaced_graphs_then_inserts_everything() -> None:
+    g1, g2 = NamedNode("http://example.org/g1"), NamedNode("http://example.org/g2")
+    s, p = NamedNode("http://example.org/s"), NamedNode("http://example.org/p")
+    graphs = GraphSet(
+        {g1.value: [Quad(s, p, Literal('a "b"\n}'), g1)], g2.value: [Quad(s, p, BlankNode("x"), g2)]}
+    )
+    text = write_update(graphs, {g1.value})
+    assert text.startswith("DROP SILENT GRAPH <http://example.org/g1> ;\nINSERT DATA {\n")
+    assert text.count("INSERT DATA") == 1 and "DROP SILENT GRAPH <http://example.org/g2>" not in text
+    store = Store()
+    store.update(text)
+    assert len(store) == 2
+    assert write_update(GraphSet({g1.value: []}), True) == "DROP SILENT GRAPH <http://example.org/g1>\n"
+    assert write_update(GraphSet({}), True) == ""
