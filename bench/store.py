@@ -93,6 +93,7 @@ MISSION_TOPICS = {
     "violation_duration": "robot_pose",
 }
 BATCH = 100
+XSD_STRING = "http://www.w3.org/2001/XMLSchema#string"
 """Runs compiled and written before the next ones are made (memory stays flat)."""
 
 
@@ -213,6 +214,8 @@ def rdflib_quads(document: ProvDocument) -> list[tuple[Node, Node, Node, URIRef]
         assert isinstance(t, OxLiteral)
         if t.language:
             return RdfLiteral(t.value, lang=t.language)
+        if t.datatype.value == XSD_STRING:
+            return RdfLiteral(t.value)  # as rdflib reads "..." in a query
         return RdfLiteral(t.value, datatype=URIRef(t.datatype.value))
 
     found = []

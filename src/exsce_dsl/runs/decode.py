@@ -100,14 +100,34 @@ def decode(
     lengths = np.fromiter((len(r) for r in raws), dtype=np.int64, count=len(raws))
     if np.all(lengths == shape.size):
         buffer = np.frombuffer(b"".join(raws), dtype=np.uint8).reshape(len(raws), shape.size)
-        out = {name: _column(buffer, offset, kind) for name, (offset, kind) in shape.fields.items()}
-        if shape.ranges is not None:
-            at, beams = shape.ranges
-            out["ranges"] = buffer[:, at : at + 4 * beams].copy().view("<f4").reshape(len(raws), beams)
-        return out
+        return decode_rows(shape, buffer)
     if fallback is None:
         raise DecodeError(f"{msgtype} messages of different sizes ({lengths.min()}–{lengths.max()} bytes)")
     return _decode_slowly(msgtype, raws, fallback)
+
+
+def decode_rows(shape: Layout, rows: np.ndarray) -> dict[str, np.ndarray]:
+    """Fields of messages given as the rows of a uint8 array (one message per row)."""
+    out = {name: _column(rows, offset, kind) for name, (offset, kind) in shape.fields.items()}
+    if shape.ranges is not None:
+        at, beams = shape.ranges
+        ranges = rows[:, at : at + 4 * beams].view("<f4")
+        out["nearest"] = nearest_valid(ranges, out["range_min"], out["range_max"])
+    return out
+
+
+def nearest_valid(ranges: np.ndarray, low: np.ndarray, high: np.ndarray) -> np.ndarray:
+    """Per scan, the smallest range within [range_min, range_max] (NaN and inf never are); NaN if none.
+
+    Scans are reduced to this at once: it is all the metrics need of them, and a
+    laser's ranges are most of a bag's bytes.
+    """
+    lo = low.astype(np.float32)[:, None]
+    hi = high.astype(np.float32)[:, None]
+    valid = (ranges >= lo) & (ranges <= hi)
+    nearest = np.where(valid, ranges, np.float32(np.inf)).min(axis=1).astype(np.float64)
+    result: np.ndarray = np.where(np.isfinite(nearest), nearest, np.nan)
+    return result
 
 
 def _column(buffer: np.ndarray, offset: int, kind: str) -> np.ndarray:
@@ -152,8 +172,6 @@ def _decode_slowly(
     ranges = np.full((len(msgs), width), np.nan, dtype=np.float32)
     for i, m in enumerate(msgs):  # scans of different sizes: pad with NaN (never a valid range)
         ranges[i, : len(m.ranges)] = m.ranges
-    return stamps | {
-        "range_min": np.array([m.range_min for m in msgs], dtype=np.float64),
-        "range_max": np.array([m.range_max for m in msgs], dtype=np.float64),
-        "ranges": ranges,
-    }
+    low = np.array([m.range_min for m in msgs], dtype=np.float64)
+    high = np.array([m.range_max for m in msgs], dtype=np.float64)
+    return stamps | {"range_min": low, "range_max": high, "nearest": nearest_valid(ranges, low, high)}

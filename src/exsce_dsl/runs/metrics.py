@@ -8,7 +8,7 @@ bag is *missing* (no value, and a problem is reported), never 0.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -65,6 +65,7 @@ class RobotSignals:
     scan: Series | None
     vel: Series | None
     distance: Series | None
+    _cache: dict[str, np.ndarray] = field(default_factory=dict, repr=False)
 
     @classmethod
     def from_bag(cls, robot: str, ns: str, bag: BagData) -> RobotSignals:
@@ -80,20 +81,15 @@ class RobotSignals:
 
     def speed(self) -> np.ndarray:
         assert self.vel is not None
-        speed: np.ndarray = np.hypot(self.vel.fields["lx"], self.vel.fields["ly"])
-        return speed
+        cached = self._cache.get("speed")
+        if cached is None:
+            cached = self._cache["speed"] = np.hypot(self.vel.fields["lx"], self.vel.fields["ly"])
+        return cached
 
     def nearest_obstacle(self) -> np.ndarray:
         """Per scan, the smallest valid range (NaN when no beam is valid)."""
         assert self.scan is not None
-        ranges = self.scan.fields["ranges"].astype(np.float64)
-        low = self.scan.fields["range_min"][:, None]
-        high = self.scan.fields["range_max"][:, None]
-        valid = np.isfinite(ranges) & (ranges >= low) & (ranges <= high)
-        masked = np.where(valid, ranges, np.inf)
-        nearest = masked.min(axis=1)
-        result: np.ndarray = np.where(np.isfinite(nearest), nearest, np.nan)
-        return result
+        return self.scan.fields["nearest"]
 
     def travelled_between(self, start: float, end: float) -> tuple[float, str] | None:
         """Metres between two instants: from the cumulative topic, else integrated poses."""
