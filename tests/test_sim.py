@@ -194,3 +194,16 @@ def test_a_scenario_without_a_map_runs_in_open_space(tmp_path: Path) -> None:
             rel=0.05,
         )
     assert all(a.status is GoalStatus.SUCCEEDED for a in execution.actions)
+
+
+def test_the_recorders_provenance_is_written_beside_the_bag(scenario_d, tmp_path: Path) -> None:
+    import prov.model as pm
+
+    [run] = simulate(scenario_d, tmp_path, runs=1, seed=2)
+    record = tmp_path / (run.bag.name.removesuffix(".bag") + ".prov.json")
+    document = pm.ProvDocument.deserialize(str(record))
+    text = document.get_provn()
+    assert f"activity(run:run_{run.run_id}," in text
+    # scenario_d: tiago1 does delivery_a (2 waypoints), delivery_b (2), navigate_home_1 (1)
+    assert text.count("prov:type='exsce:action'") == 5
+    assert "wasEndedBy(run_" in text and "pose:classroom_c025-w001-R0.00_P0.00_Y0.925" in text

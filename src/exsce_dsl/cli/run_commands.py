@@ -102,7 +102,9 @@ def ingest(
     from exsce_dsl.store.open import open_store
 
     scenario = load_spec(spec).scenario(scenario_id)
-    paths = [Path(b) for b in bags]
+    paths = [Path(b) for b in bags if not b.endswith(".prov.json")]  # the recorder's files beside bags
+    if not paths:
+        raise click.UsageError("no bag among the files given")
     with (
         open_store(store_url) as store,
         click.progressbar(length=len(paths), label="ingesting", file=sys.stderr) as bar,

@@ -15,8 +15,11 @@ import numpy as np
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.lang.occupancy import OccupancyGrid, load_occupancy_grid
 from exsce_dsl.model import Scenario
+from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Bag, Run, TaskExecution
+from exsce_dsl.prov import serialize_prov
+from exsce_dsl.prov.run import compile_run
 from exsce_dsl.sim.bag import write_bag
-from exsce_dsl.sim.executor import Execution, Fault, execute
+from exsce_dsl.sim.executor import Execution, Fault, GoalStatus, execute
 from exsce_dsl.sim.planner import PlanningGrid
 
 FORMATS = ("ros1", "ros2", "mcap")
@@ -64,7 +67,36 @@ def simulate(
             shutil.rmtree(bag) if bag.is_dir() else bag.unlink()
         start_ns = int(start.timestamp()) * 1_000_000_000
         count = write_bag(bag, fmt, scenario, execution, grid, start_ns, run_seed)
+        recorder = _recorded_run(run_id, scenario, execution, start, bag)
+        out_dir.joinpath(name + ".prov.json").write_text(
+            serialize_prov(compile_run(recorder, scenario), "json"), encoding="utf-8"
+        )
         yield SimulatedRun(run_id, bag, start, run_seed, execution, count)
+
+
+def _recorded_run(
+    run_id: str, scenario: Scenario, execution: Execution, start: dt.datetime, bag: Path
+) -> Run:
+    """What the method's recorder writes during a run: task executions and actions, no metrics."""
+
+    def at(seconds: float) -> dt.datetime:
+        return start + dt.timedelta(seconds=seconds)
+
+    grouped: dict[tuple[str, int], list[Action]] = {}
+    for a in execution.actions:
+        status = ActionStatus.SUCCEEDED if a.status == GoalStatus.SUCCEEDED else ActionStatus.ABORTED
+        grouped.setdefault((a.robot, a.task_number), []).append(
+            Action(
+                ActionId(a.robot, a.task_number, a.subtask_number, a.waypoint_number),
+                a.start_pose,
+                a.goal,
+                status,
+                at(a.start),
+                at(a.end),
+            )
+        )
+    tasks = tuple(TaskExecution(robot, n, tuple(acts)) for (robot, n), acts in grouped.items())
+    return Run(run_id, scenario.id, start, at(execution.duration), Bag(bag.name), tasks)
 
 
 def planning_grid(scenario: Scenario) -> PlanningGrid:
