@@ -298,3 +298,12 @@ def test_a_topic_of_an_unexpected_type_is_reported(scenario_c, runs_c, tmp_path:
 
 def test_statuses_in_the_bag_are_the_executors(runs_c) -> None:
     assert all(a.status is GoalStatus.SUCCEEDED for a in runs_c["ros1"].execution.actions)
+
+
+def test_bags_analysed_in_parallel_give_the_same_runs(scenario_c, runs_c, tmp_path: Path) -> None:
+    [other] = simulate(scenario_c, tmp_path, runs=1, seed=8)
+    bags = [runs_c["ros1"].bag, other.bag]
+    serial = ingest_bags(bags, scenario_c, EmbeddedStore())
+    parallel = ingest_bags(bags, scenario_c, EmbeddedStore(), jobs=2)
+    assert [r.status for r in parallel] == ["ingested", "ingested"]
+    assert [(r.run_id, r.statements) for r in parallel] == [(r.run_id, r.statements) for r in serial]
