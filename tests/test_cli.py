@@ -135,3 +135,19 @@ def test_textx_knows_the_language() -> None:
     assert "exsce (*.exsce)" in languages.stdout + languages.stderr
     checked = subprocess.run([str(textx), "check", str(SCENARIO_C)], capture_output=True, text=True)
     assert checked.returncode == 0 and "OK" in checked.stdout + checked.stderr
+
+
+def test_textx_generators_write_prov(in_tmp: Path) -> None:
+    import subprocess
+    import sys
+
+    folder = _copy_examples(in_tmp)
+    textx = Path(sys.executable).with_name("textx")
+    for target, name in (("provjson", "c.prov.json"), ("provn", "c.provn")):
+        done = subprocess.run(
+            [str(textx), "generate", str(folder / "scenario_c.exsce"), "--target", target, "-o", name],
+            capture_output=True, text=True,
+        )
+        assert done.returncode == 0, done.stderr
+    assert "exsce:scenario_c_bundle" in json.loads((in_tmp / "c.prov.json").read_text())["bundle"]
+    assert "bundle exsce:scenario_c_bundle" in (in_tmp / "c.provn").read_text()

@@ -72,53 +72,22 @@ def _generate(model: Any, output_path: str | None, overwrite: bool, fmt: str, su
         target.write_text(serialize(compile_scenario(scenario), fmt), encoding="utf-8")
 
 
-@generator("exsce", "provn")
-def provn_generator(
-    metamodel: Any,
-    model: Any,
-    output_path: str | None,
-    overwrite: bool,
-    debug: bool,
-    **custom_args: Any,
-) -> None:
-    "exsce scenario to PROV-N"
-    _generate(model, output_path, overwrite, "provn", ".provn")
+def _prov_generator(target: str, fmt: str, suffix: str, description: str) -> Any:
+    """A textX generator ``exsce -> target`` writing each scenario of the file as ``fmt``."""
+
+    def generate(
+        metamodel: Any, model: Any, output_path: str | None, overwrite: bool, debug: bool, **custom_args: Any
+    ) -> None:
+        _generate(model, output_path, overwrite, fmt, suffix)
+
+    generate.__doc__ = description
+    generate.__name__ = f"{target}_generator"
+    return generator("exsce", target)(generate)
 
 
-@generator("exsce", "provjson")
-def provjson_generator(
-    metamodel: Any,
-    model: Any,
-    output_path: str | None,
-    overwrite: bool,
-    debug: bool,
-    **custom_args: Any,
-) -> None:
-    "exsce scenario to PROV-JSON"
-    _generate(model, output_path, overwrite, "json", ".prov.json")
-
-
-@generator("exsce", "provxml")
-def provxml_generator(
-    metamodel: Any,
-    model: Any,
-    output_path: str | None,
-    overwrite: bool,
-    debug: bool,
-    **custom_args: Any,
-) -> None:
-    "exsce scenario to PROV-XML"
-    _generate(model, output_path, overwrite, "xml", ".prov.xml")
-
-
-@generator("exsce", "trig")
-def trig_generator(
-    metamodel: Any,
-    model: Any,
-    output_path: str | None,
-    overwrite: bool,
-    debug: bool,
-    **custom_args: Any,
-) -> None:
-    "exsce scenario to PROV-O (TriG, one named graph per bundle)"
-    _generate(model, output_path, overwrite, "trig", ".trig")
+provn_generator = _prov_generator("provn", "provn", ".provn", "exsce scenario to PROV-N")
+provjson_generator = _prov_generator("provjson", "json", ".prov.json", "exsce scenario to PROV-JSON")
+provxml_generator = _prov_generator("provxml", "xml", ".prov.xml", "exsce scenario to PROV-XML")
+trig_generator = _prov_generator(
+    "trig", "trig", ".trig", "exsce scenario to PROV-O (TriG, one named graph per bundle)"
+)
