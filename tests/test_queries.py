@@ -513,3 +513,15 @@ def test_a_sparql_endpoint_gives_the_same_answers(store: Store, tmp_path: Path) 
         q.update_baseline(remote, "s", "task_duration", "r1", 55.0, 6.0)
         changed = {o.metric: o for o in q.oracles(remote, "s")}["task_duration"]
         assert (changed.value, changed.tolerance) == (55.0, 6.0)
+
+
+def test_a_parameter_line_is_read_whole_and_an_unknown_kind_is_refused() -> None:
+    from exsce_dsl.store.queries.library import _parse
+
+    parsed = _parse("x", "# About x.\n#\n# ?metric  metric_property  the metric\n# ?run run+ runs\nSELECT * {}", False)
+    assert [(p.name, p.kind, p.many, p.description) for p in parsed.parameters] == [
+        ("metric", "metric_property", False, "the metric"),
+        ("run", "run", True, "runs"),
+    ]
+    with pytest.raises(ExsceError, match="unknown kind 'metrics'"):
+        _parse("x", "# ?metric metrics the metric\nSELECT * {}", False)

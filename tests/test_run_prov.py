@@ -341,6 +341,21 @@ def test_compiled_runs_conform_to_the_run_shapes(scenario_c: Scenario) -> None:
     assert validate(to_quads(compile_run(run_with_metrics(scenario_c), scenario_c)), ["runs"]) == []
 
 
+def test_a_run_with_its_segment_index_conforms_and_a_segment_without_poses_does_not(
+    scenario_c: Scenario,
+) -> None:
+    from exsce_dsl.store.writing import stored_graphs
+
+    graphs = stored_graphs(compile_run(run_with_metrics(scenario_c), scenario_c))
+    quads = [quad for graph in graphs.values() for quad in graph]
+    assert any(q.predicate.value.endswith("/startPose") for q in quads)
+    assert validate(quads, ["runs"]) == []
+    broken = [q for q in quads if not q.predicate.value.endswith("/startPose")]
+    assert {v.message for v in validate(broken, ["runs"])} == {
+        "a path segment starts at exactly one pose (exsce:startPose)"
+    }
+
+
 def test_the_run_shapes_catch_a_broken_metric(scenario_c: Scenario) -> None:
     quads = to_quads(compile_run(run_with_metrics(scenario_c), scenario_c))
     value = NamedNode(PROV + "value")

@@ -52,6 +52,8 @@ ROS = "ros"
 RUN = "run"
 TOPIC = "topic"
 HOTSPOT = "hotspot"
+SEGMENT = "segment"
+METRIC = "metric"
 
 STANDARD_PREFIXES = frozenset({"prov", "xsd", "xsi", "rdf", "rdfs", "owl", "xml"})
 """Prefix names that PROV and RDF tools bind themselves."""
@@ -59,7 +61,7 @@ STANDARD_PREFIXES = frozenset({"prov", "xsd", "xsi", "rdf", "rdfs", "owl", "xml"
 RESERVED_PREFIXES = frozenset(
     {EXSCE, MISSION, ENV, ROBOT, TASK, POSE, POINT, ORIENTATION, ORACLE}
     | {GEOM, COORD, ANGLE, ROS}
-    | {RUN, TOPIC, HOTSPOT}
+    | {RUN, TOPIC, HOTSPOT, SEGMENT, METRIC}
     | STANDARD_PREFIXES
 )
 """Prefix names no per-element namespace may take."""
@@ -158,6 +160,8 @@ class Namespaces:
             RUN: f"{base}runs/",
             TOPIC: f"{base}topics/",
             HOTSPOT: f"{base}hotspots/",
+            SEGMENT: f"{base}segments/",
+            METRIC: f"{base}metrics/",
         }
 
     def iri(self, term: Term) -> str:
@@ -301,6 +305,12 @@ ORACLE_DELTA = Term(ORACLE, "delta")
 ORACLE_TOLERANCE = Term(ORACLE, "tolerance")
 TRANSFORM_ATTR = Term(EXSCE, "transform")
 STEP = Term(EXSCE, "step")
+
+# The segment index (written by the store beside a run's bundles, see exsce_dsl.store.segment_index).
+PATH_SEGMENT = Term(EXSCE, "PathSegment")
+START_POSE = Term(EXSCE, "startPose")
+GOAL_POSE = Term(EXSCE, "goalPose")
+SEGMENT_OF = Term(EXSCE, "segmentOf")
 
 PARAMETER_SERVER = "parameter-server"
 """``<run>:parameter-server``, the saved parameters the run used."""

@@ -132,6 +132,16 @@ class Store(abc.ABC):
         """The quads of each of these named graphs (blank nodes consistent across them)."""
         return {name: self.graph(name) for name in names}
 
+    def existing_graphs(self, names: Sequence[str]) -> set[str]:
+        """Those of ``names`` that name a graph holding at least one quad (one query)."""
+        if not names:
+            return set()
+        from exsce_dsl.store.sparql import graph_node, term_text  # sparql builds on this module
+
+        values = " ".join(term_text(graph_node(name)) for name in dict.fromkeys(names))
+        rows = self.select(f"SELECT DISTINCT ?g WHERE {{ VALUES ?g {{ {values} }} GRAPH ?g {{ ?s ?p ?o }} }}")
+        return {g.value for (g,) in rows.rows if isinstance(g, NamedNode)}
+
     def graph_sizes(self) -> dict[str, int]:
         """Named graph → number of quads in it."""
         rows = self.select("SELECT ?g (COUNT(*) AS ?n) WHERE { GRAPH ?g { ?s ?p ?o } } GROUP BY ?g")

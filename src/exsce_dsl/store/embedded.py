@@ -159,6 +159,14 @@ class EmbeddedStore(Store):
     def graph(self, name: str) -> list[Quad]:
         return list(self._reader().quads_for_pattern(None, None, None, graph_node(name)))
 
+    def existing_graphs(self, names: Sequence[str]) -> set[str]:
+        store = self._reader()
+        return {
+            name
+            for name in names
+            if next(iter(store.quads_for_pattern(None, None, None, graph_node(name))), None) is not None
+        }
+
     def graph_sizes(self) -> dict[str, int]:
         store = self._reader()
         sizes = {}

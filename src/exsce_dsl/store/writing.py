@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import datetime
 import re
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Collection, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from decimal import Decimal, InvalidOperation
 
@@ -54,8 +54,17 @@ from pyoxigraph import (
 
 from exsce_dsl.prov.identifiers import PROV_NAMESPACE, ROBOT_SCHEMA, XSD_NAMESPACE
 from exsce_dsl.store.base import GraphSet, Store, StoreConflictError, StoreError
+from exsce_dsl.store.segment_index import segment_index, stale_index_graphs
 
-__all__ = ["WriteReport", "add_graphs", "add_prov", "is_revision", "revision_name"]
+__all__ = [
+    "WriteReport",
+    "add_graphs",
+    "add_prov",
+    "bundle_graphs",
+    "is_revision",
+    "revision_name",
+    "stored_graphs",
+]
 
 _RDF_TYPE = "http://www.w3.org/1999/02/22-rdf-syntax-ns#type"
 _POSE_TYPES = frozenset(f"{ROBOT_SCHEMA}{local}" for local in ("Pose", "Point", "EulerAngles"))
@@ -109,8 +118,26 @@ class WriteReport:
 
 
 def add_prov(store: Store, document: ProvDocument, *, replace: bool = False) -> WriteReport:
-    """Add a PROV document, one named graph per bundle, in one write (see the module's rules)."""
-    from exsce_dsl.rdf import prefixes_of, to_quads
+    """Add a PROV document, one named graph per bundle, in one write (see the module's rules).
+
+    A run's segment index (:mod:`exsce_dsl.store.segment_index`) goes in the same write.
+    """
+    from exsce_dsl.rdf import prefixes_of
+
+    graphs = bundle_graphs(document)
+    index = segment_index(graphs)
+    if replace and index:
+        for stale in stale_index_graphs(store, graphs, index):
+            index[stale] = []  # an action the new version of a run no longer has
+    derived = [name for name in index if name not in graphs]
+    for name in derived:
+        graphs[name] = index[name]
+    return add_graphs(store, graphs, replace=replace, prefixes=prefixes_of(document), derived=derived)
+
+
+def bundle_graphs(document: ProvDocument) -> dict[str, list[Quad]]:
+    """The document in PROV-O, a named graph per bundle (graph IRI → quads)."""
+    from exsce_dsl.rdf import to_quads
 
     graphs: dict[str, list[Quad]] = {}
     outside = 0
@@ -124,7 +151,16 @@ def add_prov(store: Store, document: ProvDocument, *, replace: bool = False) -> 
             f"the document has {outside} statements outside any bundle; the store keeps PROV bundles "
             "as named graphs, so put every record in a bundle"
         )
-    return add_graphs(store, graphs, replace=replace, prefixes=prefixes_of(document))
+    return graphs
+
+
+def stored_graphs(document: ProvDocument) -> dict[str, list[Quad]]:
+    """What :func:`add_prov` writes of a document into an empty store: its bundles and, for a
+    run, its segment index (for comparisons with other stores)."""
+    graphs = bundle_graphs(document)
+    for name, quads in segment_index(graphs).items():
+        graphs.setdefault(name, quads)
+    return graphs
 
 
 def add_graphs(
@@ -133,20 +169,35 @@ def add_graphs(
     *,
     replace: bool = False,
     prefixes: Mapping[str, str] | None = None,
+    derived: Collection[str] = (),
 ) -> WriteReport:
-    """Add named graphs with the rules of :func:`add_prov`; ``prefixes`` shorten names in messages."""
+    """Add named graphs with the rules of :func:`add_prov`; ``prefixes`` shorten names in messages.
+
+    ``derived`` graphs (the segment index) say again what the others say: a
+    changed one is replaced with no revision kept and is no conflict of its own
+    (its source graphs' conflict is); an empty one is dropped.
+    """
     prefixes = dict(prefixes or {})
+    derived = frozenset(derived)
     names = list(graphs)
-    stored = store.graphs(names) if names else {}
+    existing = store.existing_graphs(names)
+    stored = store.graphs([name for name in names if name in existing]) if existing else {}
     added: list[str] = []
     merged: list[str] = []
     unchanged: list[str] = []
     conflicts: list[_Difference] = []
     to_add: dict[str, list[Quad]] = {}
     to_replace: dict[str, list[Quad]] = {}
+    derived_changes: dict[str, list[Quad]] = {}
     for name in names:
         new = list(graphs[name])
         old = stored.get(name, [])
+        if name in derived:
+            if not old and new:
+                to_add[name] = new
+            elif old and _canonical(old) != _canonical(new):
+                derived_changes[name] = new
+            continue
         if not old:
             added.append(name)
             to_add[name] = new
@@ -190,9 +241,9 @@ def add_graphs(
             revisions[revision] = _revision_quads(
                 difference.graph, stored[difference.graph], revision, number, now
             )
-    writes = {**to_add, **to_replace, **revisions}
+    writes = {**to_add, **to_replace, **revisions, **derived_changes}
     if writes:
-        store.write(GraphSet(writes), replace=set(to_replace) | set(revisions))
+        store.write(GraphSet(writes), replace=set(to_replace) | set(revisions) | set(derived_changes))
     return WriteReport(
         location=store.location,
         added=tuple(added),

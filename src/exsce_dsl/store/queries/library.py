@@ -67,12 +67,14 @@ KINDS: Mapping[str, Callable[[Namespaces, str], Term]] = {
     "run": lambda names, text: Literal(text),
     "robot": lambda names, text: Literal(text),
     "metric": lambda names, text: Literal(text),
+    "metric_property": lambda names, text: _iri(names, ids.METRIC, text, "metric"),
     "string": lambda names, text: Literal(text),
     "double": _double,
 }
 """How a parameter's text becomes a term: ``scenario`` → ``exsce:<id>``, ``pose`` →
 ``pose:<pose name>`` (``classroom_c025-w001-R0.00_P0.00_Y0.00``), ``double`` → an
-``xsd:double``, and ``id``, ``run`` (a uuid), ``robot``, ``metric``, ``string`` → a
+``xsd:double``, ``metric_property`` → ``metric:<name>`` (the segment index's property
+for the metric), and ``id``, ``run`` (a uuid), ``robot``, ``metric``, ``string`` → a
 plain literal."""
 
 
@@ -126,7 +128,7 @@ class Query:
         return found
 
 
-_PARAMETER_LINE = re.compile(r"#\s*\?([A-Za-z_][A-Za-z0-9_]*)\s+([a-z]+)([+?*]?)\s*(.*)")
+_PARAMETER_LINE = re.compile(r"#\s*\?([A-Za-z_][A-Za-z0-9_]*)\s+([a-z_]+)([+?*]?)(?:\s+(.*))?")
 
 
 def _parse(name: str, text: str, is_update: bool) -> Query:
@@ -140,7 +142,7 @@ def _parse(name: str, text: str, is_update: bool) -> Query:
             break
         match = _PARAMETER_LINE.fullmatch(stripped)
         if match:
-            pname, kind, mark, about = match.groups()
+            pname, kind, mark, about = match.groups(default="")
             if kind not in KINDS:
                 raise ExsceError(f"query '{name}': parameter ?{pname} has an unknown kind '{kind}'")
             parameters.append(Parameter(pname, kind, mark in ("+", "*"), mark in ("?", "*"), about))
