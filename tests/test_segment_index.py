@@ -7,6 +7,7 @@ the run drives the segment a → b twice.  Values are chosen by hand.
 from __future__ import annotations
 
 import datetime
+from pathlib import Path
 
 from pyoxigraph import Literal, NamedNode
 
@@ -34,6 +35,8 @@ from exsce_dsl.store import queries as q
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.segment_index import segment_index, segment_iri
 from exsce_dsl.store.writing import add_prov
+
+from conftest import run_exscec
 
 
 def pose(name: str, x: float) -> Pose:
@@ -138,3 +141,17 @@ def test_adding_a_run_again_writes_nothing_and_replacing_it_drops_actions_it_no_
     found = q.segment_metric(store, "distance_travelled", A, B, scenario="corridor_runs")
     assert found is not None and (found.count, found.mean) == (1, 4.0)
     assert q.segment_metric(store, "distance_travelled", B, A, scenario="corridor_runs") is None
+
+
+def test_store_graphs_and_info_set_the_index_apart(tmp_path: Path) -> None:
+    with EmbeddedStore(tmp_path / ".exsce" / "store") as store:
+        add_prov(store, compile_scenario(SCENARIO))
+        add_prov(store, compile_run(run("u-1", (5.0, 6.0, 5.0)), SCENARIO))
+    listed = run_exscec("store", "graphs", cwd=tmp_path)
+    assert listed.returncode == 0, listed.stderr
+    assert "/segments/" not in listed.stdout and "w_001" not in listed.stdout and "run_u-1_bundle" in listed.stdout
+    assert "and 5 graphs of the segment index: --index lists them" in listed.stderr  # 2 segments, 3 actions
+    everything = run_exscec("store", "graphs", "--index", cwd=tmp_path)
+    assert everything.stdout.count("/segments/corridor_runs/") == 2 and everything.stdout.count("-w_00") == 3
+    info = run_exscec("store", "info", cwd=tmp_path)
+    assert "+ 5 of the segment index)" in info.stdout

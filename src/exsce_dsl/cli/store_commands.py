@@ -64,6 +64,7 @@ def info(store_url: str | None) -> None:
     from exsce_dsl.store.embedded import EmbeddedStore
     from exsce_dsl.store.open import open_store
     from exsce_dsl.store.remote import RemoteStore
+    from exsce_dsl.store.segment_index import is_index_graph
     from exsce_dsl.store.writing import is_revision
 
     with open_store(store_url) as store:
@@ -81,31 +82,44 @@ def info(store_url: str | None) -> None:
         else:
             kind = "SPARQL 1.1 endpoint"
         revisions = sum(1 for name in sizes if is_revision(name))
+        index = sum(1 for name in sizes if is_index_graph(name))
         click.echo(f"store:      {store.location} ({kind})")
-        click.echo(f"graphs:     {len(sizes) - revisions} (+ {revisions} revisions)")
+        click.echo(
+            f"graphs:     {len(sizes) - revisions - index} (+ {revisions} revisions, "
+            f"+ {index} of the segment index)"
+        )
         click.echo(f"statements: {sum(sizes.values())}")
 
 
 @store_group.command(name="graphs")
 @store_option
+@click.option("--index", "with_index", is_flag=True, help="List the graphs of the segment index too.")
 @reports_errors
-def graphs(store_url: str | None) -> None:
+def graphs(store_url: str | None, with_index: bool) -> None:
     """List the named graphs with their number of statements.
+
+    The segment index the store keeps beside each run (a graph per path segment
+    and per action) is left out unless --index is given.
 
     \b
     Example:
       exscec store graphs
     """
     from exsce_dsl.store.open import open_store
+    from exsce_dsl.store.segment_index import is_index_graph
 
     with open_store(store_url) as store:
         sizes = store.graph_sizes()
+    hidden = 0 if with_index else sum(1 for name in sizes if is_index_graph(name))
+    if not with_index:
+        sizes = {name: n for name, n in sizes.items() if not is_index_graph(name)}
     width = max((len(str(n)) for n in sizes.values()), default=1)
     for name in sorted(sizes):
         click.echo(f"{sizes[name]:>{width}}  {name}")
-    click.echo(
-        f"{len(sizes)} graph{'s' if len(sizes) != 1 else ''}, {sum(sizes.values())} statements", err=True
-    )
+    shown = f"{len(sizes)} graph{'s' if len(sizes) != 1 else ''}, {sum(sizes.values())} statements"
+    if hidden:
+        shown += f" (and {hidden} graphs of the segment index: --index lists them)"
+    click.echo(shown, err=True)
 
 
 @store_group.command(name="export")

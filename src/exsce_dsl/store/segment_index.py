@@ -33,6 +33,7 @@ by :func:`segment_index`; it adds nothing they do not say.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable, Mapping, Sequence
 
 from pyoxigraph import Literal, NamedNode, Quad
@@ -41,7 +42,7 @@ from exsce_dsl.prov import identifiers as ids
 from exsce_dsl.prov.identifiers import PROV_NAMESPACE
 from exsce_dsl.store.base import Store
 
-__all__ = ["segment_index", "segment_iri", "stale_index_graphs"]
+__all__ = ["is_index_graph", "segment_index", "segment_iri", "stale_index_graphs"]
 
 _RDF_TYPE = NamedNode("http://www.w3.org/1999/02/22-rdf-syntax-ns#type")
 _USED = f"{PROV_NAMESPACE}used"
@@ -53,6 +54,14 @@ _RUNS_PART = ids.Namespaces().fixed[ids.RUN].removeprefix(ids.DEFAULT_NAMESPACE)
 _METRIC_TYPE_SUFFIX = f"{_RUNS_PART}{ids.METRIC_TYPE.local}"
 """``runs/metricType``: what the metric type's IRI adds to the project's base namespace."""
 _ATTRIBUTE_ENDINGS = (_METRIC_TYPE_SUFFIX, f"/{ids.RUN_ATTR.local}", f"/{ids.ROBOT_ATTR.local}")
+
+
+_INDEX_GRAPH = re.compile(r"/segments/[^/]+/[^/]+/[^/]+$|/runs/run_[^/]+/[^/]+-task_\d+-subtask_\d+-w_\d+$")
+
+
+def is_index_graph(name: str) -> bool:
+    """True for the name of a graph of the segment index (a segment's or an action's)."""
+    return _INDEX_GRAPH.search(name) is not None
 
 
 def segment_iri(base: str, scenario_id: str, start_pose: str, goal_pose: str) -> str:
