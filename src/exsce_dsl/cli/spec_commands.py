@@ -112,7 +112,9 @@ def compile_command(
 @click.command()
 @click.argument("specs", nargs=-1, required=True, type=click.Path(dir_okay=False))
 @click.option("--check", "check_only", is_flag=True, help="Change nothing; exit 1 if a file would change.")
-@click.option("--diff", "show_diff", is_flag=True, help="Print what would change as a unified diff.")
+@click.option(
+    "--diff", "show_diff", is_flag=True, help="Print what would change as a unified diff; change nothing."
+)
 @reports_errors
 def fmt(specs: tuple[str, ...], check_only: bool, show_diff: bool) -> None:
     """Rewrite SPEC files in canonical form.
@@ -150,7 +152,7 @@ def fmt(specs: tuple[str, ...], check_only: bool, show_diff: bool) -> None:
                 ),
                 nl=False,
             )
-        if check_only:
+        if check_only or show_diff:  # as black does: --diff shows, it does not write
             click.echo(f"would reformat {spec_path}", err=True)
         else:
             Path(spec_path).write_text(formatted, encoding="utf-8")

@@ -15,11 +15,13 @@ from pathlib import Path
 from typing import Any
 
 from exsce_dsl.errors import Diagnostic, SourceLocation, SpecError
+from exsce_dsl.lang.build_acceptance import build_acceptance
 from exsce_dsl.lang.checks import check_environment_map, check_scenario
 from exsce_dsl.lang.loader import load_files
 from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.lang.suggest import did_you_mean
 from exsce_dsl.model import (
+    Acceptance,
     Area,
     Assignment,
     Document,
@@ -103,6 +105,8 @@ class _Builder:
         # pose id -> the environments declaring it, with the pose
         self.poses: dict[str, list[tuple[str, Pose]]] = {}
         self.task_poses: dict[str, Pose | None] = {}
+        self.acceptance: dict[int, Acceptance] = {}
+        """Built acceptance blocks, by the id of their parse tree node."""
 
     # ---------------------------------------------------------------- helpers
     def error(self, message: str, location: SourceLocation | None, code: str = "semantic") -> None:
@@ -128,7 +132,8 @@ class _Builder:
     def build(self) -> Specification:
         for pf in self.files:
             for decl in pf.tree.declarations:
-                self._declare(pf, decl)
+                if decl.__class__.__name__ != "Acceptance":
+                    self._declare(pf, decl)
         for name, d in self.declared["RobotType"].items():
             self.robot_types[name] = self._robot_type(d)
         for name, d in self.declared["Environment"].items():
@@ -146,6 +151,7 @@ class _Builder:
             self.diagnostics.extend(check_environment_map(env))
         for scenario in self.scenarios.values():
             self.diagnostics.extend(check_scenario(scenario))
+        self._acceptance()
         return Specification(self.files[0].path, tuple(self._document(pf) for pf in self.files))
 
     def _declare(self, pf: ParsedFile, decl: Any) -> None:
@@ -161,6 +167,26 @@ class _Builder:
             return
         table[decl.name] = _Declared(decl, pf, where)
 
+    def _acceptance(self) -> None:
+        first: dict[str, SourceLocation] = {}
+        for pf in self.files:
+            for decl in pf.tree.declarations:
+                if decl.__class__.__name__ != "Acceptance":
+                    continue
+                where = pf.span(decl.scenario)
+                name = decl.scenario.name
+                if name in first:
+                    self.error(f"scenario '{name}' has acceptance criteria already (at {first[name]}); "
+                               "put them in one block", where)
+                    continue
+                first[name] = where
+                built = build_acceptance(
+                    pf, decl, self.scenarios, self.declared["Scenario"],
+                    lambda message, at: self.error(message, at, code="acceptance"),
+                )
+                if built is not None:
+                    self.acceptance[id(decl)] = built
+
     def _document(self, pf: ParsedFile) -> Document:
         imports = tuple(Import(i.path, pf.span(i)) for i in pf.tree.imports)
         tables: dict[str, Mapping[str, Any]] = {
@@ -169,9 +195,13 @@ class _Builder:
             "Task": self.tasks,
             "Scenario": self.scenarios,
         }
-        declarations = []
+        declarations: list[Any] = []
         for decl in pf.tree.declarations:
             kind = decl.__class__.__name__
+            if kind == "Acceptance":
+                if id(decl) in self.acceptance:
+                    declarations.append(self.acceptance[id(decl)])
+                continue
             declared = self.declared[kind].get(decl.name)
             built = tables[kind].get(decl.name)
             if built is not None and declared is not None and declared.obj is decl:

@@ -13,8 +13,10 @@ from collections.abc import Iterable, Mapping, Sequence
 from decimal import Decimal
 
 from exsce_dsl.errors import SourceLocation
+from exsce_dsl.lang.format_acceptance import acceptance_lines
 from exsce_dsl.lang.lexical import Comment
 from exsce_dsl.model import (
+    Acceptance,
     Assignment,
     Document,
     Environment,
@@ -61,6 +63,8 @@ def format_document(document: Document, poses: Mapping[str, Pose], comments: Seq
             blocks.append(_environment(decl))
         elif isinstance(decl, Task):
             blocks.append(_task(decl, poses))
+        elif isinstance(decl, Acceptance):
+            blocks.append(acceptance_lines(decl))
         else:
             blocks.append(_scenario(decl, poses))
     lines: list[Line] = []

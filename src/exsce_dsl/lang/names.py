@@ -17,7 +17,8 @@ KEYWORDS: frozenset[str] = frozenset(
     in robots namespace starts mission parallel sequential does then acceptance feature
     given when and but each stays below above is increasing decreasing invariant within
     std of baseline by before after during derive remove add swap reverse substitute
-    replace reassign move metric oracle relation monitor topic""".split()
+    replace reassign move metric oracle relation monitor topic for least its reaches
+    around""".split()
 )
 
 NAME_PATTERN = r"[A-Za-z_][A-Za-z0-9_]*(?:-[A-Za-z0-9_]+)*"

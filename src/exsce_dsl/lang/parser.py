@@ -7,6 +7,7 @@ into the semantic model.
 from __future__ import annotations
 
 import functools
+import re
 from dataclasses import dataclass
 from typing import Any
 
@@ -73,6 +74,9 @@ def _syntax_diagnostic(exc: TextXSyntaxError, text: str, path: str) -> Diagnosti
     return Diagnostic(message, SourceLocation(path, line, col, line, end_col), code="syntax")
 
 
+_KEYWORD = re.compile(r"[A-Za-z_][\w-]*")
+
+
 def _expected_words(rules: list[Any]) -> str:
     words: list[str] = []
     for rule in rules:
@@ -82,6 +86,8 @@ def _expected_words(rules: list[Any]) -> str:
             word = _RULE_WORDS[name]
         elif isinstance(literal, str) and rule.__class__.__name__ == "StrMatch":
             word = f"'{literal}'"
+        elif isinstance(literal, str) and not name and _KEYWORD.fullmatch(literal):
+            word = f"'{literal}'"  # a keyword, which textX matches by a regex of its own (autokwd)
         elif name:
             word = _RULE_WORDS.get(name.upper(), f"a {name.lower()}")
         else:

@@ -1,5 +1,6 @@
 """The semantic model: plain, immutable dataclasses, free of textX, rdflib and prov."""
 
+from exsce_dsl.model.acceptance import Acceptance
 from exsce_dsl.model.document import Declaration, Document, Import, Specification
 from exsce_dsl.model.environment import (
     Area,
@@ -15,6 +16,7 @@ from exsce_dsl.model.scenario import Assignment, Mission, MissionType, Scenario
 from exsce_dsl.model.tasks import Subtask, Task
 
 __all__ = [
+    "Acceptance",
     "Area",
     "Assignment",
     "Declaration",

@@ -6,12 +6,13 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 
 from exsce_dsl.errors import ExsceError, SourceLocation
+from exsce_dsl.model.acceptance import Acceptance
 from exsce_dsl.model.environment import Environment
 from exsce_dsl.model.robots import RobotType
 from exsce_dsl.model.scenario import Scenario
 from exsce_dsl.model.tasks import Task
 
-Declaration = RobotType | Environment | Task | Scenario
+Declaration = RobotType | Environment | Task | Scenario | Acceptance
 
 
 @dataclass(frozen=True)
@@ -52,6 +53,14 @@ class Specification:
     @property
     def tasks(self) -> tuple[Task, ...]:
         return tuple(d for d in self.declarations() if isinstance(d, Task))
+
+    @property
+    def acceptance(self) -> tuple[Acceptance, ...]:
+        return tuple(d for d in self.declarations() if isinstance(d, Acceptance))
+
+    def acceptance_of(self, scenario_id: str) -> Acceptance | None:
+        """The acceptance criteria of a scenario, if the specification gives any."""
+        return next((a for a in self.acceptance if a.scenario == scenario_id), None)
 
     @property
     def robot_types(self) -> tuple[RobotType, ...]:

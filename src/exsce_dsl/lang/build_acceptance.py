@@ -1,0 +1,285 @@
+"""Build acceptance criteria (``acceptance for <scenario> { ... }``) from their parse trees.
+
+Every name is resolved against the scenario the criteria are for (its robots, its
+mission, the tasks it allocates to each robot and their waypoints) and every
+quantity is checked against the metric's dimension; each problem is reported at
+its ``file:line:col`` and all of them at once.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable, Mapping
+from typing import Any
+
+from exsce_dsl.errors import SourceLocation
+from exsce_dsl.lang.parser import ParsedFile
+from exsce_dsl.lang.suggest import did_you_mean
+from exsce_dsl.model import Scenario
+from exsce_dsl.model.acceptance import (
+    Acceptance,
+    AtStartPose,
+    BaselineRuns,
+    Criterion,
+    Expectation,
+    Given,
+    Moment,
+    Quantifier,
+    Quantity,
+    Relation,
+    Subject,
+    When,
+    Window,
+)
+from exsce_dsl.model.metrics import METRICS, SI_UNIT, UNITS, Dimension, MetricInfo
+
+_QUANTITY = re.compile(r"(\S+?)\s*(m/s|cm/s|km/h|mm|cm|km|ms|min|std|m|s|h|%)?")
+
+Report = Callable[[str, SourceLocation | None], None]
+
+
+def build_acceptance(
+    pf: ParsedFile,
+    tree: Any,
+    scenarios: Mapping[str, Scenario],
+    declared_scenarios: Mapping[str, object],
+    report: Report,
+) -> Acceptance | None:
+    """The criteria of one ``acceptance`` block, or None when it names no valid scenario."""
+    name = tree.scenario.name
+    scenario = scenarios.get(name)
+    if scenario is None:
+        if name not in declared_scenarios:
+            hint = did_you_mean(name, declared_scenarios)
+            report(f"unknown scenario '{name}'{hint}", pf.span(tree.scenario))
+        return None  # a scenario with errors of its own: those are reported where it is
+    builder = _AcceptanceBuilder(pf, scenario, declared_scenarios, report)
+    criteria = tuple(builder.criterion(c) for c in tree.criteria)
+    titles: dict[str, SourceLocation] = {}
+    for criterion, node in zip(criteria, tree.criteria, strict=True):
+        where = pf.span(node)
+        if criterion.title in titles:
+            report(
+                f"two acceptance scenarios are called \"{criterion.title}\" "
+                f"(the first at {titles[criterion.title]})",
+                where,
+            )
+        titles.setdefault(criterion.title, where)
+    if not tree.criteria:
+        report(f"the acceptance criteria of '{name}' have no scenario; add 'scenario \"...\" {{ then ... }}'",
+               pf.span(tree.scenario))
+    return None if builder.failed else Acceptance(name, criteria, pf.span(tree))
+
+
+class _AcceptanceBuilder:
+    def __init__(
+        self, pf: ParsedFile, scenario: Scenario, declared: Mapping[str, object], report: Report
+    ) -> None:
+        self.pf = pf
+        self.scenario = scenario
+        self.declared = declared
+        self._report = report
+        self.failed = False
+        self.robots = {r.id: r for r in scenario.robots}
+
+    def error(self, message: str, where: SourceLocation | None) -> None:
+        self.failed = True
+        self._report(message, where)
+
+    def criterion(self, node: Any) -> Criterion:
+        givens = tuple(g for g in (self.given(n) for n in node.givens) if g is not None)
+        when = self.when(node.when) if node.when is not None else None
+        expectations = tuple(e for e in (self.expectation(n, when) for n in node.expectations) if e)
+        return Criterion(node.title, givens, when, expectations, self.pf.span(node))
+
+    # -- given / when ------------------------------------------------------------
+
+    def given(self, node: Any) -> Given | None:
+        where = self.pf.span(node)
+        if node.__class__.__name__ == "BaselineRuns":
+            if node.runs < 1:
+                self.error("a baseline needs at least 1 run", where)
+                return None
+            return BaselineRuns(node.runs, where)
+        subject = self.subject(node.subject)
+        return AtStartPose(subject, where) if subject is not None else None
+
+    def when(self, node: Any) -> When | None:
+        where = self.pf.span(node)
+        if node.__class__.__name__ == "MissionRuns":
+            mission = self.scenario.mission.id
+            if node.mission.name != mission:
+                self.error(
+                    f"the mission of scenario '{self.scenario.id}' is '{mission}', not '{node.mission.name}'",
+                    self.pf.span(node.mission),
+                )
+                return None
+            return When(mission=mission, location=where)
+        robot = self.robot(node.robot)
+        if robot is None or not self.task_of(robot, node.task):
+            return None
+        return When(robot=robot, task=node.task.name, location=where)
+
+    # -- names -------------------------------------------------------------------
+
+    def robot(self, ref: Any) -> str | None:
+        if ref.name not in self.robots:
+            self.error(
+                f"robot '{ref.name}' is not in the fleet of scenario '{self.scenario.id}'"
+                f"{did_you_mean(ref.name, self.robots)}",
+                self.pf.span(ref),
+            )
+            return None
+        return str(ref.name)
+
+    def task_of(self, robot: str, ref: Any) -> bool:
+        tasks = self.scenario.mission.tasks_of(robot)
+        if ref.name not in tasks:
+            self.error(
+                f"mission '{self.scenario.mission.id}' does not give task '{ref.name}' to '{robot}'"
+                + (f" (its tasks: {', '.join(tasks)})" if tasks else " (it has no tasks)"),
+                self.pf.span(ref),
+            )
+            return False
+        return True
+
+    def subject(self, node: Any) -> Subject | None:
+        if node.__class__.__name__ == "EachRobot":
+            return Subject(Quantifier.EACH_ROBOT)
+        robot = self.robot(node.robot)
+        return Subject(Quantifier.ROBOT, robot) if robot is not None else None
+
+    # -- then --------------------------------------------------------------------
+
+    def expectation(self, node: Any, when: When | None) -> Expectation | None:
+        where = self.pf.span(node)
+        metric_ref = node.metric
+        info = METRICS.get(metric_ref.name)
+        if info is None:
+            self.error(f"unknown metric '{metric_ref.name}'{did_you_mean(metric_ref.name, METRICS)}",
+                       self.pf.span(metric_ref))
+            return None
+        subject = Subject(Quantifier.MISSION) if node.subject is None else self.subject(node.subject)
+        if subject is None:
+            return None
+        if not self.scope_fits(info, subject, where):
+            return None
+        relation, kind = node.relation, node.relation.__class__.__name__
+        against = None
+        if getattr(relation, "against", None) is not None and relation.against.scenario is not None:
+            against = self.base_scenario(relation.against.scenario)
+            if against is None:
+                return None
+        if kind == "StaysBelow" or kind == "StaysAbove":
+            limit = self.quantity(relation.limit, info, where)
+            if limit is None:
+                return None
+            rel = Relation.BELOW_MAX if kind == "StaysBelow" else Relation.ABOVE_MIN
+            window = self.window(node.window, info)
+            if node.window is not None and window is None:
+                return None
+            return Expectation(subject, info.name, rel, limit=limit, window=window, location=where)
+        value = tolerance = delta = None
+        if relation.value is not None and (value := self.quantity(relation.value, info, where)) is None:
+            return None
+        if relation.tolerance is not None:
+            tolerance = self.quantity(relation.tolerance, info, where, relative=True)
+            if tolerance is None:
+                return None
+        if kind == "Invariant":
+            rel = Relation.INVARIANT
+        else:
+            rel = Relation.INCREASING if relation.direction == "increasing" else Relation.DECREASING
+            if relation.delta is not None and (delta := self.quantity(relation.delta, info, where)) is None:
+                return None
+            if against is None and value is None:
+                self.error(
+                    f"'is {relation.direction}' compares with the scenario this one was derived from: "
+                    f"add 'of <scenario>', or a value to start from ('from <value>')",
+                    where,
+                )
+                return None
+        window = self.window(node.window, info)
+        if node.window is not None and window is None:
+            return None
+        return Expectation(subject, info.name, rel, value=value, delta=delta, tolerance=tolerance,
+                           against=against, window=window, location=where)
+
+    def scope_fits(self, info: MetricInfo, subject: Subject, where: SourceLocation) -> bool:
+        if subject.quantifier is Quantifier.MISSION and info.per_robot and not info.also_mission:
+            self.error(f"'{info.name}' is measured per robot: say of whom ('each robot' or a robot's name)",
+                       where)
+            return False
+        if subject.quantifier is not Quantifier.MISSION and not info.per_robot:
+            self.error(f"'{info.name}' is measured for the whole mission: drop '{subject.text()}'", where)
+            return False
+        return True
+
+    def base_scenario(self, ref: Any) -> str | None:
+        if ref.name == self.scenario.id:
+            self.error(
+                f"a scenario is compared with its own runs by 'of baseline', not 'of {ref.name}'",
+                self.pf.span(ref),
+            )
+            return None
+        if ref.name not in self.declared:
+            self.error(f"unknown scenario '{ref.name}'{did_you_mean(ref.name, self.declared)}",
+                       self.pf.span(ref))
+            return None
+        return str(ref.name)
+
+    def window(self, node: Any, info: MetricInfo) -> Window | None:
+        if node is None:
+            return None
+        where = self.pf.span(node)
+        if not info.per_segment:
+            per = [m.name for m in METRICS.values() if m.per_segment]
+            self.error(f"'{info.name}' has no value per path segment, so it cannot be looked at "
+                       f"{node.moment} part of a run (only {', '.join(per)} can)", where)
+            return None
+        moment = Moment(node.moment)
+        if node.__class__.__name__ == "TaskWindow":
+            owners = [r for r in self.robots if node.task.name in self.scenario.mission.tasks_of(r)]
+            if not owners:
+                self.error(f"mission '{self.scenario.mission.id}' allocates no task '{node.task.name}'",
+                           self.pf.span(node.task))
+                return None
+            return Window(moment, owners[0], task=node.task.name, location=where)
+        robot = self.robot(node.robot)
+        if robot is None:
+            return None
+        goals = {p.id for t in self.scenario.mission.tasks_of(robot)
+                 for task in (self.scenario.task(t),) if task is not None for p in task.waypoints()}
+        if node.pose.name not in goals:
+            self.error(f"'{robot}' never goes to '{node.pose.name}'{did_you_mean(node.pose.name, goals)}",
+                       self.pf.span(node.pose))
+            return None
+        return Window(moment, robot, pose=node.pose.name, location=where)
+
+    def quantity(
+        self, text: str, info: MetricInfo, where: SourceLocation, relative: bool = False
+    ) -> Quantity | None:
+        match = _QUANTITY.fullmatch(text)
+        assert match is not None, text  # the grammar lets only such tokens through
+        number, unit = match.group(1), match.group(2)
+        value = float(number)
+        if unit in ("std", "%"):
+            if not relative:
+                self.error(f"'{text}' is relative: 'std' and '%' are for tolerances ('within 1 std')", where)
+                return None
+            if value < 0:
+                self.error(f"a tolerance cannot be negative ('{text}')", where)
+                return None
+            return Quantity(value, unit, number)
+        if unit is None:
+            return Quantity(value, None, number)
+        dimension, factor = UNITS[unit]
+        if dimension is not info.dimension:
+            wanted = SI_UNIT[info.dimension] or "a plain number"
+            what = "a count" if info.dimension is Dimension.COUNT else f"a {info.dimension.value}"
+            self.error(f"'{info.name}' is {what}, in {wanted}; '{text}' is a {dimension.value}", where)
+            return None
+        if relative and value < 0:
+            self.error(f"a tolerance cannot be negative ('{text}')", where)
+            return None
+        return Quantity(value * factor, unit, number)

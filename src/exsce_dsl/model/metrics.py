@@ -1,0 +1,86 @@
+"""The metrics exsce computes from a run's bag, and what each one measures.
+
+Acceptance criteria are checked against this table: the metric exists, a robot's
+metric is said of a robot and a mission's of the mission, a quantity has the
+metric's dimension, and only metrics with per-segment values take a time window
+(a window's value combines the values of the segments inside it).
+"""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+
+
+class Dimension(enum.Enum):
+    TIME = "time"
+    LENGTH = "length"
+    SPEED = "speed"
+    COUNT = "count"
+
+
+class Combine(enum.Enum):
+    """How a metric's values over consecutive segments make the value over all of them."""
+
+    SUM = "sum"
+    MAX = "max"
+    MIN = "min"
+
+
+@dataclass(frozen=True)
+class MetricInfo:
+    name: str
+    dimension: Dimension
+    per_robot: bool
+    """Said of a robot (``each robot``, ``tiago1``); otherwise of the mission."""
+    combine: Combine | None = None
+    """For a metric with a value per path segment: how segments combine (else None)."""
+    also_mission: bool = False
+    """Also has a value for the whole mission (violation_duration)."""
+    meaning: str = ""
+
+    @property
+    def per_segment(self) -> bool:
+        return self.combine is not None
+
+
+METRICS: dict[str, MetricInfo] = {
+    m.name: m
+    for m in (
+        MetricInfo("mission_duration", Dimension.TIME, False, meaning="first goal active to last goal done"),
+        MetricInfo("task_duration", Dimension.TIME, True, Combine.SUM, meaning="time to complete its tasks"),
+        MetricInfo("waypoints_visited", Dimension.COUNT, True, meaning="goals that succeeded"),
+        MetricInfo("distance_travelled", Dimension.LENGTH, True, Combine.SUM, meaning="metres travelled"),
+        MetricInfo(
+            "distance_to_obstacles", Dimension.LENGTH, True, Combine.MIN, meaning="least laser range"
+        ),
+        MetricInfo("max_velocity", Dimension.SPEED, True, Combine.MAX, meaning="largest linear speed"),
+        MetricInfo(
+            "distance_between_robots", Dimension.LENGTH, False, meaning="least distance between two robots"
+        ),
+        MetricInfo(
+            "violation_duration",
+            Dimension.TIME,
+            True,
+            also_mission=True,
+            meaning="seconds a safety limit was violated",
+        ),
+    )
+}
+
+UNITS: dict[str, tuple[Dimension, float]] = {
+    "s": (Dimension.TIME, 1.0),
+    "ms": (Dimension.TIME, 0.001),
+    "min": (Dimension.TIME, 60.0),
+    "h": (Dimension.TIME, 3600.0),
+    "m": (Dimension.LENGTH, 1.0),
+    "cm": (Dimension.LENGTH, 0.01),
+    "mm": (Dimension.LENGTH, 0.001),
+    "km": (Dimension.LENGTH, 1000.0),
+    "m/s": (Dimension.SPEED, 1.0),
+    "cm/s": (Dimension.SPEED, 0.01),
+    "km/h": (Dimension.SPEED, 1000.0 / 3600.0),
+}
+"""Units a quantity may carry, by dimension, with the factor to SI."""
+
+SI_UNIT = {Dimension.TIME: "s", Dimension.LENGTH: "m", Dimension.SPEED: "m/s", Dimension.COUNT: ""}

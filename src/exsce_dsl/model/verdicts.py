@@ -1,0 +1,54 @@
+"""Verdicts: what judging a run against its scenario's oracles found."""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+
+
+class Outcome(enum.Enum):
+    PASSED = "passed"
+    FAILED = "failed"
+    UNJUDGED = "unjudged"
+    """Could not be judged (no value for the metric in the run, no baseline yet...): ``reason`` says why."""
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """One oracle applied to one run.
+
+    ``expected`` is the baseline or base value the relation compares with (None
+    for a limit), ``limit`` the bound of ``below_max`` / ``above_min``.  ``margin``
+    is how far the observed value is inside the relation's bound (negative: by
+    how much it is outside).  ``sources`` are the runs the expectation came from.
+    """
+
+    run: str
+    scenario: str
+    criterion: str
+    """The title of the acceptance scenario the oracle comes from ('' for an oracle from the store only)."""
+    oracle: str
+    """The oracle's id, e.g. ``tiago1-max_velocity`` or ``mission_duration``."""
+    metric: str
+    robot: str | None
+    relation: str
+    outcome: Outcome
+    observed: float | None = None
+    expected: float | None = None
+    limit: float | None = None
+    delta: float | None = None
+    tolerance: float | None = None
+    margin: float | None = None
+    window: str | None = None
+    """The part of the run looked at (``during delivery_a``), None for the whole run."""
+    sources: tuple[str, ...] = ()
+    reason: str = ""
+
+    @property
+    def description(self) -> str:
+        """``tiago1 max_velocity below_max 1.0`` — a line for people and test reports."""
+        who = f"{self.robot} " if self.robot else ""
+        bound = self.limit if self.limit is not None else self.expected
+        shown = f" {bound:g}" if bound is not None else ""
+        window = f" {self.window}" if self.window else ""
+        return f"{who}{self.metric} {self.relation}{shown}{window}"
