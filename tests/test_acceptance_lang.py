@@ -156,6 +156,9 @@ CASES = [
     ("window-on-mission-metric", "by 6 s", "by 6 s during go_p3", 56, 59, "no value per path segment"),
     ("no-baseline-runs", "at least 5 baseline", "at least 0 baseline", 45, 11, "at least 1 run"),
     ("duplicate-title", '"on the way"', '"faster alone"', 52, 3, 'two acceptance scenarios are called "faster alone"'),
+    ("when-task-of-other-robot", "r1 distance_to_obstacles stays above 0.2 m during go_p3",
+     "each robot distance_to_obstacles stays above 0.2 m", 54, 10,
+     "'when r1 does go_p3' looks at r1's task"),
     ("syntax", "stays above 0.2 m", "stays over 0.2 m", 54, 41, "expected 'below' or 'above', found 'over'"),
 ]
 

@@ -22,7 +22,8 @@ FORMATS = ("table", "json", "csv")
 _XSD_STRING = "http://www.w3.org/2001/XMLSchema#string"
 _PREFIX_DECLARATION = re.compile(r"^\s*PREFIX\s+([A-Za-z][\w.-]*)?:", re.IGNORECASE | re.MULTILINE)
 _KIND_AFTER_PROLOGUE = re.compile(
-    r"^(?:\s|#[^\n]*\n|(?:PREFIX|BASE)\s[^\n]*\n)*\s*(SELECT|ASK|CONSTRUCT|DESCRIBE)\b", re.IGNORECASE
+    r"^(?:\s|#[^\n]*\n|PREFIX\s+[^\s:]*:\s*<[^>]*>|BASE\s*<[^>]*>)*\s*(SELECT|ASK|CONSTRUCT|DESCRIBE)\b",
+    re.IGNORECASE,
 )
 
 

@@ -170,7 +170,7 @@ def fmt(specs: tuple[str, ...], check_only: bool, show_diff: bool) -> None:
     type=click.Path(file_okay=False),
     default=".",
     show_default=True,
-    help="Folder to write the .exsce files to.",
+    help="Folder to write the .exsce files to (for an oracle file: print unless given).",
 )
 @click.option(
     "-t",
@@ -180,23 +180,61 @@ def fmt(specs: tuple[str, ...], check_only: bool, show_diff: bool) -> None:
     type=click.Path(exists=True, file_okay=False),
     help="Folder to search for the task files the scenario names (repeatable).",
 )
+@click.option(
+    "--spec",
+    "spec_path",
+    type=click.Path(exists=True, dir_okay=False),
+    help="For an oracle file: the spec that declares its scenario.",
+)
 @click.option("--force", is_flag=True, help="Overwrite existing files.")
 @reports_errors
-def import_command(yaml_file: str, out_dir: str, task_dirs: tuple[str, ...], force: bool) -> None:
-    """Import a scenario in the method's YAML format (with its task files) as .exsce files.
+def import_command(
+    yaml_file: str, out_dir: str, task_dirs: tuple[str, ...], spec_path: str | None, force: bool
+) -> None:
+    """Import a scenario in the method's YAML format (with its task files) as .exsce files,
+    or an oracle file as the acceptance criteria of its scenario.
 
     Task files are found by their ROS package and path under each --tasks
-    folder (and the scenario's own folder), or by file name.
+    folder (and the scenario's own folder), or by file name.  An oracle file
+    (one with a baseline or metamorphic section) needs --spec; its criteria
+    are printed, or with -o written to <scenario>_acceptance.exsce, which
+    imports the spec.
 
     \b
     Example:
       exscec import scenario_c.yaml -t config/tasks -o specs/
+      exscec import oracles/scenario_c.yaml --spec specs/scenario_c.exsce
     """
     from exsce_dsl.lang.method_yaml import import_scenario_yaml
+    from exsce_dsl.lang.oracle_yaml import is_oracle_yaml
     from exsce_dsl.lang.writer import write_documents
 
+    if is_oracle_yaml(Path(yaml_file)):
+        _import_oracles(Path(yaml_file), spec_path, out_dir, force)
+        return
+    if spec_path is not None:
+        raise click.UsageError("--spec goes with an oracle file; this is a scenario file")
     documents = import_scenario_yaml(Path(yaml_file), [Path(d) for d in task_dirs])
     for path in write_documents(documents, Path(out_dir), overwrite=force):
+        click.echo(f"wrote {path}", err=True)
+
+
+def _import_oracles(yaml_file: Path, spec_path: str | None, out_dir: str, force: bool) -> None:
+    from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.lang.formatter import format_document
+    from exsce_dsl.lang.oracle_yaml import acceptance_document, import_oracles
+    from exsce_dsl.lang.writer import write_documents
+    from exsce_dsl.model import Document
+
+    if spec_path is None:
+        raise click.UsageError(f"{yaml_file} holds oracles: name the spec of its scenario with --spec")
+    acceptance = import_oracles(yaml_file, load_spec(spec_path))
+    source = click.get_current_context().get_parameter_source("out_dir")
+    if source == click.core.ParameterSource.DEFAULT:
+        click.echo(format_document(Document("", (), (acceptance,)), {}), nl=False)
+        return
+    document = acceptance_document(acceptance, Path(spec_path), Path(out_dir))
+    for path in write_documents([document], Path(out_dir), overwrite=force):
         click.echo(f"wrote {path}", err=True)
 
 
@@ -205,10 +243,10 @@ def import_command(yaml_file: str, out_dir: str, task_dirs: tuple[str, ...], for
 @click.option(
     "--to",
     "target",
-    type=click.Choice(["yaml"]),
+    type=click.Choice(["yaml", "oracle-yaml", "gherkin"]),
     default="yaml",
     show_default=True,
-    help="The format to write.",
+    help="The format to write: the method's scenario and task files, its oracle file, or Gherkin features.",
 )
 @click.option(
     "-o",
@@ -222,17 +260,37 @@ def import_command(yaml_file: str, out_dir: str, task_dirs: tuple[str, ...], for
 @click.option("--scenario", "scenario_id", help="Which scenario, when the file declares several.")
 @reports_errors
 def export_command(spec: str, target: str, out_dir: str, scenario_id: str | None) -> None:
-    """Export a scenario to the method's YAML scenario and task files.
+    """Export a scenario to the method's YAML scenario and task files, its acceptance
+    criteria to the method's oracle file (oracles/<scenario>.yaml), or the criteria of
+    each scenario to Gherkin (<scenario>.feature).
+
+    An oracle file holds numbers: a clause that expects the mean of stored runs
+    (no 'around' or 'from' value) cannot be written without a baseline.
 
     \b
     Example:
       exscec export examples/scenario_c/scenario_c.exsce --to yaml -o out/
+      exscec export examples/scenario_c/scenario_c.exsce --to oracle-yaml -o out/
+      exscec export examples/scenario_c/scenario_c.exsce --to gherkin -o features/
     """
+    from exsce_dsl.errors import ExportError
     from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.lang.gherkin import export_gherkin
     from exsce_dsl.lang.method_yaml import export_yaml
+    from exsce_dsl.lang.oracle_yaml import export_oracle_file
 
-    scenario = load_spec(spec).scenario(scenario_id)
-    for path in export_yaml(scenario, Path(out_dir)):
+    loaded = load_spec(spec)
+    if target == "gherkin":
+        written = export_gherkin(loaded, Path(out_dir), scenario_id)
+    elif target == "oracle-yaml":
+        scenario = loaded.scenario(scenario_id)
+        acceptance = loaded.acceptance_of(scenario.id)
+        if acceptance is None:
+            raise ExportError(f"scenario '{scenario.id}' has no acceptance criteria to write as oracles")
+        written = [export_oracle_file(acceptance, scenario, Path(out_dir))]
+    else:
+        written = export_yaml(loaded.scenario(scenario_id), Path(out_dir))
+    for path in written:
         click.echo(f"wrote {path}", err=True)
 
 

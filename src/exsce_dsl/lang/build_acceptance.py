@@ -60,14 +60,16 @@ def build_acceptance(
         where = pf.span(node)
         if criterion.title in titles:
             report(
-                f"two acceptance scenarios are called \"{criterion.title}\" "
+                f'two acceptance scenarios are called "{criterion.title}" '
                 f"(the first at {titles[criterion.title]})",
                 where,
             )
         titles.setdefault(criterion.title, where)
     if not tree.criteria:
-        report(f"the acceptance criteria of '{name}' have no scenario; add 'scenario \"...\" {{ then ... }}'",
-               pf.span(tree.scenario))
+        report(
+            f"the acceptance criteria of '{name}' have no scenario; add 'scenario \"...\" {{ then ... }}'",
+            pf.span(tree.scenario),
+        )
     return None if builder.failed else Acceptance(name, criteria, pf.span(tree))
 
 
@@ -156,13 +158,28 @@ class _AcceptanceBuilder:
         metric_ref = node.metric
         info = METRICS.get(metric_ref.name)
         if info is None:
-            self.error(f"unknown metric '{metric_ref.name}'{did_you_mean(metric_ref.name, METRICS)}",
-                       self.pf.span(metric_ref))
+            self.error(
+                f"unknown metric '{metric_ref.name}'{did_you_mean(metric_ref.name, METRICS)}",
+                self.pf.span(metric_ref),
+            )
             return None
         subject = Subject(Quantifier.MISSION) if node.subject is None else self.subject(node.subject)
         if subject is None:
             return None
         if not self.scope_fits(info, subject, where):
+            return None
+        if (
+            when is not None
+            and when.robot is not None
+            and node.window is None
+            and info.per_segment
+            and subject.robot != when.robot
+        ):
+            self.error(
+                f"'when {when.text()}' looks at {when.robot}'s task: a clause on '{info.name}' there "
+                f"is about {when.robot} (write '{when.robot} {info.name} ...')",
+                where,
+            )
             return None
         relation, kind = node.relation, node.relation.__class__.__name__
         against = None
@@ -202,13 +219,23 @@ class _AcceptanceBuilder:
         window = self.window(node.window, info)
         if node.window is not None and window is None:
             return None
-        return Expectation(subject, info.name, rel, value=value, delta=delta, tolerance=tolerance,
-                           against=against, window=window, location=where)
+        return Expectation(
+            subject,
+            info.name,
+            rel,
+            value=value,
+            delta=delta,
+            tolerance=tolerance,
+            against=against,
+            window=window,
+            location=where,
+        )
 
     def scope_fits(self, info: MetricInfo, subject: Subject, where: SourceLocation) -> bool:
         if subject.quantifier is Quantifier.MISSION and info.per_robot and not info.also_mission:
-            self.error(f"'{info.name}' is measured per robot: say of whom ('each robot' or a robot's name)",
-                       where)
+            self.error(
+                f"'{info.name}' is measured per robot: say of whom ('each robot' or a robot's name)", where
+            )
             return False
         if subject.quantifier is not Quantifier.MISSION and not info.per_robot:
             self.error(f"'{info.name}' is measured for the whole mission: drop '{subject.text()}'", where)
@@ -223,8 +250,9 @@ class _AcceptanceBuilder:
             )
             return None
         if ref.name not in self.declared:
-            self.error(f"unknown scenario '{ref.name}'{did_you_mean(ref.name, self.declared)}",
-                       self.pf.span(ref))
+            self.error(
+                f"unknown scenario '{ref.name}'{did_you_mean(ref.name, self.declared)}", self.pf.span(ref)
+            )
             return None
         return str(ref.name)
 
@@ -234,25 +262,37 @@ class _AcceptanceBuilder:
         where = self.pf.span(node)
         if not info.per_segment:
             per = [m.name for m in METRICS.values() if m.per_segment]
-            self.error(f"'{info.name}' has no value per path segment, so it cannot be looked at "
-                       f"{node.moment} part of a run (only {', '.join(per)} can)", where)
+            self.error(
+                f"'{info.name}' has no value per path segment, so it cannot be looked at "
+                f"{node.moment} part of a run (only {', '.join(per)} can)",
+                where,
+            )
             return None
         moment = Moment(node.moment)
         if node.__class__.__name__ == "TaskWindow":
             owners = [r for r in self.robots if node.task.name in self.scenario.mission.tasks_of(r)]
             if not owners:
-                self.error(f"mission '{self.scenario.mission.id}' allocates no task '{node.task.name}'",
-                           self.pf.span(node.task))
+                self.error(
+                    f"mission '{self.scenario.mission.id}' allocates no task '{node.task.name}'",
+                    self.pf.span(node.task),
+                )
                 return None
             return Window(moment, owners[0], task=node.task.name, location=where)
         robot = self.robot(node.robot)
         if robot is None:
             return None
-        goals = {p.id for t in self.scenario.mission.tasks_of(robot)
-                 for task in (self.scenario.task(t),) if task is not None for p in task.waypoints()}
+        goals = {
+            p.id
+            for t in self.scenario.mission.tasks_of(robot)
+            for task in (self.scenario.task(t),)
+            if task is not None
+            for p in task.waypoints()
+        }
         if node.pose.name not in goals:
-            self.error(f"'{robot}' never goes to '{node.pose.name}'{did_you_mean(node.pose.name, goals)}",
-                       self.pf.span(node.pose))
+            self.error(
+                f"'{robot}' never goes to '{node.pose.name}'{did_you_mean(node.pose.name, goals)}",
+                self.pf.span(node.pose),
+            )
             return None
         return Window(moment, robot, pose=node.pose.name, location=where)
 

@@ -10,6 +10,10 @@ from __future__ import annotations
 
 import enum
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from exsce_dsl.model.scenario import Scenario
 
 
 class Dimension(enum.Enum):
@@ -84,3 +88,27 @@ UNITS: dict[str, tuple[Dimension, float]] = {
 """Units a quantity may carry, by dimension, with the factor to SI."""
 
 SI_UNIT = {Dimension.TIME: "s", Dimension.LENGTH: "m", Dimension.SPEED: "m/s", Dimension.COUNT: ""}
+
+_FEEDBACK, _RESULT, _POSE = "waypoint_dispatcher/feedback", "waypoint_dispatcher/result", "robot_pose"
+TOPICS: dict[str, tuple[str, ...]] = {
+    "mission_duration": (_FEEDBACK,),
+    "task_duration": (_FEEDBACK,),
+    "waypoints_visited": (_RESULT,),
+    "distance_travelled": ("distance_travelled",),
+    "distance_to_obstacles": ("scan",),
+    "max_velocity": ("nav_vel",),
+    "distance_between_robots": (_POSE,),
+    "violation_duration": ("nav_vel", "scan"),
+}
+"""The topics each metric is computed from, below a robot's namespace (DESIGN §1; the names
+exsce_dsl.runs.metrics.robot_topics reads)."""
+
+
+def default_topics(scenario: Scenario, metric: str, robot: str | None) -> tuple[str, ...]:
+    """The topics ``metric`` is computed from: of ``robot``, or of every robot (fleet order) for
+    the mission."""
+    leaves = TOPICS.get(metric, ())
+    if robot is None and metric == "violation_duration":
+        leaves = (_POSE,)  # the mission's violations are of the distance between robots
+    robots = [r for r in scenario.robots if robot is None or r.id == robot]
+    return tuple(f"/{r.namespace.strip('/')}/{leaf}" for r in robots for leaf in leaves)

@@ -37,6 +37,21 @@ class Oracle:
     delta: float | None = None
     tolerance: float | None = None
     package: str | None = None
+    window: str | None = None
+    """The part of a run the oracle looks at (``during delivery_a``, ``before tiago1 reaches
+    classroom_c018-w001``), None for the whole run."""
+    criterion: str = ""
+    """The title of the acceptance scenario it comes from."""
+    sources: tuple[str, ...] = ()
+    """The runs (uuids) its value and tolerance were computed from."""
+
+    @property
+    def name(self) -> str:
+        """``tiago1-max_velocity``, ``mission_duration``, ``tiago1-max_velocity-during-delivery_a``."""
+        base = f"{self.robot}-{self.metric}" if self.robot else self.metric
+        if self.window is None:
+            return base
+        return f"{base}-{self.window.replace(' ', '-')}"
 
     def __post_init__(self) -> None:
         if not self.relation:

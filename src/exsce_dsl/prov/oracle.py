@@ -64,15 +64,15 @@ def compile_oracles(
     parts = w.of_element(scenario_id, names.of_scenario(scenario_id), "scenario")
     exsce, topic_ns = w.fixed(ids.EXSCE), w.fixed(ids.TOPIC)
 
-    groups: dict[tuple[str, str | None], list[Oracle]] = {}
+    groups: dict[tuple[str, str | None, str | None], list[Oracle]] = {}
     for oracle in oracles:
-        groups.setdefault((oracle.metric, oracle.robot), []).append(oracle)
+        groups.setdefault((oracle.metric, oracle.robot, oracle.window), []).append(oracle)
 
     topic_type = {PROV_TYPE: t(ids.ROS_TOPICS)}
     declared: set[QualifiedName] = set()
     topic_role = {PROV_ROLE: ids.TOPIC_ROLE}
-    for (metric, robot), group in groups.items():
-        name = ids.oracle_name(metric, robot)
+    for (metric, robot, window), group in groups.items():
+        name = ids.check_name(group[0].name, "oracle name")
         activity = parts[name]
         writer.claim(activity, f"the oracle of '{metric}'" + (f" of robot '{robot}'" if robot else ""))
         facts: Attributes = {
@@ -82,6 +82,11 @@ def compile_oracles(
         }
         if robot is not None:
             facts[t(ids.ORACLE_ROBOT)] = robot
+        if window is not None:
+            facts[t(ids.ORACLE_WINDOW)] = window
+        criteria = sorted({oracle.criterion for oracle in group if oracle.criterion})
+        if criteria:
+            facts[t(ids.ORACLE_CRITERION)] = "; ".join(criteria)
         w.activity(activity, facts)
         topics = dict.fromkeys(topic for oracle in group for topic in oracle.topics)
         for topic in topics:
@@ -90,8 +95,14 @@ def compile_oracles(
                 declared.add(topic_id)
                 w.entity(topic_id, topic_type)
             w.used(activity, topic_id, topic_role)
+        kinds = [oracle.type for oracle in group]
         for oracle in group:
-            usage = parts[f"{name}-{oracle.type.value}"]
+            # one usage per type, as the method has it; a type twice (a range: above and below)
+            # names its usages by relation too
+            suffix = oracle.type.value
+            if kinds.count(oracle.type) > 1:
+                suffix += f"-{oracle.relation}"
+            usage = parts[f"{name}-{suffix}"]
             whose = f" of '{robot}'" if robot else ""
             writer.claim(usage, f"the {oracle.type.value} oracle of '{metric}'{whose}")
             relation: Attributes = {
@@ -108,6 +119,8 @@ def compile_oracles(
                     relation[t(term)] = float(value)
             if oracle.package is not None:
                 relation[t(ids.ORACLE_PACKAGE)] = oracle.package
+            if oracle.sources:
+                relation[t(ids.ORACLE_RUNS)] = " ".join(oracle.sources)
             base = exsce[ids.check_name(oracle.base_scenario, "base scenario id")]
             w.used(activity, base, relation, identifier=usage)
     return writer.document

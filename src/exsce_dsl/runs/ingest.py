@@ -81,7 +81,10 @@ def ingest_bags(
         if digest is not None:
             seen.add(digest)
         if known:
-            result = IngestResult(path, "skipped", f"{path}: already ingested (same content)")
+            assert digest is not None
+            result = IngestResult(
+                path, "skipped", f"{path}: already ingested (same content)", run_uuid(digest)
+            )
             results.append(result)
             if progress:
                 progress(result)

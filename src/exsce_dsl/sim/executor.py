@@ -157,10 +157,14 @@ def execute(
     last_pose = {r.id: r.start_pose for r in scenario.robots if r.start_pose is not None}
     task_numbers: dict[str, int] = {}
     waypoint_counts: dict[str, int] = {}
+    detour: dict[str, list[Trajectory]] = {}
     if any(f.kind == "near-collision" for f in faults):
-        _near_collision(scenario, timelines, grid, limits)
+        detour = _near_collision(scenario, timelines, grid, limits)
+    last_entry = {entry.robot: n for n, entry in enumerate(scenario.mission.allocation)}
+    parked: dict[str, tuple[float, float]] = {}
+    """Where robots that have done all their tasks stand: later paths go round them."""
 
-    for entry in scenario.mission.allocation:
+    for number, entry in enumerate(scenario.mission.allocation):
         tl = timelines[entry.robot]
         if scenario.mission.type is MissionType.SEQUENTIAL:
             start = max(t.samples for t in timelines.values())
@@ -186,7 +190,9 @@ def execute(
                     tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, 25))
                     status, length = GoalStatus.ABORTED, 0.0
                 else:
-                    path = grid.plan((tl.x, tl.y), (goal.position.x, goal.position.y))
+                    for leg in detour.pop(entry.robot, []):  # the near-collision fault, inside the mission
+                        tl.append(leg)
+                    path = _plan_around(grid, (tl.x, tl.y), (goal.position.x, goal.position.y), parked)
                     length = sum(math.dist(path[i], path[i + 1]) for i in range(len(path) - 1))
                     tl.append(drive(path, tl.yaw, goal.orientation.yaw, robot_limits))
                     status = GoalStatus.SUCCEEDED
@@ -210,6 +216,8 @@ def execute(
                 last = w_number == len(ids)
                 events.append(GoalEvent(tl.now, entry.robot, key, ids, tuple(statuses), last))
                 tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, int(rng.uniform(0.2, 0.6) * 50)))
+        if last_entry[entry.robot] == number:
+            parked[entry.robot] = (tl.x, tl.y)
     trajectories = {r: Trajectory.concat(t.parts) for r, t in timelines.items()}
     if not any(f.kind == "near-collision" for f in faults):
         trajectories, events, actions = _give_way(scenario, trajectories, events, actions)
@@ -248,6 +256,8 @@ def _give_way(
     last = {r: len(trajectories[r]) - 1 for r in order}
     shown: dict[str, list[float]] = {r: [] for r in order}
     previous: dict[str, tuple[float, float]] = {}
+    moving = {r: _last_move(trajectories[r]) for r in order}
+    """After this sample a robot stands still for good: others pass it on paths planned round it."""
     step = DT / RAMP
 
     def at(r: str, p: float) -> tuple[float, float]:
@@ -262,14 +272,15 @@ def _give_way(
         for r in order:
             here = at(r, position[r])
             look = at(r, min(position[r] + 1.0 + rate[r] * RAMP / DT / 2, last[r]))  # where braking would end
+            active = {h: p for h, p in placed.items() if position[h] < moving[h]}
             threatened = any(
                 math.dist(p, here) < SAFE_DISTANCE
                 and math.dist(p, here) < math.dist(previous.get(h, p), here)
-                for h, p in placed.items()
+                for h, p in active.items()
             )
             blocked = any(
                 math.dist(look, p) < SAFE_DISTANCE and math.dist(look, p) < math.dist(here, p)
-                for p in placed.values()
+                for p in active.values()
             )
             if not (threatened or blocked):
                 target, waited[r] = 1.0, 0
@@ -329,6 +340,12 @@ def _give_way(
     return trajectories, events, actions
 
 
+def _last_move(trajectory: Trajectory) -> int:
+    """The last sample at which the robot is still moving (0 if it never moves)."""
+    moved = np.flatnonzero((np.abs(np.diff(trajectory.x)) > 1e-9) | (np.abs(np.diff(trajectory.y)) > 1e-9))
+    return int(moved[-1]) + 1 if len(moved) else 0
+
+
 def _speed_factor(robot: str, faults: tuple[Fault, ...]) -> float:
     factor = 1.0
     for f in faults:
@@ -341,20 +358,50 @@ def _speed_factor(robot: str, faults: tuple[Fault, ...]) -> float:
 
 def _near_collision(
     scenario: Scenario, timelines: dict[str, Timeline], grid: PlanningGrid, limits: Limits
-) -> None:
-    """The second robot first drives next to the first one, which waits at its start."""
+) -> dict[str, list[Trajectory]]:
+    """The second robot's first action starts with a drive to the first robot, which waits at its
+    start until the second has come close and gone back: the legs, to insert in that action."""
     robots = [r for r in scenario.robots if r.id in timelines]
     if len(robots) < 2:
         raise ExsceError("fault 'near-collision' needs a scenario with two robots")
     first, second = timelines[robots[0].id], timelines[robots[1].id]
-    target = (first.x + 0.05, first.y)
     path = grid.plan((second.x, second.y), (first.x, first.y))
-    path[-1] = target
-    leg = drive(path, second.yaw, second.yaw, limits)
-    second.append(leg)
-    first.wait_until(second.samples + 100)
+    path[-1] = (first.x + 0.05, first.y)
+    there = drive(path, second.yaw, second.yaw, limits)
     back = drive(list(reversed(path)), second.yaw, second.yaw, limits)
-    second.append(back)
+    first.wait_until(second.samples + 10 + len(there) + len(back) + 100)  # 10: the goal's acceptance
+    return {robots[1].id: [there, back]}
+
+
+def _plan_around(
+    grid: PlanningGrid,
+    start: tuple[float, float],
+    goal: tuple[float, float],
+    parked: dict[str, tuple[float, float]],
+) -> list[tuple[float, float]]:
+    """A path that keeps clear of robots standing still (a real planner sees them in its costmap)."""
+    path = grid.plan(start, goal)
+    points = np.array(path)
+    blockers = tuple(
+        (x, y, PARKED_RADIUS)
+        for x, y in parked.values()
+        if _distance_to_polyline(points, (x, y)) < PARKED_RADIUS + 0.3
+        and math.dist(goal, (x, y)) > PARKED_RADIUS + 0.3
+        and math.dist(start, (x, y)) > PARKED_RADIUS + 0.3
+    )
+    return grid.with_discs(blockers).plan(start, goal) if blockers else path
+
+
+PARKED_RADIUS = 0.6  # metres: a robot standing still, with room to pass it
+
+
+def _distance_to_polyline(points: np.ndarray, p: tuple[float, float]) -> float:
+    a, b = points[:-1], points[1:]
+    ab = b - a
+    length2 = np.maximum((ab**2).sum(axis=1), 1e-12)
+    t = np.clip(((np.array(p) - a) * ab).sum(axis=1) / length2, 0.0, 1.0)
+    closest = a + t[:, None] * ab
+    return float(np.min(np.hypot(closest[:, 0] - p[0], closest[:, 1] - p[1]))) if len(a) else math.inf
 
 
 __all__ = ["Action", "Execution", "Fault", "GoalEvent", "GoalStatus", "execute", "np"]

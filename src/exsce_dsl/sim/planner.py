@@ -9,7 +9,7 @@ of free cells: the graph is built once per map, vectorised.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy import ndimage
@@ -36,6 +36,10 @@ class PlanningGrid:
     resolution: float  # planning cell size
     map_resolution: float
     graph: csr_matrix
+    coarse: np.ndarray  # clearance per planning cell
+    robot_radius: float = 0.3
+    discs: tuple[tuple[float, float, float], ...] = ()
+    """Round obstacles over the map (x, y, radius): robots standing still."""
 
     @classmethod
     def from_map(cls, grid: OccupancyGrid, robot_radius: float = 0.3, cell: float = 0.1) -> PlanningGrid:
@@ -52,7 +56,31 @@ class PlanningGrid:
         )
         free = coarse > robot_radius
         graph = _grid_graph(free, coarse, factor * grid.resolution, robot_radius)
-        return cls(free, clearance, grid.origin[:2], factor * grid.resolution, grid.resolution, graph)
+        return cls(
+            free,
+            clearance,
+            grid.origin[:2],
+            factor * grid.resolution,
+            grid.resolution,
+            graph,
+            coarse,
+            robot_radius,
+        )
+
+    def with_discs(self, discs: tuple[tuple[float, float, float], ...]) -> PlanningGrid:
+        """The grid with round obstacles added (robots parked where a path would cross them)."""
+        if not discs:
+            return self
+        rows, cols = self.free.shape
+        ys = self.origin[1] + (np.arange(rows) + 0.5) * self.resolution
+        xs = self.origin[0] + (np.arange(cols) + 0.5) * self.resolution
+        coarse = self.coarse.copy()
+        for x, y, radius in discs:
+            away = np.hypot(xs[None, :] - x, ys[:, None] - y) - radius
+            np.minimum(coarse, np.maximum(away, 0.0), out=coarse)
+        free = coarse > self.robot_radius
+        graph = _grid_graph(free, coarse, self.resolution, self.robot_radius)
+        return replace(self, free=free, graph=graph, coarse=coarse, discs=self.discs + discs)
 
     def cell_of(self, p: Point) -> tuple[int, int]:
         return (
@@ -75,6 +103,9 @@ class PlanningGrid:
         )
         out = np.zeros(len(points))
         out[inside] = self.clearance[rows[inside], cols[inside]]
+        for x, y, radius in self.discs:
+            away = np.hypot(points[:, 0] - x, points[:, 1] - y) - radius
+            np.minimum(out, np.maximum(away, 0.0), out=out)
         return out
 
     def plan(self, start: Point, goal: Point, robot_radius: float = 0.3) -> list[Point]:

@@ -341,7 +341,7 @@ def hotspot_counts(
 
 
 def oracles(store: Store, scenario: str, namespace: str = DEFAULT_NAMESPACE) -> list[Oracle]:
-    """The oracles that judge runs of ``scenario``: one per metric, robot and type."""
+    """The oracles that judge runs of ``scenario``: one per metric, robot, window, type and relation."""
     found = []
     for row in run_query(store, "oracles", {"scenario": scenario}, namespace):
         topics = tuple(sorted((_text(row["topics"]) or "").split()))
@@ -364,6 +364,9 @@ def oracles(store: Store, scenario: str, namespace: str = DEFAULT_NAMESPACE) -> 
                 delta=_float(row["delta"]),
                 tolerance=_float(row["tolerance"]),
                 package=_text(row["package"]),
+                window=_text(row["window"]),
+                criterion=_text(row["criterion"]) or "",
+                sources=tuple((_text(row["runs"]) or "").split()),
             )
         )
     return found

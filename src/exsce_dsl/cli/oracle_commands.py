@@ -1,0 +1,143 @@
+"""``exscec baseline`` and ``exscec verify``: oracles from stored runs, and verdicts on runs."""
+
+from __future__ import annotations
+
+import datetime
+import sys
+from pathlib import Path
+
+import click
+
+from exsce_dsl.cli.common import reports_errors, write_text
+from exsce_dsl.cli.store_commands import store_option
+
+
+@click.command()
+@click.argument("spec", type=click.Path(dir_okay=False))
+@click.option("--scenario-id", help="Which scenario, when the file declares several.")
+@store_option
+@reports_errors
+def baseline(spec: str, scenario_id: str | None, store_url: str | None) -> None:
+    """Build the oracles of a scenario from its acceptance criteria and its stored runs.
+
+    Each clause becomes an oracle per robot it is about; the value a
+    performance clause compares with is the mean of the metric over the stored
+    runs (tolerance: as written, else one standard deviation).  The oracles
+    are written to the store (the previous ones are kept as a revision) and
+    shown.  Refuses while the scenario has fewer runs than its criteria ask
+    ('given at least N baseline runs', 3 if not said).
+
+    \b
+    Example:
+      exscec baseline examples/brsu_building_c/scenario_c.exsce
+    """
+    from exsce_dsl.errors import ExsceError
+    from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.oracles.baseline import baseline_oracles
+    from exsce_dsl.prov.oracle import compile_oracles
+    from exsce_dsl.store.open import open_store
+    from exsce_dsl.store.writing import add_prov
+
+    loaded = load_spec(spec)
+    scenario = loaded.scenario(scenario_id)
+    acceptance = loaded.acceptance_of(scenario.id)
+    if acceptance is None:
+        raise ExsceError(
+            f"{spec} gives no acceptance criteria for '{scenario.id}' "
+            f"(write 'acceptance for {scenario.id} {{...}}')"
+        )
+    with open_store(store_url) as store:
+        oracles = baseline_oracles(store, acceptance, scenario, {s.id: s for s in loaded.scenarios})
+        report = add_prov(store, compile_oracles(scenario.id, oracles), replace=True)
+    rows: list[tuple[str, ...]] = [("oracle", "relation", "value", "limit", "delta", "tolerance", "runs")]
+    for o in oracles:
+        rows.append(
+            (
+                o.name,
+                o.relation + ("" if o.base_scenario == scenario.id else f" of {o.base_scenario}"),
+                *(f"{n:.4g}" if n is not None else "" for n in (o.value, o.limit, o.delta, o.tolerance)),
+                str(len(o.sources)) if o.sources else "",
+            )
+        )
+    widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
+    click.echo(
+        "\n".join("  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True)).rstrip() for r in rows)
+    )
+    click.echo(report.summary(), err=True)
+
+
+@click.command()
+@click.argument("runs", nargs=-1, required=True)
+@click.option(
+    "--scenario",
+    "spec",
+    required=True,
+    type=click.Path(dir_okay=False),
+    help="The .exsce file of the scenario the runs are of.",
+)
+@click.option("--scenario-id", help="Which scenario, when the file declares several.")
+@click.option("--json", "as_json", is_flag=True, help="Print the verdicts as JSON.")
+@click.option("--junit", type=click.Path(dir_okay=False), help="Also write a JUnit XML report to this file.")
+@click.option("--no-record", is_flag=True, help="Do not write the verdicts to the store.")
+@store_option
+@reports_errors
+def verify(
+    runs: tuple[str, ...],
+    spec: str,
+    scenario_id: str | None,
+    as_json: bool,
+    junit: str | None,
+    no_record: bool,
+    store_url: str | None,
+) -> None:
+    """Judge runs against every oracle of their scenario.
+
+    RUNS are stored runs (their uuids, as `exscec runs` lists them) or bag
+    files, which are ingested first.  For each oracle: the value observed, the
+    expectation, the margin and the verdict, and the runs the expectation came
+    from.  The verdicts are written to the store as provenance.  Exits 0 when
+    every oracle passed, 1 when one failed, 2 when one could not be judged (and
+    none failed).
+
+    \b
+    Example:
+      exscec verify runs/*.bag --scenario examples/brsu_building_c/scenario_c.exsce --junit verdicts.xml
+    """
+    from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.model.verdicts import Outcome
+    from exsce_dsl.oracles.report import junit_xml, verdict_table, verdicts_json
+    from exsce_dsl.oracles.verify import judge_runs
+    from exsce_dsl.prov.verdicts import compile_verdicts
+    from exsce_dsl.runs.ingest import ingest_bags
+    from exsce_dsl.store.open import open_store
+    from exsce_dsl.store.writing import add_prov
+
+    scenario = load_spec(spec).scenario(scenario_id)
+    bags = [Path(r) for r in runs if Path(r).is_file()]
+    uuids = [r for r in runs if not Path(r).is_file()]
+    with open_store(store_url) as store:
+        if bags:
+            for result in ingest_bags(bags, scenario, store, 1, None):
+                if result.failed or result.run_id is None:
+                    click.echo(f"error: {result.message}", err=True)
+                    sys.exit(2)
+                uuids.append(result.run_id)
+        verdicts = judge_runs(store, list(dict.fromkeys(uuids)), scenario)
+        if not no_record:
+            now = datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0)
+            for run in dict.fromkeys(v.run for v in verdicts):
+                add_prov(
+                    store, compile_verdicts(run, [v for v in verdicts if v.run == run], now), replace=True
+                )
+    click.echo(verdicts_json(verdicts) if as_json else verdict_table(verdicts))
+    if junit:
+        write_text(junit_xml(verdicts), junit)
+    failed = sum(v.outcome is Outcome.FAILED for v in verdicts)
+    unjudged = sum(v.outcome is Outcome.UNJUDGED for v in verdicts)
+    click.echo(
+        f"{len(verdicts) - failed - unjudged} passed, {failed} failed, {unjudged} not judged", err=True
+    )
+    sys.exit(1 if failed else 2 if unjudged else 0)
+
+
+COMMANDS = [baseline, verify]

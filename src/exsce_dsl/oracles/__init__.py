@@ -1,0 +1,1 @@
+"""Oracles: from acceptance criteria and stored runs to verdicts on runs."""

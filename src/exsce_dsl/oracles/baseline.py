@@ -1,0 +1,127 @@
+"""Baselines: the oracles of a scenario with their numbers, from its stored runs.
+
+For each oracle the acceptance criteria plan, the value it compares with is a
+fixed one (``around``, ``from``), a limit (``stays below``), or the mean of the
+metric over the stored runs of the scenario (a baseline oracle) or of the
+scenario it was derived from (a metamorphic one); the tolerance follows the
+clause (``within 1 std``, ``within 10 %``, ``within 2 s``; one standard deviation
+for ``invariant`` if none is written).  The method's "update baseline" is
+writing these oracles to the store again.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from exsce_dsl.errors import ExsceError
+from exsce_dsl.model import Scenario
+from exsce_dsl.model.acceptance import Acceptance, Relation
+from exsce_dsl.model.metrics import default_topics
+from exsce_dsl.model.oracles import Oracle
+from exsce_dsl.oracles.observe import RunValues, observe, run_values
+from exsce_dsl.oracles.plan import PlannedOracle, plan_oracles, tolerance_of
+from exsce_dsl.store.base import Store
+from exsce_dsl.store.queries import runs as stored_runs
+
+PACKAGE = "exsce.metamorphic.relationships"
+"""The package the method's YAML names for the built-in relations (kept for its format)."""
+
+
+class NotEnoughRuns(ExsceError):
+    """A baseline was asked for before the scenario had the runs its criteria require."""
+
+
+@dataclass(frozen=True)
+class Statistics:
+    mean: float
+    std: float
+    runs: tuple[str, ...]
+
+
+def baseline_oracles(
+    store: Store,
+    acceptance: Acceptance,
+    scenario: Scenario,
+    bases: dict[str, Scenario] | None = None,
+) -> list[Oracle]:
+    """The oracles of ``scenario`` with their numbers from the runs in ``store``.
+
+    ``bases`` are the scenarios metamorphic clauses compare with (by id).  Raises
+    :class:`NotEnoughRuns` while the scenario has fewer runs than its criteria ask.
+    """
+    own = [run.uuid for run in stored_runs(store, scenario.id)]
+    needed = acceptance.baseline_runs
+    planned = plan_oracles(acceptance, scenario)
+    if len(own) < needed and any(p.needs_runs and p.expectation.against is None for p in planned):
+        raise NotEnoughRuns(
+            f"scenario '{scenario.id}' has {len(own)} stored run{'s' if len(own) != 1 else ''}; "
+            f"its baseline needs {needed} (ingest more runs, or lower 'given at least N baseline runs')"
+        )
+    values = {scenario.id: run_values(store, own)}
+    oracles = []
+    for oracle in planned:
+        base_id = oracle.expectation.against or scenario.id
+        if base_id not in values:
+            base_runs = [run.uuid for run in stored_runs(store, base_id)]
+            if not base_runs:
+                raise ExsceError(
+                    f"scenario '{scenario.id}' is compared with '{base_id}', which has no stored runs yet"
+                )
+            values[base_id] = run_values(store, base_runs)
+        base = (bases or {}).get(base_id, scenario) if base_id != scenario.id else scenario
+        stats = _statistics(oracle, list(values[base_id].values()), base)
+        oracles.append(_numbers(oracle, stats, scenario))
+    return oracles
+
+
+def _statistics(oracle: PlannedOracle, runs: Sequence[RunValues], scenario: Scenario) -> Statistics | None:
+    observed: list[float] = []
+    used: list[str] = []
+    for values in runs:
+        value, _ = observe(values, oracle.metric, oracle.robot, oracle.window, scenario)
+        if value is not None:
+            observed.append(value)
+            used.append(values.run)
+    if not observed:
+        return None
+    mean = math.fsum(observed) / len(observed)
+    std = math.sqrt(math.fsum((v - mean) ** 2 for v in observed) / len(observed))
+    return Statistics(mean, std, tuple(used))
+
+
+def _numbers(oracle: PlannedOracle, stats: Statistics | None, scenario: Scenario) -> Oracle:
+    e = oracle.expectation
+    common = {
+        "metric": oracle.metric,
+        "robot": oracle.robot,
+        "relation": e.relation.value,
+        "type": oracle.type,
+        "base_scenario": e.against or scenario.id,
+        "topics": default_topics(scenario, oracle.metric, oracle.robot),
+        "package": PACKAGE,
+        "window": oracle.window_text,
+        "criterion": oracle.criterion,
+    }
+    if e.limit is not None:
+        return Oracle(**common, limit=e.limit.value)  # type: ignore[arg-type]
+    needs_std = (
+        e.tolerance is not None
+        and e.tolerance.unit == "std"
+        or (e.tolerance is None and e.relation is Relation.INVARIANT)
+    )
+    if stats is None and (e.value is None or needs_std):
+        where = f"'{e.against}'" if e.against else f"scenario '{scenario.id}'"
+        raise ExsceError(
+            f"no stored run of {where} has a value of '{oracle.metric}'"
+            + (f" for robot '{oracle.robot}'" if oracle.robot else "")
+            + (f" {oracle.window_text}" if oracle.window_text else "")
+            + " to build the oracle from"
+        )
+    value = e.value.value if e.value is not None else stats.mean  # type: ignore[union-attr]
+    std = stats.std if stats is not None else 0.0
+    tolerance = tolerance_of(e.tolerance, value, std, e.relation)
+    delta = e.delta.value if e.delta is not None else (0.0 if e.relation is not Relation.INVARIANT else None)
+    sources = stats.runs if stats is not None and (e.value is None or needs_std) else ()
+    return Oracle(**common, value=value, delta=delta, tolerance=tolerance, sources=sources)  # type: ignore[arg-type]

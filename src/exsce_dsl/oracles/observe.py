@@ -1,0 +1,139 @@
+"""What a run shows for an oracle: its value of the oracle's metric, for the robot and the
+part of the run (window) the oracle looks at, read from the store in two queries per batch
+of runs."""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+from exsce_dsl.model import Scenario
+from exsce_dsl.model.acceptance import Moment, Window
+from exsce_dsl.model.metrics import METRICS, Combine
+from exsce_dsl.store.base import Store
+from exsce_dsl.store.queries import run_query
+
+_ACTION = re.compile(r"/(?P<robot>[^/]+)-task_(?P<task>\d+)-subtask_(?P<subtask>\d+)-w_(?P<waypoint>\d+)$")
+_WINDOW = re.compile(
+    r"(?P<moment>during|before|after) (?:(?P<robot>\S+) reaches (?P<pose>\S+)|(?P<task>\S+))"
+)
+
+
+@dataclass(frozen=True)
+class SegmentValue:
+    action: str
+    robot: str
+    allocation: int
+    """The robot's task it belongs to: 1 for its first task in the mission."""
+    order: tuple[int, int, int]
+    goal: str
+    """The goal pose's name with its heading (``room-p3-R0.00_P0.00_Y0.00``)."""
+    metric: str
+    value: float
+
+
+@dataclass
+class RunValues:
+    """One run's metric values: whole-run ones by (metric, robot), and per action."""
+
+    run: str
+    whole: dict[tuple[str, str | None], list[float]] = field(default_factory=dict)
+    segments: list[SegmentValue] = field(default_factory=list)
+
+
+def run_values(store: Store, runs: Sequence[str]) -> dict[str, RunValues]:
+    """The metric values of ``runs`` (uuids), by run."""
+    found = {run: RunValues(run) for run in runs}
+    if not runs:
+        return found
+    for row in run_query(store, "run_metric_values", {"run": list(runs)}):
+        run, metric, value = row["run"], row["metric"], row["value"]
+        robot = row["robot"]
+        if run is None or metric is None or value is None or run.value not in found:
+            continue
+        key = (metric.value, robot.value if robot is not None else None)
+        found[run.value].whole.setdefault(key, []).append(float(value.value))
+    for row in run_query(store, "run_segment_values", {"run": list(runs)}):
+        run, action, goal, metric, value = row["run"], row["action"], row["goal"], row["metric"], row["value"]
+        if None in (run, action, goal, metric, value) or run.value not in found:  # type: ignore[union-attr]
+            continue
+        assert run is not None and action is not None and goal is not None
+        assert metric is not None and value is not None
+        parts = _ACTION.search(action.value)
+        if parts is None:
+            continue
+        numbers = (int(parts["task"]), int(parts["subtask"]), int(parts["waypoint"]))
+        found[run.value].segments.append(
+            SegmentValue(
+                action.value,
+                parts["robot"],
+                numbers[0],
+                numbers,
+                goal.value.rsplit("/", 1)[-1],
+                metric.value,
+                float(value.value),
+            )
+        )
+    return found
+
+
+def parse_window(text: str | None) -> Window | None:
+    """The window of an oracle as the store keeps it (``during delivery_a``), or None."""
+    if text is None:
+        return None
+    match = _WINDOW.fullmatch(text)
+    if match is None:
+        raise ValueError(f"not a window: {text!r}")
+    if match["task"] is not None:
+        return Window(Moment(match["moment"]), "", task=match["task"])
+    return Window(Moment(match["moment"]), match["robot"], pose=match["pose"])
+
+
+def observe(
+    values: RunValues, metric: str, robot: str | None, window: Window | None, scenario: Scenario
+) -> tuple[float | None, str]:
+    """The run's value for an oracle, or None and why there is none."""
+    info = METRICS.get(metric)
+    if window is None:
+        found = values.whole.get((metric, robot))
+        if not found:
+            who = f" of robot '{robot}'" if robot else " of the mission"
+            return None, f"run {values.run} has no value of '{metric}'{who}"
+        # violation_duration has one value per safety metric: the total is what a clause says
+        return (sum(found) if len(found) > 1 else found[0]), ""
+    if info is None or info.combine is None:
+        return None, f"'{metric}' has no value per path segment"
+    owner = robot or window.robot
+    picked = _in_window(
+        sorted(
+            (s for s in values.segments if s.robot == owner and s.metric == metric), key=lambda s: s.order
+        ),
+        window,
+        scenario.mission.tasks_of(owner),
+    )
+    if not picked:
+        return None, f"run {values.run} has no path segment of '{owner}' {window.text()}"
+    numbers = [s.value for s in picked]
+    if info.combine is Combine.SUM:
+        return float(sum(numbers)), ""
+    return float(max(numbers) if info.combine is Combine.MAX else min(numbers)), ""
+
+
+def _in_window(segments: list[SegmentValue], window: Window, tasks: Sequence[str]) -> list[SegmentValue]:
+    if window.task is not None:
+        indices = [k for k, task in enumerate(tasks, start=1) if task == window.task]
+        if not indices:
+            return []
+        if window.moment is Moment.DURING:
+            return [s for s in segments if s.allocation in indices]
+        if window.moment is Moment.BEFORE:
+            return [s for s in segments if s.allocation < indices[0]]
+        return [s for s in segments if s.allocation > indices[-1]]
+    reached = next(
+        (n for n, s in enumerate(segments) if s.goal == window.pose or s.goal.startswith(f"{window.pose}-R")),
+        None,
+    )
+    if reached is None:
+        return []
+    return segments[: reached + 1] if window.moment is Moment.BEFORE else segments[reached + 1 :]

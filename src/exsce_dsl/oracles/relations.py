@@ -1,0 +1,266 @@
+"""Output relations: how an oracle compares a run's value with what it expects.
+
+The method's basic relations, with its signatures: ``increasing(result, value, delta,
+tolerance)``, ``decreasing(...)``, ``invariant(result, value, tolerance)``,
+``below_max(result, limit)``, ``above_min(result, limit)``.  Complex relations combine
+judgements (:func:`all_of`, :func:`any_of`), aggregate a fleet's values
+(:func:`aggregate`), or compose the relations that input transformations imply
+(:func:`compose`, :func:`composed_relation`).
+
+Third-party packages add relations through the entry-point group ``exsce.relations``;
+a relation is never imported from a module name found in a data file.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+import warnings
+from abc import ABC, abstractmethod
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from importlib.metadata import entry_points
+
+from exsce_dsl.errors import ExsceError
+from exsce_dsl.lang.suggest import did_you_mean
+
+__all__ = [
+    "ENTRY_POINT_GROUP",
+    "TRANSFORMATION_RELATIONS",
+    "Judgement",
+    "Relation",
+    "RelationError",
+    "aggregate",
+    "all_of",
+    "any_of",
+    "compose",
+    "composed_relation",
+    "relation",
+    "relation_names",
+]
+
+ENTRY_POINT_GROUP = "exsce.relations"
+
+
+class RelationError(ExsceError):
+    """A relation that does not exist, or was given the wrong parameters."""
+
+
+@dataclass(frozen=True)
+class Judgement:
+    passed: bool
+    margin: float
+    """How far inside the bound the result is (negative: by how much it is outside)."""
+    expected: str
+    """The bound in words: ``<= 1``, ``12 ± 3``."""
+
+
+class Relation(ABC):
+    """An output relation.  Plug-ins subclass it and implement :meth:`compare`;
+    :meth:`judge` checks parameters and NaN first, so that every relation treats them alike."""
+
+    name: str
+    parameters: frozenset[str]
+    """Every parameter it takes, among value, limit, delta and tolerance."""
+    required: frozenset[str]
+    """Those it cannot judge without."""
+
+    def judge(
+        self,
+        result: float,
+        *,
+        value: float | None = None,
+        limit: float | None = None,
+        delta: float | None = None,
+        tolerance: float | None = None,
+    ) -> Judgement:
+        """Judge ``result``; a parameter given as None counts as not given."""
+        named = {"value": value, "limit": limit, "delta": delta, "tolerance": tolerance}
+        given = {k: float(v) for k, v in named.items() if v is not None}
+        takes = ", ".join(sorted(self.parameters)) or "no parameters"
+        for unknown in sorted(set(given) - self.parameters):
+            raise RelationError(f"relation '{self.name}' takes no {unknown} (it takes {takes})")
+        for missing in sorted(self.required - set(given)):
+            raise RelationError(f"relation '{self.name}' needs a {missing} (it takes {takes})")
+        judged = self.compare(float(result), given)
+        if math.isnan(result) or math.isnan(judged.margin):
+            return dataclasses.replace(judged, passed=False, margin=math.nan)
+        return judged
+
+    @abstractmethod
+    def compare(self, result: float, given: Mapping[str, float]) -> Judgement:
+        """Judge ``result`` with checked parameters (those not given are absent from ``given``)."""
+
+
+Check = Callable[[float, Mapping[str, float]], Judgement]
+
+
+@dataclass(frozen=True)
+class _Basic(Relation):
+    """A built-in relation: its parameters and the function that compares."""
+
+    name: str
+    parameters: frozenset[str]
+    required: frozenset[str]
+    check: Check
+
+    def compare(self, result: float, given: Mapping[str, float]) -> Judgement:
+        return self.check(result, given)
+
+
+def _g(x: float) -> str:
+    return f"{x:g}"
+
+
+def _below_max(result: float, p: Mapping[str, float]) -> Judgement:
+    margin = p["limit"] - result
+    return Judgement(margin >= 0, margin, f"<= {_g(p['limit'])}")
+
+
+def _above_min(result: float, p: Mapping[str, float]) -> Judgement:
+    margin = result - p["limit"]
+    return Judgement(margin >= 0, margin, f">= {_g(p['limit'])}")
+
+
+def _invariant(result: float, p: Mapping[str, float]) -> Judgement:
+    tolerance = p.get("tolerance", 0.0)
+    margin = tolerance - abs(result - p["value"])
+    return Judgement(margin >= 0, margin, f"{_g(p['value'])} ± {_g(tolerance)}")
+
+
+def _changing(sign: float) -> Check:
+    """``increasing`` (sign 1) or ``decreasing`` (sign -1): a change of at least delta, less tolerance."""
+
+    def check(result: float, p: Mapping[str, float]) -> Judgement:
+        value, delta, tolerance = p["value"], p.get("delta", 0.0), p.get("tolerance", 0.0)
+        margin = sign * (result - value) - (delta - tolerance)
+        words = f"{'>=' if sign > 0 else '<='} {_g(value + sign * (delta - tolerance))}"
+        if delta or tolerance:
+            change = f"{'+' if sign > 0 else '-'} {_g(delta)}"
+            allowance = f" {'-' if sign > 0 else '+'} {_g(tolerance)}" if tolerance else ""
+            words += f" ({_g(value)} {change}{allowance})"
+        return Judgement(margin >= 0, margin, words)
+
+    return check
+
+
+_CHANGE = frozenset({"value", "delta", "tolerance"})
+_BUILT_IN: Mapping[str, Relation] = {
+    r.name: r
+    for r in (
+        _Basic("below_max", frozenset({"limit"}), frozenset({"limit"}), _below_max),
+        _Basic("above_min", frozenset({"limit"}), frozenset({"limit"}), _above_min),
+        _Basic("invariant", frozenset({"value", "tolerance"}), frozenset({"value"}), _invariant),
+        _Basic("increasing", _CHANGE, frozenset({"value"}), _changing(1.0)),
+        _Basic("decreasing", _CHANGE, frozenset({"value"}), _changing(-1.0)),
+    )
+}
+
+
+@functools.lru_cache(maxsize=1)
+def _registry() -> Mapping[str, Relation]:
+    """The built-ins and the plug-ins' relations, read once; a plug-in that cannot be used is
+    left out with a warning, so that it does not stop every other oracle."""
+    found = dict(_BUILT_IN)
+    for point in entry_points(group=ENTRY_POINT_GROUP):
+        where = f"the plug-in relation '{point.name}' ({point.value})"
+        if point.name in _BUILT_IN:
+            warnings.warn(f"{where} cannot replace exsce's own '{point.name}'; ignored", stacklevel=3)
+            continue
+        try:
+            loaded = point.load()
+            made = loaded if isinstance(loaded, Relation) or not callable(loaded) else loaded()
+        except Exception as exc:  # a broken third-party package
+            warnings.warn(f"{where} cannot be loaded: {exc!r}; ignored", stacklevel=3)
+            continue
+        if not isinstance(made, Relation) or made.name != point.name:
+            warnings.warn(f"{where} is not a Relation named '{point.name}'; ignored", stacklevel=3)
+            continue
+        found[point.name] = made
+    return found
+
+
+def relation(name: str) -> Relation:
+    """The relation called ``name``: a built-in one or a registered plug-in's."""
+    known = _registry()
+    if name not in known:
+        raise RelationError(f"unknown relation '{name}'{did_you_mean(name, known)}")
+    return known[name]
+
+
+def relation_names() -> tuple[str, ...]:
+    return tuple(sorted(_registry()))
+
+
+def all_of(*judgements: Judgement) -> Judgement:
+    """Passes when every judgement does; its margin is the smallest."""
+    if not judgements:
+        raise RelationError("all_of needs at least one judgement")
+    return Judgement(
+        all(j.passed for j in judgements),
+        min(j.margin for j in judgements),
+        " and ".join(j.expected for j in judgements),
+    )
+
+
+def any_of(*judgements: Judgement) -> Judgement:
+    """Passes when one judgement does; its margin is the largest."""
+    if not judgements:
+        raise RelationError("any_of needs at least one judgement")
+    return Judgement(
+        any(j.passed for j in judgements),
+        max(j.margin for j in judgements),
+        " or ".join(j.expected for j in judgements),
+    )
+
+
+_AGGREGATES: Mapping[str, Callable[[list[float]], float]] = {
+    "sum": math.fsum,
+    "mean": lambda xs: math.fsum(xs) / len(xs),
+    "max": max,
+    "min": min,
+}
+
+
+def aggregate(values: Mapping[str, float], how: str) -> float:
+    """The fleet's value from each robot's: ``sum``, ``mean``, ``max`` or ``min``.
+    NaN if a robot's value is NaN (``max`` and ``min`` would otherwise depend on order)."""
+    if how not in _AGGREGATES:
+        raise RelationError(f"unknown aggregate '{how}'{did_you_mean(how, _AGGREGATES)}")
+    numbers = [float(v) for v in values.values()]
+    if not numbers:
+        raise RelationError(f"no robot values to aggregate ({how})")
+    if any(math.isnan(x) for x in numbers):
+        return math.nan
+    return _AGGREGATES[how](numbers)
+
+
+TRANSFORMATION_RELATIONS: Mapping[str, Mapping[str, str]] = {
+    "add_waypoint": {"distance_travelled": "increasing", "task_duration": "increasing"},
+    "remove_waypoint": {"distance_travelled": "decreasing", "task_duration": "decreasing"},
+    "reverse_waypoint_order": {"distance_travelled": "invariant", "task_duration": "invariant"},
+    # of each robot's total over its tasks
+    "reverse_task_order": {"distance_travelled": "invariant", "task_duration": "invariant"},
+}
+"""What an input transformation does to a metric, where the method knows it (``swap_start_poses``
+has no known effect)."""
+
+
+def compose(relations: Sequence[str]) -> str | None:
+    """The relation of several changes in a row: invariant is neutral; the same direction
+    twice keeps it; opposite directions cannot be told apart without estimates (None)."""
+    unknown = sorted(set(relations) - {"increasing", "decreasing", "invariant"})
+    if unknown:
+        raise RelationError(f"cannot compose '{unknown[0]}' (only increasing, decreasing, invariant)")
+    directions = set(relations) - {"invariant"}
+    if not directions:
+        return "invariant"
+    return directions.pop() if len(directions) == 1 else None
+
+
+def composed_relation(transformations: Sequence[str], metric: str) -> str | None:
+    """The relation ``metric`` keeps through ``transformations`` (None if any effect is unknown)."""
+    implied = [TRANSFORMATION_RELATIONS.get(t, {}).get(metric) for t in transformations]
+    known = [r for r in implied if r is not None]
+    return compose(known) if len(known) == len(implied) else None
