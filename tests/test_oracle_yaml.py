@@ -336,9 +336,9 @@ def test_a_clause_without_value_and_no_baseline_cannot_be_written(scenario_c: Sc
         export_oracle_yaml(acceptance, scenario_c)
     (diagnostic,) = raised.value.diagnostics
     assert diagnostic.location is not None
-    assert (Path(diagnostic.location.file).name, diagnostic.location.line) == ("scenario_c.exsce", 33)
+    assert (Path(diagnostic.location.file).name, diagnostic.location.line) == ("scenario_c.exsce", 34)
     assert diagnostic.message.startswith(
-        "'each robot task_duration is invariant within 1 std' needs the mean of stored runs of task_duration "
+        "'each robot task_duration is invariant within 3 std' needs the mean of stored runs of task_duration "
         "of tiago1, and no baseline was given"
     )
 
@@ -432,7 +432,29 @@ def test_cli_oracle_import_needs_the_spec_and_export_says_which_clause(tmp_path:
 
     no_baseline = run_exscec("export", str(EXAMPLE / "scenario_c.exsce"), "--to", "oracle-yaml", "-o", str(tmp_path))
     assert no_baseline.returncode == 1
-    assert "scenario_c.exsce:33:10: error: 'each robot task_duration is invariant within 1 std' needs the mean" in (
+    assert "scenario_c.exsce:34:10: error: 'each robot task_duration is invariant within 3 std' needs the mean" in (
         no_baseline.stderr
     )
     assert not (tmp_path / "oracles").exists()
+
+
+def test_the_file_s_values_reach_the_oracle_prov_through_exscec_baseline(scenario_c: Scenario) -> None:
+    """Imported criteria carry fixed values, so a baseline needs no runs: the method's numbers
+    go straight into the oracle PROV (Listing 17's shape)."""
+    from exsce_dsl.model.oracles import OracleType
+    from exsce_dsl.oracles.baseline import baseline_oracles
+    from exsce_dsl.prov.oracle import compile_oracles
+    from exsce_dsl.store.embedded import EmbeddedStore
+
+    acceptance = import_oracle_yaml(ORACLES, scenario_c)
+    oracles = {o.name: o for o in baseline_oracles(EmbeddedStore(None), acceptance, scenario_c)}
+    assert {o.type for o in oracles.values()} == {OracleType.BASELINE}
+    mission = oracles["mission_duration"]
+    assert (mission.relation, mission.value, mission.tolerance) == ("invariant", 97.606, 10.0)
+    assert mission.topics == ("/tiago1/waypoint_dispatcher/feedback", "/tiago2/waypoint_dispatcher/feedback")
+    assert (oracles["tiago1-max_velocity"].relation, oracles["tiago1-max_velocity"].limit) == ("below_max", 1.0)
+    assert oracles["tiago1-distance_travelled"].value == 50.702942669287076
+    provn = compile_oracles("scenario_c", list(oracles.values())).get_provn()
+    assert 'oracle:value="97.606" %% xsd:double' in provn and 'oracle:tolerance="10.0" %% xsd:double' in provn
+    assert 'oracle:limit="0.1" %% xsd:double' in provn and 'oracle:relationship="above_min"' in provn
+    assert 'oracle:value="50.702942669287076" %% xsd:double' in provn

@@ -119,7 +119,7 @@ def test_baseline_refuses_too_few_runs_then_builds_from_enough(
     assert three.returncode == 0, three.stderr
     refused = run_exscec("baseline", "spec.exsce", cwd=folder)
     assert refused.returncode == 1 and "Traceback" not in refused.stderr
-    assert "scenario 'yard_run' has 3 stored runs; its baseline needs 4" in refused.stderr
+    assert "scenario 'yard_run' has 3 stored runs that no oracle failed; its baseline needs 4" in refused.stderr
     fourth = run_exscec("ingest", str(clean[3]), "--scenario", "spec.exsce", cwd=folder)
     assert fourth.returncode == 0, fourth.stderr
     built = run_exscec("baseline", "spec.exsce", cwd=folder)
@@ -177,3 +177,52 @@ def test_the_verdicts_are_provenance_in_the_store(yard: tuple[Path, list[Path], 
     found = run_exscec("sparql", query, "--format", "csv", cwd=folder)
     assert found.returncode == 0, found.stderr
     assert found.stdout.split() == ["outcome,n", "failed,10", f"passed,{len(ORACLES) * 6 - 10}"]
+
+
+LONG = """\
+import "spec.exsce"
+
+// yard_run with r1 alone, doing patrol_2 (to c) after patrol_1: a metamorphic test of yard_run
+scenario yard_long in yard {
+  robots {
+    r1: tiago starts at field-a
+  }
+  mission long_mission sequential {
+    r1 does patrol_1 then patrol_2
+  }
+}
+
+acceptance for yard_long {
+  scenario "longer than the pair's r1" {
+    given at least 1 baseline runs
+    when long_mission runs
+    then r1 distance_travelled is increasing by 4 m of yard_run
+     and r1 max_velocity is invariant within 10 % of yard_run
+     and r1 waypoints_visited is increasing by 1 of yard_run
+  }
+}
+"""
+
+
+def test_a_derived_scenario_is_judged_against_the_runs_of_its_base(
+    yard: tuple[Path, list[Path], dict[str, Path]],
+) -> None:
+    folder, _, _ = yard
+    (folder / "long.exsce").write_text(LONG)
+    scenario = load_spec(folder / "long.exsce").scenario()
+    bag = next(iter(simulate(scenario, folder / "long", 1, seed=5))).bag
+    built = run_exscec("baseline", "long.exsce", cwd=folder)
+    assert built.returncode == 0, built.stderr
+    rows = {line.split()[0]: line.split()[1:] for line in built.stdout.splitlines()[1:]}
+    # the base's runs that passed (4 baseline + 2 clean), not the 4 a fault made fail
+    relation, of, base, value, delta, tolerance, runs = rows["r1-distance_travelled"]
+    assert (relation, of, base, delta, tolerance, runs) == ("increasing", "of", "yard_run", "4", "0", "6")
+    assert float(value) == pytest.approx(11.95, abs=0.01)
+    judged = run_exscec("verify", str(bag), "--scenario", "long.exsce", "--json", cwd=folder)
+    assert judged.returncode == 0, judged.stdout + judged.stderr
+    verdicts = {v["oracle"]: v for v in json.loads(judged.stdout)}
+    assert set(verdicts) == {"r1-distance_travelled", "r1-max_velocity", "r1-waypoints_visited"}
+    distance = verdicts["r1-distance_travelled"]
+    assert distance["verdict"] == "passed" and distance["expected"] == pytest.approx(11.95, abs=0.01)
+    assert distance["observed"] == pytest.approx(11.95 + 4.95, abs=0.05)  # e → c is 4.95 m more
+    assert verdicts["r1-waypoints_visited"]["observed"] == 3 and len(distance["runs"]) == 6

@@ -94,7 +94,8 @@ class Expectation:
     ``against`` is None for the scenario's own baseline (its past runs), or the
     scenario whose runs a derived scenario's runs are compared with (metamorphic).
     ``tolerance`` of None means one standard deviation of the baseline for
-    ``invariant`` and none for ``increasing`` and ``decreasing``.
+    ``invariant`` around the baseline's mean, and none (exactly) around a fixed value
+    and for ``increasing`` and ``decreasing``.
     """
 
     subject: Subject

@@ -23,6 +23,7 @@ from exsce_dsl.model.oracles import Oracle
 from exsce_dsl.oracles.observe import RunValues, observe, run_values
 from exsce_dsl.oracles.plan import PlannedOracle, plan_oracles, tolerance_of
 from exsce_dsl.store.base import Store
+from exsce_dsl.store.queries import run_query
 from exsce_dsl.store.queries import runs as stored_runs
 
 PACKAGE = "exsce.metamorphic.relationships"
@@ -46,17 +47,19 @@ def baseline_oracles(
     scenario: Scenario,
     bases: dict[str, Scenario] | None = None,
 ) -> list[Oracle]:
-    """The oracles of ``scenario`` with their numbers from the runs in ``store``.
+    """The oracles of ``scenario`` with their numbers from the runs in ``store`` (less the runs
+    an oracle failed when they were verified).
 
     ``bases`` are the scenarios metamorphic clauses compare with (by id).  Raises
     :class:`NotEnoughRuns` while the scenario has fewer runs than its criteria ask.
     """
-    own = [run.uuid for run in stored_runs(store, scenario.id)]
+    own = _usable_runs(store, scenario.id)
     needed = acceptance.baseline_runs
     planned = plan_oracles(acceptance, scenario)
     if len(own) < needed and any(p.needs_runs and p.expectation.against is None for p in planned):
         raise NotEnoughRuns(
-            f"scenario '{scenario.id}' has {len(own)} stored run{'s' if len(own) != 1 else ''}; "
+            f"scenario '{scenario.id}' has {len(own)} stored run{'s' if len(own) != 1 else ''} "
+            "that no oracle failed; "
             f"its baseline needs {needed} (ingest more runs, or lower 'given at least N baseline runs')"
         )
     values = {scenario.id: run_values(store, own)}
@@ -64,7 +67,7 @@ def baseline_oracles(
     for oracle in planned:
         base_id = oracle.expectation.against or scenario.id
         if base_id not in values:
-            base_runs = [run.uuid for run in stored_runs(store, base_id)]
+            base_runs = _usable_runs(store, base_id)
             if not base_runs:
                 raise ExsceError(
                     f"scenario '{scenario.id}' is compared with '{base_id}', which has no stored runs yet"
@@ -74,6 +77,13 @@ def baseline_oracles(
         stats = _statistics(oracle, list(values[base_id].values()), base)
         oracles.append(_numbers(oracle, stats, scenario))
     return oracles
+
+
+def _usable_runs(store: Store, scenario_id: str) -> list[str]:
+    """The stored runs of a scenario, less those an oracle failed when they were verified."""
+    rows = run_query(store, "failed_runs", {"scenario": scenario_id})
+    failed = {row["run"].value for row in rows if row["run"] is not None}
+    return [run.uuid for run in stored_runs(store, scenario_id) if run.uuid not in failed]
 
 
 def _statistics(oracle: PlannedOracle, runs: Sequence[RunValues], scenario: Scenario) -> Statistics | None:
@@ -106,10 +116,9 @@ def _numbers(oracle: PlannedOracle, stats: Statistics | None, scenario: Scenario
     }
     if e.limit is not None:
         return Oracle(**common, limit=e.limit.value)  # type: ignore[arg-type]
-    needs_std = (
-        e.tolerance is not None
-        and e.tolerance.unit == "std"
-        or (e.tolerance is None and e.relation is Relation.INVARIANT)
+    # none written: one standard deviation around the runs' mean, but exactly a fixed value
+    needs_std = (e.tolerance is not None and e.tolerance.unit == "std") or (
+        e.tolerance is None and e.relation is Relation.INVARIANT and e.value is None
     )
     if stats is None and (e.value is None or needs_std):
         where = f"'{e.against}'" if e.against else f"scenario '{scenario.id}'"
@@ -121,7 +130,9 @@ def _numbers(oracle: PlannedOracle, stats: Statistics | None, scenario: Scenario
         )
     value = e.value.value if e.value is not None else stats.mean  # type: ignore[union-attr]
     std = stats.std if stats is not None else 0.0
-    tolerance = tolerance_of(e.tolerance, value, std, e.relation)
+    tolerance: float | None = tolerance_of(e.tolerance, value, std, e.relation)
+    if e.tolerance is None and e.value is not None:
+        tolerance = None
     delta = e.delta.value if e.delta is not None else (0.0 if e.relation is not Relation.INVARIANT else None)
     sources = stats.runs if stats is not None and (e.value is None or needs_std) else ()
     return Oracle(**common, value=value, delta=delta, tolerance=tolerance, sources=sources)  # type: ignore[arg-type]
