@@ -30,7 +30,14 @@ def main(debug: bool) -> None:
 
 
 def _register() -> None:
-    from exsce_dsl.cli import oracle_commands, query_commands, run_commands, spec_commands, store_commands
+    from exsce_dsl.cli import (
+        derive_commands,
+        oracle_commands,
+        query_commands,
+        run_commands,
+        spec_commands,
+        store_commands,
+    )
 
     for command in [
         *spec_commands.COMMANDS,
@@ -38,6 +45,7 @@ def _register() -> None:
         *store_commands.COMMANDS,
         *query_commands.COMMANDS,
         *oracle_commands.COMMANDS,
+        *derive_commands.COMMANDS,
     ]:
         main.add_command(command)
 

@@ -1,0 +1,109 @@
+"""``exscec derive``: a new scenario from a base one by input transformations."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from exsce_dsl.cli.common import reports_errors
+from exsce_dsl.cli.store_commands import store_option
+
+
+def _requests(words: tuple[str, ...]) -> list[tuple[str, dict[str, str]]]:
+    """``-t remove_robot --robot tiago2 --reassign tiago1 -t ...`` → steps with their arguments."""
+    steps: list[tuple[str, dict[str, str]]] = []
+    rest = list(words)
+    while rest:
+        word = rest.pop(0)
+        if word in ("-t", "--transform"):
+            if not rest:
+                raise click.UsageError(f"{word} needs a transformation name")
+            steps.append((rest.pop(0), {}))
+        elif word.startswith("--") and len(word) > 2:
+            if not steps:
+                raise click.UsageError(f"{word} comes before any -t TRANSFORMATION")
+            key, _, value = word[2:].partition("=")
+            if not value:
+                if not rest:
+                    raise click.UsageError(f"{word} needs a value")
+                value = rest.pop(0)
+            steps[-1][1][key.replace("-", "_")] = value
+        else:
+            raise click.UsageError(
+                f"unexpected '{word}' (arguments are --name value, after -t TRANSFORMATION)"
+            )
+    return steps
+
+
+@click.command(context_settings={"ignore_unknown_options": True})
+@click.argument("spec", type=click.Path(dir_okay=False, exists=True))
+@click.option("-o", "--output", type=click.Path(dir_okay=False), help="Write the new .exsce file here.")
+@click.option("--id", "new_id", help="The new scenario's id (default: the base's and a digest of the steps).")
+@click.option("--scenario-id", help="The base scenario, when the file declares several.")
+@click.option("--list", "list_them", is_flag=True, help="List the transformations and their arguments.")
+@click.option(
+    "--add-to-store", is_flag=True, help="Also add the new scenario and its generation PROV to the store."
+)
+@store_option
+@click.argument("steps", nargs=-1, type=click.UNPROCESSED)
+@reports_errors
+def derive(
+    spec: str,
+    output: str | None,
+    new_id: str | None,
+    scenario_id: str | None,
+    list_them: bool,
+    add_to_store: bool,
+    store_url: str | None,
+    steps: tuple[str, ...],
+) -> None:
+    """Derive a scenario from SPEC's by input transformations, applied in order.
+
+    Prints (or writes with -o) a formatted .exsce file that imports SPEC and
+    declares the new scenario and any task a transformation made; it checks
+    clean.  --add-to-store adds the new scenario and its generation provenance
+    (the method's shape: one activity per step) to the store.
+
+    \b
+    Example:
+      exscec derive examples/brsu_building_c/scenario_c.exsce \\
+          -t remove_robot --robot tiago2 --reassign tiago1 \\
+          -t reverse_waypoint_order --task delivery_a -o scenario_c_alone.exsce
+    """
+    from exsce_dsl.derive.derivation import derive as apply_steps
+    from exsce_dsl.derive.derivation import derived_document
+    from exsce_dsl.derive.transformations import TRANSFORMATIONS
+    from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.lang.formatter import declared_poses, format_document
+
+    if list_them:
+        for t in TRANSFORMATIONS.values():
+            arguments = " ".join([f"--{a} X" for a in t.required] + [f"[--{a} X]" for a in t.optional])
+            click.echo(f"{t.name} {arguments}\n    {t.help}")
+        return
+    loaded = load_spec(spec)
+    base = loaded.scenario(scenario_id)
+    derived = apply_steps(base, _requests(steps), new_id, {t.id: t for t in loaded.tasks})
+    target = Path(output) if output else Path(spec).with_name(f"{derived.scenario.id}.exsce")
+    document = derived_document(derived, Path(spec), target)
+    text = format_document(document, declared_poses(loaded.environments))
+    if output:
+        Path(output).write_text(text, encoding="utf-8")
+        load_spec(output)  # what we wrote must check clean
+        click.echo(f"wrote {output}: scenario {derived.scenario.id}", err=True)
+    else:
+        click.echo(text, nl=False)
+    if add_to_store:
+        from exsce_dsl.prov import compile_scenario
+        from exsce_dsl.prov.derivation import compile_derivation
+        from exsce_dsl.store.open import open_store
+        from exsce_dsl.store.writing import add_prov
+
+        with open_store(store_url) as store:
+            add_prov(store, compile_scenario(base))
+            click.echo(add_prov(store, compile_scenario(derived.scenario)).summary(), err=True)
+            click.echo(add_prov(store, compile_derivation(derived.derivation)).summary(), err=True)
+
+
+COMMANDS = [derive]

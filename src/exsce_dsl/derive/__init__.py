@@ -1,0 +1,1 @@
+"""Deriving scenarios: input transformations on the semantic model, and their record."""

@@ -1,0 +1,74 @@
+"""Apply a chain of input transformations to a scenario: the new scenario, its new tasks, the
+derivation record (for the generation PROV), and the ``.exsce`` document that declares them."""
+
+from __future__ import annotations
+
+import hashlib
+import os
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from exsce_dsl.derive.transformations import TRANSFORMATIONS, Applied
+from exsce_dsl.errors import ExsceError
+from exsce_dsl.lang.names import is_valid_name
+from exsce_dsl.lang.suggest import did_you_mean
+from exsce_dsl.model import Document, Import, Scenario, Task
+from exsce_dsl.model.derivation import Derivation
+
+Request = tuple[str, Mapping[str, str]]
+"""A transformation's name and its arguments as text."""
+
+
+@dataclass(frozen=True)
+class Derived:
+    scenario: Scenario
+    new_tasks: tuple[Task, ...]
+    derivation: Derivation
+
+
+def derive(
+    base: Scenario,
+    requests: Sequence[Request],
+    new_id: str | None = None,
+    tasks: Mapping[str, Task] | None = None,
+) -> Derived:
+    """``base`` transformed by ``requests`` in order; ``tasks`` are the tasks the spec declares
+    (a transformation may allocate one the base does not use)."""
+    if not requests:
+        raise ExsceError("say which transformations to apply (-t NAME ...)")
+    known = dict(tasks or {})
+    applied = Applied(base)
+    for name, arguments in requests:
+        transformation = TRANSFORMATIONS.get(name)
+        if transformation is None:
+            raise ExsceError(f"unknown transformation '{name}'{did_you_mean(name, TRANSFORMATIONS)}")
+        missing = [k for k in transformation.required if k not in arguments]
+        unknown = [k for k in arguments if k not in transformation.required + transformation.optional]
+        if missing or unknown:
+            takes = ", ".join(transformation.required + tuple(f"[{o}]" for o in transformation.optional))
+            problem = f"needs {', '.join(missing)}" if missing else f"takes no {', '.join(unknown)}"
+            raise ExsceError(f"{name} {problem} (it takes {takes})")
+        known.update({t.id: t for t in applied.new_tasks})
+        applied = applied.then(transformation.apply(applied.scenario, arguments, known))
+    derivation_id = new_id or _default_id(base.id, applied)
+    if not is_valid_name(derivation_id):
+        raise ExsceError(f"'{derivation_id}' cannot be a scenario id")
+    if derivation_id == base.id:
+        raise ExsceError("the derived scenario needs an id of its own")
+    mission = replace(applied.scenario.mission, id=f"{derivation_id}_mission")
+    scenario = replace(applied.scenario, id=derivation_id, mission=mission, location=None)
+    return Derived(scenario, applied.new_tasks, Derivation(derivation_id, base.id, applied.steps))
+
+
+def _default_id(base: str, applied: Applied) -> str:
+    """Deterministic: the base's id and a digest of the steps."""
+    text = repr((base, applied.steps))
+    return f"{base}_{hashlib.sha256(text.encode()).hexdigest()[:8]}"
+
+
+def derived_document(derived: Derived, base_spec: Path, target: Path) -> Document:
+    """The new file: it imports the base's spec (relative to where it is written) and declares
+    the new tasks and the new scenario."""
+    relative = os.path.relpath(base_spec.resolve(), target.resolve().parent)
+    return Document(str(target), (Import(Path(relative).as_posix()),), (*derived.new_tasks, derived.scenario))
