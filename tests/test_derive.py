@@ -106,6 +106,30 @@ def test_start_pose_and_robot_transformations(base: Scenario) -> None:
     assert [s.transformation for s in replaced.derivation.steps] == ["add_robot", "substitute_allocation", "remove_robot"]
 
 
+def test_start_pose_and_allocation_transformations(base: Scenario) -> None:
+    alone = derive(
+        base,
+        [
+            ("remove_task", {"robot": "tiago2"}),
+            ("remove_start_pose", {"robot": "tiago2"}),
+            ("add_start_pose", {"robot": "tiago2", "pose": "classroom_c022-w001"}),
+            ("substitute_allocation", {"allocation": "tiago2:delivery_b, tiago1:delivery_a"}),
+        ],
+        "moved",
+    )
+    assert alone.scenario.robot("tiago2").start_pose.id == "classroom_c022-w001"  # type: ignore[union-attr]
+    assert allocation(alone.scenario) == [("tiago2", "delivery_b"), ("tiago1", "delivery_a")]
+    assert alone.derivation.steps[-1] == TransformationStep(
+        "substitute_allocation", (("allocation", "tiago2:delivery_b,tiago1:delivery_a"),)
+    )
+    with pytest.raises(ExsceError, match="'tiago1' has tasks, so it needs a start pose"):
+        derive(base, [("remove_start_pose", {"robot": "tiago1"})])
+    with pytest.raises(ExsceError, match="starts at 'classroom_c025-w001' already"):
+        derive(base, [("add_start_pose", {"robot": "tiago1", "pose": "classroom_c022-w001"})])
+    with pytest.raises(ExsceError, match="'tiago1 delivery_a' is not robot:task"):
+        derive(base, [("substitute_allocation", {"allocation": "tiago1 delivery_a"})])
+
+
 def test_compositions_of_two_and_three_apply_in_order(base: Scenario) -> None:
     two = derive(base, [("remove_robot", {"robot": "tiago2", "reassign": "tiago1"}), ("reverse_task_order", {})], "two")
     assert allocation(two.scenario) == [
@@ -167,5 +191,16 @@ def test_exscec_derive_writes_a_file_that_checks_clean_and_stores_the_generation
     lineage = run_exscec("query", "derivation", "-p", "scenario=c_alone", "--format", "csv")
     assert lineage.returncode == 0, lineage.stderr
     assert "remove_robot" in lineage.stdout and "reverse_waypoint_order" in lineage.stdout
+    again = run_exscec("derive", "c/c_alone.exsce", "-t", "reverse_task_order", "--id", "c_alone_rev",
+                       "-o", "c/c_alone_rev.exsce", "--add-to-store")
+    assert again.returncode == 0, again.stderr
+    tree = run_exscec("lineage", "c_alone")
+    assert tree.returncode == 0, tree.stderr
+    assert tree.stdout.splitlines() == [
+        "scenario_c",
+        "  └─ remove_robot(reassign=tiago1 robot=tiago2) → reverse_waypoint_order(task=delivery_a to=delivery_a_reversed)",
+        "c_alone  (this one)",
+        "  └─ reverse_task_order: c_alone_rev",
+    ]
     bad = run_exscec("derive", "c/scenario_c.exsce", "-t", "remove_robot", "--robot", "tiago5")
     assert bad.returncode == 1 and "has no robot 'tiago5'; did you mean" in bad.stderr and "Traceback" not in bad.stderr

@@ -106,4 +106,50 @@ def derive(
             click.echo(add_prov(store, compile_derivation(derived.derivation)).summary(), err=True)
 
 
-COMMANDS = [derive]
+def _step_text(step: object) -> str:
+    from exsce_dsl.model.derivation import TransformationStep
+
+    assert isinstance(step, TransformationStep)
+    arguments = " ".join(f"{k}={v}" for k, v in step.parameters)
+    return f"{step.transformation}({arguments})" if arguments else step.transformation
+
+
+@click.command()
+@click.argument("scenario")
+@store_option
+@reports_errors
+def lineage(scenario: str, store_url: str | None) -> None:
+    """Print where a scenario comes from and what was derived from it.
+
+    Ancestors first (each with the transformations that made the next), then
+    the scenario, then its descendants as a tree, from the derivation
+    provenance in the store.
+
+    \b
+    Example:
+      exscec lineage scenario_c_alone
+    """
+    from exsce_dsl.store.open import open_store
+    from exsce_dsl.store.queries import derivation_of, derived_scenarios
+    from exsce_dsl.store.queries import lineage as ancestry
+
+    with open_store(store_url) as store:
+        chain = list(reversed(ancestry(store, scenario)))
+        for derivation in chain:
+            click.echo(derivation.base)
+            click.echo(f"  └─ {' → '.join(_step_text(s) for s in derivation.steps)}")
+        click.echo(f"{scenario}  (this one)")
+
+        def descend(parent: str, depth: int, seen: frozenset[str]) -> None:
+            for child in derived_scenarios(store, parent):
+                if child in seen:
+                    continue
+                found = derivation_of(store, child)
+                steps = " → ".join(_step_text(s) for s in found.steps) if found else ""
+                click.echo(f"{'    ' * depth}  └─ {steps}: {child}")
+                descend(child, depth + 1, seen | {child})
+
+        descend(scenario, 0, frozenset({scenario}))
+
+
+COMMANDS = [derive, lineage]

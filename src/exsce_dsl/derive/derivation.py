@@ -37,7 +37,7 @@ def derive(
     (a transformation may allocate one the base does not use)."""
     if not requests:
         raise ExsceError("say which transformations to apply (-t NAME ...)")
-    known = dict(tasks or {})
+    known = {t.id: t for t in base.tasks} | dict(tasks or {})
     applied = Applied(base)
     for name, arguments in requests:
         transformation = TRANSFORMATIONS.get(name)

@@ -14,7 +14,7 @@ from dataclasses import dataclass, replace
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.lang.names import is_valid_name
 from exsce_dsl.lang.suggest import did_you_mean
-from exsce_dsl.model import Assignment, Robot, Scenario, Task
+from exsce_dsl.model import Assignment, Pose, Robot, Scenario, Task
 from exsce_dsl.model.derivation import ParameterValue, TransformationStep
 
 
@@ -168,6 +168,54 @@ def swap_start_poses(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]
     )
 
 
+def _pose(scenario: Scenario, pose_id: str) -> Pose:
+    poses = {p.id: p for p in scenario.environment.poses()}
+    if pose_id not in poses:
+        hint = did_you_mean(pose_id, poses)
+        raise ExsceError(f"environment '{scenario.environment.id}' has no pose '{pose_id}'{hint}")
+    return poses[pose_id]
+
+
+def add_start_pose(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
+    """Give a robot that has none a start pose (a pose no other robot starts at)."""
+    robot = _robot(scenario, a["robot"])
+    if robot.start_pose is not None:
+        raise ExsceError(
+            f"'{robot.id}' starts at '{robot.start_pose.id}' already (swap or remove that first)"
+        )
+    pose = _pose(scenario, a["pose"])
+    if any(r.start_pose is not None and r.start_pose.id == pose.id for r in scenario.robots):
+        raise ExsceError(f"pose '{pose.id}' is another robot's start pose")
+    robots = tuple(replace(r, start_pose=pose) if r.id == robot.id else r for r in scenario.robots)
+    return Applied(
+        replace(scenario, robots=robots), (), (_step("add_start_pose", robot=robot.id, pose=pose.id),)
+    )
+
+
+def remove_start_pose(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
+    """Take a robot's start pose away; only a robot without tasks may have none."""
+    robot = _robot(scenario, a["robot"])
+    if robot.start_pose is None:
+        raise ExsceError(f"'{robot.id}' has no start pose to remove")
+    if scenario.mission.tasks_of(robot.id):
+        raise ExsceError(f"'{robot.id}' has tasks, so it needs a start pose (remove its tasks first)")
+    robots = tuple(replace(r, start_pose=None) if r.id == robot.id else r for r in scenario.robots)
+    return Applied(replace(scenario, robots=robots), (), (_step("remove_start_pose", robot=robot.id),))
+
+
+def substitute_allocation(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
+    """A whole new allocation: ``robot:task,robot:task,...`` in execution order."""
+    entries = []
+    for item in a["allocation"].split(","):
+        robot, _, task = item.strip().partition(":")
+        if not task:
+            raise ExsceError(f"'{item.strip()}' is not robot:task")
+        entries.append(Assignment(_robot(scenario, robot).id, task))
+    extra = {e.task: tasks[e.task] for e in entries if e.task in tasks}
+    new = _with_allocation(scenario, entries, extra)
+    return Applied(new, (), (_step("substitute_allocation", allocation=a["allocation"].replace(" ", "")),))
+
+
 def remove_robot(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     """Drop a robot; its tasks are dropped, or reassigned to another robot (``reassign``)."""
     robot = _robot(scenario, a["robot"]).id
@@ -194,14 +242,11 @@ def add_robot(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Ap
     robot, template = a["robot"], _robot(scenario, a["like"])
     if not is_valid_name(robot) or scenario.robot(robot) is not None:
         raise ExsceError(f"'{robot}' cannot be the id of a new robot of '{scenario.id}'")
-    poses = {p.id: p for p in scenario.environment.poses()}
-    if a["start"] not in poses:
-        hint = did_you_mean(a["start"], poses)
-        raise ExsceError(f"environment '{scenario.environment.id}' has no pose '{a['start']}'{hint}")
+    start = _pose(scenario, a["start"])
     taken = {r.start_pose.id for r in scenario.robots if r.start_pose is not None}
     if a["start"] in taken:
         raise ExsceError(f"pose '{a['start']}' is another robot's start pose")
-    new_robot = Robot(robot, template.type, robot, poses[a["start"]])
+    new_robot = Robot(robot, template.type, robot, start)
     new = replace(scenario, robots=scenario.robots + (new_robot,))
     applied = Applied(new, (), (_step("add_robot", robot=robot, like=template.id, start=a["start"]),))
     if "take_over" in a:
@@ -270,6 +315,23 @@ TRANSFORMATIONS: dict[str, Transformation] = {
         ),
         Transformation(
             "swap_start_poses", ("robot", "with"), (), swap_start_poses, "ROBOT and WITH swap start poses"
+        ),
+        Transformation(
+            "add_start_pose", ("robot", "pose"), (), add_start_pose, "ROBOT (without one) starts at POSE"
+        ),
+        Transformation(
+            "remove_start_pose",
+            ("robot",),
+            (),
+            remove_start_pose,
+            "ROBOT (without tasks) loses its start pose",
+        ),
+        Transformation(
+            "substitute_allocation",
+            ("allocation",),
+            (),
+            substitute_allocation,
+            "the mission becomes ALLOCATION: robot:task,robot:task,... in order",
         ),
         Transformation(
             "remove_robot",

@@ -40,6 +40,7 @@ __all__ = [
     "StoredRun",
     "ViolationDuration",
     "derivation_of",
+    "derived_scenarios",
     "hotspot_counts",
     "lineage",
     "mission_duration",
@@ -481,3 +482,9 @@ def lineage(store: Store, scenario: str, namespace: str = DEFAULT_NAMESPACE) -> 
         seen.add(derivation.base)
         current = derivation.base
     return chain
+
+
+def derived_scenarios(store: Store, scenario: str, namespace: str = DEFAULT_NAMESPACE) -> list[str]:
+    """The scenarios derived from ``scenario`` directly."""
+    rows = run_query(store, "derived_scenarios", {"base": scenario}, namespace)
+    return [_text(row["derived"]) or "" for row in rows]
