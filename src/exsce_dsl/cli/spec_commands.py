@@ -92,8 +92,14 @@ def compile_command(
     from exsce_dsl.prov import compile_scenario
     from exsce_dsl.rdf import serialize
 
-    scenario = load_spec(spec).scenario(scenario_id)
+    loaded = load_spec(spec)
+    scenario = loaded.scenario(scenario_id)
     document = compile_scenario(scenario)
+    derived = next((d for d in loaded.derived if d.id == scenario.id), None)
+    if derived is not None and derived.derivation is not None:
+        from exsce_dsl.prov.derivation import compile_derivation
+
+        document.update(compile_derivation(derived.derivation))  # the generation, with the scenario
     if store_url is not None:
         from exsce_dsl.cli.store_commands import add_to_store
 

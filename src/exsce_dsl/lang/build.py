@@ -16,6 +16,7 @@ from typing import Any
 
 from exsce_dsl.errors import Diagnostic, SourceLocation, SpecError
 from exsce_dsl.lang.build_acceptance import build_acceptance
+from exsce_dsl.lang.build_derivation import build_derivations
 from exsce_dsl.lang.checks import check_environment_map, check_scenario
 from exsce_dsl.lang.loader import load_files
 from exsce_dsl.lang.parser import ParsedFile
@@ -43,6 +44,7 @@ from exsce_dsl.model import (
     Task,
     WorldModel,
 )
+from exsce_dsl.model.derived import DerivedScenario
 
 _LENGTH_SCALE = {None: 1.0, "m": 1.0, "cm": 0.01, "mm": 0.001}
 _QUANTITY = re.compile(r"(\S+?)\s*(mm|cm|m|rad|deg)?")
@@ -106,6 +108,7 @@ class _Builder:
         self.poses: dict[str, list[tuple[str, Pose]]] = {}
         self.task_poses: dict[str, Pose | None] = {}
         self.acceptance: dict[int, Acceptance] = {}
+        self.derived: dict[int, DerivedScenario] = {}
         """Built acceptance blocks, by the id of their parse tree node."""
 
     # ---------------------------------------------------------------- helpers
@@ -132,7 +135,7 @@ class _Builder:
     def build(self) -> Specification:
         for pf in self.files:
             for decl in pf.tree.declarations:
-                if decl.__class__.__name__ != "Acceptance":
+                if decl.__class__.__name__ not in ("Acceptance", "Derivation"):
                     self._declare(pf, decl)
         for name, d in self.declared["RobotType"].items():
             self.robot_types[name] = self._robot_type(d)
@@ -151,6 +154,7 @@ class _Builder:
             self.diagnostics.extend(check_environment_map(env))
         for scenario in self.scenarios.values():
             self.diagnostics.extend(check_scenario(scenario))
+        self._derivations()
         self._acceptance()
         return Specification(self.files[0].path, tuple(self._document(pf) for pf in self.files))
 
@@ -166,6 +170,16 @@ class _Builder:
             )
             return
         table[decl.name] = _Declared(decl, pf, where)
+
+    def _derivations(self) -> None:
+        self.derived = build_derivations(
+            self.files,
+            self.scenarios,
+            self.declared["Scenario"],
+            self.tasks,
+            lambda message, at: self.error(message, at, code="derivation"),
+            lambda pf, decl: _Declared(decl, pf, self.name_span(pf, decl)),
+        )
 
     def _acceptance(self) -> None:
         first: dict[str, SourceLocation] = {}
@@ -201,6 +215,10 @@ class _Builder:
             if kind == "Acceptance":
                 if id(decl) in self.acceptance:
                     declarations.append(self.acceptance[id(decl)])
+                continue
+            if kind == "Derivation":
+                if id(decl) in self.derived:
+                    declarations.append(self.derived[id(decl)])
                 continue
             declared = self.declared[kind].get(decl.name)
             built = tables[kind].get(decl.name)

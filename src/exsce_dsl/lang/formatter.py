@@ -14,6 +14,7 @@ from decimal import Decimal
 
 from exsce_dsl.errors import SourceLocation
 from exsce_dsl.lang.format_acceptance import acceptance_lines
+from exsce_dsl.lang.format_derivation import derivation_lines
 from exsce_dsl.lang.lexical import Comment
 from exsce_dsl.model import (
     Acceptance,
@@ -29,6 +30,7 @@ from exsce_dsl.model import (
     Specification,
     Task,
 )
+from exsce_dsl.model.derived import DerivedScenario
 
 INDENT = "  "
 
@@ -65,6 +67,8 @@ def format_document(document: Document, poses: Mapping[str, Pose], comments: Seq
             blocks.append(_task(decl, poses))
         elif isinstance(decl, Acceptance):
             blocks.append(acceptance_lines(decl))
+        elif isinstance(decl, DerivedScenario):
+            blocks.append(derivation_lines(decl))
         else:
             blocks.append(_scenario(decl, poses))
     lines: list[Line] = []

@@ -7,12 +7,13 @@ from dataclasses import dataclass, field
 
 from exsce_dsl.errors import ExsceError, SourceLocation
 from exsce_dsl.model.acceptance import Acceptance
+from exsce_dsl.model.derived import DerivedScenario
 from exsce_dsl.model.environment import Environment
 from exsce_dsl.model.robots import RobotType
 from exsce_dsl.model.scenario import Scenario
 from exsce_dsl.model.tasks import Task
 
-Declaration = RobotType | Environment | Task | Scenario | Acceptance
+Declaration = RobotType | Environment | Task | Scenario | Acceptance | DerivedScenario
 
 
 @dataclass(frozen=True)
@@ -44,7 +45,16 @@ class Specification:
 
     @property
     def scenarios(self) -> tuple[Scenario, ...]:
-        return tuple(d for d in self.declarations() if isinstance(d, Scenario))
+        """Written and derived ones, in the order they are declared."""
+        return tuple(
+            d.scenario if isinstance(d, DerivedScenario) else d
+            for d in self.declarations()
+            if isinstance(d, (Scenario, DerivedScenario))
+        )
+
+    @property
+    def derived(self) -> tuple[DerivedScenario, ...]:
+        return tuple(d for d in self.declarations() if isinstance(d, DerivedScenario))
 
     @property
     def environments(self) -> tuple[Environment, ...]:
@@ -52,7 +62,9 @@ class Specification:
 
     @property
     def tasks(self) -> tuple[Task, ...]:
-        return tuple(d for d in self.declarations() if isinstance(d, Task))
+        """Declared ones, and those derivations made."""
+        declared = tuple(d for d in self.declarations() if isinstance(d, Task))
+        return declared + tuple(t for d in self.derived for t in d.new_tasks)
 
     @property
     def acceptance(self) -> tuple[Acceptance, ...]:
@@ -77,7 +89,11 @@ class Specification:
                 if s.id == scenario_id:
                     return s
             raise ExsceError(f"no scenario '{scenario_id}' in {self.root}")
-        own = [d for d in self.root_document.declarations if isinstance(d, Scenario)]
+        own = [
+            d.scenario if isinstance(d, DerivedScenario) else d
+            for d in self.root_document.declarations
+            if isinstance(d, (Scenario, DerivedScenario))
+        ]
         if len(own) != 1:
             found = ", ".join(s.id for s in own) or "none"
             raise ExsceError(f"{self.root} declares {len(own)} scenarios ({found}); name one with --scenario")

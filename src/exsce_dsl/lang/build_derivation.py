@@ -1,0 +1,140 @@
+"""Build ``derive NAME from BASE { ... }`` blocks: each step becomes an input transformation,
+applied to the base scenario in order; a step that cannot apply is reported at its line."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any
+
+from exsce_dsl.derive.derivation import derive
+from exsce_dsl.errors import ExsceError, SourceLocation
+from exsce_dsl.lang.parser import ParsedFile
+from exsce_dsl.lang.suggest import did_you_mean
+from exsce_dsl.model import Scenario, Task
+from exsce_dsl.model.derived import DerivedScenario, Step
+
+Report = Callable[[str, SourceLocation | None], None]
+
+
+def _name(ref: Any) -> str | None:
+    return None if ref is None else str(ref.name)
+
+
+def step_of(node: Any) -> tuple[str, dict[str, str | None]]:
+    """The transformation a step of the grammar names, with its arguments."""
+    kind = node.__class__.__name__
+    if kind == "RemoveRobot":
+        return "remove_robot", {"robot": _name(node.robot), "reassign": _name(node.heir)}
+    if kind == "AddRobot":
+        return "add_robot", {
+            "robot": node.robot,
+            "like": _name(node.like),
+            "start": _name(node.start),
+            "take_over": _name(node.donor),
+        }
+    if kind == "ReplaceRobot":
+        return "replace_robot", {"robot": _name(node.robot), "by": node.new, "like": _name(node.like)}
+    if kind in ("SwapTasks", "SwapStartPoses"):
+        name = "swap_assignment" if kind == "SwapTasks" else "swap_start_poses"
+        return name, {"robot": _name(node.robot), "with": _name(node.other)}
+    if kind == "ReverseWaypoints":
+        return "reverse_waypoint_order", {"task": _name(node.task), "as": node.new or None}
+    if kind == "ReverseTaskOrder":
+        return "reverse_task_order", {"robot": _name(node.robot)}
+    if kind == "AddTask":
+        position = str(node.position) if node.position else None
+        return "add_task", {"task": _name(node.task), "robot": _name(node.robot), "position": position}
+    if kind == "RemoveTasksOf":
+        return "remove_task", {"robot": _name(node.robot)}
+    if kind == "RemoveTask":
+        return "remove_task", {"task": _name(node.task), "robot": _name(node.robot)}
+    if kind == "SubstituteTask":
+        return "substitute_task", {"task": _name(node.task), "with": _name(node.other)}
+    if kind == "StartAt":
+        return "add_start_pose", {"robot": _name(node.robot), "pose": _name(node.pose)}
+    if kind == "RemoveStartPose":
+        return "remove_start_pose", {"robot": _name(node.robot)}
+    assert kind == "Reallocate", kind
+    entries = [f"{a.robot.name}:{t.name}" for a in node.assignments for t in a.tasks]
+    return "substitute_allocation", {"allocation": ",".join(entries)}
+
+
+def build_derivation(
+    pf: ParsedFile,
+    tree: Any,
+    scenarios: Mapping[str, Scenario],
+    declared_scenarios: Mapping[str, object],
+    tasks: Mapping[str, Task],
+    report: Report,
+) -> DerivedScenario | None:
+    base = scenarios.get(tree.base.name)
+    if base is None:
+        if tree.base.name not in declared_scenarios:
+            hint = did_you_mean(tree.base.name, declared_scenarios)
+            report(f"unknown scenario '{tree.base.name}'{hint}", pf.span(tree.base))
+        return None  # a base with errors of its own: reported where it is
+    steps = []
+    for node in tree.steps:
+        name, arguments = step_of(node)
+        steps.append(Step(name, tuple((k, v) for k, v in arguments.items() if v is not None), pf.span(node)))
+    done: list[Step] = []
+    derived = None
+    for step in steps:  # apply one more step at a time, to place an error at its step
+        done.append(step)
+        try:
+            derived = derive(base, [(s.transformation, dict(s.arguments)) for s in done], tree.name, tasks)
+        except ExsceError as exc:
+            report(exc.message, step.location)
+            return None
+    assert derived is not None  # the grammar asks for one step at least
+    return DerivedScenario(
+        tree.name,
+        base.id,
+        tuple(steps),
+        derived.scenario,
+        derived.new_tasks,
+        derived.derivation,
+        pf.span(tree),
+    )
+
+
+def build_derivations(
+    files: Sequence[ParsedFile],
+    scenarios: dict[str, Scenario],
+    declared: dict[str, Any],
+    tasks: Mapping[str, Task],
+    report: Report,
+    declare: Callable[[ParsedFile, Any], Any],
+) -> dict[int, DerivedScenario]:
+    """Every derive block of ``files``, bases first (one may start from a derived scenario).
+
+    The derived scenarios join ``scenarios`` and their names ``declared`` (made by ``declare``);
+    returns them by the id of their parse tree node.
+    """
+    pending = [(pf, d) for pf in files for d in pf.tree.declarations if d.__class__.__name__ == "Derivation"]
+    for pf, decl in list(pending):
+        made = declare(pf, decl)
+        first = declared.get(decl.name)
+        if first is not None:
+            report(
+                f"duplicate scenario '{decl.name}' (first declared at {first.name_location})",
+                made.name_location,
+            )
+            pending.remove((pf, decl))
+            continue
+        declared[decl.name] = made
+    built: dict[int, DerivedScenario] = {}
+    while pending:
+        waiting = {other.name for _, other in pending}
+        ready = [(pf, d) for pf, d in pending if d.base.name in scenarios or d.base.name not in waiting]
+        if not ready:
+            for pf, decl in pending:
+                report(f"scenario '{decl.name}' is derived, through others, from itself", pf.span(decl.base))
+            break
+        for pf, decl in ready:
+            pending.remove((pf, decl))
+            derived = build_derivation(pf, decl, scenarios, declared, tasks, report)
+            if derived is not None:
+                built[id(decl)] = derived
+                scenarios[derived.id] = derived.scenario
+    return built
