@@ -202,5 +202,10 @@ def test_exscec_derive_writes_a_file_that_checks_clean_and_stores_the_generation
         "c_alone  (this one)",
         "  └─ reverse_task_order: c_alone_rev",
     ]
+    expected = run_exscec("expect", "c/c_alone.exsce")  # nothing ingested: every segment says so
+    assert expected.returncode == 0, expected.stderr
+    lines = expected.stdout.splitlines()
+    assert lines[0] == "tiago1 distance_travelled: unknown"
+    assert lines[1] == "  classroom_c025-w001 → classroom_c018-w001: -  no data, nor for classroom_c025-w002 and classroom_c018-w002 near its ends"
     bad = run_exscec("derive", "c/scenario_c.exsce", "-t", "remove_robot", "--robot", "tiago5")
     assert bad.returncode == 1 and "has no robot 'tiago5'; did you mean" in bad.stderr and "Traceback" not in bad.stderr

@@ -152,4 +152,35 @@ def lineage(scenario: str, store_url: str | None) -> None:
         descend(scenario, 0, frozenset({scenario}))
 
 
-COMMANDS = [derive, lineage]
+@click.command()
+@click.argument("spec", type=click.Path(dir_okay=False, exists=True))
+@click.option("--scenario-id", help="Which scenario, when the file declares several.")
+@store_option
+@reports_errors
+def expect(spec: str, scenario_id: str | None, store_url: str | None) -> None:
+    """Show a scenario's expected distance travelled and task duration per robot, and where each
+    value comes from: the path segments, observed in stored runs (of any scenario) or
+    estimated from segments near them, with the number of runs.
+
+    \b
+    Example:
+      exscec expect examples/brsu_building_c/scenario_c_alone.exsce
+    """
+    from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.oracles.expect import SUMMED, expected_metric
+    from exsce_dsl.store.open import open_store
+
+    scenario = load_spec(spec).scenario(scenario_id)
+    with open_store(store_url) as store:
+        for robot in scenario.robots:
+            for metric in SUMMED:
+                found = expected_metric(store, scenario, robot.id, metric)
+                shown = f"{found.value:.4g}" if found.value is not None else "unknown"
+                click.echo(f"{robot.id} {metric}: {shown}")
+                for part in found.segments:
+                    value = f"{part.value:.4g}" if part.value is not None else "-"
+                    runs = f" ({part.runs} runs)" if part.runs else ""
+                    click.echo(f"  {part.start} → {part.goal}: {value}  {part.how}{runs}")
+
+
+COMMANDS = [derive, lineage, expect]

@@ -57,6 +57,7 @@ __all__ = [
     "run_query",
     "runs",
     "segment_metric",
+    "segment_metric_any",
     "standard_prefixes",
     "update_baseline",
     "violation_duration",
@@ -228,6 +229,14 @@ def segment_metric(
     assert scenario is not None
     given["scenario"] = scenario
     return _aggregate(run_query(store, "segment_metric_of_scenario", given, namespace))
+
+
+def segment_metric_any(
+    store: Store, metric: str, start: Pose | str, goal: Pose | str, namespace: str = DEFAULT_NAMESPACE
+) -> Aggregate | None:
+    """``metric`` over the segment ``start`` → ``goal`` in every stored run of any scenario."""
+    given = {"metric": metric, "start": _pose(start), "goal": _pose(goal)}
+    return _aggregate(run_query(store, "segment_metric_any", given, namespace))
 
 
 def robot_metric_over_runs(

@@ -1,0 +1,140 @@
+"""Expected values of a scenario's metrics from stored path segments, estimated where no run
+drove a segment (the method's §4.2.1, with the proportion the right way round).
+
+A robot's expected ``distance_travelled`` or ``task_duration`` is the sum over the
+segments of its path (start pose, then its tasks' waypoints) of the segment's mean
+over every stored run of any scenario, in the task's direction or else the other
+way.  A segment no run drove is estimated from the nearest poses p3, p4 of the same
+area to its ends p1, p2: from each of (p3, p2), (p1, p4), (p3, p4) that has data,
+``m_ij * dist(p1, p2) / dist(p_i, p_j)``, averaged.  (The method's report writes
+the ratio upside down, which makes a longer neighbour segment give a *longer*
+estimate for a shorter one; scaling by the distance ratio this way keeps the unit
+"per metre".)  Without neighbour data, the fallback is the segment's straight-line
+length times the robot's value per straight-line metre on its segments that have a
+value (observed or estimated); with no value anywhere, there is no expected value.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+from exsce_dsl.model import Pose, Scenario
+from exsce_dsl.store.base import Store
+from exsce_dsl.store.queries import Aggregate, segment_metric_any
+
+SUMMED = ("distance_travelled", "task_duration")
+"""The metrics a robot's value of is the sum of its segments' values."""
+
+
+@dataclass(frozen=True)
+class SegmentValue:
+    start: str
+    goal: str
+    value: float | None
+    how: str
+    """``observed``, ``observed the other way``, ``estimated from ...`` or ``no data``."""
+    runs: int = 0
+
+
+@dataclass(frozen=True)
+class Expected:
+    robot: str
+    metric: str
+    value: float | None
+    segments: tuple[SegmentValue, ...]
+
+
+def robot_path(scenario: Scenario, robot_id: str) -> list[tuple[Pose, Pose]]:
+    """The robot's path segments: from its start pose through its tasks' waypoints."""
+    robot = scenario.robot(robot_id)
+    if robot is None or robot.start_pose is None:
+        return []
+    poses = [robot.start_pose]
+    for task_id in scenario.mission.tasks_of(robot_id):
+        task = scenario.task(task_id)
+        if task is not None:
+            poses.extend(task.waypoints())
+    return list(zip(poses, poses[1:], strict=False))
+
+
+def _either_way(store: Store, metric: str, start: Pose, goal: Pose) -> tuple[Aggregate | None, bool]:
+    found = segment_metric_any(store, metric, start, goal)
+    if found is not None:
+        return found, False
+    return segment_metric_any(store, metric, goal, start), True
+
+
+def segment_value(store: Store, scenario: Scenario, metric: str, start: Pose, goal: Pose) -> SegmentValue:
+    names = (start.id, goal.id)
+    found, reverse = _either_way(store, metric, start, goal)
+    if found is not None:
+        return SegmentValue(
+            *names, found.mean, "observed the other way" if reverse else "observed", found.count
+        )
+    near_start, near_goal = _area_poses(scenario, start, names), _area_poses(scenario, goal, names)
+    if not near_start or not near_goal or math.dist(_xy(start), _xy(goal)) == 0:
+        return SegmentValue(*names, None, "no data, and no pose near it to estimate from")
+    p3 = min(near_start, key=lambda p: math.dist(_xy(p), _xy(start)))  # in p1's area
+    p4 = min(near_goal, key=lambda p: math.dist(_xy(p), _xy(goal)))  # in p2's area
+    estimates, used, runs = [], [], 0
+    for i, j in ((p3, goal), (start, p4), (p3, p4)):
+        length = math.dist(_xy(i), _xy(j))
+        if length == 0:
+            continue
+        near, _ = _either_way(store, metric, i, j)
+        if near is not None:
+            estimates.append(near.mean * math.dist(_xy(start), _xy(goal)) / length)
+            used.append(f"{i.id}–{j.id}")
+            runs += near.count
+    if not estimates:
+        return SegmentValue(*names, None, f"no data, nor for {p3.id} and {p4.id} near its ends")
+    return SegmentValue(
+        *names, math.fsum(estimates) / len(estimates), f"estimated from {', '.join(used)}", runs
+    )
+
+
+def expected_metric(store: Store, scenario: Scenario, robot: str, metric: str) -> Expected:
+    """The robot's expected value of a summed metric (see the module's description)."""
+    if metric not in SUMMED:
+        raise ValueError(f"'{metric}' is not a sum over path segments")
+    path = robot_path(scenario, robot)
+    parts = tuple(segment_value(store, scenario, metric, a, b) for a, b in path)
+    parts = _fall_back(parts, path)
+    values = [p.value for p in parts]
+    total = math.fsum(v for v in values if v is not None) if parts and None not in values else None
+    return Expected(robot, metric, total, parts)
+
+
+def _area_poses(scenario: Scenario, pose: Pose, leave_out: tuple[str, ...]) -> list[Pose]:
+    """The other poses of the area ``pose`` is in (none if it is in no area)."""
+    area = next((a for a in scenario.environment.areas if any(p.id == pose.id for p in a.poses)), None)
+    return [p for p in area.poses if p.id not in leave_out] if area is not None else []
+
+
+def _fall_back(parts: tuple[SegmentValue, ...], path: list[tuple[Pose, Pose]]) -> tuple[SegmentValue, ...]:
+    """Segments with no value and no neighbour data: their straight-line length times the
+    robot's value per straight-line metre over the segments that have a value."""
+    known = [
+        (p.value, math.dist(_xy(a), _xy(b)))
+        for p, (a, b) in zip(parts, path, strict=True)
+        if p.value is not None
+    ]
+    metres = math.fsum(d for _, d in known)
+    if not known or metres == 0:
+        return parts
+    rate = math.fsum(v for v, _ in known) / metres
+    return tuple(
+        p
+        if p.value is not None
+        else replace(
+            p,
+            value=rate * math.dist(_xy(a), _xy(b)),
+            how=f"{p.how}: its straight length × {rate:.3g} per metre, as on the robot's other segments",
+        )
+        for p, (a, b) in zip(parts, path, strict=True)
+    )
+
+
+def _xy(pose: Pose) -> tuple[float, float]:
+    return (pose.position.x, pose.position.y)

@@ -1,0 +1,129 @@
+"""Expected values from stored path segments, and the estimate for a segment no run drove.
+
+One room: a (0, 0), b (3, 4), c (6, 8), d (0, 8).  Scenario ``base``: r1 drives a → b
+(10 m, then 12 m in a second run) and b → c (5 m).  Scenario ``longer`` (r1: a → b → c → d)
+is expected to travel 11 (a → b, the mean) + 5 (b → c) + an estimate for c → d, which no
+run drove: the poses nearest c and d (other than c, d) are both b; of (b, d), (c, b), (b, b)
+only c → b has data, the other way (b → c, 5 m over 5 m), so c → d (6 m) ≈ 5 × 6 / 5 = 6.
+"""
+
+from __future__ import annotations
+
+import datetime
+import math
+
+from exsce_dsl.model import (
+    Area,
+    Assignment,
+    Environment,
+    Mission,
+    MissionType,
+    Orientation,
+    Pose,
+    Position,
+    Robot,
+    RobotType,
+    Scenario,
+    Subtask,
+    Task,
+)
+from exsce_dsl.model.runs import Action, ActionId, Bag, MetricScope, MetricValue, Run, TaskExecution
+from exsce_dsl.oracles.expect import expected_metric, robot_path
+from exsce_dsl.prov import compile_scenario
+from exsce_dsl.prov.run import compile_run
+from exsce_dsl.store.embedded import EmbeddedStore
+from exsce_dsl.store.writing import add_prov
+
+A, B, C, D = (
+    Pose(f"room-{n}", Position(x, y), Orientation(), "room")
+    for n, x, y in (("a", 0, 0), ("b", 3, 4), ("c", 6, 8), ("d", 0, 8))
+)
+ROOM = Environment("house", areas=(Area("room", (A, B, C, D)),))
+TIAGO = RobotType("tiago", base="pmb2", torso=True)
+
+
+def scenario(name: str, *waypoints: Pose) -> Scenario:
+    task = Task(f"{name}_task", (Subtask(waypoints),))
+    return Scenario(
+        name,
+        ROOM,
+        (Robot("r1", TIAGO, "r1", start_pose=A),),
+        Mission(f"{name}_m", MissionType.SEQUENTIAL, (Assignment("r1", task.id),)),
+        (task,),
+    )
+
+
+BASE, LONGER = scenario("base", B, C), scenario("longer", B, C, D)
+DIST = ("/r1/distance_travelled",)
+
+
+def run(uuid: str, a_to_b: float) -> Run:
+    actions = (Action(ActionId("r1", 1, 1, 1), A, B), Action(ActionId("r1", 1, 1, 2), B, C))
+    metrics = tuple(
+        MetricValue("distance_travelled", MetricScope.SEGMENT, v, DIST, action=a.id)
+        for a, v in zip(actions, (a_to_b, 5.0), strict=True)
+    )
+    start = datetime.datetime(2024, 7, 1, 9)
+    return Run(
+        uuid,
+        "base",
+        start,
+        start + datetime.timedelta(minutes=2),
+        Bag(f"{uuid}.bag", DIST),
+        (TaskExecution("r1", 1, actions),),
+        metrics,
+    )
+
+
+def test_observed_segments_and_an_estimate_add_up() -> None:
+    store = EmbeddedStore(None)
+    add_prov(store, compile_scenario(BASE))
+    for uuid, a_to_b in (("u1", 10.0), ("u2", 12.0)):
+        add_prov(store, compile_run(run(uuid, a_to_b), BASE))
+    assert [(s.id, g.id) for s, g in robot_path(LONGER, "r1")] == [
+        ("room-a", "room-b"),
+        ("room-b", "room-c"),
+        ("room-c", "room-d"),
+    ]
+    expected = expected_metric(store, LONGER, "r1", "distance_travelled")
+    ab, bc, cd = expected.segments
+    assert (ab.value, ab.how, ab.runs) == (11.0, "observed", 2)
+    assert (bc.value, bc.how, bc.runs) == (5.0, "observed", 2)
+    assert cd.value is not None and math.isclose(cd.value, 6.0)
+    assert cd.how == "estimated from room-c–room-b" and cd.runs == 2
+    assert expected.value is not None and math.isclose(expected.value, 22.0)
+
+
+def test_without_any_data_nearby_there_is_no_expected_value() -> None:
+    store = EmbeddedStore(None)
+    expected = expected_metric(store, LONGER, "r1", "task_duration")
+    assert expected.value is None
+    assert expected.segments[0].how == "no data, nor for room-d and room-c near its ends"
+
+
+def test_a_segment_with_no_neighbour_data_falls_back_to_the_robot_s_rate_per_metre() -> None:
+    store = EmbeddedStore(None)
+    add_prov(store, compile_scenario(BASE))
+    add_prov(store, compile_run(run("u1", 10.0), BASE))
+    # b → hall-x: the hall has no other pose to estimate from, so the fallback applies
+    lonely = Environment(
+        "house",
+        areas=(
+            Area("room", (A, B, C, D)),
+            Area("hall", (Pose("hall-x", Position(0, 20), Orientation(), "hall"),)),
+        ),
+    )
+    far = Scenario(
+        "far",
+        lonely,
+        (Robot("r1", TIAGO, "r1", start_pose=A),),
+        Mission("far_m", MissionType.SEQUENTIAL, (Assignment("r1", "far_task"),)),
+        (Task("far_task", (Subtask((B, lonely.areas[1].poses[0])),)),),
+    )
+    expected = expected_metric(store, far, "r1", "distance_travelled")
+    ab, bx = expected.segments
+    assert ab.value == 10.0 and ab.how == "observed"
+    # b (3, 4) → x (0, 20): 16.28 m in a straight line, at 10 m per 5 m
+    assert bx.value is not None and math.isclose(bx.value, 2.0 * math.dist((3, 4), (0, 20)))
+    assert "straight length × 2 per metre" in bx.how
+    assert expected.value is not None and math.isclose(expected.value, 10.0 + bx.value)
