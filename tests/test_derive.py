@@ -207,5 +207,10 @@ def test_exscec_derive_writes_a_file_that_checks_clean_and_stores_the_generation
     lines = expected.stdout.splitlines()
     assert lines[0] == "tiago1 distance_travelled: unknown"
     assert lines[1] == "  classroom_c025-w001 → classroom_c018-w001: -  no data, nor for classroom_c025-w002 and classroom_c018-w002 near its ends"
+    criteria = run_exscec("derive", "c/scenario_c.exsce", "-t", "reverse_task_order", "--id", "c_expect", "--expect")
+    assert criteria.returncode == 0, criteria.stderr  # no runs stored: only the safety clauses are copied
+    assert "acceptance for c_expect {" in criteria.stdout and 'scenario "as safe as scenario_c" {' in criteria.stdout
+    assert "then each robot max_velocity stays below 1.0 m/s" in criteria.stdout
+    assert "0.8 m/s" not in criteria.stdout  # that limit was for a part of a run only
     bad = run_exscec("derive", "c/scenario_c.exsce", "-t", "remove_robot", "--robot", "tiago5")
     assert bad.returncode == 1 and "has no robot 'tiago5'; did you mean" in bad.stderr and "Traceback" not in bad.stderr

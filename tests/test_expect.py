@@ -62,7 +62,7 @@ def run(uuid: str, a_to_b: float) -> Run:
     metrics = tuple(
         MetricValue("distance_travelled", MetricScope.SEGMENT, v, DIST, action=a.id)
         for a, v in zip(actions, (a_to_b, 5.0), strict=True)
-    )
+    ) + (MetricValue("distance_travelled", MetricScope.ROBOT, a_to_b + 5.0, DIST, robot="r1"),)
     start = datetime.datetime(2024, 7, 1, 9)
     return Run(
         uuid,
@@ -127,3 +127,32 @@ def test_a_segment_with_no_neighbour_data_falls_back_to_the_robot_s_rate_per_met
     assert bx.value is not None and math.isclose(bx.value, 2.0 * math.dist((3, 4), (0, 20)))
     assert "straight length × 2 per metre" in bx.how
     assert expected.value is not None and math.isclose(expected.value, 10.0 + bx.value)
+
+
+def test_the_derived_scenario_s_criteria_follow_from_the_expected_change() -> None:
+    from exsce_dsl.lang.format_acceptance import expectation_text
+    from exsce_dsl.model.acceptance import (
+        Acceptance,
+        Criterion,
+        Expectation,
+        Quantifier,
+        Quantity,
+        Relation,
+        Subject,
+    )
+    from exsce_dsl.oracles.expect import metamorphic_acceptance
+
+    store = EmbeddedStore(None)
+    add_prov(store, compile_scenario(BASE))
+    for uuid, a_to_b in (("u1", 10.0), ("u2", 12.0)):
+        add_prov(store, compile_run(run(uuid, a_to_b), BASE))
+    speed = Expectation(Subject(Quantifier.EACH_ROBOT), "max_velocity", Relation.BELOW_MAX, limit=Quantity(1.0, "m/s", "1.0"))
+    base_criteria = Acceptance("base", (Criterion("safe", (), None, (speed,)),))
+    made = metamorphic_acceptance(store, BASE, LONGER, base_criteria)
+    assert made.scenario == "longer"
+    assert [c.title for c in made.criteria] == ["as safe as base", "as expected from base"]
+    assert [expectation_text(e) for e in made.expectations()] == [
+        "each robot max_velocity stays below 1.0 m/s",
+        # expected 22 m against the base's mean of 16 m: 6 m more, within 10 % of the change
+        "r1 distance_travelled is increasing by 6 m within 0.6 m of base",
+    ]

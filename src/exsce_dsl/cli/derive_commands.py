@@ -45,6 +45,13 @@ def _requests(words: tuple[str, ...]) -> list[tuple[str, dict[str, str]]]:
 @click.option(
     "--add-to-store", is_flag=True, help="Also add the new scenario and its generation PROV to the store."
 )
+@click.option(
+    "--expect",
+    "with_expectations",
+    is_flag=True,
+    help="Write acceptance criteria for the new scenario: the base's safety clauses, and the "
+    "performance relations its expected values imply (see exscec expect), from the store.",
+)
 @store_option
 @click.argument("steps", nargs=-1, type=click.UNPROCESSED)
 @reports_errors
@@ -55,6 +62,7 @@ def derive(
     scenario_id: str | None,
     list_them: bool,
     add_to_store: bool,
+    with_expectations: bool,
     store_url: str | None,
     steps: tuple[str, ...],
 ) -> None:
@@ -87,6 +95,20 @@ def derive(
     derived = apply_steps(base, _requests(steps), new_id, {t.id: t for t in loaded.tasks})
     target = Path(output) if output else Path(spec).with_name(f"{derived.scenario.id}.exsce")
     document = derived_document(derived, Path(spec), target)
+    if with_expectations:
+        from dataclasses import replace
+
+        from exsce_dsl.oracles.expect import metamorphic_acceptance
+        from exsce_dsl.store.open import open_store
+
+        with open_store(store_url) as store:
+            criteria = metamorphic_acceptance(store, base, derived.scenario, loaded.acceptance_of(base.id))
+        if criteria.criteria:
+            document = replace(document, declarations=(*document.declarations, criteria))
+        else:
+            click.echo(
+                "no acceptance criteria: neither safety clauses to copy nor runs to expect from", err=True
+            )
     text = format_document(document, declared_poses(loaded.environments))
     if output:
         Path(output).write_text(text, encoding="utf-8")

@@ -20,8 +20,19 @@ import math
 from dataclasses import dataclass, replace
 
 from exsce_dsl.model import Pose, Scenario
+from exsce_dsl.model.acceptance import (
+    Acceptance,
+    Criterion,
+    Expectation,
+    Quantifier,
+    Quantity,
+    Relation,
+    Subject,
+    When,
+)
 from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries import Aggregate, segment_metric_any
+from exsce_dsl.store.queries import Aggregate, robot_metric_over_runs, segment_metric_any
+from exsce_dsl.store.queries import runs as stored_runs
 
 SUMMED = ("distance_travelled", "task_duration")
 """The metrics a robot's value of is the sum of its segments' values."""
@@ -138,3 +149,65 @@ def _fall_back(parts: tuple[SegmentValue, ...], path: list[tuple[Pose, Pose]]) -
 
 def _xy(pose: Pose) -> tuple[float, float]:
     return (pose.position.x, pose.position.y)
+
+
+RELATIVE_TOLERANCE = 10.0
+"""Percent of the expected change a derived scenario's performance clause allows."""
+
+
+def metamorphic_acceptance(
+    store: Store, base: Scenario, derived: Scenario, base_acceptance: Acceptance | None
+) -> Acceptance:
+    """The acceptance criteria of a derived scenario: the base's safety clauses (about robots it
+    still has), and per robot, for distance travelled and task duration, the relation to the
+    base's runs that the expected values imply (increasing or decreasing by the expected change,
+    within RELATIVE_TOLERANCE % of it, or invariant within that much of the base's mean).
+    Robots without an expected value or without base runs get no performance clause."""
+    safety = []
+    if base_acceptance is not None:
+        robots = {r.id for r in derived.robots}
+        safety = [
+            e
+            for c in base_acceptance.criteria
+            if c.when is None or c.when.robot is None  # a task's criteria look at a part of the run
+            for e in c.expectations
+            if e.relation in (Relation.BELOW_MAX, Relation.ABOVE_MIN)
+            and e.window is None
+            and (e.subject.robot is None or e.subject.robot in robots)
+        ]
+    performance = []
+    base_runs = [run.uuid for run in stored_runs(store, base.id)]
+    for robot in derived.robots:
+        if base.robot(robot.id) is None:
+            continue
+        for metric in SUMMED:
+            expected = expected_metric(store, derived, robot.id, metric).value
+            before = robot_metric_over_runs(store, metric, robot.id, base_runs)
+            if expected is None or before is None:
+                continue
+            change = expected - before.mean
+            tolerance = abs(change) * RELATIVE_TOLERANCE / 100.0
+            subject = Subject(Quantifier.ROBOT, robot.id)
+            unit = "m" if metric == "distance_travelled" else "s"
+            if abs(change) < 0.05 * abs(before.mean):  # a change within 5 % of the base is none
+                same = Expectation(subject, metric, Relation.INVARIANT, tolerance=Quantity(5.0, "%"))
+                performance.append(replace(same, against=base.id))
+                continue
+            direction = Relation.INCREASING if change > 0 else Relation.DECREASING
+            performance.append(
+                Expectation(
+                    subject,
+                    metric,
+                    direction,
+                    delta=Quantity(round(abs(change), 3), unit),
+                    tolerance=Quantity(round(tolerance, 3), unit),
+                    against=base.id,
+                )
+            )
+    when = When(mission=derived.mission.id)  # empty criteria are left out: an empty block is an error
+    criteria = []
+    if safety:
+        criteria.append(Criterion(f"as safe as {base.id}", (), when, tuple(safety)))
+    if performance:
+        criteria.append(Criterion(f"as expected from {base.id}", (), when, tuple(performance)))
+    return Acceptance(derived.id, tuple(criteria))
