@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from exsce_dsl.errors import Diagnostic, SourceLocation, SpecError
-from exsce_dsl.lang.build_acceptance import build_acceptance
+from exsce_dsl.lang.build_acceptance import build_all_acceptance
 from exsce_dsl.lang.build_derivation import build_derivations
 from exsce_dsl.lang.checks import check_environment_map, check_scenario
 from exsce_dsl.lang.loader import load_files
@@ -182,24 +182,12 @@ class _Builder:
         )
 
     def _acceptance(self) -> None:
-        first: dict[str, SourceLocation] = {}
-        for pf in self.files:
-            for decl in pf.tree.declarations:
-                if decl.__class__.__name__ != "Acceptance":
-                    continue
-                where = pf.span(decl.scenario)
-                name = decl.scenario.name
-                if name in first:
-                    self.error(f"scenario '{name}' has acceptance criteria already (at {first[name]}); "
-                               "put them in one block", where)
-                    continue
-                first[name] = where
-                built = build_acceptance(
-                    pf, decl, self.scenarios, self.declared["Scenario"],
-                    lambda message, at: self.error(message, at, code="acceptance"),
-                )
-                if built is not None:
-                    self.acceptance[id(decl)] = built
+        self.acceptance = build_all_acceptance(
+            self.files,
+            self.scenarios,
+            self.declared["Scenario"],
+            lambda message, at: self.error(message, at, code="acceptance"),
+        )
 
     def _document(self, pf: ParsedFile) -> Document:
         imports = tuple(Import(i.path, pf.span(i)) for i in pf.tree.imports)

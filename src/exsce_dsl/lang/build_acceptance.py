@@ -9,7 +9,7 @@ its ``file:line:col`` and all of them at once.
 from __future__ import annotations
 
 import re
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from exsce_dsl.errors import SourceLocation
@@ -36,6 +36,34 @@ from exsce_dsl.model.metrics import METRICS, SI_UNIT, UNITS, Dimension, MetricIn
 _QUANTITY = re.compile(r"(\S+?)\s*(m/s|cm/s|km/h|mm|cm|km|ms|min|std|m|s|h|%)?")
 
 Report = Callable[[str, SourceLocation | None], None]
+
+
+def build_all_acceptance(
+    files: Sequence[ParsedFile],
+    scenarios: Mapping[str, Scenario],
+    declared_scenarios: Mapping[str, object],
+    report: Report,
+) -> dict[int, Acceptance]:
+    """Every acceptance block of ``files`` (one per scenario), by the id of its parse tree node."""
+    first: dict[str, SourceLocation] = {}
+    built: dict[int, Acceptance] = {}
+    for pf in files:
+        for decl in pf.tree.declarations:
+            if decl.__class__.__name__ != "Acceptance":
+                continue
+            where, name = pf.span(decl.scenario), decl.scenario.name
+            if name in first:
+                report(
+                    f"scenario '{name}' has acceptance criteria already (at {first[name]}); "
+                    "put them in one block",
+                    where,
+                )
+                continue
+            first[name] = where
+            acceptance = build_acceptance(pf, decl, scenarios, declared_scenarios, report)
+            if acceptance is not None:
+                built[id(decl)] = acceptance
+    return built
 
 
 def build_acceptance(
