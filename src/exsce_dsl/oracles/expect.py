@@ -69,16 +69,29 @@ def robot_path(scenario: Scenario, robot_id: str) -> list[tuple[Pose, Pose]]:
     return list(zip(poses, poses[1:], strict=False))
 
 
-def _either_way(store: Store, metric: str, start: Pose, goal: Pose) -> tuple[Aggregate | None, bool]:
+def _either_way(
+    store: Store, metric: str, start: Pose, goal: Pose, held_out: frozenset[frozenset[str]] = frozenset()
+) -> tuple[Aggregate | None, bool]:
+    if frozenset((start.id, goal.id)) in held_out:
+        return None, False
     found = segment_metric_any(store, metric, start, goal)
     if found is not None:
         return found, False
     return segment_metric_any(store, metric, goal, start), True
 
 
-def segment_value(store: Store, scenario: Scenario, metric: str, start: Pose, goal: Pose) -> SegmentValue:
+def segment_value(
+    store: Store,
+    scenario: Scenario,
+    metric: str,
+    start: Pose,
+    goal: Pose,
+    held_out: frozenset[frozenset[str]] = frozenset(),
+) -> SegmentValue:
+    """One segment's value; ``held_out`` pairs of pose ids are treated as never driven (either way),
+    to measure the estimate against what was driven (bench/estimate.py)."""
     names = (start.id, goal.id)
-    found, reverse = _either_way(store, metric, start, goal)
+    found, reverse = _either_way(store, metric, start, goal, held_out)
     if found is not None:
         return SegmentValue(
             *names, found.mean, "observed the other way" if reverse else "observed", found.count
@@ -93,7 +106,7 @@ def segment_value(store: Store, scenario: Scenario, metric: str, start: Pose, go
         length = math.dist(_xy(i), _xy(j))
         if length == 0:
             continue
-        near, _ = _either_way(store, metric, i, j)
+        near, _ = _either_way(store, metric, i, j, held_out)
         if near is not None:
             estimates.append(near.mean * math.dist(_xy(start), _xy(goal)) / length)
             used.append(f"{i.id}–{j.id}")
