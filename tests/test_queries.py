@@ -525,3 +525,15 @@ def test_a_parameter_line_is_read_whole_and_an_unknown_kind_is_refused() -> None
     ]
     with pytest.raises(ExsceError, match="unknown kind 'metrics'"):
         _parse("x", "# ?metric metrics the metric\nSELECT * {}", False)
+
+
+def test_every_whole_run_value_of_some_runs(store: Store) -> None:
+    found = {(r.run, r.metric, r.robot, r.value) for r in q.run_metric_values(store, [RUN_1])}
+    assert found == {
+        (RUN_1, DIST, "r1", 25.0),
+        (RUN_1, DIST, "r2", 70.0),
+        (RUN_1, "mission_duration", None, 90.0),
+        (RUN_1, "waypoints_visited", "r1", 3.0),
+        (RUN_1, "violation_duration", "r1", 1.0),
+    }
+    assert {r.run for r in q.run_metric_values(store, [RUN_1, RUN_REV])} == {RUN_1}  # run-rev has segment values only

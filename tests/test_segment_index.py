@@ -155,3 +155,21 @@ def test_store_graphs_and_info_set_the_index_apart(tmp_path: Path) -> None:
     assert everything.stdout.count("/segments/corridor_runs/") == 2 and everything.stdout.count("-w_00") == 3
     info = run_exscec("store", "info", cwd=tmp_path)
     assert "+ 5 of the segment index)" in info.stdout
+
+
+def test_the_values_of_runs_whole_and_by_action() -> None:
+    store = EmbeddedStore(None)
+    add_prov(store, compile_scenario(SCENARIO))
+    add_prov(store, compile_run(run("u-1", (5.0, 6.0)), SCENARIO))
+    add_prov(store, compile_run(run("u-2", (7.0,), hour=10), SCENARIO))
+    assert q.run_metric_values(store, ["u-1", "u-2"]) == []  # these runs have segment values only
+    found = sorted(
+        (r.run, r.action.rsplit("/", 1)[-1] if r.action else None, r.goal, r.metric, r.value)
+        for r in q.run_segment_values(store, ["u-1"])
+    )
+    assert found == [
+        ("u-1", "r1-task_01-subtask_001-w_001", NAME[B], "distance_travelled", 5.0),
+        ("u-1", "r1-task_01-subtask_001-w_002", NAME[A], "distance_travelled", 6.0),
+    ]
+    assert {r.robot for r in q.run_segment_values(store, ["u-1", "u-2"])} == {"r1"}
+    assert q.run_segment_values(store, []) == [] and q.failed_runs(store, "corridor_runs") == set()

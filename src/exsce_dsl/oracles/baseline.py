@@ -23,7 +23,7 @@ from exsce_dsl.model.oracles import Oracle
 from exsce_dsl.oracles.observe import RunValues, observe, run_values
 from exsce_dsl.oracles.plan import PlannedOracle, plan_oracles, tolerance_of
 from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries import run_query
+from exsce_dsl.store.queries import failed_runs
 from exsce_dsl.store.queries import runs as stored_runs
 
 PACKAGE = "exsce.metamorphic.relationships"
@@ -81,8 +81,7 @@ def baseline_oracles(
 
 def _usable_runs(store: Store, scenario_id: str) -> list[str]:
     """The stored runs of a scenario, less those an oracle failed when they were verified."""
-    rows = run_query(store, "failed_runs", {"scenario": scenario_id})
-    failed = {row["run"].value for row in rows if row["run"] is not None}
+    failed = failed_runs(store, scenario_id)
     return [run.uuid for run in stored_runs(store, scenario_id) if run.uuid not in failed]
 
 

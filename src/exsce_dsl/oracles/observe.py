@@ -12,7 +12,7 @@ from exsce_dsl.model import Scenario
 from exsce_dsl.model.acceptance import Moment, Window
 from exsce_dsl.model.metrics import METRICS, Combine
 from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries import run_query
+from exsce_dsl.store.queries import run_metric_values, run_segment_values
 
 _ACTION = re.compile(r"/(?P<robot>[^/]+)-task_(?P<task>\d+)-subtask_(?P<subtask>\d+)-w_(?P<waypoint>\d+)$")
 _WINDOW = re.compile(
@@ -47,32 +47,23 @@ def run_values(store: Store, runs: Sequence[str]) -> dict[str, RunValues]:
     found = {run: RunValues(run) for run in runs}
     if not runs:
         return found
-    for row in run_query(store, "run_metric_values", {"run": list(runs)}):
-        run, metric, value = row["run"], row["metric"], row["value"]
-        robot = row["robot"]
-        if run is None or metric is None or value is None or run.value not in found:
-            continue
-        key = (metric.value, robot.value if robot is not None else None)
-        found[run.value].whole.setdefault(key, []).append(float(value.value))
-    for row in run_query(store, "run_segment_values", {"run": list(runs)}):
-        run, action, goal, metric, value = row["run"], row["action"], row["goal"], row["metric"], row["value"]
-        if None in (run, action, goal, metric, value) or run.value not in found:  # type: ignore[union-attr]
-            continue
-        assert run is not None and action is not None and goal is not None
-        assert metric is not None and value is not None
-        parts = _ACTION.search(action.value)
-        if parts is None:
+    for reading in run_metric_values(store, runs):
+        if reading.run in found:
+            found[reading.run].whole.setdefault((reading.metric, reading.robot), []).append(reading.value)
+    for reading in run_segment_values(store, runs):
+        parts = _ACTION.search(reading.action or "")
+        if parts is None or reading.run not in found or reading.goal is None:
             continue
         numbers = (int(parts["task"]), int(parts["subtask"]), int(parts["waypoint"]))
-        found[run.value].segments.append(
+        found[reading.run].segments.append(
             SegmentValue(
-                action.value,
+                reading.action or "",
                 parts["robot"],
                 numbers[0],
                 numbers,
-                goal.value.rsplit("/", 1)[-1],
-                metric.value,
-                float(value.value),
+                reading.goal,
+                reading.metric,
+                reading.value,
             )
         )
     return found

@@ -41,6 +41,7 @@ __all__ = [
     "ViolationDuration",
     "derivation_of",
     "derived_scenarios",
+    "failed_runs",
     "hotspot_counts",
     "lineage",
     "mission_duration",
@@ -58,6 +59,9 @@ __all__ = [
     "runs",
     "segment_metric",
     "segment_metric_any",
+    "run_metric_values",
+    "run_segment_values",
+    "MetricReading",
     "standard_prefixes",
     "update_baseline",
     "violation_duration",
@@ -497,3 +501,53 @@ def derived_scenarios(store: Store, scenario: str, namespace: str = DEFAULT_NAME
     """The scenarios derived from ``scenario`` directly."""
     rows = run_query(store, "derived_scenarios", {"base": scenario}, namespace)
     return [_text(row["derived"]) or "" for row in rows]
+
+
+@dataclass(frozen=True)
+class MetricReading:
+    """One metric value of a run: a whole-run value (``action`` None), or one action's
+    (``action`` its IRI, ``goal`` the goal pose's name with its heading)."""
+
+    run: str
+    metric: str
+    robot: str | None
+    value: float
+    action: str | None = None
+    goal: str | None = None
+
+
+def run_metric_values(
+    store: Store, runs: Sequence[str], namespace: str = DEFAULT_NAMESPACE
+) -> list[MetricReading]:
+    """Every whole-run metric value of ``runs``: each robot's and the mission's."""
+    if not runs:
+        return []
+    found = []
+    for row in run_query(store, "run_metric_values", {"run": list(runs)}, namespace):
+        run, metric, value = _text(row["run"]), _text(row["metric"]), _float(row["value"])
+        if run is not None and metric is not None and value is not None:
+            found.append(MetricReading(run, metric, _text(row["robot"]), value))
+    return found
+
+
+def run_segment_values(
+    store: Store, runs: Sequence[str], namespace: str = DEFAULT_NAMESPACE
+) -> list[MetricReading]:
+    """Every path-segment metric value of ``runs``, by action, from the segment index."""
+    if not runs:
+        return []
+    found = []
+    for row in run_query(store, "run_segment_values", {"run": list(runs)}, namespace):
+        run, metric, value = _text(row["run"]), _text(row["metric"]), _float(row["value"])
+        action, goal = _text(row["action"]), _text(row["goal"])
+        if None not in (run, metric, value, action, goal):
+            assert run is not None and metric is not None and value is not None and goal is not None
+            pose = goal.rsplit("/", 1)[-1]
+            found.append(MetricReading(run, metric, _text(row["robot"]), value, action, pose))
+    return found
+
+
+def failed_runs(store: Store, scenario: str, namespace: str = DEFAULT_NAMESPACE) -> set[str]:
+    """The runs of ``scenario`` an oracle failed when they were last verified."""
+    rows = run_query(store, "failed_runs", {"scenario": scenario}, namespace)
+    return {_text(row["run"]) or "" for row in rows}
