@@ -23,7 +23,7 @@ from exsce_dsl.errors import Diagnostic, ExportError, ImportFormatError, SourceL
 from exsce_dsl.lang.format_acceptance import expectation_text
 from exsce_dsl.lang.names import is_valid_name
 from exsce_dsl.lang.suggest import did_you_mean
-from exsce_dsl.lang.yaml_import import _child, _location, _Node, _YamlFile
+from exsce_dsl.lang.yaml_import import YamlFile, YamlNode, child_node, node_location
 from exsce_dsl.model import Document, Import, Scenario, Specification
 from exsce_dsl.model.acceptance import (
     Acceptance,
@@ -74,19 +74,19 @@ class OracleFileErrors(ImportFormatError):
 
 def is_oracle_yaml(path: Path) -> bool:
     """Whether ``path`` is an oracle file (it has a ``baseline`` or ``metamorphic`` section)."""
-    data = _YamlFile.read(path).data
+    data = YamlFile.read(path).data
     return isinstance(data, Mapping) and any(section in data for section in SECTIONS)
 
 
 def import_oracle_yaml(path: Path, scenario: Scenario) -> Acceptance:
     """The acceptance criteria of an oracle file of ``scenario``; every problem found is
     raised at once, each at its ``file:line:col``.  Nothing the file names is imported."""
-    return _OracleReader(_YamlFile.read(path), scenario).acceptance()
+    return _OracleReader(YamlFile.read(path), scenario).acceptance()
 
 
 def import_oracles(path: Path, spec: Specification) -> Acceptance:
     """Like :func:`import_oracle_yaml`, for the scenario of ``spec`` that the file's ``id`` names."""
-    file = _YamlFile.read(path)
+    file = YamlFile.read(path)
     id_node = file.root_node().get("id")
     scenario_id = id_node.ident("scenario")
     declared = {s.id: s for s in spec.scenarios}
@@ -105,7 +105,7 @@ def acceptance_document(acceptance: Acceptance, spec_path: Path, out_dir: Path) 
 
 
 class _OracleReader:
-    def __init__(self, file: _YamlFile, scenario: Scenario) -> None:
+    def __init__(self, file: YamlFile, scenario: Scenario) -> None:
         self.file = file
         self.scenario = scenario
         self.problems: list[ImportFormatError] = []
@@ -136,7 +136,7 @@ class _OracleReader:
             raise self.problems[0] if len(self.problems) == 1 else OracleFileErrors(self.problems)
         return Acceptance(self.scenario.id, tuple(criteria), root.location)
 
-    def section(self, node: _Node, titles: set[str]) -> Criterion | None:
+    def section(self, node: YamlNode, titles: set[str]) -> Criterion | None:
         base = node.get("base_scenario")
         base_id = base.ident("scenario")
         against = None if base_id == self.scenario.id else base_id
@@ -166,7 +166,9 @@ class _OracleReader:
             return None
         return Criterion(title, (), When(mission=self.scenario.mission.id), found, node.location)
 
-    def entry(self, parent: _Node, metric: str, robot: str | None, against: str | None) -> Expectation | None:
+    def entry(
+        self, parent: YamlNode, metric: str, robot: str | None, against: str | None
+    ) -> Expectation | None:
         """The clause of one metric entry; None (with the problems reported) if it has any."""
         known = len(self.problems)
         try:
@@ -188,7 +190,7 @@ class _OracleReader:
         return Expectation(subject, metric, relation, limit=q("limit"), value=q("value"), delta=q("delta"),
                            tolerance=q("tolerance"), against=against, location=node.location)
 
-    def metric(self, parent: _Node, metric: str, robot: str | None) -> MetricInfo | None:
+    def metric(self, parent: YamlNode, metric: str, robot: str | None) -> MetricInfo | None:
         info = METRICS.get(metric)
         where = _key_location(parent, metric)
         if info is None:
@@ -203,7 +205,7 @@ class _OracleReader:
             return info
         return None
 
-    def relation(self, node: _Node) -> Relation | None:
+    def relation(self, node: YamlNode) -> Relation | None:
         package = node.opt("package")
         if package is not None and package.text() != RELATIONSHIPS_PACKAGE:
             self.report(
@@ -222,7 +224,7 @@ class _OracleReader:
             self.report(f"unknown relationship '{name}'{hint}", name_node.location)
             return None
 
-    def check_topics(self, node: _Node, metric: str, robot: str | None) -> None:
+    def check_topics(self, node: YamlNode, metric: str, robot: str | None) -> None:
         expected = default_topics(self.scenario, metric, robot)
         whose = f"'{robot}'" if robot else "the mission"
         items = list(node.items_of_list())
@@ -238,7 +240,7 @@ class _OracleReader:
                         f"from {', '.join(expected)}, and the DSL cannot override a metric's topics yet",
                         node.location)
 
-    def numbers(self, node: _Node, relation: Relation, info: MetricInfo) -> dict[str, Quantity] | None:
+    def numbers(self, node: YamlNode, relation: Relation, info: MetricInfo) -> dict[str, Quantity] | None:
         """The relation's numbers as quantities in the metric's SI unit, by field name."""
         keys = _NUMBERS[relation]
         for key, _ in node.items_of_mapping():
@@ -260,37 +262,37 @@ class _OracleReader:
         return quantities
 
 
-def _entries(node: _Node) -> list[tuple[str, _Node]]:
+def _entries(node: YamlNode) -> list[tuple[str, YamlNode]]:
     """The keys of a mapping; nothing for an empty one (``mission:`` with no metric)."""
     return [] if node.value is None else list(node.items_of_mapping())
 
 
-def _quantity(node: _Node, info: MetricInfo) -> Quantity:
+def _quantity(node: YamlNode, info: MetricInfo) -> Quantity:
     value = node.number()
     written = _scalar_text(node)
     return Quantity(value, SI_UNIT[info.dimension] or None, written if _NUMBER.fullmatch(written) else "")
 
 
-def _yaml_node(node: _Node) -> yaml.Node | None:
+def _yaml_node(node: YamlNode) -> yaml.Node | None:
     current = node.file.tree
     for key in node.keys:
-        current = _child(current, key) if current is not None else None
+        current = child_node(current, key) if current is not None else None
     return current
 
 
-def _scalar_text(node: _Node) -> str:
+def _scalar_text(node: YamlNode) -> str:
     """The number as the file writes it (``97.606``), for the DSL text to show the same."""
     tree = _yaml_node(node)
     return str(tree.value) if isinstance(tree, yaml.ScalarNode) else ""
 
 
-def _key_location(parent: _Node, key: str) -> SourceLocation:
+def _key_location(parent: YamlNode, key: str) -> SourceLocation:
     """Where ``key`` itself is written in the mapping ``parent`` (an unknown name is the key)."""
     tree = _yaml_node(parent)
     if isinstance(tree, yaml.MappingNode):
         for key_node, _ in tree.value:
             if getattr(key_node, "value", None) == key:
-                return _location(parent.file.name, key_node.start_mark, key_node.end_mark)
+                return node_location(parent.file.name, key_node.start_mark, key_node.end_mark)
     return parent.location
 
 

@@ -62,7 +62,7 @@ def import_scenario_yaml(path: Path, task_search_path: Sequence[Path] = ()) -> t
     with the same name (sorted, first wins). The documents come back with paths
     relative to the scenario document, which is first.
     """
-    scenario_file = _YamlFile.read(path)
+    scenario_file = YamlFile.read(path)
     root = scenario_file.root_node()
     finder = _TaskFinder([path.parent, *task_search_path])
 
@@ -73,7 +73,7 @@ def import_scenario_yaml(path: Path, task_search_path: Sequence[Path] = ()) -> t
 
     # Robots and their types, in the order of the YAML list.
     robot_types: dict[str, RobotType] = {}
-    robot_rows: list[tuple[_Node, str, RobotType, str]] = []
+    robot_rows: list[tuple[YamlNode, str, RobotType, str]] = []
     for entry in robots_node.items_of_list():
         robot_id = entry.get("robot_id").ident("robot")
         if any(robot_id == row[1] for row in robot_rows):
@@ -119,7 +119,7 @@ def import_scenario_yaml(path: Path, task_search_path: Sequence[Path] = ()) -> t
         known = tasks.get(task_id)
         if known is None:
             task_file = finder.find(entry)
-            tasks[task_id] = _read_task(_YamlFile.read(task_file), task_id, source)
+            tasks[task_id] = _read_task(YamlFile.read(task_file), task_id, source)
         elif known.source != source:
             raise entry.error(
                 f"task '{task_id}' comes from package {source.package} path {source.path} "
@@ -172,7 +172,7 @@ def import_scenario_yaml(path: Path, task_search_path: Sequence[Path] = ()) -> t
 def import_task_yaml(path: Path, task_id: str | None = None, *, source: RosResource | None = None) -> Task:
     """Read one task file of the method. The task id defaults to the file's name
     without ``.yaml``; each waypoint's area is its id's prefix (see the module)."""
-    file = _YamlFile.read(path)
+    file = YamlFile.read(path)
     if task_id is None:
         task_id = _strip_yaml_suffix(path.name)
         _check_name(task_id, "task", f"the name of file {path}", file.root_node())
@@ -184,7 +184,7 @@ def import_task_yaml(path: Path, task_id: str | None = None, *, source: RosResou
 # -- reading YAML with positions -------------------------------------------------------
 
 
-class _YamlFile:
+class YamlFile:
     """A YAML file read twice: as data with ``yaml.safe_load``, and as a node tree
     (composed by the same safe loader) that only serves line and column numbers."""
 
@@ -194,7 +194,7 @@ class _YamlFile:
         self.tree = tree
 
     @classmethod
-    def read(cls, path: Path) -> _YamlFile:
+    def read(cls, path: Path) -> YamlFile:
         try:
             text = path.read_text(encoding="utf-8")
         except OSError as e:
@@ -204,13 +204,13 @@ class _YamlFile:
             tree = yaml.compose(text, Loader=yaml.SafeLoader)
         except yaml.YAMLError as e:
             mark = getattr(e, "problem_mark", None)
-            location = _location(str(path), mark) if mark is not None else None
+            location = node_location(str(path), mark) if mark is not None else None
             problem = getattr(e, "problem", None) or str(e)
             raise ImportFormatError(f"not valid YAML: {problem}", location) from e
         return cls(str(path), data, tree)
 
-    def root_node(self) -> _Node:
-        return _Node(self, (), self.data)
+    def root_node(self) -> YamlNode:
+        return YamlNode(self, (), self.data)
 
     def location(self, keys: tuple[_Key, ...]) -> SourceLocation:
         """Where the value at ``keys`` starts, or the nearest enclosing value."""
@@ -218,14 +218,14 @@ class _YamlFile:
         if node is None:
             return SourceLocation(self.name, 1, 1)
         for key in keys:
-            child = _child(node, key)
+            child = child_node(node, key)
             if child is None:
                 break
             node = child
-        return _location(self.name, node.start_mark, node.end_mark)
+        return node_location(self.name, node.start_mark, node.end_mark)
 
 
-def _child(node: yaml.Node, key: _Key) -> yaml.Node | None:
+def child_node(node: yaml.Node, key: _Key) -> yaml.Node | None:
     if isinstance(node, yaml.MappingNode) and isinstance(key, str):
         return next((v for k, v in node.value if getattr(k, "value", None) == key), None)
     if isinstance(node, yaml.SequenceNode) and isinstance(key, int) and key < len(node.value):
@@ -234,17 +234,17 @@ def _child(node: yaml.Node, key: _Key) -> yaml.Node | None:
     return None
 
 
-def _location(file: str, start: yaml.Mark, end: yaml.Mark | None = None) -> SourceLocation:
+def node_location(file: str, start: yaml.Mark, end: yaml.Mark | None = None) -> SourceLocation:
     if end is None:
         return SourceLocation(file, start.line + 1, start.column + 1)
     return SourceLocation(file, start.line + 1, start.column + 1, end.line + 1, end.column + 1)
 
 
 @dataclass(frozen=True)
-class _Node:
+class YamlNode:
     """A value of a YAML file with the keys that lead to it, for error messages."""
 
-    file: _YamlFile
+    file: YamlFile
     keys: tuple[_Key, ...]
     value: object
 
@@ -267,29 +267,29 @@ class _Node:
             raise self.error(f"{self.where} should be a mapping of keys to values, not {_kind(self.value)}")
         return self.value
 
-    def get(self, key: str) -> _Node:
+    def get(self, key: str) -> YamlNode:
         """The value of a required key."""
         mapping = self._mapping()
         if key not in mapping:
             raise self.error(f"missing key '{key}' in {self.where}")
-        return _Node(self.file, (*self.keys, key), mapping[key])
+        return YamlNode(self.file, (*self.keys, key), mapping[key])
 
-    def opt(self, key: str) -> _Node | None:
+    def opt(self, key: str) -> YamlNode | None:
         """The value of an optional key; ``None`` when absent or empty."""
         mapping = self._mapping()
         if mapping.get(key) is None:
             return None
-        return _Node(self.file, (*self.keys, key), mapping[key])
+        return YamlNode(self.file, (*self.keys, key), mapping[key])
 
-    def items_of_mapping(self) -> Iterator[tuple[str, _Node]]:
+    def items_of_mapping(self) -> Iterator[tuple[str, YamlNode]]:
         for key, value in self._mapping().items():
-            yield str(key), _Node(self.file, (*self.keys, str(key)), value)
+            yield str(key), YamlNode(self.file, (*self.keys, str(key)), value)
 
-    def items_of_list(self) -> Iterator[_Node]:
+    def items_of_list(self) -> Iterator[YamlNode]:
         if not isinstance(self.value, list):
             raise self.error(f"{self.where} should be a list, not {_kind(self.value)}")
         for i, value in enumerate(self.value):
-            yield _Node(self.file, (*self.keys, i), value)
+            yield YamlNode(self.file, (*self.keys, i), value)
 
     def text(self) -> str:
         if not isinstance(self.value, str):
@@ -320,7 +320,7 @@ def _kind(value: object) -> str:
     return f"{type(value).__name__} {value!r}"
 
 
-def _check_name(text: str, what: str, where: str, node: _Node) -> None:
+def _check_name(text: str, what: str, where: str, node: YamlNode) -> None:
     if not is_valid_name(text):
         raise node.error(f"{what} id '{text}' ({where}) is not a valid exsce id: {_why_not_a_name(text)}")
 
@@ -347,7 +347,7 @@ class _TaskFinder:
         self.folders = list(dict.fromkeys(folders))
         self._by_name: dict[Path, dict[str, list[Path]]] = {}
 
-    def find(self, entry: _Node) -> Path:
+    def find(self, entry: YamlNode) -> Path:
         package = entry.get("pkg").text()
         file_path = entry.get("file_path").text()
         name = Path(file_path).name
@@ -388,13 +388,13 @@ def _strip_yaml_suffix(name: str) -> str:
     return name
 
 
-def _task_id_of(file_path: _Node) -> str:
+def _task_id_of(file_path: YamlNode) -> str:
     task_id = _strip_yaml_suffix(Path(file_path.text()).name)
     _check_name(task_id, "task", f"the name of file {file_path.text()}", file_path)
     return task_id
 
 
-def _read_task(file: _YamlFile, task_id: str, source: RosResource | None) -> Task:
+def _read_task(file: YamlFile, task_id: str, source: RosResource | None) -> Task:
     root = file.root_node()
     subtasks = tuple(
         Subtask(
@@ -406,7 +406,7 @@ def _read_task(file: _YamlFile, task_id: str, source: RosResource | None) -> Tas
     return Task(task_id, subtasks, source, root.location)
 
 
-def _read_pose(node: _Node) -> Pose:
+def _read_pose(node: YamlNode) -> Pose:
     """A pose as the method wrote it: id, x, y, and optionally z, roll, pitch, yaw."""
     pose_id = node.get("id").ident("pose")
 
@@ -419,7 +419,7 @@ def _read_pose(node: _Node) -> Pose:
     return Pose(pose_id, position, orientation, _area_of(pose_id, node), node.location)
 
 
-def _area_of(pose_id: str, node: _Node) -> str:
+def _area_of(pose_id: str, node: YamlNode) -> str:
     if "-" not in pose_id:
         return UNASSIGNED_AREA
     # The method names poses <area>-<point>: `classroom_c025-w001`, and also
@@ -462,7 +462,7 @@ def _describe(source: RosResource | None) -> str:
 # -- the rest of a scenario --------------------------------------------------------------
 
 
-def _mission_type(node: _Node) -> MissionType:
+def _mission_type(node: YamlNode) -> MissionType:
     text = node.text()
     try:
         return MissionType(text)
@@ -471,7 +471,7 @@ def _mission_type(node: _Node) -> MissionType:
         raise node.error(f"mission type '{text}' is not {kinds}") from None
 
 
-def _model(environment: _Node, key: str, name_key: str) -> tuple[str, RosResource | None, _Node]:
+def _model(environment: YamlNode, key: str, name_key: str) -> tuple[str, RosResource | None, YamlNode]:
     node = environment.get("models").get(key)
     name = node.get(name_key).ident(f"{key} model")
     package = node.opt("pkg")
@@ -480,7 +480,7 @@ def _model(environment: _Node, key: str, name_key: str) -> tuple[str, RosResourc
     return name, source, node
 
 
-def _read_map(environment: _Node) -> MapModel | None:
+def _read_map(environment: YamlNode) -> MapModel | None:
     models = environment.opt("models")
     if models is None or models.opt("map") is None:
         return None
@@ -488,7 +488,7 @@ def _read_map(environment: _Node) -> MapModel | None:
     return MapModel(name, source, location=node.location)
 
 
-def _read_world(environment: _Node) -> WorldModel | None:
+def _read_world(environment: YamlNode) -> WorldModel | None:
     models = environment.opt("models")
     if models is None or models.opt("gazebo_world") is None:
         return None
