@@ -37,6 +37,7 @@ def baseline(spec: str, scenario_id: str | None, store_url: str | None) -> None:
     from exsce_dsl.prov.oracle import compile_oracles
     from exsce_dsl.store.open import open_store
     from exsce_dsl.store.writing import add_prov
+    from exsce_dsl.tables import aligned
 
     loaded = load_spec(spec)
     scenario = loaded.scenario(scenario_id)
@@ -59,10 +60,7 @@ def baseline(spec: str, scenario_id: str | None, store_url: str | None) -> None:
                 str(len(o.sources)) if o.sources else "",
             )
         )
-    widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
-    click.echo(
-        "\n".join("  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True)).rstrip() for r in rows)
-    )
+    click.echo("\n".join(aligned(rows)))
     click.echo(report.summary(), err=True)
 
 

@@ -17,6 +17,7 @@ from exsce_dsl.cli.common import reports_errors, write_text
 from exsce_dsl.cli.store_commands import store_option
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.store.base import Rows, Term
+from exsce_dsl.tables import aligned
 
 FORMATS = ("table", "json", "csv")
 _XSD_STRING = "http://www.w3.org/2001/XMLSchema#string"
@@ -106,7 +107,7 @@ def results_table(rows: Rows, prefixes: Mapping[str, str]) -> str:
     if not rows.variables:
         return ""
     widths = [max(len(line[i]) for line in cells) for i in range(len(rows.variables))]
-    lines = ["  ".join(c.ljust(w) for c, w in zip(line, widths, strict=True)).rstrip() for line in cells]
+    lines = aligned(cells)
     lines.insert(1, "  ".join("-" * w for w in widths))
     return "\n".join(lines) + "\n"
 

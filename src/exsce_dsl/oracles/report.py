@@ -7,6 +7,7 @@ import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 
 from exsce_dsl.model.verdicts import Outcome, Verdict
+from exsce_dsl.tables import aligned
 
 _MARK = {Outcome.PASSED: "pass", Outcome.FAILED: "FAIL", Outcome.UNJUDGED: "n/a"}
 
@@ -44,12 +45,7 @@ def verdict_table(verdicts: Sequence[Verdict]) -> str:
         )
         for v in verdicts
     ]
-    widths = [max(len(row[i]) for row in rows) for i in range(len(header) - 1)]
-    lines = [
-        "  ".join(cell.ljust(w) for cell, w in zip(row[:-1], widths, strict=True)) + "  " + row[-1]
-        for row in rows
-    ]
-    return "\n".join(line.rstrip() for line in lines)
+    return "\n".join(aligned(rows))
 
 
 def verdicts_json(verdicts: Sequence[Verdict]) -> str:
