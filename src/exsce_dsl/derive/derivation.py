@@ -14,7 +14,7 @@ from exsce_dsl.errors import ExsceError
 from exsce_dsl.lang.names import is_valid_name
 from exsce_dsl.lang.suggest import did_you_mean
 from exsce_dsl.model import Document, Import, Scenario, Task
-from exsce_dsl.model.derivation import Derivation
+from exsce_dsl.model.derivation import Derivation, TaskOrigin
 
 Request = tuple[str, Mapping[str, str]]
 """A transformation's name and its arguments as text."""
@@ -58,7 +58,18 @@ def derive(
         raise ExsceError("the derived scenario needs an id of its own")
     mission = replace(applied.scenario.mission, id=f"{derivation_id}_mission")
     scenario = replace(applied.scenario, id=derivation_id, mission=mission, location=None)
-    return Derived(scenario, applied.new_tasks, Derivation(derivation_id, base.id, applied.steps))
+    derivation = Derivation(derivation_id, base.id, applied.steps, _task_origins(applied))
+    return Derived(scenario, applied.new_tasks, derivation)
+
+
+def _task_origins(applied: Applied) -> tuple[TaskOrigin, ...]:
+    """Which step made each new task, from which task (a reversal names both)."""
+    return tuple(
+        TaskOrigin(str(arguments["to"]), str(arguments["task"]), number)
+        for number, step in enumerate(applied.steps, start=1)
+        if step.transformation == "reverse_waypoint_order"
+        for arguments in (dict(step.parameters),)
+    )
 
 
 def _default_id(base: str, applied: Applied) -> str:

@@ -19,9 +19,21 @@ class TransformationStep:
 
 
 @dataclass(frozen=True)
+class TaskOrigin:
+    """A task a step made from another (``reverse_waypoint_order`` makes a reversed copy)."""
+
+    task: str
+    source: str
+    step: int
+    """The step's position in the derivation, from 1."""
+
+
+@dataclass(frozen=True)
 class Derivation:
     """Scenario ``new`` derived from scenario ``base`` by ``steps``, applied in order."""
 
     new: str
     base: str
     steps: tuple[TransformationStep, ...]
+    origins: tuple[TaskOrigin, ...] = ()
+    """The new tasks of the derivation and the tasks they were made from."""

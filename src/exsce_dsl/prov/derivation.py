@@ -9,7 +9,10 @@
   (``prov:type=exsce:transform``, ``exsce:transform=<name>``, ``exsce:step=NN``,
   and each argument as ``exsce:<key>``), each informed by the step before it
   (``wasInformedBy``); the generation was started by the first step and ended
-  by the last (``wasStartedBy``/``wasEndedBy`` with the step as starter/ender).
+  by the last (``wasStartedBy``/``wasEndedBy`` with the step as starter/ender);
+* a task that a step made from another (``reverse_waypoint_order``): the step
+  *used* the old task (the method's Listing 26) and *generated* the new one, and
+  ``wasDerivedFrom(task:<new>, task:<old>, <step>)``.
 
 Where the method is silent or loose, exsce chooses:
 
@@ -86,4 +89,16 @@ def compile_derivation(
         previous = activity
     if previous is not None:
         w.ended(generation, ender=previous)
+    task = w.fixed(ids.TASK)
+    for origin in derivation.origins:
+        if not 1 <= origin.step <= len(derivation.steps):
+            raise ExsceError(f"task '{origin.task}' comes from step {origin.step}, which is not one")
+        ids.check_name(origin.task, "task id")
+        ids.check_name(origin.source, "task id")
+        step = derivation.steps[origin.step - 1]
+        made_by = parts[ids.transformation_step_name(origin.step, step.transformation)]
+        new_task, old_task = task[origin.task], task[origin.source]
+        w.used(made_by, old_task)
+        w.generated(new_task, made_by)
+        w.derivation(new_task, old_task, {}, activity=made_by)
     return writer.document
