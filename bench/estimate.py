@@ -3,7 +3,7 @@
 Simulates runs of the shipped building-C scenarios (a to e), ingests them into a
 temporary embedded store, then for every segment the runs drove, holds it out
 (as if no run had driven it, in either direction) and estimates it from the
-segments near it (exsce_dsl.oracles.expect.segment_value), against the mean of
+segments near it (exsce_dsl.derive.expect.segment_value), against the mean of
 what was driven.  Prints, per metric, the median and 90th-percentile relative
 error and how many segments could be estimated at all.
 
@@ -20,9 +20,9 @@ import statistics
 import tempfile
 from pathlib import Path
 
+from exsce_dsl.derive.expect import SUMMED, robot_path, segment_value
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.model import Scenario
-from exsce_dsl.oracles.expect import SUMMED, robot_path, segment_value
 from exsce_dsl.runs.ingest import ingest_bags
 from exsce_dsl.sim.run import simulate
 from exsce_dsl.store.embedded import EmbeddedStore

@@ -12,6 +12,7 @@ from __future__ import annotations
 import datetime
 import math
 
+from exsce_dsl.derive.expect import expected_metric, robot_path
 from exsce_dsl.model import (
     Area,
     Assignment,
@@ -28,7 +29,6 @@ from exsce_dsl.model import (
     Task,
 )
 from exsce_dsl.model.runs import Action, ActionId, Bag, MetricScope, MetricValue, Run, TaskExecution
-from exsce_dsl.oracles.expect import expected_metric, robot_path
 from exsce_dsl.prov import compile_scenario
 from exsce_dsl.prov.run import compile_run
 from exsce_dsl.store.embedded import EmbeddedStore
@@ -130,6 +130,7 @@ def test_a_segment_with_no_neighbour_data_falls_back_to_the_robot_s_rate_per_met
 
 
 def test_the_derived_scenario_s_criteria_follow_from_the_expected_change() -> None:
+    from exsce_dsl.derive.expect import metamorphic_acceptance
     from exsce_dsl.lang.format_acceptance import expectation_text
     from exsce_dsl.model.acceptance import (
         Acceptance,
@@ -140,7 +141,6 @@ def test_the_derived_scenario_s_criteria_follow_from_the_expected_change() -> No
         Relation,
         Subject,
     )
-    from exsce_dsl.oracles.expect import metamorphic_acceptance
 
     store = EmbeddedStore(None)
     add_prov(store, compile_scenario(BASE))
@@ -153,6 +153,56 @@ def test_the_derived_scenario_s_criteria_follow_from_the_expected_change() -> No
     assert [c.title for c in made.criteria] == ["as safe as base", "as expected from base"]
     assert [expectation_text(e) for e in made.expectations()] == [
         "each robot max_velocity stays below 1.0 m/s",
-        # expected 22 m against the base's mean of 16 m: 6 m more, within 10 % of the change
-        "r1 distance_travelled is increasing by 6 m within 0.6 m of base",
+        # expected 22 m (the method's Listing 35: the new scenario's own baseline, both ways) ...
+        "r1 distance_travelled is invariant around 22 m within 10 %",
+        # ... against the base's mean of 16 m: 6 m more, less 10 % of 22 m
+        "r1 distance_travelled is increasing by 6 m within 2.2 m of base",
     ]
+    small = metamorphic_acceptance(store, BASE, LONGER, None, tolerance_percent=30.0)
+    assert [expectation_text(e) for e in small.expectations()] == [
+        "r1 distance_travelled is invariant around 22 m within 30 %",
+        "r1 distance_travelled is invariant within 6.6 m of base",  # a change within the allowance
+    ]
+
+
+def test_a_segment_is_read_whatever_heading_its_poses_were_driven_with() -> None:
+    """The base's task faced room-b north (another pose IRI, the same point): the new path,
+    which names room-b with its declared heading, still finds those drives."""
+    north = B.with_orientation(Orientation(yaw=1.5708))
+    store = EmbeddedStore(None)
+    base = scenario("base", north, C)
+    add_prov(store, compile_scenario(base))
+    actions = (Action(ActionId("r1", 1, 1, 1), A, north),)
+    metrics = (MetricValue("distance_travelled", MetricScope.SEGMENT, 7.5, DIST, action=actions[0].id),)
+    start = datetime.datetime(2024, 7, 1, 9)
+    add_prov(
+        store,
+        compile_run(
+            Run("u9", "base", start, start + datetime.timedelta(minutes=1), Bag("u9.bag", DIST),
+                (TaskExecution("r1", 1, actions),), metrics),
+            base,
+        ),
+    )
+    ab = expected_metric(store, scenario("plain", B), "r1", "distance_travelled").segments[0]
+    assert (ab.value, ab.how, ab.runs) == (7.5, "observed", 1)
+    ba = expected_metric(store, Scenario("back", ROOM, (Robot("r1", TIAGO, "r1", start_pose=B),),
+                                         Mission("back_m", MissionType.SEQUENTIAL, (Assignment("r1", "t"),)),
+                                         (Task("t", (Subtask((A,)),)),)), "r1", "distance_travelled").segments[0]
+    assert (ba.value, ba.how) == (7.5, "observed the other way")
+
+
+def test_a_clause_between_robots_is_not_copied_to_a_scenario_of_one_robot() -> None:
+    from exsce_dsl.derive.expect import metamorphic_acceptance
+    from exsce_dsl.model.acceptance import (
+        Acceptance,
+        Criterion,
+        Expectation,
+        Quantifier,
+        Quantity,
+        Relation,
+        Subject,
+    )
+
+    apart = Expectation(Subject(Quantifier.MISSION), "distance_between_robots", Relation.ABOVE_MIN, limit=Quantity(0.1, "m", "0.1"))
+    made = metamorphic_acceptance(EmbeddedStore(None), BASE, LONGER, Acceptance("base", (Criterion("apart", (), None, (apart,)),)))
+    assert made.criteria == ()  # one robot: nothing between robots to judge, and no runs to expect from

@@ -50,7 +50,15 @@ def _requests(words: tuple[str, ...]) -> list[tuple[str, dict[str, str]]]:
     "with_expectations",
     is_flag=True,
     help="Write acceptance criteria for the new scenario: the base's safety clauses, and the "
-    "performance relations its expected values imply (see exscec expect), from the store.",
+    "performance relations its expected values imply (see exscec expect), from the store; with "
+    "--add-to-store its oracles go to the store too.",
+)
+@click.option(
+    "--tolerance",
+    type=click.FloatRange(min=0, min_open=True),
+    default=10.0,
+    show_default=True,
+    help="With --expect: how far from the expected change a run may be, in percent of that change.",
 )
 @store_option
 @click.argument("steps", nargs=-1, type=click.UNPROCESSED)
@@ -63,6 +71,7 @@ def derive(
     list_them: bool,
     add_to_store: bool,
     with_expectations: bool,
+    tolerance: float,
     store_url: str | None,
     steps: tuple[str, ...],
 ) -> None:
@@ -71,13 +80,18 @@ def derive(
     Prints (or writes with -o) a formatted .exsce file that imports SPEC and
     declares the new scenario and any task a transformation made; it checks
     clean.  --add-to-store adds the new scenario and its generation provenance
-    (the method's shape: one activity per step) to the store.
+    (the method's shape: one activity per step) to the store.  --expect writes
+    the new scenario's acceptance criteria from the stored runs (the base's
+    safety clauses; distance and duration increasing, decreasing or invariant
+    against the base's runs, by the change its expected values imply).
 
     \b
     Example:
       exscec derive examples/brsu_building_c/scenario_c.exsce \\
           -t remove_robot --robot tiago2 --reassign tiago1 \\
           -t reverse_waypoint_order --task delivery_a -o scenario_c_alone.exsce
+      exscec derive examples/brsu_building_c/scenario_c.exsce --id c_one \
+          -t remove_robot --robot tiago2 --reassign tiago1 --expect --add-to-store
     """
     from exsce_dsl.derive.derivation import derive as apply_steps
     from exsce_dsl.derive.derivation import derived_document
@@ -95,14 +109,17 @@ def derive(
     derived = apply_steps(base, _requests(steps), new_id, {t.id: t for t in loaded.tasks})
     target = Path(output) if output else Path(spec).with_name(f"{derived.scenario.id}.exsce")
     document = derived_document(derived, Path(spec), target)
+    criteria = None
     if with_expectations:
         from dataclasses import replace
 
-        from exsce_dsl.oracles.expect import metamorphic_acceptance
+        from exsce_dsl.derive.expect import metamorphic_acceptance
         from exsce_dsl.store.open import open_store
 
         with open_store(store_url) as store:
-            criteria = metamorphic_acceptance(store, base, derived.scenario, loaded.acceptance_of(base.id))
+            criteria = metamorphic_acceptance(
+                store, base, derived.scenario, loaded.acceptance_of(base.id), tolerance
+            )
         if criteria.criteria:
             document = replace(document, declarations=(*document.declarations, criteria))
         else:
@@ -126,6 +143,13 @@ def derive(
             add_prov(store, compile_scenario(base))
             click.echo(add_prov(store, compile_scenario(derived.scenario)).summary(), err=True)
             click.echo(add_prov(store, compile_derivation(derived.derivation)).summary(), err=True)
+            if criteria is not None and criteria.criteria:
+                from exsce_dsl.oracles.baseline import baseline_oracles
+                from exsce_dsl.prov.oracle import compile_oracles
+
+                oracles = baseline_oracles(store, criteria, derived.scenario, {base.id: base})
+                written = add_prov(store, compile_oracles(derived.scenario.id, oracles), replace=True)
+                click.echo(f"{len(oracles)} oracles: {written.summary()}", err=True)
 
 
 def _step_text(step: object) -> str:
@@ -188,8 +212,8 @@ def expect(spec: str, scenario_id: str | None, store_url: str | None) -> None:
     Example:
       exscec expect examples/brsu_building_c/scenario_c_alone.exsce
     """
+    from exsce_dsl.derive.expect import SUMMED, expected_metric
     from exsce_dsl.lang.build import load_spec
-    from exsce_dsl.oracles.expect import SUMMED, expected_metric
     from exsce_dsl.store.open import open_store
 
     scenario = load_spec(spec).scenario(scenario_id)

@@ -25,7 +25,7 @@ from exsce_dsl.errors import ExsceError
 from exsce_dsl.model.derivation import Derivation, ParameterValue, TransformationStep
 from exsce_dsl.model.geometry import Pose
 from exsce_dsl.model.oracles import Oracle, OracleType
-from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, pose_name
+from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, point_name, pose_name
 from exsce_dsl.store.base import Rows, Store, Term
 from exsce_dsl.store.queries.library import KINDS, Parameter, Query, query, query_names, standard_prefixes
 
@@ -241,6 +241,15 @@ def segment_metric_any(
     """``metric`` over the segment ``start`` → ``goal`` in every stored run of any scenario."""
     given = {"metric": metric, "start": _pose(start), "goal": _pose(goal)}
     return _aggregate(run_query(store, "segment_metric_any", given, namespace))
+
+
+def segment_metric_between(
+    store: Store, metric: str, start: Pose, goal: Pose, namespace: str = DEFAULT_NAMESPACE
+) -> Aggregate | None:
+    """``metric`` over every stored drive from ``start``'s position to ``goal``'s, whatever the
+    headings, in runs of any scenario."""
+    given = {"metric": metric, "from": point_name(start), "to": point_name(goal)}
+    return _aggregate(run_query(store, "segment_metric_between", given, namespace))
 
 
 def robot_metric_over_runs(

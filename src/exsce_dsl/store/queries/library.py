@@ -63,6 +63,7 @@ def _double(names: Namespaces, text: str) -> Literal:
 KINDS: Mapping[str, Callable[[Namespaces, str], Term]] = {
     "scenario": lambda names, text: _iri(names, ids.EXSCE, text, "scenario id"),
     "pose": lambda names, text: _iri(names, ids.POSE, text, "pose"),
+    "point": lambda names, text: _iri(names, ids.POINT, text, "pose"),
     "id": lambda names, text: Literal(text),
     "run": lambda names, text: Literal(text),
     "robot": lambda names, text: Literal(text),
@@ -72,7 +73,8 @@ KINDS: Mapping[str, Callable[[Namespaces, str], Term]] = {
     "double": _double,
 }
 """How a parameter's text becomes a term: ``scenario`` → ``exsce:<id>``, ``pose`` →
-``pose:<pose name>`` (``classroom_c025-w001-R0.00_P0.00_Y0.00``), ``double`` → an
+``pose:<pose name>`` (``classroom_c025-w001-R0.00_P0.00_Y0.00``), ``point`` → ``point:<pose id>``
+(the position of every heading of the pose), ``double`` → an
 ``xsd:double``, ``metric_property`` → ``metric:<name>`` (the segment index's property
 for the metric), and ``id``, ``run`` (a uuid), ``robot``, ``metric``, ``string`` → a
 plain literal."""

@@ -4,7 +4,9 @@ drove a segment (the method's §4.2.1, with the proportion the right way round).
 A robot's expected ``distance_travelled`` or ``task_duration`` is the sum over the
 segments of its path (start pose, then its tasks' waypoints) of the segment's mean
 over every stored run of any scenario, in the task's direction or else the other
-way.  A segment no run drove is estimated from the nearest poses p3, p4 of the same
+way, between the same two positions whatever the headings (what a drive costs
+hardly depends on the heading it ends with, and a task may name a pose with
+another heading).  A segment no run drove is estimated from the nearest poses p3, p4 of the same
 area to its ends p1, p2: from each of (p3, p2), (p1, p4), (p3, p4) that has data,
 ``m_ij * dist(p1, p2) / dist(p_i, p_j)``, averaged.  (The method's report writes
 the ratio upside down, which makes a longer neighbour segment give a *longer*
@@ -31,7 +33,7 @@ from exsce_dsl.model.acceptance import (
     When,
 )
 from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries import Aggregate, robot_metric_over_runs, segment_metric_any
+from exsce_dsl.store.queries import Aggregate, robot_metric_over_runs, segment_metric_between
 from exsce_dsl.store.queries import runs as stored_runs
 
 SUMMED = ("distance_travelled", "task_duration")
@@ -74,10 +76,10 @@ def _either_way(
 ) -> tuple[Aggregate | None, bool]:
     if frozenset((start.id, goal.id)) in held_out:
         return None, False
-    found = segment_metric_any(store, metric, start, goal)
+    found = segment_metric_between(store, metric, start, goal)
     if found is not None:
         return found, False
-    return segment_metric_any(store, metric, goal, start), True
+    return segment_metric_between(store, metric, goal, start), True
 
 
 def segment_value(
@@ -165,17 +167,31 @@ def _xy(pose: Pose) -> tuple[float, float]:
 
 
 RELATIVE_TOLERANCE = 10.0
-"""Percent of the expected change a derived scenario's performance clause allows."""
+"""Percent of the expected change a derived scenario's performance clause allows, by default."""
+
+PAIRWISE = frozenset({"distance_between_robots"})
+"""Mission metrics that need two robots at least."""
 
 
 def metamorphic_acceptance(
-    store: Store, base: Scenario, derived: Scenario, base_acceptance: Acceptance | None
+    store: Store,
+    base: Scenario,
+    derived: Scenario,
+    base_acceptance: Acceptance | None,
+    tolerance_percent: float = RELATIVE_TOLERANCE,
 ) -> Acceptance:
-    """The acceptance criteria of a derived scenario: the base's safety clauses (about robots it
-    still has), and per robot, for distance travelled and task duration, the relation to the
-    base's runs that the expected values imply (increasing or decreasing by the expected change,
-    within RELATIVE_TOLERANCE % of it, or invariant within that much of the base's mean).
-    Robots without an expected value or without base runs get no performance clause."""
+    """The acceptance criteria of a derived scenario, as the method's Listing 35 makes them: the
+    base's safety clauses (about robots it still has; a clause between robots is dropped when one
+    robot is left), and per robot, for distance travelled, task duration and waypoints visited,
+
+    * the expected value itself, as the new scenario's own baseline (``is invariant around E
+      within P %``): a run far from it either way fails, so a slow-down or a detour is caught;
+    * the relation to the base's runs the expected value implies: ``is increasing|decreasing by
+      |E - B| within A of BASE`` (B the base's mean, A = P % of E), or ``is invariant within A of
+      BASE`` when the change is within that allowance.
+
+    P is ``tolerance_percent``; waypoints are counted, so exactly.  Robots without an expected
+    value or without base runs get no performance clause."""
     safety = []
     if base_acceptance is not None:
         robots = {r.id for r in derived.robots}
@@ -187,35 +203,29 @@ def metamorphic_acceptance(
             if e.relation in (Relation.BELOW_MAX, Relation.ABOVE_MIN)
             and e.window is None
             and (e.subject.robot is None or e.subject.robot in robots)
+            and (e.metric not in PAIRWISE or len(robots) > 1)
         ]
-    performance = []
+    performance: list[Expectation] = []
     base_runs = [run.uuid for run in stored_runs(store, base.id)]
     for robot in derived.robots:
         if base.robot(robot.id) is None:
             continue
+        subject = Subject(Quantifier.ROBOT, robot.id)
         for metric in SUMMED:
             expected = expected_metric(store, derived, robot.id, metric).value
             before = robot_metric_over_runs(store, metric, robot.id, base_runs)
             if expected is None or before is None:
                 continue
-            change = expected - before.mean
-            tolerance = abs(change) * RELATIVE_TOLERANCE / 100.0
-            subject = Subject(Quantifier.ROBOT, robot.id)
             unit = "m" if metric == "distance_travelled" else "s"
-            if abs(change) < 0.05 * abs(before.mean):  # a change within 5 % of the base is none
-                same = Expectation(subject, metric, Relation.INVARIANT, tolerance=Quantity(5.0, "%"))
-                performance.append(replace(same, against=base.id))
-                continue
-            direction = Relation.INCREASING if change > 0 else Relation.DECREASING
-            performance.append(
-                Expectation(
-                    subject,
-                    metric,
-                    direction,
-                    delta=Quantity(round(abs(change), 3), unit),
-                    tolerance=Quantity(round(tolerance, 3), unit),
-                    against=base.id,
-                )
+            allowance = abs(expected) * tolerance_percent / 100.0
+            performance.extend(
+                _expected_clauses(subject, metric, expected, before.mean, allowance, unit, base.id)
+            )
+        waypoints = len(robot_path(derived, robot.id))
+        before = robot_metric_over_runs(store, "waypoints_visited", robot.id, base_runs)
+        if before is not None:
+            performance.extend(
+                _expected_clauses(subject, "waypoints_visited", waypoints, before.mean, 0.0, None, base.id)
             )
     when = When(mission=derived.mission.id)  # empty criteria are left out: an empty block is an error
     criteria = []
@@ -224,3 +234,35 @@ def metamorphic_acceptance(
     if performance:
         criteria.append(Criterion(f"as expected from {base.id}", (), when, tuple(performance)))
     return Acceptance(derived.id, tuple(criteria))
+
+
+def _expected_clauses(
+    subject: Subject,
+    metric: str,
+    expected: float,
+    base_mean: float,
+    allowance: float,
+    unit: str | None,
+    base: str,
+) -> list[Expectation]:
+    """The own-baseline clause and the metamorphic one for one expected value (see above)."""
+
+    def quantity(value: float) -> Quantity:
+        return Quantity(round(value, 3), unit)
+
+    own = Expectation(
+        subject,
+        metric,
+        Relation.INVARIANT,
+        value=quantity(expected),
+        tolerance=Quantity(round(100.0 * allowance / abs(expected), 3), "%") if expected else quantity(0.0),
+    )
+    change = expected - base_mean
+    if abs(change) <= allowance:
+        same = Expectation(subject, metric, Relation.INVARIANT, tolerance=quantity(allowance), against=base)
+        return [own, same]
+    direction = Relation.INCREASING if change > 0 else Relation.DECREASING
+    moved = Expectation(
+        subject, metric, direction, delta=quantity(abs(change)), tolerance=quantity(allowance), against=base
+    )
+    return [own, moved]
