@@ -234,3 +234,13 @@ def test_exscec_derive_writes_a_file_that_checks_clean_and_stores_the_generation
     assert "0.8 m/s" not in criteria.stdout  # that limit was for a part of a run only
     bad = run_exscec("derive", "c/scenario_c.exsce", "-t", "remove_robot", "--robot", "tiago5")
     assert bad.returncode == 1 and "has no robot 'tiago5'; did you mean" in bad.stderr and "Traceback" not in bad.stderr
+
+
+def test_a_reversed_task_and_its_generation_validate_together(base: Scenario) -> None:
+    """The reversed task is derived from its subtasks and from the task the step used."""
+    from exsce_dsl.prov import compile_scenario
+    from exsce_dsl.rdf import to_quads, validate
+
+    derived = derive(base, [("reverse_waypoint_order", {"task": "delivery_a"})], "rev")
+    quads = to_quads(compile_scenario(base)) + to_quads(compile_scenario(derived.scenario))
+    assert validate(quads + to_quads(compile_derivation(derived.derivation))) == []

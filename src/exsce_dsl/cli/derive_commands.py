@@ -78,8 +78,9 @@ def derive(
     """Derive a scenario from SPEC's by input transformations, applied in order.
 
     Prints (or writes with -o) a formatted .exsce file that imports SPEC and
-    declares the new scenario and any task a transformation made; it checks
-    clean.  --add-to-store adds the new scenario and its generation provenance
+    declares the new scenario and any task a transformation made (or, when the
+    environment changed, e.g. an obstacle moved, a `derive NEW from BASE {...}`
+    block that makes them); it checks clean.  --add-to-store adds the new scenario and its generation provenance
     (the method's shape: one activity per step) to the store.  --expect writes
     the new scenario's acceptance criteria from the stored runs (the base's
     safety clauses; distance and duration increasing, decreasing or invariant

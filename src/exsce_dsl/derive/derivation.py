@@ -13,8 +13,9 @@ from exsce_dsl.derive.transformations import TRANSFORMATIONS, Applied
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.lang.names import is_valid_name
 from exsce_dsl.lang.suggest import did_you_mean
-from exsce_dsl.model import Document, Import, Scenario, Task
+from exsce_dsl.model import Document, Environment, Import, Scenario, Task
 from exsce_dsl.model.derivation import Derivation, TaskOrigin
+from exsce_dsl.model.derived import DerivedScenario, Step
 
 Request = tuple[str, Mapping[str, str]]
 """A transformation's name and its arguments as text."""
@@ -25,6 +26,10 @@ class Derived:
     scenario: Scenario
     new_tasks: tuple[Task, ...]
     derivation: Derivation
+    requests: tuple[Step, ...] = ()
+    """The steps as asked for (a composite as one step), to write them as a ``derive`` block."""
+    environment_changed: bool = False
+    """The steps changed the environment, so it has an id of its own: ``<new>_environment``."""
 
 
 def derive(
@@ -57,9 +62,24 @@ def derive(
     if derivation_id == base.id:
         raise ExsceError("the derived scenario needs an id of its own")
     mission = replace(applied.scenario.mission, id=f"{derivation_id}_mission")
-    scenario = replace(applied.scenario, id=derivation_id, mission=mission, location=None)
+    environment = applied.scenario.environment
+    environment_changed = environment != base.environment
+    if environment_changed:  # another environment under the base's id would clash in the store
+        environment = _renamed(environment, f"{derivation_id}_environment")
+    scenario = replace(
+        applied.scenario, id=derivation_id, mission=mission, environment=environment, location=None
+    )
     derivation = Derivation(derivation_id, base.id, applied.steps, _task_origins(applied))
-    return Derived(scenario, applied.new_tasks, derivation)
+    asked = tuple(Step(name, tuple(arguments.items())) for name, arguments in requests)
+    return Derived(scenario, applied.new_tasks, derivation, asked, environment_changed)
+
+
+def _renamed(environment: Environment, new_id: str) -> Environment:
+    """The environment under a new id.  Its obstacles' poses are named by it too: an obstacle's
+    pose is named by the obstacle alone (``pose:mast-R.._P.._Y..``, ``point:mast``), so a moved
+    one would give the base's point IRI other coordinates when both are in one store."""
+    obstacles = tuple(replace(o, pose=replace(o.pose, id=f"{new_id}-{o.id}")) for o in environment.obstacles)
+    return replace(environment, id=new_id, obstacles=obstacles)
 
 
 def _task_origins(applied: Applied) -> tuple[TaskOrigin, ...]:
@@ -80,6 +100,24 @@ def _default_id(base: str, applied: Applied) -> str:
 
 def derived_document(derived: Derived, base_spec: Path, target: Path) -> Document:
     """The new file: it imports the base's spec (relative to where it is written) and declares
-    the new tasks and the new scenario."""
+    the new tasks and the new scenario.
+
+    When the steps changed the environment, the file holds the ``derive NEW from BASE { ... }``
+    block instead: the environment cannot be declared again (its poses would be duplicates),
+    and building the block makes it.
+    """
     relative = os.path.relpath(base_spec.resolve(), target.resolve().parent)
-    return Document(str(target), (Import(Path(relative).as_posix()),), (*derived.new_tasks, derived.scenario))
+    imports = (Import(Path(relative).as_posix()),)
+    if not derived.environment_changed:
+        return Document(str(target), imports, (*derived.new_tasks, derived.scenario))
+    if not derived.requests:
+        raise ExsceError(f"the steps that made '{derived.scenario.id}' are not known; cannot write them")
+    block = DerivedScenario(
+        derived.scenario.id,
+        derived.derivation.base,
+        derived.requests,
+        derived.scenario,
+        derived.new_tasks,
+        derived.derivation,
+    )
+    return Document(str(target), imports, (block,))

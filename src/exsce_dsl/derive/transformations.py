@@ -8,13 +8,15 @@ transformations (``replace_robot``) are made of basic ones and record those.
 
 from __future__ import annotations
 
+import math
+import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.lang.names import is_valid_name
 from exsce_dsl.lang.suggest import did_you_mean
-from exsce_dsl.model import Assignment, Pose, Robot, Scenario, Task
+from exsce_dsl.model import Assignment, Pose, Position, Robot, Scenario, Task
 from exsce_dsl.model.derivation import ParameterValue, TransformationStep
 
 
@@ -203,6 +205,45 @@ def remove_start_pose(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task
     return Applied(replace(scenario, robots=robots), (), (_step("remove_start_pose", robot=robot.id),))
 
 
+_NUMBER = re.compile(r"[-+]?(\d+\.\d*|\.\d+|\d+)([eE][-+]?\d+)?")
+"""A number as the language writes one (no ``nan``, ``inf`` or ``1_000``)."""
+
+
+def _coordinates(text: str) -> tuple[float, ...]:
+    """``x,y`` or ``x,y,z`` in metres."""
+    parts = [p.strip() for p in text.split(",")]
+    if len(parts) not in (2, 3):
+        raise ExsceError(f"'{text}' is not a position: write x,y or x,y,z in metres")
+    values = []
+    for part in parts:
+        value = float(part) if _NUMBER.fullmatch(part) else math.nan
+        if not math.isfinite(value):
+            raise ExsceError(f"'{part}' in position '{text}' is not a number of metres")
+        values.append(value)
+    return tuple(values)
+
+
+def move_obstacle(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
+    """The obstacle at another position (``x,y`` or ``x,y,z`` in metres; z is 0 unless given),
+    with its heading, model and size.  The step records z only when it is not 0, as the
+    formatter writes positions."""
+    env = scenario.environment
+    obstacles = {o.id: o for o in env.obstacles}
+    obstacle = obstacles.get(a["obstacle"])
+    if obstacle is None:
+        hint = did_you_mean(a["obstacle"], obstacles)
+        raise ExsceError(f"environment '{env.id}' has no obstacle '{a['obstacle']}'{hint}")
+    x, y, *z = _coordinates(a["to"])
+    position = Position(x, y, z[0] if z else 0.0)
+    written = [repr(x), repr(y)] + ([repr(position.z)] if position.z != 0.0 else [])
+    if position == obstacle.pose.position:
+        raise ExsceError(f"obstacle '{obstacle.id}' is at ({', '.join(written)}) already")
+    moved = replace(obstacle, pose=replace(obstacle.pose, position=position))
+    environment = replace(env, obstacles=tuple(moved if o.id == obstacle.id else o for o in env.obstacles))
+    step = _step("move_obstacle", obstacle=obstacle.id, to=",".join(written))
+    return Applied(replace(scenario, environment=environment), (), (step,))
+
+
 def substitute_allocation(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     """A whole new allocation: ``robot:task,robot:task,...`` in execution order."""
     entries = []
@@ -325,6 +366,13 @@ TRANSFORMATIONS: dict[str, Transformation] = {
             (),
             remove_start_pose,
             "ROBOT (without tasks) loses its start pose",
+        ),
+        Transformation(
+            "move_obstacle",
+            ("obstacle", "to"),
+            (),
+            move_obstacle,
+            "OBSTACLE moves to TO: x,y or x,y,z in metres (same heading, model and size)",
         ),
         Transformation(
             "substitute_allocation",

@@ -4,13 +4,15 @@ applied to the base scenario in order; a step that cannot apply is reported at i
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import replace
 from typing import Any
 
 from exsce_dsl.derive.derivation import derive
 from exsce_dsl.errors import ExsceError, SourceLocation
+from exsce_dsl.lang.checks import check_environment_map
 from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.lang.suggest import did_you_mean
-from exsce_dsl.model import Scenario, Task
+from exsce_dsl.model import Environment, Scenario, Task
 from exsce_dsl.model.derived import DerivedScenario, Step
 
 Report = Callable[[str, SourceLocation | None], None]
@@ -54,6 +56,12 @@ def step_of(node: Any) -> tuple[str, dict[str, str | None]]:
         return "add_start_pose", {"robot": _name(node.robot), "pose": _name(node.pose)}
     if kind == "RemoveStartPose":
         return "remove_start_pose", {"robot": _name(node.robot)}
+    if kind == "MoveObstacle":
+        from exsce_dsl.lang.build import _position  # not at the top: build imports this module
+
+        p = _position(node.position)
+        metres = [p.x, p.y] + ([p.z] if p.z != 0.0 else [])  # as move_obstacle records it
+        return "move_obstacle", {"obstacle": _name(node.obstacle), "to": ",".join(repr(v) for v in metres)}
     assert kind == "Reallocate", kind
     entries = [f"{a.robot.name}:{t.name}" for a in node.assignments for t in a.tasks]
     return "substitute_allocation", {"allocation": ",".join(entries)}
@@ -86,6 +94,10 @@ def build_derivation(
         except ExsceError as exc:
             report(exc.message, step.location)
             return None
+        if step.transformation == "move_obstacle":
+            moved = str(step.argument("obstacle"))
+            for problem in _obstacle_map_problems(derived.scenario.environment, moved, step.location):
+                report(problem, step.location)
     assert derived is not None  # the grammar asks for one step at least
     return DerivedScenario(
         tree.name,
@@ -96,6 +108,14 @@ def build_derivation(
         derived.derivation,
         pf.span(tree),
     )
+
+
+def _obstacle_map_problems(env: Environment, obstacle_id: str, where: SourceLocation | None) -> list[str]:
+    """What the map check says of one obstacle of ``env`` (the map's own problems are
+    reported where the map is declared)."""
+    obstacle = next(o for o in env.obstacles if o.id == obstacle_id)
+    alone = replace(env, areas=(), obstacles=(replace(obstacle, location=where),))
+    return [d.message for d in check_environment_map(alone) if d.location == where]
 
 
 def build_derivations(

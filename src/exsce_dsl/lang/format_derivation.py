@@ -49,10 +49,13 @@ def step_text(step: Step) -> list[str]:
         return [f"start {a('robot')} at {a('pose')}"]
     if name == "remove_start_pose":
         return [f"remove start pose of {a('robot')}"]
+    if name == "move_obstacle":  # metres, as x,y[,z]
+        position = ", ".join(repr(float(v)) for v in (a("to") or "").split(","))
+        return [f"move obstacle {a('obstacle')} to ({position})"]
     assert name == "substitute_allocation", name
     runs: list[tuple[str, list[str]]] = []
     for entry in (a("allocation") or "").split(","):
-        robot, _, task = entry.partition(":")
+        robot, _, task = (part.strip() for part in entry.partition(":"))
         if runs and runs[-1][0] == robot:
             runs[-1][1].append(task)
         else:
