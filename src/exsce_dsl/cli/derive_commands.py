@@ -80,8 +80,9 @@ def derive(
     Prints (or writes with -o) a formatted .exsce file that imports SPEC and
     declares the new scenario and any task a transformation made (or, when the
     environment changed, e.g. an obstacle moved, a `derive NEW from BASE {...}`
-    block that makes them); it checks clean.  --add-to-store adds the new scenario and its generation provenance
-    (the method's shape: one activity per step) to the store.  --expect writes
+    block that makes them); it checks clean.  --add-to-store adds the new
+    scenario and its generation provenance (the method's shape: one activity
+    per step) to the store.  --expect writes
     the new scenario's acceptance criteria from the stored runs (the base's
     safety clauses; distance and duration increasing, decreasing or invariant
     against the base's runs, by the change its expected values imply).
@@ -91,7 +92,7 @@ def derive(
       exscec derive examples/brsu_building_c/scenario_c.exsce \\
           -t remove_robot --robot tiago2 --reassign tiago1 \\
           -t reverse_waypoint_order --task delivery_a -o scenario_c_alone.exsce
-      exscec derive examples/brsu_building_c/scenario_c.exsce --id c_one \
+      exscec derive examples/brsu_building_c/scenario_c.exsce --id c_one \\
           -t remove_robot --robot tiago2 --reassign tiago1 --expect --add-to-store
     """
     from exsce_dsl.derive.derivation import derive as apply_steps

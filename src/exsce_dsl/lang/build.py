@@ -279,7 +279,7 @@ class _Builder:
                     pose_seen[decl.name] = pwhere
                     pose = Pose(
                         decl.name,
-                        _position(decl.position),
+                        position_of(decl.position),
                         _orientation(decl.orientation),
                         member.name,
                         pwhere,
@@ -303,7 +303,7 @@ class _Builder:
                     size = tuple(_length(v) for v in dims)
                 pose = Pose(
                     member.name,
-                    _position(member.position),
+                    position_of(member.position),
                     _orientation(member.orientation),
                     None,
                     where,
@@ -326,7 +326,7 @@ class _Builder:
                         waypoints.append(
                             Pose(
                                 f"{task.name}-w{coordinate_count:03d}",
-                                _position(wp.position),
+                                position_of(wp.position),
                                 _orientation(wp.orientation),
                                 None,
                                 pf.span(wp),
@@ -497,7 +497,8 @@ def _length(text: str) -> float:
     return value * _LENGTH_SCALE[unit]
 
 
-def _position(pos: Any) -> Position:
+def position_of(pos: Any) -> Position:
+    """A parsed `(x, y[, z])` with units, in metres (the unit the author wrote kept for the formatter)."""
     unit = _quantity(pos.x)[1] or "m"
     z = _length(pos.z) if pos.z is not None else 0.0
     return Position(_length(pos.x), _length(pos.y), z, unit)

@@ -57,9 +57,9 @@ def step_of(node: Any) -> tuple[str, dict[str, str | None]]:
     if kind == "RemoveStartPose":
         return "remove_start_pose", {"robot": _name(node.robot)}
     if kind == "MoveObstacle":
-        from exsce_dsl.lang.build import _position  # not at the top: build imports this module
+        from exsce_dsl.lang.build import position_of  # not at the top: build imports this module
 
-        p = _position(node.position)
+        p = position_of(node.position)
         metres = [p.x, p.y] + ([p.z] if p.z != 0.0 else [])  # as move_obstacle records it
         return "move_obstacle", {"obstacle": _name(node.obstacle), "to": ",".join(repr(v) for v in metres)}
     assert kind == "Reallocate", kind
