@@ -9,11 +9,11 @@ transformations (``replace_robot``) are made of basic ones and record those.
 from __future__ import annotations
 
 import math
-import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 
 from exsce_dsl.errors import ExsceError
+from exsce_dsl.lang.lexical import NUMBER
 from exsce_dsl.lang.names import is_valid_name
 from exsce_dsl.lang.suggest import did_you_mean
 from exsce_dsl.model import Assignment, Pose, Position, Robot, Scenario, Task
@@ -205,10 +205,6 @@ def remove_start_pose(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task
     return Applied(replace(scenario, robots=robots), (), (_step("remove_start_pose", robot=robot.id),))
 
 
-_NUMBER = re.compile(r"[-+]?(\d+\.\d*|\.\d+|\d+)([eE][-+]?\d+)?")
-"""A number as the language writes one (no ``nan``, ``inf`` or ``1_000``)."""
-
-
 def _coordinates(text: str) -> tuple[float, ...]:
     """``x,y`` or ``x,y,z`` in metres."""
     parts = [p.strip() for p in text.split(",")]
@@ -216,7 +212,7 @@ def _coordinates(text: str) -> tuple[float, ...]:
         raise ExsceError(f"'{text}' is not a position: write x,y or x,y,z in metres")
     values = []
     for part in parts:
-        value = float(part) if _NUMBER.fullmatch(part) else math.nan
+        value = float(part) if NUMBER.fullmatch(part) else math.nan
         if not math.isfinite(value):
             raise ExsceError(f"'{part}' in position '{text}' is not a number of metres")
         values.append(value)

@@ -7,6 +7,10 @@ from dataclasses import dataclass
 
 from exsce_dsl.lang.locations import LineIndex
 
+NUMBER = re.compile(r"[-+]?(\d+\.\d*|\.\d+|\d+)([eE][-+]?\d+)?")
+"""A number as the language writes one (the number part of its quantity tokens; no ``nan``,
+``inf`` or ``1_000``)."""
+
 # A string literal, or a comment; strings come first so `"//"` is not a comment.
 _TOKEN = re.compile(r'"(?:\\.|[^"\\])*"|//[^\n]*|/\*.*?\*/', re.DOTALL)
 

@@ -12,7 +12,6 @@ numbers.  The DSL cannot name topics yet, so a file whose topics are not the def
 from __future__ import annotations
 
 import os
-import re
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -21,6 +20,7 @@ import yaml
 
 from exsce_dsl.errors import Diagnostic, ExportError, ImportFormatError, SourceLocation
 from exsce_dsl.lang.format_acceptance import expectation_text
+from exsce_dsl.lang.lexical import NUMBER
 from exsce_dsl.lang.names import is_valid_name
 from exsce_dsl.lang.suggest import did_you_mean
 from exsce_dsl.lang.yaml_import import YamlFile, YamlNode, child_node, node_location
@@ -46,8 +46,6 @@ SECTIONS = ("baseline", "metamorphic")
 Baseline = Mapping[tuple[str, str | None], tuple[float, float]]
 """(metric, robot or None for the mission) → (mean, standard deviation) of stored runs."""
 
-_NUMBER = re.compile(r"[-+]?(\d+\.\d*|\.\d+|\d+)([eE][-+]?\d+)?")
-"""A number the DSL can write as it stands (the number part of its Quantity token)."""
 _LIMIT, _VALUE, _CHANGE = ("limit",), ("value", "tolerance"), ("value", "delta", "tolerance")
 _NUMBERS = {
     Relation.BELOW_MAX: _LIMIT, Relation.ABOVE_MIN: _LIMIT, Relation.INVARIANT: _VALUE,
@@ -270,7 +268,7 @@ def _entries(node: YamlNode) -> list[tuple[str, YamlNode]]:
 def _quantity(node: YamlNode, info: MetricInfo) -> Quantity:
     value = node.number()
     written = _scalar_text(node)
-    return Quantity(value, SI_UNIT[info.dimension] or None, written if _NUMBER.fullmatch(written) else "")
+    return Quantity(value, SI_UNIT[info.dimension] or None, written if NUMBER.fullmatch(written) else "")
 
 
 def _yaml_node(node: YamlNode) -> yaml.Node | None:
