@@ -14,7 +14,7 @@ from exsce_dsl.errors import ExsceError
 from exsce_dsl.lang.names import is_valid_name
 from exsce_dsl.lang.suggest import did_you_mean
 from exsce_dsl.model import Document, Environment, Import, Scenario, Task
-from exsce_dsl.model.derivation import Derivation, TaskOrigin
+from exsce_dsl.model.derivation import Derivation
 from exsce_dsl.model.derived import DerivedScenario, Step
 
 Request = tuple[str, Mapping[str, str]]
@@ -69,7 +69,7 @@ def derive(
     scenario = replace(
         applied.scenario, id=derivation_id, mission=mission, environment=environment, location=None
     )
-    derivation = Derivation(derivation_id, base.id, applied.steps, _task_origins(applied))
+    derivation = Derivation(derivation_id, base.id, applied.steps, applied.origins)
     asked = tuple(Step(name, tuple(arguments.items())) for name, arguments in requests)
     return Derived(scenario, applied.new_tasks, derivation, asked, environment_changed)
 
@@ -80,16 +80,6 @@ def _renamed(environment: Environment, new_id: str) -> Environment:
     one would give the base's point IRI other coordinates when both are in one store."""
     obstacles = tuple(replace(o, pose=replace(o.pose, id=f"{new_id}-{o.id}")) for o in environment.obstacles)
     return replace(environment, id=new_id, obstacles=obstacles)
-
-
-def _task_origins(applied: Applied) -> tuple[TaskOrigin, ...]:
-    """Which step made each new task, from which task (a reversal names both)."""
-    return tuple(
-        TaskOrigin(str(arguments["to"]), str(arguments["task"]), number)
-        for number, step in enumerate(applied.steps, start=1)
-        if step.transformation == "reverse_waypoint_order"
-        for arguments in (dict(step.parameters),)
-    )
 
 
 def _default_id(base: str, applied: Applied) -> str:

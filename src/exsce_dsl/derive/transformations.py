@@ -17,7 +17,7 @@ from exsce_dsl.lang.lexical import NUMBER
 from exsce_dsl.lang.names import is_valid_name
 from exsce_dsl.lang.suggest import did_you_mean
 from exsce_dsl.model import Assignment, Pose, Position, Robot, Scenario, Task
-from exsce_dsl.model.derivation import ParameterValue, TransformationStep
+from exsce_dsl.model.derivation import ParameterValue, TaskOrigin, TransformationStep
 
 
 @dataclass(frozen=True)
@@ -27,9 +27,14 @@ class Applied:
     scenario: Scenario
     new_tasks: tuple[Task, ...] = ()
     steps: tuple[TransformationStep, ...] = ()
+    origins: tuple[TaskOrigin, ...] = ()
+    """The task each new task was made from, and by which of ``steps`` (from 1)."""
 
     def then(self, other: Applied) -> Applied:
-        return Applied(other.scenario, self.new_tasks + other.new_tasks, self.steps + other.steps)
+        shifted = tuple(replace(o, step=o.step + len(self.steps)) for o in other.origins)
+        return Applied(
+            other.scenario, self.new_tasks + other.new_tasks, self.steps + other.steps, self.origins + shifted
+        )
 
 
 Arguments = Mapping[str, str]
@@ -156,7 +161,8 @@ def reverse_waypoint_order(scenario: Scenario, a: Arguments, tasks: Mapping[str,
     reversed_task = Task(new_id, subtasks)  # not the source file of the old task any more
     allocation = [replace(e, task=new_id) if e.task == old.id else e for e in scenario.mission.allocation]
     new = _with_allocation(scenario, allocation, {new_id: reversed_task})
-    return Applied(new, (reversed_task,), (_step("reverse_waypoint_order", task=old.id, to=new_id),))
+    step = _step("reverse_waypoint_order", task=old.id, to=new_id)
+    return Applied(new, (reversed_task,), (step,), (TaskOrigin(new_id, old.id, 1),))
 
 
 def swap_start_poses(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
