@@ -26,9 +26,9 @@ class Derived:
     scenario: Scenario
     new_tasks: tuple[Task, ...]
     derivation: Derivation
-    requests: tuple[Step, ...] = ()
+    requests: tuple[Step, ...]
     """The steps as asked for (a composite as one step), to write them as a ``derive`` block."""
-    environment_changed: bool = False
+    environment_changed: bool
     """The steps changed the environment, so it has an id of its own: ``<new>_environment``."""
 
 
@@ -100,8 +100,6 @@ def derived_document(derived: Derived, base_spec: Path, target: Path) -> Documen
     imports = (Import(Path(relative).as_posix()),)
     if not derived.environment_changed:
         return Document(str(target), imports, (*derived.new_tasks, derived.scenario))
-    if not derived.requests:
-        raise ExsceError(f"the steps that made '{derived.scenario.id}' are not known; cannot write them")
     block = DerivedScenario(
         derived.scenario.id,
         derived.derivation.base,
