@@ -48,6 +48,11 @@ EXPECTED = {
         ("When ", "tiago1 does delivery_a"),
         ("Then ", "tiago1 max_velocity stays below 0.8 m/s"),
     ],
+    "drives calmly": [
+        ("When ", "mission mission_c runs"),
+        ("Then ", "each robot fast_driving_time stays below 2 s"),
+        ("And ", "each robot mean_turn_rate stays below 0.5 rad/s"),
+    ],
 }
 
 

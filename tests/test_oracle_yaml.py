@@ -336,7 +336,7 @@ def test_a_clause_without_value_and_no_baseline_cannot_be_written(scenario_c: Sc
         export_oracle_yaml(acceptance, scenario_c)
     (diagnostic,) = raised.value.diagnostics
     assert diagnostic.location is not None
-    assert (Path(diagnostic.location.file).name, diagnostic.location.line) == ("scenario_c.exsce", 34)
+    assert (Path(diagnostic.location.file).name, diagnostic.location.line) == ("scenario_c.exsce", 35)
     assert diagnostic.message.startswith(
         "'each robot task_duration is invariant within 3 std' needs the mean of stored runs of task_duration "
         "of tiago1, and no baseline was given"
@@ -432,7 +432,7 @@ def test_cli_oracle_import_needs_the_spec_and_export_says_which_clause(tmp_path:
 
     no_baseline = run_exscec("export", str(EXAMPLE / "scenario_c.exsce"), "--to", "oracle-yaml", "-o", str(tmp_path))
     assert no_baseline.returncode == 1
-    assert "scenario_c.exsce:34:10: error: 'each robot task_duration is invariant within 3 std' needs the mean" in (
+    assert "scenario_c.exsce:35:10: error: 'each robot task_duration is invariant within 3 std' needs the mean" in (
         no_baseline.stderr
     )
     assert not (tmp_path / "oracles").exists()

@@ -32,6 +32,7 @@ def main(debug: bool) -> None:
 def _register() -> None:
     from exsce_dsl.cli import (
         derive_commands,
+        generate_commands,
         oracle_commands,
         query_commands,
         run_commands,
@@ -46,6 +47,7 @@ def _register() -> None:
         *query_commands.COMMANDS,
         *oracle_commands.COMMANDS,
         *derive_commands.COMMANDS,
+        *generate_commands.COMMANDS,
     ]:
         main.add_command(command)
 

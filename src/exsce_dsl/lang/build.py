@@ -10,16 +10,18 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 from exsce_dsl.errors import Diagnostic, SourceLocation, SpecError
 from exsce_dsl.lang.build_acceptance import build_all_acceptance
 from exsce_dsl.lang.build_derivation import build_derivations
+from exsce_dsl.lang.build_metrics import build_metric
 from exsce_dsl.lang.checks import check_environment_map, check_scenario
 from exsce_dsl.lang.loader import load_files
 from exsce_dsl.lang.parser import ParsedFile
+from exsce_dsl.lang.standard_metrics import reserved_metric_names
 from exsce_dsl.lang.suggest import did_you_mean
 from exsce_dsl.model import (
     Acceptance,
@@ -45,6 +47,7 @@ from exsce_dsl.model import (
     WorldModel,
 )
 from exsce_dsl.model.derived import DerivedScenario
+from exsce_dsl.model.metrics import MetricDefinition
 
 _LENGTH_SCALE = {None: 1.0, "m": 1.0, "cm": 0.01, "mm": 0.001}
 _QUANTITY = re.compile(r"(\S+?)\s*(mm|cm|m|rad|deg)?")
@@ -54,6 +57,7 @@ _KIND_WORDS = {
     "Environment": "environment",
     "Task": "task",
     "Scenario": "scenario",
+    "Metric": "metric",
 }
 
 
@@ -104,6 +108,7 @@ class _Builder:
         self.environments: dict[str, Environment] = {}
         self.tasks: dict[str, Task] = {}
         self.scenarios: dict[str, Scenario] = {}
+        self.metrics: dict[str, MetricDefinition] = {}
         # pose id -> the environments declaring it, with the pose
         self.poses: dict[str, list[tuple[str, Pose]]] = {}
         self.task_poses: dict[str, Pose | None] = {}
@@ -141,6 +146,17 @@ class _Builder:
             self.robot_types[name] = self._robot_type(d)
         for name, d in self.declared["Environment"].items():
             self.environments[name] = self._environment(d)
+        reserved = reserved_metric_names()
+        for name, d in self.declared["Metric"].items():
+            metric = build_metric(
+                d.file,
+                d.obj,
+                lambda message, at: self.error(message, at, code="metric"),
+                reserved,
+                name_location=d.name_location,
+            )
+            if metric is not None:
+                self.metrics[name] = metric
         self.task_poses = self._task_pose_candidates()
         for name, d in self.declared["Task"].items():
             task = self._task(d)
@@ -149,7 +165,7 @@ class _Builder:
         for name, d in self.declared["Scenario"].items():
             scenario = self._scenario(d)
             if scenario is not None:
-                self.scenarios[name] = scenario
+                self.scenarios[name] = replace(scenario, metrics=tuple(self.metrics.values()))
         for env in self.environments.values():
             self.diagnostics.extend(check_environment_map(env))
         for scenario in self.scenarios.values():
@@ -196,6 +212,7 @@ class _Builder:
             "Environment": self.environments,
             "Task": self.tasks,
             "Scenario": self.scenarios,
+            "Metric": self.metrics,
         }
         declarations: list[Any] = []
         for decl in pf.tree.declarations:

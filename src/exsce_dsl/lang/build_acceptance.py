@@ -31,9 +31,9 @@ from exsce_dsl.model.acceptance import (
     When,
     Window,
 )
-from exsce_dsl.model.metrics import METRICS, SI_UNIT, UNITS, Dimension, MetricInfo
+from exsce_dsl.model.metrics import SI_UNIT, UNITS, Dimension, MetricInfo, known_metrics
 
-_QUANTITY = re.compile(r"(\S+?)\s*(m/s|cm/s|km/h|mm|cm|km|ms|min|std|m|s|h|%)?")
+_QUANTITY = re.compile(r"(\S+?)\s*(m/s|cm/s|km/h|rad/s|deg/s|mm|cm|km|ms|min|std|rad|deg|m|s|h|%)?")
 
 Report = Callable[[str, SourceLocation | None], None]
 
@@ -184,10 +184,11 @@ class _AcceptanceBuilder:
     def expectation(self, node: Any, when: When | None) -> Expectation | None:
         where = self.pf.span(node)
         metric_ref = node.metric
-        info = METRICS.get(metric_ref.name)
+        metrics = known_metrics(self.scenario)
+        info = metrics.get(metric_ref.name)
         if info is None:
             self.error(
-                f"unknown metric '{metric_ref.name}'{did_you_mean(metric_ref.name, METRICS)}",
+                f"unknown metric '{metric_ref.name}'{did_you_mean(metric_ref.name, metrics)}",
                 self.pf.span(metric_ref),
             )
             return None
@@ -289,7 +290,7 @@ class _AcceptanceBuilder:
             return None
         where = self.pf.span(node)
         if not info.per_segment:
-            per = [m.name for m in METRICS.values() if m.per_segment]
+            per = [m.name for m in known_metrics(self.scenario).values() if m.per_segment]
             self.error(
                 f"'{info.name}' has no value per path segment, so it cannot be looked at "
                 f"{node.moment} part of a run (only {', '.join(per)} can)",

@@ -10,12 +10,14 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Iterable, Mapping, Sequence
-from decimal import Decimal
 
 from exsce_dsl.errors import SourceLocation
 from exsce_dsl.lang.format_acceptance import acceptance_lines
 from exsce_dsl.lang.format_derivation import derivation_lines
+from exsce_dsl.lang.format_metrics import metric_lines
 from exsce_dsl.lang.lexical import Comment
+from exsce_dsl.lang.lexical import number_text as _number
+from exsce_dsl.lang.lexical import string_literal as _string
 from exsce_dsl.model import (
     Acceptance,
     Assignment,
@@ -31,6 +33,7 @@ from exsce_dsl.model import (
     Task,
 )
 from exsce_dsl.model.derived import DerivedScenario
+from exsce_dsl.model.metrics import MetricDefinition
 
 INDENT = "  "
 
@@ -69,6 +72,8 @@ def format_document(document: Document, poses: Mapping[str, Pose], comments: Seq
             blocks.append(acceptance_lines(decl))
         elif isinstance(decl, DerivedScenario):
             blocks.append(derivation_lines(decl))
+        elif isinstance(decl, MetricDefinition):
+            blocks.append(metric_lines(decl))
         else:
             blocks.append(_scenario(decl, poses))
     lines: list[Line] = []
@@ -246,21 +251,6 @@ def _position(p: Position) -> str:
         if all(s * scale == v for s, v in zip(scaled, values, strict=True)):
             return "(" + ", ".join(f"{_number(s)} {p.unit}" for s in scaled) + ")"
     return "(" + ", ".join(_number(v) for v in values) + ")"
-
-
-def _number(value: float) -> str:
-    """Shortest text that reads back as the same float (always with a decimal point)."""
-    text = repr(float(value))
-    mantissa, _, exponent = text.partition("e")
-    if exponent and abs(int(exponent)) <= 6:
-        text, mantissa, exponent = format(Decimal(text), "f"), "", ""
-    if exponent:
-        return (mantissa if "." in mantissa else mantissa + ".0") + "e" + exponent
-    return text if "." in text else text + ".0"
-
-
-def _string(text: str) -> str:
-    return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
 
 
 def _from(source: RosResource | None) -> str:

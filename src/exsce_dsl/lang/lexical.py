@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from decimal import Decimal
 
 from exsce_dsl.lang.locations import LineIndex
 
@@ -36,3 +37,19 @@ def comments(text: str, path: str) -> list[Comment]:
             line, col = index.line_col(match.start())
             found.append(Comment(path, line, col, match.group().rstrip()))
     return found
+
+
+def number_text(value: float) -> str:
+    """Shortest text that reads back as the same float (always with a decimal point)."""
+    text = repr(float(value))
+    mantissa, _, exponent = text.partition("e")
+    if exponent and abs(int(exponent)) <= 6:
+        text, mantissa, exponent = format(Decimal(text), "f"), "", ""
+    if exponent:
+        return (mantissa if "." in mantissa else mantissa + ".0") + "e" + exponent
+    return text if "." in text else text + ".0"
+
+
+def string_literal(text: str) -> str:
+    """``text`` as a quoted string of the language."""
+    return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'

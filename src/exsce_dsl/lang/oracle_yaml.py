@@ -35,7 +35,7 @@ from exsce_dsl.model.acceptance import (
     Subject,
     When,
 )
-from exsce_dsl.model.metrics import METRICS, SI_UNIT, Dimension, MetricInfo, default_topics
+from exsce_dsl.model.metrics import SI_UNIT, Dimension, MetricInfo, default_topics, known_metrics, metric_info
 
 #: The only relationship package an oracle file may name (the method's relations, in exsce).
 RELATIONSHIPS_PACKAGE = "exsce.metamorphic.relationships"
@@ -189,11 +189,11 @@ class _OracleReader:
                            tolerance=q("tolerance"), against=against, location=node.location)
 
     def metric(self, parent: YamlNode, metric: str, robot: str | None) -> MetricInfo | None:
-        info = METRICS.get(metric)
+        info = metric_info(metric, self.scenario)
         where = _key_location(parent, metric)
         if info is None:
             hint = (f"; '{metric}' is a robot: put it under 'robots'" if self.scenario.robot(metric)
-                    else did_you_mean(metric, METRICS))
+                    else did_you_mean(metric, known_metrics(self.scenario)))
             self.report(f"unknown metric '{metric}'{hint}", where)
         elif robot is None and info.per_robot and not info.also_mission:
             self.report(f"'{metric}' is measured per robot: put it under 'robots: <robot>:'", where)
@@ -334,7 +334,7 @@ def oracles_to_yaml(
     written: dict[tuple[str, str, str | None], Expectation] = {}
     for criterion in acceptance.criteria:
         for e in criterion.expectations:
-            _check_whole_run(e, criterion)
+            _check_whole_run(e, criterion, scenario)
             key = "baseline" if e.against is None else "metamorphic"
             base = e.against or scenario.id
             _, mission, robots = sections.setdefault(key, (base, {}, {r: {} for r in fleet}))
@@ -362,10 +362,11 @@ def oracles_to_yaml(
     return data
 
 
-def _check_whole_run(e: Expectation, criterion: Criterion) -> None:
+def _check_whole_run(e: Expectation, criterion: Criterion, scenario: Scenario) -> None:
     window = e.window.text() if e.window is not None else None
     when = criterion.when
-    if window is None and when is not None and when.robot is not None and METRICS[e.metric].per_segment:
+    per_segment = (info := metric_info(e.metric, scenario)) is not None and info.per_segment
+    if window is None and when is not None and when.robot is not None and per_segment:
         window = f"during {when.task}, as 'when {when.text()}' says"
     if window is not None:
         raise ExportError(f"'{expectation_text(e)}' looks at part of a run ({window}); the method's oracle "
@@ -375,7 +376,8 @@ def _check_whole_run(e: Expectation, criterion: Criterion) -> None:
 def _entry(
     e: Expectation, robot: str | None, scenario: Scenario, baseline: Baseline | None
 ) -> dict[str, Any]:
-    info = METRICS[e.metric]
+    info = metric_info(e.metric, scenario)
+    assert info is not None  # the expectation was checked against the scenario's metrics
     stats = baseline.get((e.metric, robot)) if baseline is not None else None
     numbers = {key: _number(value, info) for key, value in _numbers(e, robot, stats).items()}
     return {

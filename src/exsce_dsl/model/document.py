@@ -9,11 +9,12 @@ from exsce_dsl.errors import ExsceError, SourceLocation
 from exsce_dsl.model.acceptance import Acceptance
 from exsce_dsl.model.derived import DerivedScenario
 from exsce_dsl.model.environment import Environment
+from exsce_dsl.model.metrics import MetricDefinition
 from exsce_dsl.model.robots import RobotType
 from exsce_dsl.model.scenario import Scenario
 from exsce_dsl.model.tasks import Task
 
-Declaration = RobotType | Environment | Task | Scenario | Acceptance | DerivedScenario
+Declaration = RobotType | Environment | Task | Scenario | Acceptance | DerivedScenario | MetricDefinition
 
 
 @dataclass(frozen=True)
@@ -73,6 +74,11 @@ class Specification:
     def acceptance_of(self, scenario_id: str) -> Acceptance | None:
         """The acceptance criteria of a scenario, if the specification gives any."""
         return next((a for a in self.acceptance if a.scenario == scenario_id), None)
+
+    @property
+    def metrics(self) -> tuple[MetricDefinition, ...]:
+        """The metrics the specification declares (not the standard library's)."""
+        return tuple(d for d in self.declarations() if isinstance(d, MetricDefinition))
 
     @property
     def robot_types(self) -> tuple[RobotType, ...]:

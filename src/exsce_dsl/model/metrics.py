@@ -9,8 +9,11 @@ metric's dimension, and only metrics with per-segment values take a time window
 from __future__ import annotations
 
 import enum
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
+
+from exsce_dsl.errors import SourceLocation
+from exsce_dsl.model.expressions import Expression
 
 if TYPE_CHECKING:
     from exsce_dsl.model.scenario import Scenario
@@ -20,7 +23,11 @@ class Dimension(enum.Enum):
     TIME = "time"
     LENGTH = "length"
     SPEED = "speed"
+    ANGULAR_SPEED = "angular speed"
+    ANGLE = "angle"
     COUNT = "count"
+    NUMBER = "number"
+    """A plain number (a ratio, a unit the language does not know)."""
 
 
 class Combine(enum.Enum):
@@ -84,10 +91,22 @@ UNITS: dict[str, tuple[Dimension, float]] = {
     "m/s": (Dimension.SPEED, 1.0),
     "cm/s": (Dimension.SPEED, 0.01),
     "km/h": (Dimension.SPEED, 1000.0 / 3600.0),
+    "rad/s": (Dimension.ANGULAR_SPEED, 1.0),
+    "deg/s": (Dimension.ANGULAR_SPEED, 0.017453292519943295),
+    "rad": (Dimension.ANGLE, 1.0),
+    "deg": (Dimension.ANGLE, 0.017453292519943295),
 }
 """Units a quantity may carry, by dimension, with the factor to SI."""
 
-SI_UNIT = {Dimension.TIME: "s", Dimension.LENGTH: "m", Dimension.SPEED: "m/s", Dimension.COUNT: ""}
+SI_UNIT = {
+    Dimension.TIME: "s",
+    Dimension.LENGTH: "m",
+    Dimension.SPEED: "m/s",
+    Dimension.ANGULAR_SPEED: "rad/s",
+    Dimension.ANGLE: "rad",
+    Dimension.COUNT: "",
+    Dimension.NUMBER: "",
+}
 
 _FEEDBACK, _RESULT, _POSE = "waypoint_dispatcher/feedback", "waypoint_dispatcher/result", "robot_pose"
 TOPICS: dict[str, tuple[str, ...]] = {
@@ -101,14 +120,104 @@ TOPICS: dict[str, tuple[str, ...]] = {
     "violation_duration": ("nav_vel", "scan"),
 }
 """The topics each metric is computed from, below a robot's namespace (DESIGN §1; the names
-exsce_dsl.runs.metrics.robot_topics reads)."""
+the standard library declares them with)."""
+
+
+class Subject(enum.Enum):
+    """What a declared metric is said of."""
+
+    ROBOT = "each robot"
+    MISSION = "mission"
+    PAIRS = "each pair of robots"
+
+
+@dataclass(frozen=True)
+class TopicRead:
+    """A topic a metric reads: ``reads vel: geometry_msgs/msg/Twist on "/{ns}/nav_vel"``."""
+
+    name: str
+    msgtype: str
+    topic: str
+    """The topic name; ``{ns}`` stands for the robot's namespace."""
+    location: SourceLocation | None = field(default=None, compare=False, repr=False)
+
+    def topic_of(self, namespace: str) -> str:
+        return self.topic.replace("{ns}", namespace.strip("/"))
+
+
+@dataclass(frozen=True)
+class SafetyLimit:
+    """A safety metric's limit: its values should stay ``below`` (or ``above``) it."""
+
+    bound: str
+    limit: float
+    """In the metric's SI unit."""
+
+
+@dataclass(frozen=True)
+class MetricDefinition:
+    """A metric as declared in the language (the standard library's or a user's)."""
+
+    name: str
+    subject: Subject
+    per_segment: bool
+    dimension: Dimension
+    reads: tuple[TopicRead, ...]
+    value: Expression
+    fallback: Expression | None = None
+    """Computed instead when a topic of ``value`` is not in the bag."""
+    safety: SafetyLimit | None = None
+    meaning: str = ""
+    pair: tuple[str, str] | None = None
+    """The names of the two robots of a pair metric (``a``, ``b``)."""
+    combine: Combine | None = None
+    """How values over segments (or over pairs of robots) make one: from the value's aggregate."""
+    standard: bool = False
+    """Declared by the standard library."""
+    location: SourceLocation | None = field(default=None, compare=False, repr=False)
+
+    @property
+    def unit(self) -> str:
+        return SI_UNIT[self.dimension]
+
+    def info(self) -> MetricInfo:
+        return MetricInfo(
+            self.name,
+            self.dimension,
+            self.subject is Subject.ROBOT,
+            self.combine if self.per_segment else None,
+            meaning=self.meaning,
+        )
+
+    def topics_of(self, namespaces: tuple[str, ...]) -> tuple[str, ...]:
+        return tuple(read.topic_of(ns) for ns in namespaces for read in self.reads)
+
+
+def metric_info(name: str, scenario: Scenario | None = None) -> MetricInfo | None:
+    """What ``name`` measures: a metric the scenario's specification declares, else a built-in one."""
+    if scenario is not None:
+        for definition in scenario.metrics:
+            if definition.name == name:
+                return definition.info()
+    return METRICS.get(name)
+
+
+def known_metrics(scenario: Scenario | None = None) -> dict[str, MetricInfo]:
+    """Every metric a clause may name: the built-in ones and the specification's own."""
+    found = dict(METRICS)
+    if scenario is not None:
+        found.update({d.name: d.info() for d in scenario.metrics})
+    return found
 
 
 def default_topics(scenario: Scenario, metric: str, robot: str | None) -> tuple[str, ...]:
     """The topics ``metric`` is computed from: of ``robot``, or of every robot (fleet order) for
     the mission."""
+    robots = [r for r in scenario.robots if robot is None or r.id == robot]
+    for definition in scenario.metrics:
+        if definition.name == metric:
+            return definition.topics_of(tuple(r.namespace for r in robots))
     leaves = TOPICS.get(metric, ())
     if robot is None and metric == "violation_duration":
         leaves = (_POSE,)  # the mission's violations are of the distance between robots
-    robots = [r for r in scenario.robots if robot is None or r.id == robot]
     return tuple(f"/{r.namespace.strip('/')}/{leaf}" for r in robots for leaf in leaves)

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 
 from exsce_dsl.errors import SourceLocation
 from exsce_dsl.model.environment import Environment
+from exsce_dsl.model.metrics import MetricDefinition
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.tasks import Task
 
@@ -50,6 +51,8 @@ class Scenario:
     tasks: tuple[Task, ...]
     """The tasks the mission allocates, each once, in order of first use."""
     location: SourceLocation | None = field(default=None, compare=False, repr=False)
+    metrics: tuple[MetricDefinition, ...] = field(default=(), compare=False, repr=False)
+    """The metrics its specification declares (the standard library's are not repeated here)."""
 
     def robot(self, robot_id: str) -> Robot | None:
         return next((r for r in self.robots if r.id == robot_id), None)

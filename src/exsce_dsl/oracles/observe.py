@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.acceptance import Moment, Window
-from exsce_dsl.model.metrics import METRICS, Combine
+from exsce_dsl.model.metrics import Combine, metric_info
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.queries import run_metric_values, run_segment_values
 
@@ -85,7 +85,7 @@ def observe(
     values: RunValues, metric: str, robot: str | None, window: Window | None, scenario: Scenario
 ) -> tuple[float | None, str]:
     """The run's value for an oracle, or None and why there is none."""
-    info = METRICS.get(metric)
+    info = metric_info(metric, scenario)
     if window is None:
         found = values.whole.get((metric, robot))
         if not found:

@@ -19,7 +19,7 @@ from exsce_dsl.model.acceptance import (
     Relation,
     Window,
 )
-from exsce_dsl.model.metrics import METRICS
+from exsce_dsl.model.metrics import metric_info
 from exsce_dsl.model.oracles import OracleType
 
 
@@ -65,7 +65,8 @@ def plan_oracles(acceptance: Acceptance, scenario: Scenario) -> list[PlannedOrac
             implied = Window(Moment.DURING, criterion.when.robot, task=criterion.when.task)
         for expectation in criterion.expectations:
             window = expectation.window
-            if window is None and implied is not None and METRICS[expectation.metric].per_segment:
+            info = metric_info(expectation.metric, scenario)
+            if window is None and implied is not None and info is not None and info.per_segment:
                 window = implied
             for robot in _robots(expectation, scenario):
                 planned.append(PlannedOracle(criterion.title, expectation, robot, window))

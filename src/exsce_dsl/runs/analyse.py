@@ -8,15 +8,21 @@ import uuid
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from exsce_dsl.lang.standard_metrics import standard_metrics
 from exsce_dsl.model import Scenario
+from exsce_dsl.model.messages import DISPATCHER, POSE
+from exsce_dsl.model.metrics import MetricDefinition, Subject
+from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Bag, Run, TaskExecution
 from exsce_dsl.runs.bagdata import BagError, read_bag
-from exsce_dsl.runs.decode import FLOAT64, POSE, SCAN, TWIST
-from exsce_dsl.runs.metrics import RobotSignals, SafetyLimits, compute_metrics, robot_topics
+from exsce_dsl.runs.monitor_code import load_monitors
+from exsce_dsl.runs.monitor_core import Topic
+from exsce_dsl.runs.monitoring import POSE_TOPIC, compute_metrics
 from exsce_dsl.runs.segments import SUCCEEDED, Segment, segments
 
 _RUN_NAMESPACE = uuid.UUID("5b8f9a52-3f0c-4a8e-8f0e-2d6c1b7e4a90")
-_TYPES = {"pose": POSE, "scan": SCAN, "vel": TWIST, "distance": FLOAT64, "feedback": "*", "result": "*"}
+_FEEDBACK = "/{ns}/waypoint_dispatcher/feedback"
+_RESULT = "/{ns}/waypoint_dispatcher/result"
 
 
 @dataclass(frozen=True)
@@ -42,29 +48,52 @@ def run_uuid(digest: str) -> str:
     return str(uuid.uuid5(_RUN_NAMESPACE, digest))
 
 
-def analyse_bag(path: Path, scenario: Scenario, limits: SafetyLimits | None = None) -> AnalysedRun:
-    limits = limits or SafetyLimits()
+def run_metrics(scenario: Scenario) -> tuple[MetricDefinition, ...]:
+    """The metrics a run of ``scenario`` gets: the standard library's, then its specification's."""
+    return standard_metrics() + scenario.metrics
+
+
+def wanted_topics(metrics: tuple[MetricDefinition, ...], robots: list[Robot]) -> dict[str, str]:
+    """Topic → message type (``*`` for the dispatcher's) of everything the metrics read."""
+    wanted: dict[str, str] = {}
+    for robot in robots:
+        ns = robot.namespace.strip("/")
+        for pattern, msgtype in [(_FEEDBACK, "*"), (_RESULT, "*"), (POSE_TOPIC, POSE)]:
+            wanted[pattern.replace("{ns}", ns)] = msgtype
+        for metric in metrics:
+            if metric.subject is Subject.MISSION and not metric.reads:
+                continue
+            for read in metric.reads:
+                msgtype = "*" if read.msgtype in DISPATCHER else read.msgtype
+                wanted.setdefault(read.topic_of(ns), msgtype)
+    return wanted
+
+
+def analyse_bag(path: Path, scenario: Scenario) -> AnalysedRun:
     digest = content_hash(path) if path.exists() else ""
     robots = [r for r in scenario.robots if r.start_pose is not None]
-    wanted = {robot_topics(r.namespace)[k]: t for r in robots for k, t in _TYPES.items()}
-    data = read_bag(path, wanted)
+    metrics = run_metrics(scenario)
+    data = read_bag(path, wanted_topics(metrics, robots))
     problems = list(data.problems)
     actions: list[Segment] = []
     results: dict[str, int | None] = {}
     for robot in robots:
-        topics = robot_topics(robot.namespace)
-        updates = data.feedback.get(topics["feedback"])
+        ns = robot.namespace.strip("/")
+        feedback, result = _FEEDBACK.replace("{ns}", ns), _RESULT.replace("{ns}", ns)
+        updates = data.feedback.get(feedback)
         if updates is None:
-            problems.append(f"topic {topics['feedback']} is missing: no path segments for '{robot.id}'")
+            problems.append(f"topic {feedback} is missing: no path segments for '{robot.id}'")
             results[robot.id] = None
             continue
         actions.extend(segments(scenario, robot.id, updates))
-        final = data.results.get(topics["result"])
+        final = data.results.get(result)
         results[robot.id] = None if final is None else sum(s == SUCCEEDED for u in final for s in u.statuses)
     if not any(a.start is not None for a in actions):
         raise BagError(f"{path}: no waypoint goal of scenario '{scenario.id}' became active in this bag")
-    signals = [RobotSignals.from_bag(r.id, r.namespace, data) for r in robots]
-    metrics, hotspots = compute_metrics(signals, actions, results, limits, problems)
+    topics = {name: Topic(name, s.t, s.fields) for name, s in data.series.items()}
+    source = scenario.location.file if scenario.location else scenario.id
+    monitors = load_monitors(metrics, source)
+    values, hotspots = compute_metrics(monitors, metrics, robots, topics, actions, results, problems)
     run = Run(
         uuid=run_uuid(digest),
         scenario=scenario.id,
@@ -72,7 +101,7 @@ def analyse_bag(path: Path, scenario: Scenario, limits: SafetyLimits | None = No
         end=_time(data.end),
         bag=Bag(path.name, data.topics, str(path)),
         tasks=_task_executions(actions),
-        metrics=tuple(metrics),
+        metrics=tuple(values),
         hotspots=tuple(hotspots),
     )
     return AnalysedRun(run, digest, problems)

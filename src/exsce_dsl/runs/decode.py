@@ -11,7 +11,7 @@ rosbags instead (slow, but right).
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -35,7 +35,8 @@ class Layout:
 
     size: int
     fields: dict[str, tuple[int, str]]  # name -> (offset, numpy scalar type)
-    ranges: tuple[int, int] | None = None  # LaserScan: offset of the float32 ranges, beam count
+    arrays: dict[str, tuple[int, int, str]] = field(default_factory=dict)
+    """name -> (offset, element count, numpy element type): LaserScan ranges, a pose's covariance."""
 
 
 def _align(offset: int, n: int) -> int:
@@ -46,7 +47,7 @@ def _header(raw: bytes, cdr: bool) -> tuple[int, dict[str, tuple[int, str]]]:
     """The end of a std_msgs/Header and the stamp fields; ``cdr`` offsets include the 4-byte prefix."""
     # ROS 1: seq, sec, nsec, frame_id; CDR: prefix, sec, nanosec, frame_id (with its NUL)
     length = int.from_bytes(raw[12:16], "little")
-    return 16 + length, {"sec": (4, "<i4" if cdr else "<u4"), "nsec": (8, "<u4")}
+    return 16 + length, {"header.stamp.sec": (4, "<i4" if cdr else "<u4"), "header.stamp.nanosec": (8, "<u4")}
 
 
 def layout(msgtype: str, raw: bytes, cdr: bool) -> Layout:
@@ -55,16 +56,18 @@ def layout(msgtype: str, raw: bytes, cdr: bool) -> Layout:
     if cdr and raw[:2] != b"\x00\x01":
         raise DecodeError("only little-endian CDR is supported")
     if msgtype == TWIST:
-        names: tuple[str, ...] = ("lx", "ly", "lz", "ax", "ay", "az")
+        names: tuple[str, ...] = ("linear.x", "linear.y", "linear.z", "angular.x", "angular.y", "angular.z")
         return Layout(base + 48, {n: (base + 8 * i, "<f8") for i, n in enumerate(names)})
     if msgtype == FLOAT64:
         return Layout(base + 8, {"data": (base, "<f8")})
     end, fields = _header(raw, cdr)
     if msgtype == POSE:
         start = base + _align(end - base, 8) if cdr else end
-        names = ("x", "y", "z", "qx", "qy", "qz", "qw")
+        position = tuple(f"pose.pose.position.{c}" for c in "xyz")
+        names = position + tuple(f"pose.pose.orientation.{c}" for c in "xyzw")
         fields.update({n: (start + 8 * i, "<f8") for i, n in enumerate(names)})
-        return Layout(start + 8 * 7 + 8 * 36, fields)
+        covariance = {"pose.covariance": (start + 8 * 7, 36, "<f8")}
+        return Layout(start + 8 * 7 + 8 * 36, fields, covariance)
     if msgtype == SCAN:
         start = base + _align(end - base, 4) if cdr else end
         names = (
@@ -82,7 +85,8 @@ def layout(msgtype: str, raw: bytes, cdr: bool) -> Layout:
         ranges_at = count_at + 4
         after = ranges_at + 4 * beams
         intensities = int.from_bytes(raw[after : after + 4], "little")
-        return Layout(after + 4 + 4 * intensities, fields, (ranges_at, beams))
+        arrays = {"ranges": (ranges_at, beams, "<f4"), "intensities": (after + 4, intensities, "<f4")}
+        return Layout(after + 4 + 4 * intensities, fields, arrays)
     raise DecodeError(f"no fixed layout for {msgtype}")
 
 
@@ -109,25 +113,10 @@ def decode(
 def decode_rows(shape: Layout, rows: np.ndarray) -> dict[str, np.ndarray]:
     """Fields of messages given as the rows of a uint8 array (one message per row)."""
     out = {name: _column(rows, offset, kind) for name, (offset, kind) in shape.fields.items()}
-    if shape.ranges is not None:
-        at, beams = shape.ranges
-        ranges = rows[:, at : at + 4 * beams].view("<f4")
-        out["nearest"] = nearest_valid(ranges, out["range_min"], out["range_max"])
+    for name, (at, count, kind) in shape.arrays.items():
+        width = np.dtype(kind).itemsize
+        out[name] = rows[:, at : at + width * count].copy().view(kind)
     return out
-
-
-def nearest_valid(ranges: np.ndarray, low: np.ndarray, high: np.ndarray) -> np.ndarray:
-    """Per scan, the smallest range within [range_min, range_max] (NaN and inf never are); NaN if none.
-
-    Scans are reduced to this at once: it is all the metrics need of them, and a
-    laser's ranges are most of a bag's bytes.
-    """
-    lo = low.astype(np.float32)[:, None]
-    hi = high.astype(np.float32)[:, None]
-    valid = (ranges >= lo) & (ranges <= hi)
-    nearest = np.where(valid, ranges, np.float32(np.inf)).min(axis=1).astype(np.float64)
-    result: np.ndarray = np.where(np.isfinite(nearest), nearest, np.nan)
-    return result
 
 
 def _column(buffer: np.ndarray, offset: int, kind: str) -> np.ndarray:
@@ -143,35 +132,32 @@ def _decode_slowly(
     msgs = [deserialize(r) for r in raws]
     if msgtype == TWIST:
         return {
-            "lx": np.array([m.linear.x for m in msgs]),
-            "ly": np.array([m.linear.y for m in msgs]),
-            "lz": np.array([m.linear.z for m in msgs]),
-            "ax": np.array([m.angular.x for m in msgs]),
-            "ay": np.array([m.angular.y for m in msgs]),
-            "az": np.array([m.angular.z for m in msgs]),
+            f"{part}.{c}": np.array([getattr(getattr(m, part), c) for m in msgs], dtype=np.float64)
+            for part in ("linear", "angular")
+            for c in "xyz"
         }
     if msgtype == FLOAT64:
-        return {"data": np.array([m.data for m in msgs])}
+        return {"data": np.array([m.data for m in msgs], dtype=np.float64)}
     stamps = {
-        "sec": np.array([m.header.stamp.sec for m in msgs], dtype=np.float64),
-        "nsec": np.array([m.header.stamp.nanosec for m in msgs], dtype=np.float64),
+        "header.stamp.sec": np.array([m.header.stamp.sec for m in msgs], dtype=np.float64),
+        "header.stamp.nanosec": np.array([m.header.stamp.nanosec for m in msgs], dtype=np.float64),
     }
     if msgtype == POSE:
         p = [m.pose.pose for m in msgs]
         return stamps | {
-            "x": np.array([q.position.x for q in p]),
-            "y": np.array([q.position.y for q in p]),
-            "z": np.array([q.position.z for q in p]),
-            "qx": np.array([q.orientation.x for q in p]),
-            "qy": np.array([q.orientation.y for q in p]),
-            "qz": np.array([q.orientation.z for q in p]),
-            "qw": np.array([q.orientation.w for q in p]),
-        }
-    beams = {len(m.ranges) for m in msgs}
-    width = max(beams) if beams else 0
-    ranges = np.full((len(msgs), width), np.nan, dtype=np.float32)
-    for i, m in enumerate(msgs):  # scans of different sizes: pad with NaN (never a valid range)
-        ranges[i, : len(m.ranges)] = m.ranges
-    low = np.array([m.range_min for m in msgs], dtype=np.float64)
-    high = np.array([m.range_max for m in msgs], dtype=np.float64)
-    return stamps | {"range_min": low, "range_max": high, "nearest": nearest_valid(ranges, low, high)}
+            f"pose.pose.{part}.{c}": np.array([getattr(getattr(q, part), c) for q in p], dtype=np.float64)
+            for part, coordinates in (("position", "xyz"), ("orientation", "xyzw"))
+            for c in coordinates
+        } | {"pose.covariance": np.array([m.pose.covariance for m in msgs], dtype=np.float64).reshape(-1, 36)}
+    out: dict[str, np.ndarray] = stamps | {
+        name: np.array([getattr(m, name) for m in msgs], dtype=np.float64)
+        for name in ("angle_min", "angle_max", "angle_increment", "time_increment", "scan_time", "range_min",
+                     "range_max")
+    }
+    for name in ("ranges", "intensities"):  # scans of different sizes: padded with NaN (never a valid range)
+        width = max((len(getattr(m, name)) for m in msgs), default=0)
+        values = np.full((len(msgs), width), np.nan, dtype=np.float32)
+        for i, m in enumerate(msgs):
+            values[i, : len(getattr(m, name))] = getattr(m, name)
+        out[name] = values
+    return out

@@ -1,8 +1,9 @@
-"""The method's metrics, computed as array work over a run's topics.
+"""The reference: the method's metrics as exsce computed them by hand, before metrics were declared.
 
-Every metric is computed for the whole run (mission or robot) and, where it
-makes sense, for each path segment.  A metric whose topic is missing from the
-bag is *missing* (no value, and a problem is reported), never 0.
+exsce now computes the built-in metrics through monitors generated from the
+standard library (``lang/stdlib/metrics.exsce``); this hand-written path is
+kept here, outside the package, only so that tests can check the generated
+path gives the same values (tests/test_generated_metrics.py).
 """
 
 from __future__ import annotations
@@ -83,13 +84,17 @@ class RobotSignals:
         assert self.vel is not None
         cached = self._cache.get("speed")
         if cached is None:
-            cached = self._cache["speed"] = np.hypot(self.vel.fields["lx"], self.vel.fields["ly"])
+            cached = self._cache["speed"] = np.hypot(self.vel.fields["linear.x"], self.vel.fields["linear.y"])
         return cached
 
     def nearest_obstacle(self) -> np.ndarray:
         """Per scan, the smallest valid range (NaN when no beam is valid)."""
         assert self.scan is not None
-        return self.scan.fields["nearest"]
+        cached = self._cache.get("nearest")
+        if cached is None:
+            f = self.scan.fields
+            cached = self._cache["nearest"] = nearest_valid(f["ranges"], f["range_min"], f["range_max"])
+        return cached
 
     def travelled_between(self, start: float, end: float) -> tuple[float, str] | None:
         """Metres between two instants: from the cumulative topic, else integrated poses."""
@@ -99,7 +104,7 @@ class RobotSignals:
             return float(values[1] - values[0]), self.topics["distance"]
         if self.pose is not None and len(self.pose) > 1:
             w = _window(self.pose, start, end)
-            x, y = self.pose.fields["x"][w], self.pose.fields["y"][w]
+            x, y = self.pose.fields["pose.pose.position.x"][w], self.pose.fields["pose.pose.position.y"][w]
             return float(np.hypot(np.diff(x), np.diff(y)).sum()), self.topics["pose"]
         return None
 
@@ -107,8 +112,8 @@ class RobotSignals:
         assert self.pose is not None
         return np.column_stack(
             [
-                np.interp(times, self.pose.t, self.pose.fields["x"]),
-                np.interp(times, self.pose.t, self.pose.fields["y"]),
+                np.interp(times, self.pose.t, self.pose.fields["pose.pose.position.x"]),
+                np.interp(times, self.pose.t, self.pose.fields["pose.pose.position.y"]),
             ]
         )
 
@@ -226,6 +231,16 @@ def compute_metrics(
     return values, hotspots
 
 
+def nearest_valid(ranges: np.ndarray, low: np.ndarray, high: np.ndarray) -> np.ndarray:
+    """Per scan, the smallest range within [range_min, range_max] (NaN and inf never are); NaN if none."""
+    lo = low.astype(np.float32)[:, None]
+    hi = high.astype(np.float32)[:, None]
+    valid = (ranges >= lo) & (ranges <= hi)
+    nearest = np.where(valid, ranges, np.float32(np.inf)).min(axis=1).astype(np.float64)
+    result: np.ndarray = np.where(np.isfinite(nearest), nearest, np.nan)
+    return result
+
+
 SafetySignal = tuple[str, str, np.ndarray, np.ndarray, np.ndarray]
 """(safety metric, topic, sample times, sample durations, violating samples)."""
 
@@ -294,7 +309,8 @@ def _between_robots(
             t = a.pose.t[w]
             if len(t) == 0:
                 continue
-            pa = np.column_stack([a.pose.fields["x"][w], a.pose.fields["y"][w]])
+            xa, ya = a.pose.fields["pose.pose.position.x"], a.pose.fields["pose.pose.position.y"]
+            pa = np.column_stack([xa[w], ya[w]])
             pb = b.position_at(t)
             gap = np.hypot(*(pa - pb).T)
             nearest = min(nearest, float(gap.min()))

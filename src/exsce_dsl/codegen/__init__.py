@@ -1,0 +1,1 @@
+"""Code generators: Jinja2 templates (top-level ``templates/``) rendered from the semantic model."""

@@ -1,0 +1,51 @@
+"""The generators exsce offers, by target name (``exscec generate TARGET``, ``textx generate --target``).
+
+Each target turns a checked specification (and one of its scenarios) into
+files below an output folder.  Modules are imported when a target runs, so
+listing the targets stays cheap.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from exsce_dsl.model import Specification
+
+Generate = Callable[[Specification, "str | None", Path, bool], list[Path]]
+"""(specification, scenario id or None for the root file's only one, output folder, overwrite) → files."""
+
+
+@dataclass(frozen=True)
+class Target:
+    name: str
+    description: str
+    module: str
+    function: str
+
+    def generate(
+        self, spec: Specification, scenario_id: str | None, out_dir: Path, overwrite: bool = False
+    ) -> list[Path]:
+        func: Generate = getattr(importlib.import_module(self.module), self.function)
+        return func(spec, scenario_id, out_dir, overwrite)
+
+
+TARGETS: dict[str, Target] = {
+    t.name: t
+    for t in (
+        Target(
+            "monitors",
+            "vectorised numpy monitor classes (RobotMetrics, MissionMetrics) for the spec's metrics",
+            "exsce_dsl.codegen.monitors",
+            "generate_monitors",
+        ),
+        Target(
+            "dispatcher-config",
+            "the waypoint files the method's waypoint dispatcher reads, one per robot",
+            "exsce_dsl.codegen.dispatcher",
+            "generate_dispatcher_config",
+        ),
+    )
+}

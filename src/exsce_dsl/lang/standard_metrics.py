@@ -1,0 +1,37 @@
+"""The standard library of metrics: the method's metrics, declared in the language itself.
+
+It ships in the package (``lang/stdlib/metrics.exsce``) and is checked like any
+user file; a specification's own metrics sit beside it and may not reuse its
+names.
+"""
+
+from __future__ import annotations
+
+import functools
+
+from exsce_dsl.errors import Diagnostic, SourceLocation, SpecError
+from exsce_dsl.lang.build_metrics import build_metric
+from exsce_dsl.lang.parser import parse_text
+from exsce_dsl.model.metrics import METRICS, MetricDefinition
+from exsce_dsl.resources import package_file
+
+
+@functools.cache
+def standard_metrics() -> tuple[MetricDefinition, ...]:
+    """The standard library's metrics, in the order it declares them."""
+    source = package_file("lang", "stdlib", "metrics.exsce")
+    pf = parse_text(source.read_text(encoding="utf-8"), str(source))
+    problems: list[Diagnostic] = []
+
+    def report(message: str, at: SourceLocation | None) -> None:
+        problems.append(Diagnostic(message, at))
+
+    built = [build_metric(pf, tree, report, standard=True) for tree in pf.tree.declarations]
+    if problems:
+        raise SpecError(problems)  # a broken installation, not a user's mistake
+    return tuple(m for m in built if m is not None)
+
+
+def reserved_metric_names() -> dict[str, str]:
+    """Names a user's metric may not take, with why."""
+    return {name: "is one of exsce's built-in metrics" for name in METRICS}

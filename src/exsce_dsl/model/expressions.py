@@ -1,0 +1,118 @@
+"""Metric expressions: a small language over message fields, as a checked tree.
+
+The builder (``lang.build_metrics``) type-checks every node; a tree here is
+known to be well formed: fields exist in their message type, aggregates are
+over numbers, a metric's value is one number per window.
+"""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass, field
+
+from exsce_dsl.errors import SourceLocation
+
+
+class Kind(enum.Enum):
+    """What an expression is, per window of a run."""
+
+    CONSTANT = "a constant"
+    NUMBERS = "a number per message"
+    ARRAYS = "an array of numbers per message"
+    CONDITIONS = "a condition per message"
+    ARRAY_CONDITIONS = "a condition per array element"
+    VALUE = "one number per window"
+
+
+@dataclass(frozen=True)
+class Number:
+    value: float
+    """In SI units."""
+    written: str | None = field(default=None, compare=False)
+    """As written, unit included (``0.8 m/s``), for the formatter."""
+    location: SourceLocation | None = field(default=None, compare=False, repr=False)
+
+
+@dataclass(frozen=True)
+class Field:
+    """A message field of a topic: ``vel.linear.x``; ``robot`` is the pair binder (``a``) if any."""
+
+    read: str
+    path: tuple[str, ...]
+    robot: str | None = None
+    location: SourceLocation | None = field(default=None, compare=False, repr=False)
+
+    @property
+    def clock(self) -> str:
+        """The topic whose receive times the values follow."""
+        return f"{self.robot}.{self.read}" if self.robot else self.read
+
+
+@dataclass(frozen=True)
+class Unary:
+    op: str  # "-" | "not"
+    operand: Expression
+    location: SourceLocation | None = field(default=None, compare=False, repr=False)
+
+
+@dataclass(frozen=True)
+class Binary:
+    """Arithmetic, comparison or logic.  Operands on different topics are time-aligned: the
+    right one is interpolated at the left one's times, where both have data."""
+
+    op: str  # + - * / < <= > >= == != and or
+    left: Expression
+    right: Expression
+    location: SourceLocation | None = field(default=None, compare=False, repr=False)
+
+
+@dataclass(frozen=True)
+class Call:
+    """An element-wise function: ``norm``, ``abs``, ``sqrt``."""
+
+    func: str
+    args: tuple[Expression, ...]
+    location: SourceLocation | None = field(default=None, compare=False, repr=False)
+
+
+@dataclass(frozen=True)
+class Aggregate:
+    """Over time, within a window: ``min max mean sum first last integral change path_length``,
+    ``duration`` and ``count`` (of a condition).  ``where`` keeps the elements it holds for."""
+
+    func: str
+    args: tuple[Expression, ...]
+    where: Expression | None = None
+    location: SourceLocation | None = field(default=None, compare=False, repr=False)
+
+
+@dataclass(frozen=True)
+class WindowValue:
+    """``elapsed`` (seconds the window lasts) or ``succeeded`` (waypoints the dispatcher reports
+    SUCCEEDED)."""
+
+    name: str
+    location: SourceLocation | None = field(default=None, compare=False, repr=False)
+
+
+Expression = Number | Field | Unary | Binary | Call | Aggregate | WindowValue
+
+AGGREGATES = ("min", "max", "mean", "sum", "first", "last", "integral", "change", "path_length")
+CONDITION_AGGREGATES = ("duration", "count")
+ELEMENTWISE = ("norm", "abs", "sqrt")
+WINDOW_VALUES = ("elapsed", "succeeded")
+
+
+def walk(expr: Expression) -> list[Expression]:
+    """Every node of ``expr``, parents before children."""
+    found: list[Expression] = [expr]
+    if isinstance(expr, Unary):
+        found += walk(expr.operand)
+    elif isinstance(expr, Binary):
+        found += walk(expr.left) + walk(expr.right)
+    elif isinstance(expr, (Call, Aggregate)):
+        for arg in expr.args:
+            found += walk(arg)
+        if isinstance(expr, Aggregate) and expr.where is not None:
+            found += walk(expr.where)
+    return found

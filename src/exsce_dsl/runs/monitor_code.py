@@ -1,0 +1,150 @@
+"""Generate the monitor module of a set of metrics, and load it to compute a run's metrics.
+
+The code comes from ``templates/monitors/monitors.py.j2``: a ``RobotMetrics``
+and a ``MissionMetrics`` class whose ``get_<metric>(start, end)`` methods call
+:mod:`exsce_dsl.runs.monitor_core`.  Ingestion renders it for the standard
+library's metrics and the specification's own, and executes the text it just
+rendered (never a file found on disk); ``exscec generate monitors`` writes the
+same text to a file.  Metric names are checked Python identifiers, topic names
+and strings go through the template's quoting filters, and local variable
+names are exsce's own, so nothing from a user's file becomes code unchecked.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import sys
+import types
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from exsce_dsl.lang.format_metrics import expression_text
+from exsce_dsl.model.expressions import Aggregate, Expression, Field, WindowValue, walk
+from exsce_dsl.model.messages import FEEDBACK, RESULT
+from exsce_dsl.model.metrics import Combine, MetricDefinition, Subject
+from exsce_dsl.runs import monitor_core
+from exsce_dsl.templating import render
+
+GENERATOR = "exscec generate monitors"
+
+_UFUNCS = {
+    "+": "np.add",
+    "-": "np.subtract",
+    "*": "np.multiply",
+    "/": "np.divide",
+    "<": "np.less",
+    "<=": "np.less_equal",
+    ">": "np.greater",
+    ">=": "np.greater_equal",
+    "==": "np.equal",
+    "!=": "np.not_equal",
+    "and": "np.logical_and",
+    "or": "np.logical_or",
+    "abs": "np.abs",
+    "sqrt": "np.sqrt",
+}
+_PAIR_COMBINE = {Combine.MIN: "min", Combine.MAX: "max", Combine.SUM: "sum"}
+
+
+@dataclass(frozen=True)
+class Alternative:
+    """One way to compute a metric (its value, or what ``otherwise`` gives), as the template needs it."""
+
+    text: str
+    value: Expression
+    aggregates: list[Aggregate]
+    reads: list[tuple[str, str, str]]
+    """(local variable, whose topic: ``first``/``second`` of a pair or "", topic pattern)."""
+    vars: dict[tuple[str | None, str], str]
+    uses_succeeded: bool
+
+
+@dataclass(frozen=True)
+class MetricCode:
+    name: str
+    meaning: str
+    alternatives: list[Alternative]
+    pairs: str | None
+    """For a metric over pairs of robots: how the pairs' values combine (min, max or sum)."""
+
+
+def alternatives(metric: MetricDefinition) -> list[Alternative]:
+    found = []
+    for expr in (metric.value, metric.fallback):
+        if expr is None:
+            continue
+        nodes = walk(expr)
+        aggregates: list[Aggregate] = []
+        for node in nodes:
+            if isinstance(node, Aggregate) and node not in aggregates:
+                aggregates.append(node)
+        fields = [n for n in nodes if isinstance(n, Field)]
+        variables: dict[tuple[str | None, str], str] = {}
+        reads: list[tuple[str, str, str]] = []
+        patterns = {r.name: r.topic for r in metric.reads}
+        for f in fields:
+            key = (f.robot, f.read)
+            if key in variables:
+                continue
+            variables[key] = f"topic_{len(variables)}"
+            first = metric.pair is not None and f.robot == metric.pair[0]
+            whose = "" if f.robot is None else ("first" if first else "second")
+            reads.append((variables[key], whose, patterns[f.read]))
+        succeeded = any(isinstance(n, WindowValue) and n.name == "succeeded" for n in nodes)
+        found.append(Alternative(expression_text(expr), expr, aggregates, reads, variables, succeeded))
+    return found
+
+
+def _code(metric: MetricDefinition) -> MetricCode:
+    pairs = _PAIR_COMBINE[metric.combine] if metric.subject is Subject.PAIRS and metric.combine else None
+    return MetricCode(metric.name, metric.meaning, alternatives(metric), pairs)
+
+
+def monitor_source(metrics: Sequence[MetricDefinition], source: str, core_import: str | None = None) -> str:
+    """The Python text of the monitor module for ``metrics``; ``source`` names the spec in its header.
+
+    ``core_import``: how the module imports the core (ingestion's default: from exsce).
+    """
+    robot = [_code(m) for m in metrics if m.subject is Subject.ROBOT]
+    mission = [_code(m) for m in metrics if m.subject is not Subject.ROBOT]
+    return render(
+        "monitors/monitors.py.j2",
+        generator=GENERATOR,
+        source=source,
+        core_import=core_import or "from exsce_dsl.runs import monitor_core as core",
+        robot_metrics=robot,
+        mission_metrics=mission,
+        ufuncs=_UFUNCS,
+    )
+
+
+@functools.lru_cache(maxsize=32)
+def _load(source_text: str) -> types.ModuleType:
+    digest = hashlib.sha256(source_text.encode()).hexdigest()[:16]
+    module = types.ModuleType(f"exsce_monitors_{digest}")
+    module.__dict__["__file__"] = f"<exsce monitors {digest}>"
+    sys.modules.setdefault("exsce_dsl.runs.monitor_core", monitor_core)
+    exec(compile(source_text, module.__dict__["__file__"], "exec"), module.__dict__)  # noqa: S102
+    return module
+
+
+def load_monitors(metrics: Sequence[MetricDefinition], source: str = "the specification") -> types.ModuleType:
+    """The generated monitor module of ``metrics``, rendered and executed in memory (cached by text)."""
+    return _load(monitor_source(metrics, source))
+
+
+def reads_used(metric: MetricDefinition, alternative: int) -> list[tuple[str | None, str]]:
+    """The (pair robot or None, read name) an alternative reads, dispatcher topics included."""
+    expr = metric.value if alternative == 0 else metric.fallback
+    assert expr is not None
+    used: list[tuple[str | None, str]] = []
+    for node in walk(expr):
+        if isinstance(node, Field) and (node.robot, node.read) not in used:
+            used.append((node.robot, node.read))
+        elif isinstance(node, WindowValue):
+            wanted = RESULT if node.name == "succeeded" else FEEDBACK
+            for read in metric.reads:
+                if read.msgtype == wanted and (None, read.name) not in used:
+                    used.append((None, read.name))
+    return used

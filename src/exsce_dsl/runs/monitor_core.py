@@ -1,0 +1,215 @@
+"""The metric core that generated monitors call: numpy over whole topics, then per window.
+
+This module imports nothing of exsce: ``exscec generate ros1-monitor`` and
+``ros2-monitor`` copy it as it is into the node packages, so the offline
+monitors (bags) and the runtime ones (live topics) compute metrics with the
+same code.
+
+A topic is its receive times and its decoded fields (dotted paths of the
+message definition: ``linear.x``, ``ranges``).  Expressions combine fields
+element-wise; a field of another topic is interpolated at the left operand's
+times, where both topics have data.  An aggregate is *prepared* once per run
+(its per-message values), then reduced over each window: the whole run, a
+robot's part of it, each path segment.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+Number = float | int
+
+
+@dataclass(frozen=True)
+class Signal:
+    """Values per message (``v``: n numbers, or n × k for arrays) at sorted times ``t``."""
+
+    t: np.ndarray
+    v: np.ndarray
+
+
+@dataclass(frozen=True)
+class Topic:
+    """One topic of a run: receive times (seconds, sorted) and fields by dotted path."""
+
+    name: str
+    t: np.ndarray
+    fields: Mapping[str, np.ndarray] = field(default_factory=dict)
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+    def field(self, path: str) -> Signal:
+        return Signal(self.t, self.fields[path])
+
+
+Operand = Signal | Number
+
+
+def window(t: np.ndarray, start: float, end: float) -> slice:
+    """The samples of ``t`` in ``[start, end]``."""
+    return slice(int(np.searchsorted(t, start, "left")), int(np.searchsorted(t, end, "right")))
+
+
+def hold(t: np.ndarray) -> np.ndarray:
+    """How long each sample holds: until the next one (the last one, one median period; at most
+    two periods, so that a gap in the recording does not count as time spent)."""
+    if len(t) < 2:
+        return np.zeros(len(t))
+    gaps = np.diff(t)
+    period = float(np.median(gaps))
+    held: np.ndarray = np.minimum(np.append(gaps, period), 2 * period)
+    return held
+
+
+def _same_clock(a: np.ndarray, b: np.ndarray) -> bool:
+    return a is b or (a.shape == b.shape and bool(np.array_equal(a, b)))
+
+
+def _columns(v: np.ndarray, other: np.ndarray) -> np.ndarray:
+    """``v`` shaped to broadcast against ``other`` (a number per message against an array)."""
+    if v.ndim == 1 and other.ndim == 2:
+        return v[:, None]
+    return v
+
+
+def combine(func: Callable[..., np.ndarray], *operands: Operand) -> Signal:
+    """``func`` element-wise over signals and numbers; signals of other topics are aligned in time
+    to the first signal's (linear interpolation, only where both have data)."""
+    signals = [o for o in operands if isinstance(o, Signal)]
+    base = signals[0]
+    t, keep = base.t, slice(None)
+    for other in signals[1:]:
+        if not _same_clock(base.t, other.t):
+            if len(other.t) == 0:
+                t = t[:0]
+                break
+            inside = window(t, float(other.t[0]), float(other.t[-1]))
+            t = t[inside]
+            offset = keep.start or 0
+            keep = slice(offset + inside.start, offset + inside.stop)
+    values: list[np.ndarray | Number] = []
+    for o in operands:
+        if not isinstance(o, Signal):
+            values.append(o)
+        elif _same_clock(o.t, base.t):
+            values.append(o.v[keep])
+        else:
+            values.append(np.interp(t, o.t, o.v))
+    arrays = [v for v in values if isinstance(v, np.ndarray)]
+    widest = max(arrays, key=lambda a: a.ndim)
+    shaped = [_columns(v, widest) if isinstance(v, np.ndarray) else v for v in values]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return Signal(t, np.asarray(func(*shaped)))
+
+
+def norm(*operands: Operand) -> Signal:
+    """The Euclidean norm of the operands, element-wise (``hypot`` for two, as precise as it gets)."""
+    if len(operands) == 2:
+        return combine(np.hypot, *operands)
+    return combine(lambda *vs: np.sqrt(sum(np.square(v) for v in vs)), *operands)
+
+
+def constant_norm(*values: float) -> float:
+    return math.sqrt(sum(v * v for v in values))
+
+
+@dataclass(frozen=True)
+class Prepared:
+    """An aggregate's per-message values over a whole run: NaN where a message has none.
+
+    For an array aggregated by ``mean``, ``count`` holds how many elements each
+    message contributed (``v`` their sum); ``extra`` holds the further
+    coordinates of ``path_length``.
+    """
+
+    func: str
+    t: np.ndarray
+    v: np.ndarray
+    count: np.ndarray | None = None
+    extra: tuple[np.ndarray, ...] = ()
+
+
+def prepare(func: str, values: Signal | None, where: Signal | None = None, *more: Signal) -> Prepared:
+    """Per-message values of aggregate ``func`` (for ``duration``/``count``: ``where`` alone)."""
+    if func in ("duration", "count"):
+        assert where is not None
+        return Prepared(func, where.t, where.v.astype(bool))
+    assert values is not None
+    v = values.v
+    if where is not None:
+        mask = where.v if where.v.ndim == v.ndim else where.v[:, None]
+        v = np.where(mask, v, np.nan)
+    if v.ndim == 2:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # messages with no valid element: NaN
+            if func == "min":
+                return Prepared(func, values.t, np.nanmin(v, axis=1))
+            if func == "max":
+                return Prepared(func, values.t, np.nanmax(v, axis=1))
+            valid = ~np.isnan(v)
+            total = np.where(valid, v, 0.0).sum(axis=1)
+            counted = valid.sum(axis=1)
+            if func == "sum":
+                return Prepared(func, values.t, np.where(counted > 0, total, np.nan))
+            return Prepared(func, values.t, total, counted)
+    return Prepared(func, values.t, v.astype(np.float64, copy=False), None, tuple(m.v for m in more))
+
+
+def value_in(p: Prepared, start: float, end: float) -> float | None:
+    """The aggregate over ``[start, end]``; None when the window has nothing to aggregate."""
+    w = window(p.t, start, end)
+    v = p.v[w]
+    if p.func == "duration":
+        return float(hold(p.t[w])[v].sum())
+    if p.func == "count":
+        return float(np.count_nonzero(v))
+    if p.func == "change":
+        if len(p.t) == 0:
+            return None
+        ends = np.interp([start, end], p.t, p.v)
+        return float(ends[1] - ends[0])
+    if p.func == "path_length":
+        steps = [np.diff(c[w]) for c in (p.v, *p.extra)]
+        return float(np.sqrt(sum(np.square(s) for s in steps)).sum()) if len(v) > 1 else 0.0
+    if p.func == "integral":
+        t = p.t[w]
+        keep = ~np.isnan(v)
+        return float(np.trapezoid(v[keep], t[keep])) if keep.sum() > 1 else 0.0
+    if p.func == "mean" and p.count is not None:
+        n = int(p.count[w].sum())
+        return float(p.v[w].sum() / n) if n else None
+    valid = v[~np.isnan(v)]
+    if p.func == "sum":
+        return float(valid.sum())
+    if len(valid) == 0:
+        return None
+    if p.func == "min":
+        return float(valid.min())
+    if p.func == "max":
+        return float(valid.max())
+    if p.func == "mean":
+        return float(valid.mean())
+    if p.func == "first":
+        return float(valid[0])
+    if p.func == "last":
+        return float(valid[-1])
+    raise ValueError(f"unknown aggregate {p.func!r}")
+
+
+def value_sqrt(a: float) -> float:
+    return math.sqrt(a) if a >= 0 else math.nan
+
+
+def divide(a: float, b: float) -> float:
+    return a / b if b != 0 else math.nan
+
+
+def finite(value: float | None) -> float | None:
+    """A metric's value, or None when there is none (missing data, a division by zero)."""
+    return value if value is not None and math.isfinite(value) else None

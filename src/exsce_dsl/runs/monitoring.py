@@ -1,0 +1,252 @@
+"""A run's metrics, computed by the generated monitors of its metric declarations.
+
+Windows come from the waypoint dispatcher (the mission, each robot's part of
+it, each path segment); the values inside them from ``RobotMetrics`` and
+``MissionMetrics`` (:mod:`exsce_dsl.runs.monitor_code`).  A metric that is
+``safe below|above`` a limit also gets its ``violation_duration`` and its
+hotspots, from the per-message values its monitor prepared.  A metric whose
+topics are missing from the bag is *missing* (no value, and a problem is
+reported), never 0.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from types import ModuleType
+from typing import Any
+
+import numpy as np
+
+from exsce_dsl.model.geometry import Position
+from exsce_dsl.model.metrics import MetricDefinition, Subject
+from exsce_dsl.model.robots import Robot
+from exsce_dsl.model.runs import ActionId, Hotspot, MetricScope, MetricValue
+from exsce_dsl.runs import monitor_core as core
+from exsce_dsl.runs.monitor_code import reads_used
+from exsce_dsl.runs.segments import Segment
+
+HOTSPOT_RADIUS = 1.0  # metres: violations closer than this to a hotspot belong to it
+POSE_TOPIC = "/{ns}/robot_pose"
+"""Where hotspots are located: each robot's pose."""
+
+Window = tuple[Segment | None, float, float]
+
+
+def compute_metrics(
+    monitors: ModuleType,
+    metrics: Sequence[MetricDefinition],
+    robots: Sequence[Robot],
+    topics: Mapping[str, core.Topic],
+    actions: Sequence[Segment],
+    results: Mapping[str, int | None],
+    problems: list[str],
+) -> tuple[list[MetricValue], list[Hotspot]]:
+    """Every metric of ``metrics`` for a run. ``results``: robot → waypoints SUCCEEDED (None: no topic)."""
+    values: list[MetricValue] = []
+    hotspots: list[Hotspot] = []
+    done = [(a, a.start, a.end) for a in actions if a.start is not None and a.end is not None]
+    by_subject = {s: [m for m in metrics if m.subject is s] for s in Subject}
+    for robot in robots:
+        mine: list[Window] = [(a, s, e) for a, s, e in done if a.robot == robot.id]
+        if not mine:
+            problems.append(f"robot '{robot.id}' started no waypoint goal: its metrics are missing")
+            continue
+        start, end = min(s for _, s, _ in mine), max(e for _, _, e in mine)
+        monitor = monitors.RobotMetrics(robot.id, robot.namespace, topics, results.get(robot.id))
+        for metric in by_subject[Subject.ROBOT]:
+            values += _robot_values(monitor, metric, robot, [(None, start, end), *mine], problems)
+            if metric.safety is not None:
+                values += _robot_violations(monitor, metric, robot, start, end, topics, hotspots)
+    if done:
+        start, end = min(s for _, s, _ in done), max(e for _, _, e in done)
+        fleet = [(r.id, r.namespace) for r in robots]
+        monitor = monitors.MissionMetrics(fleet, topics)
+        for metric in by_subject[Subject.MISSION] + by_subject[Subject.PAIRS]:
+            values += _mission_values(monitor, metric, robots, start, end, topics, hotspots, problems)
+    return values, hotspots
+
+
+def _topics(metric: MetricDefinition, alternative: int, namespaces: Sequence[str]) -> tuple[str, ...]:
+    """The topics an alternative of ``metric`` read, for robots of these namespaces (in order)."""
+    patterns = {r.name: r.topic for r in metric.reads}
+    used = reads_used(metric, alternative)
+    found: list[str] = []
+    for n, ns in enumerate(namespaces):
+        for whose, read in used:
+            if whose is None or (metric.pair is not None and metric.pair.index(whose) == n):
+                topic = patterns[read].replace("{ns}", ns.strip("/"))
+                if topic not in found:
+                    found.append(topic)
+    return tuple(found)
+
+
+def _missing(metric: MetricDefinition, robot: Robot, topics: Mapping[str, core.Topic]) -> str:
+    wanted = _topics(metric, 0, [robot.namespace])
+    absent = [t for t in wanted if t not in topics or not len(topics[t])]  # dispatcher topics never are
+    return (
+        f"topic {', '.join(absent)} is missing: {metric.name} of '{robot.id}' is missing"
+        if absent
+        else f"{metric.name} of '{robot.id}' is missing"
+    )
+
+
+def _robot_values(
+    monitor: Any, metric: MetricDefinition, robot: Robot, windows: list[Window], problems: list[str]
+) -> list[MetricValue]:
+    found: list[MetricValue] = []
+    getter = getattr(monitor, f"get_{metric.name}")
+    unit = metric.unit or None  # a count has no unit
+    for action, start, end in windows if metric.per_segment else windows[:1]:
+        value = getter(start, end)
+        prepared = monitor.prepared(metric.name)
+        if value is None or prepared is None:
+            if action is None:
+                problems.append(_missing(metric, robot, monitor.topics))
+            continue
+        topics = _topics(metric, prepared[0], [robot.namespace])
+        if action is None:
+            scope = MetricScope.ROBOT
+            found.append(MetricValue(metric.name, scope, value, topics, robot.id, unit=unit))
+        else:
+            aid = ActionId(robot.id, action.allocation, action.subtask, action.waypoint)
+            found.append(MetricValue(metric.name, MetricScope.SEGMENT, value, topics, None, aid, unit))
+    return found
+
+
+def _over(metric: MetricDefinition, values: np.ndarray) -> np.ndarray:
+    """Which per-message values break the metric's safety limit (a message without one does not)."""
+    assert metric.safety is not None
+    limit = metric.safety.limit
+    with np.errstate(invalid="ignore"):
+        over: np.ndarray = values > limit if metric.safety.bound == "below" else values < limit
+    return over
+
+
+def _violations(p: core.Prepared, metric: MetricDefinition, start: float, end: float) -> tuple[Any, ...]:
+    w = core.window(p.t, start, end)
+    t = p.t[w]
+    held = core.hold(t)
+    over = _over(metric, p.v[w])
+    return t, held, over
+
+
+def _robot_violations(
+    monitor: Any,
+    metric: MetricDefinition,
+    robot: Robot,
+    start: float,
+    end: float,
+    topics: Mapping[str, core.Topic],
+    hotspots: list[Hotspot],
+) -> list[MetricValue]:
+    prepared = monitor.prepared(metric.name)
+    if prepared is None:
+        return []
+    choice, aggregates = prepared
+    t, held, over = _violations(aggregates[0], metric, start, end)
+    source = _topics(metric, choice, [robot.namespace])
+    pose = _pose(topics, robot.namespace)
+    if over.any() and pose is not None:
+        where = _position_at(pose, t[over])
+        hotspots.extend(
+            Hotspot(metric.name, Position(float(c[0]), float(c[1])), n, d, robot.id)
+            for c, n, d in cluster(where, held[over])
+        )
+    return [
+        MetricValue(
+            "violation_duration",
+            MetricScope.ROBOT,
+            float(held[over].sum()),
+            source,
+            robot.id,
+            unit="s",
+            safety_metric=metric.name,
+        )
+    ]
+
+
+def _mission_values(
+    monitor: Any,
+    metric: MetricDefinition,
+    robots: Sequence[Robot],
+    start: float,
+    end: float,
+    topics: Mapping[str, core.Topic],
+    hotspots: list[Hotspot],
+    problems: list[str],
+) -> list[MetricValue]:
+    value = getattr(monitor, f"get_{metric.name}")(start, end)
+    if metric.subject is Subject.MISSION:
+        if value is None:
+            problems.append(f"{metric.name} of the mission is missing")
+            return []
+        read = _topics(metric, 0, [r.namespace for r in robots])
+        return [MetricValue(metric.name, MetricScope.MISSION, value, read, unit=metric.unit or None)]
+    if value is None:
+        if len(robots) >= 2:
+            needed = ", ".join(r.topic for r in metric.reads)
+            problems.append(f"{needed} of fewer than two robots: {metric.name} is missing")
+        return []
+    source: list[str] = []
+    violation = 0.0
+    by_ns = {r.namespace.strip("/"): r for r in robots}
+    for first, second in monitor.pairs():
+        prepared = monitor.prepared(metric.name, first, second)
+        if prepared is None:
+            continue
+        choice, aggregates = prepared
+        source += [t for t in _topics(metric, choice, [first[1], second[1]]) if t not in source]
+        if metric.safety is None:
+            continue
+        t, held, over = _violations(aggregates[0], metric, start, end)
+        violation += float(held[over].sum())
+        poses = [_pose(topics, by_ns[ns].namespace) for _, ns in (first, second)]
+        if over.any() and poses[0] is not None and poses[1] is not None:
+            middle = (_position_at(poses[0], t[over]) + _position_at(poses[1], t[over])) / 2
+            hotspots.extend(
+                Hotspot(metric.name, Position(float(c[0]), float(c[1])), n, d)
+                for c, n, d in cluster(middle, held[over])
+            )
+    found = [MetricValue(metric.name, MetricScope.MISSION, value, tuple(source), unit=metric.unit or None)]
+    if metric.safety is not None:
+        found.append(
+            MetricValue(
+                "violation_duration",
+                MetricScope.MISSION,
+                violation,
+                tuple(source),
+                unit="s",
+                safety_metric=metric.name,
+            )
+        )
+    return found
+
+
+def _pose(topics: Mapping[str, core.Topic], namespace: str) -> core.Topic | None:
+    found = topics.get(POSE_TOPIC.replace("{ns}", namespace.strip("/")))
+    return found if found is not None and len(found) else None
+
+
+def _position_at(pose: core.Topic, times: np.ndarray) -> np.ndarray:
+    return np.column_stack(
+        [
+            np.interp(times, pose.t, pose.fields["pose.pose.position.x"]),
+            np.interp(times, pose.t, pose.fields["pose.pose.position.y"]),
+        ]
+    )
+
+
+def cluster(points: np.ndarray, durations: np.ndarray) -> list[tuple[np.ndarray, int, float]]:
+    """Greedy spatial clustering: a point joins the first centre within HOTSPOT_RADIUS."""
+    centres: list[list[float]] = []
+    members: list[list[int]] = []
+    for i, p in enumerate(points):
+        for k, c in enumerate(centres):
+            if np.hypot(p[0] - c[0], p[1] - c[1]) <= HOTSPOT_RADIUS:
+                members[k].append(i)
+                c[:] = points[members[k]].mean(axis=0)
+                break
+        else:
+            centres.append([float(p[0]), float(p[1])])
+            members.append([i])
+    return [(np.asarray(c), len(m), float(durations[m].sum())) for c, m in zip(centres, members, strict=True)]

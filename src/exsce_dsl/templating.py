@@ -1,0 +1,94 @@
+"""The one Jinja2 environment of exsce's generated code, with escaping for each target language.
+
+It sits beside :mod:`exsce_dsl.resources` because two layers render templates:
+``runs`` (the monitors that ingestion runs) and ``codegen`` (files for users).
+
+Generated code is Python and YAML.  Nothing from a user's file is pasted into
+it raw: identifiers go through :func:`python_name` (checked, never rewritten),
+strings through :func:`python_string` or :func:`yaml_string` (quoted by the
+target's own rules), and numbers through :func:`python_number`.
+Undefined template variables are errors (``StrictUndefined``).
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import keyword
+import math
+import re
+
+import jinja2
+
+from exsce_dsl.errors import ExsceError
+from exsce_dsl.resources import resource_dir
+
+_IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+
+
+class GenerationError(ExsceError):
+    """A model that cannot be turned into the requested code."""
+
+
+def python_name(name: str) -> str:
+    """``name`` if it is a Python identifier that is not a keyword; an error otherwise."""
+    if not _IDENTIFIER.fullmatch(name) or keyword.iskeyword(name) or keyword.issoftkeyword(name):
+        raise GenerationError(f"'{name}' cannot be used as a name in generated Python code")
+    return name
+
+
+def python_string(text: str) -> str:
+    """A Python string literal of ``text`` (JSON's quoting is valid Python for any str)."""
+    return json.dumps(text, ensure_ascii=True)
+
+
+def yaml_string(text: str) -> str:
+    """A double-quoted YAML scalar of ``text`` (YAML 1.2 is a superset of JSON)."""
+    return json.dumps(text, ensure_ascii=True)
+
+
+def python_number(value: float | int) -> str:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise GenerationError(f"{value!r} is not a number")
+    if isinstance(value, float) and not math.isfinite(value):
+        raise GenerationError(f"{value!r} is not a finite number")
+    return repr(value)
+
+
+def unwrap(code: str) -> str:
+    """``code`` without the parentheses around all of it, if it has them."""
+    if not (code.startswith("(") and code.endswith(")")):
+        return code
+    depth = 0
+    for i, char in enumerate(code):
+        depth += {"(": 1, ")": -1}.get(char, 0)
+        if depth == 0 and i < len(code) - 1:
+            return code  # the first parenthesis closes before the end: `(a) + (b)`
+    return code[1:-1]
+
+
+def _is_node(value: object, kind: str) -> bool:
+    """``{% if e is node("Aggregate") %}``: the class of a semantic-model node."""
+    return type(value).__name__ == kind
+
+
+@functools.cache
+def environment() -> jinja2.Environment:
+    env = jinja2.Environment(
+        loader=jinja2.FileSystemLoader(str(resource_dir("templates"))),
+        undefined=jinja2.StrictUndefined,
+        autoescape=False,  # no HTML here; each value is escaped for its language by a filter
+        keep_trailing_newline=True,
+        trim_blocks=True,
+        lstrip_blocks=True,
+    )
+    env.filters.update(
+        pyname=python_name, pystr=python_string, yamlstr=yaml_string, pynum=python_number, unwrap=unwrap
+    )
+    env.tests["node"] = _is_node
+    return env
+
+
+def render(template: str, **context: object) -> str:
+    """Render ``templates/<template>`` with ``context``."""
+    return environment().get_template(template).render(**context)
