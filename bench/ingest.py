@@ -8,12 +8,16 @@ then measures in the same process, on the same file:
   (a) rosbags iterating the connections the metrics need, without deserializing;
   (b) the naive way: deserialize every message and update the metrics in a Python
       callback per message, as the method's monitors do;
-  (c) exsce's ingestion: metrics + run PROV + write into an embedded store.
+  (c) exsce's ingestion: metrics + run PROV + write into an embedded store;
+  (d) the metrics alone, as ingestion computes them: monitors generated from the
+      metric declarations (the standard library's);
+  (e) the metrics alone by the hand-written path (d) replaced, kept as the tests'
+      reference (tests/reference_metrics.py), on the same decoded topics.
 
 It prints MB/s and messages/s for each, the ratios, and peak memory (each
 measurement in a fresh process, so peaks do not mix).  Targets: (c) at least
 half the speed of (a) and at least 3× faster than (b); peak memory under 2× the
-bag size.
+bag size; (d) at most 10 % slower than (e).
 
     python bench/ingest.py [--minutes 10] [--keep DIR]
 """
@@ -125,6 +129,37 @@ def way_c(bag: Path, spec: Path, store: Path) -> dict[str, float]:
     return {"statements": result.statements}
 
 
+def way_d(bag: Path, spec: Path) -> dict[str, float]:
+    from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.runs.analyse import analyse_bag
+
+    analysed = analyse_bag(bag, load_spec(spec).scenario())
+    return {"values": len(analysed.run.metrics)}
+
+
+def way_e(bag: Path, spec: Path) -> dict[str, float]:
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+    import reference_metrics as reference
+
+    from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.runs.analyse import run_metrics, wanted_topics
+    from exsce_dsl.runs.bagdata import read_bag
+    from exsce_dsl.runs.segments import SUCCEEDED, segments
+
+    scenario = load_spec(spec).scenario()
+    robots = list(scenario.robots)
+    data = read_bag(bag, wanted_topics(run_metrics(scenario), robots))
+    actions, results = [], {}
+    for robot in robots:
+        topics = reference.robot_topics(robot.namespace)
+        actions += segments(scenario, robot.id, data.feedback[topics["feedback"]])
+        final = data.results.get(topics["result"])
+        results[robot.id] = None if final is None else sum(s == SUCCEEDED for u in final for s in u.statuses)
+    signals = [reference.RobotSignals.from_bag(r.id, r.namespace, data) for r in robots]
+    values, _ = reference.compute_metrics(signals, actions, results, reference.SafetyLimits(), [])
+    return {"values": len(values)}
+
+
 def child(argv: list[str]) -> None:
     way, bag = argv[0], Path(argv[1])
     start = time.perf_counter()
@@ -132,6 +167,10 @@ def child(argv: list[str]) -> None:
         out = way_a(bag)
     elif way == "b":
         out = way_b(bag)
+    elif way == "d":
+        out = way_d(bag, Path(argv[2]))
+    elif way == "e":
+        out = way_e(bag, Path(argv[2]))
     else:
         out = way_c(bag, Path(argv[2]), Path(argv[3]))
     out["seconds"] = time.perf_counter() - start
@@ -188,11 +227,15 @@ def main() -> None:
         a = measure("a", str(run.bag))
         b = measure("b", str(run.bag))
         c = measure("c", str(run.bag), str(spec), str(folder / "store"))
+        d = min((measure("d", str(run.bag), str(spec)) for _ in range(3)), key=lambda r: r["seconds"])
+        e = min((measure("e", str(run.bag), str(spec)) for _ in range(3)), key=lambda r: r["seconds"])
         n = a["messages"]
         for name, r in (
             ("(a) rosbags, no deserializing", a),
             ("(b) deserialize + callback", b),
             ("(c) exscec ingest", c),
+            ("(d) metrics, generated monitors", d),
+            ("(e) metrics, hand-written path", e),
         ):
             print(
                 f"{name:32s} {r['seconds']:7.2f} s  {size_mb / r['seconds']:7.1f} MB/s  "
@@ -202,6 +245,10 @@ def main() -> None:
         print(f"(c) vs (a): {a['seconds'] / c['seconds']:.2f}× the speed (target ≥ 0.5)")
         print(f"(c) vs (b): {b['seconds'] / c['seconds']:.1f}× faster (target ≥ 3)")
         print(f"(c) wrote {c['statements']:.0f} statements")
+        print(
+            f"(d) vs (e): {d['seconds'] / e['seconds']:.2f}× the time of the hand-written path "
+            f"(target ≤ 1.10; best of 3 each; {d['values']:.0f} and {e['values']:.0f} values)"
+        )
 
 
 if __name__ == "__main__":

@@ -57,9 +57,9 @@ def test_check_reports_every_error_as_file_line_col_and_exits_1(in_tmp: Path) ->
     assert result.returncode == 1
     assert "Traceback" not in result.stderr
     lines = result.stderr.splitlines()
-    assert "bc/scenario_c.exsce:9:13: error: unknown robot type 'tiagoo'; did you mean 'tiago'?" in lines
+    assert "bc/scenario_c.exsce:10:13: error: unknown robot type 'tiagoo'; did you mean 'tiago'?" in lines
     assert any(
-        line.startswith("bc/scenario_c.exsce:14:5: error: robot 'tiago3' is not in the fleet")
+        line.startswith("bc/scenario_c.exsce:15:5: error: robot 'tiago3' is not in the fleet")
         for line in lines
     )
     assert "bc/scenario_c.exsce: 2 errors" in lines
