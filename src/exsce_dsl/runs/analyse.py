@@ -7,6 +7,7 @@ import hashlib
 import uuid
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import ModuleType
 
 from exsce_dsl.lang.standard_metrics import standard_metrics
 from exsce_dsl.model import Scenario
@@ -14,9 +15,9 @@ from exsce_dsl.model.messages import DISPATCHER, POSE
 from exsce_dsl.model.metrics import MetricDefinition, Subject
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Bag, Run, TaskExecution
-from exsce_dsl.runs.bagdata import BagError, read_bag
+from exsce_dsl.runs.bagdata import BagError, Reduce, read_bag
 from exsce_dsl.runs.monitor_code import load_monitors
-from exsce_dsl.runs.monitor_core import Topic
+from exsce_dsl.runs.monitor_core import Compute, Topic, reducer
 from exsce_dsl.runs.monitoring import POSE_TOPIC, compute_metrics
 from exsce_dsl.runs.segments import SUCCEEDED, Segment, segments
 
@@ -69,11 +70,25 @@ def wanted_topics(metrics: tuple[MetricDefinition, ...], robots: list[Robot]) ->
     return wanted
 
 
+def reductions(monitors: ModuleType, robots: list[Robot]) -> dict[str, Reduce]:
+    """Topic → what to reduce of each block of its messages as the bag is read (the monitors'
+    aggregates over arrays), so that no topic's arrays are ever all in memory."""
+    entries: dict[str, list[tuple[str, str, Compute]]] = {}
+    for robot in robots:
+        for pattern, key, func, compute in monitors.REDUCERS:
+            entries.setdefault(pattern.replace("{ns}", robot.namespace.strip("/")), []).append(
+                (key, func, compute)
+            )
+    return {topic: reducer(found) for topic, found in entries.items()}
+
+
 def analyse_bag(path: Path, scenario: Scenario) -> AnalysedRun:
     digest = content_hash(path) if path.exists() else ""
     robots = [r for r in scenario.robots if r.start_pose is not None]
     metrics = run_metrics(scenario)
-    data = read_bag(path, wanted_topics(metrics, robots))
+    source = scenario.location.file if scenario.location else scenario.id
+    monitors = load_monitors(metrics, source)
+    data = read_bag(path, wanted_topics(metrics, robots), reductions(monitors, robots))
     problems = list(data.problems)
     actions: list[Segment] = []
     results: dict[str, int | None] = {}
@@ -91,8 +106,6 @@ def analyse_bag(path: Path, scenario: Scenario) -> AnalysedRun:
     if not any(a.start is not None for a in actions):
         raise BagError(f"{path}: no waypoint goal of scenario '{scenario.id}' became active in this bag")
     topics = {name: Topic(name, s.t, s.fields) for name, s in data.series.items()}
-    source = scenario.location.file if scenario.location else scenario.id
-    monitors = load_monitors(metrics, source)
     values, hotspots = compute_metrics(monitors, metrics, robots, topics, actions, results, problems)
     run = Run(
         uuid=run_uuid(digest),

@@ -9,7 +9,7 @@ messages are deserialized by rosbags, with their types taken from the bag.
 from __future__ import annotations
 
 import functools
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -69,20 +69,30 @@ def _typestore_for(path: Path):  # type: ignore[no-untyped-def]
     return get_typestore(Stores.ROS2_HUMBLE if ros2 else Stores.ROS1_NOETIC)
 
 
-def read_bag(path: Path, wanted: Mapping[str, str]) -> BagData:
-    """Read the ``wanted`` topics (topic → expected message type; ``*`` for the dispatcher's)."""
+Reduce = Callable[[dict[str, np.ndarray]], dict[str, np.ndarray]]
+"""Turns a block of decoded messages into the fields kept of them (arrays reduced per message)."""
+
+
+def read_bag(path: Path, wanted: Mapping[str, str], reduce: Mapping[str, Reduce] | None = None) -> BagData:
+    """Read the ``wanted`` topics (topic → expected message type; ``*`` for the dispatcher's).
+
+    ``reduce`` (topic → function) is applied to each block of decoded messages as
+    it is read, so that large arrays (laser ranges) are reduced per message and
+    never all held at once; given a ``reduce``, array fields are not kept (what
+    is needed of them is reduced).  Without it, every field is kept.
+    """
     if not path.exists():
         raise BagError(f"{path}: no such bag")
     if _is_ros1(path):
         try:
-            return _read_ros1_index(path, wanted)
+            return _read_ros1_index(path, wanted, reduce)
         except UnsupportedBag:
             pass  # rosbags reads what our index reader does not (and reports what is broken)
         except DecodeError as exc:
             raise BagError(f"{path}: {exc.message}") from None
     try:
         with AnyReader([path], default_typestore=_typestore_for(path)) as reader:
-            return _read(reader, path, wanted)
+            return _read(reader, path, wanted, reduce)
     except BagError:
         raise
     except DecodeError as exc:
@@ -91,7 +101,19 @@ def read_bag(path: Path, wanted: Mapping[str, str]) -> BagData:
         raise BagError(f"{path}: cannot read the bag: {type(exc).__name__}: {exc}") from None
 
 
-def _read(reader: AnyReader, path: Path, wanted: Mapping[str, str]) -> BagData:
+def _kept(
+    fields: dict[str, np.ndarray], topic: str, reduce: Mapping[str, Reduce] | None
+) -> dict[str, np.ndarray]:
+    if reduce is None:
+        return fields
+    if topic in reduce:
+        fields = reduce[topic](fields)
+    return {k: v for k, v in fields.items() if v.ndim == 1}
+
+
+def _read(
+    reader: AnyReader, path: Path, wanted: Mapping[str, str], reduce: Mapping[str, Reduce] | None
+) -> BagData:
     if reader.message_count == 0:
         raise BagError(f"{path}: the bag holds no messages")
     data = BagData(
@@ -127,7 +149,7 @@ def _read(reader: AnyReader, path: Path, wanted: Mapping[str, str]) -> BagData:
                 cdr=not _is_ros1(path),
                 fallback=functools.partial(_deserialize, reader, msgtype),
             )
-            data.series[topic] = Series(topic, msgtype, times[order] / 1e9, fields)
+            data.series[topic] = Series(topic, msgtype, times[order] / 1e9, _kept(fields, topic, reduce))
             del raws, in_order  # the decoded buffer is all that is kept
         else:
             updates = [
@@ -140,7 +162,9 @@ def _read(reader: AnyReader, path: Path, wanted: Mapping[str, str]) -> BagData:
     return data
 
 
-def _read_ros1_index(path: Path, wanted: Mapping[str, str]) -> BagData:
+def _read_ros1_index(
+    path: Path, wanted: Mapping[str, str], reduce: Mapping[str, Reduce] | None
+) -> BagData:
     """The fast path for ROS 1 bags: the bag's own index, numpy gathers, no per-message Python."""
     layouts: dict[str, Layout] = {}
 
@@ -150,7 +174,7 @@ def _read_ros1_index(path: Path, wanted: Mapping[str, str]) -> BagData:
         shape = layouts.get(topic) or layouts.setdefault(topic, layout(msgtype, bytes(rows[0]), cdr=False))
         if shape.size != rows.shape[1]:
             raise DecodeError(f"{msgtype} messages on {topic} are not the size their type says")
-        return decode_rows(shape, rows)
+        return _kept(decode_rows(shape, rows), topic, reduce)
 
     found = read_topics(path, set(wanted), decoder)
     if not found:
@@ -177,7 +201,7 @@ def _read_ros1_index(path: Path, wanted: Mapping[str, str]) -> BagData:
             fields = decode(
                 msgtype, raws, cdr=False, fallback=functools.partial(store.deserialize_ros1, typename=msgtype)
             )
-            data.series[topic] = Series(topic, msgtype, times, fields)
+            data.series[topic] = Series(topic, msgtype, times, _kept(fields, topic, reduce))
             continue
         updates = [
             _status_update(store.deserialize_ros1(r, msgtype), t, topic)

@@ -114,8 +114,9 @@ def decode_rows(shape: Layout, rows: np.ndarray) -> dict[str, np.ndarray]:
     """Fields of messages given as the rows of a uint8 array (one message per row)."""
     out = {name: _column(rows, offset, kind) for name, (offset, kind) in shape.fields.items()}
     for name, (at, count, kind) in shape.arrays.items():
+        # a view on the raw rows, not a copy: laser ranges are most of a bag's bytes
         width = np.dtype(kind).itemsize
-        out[name] = rows[:, at : at + width * count].copy().view(kind)
+        out[name] = rows[:, at : at + width * count].view(kind)
     return out
 
 

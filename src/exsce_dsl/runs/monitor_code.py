@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 from exsce_dsl.lang.format_metrics import expression_text
 from exsce_dsl.model.expressions import Aggregate, Expression, Field, WindowValue, walk
-from exsce_dsl.model.messages import FEEDBACK, RESULT
+from exsce_dsl.model.messages import FEEDBACK, RESULT, Leaf, field_of
 from exsce_dsl.model.metrics import Combine, MetricDefinition, Subject
 from exsce_dsl.runs import monitor_core
 from exsce_dsl.templating import render
@@ -58,6 +58,10 @@ class Alternative:
     """(local variable, whose topic: ``first``/``second`` of a pair or "", topic pattern)."""
     vars: dict[tuple[str | None, str], str]
     uses_succeeded: bool
+    blocks: list[str | None]
+    """Per aggregate: the variable of the topic whose arrays it reduces (prepared in blocks), or None."""
+    reducers: list[tuple[str, str] | None]
+    """Per aggregate over arrays: (function, key) that reduce its arrays per message as a bag is read."""
 
 
 @dataclass(frozen=True)
@@ -71,7 +75,7 @@ class MetricCode:
 
 def alternatives(metric: MetricDefinition) -> list[Alternative]:
     found = []
-    for expr in (metric.value, metric.fallback):
+    for number, expr in enumerate((metric.value, metric.fallback)):
         if expr is None:
             continue
         nodes = walk(expr)
@@ -92,8 +96,25 @@ def alternatives(metric: MetricDefinition) -> list[Alternative]:
             whose = "" if f.robot is None else ("first" if first else "second")
             reads.append((variables[key], whose, patterns[f.read]))
         succeeded = any(isinstance(n, WindowValue) and n.name == "succeeded" for n in nodes)
-        found.append(Alternative(expression_text(expr), expr, aggregates, reads, variables, succeeded))
+        types = {r.name: r.msgtype for r in metric.reads}
+        blocks = [_array_topic(a, types, variables) for a in aggregates]
+        reducers = [
+            None if var is None else (f"_reduce_{metric.name}_{number}_{k}", f"{metric.name}/{number}/{k}")
+            for k, var in enumerate(blocks)
+        ]
+        text = expression_text(expr)
+        found.append(Alternative(text, expr, aggregates, reads, variables, succeeded, blocks, reducers))
     return found
+
+
+def _array_topic(
+    aggregate: Aggregate, types: dict[str, str], variables: dict[tuple[str | None, str], str]
+) -> str | None:
+    """The variable of the topic an aggregate reads arrays of (one topic: arrays are never aligned)."""
+    for node in [n for arg in aggregate.args for n in walk(arg)]:
+        if isinstance(node, Field) and field_of(types[node.read], node.path) is Leaf.ARRAY:
+            return variables[(node.robot, node.read)]
+    return None
 
 
 def _code(metric: MetricDefinition) -> MetricCode:
@@ -108,6 +129,14 @@ def monitor_source(metrics: Sequence[MetricDefinition], source: str, core_import
     """
     robot = [_code(m) for m in metrics if m.subject is Subject.ROBOT]
     mission = [_code(m) for m in metrics if m.subject is not Subject.ROBOT]
+    reducers = []
+    for code in robot + mission:
+        for alt in code.alternatives:
+            patterns = {var: pattern for var, _, pattern in alt.reads}
+            for agg, var, names in zip(alt.aggregates, alt.blocks, alt.reducers, strict=True):
+                if var is not None and names is not None:
+                    reducers.append({"name": names[0], "key": names[1], "var": var, "pattern": patterns[var],
+                                     "aggregate": agg, "vars": alt.vars})
     return render(
         "monitors/monitors.py.j2",
         generator=GENERATOR,
@@ -115,6 +144,7 @@ def monitor_source(metrics: Sequence[MetricDefinition], source: str, core_import
         core_import=core_import or "from exsce_dsl.runs import monitor_core as core",
         robot_metrics=robot,
         mission_metrics=mission,
+        reducers=reducers,
         ufuncs=_UFUNCS,
     )
 

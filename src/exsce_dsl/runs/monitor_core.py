@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -46,6 +46,10 @@ class Topic:
 
     def field(self, path: str) -> Signal:
         return Signal(self.t, self.fields[path])
+
+    def rows(self, part: slice) -> Topic:
+        """The messages ``part`` of the topic (views, no copies)."""
+        return Topic(self.name, self.t[part], {k: v[part] for k, v in self.fields.items()})
 
 
 Operand = Signal | Number
@@ -159,6 +163,64 @@ def prepare(func: str, values: Signal | None, where: Signal | None = None, *more
                 return Prepared(func, values.t, np.where(counted > 0, total, np.nan))
             return Prepared(func, values.t, total, counted)
     return Prepared(func, values.t, v.astype(np.float64, copy=False), None, tuple(m.v for m in more))
+
+
+BLOCK = 2048
+"""Messages per block when an aggregate over arrays (laser ranges) is prepared: the element-wise
+temporaries of a block stay small, whatever the length of the run."""
+
+
+def prepare_blocks(
+    func: str, topic: Topic, compute: Callable[[Topic], tuple[Signal, Signal | None]]
+) -> Prepared:
+    """``prepare`` of an aggregate over an array field, ``BLOCK`` messages at a time.
+
+    ``compute`` gives the values (and the ``where`` condition) for some of the
+    topic's messages; arrays never mix topics, so blocks of one topic suffice.
+    """
+    parts = []
+    for first in range(0, max(len(topic), 1), BLOCK):
+        values, where = compute(topic.rows(slice(first, first + BLOCK)))
+        parts.append(prepare(func, values, where))
+    counts = [p.count for p in parts if p.count is not None]
+    return Prepared(
+        func,
+        topic.t,
+        np.concatenate([p.v for p in parts]),
+        np.concatenate(counts) if counts else None,
+    )
+
+
+Compute = Callable[[Topic], tuple[Signal, "Signal | None"]]
+
+
+def reduced(func: str, topic: Topic, key: str, compute: Compute) -> Prepared:
+    """The aggregate over arrays, from per-message values reduced while the bag was read
+    (field ``key``, see :func:`reducer`), else computed now, a block at a time."""
+    if key in topic.fields:
+        return Prepared(func, topic.t, topic.fields[key], topic.fields.get(f"{key}#count"))
+    return prepare_blocks(func, topic, compute)
+
+
+def reducer(
+    entries: Sequence[tuple[str, str, Compute]],
+) -> Callable[[dict[str, np.ndarray]], dict[str, np.ndarray]]:
+    """A function from decoded fields of some messages to the same fields plus, for each entry
+    (key, aggregate, compute), the per-message values of that aggregate."""
+
+    def reduce(fields: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        n = len(next(iter(fields.values()))) if fields else 0
+        block = Topic("", np.arange(n, dtype=np.float64), fields)
+        out = dict(fields)
+        for key, func, compute in entries:
+            values, where = compute(block)
+            p = prepare(func, values, where)
+            out[key] = p.v
+            if p.count is not None:
+                out[f"{key}#count"] = p.count
+        return out
+
+    return reduce
 
 
 def value_in(p: Prepared, start: float, end: float) -> float | None:

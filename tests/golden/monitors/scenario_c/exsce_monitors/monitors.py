@@ -16,6 +16,20 @@ import numpy as np
 from . import monitor_core as core
 
 
+def _reduce_distance_to_obstacles_0_0(topic_0: core.Topic) -> tuple[core.Signal, core.Signal | None]:
+    """The per-message values of min(...) over arrays, for some messages of "/{ns}/scan"."""
+    return (
+        topic_0.field("ranges"),
+        core.combine(np.logical_and, core.combine(np.greater_equal, topic_0.field("ranges"), topic_0.field("range_min")), core.combine(np.less_equal, topic_0.field("ranges"), topic_0.field("range_max"))),
+    )
+
+
+REDUCERS: list[tuple[str, str, str, core.Compute]] = [
+    ("/{ns}/scan", "distance_to_obstacles/0/0", "min", _reduce_distance_to_obstacles_0_0),
+]
+"""(topic, key, aggregate, values): aggregates over arrays, reduced per message as a bag is read."""
+
+
 class RobotMetrics:
     """The metrics of one robot over a window of a run: task_duration, waypoints_visited, distance_travelled, distance_to_obstacles, max_velocity, fast_driving_time, mean_turn_rate."""
 
@@ -151,11 +165,7 @@ class RobotMetrics:
         topic_0 = self.topic("/{ns}/scan")
         if topic_0 is not None:
             return 0, [
-                core.prepare(
-                    "min",
-                    topic_0.field("ranges"),
-                    core.combine(np.logical_and, core.combine(np.greater_equal, topic_0.field("ranges"), topic_0.field("range_min")), core.combine(np.less_equal, topic_0.field("ranges"), topic_0.field("range_max"))),
-                ),
+                core.reduced("min", topic_0, "distance_to_obstacles/0/0", _reduce_distance_to_obstacles_0_0),
             ]
         return None
 
