@@ -6,7 +6,8 @@ It sits beside :mod:`exsce_dsl.resources` because two layers render templates:
 Generated code is Python and YAML.  Nothing from a user's file is pasted into
 it raw: identifiers go through :func:`python_name` (checked, never rewritten),
 strings through :func:`python_string` or :func:`yaml_string` (quoted by the
-target's own rules), and numbers through :func:`python_number`.
+target's own rules), and numbers through :func:`python_number` or
+:func:`yaml_number`.
 Undefined template variables are errors (``StrictUndefined``).
 """
 
@@ -55,6 +56,16 @@ def python_number(value: float | int) -> str:
     return repr(value)
 
 
+def yaml_number(value: float | int) -> str:
+    """A number as YAML 1.1 readers (PyYAML, rosparam) read it back: a float always has a '.'
+    (Python's ``1e-05`` would read as text)."""
+    text = python_number(value)
+    if isinstance(value, float) and "e" in text and "." not in text:
+        mantissa, _, exponent = text.partition("e")
+        text = f"{mantissa}.0e{exponent}"
+    return text
+
+
 def unwrap(code: str) -> str:
     """``code`` without the parentheses around all of it, if it has them."""
     if not (code.startswith("(") and code.endswith(")")):
@@ -83,7 +94,12 @@ def environment() -> jinja2.Environment:
         lstrip_blocks=True,
     )
     env.filters.update(
-        pyname=python_name, pystr=python_string, yamlstr=yaml_string, pynum=python_number, unwrap=unwrap
+        pyname=python_name,
+        pystr=python_string,
+        yamlstr=yaml_string,
+        pynum=python_number,
+        yamlnum=yaml_number,
+        unwrap=unwrap,
     )
     env.tests["node"] = _is_node
     return env

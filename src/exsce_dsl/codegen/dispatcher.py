@@ -105,15 +105,13 @@ def _task_file(namespace: str, task: Task) -> str:
 def _read_back(path: str, text: str, content: object) -> str:
     """``text`` if a YAML reader gets ``content`` back from it.
 
-    Guards the template and the filters: ``pynum`` writes Python's repr,
-    and YAML 1.1 readers (PyYAML, rosparam) read a float such as ``1e-05``,
-    which has no '.', as a string.  A file that would be misread is refused
-    rather than written.
+    Guards the template and the filters (``yamlnum`` writes ``1e-05`` as
+    ``1.0e-05``, which YAML 1.1 readers such as PyYAML and rosparam need):
+    a file that would be misread is refused rather than written.
     """
     if yaml.safe_load(text) != content:
         raise GenerationError(
             f"{path}: the generated YAML does not read back as the model "
-            "(a number written without '.', like 1e-05, reads as text in YAML 1.1); "
-            "please report this"
+            "; please report this"
         )
     return text
