@@ -327,8 +327,8 @@ class _MetricBuilder:
 
     def _chain(self, node: Any) -> Typed:
         result = self._expr(node.first)
-        for op, operand in zip(node.ops, node.rest, strict=True):
-            result = self._arithmetic(op, result, self._expr(operand), operand)
+        for tail in node.rest:
+            result = self._arithmetic(tail.op, result, self._expr(tail.operand), tail.operand)
         return result
 
     def _arithmetic(self, op: str, left: Typed, right: Typed, node: Any) -> Typed:
