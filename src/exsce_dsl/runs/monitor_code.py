@@ -3,30 +3,33 @@
 The code comes from ``templates/monitors/monitors.py.j2``: a ``RobotMetrics``
 and a ``MissionMetrics`` class whose ``get_<metric>(start, end)`` methods call
 :mod:`exsce_dsl.runs.monitor_core`.  Ingestion renders it for the standard
-library's metrics and the specification's own, and executes the text it just
-rendered (never a file found on disk); ``exscec generate monitors`` writes the
-same text to a file.  Metric names are checked Python identifiers, topic names
-and strings go through the template's quoting filters, and local variable
-names are exsce's own, so nothing from a user's file becomes code unchecked.
+library's metrics and the specification's own and executes that text (kept in
+the user's cache folder like ``__pycache__``, never loaded by a name from a
+data file); ``exscec generate monitors`` writes the same text to a file.
+Metric names are checked Python identifiers, topic names and strings go
+through the template's quoting filters, and local variable names are exsce's
+own, so nothing from a user's file becomes code unchecked.
 """
 
 from __future__ import annotations
 
 import functools
 import hashlib
+import os
 import sys
 import types
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 from exsce_dsl.lang.format_metrics import expression_text
 from exsce_dsl.model.expressions import Aggregate, Expression, Field, WindowValue, walk
 from exsce_dsl.model.messages import FEEDBACK, RESULT, Leaf, field_of
 from exsce_dsl.model.metrics import Combine, MetricDefinition, Subject
 from exsce_dsl.runs import monitor_core
-from exsce_dsl.templating import render
 
 GENERATOR = "exscec generate monitors"
+TEMPLATE = "monitors/monitors.py.j2"
 
 _UFUNCS = {
     "+": "np.add",
@@ -137,8 +140,10 @@ def monitor_source(metrics: Sequence[MetricDefinition], source: str, core_import
                 if var is not None and names is not None:
                     reducers.append({"name": names[0], "key": names[1], "var": var, "pattern": patterns[var],
                                      "aggregate": agg, "vars": alt.vars})
+    from exsce_dsl.templating import render  # Jinja2 is imported only when there is something to render
+
     return render(
-        "monitors/monitors.py.j2",
+        TEMPLATE,
         generator=GENERATOR,
         source=source,
         core_import=core_import or "from exsce_dsl.runs import monitor_core as core",
@@ -160,8 +165,59 @@ def _load(source_text: str) -> types.ModuleType:
 
 
 def load_monitors(metrics: Sequence[MetricDefinition], source: str = "the specification") -> types.ModuleType:
-    """The generated monitor module of ``metrics``, rendered and executed in memory (cached by text)."""
-    return _load(monitor_source(metrics, source))
+    """The generated monitor module of ``metrics``, executed in memory (cached by text).
+
+    The rendered text is kept in the user's cache folder under a digest of what
+    it was rendered from (exsce's version, the template, the metrics), the way
+    Python keeps ``__pycache__``: rendering needs Jinja2, whose import and
+    template compilation cost more than the metrics of a short bag.
+    """
+    digest = _inputs_digest(metrics, source)
+    cached = _cache_folder() / f"monitors-{digest}.py" if _cache_folder() else None
+    text = _read_cached(cached)
+    if text is None:
+        text = monitor_source(metrics, source)
+        _write_cached(cached, text)
+    return _load(text)
+
+
+def _inputs_digest(metrics: Sequence[MetricDefinition], source: str) -> str:
+    from exsce_dsl import __version__
+    from exsce_dsl.resources import resource_dir
+
+    template = (resource_dir("templates") / TEMPLATE).read_bytes()
+    digest = hashlib.sha256()
+    for part in (__version__.encode(), template, repr(tuple(metrics)).encode(), source.encode()):
+        digest.update(len(part).to_bytes(8, "little") + part)
+    return digest.hexdigest()
+
+
+def _cache_folder() -> Path | None:
+    """``$EXSCE_CACHE``, else ``$XDG_CACHE_HOME/exsce`` (``~/.cache/exsce``); empty: no cache."""
+    configured = os.environ.get("EXSCE_CACHE")
+    if configured is not None:
+        return Path(configured) if configured else None
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "exsce"
+
+
+def _read_cached(path: Path | None) -> str | None:
+    try:
+        return path.read_text(encoding="utf-8") if path is not None else None
+    except (OSError, UnicodeDecodeError):
+        return None
+
+
+def _write_cached(path: Path | None, text: str) -> None:
+    if path is None:
+        return
+    try:
+        path.parent.mkdir(mode=0o700, parents=True, exist_ok=True)
+        partial = path.with_suffix(f".{os.getpid()}.tmp")
+        partial.write_text(text, encoding="utf-8")
+        partial.replace(path)  # atomic: a reader never sees half a file
+    except OSError:
+        pass  # no cache, only slower
 
 
 def reads_used(metric: MetricDefinition, alternative: int) -> list[tuple[str | None, str]]:
