@@ -46,7 +46,9 @@ def test_generate_writes_a_package_that_passes_ruff_and_computes_what_ingest_com
     package = tmp_path / "out" / "exsce_monitors"
     assert sorted(p.name for p in package.iterdir()) == ["__init__.py", "monitor_core.py", "monitors.py"]
     ruff = subprocess.run(
-        [sys.executable, "-m", "ruff", "check", "--isolated", str(package)], capture_output=True, text=True
+        [sys.executable, "-m", "ruff", "check", "--isolated", "--target-version", "py38", str(package)],
+        capture_output=True,
+        text=True,
     )
     assert ruff.returncode == 0, ruff.stdout + ruff.stderr
     header = (package / "monitors.py").read_text().splitlines()[0]

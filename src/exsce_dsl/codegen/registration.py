@@ -54,3 +54,5 @@ def _target_generator(name: str) -> Any:
 
 monitors_generator = _target_generator("monitors")
 dispatcher_config_generator = _target_generator("dispatcher-config")
+ros1_monitor_generator = _target_generator("ros1-monitor")
+ros2_monitor_generator = _target_generator("ros2-monitor")

@@ -47,5 +47,19 @@ TARGETS: dict[str, Target] = {
             "exsce_dsl.codegen.dispatcher",
             "generate_dispatcher_config",
         ),
+        Target(
+            "ros1-monitor",
+            "a ROS 1 (catkin, rospy) package of a runtime monitor node: the scenario's metrics live, "
+            "its oracles' verdicts as JSON on /exsce/verdicts",
+            "exsce_dsl.codegen.ros_monitor",
+            "generate_ros1_monitor",
+        ),
+        Target(
+            "ros2-monitor",
+            "a ROS 2 (ament_python, rclpy) package of a runtime monitor node: the scenario's metrics live, "
+            "its oracles' verdicts as JSON on /exsce/verdicts",
+            "exsce_dsl.codegen.ros_monitor",
+            "generate_ros2_monitor",
+        ),
     )
 }

@@ -173,7 +173,8 @@ def load_monitors(metrics: Sequence[MetricDefinition], source: str = "the specif
     template compilation cost more than the metrics of a short bag.
     """
     digest = _inputs_digest(metrics, source)
-    cached = _cache_folder() / f"monitors-{digest}.py" if _cache_folder() else None
+    folder = _cache_folder()
+    cached = folder / f"monitors-{digest}.py" if folder is not None else None
     text = _read_cached(cached)
     if text is None:
         text = monitor_source(metrics, source)

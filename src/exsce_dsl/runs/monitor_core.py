@@ -3,7 +3,8 @@
 This module imports nothing of exsce: ``exscec generate ros1-monitor`` and
 ``ros2-monitor`` copy it as it is into the node packages, so the offline
 monitors (bags) and the runtime ones (live topics) compute metrics with the
-same code.
+same code.  It runs on Python 3.8 and numpy 1.17 (ROS Noetic) as well: no
+``X | Y`` or ``list[...]`` outside annotations.
 
 A topic is its receive times and its decoded fields (dotted paths of the
 message definition: ``linear.x``, ``ranges``).  Expressions combine fields
@@ -17,12 +18,13 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import Any, Callable, Optional, Tuple, Union
 
 import numpy as np
 
-Number = float | int
+Number = Union[float, int]  # typing's spelling: this module also runs on ROS Noetic's Python 3.8
 
 
 @dataclass(frozen=True)
@@ -52,7 +54,11 @@ class Topic:
         return Topic(self.name, self.t[part], {k: v[part] for k, v in self.fields.items()})
 
 
-Operand = Signal | Number
+Operand = Union[Signal, float, int]
+
+
+# numpy 2 renamed trapz to trapezoid; the ROS distributions ship numpy 1
+_trapezoid: Any = getattr(np, "trapezoid", None) or getattr(np, "trapz", None)
 
 
 def window(t: np.ndarray, start: float, end: float) -> slice:
@@ -191,7 +197,7 @@ def prepare_blocks(
     )
 
 
-Compute = Callable[[Topic], tuple[Signal, "Signal | None"]]
+Compute = Callable[[Topic], Tuple[Signal, Optional[Signal]]]
 
 
 def reduced(func: str, topic: Topic, key: str, compute: Compute) -> Prepared:
@@ -242,7 +248,7 @@ def value_in(p: Prepared, start: float, end: float) -> float | None:
     if p.func == "integral":
         t = p.t[w]
         keep = ~np.isnan(v)
-        return float(np.trapezoid(v[keep], t[keep])) if keep.sum() > 1 else 0.0
+        return float(_trapezoid(v[keep], t[keep])) if keep.sum() > 1 else 0.0
     if p.func == "mean" and p.count is not None:
         n = int(p.count[w].sum())
         return float(p.v[w].sum() / n) if n else None
