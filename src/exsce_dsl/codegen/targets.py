@@ -43,7 +43,7 @@ TARGETS: dict[str, Target] = {
         ),
         Target(
             "dispatcher-config",
-            "the waypoint files the method's waypoint dispatcher reads, one per robot",
+            "the waypoint files the method's dispatcher reads: the mission, and each robot's task files",
             "exsce_dsl.codegen.dispatcher",
             "generate_dispatcher_config",
         ),
