@@ -36,6 +36,7 @@ def _register() -> None:
         oracle_commands,
         query_commands,
         run_commands,
+        similarity_commands,
         spec_commands,
         store_commands,
     )
@@ -47,6 +48,7 @@ def _register() -> None:
         *query_commands.COMMANDS,
         *oracle_commands.COMMANDS,
         *derive_commands.COMMANDS,
+        *similarity_commands.COMMANDS,
         *generate_commands.COMMANDS,
     ]:
         main.add_command(command)

@@ -61,6 +61,7 @@ __all__ = [
     "segment_metric_any",
     "run_metric_values",
     "run_segment_values",
+    "scenario_ids",
     "MetricReading",
     "standard_prefixes",
     "update_baseline",
@@ -437,6 +438,11 @@ class RobotFacts:
     type: str | None
     base: str | None
     torso: bool | None
+
+
+def scenario_ids(store: Store, namespace: str = DEFAULT_NAMESPACE) -> list[str]:
+    """The id of every scenario in the store, in order."""
+    return [_text(row["scenario"]) or "" for row in run_query(store, "scenarios", {}, namespace)]
 
 
 def robots(store: Store, scenario: str, namespace: str = DEFAULT_NAMESPACE) -> list[RobotFacts]:

@@ -1,0 +1,1 @@
+"""Scenario similarity: the method's distances d1–d6 and hierarchical clustering."""

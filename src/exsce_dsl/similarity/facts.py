@@ -1,0 +1,54 @@
+"""What the distances need of a scenario, read from the store with the query library."""
+
+from __future__ import annotations
+
+from exsce_dsl.model.metrics import METRICS, Combine
+from exsce_dsl.similarity.distances import ScenarioFacts, pose_id
+from exsce_dsl.store import queries
+from exsce_dsl.store.base import Store
+
+SAFETY_METRICS = ("max_velocity", "distance_to_obstacles", "distance_between_robots")
+def _combined(combine: Combine | None, means: list[float]) -> float:
+    """A scenario's value from its robots': as segments combine (waypoints visited: summed)."""
+    if combine is Combine.MAX:
+        return max(means)
+    if combine is Combine.MIN:
+        return min(means)
+    return sum(means)
+
+
+def scenario_facts(store: Store, scenario: str) -> ScenarioFacts:
+    """The robots, path segments and (if it has runs) metric means, violation time and hotspot
+    count of ``scenario``."""
+    robots = queries.robots(store, scenario)
+    segments = tuple((pose_id(s.start), pose_id(s.goal)) for s in queries.path_segments(store, scenario))
+    runs = [r.uuid for r in queries.runs(store, scenario)]
+    facts = ScenarioFacts(
+        scenario, tuple(r.base for r in robots), tuple(r.torso for r in robots), segments
+    )
+    if not runs:
+        return facts
+    metrics: dict[str, float] = {}
+    for name, info in METRICS.items():
+        if name == "violation_duration":
+            continue
+        if info.per_robot:
+            found = [queries.robot_metric_over_runs(store, name, r.robot, runs) for r in robots]
+            means = [a.mean for a in found if a is not None]
+            if means:
+                metrics[name] = _combined(info.combine, means)
+        else:
+            aggregate = queries.mission_metric_over_runs(store, name, runs)
+            if aggregate is not None:
+                metrics[name] = aggregate.mean
+    if "waypoints_visited" in metrics and segments:
+        metrics["waypoints_visited"] = 100.0 * metrics["waypoints_visited"] / len(segments)  # a percentage
+    violation = sum(
+        a.mean for m in SAFETY_METRICS for a in queries.violation_duration(store, scenario, m).values()
+    )
+    per_run: dict[str, int] = dict.fromkeys(runs, 0)
+    for m in SAFETY_METRICS:
+        for run, count in queries.hotspot_counts(store, scenario, m).items():
+            per_run[run] = per_run.get(run, 0) + count
+    hotspots = sum(per_run.values()) / len(per_run)
+    return ScenarioFacts(facts.id, facts.bases, facts.torsos, segments, metrics, violation, hotspots)
