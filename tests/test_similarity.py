@@ -132,3 +132,22 @@ def test_cli_cluster_prints_the_table_and_the_json(project):
     assert unknown.returncode == 1 and "not in the store: nope" in unknown.stderr and "Traceback" not in unknown.stderr
     bad = run_exscec("cluster", "-w", "d9=1", cwd=project)
     assert bad.returncode == 2 and "write NAME=W" in bad.stderr
+
+
+def test_facts_of_a_scenario_with_runs_have_metric_means_violations_and_hotspots(tmp_path):
+    from exsce_dsl.runs.ingest import ingest_bags
+    from exsce_dsl.sim.executor import Fault
+    from exsce_dsl.sim.run import simulate
+
+    scenario = load_spec(EXAMPLES / "brsu_building_c" / "scenario_c.exsce").scenario()
+    bags = [run.bag for run in simulate(scenario, tmp_path / "runs", runs=1, seed=2)]
+    bags += [run.bag for run in simulate(scenario, tmp_path / "fast", runs=1, seed=2,
+                                         faults=(Fault.parse("overspeed:tiago1"),))]
+    with EmbeddedStore(tmp_path / "store") as store:
+        assert not any(r.failed for r in ingest_bags(bags, scenario, store))
+        found = scenario_facts(store, "scenario_c")
+    assert found.metrics["waypoints_visited"] == pytest.approx(100.0)  # every planned waypoint reached
+    assert set(found.metrics) >= {"mission_duration", "task_duration", "distance_travelled", "max_velocity"}
+    # the larger of the robots' means over the two runs: tiago1's, ~0.6 m/s clean and ~1.3 m/s too fast
+    assert 0.9 < found.metrics["max_velocity"] < 1.3
+    assert found.violation > 0 and found.hotspots > 0  # the over-speed run's violations, over two runs
