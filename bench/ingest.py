@@ -142,21 +142,8 @@ def way_e(bag: Path, spec: Path) -> dict[str, float]:
     import reference_metrics as reference
 
     from exsce_dsl.lang.build import load_spec
-    from exsce_dsl.runs.analyse import run_metrics, wanted_topics
-    from exsce_dsl.runs.bagdata import read_bag
-    from exsce_dsl.runs.segments import SUCCEEDED, segments
 
-    scenario = load_spec(spec).scenario()
-    robots = list(scenario.robots)
-    data = read_bag(bag, wanted_topics(run_metrics(scenario), robots))
-    actions, results = [], {}
-    for robot in robots:
-        topics = reference.robot_topics(robot.namespace)
-        actions += segments(scenario, robot.id, data.feedback[topics["feedback"]])
-        final = data.results.get(topics["result"])
-        results[robot.id] = None if final is None else sum(s == SUCCEEDED for u in final for s in u.statuses)
-    signals = [reference.RobotSignals.from_bag(r.id, r.namespace, data) for r in robots]
-    values, _ = reference.compute_metrics(signals, actions, results, reference.SafetyLimits(), [])
+    values, _ = reference.metrics_of_bag(bag, load_spec(spec).scenario())
     return {"values": len(values)}
 
 

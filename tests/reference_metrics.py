@@ -338,3 +338,23 @@ def _between_robots(
             safety_metric="distance_between_robots",
         ),
     ]
+
+
+def metrics_of_bag(path, scenario) -> tuple[list[MetricValue], list[Hotspot]]:  # type: ignore[no-untyped-def]
+    """The hand-written path's values and hotspots for a bag of ``scenario``: the bag read with
+    every field kept, the dispatcher's statuses segmented, then :func:`compute_metrics`."""
+    from exsce_dsl.runs.analyse import run_metrics, wanted_topics
+    from exsce_dsl.runs.bagdata import read_bag
+    from exsce_dsl.runs.segments import SUCCEEDED, segments
+
+    robots = [r for r in scenario.robots if r.start_pose is not None]
+    data = read_bag(path, wanted_topics(run_metrics(scenario), robots))
+    actions: list[Segment] = []
+    results: dict[str, int | None] = {}
+    for robot in robots:
+        topics = robot_topics(robot.namespace)
+        actions += segments(scenario, robot.id, data.feedback[topics["feedback"]])
+        final = data.results.get(topics["result"])
+        results[robot.id] = None if final is None else sum(s == SUCCEEDED for u in final for s in u.statuses)
+    signals = [RobotSignals.from_bag(r.id, r.namespace, data) for r in robots]
+    return compute_metrics(signals, actions, results, SafetyLimits(), [])

@@ -15,9 +15,7 @@ import reference_metrics as reference
 
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.model.metrics import METRICS
-from exsce_dsl.runs.analyse import analyse_bag, run_metrics, wanted_topics
-from exsce_dsl.runs.bagdata import read_bag
-from exsce_dsl.runs.segments import SUCCEEDED, segments
+from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
 
@@ -32,17 +30,7 @@ def scenario_c():
 
 
 def _reference(path, scenario):
-    """The hand-written path's values and hotspots for a bag (its own reading of the dispatcher)."""
-    robots = [r for r in scenario.robots if r.start_pose is not None]
-    data = read_bag(path, wanted_topics(run_metrics(scenario), robots))
-    actions, results, problems = [], {}, []
-    for robot in robots:
-        topics = reference.robot_topics(robot.namespace)
-        actions += segments(scenario, robot.id, data.feedback[topics["feedback"]])
-        final = data.results.get(topics["result"])
-        results[robot.id] = None if final is None else sum(s == SUCCEEDED for u in final for s in u.statuses)
-    signals = [reference.RobotSignals.from_bag(r.id, r.namespace, data) for r in robots]
-    return reference.compute_metrics(signals, actions, results, reference.SafetyLimits(), problems)
+    return reference.metrics_of_bag(path, scenario)
 
 
 def _keyed(values):

@@ -12,7 +12,7 @@ from types import ModuleType
 from exsce_dsl.lang.standard_metrics import standard_metrics
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.messages import DISPATCHER, POSE
-from exsce_dsl.model.metrics import MetricDefinition, Subject
+from exsce_dsl.model.metrics import MetricDefinition
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Bag, Run, TaskExecution
 from exsce_dsl.runs.bagdata import BagError, Reduce, read_bag
@@ -62,8 +62,6 @@ def wanted_topics(metrics: tuple[MetricDefinition, ...], robots: list[Robot]) ->
         for pattern, msgtype in [(_FEEDBACK, "*"), (_RESULT, "*"), (POSE_TOPIC, POSE)]:
             wanted[pattern.replace("{ns}", ns)] = msgtype
         for metric in metrics:
-            if metric.subject is Subject.MISSION and not metric.reads:
-                continue
             for read in metric.reads:
                 msgtype = "*" if read.msgtype in DISPATCHER else read.msgtype
                 wanted.setdefault(read.topic_of(ns), msgtype)

@@ -16,7 +16,6 @@ from __future__ import annotations
 import functools
 import hashlib
 import os
-import sys
 import types
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -26,7 +25,6 @@ from exsce_dsl.lang.format_metrics import expression_text
 from exsce_dsl.model.expressions import Aggregate, Expression, Field, WindowValue, walk
 from exsce_dsl.model.messages import FEEDBACK, RESULT, Leaf, field_of
 from exsce_dsl.model.metrics import Combine, MetricDefinition, Subject
-from exsce_dsl.runs import monitor_core
 
 GENERATOR = "exscec generate monitors"
 TEMPLATE = "monitors/monitors.py.j2"
@@ -159,7 +157,6 @@ def _load(source_text: str) -> types.ModuleType:
     digest = hashlib.sha256(source_text.encode()).hexdigest()[:16]
     module = types.ModuleType(f"exsce_monitors_{digest}")
     module.__dict__["__file__"] = f"<exsce monitors {digest}>"
-    sys.modules.setdefault("exsce_dsl.runs.monitor_core", monitor_core)
     exec(compile(source_text, module.__dict__["__file__"], "exec"), module.__dict__)  # noqa: S102
     return module
 

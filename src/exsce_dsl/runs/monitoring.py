@@ -93,20 +93,22 @@ def _missing(metric: MetricDefinition, robot: Robot, topics: Mapping[str, core.T
 def _robot_values(
     monitor: Any, metric: MetricDefinition, robot: Robot, windows: list[Window], problems: list[str]
 ) -> list[MetricValue]:
-    found: list[MetricValue] = []
+    prepared = monitor.prepared(metric.name)
+    if prepared is None:
+        problems.append(_missing(metric, robot, monitor.topics))
+        return []
     getter = getattr(monitor, f"get_{metric.name}")
     unit = metric.unit or None  # a count has no unit
+    topics = _topics(metric, prepared[0], [robot.namespace])  # one alternative for the whole run
+    found: list[MetricValue] = []
     for action, start, end in windows if metric.per_segment else windows[:1]:
         value = getter(start, end)
-        prepared = monitor.prepared(metric.name)
-        if value is None or prepared is None:
+        if value is None:
             if action is None:
                 problems.append(_missing(metric, robot, monitor.topics))
             continue
-        topics = _topics(metric, prepared[0], [robot.namespace])
         if action is None:
-            scope = MetricScope.ROBOT
-            found.append(MetricValue(metric.name, scope, value, topics, robot.id, unit=unit))
+            found.append(MetricValue(metric.name, MetricScope.ROBOT, value, topics, robot.id, unit=unit))
         else:
             aid = ActionId(robot.id, action.allocation, action.subtask, action.waypoint)
             found.append(MetricValue(metric.name, MetricScope.SEGMENT, value, topics, None, aid, unit))
@@ -189,7 +191,6 @@ def _mission_values(
         return []
     source: list[str] = []
     violation = 0.0
-    by_ns = {r.namespace.strip("/"): r for r in robots}
     for first, second in monitor.pairs():
         prepared = monitor.prepared(metric.name, first, second)
         if prepared is None:
@@ -200,7 +201,7 @@ def _mission_values(
             continue
         t, held, over = _violations(aggregates[0], metric, start, end)
         violation += float(held[over].sum())
-        poses = [_pose(topics, by_ns[ns].namespace) for _, ns in (first, second)]
+        poses = [_pose(topics, ns) for _, ns in (first, second)]
         if over.any() and poses[0] is not None and poses[1] is not None:
             middle = (_position_at(poses[0], t[over]) + _position_at(poses[1], t[over])) / 2
             hotspots.extend(

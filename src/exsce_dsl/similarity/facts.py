@@ -23,11 +23,9 @@ def scenario_facts(store: Store, scenario: str) -> ScenarioFacts:
     robots = queries.robots(store, scenario)
     segments = tuple((pose_id(s.start), pose_id(s.goal)) for s in queries.path_segments(store, scenario))
     runs = [r.uuid for r in queries.runs(store, scenario)]
-    facts = ScenarioFacts(
-        scenario, tuple(r.base for r in robots), tuple(r.torso for r in robots), segments
-    )
+    bases, torsos = tuple(r.base for r in robots), tuple(r.torso for r in robots)
     if not runs:
-        return facts
+        return ScenarioFacts(scenario, bases, torsos, segments)
     metrics: dict[str, float] = {}
     for name, info in METRICS.items():
         if name == "violation_duration":
@@ -51,4 +49,4 @@ def scenario_facts(store: Store, scenario: str) -> ScenarioFacts:
         for run, count in queries.hotspot_counts(store, scenario, m).items():
             per_run[run] = per_run.get(run, 0) + count
     hotspots = sum(per_run.values()) / len(per_run)
-    return ScenarioFacts(facts.id, facts.bases, facts.torsos, segments, metrics, violation, hotspots)
+    return ScenarioFacts(scenario, bases, torsos, segments, metrics, violation, hotspots)
