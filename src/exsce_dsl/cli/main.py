@@ -35,6 +35,7 @@ def _register() -> None:
         generate_commands,
         oracle_commands,
         query_commands,
+        report_commands,
         run_commands,
         similarity_commands,
         spec_commands,
@@ -49,6 +50,7 @@ def _register() -> None:
         *oracle_commands.COMMANDS,
         *derive_commands.COMMANDS,
         *similarity_commands.COMMANDS,
+        *report_commands.COMMANDS,
         *generate_commands.COMMANDS,
     ]:
         main.add_command(command)

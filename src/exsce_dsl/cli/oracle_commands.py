@@ -111,8 +111,9 @@ def verify(
     from exsce_dsl.store.writing import add_prov
 
     scenario = load_spec(spec).scenario(scenario_id)
-    bags = [Path(r) for r in runs if Path(r).is_file()]
-    uuids = [r for r in runs if not Path(r).is_file()]
+    # bags are files (ROS 1, MCAP) or folders (ROS 2); the recorder's .prov.json files beside them are not
+    bags = [Path(r) for r in runs if Path(r).exists() and not r.endswith(".prov.json")]
+    uuids = [r for r in runs if not Path(r).exists()]
     with open_store(store_url) as store:
         if bags:
             for result in ingest_bags(bags, scenario, store, 1, None):

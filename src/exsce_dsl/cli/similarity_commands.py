@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import click
 
@@ -38,6 +39,13 @@ def _weight(text: str) -> tuple[str, float]:
 @click.option("--threshold", type=click.FloatRange(0), help="Cut at this combined distance.")
 @click.option("--weight", "-w", "weights", multiple=True, metavar="NAME=W", help="Weight of d1…d6, metrics.")
 @click.option("--json", "as_json", is_flag=True, help="The matrix, each pair's distances, the clusters.")
+@click.option(
+    "--dendrogram",
+    "images",
+    multiple=True,
+    type=click.Path(dir_okay=False),
+    help="Draw the tree into this .png or .svg file (repeatable).",
+)
 @store_option
 @reports_errors
 def cluster(
@@ -47,6 +55,7 @@ def cluster(
     threshold: float | None,
     weights: tuple[str, ...],
     as_json: bool,
+    images: tuple[str, ...],
     store_url: str | None,
 ) -> None:
     """Cluster stored scenarios by the method's distances.
@@ -60,7 +69,7 @@ def cluster(
 
     \b
     Example:
-      exscec cluster --k 3
+      exscec cluster --k 3 --dendrogram clusters.svg
       exscec cluster -s scenario_c -s scenario_c_alone -s scenario_d -w d4=2 --json
     """
     from exsce_dsl.errors import ExsceError
@@ -71,6 +80,11 @@ def cluster(
 
     if k is not None and threshold is not None:
         raise click.UsageError("give --k or --threshold, not both")
+    for image in images:
+        if Path(image).suffix.lower() not in (".png", ".svg"):
+            raise click.BadParameter(
+                f"'{image}': write the dendrogram to a .png or .svg file", param_hint="--dendrogram"
+            )
     weighting = dict(_weight(w) for w in weights)
     with open_store(store_url) as store:
         stored = scenario_ids(store)
@@ -81,6 +95,12 @@ def cluster(
             raise ExsceError(f"not in the store: {', '.join(unknown)} (stored: {known})")
         facts = [scenario_facts(store, s) for s in chosen]
     result = run_clustering(facts, method, k, threshold, weighting)
+    if images:
+        from exsce_dsl.similarity.dendrogram import save_dendrogram
+
+        for image in images:
+            save_dendrogram(result, Path(image))
+            click.echo(f"wrote {image}", err=True)
     if as_json:
         click.echo(
             json.dumps(

@@ -110,7 +110,7 @@ def analyse_bag(path: Path, scenario: Scenario) -> AnalysedRun:
         scenario=scenario.id,
         start=_time(data.start),
         end=_time(data.end),
-        bag=Bag(path.name, data.topics, str(path)),
+        bag=Bag(path.name, data.topics, str(path.resolve())),
         tasks=_task_executions(actions),
         metrics=tuple(values),
         hotspots=tuple(hotspots),

@@ -64,7 +64,7 @@ class BagData:
     problems: list[str] = field(default_factory=list)
 
 
-def _typestore_for(path: Path):  # type: ignore[no-untyped-def]
+def typestore_for(path: Path):  # type: ignore[no-untyped-def]
     ros2 = path.is_dir() or path.suffix in (".db3", ".mcap")
     return get_typestore(Stores.ROS2_HUMBLE if ros2 else Stores.ROS1_NOETIC)
 
@@ -91,7 +91,7 @@ def read_bag(path: Path, wanted: Mapping[str, str], reduce: Mapping[str, Reduce]
         except DecodeError as exc:
             raise BagError(f"{path}: {exc.message}") from None
     try:
-        with AnyReader([path], default_typestore=_typestore_for(path)) as reader:
+        with AnyReader([path], default_typestore=typestore_for(path)) as reader:
             return _read(reader, path, wanted, reduce)
     except BagError:
         raise

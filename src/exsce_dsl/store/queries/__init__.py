@@ -153,6 +153,8 @@ class StoredRun:
     end: datetime.datetime | None
     bag: str | None
     """The bag file's name."""
+    path: str | None = None
+    """Where the bag file was when it was ingested."""
 
 
 def runs(store: Store, scenario: str | None = None, namespace: str = DEFAULT_NAMESPACE) -> list[StoredRun]:
@@ -167,6 +169,7 @@ def runs(store: Store, scenario: str | None = None, namespace: str = DEFAULT_NAM
                 start=_datetime(row["start"]),
                 end=_datetime(row["end"]),
                 bag=_text(row["bag"]) or None,
+                path=_text(row["path"]),
             )
         )
     return found

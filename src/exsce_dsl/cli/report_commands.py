@@ -1,0 +1,53 @@
+"""``exscec report``: a static HTML report of the store."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import click
+
+from exsce_dsl.cli.common import reports_errors
+from exsce_dsl.cli.store_commands import store_option
+
+
+@click.command()
+@click.option(
+    "--output", "-o", default="report", show_default=True, type=click.Path(file_okay=False),
+    help="The folder to write the report into.",
+)
+@click.option(
+    "--spec", "specs", multiple=True, type=click.Path(dir_okay=False, exists=True),
+    help="A scenario file whose map to draw paths on (repeatable; derived scenarios use their base's).",
+)
+@store_option
+@reports_errors
+def report(output: str, specs: tuple[str, ...], store_url: str | None) -> None:
+    """Write an HTML report of the store that opens in any browser, offline.
+
+    The overview has every scenario's lineage tree, the runs per scenario, the
+    verdicts of all runs (failures first) and the similarity dendrogram; each
+    scenario has a page with its runs, its metric values against the bands
+    its oracles accept, and its oracles; each run a page with the paths its
+    robots drove (read from its bag) over the occupancy grid, the planned
+    waypoints and the hotspots where a safety limit was broken.
+
+    \b
+    Example:
+      exscec report -o report --spec examples/brsu_building_c/scenario_c.exsce
+    """
+    from exsce_dsl.report.contents import gather
+    from exsce_dsl.report.html import write_report
+    from exsce_dsl.store.open import open_store
+
+    with open_store(store_url) as store:
+        contents = gather(store, [Path(s) for s in specs])
+    runs = sum(len(s.runs) for s in contents.scenarios)
+    with click.progressbar(length=runs, label="drawing runs", file=sys.stderr) as bar:
+        index = write_report(contents, Path(output), bar.update)
+    for note in contents.notes:
+        click.echo(f"note: {note}", err=True)
+    click.echo(f"wrote {index} ({len(contents.scenarios)} scenarios, {runs} runs)", err=True)
+
+
+COMMANDS = [report]

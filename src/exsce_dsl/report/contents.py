@@ -1,0 +1,185 @@
+"""What the report shows, gathered from the store (and the maps of the specs given).
+
+Everything here comes from the query library, so a report of a remote store is
+the same as one of the embedded store.  Occupancy grids are not in the store
+(it only names the map's ROS package), so they come from the specifications
+the user passes: a scenario's map is its own spec's, or that of the scenario it
+was derived from.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from exsce_dsl.errors import ExsceError
+from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang.occupancy import OccupancyGrid, load_occupancy_grid
+from exsce_dsl.model.derivation import Derivation
+from exsce_dsl.model.oracles import Oracle
+from exsce_dsl.model.runs import Hotspot
+from exsce_dsl.model.verdicts import Outcome, Verdict
+from exsce_dsl.similarity.clustering import Clustering, cluster
+from exsce_dsl.similarity.facts import scenario_facts
+from exsce_dsl.store import queries
+from exsce_dsl.store.base import Store
+from exsce_dsl.store.queries import MetricReading, StoredRun
+from exsce_dsl.store.queries.results import hotspots, pose_positions, verdicts
+
+
+@dataclass(frozen=True)
+class RunContents:
+    run: StoredRun
+    verdicts: tuple[Verdict, ...]
+    hotspots: tuple[Hotspot, ...]
+
+    @property
+    def failed(self) -> int:
+        return sum(v.outcome is Outcome.FAILED for v in self.verdicts)
+
+    @property
+    def unjudged(self) -> int:
+        return sum(v.outcome is Outcome.UNJUDGED for v in self.verdicts)
+
+    @property
+    def passed(self) -> int:
+        return sum(v.outcome is Outcome.PASSED for v in self.verdicts)
+
+    @property
+    def status(self) -> str:
+        """failed, unjudged, passed, or 'not verified'."""
+        if not self.verdicts:
+            return "not verified"
+        return "failed" if self.failed else "unjudged" if self.unjudged else "passed"
+
+
+@dataclass(frozen=True)
+class ScenarioContents:
+    id: str
+    derivation: Derivation | None
+    """How it was derived (None: written by hand)."""
+    children: tuple[str, ...]
+    runs: tuple[RunContents, ...]
+    oracles: tuple[Oracle, ...]
+    values: tuple[MetricReading, ...]
+    """Whole-run metric values of its runs."""
+    waypoints: Mapping[str, tuple[tuple[str, float, float], ...]]
+    """Robot → its planned path: (pose name, x, y) from its start pose on."""
+    grid: OccupancyGrid | None = None
+
+    @property
+    def verdicts(self) -> tuple[Verdict, ...]:
+        return tuple(v for r in self.runs for v in r.verdicts)
+
+
+@dataclass(frozen=True)
+class ReportContents:
+    scenarios: tuple[ScenarioContents, ...]
+    verdicts: tuple[Verdict, ...]
+    """Every run's last verdicts, failed first."""
+    clustering: Clustering | None
+    """Of all scenarios (None with fewer than two)."""
+    notes: tuple[str, ...] = field(default=())
+    """What could not be shown, and why."""
+
+    def scenario(self, scenario_id: str) -> ScenarioContents:
+        return next(s for s in self.scenarios if s.id == scenario_id)
+
+    def roots(self) -> tuple[str, ...]:
+        """Scenarios written by hand, or whose base is not in the store: the lineage trees' roots."""
+        known = {s.id for s in self.scenarios}
+        return tuple(
+            s.id for s in self.scenarios if s.derivation is None or s.derivation.base not in known
+        )
+
+
+def gather(store: Store, specs: Sequence[Path] = ()) -> ReportContents:
+    """Read everything the report shows from ``store``; ``specs`` give occupancy grids."""
+    grids, notes = _grids(specs)
+    ids = queries.scenario_ids(store)
+    all_verdicts = verdicts(store)
+    derivations = {s: queries.derivation_of(store, s) for s in ids}
+    children: dict[str, list[str]] = {}
+    for scenario_id, derivation in derivations.items():
+        if derivation is not None:
+            children.setdefault(derivation.base, []).append(scenario_id)
+    scenarios = []
+    for scenario_id in ids:
+        runs = queries.runs(store, scenario_id)
+        uuids = [r.uuid for r in runs]
+        spots: dict[str, list[Hotspot]] = {}
+        for found in hotspots(store, uuids):
+            spots.setdefault(found.run, []).append(found.hotspot)
+        judged: dict[str, list[Verdict]] = {}
+        for verdict in all_verdicts:
+            if verdict.scenario == scenario_id:
+                judged.setdefault(verdict.run, []).append(verdict)
+        scenarios.append(
+            ScenarioContents(
+                id=scenario_id,
+                derivation=derivations[scenario_id],
+                children=tuple(sorted(children.get(scenario_id, ()))),
+                runs=tuple(
+                    RunContents(r, tuple(judged.get(r.uuid, ())), tuple(spots.get(r.uuid, ()))) for r in runs
+                ),
+                oracles=tuple(queries.oracles(store, scenario_id)),
+                values=tuple(queries.run_metric_values(store, uuids)),
+                waypoints=_waypoints(store, scenario_id),
+                grid=_grid_of(scenario_id, derivations, grids),
+            )
+        )
+    clustering = None
+    if len(ids) >= 2:
+        clustering = cluster([scenario_facts(store, s) for s in ids])
+    if not specs and any(s.waypoints for s in scenarios):
+        notes.append("no occupancy grid: pass the scenarios' .exsce files with --spec to draw paths on a map")
+    return ReportContents(tuple(scenarios), tuple(all_verdicts), clustering, tuple(notes))
+
+
+def _waypoints(store: Store, scenario_id: str) -> dict[str, tuple[tuple[str, float, float], ...]]:
+    segments = queries.path_segments(store, scenario_id)
+    where = pose_positions(store, [p for s in segments for p in (s.start, s.goal)])
+    paths: dict[str, list[str]] = {}
+    for segment in segments:
+        path = paths.setdefault(segment.robot, [segment.start])
+        path.append(segment.goal)
+    return {
+        robot: tuple((pose, *where[pose]) for pose in path if pose in where) for robot, path in paths.items()
+    }
+
+
+def _grids(specs: Sequence[Path]) -> tuple[dict[str, OccupancyGrid], list[str]]:
+    """Scenario id → the occupancy grid of its environment, for every scenario of ``specs``."""
+    grids: dict[str, OccupancyGrid] = {}
+    loaded: dict[str, OccupancyGrid] = {}
+    notes: list[str] = []
+    for spec in specs:
+        for scenario in load_spec(spec).scenarios:
+            map_model = scenario.environment.map
+            if map_model is None or map_model.file is None:
+                notes.append(f"scenario '{scenario.id}' names no map file: its paths are drawn without one")
+                continue
+            if map_model.file not in loaded:
+                try:
+                    loaded[map_model.file] = load_occupancy_grid(Path(map_model.file))
+                except ExsceError as exc:
+                    notes.append(f"scenario '{scenario.id}': {exc.message}")
+                    continue
+            grids[scenario.id] = loaded[map_model.file]
+    return grids, notes
+
+
+def _grid_of(
+    scenario_id: str, derivations: Mapping[str, Derivation | None], grids: Mapping[str, OccupancyGrid]
+) -> OccupancyGrid | None:
+    """The grid of the scenario, or of the nearest scenario it was derived from that has one."""
+    seen: set[str] = set()
+    current: str | None = scenario_id
+    while current is not None and current not in seen:
+        if current in grids:
+            return grids[current]
+        seen.add(current)
+        derivation = derivations.get(current)
+        current = derivation.base if derivation is not None else None
+    return None

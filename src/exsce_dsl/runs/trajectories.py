@@ -1,0 +1,56 @@
+"""The paths robots drove in a run, read from the pose topics of its bag (for plots)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from rosbags.highlevel import AnyReader
+
+from exsce_dsl.runs.bagdata import BagError, read_bag, typestore_for
+
+POSITION_FIELDS = {
+    "geometry_msgs/msg/PoseWithCovarianceStamped": "pose.pose.position",
+    "geometry_msgs/msg/PoseStamped": "pose.position",
+    "nav_msgs/msg/Odometry": "pose.pose.position",
+}
+"""Message types that say where a robot is, and the path of the position in each."""
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    topic: str
+    t: np.ndarray
+    """Seconds since the start of the bag."""
+    xy: np.ndarray
+    """Positions, shape (n, 2), in the map frame."""
+
+
+def pose_topics(path: Path) -> dict[str, str]:
+    """Topic → message type of the bag's topics that carry a robot's pose."""
+    if not path.exists():
+        raise BagError(f"{path}: no such bag")
+    try:
+        with AnyReader([path], default_typestore=typestore_for(path)) as reader:
+            return {c.topic: c.msgtype for c in reader.connections if c.msgtype in POSITION_FIELDS}
+    except Exception as exc:  # rosbags' readers raise their own errors for corrupt files
+        raise BagError(f"{path}: cannot read the bag: {type(exc).__name__}: {exc}") from None
+
+
+def trajectories(path: Path, max_points: int = 2000) -> list[Trajectory]:
+    """Each pose topic's path, thinned to at most ``max_points`` positions (first and last kept)."""
+    wanted = pose_topics(path)
+    if not wanted:
+        return []
+    data = read_bag(path, wanted)
+    found = []
+    for topic, msgtype in sorted(wanted.items()):
+        series = data.series.get(topic)
+        if series is None or len(series) == 0:
+            continue
+        prefix = POSITION_FIELDS[msgtype]
+        xy = np.column_stack([series.fields[f"{prefix}.x"], series.fields[f"{prefix}.y"]]).astype(float)
+        keep = np.unique(np.linspace(0, len(xy) - 1, min(len(xy), max_points)).round().astype(int))
+        found.append(Trajectory(topic, series.t[keep] - data.start, xy[keep]))
+    return found
