@@ -151,3 +151,28 @@ def test_facts_of_a_scenario_with_runs_have_metric_means_violations_and_hotspots
     # the larger of the robots' means over the two runs: tiago1's, ~0.6 m/s clean and ~1.3 m/s too fast
     assert 0.9 < found.metrics["max_velocity"] < 1.3
     assert found.violation > 0 and found.hotspots > 0  # the over-speed run's violations, over two runs
+
+
+def test_d5_and_d6_count_the_users_safety_metrics_too(tmp_path):
+    from exsce_dsl.runs.ingest import ingest_bags
+    from exsce_dsl.sim.run import simulate
+    from exsce_dsl.store import queries
+
+    (tmp_path / "safety.exsce").write_text(
+        f'import "{EXAMPLES / "brsu_building_c" / "scenario_c.exsce"}"\n\n'
+        "metric turn_rate for each robot {\n  unit rad/s\n  safe below 0.3 rad/s\n"
+        '  reads vel: geometry_msgs/msg/Twist on "/{ns}/nav_vel"\n  value max(abs(vel.angular.z))\n}\n'
+    )
+    scenario = load_spec(tmp_path / "safety.exsce").scenario("scenario_c")
+    bags = [run.bag for run in simulate(scenario, tmp_path / "runs", runs=1, seed=2)]
+    with EmbeddedStore(tmp_path / "store") as store:
+        assert not any(r.failed for r in ingest_bags(bags, scenario, store))
+        assert "turn_rate" in queries.safety_metrics(store, "scenario_c")
+        turning = queries.violation_duration(store, "scenario_c", "turn_rate")
+        spots = sum(queries.hotspot_counts(store, "scenario_c", "turn_rate").values())
+        found = scenario_facts(store, "scenario_c")
+    assert turning and all(a.mean > 1.0 for a in turning.values())  # both robots turn faster than 0.3 rad/s
+    assert spots > 0
+    # the clean run breaks none of the built-in limits: d5 and d6 see only the user's metric
+    assert found.violation == pytest.approx(sum(a.mean for a in turning.values()))
+    assert found.hotspots == spots

@@ -7,7 +7,7 @@ from exsce_dsl.similarity.distances import ScenarioFacts, pose_id
 from exsce_dsl.store import queries
 from exsce_dsl.store.base import Store
 
-SAFETY_METRICS = ("max_velocity", "distance_to_obstacles", "distance_between_robots")
+
 def _combined(combine: Combine | None, means: list[float]) -> float:
     """A scenario's value from its robots': as segments combine (waypoints visited: summed)."""
     if combine is Combine.MAX:
@@ -41,11 +41,10 @@ def scenario_facts(store: Store, scenario: str) -> ScenarioFacts:
                 metrics[name] = aggregate.mean
     if "waypoints_visited" in metrics and segments:
         metrics["waypoints_visited"] = 100.0 * metrics["waypoints_visited"] / len(segments)  # a percentage
-    violation = sum(
-        a.mean for m in SAFETY_METRICS for a in queries.violation_duration(store, scenario, m).values()
-    )
+    safety = queries.safety_metrics(store, scenario)  # the built-ins' and the user's with a safety limit
+    violation = sum(a.mean for m in safety for a in queries.violation_duration(store, scenario, m).values())
     per_run: dict[str, int] = dict.fromkeys(runs, 0)
-    for m in SAFETY_METRICS:
+    for m in safety:
         for run, count in queries.hotspot_counts(store, scenario, m).items():
             per_run[run] = per_run.get(run, 0) + count
     hotspots = sum(per_run.values()) / len(per_run)

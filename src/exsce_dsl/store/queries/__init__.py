@@ -61,6 +61,7 @@ __all__ = [
     "segment_metric_any",
     "run_metric_values",
     "run_segment_values",
+    "safety_metrics",
     "scenario_ids",
     "MetricReading",
     "standard_prefixes",
@@ -354,6 +355,12 @@ def violation_duration(
         if aggregate is not None:
             found[_text(row["robot"])] = aggregate
     return found
+
+
+def safety_metrics(store: Store, scenario: str, namespace: str = DEFAULT_NAMESPACE) -> list[str]:
+    """The metrics with a safety limit whose violation time the runs of ``scenario`` recorded."""
+    rows = run_query(store, "safety_metrics", {"scenario": scenario}, namespace)
+    return [_text(row["metric"]) or "" for row in rows]
 
 
 def hotspot_counts(
