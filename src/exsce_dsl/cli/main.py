@@ -31,6 +31,7 @@ def main(debug: bool) -> None:
 
 def _register() -> None:
     from exsce_dsl.cli import (
+        demo_commands,
         derive_commands,
         generate_commands,
         oracle_commands,
@@ -52,6 +53,7 @@ def _register() -> None:
         *similarity_commands.COMMANDS,
         *report_commands.COMMANDS,
         *generate_commands.COMMANDS,
+        *demo_commands.COMMANDS,
     ]:
         main.add_command(command)
 
