@@ -22,9 +22,17 @@ class State:
     debug = False
 
 
+SHOWN_DIAGNOSTICS = 100
+"""At most this many problems are printed: a file with thousands of errors is fixed from the top."""
+
+
 def print_diagnostics(diagnostics: Iterable[Diagnostic]) -> None:
-    for d in diagnostics:
+    found = list(diagnostics)
+    for d in found[:SHOWN_DIAGNOSTICS]:
         click.echo(str(d), err=True)
+    if len(found) > SHOWN_DIAGNOSTICS:
+        hidden = len(found) - SHOWN_DIAGNOSTICS
+        click.echo(f"... and {hidden} more errors (the first {SHOWN_DIAGNOSTICS} are shown)", err=True)
 
 
 def reports_errors(func: F) -> F:

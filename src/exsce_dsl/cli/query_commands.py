@@ -213,13 +213,11 @@ def sparql_command(text: str, fmt: str, output: str | None, store_url: str | Non
     """
     from exsce_dsl.store.open import open_store
     from exsce_dsl.store.queries import standard_prefixes
+    from exsce_dsl.textfiles import read_text
 
     if text.startswith("@"):
         path = Path(text[1:])
-        try:
-            text = path.read_text(encoding="utf-8")
-        except OSError as exc:
-            raise ExsceError(f"cannot read the query from {path}: {exc.strerror or exc}") from None
+        text = read_text(path, "query file")
     declared = {m.group(1) or "" for m in _PREFIX_DECLARATION.finditer(text)}
     prologue = "".join(
         f"PREFIX {p}: <{iri}>\n" for p, iri in standard_prefixes().items() if p not in declared

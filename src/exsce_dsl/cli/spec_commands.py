@@ -136,11 +136,12 @@ def fmt(specs: tuple[str, ...], check_only: bool, show_diff: bool) -> None:
     from exsce_dsl.lang.formatter import format_spec_document
     from exsce_dsl.lang.lexical import comments
     from exsce_dsl.lang.loader import display_path
+    from exsce_dsl.textfiles import read_text
 
     changed = []
     for spec_path in specs:
         spec = load_spec(spec_path)
-        original = Path(spec_path).read_text(encoding="utf-8")
+        original = read_text(spec_path, "specification")
         path = display_path(spec_path)
         formatted = format_spec_document(spec, path, comments(original, path))
         if formatted == original:

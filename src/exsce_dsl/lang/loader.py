@@ -11,8 +11,9 @@ import os
 from collections.abc import Mapping
 from pathlib import Path
 
-from exsce_dsl.errors import Diagnostic, ExsceSyntaxError
+from exsce_dsl.errors import Diagnostic, ExsceError, ExsceSyntaxError
 from exsce_dsl.lang.parser import ParsedFile, parse_text
+from exsce_dsl.textfiles import read_text
 
 
 def display_path(path: str | Path) -> str:
@@ -48,10 +49,10 @@ def load_files(
         text = overlay.get(path)
         if text is None:
             try:
-                text = Path(path).read_text(encoding="utf-8")
-            except OSError as exc:
-                if not parsed:  # the root itself; imports are reported where they are written
-                    diagnostics.append(Diagnostic(f"cannot read {path}: {exc.strerror}"))
+                text = read_text(path, "specification")
+            except ExsceError as exc:
+                if not parsed or exc.location is not None:  # imports are reported where they are written
+                    diagnostics.extend(exc.diagnostics)
                 continue
         try:
             pf = parse_text(text, path)

@@ -62,6 +62,9 @@ def parse_text(text: str, path: str) -> ParsedFile:
         tree = _shared_metamodel().model_from_str(text, file_name=path)
     except TextXSyntaxError as exc:
         raise ExsceSyntaxError([_syntax_diagnostic(exc, text, path)]) from None
+    if isinstance(tree, str):  # textX's model of a text with nothing but whitespace and comments
+        where = SourceLocation(path, 1, 1, 1, 1)
+        raise ExsceSyntaxError([Diagnostic("the file declares nothing (it is empty or all comments)", where)])
     return ParsedFile(path, text, tree, lines)
 
 

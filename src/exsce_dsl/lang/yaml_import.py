@@ -18,7 +18,7 @@ from pathlib import Path
 
 import yaml
 
-from exsce_dsl.errors import ImportFormatError, SourceLocation
+from exsce_dsl.errors import ExsceError, ImportFormatError, SourceLocation
 from exsce_dsl.lang.names import KEYWORDS, is_valid_name
 from exsce_dsl.model import (
     Area,
@@ -40,6 +40,7 @@ from exsce_dsl.model import (
     Task,
     WorldModel,
 )
+from exsce_dsl.textfiles import read_text
 
 #: Hardware facts of the robot types the method used (PAL Robotics): base, torso.
 KNOWN_ROBOT_TYPES: Mapping[str, tuple[str, bool]] = {
@@ -196,9 +197,9 @@ class YamlFile:
     @classmethod
     def read(cls, path: Path) -> YamlFile:
         try:
-            text = path.read_text(encoding="utf-8")
-        except OSError as e:
-            raise ImportFormatError(f"cannot read {path}: {e.strerror or e}") from e
+            text = read_text(path, "YAML file")
+        except ExsceError as e:
+            raise ImportFormatError(e.message, e.location) from None
         try:
             data = yaml.safe_load(text)
             tree = yaml.compose(text, Loader=yaml.SafeLoader)
