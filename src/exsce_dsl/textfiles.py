@@ -15,7 +15,7 @@ def read_text(path: str | Path, what: str = "file") -> str:
     try:
         mode = path.stat().st_mode
     except OSError as exc:
-        raise ExsceError(f"cannot read {what} {path}: {exc.strerror or exc}") from None
+        raise ExsceError(f"cannot read {path}: {exc.strerror or exc}") from None
     if stat.S_ISDIR(mode):
         raise ExsceError(f"{path} is a folder, not a {what}")
     if not stat.S_ISREG(mode):
@@ -23,7 +23,7 @@ def read_text(path: str | Path, what: str = "file") -> str:
     try:
         data = path.read_bytes()
     except OSError as exc:
-        raise ExsceError(f"cannot read {what} {path}: {exc.strerror or exc}") from None
+        raise ExsceError(f"cannot read {path}: {exc.strerror or exc}") from None
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
