@@ -161,22 +161,27 @@ def test_a_folder_that_is_not_a_store_is_refused(tmp_path: Path) -> None:
 HOLD = """
 import sys, time
 from exsce_dsl.store.embedded import EmbeddedStore
+from pyoxigraph import NamedNode, Quad
+from exsce_dsl.store.base import GraphSet
 store = EmbeddedStore(sys.argv[1])
-store.oxigraph
+store.write(GraphSet({"http://example.org/held": [Quad(NamedNode("http://example.org/s"),
+    NamedNode("http://example.org/p"), NamedNode("http://example.org/o"), NamedNode("http://example.org/held"))]}))
 print("holding", flush=True)
 sys.stdin.read()
 """
 
 
-def test_a_store_held_by_another_process_is_a_clear_error(tmp_path: Path) -> None:
+def test_a_store_held_by_another_process_is_read_only_and_writing_is_a_clear_error(tmp_path: Path) -> None:
     path = tmp_path / "store"
     holder = subprocess.Popen(
         [sys.executable, "-c", HOLD, str(path)], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True
     )
     try:
         assert holder.stdout is not None and holder.stdout.readline().strip() == "holding"
-        with pytest.raises(StoreLockedError) as held:
-            open_store(str(path))
+        with open_store(str(path)) as reader:  # readers see what the holder committed
+            assert reader.graph_names() == {"http://example.org/held"}
+            with pytest.raises(StoreLockedError) as held:
+                reader.write(one_quad())
         message = str(held.value)
         assert f"the store at {path} is in use" in message
         assert "one process at a time" in message and "--store" in message
@@ -186,19 +191,22 @@ def test_a_store_held_by_another_process_is_a_clear_error(tmp_path: Path) -> Non
         serve_info_path(path).write_text(
             json.dumps({"url": "http://127.0.0.1:9", "pid": 2**22 + 7, "store": str(path), "updates": False})
         )
-        with pytest.raises(StoreLockedError):
-            open_store(str(path))
+        with pytest.raises(StoreLockedError), open_store(str(path)) as store:
+            store.write(one_quad())
     finally:
         holder.communicate("", timeout=10)
     with open_store(str(path)) as store:  # released when the other process ends
         store.write(one_quad())
 
 
-def test_one_process_cannot_open_a_folder_twice(tmp_path: Path) -> None:
+def test_one_process_cannot_open_a_folder_twice_for_writing(tmp_path: Path) -> None:
     first = EmbeddedStore(tmp_path / "store")
     first.write(one_quad())
+    second = EmbeddedStore(tmp_path / "store")
+    assert second.graph_names() == {G}  # a read-only view
     with pytest.raises(StoreLockedError, match="this process has it open already"):
-        EmbeddedStore(tmp_path / "store")
+        second.write(one_quad())
+    second.close()
     first.close()
     with EmbeddedStore(tmp_path / "store") as again:
         assert again.graph_names() == {G}

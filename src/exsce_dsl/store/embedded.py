@@ -7,10 +7,14 @@ replaces graphs is one SPARQL Update request (``DROP SILENT GRAPH`` for each,
 then one ``INSERT DATA``), which Oxigraph also runs as one transaction.  The
 quads are collected and checked before the store is touched.
 
-A folder holds a RocksDB database, which one process at a time may open; a
-second one gets :class:`~exsce_dsl.store.base.StoreLockedError`, naming the
-process that holds it when the system says (Linux).  The folder is created on
-the first write: reading a store that does not exist yet finds it empty.
+A folder holds a RocksDB database, which one process at a time may open for
+writing; a second process that writes gets
+:class:`~exsce_dsl.store.base.StoreLockedError`, naming the process that holds
+it when the system says (Linux).  A second process that only reads gets a
+read-only view instead (``Store.read_only``): what was committed when it
+opened the store, so while an ingest runs a reader sees each run wholly or not
+at all.  The folder is created on the first write: reading a store that does
+not exist yet finds it empty.
 """
 
 from __future__ import annotations
@@ -43,10 +47,14 @@ class EmbeddedStore(Store):
         self.location = str(path) if path is not None else "memory:"
         self._store: OxStore | None = None
         self._empty: OxStore | None = None
+        self._view: OxStore | None = None
         if self.path is None:
             self._store = OxStore()
         elif self.path.exists():
-            self._open()
+            try:
+                self._open()
+            except StoreLockedError:
+                pass  # another process writes: reads use a read-only view, writes say who holds it
 
     # -- opening -------------------------------------------------------------
 
@@ -70,17 +78,45 @@ class EmbeddedStore(Store):
         return self._store
 
     def _reader(self) -> OxStore:
-        """The store to read from: an empty one while the folder does not exist yet."""
+        """The store to read from: an empty one while the folder does not exist yet, a read-only
+        view while another process has it open."""
         if self._store is not None:
             return self._store
+        if self._view is not None:
+            return self._view
         if self.path is not None and self.path.exists():  # made since, or reopened after close()
-            return self._open()
+            try:
+                return self._open()
+            except StoreLockedError:
+                return self._read_only_view()
         if self._empty is None:
             self._empty = OxStore()
         return self._empty
 
+    def _read_only_view(self) -> OxStore:
+        assert self.path is not None
+        try:
+            self._view = OxStore.read_only(str(self.path))
+        except OSError as exc:
+            raise StoreError(f"cannot read the store at {self.path}: {exc}") from None
+        return self._view
+
     def _writer(self) -> OxStore:
         return self._store if self._store is not None else self._open()
+
+    @property
+    def held_elsewhere(self) -> bool:
+        """The folder is a store that another process (or another EmbeddedStore) has open."""
+        if self._store is not None or self.path is None or not self.path.exists():
+            return False
+        try:
+            self._open()
+        except StoreLockedError:
+            return True
+        return False
+
+    def _exists(self) -> bool:
+        return self._store is not None or (self.path is not None and self.path.exists())
 
     # -- writing -------------------------------------------------------------
 
@@ -111,14 +147,14 @@ class EmbeddedStore(Store):
             raise StoreError(f"the update failed on the store at {self.location}: {exc}") from None
 
     def remove_graphs(self, names: Sequence[str]) -> None:
-        if not names or self._store is None:
+        if not names or not self._exists():
             return
         text = " ;\n".join(f"DROP SILENT GRAPH {graph_node(name)}" for name in names)
-        self._run_update(self._store, text)
+        self._run_update(self._writer(), text)
 
     def clear(self) -> None:
-        if self._store is not None:
-            self._run_update(self._store, "DROP ALL")
+        if self._exists():
+            self._run_update(self._writer(), "DROP ALL")
 
     # -- reading -------------------------------------------------------------
 
@@ -194,6 +230,7 @@ class EmbeddedStore(Store):
                 pass
         self._store = None
         self._empty = None
+        self._view = None
 
 
 def _with_fresh_blank_nodes(graphs: GraphSet) -> list[Quad]:

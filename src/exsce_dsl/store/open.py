@@ -27,6 +27,8 @@ a running ``exscec serve`` (its ``<folder>.serve.json`` names a live process),
 the store is reached through that server instead: queries always work;
 writes work when the server allows updates and ``EXSCE_STORE_TOKEN`` holds its
 token, and otherwise fail saying which server holds the store and what to do.
+When another process holds it (an ingest, say), reads see a read-only view of
+what that process had committed and writes fail saying who holds it.
 """
 
 from __future__ import annotations
@@ -36,7 +38,7 @@ import urllib.parse
 from dataclasses import dataclass
 from pathlib import Path
 
-from exsce_dsl.store.base import Store, StoreError, StoreLockedError
+from exsce_dsl.store.base import Store, StoreError
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.remote import RemoteStore
 
@@ -147,19 +149,18 @@ def _preset_store(preset: Preset, url: str, token: str | None, timeout: float) -
 
 
 def _embedded_store(path: Path, token: str | None, timeout: float) -> Store:
-    try:
-        return EmbeddedStore(path)
-    except StoreLockedError:
-        from exsce_dsl.store.server import read_serve_info
+    embedded = EmbeddedStore(path)
+    if not embedded.held_elsewhere:
+        return embedded
+    from exsce_dsl.store.server import read_serve_info
 
-        info = read_serve_info(path)
-        if info is None or not info.is_alive():
-            raise
-        mode = "updates allowed" if info.updates else "read-only"
-        label = f"the store {path} (held by exscec serve, pid {info.pid}, {mode}, at {info.url})"
-        store = RemoteStore(
-            info.query_url, update_url=info.update_url, token=token, timeout=timeout, label=label
-        )
-        store.location = str(path)
-        store.served_by = info.pid
-        return store
+    info = read_serve_info(path)
+    if info is None or not info.is_alive():
+        return embedded  # reads see a read-only view; a write says who holds the store
+    embedded.close()
+    mode = "updates allowed" if info.updates else "read-only"
+    label = f"the store {path} (held by exscec serve, pid {info.pid}, {mode}, at {info.url})"
+    store = RemoteStore(info.query_url, update_url=info.update_url, token=token, timeout=timeout, label=label)
+    store.location = str(path)
+    store.served_by = info.pid
+    return store
