@@ -9,7 +9,6 @@ of its own).
 
 from __future__ import annotations
 
-import os
 import random
 import shutil
 import signal
