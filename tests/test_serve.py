@@ -306,3 +306,25 @@ def test_sigterm_stops_the_server_cleanly(tmp_path: Path) -> None:
     with EmbeddedStore(store) as reopened:  # the folder is free again
         assert reopened.graph_names() == set()
     shutil.rmtree(store)
+
+
+# -- limits --------------------------------------------------------------------------
+
+
+def test_queries_over_the_time_or_size_limit_get_503_and_the_server_goes_on(tmp_path: Path) -> None:
+    folder = tmp_path / "limited"
+    with EmbeddedStore(folder / ".exsce" / "store") as store:
+        add_prov(store, document(SCENARIO_C))
+    with exscec_serve("--query-timeout", "0.5", "--max-answer-mb", "0.01", cwd=folder) as server:
+        slow = "SELECT (COUNT(*) AS ?n) WHERE { GRAPH ?a { ?s ?p ?o } GRAPH ?b { ?t ?q ?r } GRAPH ?c { ?u ?v ?w } }"
+        status, _, body = http(f"{server.url}/query?" + urllib.parse.urlencode({"query": slow}))
+        assert status == 503 and b"time limit of 0.5 s" in body
+        everything = "SELECT * WHERE { GRAPH ?g { ?s ?p ?o } }"
+        status, _, body = http(f"{server.url}/query?" + urllib.parse.urlencode({"query": everything}))
+        assert status == 503 and b"MiB, over the endpoint's limit of 0.0" in body
+        huge = ("ASK { " + "?s ?p ?o . " * 120_000 + "}").encode()
+        status, _, body = http(f"{server.url}/query", huge, {"Content-Type": "application/sparql-query"})
+        assert status == 413 and b"a query is at most 1024 KiB" in body
+        small = "SELECT ?g WHERE { GRAPH ?g { ?s ?p ?o } } LIMIT 1"
+        status, _, body = http(f"{server.url}/query?" + urllib.parse.urlencode({"query": small}))
+        assert status == 200 and b"bindings" in body  # still answering

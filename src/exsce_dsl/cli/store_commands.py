@@ -188,6 +188,14 @@ def clear(store_url: str | None) -> None:
 )
 @click.option("--union-default-graph", is_flag=True, help="Queries without GRAPH see every named graph.")
 @click.option("--log", "log_requests", is_flag=True, help="Print each request on stderr.")
+@click.option(
+    "--query-timeout", type=click.FloatRange(min=0, min_open=True), default=60.0, show_default=True,
+    metavar="SECONDS", help="Answer 503 to a query that runs longer.",
+)
+@click.option(
+    "--max-answer-mb", type=click.FloatRange(min=0, min_open=True), default=256.0, show_default=True,
+    metavar="MIB", help="Answer 503 instead of a larger answer.",
+)
 @reports_errors
 def serve(
     store_url: str | None,
@@ -196,6 +204,8 @@ def serve(
     token: str | None,
     union_default_graph: bool,
     log_requests: bool,
+    query_timeout: float,
+    max_answer_mb: float,
 ) -> None:
     """Serve the store as a SPARQL 1.1 Protocol endpoint, read-only unless told.
 
@@ -251,6 +261,8 @@ def serve(
         token=token,
         union_default_graph=union_default_graph,
         log=log if log_requests else None,
+        query_timeout=query_timeout,
+        max_answer=int(max_answer_mb * 2**20),
     )
 
     def ready(server: SparqlServer) -> None:

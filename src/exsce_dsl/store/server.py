@@ -28,6 +28,7 @@ is removed when the server stops (Ctrl-C, SIGTERM).
 
 from __future__ import annotations
 
+import concurrent.futures
 import contextlib
 import hmac
 import json
@@ -64,6 +65,12 @@ __all__ = ["ServeInfo", "SparqlServer", "make_server", "read_serve_info", "run_s
 
 MAX_BODY = 256 * 1024 * 1024
 """The largest request body accepted (bytes)."""
+MAX_QUERY = 1024 * 1024
+"""The longest query text accepted (bytes)."""
+QUERY_TIMEOUT = 60.0
+"""Seconds a query may take, evaluation and serialization, by default."""
+MAX_ANSWER = 256 * 1024 * 1024
+"""The largest answer sent (bytes), by default."""
 
 _RESULT_FORMATS = {
     "application/sparql-results+json": QueryResultsFormat.JSON,
@@ -176,9 +183,16 @@ class SparqlServer(ThreadingHTTPServer):
         token: str | None = None,
         union_default_graph: bool = False,
         log: Callable[[str], None] | None = None,
+        query_timeout: float = QUERY_TIMEOUT,
+        max_answer: int = MAX_ANSWER,
     ) -> None:
         if token is not None and not token:
             raise StoreError("the update token must not be empty")
+        self.query_timeout = query_timeout
+        self.max_answer = max_answer
+        # queries run here, so that one over its time limit is answered 503 while it finishes in the
+        # background (Oxigraph cannot stop a query); two workers keep such queries from starving the rest
+        self.evaluator = concurrent.futures.ThreadPoolExecutor(max_workers=2, thread_name_prefix="sparql")
         self.store = store
         self.oxigraph = store.oxigraph
         self.token = token
@@ -196,6 +210,10 @@ class SparqlServer(ThreadingHTTPServer):
     @property
     def updates(self) -> bool:
         return self.token is not None
+
+    def server_close(self) -> None:
+        super().server_close()
+        self.evaluator.shutdown(wait=False, cancel_futures=True)
 
     @property
     def url(self) -> str:
@@ -219,9 +237,15 @@ def make_server(
     token: str | None = None,
     union_default_graph: bool = False,
     log: Callable[[str], None] | None = None,
+    query_timeout: float = QUERY_TIMEOUT,
+    max_answer: int = MAX_ANSWER,
 ) -> SparqlServer:
-    """A server over ``store`` on ``host:port`` (0 picks a free port); updates need ``token``."""
-    return SparqlServer((host, port), store, token=token, union_default_graph=union_default_graph, log=log)
+    """A server over ``store`` on ``host:port`` (0 picks a free port); updates need ``token``.
+    A query may run ``query_timeout`` seconds and answer ``max_answer`` bytes."""
+    return SparqlServer(
+        (host, port), store, token=token, union_default_graph=union_default_graph, log=log,
+        query_timeout=query_timeout, max_answer=max_answer,
+    )
 
 
 def run_server(server: SparqlServer, *, on_ready: Callable[[SparqlServer], None] | None = None) -> None:
@@ -385,27 +409,25 @@ class _Handler(BaseHTTPRequestHandler):
             options["use_default_graph_as_union"] = False
         if named_graphs:
             options["named_graphs"] = [_iri(g) for g in named_graphs]
-        try:
-            result = self.server.oxigraph.query(text, **options)
-        except SyntaxError as exc:
-            hint = " (this is an update: POST it to /update)" if _UPDATE_START.match(text) else ""
-            raise _HttpError(HTTPStatus.BAD_REQUEST, f"SPARQL syntax error: {exc}{hint}") from None
-        except (OSError, RuntimeError, ValueError) as exc:
-            raise _HttpError(HTTPStatus.INTERNAL_SERVER_ERROR, f"the query failed: {exc}") from None
+        if len(text.encode("utf-8")) > MAX_QUERY:
+            too_long = f"a query is at most {MAX_QUERY // 1024} KiB"
+            raise _HttpError(HTTPStatus.REQUEST_ENTITY_TOO_LARGE, too_long)
         accept = _format_parameter(params) or self.headers.get("Accept", "")
-        if isinstance(result, (QuerySolutions, QueryBoolean)):
-            media = _negotiate(accept, _RESULT_FORMATS, "application/sparql-results+json")
-            try:
-                data = result.serialize(format=_RESULT_FORMATS[media])
-            except (ValueError, OSError, RuntimeError) as exc:
-                raise _HttpError(HTTPStatus.INTERNAL_SERVER_ERROR, f"the query failed: {exc}") from None
-        else:
-            assert isinstance(result, QueryTriples)
-            media = _negotiate(accept, _GRAPH_FORMATS, "text/turtle")
-            try:
-                data = result.serialize(format=_GRAPH_FORMATS[media])
-            except (ValueError, OSError, RuntimeError) as exc:
-                raise _HttpError(HTTPStatus.INTERNAL_SERVER_ERROR, f"the query failed: {exc}") from None
+        server = self.server
+        running = server.evaluator.submit(_evaluate, server.oxigraph, text, options, accept)
+        try:
+            data, media = running.result(timeout=server.query_timeout)
+        except concurrent.futures.TimeoutError:
+            raise _HttpError(
+                HTTPStatus.SERVICE_UNAVAILABLE,
+                f"the query ran over the endpoint's time limit of {server.query_timeout:g} s",
+            ) from None
+        if len(data) > server.max_answer:
+            raise _HttpError(
+                HTTPStatus.SERVICE_UNAVAILABLE,
+                f"the answer is {len(data) / 2**20:.1f} MiB, over the endpoint's limit of "
+                f"{server.max_answer / 2**20:.3g} MiB: ask for less (LIMIT, fewer variables)",
+            )
         assert data is not None
         charset = "; charset=utf-8" if media.startswith("text/") or media.endswith("json") else ""
         self._send(HTTPStatus.OK, data, media + charset)
@@ -528,6 +550,30 @@ class _Handler(BaseHTTPRequestHandler):
     def log_message(self, format: str, *args: Any) -> None:
         if self.server.log is not None:
             self.server.log(f"{self.address_string()} {format % args}")
+
+
+def _evaluate(store: Any, text: str, options: dict[str, Any], accept: str) -> tuple[bytes, str]:
+    """Run a query and serialize its answer in the format ``accept`` asks for: (bytes, media type)."""
+    try:
+        result = store.query(text, **options)
+    except SyntaxError as exc:
+        hint = " (this is an update: POST it to /update)" if _UPDATE_START.match(text) else ""
+        raise _HttpError(HTTPStatus.BAD_REQUEST, f"SPARQL syntax error: {exc}{hint}") from None
+    except (OSError, RuntimeError, ValueError) as exc:
+        raise _HttpError(HTTPStatus.INTERNAL_SERVER_ERROR, f"the query failed: {exc}") from None
+    if isinstance(result, (QuerySolutions, QueryBoolean)):
+        media = _negotiate(accept, _RESULT_FORMATS, "application/sparql-results+json")
+        formats: dict[str, Any] = _RESULT_FORMATS
+    else:
+        assert isinstance(result, QueryTriples)
+        media = _negotiate(accept, _GRAPH_FORMATS, "text/turtle")
+        formats = _GRAPH_FORMATS
+    try:
+        data = result.serialize(format=formats[media])
+    except (ValueError, OSError, RuntimeError) as exc:
+        raise _HttpError(HTTPStatus.INTERNAL_SERVER_ERROR, f"the query failed: {exc}") from None
+    assert data is not None
+    return data, media
 
 
 def _one(params: dict[str, list[str]], name: str, default: str | None = None) -> str:
