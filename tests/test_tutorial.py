@@ -68,3 +68,17 @@ def test_exscec_demo_shows_the_fault_run_failing_and_the_others_passing(tmp_path
     assert f"[{len(STEPS)}/{len(STEPS)}]" in done.stderr and "$ exscec verify runs/faulty/" in done.stderr
     again = run_exscec("demo", "demo", cwd=tmp_path)
     assert again.returncode == 1 and "is not empty" in again.stderr and "Traceback" not in again.stderr
+
+
+def test_the_demo_runs_unchanged_against_a_remote_sparql_endpoint(tmp_path: Path) -> None:
+    from store_servers import oxigraph_server
+
+    with oxigraph_server(tmp_path / "oxigraph") as server:
+        done = run_exscec("demo", "remote-demo", "--store", f"{server.url}/query", cwd=tmp_path)
+        assert done.returncode == 0, done.stderr[-3000:]
+        listed = run_exscec("runs", "--store", f"{server.url}/query", "-f", "csv", cwd=tmp_path)
+    summary = done.stderr[done.stderr.index("Summary"):]
+    assert re.search(r"FAILED\s+run of scenario_c with the over-speed fault", summary)
+    assert f"store      {server.url}/query" in summary
+    assert not (tmp_path / "remote-demo" / ".exsce").exists()  # nothing went to an embedded store
+    assert len(listed.stdout.strip().splitlines()) == 1 + 6  # the header and the six runs of the demo
