@@ -151,3 +151,12 @@ def test_textx_generators_write_prov(in_tmp: Path) -> None:
         assert done.returncode == 0, done.stderr
     assert "exsce:scenario_c_bundle" in json.loads((in_tmp / "c.prov.json").read_text())["bundle"]
     assert "bundle exsce:scenario_c_bundle" in (in_tmp / "c.provn").read_text()
+
+
+def test_version_is_the_installed_distributions() -> None:
+    from importlib.metadata import version
+
+    result = run_exscec("--version")
+    assert result.returncode == 0 and result.stdout.strip() == f"exscec, version {version('exsce')}"
+    changelog = (Path(__file__).resolve().parents[1] / "CHANGELOG.md").read_text(encoding="utf-8")
+    assert f"## [{version('exsce')}]" in changelog  # every released version has its entry
