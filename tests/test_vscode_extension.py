@@ -129,9 +129,8 @@ def test_snapshots_of_the_shipped_examples_hold(node_modules: Path, node: str) -
 
 
 def _lsp_server() -> dict[str, str]:
-    """EXSCE_SERVER_COMMAND for the client's tests, when this exscec has the `lsp` command."""
-    if run_exscec("lsp", "--help").returncode != 0:
-        return {}
+    """EXSCE_SERVER_COMMAND for the client's tests: this environment's exscec, whose `lsp` they start."""
+    assert run_exscec("lsp", "--help").returncode == 0
     return {"EXSCE_SERVER_COMMAND": str(Path(sys.executable).with_name("exscec"))}
 
 

@@ -34,6 +34,7 @@ def _register() -> None:
         demo_commands,
         derive_commands,
         generate_commands,
+        lsp_commands,
         oracle_commands,
         query_commands,
         report_commands,
@@ -54,6 +55,7 @@ def _register() -> None:
         *report_commands.COMMANDS,
         *generate_commands.COMMANDS,
         *demo_commands.COMMANDS,
+        *lsp_commands.COMMANDS,
     ]:
         main.add_command(command)
 

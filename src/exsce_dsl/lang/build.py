@@ -84,6 +84,12 @@ def load_spec(path: str | Path, overlay: Mapping[str, str] | None = None) -> Spe
 def analyse(path: str | Path, overlay: Mapping[str, str] | None = None) -> Analysis:
     """Like :func:`load_spec`, but return diagnostics instead of raising (for editors and ``check``)."""
     files, diagnostics = load_files(path, overlay)
+    return analyse_files(files, diagnostics)
+
+
+def analyse_files(files: list[ParsedFile], diagnostics: list[Diagnostic]) -> Analysis:
+    """:func:`analyse` of files already parsed (the root first), with the problems found reading them."""
+    diagnostics = list(diagnostics)
     builder = _Builder(files)
     spec = builder.build() if files else None
     diagnostics.extend(builder.diagnostics)

@@ -8,12 +8,23 @@ of the others: every problem found becomes a diagnostic.
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
 from exsce_dsl.errors import Diagnostic, ExsceError, ExsceSyntaxError
 from exsce_dsl.lang.parser import ParsedFile, parse_text
 from exsce_dsl.textfiles import read_text
+
+Parse = Callable[[str, str], tuple[ParsedFile | None, Sequence[Diagnostic]]]
+"""Parses (text, path): the tree (None if nothing could be parsed) and the syntax errors found."""
+
+
+def parse_whole(text: str, path: str) -> tuple[ParsedFile | None, Sequence[Diagnostic]]:
+    """The default :data:`Parse`: the whole file at once, stopping at its first syntax error."""
+    try:
+        return parse_text(text, path), ()
+    except ExsceSyntaxError as exc:
+        return None, exc.diagnostics
 
 
 def display_path(path: str | Path) -> str:
@@ -33,9 +44,13 @@ def import_target(importer: str, import_path: str) -> str:
 
 
 def load_files(
-    root: str | Path, overlay: Mapping[str, str] | None = None
+    root: str | Path, overlay: Mapping[str, str] | None = None, parse: Parse = parse_whole
 ) -> tuple[list[ParsedFile], list[Diagnostic]]:
-    """Parse ``root`` and its imports; ``overlay`` maps paths to unsaved texts (editors)."""
+    """Parse ``root`` and its imports; ``overlay`` maps paths to unsaved texts (editors).
+
+    ``parse`` may keep what a syntax error leaves intact (the language server's
+    :class:`~exsce_dsl.lang.incremental.ParseCache` does, declaration by declaration).
+    """
     overlay = {display_path(k): v for k, v in (overlay or {}).items()}
     parsed: list[ParsedFile] = []
     diagnostics: list[Diagnostic] = []
@@ -54,10 +69,9 @@ def load_files(
                 if not parsed or exc.location is not None:  # imports are reported where they are written
                     diagnostics.extend(exc.diagnostics)
                 continue
-        try:
-            pf = parse_text(text, path)
-        except ExsceSyntaxError as exc:
-            diagnostics.extend(exc.diagnostics)
+        pf, problems = parse(text, path)
+        diagnostics.extend(problems)
+        if pf is None:
             continue
         parsed.append(pf)
         for imp in pf.tree.imports:

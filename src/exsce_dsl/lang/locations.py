@@ -19,6 +19,10 @@ class LineIndex:
         line = bisect.bisect_right(self._starts, offset) - 1
         return line + 1, offset - self._starts[line] + 1
 
+    def offset(self, line: int, col: int) -> int:
+        """The offset of 1-based (line, column); the inverse of :meth:`line_col`."""
+        return self._starts[min(max(line, 1), len(self._starts)) - 1] + col - 1
+
     def span(self, start: int, end: int) -> SourceLocation:
         line, col = self.line_col(start)
         end_line, end_col = self.line_col(max(start, end))

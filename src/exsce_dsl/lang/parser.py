@@ -59,7 +59,8 @@ def parse_text(text: str, path: str) -> ParsedFile:
     """Parse one file's text; raise :class:`ExsceSyntaxError` on bad syntax."""
     lines = LineIndex(path, text)
     try:
-        tree = _shared_metamodel().model_from_str(text, file_name=path)
+        # textX reads the file itself when given no text: an empty editor buffer is not the file
+        tree = _shared_metamodel().model_from_str(text or " ", file_name=path)
     except TextXSyntaxError as exc:
         raise ExsceSyntaxError([_syntax_diagnostic(exc, text, path)]) from None
     if isinstance(tree, str):  # textX's model of a text with nothing but whitespace and comments
@@ -68,9 +69,20 @@ def parse_text(text: str, path: str) -> ParsedFile:
     return ParsedFile(path, text, tree, lines)
 
 
+def metamodel() -> Any:
+    """The metamodel :func:`parse_text` uses, made once per process."""
+    return _shared_metamodel()
+
+
 def _syntax_diagnostic(exc: TextXSyntaxError, text: str, path: str) -> Diagnostic:
-    line, col = exc.line or 1, exc.col or 1
-    expected = _expected_words(getattr(exc, "expected_rules", None) or [])
+    rules = getattr(exc, "expected_rules", None) or []
+    return syntax_diagnostic_at(exc.line or 1, exc.col or 1, rules, text, path)
+
+
+def syntax_diagnostic_at(line: int, col: int, rules: list[Any], text: str, path: str) -> Diagnostic:
+    """The diagnostic of a syntax error at ``line``:``col`` of ``text``, where the grammar
+    expected ``rules`` (those of a textX syntax error)."""
+    expected = _expected_words(rules)
     found = _token_at(text, line, col)
     message = f"expected {expected}, found {found}" if expected else f"syntax error near {found}"
     end_col = col + max(1, len(found) - 2 if found.startswith("'") else 1)

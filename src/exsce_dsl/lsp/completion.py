@@ -1,0 +1,306 @@
+"""Completion by context: the keywords the grammar allows at the point, and the names of
+what may be referred to there (poses where a waypoint goes, robots of the scenario in its
+mission, a scenario's metrics in its acceptance criteria, relations, transformations).
+
+The grammar says *whether* a name may come (:mod:`exsce_dsl.lang.expected`); the words
+before the point say *which kind* of name.  Names come from the files' indexes, which
+keep a file's last complete parse while its text does not parse.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from lsprotocol import types
+
+from exsce_dsl.derive.transformations import TRANSFORMATIONS
+from exsce_dsl.lang.expected import Expected
+from exsce_dsl.lang.symbols import Symbol
+from exsce_dsl.lsp.navigation import Names
+from exsce_dsl.model.metrics import METRICS
+from exsce_dsl.oracles.relations import relation, relation_names
+
+LIMIT = 300
+"""At most this many items; the list is marked incomplete beyond (the client asks again)."""
+
+_BLOCK_WORDS = frozenset(
+    {"robots", "mission", "scenario", "environment", "area", "task", "subtask", "acceptance", "derive"}
+    | {"reallocate", "metric", "robot"}
+)
+_STEP_WORDS = frozenset(
+    {"remove", "add", "replace", "swap", "reverse", "substitute", "move", "reallocate", "start"}
+)
+
+# How each relation of the oracles is written in acceptance criteria.
+_RELATION_PHRASES = {
+    "below_max": "stays below ",
+    "above_min": "stays above ",
+    "invariant": "is invariant",
+    "increasing": "is increasing",
+    "decreasing": "is decreasing",
+}
+
+# Each transformation as a derive step: (snippet, plain text).
+_STEPS = {
+    "remove_robot": ("remove robot ${1:robot}", "remove robot "),
+    "add_robot": ("add robot ${1:new_robot} like ${2:robot} at ${3:pose}", "add robot "),
+    "replace_robot": ("replace robot ${1:robot} by ${2:new_robot}", "replace robot "),
+    "swap_assignment": ("swap tasks of ${1:robot} and ${2:robot}", "swap tasks of "),
+    "swap_start_poses": ("swap start poses of ${1:robot} and ${2:robot}", "swap start poses of "),
+    "reverse_waypoint_order": ("reverse waypoints of ${1:task}", "reverse waypoints of "),
+    "reverse_task_order": ("reverse task order", "reverse task order"),
+    "add_task": ("add task ${1:task} to ${2:robot}", "add task "),
+    "remove_task": ("remove task ${1:task}", "remove task "),
+    "substitute_task": ("substitute task ${1:task} by ${2:task}", "substitute task "),
+    "add_start_pose": ("start ${1:robot} at ${2:pose}", "start "),
+    "remove_start_pose": ("remove start pose of ${1:robot}", "remove start pose of "),
+    "move_obstacle": ("move obstacle ${1:obstacle} to (${2:x}, ${3:y})", "move obstacle "),
+    "substitute_allocation": ("reallocate {\n\t${1:robot} does ${2:task}\n}", "reallocate {"),
+}
+
+_ITEM_KINDS = {
+    "robot type": types.CompletionItemKind.Class,
+    "environment": types.CompletionItemKind.Module,
+    "area": types.CompletionItemKind.Folder,
+    "pose": types.CompletionItemKind.Constant,
+    "obstacle": types.CompletionItemKind.Struct,
+    "task": types.CompletionItemKind.Function,
+    "scenario": types.CompletionItemKind.Module,
+    "robot": types.CompletionItemKind.Variable,
+    "mission": types.CompletionItemKind.Event,
+    "metric": types.CompletionItemKind.Field,
+}
+
+
+@dataclass(frozen=True)
+class Wanted:
+    """A kind of name that fits, said in scenario ``scope`` (robots, missions) or of
+    environment ``environment`` (poses, obstacles)."""
+
+    kind: str
+    scope: str | None = None
+    environment: str | None = None
+
+
+def wanted_names(expected: Expected, names: Names) -> list[Wanted]:
+    """Which kinds of names fit at the point, from the words before it."""
+    before = expected.before
+    if not before:
+        return []
+    declaration = expected.declaration
+    if declaration == "scenario":
+        return _in_scenario(before, names)
+    if declaration == "task":
+        return [Wanted("pose")] if before[-1] in ("visit", ",") else []
+    if declaration == "acceptance":
+        return _in_acceptance(before)
+    if declaration == "derive":
+        return _in_derivation(before, names)
+    return []
+
+
+def _blocks(before: Sequence[str]) -> list[str]:
+    """The blocks open at the point, outermost first, each by the word that opens it."""
+    stack: list[str] = []
+    for i, token in enumerate(before):
+        if token == "{":
+            stack.append(next((before[j] for j in range(i - 1, -1, -1) if before[j] in _BLOCK_WORDS), ""))
+        elif token == "}" and stack:
+            stack.pop()
+    return stack
+
+
+def _in_scenario(before: Sequence[str], names: Names) -> list[Wanted]:
+    last = before[-1]
+    name = before[1] if len(before) > 1 else None
+    environment = before[3] if len(before) > 3 else None
+    if len(before) == 3 and last == "in":
+        return [Wanted("environment")]
+    blocks = _blocks(before)
+    if last == ":" and blocks[-1:] == ["robots"]:
+        return [Wanted("robot type")]
+    if last == "at" and before[-2] == "starts":
+        return [Wanted("pose", environment=environment)]
+    if blocks[-1:] == ["mission"]:
+        if last in ("does", "then"):
+            return [Wanted("task")]
+        return [Wanted("robot", name)]
+    return []
+
+
+def _in_acceptance(before: Sequence[str]) -> list[Wanted]:
+    last, previous = before[-1], before[-2] if len(before) > 1 else ""
+    scenario = before[2] if len(before) > 2 else None
+    if len(before) == 2 and last == "for":
+        return [Wanted("scenario")]
+    table = {
+        "given": [Wanted("robot", scenario)],
+        "when": [Wanted("robot", scenario), Wanted("mission", scenario)],
+        "does": [Wanted("task")],
+        "then": [Wanted("robot", scenario), Wanted("metric")],
+        "and": [Wanted("robot", scenario), Wanted("metric")],
+        "before": [Wanted("robot", scenario), Wanted("task")],
+        "after": [Wanted("robot", scenario), Wanted("task")],
+        "during": [Wanted("task")],
+        "reaches": [Wanted("pose")],
+        "of": [Wanted("scenario")],
+    }
+    if last in table:
+        return table[last]
+    if previous in ("then", "and") or (last == "robot" and previous == "each"):
+        return [Wanted("metric")]
+    return []
+
+
+def _in_derivation(before: Sequence[str], names: Names) -> list[Wanted]:
+    derived = before[1] if len(before) > 1 else None
+    if len(before) == 4 and before[-1] == "from":
+        return [Wanted("scenario")]
+    environment = _environment_of(names, before[3]) if len(before) > 3 else None
+    start = 0
+    for i, token in enumerate(before):
+        if token in _STEP_WORDS and not (token == "start" and i and before[i - 1] in ("swap", "remove")):
+            start = i
+    step = list(before[start:])
+    if not step or step[0] not in _STEP_WORDS:
+        return []
+    head, pair, last, n = step[0], step[:2], step[-1], len(step)
+    task = Wanted("task")
+    # the robots the steps add, and the base's (known from the text while this file is not indexed yet)
+    robots = [Wanted("robot", derived), Wanted("robot", before[3] if len(before) > 3 else None)]
+    if head == "reallocate":
+        return [task] if last in ("does", "then") else robots
+    if pair in (["add", "task"], ["remove", "task"], ["substitute", "task"]) and n == 2:
+        return [task]
+    if (last == "of" and pair == ["reverse", "waypoints"]) or (last == "by" and head == "substitute"):
+        return [task]
+    if pair == ["move", "obstacle"] and n == 2:
+        return [Wanted("obstacle", environment=environment)]
+    if last == "at" and (pair == ["add", "robot"] or head == "start"):
+        return [Wanted("pose", environment=environment)]
+    robot_places = (
+        (pair in (["remove", "robot"], ["replace", "robot"]) and n == 2)
+        or last in ("like", "over")
+        or (last == "to" and ("reassign" in step or pair == ["add", "task"]))
+        or (last == "from" and pair == ["remove", "task"])
+        or (last == "and" and head == "swap")
+        or (head == "start" and n == 1)
+        or (last == "of" and pair in (["swap", "tasks"], ["swap", "start"], ["remove", "tasks"]))
+        or (last == "of" and pair in (["reverse", "task"], ["remove", "start"]))
+    )
+    return robots if robot_places else []
+
+
+def _environment_of(names: Names, scenario: str) -> str | None:
+    seen: set[str] = set()
+    current: str | None = scenario
+    while current is not None and current not in seen:
+        seen.add(current)
+        for symbol in names.symbols("scenario", current):
+            environment = symbol.fact("environment")
+            if environment is not None:
+                return environment
+        current = names.base_of(current)
+    return None
+
+
+def candidates(wanted: Wanted, names: Names, all_symbols: Sequence[Symbol]) -> list[Symbol]:
+    """The declarations that fit ``wanted``."""
+    found = [s for s in all_symbols if s.kind == wanted.kind]
+    if wanted.kind in ("robot", "mission"):
+        scopes: list[str] = []
+        scope = wanted.scope
+        while scope is not None and scope not in scopes:
+            scopes.append(scope)
+            scope = names.base_of(scope)
+        return [s for s in found if s.scope in scopes]
+    if wanted.environment is not None:
+        mine = [s for s in found if s.scope == wanted.environment]
+        found = mine or found
+    return names.nearest(found)
+
+
+def _matches(typed: str, name: str) -> bool:
+    """Whether the letters typed appear in ``name`` in order (as editors filter)."""
+    if not typed:
+        return True
+    rest = iter(name.lower())
+    return all(char in rest for char in typed.lower())
+
+
+def _detail(symbol: Symbol) -> str:
+    if symbol.kind == "pose":
+        return f"pose in {symbol.fact('area')} at {symbol.fact('at')}"
+    if symbol.kind == "metric":
+        unit = symbol.fact("unit")
+        return f"metric of {symbol.fact('of')}" + (f", in {unit}" if unit else "")
+    if symbol.kind == "task":
+        return f"task: {symbol.fact('waypoints') or symbol.fact('subtask 1') or ''}"
+    if symbol.kind == "robot":
+        return f"robot ({symbol.fact('type') or symbol.fact('like') or ''}) of {symbol.scope}"
+    return symbol.kind
+
+
+def complete(
+    expected: Expected,
+    names: Names,
+    typed: str,
+    replace: types.Range,
+    snippets: bool,
+) -> types.CompletionList:
+    """The completion list at a point: names that fit, then keywords, relations, transformations."""
+    items: list[types.CompletionItem] = []
+    seen: set[tuple[str, str]] = set()
+    all_symbols = [s for index in names.indexes for s in index.all_symbols()]
+
+    def add(
+        label: str,
+        kind: types.CompletionItemKind,
+        detail: str,
+        sort: str,
+        insert: str | None = None,
+        snippet: bool = False,
+    ) -> None:
+        text = insert or label
+        if (label, detail) in seen or not (_matches(typed, label) or _matches(typed, text)):
+            return
+        seen.add((label, detail))
+        items.append(
+            types.CompletionItem(
+                label=label,
+                kind=kind,
+                detail=detail,
+                sort_text=f"{sort}{label}",
+                filter_text=text if insert else None,
+                text_edit=types.TextEdit(replace, text),
+                insert_text_format=types.InsertTextFormat.Snippet if snippet else None,
+            )
+        )
+
+    if expected.name or not expected.known:
+        for wanted in wanted_names(expected, names):
+            for symbol in candidates(wanted, names, all_symbols):
+                kind = _ITEM_KINDS.get(symbol.kind, types.CompletionItemKind.Text)
+                add(symbol.name, kind, _detail(symbol), "0")
+            if wanted.kind == "metric":
+                for name, info in METRICS.items():
+                    if not names.symbols("metric", name):
+                        add(name, types.CompletionItemKind.Field, f"built-in metric: {info.meaning}", "0")
+    for keyword in expected.keywords:
+        add(keyword, types.CompletionItemKind.Keyword, "keyword", "1")
+    if expected.declaration == "acceptance" and {"stays", "is"} & set(expected.keywords):
+        for name in relation_names():
+            if name in _RELATION_PHRASES:
+                phrase = _RELATION_PHRASES[name]
+                params = ", ".join(sorted(relation(name).parameters))
+                add(name, types.CompletionItemKind.Operator, f"relation {name}({params})", "2", insert=phrase)
+    if expected.declaration == "derive" and "remove" in expected.keywords:
+        for name, (snippet, plain) in _STEPS.items():
+            if name in TRANSFORMATIONS:
+                kind = types.CompletionItemKind.Snippet
+                help_text = TRANSFORMATIONS[name].help
+                add(name, kind, help_text, "2", insert=snippet if snippets else plain, snippet=snippets)
+    incomplete = len(items) > LIMIT
+    items.sort(key=lambda item: item.sort_text or item.label)
+    return types.CompletionList(is_incomplete=incomplete, items=items[:LIMIT])
