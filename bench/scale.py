@@ -8,7 +8,7 @@ speed-up over 1 job measured in the same run.  Then it runs every query of the
 library (`exscec query --list`) against the store holding the N runs, 20 times
 each, and prints p50 and p95 per query.
 
-    python bench/scale.py [--bags 200] [--keep DIR]
+    python bench/scale.py [--bags 200] [--keep DIR]   (a kept DIR's bags are reused)
 """
 
 from __future__ import annotations
@@ -35,6 +35,11 @@ def _simulate(folder: Path, runs: int, seed: int) -> list[Path]:
 
 
 def make_bags(folder: Path, count: int) -> list[Path]:
+    """``count`` bags in ``folder``: those of an earlier run kept with --keep, or new ones."""
+    kept = sorted(folder.glob("*/*.bag"))
+    if len(kept) >= count:
+        return kept[:count]
+    shutil.rmtree(folder, ignore_errors=True)
     halves = [count // 2, count - count // 2]
     with ProcessPoolExecutor(max_workers=2) as pool:
         parts = pool.map(_simulate, [folder / "a", folder / "b"], halves, [1, 100_001])
