@@ -101,3 +101,26 @@ def test_no_command_reads_from_a_fifo_forever(tmp_path: Path) -> None:
     os.mkfifo(fifo)
     result = CliRunner().invoke(main, ["check", str(fifo)])
     assert result.exit_code != 0 and "Traceback" not in result.output
+
+
+@pytest.mark.parametrize(
+    ("args", "said"),
+    [
+        (["runs", "--store", "a-file"], "it is a file, not a store folder"),
+        (["runs", "--store", "junk"], "holds no Oxigraph store"),
+        (["cluster", "--store", "junk"], "holds no Oxigraph store"),
+        (["report", "-o", "a-file"], "is a file"),
+        (["generate", "monitors", SPEC, "-o", "a-file"], "is a file"),
+        (["simulate", SPEC, "-o", "a-file"], "is a file"),
+    ],
+)
+def test_a_store_or_output_folder_that_is_not_one_is_refused(
+    args: list[str], said: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "a-file").write_text("not a folder\n")
+    (tmp_path / "junk").mkdir()
+    (tmp_path / "junk" / "notes.txt").write_text("mine\n")
+    result = CliRunner().invoke(main, args)
+    assert result.exit_code in (1, 2) and said in result.output, result.output
+    assert (tmp_path / "junk" / "notes.txt").read_text() == "mine\n"  # nothing of the user's is touched
