@@ -302,8 +302,12 @@ def test_statuses_in_the_bag_are_the_executors(runs_c) -> None:
 
 def test_bags_analysed_in_parallel_give_the_same_runs(scenario_c, runs_c, tmp_path: Path) -> None:
     [other] = simulate(scenario_c, tmp_path, runs=1, seed=8)
-    bags = [runs_c["ros1"].bag, other.bag]
+    broken = tmp_path / "broken.bag"
+    broken.write_bytes(runs_c["ros1"].bag.read_bytes()[:5000])
+    bags = [runs_c["ros1"].bag, other.bag, runs_c["ros1"].bag, broken, tmp_path / "missing.bag"]
     serial = ingest_bags(bags, scenario_c, EmbeddedStore())
     parallel = ingest_bags(bags, scenario_c, EmbeddedStore(), jobs=2)
-    assert [r.status for r in parallel] == ["ingested", "ingested"]
-    assert [(r.run_id, r.statements) for r in parallel] == [(r.run_id, r.statements) for r in serial]
+    assert sorted(r.status for r in parallel) == ["failed", "failed", "ingested", "ingested", "skipped"]
+    assert [(r.bag, r.status, r.run_id, r.statements) for r in parallel] == [
+        (r.bag, r.status, r.run_id, r.statements) for r in serial
+    ]

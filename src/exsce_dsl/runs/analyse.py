@@ -80,8 +80,11 @@ def reductions(monitors: ModuleType, robots: list[Robot]) -> dict[str, Reduce]:
     return {topic: reducer(found) for topic, found in entries.items()}
 
 
-def analyse_bag(path: Path, scenario: Scenario) -> AnalysedRun:
-    digest = content_hash(path) if path.exists() else ""
+def analyse_bag(path: Path, scenario: Scenario, digest: str | None = None) -> AnalysedRun:
+    """The metrics of the bag at ``path`` as a run of ``scenario``; ``digest`` is the bag's
+    :func:`content_hash` when the caller has it already."""
+    if digest is None:
+        digest = content_hash(path) if path.exists() else ""
     robots = [r for r in scenario.robots if r.start_pose is not None]
     metrics = run_metrics(scenario)
     source = scenario.location.file if scenario.location else scenario.id

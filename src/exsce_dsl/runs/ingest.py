@@ -9,10 +9,12 @@ same run id) is skipped.
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from pyoxigraph import Literal
 
@@ -42,23 +44,38 @@ class IngestResult:
         return self.status == "failed"
 
 
-def _analyse(args: tuple[Path, Scenario]) -> AnalysedRun | ExsceError:
+def _analyse(args: tuple[Path, Scenario, str | None]) -> AnalysedRun | ExsceError:
     try:
         return analyse_bag(*args)
     except ExsceError as exc:
         return exc
 
 
+def _digest(path: Path) -> str | None:
+    return content_hash(path) if path.exists() else None
+
+
+Mapper = Callable[[Callable[[Any], Any], Iterable[Any]], Iterator[Any]]
+"""``map``, or a process pool's."""
+
+
+@contextmanager
+def _workers(jobs: int, tasks: int) -> Iterator[Mapper]:
+    """``map`` in this process (one job), or over a pool of ``jobs`` processes kept for every phase."""
+    if jobs <= 1 or tasks <= 1:
+        yield map
+        return
+    with ProcessPoolExecutor(max_workers=min(jobs, tasks, os.cpu_count() or 1)) as pool:
+        yield pool.map
+
+
 def analyse_all(
-    paths: Sequence[Path], scenario: Scenario, jobs: int = 1
+    paths: Sequence[Path], scenario: Scenario, jobs: int = 1, digests: Sequence[str | None] | None = None
 ) -> Iterator[AnalysedRun | ExsceError]:
     """Analyse bags in order, in ``jobs`` processes (bag reading and metrics are the costly part)."""
-    work = [(p, scenario) for p in paths]
-    if jobs <= 1 or len(paths) <= 1:
-        yield from map(_analyse, work)
-        return
-    with ProcessPoolExecutor(max_workers=min(jobs, len(paths), os.cpu_count() or 1)) as pool:
-        yield from pool.map(_analyse, work)
+    known = list(digests) if digests is not None else [None] * len(paths)
+    with _workers(jobs, len(paths)) as mapper:
+        yield from mapper(_analyse, [(p, scenario, d) for p, d in zip(paths, known, strict=True)])
 
 
 def ingest_bags(
@@ -68,50 +85,56 @@ def ingest_bags(
     jobs: int = 1,
     progress: Callable[[IngestResult], None] | None = None,
 ) -> list[IngestResult]:
-    """Ingest each bag as a run of ``scenario``; the scenario itself is added to the store first."""
+    """Ingest each bag as a run of ``scenario``; the scenario itself is added to the store first.
+
+    With ``jobs`` > 1, worker processes hash the bags, then read them and compute their metrics;
+    this process alone compiles each run's PROV and writes it, one transaction per run.
+    """
     add_prov(store, compile_scenario(scenario))
     results: list[IngestResult] = []
-    todo: list[Path] = []
+    todo: list[tuple[Path, str | None]] = []
     seen: set[str] = set()
-    for path in paths:
-        digest = content_hash(path) if path.exists() else None
-        known = digest is not None and (
-            digest in seen or store.ask(_KNOWN, {"id": Literal(run_uuid(digest))})
-        )
-        if digest is not None:
-            seen.add(digest)
-        if known:
-            assert digest is not None
-            result = IngestResult(
-                path, "skipped", f"{path}: already ingested (same content)", run_uuid(digest)
+    with _workers(jobs, len(paths)) as mapper:
+        digests = list(mapper(_digest, paths))
+        for path, digest in zip(paths, digests, strict=True):
+            known = digest is not None and (
+                digest in seen or store.ask(_KNOWN, {"id": Literal(run_uuid(digest))})
             )
+            if digest is not None:
+                seen.add(digest)
+            if known:
+                assert digest is not None
+                result = IngestResult(
+                    path, "skipped", f"{path}: already ingested (same content)", run_uuid(digest)
+                )
+                results.append(result)
+                if progress:
+                    progress(result)
+            else:
+                todo.append((path, digest))
+        outcomes = mapper(_analyse, [(path, scenario, digest) for path, digest in todo])
+        for (path, _), outcome in zip(todo, outcomes, strict=True):
+            result = _write(path, outcome, scenario, store)
             results.append(result)
             if progress:
                 progress(result)
-        else:
-            todo.append(path)
-    for path, outcome in zip(todo, analyse_all(todo, scenario, jobs), strict=True):
-        if isinstance(outcome, ExsceError):
-            result = IngestResult(
-                path,
-                "failed",
-                outcome.message if str(path) in outcome.message else f"{path}: {outcome.message}",
-            )
-        else:
-            try:
-                report = add_prov(store, compile_run(outcome.run, scenario))
-            except ExsceError as exc:
-                result = IngestResult(path, "failed", f"{path}: {exc.message}")
-            else:
-                result = IngestResult(
-                    path,
-                    "ingested",
-                    f"{path}: run {outcome.run.uuid} ({len(outcome.run.metrics)} metric values)",
-                    outcome.run.uuid,
-                    tuple(outcome.problems),
-                    report.statements,
-                )
-        results.append(result)
-        if progress:
-            progress(result)
     return results
+
+
+def _write(path: Path, outcome: AnalysedRun | ExsceError, scenario: Scenario, store: Store) -> IngestResult:
+    """Write an analysed run to the store (one transaction), or say why it could not be."""
+    if isinstance(outcome, ExsceError):
+        message = outcome.message if str(path) in outcome.message else f"{path}: {outcome.message}"
+        return IngestResult(path, "failed", message)
+    try:
+        report = add_prov(store, compile_run(outcome.run, scenario))
+    except ExsceError as exc:
+        return IngestResult(path, "failed", f"{path}: {exc.message}")
+    return IngestResult(
+        path,
+        "ingested",
+        f"{path}: run {outcome.run.uuid} ({len(outcome.run.metrics)} metric values)",
+        outcome.run.uuid,
+        tuple(outcome.problems),
+        report.statements,
+    )
