@@ -28,7 +28,7 @@ def trajectory_figure(
     points += [np.array([(h.position.x, h.position.y) for h in run.hotspots])] if run.hotspots else []
     box = _bounding_box(points)
     if scenario.grid is not None:
-        _draw_grid(axes, scenario.grid)
+        _draw_grid(axes, scenario.grid, box)
     colours = [f"C{i}" for i in range(10)]
     for i, path in enumerate(paths):
         colour = colours[i % len(colours)]
@@ -71,10 +71,22 @@ def _bounding_box(points: Sequence[np.ndarray]) -> tuple[float, float, float, fl
     return float(x0) - _MARGIN, float(x1) + _MARGIN, float(y0) - _MARGIN, float(y1) + _MARGIN
 
 
-def _draw_grid(axes: object, grid: OccupancyGrid) -> None:
-    x0, x1, y0, y1 = grid.bounds()
-    image = grid.cells if not grid.negate else 255 - grid.cells
-    axes.imshow(image, cmap="gray", vmin=0, vmax=255, extent=(x0, x1, y0, y1), origin="upper",  # type: ignore[attr-defined]
+def _draw_grid(axes: object, grid: OccupancyGrid, box: tuple[float, float, float, float] | None) -> None:
+    """The grid as a grey image, cut to ``box`` (drawing a whole building's map for every run is slow)."""
+    x0, _, y0, _ = grid.bounds()
+    res = grid.resolution
+    first_col, last_col, first_row, last_row = 0, grid.width, 0, grid.height  # rows from the bottom
+    if box is not None:
+        first_col = max(0, int((box[0] - x0) / res))
+        last_col = min(grid.width, int((box[1] - x0) / res) + 1)
+        first_row = max(0, int((box[2] - y0) / res))
+        last_row = min(grid.height, int((box[3] - y0) / res) + 1)
+    if first_col >= last_col or first_row >= last_row:
+        return
+    cells = grid.cells[grid.height - last_row : grid.height - first_row, first_col:last_col]
+    image = cells if not grid.negate else 255 - cells
+    extent = (x0 + first_col * res, x0 + last_col * res, y0 + first_row * res, y0 + last_row * res)
+    axes.imshow(image, cmap="gray", vmin=0, vmax=255, extent=extent, origin="upper",  # type: ignore[attr-defined]
                 interpolation="nearest", alpha=0.9)
 
 

