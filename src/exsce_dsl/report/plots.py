@@ -12,6 +12,7 @@ from exsce_dsl.lang.occupancy import OccupancyGrid
 from exsce_dsl.model.oracles import Oracle
 from exsce_dsl.report.contents import RunContents, ScenarioContents
 from exsce_dsl.runs.trajectories import Trajectory
+from exsce_dsl.store.queries import MetricReading
 
 _MARGIN = 2.5  # metres of map shown around what is drawn
 _STATUS_COLOURS = {"failed": "#c0392b", "unjudged": "#d68910", "passed": "#1e8449", "not verified": "#5d6d7e"}
@@ -111,6 +112,12 @@ def _accepted(oracle: Oracle) -> tuple[float, float] | None:
     return None
 
 
+def _row(value: MetricReading) -> str:
+    """The robot (or the mission), and for a violation time the safety metric it is of."""
+    who = value.robot or "mission"
+    return f"{who} · {value.safety}" if value.safety else who
+
+
 def metrics_figure(scenario: ScenarioContents) -> Figure | None:
     """One panel per metric: each run's value per robot (coloured by the run's verdict) over the
     band of values the scenario's whole-run oracles accept."""
@@ -119,12 +126,16 @@ def metrics_figure(scenario: ScenarioContents) -> Figure | None:
     metrics = sorted({v.metric for v in scenario.values} | judged)
     if not metrics:
         return None
-    figure = Figure(figsize=(7.5, 1.0 + 1.15 * len(metrics)), layout="constrained")
-    panels = figure.subplots(len(metrics), 1, squeeze=False)[:, 0]
-    for axes, metric in zip(panels, metrics, strict=True):
+    panels_rows = []
+    for metric in metrics:
         values = [v for v in scenario.values if v.metric == metric and v.action is None]
         oracles = [o for o in scenario.oracles if o.metric == metric and o.window is None]
-        rows = sorted({v.robot or "mission" for v in values} | {o.robot or "mission" for o in oracles})
+        rows = sorted({_row(v) for v in values} | {o.robot or "mission" for o in oracles})
+        panels_rows.append((metric, values, oracles, rows))
+    heights = [0.55 + 0.28 * max(1, len(rows)) for *_, rows in panels_rows]
+    figure = Figure(figsize=(7.5, 0.6 + sum(heights)), layout="constrained")
+    panels = figure.subplots(len(metrics), 1, squeeze=False, gridspec_kw={"height_ratios": heights})[:, 0]
+    for axes, (metric, values, oracles, rows) in zip(panels, panels_rows, strict=True):
         row_of = {name: i for i, name in enumerate(rows)}
         bounds = [b for o in oracles for b in (_accepted(o) or ()) if math.isfinite(b)]
         finite = [v.value for v in values] + bounds
@@ -144,7 +155,7 @@ def metrics_figure(scenario: ScenarioContents) -> Figure | None:
                 axes.plot([left, left], [y - 0.35, y + 0.35], color="#1e8449", linewidth=2.5, alpha=0.6)
         for value in values:
             colour = _STATUS_COLOURS[status.get(value.run, "not verified")]
-            axes.scatter([value.value], [row_of[value.robot or "mission"]], s=26, color=colour, zorder=3)
+            axes.scatter([value.value], [row_of[_row(value)]], s=26, color=colour, zorder=3)
         axes.set_xlim(low, high)
         axes.set_yticks(range(len(rows)), rows, fontsize=8)
         axes.set_ylim(-0.6, len(rows) - 0.4)

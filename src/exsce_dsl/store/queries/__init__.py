@@ -539,6 +539,8 @@ class MetricReading:
     value: float
     action: str | None = None
     goal: str | None = None
+    safety: str | None = None
+    """For a ``violation_duration``: the safety metric whose limit was violated."""
 
 
 def run_metric_values(
@@ -551,7 +553,7 @@ def run_metric_values(
     for row in run_query(store, "run_metric_values", {"run": list(runs)}, namespace):
         run, metric, value = _text(row["run"]), _text(row["metric"]), _float(row["value"])
         if run is not None and metric is not None and value is not None:
-            found.append(MetricReading(run, metric, _text(row["robot"]), value))
+            found.append(MetricReading(run, metric, _text(row["robot"]), value, safety=_text(row["safety"])))
     return found
 
 
