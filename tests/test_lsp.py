@@ -6,100 +6,44 @@ from __future__ import annotations
 
 import asyncio
 import shutil
-import sys
-from collections.abc import AsyncIterator, Callable, Sequence
+from collections.abc import AsyncIterator
 from pathlib import Path
 
 import pytest
 import pytest_lsp
 from lsprotocol import types
-from pygls.uris import from_fs_path
 from pytest_lsp import ClientServerConfig, LanguageClient
 
-from conftest import EXAMPLES
+from lsp_helpers import (
+    EXSCEC,
+    change_document,
+    close_document,
+    copy_workspace,
+    diagnostics_of,
+    open_document,
+    position,
+    start_session,
+    uri_of,
+)
 
 pytestmark = pytest.mark.asyncio(loop_scope="module")
-
-EXSCEC = str(Path(sys.executable).with_name("exscec"))
 
 
 @pytest.fixture(scope="module")
 def workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    folder = tmp_path_factory.mktemp("lsp") / "bc"
-    shutil.copytree(EXAMPLES / "brsu_building_c", folder)
-    return folder
+    return copy_workspace(tmp_path_factory, "lsp")
 
 
 @pytest_lsp.fixture(scope="module", config=ClientServerConfig(server_command=[EXSCEC, "lsp"]))
 async def client(lsp_client: LanguageClient, workspace: Path) -> AsyncIterator[None]:
-    uri = from_fs_path(str(workspace))
-    await lsp_client.initialize_session(
-        types.InitializeParams(
-            capabilities=pytest_lsp.client_capabilities("visual-studio-code"),
-            root_uri=uri,
-            workspace_folders=[types.WorkspaceFolder(uri, "bc")],
-        )
-    )
+    await start_session(lsp_client, workspace)
     yield
     await lsp_client.shutdown_session()
-
-
-def uri_of(path: Path) -> str:
-    return from_fs_path(str(path)) or ""
-
-
-def open_document(client: LanguageClient, path: Path, text: str | None = None) -> str:
-    uri = uri_of(path)
-    client.diagnostics.pop(uri, None)
-    source = path.read_text() if text is None else text
-    client.text_document_did_open(
-        types.DidOpenTextDocumentParams(types.TextDocumentItem(uri, "exsce", 1, source))
-    )
-    return uri
-
-
-def change_document(client: LanguageClient, uri: str, version: int, text: str) -> None:
-    client.diagnostics.pop(uri, None)
-    client.text_document_did_change(
-        types.DidChangeTextDocumentParams(
-            types.VersionedTextDocumentIdentifier(version=version, uri=uri),
-            [types.TextDocumentContentChangeWholeDocument(text)],
-        )
-    )
-
-
-def close_document(client: LanguageClient, uri: str) -> None:
-    client.text_document_did_close(types.DidCloseTextDocumentParams(types.TextDocumentIdentifier(uri)))
-
-
-async def diagnostics_of(
-    client: LanguageClient,
-    uri: str,
-    until: Callable[[Sequence[types.Diagnostic]], bool] = lambda found: True,
-    timeout: float = 20.0,
-) -> list[types.Diagnostic]:
-    """The diagnostics published for ``uri`` once they satisfy ``until``."""
-    loop = asyncio.get_running_loop()
-    deadline = loop.time() + timeout
-    while True:
-        found = client.diagnostics.get(uri)
-        if found is not None and until(found):
-            return list(found)
-        if loop.time() > deadline:
-            raise AssertionError(f"no such diagnostics for {uri}; last: {found}")
-        await asyncio.sleep(0.02)
 
 
 def span(diagnostic: types.Diagnostic) -> tuple[int, int, int, int]:
     r = diagnostic.range
     return (r.start.line, r.start.character, r.end.line, r.end.character)
-
-
-def position(text: str, needle: str, after: int = 0) -> types.Position:
-    """The position ``after`` characters into the first ``needle`` of ``text``."""
-    offset = text.index(needle) + after
-    line = text.count("\n", 0, offset)
-    return types.Position(line, offset - (text.rfind("\n", 0, offset) + 1))
 
 
 # ------------------------------------------------------------------ diagnostics

@@ -4,8 +4,6 @@ formatting, quick fixes and symbols, driven by a real LSP client over stdio."""
 from __future__ import annotations
 
 import asyncio
-import shutil
-import sys
 from collections.abc import AsyncIterator
 from pathlib import Path
 
@@ -13,60 +11,32 @@ import pytest
 import pytest_lsp
 from lsprotocol import types
 from pygls.exceptions import JsonRpcException
-from pygls.uris import from_fs_path
 from pytest_lsp import ClientServerConfig, LanguageClient
 
-from conftest import EXAMPLES, run_exscec
+from conftest import run_exscec
+from lsp_helpers import (
+    EXSCEC,
+    close_document,
+    copy_workspace,
+    diagnostics_of,
+    open_document,
+    position,
+    start_session,
+)
 
 pytestmark = pytest.mark.asyncio(loop_scope="module")
-
-EXSCEC = str(Path(sys.executable).with_name("exscec"))
 
 
 @pytest.fixture(scope="module")
 def workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    folder = tmp_path_factory.mktemp("lsp-nav") / "bc"
-    shutil.copytree(EXAMPLES / "brsu_building_c", folder)
-    return folder
+    return copy_workspace(tmp_path_factory, "lsp-nav")
 
 
 @pytest_lsp.fixture(scope="module", config=ClientServerConfig(server_command=[EXSCEC, "lsp"]))
 async def client(lsp_client: LanguageClient, workspace: Path) -> AsyncIterator[None]:
-    uri = from_fs_path(str(workspace))
-    await lsp_client.initialize_session(
-        types.InitializeParams(
-            capabilities=pytest_lsp.client_capabilities("visual-studio-code"),
-            root_uri=uri,
-            workspace_folders=[types.WorkspaceFolder(uri, "bc")],
-            initialization_options={"shacl": False},
-        )
-    )
+    await start_session(lsp_client, workspace, {"shacl": False})
     yield
     await lsp_client.shutdown_session()
-
-
-def uri_of(path: Path) -> str:
-    return from_fs_path(str(path)) or ""
-
-
-def open_document(client: LanguageClient, path: Path, text: str | None = None) -> str:
-    uri = uri_of(path)
-    client.diagnostics.pop(uri, None)
-    source = path.read_text() if text is None else text
-    client.text_document_did_open(
-        types.DidOpenTextDocumentParams(types.TextDocumentItem(uri, "exsce", 1, source))
-    )
-    return uri
-
-
-def close_document(client: LanguageClient, uri: str) -> None:
-    client.text_document_did_close(types.DidCloseTextDocumentParams(types.TextDocumentIdentifier(uri)))
-
-
-def position(text: str, needle: str, after: int = 0) -> types.Position:
-    offset = text.index(needle) + after
-    line = text.count("\n", 0, offset)
-    return types.Position(line, offset - (text.rfind("\n", 0, offset) + 1))
 
 
 def where(location: types.Location) -> tuple[str, int, int, int, int]:
@@ -90,13 +60,6 @@ def apply(text: str, edits: list[types.TextEdit]) -> str:
     return text
 
 
-async def diagnostics_of(client: LanguageClient, uri: str, count: int) -> list[types.Diagnostic]:
-    for _ in range(1000):
-        found = client.diagnostics.get(uri)
-        if found is not None and len(found) == count:
-            return list(found)
-        await asyncio.sleep(0.02)
-    raise AssertionError(f"not {count} diagnostics for {uri}: {client.diagnostics.get(uri)}")
 
 
 # ------------------------------------------------------------------- definition
@@ -260,7 +223,7 @@ async def test_a_quick_fix_writes_the_suggested_name(client: LanguageClient, wor
     path = workspace / "tasks" / "navigation.exsce"
     text = path.read_text().replace("visit classroom_c025-w002", "visit c025-w02")
     uri = open_document(client, path, text)
-    (diagnostic,) = await diagnostics_of(client, uri, 1)
+    (diagnostic,) = await diagnostics_of(client, uri, lambda found: len(found) == 1)
     actions = await client.text_document_code_action_async(
         types.CodeActionParams(
             types.TextDocumentIdentifier(uri), diagnostic.range, types.CodeActionContext([diagnostic])

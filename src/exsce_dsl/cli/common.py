@@ -64,6 +64,12 @@ def reports_errors(func: F) -> F:
     return wrapper  # type: ignore[return-value]
 
 
+def bag_arguments(args: Iterable[str]) -> list[str]:
+    """The arguments that may be bags: not the ``.prov.json`` files the recorder writes beside them
+    (so that ``runs/*`` works)."""
+    return [a for a in args if not a.endswith(".prov.json")]
+
+
 def write_text(text: str, output: str | None) -> None:
     """Print ``text``, or write it to ``output`` and say so on stderr."""
     if output is None:

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from exsce_dsl.cli.common import reports_errors, write_text
+from exsce_dsl.cli.common import bag_arguments, reports_errors, write_text
 from exsce_dsl.cli.store_commands import store_option
 
 
@@ -111,8 +111,7 @@ def verify(
     from exsce_dsl.store.writing import add_prov
 
     scenario = load_spec(spec).scenario(scenario_id)
-    # bags are files (ROS 1, MCAP) or folders (ROS 2); the recorder's .prov.json files beside them are not
-    bags = [Path(r) for r in runs if Path(r).exists() and not r.endswith(".prov.json")]
+    bags = [Path(r) for r in bag_arguments(runs) if Path(r).exists()]  # files, or ROS 2 bag folders
     uuids = [r for r in runs if not Path(r).exists()]
     with open_store(store_url) as store:
         if bags:

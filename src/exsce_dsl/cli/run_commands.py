@@ -7,7 +7,7 @@ from pathlib import Path
 
 import click
 
-from exsce_dsl.cli.common import reports_errors
+from exsce_dsl.cli.common import bag_arguments, reports_errors
 
 
 @click.command()
@@ -102,7 +102,7 @@ def ingest(
     from exsce_dsl.store.open import open_store
 
     scenario = load_spec(spec).scenario(scenario_id)
-    paths = [Path(b) for b in bags if not b.endswith(".prov.json")]  # the recorder's files beside bags
+    paths = [Path(b) for b in bag_arguments(bags)]
     if not paths:
         raise click.UsageError("no bag among the files given")
     with (

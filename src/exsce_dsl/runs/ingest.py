@@ -69,15 +69,6 @@ def _workers(jobs: int, tasks: int) -> Iterator[Mapper]:
         yield pool.map
 
 
-def analyse_all(
-    paths: Sequence[Path], scenario: Scenario, jobs: int = 1, digests: Sequence[str | None] | None = None
-) -> Iterator[AnalysedRun | ExsceError]:
-    """Analyse bags in order, in ``jobs`` processes (bag reading and metrics are the costly part)."""
-    known = list(digests) if digests is not None else [None] * len(paths)
-    with _workers(jobs, len(paths)) as mapper:
-        yield from mapper(_analyse, [(p, scenario, d) for p, d in zip(paths, known, strict=True)])
-
-
 def ingest_bags(
     paths: Sequence[Path],
     scenario: Scenario,
