@@ -1,14 +1,27 @@
-"""The ROS message types a metric may read, and the fields exsce decodes from their raw bytes.
+"""ROS message fields as a metric sees them: field trees, and paths into them.
 
-Field paths are the message definition's (``linear.x``, ``pose.pose.position.x``,
-``ranges``); ROS 1 and ROS 2 names of a type are one (``geometry_msgs/Twist`` is
-``geometry_msgs/msg/Twist``).  The waypoint dispatcher's feedback and result are
-read as windows and successes (``elapsed``, ``succeeded``), not field by field.
+A message type's fields form a tree (:data:`Fields`): a leaf is a number, an
+array of numbers, text or an array of texts; an inner node is a sub-message; an
+array of sub-messages is a :class:`MessageArray`.  Where a type's definition
+comes from (the bag, rosbags' typestores, the user's ``.msg`` files) is the
+business of :mod:`exsce_dsl.messages`; this module only describes shapes.
+
+A :class:`FieldPath` names what a metric reads of a message: field names, an
+element of an array (``status_list[0]``, ``ranges[-1]``), the element of an
+array of messages whose field has a value (``transforms[child_frame_id ==
+"base_link"]``), or the length of an array (``len(status_list)``).  Its
+:attr:`FieldPath.key` is the one text by which the bag reader, the monitors
+and the formatter know it.  ROS 1 and ROS 2 names of a type are one
+(``geometry_msgs/Twist`` is ``geometry_msgs/msg/Twist``).  The waypoint
+dispatcher's feedback and result are read as windows and successes
+(``elapsed``, ``succeeded``), not field by field.
 """
 
 from __future__ import annotations
 
 import enum
+import json
+from dataclasses import dataclass
 from typing import Union
 
 
@@ -16,76 +29,96 @@ class Leaf(enum.Enum):
     NUMBER = "a number"
     ARRAY = "an array of numbers"
     TEXT = "text"
+    TEXTS = "an array of texts"
 
 
-Fields = dict[str, Union[Leaf, "Fields"]]
+@dataclass(frozen=True)
+class MessageArray:
+    """An array of sub-messages (``transforms`` of a ``tf2_msgs/msg/TFMessage``)."""
 
-_VECTOR3: Fields = {"x": Leaf.NUMBER, "y": Leaf.NUMBER, "z": Leaf.NUMBER}
-_QUATERNION: Fields = {"x": Leaf.NUMBER, "y": Leaf.NUMBER, "z": Leaf.NUMBER, "w": Leaf.NUMBER}
-_HEADER: Fields = {"stamp": {"sec": Leaf.NUMBER, "nanosec": Leaf.NUMBER}, "frame_id": Leaf.TEXT}
+    element: Fields
+    length: int | None = None
+    """The fixed length of the array, None for a sequence."""
 
-TWIST = "geometry_msgs/msg/Twist"
-POSE = "geometry_msgs/msg/PoseWithCovarianceStamped"
-FLOAT64 = "std_msgs/msg/Float64"
-SCAN = "sensor_msgs/msg/LaserScan"
+
+Node = Union[Leaf, MessageArray, "Fields"]
+Fields = dict[str, Node]
+
 FEEDBACK = "waypoint_dispatcher/msg/FollowWaypointsActionFeedback"
 RESULT = "waypoint_dispatcher/msg/FollowWaypointsActionResult"
-
-MESSAGES: dict[str, Fields] = {
-    TWIST: {"linear": _VECTOR3, "angular": _VECTOR3},
-    POSE: {
-        "header": _HEADER,
-        "pose": {
-            "pose": {"position": _VECTOR3, "orientation": _QUATERNION},
-            "covariance": Leaf.ARRAY,
-        },
-    },
-    FLOAT64: {"data": Leaf.NUMBER},
-    SCAN: {
-        "header": _HEADER,
-        "angle_min": Leaf.NUMBER,
-        "angle_max": Leaf.NUMBER,
-        "angle_increment": Leaf.NUMBER,
-        "time_increment": Leaf.NUMBER,
-        "scan_time": Leaf.NUMBER,
-        "range_min": Leaf.NUMBER,
-        "range_max": Leaf.NUMBER,
-        "ranges": Leaf.ARRAY,
-        "intensities": Leaf.ARRAY,
-    },
-}
-"""Decoded types: each field and what it holds."""
-
 DISPATCHER = (FEEDBACK, RESULT)
 """Read whole by the run's segmentation; a metric uses them through ``elapsed`` and ``succeeded``."""
+
+POSE = "geometry_msgs/msg/PoseWithCovarianceStamped"
+"""The method's robot pose (``/{ns}/robot_pose``), where hotspots are placed."""
+
+
+@dataclass(frozen=True)
+class Index:
+    """``[3]`` or ``[-1]``: one element of an array (counted from the end when negative)."""
+
+    position: int
+
+    def text(self) -> str:
+        return f"[{self.position}]"
+
+
+@dataclass(frozen=True)
+class Select:
+    """``[child_frame_id == "base_link"]``: the first element of an array of messages whose
+    field (a path of names) equals ``value``."""
+
+    field: tuple[str, ...]
+    value: str | float
+
+    def text(self) -> str:
+        value = json.dumps(self.value) if isinstance(self.value, str) else _number(self.value)
+        return f"[{'.'.join(self.field)} == {value}]"
+
+
+Step = Union[str, Index, Select]
+
+
+@dataclass(frozen=True)
+class FieldPath:
+    """What a metric reads of one message: ``steps`` from the message's top, or their ``length``."""
+
+    steps: tuple[Step, ...]
+    length: bool = False
+
+    @property
+    def key(self) -> str:
+        """The path's one text: ``pose.pose.position.x``, ``transforms[child_frame_id ==
+        "base_link"].transform.translation.x``, ``len(status_list)``."""
+        text = ""
+        for step in self.steps:
+            if isinstance(step, str):
+                text += f".{step}" if text else step
+            else:
+                text += step.text()
+        return f"len({text})" if self.length else text
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The field names along the path, without indices and selections."""
+        return tuple(s for s in self.steps if isinstance(s, str))
+
+    @property
+    def picks(self) -> bool:
+        """Whether the path picks elements of arrays, so that a message may have no value."""
+        return any(not isinstance(s, str) for s in self.steps)
+
+
+def path_of(*names: str) -> FieldPath:
+    """A path of plain field names: ``path_of("linear", "x")``."""
+    return FieldPath(tuple(names))
 
 
 def canonical_type(name: str) -> str:
     """``pkg/Type`` and ``pkg/msg/Type`` are one type; the ROS 2 spelling is kept."""
     package, _, rest = name.partition("/")
-    return name if rest.startswith("msg/") else f"{package}/msg/{rest}"
+    return name if "/" in rest else f"{package}/msg/{rest}"
 
 
-def field_of(msgtype: str, path: tuple[str, ...]) -> Leaf | Fields | None:
-    """What ``path`` names in ``msgtype`` (a leaf, or a sub-message), None if it does not exist."""
-    node: Leaf | Fields = MESSAGES[msgtype]
-    for part in path:
-        if not isinstance(node, dict) or part not in node:
-            return None
-        node = node[part]
-    return node
-
-
-def leaf_paths(msgtype: str) -> dict[str, Leaf]:
-    """Every leaf of ``msgtype`` by its dotted path."""
-    found: dict[str, Leaf] = {}
-
-    def visit(node: Fields, prefix: str) -> None:
-        for name, child in node.items():
-            if isinstance(child, dict):
-                visit(child, f"{prefix}{name}.")
-            else:
-                found[f"{prefix}{name}"] = child
-
-    visit(MESSAGES[msgtype], "")
-    return found
+def _number(value: float) -> str:
+    return str(int(value)) if float(value).is_integer() else repr(float(value))

@@ -11,14 +11,15 @@ from types import ModuleType
 
 from exsce_dsl.lang.standard_metrics import standard_metrics
 from exsce_dsl.model import Scenario
-from exsce_dsl.model.messages import DISPATCHER, POSE
+from exsce_dsl.model.expressions import Field, walk
+from exsce_dsl.model.messages import DISPATCHER, POSE, FieldPath
 from exsce_dsl.model.metrics import MetricDefinition
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Bag, Run, TaskExecution
-from exsce_dsl.runs.bagdata import BagError, Reduce, read_bag
+from exsce_dsl.runs.bagdata import ANY, BagError, Reduce, Wanted, read_bag
 from exsce_dsl.runs.monitor_code import load_monitors
-from exsce_dsl.runs.monitor_core import Compute, Topic, reducer
-from exsce_dsl.runs.monitoring import POSE_TOPIC, compute_metrics
+from exsce_dsl.runs.monitor_core import Compute, Topic, reducer, topic_name
+from exsce_dsl.runs.monitoring import HOTSPOT_PATHS, POSE_TOPIC, compute_metrics
 from exsce_dsl.runs.segments import SUCCEEDED, Segment, segments
 
 _RUN_NAMESPACE = uuid.UUID("5b8f9a52-3f0c-4a8e-8f0e-2d6c1b7e4a90")
@@ -54,18 +55,33 @@ def run_metrics(scenario: Scenario) -> tuple[MetricDefinition, ...]:
     return standard_metrics() + scenario.metrics
 
 
-def wanted_topics(metrics: tuple[MetricDefinition, ...], robots: list[Robot]) -> dict[str, str]:
-    """Topic → message type (``*`` for the dispatcher's) of everything the metrics read."""
-    wanted: dict[str, str] = {}
+def wanted_topics(metrics: tuple[MetricDefinition, ...], robots: list[Robot]) -> dict[str, Wanted]:
+    """Topic → its message type (``*`` for the dispatcher's) and the fields the metrics read of it
+    (and of each robot's pose, where hotspots are placed)."""
+    types: dict[str, str] = {}
+    paths: dict[str, dict[FieldPath, None]] = {}
     for robot in robots:
         ns = robot.namespace.strip("/")
-        for pattern, msgtype in [(_FEEDBACK, "*"), (_RESULT, "*"), (POSE_TOPIC, POSE)]:
-            wanted[pattern.replace("{ns}", ns)] = msgtype
+        for pattern, msgtype in [(_FEEDBACK, ANY), (_RESULT, ANY), (POSE_TOPIC, POSE)]:
+            types[topic_name(pattern, ns)] = msgtype
+        paths.setdefault(topic_name(POSE_TOPIC, ns), {}).update(dict.fromkeys(HOTSPOT_PATHS))
         for metric in metrics:
+            read_paths = fields_read(metric)
             for read in metric.reads:
-                msgtype = "*" if read.msgtype in DISPATCHER else read.msgtype
-                wanted.setdefault(read.topic_of(ns), msgtype)
-    return wanted
+                topic = topic_name(read.topic, ns)
+                types.setdefault(topic, ANY if read.msgtype in DISPATCHER else read.msgtype)
+                paths.setdefault(topic, {}).update(dict.fromkeys(read_paths.get(read.name, ())))
+    return {topic: Wanted(msgtype, tuple(paths.get(topic, {}))) for topic, msgtype in types.items()}
+
+
+def fields_read(metric: MetricDefinition) -> dict[str, list[FieldPath]]:
+    """Read name → the field paths the metric's expressions use of it."""
+    found: dict[str, list[FieldPath]] = {}
+    for expr in (metric.value, metric.fallback):
+        for node in walk(expr) if expr is not None else []:
+            if isinstance(node, Field) and node.path not in found.setdefault(node.read, []):
+                found[node.read].append(node.path)
+    return found
 
 
 def reductions(monitors: ModuleType, robots: list[Robot]) -> dict[str, Reduce]:
@@ -74,7 +90,7 @@ def reductions(monitors: ModuleType, robots: list[Robot]) -> dict[str, Reduce]:
     entries: dict[str, list[tuple[str, str, Compute]]] = {}
     for robot in robots:
         for pattern, key, func, compute in monitors.REDUCERS:
-            entries.setdefault(pattern.replace("{ns}", robot.namespace.strip("/")), []).append(
+            entries.setdefault(topic_name(pattern, robot.namespace), []).append(
                 (key, func, compute)
             )
     return {topic: reducer(found) for topic, found in entries.items()}
@@ -95,7 +111,7 @@ def analyse_bag(path: Path, scenario: Scenario, digest: str | None = None) -> An
     results: dict[str, int | None] = {}
     for robot in robots:
         ns = robot.namespace.strip("/")
-        feedback, result = _FEEDBACK.replace("{ns}", ns), _RESULT.replace("{ns}", ns)
+        feedback, result = topic_name(_FEEDBACK, ns), topic_name(_RESULT, ns)
         updates = data.feedback.get(feedback)
         if updates is None:
             problems.append(f"topic {feedback} is missing: no path segments for '{robot.id}'")

@@ -1,28 +1,45 @@
 """Read the topics a run's metrics need from a bag (ROS 1, ROS 2 sqlite3, MCAP).
 
-Only the needed connections are read.  Fixed-layout messages (poses, scans,
-twists, floats) become numpy arrays over their raw bytes
-(:mod:`exsce_dsl.runs.decode`); the dispatcher's few feedback and result
-messages are deserialized by rosbags, with their types taken from the bag.
+Only the needed connections are read, and of their messages only the fields
+the metrics read (:mod:`exsce_dsl.runs.decode`, a decoder driven by the
+message definition).  A type's definition comes from the bag itself (a ROS 1
+connection's definition, an MCAP schema, a ROS 2 bag's type descriptions),
+else from the user's ``.msg``/``.idl`` files, else from rosbags' standard
+typestores.  Several connections on one topic are merged, and every topic's
+messages are put in time order.  The dispatcher's few feedback and result
+messages are deserialized by rosbags.
 """
 
 from __future__ import annotations
 
-import functools
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from rosbags.highlevel import AnyReader
-from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+from rosbags.typesys import Stores, get_typestore
 
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.runs.decode import FIXED_TYPES, DecodeError, Layout, decode, decode_rows, layout
+from exsce_dsl.messages.catalogue import (
+    MessageCatalogue,
+    MessageTypeError,
+    Source,
+    parse_definition,
+    standard_catalogue,
+    standard_ros1_catalogue,
+)
+from exsce_dsl.messages.user import configured_user_catalogue
+from exsce_dsl.model.messages import FieldPath, Fields, canonical_type
+from exsce_dsl.runs.decode import DecodeError, RawMessages, decode, decode_slowly, vectorisable
 from exsce_dsl.runs.ros1_index import UnsupportedBag, read_topics
 
 _PROGRESS = {0: 0, 1: 1}  # PENDING, ACTIVE; every other status is final
+BLOCK = 4096
+"""Messages decoded at a time from readers that hand out one message at a time (rosbags')."""
+ANY = "*"
+"""The expected type of the dispatcher's topics: whatever the bag says, deserialized whole."""
 
 
 class BagError(ExsceError):
@@ -30,8 +47,17 @@ class BagError(ExsceError):
 
 
 @dataclass(frozen=True)
+class Wanted:
+    """What is read of one topic: its expected type (``*``: the dispatcher's, read whole) and
+    the field paths the metrics use."""
+
+    msgtype: str
+    paths: tuple[FieldPath, ...] = ()
+
+
+@dataclass(frozen=True)
 class Series:
-    """One topic: receive times (seconds since the epoch, sorted) and decoded fields."""
+    """One topic: receive times (seconds since the epoch, sorted) and decoded fields by key."""
 
     topic: str
     msgtype: str
@@ -72,33 +98,74 @@ def typestore_for(path: Path):  # type: ignore[no-untyped-def]
 Reduce = Callable[[dict[str, np.ndarray]], dict[str, np.ndarray]]
 """Turns a block of decoded messages into the fields kept of them (arrays reduced per message)."""
 
+Check = Callable[[str, str, Fields, Source | None], None]
+"""(topic, message type, its fields, where the definition came from) → raises if the metrics read
+a field the type does not have; called before any message of the topic is decoded."""
 
-def read_bag(path: Path, wanted: Mapping[str, str], reduce: Mapping[str, Reduce] | None = None) -> BagData:
-    """Read the ``wanted`` topics (topic → expected message type; ``*`` for the dispatcher's).
+
+def read_bag(
+    path: Path,
+    wanted: Mapping[str, Wanted],
+    reduce: Mapping[str, Reduce] | None = None,
+    check: Check | None = None,
+) -> BagData:
+    """Read the ``wanted`` topics.
 
     ``reduce`` (topic → function) is applied to each block of decoded messages as
     it is read, so that large arrays (laser ranges) are reduced per message and
     never all held at once; given a ``reduce``, array fields are not kept (what
-    is needed of them is reduced).  Without it, every field is kept.
+    is needed of them is reduced).  Without it, every wanted field is kept.
     """
     if not path.exists():
         raise BagError(f"{path}: no such bag")
-    if _is_ros1(path):
-        try:
-            return _read_ros1_index(path, wanted, reduce)
-        except UnsupportedBag:
-            pass  # rosbags reads what our index reader does not (and reports what is broken)
-        except DecodeError as exc:
-            raise BagError(f"{path}: {exc.message}") from None
     try:
-        with AnyReader([path], default_typestore=typestore_for(path)) as reader:
-            return _read(reader, path, wanted, reduce)
+        if _is_ros1(path):
+            try:
+                return _Ros1(path, wanted, reduce, check).read()
+            except UnsupportedBag:
+                pass  # rosbags reads what our index reader does not (and reports what is broken)
+        return _read_with_rosbags(path, wanted, reduce, check)
     except BagError:
         raise
-    except DecodeError as exc:
+    except (DecodeError, MessageTypeError) as exc:
         raise BagError(f"{path}: {exc.message}") from None
-    except Exception as exc:  # rosbags' readers raise their own errors for corrupt and truncated files
-        raise BagError(f"{path}: cannot read the bag: {type(exc).__name__}: {exc}") from None
+
+
+class _Topic:
+    """The messages of one topic as they are decoded, block by block."""
+
+    def __init__(self, topic: str, msgtype: str) -> None:
+        self.topic = topic
+        self.msgtype = msgtype
+        self.times: list[np.ndarray] = []
+        self.blocks: list[dict[str, np.ndarray]] = []
+
+    def add(self, times: np.ndarray, fields: dict[str, np.ndarray]) -> None:
+        self.times.append(times)
+        self.blocks.append(fields)
+
+    def series(self) -> Series:
+        times = np.concatenate(self.times) if self.times else np.zeros(0, dtype=np.int64)
+        order = np.argsort(times, kind="stable")  # recordings out of time order are put in order
+        in_order = bool(np.all(order[1:] > order[:-1]))
+        fields = {}
+        for key in self.blocks[0] if self.blocks else {}:
+            values = _concatenate([b[key] for b in self.blocks])
+            fields[key] = values if in_order else values[order]
+        return Series(self.topic, self.msgtype, times[order] / 1e9, fields)
+
+
+def _concatenate(parts: Sequence[np.ndarray]) -> np.ndarray:
+    """Blocks of one field joined; rows of arrays padded with NaN to the widest block."""
+    if len(parts) == 1:
+        return parts[0]
+    if parts[0].ndim == 2:
+        width = max(p.shape[1] for p in parts)
+        parts = [
+            p if p.shape[1] == width else np.pad(p, ((0, 0), (0, width - p.shape[1])), constant_values=np.nan)
+            for p in parts
+        ]
+    return np.concatenate(parts)
 
 
 def _kept(
@@ -111,109 +178,217 @@ def _kept(
     return {k: v for k, v in fields.items() if v.ndim == 1}
 
 
-def _read(
-    reader: AnyReader, path: Path, wanted: Mapping[str, str], reduce: Mapping[str, Reduce] | None
-) -> BagData:
-    if reader.message_count == 0:
-        raise BagError(f"{path}: the bag holds no messages")
-    data = BagData(
-        path,
-        reader.start_time / 1e9,
-        reader.end_time / 1e9,
-        tuple(sorted({c.topic for c in reader.connections})),
-    )
-    by_topic: dict[str, list] = {}  # type: ignore[type-arg]
-    for conn in reader.connections:
-        if conn.topic in wanted:
-            by_topic.setdefault(conn.topic, []).append(conn)
-    for topic, conns in sorted(by_topic.items()):
-        expected = wanted[topic]
-        msgtype = conns[0].msgtype
-        if expected != "*" and msgtype != expected:
-            data.problems.append(f"topic {topic} carries {msgtype}, not {expected}: its metrics are missing")
-            continue
-        stamps: list[int] = []
-        raws: list[bytes | memoryview] = []
-        for _, timestamp, raw in reader.messages(connections=conns):
-            stamps.append(timestamp)
-            raws.append(raw)
-        if not raws:
-            continue
-        times = np.asarray(stamps, dtype=np.int64)
-        order = np.argsort(times, kind="stable")  # out-of-order recordings are put in time order
-        if msgtype in FIXED_TYPES:
-            in_order = raws if np.all(order[1:] > order[:-1]) else [raws[i] for i in order]
-            fields = decode(
-                msgtype,
-                in_order,
-                cdr=not _is_ros1(path),
-                fallback=functools.partial(_deserialize, reader, msgtype),
+class _Reading:
+    """What reading one bag needs, whatever its format: which topics, how to decode and check."""
+
+    def __init__(
+        self,
+        path: Path,
+        wanted: Mapping[str, Wanted],
+        reduce: Mapping[str, Reduce] | None,
+        check: Check | None,
+    ) -> None:
+        self.path = path
+        self.wanted = wanted
+        self.reduce = reduce
+        self.check = check
+        self.topics: dict[str, _Topic] = {}
+        self.updates: dict[str, list[StatusUpdate]] = {}
+        self.problems: list[str] = []
+        self.checked: set[tuple[str, str]] = set()
+
+    def accepts(self, topic: str, msgtype: str) -> bool:
+        """Whether the connection of ``topic`` with ``msgtype`` is read (a problem says why not)."""
+        expected = self.wanted[topic].msgtype
+        msgtype = canonical_type(msgtype)
+        if expected != ANY and msgtype != canonical_type(expected):
+            problem = f"topic {topic} carries {msgtype}, not {expected}: its metrics are missing"
+            if problem not in self.problems:
+                self.problems.append(problem)
+            return False
+        found = self.topics.get(topic)
+        if found is not None and found.msgtype != msgtype:
+            raise BagError(f"{self.path}: topic {topic} carries both {found.msgtype} and {msgtype}")
+        return True
+
+    def prepare(self, topic: str, msgtype: str, catalogue: MessageCatalogue) -> None:
+        """Check the fields the metrics read of ``topic`` against the type's definition, once."""
+        if (topic, msgtype) in self.checked or self.wanted[topic].msgtype == ANY:
+            return
+        lacking = catalogue.missing(msgtype)
+        if lacking:
+            raise BagError(
+                f"{self.path}: no definition of {', '.join(lacking)} (topic {topic}): the bag carries none "
+                "and no .msg/.idl file gives it; point EXSCE_MSG_PATH (or exscec --msg-path) at a folder "
+                "of message packages"
             )
-            data.series[topic] = Series(topic, msgtype, times[order] / 1e9, _kept(fields, topic, reduce))
-            del raws, in_order  # the decoded buffer is all that is kept
-        else:
-            updates = [
-                _status_update(reader.deserialize(raws[i], msgtype), times[i] / 1e9, topic) for i in order
-            ]
+        if self.check is not None:
+            self.check(topic, canonical_type(msgtype), catalogue.tree(msgtype), catalogue.source_of(msgtype))
+        self.checked.add((topic, msgtype))
+
+    def add(
+        self,
+        topic: str,
+        msgtype: str,
+        times: np.ndarray,
+        fields: dict[str, np.ndarray],
+    ) -> None:
+        msgtype = canonical_type(msgtype)
+        found = self.topics.setdefault(topic, _Topic(topic, msgtype))
+        found.add(times, _kept(fields, topic, self.reduce))
+
+    def add_updates(self, topic: str, updates: list[StatusUpdate]) -> None:
+        self.updates.setdefault(topic, []).extend(updates)
+
+    def data(self, start: float, end: float, topics: tuple[str, ...]) -> BagData:
+        data = BagData(self.path, start, end, topics, problems=self.problems)
+        for topic, found in sorted(self.topics.items()):
+            data.series[topic] = found.series()
+        for topic, updates in sorted(self.updates.items()):
             # statuses only move forward: updates recorded at the same instant go in that order
             updates.sort(key=lambda u: (u.t, sum(_PROGRESS.get(s, 2) for s in u.statuses)))
-            target = data.results if topic.endswith("/result") else data.feedback
-            target[topic] = updates
-    return data
+            (data.results if topic.endswith("/result") else data.feedback)[topic] = updates
+        return data
 
 
-def _read_ros1_index(
-    path: Path, wanted: Mapping[str, str], reduce: Mapping[str, Reduce] | None
-) -> BagData:
+class _Ros1(_Reading):
     """The fast path for ROS 1 bags: the bag's own index, numpy gathers, no per-message Python."""
-    layouts: dict[str, Layout] = {}
 
-    def decoder(topic: str, msgtype: str, rows: np.ndarray) -> dict[str, np.ndarray] | None:
-        if msgtype not in FIXED_TYPES or wanted.get(topic) not in (msgtype, "*"):
-            return None
-        shape = layouts.get(topic) or layouts.setdefault(topic, layout(msgtype, bytes(rows[0]), cdr=False))
-        if shape.size != rows.shape[1]:
-            raise DecodeError(f"{msgtype} messages on {topic} are not the size their type says")
-        return _kept(decode_rows(shape, rows), topic, reduce)
+    def read(self) -> BagData:
+        self.catalogues: dict[str, MessageCatalogue] = {}
+        found = read_topics(self.path, set(self.wanted), self._decoder)
+        if not found:
+            raise UnsupportedBag("none of the topics")  # rosbags then says whether the bag is empty
+        start = min(int(m.times.min()) for m in found.values())
+        end = max(int(m.times.max()) for m in found.values())
+        for topic, messages in sorted(found.items()):
+            if not messages.raws:
+                continue
+            store = deserializer_for(self._catalogue(messages.msgtype, messages.definition), messages.msgtype)
+            order = np.argsort(messages.times, kind="stable")
+            times = messages.times[order] / 1e9
+            updates = [
+                _status_update(store.deserialize_ros1(messages.raws[i], messages.msgtype), t, topic)
+                for i, t in zip(order.tolist(), times.tolist(), strict=True)
+            ]
+            self.add_updates(topic, updates)
+        return self.data(start / 1e9, end / 1e9, tuple(sorted(found)))
 
-    found = read_topics(path, set(wanted), decoder)
-    if not found:
-        raise UnsupportedBag("none of the topics")  # rosbags then says whether the bag is empty
-    start = min(int(m.times.min()) for m in found.values())
-    end = max(int(m.times.max()) for m in found.values())
-    data = BagData(path, start / 1e9, end / 1e9, tuple(sorted(found)))
-    store = get_typestore(Stores.ROS1_NOETIC)
-    for topic, messages in sorted(found.items()):
-        expected, msgtype = wanted[topic], messages.msgtype
-        if expected != "*" and msgtype != expected:
-            data.problems.append(f"topic {topic} carries {msgtype}, not {expected}: its metrics are missing")
-            continue
-        order = np.argsort(messages.times, kind="stable")
-        times = messages.times[order] / 1e9
-        if messages.fields is not None:
-            sorted_fields = {k: v[order] for k, v in messages.fields.items()}
-            data.series[topic] = Series(topic, msgtype, times, sorted_fields)
-            continue
-        if msgtype not in store.types:
-            store.register(get_types_from_msg(messages.definition, msgtype))
-        raws = [messages.raws[i] for i in order]
-        if msgtype in FIXED_TYPES:
-            fields = decode(
-                msgtype, raws, cdr=False, fallback=functools.partial(store.deserialize_ros1, typename=msgtype)
-            )
-            data.series[topic] = Series(topic, msgtype, times, _kept(fields, topic, reduce))
-            continue
-        updates = [
-            _status_update(store.deserialize_ros1(r, msgtype), t, topic)
-            for r, t in zip(raws, times, strict=True)
-        ]
-        updates.sort(key=lambda u: (u.t, sum(_PROGRESS.get(s, 2) for s in u.statuses)))
-        (data.results if topic.endswith("/result") else data.feedback)[topic] = updates
+    def _catalogue(self, msgtype: str, definition: str) -> MessageCatalogue:
+        if msgtype not in self.catalogues:
+            source = Source(f"the bag {self.path.name}")
+            own = MessageCatalogue()
+            if definition.strip():
+                own = parse_definition(definition, msgtype, "msg", source)
+            self.catalogues[msgtype] = own.layered(configured_user_catalogue(), standard_ros1_catalogue())
+        return self.catalogues[msgtype]
+
+    def _decoder(
+        self, topic: str, msgtype: str, definition: str, times: np.ndarray, messages: RawMessages
+    ) -> bool:
+        """Decode one chunk's messages of a topic; False: keep their bytes (the dispatcher's)."""
+        if not self.accepts(topic, msgtype):
+            return True  # nothing kept
+        if self.wanted[topic].msgtype == ANY:
+            return False
+        catalogue = self._catalogue(msgtype, definition)
+        self.prepare(topic, msgtype, catalogue)
+        paths = self.wanted[topic].paths
+        if vectorisable(catalogue, msgtype):
+            fields = decode(catalogue, msgtype, messages, paths, cdr=False)
+        else:
+            store = deserializer_for(catalogue, msgtype)
+            spans = zip(messages.starts.tolist(), messages.ends.tolist(), strict=True)
+            raws = [messages.buffer[start:end].tobytes() for start, end in spans]
+            fields = decode_slowly(lambda raw: store.deserialize_ros1(raw, msgtype), raws, paths)
+        self.add(topic, msgtype, times, fields)
+        return True
+
+
+def _read_with_rosbags(
+    path: Path, wanted: Mapping[str, Wanted], reduce: Mapping[str, Reduce] | None, check: Check | None
+) -> BagData:
+    try:
+        reader = AnyReader([path], default_typestore=typestore_for(path))
+        reader.open()
+    except Exception as exc:  # rosbags' readers raise their own errors for corrupt and truncated files
+        raise BagError(f"{path}: cannot read the bag: {type(exc).__name__}: {exc}") from None
+    try:
+        if reader.message_count == 0:
+            raise BagError(f"{path}: the bag holds no messages")
+        reading = _Reading(path, wanted, reduce, check)
+        bag_types = MessageCatalogue()
+        bag_types.add(reader.typestore.fielddefs, Source(f"the bag {path.name}"))
+        catalogue = bag_types.layered(configured_user_catalogue(), standard_catalogue())
+        cdr = not _is_ros1(path)
+        by_topic: dict[str, list[Any]] = {}
+        for conn in reader.connections:
+            if conn.topic in wanted and reading.accepts(conn.topic, conn.msgtype):
+                by_topic.setdefault(conn.topic, []).append(conn)
+        for _, conns in sorted(by_topic.items()):
+            for conn in conns:
+                _read_connection(reader, reading, conn, catalogue, cdr)
+        data = reading.data(
+            reader.start_time / 1e9,
+            reader.end_time / 1e9,
+            tuple(sorted({c.topic for c in reader.connections})),
+        )
+    except (BagError, DecodeError, MessageTypeError):
+        raise
+    except Exception as exc:  # rosbags' readers raise their own errors for corrupt and truncated files
+        raise BagError(f"{path}: cannot read the bag: {type(exc).__name__}: {exc}") from None
+    finally:
+        reader.close()
     return data
 
 
-def _deserialize(reader: AnyReader, msgtype: str, raw: bytes | memoryview) -> Any:
-    return reader.deserialize(bytes(raw), msgtype)
+def _read_connection(
+    reader: AnyReader, reading: _Reading, conn: Any, catalogue: MessageCatalogue, cdr: bool
+) -> None:
+    topic, msgtype = conn.topic, canonical_type(conn.msgtype)
+    whole = reading.wanted[topic].msgtype == ANY
+    if not whole:
+        reading.prepare(topic, msgtype, catalogue)
+    fast = not whole and vectorisable(catalogue, msgtype)
+    paths = reading.wanted[topic].paths
+    store = None if fast else deserializer_for(catalogue, msgtype)
+
+    def deserialize(raw: bytes | memoryview) -> Any:
+        assert store is not None
+        raw = bytes(raw)
+        return store.deserialize_cdr(raw, msgtype) if cdr else store.deserialize_ros1(raw, msgtype)
+
+    for stamps, raws in _blocks(reader.messages(connections=[conn])):
+        times = np.asarray(stamps, dtype=np.int64)
+        if whole:
+            updates = [
+                _status_update(deserialize(r), t / 1e9, topic) for r, t in zip(raws, stamps, strict=True)
+            ]
+            reading.add_updates(topic, updates)
+        elif fast:
+            reading.add(topic, msgtype, times, decode(catalogue, msgtype, RawMessages.join(raws), paths, cdr))
+        else:
+            reading.add(topic, msgtype, times, decode_slowly(deserialize, raws, paths))
+
+
+def deserializer_for(catalogue: MessageCatalogue, msgtype: str) -> Any:
+    """A rosbags typestore that knows ``msgtype`` (and only what it needs: registering costs)."""
+    store = get_typestore(Stores.EMPTY)
+    store.register(catalogue.needed(msgtype))
+    return store
+
+
+def _blocks(messages: Iterator[tuple[Any, int, bytes]]) -> Iterator[tuple[list[int], list[bytes]]]:
+    stamps: list[int] = []
+    raws: list[bytes] = []
+    for _, timestamp, raw in messages:
+        stamps.append(timestamp)
+        raws.append(raw)
+        if len(raws) == BLOCK:
+            yield stamps, raws
+            stamps, raws = [], []
+    if raws:
+        yield stamps, raws
 
 
 def _is_ros1(path: Path) -> bool:

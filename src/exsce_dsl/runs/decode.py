@@ -1,28 +1,49 @@
-"""Decode fixed-layout ROS messages as numpy arrays over their raw bytes.
+"""Decode the fields a metric reads from raw ROS messages, with numpy, for any message type.
 
-Messages on one topic almost always have the same layout (same frame id,
-same number of laser beams), so the raw messages of a connection are joined
-into one buffer and read as one structured array: no Python object per
-message.  The offsets follow the ROS 1 serialization and CDR (ROS 2, little
-endian) rules; a connection whose messages differ in length is decoded with
-rosbags instead (slow, but right).
+The decoder is driven by the message definition (rosbags' field descriptions,
+from the bag, a typestore or the user): it walks the fields in order over *all*
+messages at once, keeping each message's read position in an int64 array.
+Fixed-size fields move every position by the same amount; a string or a
+sequence moves each by its own length prefix, read for all messages with one
+gather.  So messages whose sizes differ (a ``frame_id``, a ``child_frame_id``,
+a variable array) cost no Python per message either.  ROS 1 serialization
+packs fields; CDR (ROS 2) aligns each primitive to its size, counted from the
+end of the 4-byte encapsulation header, and may be big-endian.
+
+Only the fields of the wanted :class:`~exsce_dsl.model.messages.FieldPath`\\ s
+are gathered.  An array of messages (``transforms`` of a TFMessage) is walked
+one element index at a time, over every message that has that element: its
+loop runs as many times as the longest array has elements, not once per
+message.  What comes out, per path key:
+
+- a number: one float64 per message;
+- an array of numbers, or a field of every element of an array of messages:
+  one row per message (float32 arrays stay float32), padded with NaN where
+  messages hold fewer elements;
+- a path that picks elements (``[0]``, ``[child_frame_id == "base_link"]``):
+  as above, NaN where a message has no such element, and a boolean mask under
+  ``KEY#present``;
+- ``len(...)``: the number of elements, as float64.
+
+Layouts that truly cannot be vectorised are decoded with rosbags, one message
+object at a time, and read by attribute (:func:`decode_slowly`): ``wstring``
+and ``float128`` fields, which no numpy type matches.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from exsce_dsl.errors import ExsceError
+from exsce_dsl.messages.catalogue import ARRAY, BASE, NAME, NUMERIC, SEQUENCE, MessageCatalogue
+from exsce_dsl.model.messages import FieldPath, Index, Select, Step, canonical_type
+from exsce_dsl.runs.monitor_core import PRESENT
 
-POSE = "geometry_msgs/msg/PoseWithCovarianceStamped"
-TWIST = "geometry_msgs/msg/Twist"
-FLOAT64 = "std_msgs/msg/Float64"
-SCAN = "sensor_msgs/msg/LaserScan"
-FIXED_TYPES = (POSE, TWIST, FLOAT64, SCAN)
+_UNVECTORISED = ("wstring", "float128")
 
 
 class DecodeError(ExsceError):
@@ -30,135 +51,458 @@ class DecodeError(ExsceError):
 
 
 @dataclass(frozen=True)
-class Layout:
-    """Where the fields we need are, in bytes from the start of a raw message."""
+class RawMessages:
+    """Messages of one type, back to back in ``buffer``: message i is ``buffer[starts[i]:ends[i]]``.
 
-    size: int
-    fields: dict[str, tuple[int, str]]  # name -> (offset, numpy scalar type)
-    arrays: dict[str, tuple[int, int, str]] = field(default_factory=dict)
-    """name -> (offset, element count, numpy element type): LaserScan ranges, a pose's covariance."""
+    ``width`` is set when every message has that size and follows the previous
+    one directly, so that fields at the same place in every message are read as
+    a column of a 2-D view, without an index array.
+    """
+
+    buffer: np.ndarray  # uint8
+    starts: np.ndarray  # int64
+    ends: np.ndarray  # int64
+    width: int | None = None
+
+    def __len__(self) -> int:
+        return len(self.starts)
+
+    @staticmethod
+    def join(raws: Sequence[bytes | memoryview]) -> RawMessages:
+        """Messages given one by one, joined into one buffer."""
+        sizes = np.fromiter((len(r) for r in raws), dtype=np.int64, count=len(raws))
+        starts = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64) if len(raws) else sizes
+        buffer = np.frombuffer(b"".join(raws), dtype=np.uint8)
+        width = int(sizes[0]) if len(raws) and np.all(sizes == sizes[0]) else None
+        return RawMessages(buffer, starts, starts + sizes, width)
+
+    @staticmethod
+    def rows(rows: np.ndarray) -> RawMessages:
+        """Equal-size messages given as the rows of a 2-D uint8 array."""
+        n, size = rows.shape
+        starts = np.arange(n, dtype=np.int64) * size
+        return RawMessages(np.ascontiguousarray(rows).reshape(-1), starts, starts + size, size)
 
 
-def _align(offset: int, n: int) -> int:
-    return (offset + n - 1) // n * n
-
-
-def _header(raw: bytes, cdr: bool) -> tuple[int, dict[str, tuple[int, str]]]:
-    """The end of a std_msgs/Header and the stamp fields; ``cdr`` offsets include the 4-byte prefix."""
-    # ROS 1: seq, sec, nsec, frame_id; CDR: prefix, sec, nanosec, frame_id (with its NUL)
-    length = int.from_bytes(raw[12:16], "little")
-    return 16 + length, {"header.stamp.sec": (4, "<i4" if cdr else "<u4"), "header.stamp.nanosec": (8, "<u4")}
-
-
-def layout(msgtype: str, raw: bytes, cdr: bool) -> Layout:
-    """The layout of ``msgtype`` as shown by one raw message of the connection."""
-    base = 4 if cdr else 0  # CDR: a 4-byte encapsulation header; alignment counts after it
-    if cdr and raw[:2] != b"\x00\x01":
-        raise DecodeError("only little-endian CDR is supported")
-    if msgtype == TWIST:
-        names: tuple[str, ...] = ("linear.x", "linear.y", "linear.z", "angular.x", "angular.y", "angular.z")
-        return Layout(base + 48, {n: (base + 8 * i, "<f8") for i, n in enumerate(names)})
-    if msgtype == FLOAT64:
-        return Layout(base + 8, {"data": (base, "<f8")})
-    end, fields = _header(raw, cdr)
-    if msgtype == POSE:
-        start = base + _align(end - base, 8) if cdr else end
-        position = tuple(f"pose.pose.position.{c}" for c in "xyz")
-        names = position + tuple(f"pose.pose.orientation.{c}" for c in "xyzw")
-        fields.update({n: (start + 8 * i, "<f8") for i, n in enumerate(names)})
-        covariance = {"pose.covariance": (start + 8 * 7, 36, "<f8")}
-        return Layout(start + 8 * 7 + 8 * 36, fields, covariance)
-    if msgtype == SCAN:
-        start = base + _align(end - base, 4) if cdr else end
-        names = (
-            "angle_min",
-            "angle_max",
-            "angle_increment",
-            "time_increment",
-            "scan_time",
-            "range_min",
-            "range_max",
-        )
-        fields.update({n: (start + 4 * i, "<f4") for i, n in enumerate(names)})
-        count_at = start + 28
-        beams = int.from_bytes(raw[count_at : count_at + 4], "little")
-        ranges_at = count_at + 4
-        after = ranges_at + 4 * beams
-        intensities = int.from_bytes(raw[after : after + 4], "little")
-        arrays = {"ranges": (ranges_at, beams, "<f4"), "intensities": (after + 4, intensities, "<f4")}
-        return Layout(after + 4 + 4 * intensities, fields, arrays)
-    raise DecodeError(f"no fixed layout for {msgtype}")
+def vectorisable(catalogue: MessageCatalogue, msgtype: str) -> bool:
+    """Whether ``msgtype`` can be decoded by :func:`decode` (no ``wstring`` or ``float128``)."""
+    seen: set[str] = set()
+    todo = [canonical_type(msgtype)]
+    while todo:
+        name = todo.pop()
+        if name in seen:
+            continue
+        seen.add(name)
+        for _, desc in catalogue.fields_of(name):
+            while int(desc[0]) in (ARRAY, SEQUENCE):
+                desc = desc[1][0]
+            if int(desc[0]) == BASE and desc[1][0] in _UNVECTORISED:
+                return False
+            if int(desc[0]) == NAME:
+                todo.append(canonical_type(desc[1]))
+    return True
 
 
 def decode(
+    catalogue: MessageCatalogue,
     msgtype: str,
-    raws: Sequence[bytes | memoryview],
+    messages: RawMessages,
+    paths: Iterable[FieldPath],
     cdr: bool,
-    fallback: Callable[[bytes | memoryview], Any] | None = None,
 ) -> dict[str, np.ndarray]:
-    """Fields of every message as arrays (``ranges`` is messages × beams for LaserScan)."""
-    if not raws:
+    """The values of ``paths`` in every message (see the module's docstring for their shapes)."""
+    wanted = list(dict.fromkeys(paths))
+    if not len(messages) or not wanted:
         return {}
-    first = bytes(raws[0])
-    shape = layout(msgtype, first, cdr)
-    lengths = np.fromiter((len(r) for r in raws), dtype=np.int64, count=len(raws))
-    if np.all(lengths == shape.size):
-        buffer = np.frombuffer(b"".join(raws), dtype=np.uint8).reshape(len(raws), shape.size)
-        return decode_rows(shape, buffer)
-    if fallback is None:
-        raise DecodeError(f"{msgtype} messages of different sizes ({lengths.min()}–{lengths.max()} bytes)")
-    return _decode_slowly(msgtype, raws, fallback)
-
-
-def decode_rows(shape: Layout, rows: np.ndarray) -> dict[str, np.ndarray]:
-    """Fields of messages given as the rows of a uint8 array (one message per row)."""
-    out = {name: _column(rows, offset, kind) for name, (offset, kind) in shape.fields.items()}
-    for name, (at, count, kind) in shape.arrays.items():
-        # a view on the raw rows, not a copy: laser ranges are most of a bag's bytes
-        width = np.dtype(kind).itemsize
-        out[name] = rows[:, at : at + width * count].view(kind)
+    walker = _Walker(catalogue, messages, cdr)
+    pos = messages.starts + (4 if cdr else 0)
+    out: dict[str, np.ndarray] = {}
+    requests = [_Request(p.steps, p.key, p) for p in wanted]
+    walker.struct(canonical_type(msgtype), pos, pos.copy(), np.arange(len(messages)), requests, out)
     return out
 
 
-def _column(buffer: np.ndarray, offset: int, kind: str) -> np.ndarray:
-    width = np.dtype(kind).itemsize
-    if offset + width > buffer.shape[1]:
-        raise DecodeError("message shorter than its type")
-    return buffer[:, offset : offset + width].copy().view(kind).reshape(-1).astype(np.float64)
+@dataclass(frozen=True)
+class _Request:
+    """A path still to follow from the current field: its remaining steps, and the key its
+    values go under.  A probe (``equals`` set) asks whether a field has a value, for a selection."""
+
+    steps: tuple[Step, ...]
+    key: str
+    path: FieldPath
+    equals: str | float | None = None
+
+    def rest(self) -> _Request:
+        return _Request(self.steps[1:], self.key, self.path, self.equals)
 
 
-def _decode_slowly(
-    msgtype: str, raws: Sequence[bytes | memoryview], deserialize: Callable[[Any], Any]
+def _probe_key(select: Select) -> str:
+    return f"#select{select.text()}"
+
+
+class _Walker:
+    def __init__(self, catalogue: MessageCatalogue, messages: RawMessages, cdr: bool) -> None:
+        self.catalogue = catalogue
+        self.buffer = messages.buffer
+        self.starts = messages.starts
+        self.ends = messages.ends
+        self.width = messages.width
+        self.cdr = cdr
+        self.order = "<"
+        if cdr:
+            kinds = self.buffer[messages.starts[:, None] + np.arange(2)]
+            if np.all(kinds == 0):
+                self.order = ">"
+            elif not (np.all(kinds[:, 0] == 0) and np.all(kinds[:, 1] == 1)):
+                raise DecodeError("messages are not plain CDR (encapsulation kind 0 or 1)")
+
+    # -------------------------------------------------------------- reading
+    def _check(self, pos: np.ndarray, rows: np.ndarray, width: np.ndarray | int) -> None:
+        if len(pos) and np.any(pos + width > self.ends[rows]):
+            raise DecodeError("a message is shorter than its definition says")
+
+    def read(self, code: str, pos: np.ndarray, rows: np.ndarray, count: int | None = None) -> np.ndarray:
+        """The ``code`` values at byte positions ``pos`` of messages ``rows``: one each, or
+        ``count`` consecutive ones each (a 2-D result)."""
+        size = np.dtype(code).itemsize
+        many = 1 if count is None else count
+        if self.width is not None and len(pos) == len(self.starts) and len(pos):
+            offset = pos - self.starts[rows]
+            at = int(offset[0])
+            if np.all(offset == at) and np.array_equal(rows, np.arange(len(rows))):
+                table = self.buffer[: len(rows) * self.width].reshape(len(rows), self.width)
+                values = table[:, at : at + size * many].view(code)
+                return values[:, 0] if count is None else values
+        at_bytes = pos[:, None] + np.arange(size * many, dtype=np.int64)
+        raw = self.buffer[at_bytes]
+        values = raw.view(code)
+        return values[:, 0] if count is None else values
+
+    def _code(self, basetype: str) -> str:
+        kind = NUMERIC[basetype]
+        return kind if kind[1] == "1" else f"{self.order}{kind}"
+
+    def _align(self, pos: np.ndarray, origin: np.ndarray, size: int) -> np.ndarray:
+        if not self.cdr or size == 1:
+            return pos
+        aligned: np.ndarray = origin + (pos - origin + size - 1) // size * size
+        return aligned
+
+    def _count(self, pos: np.ndarray, origin: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """A u32 length prefix at ``pos`` (aligned in CDR): (counts, position after it)."""
+        pos = self._align(pos, origin, 4)
+        self._check(pos, rows, 4)
+        return self.read(f"{self.order}u4", pos, rows).astype(np.int64), pos + 4
+
+    # -------------------------------------------------------------- walking
+    def struct(
+        self,
+        msgtype: str,
+        pos: np.ndarray,
+        origin: np.ndarray,
+        rows: np.ndarray,
+        requests: list[_Request],
+        out: dict[str, np.ndarray],
+        need_end: bool = False,
+    ) -> np.ndarray:
+        """Walk the fields of ``msgtype`` for messages ``rows`` at ``pos``; returns where it ends."""
+        fields = self.catalogue.fields_of(msgtype)
+        pending = {r.steps[0] for r in requests if r.steps}
+        for name, desc in fields:
+            if not need_end and not pending:
+                break
+            mine = [r.rest() for r in requests if r.steps and r.steps[0] == name]
+            pos = self.field(desc, pos, origin, rows, mine, out)
+            pending.discard(name)
+        return pos
+
+    def field(
+        self,
+        desc: Any,
+        pos: np.ndarray,
+        origin: np.ndarray,
+        rows: np.ndarray,
+        requests: list[_Request],
+        out: dict[str, np.ndarray],
+    ) -> np.ndarray:
+        kind, detail = int(desc[0]), desc[1]
+        if kind == NAME:
+            return self.struct(canonical_type(detail), pos, origin, rows, requests, out, need_end=True)
+        if kind == BASE:
+            return self._base(detail[0], pos, origin, rows, requests, out)
+        element, length = detail
+        if kind == ARRAY:
+            counts = np.full(len(pos), int(length), dtype=np.int64)
+        else:
+            counts, pos = self._count(pos, origin, rows)
+        if int(element[0]) == BASE and element[1][0] not in ("string", "wstring"):
+            return self._numbers(element[1][0], counts, pos, origin, rows, requests, out)
+        return self._elements(element, counts, pos, origin, rows, requests, out)
+
+    def _base(
+        self,
+        basetype: str,
+        pos: np.ndarray,
+        origin: np.ndarray,
+        rows: np.ndarray,
+        requests: list[_Request],
+        out: dict[str, np.ndarray],
+    ) -> np.ndarray:
+        if basetype in _UNVECTORISED:
+            raise DecodeError(f"{basetype} fields are not vectorised")
+        if basetype == "string":
+            lengths, pos = self._count(pos, origin, rows)
+            self._check(pos, rows, lengths)
+            for request in requests:
+                if isinstance(request.equals, str):
+                    out[request.key] = self._text_equals(pos, lengths, request.equals)
+            after: np.ndarray = pos + lengths
+            return after
+        size = np.dtype(NUMERIC[basetype]).itemsize
+        pos = self._align(pos, origin, size)
+        self._check(pos, rows, size)
+        if requests:
+            values = self.read(self._code(basetype), pos, rows).astype(np.float64)
+            for request in requests:
+                if request.equals is None:
+                    self._put(out, request, values)
+                elif not isinstance(request.equals, str):
+                    out[request.key] = values == request.equals
+        return pos + size
+
+    def _text_equals(self, pos: np.ndarray, lengths: np.ndarray, text: str) -> np.ndarray:
+        """Whether each string (its bytes at ``pos``, ``lengths`` long) is ``text``."""
+        wanted = np.frombuffer(text.encode(), dtype=np.uint8)
+        same = lengths == len(wanted) + (1 if self.cdr else 0)  # CDR counts the terminating NUL
+        if len(wanted) and same.any():
+            rows = np.flatnonzero(same)
+            found = self.buffer[pos[rows][:, None] + np.arange(len(wanted))]
+            same[rows] = np.all(found == wanted, axis=1)
+        return np.asarray(same, dtype=bool)
+
+    def _numbers(
+        self,
+        basetype: str,
+        counts: np.ndarray,
+        pos: np.ndarray,
+        origin: np.ndarray,
+        rows: np.ndarray,
+        requests: list[_Request],
+        out: dict[str, np.ndarray],
+    ) -> np.ndarray:
+        """An array of numbers: its values, an element, or its length."""
+        if basetype in _UNVECTORISED:
+            raise DecodeError(f"{basetype} fields are not vectorised")
+        size = np.dtype(NUMERIC[basetype]).itemsize
+        pos = np.where(counts > 0, self._align(pos, origin, size), pos)  # CDR aligns only elements there are
+        self._check(pos, rows, counts * size)
+        code = self._code(basetype)
+        for request in requests:
+            if request.path.length and not request.steps:
+                self._put(out, request, counts.astype(np.float64))
+            elif request.steps and isinstance(request.steps[0], Index):
+                which = _element(counts, request.steps[0])
+                found = which >= 0
+                values = np.full(len(pos), np.nan)
+                values[found] = self.read(code, pos[found] + which[found] * size, rows[found])
+                self._put(out, request, values, found)
+            else:
+                self._put(out, request, self._rows_of(code, pos, rows, counts, size))
+        after: np.ndarray = pos + counts * size
+        return after
+
+    def _rows_of(
+        self, code: str, pos: np.ndarray, rows: np.ndarray, counts: np.ndarray, size: int
+    ) -> np.ndarray:
+        """One row of values per message, NaN-padded to the longest."""
+        width = int(counts.max()) if len(counts) else 0
+        kind = np.dtype(code)
+        dtype = kind.newbyteorder("=") if kind.kind == "f" else np.dtype(np.float64)
+        if len(counts) and np.all(counts == width):
+            values = self.read(code, pos, rows, width)
+            return values if values.dtype == dtype else values.astype(dtype)
+        table = np.full((len(counts), width), np.nan, dtype=dtype)
+        total = int(counts.sum())
+        if total:
+            owner = np.repeat(np.arange(len(counts)), counts)
+            column = np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts)
+            table[owner, column] = self.read(code, pos[owner] + column * size, rows[owner])
+        return table
+
+    def _elements(
+        self,
+        element: Any,
+        counts: np.ndarray,
+        pos: np.ndarray,
+        origin: np.ndarray,
+        rows: np.ndarray,
+        requests: list[_Request],
+        out: dict[str, np.ndarray],
+    ) -> np.ndarray:
+        """An array of messages or of strings, walked one element index at a time."""
+        width = int(counts.max()) if len(counts) else 0
+        for request in requests:
+            if request.path.length and not request.steps:
+                self._put(out, request, counts.astype(np.float64))
+        inner = [r for r in requests if r.steps]
+        selects = list(dict.fromkeys(r.steps[0] for r in inner if isinstance(r.steps[0], Select)))
+        columns: list[dict[str, np.ndarray]] = []
+        pos = pos.copy()
+        for k in range(width):
+            active = np.flatnonzero(counts > k)
+            if int(element[0]) == BASE:  # strings: only their lengths matter
+                if element[1][0] != "string":
+                    raise DecodeError(f"{element[1][0]} fields are not vectorised")
+                lengths, after = self._count(pos[active], origin[active], rows[active])
+                self._check(after, rows[active], lengths)
+                pos[active] = after + lengths
+                continue
+            sub = [r if isinstance(r.steps[0], str) else r.rest() for r in inner]
+            probes = [
+                _Request(s.field, _probe_key(s), FieldPath(s.field), s.value)
+                for s in selects
+                if isinstance(s, Select)
+            ]
+            local: dict[str, np.ndarray] = {}
+            pos[active] = self.struct(
+                canonical_type(element[1]),
+                pos[active],
+                origin[active],
+                rows[active],
+                [*sub, *probes],
+                local,
+                need_end=True,
+            )
+            columns.append({key: _spread(values, active, len(pos)) for key, values in local.items()})
+        for request in inner:
+            self._collect(request, columns, counts, out)
+        return pos
+
+    def _collect(
+        self,
+        request: _Request,
+        columns: list[dict[str, np.ndarray]],
+        counts: np.ndarray,
+        out: dict[str, np.ndarray],
+    ) -> None:
+        """A request's values from the element columns: all of them, or the picked one."""
+        first = request.steps[0]
+        n = len(counts)
+        stack = [c.get(request.key) for c in columns]
+        if isinstance(first, str):  # a field of every element: one row per message
+            values = np.full((n, len(stack)), np.nan)
+            for k, column in enumerate(stack):
+                if column is not None:
+                    values[:, k] = column
+            self._put(out, request, values)
+            return
+        if isinstance(first, Index):
+            which = _element(counts, first)
+        else:
+            assert isinstance(first, Select)
+            hits = [c.get(_probe_key(first), np.zeros(n, dtype=bool)) for c in columns]
+            table = np.stack(hits, axis=1) if hits else np.zeros((n, 0), dtype=bool)
+            which = np.where(table.any(axis=1), table.argmax(axis=1), -1) if len(hits) else np.full(n, -1)
+        picked = np.full(n, np.nan)
+        present = which >= 0
+        for k, column in enumerate(stack):
+            take = which == k
+            if column is not None:
+                picked[take] = column[take]
+            inner = columns[k].get(request.key + PRESENT)
+            if inner is not None:
+                present[take] &= inner[take]
+        self._put(out, request, picked, present)
+
+    def _put(
+        self,
+        out: dict[str, np.ndarray],
+        request: _Request,
+        values: np.ndarray,
+        present: np.ndarray | None = None,
+    ) -> None:
+        out[request.key] = values
+        if request.path.picks:
+            mask = np.ones(len(values), dtype=bool) if present is None else present
+            previous = out.get(request.key + PRESENT)
+            out[request.key + PRESENT] = mask if previous is None else mask & previous
+
+
+def _element(counts: np.ndarray, index: Index) -> np.ndarray:
+    """Which element ``index`` picks in each message, -1 where there is none."""
+    which = np.full(len(counts), index.position, dtype=np.int64)
+    if index.position < 0:
+        which = counts + index.position
+    return np.where((which >= 0) & (which < counts), which, -1)
+
+
+def _spread(values: np.ndarray, active: np.ndarray, n: int) -> np.ndarray:
+    """Values of the ``active`` messages placed among ``n`` (NaN, or False, elsewhere)."""
+    if values.dtype == bool:
+        full = np.zeros((n, *values.shape[1:]), dtype=bool)
+    else:
+        full = np.full((n, *values.shape[1:]), np.nan, dtype=np.float64)
+    full[active] = values
+    return full
+
+
+def decode_slowly(
+    deserialize: Callable[[bytes | memoryview], Any],
+    raws: Sequence[bytes | memoryview],
+    paths: Iterable[FieldPath],
 ) -> dict[str, np.ndarray]:
-    msgs = [deserialize(r) for r in raws]
-    if msgtype == TWIST:
-        return {
-            f"{part}.{c}": np.array([getattr(getattr(m, part), c) for m in msgs], dtype=np.float64)
-            for part in ("linear", "angular")
-            for c in "xyz"
-        }
-    if msgtype == FLOAT64:
-        return {"data": np.array([m.data for m in msgs], dtype=np.float64)}
-    stamps = {
-        "header.stamp.sec": np.array([m.header.stamp.sec for m in msgs], dtype=np.float64),
-        "header.stamp.nanosec": np.array([m.header.stamp.nanosec for m in msgs], dtype=np.float64),
-    }
-    if msgtype == POSE:
-        p = [m.pose.pose for m in msgs]
-        return stamps | {
-            f"pose.pose.{part}.{c}": np.array([getattr(getattr(q, part), c) for q in p], dtype=np.float64)
-            for part, coordinates in (("position", "xyz"), ("orientation", "xyzw"))
-            for c in coordinates
-        } | {"pose.covariance": np.array([m.pose.covariance for m in msgs], dtype=np.float64).reshape(-1, 36)}
-    out: dict[str, np.ndarray] = stamps | {
-        name: np.array([getattr(m, name) for m in msgs], dtype=np.float64)
-        for name in ("angle_min", "angle_max", "angle_increment", "time_increment", "scan_time", "range_min",
-                     "range_max")
-    }
-    for name in ("ranges", "intensities"):  # scans of different sizes: padded with NaN (never a valid range)
-        width = max((len(getattr(m, name)) for m in msgs), default=0)
-        values = np.full((len(msgs), width), np.nan, dtype=np.float32)
-        for i, m in enumerate(msgs):
-            values[i, : len(getattr(m, name))] = getattr(m, name)
-        out[name] = values
+    """The values of ``paths`` from message objects (rosbags' ``deserialize``), one message at a
+    time: the checked fallback for what :func:`decode` cannot vectorise."""
+    messages = [deserialize(r) for r in raws]
+    out: dict[str, np.ndarray] = {}
+    for path in dict.fromkeys(paths):
+        values = [_attribute_value(m, path) for m in messages]
+        present = np.array([v is not None for v in values], dtype=bool)
+        arrays = [np.atleast_1d(np.asarray(v, dtype=np.float64)) for v in values if v is not None]
+        is_array = any(isinstance(v, (list, tuple, np.ndarray)) for v in values)
+        if is_array:
+            width = max((len(a) for a in arrays), default=0)
+            table = np.full((len(values), width), np.nan)
+            for i, v in enumerate(values):
+                if v is not None:
+                    row = np.atleast_1d(np.asarray(v, dtype=np.float64))
+                    table[i, : len(row)] = row
+            out[path.key] = table
+        else:
+            out[path.key] = np.array([np.nan if v is None else float(v) for v in values], dtype=np.float64)
+        if path.picks:
+            out[path.key + PRESENT] = present
     return out
+
+
+def _attribute_value(message: Any, path: FieldPath) -> Any:
+    """The value of ``path`` in a message object (None if it picks an element that is not there)."""
+    node: Any = message
+    spread = False
+    for step in path.steps:
+        if isinstance(step, str):
+            node = [getattr(x, step) for x in node] if spread else getattr(node, step)
+        elif isinstance(step, Index):
+            try:
+                node = node[step.position]
+            except IndexError:
+                return None
+        else:
+            node = next((x for x in node if _select_value(x, step.field) == step.value), None)
+            if node is None:
+                return None
+        if isinstance(step, str) and isinstance(node, list) and node and not _is_number(node[0]):
+            spread = True
+    if path.length:
+        return len(node)
+    return node
+
+
+def _select_value(element: Any, field: tuple[str, ...]) -> Any:
+    for name in field:
+        element = getattr(element, name)
+    return element
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float, bool, np.number))

@@ -25,6 +25,17 @@ from typing import Any, Callable, Optional, Tuple, Union
 import numpy as np
 
 Number = Union[float, int]  # typing's spelling: this module also runs on ROS Noetic's Python 3.8
+PRESENT = "#present"
+"""Suffix of the key of a field path's mask: which messages have the array element it picks."""
+
+
+def topic_name(pattern: str, namespace: str) -> str:
+    """``pattern`` with ``{ns}`` replaced by a robot's namespace; a robot at the root (no
+    namespace) leaves no empty level: ``/{ns}/odom`` is then ``/odom``."""
+    name = pattern.replace("{ns}", namespace.strip("/"))
+    while "//" in name:
+        name = name.replace("//", "/")
+    return name
 
 
 @dataclass(frozen=True)
@@ -46,8 +57,14 @@ class Topic:
     def __len__(self) -> int:
         return len(self.t)
 
-    def field(self, path: str) -> Signal:
-        return Signal(self.t, self.fields[path])
+    def field(self, key: str) -> Signal:
+        """The values of a field path (its key); a path that picks array elements has values
+        only in the messages that have the element (``KEY#present``)."""
+        values = self.fields[key]
+        present = self.fields.get(key + PRESENT)
+        if present is None or values.ndim > 1:  # rows of arrays keep their place: NaN is no value
+            return Signal(self.t, values)
+        return Signal(self.t[present], values[present])
 
     def rows(self, part: slice) -> Topic:
         """The messages ``part`` of the topic (views, no copies)."""

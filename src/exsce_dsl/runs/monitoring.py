@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from exsce_dsl.model.geometry import Position
+from exsce_dsl.model.messages import path_of
 from exsce_dsl.model.metrics import MetricDefinition, Subject
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import ActionId, Hotspot, MetricScope, MetricValue
@@ -28,6 +29,8 @@ from exsce_dsl.runs.segments import Segment
 HOTSPOT_RADIUS = 1.0  # metres: violations closer than this to a hotspot belong to it
 POSE_TOPIC = "/{ns}/robot_pose"
 """Where hotspots are located: each robot's pose."""
+HOTSPOT_PATHS = (path_of("pose", "pose", "position", "x"), path_of("pose", "pose", "position", "y"))
+"""What hotspots read of the pose."""
 
 Window = tuple[Segment | None, float, float]
 
@@ -74,7 +77,7 @@ def _topics(metric: MetricDefinition, alternative: int, namespaces: Sequence[str
     for n, ns in enumerate(namespaces):
         for whose, read in used:
             if whose is None or (metric.pair is not None and metric.pair.index(whose) == n):
-                topic = patterns[read].replace("{ns}", ns.strip("/"))
+                topic = core.topic_name(patterns[read], ns)
                 if topic not in found:
                     found.append(topic)
     return tuple(found)
@@ -224,15 +227,15 @@ def _mission_values(
 
 
 def _pose(topics: Mapping[str, core.Topic], namespace: str) -> core.Topic | None:
-    found = topics.get(POSE_TOPIC.replace("{ns}", namespace.strip("/")))
+    found = topics.get(core.topic_name(POSE_TOPIC, namespace))
     return found if found is not None and len(found) else None
 
 
 def _position_at(pose: core.Topic, times: np.ndarray) -> np.ndarray:
     return np.column_stack(
         [
-            np.interp(times, pose.t, pose.fields["pose.pose.position.x"]),
-            np.interp(times, pose.t, pose.fields["pose.pose.position.y"]),
+            np.interp(times, pose.t, pose.fields[HOTSPOT_PATHS[0].key]),
+            np.interp(times, pose.t, pose.fields[HOTSPOT_PATHS[1].key]),
         ]
     )
 

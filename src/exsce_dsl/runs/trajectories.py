@@ -8,15 +8,21 @@ from pathlib import Path
 import numpy as np
 from rosbags.highlevel import AnyReader
 
+from exsce_dsl.model.messages import FieldPath, path_of
 from exsce_dsl.runs import ros1_index
-from exsce_dsl.runs.bagdata import BagError, read_bag, typestore_for
+from exsce_dsl.runs.bagdata import BagError, Wanted, read_bag, typestore_for
 
 POSITION_FIELDS = {
-    "geometry_msgs/msg/PoseWithCovarianceStamped": "pose.pose.position",
-    "geometry_msgs/msg/PoseStamped": "pose.position",
-    "nav_msgs/msg/Odometry": "pose.pose.position",
+    "geometry_msgs/msg/PoseWithCovarianceStamped": ("pose", "pose", "position"),
+    "geometry_msgs/msg/PoseStamped": ("pose", "position"),
+    "nav_msgs/msg/Odometry": ("pose", "pose", "position"),
 }
 """Message types that say where a robot is, and the path of the position in each."""
+
+
+def _xy(msgtype: str) -> tuple[FieldPath, FieldPath]:
+    prefix = POSITION_FIELDS[msgtype]
+    return path_of(*prefix, "x"), path_of(*prefix, "y")
 
 
 @dataclass(frozen=True)
@@ -49,14 +55,14 @@ def trajectories(path: Path, max_points: int = 2000) -> list[Trajectory]:
     wanted = pose_topics(path)
     if not wanted:
         return []
-    data = read_bag(path, wanted)
+    data = read_bag(path, {topic: Wanted(msgtype, _xy(msgtype)) for topic, msgtype in wanted.items()})
     found = []
     for topic, msgtype in sorted(wanted.items()):
         series = data.series.get(topic)
         if series is None or len(series) == 0:
             continue
-        prefix = POSITION_FIELDS[msgtype]
-        xy = np.column_stack([series.fields[f"{prefix}.x"], series.fields[f"{prefix}.y"]]).astype(float)
+        x, y = _xy(msgtype)
+        xy = np.column_stack([series.fields[x.key], series.fields[y.key]]).astype(float)
         keep = np.unique(np.linspace(0, len(xy) - 1, min(len(xy), max_points)).round().astype(int))
         found.append(Trajectory(topic, series.t[keep] - data.start, xy[keep]))
     return found
