@@ -48,6 +48,7 @@ from exsce_dsl.model import (
 )
 from exsce_dsl.model.derived import DerivedScenario
 from exsce_dsl.model.metrics import MetricDefinition
+from exsce_dsl.model.robots import root_namespace
 
 _LENGTH_SCALE = {None: 1.0, "m": 1.0, "cm": 0.01, "mm": 0.001}
 _QUANTITY = re.compile(r"(\S+?)\s*(mm|cm|m|rad|deg)?")
@@ -126,8 +127,14 @@ class _Builder:
     def error(self, message: str, location: SourceLocation | None, code: str = "semantic") -> None:
         self.diagnostics.append(Diagnostic(message, location, code=code))
 
-    def warning(self, message: str, location: SourceLocation | None) -> None:
-        self.diagnostics.append(Diagnostic(message, location, severity="warning", code="semantic"))
+    def warning(self, message: str, location: SourceLocation | None, code: str = "semantic") -> None:
+        self.diagnostics.append(Diagnostic(message, location, severity="warning", code=code))
+
+    def metric_problem(self, message: str, location: SourceLocation | None, severity: str = "error") -> None:
+        if severity == "error":
+            self.error(message, location, code="metric")
+        else:
+            self.warning(message, location, code="metric")
 
     @staticmethod
     def name_span(pf: ParsedFile, obj: Any) -> SourceLocation:
@@ -157,7 +164,7 @@ class _Builder:
             metric = build_metric(
                 d.file,
                 d.obj,
-                lambda message, at: self.error(message, at, code="metric"),
+                self.metric_problem,
                 reserved,
                 name_location=d.name_location,
             )
@@ -450,7 +457,7 @@ class _Builder:
                 else:
                     start = self._pose_use(pf, decl.start, env_poses)
                     ok = ok and start is not None
-            namespace = decl.namespace if decl.namespace else decl.name
+            namespace = root_namespace(decl.namespace) if decl.has_namespace else decl.name
             if rtype is not None:
                 robots.append(Robot(decl.name, rtype, namespace, start, where))
 

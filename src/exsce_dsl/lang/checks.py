@@ -15,7 +15,7 @@ from exsce_dsl.lang.occupancy import FREE, OUTSIDE, OccupancyGrid, load_occupanc
 from exsce_dsl.model import Environment, Pose, Scenario
 
 # ROS graph resource names (namespaces): letters, digits, _ and / separators.
-_ROS_NAMESPACE = re.compile(r"/?[A-Za-z][A-Za-z0-9_]*(/[A-Za-z][A-Za-z0-9_]*)*")
+_ROS_NAMESPACE = re.compile(r"(/?[A-Za-z][A-Za-z0-9_]*(/[A-Za-z][A-Za-z0-9_]*)*)?")  # "": the root
 
 
 def check_scenario(scenario: Scenario) -> list[Diagnostic]:

@@ -18,10 +18,17 @@ class RobotType:
     location: SourceLocation | None = field(default=None, compare=False, repr=False)
 
 
+def root_namespace(namespace: str) -> str:
+    """A namespace as written; ``/`` (like ``""``) is the root, where a single robot's topics
+    often are (``/odom``, not ``/robot1/odom``), and is kept as ``""``."""
+    return "" if namespace.strip("/") == "" else namespace
+
+
 @dataclass(frozen=True)
 class Robot:
     id: str
     type: RobotType
     namespace: str
+    """The robot's ROS namespace; ``""``: its topics are at the root."""
     start_pose: Pose | None = None
     location: SourceLocation | None = field(default=None, compare=False, repr=False)

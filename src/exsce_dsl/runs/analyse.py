@@ -9,14 +9,17 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
 
+from exsce_dsl.errors import ExsceError
+from exsce_dsl.lang.check_fields import check_fields
 from exsce_dsl.lang.standard_metrics import standard_metrics
+from exsce_dsl.messages.catalogue import Source
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.expressions import Field, walk
-from exsce_dsl.model.messages import DISPATCHER, POSE, FieldPath
+from exsce_dsl.model.messages import DISPATCHER, POSE, FieldPath, Fields
 from exsce_dsl.model.metrics import MetricDefinition
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Bag, Run, TaskExecution
-from exsce_dsl.runs.bagdata import ANY, BagError, Reduce, Wanted, read_bag
+from exsce_dsl.runs.bagdata import ANY, BagError, Check, Reduce, Wanted, read_bag
 from exsce_dsl.runs.monitor_code import load_monitors
 from exsce_dsl.runs.monitor_core import Compute, Topic, reducer, topic_name
 from exsce_dsl.runs.monitoring import HOTSPOT_PATHS, POSE_TOPIC, compute_metrics
@@ -84,6 +87,23 @@ def fields_read(metric: MetricDefinition) -> dict[str, list[FieldPath]]:
     return found
 
 
+def field_checker(metrics: tuple[MetricDefinition, ...], robots: list[Robot]) -> Check:
+    """Checks what ``metrics`` read of a topic against the definition of the type the bag has for
+    it, before anything is computed: a type unknown when the specification was checked is checked
+    here, with the same messages at the same places (``file:line:col``)."""
+
+    def check(topic: str, msgtype: str, tree: Fields, source: Source | None) -> None:
+        problems: list[ExsceError] = []
+        for metric in metrics:
+            if any(read.topic_of(r.namespace) == topic for read in metric.reads for r in robots):
+                problems += check_fields(metric, msgtype, tree, source.text if source else None)
+        if problems:
+            where = "\n".join(f"  {p}" for p in dict.fromkeys(str(p) for p in problems))
+            raise BagError(f"topic {topic} ({msgtype}) lacks what the metrics read of it:\n{where}")
+
+    return check
+
+
 def reductions(monitors: ModuleType, robots: list[Robot]) -> dict[str, Reduce]:
     """Topic → what to reduce of each block of its messages as the bag is read (the monitors'
     aggregates over arrays), so that no topic's arrays are ever all in memory."""
@@ -105,7 +125,9 @@ def analyse_bag(path: Path, scenario: Scenario, digest: str | None = None) -> An
     metrics = run_metrics(scenario)
     source = scenario.location.file if scenario.location else scenario.id
     monitors = load_monitors(metrics, source)
-    data = read_bag(path, wanted_topics(metrics, robots), reductions(monitors, robots))
+    data = read_bag(
+        path, wanted_topics(metrics, robots), reductions(monitors, robots), field_checker(metrics, robots)
+    )
     problems = list(data.problems)
     actions: list[Segment] = []
     results: dict[str, int | None] = {}

@@ -118,6 +118,9 @@ def read_bag(
     """
     if not path.exists():
         raise BagError(f"{path}: no such bag")
+    from exsce_dsl.runs.bagfiles import check_bag_file  # here: bagfiles imports this module's BagError
+
+    check_bag_file(path)
     try:
         if _is_ros1(path):
             try:
@@ -125,8 +128,10 @@ def read_bag(
             except UnsupportedBag:
                 pass  # rosbags reads what our index reader does not (and reports what is broken)
         return _read_with_rosbags(path, wanted, reduce, check)
-    except BagError:
-        raise
+    except BagError as exc:
+        if str(path) in exc.message:
+            raise
+        raise BagError(f"{path}: {exc.message}") from None
     except (DecodeError, MessageTypeError) as exc:
         raise BagError(f"{path}: {exc.message}") from None
 

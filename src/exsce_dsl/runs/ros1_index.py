@@ -4,12 +4,12 @@ rosbags hands out one Python tuple per message (about 100,000 messages/s
 here).  A ROS 1 bag (format 2.0) indexes every message: after each chunk come
 index-data records giving, per connection, each message's time and offset in
 the chunk.  So for each chunk we read the index as arrays, find each message's
-data with a vectorised gather, and cut fixed-size messages out as the rows of
-one 2-D array: per chunk Python work, no per-message Python work.
+data with a vectorised gather, and hand the chunk's messages of a connection
+to a decoder as one buffer with their offsets: per chunk Python work, no
+per-message Python work.
 
-Only what the metrics need is supported: uncompressed, bz2 and lz4 chunks are
-read; anything unexpected raises :class:`UnsupportedBag` and the caller falls
-back to rosbags.
+Uncompressed, bz2 and lz4 chunks are read; anything unexpected raises
+:class:`UnsupportedBag` and the caller falls back to rosbags.
 """
 
 from __future__ import annotations
@@ -17,12 +17,15 @@ from __future__ import annotations
 import bz2
 import mmap
 import struct
+import traceback
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+
+from exsce_dsl.runs.decode import RawMessages
 
 MAGIC = b"#ROSBAG V2.0\n"
 OP_MSG, OP_BAG, OP_INDEX, OP_CHUNK, OP_CHUNK_INFO, OP_CONN = 0x02, 0x03, 0x04, 0x05, 0x06, 0x07
@@ -34,19 +37,20 @@ class UnsupportedBag(Exception):
 
 Buffer = bytes | memoryview | mmap.mmap
 
-Decoder = Callable[[str, str, np.ndarray], dict[str, np.ndarray] | None]
-"""(topic, message type, rows of equal-size messages) → their fields, or None to keep the raw bytes."""
+Decoder = Callable[[str, str, str, np.ndarray, RawMessages], bool]
+"""(topic, message type, its definition, receive times in ns, the messages of one chunk) → whether
+it took them; False keeps their raw bytes (for messages deserialized whole)."""
 
 
 @dataclass(frozen=True)
 class Messages:
-    """One topic's messages: receive times (ns, bag order) and either decoded fields or raw bytes."""
+    """One topic's messages: receive times (ns, bag order), and the raw bytes of each message the
+    decoder did not take."""
 
     msgtype: str
     definition: str  # the message definition the bag carries (ROS 1 concatenated form)
     times: np.ndarray
-    fields: dict[str, np.ndarray] | None  # decoded chunk by chunk, when the decoder could
-    raws: list[bytes]  # otherwise, each message's bytes
+    raws: list[bytes]
 
 
 def _header(buf: Buffer, pos: int) -> tuple[dict[str, bytes], int]:
@@ -77,13 +81,18 @@ def _mapped(path: Path) -> Iterator[mmap.mmap]:
             raise UnsupportedBag(str(exc)) from None
         try:
             yield data
+        except BaseException as exc:
+            # the frames the error went through still hold numpy views of the map (the whole file,
+            # a chunk, an index): drop them, or close() fails with BufferError and hides the error
+            traceback.clear_frames(exc.__traceback__)
+            raise
         finally:
             data.close()
 
 
 def read_topics(path: Path, topics: set[str], decoder: Decoder) -> dict[str, Messages]:
-    """The messages of ``topics``; equal-size messages are decoded a chunk at a time, so only
-    the fields ``decoder`` keeps stay in memory, never the chunks themselves."""
+    """The messages of ``topics``, handed to ``decoder`` a chunk at a time, so only what it keeps
+    stays in memory, never the chunks themselves."""
     with _mapped(path) as data:
         return _read_topics(data, topics, decoder)
 
@@ -136,7 +145,6 @@ def _read_topics(data: mmap.mmap, topics: set[str], decoder: Decoder) -> dict[st
             raise UnsupportedBag("chunk info record expected")
         chunks.append(struct.unpack("<Q", fields["chunk_pos"])[0])
     times_of: dict[int, list[np.ndarray]] = {c: [] for c in wanted}
-    fields_of: dict[int, list[dict[str, np.ndarray]]] = {c: [] for c in wanted}
     raws_of: dict[int, list[bytes]] = {c: [] for c in wanted}
     view = np.frombuffer(data, dtype=np.uint8)
     for chunk_pos in chunks:
@@ -162,29 +170,28 @@ def _read_topics(data: mmap.mmap, topics: set[str], decoder: Decoder) -> dict[st
             fields, idx_at, nxt = _record(data, pos)
             if fields.get("op") != bytes([OP_INDEX]):
                 break
+            if fields.get("ver") != struct.pack("<I", 1):  # rosbag writes version 1: 12-byte entries
+                raise UnsupportedBag(f"index-data records of version {fields.get('ver')!r}, not 1")
             conn = struct.unpack("<I", fields["conn"])[0]
             if conn in wanted:
                 count = struct.unpack("<I", fields["count"])[0]
+                if nxt - idx_at != 12 * count:
+                    raise UnsupportedBag("an index-data record whose size is not its count's")
                 entries = view[idx_at : idx_at + 12 * count].view("<u4").reshape(count, 3)
                 times = entries[:, 0].astype(np.int64) * 1_000_000_000 + entries[:, 1]
                 offsets = entries[:, 2].astype(np.int64)
                 header_len = _u32(chunk, offsets)
                 data_len = _u32(chunk, offsets + 4 + header_len)
                 starts = offsets + 8 + header_len
-                topic, msgtype, _ = wanted[conn]
-                decoded = None
-                if count and np.all(data_len == data_len[0]) and not raws_of[conn]:
-                    rows = chunk[starts[:, None] + np.arange(int(data_len[0]), dtype=np.int64)]
-                    decoded = decoder(topic, _ros2_name(msgtype), rows)
-                if decoded is None:  # keep the bytes: variable sizes, or a type the decoder leaves alone
-                    if fields_of[conn]:
-                        raise UnsupportedBag(f"messages of {topic} change size")
+                if count and int((starts + data_len).max()) > len(chunk):
+                    raise UnsupportedBag("a message runs past the end of its chunk")
+                topic, msgtype, definition = wanted[conn]
+                messages = RawMessages(chunk, starts, starts + data_len)
+                if not decoder(topic, _ros2_name(msgtype), definition, times, messages):
                     raws_of[conn].extend(
                         bytes(chunk[a : a + n])
                         for a, n in zip(starts.tolist(), data_len.tolist(), strict=True)
                     )
-                else:
-                    fields_of[conn].append(decoded)
                 times_of[conn].append(times)
             pos = nxt
         del chunk
@@ -193,14 +200,13 @@ def _read_topics(data: mmap.mmap, topics: set[str], decoder: Decoder) -> dict[st
     for conn, (topic, msgtype, definition) in wanted.items():
         if not times_of[conn]:
             continue
-        if topic in out:
-            raise UnsupportedBag(f"topic {topic} has several connections")
-        result: dict[str, np.ndarray] | None = None
-        if fields_of[conn]:
-            names = fields_of[conn][0].keys()
-            result = {n: np.concatenate([f[n] for f in fields_of[conn]]) for n in names}
         times = np.concatenate(times_of[conn])
-        out[topic] = Messages(_ros2_name(msgtype), definition, times, result, raws_of[conn])
+        if topic in out:  # several connections on one topic: one topic, its messages merged
+            known = out[topic]
+            times = np.concatenate([known.times, times])
+            out[topic] = Messages(known.msgtype, known.definition, times, known.raws + raws_of[conn])
+        else:
+            out[topic] = Messages(_ros2_name(msgtype), definition, times, raws_of[conn])
     return out
 
 

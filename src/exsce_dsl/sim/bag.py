@@ -34,29 +34,33 @@ class Topics:
     def __getattr__(self, name: str) -> str:  # pragma: no cover - only the names below are used
         raise AttributeError(name)
 
+    def _name(self, topic: str) -> str:
+        """``/ns/topic``; ``/topic`` for a robot at the root (no namespace)."""
+        return f"/{self.ns}/{topic}" if self.ns else f"/{topic}"
+
     @property
     def pose(self) -> str:
-        return f"/{self.ns}/robot_pose"
+        return self._name("robot_pose")
 
     @property
     def scan(self) -> str:
-        return f"/{self.ns}/scan"
+        return self._name("scan")
 
     @property
     def vel(self) -> str:
-        return f"/{self.ns}/nav_vel"
+        return self._name("nav_vel")
 
     @property
     def distance(self) -> str:
-        return f"/{self.ns}/distance_travelled"
+        return self._name("distance_travelled")
 
     @property
     def feedback(self) -> str:
-        return f"/{self.ns}/waypoint_dispatcher/feedback"
+        return self._name("waypoint_dispatcher/feedback")
 
     @property
     def result(self) -> str:
-        return f"/{self.ns}/waypoint_dispatcher/result"
+        return self._name("waypoint_dispatcher/result")
 
 
 def write_bag(
