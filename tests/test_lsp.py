@@ -267,6 +267,34 @@ async def test_completion_of_transformations_in_a_derive_block(
     close_document(client, uri)
 
 
+async def test_completion_of_a_metric_s_fields_follows_the_path_before_the_point(
+    client: LanguageClient, workspace: Path
+) -> None:
+    path = workspace / "metrics.exsce"
+    text = path.read_text().replace("value mean(abs(vel.angular.z))", "value mean(abs(vel.angular.z + vel.lin))")
+    uri = open_document(client, path, text)
+
+    async def items(needle: str) -> dict[str, types.CompletionItem]:
+        where = position(text, needle, len(needle))
+        result = await client.text_document_completion_async(
+            types.CompletionParams(types.TextDocumentIdentifier(uri), where)
+        )
+        assert isinstance(result, types.CompletionList)
+        return {item.label: item for item in result.items}
+
+    fields = await items("vel.angular.z + vel.lin")
+    assert set(fields) == {"linear"}  # 'angular' has no 'lin' in order
+    linear = fields["linear"]
+    assert linear.detail == "geometry_msgs/msg/Vector3 (geometry_msgs/msg/Twist)"
+    assert linear.kind == types.CompletionItemKind.Field
+    assert isinstance(linear.text_edit, types.TextEdit)
+    assert linear.text_edit.range.end.character - linear.text_edit.range.start.character == len("lin")
+    assert set(await items("vel.angular.")) == {"x", "y", "z"}
+    reads = await items("value mean(abs(")
+    assert reads["vel"].detail == "geometry_msgs/msg/Twist on /{ns}/nav_vel"
+    close_document(client, uri)
+
+
 # ------------------------------------------------------------------------ hover
 async def hover_at(client: LanguageClient, uri: str, where: types.Position) -> str:
     result = await client.text_document_hover_async(
@@ -297,6 +325,11 @@ async def test_hover_shows_a_pose_a_task_a_metric_a_derivation_and_a_keyword(
     keyword = await hover_at(client, uri, position(text, "parallel", 2))
     assert keyword.startswith("**parallel** (keyword)") and "side by side" in keyword
     close_document(client, uri)
+    metrics = workspace / "metrics.exsce"
+    metrics_uri = open_document(client, metrics)
+    field = await hover_at(client, metrics_uri, position(metrics.read_text(), "vel.angular.z", 5))
+    assert field == "**field** `vel.angular`: `geometry_msgs/msg/Vector3`, of `geometry_msgs/msg/Twist`"
+    close_document(client, metrics_uri)
     alone = workspace / "scenario_c_alone.exsce"
     alone_uri = open_document(client, alone)
     derived = await hover_at(client, alone_uri, position(alone.read_text(), "scenario_c_alone", 1))

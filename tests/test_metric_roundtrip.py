@@ -1,5 +1,7 @@
 """Property: any well-typed metric expression prints back (with the fewest parentheses) to text
-that parses to the same expression, and the monitors generated from it compile."""
+that parses to the same expression, and the monitors generated from it compile.  Its fields
+are those of one topic: plain paths, elements of arrays (``scan.ranges[-2]``), selections by
+text or number (``tf.transforms[child_frame_id == "..."]``) and lengths (``len(...)``)."""
 
 from __future__ import annotations
 
@@ -10,24 +12,52 @@ from hypothesis import strategies as st
 
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.lang.format_metrics import expression_text
+from exsce_dsl.lang.lexical import number_text, string_literal
 from exsce_dsl.runs.monitor_code import monitor_source
 
 HEADER = """metric m for each robot {{
   reads vel: geometry_msgs/msg/Twist on "/{{ns}}/nav_vel"
   reads scan: sensor_msgs/msg/LaserScan on "/{{ns}}/scan"
   reads feedback: waypoint_dispatcher/msg/FollowWaypointsActionFeedback on "/{{ns}}/waypoint_dispatcher/feedback"
+  reads tf: tf2_msgs/msg/TFMessage on "/{{ns}}/tf"
+  reads diag: actionlib_msgs/msg/GoalStatusArray on "/{{ns}}/status"
   value {value}
 }}
 """
 
 numbers = st.sampled_from(["0.5", "2", "1.5e-3", "0.8 m/s", "3 s"])
-fields = st.sampled_from(["vel.linear.x", "vel.linear.y", "vel.angular.z"])
+texts = st.text(st.characters(exclude_categories=("Cs", "Cc")), max_size=8).map(string_literal)
+values = st.one_of(
+    st.integers(-5, 300).map(str),
+    st.floats(allow_nan=False, allow_infinity=False).map(number_text),
+)
+FIELDS = {
+    "vel": st.sampled_from(["vel.linear.x", "vel.linear.y", "vel.angular.z"]),
+    "tf": st.one_of(
+        texts.map(lambda t: f"tf.transforms[child_frame_id == {t}].transform.translation.x"),
+        texts.map(lambda t: f"tf.transforms[header.frame_id == {t}].header.stamp.sec"),
+        values.map(lambda v: f"tf.transforms[header.stamp.nanosec == {v}].transform.rotation.w"),
+        st.integers(-3, 3).map(lambda i: f"tf.transforms[{i}].transform.translation.y"),
+        st.just("len(tf.transforms)"),
+    ),
+    "diag": st.one_of(
+        values.map(lambda v: f"diag.status_list[status == {v}].goal_id.stamp.sec"),
+        texts.map(lambda t: f"diag.status_list[goal_id.id == {t}].status"),
+        st.integers(-3, 3).map(lambda i: f"diag.status_list[{i}].status"),
+        st.just("len(diag.status_list)"),
+    ),
+    "scan": st.one_of(
+        st.integers(-3, 700).map(lambda i: f"scan.ranges[{i}]"),
+        st.sampled_from(["len(scan.ranges)", "scan.angle_min", "scan.header.stamp.sec"]),
+    ),
+}
+"""Per topic, its fields of a number per message (conditions join fields of one topic only)."""
 
 
-def _per_message(depth: int) -> st.SearchStrategy[str]:
+def _per_message(depth: int, fields: st.SearchStrategy[str]) -> st.SearchStrategy[str]:
     if depth == 0:
         return fields
-    inner = _per_message(depth - 1)
+    inner = _per_message(depth - 1, fields)
     return st.one_of(
         fields,
         st.tuples(inner, st.sampled_from(["+", "-", "*", "/"]), st.one_of(inner, numbers)).map(" ".join),
@@ -39,8 +69,8 @@ def _per_message(depth: int) -> st.SearchStrategy[str]:
     )
 
 
-def _condition(depth: int) -> st.SearchStrategy[str]:
-    compare = st.tuples(_per_message(depth), st.sampled_from(["<", "<=", ">", ">=", "==", "!="]), numbers)
+def _condition(depth: int, fields: st.SearchStrategy[str]) -> st.SearchStrategy[str]:
+    compare = st.tuples(_per_message(depth, fields), st.sampled_from(["<", "<=", ">", ">=", "==", "!="]), numbers)
     single = compare.map(" ".join)
     return st.one_of(
         single,
@@ -50,13 +80,13 @@ def _condition(depth: int) -> st.SearchStrategy[str]:
     )
 
 
-def _value(depth: int) -> st.SearchStrategy[str]:
+def _value(depth: int, fields: st.SearchStrategy[str]) -> st.SearchStrategy[str]:
     aggregate = st.one_of(
         st.tuples(st.sampled_from(["min", "max", "mean", "sum", "first", "last", "integral", "change"]),
-                  _per_message(depth)).map(lambda p: f"{p[0]}({p[1]})"),
-        st.tuples(st.sampled_from(["min", "max"]), _per_message(depth), _condition(1))
+                  _per_message(depth, fields)).map(lambda p: f"{p[0]}({p[1]})"),
+        st.tuples(st.sampled_from(["min", "max"]), _per_message(depth, fields), _condition(1, fields))
         .map(lambda p: f"{p[0]}({p[1]} where {p[2]})"),
-        st.tuples(st.sampled_from(["duration", "count"]), _condition(depth))
+        st.tuples(st.sampled_from(["duration", "count"]), _condition(depth, fields))
         .map(lambda p: f"({p[0]} where {p[1]})"),
         st.just("min(scan.ranges where scan.ranges >= scan.range_min)"),
         st.just("elapsed"),
@@ -69,7 +99,7 @@ def _value(depth: int) -> st.SearchStrategy[str]:
 
 
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
-@given(value=_value(2))
+@given(value=st.one_of(*(_value(2, fields) for fields in FIELDS.values())))
 def test_a_metric_prints_back_to_itself_and_generates_code(tmp_path_factory, value):
     folder = tmp_path_factory.mktemp("m")
     first = Path(folder / "first.exsce")

@@ -182,8 +182,6 @@ DECLARATION_ERRORS = [
      1, 8, "one of exsce's built-in metrics"),
     ('metric bad-name for each robot {\n  reads v: std_msgs/Float64 on "/{ns}/v"\n  value max(v.data)\n}\n',
      1, 8, "must be letters, digits and '_'"),
-    ('metric m for each robot {\n  reads v: std_msgs/Flaot64 on "/{ns}/v"\n  value max(v.data)\n}\n',
-     2, 3, "did you mean 'std_msgs/msg/Float64'?"),
     ('metric m for each robot {\n  reads v: std_msgs/Float64 on "/{ns}/v\\"; x"\n  value max(v.data)\n}\n',
      2, 3, "is not a ROS topic name"),
     ('metric m for each robot {\n  reads v: std_msgs/Float64 on "/v"\n  value max(v.data)\n}\n',

@@ -527,7 +527,7 @@ def repository() -> dict[str, Rule]:
             ),
             match(
                 METRIC_BEFORE
-                + r"(min|max|mean|sum|first|last|integral|change|path_length|norm|abs|sqrt)(?=\s*\()",
+                + r"(min|max|mean|sum|first|last|integral|change|path_length|norm|abs|sqrt|len)(?=\s*\()",
                 None,
                 _1="support.function.builtin" + S,
             ),

@@ -6,6 +6,8 @@ adds its commands to :data:`main`.
 
 from __future__ import annotations
 
+import os
+
 import click
 
 from exsce_dsl import __version__
@@ -15,18 +17,38 @@ from exsce_dsl.cli.common import State
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(__version__, prog_name="exscec")
 @click.option("--debug", is_flag=True, help="Show Python tracebacks for errors.")
-def main(debug: bool) -> None:
+@click.option(
+    "--msg-path",
+    "msg_paths",
+    multiple=True,
+    type=click.Path(exists=True, file_okay=False),
+    metavar="DIR",
+    help="A folder of your own message definitions (<pkg>/msg/Name.msg, .idl files), searched "
+    "before the standard ROS packages; repeatable, the first wins.  Added in front of the "
+    "folders of $EXSCE_MSG_PATH (separated by the system's path separator).",
+)
+def main(debug: bool, msg_paths: tuple[str, ...]) -> None:
     """exsce: executable scenarios for robot testing.
 
     Write scenarios in the exsce language, check them, and compile them to
     W3C PROV.
 
+    A metric reads any message type of the standard ROS 1 and ROS 2 packages;
+    the definitions of other types come from --msg-path, $EXSCE_MSG_PATH, or
+    the bag itself.
+
     \b
     Example:
       exscec check examples/brsu_building_c/scenario_c.exsce
       exscec compile examples/brsu_building_c/scenario_c.exsce -f provn
+      exscec --msg-path ~/ws/src check spec.exsce
     """
     State.debug = debug
+    if msg_paths:  # in the environment, so that worker processes see them too
+        from exsce_dsl.messages.user import MSG_PATH
+
+        folders = [os.path.abspath(p) for p in msg_paths]
+        os.environ[MSG_PATH] = os.pathsep.join([*folders, *filter(None, [os.environ.get(MSG_PATH)])])
 
 
 def _register() -> None:

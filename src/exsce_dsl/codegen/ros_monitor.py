@@ -26,10 +26,22 @@ from exsce_dsl.codegen.output import write_files
 from exsce_dsl.errors import SourceLocation
 from exsce_dsl.lang.format_acceptance import expectation_text
 from exsce_dsl.lang.standard_metrics import standard_metrics
+from exsce_dsl.messages.catalogue import MessageTypeError
+from exsce_dsl.messages.user import configured_catalogue
 from exsce_dsl.model import Scenario, Specification
 from exsce_dsl.model.acceptance import Relation
 from exsce_dsl.model.expressions import Field, walk
-from exsce_dsl.model.messages import FEEDBACK, MESSAGES, RESULT, Leaf, canonical_type, leaf_paths
+from exsce_dsl.model.messages import (
+    FEEDBACK,
+    RESULT,
+    FieldPath,
+    Fields,
+    MessageArray,
+    Node,
+    Select,
+    Step,
+    canonical_type,
+)
 from exsce_dsl.model.metrics import MetricDefinition, Subject
 from exsce_dsl.oracles.plan import PlannedOracle, plan_oracles
 from exsce_dsl.prov.identifiers import oracle_name
@@ -44,8 +56,9 @@ VERDICT_TOPIC = "/exsce/verdicts"
 _ROS_PACKAGE = re.compile(r"[a-z][a-z0-9]*(?:_[a-z0-9]+)*")
 """REP 144: lowercase letters, digits and single underscores, starting with a letter."""
 _ROS_TOPIC = re.compile(r"/?[A-Za-z_][A-Za-z0-9_]*(?:/[A-Za-z_][A-Za-z0-9_]*)*")
-_ROS1_ATTRIBUTES = {"header.stamp.sec": "header.stamp.secs", "header.stamp.nanosec": "header.stamp.nsecs"}
-"""rospy's names of the fields ROS 2 (and exsce's paths) name otherwise."""
+_ROSPY_TIME = {"sec": "secs", "nanosec": "nsecs"}
+"""rospy's names of the fields of a time or a duration, which ROS 2 (and exsce's paths) name
+otherwise."""
 _COPIED = ("monitor_core.py", "monitor_runtime.py")
 
 
@@ -104,6 +117,7 @@ def monitor_topics(
 ) -> dict[str, TopicEntry]:
     """Topic → subscription, for every field a metric reads of each robot, and the dispatcher's."""
     topics: dict[str, TopicEntry] = {}
+    trees: dict[str, Fields | None] = {}
 
     def add(topic: str, entry: TopicEntry, by: str) -> TopicEntry:
         if not _ROS_TOPIC.fullmatch(topic) or "__" in topic:
@@ -137,15 +151,60 @@ def monitor_topics(
                 read = reads[node.read]
                 wanted = TopicEntry(canonical_type(read.msgtype))
                 entry = add(read.topic_of(ns), wanted, f"metric {metric.name}")
-                path = ".".join(node.path)
-                leaf = leaf_paths(entry.msgtype).get(path) if entry.msgtype in MESSAGES else None
-                entry.fields[path] = _ROS1_ATTRIBUTES.get(path, path) if ros == 1 else path
-                if leaf is Leaf.ARRAY and path not in entry.arrays:
-                    entry.arrays.append(path)
+                if entry.msgtype not in trees:
+                    trees[entry.msgtype] = _tree(entry.msgtype)
+                key = node.path.key
+                entry.fields[key] = attribute_path(node.path, trees[entry.msgtype]) if ros == 1 else key
+                if node.arrays and key not in entry.arrays:
+                    entry.arrays.append(key)
     for entry in topics.values():
         entry.fields = dict(sorted(entry.fields.items()))
         entry.arrays.sort()
     return dict(sorted(topics.items()))
+
+
+def attribute_path(path: FieldPath, tree: Fields | None) -> str:
+    """The attributes that hold ``path`` in a rospy message object, written as the path's key:
+    rospy names a time's fields ``secs`` and ``nsecs``.  Without the type's fields (a type
+    only the robot knows), a ``stamp``'s are taken for a time's."""
+    node: Node | None = tree
+    steps: list[Step] = []
+    previous = ""
+    for step in path.steps:
+        if isinstance(step, str):
+            renamed, node = _rospy_name(step, node, previous)
+            steps.append(renamed)
+            previous = step
+            continue
+        node = node.element if isinstance(node, MessageArray) else None
+        if isinstance(step, Select):
+            names: list[str] = []
+            inner: Node | None = node
+            before = ""
+            for name in step.field:
+                renamed, inner = _rospy_name(name, inner, before)
+                names.append(renamed)
+                before = name
+            step = Select(tuple(names), step.value)
+        steps.append(step)
+    return FieldPath(tuple(steps), path.length).key
+
+
+def _rospy_name(name: str, node: Node | None, previous: str) -> tuple[str, Node | None]:
+    """rospy's name of field ``name`` of ``node`` (or of each of its elements), and the field."""
+    if isinstance(node, MessageArray):
+        node = node.element
+    if isinstance(node, dict):
+        time = set(node) == set(_ROSPY_TIME)
+        return (_ROSPY_TIME.get(name, name) if time else name), node.get(name)
+    return (_ROSPY_TIME.get(name, name) if previous == "stamp" else name), None
+
+
+def _tree(msgtype: str) -> Fields | None:
+    try:
+        return configured_catalogue().tree(msgtype)
+    except MessageTypeError:
+        return None
 
 
 def live_oracles(

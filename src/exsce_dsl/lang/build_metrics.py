@@ -1,36 +1,35 @@
-"""Build metric declarations (``metric NAME for ... { ... }``) and type-check their expressions.
+"""Build metric declarations (``metric NAME for ... { ... }``): what a metric is said of, the
+topics it reads, its unit, safety limit and how its values combine; its expressions are
+checked by :mod:`exsce_dsl.lang.build_expressions`.
 
 Every problem is reported at its ``file:line:col``: an unknown topic or field of
 a message type (with a did-you-mean), an aggregate over something that is not a
 number, per-message values mixed with one number per window, a value that cannot
 be combined over segments.  A checked metric is safe to turn into code: its
 name is a Python identifier and every other name in it was looked up.
+
+Message types come from a catalogue (the user's definitions over rosbags'
+standard packages, :func:`exsce_dsl.messages.user.configured_catalogue`).  A
+type it lacks is a warning, not an error: the bag may define it, and its fields
+are checked against the bag's definition when the bag is read
+(:mod:`exsce_dsl.lang.check_fields`).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import keyword
 import re
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass
-from typing import Any
+from collections.abc import Mapping
+from typing import Any, Protocol
 
 from exsce_dsl.errors import SourceLocation
+from exsce_dsl.lang.build_expressions import ExpressionBuilder, Scope, Typed, read_quantity
 from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.lang.suggest import did_you_mean
-from exsce_dsl.model.expressions import (
-    AGGREGATES,
-    Aggregate,
-    Binary,
-    Call,
-    Expression,
-    Field,
-    Kind,
-    Number,
-    Unary,
-    WindowValue,
-)
-from exsce_dsl.model.messages import DISPATCHER, FEEDBACK, MESSAGES, RESULT, Leaf, canonical_type, field_of
+from exsce_dsl.messages.catalogue import MessageCatalogue, MessageTypeError
+from exsce_dsl.model.expressions import Aggregate, Expression, WindowValue
+from exsce_dsl.model.messages import DISPATCHER, Fields, canonical_type
 from exsce_dsl.model.metrics import (
     SI_UNIT,
     UNITS,
@@ -42,14 +41,15 @@ from exsce_dsl.model.metrics import (
     TopicRead,
 )
 
-Report = Callable[[str, SourceLocation | None], None]
+
+class Report(Protocol):
+    """Where problems go: ``severity`` is ``error`` (the metric is not built) or ``warning``."""
+
+    def __call__(self, message: str, location: SourceLocation | None, severity: str = "error", /) -> None: ...
+
 
 _PYTHON_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 _TOPIC = re.compile(r"/?(?:[A-Za-z0-9_]|\{ns\})+(?:/(?:[A-Za-z0-9_]|\{ns\})+)*")
-_QUANTITY = re.compile(r"(\S+?)\s*([a-z/]+)?")
-_NUMERIC = (Kind.CONSTANT, Kind.NUMBERS, Kind.ARRAYS, Kind.VALUE)
-_PER_MESSAGE = (Kind.NUMBERS, Kind.ARRAYS, Kind.CONDITIONS, Kind.ARRAY_CONDITIONS)
-_CONDITIONS = (Kind.CONDITIONS, Kind.ARRAY_CONDITIONS)
 _COMBINE = {
     "sum": Combine.SUM,
     "integral": Combine.SUM,
@@ -64,19 +64,6 @@ _COMBINE = {
 _COUNTS = ("count", "succeeded")
 
 
-@dataclass(frozen=True)
-class Typed:
-    """An expression with its kind and, for per-message values, the topic whose times they follow."""
-
-    expr: Expression
-    kind: Kind
-    clock: str | None = None
-
-
-class _Failed(Exception):
-    """An expression with an error (already reported): its parents are not checked further."""
-
-
 def build_metric(
     pf: ParsedFile,
     tree: Any,
@@ -84,18 +71,27 @@ def build_metric(
     reserved: Mapping[str, str] | None = None,
     standard: bool = False,
     name_location: SourceLocation | None = None,
+    catalogue: MessageCatalogue | None = None,
 ) -> MetricDefinition | None:
     """The metric declared by ``tree``, or None if it has errors (all of them are reported).
 
     ``reserved``: names a metric may not take, with why (the standard library's metrics).
     Errors about the whole metric are reported at ``name_location`` (else at its start).
+    ``catalogue``: the message types known (else the configured one: the user's and the
+    standard types).
     """
-    return _MetricBuilder(pf, report, standard, name_location).build(tree, reserved or {})
+    builder = _MetricBuilder(pf, report, standard, name_location, catalogue)
+    return builder.build(tree, reserved or {})
 
 
 class _MetricBuilder:
     def __init__(
-        self, pf: ParsedFile, report: Report, standard: bool, name_location: SourceLocation | None
+        self,
+        pf: ParsedFile,
+        report: Report,
+        standard: bool,
+        name_location: SourceLocation | None,
+        catalogue: MessageCatalogue | None,
     ) -> None:
         self.pf = pf
         self.name_location = name_location
@@ -104,8 +100,11 @@ class _MetricBuilder:
         self.standard = standard
         self.failed = False
         self.reads: dict[str, TopicRead] = {}
+        self.trees: dict[str, Fields] = {}
+        """The fields of each read's type, if the catalogue knows it."""
         self.pair: tuple[str, str] | None = None
         self.subject = Subject.ROBOT
+        self._catalogue = catalogue
 
     def error(self, message: str, node: Any) -> None:
         self.failed = True
@@ -113,6 +112,22 @@ class _MetricBuilder:
         if node.__class__.__name__ == "Metric" and self.name_location is not None:
             where = self.name_location
         self.report(message, where)
+
+    def warning(self, message: str, node: Any) -> None:
+        self.report(message, self.pf.span(node), "warning")
+
+    def catalogue(self) -> MessageCatalogue:
+        if self._catalogue is None:
+            from exsce_dsl.messages.catalogue import standard_catalogue
+            from exsce_dsl.messages.user import configured_catalogue
+
+            try:
+                self._catalogue = configured_catalogue()
+            except MessageTypeError as exc:  # a user's file: said once (no location), standard types used
+                self.failed = True
+                self.report(exc.message, None)
+                self._catalogue = standard_catalogue()
+        return self._catalogue
 
     def build(self, tree: Any, reserved: Mapping[str, str]) -> MetricDefinition | None:
         name = tree.name
@@ -129,19 +144,25 @@ class _MetricBuilder:
             self.subject = Subject.MISSION
         for read in tree.reads:
             self._read(read)
-        value = self._checked_value(tree.value)
-        fallback = self._checked_value(tree.fallback) if tree.fallback is not None else None
+        scope = Scope(self.subject, self.reads, self.trees, self.broken_reads, self.pair)
+        expressions = ExpressionBuilder(self.pf, scope, self.error)
+        value = expressions.checked_value(tree.value)
+        fallback = expressions.checked_value(tree.fallback) if tree.fallback is not None else None
         dimension = self._dimension(tree, value)
         safety = self._safety(tree, value, dimension) if tree.safety is not None else None
         combine = self._combine(tree, value, fallback)
         if self.failed or value is None or dimension is None:
             return None
+        reads = tuple(
+            dataclasses.replace(r, fields=tuple(f for f in scope.fields if f.read == r.name))
+            for r in self.reads.values()
+        )
         return MetricDefinition(
             name,
             self.subject,
             bool(tree.per_segment),
             dimension,
-            tuple(self.reads.values()),
+            reads,
             value.expr,
             fallback.expr if fallback is not None else None,
             safety,
@@ -162,14 +183,7 @@ class _MetricBuilder:
         if self.pair is not None and read.name in self.pair:
             self.error(f"'{read.name}' names a robot of the pair; give the topic another name", read)
             return
-        if msgtype not in MESSAGES and msgtype not in DISPATCHER:
-            known = sorted([*MESSAGES, *DISPATCHER])
-            self.error(
-                f"exsce does not decode {read.msgtype}{did_you_mean(msgtype, known)} "
-                f"(it reads {', '.join(known)})",
-                read,
-            )
-            return
+        tree = self._tree(read, msgtype)
         if not _TOPIC.fullmatch(read.topic) or "{" in read.topic.replace("{ns}", ""):
             self.error(
                 f"'{read.topic}' is not a ROS topic name (letters, digits, '_' and '/'; "
@@ -181,7 +195,29 @@ class _MetricBuilder:
             self.error(f"a topic of each robot needs '{{ns}}' in its name: '{read.topic}'", read)
             return
         self.reads[read.name] = TopicRead(read.name, msgtype, read.topic, self.pf.span(read))
+        if tree is not None:
+            self.trees[read.name] = tree
         self.broken_reads.discard(read.name)
+
+    def _tree(self, read: Any, msgtype: str) -> Fields | None:
+        """The fields of ``msgtype``; None (and a warning) for a type the catalogue lacks."""
+        if msgtype in DISPATCHER:
+            return None
+        catalogue = self.catalogue()
+        try:
+            return catalogue.tree(msgtype)
+        except MessageTypeError as exc:
+            if msgtype in catalogue:  # known, but it needs a type that is not
+                self.warning(f"{exc.message}: the fields of {read.name} are checked when a bag is read", read)
+                return None
+        self.warning(
+            f"exsce does not know the message type {read.msgtype}"
+            f"{did_you_mean(msgtype, catalogue.definitions)}: the fields of {read.name} are checked when "
+            "a bag is read, against the bag's definition (to check them now, give exsce the type's "
+            ".msg or .idl file: exscec --msg-path DIR, or EXSCE_MSG_PATH)",
+            read,
+        )
+        return None
 
     def _dimension(self, tree: Any, value: Typed | None) -> Dimension | None:
         if tree.unit is None:
@@ -198,8 +234,8 @@ class _MetricBuilder:
         return dimension
 
     def _safety(self, tree: Any, value: Typed | None, dimension: Dimension | None) -> SafetyLimit | None:
-        limit = self._quantity(tree.safety.limit, tree.safety)
-        if limit is None or value is None or dimension is None:
+        limit = read_quantity(tree.safety.limit)
+        if value is None or dimension is None:
             return None
         number, unit_dimension = limit
         if unit_dimension is not None and unit_dimension is not dimension:
@@ -235,300 +271,6 @@ class _MetricBuilder:
             )
             return None
         return combines.pop()
-
-    def _quantity(self, text: str, node: Any) -> tuple[float, Dimension | None] | None:
-        match = _QUANTITY.fullmatch(text.strip())
-        assert match is not None  # the grammar's token
-        number = float(match[1])
-        if match[2] is None:
-            return number, None
-        dimension, factor = UNITS[match[2]]
-        return number * factor, dimension
-
-    # ------------------------------------------------------------- expressions
-    def _checked_value(self, tree: Any) -> Typed | None:
-        try:
-            typed = self._expr(tree)
-        except _Failed:
-            return None
-        if typed.kind is not Kind.VALUE:
-            self.error(
-                f"a metric's value is one number per window, but this is {typed.kind.value}: "
-                "aggregate it over time, e.g. max(...), mean(...), duration where ...",
-                tree,
-            )
-            return None
-        return typed
-
-    def _expr(self, node: Any) -> Typed:
-        kind = node.__class__.__name__
-        method = getattr(self, f"_{kind.lower()}")
-        result: Typed = method(node)
-        return result
-
-    def _fail(self, message: str, node: Any) -> _Failed:
-        self.error(message, node)
-        return _Failed()
-
-    def _disjunction(self, node: Any) -> Typed:
-        return self._logic(node, "or")
-
-    def _conjunction(self, node: Any) -> Typed:
-        return self._logic(node, "and")
-
-    def _logic(self, node: Any, op: str) -> Typed:
-        typed = [self._expr(o) for o in node.operands]
-        result = typed[0]
-        for operand, right in zip(node.operands[1:], typed[1:], strict=True):
-            for side in (result, right):
-                if side.kind not in _CONDITIONS:
-                    raise self._fail(f"'{op}' joins conditions, but this is {side.kind.value}", operand)
-            if result.clock != right.clock:
-                raise self._fail(
-                    f"'{op}' joins conditions on different topics ({result.clock}, {right.clock}): "
-                    "compare values instead, which are aligned in time",
-                    operand,
-                )
-            arrays = Kind.ARRAY_CONDITIONS in (result.kind, right.kind)
-            result = Typed(
-                Binary(op, result.expr, right.expr, self.pf.span(node)),
-                Kind.ARRAY_CONDITIONS if arrays else Kind.CONDITIONS,
-                result.clock,
-            )
-        return result
-
-    def _negation(self, node: Any) -> Typed:
-        inner = self._expr(node.operand)
-        if not node.negated:
-            return inner
-        if inner.kind not in _CONDITIONS:
-            raise self._fail(f"'not' negates a condition, but this is {inner.kind.value}", node)
-        return Typed(Unary("not", inner.expr, self.pf.span(node)), inner.kind, inner.clock)
-
-    def _comparison(self, node: Any) -> Typed:
-        left = self._expr(node.left)
-        if node.op is None or node.op == "":
-            return left
-        right = self._expr(node.right)
-        combined = self._arithmetic(node.op, left, right, node)
-        if combined.kind in (Kind.VALUE, Kind.CONSTANT):
-            raise self._fail(
-                "a metric is a number: comparisons of whole-window values belong in acceptance criteria",
-                node,
-            )
-        kind = Kind.ARRAY_CONDITIONS if combined.kind is Kind.ARRAYS else Kind.CONDITIONS
-        return Typed(combined.expr, kind, combined.clock)
-
-    def _sum(self, node: Any) -> Typed:
-        return self._chain(node)
-
-    def _product(self, node: Any) -> Typed:
-        return self._chain(node)
-
-    def _chain(self, node: Any) -> Typed:
-        result = self._expr(node.first)
-        for tail in node.rest:
-            result = self._arithmetic(tail.op, result, self._expr(tail.operand), tail.operand)
-        return result
-
-    def _arithmetic(self, op: str, left: Typed, right: Typed, node: Any) -> Typed:
-        """``left op right`` for numbers (``op`` may be a comparison: same rules for the operands)."""
-        for side in (left, right):
-            if side.kind not in _NUMERIC:
-                raise self._fail(f"'{op}' needs numbers, but one side is {side.kind.value}", node)
-        where = self.pf.span(node)
-        expr = Binary(op, left.expr, right.expr, where)
-        kinds = {left.kind, right.kind}
-        if kinds <= {Kind.CONSTANT}:
-            return Typed(expr, Kind.CONSTANT)
-        if Kind.VALUE in kinds:
-            if kinds - {Kind.VALUE, Kind.CONSTANT}:
-                raise self._fail(
-                    "this mixes one number per window with values per message: aggregate the "
-                    "per-message values first (e.g. max(...))",
-                    node,
-                )
-            return Typed(expr, Kind.VALUE)
-        return self._elementwise(expr, [left, right], node)
-
-    def _elementwise(self, expr: Expression, operands: list[Typed], node: Any) -> Typed:
-        """Per-message operands: arrays broadcast over numbers; other topics are aligned in time."""
-        per_message = [o for o in operands if o.kind in _PER_MESSAGE]
-        clock = per_message[0].clock
-        arrays = any(o.kind is Kind.ARRAYS for o in per_message)
-        for other in per_message[1:]:
-            if other.clock == clock:
-                continue
-            if arrays:
-                raise self._fail(
-                    f"arrays cannot be aligned in time: {clock} and {other.clock} are different topics",
-                    node,
-                )
-            clock = f"{clock}&{other.clock}"
-        return Typed(expr, Kind.ARRAYS if arrays else Kind.NUMBERS, clock)
-
-    def _signed(self, node: Any) -> Typed:
-        inner = self._expr(node.operand)
-        if not node.minus:
-            return inner
-        if inner.kind not in _NUMERIC:
-            raise self._fail(f"'-' needs a number, but this is {inner.kind.value}", node)
-        return Typed(Unary("-", inner.expr, self.pf.span(node)), inner.kind, inner.clock)
-
-    def _parenthesized(self, node: Any) -> Typed:
-        return self._expr(node.inner)
-
-    def _literal(self, node: Any) -> Typed:
-        quantity = self._quantity(node.quantity, node)
-        assert quantity is not None
-        written = " ".join(node.quantity.split())
-        return Typed(Number(quantity[0], written, self.pf.span(node)), Kind.CONSTANT)
-
-    def _windowvalue(self, node: Any) -> Typed:
-        needed = FEEDBACK if node.name == "elapsed" else RESULT
-        if not any(r.msgtype == needed for r in self.reads.values()):
-            which = "feedback" if node.name == "elapsed" else "result"
-            raise self._fail(
-                f"'{node.name}' comes from the waypoint dispatcher: read its {which} topic "
-                f'(reads {which}: {needed} on "/{{ns}}/waypoint_dispatcher/{which}")',
-                node,
-            )
-        if node.name == "succeeded" and self.subject is not Subject.ROBOT:
-            raise self._fail("'succeeded' counts the waypoints of one robot: use it 'for each robot'", node)
-        return Typed(WindowValue(node.name, self.pf.span(node)), Kind.VALUE)
-
-    def _fieldpath(self, node: Any) -> Typed:
-        parts = list(node.parts)
-        robot = None
-        if self.subject is Subject.MISSION:
-            raise self._fail(
-                "a mission metric reads every robot's topics, so a field does not say whose: "
-                "use 'for each pair of robots (a, b)' and a.<topic>..., or 'elapsed'",
-                node,
-            )
-        if self.pair is not None:
-            if parts[0] not in self.pair:
-                raise self._fail(
-                    f"say whose topic this is: {self.pair[0]}.{'.'.join(parts)} or "
-                    f"{self.pair[1]}.{'.'.join(parts)}",
-                    node,
-                )
-            robot = parts.pop(0)
-            if not parts:
-                raise self._fail(f"'{robot}' is a robot: name one of its topics", node)
-        read = self.reads.get(parts[0])
-        if read is None and parts[0] in self.broken_reads:
-            raise _Failed()  # its declaration's error says enough
-        if read is None:
-            raise self._fail(f"unknown topic '{parts[0]}'{did_you_mean(parts[0], self.reads)}", node)
-        if read.msgtype in DISPATCHER:
-            raise self._fail(
-                f"the dispatcher's {read.msgtype} is read as windows: use 'elapsed' or 'succeeded'", node
-            )
-        path = tuple(parts[1:])
-        found = field_of(read.msgtype, path)
-        if found is None:
-            done: tuple[str, ...] = ()
-            for part in path:
-                here = field_of(read.msgtype, done)
-                if not isinstance(here, dict) or part not in here:
-                    options = list(here) if isinstance(here, dict) else []
-                    owner = ".".join((read.name, *done))
-                    raise self._fail(
-                        f"{owner} ({read.msgtype}{'.' + '.'.join(done) if done else ''}) has no field "
-                        f"'{part}'{did_you_mean(part, options)}",
-                        node,
-                    )
-                done = (*done, part)
-        text = ".".join((read.name, *path))
-        if isinstance(found, dict):
-            raise self._fail(
-                f"{text} is a message ({', '.join(found)}), not a number: name one of its fields", node
-            )
-        if found is Leaf.TEXT:
-            raise self._fail(f"{text} is text, not a number", node)
-        expr = Field(read.name, path, robot, self.pf.span(node))
-        return Typed(expr, Kind.ARRAYS if found is Leaf.ARRAY else Kind.NUMBERS, expr.clock)
-
-    def _call(self, node: Any) -> Typed:
-        func = node.func
-        if func in AGGREGATES:
-            return self._aggregate(node)
-        args = [self._argument(a, allow_where=False) for a in node.args]
-        if func in ("abs", "sqrt") and len(args) != 1:
-            raise self._fail(f"{func}(...) takes one value, not {len(args)}", node)
-        for arg in args:
-            if arg.kind not in _NUMERIC:
-                raise self._fail(f"{func}(...) needs numbers, but this is {arg.kind.value}", node)
-        expr = Call(func, tuple(a.expr for a in args), self.pf.span(node))
-        kinds = {a.kind for a in args}
-        if kinds <= {Kind.CONSTANT}:
-            return Typed(expr, Kind.CONSTANT)
-        if Kind.VALUE in kinds:
-            if kinds - {Kind.VALUE, Kind.CONSTANT}:
-                raise self._fail(f"{func}(...) mixes one number per window with values per message", node)
-            return Typed(expr, Kind.VALUE)
-        return self._elementwise(expr, args, node)
-
-    def _argument(self, arg: Any, allow_where: bool) -> Typed:
-        if arg.condition is not None and not allow_where:
-            raise self._fail(
-                "'where' filters the values of an aggregate over time, e.g. min(x where ...)", arg
-            )
-        return self._expr(arg.value)
-
-    def _aggregate(self, node: Any) -> Typed:
-        func = node.func
-        args = [self._expr(a.value) for a in node.args]
-        wheres = [a for a in node.args if a.condition is not None]
-        arity = (2, 3) if func == "path_length" else (1,)
-        if len(args) not in arity:
-            wanted = "two or three values (x, y[, z])" if func == "path_length" else "one value"
-            raise self._fail(f"{func}(...) takes {wanted}, not {len(args)}", node)
-        for arg in args:
-            if arg.kind in _CONDITIONS:
-                raise self._fail(
-                    f"{func}(...) is over numbers, but this is {arg.kind.value}: "
-                    "use 'count where ...' or 'duration where ...'",
-                    node,
-                )
-            if arg.kind not in _PER_MESSAGE:
-                raise self._fail(
-                    f"{func}(...) aggregates values per message over time, but this is {arg.kind.value}",
-                    node,
-                )
-            if arg.kind is Kind.ARRAYS and func not in ("min", "max", "mean", "sum"):
-                raise self._fail(
-                    f"{func}(...) of an array has no single time course: take min, max, mean or sum", node
-                )
-        if len({a.clock for a in args}) > 1:
-            raise self._fail(f"{func}(...) needs its values on one topic", node)
-        where: Expression | None = None
-        if wheres:
-            if len(wheres) > 1 or func in ("integral", "change", "path_length"):
-                raise self._fail(f"{func}(...) takes no 'where'", wheres[0])
-            condition = self._expr(wheres[0].condition)
-            if condition.kind not in _CONDITIONS:
-                raise self._fail(f"'where' needs a condition, but this is {condition.kind.value}", wheres[0])
-            if condition.clock != args[0].clock:
-                raise self._fail(
-                    f"the condition is on {condition.clock}, the values on {args[0].clock}: "
-                    "filter a topic by its own fields",
-                    wheres[0],
-                )
-            if condition.kind is Kind.ARRAY_CONDITIONS and args[0].kind is not Kind.ARRAYS:
-                raise self._fail("a condition per array element filters an array, not a number", wheres[0])
-            where = condition.expr
-        return Typed(Aggregate(func, tuple(a.expr for a in args), where, self.pf.span(node)), Kind.VALUE)
-
-    def _whereaggregate(self, node: Any) -> Typed:
-        condition = self._expr(node.condition)
-        if condition.kind is not Kind.CONDITIONS:
-            raise self._fail(
-                f"'{node.func} where' needs a condition per message, but this is {condition.kind.value}",
-                node,
-            )
-        return Typed(Aggregate(node.func, (), condition.expr, self.pf.span(node)), Kind.VALUE)
 
 
 def _top(expr: Expression) -> str | None:

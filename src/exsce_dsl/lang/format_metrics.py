@@ -2,6 +2,8 @@
 
 Numbers print in SI without their unit (``0.8 m/s`` reads back as ``0.8``), and
 parentheses only where precedence needs them, so parse → print → parse is stable.
+A field prints as written: ``tf.transforms[child_frame_id == "base_link"].transform``,
+``scan.ranges[-1]``, ``len(diag.status)``.
 """
 
 from __future__ import annotations
@@ -10,6 +12,7 @@ from exsce_dsl.errors import SourceLocation
 from exsce_dsl.lang.lexical import number_text as _number
 from exsce_dsl.lang.lexical import string_literal as _string
 from exsce_dsl.model.expressions import Aggregate, Binary, Expression, Field, Number, Unary, WindowValue
+from exsce_dsl.model.messages import Index
 from exsce_dsl.model.metrics import MetricDefinition, Subject
 
 INDENT = "  "
@@ -54,8 +57,7 @@ def _text(expr: Expression) -> tuple[str, int]:
     if isinstance(expr, Number):
         return expr.written or _number(expr.value), _ATOM
     if isinstance(expr, Field):
-        parts = ((expr.robot,) if expr.robot else ()) + (expr.read, *expr.path)
-        return ".".join(parts), _ATOM
+        return field_text(expr), _ATOM
     if isinstance(expr, WindowValue):
         return expr.name, _ATOM
     if isinstance(expr, Unary):
@@ -75,6 +77,25 @@ def _text(expr: Expression) -> tuple[str, int]:
     if isinstance(expr, Aggregate) and expr.where is not None:
         args += f" where {expression_text(expr.where)}"
     return f"{expr.func}({args})", _ATOM
+
+
+def field_text(f: Field) -> str:
+    """``a.odom.pose.pose.position.x``, ``len(diag.status)``: a field as the language writes it."""
+    text = f"{f.robot}.{f.read}" if f.robot else f.read
+    for step in f.path.steps:
+        if isinstance(step, str):
+            text += f".{step}"
+        elif isinstance(step, Index):
+            text += f"[{step.position}]"
+        else:
+            value = _string(step.value) if isinstance(step.value, str) else _select_number(step.value)
+            text += f"[{'.'.join(step.field)} == {value}]"
+    return f"len({text})" if f.path.length else text
+
+
+def _select_number(value: float) -> str:
+    """A whole number without its ``.0`` (``[status == 3]``), else the shortest text of it."""
+    return str(int(value)) if value.is_integer() and abs(value) < 1e15 else _number(value)
 
 
 def _operand(expr: Expression, needed: int) -> str:

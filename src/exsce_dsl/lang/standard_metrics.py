@@ -12,6 +12,7 @@ import functools
 from exsce_dsl.errors import Diagnostic, SourceLocation, SpecError
 from exsce_dsl.lang.build_metrics import build_metric
 from exsce_dsl.lang.parser import parse_text
+from exsce_dsl.messages.catalogue import standard_catalogue
 from exsce_dsl.model.metrics import METRICS, MetricDefinition
 from exsce_dsl.resources import package_file
 
@@ -23,10 +24,11 @@ def standard_metrics() -> tuple[MetricDefinition, ...]:
     pf = parse_text(source.read_text(encoding="utf-8"), str(source))
     problems: list[Diagnostic] = []
 
-    def report(message: str, at: SourceLocation | None) -> None:
-        problems.append(Diagnostic(message, at))
+    def report(message: str, at: SourceLocation | None, severity: str = "error") -> None:
+        problems.append(Diagnostic(message, at, severity))
 
-    built = [build_metric(pf, tree, report, standard=True) for tree in pf.tree.declarations]
+    types = standard_catalogue()  # the method's types only, whatever the user defines
+    built = [build_metric(pf, tree, report, standard=True, catalogue=types) for tree in pf.tree.declarations]
     if problems:
         raise SpecError(problems)  # a broken installation, not a user's mistake
     return tuple(m for m in built if m is not None)

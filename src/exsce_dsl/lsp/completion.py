@@ -1,6 +1,7 @@
 """Completion by context: the keywords the grammar allows at the point, and the names of
 what may be referred to there (poses where a waypoint goes, robots of the scenario in its
-mission, a scenario's metrics in its acceptance criteria, relations, transformations).
+mission, a scenario's metrics in its acceptance criteria, relations, transformations, and in
+a metric the topics it reads, their messages' fields and message types: :mod:`.fields`).
 
 The grammar says *whether* a name may come (:mod:`exsce_dsl.lang.expected`); the words
 before the point say *which kind* of name.  Names come from the files' indexes, which
@@ -70,6 +71,12 @@ _ITEM_KINDS = {
     "robot": types.CompletionItemKind.Variable,
     "mission": types.CompletionItemKind.Event,
     "metric": types.CompletionItemKind.Field,
+}
+_OFFERED_KINDS = {
+    "field": types.CompletionItemKind.Field,
+    "read": types.CompletionItemKind.Variable,
+    "robot": types.CompletionItemKind.Variable,
+    "type": types.CompletionItemKind.Class,
 }
 
 
@@ -248,8 +255,10 @@ def complete(
     typed: str,
     replace: types.Range,
     snippets: bool,
+    offered: Sequence[tuple[str, str, str]] = (),
 ) -> types.CompletionList:
-    """The completion list at a point: names that fit, then keywords, relations, transformations."""
+    """The completion list at a point: names that fit, then keywords, relations, transformations.
+    ``offered``: (label, kind, detail) items that fit too (a metric's fields, its reads)."""
     items: list[types.CompletionItem] = []
     seen: set[tuple[str, str]] = set()
     all_symbols = [s for index in names.indexes for s in index.all_symbols()]
@@ -278,6 +287,8 @@ def complete(
             )
         )
 
+    for label, what, detail in offered:
+        add(label, _OFFERED_KINDS.get(what, types.CompletionItemKind.Text), detail, "0")
     if expected.name or not expected.known:
         for wanted in wanted_names(expected, names):
             for symbol in candidates(wanted, names, all_symbols):

@@ -14,6 +14,7 @@ from exsce_dsl.lang.loader import display_path, import_target
 from exsce_dsl.lsp.actions import quick_fixes
 from exsce_dsl.lsp.completion import complete
 from exsce_dsl.lsp.convert import path_of, uri_of
+from exsce_dsl.lsp.fields import field_hover, offers
 from exsce_dsl.lsp.hover import keyword_hover, symbol_hover, word_at
 from exsce_dsl.lsp.navigation import RENAMEABLE, Names, RenameError, import_at
 from exsce_dsl.lsp.outline import document_symbol, workspace_symbols
@@ -79,7 +80,7 @@ def _documents(server: ExsceLanguageServer) -> None:
 def _editing(server: ExsceLanguageServer) -> None:
     @server.feature(
         types.TEXT_DOCUMENT_COMPLETION,
-        types.CompletionOptions(trigger_characters=[" ", ",", ":"]),
+        types.CompletionOptions(trigger_characters=[" ", ",", ":", ".", "["]),
     )
     def completion(ls: ExsceLanguageServer, params: types.CompletionParams) -> types.CompletionList:
         text = ls.workspace.get_text_document(params.text_document.uri).source
@@ -95,7 +96,14 @@ def _editing(server: ExsceLanguageServer) -> None:
         item = capabilities.completion.completion_item if capabilities and capabilities.completion else None
         snippets = bool(item and item.snippet_support)
         typed = text[expected.word_start : offset]
-        return complete(expected, names, typed, types.Range(start, params.position), snippets)
+        offer = None
+        if expected.declaration == "metric":
+            offer = offers(text, offset, expected.word_start, "message type" in expected.others)
+        if offer is not None and offer.start != expected.word_start:  # a message type holds '/'
+            start = lines.position(*lines.location(offer.start))
+            typed = text[offer.start : offset]
+        offered = offer.items if offer is not None else []
+        return complete(expected, names, typed, types.Range(start, params.position), snippets, offered)
 
     @server.feature(types.TEXT_DOCUMENT_HOVER)
     async def hover(ls: ExsceLanguageServer, params: types.HoverParams) -> types.Hover | None:
@@ -109,7 +117,7 @@ def _editing(server: ExsceLanguageServer) -> None:
             word = word_at(lines.text, lines.offset(params.position))
             if word is None:
                 return None
-            text = keyword_hover(word[0])
+            text = field_hover(lines.text, word[1], word[2]) or keyword_hover(word[0])
             where = types.Range(
                 lines.position(*lines.location(word[1])), lines.position(*lines.location(word[2]))
             )

@@ -100,7 +100,9 @@ MEANINGS: dict[str, str] = {
     "unit": "`unit U`: the metric's SI unit (s, m, m/s, rad, rad/s).",
     "safe": "`safe below|above LIMIT`: a safety metric (its violation durations and hotspots are computed).",
     "reads": '`reads NAME: pkg/msg/Type on "/{ns}/topic"`: a topic the metric reads ({ns} is the '
-    "robot's namespace).",
+    "robot's namespace), of any standard ROS type or one of yours (`exscec --msg-path`); its fields: "
+    '`NAME.pose.pose.position.x`, `NAME.ranges[-1]`, `NAME.transforms[child_frame_id == "base_link"]`, '
+    "`len(NAME.status_list)`.",
     "value": "`value EXPR`: how the metric's value is computed from what it reads.",
     "otherwise": "`otherwise EXPR`: computed instead when a topic of the value is not in the bag.",
     "runs": "`when MISSION runs`.",

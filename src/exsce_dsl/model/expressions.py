@@ -2,7 +2,9 @@
 
 The builder (``lang.build_metrics``) type-checks every node; a tree here is
 known to be well formed: fields exist in their message type, aggregates are
-over numbers, a metric's value is one number per window.
+over numbers, a metric's value is one number per window.  (A field of a type
+exsce does not know is checked later, against the bag's definition, by
+``lang.check_fields``.)
 """
 
 from __future__ import annotations
@@ -11,6 +13,7 @@ import enum
 from dataclasses import dataclass, field
 
 from exsce_dsl.errors import SourceLocation
+from exsce_dsl.model.messages import FieldPath
 
 
 class Kind(enum.Enum):
@@ -35,11 +38,15 @@ class Number:
 
 @dataclass(frozen=True)
 class Field:
-    """A message field of a topic: ``vel.linear.x``; ``robot`` is the pair binder (``a``) if any."""
+    """A message field of a topic: ``vel.linear.x``, ``tf.transforms[0].transform.translation.x``,
+    ``len(diag.status)``; ``robot`` is the pair binder (``a``) if any."""
 
     read: str
-    path: tuple[str, ...]
+    path: FieldPath
     robot: str | None = None
+    arrays: bool = False
+    """An array per message: an array field, or a field of every element of an array of messages
+    (``tf.transforms.transform.translation.x``).  False for a type unknown when checked."""
     location: SourceLocation | None = field(default=None, compare=False, repr=False)
 
     @property

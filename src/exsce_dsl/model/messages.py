@@ -76,7 +76,7 @@ class Select:
         return f"[{'.'.join(self.field)} == {value}]"
 
 
-Step = Union[str, Index, Select]
+Step = str | Index | Select
 
 
 @dataclass(frozen=True)

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 from exsce_dsl.errors import SourceLocation
-from exsce_dsl.model.expressions import Expression
+from exsce_dsl.model.expressions import Expression, Field
 
 if TYPE_CHECKING:
     from exsce_dsl.model.scenario import Scenario
@@ -140,9 +140,15 @@ class TopicRead:
     topic: str
     """The topic name; ``{ns}`` stands for the robot's namespace."""
     location: SourceLocation | None = field(default=None, compare=False, repr=False)
+    fields: tuple[Field, ...] = ()
+    """Every field the metric reads of the topic, where it is written: what the bag reader
+    decodes, and what ``lang.check_fields`` checks against the bag's definition."""
 
     def topic_of(self, namespace: str) -> str:
-        return self.topic.replace("{ns}", namespace.strip("/"))
+        name = self.topic.replace("{ns}", namespace.strip("/"))
+        while "//" in name:  # a robot at the root: /{ns}/odom is /odom
+            name = name.replace("//", "/")
+        return name
 
 
 @dataclass(frozen=True)

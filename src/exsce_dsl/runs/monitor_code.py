@@ -23,7 +23,7 @@ from pathlib import Path
 
 from exsce_dsl.lang.format_metrics import expression_text
 from exsce_dsl.model.expressions import Aggregate, Expression, Field, WindowValue, walk
-from exsce_dsl.model.messages import FEEDBACK, RESULT, Leaf, field_of
+from exsce_dsl.model.messages import FEEDBACK, RESULT
 from exsce_dsl.model.metrics import Combine, MetricDefinition, Subject
 
 GENERATOR = "exscec generate monitors"
@@ -97,8 +97,7 @@ def alternatives(metric: MetricDefinition) -> list[Alternative]:
             whose = "" if f.robot is None else ("first" if first else "second")
             reads.append((variables[key], whose, patterns[f.read]))
         succeeded = any(isinstance(n, WindowValue) and n.name == "succeeded" for n in nodes)
-        types = {r.name: r.msgtype for r in metric.reads}
-        blocks = [_array_topic(a, types, variables) for a in aggregates]
+        blocks = [_array_topic(a, variables) for a in aggregates]
         reducers = [
             None if var is None else (f"_reduce_{metric.name}_{number}_{k}", f"{metric.name}/{number}/{k}")
             for k, var in enumerate(blocks)
@@ -108,12 +107,10 @@ def alternatives(metric: MetricDefinition) -> list[Alternative]:
     return found
 
 
-def _array_topic(
-    aggregate: Aggregate, types: dict[str, str], variables: dict[tuple[str | None, str], str]
-) -> str | None:
+def _array_topic(aggregate: Aggregate, variables: dict[tuple[str | None, str], str]) -> str | None:
     """The variable of the topic an aggregate reads arrays of (one topic: arrays are never aligned)."""
     for node in [n for arg in aggregate.args for n in walk(arg)]:
-        if isinstance(node, Field) and field_of(types[node.read], node.path) is Leaf.ARRAY:
+        if isinstance(node, Field) and node.arrays:
             return variables[(node.robot, node.read)]
     return None
 

@@ -11,11 +11,15 @@ classes over ``core.Topic``s built from what has been received, in windows
 taken from the waypoint dispatcher's goal statuses as ingestion takes them:
 a robot's window runs from its first waypoint that became ACTIVE to the last
 one that reached a final status (to *now* while one is still active).
-Fields are read from message objects by attribute access along their paths
-and appended to growing numpy buffers (capacity doubles: amortised O(1) per
-message, no Python object kept per value).  Arrays (laser ranges, rows of any
-length) are reduced a block of messages at a time by the monitors'
-``REDUCERS``, as ingestion reduces them, so their rows are not kept.  Each
+Fields are read from message objects by attribute access along their paths,
+written as exsce writes them (``transforms[child_frame_id == "base_link"].
+transform.translation.x``, ``ranges[-1]``, ``len(status_list)``), and appended
+to growing numpy buffers (capacity doubles: amortised O(1) per message, no
+Python object kept per value).  A path that picks an element keeps a
+``#present`` mask, as ingestion does, so that a message without that element
+gives no sample.  Arrays (laser ranges, rows of any length) are reduced a block
+of messages at a time by the monitors' ``REDUCERS``, as ingestion reduces them,
+so their rows are not kept.  Each
 evaluation computes every metric over all data so far (vectorised: ~15 ms for
 an hour of scenario_c's two robots, ~700k messages).
 """
@@ -25,6 +29,7 @@ from __future__ import annotations
 import importlib
 import json
 import math
+import re
 import threading
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -39,6 +44,8 @@ FINAL = frozenset({2, 3, 4, 5, 8, 9})
 PASSED, FAILED, NOT_YET = "passed", "failed", "not_yet"
 BLOCK = 256
 """Messages with arrays held before they are reduced to one value per message."""
+PRESENT = "#present"
+"""Suffix of the key of a path's mask: which messages have the element it picks."""
 
 
 def judge(
@@ -67,6 +74,101 @@ def message_class(path: str) -> Any:
     """The message class of an import path such as ``geometry_msgs.msg.Twist``."""
     module, _, name = path.rpartition(".")
     return getattr(importlib.import_module(module), name)
+
+
+@dataclass(frozen=True)
+class Pick:
+    """``[3]`` (``names`` empty: by position) or ``[child_frame_id == "base_link"]`` (the first
+    element whose field ``names`` equals ``value``)."""
+
+    names: tuple[str, ...]
+    value: Any
+
+
+@dataclass(frozen=True)
+class Attributes:
+    """A path into message objects: attribute names and picks, or the length of what they name."""
+
+    steps: tuple[str | Pick, ...]
+    length: bool = False
+
+    @property
+    def picks(self) -> bool:
+        return any(isinstance(step, Pick) for step in self.steps)
+
+    def read(self, msg: Any) -> tuple[Any, bool]:
+        """(the value in ``msg``, whether it is there).  A name after an array of messages
+        applies to every element; a pick with no element gives (None, False)."""
+        node = msg
+        for step in self.steps:
+            if isinstance(step, str) and isinstance(node, (list, tuple)):
+                node = [getattr(x, step) for x in node]
+            elif isinstance(step, str):
+                node = getattr(node, step)
+            elif not step.names:
+                try:
+                    node = node[step.value]
+                except IndexError:
+                    return None, False
+            else:
+                node = next((x for x in node if _attribute(x, step.names) == step.value), None)
+                if node is None:
+                    return None, False
+        if self.length:
+            return len(node), True
+        return node, True
+
+
+def _attribute(element: Any, names: tuple[str, ...]) -> Any:
+    for name in names:
+        element = getattr(element, name)
+    return element
+
+
+def attributes(text: str) -> Attributes:
+    """The path written ``text`` (``transforms[child_frame_id == "base_link"].transform.x``,
+    ``ranges[-1]``, ``len(status_list)``); selected values are JSON (a string or a number)."""
+    length = text.startswith("len(") and text.endswith(")")
+    if length:
+        text = text[4:-1]
+    steps: list[str | Pick] = []
+    at = 0
+    while at < len(text):
+        if text[at] == ".":
+            at += 1
+        if text[at] == "[":
+            end = _closing(text, at)
+            inside = text[at + 1 : end].strip()
+            field, equals, value = inside.partition("==")
+            if equals:
+                steps.append(Pick(tuple(field.strip().split(".")), json.loads(value.strip())))
+            else:
+                steps.append(Pick((), int(inside)))
+            at = end + 1
+            continue
+        name = re.match(r"[A-Za-z_][A-Za-z0-9_]*", text[at:])
+        if name is None:
+            raise ValueError(f"not a field path: {text!r}")
+        steps.append(name.group())
+        at += name.end()
+    return Attributes(tuple(steps), length)
+
+
+def _closing(text: str, start: int) -> int:
+    """Where the ``]`` that closes the ``[`` at ``start`` is (``]`` inside a string is text)."""
+    quoted = False
+    at = start + 1
+    while at < len(text):
+        char = text[at]
+        if quoted and char == "\\":
+            at += 2
+            continue
+        if char == '"':
+            quoted = not quoted
+        elif char == "]" and not quoted:
+            return at
+        at += 1
+    raise ValueError(f"no ']' closes the '[' of {text!r}")
 
 
 @dataclass(frozen=True)
@@ -120,15 +222,26 @@ def _padded(rows: Sequence[np.ndarray]) -> np.ndarray:
     return out
 
 
+def _row(value: Any) -> np.ndarray:
+    """An array field's value as a row of floats (none for an element that is not there)."""
+    if value is None:
+        return np.empty(0)
+    if isinstance(value, (bytes, bytearray)):  # rospy's uint8[] and char[]
+        return np.frombuffer(bytes(value), dtype=np.uint8).astype(np.float64)
+    return np.asarray(value, dtype=np.float64).ravel()
+
+
 class _Buffer:
     """One data topic: receive times, scalar fields, and arrays waiting to be reduced."""
 
     def __init__(self, spec: TopicSpec, reduce: Any) -> None:
         self.spec = spec
-        self.paths = {p: tuple(a.split(".")) for p, a in spec.fields.items()}
+        self.paths = {p: attributes(a) for p, a in spec.fields.items()}
         self.reduce = reduce
         self.t = _Column()
         self.columns: dict[str, _Column] = {p: _Column() for p in spec.fields if p not in spec.arrays}
+        self.present: dict[str, _Column] = {p + PRESENT: _Column() for p, a in self.paths.items() if a.picks}
+        """Per path that picks elements: 1 where the message has the element, else 0."""
         self.outputs: dict[str, _Column] = {}
         """Per-message values of the monitors' aggregates over arrays (``core.reduced`` reads them)."""
         self.pending: dict[str, list[np.ndarray]] = {p: [] for p in spec.arrays}
@@ -140,15 +253,17 @@ class _Buffer:
         """Keep the fields of ``msg``; all are read before any is kept, so that a message that
         lacks one (an exception) leaves the columns aligned."""
         values: dict[str, Any] = {}
-        for path, attributes in self.paths.items():
-            value = msg
-            for name in attributes:
-                value = getattr(value, name)
-            values[path] = value
-        scalars = {path: float(values[path]) for path in self.columns}
-        rows = {path: np.asarray(values[path], dtype=np.float64).ravel() for path in self.pending}
+        present: dict[str, float] = {}
+        for path, where in self.paths.items():
+            values[path], found = where.read(msg)
+            if where.picks:
+                present[path + PRESENT] = 1.0 if found else 0.0
+        scalars = {path: math.nan if values[path] is None else float(values[path]) for path in self.columns}
+        rows = {path: _row(values[path]) for path in self.pending}
         for path, column in self.columns.items():
             column.append(scalars[path])
+        for key, column in self.present.items():
+            column.append(present[key])
         for path, row in rows.items():
             self.pending[path].append(row)
         self.t.append(t)
@@ -164,7 +279,8 @@ class _Buffer:
                 self.kept[p].extend(rows)
         else:
             block = {p: c.view()[self.reduced :] for p, c in self.columns.items()}
-            block |= {p: _padded(rows) for p, rows in self.pending.items()}
+            block.update({p: c.view()[self.reduced :] > 0 for p, c in self.present.items()})
+            block.update({p: _padded(rows) for p, rows in self.pending.items()})
             for key, values in self.reduce(block).items():
                 if key not in block:
                     self.outputs.setdefault(key, _Column()).extend(values)
@@ -175,7 +291,8 @@ class _Buffer:
     def topic(self, core: ModuleType, name: str) -> Any:
         self.flush()
         fields = {p: c.view() for p, c in {**self.columns, **self.outputs}.items()}
-        fields |= {p: _padded(rows) for p, rows in self.kept.items() if self.reduce is None}
+        fields.update({p: c.view() > 0 for p, c in self.present.items()})
+        fields.update({p: _padded(rows) for p, rows in self.kept.items() if self.reduce is None})
         t = self.t.view()
         if len(t) > 1 and bool(np.any(np.diff(t) < 0)):  # a clock that went back: time order
             order = np.argsort(t, kind="stable")
