@@ -127,6 +127,15 @@ def read_bag(
                 return _Ros1(path, wanted, reduce, check).read()
             except UnsupportedBag:
                 pass  # rosbags reads what our index reader does not (and reports what is broken)
+        # MCAP's own index, read with numpy like ROS 1's; its reading class builds on this module's
+        from exsce_dsl.runs.mcap_reading import Mcap, mcap_files
+
+        files = mcap_files(path)
+        if files is not None:
+            try:
+                return Mcap(path, wanted, reduce, check).read(files)
+            except UnsupportedBag:
+                pass  # files without a summary, chunk or message indexes: rosbags reads them
         return _read_with_rosbags(path, wanted, reduce, check)
     except BagError as exc:
         if str(path) in exc.message:

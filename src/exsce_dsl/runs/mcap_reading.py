@@ -1,0 +1,171 @@
+"""The fast path for MCAP bags (ROS 2): the file's own index, numpy gathers, no per-message Python.
+
+:func:`read_mcap` is :func:`~exsce_dsl.runs.bagdata.read_bag` for MCAP bags
+(an ``.mcap`` file, or a ROS 2 bag folder whose ``metadata.yaml`` says
+``storage_identifier: mcap``): it reads them with
+:mod:`exsce_dsl.runs.mcap_index`, and with rosbags when that raises
+:class:`~exsce_dsl.runs.ros1_index.UnsupportedBag`.  A type's definition
+comes from the channel's schema (``ros2msg`` or ``ros2idl``), else from the
+user's files, else from rosbags' standard typestores.  Meant to be folded into
+``bagdata.read_bag`` (``Mcap`` beside ``_Ros1``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from exsce_dsl.messages.catalogue import (
+    MessageCatalogue,
+    MessageTypeError,
+    Source,
+    parse_definition,
+    standard_catalogue,
+)
+from exsce_dsl.messages.user import configured_user_catalogue
+from exsce_dsl.runs.bagdata import (
+    ANY,
+    BagData,
+    BagError,
+    Check,
+    Reduce,
+    Wanted,
+    _read_with_rosbags,
+    _Reading,
+    _status_update,
+    deserializer_for,
+)
+from exsce_dsl.runs.decode import DecodeError, RawMessages, decode, decode_slowly, vectorisable
+from exsce_dsl.runs.mcap_index import Schema, read_topics, schemas
+from exsce_dsl.runs.ros1_index import Messages, UnsupportedBag
+
+IDL_SEPARATOR = "=" * 80 + "\n"
+"""Between the ``.idl`` files of a ``ros2idl`` schema, each then headed ``IDL: pkg/msg/Name``."""
+
+
+def read_mcap(
+    path: Path,
+    wanted: Mapping[str, Wanted],
+    reduce: Mapping[str, Reduce] | None = None,
+    check: Check | None = None,
+) -> BagData:
+    """:func:`~exsce_dsl.runs.bagdata.read_bag` for an MCAP bag: its index, else rosbags."""
+    if not path.exists():
+        raise BagError(f"{path}: no such bag")
+    try:
+        files = mcap_files(path)
+        if files is not None:
+            try:
+                return Mcap(path, wanted, reduce, check).read(files)
+            except UnsupportedBag:
+                pass  # rosbags reads what our index reader does not (and reports what is broken)
+        return _read_with_rosbags(path, wanted, reduce, check)
+    except BagError:
+        raise
+    except (DecodeError, MessageTypeError) as exc:
+        raise BagError(f"{path}: {exc.message}") from None
+
+
+_YAML_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml's: ten times faster
+
+
+def mcap_files(path: Path) -> list[Path] | None:
+    """The MCAP files of the bag at ``path``, in order: the file itself, or those a ROS 2 bag
+    folder lists; None if it is not an MCAP bag the index reader can read (another storage, or
+    files or messages compressed whole, which only rosbags reads)."""
+    if path.is_file():
+        return [path] if path.suffix == ".mcap" else None
+    try:
+        text = (path / "metadata.yaml").read_text()
+        info = yaml.load(text, Loader=_YAML_LOADER)["rosbag2_bagfile_information"]
+        storage, mode = info.get("storage_identifier"), info.get("compression_mode") or ""
+        files = [path / str(name) for name in info.get("relative_file_paths") or ()]
+    except (OSError, UnicodeDecodeError, yaml.YAMLError, KeyError, TypeError, AttributeError):
+        return None
+    if storage != "mcap" or str(mode).lower() not in ("", "none") or not files:
+        return None
+    if any(f.suffix != ".mcap" or not f.is_file() for f in files):
+        return None
+    return files
+
+
+def schema_catalogue(schema: Schema, source: Source) -> MessageCatalogue:
+    """The definitions a schema holds: ``ros2msg`` (a ``.msg`` text followed by those of the
+    types it uses) or ``ros2idl`` (``.idl`` texts, each headed ``IDL: name``)."""
+    if not schema.text.strip():
+        return MessageCatalogue()
+    if schema.encoding == "ros2msg":
+        return parse_definition(schema.text, schema.name, "msg", source)
+    if not schema.text.startswith(IDL_SEPARATOR + "IDL: "):
+        return parse_definition(schema.text, schema.name, "idl", source)
+    catalogue = MessageCatalogue()
+    for part in schema.text.split(IDL_SEPARATOR)[1:]:
+        header, _, text = part.partition("\n")
+        name = header.removeprefix("IDL: ").strip()
+        catalogue.add(parse_definition(text, name, "idl", source).definitions, source)
+    return catalogue
+
+
+class Mcap(_Reading):
+    """The fast path for MCAP bags: the file's own index, numpy gathers, no per-message Python."""
+
+    def read(self, files: list[Path]) -> BagData:
+        self.catalogues: dict[tuple[str, str], MessageCatalogue] = {}
+        found: dict[str, list[Messages]] = {}
+        for file in files:
+            self.schemas = schemas(file)
+            for topic, messages in read_topics(file, set(self.wanted), self._decoder).items():
+                found.setdefault(topic, []).append(messages)
+        if not found:
+            raise UnsupportedBag("none of the topics")  # rosbags then says whether the bag is empty
+        start = min(int(m.times.min()) for parts in found.values() for m in parts)
+        end = max(int(m.times.max()) for parts in found.values() for m in parts)
+        for topic, parts in sorted(found.items()):
+            raws = [raw for m in parts for raw in m.raws]
+            if not raws:
+                continue
+            msgtype = parts[0].msgtype
+            catalogue = self.catalogues[(msgtype, parts[0].definition)]
+            store = deserializer_for(catalogue, msgtype)
+            all_times = np.concatenate([m.times for m in parts])
+            order = np.argsort(all_times, kind="stable")
+            times = all_times[order] / 1e9
+            updates = [
+                _status_update(store.deserialize_cdr(raws[i], msgtype), t, topic)
+                for i, t in zip(order.tolist(), times.tolist(), strict=True)
+            ]
+            self.add_updates(topic, updates)
+        return self.data(start / 1e9, end / 1e9, tuple(sorted(found)))
+
+    def _catalogue(self, topic: str, msgtype: str, definition: str) -> MessageCatalogue:
+        key = (msgtype, definition)
+        if key not in self.catalogues:
+            schema = self.schemas[topic]  # read_topics hands out the one schema of this topic
+            own = schema_catalogue(schema, Source(f"the bag {self.path.name}"))
+            self.catalogues[key] = own.layered(configured_user_catalogue(), standard_catalogue())
+        return self.catalogues[key]
+
+    def _decoder(
+        self, topic: str, msgtype: str, definition: str, times: np.ndarray, messages: RawMessages
+    ) -> bool:
+        """Decode one chunk's messages of a topic; False: keep their bytes (the dispatcher's)."""
+        if not self.accepts(topic, msgtype):
+            return True  # nothing kept
+        catalogue = self._catalogue(topic, msgtype, definition)
+        if self.wanted[topic].msgtype == ANY:
+            return False
+        self.prepare(topic, msgtype, catalogue)
+        paths = self.wanted[topic].paths
+        if vectorisable(catalogue, msgtype):
+            fields = decode(catalogue, msgtype, messages, paths, cdr=True)
+        else:
+            store = deserializer_for(catalogue, msgtype)
+            raws = [
+                messages.buffer[s:e].tobytes() for s, e in zip(messages.starts, messages.ends, strict=True)
+            ]
+            fields = decode_slowly(lambda raw: store.deserialize_cdr(raw, msgtype), raws, paths)
+        self.add(topic, msgtype, times, fields)
+        return True
