@@ -212,10 +212,11 @@ def test_the_recorders_provenance_is_written_beside_the_bag(scenario_d, tmp_path
 def test_any_seed_gives_a_bag_with_valid_stamps(tmp_path):
     """Seed 100001 once started in the year 2300, past what a nanosecond stamp (and ROS 1 time) holds."""
     from exsce_dsl.lang.build import load_spec
-    from exsce_dsl.runs.bagdata import read_bag
+    from exsce_dsl.model.messages import path_of
+    from exsce_dsl.runs.bagdata import Wanted, read_bag
     from exsce_dsl.sim.run import EPOCH, simulate
 
     scenario = load_spec(EXAMPLES / "brsu_building_c" / "scenario_c.exsce").scenario("scenario_c")
     (run,) = simulate(scenario, tmp_path, 1, seed=100_001)
-    data = read_bag(run.bag, {"/tiago1/nav_vel": "geometry_msgs/msg/Twist"})
+    data = read_bag(run.bag, {"/tiago1/nav_vel": Wanted("geometry_msgs/msg/Twist", (path_of("linear", "x"),))})
     assert EPOCH.timestamp() <= data.start < 2**32 and run.start.year < 2106
