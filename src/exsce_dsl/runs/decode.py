@@ -150,6 +150,8 @@ class _Walker:
         self.cdr = cdr
         self.order = "<"
         if cdr:
+            if len(messages) and int((messages.ends - messages.starts).min()) < 4:
+                raise DecodeError("a CDR message shorter than its 4-byte encapsulation header")
             kinds = self.buffer[messages.starts[:, None] + np.arange(2)]
             if np.all(kinds == 0):
                 self.order = ">"
@@ -170,7 +172,8 @@ class _Walker:
             offset = pos - self.starts[rows]
             at = int(offset[0])
             if np.all(offset == at) and np.array_equal(rows, np.arange(len(rows))):
-                table = self.buffer[: len(rows) * self.width].reshape(len(rows), self.width)
+                first = int(self.starts[0])
+                table = self.buffer[first : first + len(rows) * self.width].reshape(len(rows), self.width)
                 values = table[:, at : at + size * many].view(code)
                 return values[:, 0] if count is None else values
         at_bytes = pos[:, None] + np.arange(size * many, dtype=np.int64)
