@@ -27,7 +27,7 @@ BASE, NAME, ARRAY, SEQUENCE = 1, 2, 3, 4
 
 NUMERIC = {
     "bool": "u1",
-    "byte": "u1",
+    "byte": "i1",  # ROS 1 defines byte as int8; rosbags reads it so in ROS 2 bags too
     "char": "u1",
     "int8": "i1",
     "uint8": "u1",

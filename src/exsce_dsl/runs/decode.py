@@ -39,11 +39,14 @@ from typing import Any
 import numpy as np
 
 from exsce_dsl.errors import ExsceError
+from exsce_dsl.lang.check_fields import FieldProblem, field_shape
 from exsce_dsl.messages.catalogue import ARRAY, BASE, NAME, NUMERIC, SEQUENCE, MessageCatalogue
 from exsce_dsl.model.messages import FieldPath, Index, Select, Step, canonical_type
 from exsce_dsl.runs.monitor_core import PRESENT
 
 _UNVECTORISED = ("wstring", "float128")
+_LENGTHS = "#lengths"
+"""Key suffix, while decoding, of how many values each message's row holds (its width without padding)."""
 
 
 class DecodeError(ExsceError):
@@ -114,12 +117,19 @@ def decode(
     wanted = list(dict.fromkeys(paths))
     if not len(messages) or not wanted:
         return {}
+    tree = catalogue.tree(msgtype)
+    requests = []
+    for path in wanted:
+        try:
+            row = field_shape(tree, path, "message", msgtype)
+        except FieldProblem as problem:
+            raise DecodeError(f"{msgtype}: {problem.message}") from None
+        requests.append(_Request(path.steps, path.key, path, row=row))
     walker = _Walker(catalogue, messages, cdr)
     pos = messages.starts + (4 if cdr else 0)
     out: dict[str, np.ndarray] = {}
-    requests = [_Request(p.steps, p.key, p) for p in wanted]
     walker.struct(canonical_type(msgtype), pos, pos.copy(), np.arange(len(messages)), requests, out)
-    return out
+    return {key: values for key, values in out.items() if not key.endswith(_LENGTHS)}
 
 
 @dataclass(frozen=True)
@@ -131,9 +141,11 @@ class _Request:
     key: str
     path: FieldPath
     equals: str | float | None = None
+    row: bool = False
+    """Whether the path's values are a row per message (by the definition)."""
 
     def rest(self) -> _Request:
-        return _Request(self.steps[1:], self.key, self.path, self.equals)
+        return _Request(self.steps[1:], self.key, self.path, self.equals, self.row)
 
 
 def _probe_key(select: Select) -> str:
@@ -310,7 +322,7 @@ class _Walker:
                 values[found] = self.read(code, pos[found] + which[found] * size, rows[found])
                 self._put(out, request, values, found)
             else:
-                self._put(out, request, self._rows_of(code, pos, rows, counts, size))
+                self._put(out, request, self._rows_of(code, pos, rows, counts, size), lengths=counts)
         after: np.ndarray = pos + counts * size
         return after
 
@@ -397,7 +409,7 @@ class _Walker:
             for k, column in enumerate(stack):
                 if column is not None:
                     values[:, k] = column
-            self._put(out, request, values)
+            self._put(out, request, values, lengths=counts)
             return
         if isinstance(first, Index):
             which = _element(counts, first)
@@ -406,16 +418,32 @@ class _Walker:
             hits = [c.get(_probe_key(first), np.zeros(n, dtype=bool)) for c in columns]
             table = np.stack(hits, axis=1) if hits else np.zeros((n, 0), dtype=bool)
             which = np.where(table.any(axis=1), table.argmax(axis=1), -1) if len(hits) else np.full(n, -1)
-        picked = np.full(n, np.nan)
+        given = [c for c in stack if c is not None]
+        if request.row:  # an array in the picked element: one row a message, NaN-padded
+            width = max((c.shape[1] for c in given), default=0)
+            dtype = np.result_type(*given) if given else np.dtype(np.float64)
+            picked = np.full((n, width), np.nan, dtype=dtype)
+        else:
+            picked = np.full(n, np.nan)
         present = which >= 0
+        lengths = np.zeros(n, dtype=np.int64)
         for k, column in enumerate(stack):
             take = which == k
             if column is not None:
-                picked[take] = column[take]
+                if picked.ndim == 2:
+                    picked[take, : column.shape[1]] = column[take]
+                    held = np.nan_to_num(columns[k].get(request.key + _LENGTHS, np.zeros(n)))
+                    lengths[take] = held[take].astype(np.int64)
+                else:
+                    picked[take] = column[take]
             inner = columns[k].get(request.key + PRESENT)
             if inner is not None:
                 present[take] &= inner[take]
-        self._put(out, request, picked, present)
+        if picked.ndim == 2:
+            picked = picked[:, : int(lengths.max(initial=0))]
+            self._put(out, request, picked, present, lengths)
+        else:
+            self._put(out, request, picked, present)
 
     def _put(
         self,
@@ -423,8 +451,11 @@ class _Walker:
         request: _Request,
         values: np.ndarray,
         present: np.ndarray | None = None,
+        lengths: np.ndarray | None = None,
     ) -> None:
         out[request.key] = values
+        if lengths is not None:
+            out[request.key + _LENGTHS] = lengths
         if request.path.picks:
             mask = np.ones(len(values), dtype=bool) if present is None else present
             previous = out.get(request.key + PRESENT)
@@ -444,7 +475,8 @@ def _spread(values: np.ndarray, active: np.ndarray, n: int) -> np.ndarray:
     if values.dtype == bool:
         full = np.zeros((n, *values.shape[1:]), dtype=bool)
     else:
-        full = np.full((n, *values.shape[1:]), np.nan, dtype=np.float64)
+        dtype = values.dtype if values.dtype.kind == "f" else np.dtype(np.float64)
+        full = np.full((n, *values.shape[1:]), np.nan, dtype=dtype)
     full[active] = values
     return full
 
