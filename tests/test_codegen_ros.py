@@ -417,3 +417,19 @@ def test_a_message_without_a_field_is_dropped_and_reported_once(packages: dict[i
     runtime.on_message("/not/monitored", 1.0, object())
     (problem,) = runtime.evaluate(3.0).problems
     assert problem.startswith("/tiago1/nav_vel: message dropped: AttributeError")
+
+
+def test_a_robot_at_the_root_reduces_its_topics_without_an_empty_level(
+    packages: dict[int, SimpleNamespace],
+) -> None:
+    """A robot with no namespace (a Nav2 TurtleBot's topics sit at the root): ``/{ns}/scan`` is
+    ``/scan``, and its scans are reduced there, as for a namespaced robot."""
+    package = packages[2]
+    topics = {t.replace("/tiago1/", "/"): s for t, s in package.config.TOPICS.items() if t.startswith("/tiago1/")}
+    runtime = package.monitor_runtime.MonitorRuntime(package.monitors, [("tiago1", "")], topics, [])
+    runtime.on_message("/waypoint_dispatcher/feedback", 0.0, _feedback("g1", [("w1", 1)]))
+    for i, closest in enumerate((3.0, 1.25, 2.0)):
+        runtime.on_message("/scan", 1.0 + i, SimpleNamespace(ranges=[closest, 9.0], range_min=0.5, range_max=10.0))
+    runtime.on_message("/waypoint_dispatcher/feedback", 10.0, _feedback("g1", [("w1", 3)]))
+    assert runtime.buffers["/scan"].reduce is not None  # reduced as it arrives, like /tiago1/scan
+    assert runtime.evaluate(20.0).robots["tiago1"]["distance_to_obstacles"] == 1.25

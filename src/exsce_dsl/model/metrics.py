@@ -38,6 +38,16 @@ class Combine(enum.Enum):
     MIN = "min"
 
 
+def topic_name(pattern: str, namespace: str) -> str:
+    """``pattern`` with ``{ns}`` replaced by a robot's namespace; a robot at the root (no
+    namespace) leaves no empty level: ``/{ns}/odom`` is then ``/odom``.  (``runs.monitor_core``
+    has its own copy: it runs standalone in generated ROS nodes.)"""
+    name = pattern.replace("{ns}", namespace.strip("/"))
+    while "//" in name:
+        name = name.replace("//", "/")
+    return name
+
+
 @dataclass(frozen=True)
 class MetricInfo:
     name: str
@@ -145,10 +155,7 @@ class TopicRead:
     decodes, and what ``lang.check_fields`` checks against the bag's definition."""
 
     def topic_of(self, namespace: str) -> str:
-        name = self.topic.replace("{ns}", namespace.strip("/"))
-        while "//" in name:  # a robot at the root: /{ns}/odom is /odom
-            name = name.replace("//", "/")
-        return name
+        return topic_name(self.topic, namespace)
 
 
 @dataclass(frozen=True)

@@ -399,7 +399,7 @@ class MonitorRuntime:
         entries: dict[str, list[tuple[str, str, Any]]] = {}
         for _, namespace in self.robots:
             for pattern, key, func, compute in monitors.REDUCERS:
-                entries.setdefault(pattern.replace("{ns}", namespace), []).append((key, func, compute))
+                entries.setdefault(self.core.topic_name(pattern, namespace), []).append((key, func, compute))
         self.buffers = {
             name: _Buffer(spec, self.core.reducer(entries[name]) if name in entries else None)
             for name, spec in self.specs.items()
