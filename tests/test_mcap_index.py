@@ -31,10 +31,10 @@ from rosbags.typesys import Stores, get_typestore
 
 from exsce_dsl.model.messages import path_of
 from exsce_dsl.runs import bagdata
-from exsce_dsl.runs.bagdata import ANY, Wanted
+from exsce_dsl.runs.bagdata import ANY, Wanted, read_bag
 from exsce_dsl.runs.decode import RawMessages
 from exsce_dsl.runs.mcap_index import read_topics, schemas
-from exsce_dsl.runs.mcap_reading import mcap_files, read_mcap
+from exsce_dsl.runs.mcap_reading import mcap_files
 from exsce_dsl.runs.ros1_index import UnsupportedBag
 from exsce_dsl.sim.messages import FEEDBACK
 from exsce_dsl.sim.messages import typestore as sim_typestore
@@ -336,7 +336,7 @@ def test_idl_schemas_say_so(tmp_path: Path) -> None:
         )
     [schema] = schemas(mcap_of(tmp_path / "idl")).values()
     assert (schema.name, schema.encoding, schema.text) == ("test_msgs/msg/Reading", "ros2idl", IDL)
-    data = read_mcap(tmp_path / "idl", {"/reading": Wanted("test_msgs/msg/Reading", (path_of("value"),))})
+    data = read_bag(tmp_path / "idl", {"/reading": Wanted("test_msgs/msg/Reading", (path_of("value"),))})
     assert data.series["/reading"].fields["value"].tolist() == [1.5]
 
 
@@ -658,7 +658,7 @@ def test_decoder_may_keep_what_it_is_handed(
     assert pairs == expected(written, {"/chatter"})["/chatter"]
 
 
-# ------------------------------------------------------------------ the fast path, read_mcap
+# ------------------------------------------------------------------ the fast path, through read_bag
 ODOM_PATHS = (path_of("pose", "pose", "position", "x"), path_of("twist", "twist", "angular", "z"))
 
 
@@ -714,33 +714,33 @@ def _dispatcher_bag(tmp_path: Path, written: list[Written]) -> tuple[Path, dict[
     return path, wanted
 
 
-def test_read_mcap_reads_what_rosbags_reads(tmp_path: Path, written: list[Written]) -> None:
+def test_read_bag_reads_what_rosbags_reads(tmp_path: Path, written: list[Written]) -> None:
     bag, wanted = _dispatcher_bag(tmp_path, written)
-    ours = read_mcap(bag, wanted)
+    ours = read_bag(bag, wanted)
     theirs = bagdata._read_with_rosbags(bag, wanted, None, None)
     _same_data(ours, theirs)
     assert len(ours.series["/odom"]) == len([w for w in written if w[0] == "/odom"])
     assert len(ours.feedback["/wd/feedback"]) == (len(written) + 49) // 50
     assert len(ours.problems) == 1 and "/late" in ours.problems[0]  # of the wrong type
-    _same_data(read_mcap(mcap_of(bag), wanted), theirs)  # the .mcap file itself
+    _same_data(read_bag(mcap_of(bag), wanted), theirs)  # the .mcap file itself
 
 
-def test_read_mcap_falls_back_to_rosbags(tmp_path: Path, written: list[Written]) -> None:
+def test_read_bag_falls_back_to_rosbags(tmp_path: Path, written: list[Written]) -> None:
     bag, wanted = _dispatcher_bag(tmp_path, written)
-    good = read_mcap(bag, wanted)
+    good = read_bag(bag, wanted)
     file = mcap_of(bag)
     file.write_bytes(without_summary(file.read_bytes()))
-    _same_data(read_mcap(bag, wanted), good)
+    _same_data(read_bag(bag, wanted), good)
 
 
-def test_read_mcap_without_definitions_in_the_bag(tmp_path: Path, written: list[Written]) -> None:
+def test_read_bag_without_definitions_in_the_bag(tmp_path: Path, written: list[Written]) -> None:
     """A schema without text (rosbag2's, when it lacks the definition): the standard one is used."""
     bag = write_bag(tmp_path / "bag", written)
     wanted = {"/odom": Wanted("nav_msgs/msg/Odometry", ODOM_PATHS)}
-    good = read_mcap(bag, wanted)
+    good = read_bag(bag, wanted)
     mcap_of(bag).write_bytes(with_summary(mcap_of(bag).read_bytes(), _schema_encoding_unknown))
     assert {s.encoding for s in schemas(mcap_of(bag)).values()} == {"unknown"}
-    _same_data(read_mcap(bag, wanted), good)
+    _same_data(read_bag(bag, wanted), good)
     assert len(good.series["/odom"]) == len([w for w in written if w[0] == "/odom"])
 
 

@@ -33,6 +33,7 @@ from exsce_dsl.messages.catalogue import (
 from exsce_dsl.messages.user import configured_user_catalogue
 from exsce_dsl.model.messages import FieldPath, Fields, canonical_type
 from exsce_dsl.runs.decode import DecodeError, RawMessages, decode, decode_slowly, vectorisable
+from exsce_dsl.runs.mcap_index import CorruptBag
 from exsce_dsl.runs.ros1_index import UnsupportedBag, read_topics
 
 _PROGRESS = {0: 0, 1: 1}  # PENDING, ACTIVE; every other status is final
@@ -141,7 +142,7 @@ def read_bag(
         if str(path) in exc.message:
             raise
         raise BagError(f"{path}: {exc.message}") from None
-    except (DecodeError, MessageTypeError) as exc:
+    except (DecodeError, MessageTypeError, CorruptBag) as exc:
         raise BagError(f"{path}: {exc.message}") from None
 
 

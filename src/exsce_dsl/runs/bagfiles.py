@@ -475,6 +475,8 @@ def _check_mcap_summary(data: mmap.mmap, at: int, end: int) -> None:
         topics.setdefault(schema, []).append(topic)
     problems = []
     for schema, (name, encoding, definition) in sorted(schemas.items()):
+        if not definition.strip():
+            continue  # rosbag2 writes an empty "unknown" schema when it lacks the definition: ours then
         if encoding not in ("ros2msg", "ros2idl"):
             problems.append(f"the message definition of {name} is in {encoding!r}, not ros2msg or ros2idl")
             continue

@@ -1,18 +1,18 @@
 """The fast path for MCAP bags (ROS 2): the file's own index, numpy gathers, no per-message Python.
 
-:func:`read_mcap` is :func:`~exsce_dsl.runs.bagdata.read_bag` for MCAP bags
-(an ``.mcap`` file, or a ROS 2 bag folder whose ``metadata.yaml`` says
-``storage_identifier: mcap``): it reads them with
-:mod:`exsce_dsl.runs.mcap_index`, and with rosbags when that raises
-:class:`~exsce_dsl.runs.ros1_index.UnsupportedBag`.  A type's definition
-comes from the channel's schema (``ros2msg`` or ``ros2idl``), else from the
-user's files, else from rosbags' standard typestores.  Meant to be folded into
-``bagdata.read_bag`` (``Mcap`` beside ``_Ros1``).
+:func:`~exsce_dsl.runs.bagdata.read_bag` reads MCAP bags (an ``.mcap`` file,
+or a ROS 2 bag folder whose ``metadata.yaml`` says ``storage_identifier:
+mcap``) with :class:`Mcap`, over :mod:`exsce_dsl.runs.mcap_index`, and with
+rosbags when that raises :class:`~exsce_dsl.runs.ros1_index.UnsupportedBag`.
+A type's definition comes from the channel's schema (``ros2msg`` or
+``ros2idl``), else from the user's files, else from rosbags' standard
+typestores.  (A module of its own, beside ``bagdata``'s ROS 1 reader, to keep
+each under the size one reads at once; it builds on ``bagdata``'s
+``_Reading``, so ``read_bag`` imports it when it first reads an MCAP bag.)
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
@@ -20,7 +20,6 @@ import yaml
 
 from exsce_dsl.messages.catalogue import (
     MessageCatalogue,
-    MessageTypeError,
     Source,
     parse_definition,
     standard_catalogue,
@@ -29,44 +28,16 @@ from exsce_dsl.messages.user import configured_user_catalogue
 from exsce_dsl.runs.bagdata import (
     ANY,
     BagData,
-    BagError,
-    Check,
-    Reduce,
-    Wanted,
-    _read_with_rosbags,
     _Reading,
     _status_update,
     deserializer_for,
 )
-from exsce_dsl.runs.decode import DecodeError, RawMessages, decode, decode_slowly, vectorisable
+from exsce_dsl.runs.decode import RawMessages, decode, decode_slowly, vectorisable
 from exsce_dsl.runs.mcap_index import Schema, read_topics, schemas
 from exsce_dsl.runs.ros1_index import Messages, UnsupportedBag
 
 IDL_SEPARATOR = "=" * 80 + "\n"
 """Between the ``.idl`` files of a ``ros2idl`` schema, each then headed ``IDL: pkg/msg/Name``."""
-
-
-def read_mcap(
-    path: Path,
-    wanted: Mapping[str, Wanted],
-    reduce: Mapping[str, Reduce] | None = None,
-    check: Check | None = None,
-) -> BagData:
-    """:func:`~exsce_dsl.runs.bagdata.read_bag` for an MCAP bag: its index, else rosbags."""
-    if not path.exists():
-        raise BagError(f"{path}: no such bag")
-    try:
-        files = mcap_files(path)
-        if files is not None:
-            try:
-                return Mcap(path, wanted, reduce, check).read(files)
-            except UnsupportedBag:
-                pass  # rosbags reads what our index reader does not (and reports what is broken)
-        return _read_with_rosbags(path, wanted, reduce, check)
-    except BagError:
-        raise
-    except (DecodeError, MessageTypeError) as exc:
-        raise BagError(f"{path}: {exc.message}") from None
 
 
 _YAML_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml's: ten times faster
