@@ -228,7 +228,7 @@ def repository() -> dict[str, Rule]:
     # import "file.exsce"
     r["import"] = match(kw("import"), "keyword.control.import" + S)
 
-    # robot type NAME { base NAME  torso yes|no }
+    # robot type NAME { base NAME  torso yes|no  convention nav2 ... }
     r["robot-type"] = region(
         "robot-type",
         then_name(seq("robot", "type")),
@@ -238,6 +238,12 @@ def repository() -> dict[str, Rule]:
             match(then_name(kw("base")), None, _1=KEYWORD, _2="constant.other.base" + S),
             keywords("torso"),
             keywords("yes no", "constant.language.boolean" + S),
+            # where its signals are: convention nav2, pose from tf map -> base_link, velocity on "..." TYPE
+            keywords("convention pose velocity scan navigation arrival from tf on within and"),
+            keywords("method nav2 move_base dispatcher none", "constant.language.convention" + S),
+            match(MESSAGE_TYPE, "support.type.message" + S),
+            include("topic-strings"),
+            include("quantity"),
         ],
         TOP_LEVEL,
     )

@@ -18,6 +18,7 @@ from exsce_dsl.errors import Diagnostic, SourceLocation, SpecError
 from exsce_dsl.lang.build_acceptance import build_all_acceptance
 from exsce_dsl.lang.build_derivation import build_derivations
 from exsce_dsl.lang.build_metrics import build_metric
+from exsce_dsl.lang.build_signals import build_signals
 from exsce_dsl.lang.checks import check_environment_map, check_scenario
 from exsce_dsl.lang.loader import load_files
 from exsce_dsl.lang.parser import ParsedFile
@@ -251,6 +252,8 @@ class _Builder:
         seen: set[str] = set()
         for fact in d.obj.facts:
             kind = fact.__class__.__name__
+            if kind not in ("BaseFact", "TorsoFact"):
+                continue  # where its signals are: build_signals
             if kind in seen:
                 word = "base" if kind == "BaseFact" else "torso"
                 self.error(f"robot type '{d.obj.name}' states its {word} twice", d.file.span(fact))
@@ -259,7 +262,8 @@ class _Builder:
                 base = fact.base
             else:
                 torso = fact.torso == "yes"
-        return RobotType(d.obj.name, base, torso, d.name_location)
+        signals = build_signals(d.obj.name, d.obj.facts, d.file.span, self.error)
+        return RobotType(d.obj.name, base, torso, d.name_location, signals)
 
     # ----------------------------------------------------------- environments
     def _environment(self, d: _Declared) -> Environment:

@@ -25,6 +25,7 @@ from typing import Any, Protocol
 
 from exsce_dsl.errors import SourceLocation
 from exsce_dsl.lang.build_expressions import ExpressionBuilder, Scope, Typed, read_quantity
+from exsce_dsl.lang.names import is_topic_pattern
 from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.lang.suggest import did_you_mean
 from exsce_dsl.messages.catalogue import MessageCatalogue, MessageTypeError
@@ -49,7 +50,6 @@ class Report(Protocol):
 
 
 _PYTHON_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
-_TOPIC = re.compile(r"/?(?:[A-Za-z0-9_]|\{ns\})+(?:/(?:[A-Za-z0-9_]|\{ns\})+)*")
 _COMBINE = {
     "sum": Combine.SUM,
     "integral": Combine.SUM,
@@ -184,7 +184,7 @@ class _MetricBuilder:
             self.error(f"'{read.name}' names a robot of the pair; give the topic another name", read)
             return
         tree = self._tree(read, msgtype)
-        if not _TOPIC.fullmatch(read.topic) or "{" in read.topic.replace("{ns}", ""):
+        if not is_topic_pattern(read.topic):
             self.error(
                 f"'{read.topic}' is not a ROS topic name (letters, digits, '_' and '/'; "
                 "'{ns}' for the robot's namespace)",

@@ -32,6 +32,7 @@ from exsce_dsl.model import (
     Specification,
     Task,
 )
+from exsce_dsl.model.conventions import CONVENTIONS, Signals
 from exsce_dsl.model.derived import DerivedScenario
 from exsce_dsl.model.metrics import MetricDefinition
 
@@ -112,9 +113,34 @@ def _robot_type(rtype: RobotType) -> list[Line]:
         facts.append((f"{INDENT}base {rtype.base}", None))
     if rtype.torso is not None:
         facts.append((f"{INDENT}torso {'yes' if rtype.torso else 'no'}", None))
+    facts += [(f"{INDENT}{line}", None) for line in signal_lines(rtype.declared_signals)]
     if not facts:
         return [(f"robot type {rtype.id} {{ }}", rtype.location)]
     return [(f"robot type {rtype.id} {{", rtype.location), *facts, ("}", None)]
+
+
+def signal_lines(signals: Signals | None) -> list[str]:
+    """A robot type's signal lines: its convention, then what it says otherwise than that."""
+    if signals is None:
+        return []
+    base = CONVENTIONS[signals.convention]
+    lines = [f"convention {signals.convention}"]
+    if signals.pose != base.pose:
+        lines += [f"pose {p.clause()}" for p in signals.pose]
+    if signals.velocity != base.velocity:
+        lines += [f"velocity {v.clause()}" for v in signals.velocity]
+    if signals.scan != base.scan:
+        lines += [f"scan {v.clause()}" for v in signals.scan]
+    if (signals.navigation, signals.actions) != (base.navigation, base.actions):
+        actions = ", ".join(f'"{a}"' for a in signals.actions)
+        lines.append(f"navigation {signals.navigation.value}" + (f" on {actions}" if actions else ""))
+    if signals.tolerance != base.tolerance:
+        heading = signals.tolerance.heading
+        lines.append(
+            f"arrival within {_number(signals.tolerance.position)} m"
+            + (f" and {_number(heading)} rad" if heading is not None else "")
+        )
+    return lines
 
 
 def _environment(env: Environment) -> list[Line]:

@@ -28,3 +28,11 @@ _NAME_RE = re.compile(NAME_PATTERN)
 def is_valid_name(text: str) -> bool:
     """True if ``text`` can be written as an id in the DSL."""
     return bool(_NAME_RE.fullmatch(text)) and text not in KEYWORDS
+
+
+_TOPIC_RE = re.compile(r"/?(?:[A-Za-z0-9_]|\{ns\})+(?:/(?:[A-Za-z0-9_]|\{ns\})+)*")
+
+
+def is_topic_pattern(text: str) -> bool:
+    """True if ``text`` is a ROS topic name, ``{ns}`` standing for a robot's namespace."""
+    return bool(_TOPIC_RE.fullmatch(text)) and "{" not in text.replace("{ns}", "")

@@ -9,6 +9,20 @@ MEANINGS: dict[str, str] = {
     "type": "`robot type NAME { base B  torso yes|no }`: hardware facts that similarity compares.",
     "base": "`base NAME`: the robot type's mobile base (e.g. pmb2, omni_base).",
     "torso": "`torso yes|no`: whether the robot type has a torso.",
+    "convention": "`convention method|nav2|move_base`: where the robot type's signals are in its bags: "
+    "the method's topics (the default), Nav2's (pose from TF map -> base_link, else amcl_pose, else "
+    "odom; velocity on cmd_vel) or move_base's; each `pose`, `velocity`, `scan`, `navigation` or "
+    "`arrival` line overrides one.",
+    "velocity": '`velocity on "/{ns}/cmd_vel" [TYPE]`: where the robot\'s velocity is (Twist, TwistStamped '
+    "or an Odometry's twist); several lines are tried in order.",
+    "scan": '`scan on "/{ns}/scan"`: the robot\'s laser scan (sensor_msgs/msg/LaserScan).',
+    "navigation": '`navigation dispatcher|nav2|move_base|none [on "/{ns}/ACTION", ...]`: the '
+    "navigation interface whose goals make the path segments; `none`: segments by arrival at the "
+    "planned waypoints.",
+    "arrival": "`arrival within 0.25 m [and 0.3 rad]`: how close the robot must come to a planned "
+    "waypoint (and its heading) to have reached it, or to be a goal's target.",
+    "tf": "`pose from tf FIXED -> BODY`: the pose of frame BODY in frame FIXED, composed from /tf and "
+    "/tf_static.",
     "yes": "A hardware fact holds.",
     "no": "A hardware fact does not hold.",
     "environment": "`environment NAME { map ...  world ...  area ... }`: where scenarios happen: its models, "
@@ -23,7 +37,8 @@ MEANINGS: dict[str, str] = {
     "file": '`file "map.yaml"`: the map_server YAML on this machine, relative to this file.',
     "area": "`area NAME { pose ... }`: a region (a room) holding named poses.",
     "pose": "`pose NAME at (x, y[, z]) [facing YAW | rpy(R, P, Y)]`: a named pose of an area "
-    "(lengths in m unless cm or mm follow; angles in rad unless deg follows).",
+    "(lengths in m unless cm or mm follow; angles in rad unless deg follows); in a robot type, "
+    '`pose from tf map -> base_link` or `pose on "/{ns}/odom" [TYPE]`: where the robot\'s pose is.',
     "at": "`at (x, y[, z])`: a position; `starts at POSE`: a robot's start pose.",
     "facing": "`facing YAW`: the heading (rad, or deg).",
     "rpy": "`rpy(roll, pitch, yaw)`: a full orientation (rad, or deg).",

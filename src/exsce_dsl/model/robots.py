@@ -5,17 +5,24 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from exsce_dsl.errors import SourceLocation
+from exsce_dsl.model.conventions import METHOD, Signals
 from exsce_dsl.model.geometry import Pose
 
 
 @dataclass(frozen=True)
 class RobotType:
-    """Hardware facts that similarity uses; unknown facts are ``None``."""
+    """Hardware facts that similarity uses (unknown facts are ``None``), and where the robot's
+    signals are in its bags (``None``: the method's convention, as the robot type did not say)."""
 
     id: str
     base: str | None = None
     torso: bool | None = None
     location: SourceLocation | None = field(default=None, compare=False, repr=False)
+    declared_signals: Signals | None = None
+
+    @property
+    def signals(self) -> Signals:
+        return self.declared_signals or METHOD
 
 
 def root_namespace(namespace: str) -> str:

@@ -1,0 +1,140 @@
+"""A robot type's signals: its convention, and the sources its own lines override (IR building).
+
+``convention nav2`` takes Nav2's sources; each ``pose``, ``velocity``, ``scan``,
+``navigation`` or ``arrival`` line replaces the convention's for that signal
+(several ``pose`` lines are a list of preference, tried in order at ingest).
+A robot type that says none of this follows the method's convention.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Callable
+from typing import Any
+
+from exsce_dsl.errors import SourceLocation
+from exsce_dsl.lang.names import is_topic_pattern
+from exsce_dsl.model.conventions import (
+    CONVENTIONS,
+    LASER_SCAN,
+    METHOD,
+    MOVE_BASE,
+    NAV2,
+    POSE_TYPES,
+    VELOCITY_TYPES,
+    Navigation,
+    PoseSource,
+    Signals,
+    TfSource,
+    Tolerance,
+    TopicSource,
+)
+from exsce_dsl.model.messages import canonical_type
+
+_QUANTITY = re.compile(r"([-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?)\s*([a-z]*)")
+_METRES = {"": 1.0, "m": 1.0, "cm": 0.01, "mm": 0.001}
+_SIGNAL_FACTS = ("ConventionFact", "PoseFact", "VelocityFact", "ScanFact", "NavigationFact", "ArrivalFact")
+_ACTIONS = {
+    Navigation.DISPATCHER: METHOD.actions,
+    Navigation.NAV2: NAV2.actions,
+    Navigation.MOVE_BASE: MOVE_BASE.actions,
+    Navigation.NONE: (),
+}
+
+Report = Callable[[str, SourceLocation], None]
+Span = Callable[[Any], SourceLocation]
+
+
+def build_signals(type_name: str, facts: list[Any], span: Span, error: Report) -> Signals | None:
+    """The signals a robot type's facts declare; None when it declares none (the method's)."""
+    mine = [f for f in facts if f.__class__.__name__ in _SIGNAL_FACTS]
+    if not mine:
+        return None
+    conventions = [f for f in mine if f.__class__.__name__ == "ConventionFact"]
+    for extra in conventions[1:]:
+        error(f"robot type '{type_name}' names its convention twice", span(extra))
+    signals = CONVENTIONS[conventions[0].convention] if conventions else METHOD
+    poses: list[PoseSource] = []
+    velocities: list[TopicSource] = []
+    scans: list[TopicSource] = []
+    said: dict[str, Any] = {}
+    for fact in mine:
+        kind = fact.__class__.__name__
+        if kind == "PoseFact":
+            if fact.source is None:
+                poses.append(TfSource(fact.fixed, fact.body))
+            elif (source := _topic(fact.source, POSE_TYPES, "a pose", span, error)) is not None:
+                poses.append(source)
+        elif kind == "VelocityFact":
+            if (source := _topic(fact.source, VELOCITY_TYPES, "a velocity", span, error)) is not None:
+                velocities.append(source)
+        elif kind == "ScanFact":
+            if (source := _topic(fact.source, (LASER_SCAN,), "a laser scan", span, error)) is not None:
+                scans.append(source)
+        elif kind in ("NavigationFact", "ArrivalFact"):
+            if kind in said:
+                word = "navigation" if kind == "NavigationFact" else "arrival tolerance"
+                error(f"robot type '{type_name}' states its {word} twice", span(fact))
+            said[kind] = fact
+    changes: dict[str, Any] = {}
+    if poses:
+        changes["pose"] = tuple(poses)
+    if velocities:
+        changes["velocity"] = tuple(velocities)
+    if scans:
+        changes["scan"] = tuple(scans)
+    if "NavigationFact" in said:
+        fact = said["NavigationFact"]
+        navigation = Navigation(fact.navigation)
+        actions = tuple(fact.actions) or _ACTIONS[navigation]
+        for action in fact.actions:
+            _check_topic(action, span(fact), error)
+        changes["navigation"], changes["actions"] = navigation, actions
+    if "ArrivalFact" in said:
+        changes["tolerance"] = _tolerance(said["ArrivalFact"], span, error)
+    location = span(conventions[0] if conventions else mine[0])
+    return signals.overridden(**changes, location=location)
+
+
+def _topic(source: Any, allowed: tuple[str, ...], what: str, span: Span, error: Report) -> TopicSource | None:
+    where = span(source)
+    if not _check_topic(source.topic, where, error):
+        return None
+    if source.msgtype is None:
+        return TopicSource(source.topic)
+    msgtype = canonical_type(source.msgtype)
+    if msgtype not in allowed:
+        error(f"{what} is read from {', '.join(allowed)}, not from {msgtype}", where)
+        return None
+    return TopicSource(source.topic, msgtype)
+
+
+def _check_topic(topic: str, where: SourceLocation, error: Report) -> bool:
+    if is_topic_pattern(topic):
+        return True
+    error(
+        f"'{topic}' is not a ROS topic name (letters, digits, '_' and '/'; '{{ns}}' for the robot's "
+        "namespace)",
+        where,
+    )
+    return False
+
+
+def _tolerance(fact: Any, span: Span, error: Report) -> Tolerance:
+    number, unit = _split(fact.position)
+    position = number * _METRES.get(unit, 1.0)
+    heading: float | None = None
+    if fact.heading is not None:
+        number, unit = _split(fact.heading)
+        heading = math.radians(number) if unit == "deg" else number
+    if position <= 0 or (heading is not None and heading <= 0):
+        error("an arrival tolerance is a distance (and an angle) above zero", span(fact))
+        return Tolerance()
+    return Tolerance(position, heading)
+
+
+def _split(text: str) -> tuple[float, str]:
+    match = _QUANTITY.fullmatch(text.strip())
+    assert match is not None, text  # the grammar lets only such tokens through
+    return float(match.group(1)), match.group(2)

@@ -1,0 +1,140 @@
+"""Where a robot's signals are in its bags: its pose, velocity, laser scan and navigation goals.
+
+A robot type names a *convention* in one word (the method's own topics, Nav2's
+or move_base's) and may override any single source.  Each signal lists its
+sources in order of preference; ingestion takes the first one the bag has, so
+one convention serves Nav2 on Humble (``Twist`` on ``cmd_vel``) and on Jazzy
+(``TwistStamped``), robots with or without AMCL, with or without TF recorded.
+Topic names are patterns: ``{ns}`` is the robot's namespace (empty for a robot
+at the root, whose ``/{ns}/odom`` is ``/odom``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from enum import Enum
+
+from exsce_dsl.errors import SourceLocation
+
+ODOMETRY = "nav_msgs/msg/Odometry"
+POSE_STAMPED = "geometry_msgs/msg/PoseStamped"
+POSE_WITH_COVARIANCE = "geometry_msgs/msg/PoseWithCovarianceStamped"
+TWIST = "geometry_msgs/msg/Twist"
+TWIST_STAMPED = "geometry_msgs/msg/TwistStamped"
+LASER_SCAN = "sensor_msgs/msg/LaserScan"
+FLOAT64 = "std_msgs/msg/Float64"
+
+POSE_TYPES = (ODOMETRY, POSE_STAMPED, POSE_WITH_COVARIANCE)
+"""The types a pose topic may have (its pose is read where the type keeps it)."""
+VELOCITY_TYPES = (TWIST, TWIST_STAMPED, ODOMETRY)
+"""The types a velocity topic may have (an odometry's twist is the robot's velocity)."""
+
+
+class Navigation(Enum):
+    """Which navigation interface a robot's goals come through (segments follow from them)."""
+
+    DISPATCHER = "dispatcher"
+    """The method's waypoint dispatcher (``waypoint_dispatcher/feedback`` and ``result``)."""
+    NAV2 = "nav2"
+    """Nav2's actions: ``navigate_to_pose``, ``follow_waypoints``, ``navigate_through_poses``."""
+    MOVE_BASE = "move_base"
+    """ROS 1 move_base's actionlib topics: ``status``, ``goal``, ``result``."""
+    NONE = "none"
+    """No goals in the bags: segments come from arrival at the planned waypoints."""
+
+
+@dataclass(frozen=True)
+class TopicSource:
+    """A signal read from one topic; ``msgtype`` None: whatever type of the signal's the bag has."""
+
+    topic: str
+    msgtype: str | None = None
+
+    def clause(self) -> str:
+        """How a robot type writes it: ``on "/{ns}/odom" nav_msgs/msg/Odometry``."""
+        return f'on "{self.topic}"' + (f" {self.msgtype}" if self.msgtype else "")
+
+
+@dataclass(frozen=True)
+class TfSource:
+    """A pose read from TF: the pose of ``body`` in ``fixed``, composed along the frame tree from
+    ``tf`` and ``tf_static``, each transform interpolated at its own rate."""
+
+    fixed: str = "map"
+    body: str = "base_link"
+    tf: str = "/{ns}/tf"
+    tf_static: str = "/{ns}/tf_static"
+
+    def clause(self) -> str:
+        """How a robot type writes it: ``from tf map -> base_link``."""
+        return f"from tf {self.fixed} -> {self.body}"
+
+
+PoseSource = TopicSource | TfSource
+
+
+@dataclass(frozen=True)
+class Tolerance:
+    """How close a pose must come to a planned waypoint to have reached it (or to be the target
+    of a navigation goal).  0.25 m is Nav2's default goal tolerance; the heading is not compared
+    unless set, because planned waypoints often leave the final heading free."""
+
+    position: float = 0.25
+    heading: float | None = None
+
+
+@dataclass(frozen=True)
+class Signals:
+    """Where a robot's signals are: each a list of sources, the first one the bag has wins."""
+
+    convention: str
+    pose: tuple[PoseSource, ...]
+    velocity: tuple[TopicSource, ...]
+    scan: tuple[TopicSource, ...]
+    distance: tuple[TopicSource, ...] = ()
+    """A topic of the distance travelled so far (the method's); else it is the pose's path length."""
+    navigation: Navigation = Navigation.NONE
+    actions: tuple[str, ...] = ()
+    """The navigation interface's action (or dispatcher) names, patterns with ``{ns}``."""
+    tolerance: Tolerance = field(default_factory=Tolerance)
+    location: SourceLocation | None = field(default=None, compare=False, repr=False)
+
+    def overridden(self, **sources: object) -> Signals:
+        """These signals with some replaced (a robot type's own ``pose``, ``velocity``...)."""
+        return replace(self, **sources)  # type: ignore[arg-type]
+
+
+METHOD = Signals(
+    convention="method",
+    pose=(TopicSource("/{ns}/robot_pose", POSE_WITH_COVARIANCE),),
+    velocity=(TopicSource("/{ns}/nav_vel", TWIST),),
+    scan=(TopicSource("/{ns}/scan", LASER_SCAN),),
+    distance=(TopicSource("/{ns}/distance_travelled", FLOAT64),),
+    navigation=Navigation.DISPATCHER,
+    actions=("/{ns}/waypoint_dispatcher",),
+)
+"""The method's own topics, as its executor and the robots of its published runs publish them."""
+
+NAV2 = Signals(
+    convention="nav2",
+    pose=(TfSource(), TopicSource("/{ns}/amcl_pose"), TopicSource("/{ns}/odom")),
+    velocity=(TopicSource("/{ns}/cmd_vel"), TopicSource("/{ns}/odom")),
+    scan=(TopicSource("/{ns}/scan", LASER_SCAN),),
+    navigation=Navigation.NAV2,
+    actions=("/{ns}/navigate_to_pose", "/{ns}/follow_waypoints", "/{ns}/navigate_through_poses"),
+)
+"""Nav2 (Humble and Jazzy): pose from TF ``map → base_link`` (else AMCL's, else odometry),
+velocity commanded on ``cmd_vel`` (Twist on Humble, TwistStamped from Jazzy on)."""
+
+MOVE_BASE = Signals(
+    convention="move_base",
+    pose=(TfSource(), TopicSource("/{ns}/amcl_pose"), TopicSource("/{ns}/odom")),
+    velocity=(TopicSource("/{ns}/cmd_vel"), TopicSource("/{ns}/odom")),
+    scan=(TopicSource("/{ns}/scan", LASER_SCAN),),
+    navigation=Navigation.MOVE_BASE,
+    actions=("/{ns}/move_base",),
+)
+"""ROS 1 move_base: the same signals as Nav2's, goals through actionlib's ``move_base``."""
+
+CONVENTIONS = {c.convention: c for c in (METHOD, NAV2, MOVE_BASE)}
+"""The conventions a robot type names in one word."""
