@@ -92,8 +92,8 @@ def test_navigation_without_actions_takes_its_interfaces_defaults(tmp_path: Path
     assert signals.pose == METHOD.pose
 
 
-def test_arrival_defaults_are_nav2s_position_and_no_heading() -> None:
-    assert Tolerance() == Tolerance(0.25, None)
+def test_arrival_defaults_to_nav2s_goal_tolerance_with_localisation_and_no_heading() -> None:
+    assert Tolerance() == Tolerance(0.35, None)
 
 
 @pytest.mark.parametrize(

@@ -75,11 +75,25 @@ PoseSource = TopicSource | TfSource
 
 @dataclass(frozen=True)
 class Tolerance:
-    """How close a pose must come to a planned waypoint to have reached it (or to be the target
-    of a navigation goal).  0.25 m is Nav2's default goal tolerance; the heading is not compared
-    unless set, because planned waypoints often leave the final heading free."""
+    """How close a pose must be to a planned waypoint to be that waypoint (map frame).
 
-    position: float = 0.25
+    ``position`` (metres, in the plane) defaults to 0.35 m: Nav2's default goal checker declares
+    success within ``xy_goal_tolerance`` = 0.25 m of the goal (move_base's DWA planner: 0.1 m), and
+    the track we compare with (AMCL, TF map → base_link, a simulator's ground truth) differs from
+    the estimate the checker used by up to ~0.1 m.  Goals read from the bag carry the planned pose
+    itself, so for them any tolerance above float rounding works.  Planned waypoints closer than
+    twice the tolerance cannot be told apart by position (scenario_c's closest pair is 1.9 m apart).
+    A track that updates only every so far (``/amcl_pose`` publishes after ``update_min_d`` =
+    0.25 m of motion) lags the robot by that much: prefer TF, or widen the tolerance.
+
+    ``heading`` (radians) is ``None`` by default: not compared.  Planned waypoints often leave the
+    final heading free (a pose's yaw is whatever its declaration says, and stacks are commonly run
+    with a loose yaw tolerance), and the position alone names the waypoint.  Set it (e.g. 0.35 rad:
+    Nav2's ``yaw_goal_tolerance`` 0.25 rad plus localisation) when a plan visits one position with
+    two headings.
+    """
+
+    position: float = 0.35
     heading: float | None = None
 
 

@@ -40,7 +40,7 @@ class Segment:
 
 def segments(scenario: Scenario, robot: str, updates: list[StatusUpdate]) -> list[Segment]:
     """The actions of ``robot`` in a run, from its dispatcher feedback ``updates`` (time order)."""
-    plan = _planned_goals(scenario, robot)
+    plan = planned_goals(scenario, robot)
     goals = _split_goals(updates)
     if len(goals) > len(plan):
         raise SegmentError(
@@ -83,7 +83,7 @@ def segments(scenario: Scenario, robot: str, updates: list[StatusUpdate]) -> lis
     return out
 
 
-def _planned_goals(scenario: Scenario, robot: str) -> list[tuple[int, str, int, tuple[Pose, ...]]]:
+def planned_goals(scenario: Scenario, robot: str) -> list[tuple[int, str, int, tuple[Pose, ...]]]:
     plan = []
     allocation = 0
     for entry in scenario.mission.allocation:
