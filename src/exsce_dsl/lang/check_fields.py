@@ -39,10 +39,11 @@ class FieldProblem(Exception):
         self.message = message
 
 
-def field_shape(tree: Fields, path: FieldPath, read: str, msgtype: str) -> bool:
+def field_shape(tree: Fields, path: FieldPath, read: str, msgtype: str, text: bool = False) -> bool:
     """Whether ``path`` of topic ``read`` (of type ``msgtype``, whose fields are ``tree``) is an
-    array per message (else a number per message); a :class:`FieldProblem` says what is wrong."""
-    return _Walk(tree, path, read, msgtype).shape()
+    array per message (else a number per message); a :class:`FieldProblem` says what is wrong.
+    ``text``: the path is to end at a text (a frame id, read by ingestion itself), not a number."""
+    return _Walk(tree, path, read, msgtype, text).shape()
 
 
 def check_fields(
@@ -102,7 +103,7 @@ def _is_array(node: Node) -> bool:
 
 
 class _Walk:
-    def __init__(self, tree: Fields, path: FieldPath, read: str, msgtype: str) -> None:
+    def __init__(self, tree: Fields, path: FieldPath, read: str, msgtype: str, text: bool = False) -> None:
         self.path = path
         self.read = read
         self.msgtype = msgtype
@@ -110,6 +111,7 @@ class _Walk:
         self.done: list[Step] = []
         self.spread: int | None = None
         """Where the path went into every element of an array of messages (a step number)."""
+        self.text = text
 
     def here(self) -> str:
         return _text(self.read, FieldPath(tuple(self.done)))
@@ -144,6 +146,8 @@ class _Walk:
         if node is Leaf.ARRAY:
             self.node = Leaf.NUMBER
         elif node is Leaf.TEXTS:
+            if self.text:
+                raise FieldProblem(f"{self.here()} is {describe(node)}: its elements are not read")
             self.node = Leaf.TEXT
         elif isinstance(node, MessageArray):
             if node.length is not None and not -node.length <= index.position < node.length:
@@ -203,6 +207,10 @@ class _Walk:
 
     def _end(self) -> bool:
         node, text = self.node, self.here()
+        if self.text:
+            if node is not Leaf.TEXT or self.path.length:
+                raise FieldProblem(f"{text} is {describe(node)}, not a text")
+            return self.spread is not None
         if self.path.length:
             if not _is_array(node):
                 raise FieldProblem(

@@ -32,7 +32,7 @@ from exsce_dsl.messages.catalogue import (
 )
 from exsce_dsl.messages.user import configured_user_catalogue
 from exsce_dsl.model.messages import FieldPath, Fields, canonical_type
-from exsce_dsl.runs.decode import DecodeError, RawMessages, decode, decode_slowly, vectorisable
+from exsce_dsl.runs.decode import TEXTS, DecodeError, RawMessages, decode, decode_slowly, vectorisable
 from exsce_dsl.runs.mcap_index import CorruptBag
 from exsce_dsl.runs.ros1_index import UnsupportedBag, read_topics
 
@@ -54,6 +54,8 @@ class Wanted:
 
     msgtype: str
     paths: tuple[FieldPath, ...] = ()
+    texts: tuple[FieldPath, ...] = ()
+    """Paths to texts (TF frame ids): their values are codes into the series' ``fields[TEXTS]``."""
 
 
 @dataclass(frozen=True)
@@ -154,8 +156,19 @@ class _Topic:
         self.msgtype = msgtype
         self.times: list[np.ndarray] = []
         self.blocks: list[dict[str, np.ndarray]] = []
+        self.texts: dict[str, int] = {}
+        """The texts of the topic's text paths, in the order of their codes (every block's)."""
 
-    def add(self, times: np.ndarray, fields: dict[str, np.ndarray]) -> None:
+    def add(self, times: np.ndarray, fields: dict[str, np.ndarray], text_keys: Sequence[str] = ()) -> None:
+        if TEXTS in fields:  # each block codes its own texts: recode them into the topic's table
+            table = fields.pop(TEXTS)
+            recode = np.array(
+                [self.texts.setdefault(str(t), len(self.texts)) for t in table] + [-1], dtype=float
+            )
+            for key in text_keys:
+                codes = fields[key]
+                at = np.where(np.isnan(codes), -1, codes).astype(np.int64)
+                fields[key] = np.where(at < 0, np.nan, recode[at])
         self.times.append(times)
         self.blocks.append(fields)
 
@@ -167,6 +180,8 @@ class _Topic:
         for key in self.blocks[0] if self.blocks else {}:
             values = _concatenate([b[key] for b in self.blocks])
             fields[key] = values if in_order else values[order]
+        if self.texts:
+            fields[TEXTS] = np.array(list(self.texts), dtype=object)
         return Series(self.topic, self.msgtype, times[order] / 1e9, fields)
 
 
@@ -184,13 +199,13 @@ def _concatenate(parts: Sequence[np.ndarray]) -> np.ndarray:
 
 
 def _kept(
-    fields: dict[str, np.ndarray], topic: str, reduce: Mapping[str, Reduce] | None
+    fields: dict[str, np.ndarray], topic: str, reduce: Mapping[str, Reduce] | None, text_keys: Sequence[str]
 ) -> dict[str, np.ndarray]:
     if reduce is None:
         return fields
     if topic in reduce:
         fields = reduce[topic](fields)
-    return {k: v for k, v in fields.items() if v.ndim == 1}
+    return {k: v for k, v in fields.items() if v.ndim == 1 or k == TEXTS or k in text_keys}
 
 
 class _Reading:
@@ -250,7 +265,22 @@ class _Reading:
     ) -> None:
         msgtype = canonical_type(msgtype)
         found = self.topics.setdefault(topic, _Topic(topic, msgtype))
-        found.add(times, _kept(fields, topic, self.reduce))
+        text_keys = [p.key for p in self.wanted[topic].texts]
+        found.add(times, _kept(fields, topic, self.reduce, text_keys), text_keys)
+
+    def decode(
+        self, topic: str, msgtype: str, catalogue: MessageCatalogue, messages: RawMessages, cdr: bool
+    ) -> dict[str, np.ndarray]:
+        """The wanted fields of one block of ``topic``'s messages: vectorised, or by rosbags
+        where :func:`decode` cannot (``wstring`` and ``float128`` fields)."""
+        wanted = self.wanted[topic]
+        if vectorisable(catalogue, msgtype):
+            return decode(catalogue, msgtype, messages, wanted.paths, cdr, wanted.texts)
+        store = deserializer_for(catalogue, msgtype)
+        spans = zip(messages.starts.tolist(), messages.ends.tolist(), strict=True)
+        raws = [messages.buffer[start:end].tobytes() for start, end in spans]
+        read = store.deserialize_cdr if cdr else store.deserialize_ros1
+        return decode_slowly(lambda raw: read(raw, msgtype), raws, wanted.paths, wanted.texts)
 
     def add_updates(self, topic: str, updates: list[StatusUpdate]) -> None:
         self.updates.setdefault(topic, []).extend(updates)
@@ -308,15 +338,7 @@ class _Ros1(_Reading):
             return False
         catalogue = self._catalogue(msgtype, definition)
         self.prepare(topic, msgtype, catalogue)
-        paths = self.wanted[topic].paths
-        if vectorisable(catalogue, msgtype):
-            fields = decode(catalogue, msgtype, messages, paths, cdr=False)
-        else:
-            store = deserializer_for(catalogue, msgtype)
-            spans = zip(messages.starts.tolist(), messages.ends.tolist(), strict=True)
-            raws = [messages.buffer[start:end].tobytes() for start, end in spans]
-            fields = decode_slowly(lambda raw: store.deserialize_ros1(raw, msgtype), raws, paths)
-        self.add(topic, msgtype, times, fields)
+        self.add(topic, msgtype, times, self.decode(topic, msgtype, catalogue, messages, cdr=False))
         return True
 
 
@@ -364,26 +386,21 @@ def _read_connection(
     whole = reading.wanted[topic].msgtype == ANY
     if not whole:
         reading.prepare(topic, msgtype, catalogue)
-    fast = not whole and vectorisable(catalogue, msgtype)
-    paths = reading.wanted[topic].paths
-    store = None if fast else deserializer_for(catalogue, msgtype)
-
-    def deserialize(raw: bytes | memoryview) -> Any:
-        assert store is not None
-        raw = bytes(raw)
-        return store.deserialize_cdr(raw, msgtype) if cdr else store.deserialize_ros1(raw, msgtype)
+    store = deserializer_for(catalogue, msgtype) if whole else None
 
     for stamps, raws in _blocks(reader.messages(connections=[conn])):
         times = np.asarray(stamps, dtype=np.int64)
-        if whole:
+        if store is not None:
+            read = store.deserialize_cdr if cdr else store.deserialize_ros1
             updates = [
-                _status_update(deserialize(r), t / 1e9, topic) for r, t in zip(raws, stamps, strict=True)
+                _status_update(read(bytes(r), msgtype), t / 1e9, topic)
+                for r, t in zip(raws, stamps, strict=True)
             ]
             reading.add_updates(topic, updates)
-        elif fast:
-            reading.add(topic, msgtype, times, decode(catalogue, msgtype, RawMessages.join(raws), paths, cdr))
         else:
-            reading.add(topic, msgtype, times, decode_slowly(deserialize, raws, paths))
+            reading.add(
+                topic, msgtype, times, reading.decode(topic, msgtype, catalogue, RawMessages.join(raws), cdr)
+            )
 
 
 def deserializer_for(catalogue: MessageCatalogue, msgtype: str) -> Any:

@@ -23,7 +23,10 @@ message.  What comes out, per path key:
 - a path that picks elements (``[0]``, ``[child_frame_id == "base_link"]``):
   as above, NaN where a message has no such element, and a boolean mask under
   ``KEY#present``;
-- ``len(...)``: the number of elements, as float64.
+- ``len(...)``: the number of elements, as float64;
+- a text (asked for with ``texts``, e.g. the frame ids of a TFMessage): a float64
+  code per message (or row of codes), NaN where absent, indexing the strings in
+  ``out[TEXTS]`` (one table for every text path of the call).
 
 Layouts that truly cannot be vectorised are decoded with rosbags, one message
 object at a time, and read by attribute (:func:`decode_slowly`): ``wstring``
@@ -45,6 +48,8 @@ from exsce_dsl.model.messages import FieldPath, Index, Select, Step, canonical_t
 from exsce_dsl.runs.monitor_core import PRESENT
 
 _UNVECTORISED = ("wstring", "float128")
+TEXTS = "#texts"
+"""Key of the strings that text paths' codes index."""
 _LENGTHS = "#lengths"
 """Key suffix, while decoding, of how many values each message's row holds (its width without padding)."""
 
@@ -112,24 +117,29 @@ def decode(
     messages: RawMessages,
     paths: Iterable[FieldPath],
     cdr: bool,
+    texts: Iterable[FieldPath] = (),
 ) -> dict[str, np.ndarray]:
-    """The values of ``paths`` in every message (see the module's docstring for their shapes)."""
-    wanted = list(dict.fromkeys(paths))
-    if not len(messages) or not wanted:
+    """The values of ``paths`` (numbers) and ``texts`` in every message (see the module's
+    docstring for their shapes)."""
+    numbers, strings = list(dict.fromkeys(paths)), list(dict.fromkeys(texts))
+    if not len(messages) or not (numbers or strings):
         return {}
     tree = catalogue.tree(msgtype)
     requests = []
-    for path in wanted:
+    for path, text in [(p, False) for p in numbers] + [(p, True) for p in strings]:
         try:
-            row = field_shape(tree, path, "message", msgtype)
+            row = field_shape(tree, path, "message", msgtype, text=text)
         except FieldProblem as problem:
             raise DecodeError(f"{msgtype}: {problem.message}") from None
-        requests.append(_Request(path.steps, path.key, path, row=row))
+        requests.append(_Request(path.steps, path.key, path, row=row, text=text))
     walker = _Walker(catalogue, messages, cdr)
     pos = messages.starts + (4 if cdr else 0)
     out: dict[str, np.ndarray] = {}
     walker.struct(canonical_type(msgtype), pos, pos.copy(), np.arange(len(messages)), requests, out)
-    return {key: values for key, values in out.items() if not key.endswith(_LENGTHS)}
+    found = {key: values for key, values in out.items() if not key.endswith(_LENGTHS)}
+    if strings:
+        found[TEXTS] = np.array(list(walker.texts), dtype=object)
+    return found
 
 
 @dataclass(frozen=True)
@@ -143,9 +153,11 @@ class _Request:
     equals: str | float | None = None
     row: bool = False
     """Whether the path's values are a row per message (by the definition)."""
+    text: bool = False
+    """Whether the path ends at a text, whose values are codes (see :func:`decode`)."""
 
     def rest(self) -> _Request:
-        return _Request(self.steps[1:], self.key, self.path, self.equals, self.row)
+        return _Request(self.steps[1:], self.key, self.path, self.equals, self.row, self.text)
 
 
 def _probe_key(select: Select) -> str:
@@ -160,6 +172,8 @@ class _Walker:
         self.ends = messages.ends
         self.width = messages.width
         self.cdr = cdr
+        self.texts: dict[str, int] = {}
+        """Every text a text path met, in the order of their codes."""
         self.order = "<"
         if cdr:
             if len(messages) and int((messages.ends - messages.starts).min()) < 4:
@@ -271,6 +285,8 @@ class _Walker:
             for request in requests:
                 if isinstance(request.equals, str):
                     out[request.key] = self._text_equals(pos, lengths, request.equals)
+                elif request.text:
+                    self._put(out, request, self._text_codes(pos, lengths))
             after: np.ndarray = pos + lengths
             return after
         size = np.dtype(NUMERIC[basetype]).itemsize
@@ -294,6 +310,25 @@ class _Walker:
             found = self.buffer[pos[rows][:, None] + np.arange(len(wanted))]
             same[rows] = np.all(found == wanted, axis=1)
         return np.asarray(same, dtype=bool)
+
+    def _text_codes(self, pos: np.ndarray, lengths: np.ndarray) -> np.ndarray:
+        """Each string's code in :attr:`texts` (as float64): the strings are gathered as padded
+        rows of bytes, the distinct rows found with numpy, and only those decoded."""
+        sizes = np.maximum(lengths - (1 if self.cdr else 0), 0)  # CDR counts the terminating NUL
+        width = int(sizes.max(initial=0))
+        inside = np.arange(width) < sizes[:, None]
+        table = np.where(inside, self.buffer[np.where(inside, pos[:, None] + np.arange(width), 0)], 0)
+        size_bytes = sizes.astype("<u4").view(np.uint8).reshape(-1, 4)
+        rows = np.concatenate([table.astype(np.uint8), size_bytes], axis=1)
+        distinct, inverse = np.unique(rows.view(f"V{width + 4}").ravel(), return_inverse=True)
+        codes = np.empty(len(distinct), dtype=np.float64)
+        for i, row in enumerate(distinct):
+            raw = bytes(row)
+            size = int.from_bytes(raw[width:], "little")
+            text = raw[:size].decode("utf-8", "replace")
+            codes[i] = self.texts.setdefault(text, len(self.texts))
+        result: np.ndarray = codes[inverse.ravel()]
+        return result
 
     def _numbers(
         self,
@@ -485,38 +520,53 @@ def decode_slowly(
     deserialize: Callable[[bytes | memoryview], Any],
     raws: Sequence[bytes | memoryview],
     paths: Iterable[FieldPath],
+    texts: Iterable[FieldPath] = (),
 ) -> dict[str, np.ndarray]:
-    """The values of ``paths`` from message objects (rosbags' ``deserialize``), one message at a
-    time: the checked fallback for what :func:`decode` cannot vectorise."""
+    """The values of ``paths`` and ``texts`` from message objects (rosbags' ``deserialize``), one
+    message at a time: the checked fallback for what :func:`decode` cannot vectorise."""
     messages = [deserialize(r) for r in raws]
     out: dict[str, np.ndarray] = {}
+    strings = list(dict.fromkeys(texts))
+    if strings:
+        table: dict[str, int] = {}
+
+        def code(value: Any) -> Any:
+            if value is None:
+                return None
+            if isinstance(value, (list, tuple)):
+                return [code(v) for v in value]
+            return table.setdefault(str(value), len(table))
+
+        for path in strings:
+            _put_slowly(out, path, [code(_attribute_value(m, path)) for m in messages])
+        out[TEXTS] = np.array(list(table), dtype=object)
     for path in dict.fromkeys(paths):
-        values = [_attribute_value(m, path) for m in messages]
-        present = np.array([v is not None for v in values], dtype=bool)
-        arrays = [np.atleast_1d(np.asarray(v, dtype=np.float64)) for v in values if v is not None]
-        is_array = any(isinstance(v, (list, tuple, np.ndarray)) for v in values)
-        if is_array:
-            width = max((len(a) for a in arrays), default=0)
-            table = np.full((len(values), width), np.nan)
-            for i, v in enumerate(values):
-                if v is not None:
-                    row = np.atleast_1d(np.asarray(v, dtype=np.float64))
-                    table[i, : len(row)] = row
-            out[path.key] = table
-        else:
-            out[path.key] = np.array([np.nan if v is None else float(v) for v in values], dtype=np.float64)
-        if path.picks:
-            out[path.key + PRESENT] = present
+        _put_slowly(out, path, [_attribute_value(m, path) for m in messages])
     return out
+
+
+def _put_slowly(out: dict[str, np.ndarray], path: FieldPath, values: list[Any]) -> None:
+    """One path's values, a value (or list of them) or None per message, in :func:`decode`'s shapes."""
+    if any(isinstance(v, (list, tuple, np.ndarray)) for v in values):
+        width = max((len(np.atleast_1d(v)) for v in values if v is not None), default=0)
+        table = np.full((len(values), width), np.nan)
+        for i, v in enumerate(values):
+            if v is not None:
+                row = np.atleast_1d(np.asarray(v, dtype=np.float64))
+                table[i, : len(row)] = row
+        out[path.key] = table
+    else:
+        out[path.key] = np.array([np.nan if v is None else float(v) for v in values], dtype=np.float64)
+    if path.picks:
+        out[path.key + PRESENT] = np.array([v is not None for v in values], dtype=bool)
 
 
 def _attribute_value(message: Any, path: FieldPath) -> Any:
     """The value of ``path`` in a message object (None if it picks an element that is not there)."""
     node: Any = message
-    spread = False
     for step in path.steps:
-        if isinstance(step, str):
-            node = [getattr(x, step) for x in node] if spread else getattr(node, step)
+        if isinstance(step, str):  # on a list of messages (rosbags' arrays of messages): every element
+            node = [getattr(x, step) for x in node] if isinstance(node, list) else getattr(node, step)
         elif isinstance(step, Index):
             try:
                 node = node[step.position]
@@ -526,8 +576,6 @@ def _attribute_value(message: Any, path: FieldPath) -> Any:
             node = next((x for x in node if _select_value(x, step.field) == step.value), None)
             if node is None:
                 return None
-        if isinstance(step, str) and isinstance(node, list) and node and not _is_number(node[0]):
-            spread = True
     if path.length:
         return len(node)
     return node
@@ -537,7 +585,3 @@ def _select_value(element: Any, field: tuple[str, ...]) -> Any:
     for name in field:
         element = getattr(element, name)
     return element
-
-
-def _is_number(value: Any) -> bool:
-    return isinstance(value, (int, float, bool, np.number))

@@ -32,7 +32,7 @@ from exsce_dsl.runs.bagdata import (
     _status_update,
     deserializer_for,
 )
-from exsce_dsl.runs.decode import RawMessages, decode, decode_slowly, vectorisable
+from exsce_dsl.runs.decode import RawMessages
 from exsce_dsl.runs.mcap_index import Schema, read_topics, schemas
 from exsce_dsl.runs.ros1_index import Messages, UnsupportedBag
 
@@ -129,14 +129,5 @@ class Mcap(_Reading):
         if self.wanted[topic].msgtype == ANY:
             return False
         self.prepare(topic, msgtype, catalogue)
-        paths = self.wanted[topic].paths
-        if vectorisable(catalogue, msgtype):
-            fields = decode(catalogue, msgtype, messages, paths, cdr=True)
-        else:
-            store = deserializer_for(catalogue, msgtype)
-            raws = [
-                messages.buffer[s:e].tobytes() for s, e in zip(messages.starts, messages.ends, strict=True)
-            ]
-            fields = decode_slowly(lambda raw: store.deserialize_cdr(raw, msgtype), raws, paths)
-        self.add(topic, msgtype, times, fields)
+        self.add(topic, msgtype, times, self.decode(topic, msgtype, catalogue, messages, cdr=True))
         return True
