@@ -8,6 +8,7 @@ from pathlib import Path
 import click
 
 from exsce_dsl.cli.common import bag_arguments, reports_errors
+from exsce_dsl.model.conventions import CONVENTIONS
 
 
 @click.command()
@@ -39,21 +40,50 @@ from exsce_dsl.cli.common import bag_arguments, reports_errors
     help="overspeed:R, slow:R, skip-waypoint:R[:N], near-collision (repeatable).",
 )
 @click.option("--scenario", "scenario_id", help="Which scenario, when the file declares several.")
+@click.option(
+    "--convention",
+    type=click.Choice(list(CONVENTIONS)),
+    default="method",
+    show_default=True,
+    help="Which topics the robots publish: the method's, Nav2's or move_base's.",
+)
+@click.option(
+    "--cmd-vel-stamped",
+    is_flag=True,
+    help="nav2, move_base: cmd_vel as TwistStamped (Nav2 from Jazzy on), not Twist.",
+)
 @reports_errors
 def simulate(
-    spec: str, runs: int, out_dir: str, fmt: str, seed: int, faults: tuple[str, ...], scenario_id: str | None
+    spec: str,
+    runs: int,
+    out_dir: str,
+    fmt: str,
+    seed: int,
+    faults: tuple[str, ...],
+    scenario_id: str | None,
+    convention: str,
+    cmd_vel_stamped: bool,
 ) -> None:
     """Play a scenario with the kinematic executor and write one bag per run.
 
     Robots plan around the occupied cells of the environment's map, drive
-    with bounded speed and acceleration and seeded noise, and the bag holds
-    robot_pose, scan, nav_vel, distance_travelled and the waypoint
-    dispatcher's feedback and result per robot namespace.
+    with bounded speed and acceleration and seeded noise.  Per robot
+    namespace the bag holds, by --convention:
+
+    \b
+      method     robot_pose, scan, nav_vel, distance_travelled and the
+                 waypoint dispatcher's feedback and result
+      nav2       tf (odom -> base_link, map -> odom), tf_static, odom,
+                 amcl_pose, cmd_vel, scan, plan and navigate_to_pose's
+                 status and feedback, one goal per waypoint
+      move_base  the same robot topics and move_base's goal, status,
+                 feedback and result
 
     \b
     Example:
       exscec simulate examples/brsu_building_c/scenario_c.exsce --runs 3 -o runs/
       exscec simulate examples/brsu_building_c/scenario_c.exsce --fault overspeed:tiago1
+      exscec simulate examples/brsu_building_c/scenario_d.exsce --convention nav2 --format mcap -o runs/
     """
     from exsce_dsl.lang.build import load_spec
     from exsce_dsl.sim.executor import Fault
@@ -61,8 +91,9 @@ def simulate(
 
     scenario = load_spec(spec).scenario(scenario_id)
     parsed = tuple(Fault.parse(f) for f in faults)
+    played = play(scenario, Path(out_dir), runs, fmt, seed, parsed, convention, cmd_vel_stamped)
     with click.progressbar(length=runs, label=f"simulating {scenario.id}", file=sys.stderr) as bar:
-        for run in play(scenario, Path(out_dir), runs, fmt, seed, parsed):
+        for run in played:
             bar.update(1)
             click.echo(
                 f"\nwrote {run.bag} ({run.messages} messages, {run.execution.duration:.1f} s)", err=True

@@ -163,14 +163,19 @@ STANDARD_STORES = ("ros2_jazzy", "ros2_humble", "ros1_noetic")
 
 @functools.lru_cache(maxsize=1)
 def standard_catalogue() -> MessageCatalogue:
-    """The standard ROS 1 and ROS 2 message packages that rosbags ships."""
+    """The standard ROS 1 and ROS 2 message packages that rosbags ships, and Nav2's and
+    move_base's messages, which exsce ships."""
     from rosbags.typesys import Stores, get_typestore
+
+    from exsce_dsl.messages.navigation import navigation_catalogue  # which builds on this module
 
     catalogue = MessageCatalogue()
     for name in STANDARD_STORES:
         store = get_typestore(Stores(name))
         catalogue.add(store.fielddefs, Source(f"rosbags' {name} typestore"))
-    return catalogue
+    # rosbag2 stores no definitions in sqlite3 bags, and none of an action's feedback anywhere:
+    # the navigation stacks' own types come with exsce
+    return catalogue.layered(navigation_catalogue())
 
 
 def standard_ros1_catalogue() -> MessageCatalogue:

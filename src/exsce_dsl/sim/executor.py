@@ -73,6 +73,9 @@ class Action:
     end: float
     status: GoalStatus
     path_length: float
+    path: tuple[tuple[float, float], ...] = ()
+    """The planned path, from where the robot was at ``start`` to the goal (a skipped waypoint's
+    too: it is planned, then not driven)."""
 
 
 @dataclass(frozen=True)
@@ -187,6 +190,7 @@ def execute(
                 events.append(GoalEvent(start_t, entry.robot, key, ids, tuple(statuses), False))
                 previous = last_pose[entry.robot]
                 if (entry.robot, waypoint_counts[entry.robot]) in skip:
+                    path = _plan_around(grid, (tl.x, tl.y), (goal.position.x, goal.position.y), parked)
                     tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, 25))
                     status, length = GoalStatus.ABORTED, 0.0
                 else:
@@ -211,6 +215,7 @@ def execute(
                         tl.now,
                         status,
                         length,
+                        tuple(path),
                     )
                 )
                 last = w_number == len(ids)
@@ -334,6 +339,7 @@ def _give_way(
             moved(a.robot, a.end),
             a.status,
             a.path_length,
+            a.path,
         )
         for a in actions
     ]

@@ -14,6 +14,8 @@ from functools import lru_cache
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.store import Typestore
 
+from exsce_dsl.messages.navigation import register_navigation_types
+
 PACKAGE = "waypoint_dispatcher"
 FEEDBACK = f"{PACKAGE}/msg/FollowWaypointsActionFeedback"
 RESULT = f"{PACKAGE}/msg/FollowWaypointsActionResult"
@@ -42,4 +44,13 @@ def typestore(fmt: str) -> Typestore:
     for name, text in _DEFINITIONS.items():
         types.update(get_types_from_msg(text, name))
     store.register(types)
+    return store
+
+
+@lru_cache(maxsize=4)
+def navigation_typestore(fmt: str) -> Typestore:
+    """The type store for a bag format with the navigation stacks' types too (``nav2_msgs``,
+    ``move_base_msgs``, and what a ROS 1 store lacks: ``tf2_msgs``, ``action_msgs``)."""
+    store = get_typestore(STORES[fmt])
+    register_navigation_types(store)
     return store

@@ -15,10 +15,12 @@ import numpy as np
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.lang.occupancy import OccupancyGrid, load_occupancy_grid
 from exsce_dsl.model import Scenario
+from exsce_dsl.model.conventions import Signals
 from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Bag, Run, TaskExecution
 from exsce_dsl.prov import serialize_prov
 from exsce_dsl.prov.run import compile_run
 from exsce_dsl.sim.bag import write_bag
+from exsce_dsl.sim.conventions import convention_writer
 from exsce_dsl.sim.executor import Execution, Fault, GoalStatus, execute
 from exsce_dsl.sim.planner import PlanningGrid
 
@@ -47,10 +49,19 @@ def simulate(
     fmt: str = "ros1",
     seed: int = 0,
     faults: Sequence[Fault] = (),
+    convention: Signals | str = "method",
+    twist_stamped: bool = False,
 ) -> Iterator[SimulatedRun]:
-    """Play ``scenario`` ``runs`` times and write one bag per run into ``out_dir``."""
+    """Play ``scenario`` ``runs`` times and write one bag per run into ``out_dir``.
+
+    ``convention`` (a name or a robot type's :class:`Signals`) says which topics the robots
+    publish: the method's (the default), Nav2's or move_base's; ``twist_stamped`` makes the
+    navigation stacks' ``cmd_vel`` a TwistStamped (Nav2 from Jazzy on).  Runs in another
+    convention than the method's get other run ids, so their bags can share a folder."""
     if fmt not in FORMATS:
         raise ExsceError(f"unknown bag format '{fmt}'; use one of {', '.join(FORMATS)}")
+    written = convention_writer(convention).name
+    variant = "" if written == "method" else f"/{written}" + ("/stamped" if twist_stamped else "")
     grid = planning_grid(scenario)
     out_dir.mkdir(parents=True, exist_ok=True)
     for index in range(runs):
@@ -60,7 +71,7 @@ def simulate(
         run_id = str(
             uuid.uuid5(
                 _RUN_NAMESPACE,
-                f"{scenario.id}/{seed}/{index}/{','.join(f.kind + str(f.robot) for f in faults)}",
+                f"{scenario.id}/{seed}/{index}/{','.join(f.kind + str(f.robot) for f in faults)}{variant}",
             )
         )
         execution = execute(scenario, grid, run_seed, tuple(faults))
@@ -69,7 +80,9 @@ def simulate(
         if bag.exists():
             shutil.rmtree(bag) if bag.is_dir() else bag.unlink()
         start_ns = int(start.timestamp()) * 1_000_000_000
-        count = write_bag(bag, fmt, scenario, execution, grid, start_ns, run_seed)
+        count = write_bag(
+            bag, fmt, scenario, execution, grid, start_ns, run_seed, None, convention, twist_stamped
+        )
         recorder = _recorded_run(run_id, scenario, execution, start, bag)
         out_dir.joinpath(name + ".prov.json").write_text(
             serialize_prov(compile_run(recorder, scenario), "json"), encoding="utf-8"

@@ -7,11 +7,19 @@ scans of a robot are marched together as one numpy array.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
+from exsce_dsl.sim.executor import Execution
+from exsce_dsl.sim.motion import DT
 from exsce_dsl.sim.planner import PlanningGrid
+from exsce_dsl.sim.values import header
+
+SCAN_EVERY = 5  # samples of the 50 Hz clock: 10 Hz
+ROBOT_RADIUS = 0.3  # other robots are discs of this radius
 
 
 @dataclass(frozen=True)
@@ -71,3 +79,38 @@ def scan_ranges(
     noisy = ranges + rng.normal(0.0, laser.noise, ranges.shape)
     noisy = np.where(np.isfinite(ranges), np.maximum(noisy, laser.range_min), np.inf)
     return noisy.astype(np.float32)
+
+
+def laser_scans(
+    store: Any,
+    topic: str,
+    frame: str,
+    robot: str,
+    execution: Execution,
+    grid: PlanningGrid,
+    laser: Laser,
+    rng: np.random.Generator,
+    stamps: np.ndarray,
+) -> Iterator[tuple[str, str, int, Any]]:
+    """``sensor_msgs/LaserScan`` messages of ``robot`` every SCAN_EVERY samples (stamps: one per
+    sample), against the map and the other robots: (topic, type, stamp, message)."""
+    T = store.types
+    tr = execution.trajectories[robot]
+    idx = np.arange(0, len(tr), SCAN_EVERY)
+    others = [(o.x[idx], o.y[idx]) for r, o in execution.trajectories.items() if r != robot]
+    ranges = scan_ranges(grid, laser, tr.x[idx], tr.y[idx], tr.yaw[idx], others, ROBOT_RADIUS, rng)
+    empty = np.zeros(0, dtype=np.float32)
+    for k, i in enumerate(idx.tolist()):
+        msg = T["sensor_msgs/msg/LaserScan"](
+            header=header(store, int(stamps[i]), frame, k),
+            angle_min=laser.angle_min,
+            angle_max=laser.angle_max,
+            angle_increment=laser.angle_increment,
+            time_increment=0.0,
+            scan_time=SCAN_EVERY * DT,
+            range_min=laser.range_min,
+            range_max=laser.range_max,
+            ranges=ranges[k],
+            intensities=empty,
+        )
+        yield topic, "sensor_msgs/msg/LaserScan", int(stamps[i]), msg

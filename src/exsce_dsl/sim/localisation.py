@@ -1,0 +1,144 @@
+"""Where a robot believes it is: wheel odometry that drifts, a localiser's estimate that does
+not, and the correction ``map → odom`` between them (what AMCL publishes).
+
+Everything is on the executor's 50 Hz clock, as planar poses (x, y, heading).
+
+- **Odometry** (``odom → base_link``) starts at zero, where the robot is switched on, and
+  integrates the robot's true motion as its wheels measure it: every distance driven is off by a
+  scale error, every turn by a turn-rate error, and the heading gains a bias per metre driven
+  (all three seeded per robot, of a few per cent and a fraction of a degree per metre).  Its
+  error grows with the distance driven, as wheel odometry's does.
+- **The estimate** (``map → base_link``, AMCL's pose) is the true pose plus noise that wanders
+  slowly (a first-order Gauss–Markov process of standard deviation ``LOCALISATION_NOISE`` m and
+  ``LOCALISATION_YAW_NOISE`` rad, correlation time ``NOISE_TIME`` s).
+- **The correction** (``map → odom``) is ``estimate ∘ odom⁻¹``, so that ``map → odom →
+  base_link`` composed at any sample is the estimate: the true pose within the noise.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.signal import lfilter
+
+from exsce_dsl.sim.motion import DT, Trajectory
+
+SCALE_ERROR = (0.01, 0.03)
+"""Odometry's distance scale error, a fraction (its sign is seeded too)."""
+TURN_ERROR = (0.01, 0.03)
+"""Odometry's turn scale error, a fraction."""
+HEADING_BIAS = (math.radians(0.25), math.radians(0.75))
+"""Odometry's heading drift per metre driven (rad/m)."""
+LOCALISATION_NOISE = 0.02
+LOCALISATION_YAW_NOISE = 0.01
+NOISE_TIME = 1.0
+
+
+@dataclass(frozen=True)
+class Poses:
+    """Planar poses, one per sample: the pose of a child frame in a parent frame."""
+
+    x: np.ndarray
+    y: np.ndarray
+    yaw: np.ndarray
+
+    def compose(self, other: Poses) -> Poses:
+        """``self ∘ other``: ``other``'s poses (given in ``self``'s child frame) in ``self``'s parent."""
+        c, s = np.cos(self.yaw), np.sin(self.yaw)
+        return Poses(
+            self.x + c * other.x - s * other.y,
+            self.y + s * other.x + c * other.y,
+            _wrap(self.yaw + other.yaw),
+        )
+
+    def inverse(self) -> Poses:
+        c, s = np.cos(self.yaw), np.sin(self.yaw)
+        return Poses(-(c * self.x + s * self.y), s * self.x - c * self.y, _wrap(-self.yaw))
+
+
+@dataclass(frozen=True)
+class Odometry:
+    """Drift of one robot's wheel odometry."""
+
+    scale: float
+    turn: float
+    heading_bias: float  # rad per metre driven
+
+    @staticmethod
+    def seeded(rng: np.random.Generator) -> Odometry:
+        scale, turn, bias = (
+            float(rng.choice((-1.0, 1.0)) * rng.uniform(*bounds))
+            for bounds in (SCALE_ERROR, TURN_ERROR, HEADING_BIAS)
+        )
+        return Odometry(scale, turn, bias)
+
+
+@dataclass(frozen=True)
+class Localisation:
+    """A robot's frames, sample by sample."""
+
+    truth: Poses
+    """``map → base_link`` as the robot really is."""
+    odom: Poses
+    """``odom → base_link``, the odometry."""
+    estimate: Poses
+    """``map → base_link`` as the localiser has it."""
+    correction: Poses
+    """``map → odom``."""
+    v: np.ndarray
+    """Forward speed as odometry measures it (m/s)."""
+    w: np.ndarray
+    """Turn rate as odometry measures it (rad/s)."""
+    drift: Odometry
+
+
+def localise(trajectory: Trajectory, rng: np.random.Generator) -> Localisation:
+    """The odometry, estimate and correction of a robot that drove ``trajectory`` (seeded)."""
+    drift = Odometry.seeded(rng)
+    truth = Poses(trajectory.x, trajectory.y, trajectory.yaw)
+    odom = _odometry(truth, drift)
+    estimate = Poses(
+        truth.x + _wandering(rng, LOCALISATION_NOISE, len(truth.x)),
+        truth.y + _wandering(rng, LOCALISATION_NOISE, len(truth.x)),
+        _wrap(truth.yaw + _wandering(rng, LOCALISATION_YAW_NOISE, len(truth.x))),
+    )
+    return Localisation(
+        truth,
+        odom,
+        estimate,
+        estimate.compose(odom.inverse()),
+        trajectory.v * (1.0 + drift.scale),
+        trajectory.w * (1.0 + drift.turn) + drift.heading_bias * np.abs(trajectory.v),
+        drift,
+    )
+
+
+def _odometry(truth: Poses, drift: Odometry) -> Poses:
+    """Integrate each step's motion, measured in the body frame with the drift's errors, from zero."""
+    dx, dy = np.diff(truth.x), np.diff(truth.y)
+    c, s = np.cos(truth.yaw[:-1]), np.sin(truth.yaw[:-1])
+    forward, lateral = c * dx + s * dy, -s * dx + c * dy
+    turned = _wrap(np.diff(truth.yaw))
+    measured_turn = turned * (1.0 + drift.turn) + drift.heading_bias * np.hypot(forward, lateral)
+    yaw = np.concatenate([[0.0], np.cumsum(measured_turn)])
+    oc, os_ = np.cos(yaw[:-1]), np.sin(yaw[:-1])
+    f, lat = forward * (1.0 + drift.scale), lateral * (1.0 + drift.scale)
+    x = np.concatenate([[0.0], np.cumsum(oc * f - os_ * lat)])
+    y = np.concatenate([[0.0], np.cumsum(os_ * f + oc * lat)])
+    return Poses(x, y, _wrap(yaw))
+
+
+def _wandering(rng: np.random.Generator, sigma: float, samples: int) -> np.ndarray:
+    """A first-order Gauss–Markov process: standard deviation ``sigma``, correlation ``NOISE_TIME``."""
+    a = math.exp(-DT / NOISE_TIME)
+    white = rng.normal(0.0, sigma, samples + 1)
+    # the first value already has the stationary spread: a·e₀ + √(1−a²)·n₁ with e₀ ~ N(0, σ²)
+    wandering: np.ndarray = lfilter([math.sqrt(1.0 - a * a)], [1.0, -a], white[1:], zi=[a * white[0]])[0]
+    return wandering
+
+
+def _wrap(angle: np.ndarray) -> np.ndarray:
+    wrapped: np.ndarray = np.arctan2(np.sin(angle), np.cos(angle))
+    return wrapped

@@ -1,0 +1,181 @@
+"""The method's topics: what the method's executor and its waypoint dispatcher publish.
+
+Per robot namespace: ``robot_pose`` (PoseWithCovarianceStamped, 50 Hz), ``nav_vel`` (Twist,
+25 Hz), ``distance_travelled`` (Float64, 10 Hz), ``scan`` (LaserScan, 10 Hz) and the dispatcher's
+``waypoint_dispatcher/feedback`` and ``result`` (see :mod:`exsce_dsl.sim.messages`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from exsce_dsl.sim.executor import Execution, GoalStatus
+from exsce_dsl.sim.messages import FEEDBACK, RESULT
+from exsce_dsl.sim.planner import PlanningGrid
+from exsce_dsl.sim.scan import Laser, laser_scans
+from exsce_dsl.sim.values import header, quaternion, ros_time, sample_stamps
+from exsce_dsl.sim.writing import Message, RobotRun
+
+POSE_EVERY, VEL_EVERY, DIST_EVERY = 1, 2, 5  # samples of the 50 Hz clock
+POSE_NOISE, YAW_NOISE = 0.005, 0.002
+
+
+@dataclass(frozen=True)
+class Topics:
+    """The topic names of one robot namespace (the method's defaults)."""
+
+    ns: str
+
+    def __getattr__(self, name: str) -> str:  # pragma: no cover - only the names below are used
+        raise AttributeError(name)
+
+    def _name(self, topic: str) -> str:
+        """``/ns/topic``; ``/topic`` for a robot at the root (no namespace)."""
+        return f"/{self.ns}/{topic}" if self.ns else f"/{topic}"
+
+    @property
+    def pose(self) -> str:
+        return self._name("robot_pose")
+
+    @property
+    def scan(self) -> str:
+        return self._name("scan")
+
+    @property
+    def vel(self) -> str:
+        return self._name("nav_vel")
+
+    @property
+    def distance(self) -> str:
+        return self._name("distance_travelled")
+
+    @property
+    def feedback(self) -> str:
+        return self._name("waypoint_dispatcher/feedback")
+
+    @property
+    def result(self) -> str:
+        return self._name("waypoint_dispatcher/result")
+
+
+def method_messages(run: RobotRun) -> Iterator[Message]:
+    """Every message of one robot in the method's convention."""
+    topics = Topics(run.namespace)
+    yield from robot_messages(
+        run.store, run.robot, topics, run.execution, run.grid, run.laser, run.rng, run.start_ns
+    )
+    yield from dispatcher_messages(run.store, run.robot, topics, run.execution, run.start_ns)
+
+
+def robot_messages(
+    store: Any,
+    robot: str,
+    topics: Topics,
+    execution: Execution,
+    grid: PlanningGrid,
+    laser: Laser,
+    rng: np.random.Generator,
+    start_ns: int,
+) -> Iterator[Message]:
+    tr = execution.trajectories[robot]
+    n = len(tr)
+    stamps = sample_stamps(start_ns, n)
+    T = store.types
+    # robot_pose: PoseWithCovarianceStamped, with measurement noise
+    px = tr.x + rng.normal(0, POSE_NOISE, n)
+    py = tr.y + rng.normal(0, POSE_NOISE, n)
+    pyaw = tr.yaw + rng.normal(0, YAW_NOISE, n)
+    covariance = np.zeros(36)
+    covariance[[0, 7, 35]] = [POSE_NOISE**2, POSE_NOISE**2, YAW_NOISE**2]
+    pose_type = "geometry_msgs/msg/PoseWithCovarianceStamped"
+    for i in range(0, n, POSE_EVERY):
+        pose = T["geometry_msgs/msg/Pose"](
+            position=T["geometry_msgs/msg/Point"](x=float(px[i]), y=float(py[i]), z=0.0),
+            orientation=quaternion(store, float(pyaw[i])),
+        )
+        msg = T[pose_type](
+            header=header(store, int(stamps[i]), "map", i),
+            pose=T["geometry_msgs/msg/PoseWithCovariance"](pose=pose, covariance=covariance),
+        )
+        yield topics.pose, pose_type, int(stamps[i]), msg
+    # nav_vel: Twist (the command the robot follows)
+    for i in range(0, n, VEL_EVERY):
+        msg = T["geometry_msgs/msg/Twist"](
+            linear=T["geometry_msgs/msg/Vector3"](x=float(tr.v[i]), y=0.0, z=0.0),
+            angular=T["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=float(tr.w[i])),
+        )
+        yield topics.vel, "geometry_msgs/msg/Twist", int(stamps[i]), msg
+    # distance_travelled: Float64, cumulative
+    step = np.concatenate([[0.0], np.hypot(np.diff(tr.x), np.diff(tr.y))])
+    travelled = np.cumsum(step)
+    for i in range(0, n, DIST_EVERY):
+        yield (
+            topics.distance,
+            "std_msgs/msg/Float64",
+            int(stamps[i]),
+            T["std_msgs/msg/Float64"](data=float(travelled[i])),
+        )
+    # scan: LaserScan against the map and the other robots
+    yield from laser_scans(
+        store, topics.scan, f"{topics.ns}/base_laser_link", robot, execution, grid, laser, rng, stamps
+    )
+
+
+def dispatcher_messages(
+    store: Any, robot: str, topics: Topics, execution: Execution, start_ns: int
+) -> Iterator[Message]:
+    T = store.types
+    last_change: dict[tuple[str, int], int] = {}
+    previous: dict[str, tuple[GoalStatus, ...]] = {}
+    seq = 0
+    for event in execution.events:
+        if event.robot != robot:
+            continue
+        stamp = start_ns + int(round(event.t * 1e9))
+        before = previous.get(event.goal_key)
+        for i, status in enumerate(event.statuses):
+            if before is None or before[i] != status:
+                last_change[(event.goal_key, i)] = stamp
+        previous[event.goal_key] = event.statuses
+        status_list = [
+            T["actionlib_msgs/msg/GoalStatus"](
+                goal_id=T["actionlib_msgs/msg/GoalID"](
+                    stamp=ros_time(store, last_change[(event.goal_key, i)]), id=wid
+                ),
+                status=int(s),
+                text="",
+            )
+            for i, (wid, s) in enumerate(zip(event.waypoint_ids, event.statuses, strict=True))
+        ]
+        array = T["actionlib_msgs/msg/GoalStatusArray"](
+            header=header(store, stamp, "map", seq), status_list=status_list
+        )
+        failed = any(s == GoalStatus.ABORTED for s in event.statuses)
+        goal_state = (
+            GoalStatus.ABORTED
+            if failed and event.final
+            else (GoalStatus.SUCCEEDED if event.final else GoalStatus.ACTIVE)
+        )
+        goal = T["actionlib_msgs/msg/GoalStatus"](
+            goal_id=T["actionlib_msgs/msg/GoalID"](stamp=ros_time(store, stamp), id=event.goal_key),
+            status=int(goal_state),
+            text="",
+        )
+        feedback = T[FEEDBACK](
+            header=header(store, stamp, "map", seq),
+            status=goal,
+            feedback=T["waypoint_dispatcher/msg/FollowWaypointsFeedback"](goal_status=array),
+        )
+        yield topics.feedback, FEEDBACK, stamp, feedback
+        if event.final:
+            result = T[RESULT](
+                header=header(store, stamp, "map", seq),
+                status=goal,
+                result=T["waypoint_dispatcher/msg/FollowWaypointsResult"](goal_status=array),
+            )
+            yield topics.result, RESULT, stamp, result
+        seq += 1

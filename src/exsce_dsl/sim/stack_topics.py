@@ -1,0 +1,125 @@
+"""What a navigation stack's robot publishes about itself, Nav2 and move_base alike.
+
+Per robot namespace (the root for ``""``):
+
+| topic | type | rate |
+|---|---|---|
+| ``tf`` | tf2_msgs/TFMessage: ``odom → base_link`` | 50 Hz (odometry) |
+| ``tf`` | tf2_msgs/TFMessage: ``map → odom`` | 10 Hz (the localiser) |
+| ``tf_static`` | ``base_link → base_footprint``, ``base_link → base_laser_link`` | once, latched |
+| ``odom`` | nav_msgs/Odometry (odometry's pose, body twist) | 50 Hz |
+| ``amcl_pose`` | geometry_msgs/PoseWithCovarianceStamped (the estimate) | 2 Hz |
+| ``cmd_vel`` | geometry_msgs/Twist, or TwistStamped | 20 Hz (the controller's rate) |
+| ``scan`` | sensor_msgs/LaserScan | 10 Hz |
+
+Frames are plain (``map``, ``odom``, ``base_link``): each robot's TF is on its own namespaced
+``tf`` topic, as Nav2's multi-robot bringup remaps it, so frame names need no prefix.  See
+:mod:`exsce_dsl.sim.localisation` for the odometry's drift and the estimate's noise.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import numpy as np
+
+from exsce_dsl.sim.localisation import LOCALISATION_NOISE, LOCALISATION_YAW_NOISE, Localisation
+from exsce_dsl.sim.scan import laser_scans
+from exsce_dsl.sim.values import header, pose, transform, twist
+from exsce_dsl.sim.writing import Message, RobotRun
+
+MAP, ODOM, BASE, FOOTPRINT, LASER = "map", "odom", "base_link", "base_footprint", "base_laser_link"
+ODOM_EVERY, CORRECTION_EVERY, AMCL_EVERY = 1, 5, 25  # samples of the 50 Hz clock: 50, 10, 2 Hz
+CMD_VEL_PERIOD_NS = 50_000_000  # 20 Hz: Nav2's default controller_frequency
+FOOTPRINT_HEIGHT = 0.1  # base_footprint: on the floor, below base_link
+LASER_HEIGHT = 0.2  # base_laser_link: above base_link's origin, where the executor's scans start
+TF_STATIC = "tf_static"
+"""The latched topic (ROS 1 latching, ROS 2 transient-local durability)."""
+
+ODOM_COVARIANCE = np.diag([1e-3, 1e-3, 1e6, 1e6, 1e6, 1e-3]).ravel()
+TWIST_COVARIANCE = np.diag([1e-3, 1e-3, 1e6, 1e6, 1e6, 1e-3]).ravel()
+AMCL_COVARIANCE = np.diag(
+    [LOCALISATION_NOISE**2, LOCALISATION_NOISE**2, 0.0, 0.0, 0.0, LOCALISATION_YAW_NOISE**2]
+).ravel()
+
+
+def stack_messages(run: RobotRun, frames: Localisation, stamps: np.ndarray) -> Iterator[Message]:
+    """TF, odometry, AMCL's pose, velocity commands and scans of one robot."""
+    yield from _tf(run, frames, stamps)
+    yield from _odometry(run, frames, stamps)
+    yield from _amcl_pose(run, frames, stamps)
+    yield from _cmd_vel(run, stamps)
+    yield from laser_scans(
+        run.store, run.topic("scan"), LASER, run.robot, run.execution, run.grid, run.laser, run.rng, stamps
+    )
+
+
+def _tf(run: RobotRun, frames: Localisation, stamps: np.ndarray) -> Iterator[Message]:
+    T, store = run.store.types, run.store
+    tf, kind = run.topic("tf"), "tf2_msgs/msg/TFMessage"
+    static = [
+        transform(store, int(stamps[0]), BASE, FOOTPRINT, 0.0, 0.0, 0.0, -FOOTPRINT_HEIGHT),
+        transform(store, int(stamps[0]), BASE, LASER, 0.0, 0.0, 0.0, LASER_HEIGHT),
+    ]
+    yield run.topic(TF_STATIC), kind, int(stamps[0]), T[kind](transforms=static)
+    odom, correction = frames.odom, frames.correction
+    for i in range(0, len(stamps), ODOM_EVERY):
+        moved = transform(store, int(stamps[i]), ODOM, BASE, odom.x[i], odom.y[i], odom.yaw[i])
+        yield tf, kind, int(stamps[i]), T[kind](transforms=[moved])
+    for i in range(0, len(stamps), CORRECTION_EVERY):
+        corrected = transform(
+            store, int(stamps[i]), MAP, ODOM, correction.x[i], correction.y[i], correction.yaw[i]
+        )
+        yield tf, kind, int(stamps[i]), T[kind](transforms=[corrected])
+
+
+def _odometry(run: RobotRun, frames: Localisation, stamps: np.ndarray) -> Iterator[Message]:
+    T, store = run.store.types, run.store
+    kind = "nav_msgs/msg/Odometry"
+    odom = frames.odom
+    for seq, i in enumerate(range(0, len(stamps), ODOM_EVERY)):
+        msg = T[kind](
+            header=header(store, int(stamps[i]), ODOM, seq),
+            child_frame_id=BASE,
+            pose=T["geometry_msgs/msg/PoseWithCovariance"](
+                pose=pose(store, odom.x[i], odom.y[i], odom.yaw[i]), covariance=ODOM_COVARIANCE
+            ),
+            twist=T["geometry_msgs/msg/TwistWithCovariance"](
+                twist=twist(store, frames.v[i], frames.w[i]), covariance=TWIST_COVARIANCE
+            ),
+        )
+        yield run.topic("odom"), kind, int(stamps[i]), msg
+
+
+def _amcl_pose(run: RobotRun, frames: Localisation, stamps: np.ndarray) -> Iterator[Message]:
+    T, store = run.store.types, run.store
+    kind = "geometry_msgs/msg/PoseWithCovarianceStamped"
+    estimate = frames.estimate
+    for seq, i in enumerate(range(0, len(stamps), AMCL_EVERY)):
+        msg = T[kind](
+            header=header(store, int(stamps[i]), MAP, seq),
+            pose=T["geometry_msgs/msg/PoseWithCovariance"](
+                pose=pose(store, estimate.x[i], estimate.y[i], estimate.yaw[i]), covariance=AMCL_COVARIANCE
+            ),
+        )
+        yield run.topic("amcl_pose"), kind, int(stamps[i]), msg
+
+
+def _cmd_vel(run: RobotRun, stamps: np.ndarray) -> Iterator[Message]:
+    """The controller's commands on its own 20 Hz clock: the executor's speed at that moment."""
+    T, store = run.store.types, run.store
+    tr = run.execution.trajectories[run.robot]
+    start, end = int(stamps[0]), int(stamps[-1])
+    for seq, stamp in enumerate(range(start, end + 1, CMD_VEL_PERIOD_NS)):
+        i = min(int(np.searchsorted(stamps, stamp, side="right")) - 1, len(stamps) - 1)
+        command = twist(store, tr.v[i], tr.w[i])
+        if run.twist_stamped:
+            kind = "geometry_msgs/msg/TwistStamped"
+            yield (
+                run.topic("cmd_vel"),
+                kind,
+                stamp,
+                T[kind](header=header(store, stamp, BASE, seq), twist=command),
+            )
+        else:
+            yield run.topic("cmd_vel"), "geometry_msgs/msg/Twist", stamp, command
