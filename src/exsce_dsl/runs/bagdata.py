@@ -41,6 +41,10 @@ BLOCK = 4096
 """Messages decoded at a time from readers that hand out one message at a time (rosbags')."""
 ANY = "*"
 """The expected type of the dispatcher's topics: whatever the bag says, deserialized whole."""
+OBJECTS = "**"
+"""The expected type of topics kept as message objects (a navigation stack's goals and statuses:
+few messages, read by attribute): whatever the bag says, in :attr:`BagData.messages`."""
+WHOLE = (ANY, OBJECTS)
 
 
 class BagError(ExsceError):
@@ -90,6 +94,8 @@ class BagData:
     series: dict[str, Series] = field(default_factory=dict)
     feedback: dict[str, list[StatusUpdate]] = field(default_factory=dict)  # topic -> updates
     results: dict[str, list[StatusUpdate]] = field(default_factory=dict)
+    messages: dict[str, list[tuple[float, Any]]] = field(default_factory=dict)
+    """Topics wanted as :data:`OBJECTS`: (receive time, rosbags message object), in time order."""
     problems: list[str] = field(default_factory=list)
 
 
@@ -146,6 +152,20 @@ def read_bag(
         raise BagError(f"{path}: {exc.message}") from None
     except (DecodeError, MessageTypeError, CorruptBag) as exc:
         raise BagError(f"{path}: {exc.message}") from None
+
+
+def bag_topics(path: Path) -> dict[str, str]:
+    """Topic → its message type (ROS 2 spelling), from the bag's own index (nothing decoded)."""
+    if not path.exists():
+        raise BagError(f"{path}: no such bag")
+    from exsce_dsl.runs.bagfiles import check_bag_file  # here: bagfiles imports this module's BagError
+
+    check_bag_file(path)
+    try:
+        with AnyReader([path], default_typestore=typestore_for(path)) as reader:
+            return {c.topic: canonical_type(c.msgtype) for c in reader.connections}
+    except Exception as exc:  # rosbags' readers raise their own errors for corrupt and truncated files
+        raise BagError(f"{path}: cannot read the bag: {type(exc).__name__}: {exc}") from None
 
 
 class _Topic:
@@ -224,6 +244,7 @@ class _Reading:
         self.check = check
         self.topics: dict[str, _Topic] = {}
         self.updates: dict[str, list[StatusUpdate]] = {}
+        self.objects: dict[str, list[tuple[float, Any]]] = {}
         self.problems: list[str] = []
         self.checked: set[tuple[str, str]] = set()
 
@@ -231,7 +252,7 @@ class _Reading:
         """Whether the connection of ``topic`` with ``msgtype`` is read (a problem says why not)."""
         expected = self.wanted[topic].msgtype
         msgtype = canonical_type(msgtype)
-        if expected != ANY and msgtype != canonical_type(expected):
+        if expected not in WHOLE and msgtype != canonical_type(expected):
             problem = f"topic {topic} carries {msgtype}, not {expected}: its metrics are missing"
             if problem not in self.problems:
                 self.problems.append(problem)
@@ -243,7 +264,7 @@ class _Reading:
 
     def prepare(self, topic: str, msgtype: str, catalogue: MessageCatalogue) -> None:
         """Check the fields the metrics read of ``topic`` against the type's definition, once."""
-        if (topic, msgtype) in self.checked or self.wanted[topic].msgtype == ANY:
+        if (topic, msgtype) in self.checked or self.wanted[topic].msgtype in WHOLE:
             return
         lacking = catalogue.missing(msgtype)
         if lacking:
@@ -282,8 +303,14 @@ class _Reading:
         read = store.deserialize_cdr if cdr else store.deserialize_ros1
         return decode_slowly(lambda raw: read(raw, msgtype), raws, wanted.paths, wanted.texts)
 
-    def add_updates(self, topic: str, updates: list[StatusUpdate]) -> None:
-        self.updates.setdefault(topic, []).extend(updates)
+    def add_whole(self, topic: str, times: np.ndarray, objects: Sequence[Any]) -> None:
+        """Messages of a topic wanted whole (``times`` in seconds): the dispatcher's statuses, or
+        the objects themselves."""
+        if self.wanted[topic].msgtype == OBJECTS:
+            self.objects.setdefault(topic, []).extend(zip(times.tolist(), objects, strict=True))
+        else:
+            updates = [_status_update(m, t, topic) for m, t in zip(objects, times.tolist(), strict=True)]
+            self.updates.setdefault(topic, []).extend(updates)
 
     def data(self, start: float, end: float, topics: tuple[str, ...]) -> BagData:
         data = BagData(self.path, start, end, topics, problems=self.problems)
@@ -293,6 +320,8 @@ class _Reading:
             # statuses only move forward: updates recorded at the same instant go in that order
             updates.sort(key=lambda u: (u.t, sum(_PROGRESS.get(s, 2) for s in u.statuses)))
             (data.results if topic.endswith("/result") else data.feedback)[topic] = updates
+        for topic, objects in sorted(self.objects.items()):
+            data.messages[topic] = sorted(objects, key=lambda pair: pair[0])
         return data
 
 
@@ -311,12 +340,8 @@ class _Ros1(_Reading):
                 continue
             store = deserializer_for(self._catalogue(messages.msgtype, messages.definition), messages.msgtype)
             order = np.argsort(messages.times, kind="stable")
-            times = messages.times[order] / 1e9
-            updates = [
-                _status_update(store.deserialize_ros1(messages.raws[i], messages.msgtype), t, topic)
-                for i, t in zip(order.tolist(), times.tolist(), strict=True)
-            ]
-            self.add_updates(topic, updates)
+            objects = [store.deserialize_ros1(messages.raws[i], messages.msgtype) for i in order.tolist()]
+            self.add_whole(topic, messages.times[order] / 1e9, objects)
         return self.data(start / 1e9, end / 1e9, tuple(sorted(found)))
 
     def _catalogue(self, msgtype: str, definition: str) -> MessageCatalogue:
@@ -334,7 +359,7 @@ class _Ros1(_Reading):
         """Decode one chunk's messages of a topic; False: keep their bytes (the dispatcher's)."""
         if not self.accepts(topic, msgtype):
             return True  # nothing kept
-        if self.wanted[topic].msgtype == ANY:
+        if self.wanted[topic].msgtype in WHOLE:
             return False
         catalogue = self._catalogue(msgtype, definition)
         self.prepare(topic, msgtype, catalogue)
@@ -383,7 +408,7 @@ def _read_connection(
     reader: AnyReader, reading: _Reading, conn: Any, catalogue: MessageCatalogue, cdr: bool
 ) -> None:
     topic, msgtype = conn.topic, canonical_type(conn.msgtype)
-    whole = reading.wanted[topic].msgtype == ANY
+    whole = reading.wanted[topic].msgtype in WHOLE
     if not whole:
         reading.prepare(topic, msgtype, catalogue)
     store = deserializer_for(catalogue, msgtype) if whole else None
@@ -392,11 +417,7 @@ def _read_connection(
         times = np.asarray(stamps, dtype=np.int64)
         if store is not None:
             read = store.deserialize_cdr if cdr else store.deserialize_ros1
-            updates = [
-                _status_update(read(bytes(r), msgtype), t / 1e9, topic)
-                for r, t in zip(raws, stamps, strict=True)
-            ]
-            reading.add_updates(topic, updates)
+            reading.add_whole(topic, times / 1e9, [read(bytes(r), msgtype) for r in raws])
         else:
             reading.add(
                 topic, msgtype, times, reading.decode(topic, msgtype, catalogue, RawMessages.join(raws), cdr)

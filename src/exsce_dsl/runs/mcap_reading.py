@@ -26,10 +26,9 @@ from exsce_dsl.messages.catalogue import (
 )
 from exsce_dsl.messages.user import configured_user_catalogue
 from exsce_dsl.runs.bagdata import (
-    ANY,
+    WHOLE,
     BagData,
     _Reading,
-    _status_update,
     deserializer_for,
 )
 from exsce_dsl.runs.decode import RawMessages
@@ -103,12 +102,8 @@ class Mcap(_Reading):
             store = deserializer_for(catalogue, msgtype)
             all_times = np.concatenate([m.times for m in parts])
             order = np.argsort(all_times, kind="stable")
-            times = all_times[order] / 1e9
-            updates = [
-                _status_update(store.deserialize_cdr(raws[i], msgtype), t, topic)
-                for i, t in zip(order.tolist(), times.tolist(), strict=True)
-            ]
-            self.add_updates(topic, updates)
+            objects = [store.deserialize_cdr(raws[i], msgtype) for i in order.tolist()]
+            self.add_whole(topic, all_times[order] / 1e9, objects)
         return self.data(start / 1e9, end / 1e9, tuple(sorted(found)))
 
     def _catalogue(self, topic: str, msgtype: str, definition: str) -> MessageCatalogue:
@@ -126,7 +121,7 @@ class Mcap(_Reading):
         if not self.accepts(topic, msgtype):
             return True  # nothing kept
         catalogue = self._catalogue(topic, msgtype, definition)
-        if self.wanted[topic].msgtype == ANY:
+        if self.wanted[topic].msgtype in WHOLE:
             return False
         self.prepare(topic, msgtype, catalogue)
         self.add(topic, msgtype, times, self.decode(topic, msgtype, catalogue, messages, cdr=True))

@@ -1,0 +1,282 @@
+"""A robot's signals (pose, velocity, laser scan, distance travelled), read from wherever its
+robot type's convention puts them, as the same time series for every robot.
+
+DESIGN §2's middle step: :func:`choose_sources` picks, per signal, the first of the
+robot type's sources that the bag has (a TF chain, a topic of a type the signal
+can be read from); :func:`signals_wanted` says what to decode of those topics;
+:func:`signal_topics` turns what was decoded into one topic per signal under a
+name no bag topic can have (``/{ns}/~pose``), with the same fields whatever the
+source:
+
+- ``pose``: ``x``, ``y``, ``z`` (metres) and ``yaw`` (radians), from an Odometry's
+  or a PoseWithCovarianceStamped's ``pose.pose``, a PoseStamped's ``pose``, or
+  the TF chain ``fixed → body`` composed from ``tf`` and ``tf_static`` (at the
+  header stamps of the chain's fastest transform: a topic's receive time is the
+  recorder's, a transform's stamp the robot's; in a simulation both are the
+  simulated clock);
+- ``velocity``: ``linear.x|y|z`` and ``angular.x|y|z``, from a Twist, a
+  TwistStamped's ``twist`` or an Odometry's ``twist.twist``;
+- ``scan``: a LaserScan's fields, as its topic has them;
+- ``distance``: ``data``, a Float64 of the distance travelled so far (the method's).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from exsce_dsl.model.conventions import (
+    FLOAT64,
+    LASER_SCAN,
+    ODOMETRY,
+    POSE_STAMPED,
+    POSE_TYPES,
+    POSE_WITH_COVARIANCE,
+    TWIST,
+    TWIST_STAMPED,
+    VELOCITY_TYPES,
+    TfSource,
+    TopicSource,
+)
+from exsce_dsl.model.messages import FieldPath, canonical_type, path_of
+from exsce_dsl.model.metrics import topic_name
+from exsce_dsl.model.robots import Robot
+from exsce_dsl.runs.bagdata import BagData, Series, Wanted
+from exsce_dsl.runs.decode import TEXTS
+from exsce_dsl.runs.monitor_core import Topic
+from exsce_dsl.runs.tf_poses import (
+    EdgeSeries,
+    FrameTree,
+    TfError,
+    default_times,
+    pose_at,
+    yaw_from_quaternion,
+)
+
+SIGNALS = ("pose", "velocity", "scan", "distance")
+TF_MESSAGE = "tf2_msgs/msg/TFMessage"
+
+_POSE_AT = {ODOMETRY: ("pose", "pose"), POSE_WITH_COVARIANCE: ("pose", "pose"), POSE_STAMPED: ("pose",)}
+_VELOCITY_AT = {TWIST: (), TWIST_STAMPED: ("twist",), ODOMETRY: ("twist", "twist")}
+_AXES = ("x", "y", "z")
+_QUATERNION = ("x", "y", "z", "w")
+_VELOCITY_KEYS = tuple(f"{part}.{axis}" for part in ("linear", "angular") for axis in _AXES)
+_TF_NUMBERS = tuple(
+    path_of("transforms", *steps)
+    for steps in [
+        ("header", "stamp", "sec"),
+        ("header", "stamp", "nanosec"),
+        *[("transform", "translation", a) for a in _AXES],
+        *[("transform", "rotation", a) for a in _QUATERNION],
+    ]
+)
+_TF_TEXTS = (path_of("transforms", "header", "frame_id"), path_of("transforms", "child_frame_id"))
+
+
+def signal_topic(signal: str, namespace: str) -> str:
+    """The name a robot's signal goes under among a run's topics (``~`` is in no bag's topics)."""
+    return topic_name(f"/{{ns}}/~{signal}", namespace)
+
+
+@dataclass(frozen=True)
+class Chosen:
+    """Where one signal of one robot is read in this bag: a topic and its type, or a TF chain."""
+
+    signal: str
+    topic: str = ""
+    msgtype: str = ""
+    tf: TfSource | None = None
+    tf_topics: tuple[str, ...] = ()
+
+    @property
+    def topics(self) -> tuple[str, ...]:
+        """The bag's topics it is read from (what a metric's sources name)."""
+        return self.tf_topics if self.tf is not None else (self.topic,)
+
+
+@dataclass(frozen=True)
+class RobotSources:
+    """The sources chosen for one robot's signals (a signal the bag lacks is not there)."""
+
+    robot: str
+    namespace: str
+    chosen: Mapping[str, Chosen]
+    notes: tuple[str, ...] = ()
+    """Why a signal has no source, for the run's problems."""
+
+
+def choose_sources(robot: Robot, available: Mapping[str, str]) -> RobotSources:
+    """For each signal, the first of the robot type's sources that ``available`` (the bag's
+    topic → type) has."""
+    signals = robot.type.signals
+    ns = robot.namespace
+    chosen: dict[str, Chosen] = {}
+    notes: list[str] = []
+    options: dict[str, tuple[tuple[TopicSource | TfSource, ...], tuple[str, ...]]] = {
+        "pose": (signals.pose, POSE_TYPES),
+        "velocity": (signals.velocity, VELOCITY_TYPES),
+        "scan": (signals.scan, (LASER_SCAN,)),
+        "distance": (signals.distance, (FLOAT64,)),
+    }
+    for signal, (sources, types) in options.items():
+        found = _first_present(signal, sources, types, ns, available)
+        if found is not None:
+            chosen[signal] = found
+        elif sources:
+            tried = ", ".join(_described(s, ns) for s in sources)
+            notes.append(f"robot '{robot.id}' has no {signal} in this bag (looked for {tried})")
+    return RobotSources(robot.id, ns, chosen, tuple(notes))
+
+
+def _first_present(
+    signal: str,
+    sources: Iterable[TopicSource | TfSource],
+    types: tuple[str, ...],
+    ns: str,
+    available: Mapping[str, str],
+) -> Chosen | None:
+    for source in sources:
+        if isinstance(source, TfSource):
+            tf, static = topic_name(source.tf, ns), topic_name(source.tf_static, ns)
+            if available.get(tf) == TF_MESSAGE:
+                topics = (tf, static) if available.get(static) == TF_MESSAGE else (tf,)
+                return Chosen(signal, tf=source, tf_topics=topics)
+            continue
+        topic = topic_name(source.topic, ns)
+        msgtype = available.get(topic)
+        if msgtype is None or msgtype not in types:
+            continue
+        if source.msgtype is not None and canonical_type(source.msgtype) != msgtype:
+            continue
+        return Chosen(signal, topic, msgtype)
+    return None
+
+
+def _described(source: TopicSource | TfSource, ns: str) -> str:
+    if isinstance(source, TfSource):
+        return f"TF {source.fixed} -> {source.body} on {topic_name(source.tf, ns)}"
+    return topic_name(source.topic, ns)
+
+
+def signals_wanted(sources: Iterable[RobotSources], scan_paths: Iterable[FieldPath]) -> dict[str, Wanted]:
+    """What to decode of each topic the chosen sources read (``scan_paths``: what the metrics read
+    of a scan, which is kept as it is)."""
+    wanted: dict[str, Wanted] = {}
+
+    def want(topic: str, msgtype: str, paths: Iterable[FieldPath], texts: Iterable[FieldPath] = ()) -> None:
+        before = wanted.get(topic, Wanted(msgtype))
+        merged_paths = tuple(dict.fromkeys([*before.paths, *paths]))
+        merged_texts = tuple(dict.fromkeys([*before.texts, *texts]))
+        wanted[topic] = Wanted(msgtype, merged_paths, merged_texts)
+
+    for robot in sources:
+        for chosen in robot.chosen.values():
+            if chosen.tf is not None:
+                for topic in chosen.tf_topics:
+                    want(topic, TF_MESSAGE, _TF_NUMBERS, _TF_TEXTS)
+            elif chosen.signal == "pose":
+                want(chosen.topic, chosen.msgtype, _pose_paths(chosen.msgtype))
+            elif chosen.signal == "velocity":
+                want(chosen.topic, chosen.msgtype, _velocity_paths(chosen.msgtype))
+            elif chosen.signal == "scan":
+                want(chosen.topic, chosen.msgtype, scan_paths)
+            else:
+                want(chosen.topic, chosen.msgtype, [path_of("data")])
+    return wanted
+
+
+def _pose_paths(msgtype: str) -> list[FieldPath]:
+    prefix = _POSE_AT[msgtype]
+    return [path_of(*prefix, "position", a) for a in _AXES] + [
+        path_of(*prefix, "orientation", a) for a in _QUATERNION
+    ]
+
+
+def _velocity_paths(msgtype: str) -> list[FieldPath]:
+    prefix = _VELOCITY_AT[msgtype]
+    return [path_of(*prefix, *key.split(".")) for key in _VELOCITY_KEYS]
+
+
+def signal_topics(robot: RobotSources, data: BagData) -> dict[str, Topic]:
+    """The robot's signals as topics (:func:`signal_topic` names), from what the bag gave."""
+    found: dict[str, Topic] = {}
+    for signal, chosen in robot.chosen.items():
+        name = signal_topic(signal, robot.namespace)
+        if chosen.tf is not None:
+            found[name] = _tf_pose(name, chosen, data)
+            continue
+        series = data.series.get(chosen.topic)
+        if series is None:
+            continue
+        if signal == "pose":
+            found[name] = _pose(name, series, _POSE_AT[chosen.msgtype])
+        elif signal == "velocity":
+            prefix = ".".join(_VELOCITY_AT[chosen.msgtype])
+            fields = {key: series.fields[f"{prefix}.{key}" if prefix else key] for key in _VELOCITY_KEYS}
+            found[name] = Topic(name, series.t, fields)
+        else:
+            found[name] = Topic(name, series.t, dict(series.fields))
+    return found
+
+
+def _pose(name: str, series: Series, prefix: tuple[str, ...]) -> Topic:
+    at = ".".join(prefix)
+    position = {a: series.fields[f"{at}.position.{a}"] for a in _AXES}
+    quaternion = np.stack([series.fields[f"{at}.orientation.{a}"] for a in _QUATERNION], axis=1)
+    return Topic(name, series.t, {**position, "yaw": yaw_from_quaternion(quaternion)})
+
+
+def _tf_pose(name: str, chosen: Chosen, data: BagData) -> Topic:
+    """The pose of the chain's body frame in its fixed frame, at the fastest transform's stamps."""
+    assert chosen.tf is not None
+    edges: dict[tuple[str, str], EdgeSeries] = {}
+    for topic in chosen.tf_topics:
+        series = data.series.get(topic)
+        if series is None:
+            continue
+        static = topic != chosen.tf_topics[0]
+        for edge in _edges(series, static):
+            key = (edge.parent, edge.child)
+            if key not in edges or not static:  # a transform on both: the dynamic one
+                edges[key] = edge
+    tree = FrameTree(edges.values())
+    fixed, body = chosen.tf.fixed, chosen.tf.body
+    times = default_times(tree, fixed, body)
+    poses = pose_at(tree, fixed, body, times)
+    keep = poses.valid
+    if not keep.any():
+        raise TfError(f"no time at which every transform of {fixed} -> {body} is known")
+    position = poses.position[keep]
+    fields = {"x": position[:, 0], "y": position[:, 1], "z": position[:, 2], "yaw": poses.yaw[keep]}
+    return Topic(name, poses.times[keep], fields)
+
+
+def _edges(series: Series, static: bool) -> list[EdgeSeries]:
+    """One edge series per (parent, child) pair of the TFMessages' transforms."""
+    fields = series.fields
+    texts = fields[TEXTS] if TEXTS in fields else np.array([], dtype=object)
+    parents = fields["transforms.header.frame_id"]
+    children = fields["transforms.child_frame_id"]
+    held = ~np.isnan(children)
+    if not held.any():
+        return []
+    stamp = fields["transforms.header.stamp.sec"] + fields["transforms.header.stamp.nanosec"] * 1e-9
+    translation = np.stack([fields[f"transforms.transform.translation.{a}"][held] for a in _AXES], axis=1)
+    rotation = np.stack([fields[f"transforms.transform.rotation.{a}"][held] for a in _QUATERNION], axis=1)
+    parent_codes, child_codes, times = parents[held].astype(int), children[held].astype(int), stamp[held]
+    pairs = np.stack([parent_codes, child_codes], axis=1)
+    distinct, which = np.unique(pairs, axis=0, return_inverse=True)
+    which = which.ravel()
+    return [
+        EdgeSeries(
+            str(texts[p]),
+            str(texts[c]),
+            times[which == k],
+            translation[which == k],
+            rotation[which == k],
+            static=static,
+        )
+        for k, (p, c) in enumerate(distinct.tolist())
+    ]
