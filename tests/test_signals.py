@@ -199,7 +199,7 @@ def test_a_signal_the_bag_lacks_is_said_and_not_made_up(tmp_path: Path) -> None:
     bag = _bag(tmp_path, scenario, "ros1", "nav2")
     sources, topics = _signals(scenario, bag)
     r2 = next(s for s in sources if s.robot == "r2")
-    assert set(r2.chosen) == {"velocity"}  # nav2 has no distance topic; the others are not in the bag
+    assert set(r2.chosen) == {"velocity", "distance"}  # from cmd_vel and odom; the others are not in the bag
     assert r2.notes == (
         "robot 'r2' has no pose in this bag (looked for /r2/ground_truth)",
         "robot 'r2' has no scan in this bag (looked for /r2/front_scan)",

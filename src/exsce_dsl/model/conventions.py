@@ -28,6 +28,8 @@ POSE_TYPES = (ODOMETRY, POSE_STAMPED, POSE_WITH_COVARIANCE)
 """The types a pose topic may have (its pose is read where the type keeps it)."""
 VELOCITY_TYPES = (TWIST, TWIST_STAMPED, ODOMETRY)
 """The types a velocity topic may have (an odometry's twist is the robot's velocity)."""
+DISTANCE_TYPES = (FLOAT64, ODOMETRY)
+"""The types a distance topic may have (the distance so far, or an odometry whose path it is)."""
 
 
 class Navigation(Enum):
@@ -106,7 +108,9 @@ class Signals:
     velocity: tuple[TopicSource, ...]
     scan: tuple[TopicSource, ...]
     distance: tuple[TopicSource, ...] = ()
-    """A topic of the distance travelled so far (the method's); else it is the pose's path length."""
+    """Where the distance travelled is: a Float64 of it so far (the method's), or an Odometry
+    whose path it is (wheel odometry is smooth where a localised pose jitters, and a path length
+    adds up jitter); with neither, it is the pose's path length."""
     navigation: Navigation = Navigation.NONE
     actions: tuple[str, ...] = ()
     """The navigation interface's action (or dispatcher) names, patterns with ``{ns}``."""
@@ -134,17 +138,20 @@ NAV2 = Signals(
     pose=(TfSource(), TopicSource("/{ns}/amcl_pose"), TopicSource("/{ns}/odom")),
     velocity=(TopicSource("/{ns}/cmd_vel"), TopicSource("/{ns}/odom")),
     scan=(TopicSource("/{ns}/scan", LASER_SCAN),),
+    distance=(TopicSource("/{ns}/odom", ODOMETRY),),
     navigation=Navigation.NAV2,
     actions=("/{ns}/navigate_to_pose", "/{ns}/follow_waypoints", "/{ns}/navigate_through_poses"),
 )
 """Nav2 (Humble and Jazzy): pose from TF ``map → base_link`` (else AMCL's, else odometry),
-velocity commanded on ``cmd_vel`` (Twist on Humble, TwistStamped from Jazzy on)."""
+velocity commanded on ``cmd_vel`` (Twist on Humble, TwistStamped from Jazzy on), distance
+travelled along the wheel odometry."""
 
 MOVE_BASE = Signals(
     convention="move_base",
     pose=(TfSource(), TopicSource("/{ns}/amcl_pose"), TopicSource("/{ns}/odom")),
     velocity=(TopicSource("/{ns}/cmd_vel"), TopicSource("/{ns}/odom")),
     scan=(TopicSource("/{ns}/scan", LASER_SCAN),),
+    distance=(TopicSource("/{ns}/odom", ODOMETRY),),
     navigation=Navigation.MOVE_BASE,
     actions=("/{ns}/move_base",),
 )

@@ -19,11 +19,12 @@ from exsce_dsl.model.messages import DISPATCHER, POSE, FieldPath, Fields
 from exsce_dsl.model.metrics import MetricDefinition
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Bag, Run, TaskExecution
-from exsce_dsl.runs.bagdata import ANY, BagError, Check, Reduce, Wanted, read_bag
+from exsce_dsl.runs.bagdata import ANY, BagError, Check, Reduce, Wanted, bag_topics, read_bag
 from exsce_dsl.runs.monitor_code import load_monitors
 from exsce_dsl.runs.monitor_core import Compute, Topic, reducer, topic_name
 from exsce_dsl.runs.monitoring import HOTSPOT_PATHS, POSE_TOPIC, compute_metrics
 from exsce_dsl.runs.segments import SUCCEEDED, Segment, segments
+from exsce_dsl.runs.stack_runs import SERVED, segment_robot, stack_robots
 
 _RUN_NAMESPACE = uuid.UUID("5b8f9a52-3f0c-4a8e-8f0e-2d6c1b7e4a90")
 _FEEDBACK = "/{ns}/waypoint_dispatcher/feedback"
@@ -110,9 +111,7 @@ def reductions(monitors: ModuleType, robots: list[Robot]) -> dict[str, Reduce]:
     entries: dict[str, list[tuple[str, str, Compute]]] = {}
     for robot in robots:
         for pattern, key, func, compute in monitors.REDUCERS:
-            entries.setdefault(topic_name(pattern, robot.namespace), []).append(
-                (key, func, compute)
-            )
+            entries.setdefault(topic_name(pattern, robot.namespace), []).append((key, func, compute))
     return {topic: reducer(found) for topic, found in entries.items()}
 
 
@@ -125,27 +124,55 @@ def analyse_bag(path: Path, scenario: Scenario, digest: str | None = None) -> An
     metrics = run_metrics(scenario)
     source = scenario.location.file if scenario.location else scenario.id
     monitors = load_monitors(metrics, source)
-    data = read_bag(
-        path, wanted_topics(metrics, robots), reductions(monitors, robots), field_checker(metrics, robots)
-    )
+    declared = [r for r in robots if r.type.declared_signals is not None]
+    stacks = stack_robots(declared, bag_topics(path) if declared else {})
+    wanted = stacks.adapt(wanted_topics(metrics, robots), robots)
+    data = read_bag(path, wanted, reductions(monitors, robots), field_checker(metrics, robots))
     problems = list(data.problems)
+    for sources in stacks.sources.values():
+        problems += sources.notes
+    topics = {name: Topic(name, s.t, s.fields) for name, s in data.series.items()}
+    topics.update(stacks.served_topics(data))
     actions: list[Segment] = []
     results: dict[str, int | None] = {}
+    whole_runs: dict[str, tuple[float, float]] = {}
     for robot in robots:
         ns = robot.namespace.strip("/")
         feedback, result = topic_name(_FEEDBACK, ns), topic_name(_RESULT, ns)
         updates = data.feedback.get(feedback)
-        if updates is None:
-            problems.append(f"topic {feedback} is missing: no path segments for '{robot.id}'")
-            results[robot.id] = None
+        dispatched = segments(scenario, robot.id, updates) if updates is not None else None
+        if robot.id not in stacks.sources:
+            if dispatched is None:
+                problems.append(f"topic {feedback} is missing: no path segments for '{robot.id}'")
+                results[robot.id] = None
+                continue
+            actions.extend(dispatched)
+            final = data.results.get(result)
+            results[robot.id] = (
+                None if final is None else sum(s == SUCCEEDED for u in final for s in u.statuses)
+            )
             continue
-        actions.extend(segments(scenario, robot.id, updates))
-        final = data.results.get(result)
-        results[robot.id] = None if final is None else sum(s == SUCCEEDED for u in final for s in u.statuses)
-    if not any(a.start is not None for a in actions):
+        found = segment_robot(scenario, robot, data, stacks.track(robot, topics), dispatched)
+        problems += found.problems
+        actions.extend(found.segments)
+        if found.succeeded is None and dispatched is not None:
+            final = data.results.get(result)
+            results[robot.id] = (
+                None if final is None else sum(s == SUCCEEDED for u in final for s in u.statuses)
+            )
+        else:
+            results[robot.id] = found.succeeded
+            stacks.real_topics[feedback] = stacks.real_topics[result] = (
+                found.topics or stacks.real_topics.get(topic_name(SERVED["pose"], ns), ())
+            )
+        if not found.segments:
+            whole_runs[robot.id] = (data.start, data.end)
+    if not any(a.start is not None for a in actions) and not whole_runs:
         raise BagError(f"{path}: no waypoint goal of scenario '{scenario.id}' became active in this bag")
-    topics = {name: Topic(name, s.t, s.fields) for name, s in data.series.items()}
-    values, hotspots = compute_metrics(monitors, metrics, robots, topics, actions, results, problems)
+    values, hotspots = compute_metrics(
+        monitors, metrics, robots, topics, actions, results, problems, whole_runs
+    )
+    values = [stacks.with_real_sources(v) for v in values]
     run = Run(
         uuid=run_uuid(digest),
         scenario=scenario.id,

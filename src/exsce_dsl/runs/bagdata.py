@@ -60,6 +60,8 @@ class Wanted:
     paths: tuple[FieldPath, ...] = ()
     texts: tuple[FieldPath, ...] = ()
     """Paths to texts (TF frame ids): their values are codes into the series' ``fields[TEXTS]``."""
+    rows: bool = False
+    """Keep rows of arrays even where blocks are reduced (a TFMessage's transforms: few a message)."""
 
 
 @dataclass(frozen=True)
@@ -287,7 +289,8 @@ class _Reading:
         msgtype = canonical_type(msgtype)
         found = self.topics.setdefault(topic, _Topic(topic, msgtype))
         text_keys = [p.key for p in self.wanted[topic].texts]
-        found.add(times, _kept(fields, topic, self.reduce, text_keys), text_keys)
+        kept = fields if self.wanted[topic].rows else _kept(fields, topic, self.reduce, text_keys)
+        found.add(times, kept, text_keys)
 
     def decode(
         self, topic: str, msgtype: str, catalogue: MessageCatalogue, messages: RawMessages, cdr: bool

@@ -43,25 +43,29 @@ def compute_metrics(
     actions: Sequence[Segment],
     results: Mapping[str, int | None],
     problems: list[str],
+    whole_runs: Mapping[str, tuple[float, float]] | None = None,
 ) -> tuple[list[MetricValue], list[Hotspot]]:
-    """Every metric of ``metrics`` for a run. ``results``: robot → waypoints SUCCEEDED (None: no topic)."""
+    """Every metric of ``metrics`` for a run. ``results``: robot → waypoints SUCCEEDED (None: no topic);
+    ``whole_runs``: robot → the run's span, for robots without path segments (whole-run values only)."""
     values: list[MetricValue] = []
     hotspots: list[Hotspot] = []
     done = [(a, a.start, a.end) for a in actions if a.start is not None and a.end is not None]
+    spans = [(s, e) for _, s, e in done] + list((whole_runs or {}).values())
     by_subject = {s: [m for m in metrics if m.subject is s] for s in Subject}
     for robot in robots:
         mine: list[Window] = [(a, s, e) for a, s, e in done if a.robot == robot.id]
-        if not mine:
+        whole = (whole_runs or {}).get(robot.id)
+        if not mine and whole is None:
             problems.append(f"robot '{robot.id}' started no waypoint goal: its metrics are missing")
             continue
-        start, end = min(s for _, s, _ in mine), max(e for _, _, e in mine)
+        start, end = (min(s for _, s, _ in mine), max(e for _, _, e in mine)) if mine else whole  # type: ignore[misc]
         monitor = monitors.RobotMetrics(robot.id, robot.namespace, topics, results.get(robot.id))
         for metric in by_subject[Subject.ROBOT]:
             values += _robot_values(monitor, metric, robot, [(None, start, end), *mine], problems)
             if metric.safety is not None:
                 values += _robot_violations(monitor, metric, robot, start, end, topics, hotspots)
-    if done:
-        start, end = min(s for _, s, _ in done), max(e for _, _, e in done)
+    if spans:
+        start, end = min(s for s, _ in spans), max(e for _, e in spans)
         fleet = [(r.id, r.namespace) for r in robots]
         monitor = monitors.MissionMetrics(fleet, topics)
         for metric in by_subject[Subject.MISSION] + by_subject[Subject.PAIRS]:

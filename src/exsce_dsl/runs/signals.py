@@ -17,7 +17,8 @@ source:
 - ``velocity``: ``linear.x|y|z`` and ``angular.x|y|z``, from a Twist, a
   TwistStamped's ``twist`` or an Odometry's ``twist.twist``;
 - ``scan``: a LaserScan's fields, as its topic has them;
-- ``distance``: ``data``, a Float64 of the distance travelled so far (the method's).
+- ``distance``: ``data``, the distance travelled so far: a Float64 of it (the method's),
+  or the path length along an odometry's positions.
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from exsce_dsl.model.conventions import (
+    DISTANCE_TYPES,
     FLOAT64,
     LASER_SCAN,
     ODOMETRY,
@@ -118,7 +120,7 @@ def choose_sources(robot: Robot, available: Mapping[str, str]) -> RobotSources:
         "pose": (signals.pose, POSE_TYPES),
         "velocity": (signals.velocity, VELOCITY_TYPES),
         "scan": (signals.scan, (LASER_SCAN,)),
-        "distance": (signals.distance, (FLOAT64,)),
+        "distance": (signals.distance, DISTANCE_TYPES),
     }
     for signal, (sources, types) in options.items():
         found = _first_present(signal, sources, types, ns, available)
@@ -169,7 +171,7 @@ def signals_wanted(sources: Iterable[RobotSources], scan_paths: Iterable[FieldPa
         before = wanted.get(topic, Wanted(msgtype))
         merged_paths = tuple(dict.fromkeys([*before.paths, *paths]))
         merged_texts = tuple(dict.fromkeys([*before.texts, *texts]))
-        wanted[topic] = Wanted(msgtype, merged_paths, merged_texts)
+        wanted[topic] = Wanted(msgtype, merged_paths, merged_texts, rows=bool(merged_texts))
 
     for robot in sources:
         for chosen in robot.chosen.values():
@@ -182,8 +184,10 @@ def signals_wanted(sources: Iterable[RobotSources], scan_paths: Iterable[FieldPa
                 want(chosen.topic, chosen.msgtype, _velocity_paths(chosen.msgtype))
             elif chosen.signal == "scan":
                 want(chosen.topic, chosen.msgtype, scan_paths)
-            else:
+            elif chosen.msgtype == FLOAT64:
                 want(chosen.topic, chosen.msgtype, [path_of("data")])
+            else:
+                want(chosen.topic, chosen.msgtype, _pose_paths(chosen.msgtype))
     return wanted
 
 
@@ -216,9 +220,18 @@ def signal_topics(robot: RobotSources, data: BagData) -> dict[str, Topic]:
             prefix = ".".join(_VELOCITY_AT[chosen.msgtype])
             fields = {key: series.fields[f"{prefix}.{key}" if prefix else key] for key in _VELOCITY_KEYS}
             found[name] = Topic(name, series.t, fields)
+        elif signal == "distance" and chosen.msgtype != FLOAT64:
+            found[name] = _distance(name, series, _POSE_AT[chosen.msgtype])
         else:
             found[name] = Topic(name, series.t, dict(series.fields))
     return found
+
+
+def _distance(name: str, series: Series, prefix: tuple[str, ...]) -> Topic:
+    """The distance travelled so far along a pose topic's path (``data``, as the method's Float64)."""
+    at = ".".join(prefix)
+    steps = np.hypot(np.diff(series.fields[f"{at}.position.x"]), np.diff(series.fields[f"{at}.position.y"]))
+    return Topic(name, series.t, {"data": np.concatenate([[0.0], np.cumsum(steps)])})
 
 
 def _pose(name: str, series: Series, prefix: tuple[str, ...]) -> Topic:

@@ -1,0 +1,169 @@
+"""A robot's navigation goals as its stack recorded them: Nav2's actions and ROS 1 move_base's.
+
+Few messages (a status array a second, a feedback a few times a second), so they are
+read as message objects (:data:`~exsce_dsl.runs.bagdata.OBJECTS`) and walked here
+into :class:`~exsce_dsl.runs.goal_segments.Goal`\\ s, in receive time:
+
+- **Nav2** (``navigate_to_pose``, ``navigate_through_poses``, ``follow_waypoints``):
+  ``ACTION/_action/status`` (action_msgs/GoalStatusArray: each goal's UUID and status)
+  says when each goal was accepted, executed and ended; ``follow_waypoints``'
+  feedback ``current_waypoint`` says which of its poses the robot was going to.  No
+  action topic carries the goal's target: it is taken from the global plan the
+  planner published while the goal executed (``/{ns}/plan``, nav_msgs/Path: its
+  last pose), else left to the segmentation (where the robot was when it succeeded).
+- **move_base** (actionlib): ``move_base/goal`` carries each goal's id and target
+  pose, ``move_base/status`` (actionlib_msgs/GoalStatusArray) its statuses.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from exsce_dsl.model.conventions import Navigation, Signals
+from exsce_dsl.model.metrics import topic_name
+from exsce_dsl.runs.goal_segments import Goal
+
+NAV2_STATUS = {1: "ACCEPTED", 2: "EXECUTING", 3: "CANCELING", 4: "SUCCEEDED", 5: "CANCELED", 6: "ABORTED"}
+NAV2_FINAL = {4, 5, 6}
+MOVE_BASE_STATUS = {
+    0: "PENDING",
+    1: "ACTIVE",
+    2: "PREEMPTED",
+    3: "SUCCEEDED",
+    4: "ABORTED",
+    5: "REJECTED",
+    6: "PREEMPTING",
+    7: "RECALLING",
+    8: "RECALLED",
+    9: "LOST",
+}
+MOVE_BASE_FINAL = {2, 3, 4, 5, 8, 9}
+PLAN = "/{ns}/plan"
+
+Messages = Sequence[tuple[float, Any]]
+
+
+def goal_topics(signals: Signals, namespace: str) -> list[str]:
+    """The topics the robot's navigation goals are read from (wanted as message objects)."""
+    actions = [topic_name(a, namespace) for a in signals.actions]
+    if signals.navigation is Navigation.NAV2:
+        found = [f"{a}/_action/status" for a in actions] + [f"{a}/_action/feedback" for a in actions]
+        return [*found, topic_name(PLAN, namespace)]
+    if signals.navigation is Navigation.MOVE_BASE:
+        return [f"{a}/{part}" for a in actions for part in ("goal", "status", "result")]
+    return []
+
+
+def read_goals(
+    signals: Signals, namespace: str, messages: Mapping[str, Messages]
+) -> tuple[list[Goal], list[str]]:
+    """The robot's goals from the bag's messages, and the topics they came from."""
+    actions = [topic_name(a, namespace) for a in signals.actions]
+    goals: list[Goal] = []
+    used: list[str] = []
+    for action in actions:
+        if signals.navigation is Navigation.NAV2:
+            status = messages.get(f"{action}/_action/status")
+            if not status:
+                continue
+            feedback = messages.get(f"{action}/_action/feedback", [])
+            plans = messages.get(topic_name(PLAN, namespace), [])
+            goals += _nav2_goals(status, feedback, plans)
+            used += [f"{action}/_action/status"] + ([topic_name(PLAN, namespace)] if plans else [])
+        elif signals.navigation is Navigation.MOVE_BASE:
+            status = messages.get(f"{action}/status")
+            if not status:
+                continue
+            targets = {
+                _move_base_key(m.goal_id): _xy_yaw(m.goal.target_pose.pose)
+                for _, m in messages.get(f"{action}/goal", [])
+            }
+            goals += _statuses(
+                status,
+                lambda entry: str(entry.goal_id.id),
+                MOVE_BASE_STATUS,
+                MOVE_BASE_FINAL,
+                started_at={1},
+                targets=targets,
+            )
+            used += [f"{action}/status"] + ([f"{action}/goal"] if targets else [])
+    return sorted(goals, key=lambda g: (g.first_seen or 0.0, g.key)), used
+
+
+def _move_base_key(goal_id: Any) -> str:
+    return str(goal_id.id)
+
+
+def _nav2_goals(status: Messages, feedback: Messages, plans: Messages) -> list[Goal]:
+    progress: dict[str, list[tuple[int, float]]] = {}
+    for t, message in feedback:
+        current = getattr(message.feedback, "current_waypoint", None)
+        if current is None:
+            continue
+        steps = progress.setdefault(_uuid(message.goal_id), [])
+        if not steps or steps[-1][0] != int(current):
+            steps.append((int(current), t))
+    goals = _statuses(
+        status,
+        lambda entry: _uuid(entry.goal_info.goal_id),
+        NAV2_STATUS,
+        NAV2_FINAL,
+        started_at={2},
+        targets={},
+    )
+    found = []
+    for goal in goals:
+        reported = tuple(progress.get(goal.key, ()))
+        target = None if reported else _plan_target(plans, goal)
+        found.append(Goal(goal.key, goal.accepted, goal.started, goal.ended, goal.status, target, reported))
+    return found
+
+
+def _statuses(
+    status: Messages,
+    key_of: Any,
+    names: Mapping[int, str],
+    final: set[int],
+    started_at: set[int],
+    targets: Mapping[str, tuple[float, float, float]],
+) -> list[Goal]:
+    """Goals from status arrays: when each was first seen, became active and reached a final status."""
+    seen: dict[str, dict[str, Any]] = {}
+    for t, message in status:
+        for entry in message.status_list:
+            key = key_of(entry)
+            goal = seen.setdefault(key, {"accepted": t, "started": None, "ended": None, "status": "ACTIVE"})
+            code = int(entry.status)
+            if code in started_at and goal["started"] is None:
+                goal["started"] = t
+            if code in final and goal["ended"] is None:
+                goal["ended"], goal["status"] = t, names.get(code, str(code))
+    return [
+        Goal(key, g["accepted"], g["started"], g["ended"], g["status"], targets.get(key))
+        for key, g in seen.items()
+    ]
+
+
+def _plan_target(plans: Messages, goal: Goal) -> tuple[float, float, float] | None:
+    """The last pose of the first global plan published while the goal was under way."""
+    begin = goal.accepted if goal.accepted is not None else goal.started
+    if begin is None:
+        return None
+    end = goal.ended if goal.ended is not None else float("inf")
+    for t, plan in plans:
+        if begin <= t <= end and len(plan.poses):
+            return _xy_yaw(plan.poses[-1].pose)
+    return None
+
+
+def _uuid(goal_id: Any) -> str:
+    return bytes(np.asarray(goal_id.uuid, dtype=np.uint8)).hex()
+
+
+def _xy_yaw(pose: Any) -> tuple[float, float, float]:
+    q = pose.orientation
+    yaw = float(np.arctan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z)))
+    return float(pose.position.x), float(pose.position.y), yaw

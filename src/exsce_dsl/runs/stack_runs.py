@@ -1,0 +1,189 @@
+"""Runs of robots whose type declares where its signals are (Nav2, move_base, or its own topics).
+
+The standard library's metrics are declared over the method's topics
+(``/{ns}/robot_pose``, ``/{ns}/nav_vel``, ``/{ns}/scan``,
+``/{ns}/distance_travelled``) and its dispatcher's windows.  For a robot whose
+type says otherwise, ingestion reads the signals from the sources chosen in the
+bag (:mod:`~exsce_dsl.runs.signals`) and serves them to the monitors under
+those names, with the fields the method's types have there; the metrics' sources
+in the run's PROV then name the topics the values really came from.  Its path
+segments come from the first source that gives any: the method's dispatcher, the
+navigation stack's goals matched to the planned waypoints by pose, arrival at
+the planned waypoints; else the robot has whole-run metrics only, and a problem
+says why.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from exsce_dsl.model import Scenario
+from exsce_dsl.model.conventions import METHOD, Navigation
+from exsce_dsl.model.messages import FieldPath
+from exsce_dsl.model.metrics import topic_name
+from exsce_dsl.model.robots import Robot
+from exsce_dsl.model.runs import MetricValue
+from exsce_dsl.runs.arrival_segments import arrival_segments
+from exsce_dsl.runs.bagdata import OBJECTS, BagData, Wanted
+from exsce_dsl.runs.goal_segments import goal_segments
+from exsce_dsl.runs.monitor_core import Topic
+from exsce_dsl.runs.navigation_goals import goal_topics, read_goals
+from exsce_dsl.runs.segmentation import Track
+from exsce_dsl.runs.segments import Segment
+from exsce_dsl.runs.signals import RobotSources, choose_sources, signal_topic, signal_topics, signals_wanted
+
+FEEDBACK = "/{ns}/waypoint_dispatcher/feedback"
+RESULT = "/{ns}/waypoint_dispatcher/result"
+SERVED = {
+    "pose": METHOD.pose[0].topic,  # type: ignore[union-attr]
+    "velocity": METHOD.velocity[0].topic,
+    "scan": METHOD.scan[0].topic,
+    "distance": METHOD.distance[0].topic,
+}
+"""The method's topic each signal is served under, for the standard library's metrics."""
+
+
+@dataclass
+class StackRobots:
+    """What ingestion reads of the robots that declare their signals, and where it came from."""
+
+    sources: dict[str, RobotSources] = field(default_factory=dict)
+    real_topics: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    """A served topic name → the bag's topics its values came from."""
+
+    def adapt(self, wanted: Mapping[str, Wanted], robots: list[Robot]) -> dict[str, Wanted]:
+        """``wanted`` with the served topics of these robots replaced by their sources, and
+        their navigation goals' topics added (as message objects)."""
+        adapted = dict(wanted)
+        scan_paths: list[FieldPath] = []
+        for robot in robots:
+            if robot.id not in self.sources:
+                continue
+            for signal, pattern in SERVED.items():
+                served = adapted.pop(topic_name(pattern, robot.namespace), None)
+                if served is not None and signal == "scan":
+                    scan_paths += served.paths
+            signals = robot.type.signals
+            if signals.navigation is not Navigation.DISPATCHER:
+                for pattern in (FEEDBACK, RESULT):
+                    adapted.pop(topic_name(pattern, robot.namespace), None)
+            for topic in goal_topics(signals, robot.namespace):
+                adapted[topic] = Wanted(OBJECTS)
+        for topic, more in signals_wanted(self.sources.values(), scan_paths).items():
+            before = adapted.get(topic)
+            if before is not None and before.msgtype == more.msgtype:
+                more = Wanted(
+                    more.msgtype,
+                    tuple(dict.fromkeys([*before.paths, *more.paths])),
+                    tuple(dict.fromkeys([*before.texts, *more.texts])),
+                    more.rows,
+                )
+            adapted[topic] = more
+        return adapted
+
+    def served_topics(self, data: BagData) -> dict[str, Topic]:
+        """The robots' signals under the method's topic names, with the method's fields."""
+        found: dict[str, Topic] = {}
+        for robot in self.sources.values():
+            signals = signal_topics(robot, data)
+            for signal, pattern in SERVED.items():
+                topic = signals.get(signal_topic(signal, robot.namespace))
+                if topic is None:
+                    continue
+                name = topic_name(pattern, robot.namespace)
+                found[name] = _as_method_fields(name, signal, topic)
+                self.real_topics[name] = robot.chosen[signal].topics
+        return found
+
+    def with_real_sources(self, value: MetricValue) -> MetricValue:
+        """``value`` with the topics it came from named as the bag has them."""
+        if not any(t in self.real_topics for t in value.topics):
+            return value
+        named = [real for t in value.topics for real in self.real_topics.get(t, (t,))]
+        return replace(value, topics=tuple(dict.fromkeys(named)))
+
+    def track(self, robot: Robot, topics: Mapping[str, Topic]) -> Track:
+        pose = topics.get(topic_name(SERVED["pose"], robot.namespace))
+        if pose is None or not len(pose):
+            return Track.empty()
+        quarter = np.arctan2(pose.fields["pose.pose.orientation.z"], pose.fields["pose.pose.orientation.w"])
+        return Track(
+            pose.t, pose.fields["pose.pose.position.x"], pose.fields["pose.pose.position.y"], 2 * quarter
+        )
+
+
+def stack_robots(robots: list[Robot], available: Mapping[str, str]) -> StackRobots:
+    """The robots that declare their signals, with the sources the bag (``available``) has."""
+    return StackRobots({r.id: choose_sources(r, available) for r in robots if r.type.declared_signals})
+
+
+def _as_method_fields(name: str, signal: str, topic: Topic) -> Topic:
+    if signal != "pose":
+        return Topic(name, topic.t, dict(topic.fields))
+    yaw = topic.fields["yaw"]
+    fields = {f"pose.pose.position.{a}": topic.fields[a] for a in ("x", "y", "z")}
+    fields["pose.pose.orientation.x"] = fields["pose.pose.orientation.y"] = np.zeros_like(yaw)
+    fields["pose.pose.orientation.z"], fields["pose.pose.orientation.w"] = np.sin(yaw / 2), np.cos(yaw / 2)
+    return Topic(name, topic.t, fields)
+
+
+@dataclass(frozen=True)
+class RobotSegments:
+    """One robot's segments, what segmented them, and what it could not make sense of."""
+
+    segments: list[Segment]
+    source: str
+    succeeded: int | None
+    topics: tuple[str, ...] = ()
+    """The bag's topics the segments came from."""
+    problems: tuple[str, ...] = ()
+
+
+def segment_robot(
+    scenario: Scenario, robot: Robot, data: BagData, track: Track, dispatcher: list[Segment] | None
+) -> RobotSegments:
+    """The robot's segments from the first source that gives any (see the module's docstring);
+    ``dispatcher``: its segments from the method's dispatcher, if its bag has that."""
+    signals = robot.type.signals
+    if dispatcher is not None and any(s.start is not None for s in dispatcher):
+        return RobotSegments(dispatcher, "the waypoint dispatcher", None)
+    problems: list[str] = []
+    if signals.navigation in (Navigation.NAV2, Navigation.MOVE_BASE):
+        goals, used = read_goals(signals, robot.namespace, data.messages)
+        if goals:
+            found = goal_segments(scenario, robot.id, goals, track, signals.tolerance)
+            problems += [f"robot '{robot.id}': {w}" for w in found.warnings]
+            if any(s.start is not None for s in found.segments):
+                done = _succeeded(found.segments)
+                return RobotSegments(
+                    list(found.segments),
+                    f"{signals.navigation.value} goals",
+                    done,
+                    tuple(used),
+                    tuple(problems),
+                )
+        else:
+            problems.append(f"robot '{robot.id}': no {signals.navigation.value} goals in this bag")
+    if len(track):
+        found = arrival_segments(scenario, robot.id, track, signals.tolerance)
+        problems += [f"robot '{robot.id}': {w}" for w in found.warnings]
+        if any(s.start is not None for s in found.segments):
+            return RobotSegments(
+                list(found.segments),
+                "arrival at the planned waypoints",
+                _succeeded(found.segments),
+                (),
+                tuple(problems),
+            )
+    problems.append(
+        f"robot '{robot.id}': no path segments (no navigation goals, and no pose that reaches its planned "
+        "waypoints): its metrics are of the whole run only"
+    )
+    return RobotSegments([], "", None, (), tuple(problems))
+
+
+def _succeeded(segments: tuple[Segment, ...]) -> int:
+    return sum(s.status == "SUCCEEDED" for s in segments)

@@ -1,0 +1,105 @@
+"""Ingesting runs of Nav2 and move_base robots: the built-in metrics from their own topics, path
+segments from their goals, from arrival, or none.
+
+The reference is the same run (same scenario, same seed: the same trajectories)
+written in the method's convention and ingested as before: the metrics must agree
+within what the conventions' different sensors explain (localisation noise in the
+pose, status arrays recorded once a second besides each change).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from test_signals import YARD
+
+from exsce_dsl.lang.build import load_spec
+from exsce_dsl.model import Scenario
+from exsce_dsl.runs.analyse import AnalysedRun, analyse_bag
+from exsce_dsl.sim.run import simulate
+
+
+def _scenario(tmp_path: Path, robot_type: str, name: str) -> Scenario:
+    path = tmp_path / f"{name}.exsce"
+    path.write_text(YARD.replace("ROBOT_TYPE", "".join(f"  {line}\n" for line in robot_type.splitlines())))
+    return load_spec(path).scenario()
+
+
+def _run(tmp_path: Path, robot_type: str, fmt: str, convention: str) -> AnalysedRun:
+    scenario = _scenario(tmp_path, robot_type, f"{convention}-{fmt}")
+    (run,) = simulate(scenario, tmp_path / f"bags-{convention}-{fmt}", fmt=fmt, seed=5, convention=convention)
+    return analyse_bag(run.bag, scenario)
+
+
+def _values(analysed: AnalysedRun) -> dict[tuple[str, str, str], float]:
+    found = {}
+    for v in analysed.run.metrics:
+        where = str(v.action) if v.action is not None else v.robot or "mission"
+        found[(v.metric, where, v.scope.value)] = v.value
+    return found
+
+
+@pytest.fixture(scope="module")
+def method_run(tmp_path_factory: pytest.TempPathFactory) -> AnalysedRun:
+    return _run(tmp_path_factory.mktemp("method"), "torso no", "ros1", "method")
+
+
+TOLERANCES = {
+    "distance_travelled": (0.15, 0.03),  # m, and relative: localisation noise along the path
+    "max_velocity": (0.0, 0.02),  # cmd_vel is the command the method's nav_vel records too
+    "task_duration": (1.05, 0.0),  # s: goal statuses stamped on change; arrival within the tolerance
+    "mission_duration": (1.05, 0.0),
+    "waypoints_visited": (0.0, 0.0),
+    "distance_to_obstacles": (0.0, 0.01),  # scans of the same places, their noise drawn in another order
+    "distance_between_robots": (0.15, 0.0),  # two localisation noises
+}
+
+
+def _agree(ours: dict[tuple[str, str, str], float], reference: dict[tuple[str, str, str], float]) -> None:
+    compared = 0
+    for key, expected in reference.items():
+        if key[0] not in TOLERANCES:
+            continue
+        absolute, relative = TOLERANCES[key[0]]
+        assert key in ours, f"{key} is missing"
+        assert ours[key] == pytest.approx(expected, abs=absolute + relative * abs(expected)), key
+        compared += 1
+    assert compared >= 15
+
+
+@pytest.mark.parametrize("fmt, convention", [("ros1", "nav2"), ("mcap", "nav2"), ("ros2", "move_base")])
+def test_a_stacks_run_has_the_methods_metrics(
+    tmp_path: Path, method_run: AnalysedRun, fmt: str, convention: str
+) -> None:
+    analysed = _run(tmp_path, f"convention {convention}", fmt, convention)
+    assert not [p for p in analysed.problems if "missing" in p], analysed.problems
+    _agree(_values(analysed), _values(method_run))
+    sources = {v.metric: v.topics for v in analysed.run.metrics if v.robot == "r2"}
+    assert sources["max_velocity"] == ("/r2/cmd_vel",)  # the topics the values came from
+    assert sources["distance_travelled"] == ("/r2/odom",)  # the wheel odometry: no localisation jitter
+    mission = {v.metric: v.topics for v in analysed.run.metrics if v.robot is None and v.action is None}
+    assert mission["distance_between_robots"] == ("/tf", "/tf_static", "/r2/tf", "/r2/tf_static")
+    goals = "/r2/navigate_to_pose/_action/status" if convention == "nav2" else "/r2/move_base/status"
+    assert goals in sources["task_duration"]
+
+
+def test_without_goals_a_run_is_segmented_by_arrival(tmp_path: Path, method_run: AnalysedRun) -> None:
+    analysed = _run(tmp_path, "convention nav2\nnavigation none", "ros1", "nav2")
+    ours, reference = _values(analysed), _values(method_run)
+    segments = [k for k in reference if k[0] == "task_duration" and k[2] == "segment"]
+    assert len(segments) == 3 and all(k in ours for k in segments)
+    for key in segments:  # arrival within 0.35 m comes a little before the goal's success
+        assert 0 <= reference[key] - ours[key] < 3.0 or abs(reference[key] - ours[key]) < 1.5, key
+    assert ours[("waypoints_visited", "r1", "robot")] == 2
+
+
+def test_without_goals_or_a_pose_a_run_has_whole_run_metrics_and_says_why(tmp_path: Path) -> None:
+    robot_type = 'convention nav2\npose on "/{ns}/ground_truth"\nnavigation none'
+    analysed = _run(tmp_path, robot_type, "ros1", "nav2")
+    ours = _values(analysed)
+    assert ("max_velocity", "r2", "robot") in ours
+    assert not any(k[2] == "segment" for k in ours)
+    said = " ".join(analysed.problems)
+    assert "robot 'r2' has no pose in this bag (looked for /r2/ground_truth)" in said
+    assert "robot 'r2': no path segments" in said and "whole run only" in said
