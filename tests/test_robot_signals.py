@@ -153,3 +153,16 @@ def test_the_formatter_prints_what_parses_back_to_the_same_model(tmp_path: Path,
         t.signals for t in spec.robot_types
     ]
     assert format_spec_document(again, source, comments(printed, source)) == printed
+
+
+def test_the_readmes_robot_types_check(tmp_path: Path) -> None:
+    """The robot types "Your robot's bags" shows are valid, with the sources the README says."""
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    section = readme[readme.index("### Your robot's bags") :]
+    block = section.split("```")[1]
+    robot_types = _types(tmp_path, block)
+    husky = robot_types["husky"].signals  # type: ignore[attr-defined]
+    assert husky.navigation is Navigation.MOVE_BASE and husky.tolerance.position == 0.5
+    assert husky.velocity == (TopicSource("/{ns}/husky_velocity_controller/cmd_vel"),)
+    assert robot_types["turtlebot4"].signals.pose == (TfSource("map", "base_footprint"),)  # type: ignore[attr-defined]
+    assert robot_types["custom"].signals.navigation is Navigation.NONE  # type: ignore[attr-defined]
