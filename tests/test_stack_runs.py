@@ -14,9 +14,11 @@ from pathlib import Path
 import pytest
 from test_signals import YARD
 
+from exsce_dsl.errors import ExsceError
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.runs.analyse import AnalysedRun, analyse_bag
+from exsce_dsl.runs.bagdata import bag_topics
 from exsce_dsl.sim.run import simulate
 
 
@@ -103,3 +105,25 @@ def test_without_goals_or_a_pose_a_run_has_whole_run_metrics_and_says_why(tmp_pa
     said = " ".join(analysed.problems)
     assert "robot 'r2' has no pose in this bag (looked for /r2/ground_truth)" in said
     assert "robot 'r2': no path segments" in said and "whole run only" in said
+
+
+def test_the_executor_writes_the_convention_the_robot_types_name(tmp_path: Path) -> None:
+    scenario = _scenario(tmp_path, "convention move_base", "named")
+    (run,) = simulate(scenario, tmp_path / "bags", seed=5)  # no convention given
+    topics = bag_topics(run.bag)
+    assert topics["/r2/move_base/status"] == "actionlib_msgs/msg/GoalStatusArray"
+    assert "/r2/robot_pose" not in topics
+
+
+def test_robots_of_two_conventions_need_one_chosen(tmp_path: Path) -> None:
+    text = (
+        YARD.replace("ROBOT_TYPE", "  convention nav2\n").replace("r2: rover starts", "r2: plain starts")
+        + "\nrobot type plain {\n  torso no\n}\n"
+    )
+    path = tmp_path / "mixed.exsce"
+    path.write_text(text)
+    scenario = load_spec(path).scenario()
+    with pytest.raises(ExsceError, match=r"different conventions \(r1: nav2, r2: method\).*--convention"):
+        list(simulate(scenario, tmp_path / "bags"))
+    (run,) = simulate(scenario, tmp_path / "bags", convention="method")
+    assert "/r2/robot_pose" in bag_topics(run.bag)

@@ -43,9 +43,8 @@ from exsce_dsl.model.conventions import CONVENTIONS
 @click.option(
     "--convention",
     type=click.Choice(list(CONVENTIONS)),
-    default="method",
-    show_default=True,
-    help="Which topics the robots publish: the method's, Nav2's or move_base's.",
+    help="Which topics the robots publish: the method's, Nav2's or move_base's "
+    "[default: the convention the robots' types name, else the method's].",
 )
 @click.option(
     "--cmd-vel-stamped",
@@ -61,7 +60,7 @@ def simulate(
     seed: int,
     faults: tuple[str, ...],
     scenario_id: str | None,
-    convention: str,
+    convention: str | None,
     cmd_vel_stamped: bool,
 ) -> None:
     """Play a scenario with the kinematic executor and write one bag per run.

@@ -49,17 +49,19 @@ def simulate(
     fmt: str = "ros1",
     seed: int = 0,
     faults: Sequence[Fault] = (),
-    convention: Signals | str = "method",
+    convention: Signals | str | None = None,
     twist_stamped: bool = False,
 ) -> Iterator[SimulatedRun]:
     """Play ``scenario`` ``runs`` times and write one bag per run into ``out_dir``.
 
     ``convention`` (a name or a robot type's :class:`Signals`) says which topics the robots
-    publish: the method's (the default), Nav2's or move_base's; ``twist_stamped`` makes the
+    publish: the method's, Nav2's or move_base's; None: the one the robots' types name (the
+    method's if they name none); ``twist_stamped`` makes the
     navigation stacks' ``cmd_vel`` a TwistStamped (Nav2 from Jazzy on).  Runs in another
     convention than the method's get other run ids, so their bags can share a folder."""
     if fmt not in FORMATS:
         raise ExsceError(f"unknown bag format '{fmt}'; use one of {', '.join(FORMATS)}")
+    convention = convention or scenario_convention(scenario)
     written = convention_writer(convention).name
     variant = "" if written == "method" else f"/{written}" + ("/stamped" if twist_stamped else "")
     grid = planning_grid(scenario)
@@ -113,6 +115,19 @@ def _recorded_run(
         )
     tasks = tuple(TaskExecution(robot, n, tuple(acts)) for (robot, n), acts in grouped.items())
     return Run(run_id, scenario.id, start, at(execution.duration), Bag(bag.name), tasks)
+
+
+def scenario_convention(scenario: Scenario) -> str:
+    """The convention the robots' types name (the method's when they name none): one per run."""
+    named = {r.id: r.type.signals.convention for r in scenario.robots}
+    found = sorted(set(named.values()))
+    if len(found) > 1:
+        listed = ", ".join(f"{robot}: {name}" for robot, name in named.items())
+        raise ExsceError(
+            f"the robots of scenario '{scenario.id}' follow different conventions ({listed}); the "
+            "executor writes one for the whole run: choose it with --convention"
+        )
+    return found[0] if found else "method"
 
 
 def planning_grid(scenario: Scenario) -> PlanningGrid:
