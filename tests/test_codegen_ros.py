@@ -433,3 +433,17 @@ def test_a_robot_at_the_root_reduces_its_topics_without_an_empty_level(
     runtime.on_message("/waypoint_dispatcher/feedback", 10.0, _feedback("g1", [("w1", 3)]))
     assert runtime.buffers["/scan"].reduce is not None  # reduced as it arrives, like /tiago1/scan
     assert runtime.evaluate(20.0).robots["tiago1"]["distance_to_obstacles"] == 1.25
+
+
+def test_a_window_closing_is_published_at_once(packages: dict[int, SimpleNamespace]) -> None:
+    """When the clock stops less than a period after a robot's last goal ended (a replay's end),
+    the last verdict message must already say so."""
+    package = packages[2]
+    topics = {t: s for t, s in package.config.TOPICS.items() if t.startswith("/tiago1/")}
+    runtime = package.monitor_runtime.MonitorRuntime(package.monitors, [("tiago1", "tiago1")], topics, [])
+    runtime.on_message("/tiago1/waypoint_dispatcher/feedback", 0.0, _feedback("g1", [("w1", 1)]))
+    assert runtime.tick(1.0, period=10.0) is not None
+    assert runtime.tick(2.0, period=10.0) is None  # nothing changed
+    runtime.on_message("/tiago1/waypoint_dispatcher/feedback", 3.0, _feedback("g1", [("w1", 3)]))
+    message = runtime.tick(3.5, period=10.0)
+    assert message is not None and json.loads(message)["verdicts"] == []  # no verdict changed: the window

@@ -409,7 +409,7 @@ class MonitorRuntime:
         self.succeeded: dict[str, int] = {}
         self.problems: dict[str, None] = {}  # insertion-ordered set
         self._lock = threading.Lock()
-        self._published: tuple[float, tuple[str, ...]] | None = None
+        self._published: tuple[float, Any] | None = None
 
     def on_message(self, topic: str, t: float, msg: Any) -> None:
         """Take one message received at ``t`` (seconds); a message that lacks a field is dropped
@@ -484,10 +484,12 @@ class MonitorRuntime:
         return values
 
     def tick(self, now: float, period: float = 1.0) -> str | None:
-        """The JSON text to publish at ``now``: when a verdict changed, or ``period`` seconds after
-        the last one; None otherwise."""
+        """The JSON text to publish at ``now``: when a verdict changed or a robot's window closed
+        (a run's end may come less than a period before the clock stops), or ``period`` seconds
+        after the last one; None otherwise."""
         evaluation = self.evaluate(now)
-        outcome = evaluation.outcome()
+        closed = sorted(r for r, w in evaluation.windows.items() if w is not None and w[1] < now)
+        outcome = (evaluation.outcome(), tuple(closed))  # an open window ends at now: not a change
         last = self._published
         if last is not None and last[1] == outcome and now - last[0] < period and now >= last[0]:
             return None
