@@ -127,3 +127,13 @@ def test_robots_of_two_conventions_need_one_chosen(tmp_path: Path) -> None:
         list(simulate(scenario, tmp_path / "bags"))
     (run,) = simulate(scenario, tmp_path / "bags", convention="method")
     assert "/r2/robot_pose" in bag_topics(run.bag)
+
+
+def test_a_tf_chain_the_bag_cannot_compose_is_said_with_the_frames_it_has(tmp_path: Path) -> None:
+    analysed = _run(tmp_path, "convention nav2\npose from tf map -> base_footprint_typo", "ros1", "nav2")
+    said = "\n".join(analysed.problems)
+    assert "robot 'r2': no pose from TF on /r2/tf: no frame 'base_footprint_typo'" in said, said
+    assert "did you mean 'base_footprint'" in said
+    values = _values(analysed)
+    assert ("max_velocity", "r2", "robot") in values  # what does not need the pose is there
+    assert ("distance_between_robots", "mission", "mission") not in values

@@ -132,7 +132,7 @@ def analyse_bag(path: Path, scenario: Scenario, digest: str | None = None) -> An
     for sources in stacks.sources.values():
         problems += sources.notes
     topics = {name: Topic(name, s.t, s.fields) for name, s in data.series.items()}
-    topics.update(stacks.served_topics(data))
+    topics.update(stacks.served_topics(data, problems))
     actions: list[Segment] = []
     results: dict[str, int | None] = {}
     whole_runs: dict[str, tuple[float, float]] = {}

@@ -203,13 +203,21 @@ def _velocity_paths(msgtype: str) -> list[FieldPath]:
     return [path_of(*prefix, *key.split(".")) for key in _VELOCITY_KEYS]
 
 
-def signal_topics(robot: RobotSources, data: BagData) -> dict[str, Topic]:
-    """The robot's signals as topics (:func:`signal_topic` names), from what the bag gave."""
+def signal_topics(robot: RobotSources, data: BagData, problems: list[str] | None = None) -> dict[str, Topic]:
+    """The robot's signals as topics (:func:`signal_topic` names), from what the bag gave; a TF
+    chain the bag's transforms cannot compose leaves the pose out, and ``problems`` says why."""
     found: dict[str, Topic] = {}
     for signal, chosen in robot.chosen.items():
         name = signal_topic(signal, robot.namespace)
         if chosen.tf is not None:
-            found[name] = _tf_pose(name, chosen, data)
+            try:
+                found[name] = _tf_pose(name, chosen, data)
+            except TfError as exc:
+                if problems is None:
+                    raise
+                problems.append(
+                    f"robot '{robot.robot}': no {signal} from TF on {chosen.topics[0]}: {exc.message}"
+                )
             continue
         series = data.series.get(chosen.topic)
         if series is None:

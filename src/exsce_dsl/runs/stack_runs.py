@@ -84,11 +84,11 @@ class StackRobots:
             adapted[topic] = more
         return adapted
 
-    def served_topics(self, data: BagData) -> dict[str, Topic]:
+    def served_topics(self, data: BagData, problems: list[str]) -> dict[str, Topic]:
         """The robots' signals under the method's topic names, with the method's fields."""
         found: dict[str, Topic] = {}
         for robot in self.sources.values():
-            signals = signal_topics(robot, data)
+            signals = signal_topics(robot, data, problems)
             for signal, pattern in SERVED.items():
                 topic = signals.get(signal_topic(signal, robot.namespace))
                 if topic is None:
