@@ -1,6 +1,8 @@
 """The method end to end on the executor's runs: clean runs build a baseline, further clean
 runs pass every oracle, and each injected fault fails exactly the oracles it should.
 
+The same table holds when the robots are Nav2's (their runs in Nav2's topics and types).
+
 Two robots in a 10 m yard whose paths never meet: r1 goes a → b → e, r2 goes d → c.  The
 whole verdict table is asserted; what each fault should fail, and why:
 
@@ -21,6 +23,7 @@ from pathlib import Path
 import pytest
 
 from exsce_dsl.lang.build import load_spec
+from exsce_dsl.runs.bagdata import bag_topics
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
 
@@ -135,7 +138,39 @@ def test_baseline_refuses_too_few_runs_then_builds_from_enough(
 def test_clean_runs_pass_and_each_fault_fails_exactly_its_oracles(
     yard: tuple[Path, list[Path], dict[str, Path]],
 ) -> None:
-    folder, clean, faulty = yard
+    _fault_table_holds(*yard)
+
+
+@pytest.fixture(scope="module")
+def nav2_yard(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[Path], dict[str, Path]]:
+    """The yard with Nav2 robots: their runs written in Nav2's topics, four of them ingested as
+    the baseline (the others are judged)."""
+    folder = tmp_path_factory.mktemp("nav2-yard")
+    write_map(folder, size=200)
+    (folder / "spec.exsce").write_text(SPEC.replace("  torso yes\n", "  torso yes\n  convention nav2\n"))
+    scenario = load_spec(folder / "spec.exsce").scenario()
+    assert {r.type.signals.convention for r in scenario.robots} == {"nav2"}
+    clean = [run.bag for run in simulate(scenario, folder / "runs", 6, seed=1)]
+    faulty = {
+        fault: next(iter(simulate(scenario, folder / "faults", 1, seed=2, faults=(Fault.parse(fault),)))).bag
+        for fault in FAULTS
+    }
+    baseline = run_exscec("ingest", *map(str, clean[:4]), "--scenario", "spec.exsce", cwd=folder)
+    assert baseline.returncode == 0, baseline.stderr
+    built = run_exscec("baseline", "spec.exsce", cwd=folder)
+    assert built.returncode == 0, built.stderr
+    return folder, clean, faulty
+
+
+def test_the_fault_table_holds_for_nav2_runs(nav2_yard: tuple[Path, list[Path], dict[str, Path]]) -> None:
+    """The same verdicts when the robots are Nav2's: TF poses, cmd_vel, odometry, goals."""
+    folder, clean, _ = nav2_yard
+    assert "/r1/navigate_to_pose/_action/status" in bag_topics(clean[4])
+    assert "/r1/robot_pose" not in bag_topics(clean[4])
+    _fault_table_holds(*nav2_yard)
+
+
+def _fault_table_holds(folder: Path, clean: list[Path], faulty: dict[str, Path]) -> None:
     bags = {"clean": clean[4:], **{fault: [bag] for fault, bag in faulty.items()}}
     given = [str(bag) for group in bags.values() for bag in group]
     judged = run_exscec(
