@@ -17,6 +17,8 @@ from test_signals import YARD
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.model import Scenario
+from exsce_dsl.prov.run import compile_run
+from exsce_dsl.prov.serialize import serialize_prov
 from exsce_dsl.runs.analyse import AnalysedRun, analyse_bag
 from exsce_dsl.runs.bagdata import bag_topics
 from exsce_dsl.sim.run import simulate
@@ -137,3 +139,13 @@ def test_a_tf_chain_the_bag_cannot_compose_is_said_with_the_frames_it_has(tmp_pa
     values = _values(analysed)
     assert ("max_velocity", "r2", "robot") in values  # what does not need the pose is there
     assert ("distance_between_robots", "mission", "mission") not in values
+
+
+def test_the_runs_prov_says_what_segmented_it(tmp_path: Path) -> None:
+    analysed = _run(tmp_path, "convention nav2", "mcap", "nav2")
+    assert {t.segmented_by for t in analysed.run.tasks} == {"nav2 goals"}
+    scenario = _scenario(tmp_path, "convention nav2", "prov")
+    provn = serialize_prov(compile_run(analysed.run, scenario), "provn")
+    assert provn.count('exsce:segmented_by="nav2 goals"') == len(analysed.run.tasks) == 2
+    arrival = _run(tmp_path, "convention nav2\nnavigation none", "ros1", "nav2")
+    assert {t.segmented_by for t in arrival.run.tasks} == {"arrival at the planned waypoints"}

@@ -81,6 +81,8 @@ class TaskExecution:
     robot: str
     allocation: int
     actions: tuple[Action, ...]
+    segmented_by: str | None = None
+    """What its actions were found from, when not the method's dispatcher (see ``runs.stack_runs``)."""
 
     def __post_init__(self) -> None:
         for action in self.actions:

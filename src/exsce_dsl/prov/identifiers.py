@@ -287,6 +287,9 @@ ROS_TOPICS = Term(ROS, "Topics")
 FILE_PATH = Term(EXSCE, "file_path")
 ROBOT_ATTR = Term(EXSCE, "robot")
 STATUS = Term(EXSCE, "status")
+SEGMENTED_BY = Term(EXSCE, "segmented_by")
+"""On a task execution: what its actions (path segments) were found from, when not the method's
+dispatcher (a navigation stack's goals, arrival at the planned waypoints)."""
 UNIT = Term(EXSCE, "unit")
 METRIC_ATTR = Term(EXSCE, "metric")
 """On a ``violation_duration`` value: the safety metric whose limit was violated."""

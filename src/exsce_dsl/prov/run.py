@@ -178,7 +178,10 @@ class _RunCompiler:
                 agent = agents[robot] = robot_parts[ids.ROBOT_AGENT]
             task_id = parts[ids.task_execution_name(robot, task.allocation)]
             writer.claim(task_id, f"task {task.allocation} of robot '{robot}'")
-            w.activity(task_id, task_type)
+            w.activity(
+                task_id,
+                {**task_type, t(ids.SEGMENTED_BY): task.segmented_by} if task.segmented_by else task_type,
+            )
             w.used(task_id, robot_ns[robot])
             w.associated(task_id, agent, mission_ns[ids.allocation_name(robot, task.allocation)])
             w.informed(run_id, task_id)
@@ -274,7 +277,8 @@ class _RunCompiler:
                 known = collections[key] = (topics, collection)
             elif known is not None and set(known[0]) != set(topics):
                 raise ExsceError(
-                    f"the values of '{metric}'" + (f" of robot '{robot}'" if robot else "")
+                    f"the values of '{metric}'"
+                    + (f" of robot '{robot}'" if robot else "")
                     + f" in run {run.uuid} come from different topics: "
                     f"{', '.join(known[0])} and {', '.join(topics) or 'none'}"
                 )

@@ -24,7 +24,7 @@ from exsce_dsl.runs.monitor_code import load_monitors
 from exsce_dsl.runs.monitor_core import Compute, Topic, reducer, topic_name
 from exsce_dsl.runs.monitoring import HOTSPOT_PATHS, POSE_TOPIC, compute_metrics
 from exsce_dsl.runs.segments import SUCCEEDED, Segment, segments
-from exsce_dsl.runs.stack_runs import SERVED, segment_robot, stack_robots
+from exsce_dsl.runs.stack_runs import DISPATCHER_SOURCE, SERVED, segment_robot, stack_robots
 
 _RUN_NAMESPACE = uuid.UUID("5b8f9a52-3f0c-4a8e-8f0e-2d6c1b7e4a90")
 _FEEDBACK = "/{ns}/waypoint_dispatcher/feedback"
@@ -136,6 +136,7 @@ def analyse_bag(path: Path, scenario: Scenario, digest: str | None = None) -> An
     actions: list[Segment] = []
     results: dict[str, int | None] = {}
     whole_runs: dict[str, tuple[float, float]] = {}
+    segmented_by: dict[str, str] = {}
     for robot in robots:
         ns = robot.namespace.strip("/")
         feedback, result = topic_name(_FEEDBACK, ns), topic_name(_RESULT, ns)
@@ -155,6 +156,8 @@ def analyse_bag(path: Path, scenario: Scenario, digest: str | None = None) -> An
         found = segment_robot(scenario, robot, data, stacks.track(robot, topics), dispatched)
         problems += found.problems
         actions.extend(found.segments)
+        if found.source and found.source != DISPATCHER_SOURCE:
+            segmented_by[robot.id] = found.source
         if found.succeeded is None and dispatched is not None:
             final = data.results.get(result)
             results[robot.id] = (
@@ -179,7 +182,7 @@ def analyse_bag(path: Path, scenario: Scenario, digest: str | None = None) -> An
         start=_time(data.start),
         end=_time(data.end),
         bag=Bag(path.name, data.topics, str(path.resolve())),
-        tasks=_task_executions(actions),
+        tasks=_task_executions(actions, segmented_by),
         metrics=tuple(values),
         hotspots=tuple(hotspots),
     )
@@ -190,7 +193,7 @@ def _time(seconds: float) -> dt.datetime:
     return dt.datetime.fromtimestamp(seconds, tz=dt.timezone.utc)
 
 
-def _task_executions(actions: list[Segment]) -> tuple[TaskExecution, ...]:
+def _task_executions(actions: list[Segment], segmented_by: dict[str, str]) -> tuple[TaskExecution, ...]:
     started = [
         a
         for a in actions
@@ -209,4 +212,6 @@ def _task_executions(actions: list[Segment]) -> tuple[TaskExecution, ...]:
                 _time(a.end),  # type: ignore[arg-type]
             )
         )
-    return tuple(TaskExecution(robot, n, tuple(acts)) for (robot, n), acts in grouped.items())
+    return tuple(
+        TaskExecution(robot, n, tuple(acts), segmented_by.get(robot)) for (robot, n), acts in grouped.items()
+    )

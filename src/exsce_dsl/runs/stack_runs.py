@@ -35,6 +35,7 @@ from exsce_dsl.runs.segmentation import Track
 from exsce_dsl.runs.segments import Segment
 from exsce_dsl.runs.signals import RobotSources, choose_sources, signal_topic, signal_topics, signals_wanted
 
+DISPATCHER_SOURCE = "the waypoint dispatcher"
 FEEDBACK = "/{ns}/waypoint_dispatcher/feedback"
 RESULT = "/{ns}/waypoint_dispatcher/result"
 SERVED = {
@@ -149,7 +150,7 @@ def segment_robot(
     ``dispatcher``: its segments from the method's dispatcher, if its bag has that."""
     signals = robot.type.signals
     if dispatcher is not None and any(s.start is not None for s in dispatcher):
-        return RobotSegments(dispatcher, "the waypoint dispatcher", None)
+        return RobotSegments(dispatcher, DISPATCHER_SOURCE, None)
     problems: list[str] = []
     if signals.navigation in (Navigation.NAV2, Navigation.MOVE_BASE):
         goals, used = read_goals(signals, robot.namespace, data.messages)
