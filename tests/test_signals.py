@@ -22,6 +22,7 @@ from exsce_dsl.lang.build import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.runs.bagdata import bag_topics, read_bag
 from exsce_dsl.runs.signals import RobotSources, choose_sources, signal_topic, signal_topics, signals_wanted
+from exsce_dsl.runs.trajectories import trajectories
 from exsce_dsl.sim.run import simulate
 
 YARD = """
@@ -205,3 +206,16 @@ def test_a_signal_the_bag_lacks_is_said_and_not_made_up(tmp_path: Path) -> None:
         "robot 'r2' has no scan in this bag (looked for /r2/front_scan)",
     )
     assert signal_topic("pose", "r2") not in topics and signal_topic("pose", "") not in topics
+
+
+def test_the_reports_paths_are_in_the_map_frame_whatever_the_convention(tmp_path: Path) -> None:
+    """A Nav2 bag's paths come from TF map -> base_link, not from the drifting odometry; the
+    method's from robot_pose; both are the same drive (same seed) within localisation noise."""
+    nav2 = trajectories(_bag(tmp_path / "nav2", _scenario(tmp_path, "convention nav2"), "ros1", "nav2"))
+    method = trajectories(_bag(tmp_path / "method", _scenario(tmp_path, "torso no"), "ros1", "method"))
+    assert [p.topic for p in nav2] == ["/tf (map → base_link)", "/r2/tf (map → base_link)"]
+    assert [p.topic for p in method] == ["/robot_pose", "/r2/robot_pose"]
+    for ours, theirs in zip(nav2, method, strict=True):
+        assert np.linalg.norm(ours.xy[-1] - theirs.xy[-1]) < 0.15  # both end where the robot stopped
+        ends = np.linalg.norm(ours.xy[-1] - ours.xy[0])
+        assert ends > 3.0  # and it drove

@@ -1,4 +1,11 @@
-"""The paths robots drove in a run, read from the pose topics of its bag (for plots)."""
+"""The paths robots drove in a run, in the map frame, read from their bag (for plots).
+
+The report does not know the robots' types, so each robot's pose is taken from
+the bag's own evidence, in the order the conventions prefer it: TF ``map →
+base_link`` on the namespace's ``tf``, the method's ``robot_pose``, AMCL's
+``amcl_pose``, any other pose topic, and last the odometry (which drifts away
+from the map).  A robot is a namespace with any of these.
+"""
 
 from __future__ import annotations
 
@@ -6,63 +13,77 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from rosbags.highlevel import AnyReader
 
-from exsce_dsl.model.messages import FieldPath, path_of
-from exsce_dsl.runs import ros1_index
-from exsce_dsl.runs.bagdata import BagError, Wanted, read_bag, typestore_for
+from exsce_dsl.model.conventions import POSE_TYPES, TfSource
+from exsce_dsl.runs.bagdata import bag_topics, read_bag
+from exsce_dsl.runs.signals import (
+    TF_MESSAGE,
+    Chosen,
+    RobotSources,
+    signal_topic,
+    signal_topics,
+    signals_wanted,
+)
 
-POSITION_FIELDS = {
-    "geometry_msgs/msg/PoseWithCovarianceStamped": ("pose", "pose", "position"),
-    "geometry_msgs/msg/PoseStamped": ("pose", "position"),
-    "nav_msgs/msg/Odometry": ("pose", "pose", "position"),
-}
-"""Message types that say where a robot is, and the path of the position in each."""
-
-
-def _xy(msgtype: str) -> tuple[FieldPath, FieldPath]:
-    prefix = POSITION_FIELDS[msgtype]
-    return path_of(*prefix, "x"), path_of(*prefix, "y")
+_PREFERRED = ("robot_pose", "amcl_pose")
+_LAST = ("odom",)
 
 
 @dataclass(frozen=True)
 class Trajectory:
     topic: str
+    """Where the path was read: a pose topic, or ``/ns/tf (map → base_link)``."""
     t: np.ndarray
     """Seconds since the start of the bag."""
     xy: np.ndarray
     """Positions, shape (n, 2), in the map frame."""
 
 
-def pose_topics(path: Path) -> dict[str, str]:
-    """Topic → message type of the bag's topics that carry a robot's pose."""
-    if not path.exists():
-        raise BagError(f"{path}: no such bag")
-    if path.is_file() and path.suffix == ".bag":
-        try:  # a ROS 1 bag's own index: ten times faster than opening it with rosbags
-            return {t: m for t, m in ros1_index.connections(path).items() if m in POSITION_FIELDS}
-        except ros1_index.UnsupportedBag:
-            pass  # rosbags reads what the index reader does not, and reports what is broken
-    try:
-        with AnyReader([path], default_typestore=typestore_for(path)) as reader:
-            return {c.topic: c.msgtype for c in reader.connections if c.msgtype in POSITION_FIELDS}
-    except Exception as exc:  # rosbags' readers raise their own errors for corrupt files
-        raise BagError(f"{path}: cannot read the bag: {type(exc).__name__}: {exc}") from None
+def pose_sources(available: dict[str, str]) -> list[RobotSources]:
+    """Per namespace of the bag (topic → type) that says where a robot is, its preferred source."""
+    spaces: dict[str, list[str]] = {}
+    for topic, msgtype in sorted(available.items()):
+        if msgtype in POSE_TYPES or (msgtype == TF_MESSAGE and topic.endswith("/tf")):
+            spaces.setdefault(topic.rsplit("/", 1)[0], []).append(topic)
+    found = []
+    for ns, topics in sorted(spaces.items()):
+        names = {t.rsplit("/", 1)[1]: t for t in topics}
+        order = [*_PREFERRED, *sorted(set(names) - {*_PREFERRED, *_LAST, "tf"}), *_LAST]
+        chosen = [
+            Chosen("pose", names[n], available[names[n]])
+            for n in order
+            if n in names and available[names[n]] in POSE_TYPES
+        ]
+        tf = TfSource(tf=f"{ns}/tf", tf_static=f"{ns}/tf_static")
+        if "tf" in names:
+            static = (f"{ns}/tf_static",) if available.get(f"{ns}/tf_static") == TF_MESSAGE else ()
+            chosen.insert(0, Chosen("pose", tf=tf, tf_topics=(f"{ns}/tf", *static)))
+        if chosen:
+            found.append(RobotSources(ns or "/", ns.strip("/"), {"pose": chosen[0]}, ()))
+            found += [RobotSources(ns or "/", ns.strip("/"), {"pose": c}, ()) for c in chosen[1:2]]
+    return found
 
 
 def trajectories(path: Path, max_points: int = 2000) -> list[Trajectory]:
-    """Each pose topic's path, thinned to at most ``max_points`` positions (first and last kept)."""
-    wanted = pose_topics(path)
-    if not wanted:
+    """Each robot's path in the map frame, thinned to at most ``max_points`` positions (first and
+    last kept); a robot whose TF has no ``map → base_link`` chain is drawn from its next source."""
+    candidates = pose_sources(bag_topics(path))
+    if not candidates:
         return []
-    data = read_bag(path, {topic: Wanted(msgtype, _xy(msgtype)) for topic, msgtype in wanted.items()})
-    found = []
-    for topic, msgtype in sorted(wanted.items()):
-        series = data.series.get(topic)
-        if series is None or len(series) == 0:
+    data = read_bag(path, signals_wanted(candidates, []))
+    found: list[Trajectory] = []
+    drawn: set[str] = set()
+    for sources in candidates:
+        if sources.robot in drawn:
             continue
-        x, y = _xy(msgtype)
-        xy = np.column_stack([series.fields[x.key], series.fields[y.key]]).astype(float)
+        problems: list[str] = []
+        pose = signal_topics(sources, data, problems).get(signal_topic("pose", sources.namespace))
+        if pose is None or not len(pose):
+            continue
+        drawn.add(sources.robot)
+        chosen = sources.chosen["pose"]
+        label = f"{chosen.topics[0]} (map → base_link)" if chosen.tf is not None else chosen.topic
+        xy = np.column_stack([pose.fields["x"], pose.fields["y"]]).astype(float)
         keep = np.unique(np.linspace(0, len(xy) - 1, min(len(xy), max_points)).round().astype(int))
-        found.append(Trajectory(topic, series.t[keep] - data.start, xy[keep]))
+        found.append(Trajectory(label, pose.t[keep] - data.start, xy[keep]))
     return found
