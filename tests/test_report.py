@@ -33,13 +33,28 @@ def project(tmp_path_factory: pytest.TempPathFactory) -> Path:
     shutil.copytree(EXAMPLES / "brsu_building_c", folder / "c")
     scenario = load_spec(folder / "c" / "scenario_c.exsce").scenario("scenario_c")
     bags = [str(run.bag) for run in simulate(scenario, folder / "base", 3, seed=1)]
-    fast = [str(run.bag) for run in simulate(scenario, folder / "fast", 1, seed=2,
-                                             faults=(Fault.parse("overspeed:tiago1"),))]
+    fast = [
+        str(run.bag)
+        for run in simulate(scenario, folder / "fast", 1, seed=2, faults=(Fault.parse("overspeed:tiago1"),))
+    ]
     steps = [
         ("ingest", *bags, "--scenario", "c/scenario_c.exsce"),
         ("baseline", "c/scenario_c.exsce"),
-        ("derive", "c/scenario_c.exsce", "-t", "remove_robot", "--robot", "tiago2", "--reassign", "tiago1",
-         "--id", "c_one", "-o", "c/c_one.exsce", "--add-to-store"),
+        (
+            "derive",
+            "c/scenario_c.exsce",
+            "-t",
+            "remove_robot",
+            "--robot",
+            "tiago2",
+            "--reassign",
+            "tiago1",
+            "--id",
+            "c_one",
+            "-o",
+            "c/c_one.exsce",
+            "--add-to-store",
+        ),
     ]
     for step in steps:
         done = run_exscec(*step, cwd=folder)
@@ -75,7 +90,9 @@ def test_the_store_gives_lineage_runs_verdicts_hotspots_and_maps(project: Path) 
     assert base.children == ("c_one",) and derived.derivation is not None
     assert derived.derivation.base == "scenario_c"
     assert [s.transformation for s in derived.derivation.steps] == ["remove_robot"]
-    assert derived.grid is not None and derived.grid is base.grid  # a derived scenario is drawn on its base's map
+    assert (
+        derived.grid is not None and derived.grid is base.grid
+    )  # a derived scenario is drawn on its base's map
     assert len(base.runs) == 4 and derived.runs == ()
     failed = [r for r in base.runs if r.status == "failed"]
     assert len(failed) == 1 and [r.status for r in base.runs].count("not verified") == 3
@@ -104,27 +121,40 @@ def test_every_page_is_written_and_every_link_and_image_is_there(project: Path) 
             if local:
                 assert (project / "out" / local).is_file(), f"{page.name}: {target} is missing"
     index = (project / "out" / "index.html").read_text(encoding="utf-8")
-    table = index[index.index('id="verdicts"'):]
-    assert 0 <= table.index('badge failed') < table.index('badge passed')  # failures first
+    table = index[index.index('id="verdicts"') :]
+    assert 0 <= table.index("badge failed") < table.index("badge passed")  # failures first
 
 
 def test_the_report_opens_in_chromium_with_every_image_and_no_console_error(project: Path) -> None:
     from playwright.sync_api import sync_playwright
 
-    chromium = os.environ.get("EXSCE_CHROMIUM") or shutil.which("chromium") or shutil.which("chromium-browser")
+    chromium = (
+        os.environ.get("EXSCE_CHROMIUM") or shutil.which("chromium") or shutil.which("chromium-browser")
+    )
     assert chromium, "Debian's chromium is needed (sh scripts/install-test-browser)"
     ARTIFACTS.mkdir(parents=True, exist_ok=True)
     problems: list[str] = []
     with sync_playwright() as playwright:
         browser = playwright.chromium.launch(
             executable_path=chromium,
-            args=["--no-sandbox", "--disable-gpu", "--disable-background-networking", "--disable-component-update",
-                  "--disable-sync", "--no-first-run", "--disable-quic"],
+            args=[
+                "--no-sandbox",
+                "--disable-gpu",
+                "--disable-background-networking",
+                "--disable-component-update",
+                "--disable-sync",
+                "--no-first-run",
+                "--disable-quic",
+            ],
         )
         try:
             page = browser.new_page(viewport={"width": 1280, "height": 900})
-            page.on("console", lambda m: problems.append(f"console {m.type}: {m.text}")
-                    if m.type in ("error", "warning") else None)
+            page.on(
+                "console",
+                lambda m: (
+                    problems.append(f"console {m.type}: {m.text}") if m.type in ("error", "warning") else None
+                ),
+            )
             page.on("pageerror", lambda e: problems.append(f"page error: {e}"))
             page.on("requestfailed", lambda r: problems.append(f"failed to load {r.url}"))
             for html in _pages(project):
@@ -162,8 +192,19 @@ def test_run_pages_show_the_hotspots_and_say_what_is_missing_without_a_map(proje
 def test_text_from_the_store_is_escaped(tmp_path: Path) -> None:
     nasty = '<script>alert("x")</script>'
     run = StoredRun("0fcc1782-0c63-5500-b8af-3de8573bc05f", "s", None, None, "a.bag", None)
-    verdict = Verdict(run.uuid, "s", nasty, "o", "max_velocity", "r1", "below_max", Outcome.FAILED,
-                      observed=2.0, limit=1.0, reason=nasty)
+    verdict = Verdict(
+        run.uuid,
+        "s",
+        nasty,
+        "o",
+        "max_velocity",
+        "r1",
+        "below_max",
+        Outcome.FAILED,
+        observed=2.0,
+        limit=1.0,
+        reason=nasty,
+    )
     spot = Hotspot("max_velocity", Position(1.0, 2.0), 3, 1.5, "r1")
     scenario = ScenarioContents("s", None, (), (RunContents(run, (verdict,), (spot,)),), (), (), {})
     write_report(ReportContents((scenario,), (verdict,), None), tmp_path)
@@ -183,7 +224,9 @@ def test_page_names_keep_safe_ids_and_digest_the_others() -> None:
 
 
 def test_cluster_draws_the_dendrogram_as_png_and_svg(project: Path) -> None:
-    done = run_exscec("cluster", "--k", "2", "--dendrogram", "tree.png", "--dendrogram", "tree.svg", cwd=project)
+    done = run_exscec(
+        "cluster", "--k", "2", "--dendrogram", "tree.png", "--dendrogram", "tree.svg", cwd=project
+    )
     assert done.returncode == 0, done.stderr
     assert (project / "tree.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     svg = (project / "tree.svg").read_text(encoding="utf-8")
@@ -192,3 +235,17 @@ def test_cluster_draws_the_dendrogram_as_png_and_svg(project: Path) -> None:
     assert again.returncode == 0 and (project / "tree.svg").read_text(encoding="utf-8") == svg  # reproducible
     bad = run_exscec("cluster", "--dendrogram", "tree.pdf", cwd=project)
     assert bad.returncode == 2 and ".png or .svg" in bad.stderr
+
+
+def test_every_metric_value_on_a_run_page_has_its_unit(project: Path) -> None:
+    done = run_exscec("report", "-o", "units", cwd=project)
+    assert done.returncode == 0, done.stderr
+    page = next((project / "units").glob("run-*.html")).read_text(encoding="utf-8")
+    table = page[page.index("<h2>Metric values</h2>") :]
+    rows = re.findall(
+        r"<tr><td>(\w+)[^<]*</td><td>\w+</td><td class=\"num\">[^<]+</td><td>([^<]+)</td></tr>", table
+    )
+    units = dict(rows)
+    assert units["distance_travelled"] == "m" and units["max_velocity"] == "m/s"
+    assert units["task_duration"] == "s" and units["waypoints_visited"] == "(count)"
+    assert len(rows) == table.count("<tr><td>")  # every row has one

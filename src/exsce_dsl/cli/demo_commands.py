@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import glob
 import os
+import re
 import shlex
 import shutil
 import sys
@@ -75,6 +76,15 @@ STEPS: tuple[Step, ...] = (
 )
 
 
+_ROBOT_TYPE = re.compile(r"^(robot type \S+ \{\n(?:(?!\}).*\n)*?)\}", re.MULTILINE)
+
+
+def with_convention(text: str, convention: str) -> str:
+    """``text`` with every robot type naming ``convention`` (as its last line, where the
+    formatter puts it)."""
+    return _ROBOT_TYPE.sub(lambda m: f"{m.group(1)}  convention {convention}\n}}", text)
+
+
 def example_folder() -> Path:
     from exsce_dsl.resources import resource_dir
 
@@ -129,8 +139,16 @@ def _run(argv: Sequence[str]) -> int:
 @click.option(
     "--setup-only", is_flag=True, help="Only copy the example into FOLDER/scenarios (for the tutorial)."
 )
+@click.option(
+    "--convention",
+    type=click.Choice(["method", "nav2", "move_base"]),
+    default="method",
+    show_default=True,
+    help="Whose topics the robots publish: the example's robot types are given this convention, so "
+    "every step runs on Nav2's (or move_base's) topics and types.",
+)
 @reports_errors
-def demo(folder: str, store_url: str | None, setup_only: bool) -> None:
+def demo(folder: str, store_url: str | None, setup_only: bool, convention: str) -> None:
     """Run the whole method on the shipped example, in a new FOLDER.
 
     Copies the example (building C of the method, scenario_c with two TIAGo
@@ -145,6 +163,7 @@ def demo(folder: str, store_url: str | None, setup_only: bool) -> None:
     \b
     Example:
       exscec demo exsce-demo && xdg-open exsce-demo/report/index.html
+      exscec demo exsce-nav2 --convention nav2
     """
     from exsce_dsl.errors import ExsceError
 
@@ -153,10 +172,14 @@ def demo(folder: str, store_url: str | None, setup_only: bool) -> None:
         raise ExsceError(f"{folder} is not empty: the demo starts from an empty folder (give another one)")
     target.mkdir(parents=True, exist_ok=True)
     shutil.copytree(example_folder(), target / SCENARIOS)
+    if convention != "method":
+        for spec in sorted((target / SCENARIOS).rglob("*.exsce")):
+            spec.write_text(with_convention(spec.read_text(encoding="utf-8"), convention), encoding="utf-8")
     if setup_only:
         click.echo(f"copied the example scenarios into {target / SCENARIOS}", err=True)
         return
-    click.secho(f"exsce demo in {target.resolve()}", bold=True, err=True)
+    shown = "" if convention == "method" else f" (robots on {convention}'s topics)"
+    click.secho(f"exsce demo in {target.resolve()}{shown}", bold=True, err=True)
     outcomes: list[tuple[Step, int]] = []
     started = time.monotonic()
     with _inside(target, store_url):

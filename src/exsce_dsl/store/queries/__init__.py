@@ -498,8 +498,10 @@ def derivation_of(store: Store, scenario: str, namespace: str = DEFAULT_NAMESPAC
     if not bases:
         return None
     if len(bases) > 1:
-        raise ExsceError(f"the store says scenario '{scenario}' was derived from {len(bases)} scenarios: "
-                         f"{', '.join(sorted(bases))}")
+        raise ExsceError(
+            f"the store says scenario '{scenario}' was derived from {len(bases)} scenarios: "
+            f"{', '.join(sorted(bases))}"
+        )
     return Derivation(
         scenario,
         bases.pop(),
@@ -541,6 +543,8 @@ class MetricReading:
     goal: str | None = None
     safety: str | None = None
     """For a ``violation_duration``: the safety metric whose limit was violated."""
+    unit: str | None = None
+    """The value's unit (None for a count)."""
 
 
 def run_metric_values(
@@ -553,7 +557,10 @@ def run_metric_values(
     for row in run_query(store, "run_metric_values", {"run": list(runs)}, namespace):
         run, metric, value = _text(row["run"]), _text(row["metric"]), _float(row["value"])
         if run is not None and metric is not None and value is not None:
-            found.append(MetricReading(run, metric, _text(row["robot"]), value, safety=_text(row["safety"])))
+            reading = MetricReading(
+                run, metric, _text(row["robot"]), value, safety=_text(row["safety"]), unit=_text(row["unit"])
+            )
+            found.append(reading)
     return found
 
 
