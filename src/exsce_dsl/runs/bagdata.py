@@ -12,6 +12,7 @@ messages are deserialized by rosbags.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -34,7 +35,7 @@ from exsce_dsl.messages.user import configured_user_catalogue
 from exsce_dsl.model.messages import FieldPath, Fields, canonical_type
 from exsce_dsl.runs.decode import TEXTS, DecodeError, RawMessages, decode, decode_slowly, vectorisable
 from exsce_dsl.runs.mcap_index import CorruptBag
-from exsce_dsl.runs.ros1_index import UnsupportedBag, read_topics
+from exsce_dsl.runs.ros1_index import UnsupportedBag, connections, read_topics
 
 _PROGRESS = {0: 0, 1: 1}  # PENDING, ACTIVE; every other status is final
 BLOCK = 4096
@@ -163,6 +164,11 @@ def bag_topics(path: Path) -> dict[str, str]:
     from exsce_dsl.runs.bagfiles import check_bag_file  # here: bagfiles imports this module's BagError
 
     check_bag_file(path)
+    if _is_ros1(path):
+        try:  # the bag's own index: rosbags would read every chunk's index first
+            return {topic: canonical_type(msgtype) for topic, msgtype in connections(path).items()}
+        except UnsupportedBag:
+            pass  # rosbags reads what the index reader does not, and says what is broken
     try:
         with AnyReader([path], default_typestore=typestore_for(path)) as reader:
             return {c.topic: canonical_type(c.msgtype) for c in reader.connections}
@@ -343,7 +349,8 @@ class _Ros1(_Reading):
                 continue
             store = deserializer_for(self._catalogue(messages.msgtype, messages.definition), messages.msgtype)
             order = np.argsort(messages.times, kind="stable")
-            objects = [store.deserialize_ros1(messages.raws[i], messages.msgtype) for i in order.tolist()]
+            read = functools.partial(store.deserialize_ros1, typename=messages.msgtype)
+            objects = deserialized(read, [messages.raws[i] for i in order.tolist()])
             self.add_whole(topic, messages.times[order] / 1e9, objects)
         return self.data(start / 1e9, end / 1e9, tuple(sorted(found)))
 
@@ -420,11 +427,26 @@ def _read_connection(
         times = np.asarray(stamps, dtype=np.int64)
         if store is not None:
             read = store.deserialize_cdr if cdr else store.deserialize_ros1
-            reading.add_whole(topic, times / 1e9, [read(bytes(r), msgtype) for r in raws])
+            reading.add_whole(
+                topic, times / 1e9, deserialized(functools.partial(read, typename=msgtype), raws)
+            )
         else:
             reading.add(
                 topic, msgtype, times, reading.decode(topic, msgtype, catalogue, RawMessages.join(raws), cdr)
             )
+
+
+def deserialized(read: Callable[[bytes], Any], raws: Sequence[bytes | memoryview]) -> list[Any]:
+    """``read`` of each message, once per distinct message: a status array published once a
+    second is mostly the same bytes again (its objects are then shared, and only read)."""
+    seen: dict[bytes, Any] = {}
+    found = []
+    for raw in raws:
+        key = bytes(raw)
+        if key not in seen:
+            seen[key] = read(key)
+        found.append(seen[key])
+    return found
 
 
 def deserializer_for(catalogue: MessageCatalogue, msgtype: str) -> Any:

@@ -13,6 +13,7 @@ each under the size one reads at once; it builds on ``bagdata``'s
 
 from __future__ import annotations
 
+import functools
 from pathlib import Path
 
 import numpy as np
@@ -29,6 +30,7 @@ from exsce_dsl.runs.bagdata import (
     WHOLE,
     BagData,
     _Reading,
+    deserialized,
     deserializer_for,
 )
 from exsce_dsl.runs.decode import RawMessages
@@ -102,7 +104,8 @@ class Mcap(_Reading):
             store = deserializer_for(catalogue, msgtype)
             all_times = np.concatenate([m.times for m in parts])
             order = np.argsort(all_times, kind="stable")
-            objects = [store.deserialize_cdr(raws[i], msgtype) for i in order.tolist()]
+            read = functools.partial(store.deserialize_cdr, typename=msgtype)
+            objects = deserialized(read, [raws[i] for i in order.tolist()])
             self.add_whole(topic, all_times[order] / 1e9, objects)
         return self.data(start / 1e9, end / 1e9, tuple(sorted(found)))
 

@@ -1,8 +1,10 @@
 """A robot's navigation goals as its stack recorded them: Nav2's actions and ROS 1 move_base's.
 
-Few messages (a status array a second, a feedback a few times a second), so they are
-read as message objects (:data:`~exsce_dsl.runs.bagdata.OBJECTS`) and walked here
-into :class:`~exsce_dsl.runs.goal_segments.Goal`\\ s, in receive time:
+Few messages (a status array a second and at each change), so they are read as
+message objects (:data:`~exsce_dsl.runs.bagdata.OBJECTS`, each distinct one once)
+and walked here into :class:`~exsce_dsl.runs.goal_segments.Goal`\\ s, in receive
+time.  (A global plan is long, but rosbags deserializes its poses faster than the
+vectorised decoder walks them one element index at a time, for a plan a chunk.)
 
 - **Nav2** (``navigate_to_pose``, ``navigate_through_poses``, ``follow_waypoints``):
   ``ACTION/_action/status`` (action_msgs/GoalStatusArray: each goal's UUID and status)
@@ -24,6 +26,7 @@ import numpy as np
 
 from exsce_dsl.model.conventions import Navigation, Signals
 from exsce_dsl.model.metrics import topic_name
+from exsce_dsl.runs.bagdata import OBJECTS, BagData, Wanted
 from exsce_dsl.runs.goal_segments import Goal
 
 NAV2_STATUS = {1: "ACCEPTED", 2: "EXECUTING", 3: "CANCELING", 4: "SUCCEEDED", 5: "CANCELED", 6: "ABORTED"}
@@ -46,21 +49,22 @@ PLAN = "/{ns}/plan"
 Messages = Sequence[tuple[float, Any]]
 
 
-def goal_topics(signals: Signals, namespace: str) -> list[str]:
-    """The topics the robot's navigation goals are read from (wanted as message objects)."""
+def goal_wanted(signals: Signals, namespace: str) -> dict[str, Wanted]:
+    """What the robot's navigation goals are read from, all as message objects (few: a status
+    array a second and at each change, a plan per goal or replanning)."""
     actions = [topic_name(a, namespace) for a in signals.actions]
     if signals.navigation is Navigation.NAV2:
-        found = [f"{a}/_action/status" for a in actions] + [f"{a}/_action/feedback" for a in actions]
-        return [*found, topic_name(PLAN, namespace)]
+        found = [f"{a}/_action/status" for a in actions]
+        found += [f"{a}/_action/feedback" for a in actions if _follows_waypoints(a)]
+        return {t: Wanted(OBJECTS) for t in [*found, topic_name(PLAN, namespace)]}
     if signals.navigation is Navigation.MOVE_BASE:
-        return [f"{a}/{part}" for a in actions for part in ("goal", "status", "result")]
-    return []
+        return {f"{a}/{part}": Wanted(OBJECTS) for a in actions for part in ("goal", "status", "result")}
+    return {}
 
 
-def read_goals(
-    signals: Signals, namespace: str, messages: Mapping[str, Messages]
-) -> tuple[list[Goal], list[str]]:
+def read_goals(signals: Signals, namespace: str, data: BagData) -> tuple[list[Goal], list[str]]:
     """The robot's goals from the bag's messages, and the topics they came from."""
+    messages = data.messages
     actions = [topic_name(a, namespace) for a in signals.actions]
     goals: list[Goal] = []
     used: list[str] = []
@@ -69,10 +73,12 @@ def read_goals(
             status = messages.get(f"{action}/_action/status")
             if not status:
                 continue
-            feedback = messages.get(f"{action}/_action/feedback", [])
+            feedback = messages.get(f"{action}/_action/feedback", []) if _follows_waypoints(action) else []
             plans = messages.get(topic_name(PLAN, namespace), [])
             goals += _nav2_goals(status, feedback, plans)
-            used += [f"{action}/_action/status"] + ([topic_name(PLAN, namespace)] if plans else [])
+            used += [f"{action}/_action/status"] + (
+                [topic_name(PLAN, namespace)] if plans is not None else []
+            )
         elif signals.navigation is Navigation.MOVE_BASE:
             status = messages.get(f"{action}/status")
             if not status:
@@ -91,6 +97,12 @@ def read_goals(
             )
             used += [f"{action}/status"] + ([f"{action}/goal"] if targets else [])
     return sorted(goals, key=lambda g: (g.first_seen or 0.0, g.key)), used
+
+
+def _follows_waypoints(action: str) -> bool:
+    """Whether the action's feedback says which pose it goes to (only follow_waypoints' does:
+    the others' feedback, five times a second, is not read)."""
+    return action.rsplit("/", 1)[-1] == "follow_waypoints"
 
 
 def _move_base_key(goal_id: Any) -> str:

@@ -27,10 +27,10 @@ from exsce_dsl.model.metrics import topic_name
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import MetricValue
 from exsce_dsl.runs.arrival_segments import arrival_segments
-from exsce_dsl.runs.bagdata import OBJECTS, BagData, Wanted
+from exsce_dsl.runs.bagdata import BagData, Wanted
 from exsce_dsl.runs.goal_segments import goal_segments
 from exsce_dsl.runs.monitor_core import Topic
-from exsce_dsl.runs.navigation_goals import goal_topics, read_goals
+from exsce_dsl.runs.navigation_goals import goal_wanted, read_goals
 from exsce_dsl.runs.segmentation import Track
 from exsce_dsl.runs.segments import Segment
 from exsce_dsl.runs.signals import RobotSources, choose_sources, signal_topic, signal_topics, signals_wanted
@@ -71,8 +71,7 @@ class StackRobots:
             if signals.navigation is not Navigation.DISPATCHER:
                 for pattern in (FEEDBACK, RESULT):
                     adapted.pop(topic_name(pattern, robot.namespace), None)
-            for topic in goal_topics(signals, robot.namespace):
-                adapted[topic] = Wanted(OBJECTS)
+            adapted.update(goal_wanted(signals, robot.namespace))
         for topic, more in signals_wanted(self.sources.values(), scan_paths).items():
             before = adapted.get(topic)
             if before is not None and before.msgtype == more.msgtype:
@@ -153,7 +152,7 @@ def segment_robot(
         return RobotSegments(dispatcher, DISPATCHER_SOURCE, None)
     problems: list[str] = []
     if signals.navigation in (Navigation.NAV2, Navigation.MOVE_BASE):
-        goals, used = read_goals(signals, robot.namespace, data.messages)
+        goals, used = read_goals(signals, robot.namespace, data)
         if goals:
             found = goal_segments(scenario, robot.id, goals, track, signals.tolerance)
             problems += [f"robot '{robot.id}': {w}" for w in found.warnings]
