@@ -166,3 +166,69 @@ def test_the_readmes_robot_types_check(tmp_path: Path) -> None:
     assert husky.velocity == (TopicSource("/{ns}/husky_velocity_controller/cmd_vel"),)
     assert robot_types["turtlebot4"].signals.pose == (TfSource("map", "base_footprint"),)  # type: ignore[attr-defined]
     assert robot_types["custom"].signals.navigation is Navigation.NONE  # type: ignore[attr-defined]
+
+
+SCENE = """\
+environment yard {
+  area yard {
+    pose yard-a at (0.0, 0.0)
+    pose yard-b at (5.0, 0.0)
+  }
+}
+
+robot type rover {
+  base diff_drive
+  convention nav2
+}
+
+task go {
+  visit yard-b
+}
+
+scenario s in yard {
+  robots {
+    r1: rover starts at yard-a OVERRIDE
+  }
+  mission m parallel {
+    r1 does go
+  }
+}
+"""
+
+
+def _robot(tmp_path: Path, override: str) -> object:
+    path = tmp_path / "scene.exsce"
+    path.write_text(SCENE.replace("OVERRIDE", override))
+    return load_spec(path).scenario().robots[0]
+
+
+def test_a_robot_overrides_its_types_sources_for_itself(tmp_path: Path) -> None:
+    robot = _robot(tmp_path, '{\n      pose on "/{ns}/ground_truth" nav_msgs/msg/Odometry\n    }')
+    signals = robot.signals  # type: ignore[attr-defined]
+    assert signals.pose == (TopicSource("/{ns}/ground_truth", "nav_msgs/msg/Odometry"),)
+    assert (signals.convention, signals.velocity) == ("nav2", NAV2.velocity)  # the rest is its type's
+    assert robot.type.signals == NAV2  # type: ignore[attr-defined]  # the type is unchanged
+    other = _robot(tmp_path, "{\n      convention move_base\n    }")
+    assert other.signals == MOVE_BASE  # type: ignore[attr-defined]
+    plain = _robot(tmp_path, "")
+    assert plain.declared_signals is None and plain.signals == NAV2  # type: ignore[attr-defined]
+
+
+def test_a_robots_override_is_formatted_back_to_the_same_model(tmp_path: Path) -> None:
+    path = tmp_path / "scene.exsce"
+    path.write_text(SCENE.replace("OVERRIDE", "{ arrival within 50 cm  navigation none }"))
+    spec = load_spec(path)
+    source = display_path(path)
+    printed = format_spec_document(spec, source, comments(path.read_text(), source))
+    assert "    r1: rover starts at yard-a {\n      navigation none\n      arrival within 0.5 m\n    }\n" in printed
+    again = load_spec(path, overlay={source: printed})
+    assert again.root_document == spec.root_document
+    assert again.scenario().robots[0].signals == spec.scenario().robots[0].signals
+
+
+def test_a_robots_override_is_checked_at_its_place(tmp_path: Path) -> None:
+    path = tmp_path / "scene.exsce"
+    path.write_text(SCENE.replace("OVERRIDE", '{\n      velocity on "/{ns}/cmd_vel" std_msgs/msg/Float64\n    }'))
+    with pytest.raises(SpecError) as caught:
+        load_spec(path)
+    assert "scene.exsce:20:16:" in str(caught.value) and "a velocity is read from" in str(caught.value)

@@ -149,3 +149,18 @@ def test_the_runs_prov_says_what_segmented_it(tmp_path: Path) -> None:
     assert provn.count('exsce:segmented_by="nav2 goals"') == len(analysed.run.tasks) == 2
     arrival = _run(tmp_path, "convention nav2\nnavigation none", "ros1", "nav2")
     assert {t.segmented_by for t in arrival.run.tasks} == {"arrival at the planned waypoints"}
+
+
+def test_one_robot_may_say_otherwise_than_its_type(tmp_path: Path) -> None:
+    scenario = _scenario(tmp_path, "convention nav2", "override")
+    path = tmp_path / "override.exsce"
+    path.write_text(
+        path.read_text().replace(
+            "r2: rover starts at yard-d", "r2: rover starts at yard-d { navigation none }"
+        )
+    )
+    scenario = load_spec(path).scenario()
+    (run,) = simulate(scenario, tmp_path / "bags", fmt="ros1", seed=5)
+    analysed = analyse_bag(run.bag, scenario)
+    by = {t.robot: t.segmented_by for t in analysed.run.tasks}
+    assert by == {"r1": "nav2 goals", "r2": "arrival at the planned waypoints"}

@@ -262,7 +262,7 @@ class _Builder:
                 base = fact.base
             else:
                 torso = fact.torso == "yes"
-        signals = build_signals(d.obj.name, d.obj.facts, d.file.span, self.error)
+        signals = build_signals(f"robot type '{d.obj.name}'", d.obj.facts, d.file.span, self.error)
         return RobotType(d.obj.name, base, torso, d.name_location, signals)
 
     # ----------------------------------------------------------- environments
@@ -463,7 +463,12 @@ class _Builder:
                     ok = ok and start is not None
             namespace = root_namespace(decl.namespace) if decl.has_namespace else decl.name
             if rtype is not None:
-                robots.append(Robot(decl.name, rtype, namespace, start, where))
+                own = build_signals(
+                    f"robot '{decl.name}'", decl.overrides, pf.span, self.error, rtype.signals
+                )
+                if own == rtype.signals:
+                    own = None  # it says what its type says
+                robots.append(Robot(decl.name, rtype, namespace, start, where, own))
 
         mission = self._mission(pf, sc, robot_seen)
         if mission is None or env is None or not ok:

@@ -46,15 +46,18 @@ Report = Callable[[str, SourceLocation], None]
 Span = Callable[[Any], SourceLocation]
 
 
-def build_signals(type_name: str, facts: list[Any], span: Span, error: Report) -> Signals | None:
-    """The signals a robot type's facts declare; None when it declares none (the method's)."""
+def build_signals(
+    type_name: str, facts: list[Any], span: Span, error: Report, base: Signals = METHOD
+) -> Signals | None:
+    """The signals a robot type's facts declare (or a robot's, over its type's ``base``); None
+    when they declare none."""
     mine = [f for f in facts if f.__class__.__name__ in _SIGNAL_FACTS]
     if not mine:
         return None
     conventions = [f for f in mine if f.__class__.__name__ == "ConventionFact"]
     for extra in conventions[1:]:
-        error(f"robot type '{type_name}' names its convention twice", span(extra))
-    signals = CONVENTIONS[conventions[0].convention] if conventions else METHOD
+        error(f"{type_name} names its convention twice", span(extra))
+    signals = CONVENTIONS[conventions[0].convention] if conventions else base
     poses: list[PoseSource] = []
     velocities: list[TopicSource] = []
     scans: list[TopicSource] = []
@@ -75,7 +78,7 @@ def build_signals(type_name: str, facts: list[Any], span: Span, error: Report) -
         elif kind in ("NavigationFact", "ArrivalFact"):
             if kind in said:
                 word = "navigation" if kind == "NavigationFact" else "arrival tolerance"
-                error(f"robot type '{type_name}' states its {word} twice", span(fact))
+                error(f"{type_name} states its {word} twice", span(fact))
             said[kind] = fact
     changes: dict[str, Any] = {}
     if poses:

@@ -119,12 +119,17 @@ def _robot_type(rtype: RobotType) -> list[Line]:
     return [(f"robot type {rtype.id} {{", rtype.location), *facts, ("}", None)]
 
 
-def signal_lines(signals: Signals | None) -> list[str]:
-    """A robot type's signal lines: its convention, then what it says otherwise than that."""
+def signal_lines(signals: Signals | None, over: Signals | None = None) -> list[str]:
+    """A robot type's signal lines: its convention, then what it says otherwise than that; or a
+    robot's, ``over`` its type's signals (its convention only if it names another)."""
     if signals is None:
         return []
-    base = CONVENTIONS[signals.convention]
-    lines = [f"convention {signals.convention}"]
+    lines = []
+    if over is None or over.convention != signals.convention:
+        base = CONVENTIONS[signals.convention]
+        lines.append(f"convention {signals.convention}")
+    else:
+        base = over
     if signals.pose != base.pose:
         lines += [f"pose {p.clause()}" for p in signals.pose]
     if signals.velocity != base.velocity:
@@ -222,6 +227,12 @@ def _scenario(sc: Scenario, poses: Mapping[str, Pose]) -> list[Line]:
             text += f" namespace {_string(robot.namespace)}"
         if robot.start_pose is not None:
             text += f" starts at {_pose_use(robot.start_pose, poses)}"
+        own = signal_lines(robot.declared_signals, robot.type.signals)
+        if own:
+            lines.append((text + " {", robot.location))
+            lines += [(f"{INDENT * 3}{line}", None) for line in own]
+            lines.append((f"{INDENT * 2}}}", None))
+            continue
         lines.append((text, robot.location))
     lines.append((f"{INDENT}}}", None))
     m = sc.mission

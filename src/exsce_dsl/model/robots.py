@@ -39,3 +39,14 @@ class Robot:
     """The robot's ROS namespace; ``""``: its topics are at the root."""
     start_pose: Pose | None = None
     location: SourceLocation | None = field(default=None, compare=False, repr=False)
+    declared_signals: Signals | None = None
+    """Where this robot's signals are, when it says otherwise than its type."""
+
+    @property
+    def signals(self) -> Signals:
+        return self.declared_signals or self.type.signals
+
+    @property
+    def declares_signals(self) -> bool:
+        """Whether the robot or its type says where its signals are (else: the method's topics)."""
+        return self.declared_signals is not None or self.type.declared_signals is not None

@@ -112,7 +112,7 @@ class RobotSources:
 def choose_sources(robot: Robot, available: Mapping[str, str]) -> RobotSources:
     """For each signal, the first of the robot type's sources that ``available`` (the bag's
     topic → type) has."""
-    signals = robot.type.signals
+    signals = robot.signals
     ns = robot.namespace
     chosen: dict[str, Chosen] = {}
     notes: list[str] = []

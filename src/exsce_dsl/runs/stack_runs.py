@@ -67,7 +67,7 @@ class StackRobots:
                 served = adapted.pop(topic_name(pattern, robot.namespace), None)
                 if served is not None and signal == "scan":
                     scan_paths += served.paths
-            signals = robot.type.signals
+            signals = robot.signals
             if signals.navigation is not Navigation.DISPATCHER:
                 for pattern in (FEEDBACK, RESULT):
                     adapted.pop(topic_name(pattern, robot.namespace), None)
@@ -117,7 +117,7 @@ class StackRobots:
 
 def stack_robots(robots: list[Robot], available: Mapping[str, str]) -> StackRobots:
     """The robots that declare their signals, with the sources the bag (``available``) has."""
-    return StackRobots({r.id: choose_sources(r, available) for r in robots if r.type.declared_signals})
+    return StackRobots({r.id: choose_sources(r, available) for r in robots if r.declares_signals})
 
 
 def _as_method_fields(name: str, signal: str, topic: Topic) -> Topic:
@@ -147,7 +147,7 @@ def segment_robot(
 ) -> RobotSegments:
     """The robot's segments from the first source that gives any (see the module's docstring);
     ``dispatcher``: its segments from the method's dispatcher, if its bag has that."""
-    signals = robot.type.signals
+    signals = robot.signals
     if dispatcher is not None and any(s.start is not None for s in dispatcher):
         return RobotSegments(dispatcher, DISPATCHER_SOURCE, None)
     problems: list[str] = []

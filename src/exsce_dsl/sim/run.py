@@ -119,7 +119,7 @@ def _recorded_run(
 
 def scenario_convention(scenario: Scenario) -> str:
     """The convention the robots' types name (the method's when they name none): one per run."""
-    named = {r.id: r.type.signals.convention for r in scenario.robots}
+    named = {r.id: r.signals.convention for r in scenario.robots}
     found = sorted(set(named.values()))
     if len(found) > 1:
         listed = ", ".join(f"{robot}: {name}" for robot, name in named.items())
