@@ -72,7 +72,8 @@ def _agree(ours: dict[tuple[str, str, str], float], reference: dict[tuple[str, s
     assert compared >= 15
 
 
-@pytest.mark.parametrize("fmt, convention", [("ros1", "nav2"), ("mcap", "nav2"), ("ros2", "move_base")])
+@pytest.mark.parametrize("fmt", ["ros1", "ros2", "mcap"])
+@pytest.mark.parametrize("convention", ["nav2", "move_base"])
 def test_a_stacks_run_has_the_methods_metrics(
     tmp_path: Path, method_run: AnalysedRun, fmt: str, convention: str
 ) -> None:
@@ -164,3 +165,11 @@ def test_one_robot_may_say_otherwise_than_its_type(tmp_path: Path) -> None:
     analysed = analyse_bag(run.bag, scenario)
     by = {t.robot: t.segmented_by for t in analysed.run.tasks}
     assert by == {"r1": "nav2 goals", "r2": "arrival at the planned waypoints"}
+
+
+def test_a_bag_without_the_navigation_topics_is_segmented_by_arrival(tmp_path: Path) -> None:
+    """The robot type expects move_base's goals, the bag (Nav2's) has none of them: arrival."""
+    analysed = _run(tmp_path, "convention nav2\nnavigation move_base", "ros1", "nav2")
+    assert {t.segmented_by for t in analysed.run.tasks} == {"arrival at the planned waypoints"}
+    assert "robot 'r2': no move_base goals in this bag" in analysed.problems
+    assert _values(analysed)[("waypoints_visited", "r2", "robot")] == 1
