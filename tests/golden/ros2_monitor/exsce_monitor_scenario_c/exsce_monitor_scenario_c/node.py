@@ -44,9 +44,21 @@ class ExsceMonitor(Node):
         check_period = float(self.get_parameter("check_period").value)
         self.runtime = MonitorRuntime(monitors, config.ROBOTS, config.TOPICS, config.ORACLES, config.SCENARIO)
         self.verdicts = self.create_publisher(String, verdict_topic, VERDICT_QOS)
+        classes, missing = {}, []
+        for topic, spec in config.TOPICS.items():
+            try:
+                classes[topic] = message_class(spec["type"])
+            except (ImportError, AttributeError):
+                missing.append(f"{spec['type']} (topic {topic})")
+        if missing:  # ROS 2 sends no definitions: a subscriber needs the type's Python package
+            raise SystemExit(
+                "exsce monitor: no Python message package on this machine for "
+                + ", ".join(missing)
+                + ": build and source the packages that define them before starting the node"
+            )
         self.subscribers = [
             self.create_subscription(
-                message_class(spec["type"]),
+                classes[topic],
                 topic,
                 self.receiver(topic),
                 DATA_QOS if spec["role"] == "data" else STATUS_QOS,
