@@ -271,7 +271,9 @@ async def test_completion_of_a_metric_s_fields_follows_the_path_before_the_point
     client: LanguageClient, workspace: Path
 ) -> None:
     path = workspace / "metrics.exsce"
-    text = path.read_text().replace("value mean(abs(vel.angular.z))", "value mean(abs(vel.angular.z + vel.lin))")
+    text = path.read_text().replace(
+        "value mean(abs(vel.angular.z))", "value mean(abs(vel.angular.z + vel.lin))"
+    )
     uri = open_document(client, path, text)
 
     async def items(needle: str) -> dict[str, types.CompletionItem]:
@@ -373,4 +375,25 @@ async def test_a_burst_of_changes_is_analysed_once_after_the_debounce(
     await asyncio.sleep(0.4)
     watching = False
     assert published == [6]
+    close_document(client, uri)
+
+
+async def test_completion_of_a_robot_types_signal_lines(client: LanguageClient, workspace: Path) -> None:
+    path = workspace / "robots.exsce"
+    text = path.read_text().replace("  torso no\n", "  torso no\n  convention \n", 1)
+    uri = open_document(client, path, text)
+    at = position(text, "  convention ", len("  convention "))
+    result = await client.text_document_completion_async(
+        types.CompletionParams(types.TextDocumentIdentifier(uri), at)
+    )
+    assert isinstance(result, types.CompletionList)
+    assert {"method", "nav2", "move_base"} <= {item.label for item in result.items}
+    line_start = position(text, "  convention ", 2)
+    result = await client.text_document_completion_async(
+        types.CompletionParams(types.TextDocumentIdentifier(uri), line_start)
+    )
+    assert isinstance(result, types.CompletionList)
+    assert {"convention", "pose", "velocity", "scan", "navigation", "arrival"} <= {
+        i.label for i in result.items
+    }
     close_document(client, uri)

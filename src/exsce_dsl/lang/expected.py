@@ -22,7 +22,7 @@ from exsce_dsl.lang.parser import new_metamodel
 # Nothing in the grammar matches it: the parse fails there and says what it expected.
 _STOP = "\u0001"
 _WORD_BEFORE = re.compile(r"[\w-]*\Z")
-_KEYWORD = re.compile(r"[a-z]+")
+_KEYWORD = re.compile(r"[a-z][a-z0-9_]*")  # nav2, move_base
 _OTHER_RULES = {
     "Name": "name",
     "Ref": "name",
