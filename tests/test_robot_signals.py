@@ -11,7 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from exsce_dsl.errors import SpecError
+from exsce_dsl.codegen.ros_monitor import ros1_monitor_files
+from exsce_dsl.errors import ExsceError, SpecError
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.lang.formatter import format_spec_document
 from exsce_dsl.lang.lexical import comments
@@ -101,7 +102,11 @@ def test_arrival_defaults_to_nav2s_goal_tolerance_with_localisation_and_no_headi
     [
         ('pose on "/{ns}/odom" sensor_msgs/msg/Imu', 8, "a pose is read from nav_msgs/msg/Odometry"),
         ('velocity on "/{ns}/cmd vel"', 12, "'/{ns}/cmd vel' is not a ROS topic name"),
-        ('scan on "/{ns}/scan" sensor_msgs/msg/PointCloud2', 8, "a laser scan is read from sensor_msgs/msg/LaserScan"),
+        (
+            'scan on "/{ns}/scan" sensor_msgs/msg/PointCloud2',
+            8,
+            "a laser scan is read from sensor_msgs/msg/LaserScan",
+        ),
         ("arrival within 0 m", 3, "an arrival tolerance is a distance (and an angle) above zero"),
         ('navigation nav2 on "/{x}/go"', 3, "'/{x}/go' is not a ROS topic name"),
     ],
@@ -149,9 +154,7 @@ def test_the_formatter_prints_what_parses_back_to_the_same_model(tmp_path: Path,
     printed = format_spec_document(spec, source, comments(body, source))
     again = load_spec(path, overlay={source: printed})
     assert again.root_document == spec.root_document
-    assert [t.signals for t in again.robot_types] == [
-        t.signals for t in spec.robot_types
-    ]
+    assert [t.signals for t in again.robot_types] == [t.signals for t in spec.robot_types]
     assert format_spec_document(again, source, comments(printed, source)) == printed
 
 
@@ -220,7 +223,10 @@ def test_a_robots_override_is_formatted_back_to_the_same_model(tmp_path: Path) -
     spec = load_spec(path)
     source = display_path(path)
     printed = format_spec_document(spec, source, comments(path.read_text(), source))
-    assert "    r1: rover starts at yard-a {\n      navigation none\n      arrival within 0.5 m\n    }\n" in printed
+    assert (
+        "    r1: rover starts at yard-a {\n      navigation none\n      arrival within 0.5 m\n    }\n"
+        in printed
+    )
     again = load_spec(path, overlay={source: printed})
     assert again.root_document == spec.root_document
     assert again.scenario().robots[0].signals == spec.scenario().robots[0].signals
@@ -228,7 +234,50 @@ def test_a_robots_override_is_formatted_back_to_the_same_model(tmp_path: Path) -
 
 def test_a_robots_override_is_checked_at_its_place(tmp_path: Path) -> None:
     path = tmp_path / "scene.exsce"
-    path.write_text(SCENE.replace("OVERRIDE", '{\n      velocity on "/{ns}/cmd_vel" std_msgs/msg/Float64\n    }'))
+    path.write_text(
+        SCENE.replace("OVERRIDE", '{\n      velocity on "/{ns}/cmd_vel" std_msgs/msg/Float64\n    }')
+    )
     with pytest.raises(SpecError) as caught:
         load_spec(path)
     assert "scene.exsce:20:16:" in str(caught.value) and "a velocity is read from" in str(caught.value)
+
+
+SIGNAL_METRIC = """
+metric furthest_east for SUBJECT {
+  unit m
+  reads pose: robot pose
+  value max(pose.x)
+}
+"""
+
+
+def test_a_metric_reading_a_signal_checks_its_fields_and_formats_back(tmp_path: Path) -> None:
+    path = tmp_path / "scene.exsce"
+    path.write_text(SCENE.replace("OVERRIDE", "") + SIGNAL_METRIC.replace("SUBJECT", "each robot"))
+    spec = load_spec(path)
+    (read,) = spec.metrics[0].reads
+    assert (read.signal, read.msgtype, read.topic) == ("pose", "exsce_msgs/msg/RobotPose", "/{ns}/~pose")
+    source = display_path(path)
+    printed = format_spec_document(spec, source, comments(path.read_text(), source))
+    assert "  reads pose: robot pose\n" in printed
+    assert load_spec(path, overlay={source: printed}).root_document == spec.root_document
+    path.write_text(
+        SCENE.replace("OVERRIDE", "")
+        + SIGNAL_METRIC.replace("SUBJECT", "each robot").replace("pose.x", "pose.heading")
+    )
+    with pytest.raises(SpecError, match=r"has no field 'heading'"):
+        load_spec(path)
+
+
+def test_a_signal_is_a_robots_not_the_missions(tmp_path: Path) -> None:
+    path = tmp_path / "scene.exsce"
+    path.write_text(SCENE.replace("OVERRIDE", "") + SIGNAL_METRIC.replace("SUBJECT", "mission"))
+    with pytest.raises(SpecError, match="the robot's pose is read for each robot or each pair of robots"):
+        load_spec(path)
+
+
+def test_live_monitors_refuse_a_metric_that_reads_a_signal(tmp_path: Path) -> None:
+    path = tmp_path / "scene.exsce"
+    path.write_text(SCENE.replace("OVERRIDE", "") + SIGNAL_METRIC.replace("SUBJECT", "each robot"))
+    with pytest.raises(ExsceError, match="live monitors subscribe to topics and do not compute signals yet"):
+        ros1_monitor_files(load_spec(path), None)

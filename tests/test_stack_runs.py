@@ -12,6 +12,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from rosbags.highlevel import AnyReader
+from rosbags.typesys import Stores, get_typestore
 from test_signals import YARD
 
 from exsce_dsl.errors import ExsceError
@@ -173,3 +175,60 @@ def test_a_bag_without_the_navigation_topics_is_segmented_by_arrival(tmp_path: P
     assert {t.segmented_by for t in analysed.run.tasks} == {"arrival at the planned waypoints"}
     assert "robot 'r2': no move_base goals in this bag" in analysed.problems
     assert _values(analysed)[("waypoints_visited", "r2", "robot")] == 1
+
+
+SIGNAL_METRICS = """
+metric furthest_east for each robot {
+  "the largest x the robot reached"
+  unit m
+  reads pose: robot pose
+  value max(pose.x)
+}
+
+metric fastest_turn for each robot {
+  "the fastest turn commanded"
+  unit rad/s
+  reads vel: robot velocity
+  value max(norm(vel.angular.z))
+}
+"""
+
+
+def _signal_run(tmp_path: Path, robot_type: str, convention: str) -> AnalysedRun:
+    path = tmp_path / f"signals-{convention}.exsce"
+    path.write_text(
+        YARD.replace("ROBOT_TYPE", "".join(f"  {line}\n" for line in robot_type.splitlines())) + SIGNAL_METRICS
+    )
+    scenario = load_spec(path).scenario()
+    (run,) = simulate(scenario, tmp_path / f"bags-{convention}", fmt="ros1", seed=5)
+    return analyse_bag(run.bag, scenario)
+
+
+def test_a_metric_reads_a_robots_signal_wherever_its_type_says_it_is(tmp_path: Path) -> None:
+    method = _signal_run(tmp_path, "torso no", "method")
+    nav2 = _signal_run(tmp_path, "convention nav2", "nav2")
+    ours, theirs = _values(nav2), _values(method)
+    for robot in ("r1", "r2"):
+        assert ours[("furthest_east", robot, "robot")] == pytest.approx(
+            theirs[("furthest_east", robot, "robot")], abs=0.15
+        )
+        assert ours[("fastest_turn", robot, "robot")] == pytest.approx(
+            theirs[("fastest_turn", robot, "robot")], rel=0.02
+        )
+    (bag,) = (tmp_path / "bags-method").glob("*.bag")  # the reference: rosbags' own reading
+    store = get_typestore(Stores.ROS1_NOETIC)
+    with AnyReader([bag], default_typestore=store) as reader:
+        poses = [c for c in reader.connections if c.topic == "/r2/robot_pose"]
+        samples = [
+            (t / 1e9, reader.deserialize(raw, c.msgtype).pose.pose.position.x)
+            for c, t, raw in reader.messages(poses)
+        ]
+    actions = [a for task in method.run.tasks if task.robot == "r2" for a in task.actions]
+    begin, end = min(a.start for a in actions).timestamp(), max(a.end for a in actions).timestamp()
+    inside = [x for t, x in samples if begin <= t <= end]
+    assert theirs[("furthest_east", "r2", "robot")] == pytest.approx(max(inside), abs=1e-9)
+    sources = {v.metric: v.topics for v in nav2.run.metrics if v.robot == "r2"}
+    assert sources["furthest_east"] == ("/r2/tf", "/r2/tf_static")
+    assert sources["fastest_turn"] == ("/r2/cmd_vel",)
+    method_sources = {v.metric: v.topics for v in method.run.metrics if v.robot == "r2"}
+    assert method_sources["furthest_east"] == ("/r2/robot_pose",)

@@ -149,6 +149,13 @@ def monitor_topics(
                 if not isinstance(node, Field):
                     continue
                 read = reads[node.read]
+                if read.signal:
+                    raise GenerationError(
+                        f"metric '{metric.name}' reads the robot's {read.signal} (its signal, wherever its "
+                        "type says it is): live monitors subscribe to topics and do not compute signals yet; "
+                        "read a topic in this metric to monitor it live",
+                        read.location,
+                    )
                 wanted = TopicEntry(canonical_type(read.msgtype))
                 entry = add(read.topic_of(ns), wanted, f"metric {metric.name}")
                 if entry.msgtype not in trees:

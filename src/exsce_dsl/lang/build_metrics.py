@@ -33,6 +33,7 @@ from exsce_dsl.model.expressions import Aggregate, Expression, WindowValue
 from exsce_dsl.model.messages import DISPATCHER, Fields, canonical_type
 from exsce_dsl.model.metrics import (
     SI_UNIT,
+    SIGNAL_TYPES,
     UNITS,
     Combine,
     Dimension,
@@ -40,6 +41,7 @@ from exsce_dsl.model.metrics import (
     SafetyLimit,
     Subject,
     TopicRead,
+    signal_pattern,
 )
 
 
@@ -175,6 +177,9 @@ class _MetricBuilder:
 
     # ------------------------------------------------------------ declarations
     def _read(self, read: Any) -> None:
+        if read.signal:
+            self._signal_read(read)
+            return
         msgtype = canonical_type(read.msgtype)
         self.broken_reads.add(read.name)  # until it is known to be good
         if read.name in self.reads:
@@ -197,6 +202,23 @@ class _MetricBuilder:
         self.reads[read.name] = TopicRead(read.name, msgtype, read.topic, self.pf.span(read))
         if tree is not None:
             self.trees[read.name] = tree
+        self.broken_reads.discard(read.name)
+
+    def _signal_read(self, read: Any) -> None:
+        self.broken_reads.add(read.name)
+        if read.name in self.reads:
+            self.error(f"topic '{read.name}' is read twice in this metric", read)
+            return
+        if self.pair is not None and read.name in self.pair:
+            self.error(f"'{read.name}' names a robot of the pair; give the signal another name", read)
+            return
+        if self.subject is Subject.MISSION:
+            self.error(f"the robot's {read.signal} is read for each robot or each pair of robots", read)
+            return
+        msgtype = SIGNAL_TYPES[read.signal]
+        topic = signal_pattern(read.signal)
+        self.reads[read.name] = TopicRead(read.name, msgtype, topic, self.pf.span(read), signal=read.signal)
+        self.trees[read.name] = self.catalogue().tree(msgtype)
         self.broken_reads.discard(read.name)
 
     def _tree(self, read: Any, msgtype: str) -> Fields | None:

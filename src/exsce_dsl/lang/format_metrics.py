@@ -40,7 +40,8 @@ def metric_lines(metric: MetricDefinition) -> list[Line]:
         limit = f"{_number(metric.safety.limit)} {metric.unit}".rstrip()
         lines.append((f"{INDENT}safe {metric.safety.bound} {limit}", None))
     for read in metric.reads:
-        lines.append((f"{INDENT}reads {read.name}: {read.msgtype} on {_string(read.topic)}", read.location))
+        source = f"robot {read.signal}" if read.signal else f"{read.msgtype} on {_string(read.topic)}"
+        lines.append((f"{INDENT}reads {read.name}: {source}", read.location))
     lines.append((f"{INDENT}value {expression_text(metric.value)}", None))
     if metric.fallback is not None:
         lines.append((f"{INDENT}otherwise {expression_text(metric.fallback)}", None))

@@ -14,8 +14,11 @@ MEANINGS: dict[str, str] = {
     "odom; velocity on cmd_vel) or move_base's; each `pose`, `velocity`, `scan`, `navigation` or "
     "`arrival` line overrides one.",
     "velocity": '`velocity on "/{ns}/cmd_vel" [TYPE]`: where the robot\'s velocity is (Twist, TwistStamped '
-    "or an Odometry's twist); several lines are tried in order.",
+    "or an Odometry's twist); several lines are tried in order. In a metric, `reads vel: robot "
+    "velocity` reads it (`vel.linear.x` ... `vel.angular.z`).",
     "scan": '`scan on "/{ns}/scan"`: the robot\'s laser scan (sensor_msgs/msg/LaserScan).',
+    "distance": "`reads odometer: robot distance`: in a metric, the distance the robot has travelled "
+    "so far (`odometer.data`, m), wherever its type says it is.",
     "navigation": '`navigation dispatcher|nav2|move_base|none [on "/{ns}/ACTION", ...]`: the '
     "navigation interface whose goals make the path segments; `none`: segments by arrival at the "
     "planned waypoints.",

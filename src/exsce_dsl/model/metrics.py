@@ -38,6 +38,19 @@ class Combine(enum.Enum):
     MIN = "min"
 
 
+SIGNAL_TYPES = {
+    "pose": "exsce_msgs/msg/RobotPose",
+    "velocity": "geometry_msgs/msg/Twist",
+    "distance": "std_msgs/msg/Float64",
+}
+"""A robot's signals a metric can read, and the type whose fields each has."""
+
+
+def signal_pattern(signal: str) -> str:
+    """The topic name a robot's signal goes under among a run's topics (``~`` is in no bag's)."""
+    return f"/{{ns}}/~{signal}"
+
+
 def topic_name(pattern: str, namespace: str) -> str:
     """``pattern`` with ``{ns}`` replaced by a robot's namespace; a robot at the root (no
     namespace) leaves no empty level: ``/{ns}/odom`` is then ``/odom``.  (``runs.monitor_core``
@@ -153,6 +166,9 @@ class TopicRead:
     fields: tuple[Field, ...] = ()
     """Every field the metric reads of the topic, where it is written: what the bag reader
     decodes, and what ``lang.check_fields`` checks against the bag's definition."""
+    signal: str | None = None
+    """A robot's signal (``pose``, ``velocity``, ``distance``) rather than a topic: ``topic`` is
+    then the name ingestion gives the signal (``/{ns}/~pose``), ``msgtype`` the signal's fields'."""
 
     def topic_of(self, namespace: str) -> str:
         return topic_name(self.topic, namespace)

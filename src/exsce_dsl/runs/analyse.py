@@ -72,6 +72,8 @@ def wanted_topics(metrics: tuple[MetricDefinition, ...], robots: list[Robot]) ->
         for metric in metrics:
             read_paths = fields_read(metric)
             for read in metric.reads:
+                if read.signal:  # a signal: read from the sources runs/signals.py chooses
+                    continue
                 topic = topic_name(read.topic, ns)
                 types.setdefault(topic, ANY if read.msgtype in DISPATCHER else read.msgtype)
                 paths.setdefault(topic, {}).update(dict.fromkeys(read_paths.get(read.name, ())))
@@ -125,7 +127,8 @@ def analyse_bag(path: Path, scenario: Scenario, digest: str | None = None) -> An
     source = scenario.location.file if scenario.location else scenario.id
     monitors = load_monitors(metrics, source)
     declared = [r for r in robots if r.declares_signals]
-    stacks = stack_robots(declared, bag_topics(path) if declared else {})
+    signalled = robots if any(read.signal for m in metrics for read in m.reads) else declared
+    stacks = stack_robots(signalled, bag_topics(path) if signalled else {}, {r.id for r in declared})
     wanted = stacks.adapt(wanted_topics(metrics, robots), robots)
     data = read_bag(path, wanted, reductions(monitors, robots), field_checker(metrics, robots))
     problems = list(data.problems)
@@ -142,7 +145,7 @@ def analyse_bag(path: Path, scenario: Scenario, digest: str | None = None) -> An
         feedback, result = topic_name(_FEEDBACK, ns), topic_name(_RESULT, ns)
         updates = data.feedback.get(feedback)
         dispatched = segments(scenario, robot.id, updates) if updates is not None else None
-        if robot.id not in stacks.sources:
+        if robot.id not in stacks.serves:
             if dispatched is None:
                 problems.append(f"topic {feedback} is missing: no path segments for '{robot.id}'")
                 results[robot.id] = None

@@ -43,7 +43,7 @@ from exsce_dsl.model.conventions import (
     TopicSource,
 )
 from exsce_dsl.model.messages import FieldPath, canonical_type, path_of
-from exsce_dsl.model.metrics import topic_name
+from exsce_dsl.model.metrics import signal_pattern, topic_name
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.runs.bagdata import BagData, Series, Wanted
 from exsce_dsl.runs.decode import TEXTS
@@ -79,7 +79,7 @@ _TF_TEXTS = (path_of("transforms", "header", "frame_id"), path_of("transforms", 
 
 def signal_topic(signal: str, namespace: str) -> str:
     """The name a robot's signal goes under among a run's topics (``~`` is in no bag's topics)."""
-    return topic_name(f"/{{ns}}/~{signal}", namespace)
+    return topic_name(signal_pattern(signal), namespace)
 
 
 @dataclass(frozen=True)

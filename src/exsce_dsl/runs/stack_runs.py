@@ -49,9 +49,12 @@ SERVED = {
 
 @dataclass
 class StackRobots:
-    """What ingestion reads of the robots that declare their signals, and where it came from."""
+    """What ingestion reads of robots' signals, and where it came from: of the robots that declare
+    where their signals are (``serves``: served under the method's names, segmented by their
+    stack's goals) and of every robot when a metric reads a signal (``/{ns}/~pose``...)."""
 
     sources: dict[str, RobotSources] = field(default_factory=dict)
+    serves: set[str] = field(default_factory=set)
     real_topics: dict[str, tuple[str, ...]] = field(default_factory=dict)
     """A served topic name → the bag's topics its values came from."""
 
@@ -61,7 +64,7 @@ class StackRobots:
         adapted = dict(wanted)
         scan_paths: list[FieldPath] = []
         for robot in robots:
-            if robot.id not in self.sources:
+            if robot.id not in self.serves:
                 continue
             for signal, pattern in SERVED.items():
                 served = adapted.pop(topic_name(pattern, robot.namespace), None)
@@ -85,10 +88,16 @@ class StackRobots:
         return adapted
 
     def served_topics(self, data: BagData, problems: list[str]) -> dict[str, Topic]:
-        """The robots' signals under the method's topic names, with the method's fields."""
+        """The robots' signals under their own names (``/{ns}/~pose``), and under the method's
+        topic names with the method's fields for the robots that declare where they are."""
         found: dict[str, Topic] = {}
         for robot in self.sources.values():
             signals = signal_topics(robot, data, problems)
+            for name, series in signals.items():
+                found[name] = series
+                self.real_topics[name] = robot.chosen[name.rsplit("~", 1)[1]].topics
+            if robot.robot not in self.serves:
+                continue
             for signal, pattern in SERVED.items():
                 topic = signals.get(signal_topic(signal, robot.namespace))
                 if topic is None:
@@ -115,9 +124,10 @@ class StackRobots:
         )
 
 
-def stack_robots(robots: list[Robot], available: Mapping[str, str]) -> StackRobots:
-    """The robots that declare their signals, with the sources the bag (``available``) has."""
-    return StackRobots({r.id: choose_sources(r, available) for r in robots if r.declares_signals})
+def stack_robots(robots: list[Robot], available: Mapping[str, str], serves: set[str]) -> StackRobots:
+    """``robots``' signals, from the sources the bag (``available``) has; ``serves``: the robots
+    whose signals are served under the method's topic names."""
+    return StackRobots({r.id: choose_sources(r, available) for r in robots}, serves)
 
 
 def _as_method_fields(name: str, signal: str, topic: Topic) -> Topic:
