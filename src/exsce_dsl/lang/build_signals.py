@@ -8,12 +8,11 @@ A robot type that says none of this follows the method's convention.
 
 from __future__ import annotations
 
-import math
-import re
 from collections.abc import Callable
 from typing import Any
 
 from exsce_dsl.errors import SourceLocation
+from exsce_dsl.lang.build_expressions import read_quantity
 from exsce_dsl.lang.names import is_topic_pattern
 from exsce_dsl.model.conventions import (
     CONVENTIONS,
@@ -32,8 +31,6 @@ from exsce_dsl.model.conventions import (
 )
 from exsce_dsl.model.messages import canonical_type
 
-_QUANTITY = re.compile(r"([-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?)\s*([a-z]*)")
-_METRES = {"": 1.0, "m": 1.0, "cm": 0.01, "mm": 0.001}
 _SIGNAL_FACTS = ("ConventionFact", "PoseFact", "VelocityFact", "ScanFact", "NavigationFact", "ArrivalFact")
 _ACTIONS = {
     Navigation.DISPATCHER: METHOD.actions,
@@ -125,19 +122,9 @@ def _check_topic(topic: str, where: SourceLocation, error: Report) -> bool:
 
 
 def _tolerance(fact: Any, span: Span, error: Report) -> Tolerance:
-    number, unit = _split(fact.position)
-    position = number * _METRES.get(unit, 1.0)
-    heading: float | None = None
-    if fact.heading is not None:
-        number, unit = _split(fact.heading)
-        heading = math.radians(number) if unit == "deg" else number
+    position = read_quantity(fact.position)[0]  # in SI: metres, radians
+    heading = read_quantity(fact.heading)[0] if fact.heading is not None else None
     if position <= 0 or (heading is not None and heading <= 0):
         error("an arrival tolerance is a distance (and an angle) above zero", span(fact))
         return Tolerance()
     return Tolerance(position, heading)
-
-
-def _split(text: str) -> tuple[float, str]:
-    match = _QUANTITY.fullmatch(text.strip())
-    assert match is not None, text  # the grammar lets only such tokens through
-    return float(match.group(1)), match.group(2)

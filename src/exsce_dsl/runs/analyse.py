@@ -19,7 +19,7 @@ from exsce_dsl.model.messages import DISPATCHER, POSE, FieldPath, Fields
 from exsce_dsl.model.metrics import MetricDefinition
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Bag, Run, TaskExecution
-from exsce_dsl.runs.bagdata import ANY, BagError, Check, Reduce, Wanted, bag_topics, read_bag
+from exsce_dsl.runs.bagdata import ANY, BagError, Check, Reduce, StatusUpdate, Wanted, bag_topics, read_bag
 from exsce_dsl.runs.monitor_code import load_monitors
 from exsce_dsl.runs.monitor_core import Compute, Topic, reducer, topic_name
 from exsce_dsl.runs.monitoring import HOTSPOT_PATHS, POSE_TOPIC, compute_metrics
@@ -151,10 +151,7 @@ def analyse_bag(path: Path, scenario: Scenario, digest: str | None = None) -> An
                 results[robot.id] = None
                 continue
             actions.extend(dispatched)
-            final = data.results.get(result)
-            results[robot.id] = (
-                None if final is None else sum(s == SUCCEEDED for u in final for s in u.statuses)
-            )
+            results[robot.id] = _succeeded(data.results.get(result))
             continue
         found = segment_robot(scenario, robot, data, stacks.track(robot, topics), dispatched)
         problems += found.problems
@@ -162,10 +159,7 @@ def analyse_bag(path: Path, scenario: Scenario, digest: str | None = None) -> An
         if found.source and found.source != DISPATCHER_SOURCE:
             segmented_by[robot.id] = found.source
         if found.succeeded is None and dispatched is not None:
-            final = data.results.get(result)
-            results[robot.id] = (
-                None if final is None else sum(s == SUCCEEDED for u in final for s in u.statuses)
-            )
+            results[robot.id] = _succeeded(data.results.get(result))
         else:
             results[robot.id] = found.succeeded
             stacks.real_topics[feedback] = stacks.real_topics[result] = (
@@ -190,6 +184,11 @@ def analyse_bag(path: Path, scenario: Scenario, digest: str | None = None) -> An
         hotspots=tuple(hotspots),
     )
     return AnalysedRun(run, digest, problems)
+
+
+def _succeeded(final: list[StatusUpdate] | None) -> int | None:
+    """Waypoints the dispatcher's results say SUCCEEDED (None: the bag has no result topic)."""
+    return None if final is None else sum(s == SUCCEEDED for u in final for s in u.statuses)
 
 
 def _time(seconds: float) -> dt.datetime:

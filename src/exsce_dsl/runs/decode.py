@@ -94,20 +94,13 @@ class RawMessages:
 
 def vectorisable(catalogue: MessageCatalogue, msgtype: str) -> bool:
     """Whether ``msgtype`` can be decoded by :func:`decode` (no ``wstring`` or ``float128``)."""
-    seen: set[str] = set()
-    todo = [canonical_type(msgtype)]
-    while todo:
-        name = todo.pop()
-        if name in seen:
-            continue
-        seen.add(name)
-        for _, desc in catalogue.fields_of(name):
+    catalogue.fields_of(msgtype)  # an unknown type is an error, not "vectorisable"
+    for _, fields in catalogue.needed(msgtype).values():
+        for _, desc in fields:
             while int(desc[0]) in (ARRAY, SEQUENCE):
                 desc = desc[1][0]
             if int(desc[0]) == BASE and desc[1][0] in _UNVECTORISED:
                 return False
-            if int(desc[0]) == NAME:
-                todo.append(canonical_type(desc[1]))
     return True
 
 

@@ -38,8 +38,7 @@ import importlib
 import mmap
 import struct
 import zlib
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -47,7 +46,7 @@ import numpy as np
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.runs.decode import RawMessages
-from exsce_dsl.runs.ros1_index import Decoder, Messages, UnsupportedBag
+from exsce_dsl.runs.ros1_index import Decoder, Messages, UnsupportedBag, mapped
 
 MAGIC = b"\x89MCAP0\r\n"
 OP_FOOTER = 0x02
@@ -154,33 +153,20 @@ def read_topics(path: Path, topics: set[str], decoder: Decoder) -> dict[str, Mes
     ``definition`` is the schema's text; its encoding (``ros2msg`` or ``ros2idl``) is
     :func:`schemas`' ``encoding``, the same for every channel of a topic read here (a topic
     whose channels carry different schemas is an :class:`UnsupportedBag`)."""
-    with _mapped(path) as data:
+    with mapped(path) as data:
         return _read_topics(data, topics, decoder)
 
 
 def schemas(path: Path) -> dict[str, Schema]:
     """Topic → the schema of its channels (of its first channel if they differ), from the
     summary section."""
-    with _mapped(path) as data:
+    with mapped(path) as data:
         summary = _summary(data)
     found: dict[str, Schema] = {}
     for _, channel in sorted(summary.channels.items()):
         if channel.schema is not None:
             found.setdefault(channel.topic, channel.schema)
     return found
-
-
-@contextmanager
-def _mapped(path: Path) -> Iterator[mmap.mmap]:
-    with path.open("rb") as f:
-        try:
-            data = mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ)
-        except ValueError as exc:  # an empty file
-            raise UnsupportedBag(str(exc)) from None
-        try:
-            yield data
-        finally:
-            data.close()  # nothing views the map (see the module's docstring): this cannot fail
 
 
 class _Fields:

@@ -28,6 +28,7 @@ from exsce_dsl.model.conventions import Navigation, Signals
 from exsce_dsl.model.metrics import topic_name
 from exsce_dsl.runs.bagdata import OBJECTS, BagData, Wanted
 from exsce_dsl.runs.goal_segments import Goal
+from exsce_dsl.runs.tf_poses import yaw_from_quaternion
 
 NAV2_STATUS = {1: "ACCEPTED", 2: "EXECUTING", 3: "CANCELING", 4: "SUCCEEDED", 5: "CANCELED", 6: "ABORTED"}
 NAV2_FINAL = {4, 5, 6}
@@ -89,7 +90,7 @@ def read_goals(signals: Signals, namespace: str, data: BagData) -> tuple[list[Go
             }
             goals += _statuses(
                 status,
-                lambda entry: str(entry.goal_id.id),
+                lambda entry: _move_base_key(entry.goal_id),
                 MOVE_BASE_STATUS,
                 MOVE_BASE_FINAL,
                 started_at={1},
@@ -177,5 +178,5 @@ def _uuid(goal_id: Any) -> str:
 
 def _xy_yaw(pose: Any) -> tuple[float, float, float]:
     q = pose.orientation
-    yaw = float(np.arctan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z)))
+    yaw = float(yaw_from_quaternion(np.array([[q.x, q.y, q.z, q.w]]))[0])
     return float(pose.position.x), float(pose.position.y), yaw

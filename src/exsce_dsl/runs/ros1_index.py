@@ -73,7 +73,9 @@ def _record(buf: Buffer, pos: int) -> tuple[dict[str, bytes], int, int]:
 
 
 @contextmanager
-def _mapped(path: Path) -> Iterator[mmap.mmap]:
+def mapped(path: Path) -> Iterator[mmap.mmap]:
+    """The file mapped read-only (an empty file is :class:`UnsupportedBag`), closed however the
+    reading ends."""
     with path.open("rb") as f:
         try:
             data = mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ)
@@ -93,13 +95,13 @@ def _mapped(path: Path) -> Iterator[mmap.mmap]:
 def read_topics(path: Path, topics: set[str], decoder: Decoder) -> dict[str, Messages]:
     """The messages of ``topics``, handed to ``decoder`` a chunk at a time, so only what it keeps
     stays in memory, never the chunks themselves."""
-    with _mapped(path) as data:
+    with mapped(path) as data:
         return _read_topics(data, topics, decoder)
 
 
 def connections(path: Path) -> dict[str, str]:
     """Topic → message type (``pkg/msg/Name``) of every connection of a ROS 1 bag, from its index."""
-    with _mapped(path) as data:
+    with mapped(path) as data:
         found, _, _ = _connections(data, None)
         return {topic: _ros2_name(msgtype) for topic, msgtype, _ in found.values()}
 

@@ -115,13 +115,11 @@ class StackRobots:
         return replace(value, topics=tuple(dict.fromkeys(named)))
 
     def track(self, robot: Robot, topics: Mapping[str, Topic]) -> Track:
-        pose = topics.get(topic_name(SERVED["pose"], robot.namespace))
+        """The robot's pose signal, for segmentation (empty if the bag has none)."""
+        pose = topics.get(signal_topic("pose", robot.namespace))
         if pose is None or not len(pose):
             return Track.empty()
-        quarter = np.arctan2(pose.fields["pose.pose.orientation.z"], pose.fields["pose.pose.orientation.w"])
-        return Track(
-            pose.t, pose.fields["pose.pose.position.x"], pose.fields["pose.pose.position.y"], 2 * quarter
-        )
+        return Track(pose.t, pose.fields["x"], pose.fields["y"], pose.fields["yaw"])
 
 
 def stack_robots(robots: list[Robot], available: Mapping[str, str], serves: set[str]) -> StackRobots:
