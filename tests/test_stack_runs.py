@@ -96,8 +96,10 @@ def test_without_goals_a_run_is_segmented_by_arrival(tmp_path: Path, method_run:
     ours, reference = _values(analysed), _values(method_run)
     segments = [k for k in reference if k[0] == "task_duration" and k[2] == "segment"]
     assert len(segments) == 3 and all(k in ours for k in segments)
-    for key in segments:  # arrival within 0.35 m comes a little before the goal's success
-        assert 0 <= reference[key] - ours[key] < 3.0 or abs(reference[key] - ours[key]) < 1.5, key
+    # a segment ends on arrival within 0.35 m, before the goal's success (0.35 m at the ~0.3 m/s of
+    # the approach: ~1.2 s), and the first starts when the robot first moves, not when its goal does
+    for key in segments:
+        assert abs(reference[key] - ours[key]) <= 2.0, (key, reference[key], ours[key])
     assert ours[("waypoints_visited", "r1", "robot")] == 2
 
 
