@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 from rosbags.highlevel import AnyReader
 from rosbags.typesys import Stores, get_typestore
+from yard_spec import yard_text
 
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.model import Scenario
@@ -25,46 +26,10 @@ from exsce_dsl.runs.signals import RobotSources, choose_sources, signal_topic, s
 from exsce_dsl.runs.trajectories import trajectories
 from exsce_dsl.sim.run import simulate
 
-YARD = """
-environment yard {
-  area yard {
-    pose yard-a at (0.0, 0.0)
-    pose yard-b at (5.0, 0.0)
-    pose yard-c at (5.0, 4.0) facing 90.0 deg
-    pose yard-d at (0.0, 8.0)
-    pose yard-e at (5.0, 8.0)
-  }
-}
-
-robot type rover {
-  base diff_drive
-ROBOT_TYPE}
-
-task round_1 {
-  visit yard-b
-  visit yard-c
-}
-
-task round_2 {
-  visit yard-e
-}
-
-scenario yard_run in yard {
-  robots {
-    r1: rover namespace "" starts at yard-a
-    r2: rover starts at yard-d
-  }
-  mission yard_mission parallel {
-    r1 does round_1
-    r2 does round_2
-  }
-}
-"""
-
 
 def _scenario(tmp_path: Path, robot_type: str) -> Scenario:
     path = tmp_path / "yard.exsce"
-    path.write_text(YARD.replace("ROBOT_TYPE", "".join(f"  {line}\n" for line in robot_type.splitlines())))
+    path.write_text(yard_text(robot_type))
     return load_spec(path).scenario()
 
 

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 from rosbags.highlevel import AnyReader
 from rosbags.typesys import Stores, get_typestore
-from test_signals import YARD
+from yard_spec import yard_text
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.lang.build import load_spec
@@ -28,7 +28,7 @@ from exsce_dsl.sim.run import simulate
 
 def _scenario(tmp_path: Path, robot_type: str, name: str) -> Scenario:
     path = tmp_path / f"{name}.exsce"
-    path.write_text(YARD.replace("ROBOT_TYPE", "".join(f"  {line}\n" for line in robot_type.splitlines())))
+    path.write_text(yard_text(robot_type))
     return load_spec(path).scenario()
 
 
@@ -124,7 +124,7 @@ def test_the_executor_writes_the_convention_the_robot_types_name(tmp_path: Path)
 
 def test_robots_of_two_conventions_need_one_chosen(tmp_path: Path) -> None:
     text = (
-        YARD.replace("ROBOT_TYPE", "  convention nav2\n").replace("r2: rover starts", "r2: plain starts")
+        yard_text("convention nav2").replace("r2: rover starts", "r2: plain starts")
         + "\nrobot type plain {\n  torso no\n}\n"
     )
     path = tmp_path / "mixed.exsce"
@@ -198,9 +198,7 @@ metric fastest_turn for each robot {
 
 def _signal_run(tmp_path: Path, robot_type: str, convention: str) -> AnalysedRun:
     path = tmp_path / f"signals-{convention}.exsce"
-    path.write_text(
-        YARD.replace("ROBOT_TYPE", "".join(f"  {line}\n" for line in robot_type.splitlines())) + SIGNAL_METRICS
-    )
+    path.write_text(yard_text(robot_type) + SIGNAL_METRICS)
     scenario = load_spec(path).scenario()
     (run,) = simulate(scenario, tmp_path / f"bags-{convention}", fmt="ros1", seed=5)
     return analyse_bag(run.bag, scenario)
