@@ -311,16 +311,14 @@ class _Walker:
         width = int(sizes.max(initial=0))
         inside = np.arange(width) < sizes[:, None]
         table = np.where(inside, self.buffer[np.where(inside, pos[:, None] + np.arange(width), 0)], 0)
-        size_bytes = sizes.astype("<u4").view(np.uint8).reshape(-1, 4)
-        rows = np.concatenate([table.astype(np.uint8), size_bytes], axis=1)
-        distinct, inverse = np.unique(rows.view(f"V{width + 4}").ravel(), return_inverse=True)
-        codes = np.empty(len(distinct), dtype=np.float64)
-        for i, row in enumerate(distinct):
+        rows = np.concatenate([table.astype(np.uint8), sizes.astype("<u4").view(np.uint8).reshape(-1, 4)], 1)
+        first, inverse = _distinct_rows(rows)
+        codes = np.empty(len(first), dtype=np.float64)
+        for i, row in enumerate(rows[first]):
             raw = bytes(row)
             size = int.from_bytes(raw[width:], "little")
-            text = raw[:size].decode("utf-8", "replace")
-            codes[i] = self.texts.setdefault(text, len(self.texts))
-        result: np.ndarray = codes[inverse.ravel()]
+            codes[i] = self.texts.setdefault(raw[:size].decode("utf-8", "replace"), len(self.texts))
+        result: np.ndarray = codes[inverse]
         return result
 
     def _numbers(
@@ -496,6 +494,27 @@ def _element(counts: np.ndarray, index: Index) -> np.ndarray:
     if index.position < 0:
         which = counts + index.position
     return np.where((which >= 0) & (which < counts), which, -1)
+
+
+def _distinct_rows(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The distinct rows of a uint8 table: the index of each one's first occurrence, and which of
+    them every row is.  Rows are keyed by a 64-bit hash of their bytes, so numpy sorts integers, not
+    byte strings; a collision (rows with one key that differ) falls back to sorting the bytes."""
+    n, width = rows.shape
+    words = np.zeros((n, -(-width // 8) * 8), dtype=np.uint8)
+    words[:, :width] = rows
+    keys = np.zeros(n, dtype=np.uint64)
+    for column in words.view("<u8").T:  # FNV-style mixing, one 8-byte word at a time
+        keys = (keys ^ column) * np.uint64(0x100000001B3)
+        keys ^= keys >> np.uint64(29)
+    _, first, inverse = np.unique(keys, return_index=True, return_inverse=True)
+    inverse = inverse.ravel()
+    if not np.array_equal(rows[first][inverse], rows):
+        _, first, inverse = np.unique(
+            np.ascontiguousarray(rows).view(f"V{width}").ravel(), return_index=True, return_inverse=True
+        )
+        inverse = inverse.ravel()
+    return first, inverse
 
 
 def _spread(values: np.ndarray, active: np.ndarray, n: int) -> np.ndarray:

@@ -20,7 +20,7 @@ import struct
 import traceback
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -138,6 +138,30 @@ def _connections(
     return found, pos, chunk_count
 
 
+BATCH_BYTES = 16 << 20
+"""Chunks are decoded together until they hold this many bytes: the decoder's Python work is per
+call and per field, not per message, so a few large calls cost less than one per 768 kB chunk."""
+
+
+@dataclass
+class _Batch:
+    """Consecutive chunks not yet decoded, with each wanted connection's messages in them."""
+
+    chunks: list[np.ndarray] = field(default_factory=list)
+    size: int = 0
+    entries: dict[int, list[tuple[np.ndarray, np.ndarray, np.ndarray]]] = field(default_factory=dict)
+    """Connection → (receive times in ns, starts, ends) per chunk, offsets into the joined chunks."""
+
+    def add(self, conn: int, times: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> None:
+        """Messages of the chunk being read (offsets into it)."""
+        self.entries.setdefault(conn, []).append((times, starts + self.size, ends + self.size))
+
+    def close_chunk(self, chunk: np.ndarray) -> None:
+        """The chunk being read is done: the next one's offsets start after it."""
+        self.chunks.append(chunk)
+        self.size += len(chunk)
+
+
 def _read_topics(data: mmap.mmap, topics: set[str], decoder: Decoder) -> dict[str, Messages]:
     wanted, pos, chunk_count = _connections(data, topics)
     chunks = []
@@ -148,56 +172,34 @@ def _read_topics(data: mmap.mmap, topics: set[str], decoder: Decoder) -> dict[st
         chunks.append(struct.unpack("<Q", fields["chunk_pos"])[0])
     times_of: dict[int, list[np.ndarray]] = {c: [] for c in wanted}
     raws_of: dict[int, list[bytes]] = {c: [] for c in wanted}
+
+    def decode(batch: _Batch) -> None:
+        if not batch.entries:
+            return
+        joined = batch.chunks[0] if len(batch.chunks) == 1 else np.concatenate(batch.chunks)
+        for conn, parts in batch.entries.items():
+            times = np.concatenate([t for t, _, _ in parts])
+            starts = np.concatenate([a for _, a, _ in parts])
+            ends = np.concatenate([b for _, _, b in parts])
+            topic, msgtype, definition = wanted[conn]
+            if not decoder(topic, _ros2_name(msgtype), definition, times, RawMessages(joined, starts, ends)):
+                raws_of[conn].extend(
+                    bytes(joined[a:b]) for a, b in zip(starts.tolist(), ends.tolist(), strict=True)
+                )
+            times_of[conn].append(times)
+
     view = np.frombuffer(data, dtype=np.uint8)
+    batch, batch_from = _Batch(), 0
     for chunk_pos in chunks:
-        fields, data_at, after = _record(data, chunk_pos)
-        compression = fields.get("compression", b"none")
-        if after > len(data):
-            raise UnsupportedBag("a chunk runs past the end of the file (truncated?)")
-        raw = data[data_at:after] if compression != b"none" else b""
-        if compression == b"none":
-            chunk = view[data_at:after]
-        elif compression == b"bz2":
-            chunk = np.frombuffer(bz2.decompress(raw), dtype=np.uint8)
-        elif compression == b"lz4":
-            try:
-                import lz4.frame  # type: ignore[import-untyped]  # rosbags' own dependency
-            except ImportError as exc:  # pragma: no cover
-                raise UnsupportedBag("lz4 chunks need the lz4 package") from exc
-            chunk = np.frombuffer(lz4.frame.decompress(raw), dtype=np.uint8)
-        else:
-            raise UnsupportedBag(f"chunk compression {compression!r}")
-        pos = after
-        while pos < len(data):  # the index-data records that follow the chunk
-            fields, idx_at, nxt = _record(data, pos)
-            if fields.get("op") != bytes([OP_INDEX]):
-                break
-            if fields.get("ver") != struct.pack("<I", 1):  # rosbag writes version 1: 12-byte entries
-                raise UnsupportedBag(f"index-data records of version {fields.get('ver')!r}, not 1")
-            conn = struct.unpack("<I", fields["conn"])[0]
-            if conn in wanted:
-                count = struct.unpack("<I", fields["count"])[0]
-                if nxt - idx_at != 12 * count:
-                    raise UnsupportedBag("an index-data record whose size is not its count's")
-                entries = view[idx_at : idx_at + 12 * count].view("<u4").reshape(count, 3)
-                times = entries[:, 0].astype(np.int64) * 1_000_000_000 + entries[:, 1]
-                offsets = entries[:, 2].astype(np.int64)
-                header_len = _u32(chunk, offsets)
-                data_len = _u32(chunk, offsets + 4 + header_len)
-                starts = offsets + 8 + header_len
-                if count and int((starts + data_len).max()) > len(chunk):
-                    raise UnsupportedBag("a message runs past the end of its chunk")
-                topic, msgtype, definition = wanted[conn]
-                messages = RawMessages(chunk, starts, starts + data_len)
-                if not decoder(topic, _ros2_name(msgtype), definition, times, messages):
-                    raws_of[conn].extend(
-                        bytes(chunk[a : a + n])
-                        for a, n in zip(starts.tolist(), data_len.tolist(), strict=True)
-                    )
-                times_of[conn].append(times)
-            pos = nxt
-        del chunk
-        _release(data, chunk_pos, pos)
+        if not batch.chunks:
+            batch_from = chunk_pos
+        pos = _read_chunk(data, view, chunk_pos, wanted, batch)
+        if batch.size >= BATCH_BYTES:
+            decode(batch)
+            batch = _Batch()
+            _release(data, batch_from, pos)
+    decode(batch)
+    del batch
     out: dict[str, Messages] = {}
     for conn, (topic, msgtype, definition) in wanted.items():
         if not times_of[conn]:
@@ -210,6 +212,54 @@ def _read_topics(data: mmap.mmap, topics: set[str], decoder: Decoder) -> dict[st
         else:
             out[topic] = Messages(_ros2_name(msgtype), definition, times, raws_of[conn])
     return out
+
+
+def _read_chunk(
+    data: mmap.mmap, view: np.ndarray, chunk_pos: int, wanted: dict[int, tuple[str, str, str]], batch: _Batch
+) -> int:
+    """Add the chunk at ``chunk_pos`` and its wanted messages to ``batch``; where the records after
+    its index-data records start."""
+    fields, data_at, after = _record(data, chunk_pos)
+    compression = fields.get("compression", b"none")
+    if after > len(data):
+        raise UnsupportedBag("a chunk runs past the end of the file (truncated?)")
+    raw = data[data_at:after] if compression != b"none" else b""
+    if compression == b"none":
+        chunk = view[data_at:after]
+    elif compression == b"bz2":
+        chunk = np.frombuffer(bz2.decompress(raw), dtype=np.uint8)
+    elif compression == b"lz4":
+        try:
+            import lz4.frame  # type: ignore[import-untyped]  # rosbags' own dependency
+        except ImportError as exc:  # pragma: no cover
+            raise UnsupportedBag("lz4 chunks need the lz4 package") from exc
+        chunk = np.frombuffer(lz4.frame.decompress(raw), dtype=np.uint8)
+    else:
+        raise UnsupportedBag(f"chunk compression {compression!r}")
+    pos = after
+    while pos < len(data):  # the index-data records that follow the chunk
+        fields, idx_at, nxt = _record(data, pos)
+        if fields.get("op") != bytes([OP_INDEX]):
+            break
+        if fields.get("ver") != struct.pack("<I", 1):  # rosbag writes version 1: 12-byte entries
+            raise UnsupportedBag(f"index-data records of version {fields.get('ver')!r}, not 1")
+        conn = struct.unpack("<I", fields["conn"])[0]
+        if conn in wanted:
+            count = struct.unpack("<I", fields["count"])[0]
+            if nxt - idx_at != 12 * count:
+                raise UnsupportedBag("an index-data record whose size is not its count's")
+            entries = view[idx_at : idx_at + 12 * count].view("<u4").reshape(count, 3)
+            times = entries[:, 0].astype(np.int64) * 1_000_000_000 + entries[:, 1]
+            offsets = entries[:, 2].astype(np.int64)
+            header_len = _u32(chunk, offsets)
+            data_len = _u32(chunk, offsets + 4 + header_len)
+            starts = offsets + 8 + header_len
+            if count and int((starts + data_len).max()) > len(chunk):
+                raise UnsupportedBag("a message runs past the end of its chunk")
+            batch.add(conn, times, starts, starts + data_len)
+        pos = nxt
+    batch.close_chunk(chunk)
+    return pos
 
 
 def _release(data: mmap.mmap, start: int, end: int) -> None:

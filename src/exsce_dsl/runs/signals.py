@@ -287,17 +287,16 @@ def _edges(series: Series, static: bool) -> list[EdgeSeries]:
     translation = np.stack([fields[f"transforms.transform.translation.{a}"][held] for a in _AXES], axis=1)
     rotation = np.stack([fields[f"transforms.transform.rotation.{a}"][held] for a in _QUATERNION], axis=1)
     parent_codes, child_codes, times = parents[held].astype(int), children[held].astype(int), stamp[held]
-    pairs = np.stack([parent_codes, child_codes], axis=1)
-    distinct, which = np.unique(pairs, axis=0, return_inverse=True)
+    pairs = parent_codes * len(texts) + child_codes  # one integer per (parent, child): cheap to sort
+    distinct, which = np.unique(pairs, return_inverse=True)
     which = which.ravel()
-    return [
-        EdgeSeries(
-            str(texts[p]),
-            str(texts[c]),
-            times[which == k],
-            translation[which == k],
-            rotation[which == k],
-            static=static,
+    edges = []
+    for k, pair in enumerate(distinct.tolist()):
+        mine = which == k
+        parent, child = divmod(pair, len(texts))
+        edges.append(
+            EdgeSeries(
+                str(texts[parent]), str(texts[child]), times[mine], translation[mine], rotation[mine], static
+            )
         )
-        for k, (p, c) in enumerate(distinct.tolist())
-    ]
+    return edges

@@ -6,6 +6,7 @@ Per robot namespace (the root for ``""``):
 |---|---|---|
 | ``tf`` | tf2_msgs/TFMessage: ``odom → base_link`` | 50 Hz (odometry) |
 | ``tf`` | tf2_msgs/TFMessage: ``map → odom`` | 10 Hz (the localiser) |
+| ``tf`` | tf2_msgs/TFMessage: ``base_link →`` both wheels and the caster | 100 Hz (robot_state_publisher) |
 | ``tf_static`` | ``base_link → base_footprint``, ``base_link → base_laser_link`` | once, latched |
 | ``odom`` | nav_msgs/Odometry (odometry's pose, body twist) | 50 Hz |
 | ``amcl_pose`` | geometry_msgs/PoseWithCovarianceStamped (the estimate) | 2 Hz |
@@ -13,17 +14,22 @@ Per robot namespace (the root for ``""``):
 | ``scan`` | sensor_msgs/LaserScan | 10 Hz |
 
 Frames are plain (``map``, ``odom``, ``base_link``): each robot's TF is on its own namespaced
-``tf`` topic, as Nav2's multi-robot bringup remaps it, so frame names need no prefix.  See
-:mod:`exsce_dsl.sim.localisation` for the odometry's drift and the estimate's noise.
+``tf`` topic, as Nav2's multi-robot bringup remaps it, so frame names need no prefix.  The wheels'
+transforms are off the map → base_link chain, as a real robot's joints are: a reader of the pose
+must step over them.  See :mod:`exsce_dsl.sim.localisation` for the odometry's drift and the
+estimate's noise.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator
+from typing import Any
 
 import numpy as np
 
 from exsce_dsl.sim.localisation import LOCALISATION_NOISE, LOCALISATION_YAW_NOISE, Localisation
+from exsce_dsl.sim.motion import DT
 from exsce_dsl.sim.scan import laser_scans
 from exsce_dsl.sim.values import header, pose, transform, twist
 from exsce_dsl.sim.writing import Message, RobotRun
@@ -33,6 +39,13 @@ ODOM_EVERY, CORRECTION_EVERY, AMCL_EVERY = 1, 5, 25  # samples of the 50 Hz cloc
 CMD_VEL_PERIOD_NS = 50_000_000  # 20 Hz: Nav2's default controller_frequency
 FOOTPRINT_HEIGHT = 0.1  # base_footprint: on the floor, below base_link
 LASER_HEIGHT = 0.2  # base_laser_link: above base_link's origin, where the executor's scans start
+JOINTS_PER_SAMPLE = 2  # robot_state_publisher at 100 Hz: twice per sample of the 50 Hz clock
+WHEELS = (
+    ("wheel_left_link", 0.0, 0.2, 0.0985),
+    ("wheel_right_link", 0.0, -0.2, 0.0985),
+    ("caster_back_link", -0.2, 0.0, 0.025),
+)
+"""Each wheel's frame, its axle's place in base_link (x, y metres) and its radius (metres; TIAGo's)."""
 TF_STATIC = "tf_static"
 """The latched topic (ROS 1 latching, ROS 2 transient-local durability)."""
 
@@ -71,6 +84,42 @@ def _tf(run: RobotRun, frames: Localisation, stamps: np.ndarray) -> Iterator[Mes
             store, int(stamps[i]), MAP, ODOM, correction.x[i], correction.y[i], correction.yaw[i]
         )
         yield tf, kind, int(stamps[i]), T[kind](transforms=[corrected])
+    yield from _joints(run, frames, stamps)
+
+
+def _joints(run: RobotRun, frames: Localisation, stamps: np.ndarray) -> Iterator[Message]:
+    """robot_state_publisher's moving joints: each wheel turned about its axle (y) by the distance its
+    contact point rolled, at twice the clock's rate (angles interpolated between samples)."""
+    T, store = run.store.types, run.store
+    kind = "tf2_msgs/msg/TFMessage"
+    times = np.arange(len(stamps) * JOINTS_PER_SAMPLE) / JOINTS_PER_SAMPLE
+    joint_stamps = np.interp(times, np.arange(len(stamps)), stamps.astype(float)).astype(np.int64)
+    angles = []
+    for _, _, y, radius in WHEELS:
+        speed = frames.v - frames.w * y  # the wheel's forward speed: the body's, less the turn's share
+        rolled = np.concatenate([[0.0], np.cumsum(speed[:-1] * DT)])
+        angles.append(np.interp(times, np.arange(len(stamps)), rolled / radius))
+    for k, stamp in enumerate(joint_stamps.tolist()):
+        transforms = [
+            _wheel(store, stamp, child, x, y, float(angle[k]))
+            for (child, x, y, _), angle in zip(WHEELS, angles, strict=True)
+        ]
+        yield run.topic("tf"), kind, stamp, T[kind](transforms=transforms)
+
+
+def _wheel(store: Any, ns: int, child: str, x: float, y: float, angle: float) -> Any:
+    """The transform base_link → a wheel turned by ``angle`` radians about its axle."""
+    T = store.types
+    return T["geometry_msgs/msg/TransformStamped"](
+        header=header(store, ns, BASE),
+        child_frame_id=child,
+        transform=T["geometry_msgs/msg/Transform"](
+            translation=T["geometry_msgs/msg/Vector3"](x=x, y=y, z=0.0),
+            rotation=T["geometry_msgs/msg/Quaternion"](
+                x=0.0, y=math.sin(angle / 2), z=0.0, w=math.cos(angle / 2)
+            ),
+        ),
+    )
 
 
 def _odometry(run: RobotRun, frames: Localisation, stamps: np.ndarray) -> Iterator[Message]:
