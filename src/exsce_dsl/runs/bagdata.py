@@ -322,8 +322,7 @@ class _Reading:
         if vectorisable(catalogue, msgtype):
             return decode(catalogue, msgtype, messages, wanted.paths, cdr, wanted.texts)
         store = deserializer_for(catalogue, msgtype)
-        spans = zip(messages.starts.tolist(), messages.ends.tolist(), strict=True)
-        raws = [messages.buffer[start:end].tobytes() for start, end in spans]
+        raws = messages.raws()
         read = store.deserialize_cdr if cdr else store.deserialize_ros1
         return decode_slowly(lambda raw: read(raw, msgtype), raws, wanted.paths, wanted.texts)
 

@@ -75,6 +75,11 @@ class RawMessages:
     def __len__(self) -> int:
         return len(self.starts)
 
+    def raws(self) -> list[bytes]:
+        """Each message's bytes."""
+        spans = zip(self.starts.tolist(), self.ends.tolist(), strict=True)
+        return [self.buffer[start:end].tobytes() for start, end in spans]
+
     @staticmethod
     def join(raws: Sequence[bytes | memoryview]) -> RawMessages:
         """Messages given one by one, joined into one buffer."""

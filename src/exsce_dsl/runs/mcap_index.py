@@ -45,7 +45,7 @@ from pathlib import Path
 import numpy as np
 
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.runs.decode import RawMessages
+from exsce_dsl.runs.chunk_batches import ChunkBatch
 from exsce_dsl.runs.ros1_index import Decoder, Messages, UnsupportedBag, mapped
 
 MAGIC = b"\x89MCAP0\r\n"
@@ -147,8 +147,8 @@ DECOMPRESSORS: dict[str, Callable[[bytes], bytes]] = {"": _stored, "zstd": _zstd
 
 
 def read_topics(path: Path, topics: set[str], decoder: Decoder) -> dict[str, Messages]:
-    """The messages of ``topics``, handed to ``decoder`` a chunk and a channel at a time, so
-    only what it keeps stays in memory, never the chunks themselves.
+    """The messages of ``topics``, handed to ``decoder`` a batch of chunks and a channel at a time,
+    so only what it keeps stays in memory, never the whole bag's chunks.
 
     ``definition`` is the schema's text; its encoding (``ros2msg`` or ``ros2idl``) is
     :func:`schemas`' ``encoding``, the same for every channel of a topic read here (a topic
@@ -326,6 +326,16 @@ def _read_topics(data: mmap.mmap, topics: set[str], decoder: Decoder) -> dict[st
     wanted = _wanted(summary, topics)
     times_of: dict[int, list[np.ndarray]] = {c: [] for c in wanted}
     raws_of: dict[int, list[bytes]] = {c: [] for c in wanted}
+
+    def decode(batch: ChunkBatch) -> None:
+        for cid, times, messages in batch.messages():
+            channel = wanted[cid]
+            assert channel.schema is not None  # _wanted checked it
+            if not decoder(channel.topic, channel.schema.name, channel.schema.text, times, messages):
+                raws_of[cid].extend(messages.raws())
+            times_of[cid].append(times)
+
+    batch, batch_from, batch_to = ChunkBatch(), 0, 0
     for index in summary.chunks:
         if not index.message_indexes:
             if index.message_start_time <= index.message_end_time:
@@ -334,20 +344,21 @@ def _read_topics(data: mmap.mmap, topics: set[str], decoder: Decoder) -> dict[st
         here = sorted(wanted.keys() & index.message_indexes.keys())
         if not here:
             continue
-        buffer = _chunk_records(data, index)
-        chunk = np.frombuffer(buffer, dtype=np.uint8)
+        if not batch.chunks:
+            batch_from = index.start
+        chunk = np.frombuffer(_chunk_records(data, index), dtype=np.uint8)
         for cid in here:
             times, offsets = _message_index(data, index.message_indexes[cid], cid)
-            if not len(times):
-                continue
-            starts, ends = _message_data(chunk, offsets, times, cid)
-            channel = wanted[cid]
-            assert channel.schema is not None  # _wanted checked it
-            messages = RawMessages(chunk, starts, ends)
-            if not decoder(channel.topic, channel.schema.name, channel.schema.text, times, messages):
-                raws_of[cid].extend(buffer[a:b] for a, b in zip(starts.tolist(), ends.tolist(), strict=True))
-            times_of[cid].append(times)
-        _release(data, index.start, index.start + index.length + index.message_index_length)
+            if len(times):
+                batch.add(cid, times, *_message_data(chunk, offsets, times, cid))
+        batch.close_chunk(chunk)
+        batch_to = index.start + index.length + index.message_index_length
+        if batch.full:
+            decode(batch)
+            batch = ChunkBatch()
+            _release(data, batch_from, batch_to)
+    decode(batch)
+    del batch
     if summary.message_counts is not None:
         for cid, channel in wanted.items():
             found = sum(len(t) for t in times_of[cid])

@@ -4,9 +4,9 @@ rosbags hands out one Python tuple per message (about 100,000 messages/s
 here).  A ROS 1 bag (format 2.0) indexes every message: after each chunk come
 index-data records giving, per connection, each message's time and offset in
 the chunk.  So for each chunk we read the index as arrays, find each message's
-data with a vectorised gather, and hand the chunk's messages of a connection
-to a decoder as one buffer with their offsets: per chunk Python work, no
-per-message Python work.
+data with a vectorised gather, and hand a connection's messages of a batch of
+chunks (:mod:`exsce_dsl.runs.chunk_batches`) to a decoder as one buffer with
+their offsets: Python work per batch, none per message.
 
 Uncompressed, bz2 and lz4 chunks are read; anything unexpected raises
 :class:`UnsupportedBag` and the caller falls back to rosbags.
@@ -20,11 +20,12 @@ import struct
 import traceback
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from exsce_dsl.runs.chunk_batches import ChunkBatch
 from exsce_dsl.runs.decode import RawMessages
 
 MAGIC = b"#ROSBAG V2.0\n"
@@ -38,7 +39,7 @@ class UnsupportedBag(Exception):
 Buffer = bytes | memoryview | mmap.mmap
 
 Decoder = Callable[[str, str, str, np.ndarray, RawMessages], bool]
-"""(topic, message type, its definition, receive times in ns, the messages of one chunk) → whether
+"""(topic, message type, its definition, receive times in ns, its messages in a batch of chunks) → whether
 it took them; False keeps their raw bytes (for messages deserialized whole)."""
 
 
@@ -93,8 +94,8 @@ def mapped(path: Path) -> Iterator[mmap.mmap]:
 
 
 def read_topics(path: Path, topics: set[str], decoder: Decoder) -> dict[str, Messages]:
-    """The messages of ``topics``, handed to ``decoder`` a chunk at a time, so only what it keeps
-    stays in memory, never the chunks themselves."""
+    """The messages of ``topics``, handed to ``decoder`` a batch of chunks at a time, so only what
+    it keeps stays in memory, never the whole bag's chunks."""
     with mapped(path) as data:
         return _read_topics(data, topics, decoder)
 
@@ -138,30 +139,6 @@ def _connections(
     return found, pos, chunk_count
 
 
-BATCH_BYTES = 16 << 20
-"""Chunks are decoded together until they hold this many bytes: the decoder's Python work is per
-call and per field, not per message, so a few large calls cost less than one per 768 kB chunk."""
-
-
-@dataclass
-class _Batch:
-    """Consecutive chunks not yet decoded, with each wanted connection's messages in them."""
-
-    chunks: list[np.ndarray] = field(default_factory=list)
-    size: int = 0
-    entries: dict[int, list[tuple[np.ndarray, np.ndarray, np.ndarray]]] = field(default_factory=dict)
-    """Connection → (receive times in ns, starts, ends) per chunk, offsets into the joined chunks."""
-
-    def add(self, conn: int, times: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> None:
-        """Messages of the chunk being read (offsets into it)."""
-        self.entries.setdefault(conn, []).append((times, starts + self.size, ends + self.size))
-
-    def close_chunk(self, chunk: np.ndarray) -> None:
-        """The chunk being read is done: the next one's offsets start after it."""
-        self.chunks.append(chunk)
-        self.size += len(chunk)
-
-
 def _read_topics(data: mmap.mmap, topics: set[str], decoder: Decoder) -> dict[str, Messages]:
     wanted, pos, chunk_count = _connections(data, topics)
     chunks = []
@@ -173,30 +150,22 @@ def _read_topics(data: mmap.mmap, topics: set[str], decoder: Decoder) -> dict[st
     times_of: dict[int, list[np.ndarray]] = {c: [] for c in wanted}
     raws_of: dict[int, list[bytes]] = {c: [] for c in wanted}
 
-    def decode(batch: _Batch) -> None:
-        if not batch.entries:
-            return
-        joined = batch.chunks[0] if len(batch.chunks) == 1 else np.concatenate(batch.chunks)
-        for conn, parts in batch.entries.items():
-            times = np.concatenate([t for t, _, _ in parts])
-            starts = np.concatenate([a for _, a, _ in parts])
-            ends = np.concatenate([b for _, _, b in parts])
+    def decode(batch: ChunkBatch) -> None:
+        for conn, times, messages in batch.messages():
             topic, msgtype, definition = wanted[conn]
-            if not decoder(topic, _ros2_name(msgtype), definition, times, RawMessages(joined, starts, ends)):
-                raws_of[conn].extend(
-                    bytes(joined[a:b]) for a, b in zip(starts.tolist(), ends.tolist(), strict=True)
-                )
+            if not decoder(topic, _ros2_name(msgtype), definition, times, messages):
+                raws_of[conn].extend(messages.raws())
             times_of[conn].append(times)
 
     view = np.frombuffer(data, dtype=np.uint8)
-    batch, batch_from = _Batch(), 0
+    batch, batch_from = ChunkBatch(), 0
     for chunk_pos in chunks:
         if not batch.chunks:
             batch_from = chunk_pos
         pos = _read_chunk(data, view, chunk_pos, wanted, batch)
-        if batch.size >= BATCH_BYTES:
+        if batch.full:
             decode(batch)
-            batch = _Batch()
+            batch = ChunkBatch()
             _release(data, batch_from, pos)
     decode(batch)
     del batch
@@ -215,7 +184,11 @@ def _read_topics(data: mmap.mmap, topics: set[str], decoder: Decoder) -> dict[st
 
 
 def _read_chunk(
-    data: mmap.mmap, view: np.ndarray, chunk_pos: int, wanted: dict[int, tuple[str, str, str]], batch: _Batch
+    data: mmap.mmap,
+    view: np.ndarray,
+    chunk_pos: int,
+    wanted: dict[int, tuple[str, str, str]],
+    batch: ChunkBatch,
 ) -> int:
     """Add the chunk at ``chunk_pos`` and its wanted messages to ``batch``; where the records after
     its index-data records start."""

@@ -1,4 +1,4 @@
-"""The ROS 1 index reader hands the decoder several chunks' messages at once (ros1_index.BATCH_BYTES).
+"""The ROS 1 and MCAP index readers hand the decoder several chunks' messages at once (BATCH_BYTES).
 
 A bag of many small chunks, plain and compressed, is read with a small batch size, so that a batch
 joins several chunks and there are several batches.  What the decoder is given must be what rosbags
@@ -14,11 +14,10 @@ import bag_factory as factory
 import numpy as np
 import pytest
 from rosbags.highlevel import AnyReader
-from rosbags.rosbag1 import Reader
 
-from exsce_dsl.messages.catalogue import standard_ros1_catalogue
+from exsce_dsl.messages.catalogue import standard_catalogue, standard_ros1_catalogue
 from exsce_dsl.model.messages import path_of
-from exsce_dsl.runs import ros1_index
+from exsce_dsl.runs import chunk_batches, mcap_index, ros1_index
 from exsce_dsl.runs.decode import RawMessages, decode
 
 
@@ -30,16 +29,32 @@ def _bag(tmp_path: Path, fmt: str) -> factory.WrittenBag:
         for i, (t, _) in enumerate(factory.series(store, factory.ODOMETRY, 120))
     ]
     tf = factory.series(store, factory.TF_MESSAGE, 90, period_ns=70_000_000)
-    topics = [factory.Topic("/odom", factory.ODOMETRY, odometry), factory.Topic("/tf", factory.TF_MESSAGE, tf)]
-    return factory.write_bag(tmp_path / "many_chunks.bag", fmt, topics, store, chunk_bytes=2_000)
+    topics = [
+        factory.Topic("/odom", factory.ODOMETRY, odometry),
+        factory.Topic("/tf", factory.TF_MESSAGE, tf),
+    ]
+    name = "many_chunks.bag" if fmt.startswith("ros1") else "many_chunks"
+    return factory.write_bag(tmp_path / name, fmt, topics, store, chunk_bytes=2_000)
 
 
-@pytest.mark.parametrize("fmt", ["ros1", "ros1-bz2", "ros1-lz4"])
+def _chunks(path: Path, ros1: bool) -> int:
+    """How many chunks the bag has, counted from its chunk records (op 0x05 in ROS 1, 0x06 in MCAP)."""
+    if ros1:
+        with ros1_index.mapped(path) as data:
+            _, pos, count = ros1_index._connections(data, None)
+        return count
+    [file] = path.glob("*.mcap")
+    with mcap_index.mapped(file) as data:
+        return len(mcap_index._summary(data).chunks)
+
+
+@pytest.mark.parametrize("fmt", ["ros1", "ros1-bz2", "ros1-lz4", "mcap", "mcap-zstd"])
 def test_batches_of_chunks_give_the_messages_rosbags_reads(
     tmp_path: Path, fmt: str, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     written = _bag(tmp_path, fmt)
-    monkeypatch.setattr(ros1_index, "BATCH_BYTES", 10_000)
+    ros1 = fmt.startswith("ros1")
+    monkeypatch.setattr(chunk_batches, "BATCH_BYTES", 10_000)
     x = path_of("pose", "pose", "position", "x")
     calls: list[tuple[str, int]] = []
     decoded: list[np.ndarray] = []
@@ -48,14 +63,16 @@ def test_batches_of_chunks_give_the_messages_rosbags_reads(
         calls.append((topic, len(messages)))
         if topic == "/tf":
             return False  # keep the raw bytes
-        out = decode(standard_ros1_catalogue(), msgtype, messages, [x], cdr=False)
+        catalogue = standard_ros1_catalogue() if ros1 else standard_catalogue()
+        out = decode(catalogue, msgtype, messages, [x], cdr=not ros1)
         decoded.append(out[x.key])
         return True
 
-    found = ros1_index.read_topics(written.path, {"/odom", "/tf"}, decoder)
+    reader = ros1_index if ros1 else mcap_index
+    path = written.path if ros1 else next(written.path.glob("*.mcap"))
+    found = reader.read_topics(path, {"/odom", "/tf"}, decoder)
 
-    with Reader(written.path) as plain:
-        chunks = len(plain.chunk_infos)  # type: ignore[attr-defined]
+    chunks = _chunks(written.path, ros1)
     odom_calls = [n for topic, n in calls if topic == "/odom"]
     assert 1 < len(odom_calls) < chunks  # several batches, each joining several chunks
     expected: dict[str, list[tuple[int, Any, bytes]]] = {"/odom": [], "/tf": []}
