@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from exsce_dsl.errors import ExsceError
+from exsce_dsl.messages.typestore_cache import standard_fielddefs
 from exsce_dsl.model.messages import Fields, Leaf, MessageArray, Node, canonical_type
 
 Definitions = Mapping[str, tuple[list[Any], list[tuple[str, Any]]]]
@@ -165,14 +166,11 @@ STANDARD_STORES = ("ros2_jazzy", "ros2_humble", "ros1_noetic")
 def standard_catalogue() -> MessageCatalogue:
     """The standard ROS 1 and ROS 2 message packages that rosbags ships, and Nav2's and
     move_base's messages, which exsce ships."""
-    from rosbags.typesys import Stores, get_typestore
-
     from exsce_dsl.messages.navigation import navigation_catalogue  # which builds on this module
 
     catalogue = MessageCatalogue()
     for name in STANDARD_STORES:
-        store = get_typestore(Stores(name))
-        catalogue.add(store.fielddefs, Source(f"rosbags' {name} typestore"))
+        catalogue.add(standard_fielddefs(name), Source(f"rosbags' {name} typestore"))
     # rosbag2 stores no definitions in sqlite3 bags, and none of an action's feedback anywhere:
     # the navigation stacks' own types come with exsce
     return catalogue.layered(navigation_catalogue())
@@ -185,10 +183,8 @@ def standard_ros1_catalogue() -> MessageCatalogue:
 
 @functools.lru_cache(maxsize=1)
 def _ros1_first() -> MessageCatalogue:
-    from rosbags.typesys import Stores, get_typestore
-
     catalogue = MessageCatalogue()
-    catalogue.add(get_typestore(Stores.ROS1_NOETIC).fielddefs, Source("rosbags' ros1_noetic typestore"))
+    catalogue.add(standard_fielddefs("ros1_noetic"), Source("rosbags' ros1_noetic typestore"))
     return catalogue.layered(standard_catalogue())
 
 

@@ -1,0 +1,61 @@
+"""rosbags' standard definitions, cached between runs (exsce_dsl.messages.typestore_cache)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from rosbags.typesys import Stores, get_typestore
+
+from exsce_dsl.messages import typestore_cache
+
+
+@pytest.fixture
+def cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    folder = tmp_path / "cache"
+    monkeypatch.setenv("EXSCE_CACHE_DIR", str(folder))
+    return folder
+
+
+@pytest.mark.parametrize("store", ["ros2_jazzy", "ros2_humble", "ros1_noetic"])
+def test_the_cached_definitions_are_rosbags_own(cache: Path, store: str) -> None:
+    rosbags = get_typestore(Stores(store)).fielddefs
+    assert typestore_cache.standard_fielddefs(store) == rosbags  # written
+    [written] = cache.glob(f"typestore-{store}-*.json")
+    assert typestore_cache.standard_fielddefs(store) == rosbags  # read back: tuples, lists, Nodetypes
+    assert json.loads(written.read_text())["std_msgs/msg/Header"]  # a real file, JSON
+
+
+def test_the_file_is_what_is_read(cache: Path) -> None:
+    typestore_cache.standard_fielddefs("ros2_humble")
+    [written] = cache.glob("typestore-ros2_humble-*.json")
+    data = json.loads(written.read_text())
+    del data["nav_msgs/msg/Odometry"]
+    written.write_text(json.dumps(data))
+    assert "nav_msgs/msg/Odometry" not in typestore_cache.standard_fielddefs("ros2_humble")
+
+
+@pytest.mark.parametrize("text", ["", "not json", "[1, 2]", '{"a/msg/B": [[], [["x", [99, "y"]]]]}'])
+def test_a_broken_cache_falls_back_to_rosbags_and_is_rewritten(cache: Path, text: str) -> None:
+    typestore_cache.standard_fielddefs("ros1_noetic")
+    [written] = cache.glob("typestore-ros1_noetic-*.json")
+    written.write_text(text)
+    rosbags = get_typestore(Stores.ROS1_NOETIC).fielddefs
+    assert typestore_cache.standard_fielddefs("ros1_noetic") == rosbags
+    assert typestore_cache.standard_fielddefs("ros1_noetic") == rosbags  # from the rewritten file
+    assert json.loads(written.read_text())["std_msgs/msg/Header"]
+
+
+def test_a_cache_that_cannot_be_written_is_not_kept(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    blocker = tmp_path / "a_file"
+    blocker.write_text("")
+    monkeypatch.setenv("EXSCE_CACHE_DIR", str(blocker / "cache"))  # a folder inside a file
+    assert typestore_cache.standard_fielddefs("ros2_humble") == get_typestore(Stores.ROS2_HUMBLE).fielddefs
+    assert not (blocker / "cache").exists()
+
+
+def test_the_cache_folder_follows_xdg(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delenv("EXSCE_CACHE_DIR", raising=False)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    assert typestore_cache.cache_folder() == tmp_path / "exsce"
