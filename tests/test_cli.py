@@ -153,6 +153,26 @@ def test_textx_generators_write_prov(in_tmp: Path) -> None:
     assert "bundle exsce:scenario_c_bundle" in (in_tmp / "c.provn").read_text()
 
 
+def test_textx_generate_and_exscec_compile_write_the_same_prov_for_a_derived_scenario(in_tmp: Path) -> None:
+    """Both go through one library function: the derived scenario comes with its generation."""
+    import subprocess
+    import sys
+
+    folder = _copy_examples(in_tmp)
+    derived = folder / "scenario_c_alone.exsce"
+    textx = Path(sys.executable).with_name("textx")
+    done = subprocess.run(
+        [str(textx), "generate", str(derived), "--target", "provjson", "-o", "by_textx.json"],
+        capture_output=True, text=True,
+    )
+    assert done.returncode == 0, done.stderr
+    compiled = run_exscec("compile", str(derived), "-f", "json", "-o", "by_exscec.json")
+    assert compiled.returncode == 0, compiled.stderr
+    by_textx = json.loads((in_tmp / "by_textx.json").read_text())
+    assert by_textx == json.loads((in_tmp / "by_exscec.json").read_text())
+    assert any("generation" in name for name in by_textx["bundle"]), sorted(by_textx["bundle"])
+
+
 def test_version_is_the_installed_distributions() -> None:
     from importlib.metadata import version
 

@@ -8,12 +8,12 @@ from pathlib import Path
 
 import pytest
 
-from exsce_dsl.derive.derivation import derive
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.derivation import TaskOrigin, TransformationStep
 from exsce_dsl.prov.derivation import compile_derivation
+from exsce_dsl.transform.derivation import derive
 
 from conftest import EXAMPLES, run_exscec
 

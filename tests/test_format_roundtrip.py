@@ -13,7 +13,6 @@ from exsce_dsl.lang.build import analyse, load_spec
 from exsce_dsl.lang.formatter import declared_poses, format_document, format_spec_document
 from exsce_dsl.lang.lexical import comments
 from exsce_dsl.lang.loader import display_path
-from exsce_dsl.lang.names import KEYWORDS
 from exsce_dsl.model import (
     Area,
     Assignment,
@@ -31,6 +30,7 @@ from exsce_dsl.model import (
     Subtask,
     Task,
 )
+from exsce_dsl.model.names import KEYWORDS
 
 from conftest import EXAMPLES
 

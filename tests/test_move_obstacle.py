@@ -11,7 +11,6 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from exsce_dsl.derive.derivation import derive, derived_document
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.lang.build import analyse, load_spec
 from exsce_dsl.lang.formatter import format_document, format_spec_document
@@ -34,6 +33,7 @@ from exsce_dsl.model import (
 from exsce_dsl.model.derivation import TransformationStep
 from exsce_dsl.model.derived import DerivedScenario, Step
 from exsce_dsl.prov.derivation import compile_derivation
+from exsce_dsl.transform.derivation import derive, derived_document
 
 from conftest import run_exscec, write_map
 

@@ -95,11 +95,11 @@ def derive(
       exscec derive examples/brsu_building_c/scenario_c.exsce --id c_one \\
           -t remove_robot --robot tiago2 --reassign tiago1 --expect --add-to-store
     """
-    from exsce_dsl.derive.derivation import derive as apply_steps
-    from exsce_dsl.derive.derivation import derived_document
-    from exsce_dsl.derive.transformations import TRANSFORMATIONS
     from exsce_dsl.lang.build import load_spec
     from exsce_dsl.lang.formatter import declared_poses, format_document
+    from exsce_dsl.transform.derivation import derive as apply_steps
+    from exsce_dsl.transform.derivation import derived_document
+    from exsce_dsl.transform.transformations import TRANSFORMATIONS
 
     if list_them:
         for t in TRANSFORMATIONS.values():

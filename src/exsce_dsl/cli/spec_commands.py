@@ -89,17 +89,10 @@ def compile_command(
       exscec compile examples/scenario_c/scenario_c.exsce --store
     """
     from exsce_dsl.lang.build import load_spec
-    from exsce_dsl.prov import compile_scenario
+    from exsce_dsl.prov.spec import compile_spec_scenario
     from exsce_dsl.rdf import serialize
 
-    loaded = load_spec(spec)
-    scenario = loaded.scenario(scenario_id)
-    document = compile_scenario(scenario)
-    derived = next((d for d in loaded.derived if d.id == scenario.id), None)
-    if derived is not None and derived.derivation is not None:
-        from exsce_dsl.prov.derivation import compile_derivation
-
-        document.update(compile_derivation(derived.derivation))  # the generation, with the scenario
+    document = compile_spec_scenario(load_spec(spec), scenario_id)
     if store_url is not None:
         from exsce_dsl.cli.store_commands import add_to_store
 

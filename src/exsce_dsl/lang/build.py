@@ -23,7 +23,6 @@ from exsce_dsl.lang.checks import check_environment_map, check_scenario
 from exsce_dsl.lang.loader import load_files
 from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.lang.standard_metrics import reserved_metric_names
-from exsce_dsl.lang.suggest import did_you_mean
 from exsce_dsl.model import (
     Acceptance,
     Area,
@@ -50,6 +49,7 @@ from exsce_dsl.model import (
 from exsce_dsl.model.derived import DerivedScenario
 from exsce_dsl.model.metrics import MetricDefinition
 from exsce_dsl.model.robots import root_namespace
+from exsce_dsl.suggest import did_you_mean
 
 _LENGTH_SCALE = {None: 1.0, "m": 1.0, "cm": 0.01, "mm": 0.001}
 _QUANTITY = re.compile(r"(\S+?)\s*(mm|cm|m|rad|deg)?")

@@ -14,7 +14,6 @@ from typing import Any
 
 from exsce_dsl.errors import SourceLocation
 from exsce_dsl.lang.parser import ParsedFile
-from exsce_dsl.lang.suggest import did_you_mean
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.acceptance import (
     Acceptance,
@@ -32,6 +31,7 @@ from exsce_dsl.model.acceptance import (
     Window,
 )
 from exsce_dsl.model.metrics import SI_UNIT, UNITS, Dimension, MetricInfo, known_metrics
+from exsce_dsl.suggest import did_you_mean
 
 _QUANTITY = re.compile(r"(\S+?)\s*(m/s|cm/s|km/h|rad/s|deg/s|mm|cm|km|ms|min|std|rad|deg|m|s|h|%)?")
 

@@ -7,13 +7,13 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
 from typing import Any
 
-from exsce_dsl.derive.derivation import derive
 from exsce_dsl.errors import ExsceError, SourceLocation
 from exsce_dsl.lang.checks import check_environment_map
 from exsce_dsl.lang.parser import ParsedFile
-from exsce_dsl.lang.suggest import did_you_mean
 from exsce_dsl.model import Environment, Scenario, Task
 from exsce_dsl.model.derived import DerivedScenario, Step
+from exsce_dsl.suggest import did_you_mean
+from exsce_dsl.transform.derivation import derive
 
 Report = Callable[[str, SourceLocation | None], None]
 

@@ -18,7 +18,6 @@ from typing import Any
 
 from exsce_dsl.lang.check_fields import FieldProblem, field_shape
 from exsce_dsl.lang.parser import ParsedFile
-from exsce_dsl.lang.suggest import did_you_mean
 from exsce_dsl.model.expressions import (
     AGGREGATES,
     Aggregate,
@@ -33,6 +32,7 @@ from exsce_dsl.model.expressions import (
 )
 from exsce_dsl.model.messages import DISPATCHER, FEEDBACK, RESULT, FieldPath, Fields, Index, Select, Step
 from exsce_dsl.model.metrics import UNITS, Dimension, Subject, TopicRead
+from exsce_dsl.suggest import did_you_mean
 
 _QUANTITY = re.compile(r"(\S+?)\s*([a-z/]+)?")
 _NUMERIC = (Kind.CONSTANT, Kind.NUMBERS, Kind.ARRAYS, Kind.VALUE)

@@ -25,9 +25,7 @@ from typing import Any, Protocol
 
 from exsce_dsl.errors import SourceLocation
 from exsce_dsl.lang.build_expressions import ExpressionBuilder, Scope, Typed, read_quantity
-from exsce_dsl.lang.names import is_topic_pattern
 from exsce_dsl.lang.parser import ParsedFile
-from exsce_dsl.lang.suggest import did_you_mean
 from exsce_dsl.messages.catalogue import MessageCatalogue, MessageTypeError
 from exsce_dsl.model.expressions import Aggregate, Expression, WindowValue
 from exsce_dsl.model.messages import DISPATCHER, Fields, canonical_type
@@ -43,6 +41,8 @@ from exsce_dsl.model.metrics import (
     TopicRead,
     signal_pattern,
 )
+from exsce_dsl.model.names import is_topic_pattern
+from exsce_dsl.suggest import did_you_mean
 
 
 class Report(Protocol):

@@ -13,7 +13,6 @@ from typing import Any
 
 from exsce_dsl.errors import SourceLocation
 from exsce_dsl.lang.build_expressions import read_quantity
-from exsce_dsl.lang.names import is_topic_pattern
 from exsce_dsl.model.conventions import (
     CONVENTIONS,
     LASER_SCAN,
@@ -30,6 +29,7 @@ from exsce_dsl.model.conventions import (
     TopicSource,
 )
 from exsce_dsl.model.messages import canonical_type
+from exsce_dsl.model.names import is_topic_pattern
 
 _SIGNAL_FACTS = ("ConventionFact", "PoseFact", "VelocityFact", "ScanFact", "NavigationFact", "ArrivalFact")
 _ACTIONS = {

@@ -16,7 +16,6 @@ element of another would be an array of arrays, which no metric reads.
 from __future__ import annotations
 
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.lang.suggest import did_you_mean
 from exsce_dsl.model.messages import (
     FieldPath,
     Fields,
@@ -29,6 +28,7 @@ from exsce_dsl.model.messages import (
     canonical_type,
 )
 from exsce_dsl.model.metrics import MetricDefinition
+from exsce_dsl.suggest import did_you_mean
 
 
 class FieldProblem(Exception):

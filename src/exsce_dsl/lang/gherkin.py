@@ -12,9 +12,9 @@ from pathlib import Path
 
 from exsce_dsl.errors import ExportError
 from exsce_dsl.lang.format_acceptance import expectation_text
-from exsce_dsl.lang.names import is_valid_name
 from exsce_dsl.model import Scenario, Specification
 from exsce_dsl.model.acceptance import Acceptance, BaselineRuns, Criterion, Given, When
+from exsce_dsl.model.names import is_valid_name
 
 INDENT = "  "
 

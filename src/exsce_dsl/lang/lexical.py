@@ -8,7 +8,6 @@ from decimal import Decimal
 
 from exsce_dsl.lang.locations import LineIndex
 
-NUMBER = re.compile(r"[-+]?(\d+\.\d*|\.\d+|\d+)([eE][-+]?\d+)?")
 """A number as the language writes one (the number part of its quantity tokens; no ``nan``,
 ``inf`` or ``1_000``)."""
 

@@ -20,9 +20,6 @@ import yaml
 
 from exsce_dsl.errors import Diagnostic, ExportError, ImportFormatError, SourceLocation
 from exsce_dsl.lang.format_acceptance import expectation_text
-from exsce_dsl.lang.lexical import NUMBER
-from exsce_dsl.lang.names import is_valid_name
-from exsce_dsl.lang.suggest import did_you_mean
 from exsce_dsl.lang.yaml_import import YamlFile, YamlNode, child_node, node_location
 from exsce_dsl.model import Document, Import, Scenario, Specification
 from exsce_dsl.model.acceptance import (
@@ -36,6 +33,8 @@ from exsce_dsl.model.acceptance import (
     When,
 )
 from exsce_dsl.model.metrics import SI_UNIT, Dimension, MetricInfo, default_topics, known_metrics, metric_info
+from exsce_dsl.model.names import NUMBER, is_valid_name
+from exsce_dsl.suggest import did_you_mean
 
 #: The only relationship package an oracle file may name (the method's relations, in exsce).
 RELATIONSHIPS_PACKAGE = "exsce.metamorphic.relationships"

@@ -13,8 +13,8 @@ from typing import Any
 import yaml
 
 from exsce_dsl.errors import ExportError
-from exsce_dsl.lang.names import is_valid_name
 from exsce_dsl.model import MapModel, Pose, RosResource, Scenario, Task, WorldModel
+from exsce_dsl.model.names import is_valid_name
 
 #: The package named in a scenario file for a task that came from no ROS package.
 DEFAULT_TASK_PACKAGE = "exsce"

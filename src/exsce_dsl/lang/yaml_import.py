@@ -19,7 +19,6 @@ from pathlib import Path
 import yaml
 
 from exsce_dsl.errors import ExsceError, ImportFormatError, SourceLocation
-from exsce_dsl.lang.names import KEYWORDS, is_valid_name
 from exsce_dsl.model import (
     Area,
     Assignment,
@@ -40,6 +39,7 @@ from exsce_dsl.model import (
     Task,
     WorldModel,
 )
+from exsce_dsl.model.names import KEYWORDS, is_valid_name
 from exsce_dsl.textfiles import read_text
 
 #: Hardware facts of the robot types the method used (PAL Robotics): base, torso.

@@ -15,12 +15,12 @@ from dataclasses import dataclass
 
 from lsprotocol import types
 
-from exsce_dsl.derive.transformations import TRANSFORMATIONS
 from exsce_dsl.lang.expected import Expected
 from exsce_dsl.lang.symbols import Symbol
 from exsce_dsl.lsp.navigation import Names
 from exsce_dsl.model.metrics import METRICS
 from exsce_dsl.oracles.relations import relation, relation_names
+from exsce_dsl.transform.transformations import TRANSFORMATIONS
 
 LIMIT = 300
 """At most this many items; the list is marked incomplete beyond (the client asks again)."""

@@ -14,8 +14,8 @@ from collections.abc import Collection, Sequence
 from dataclasses import dataclass
 
 from exsce_dsl.errors import SourceLocation
-from exsce_dsl.lang.names import is_valid_name
 from exsce_dsl.lang.symbols import SCOPED_KINDS, FileIndex, Reference, Symbol
+from exsce_dsl.model.names import is_valid_name
 
 NOT_NAMES = frozenset({"acceptance", "criterion"})
 """Symbols whose location is not a name of their own (an acceptance block names its scenario)."""

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from importlib.metadata import entry_points
 
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.lang.suggest import did_you_mean
+from exsce_dsl.suggest import did_you_mean
 
 __all__ = [
     "ENTRY_POINT_GROUP",

@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.lang.suggest import did_you_mean
+from exsce_dsl.suggest import did_you_mean
 
 MAX_EXTRAPOLATION = 0.5
 """Seconds a transform's first or last value is held outside its data (see :func:`pose_at`)."""

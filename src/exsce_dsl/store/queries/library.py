@@ -35,10 +35,10 @@ from importlib.resources import files
 from pyoxigraph import Literal, NamedNode
 
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.lang.suggest import did_you_mean
 from exsce_dsl.prov import identifiers as ids
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, Namespaces
 from exsce_dsl.store.base import Bindings, Term
+from exsce_dsl.suggest import did_you_mean
 
 __all__ = ["KINDS", "Parameter", "Query", "query", "query_names", "standard_prefixes"]
 

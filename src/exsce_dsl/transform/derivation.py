@@ -9,13 +9,13 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from exsce_dsl.derive.transformations import TRANSFORMATIONS, Applied
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.lang.names import is_valid_name
-from exsce_dsl.lang.suggest import did_you_mean
 from exsce_dsl.model import Document, Environment, Import, Scenario, Task
 from exsce_dsl.model.derivation import Derivation
 from exsce_dsl.model.derived import DerivedScenario, Step
+from exsce_dsl.model.names import is_valid_name
+from exsce_dsl.suggest import did_you_mean
+from exsce_dsl.transform.transformations import TRANSFORMATIONS, Applied
 
 Request = tuple[str, Mapping[str, str]]
 """A transformation's name and its arguments as text."""

@@ -21,6 +21,9 @@ KEYWORDS: frozenset[str] = frozenset(
     around""".split()
 )
 
+NUMBER = re.compile(r"[-+]?(\d+\.\d*|\.\d+|\d+)([eE][-+]?\d+)?")
+"""A number as the language writes it."""
+
 NAME_PATTERN = r"[A-Za-z_][A-Za-z0-9_]*(?:-[A-Za-z0-9_]+)*"
 _NAME_RE = re.compile(NAME_PATTERN)
 

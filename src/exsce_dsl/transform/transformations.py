@@ -13,11 +13,10 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.lang.lexical import NUMBER
-from exsce_dsl.lang.names import is_valid_name
-from exsce_dsl.lang.suggest import did_you_mean
 from exsce_dsl.model import Assignment, Pose, Position, Robot, Scenario, Task
 from exsce_dsl.model.derivation import ParameterValue, TaskOrigin, TransformationStep
+from exsce_dsl.model.names import NUMBER, is_valid_name
+from exsce_dsl.suggest import did_you_mean
 
 
 @dataclass(frozen=True)
