@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import datetime
 import sys
 from pathlib import Path
 
@@ -31,25 +30,14 @@ def baseline(spec: str, scenario_id: str | None, store_url: str | None) -> None:
     Example:
       exscec baseline examples/brsu_building_c/scenario_c.exsce
     """
-    from exsce_dsl.errors import ExsceError
     from exsce_dsl.lang.build import load_spec
-    from exsce_dsl.oracles.baseline import baseline_oracles
-    from exsce_dsl.prov.oracle import compile_oracles
+    from exsce_dsl.oracles.workflows import build_baseline
     from exsce_dsl.store.open import open_store
-    from exsce_dsl.store.writing import add_prov
     from exsce_dsl.tables import aligned
 
-    loaded = load_spec(spec)
-    scenario = loaded.scenario(scenario_id)
-    acceptance = loaded.acceptance_of(scenario.id)
-    if acceptance is None:
-        raise ExsceError(
-            f"{spec} gives no acceptance criteria for '{scenario.id}' "
-            f"(write 'acceptance for {scenario.id} {{...}}')"
-        )
     with open_store(store_url) as store:
-        oracles = baseline_oracles(store, acceptance, scenario, {s.id: s for s in loaded.scenarios})
-        report = add_prov(store, compile_oracles(scenario.id, oracles), replace=True)
+        built = build_baseline(store, load_spec(spec), scenario_id)
+    scenario, oracles, report = built.scenario, built.oracles, built.written
     rows: list[tuple[str, ...]] = [("oracle", "relation", "value", "limit", "delta", "tolerance", "runs")]
     for o in oracles:
         rows.append(
@@ -104,29 +92,19 @@ def verify(
     from exsce_dsl.lang.build import load_spec
     from exsce_dsl.model.verdicts import Outcome
     from exsce_dsl.oracles.report import junit_xml, verdict_table, verdicts_json
-    from exsce_dsl.oracles.verify import judge_runs
-    from exsce_dsl.prov.verdicts import compile_verdicts
-    from exsce_dsl.runs.ingest import ingest_bags
+    from exsce_dsl.oracles.workflows import IngestFailed, verify_runs
     from exsce_dsl.store.open import open_store
-    from exsce_dsl.store.writing import add_prov
 
     scenario = load_spec(spec).scenario(scenario_id)
-    bags = [Path(r) for r in bag_arguments(runs) if Path(r).exists()]  # files, or ROS 2 bag folders
-    uuids = [r for r in runs if not Path(r).exists()]
+    bags: list[str | Path] = [Path(r) for r in bag_arguments(runs) if Path(r).exists()]  # files, bag folders
+    uuids: list[str | Path] = [r for r in runs if not Path(r).exists()]
     with open_store(store_url) as store:
-        if bags:
-            for result in ingest_bags(bags, scenario, store, 1, None):
-                if result.failed or result.run_id is None:
-                    click.echo(f"error: {result.message}", err=True)
-                    sys.exit(2)
-                uuids.append(result.run_id)
-        verdicts = judge_runs(store, list(dict.fromkeys(uuids)), scenario)
-        if not no_record:
-            now = datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0)
-            for run in dict.fromkeys(v.run for v in verdicts):
-                add_prov(
-                    store, compile_verdicts(run, [v for v in verdicts if v.run == run], now), replace=True
-                )
+        try:
+            verification = verify_runs(store, scenario, [*uuids, *bags], record=not no_record)
+        except IngestFailed as exc:
+            click.echo(f"error: {exc.message}", err=True)
+            sys.exit(2)
+    verdicts = list(verification.verdicts)
     click.echo(verdicts_json(verdicts) if as_json else verdict_table(verdicts))
     if junit:
         write_text(junit_xml(verdicts), junit)
@@ -135,7 +113,7 @@ def verify(
     click.echo(
         f"{len(verdicts) - failed - unjudged} passed, {failed} failed, {unjudged} not judged", err=True
     )
-    sys.exit(1 if failed else 2 if unjudged else 0)
+    sys.exit(verification.exit_code)
 
 
 COMMANDS = [baseline, verify]

@@ -27,22 +27,18 @@ def check(specs: tuple[str, ...]) -> None:
     Example:
       exscec check examples/scenario_c/scenario_c.exsce
     """
-    from exsce_dsl.lang.build import analyse
-    from exsce_dsl.rdf.shacl import check_spec_shapes
+    from exsce_dsl.rdf.spec_check import check_spec
 
     failed = False
     for spec in specs:
-        analysis = analyse(spec)
-        diagnostics = list(analysis.diagnostics)
-        if not analysis.errors and analysis.spec is not None:
-            diagnostics.extend(check_spec_shapes(analysis.spec))
-        print_diagnostics(diagnostics)
-        errors = sum(d.severity == "error" for d in diagnostics)
-        if errors or analysis.spec is None:
+        checked = check_spec(spec)
+        print_diagnostics(list(checked.diagnostics))
+        errors = len(checked.errors)
+        if not checked.ok or checked.spec is None:
             failed = True
             click.echo(f"{spec}: {errors} error{'s' if errors != 1 else ''}", err=True)
         else:
-            n = len(analysis.spec.scenarios)
+            n = len(checked.spec.scenarios)
             click.echo(f"{spec}: ok ({n} scenario{'s' if n != 1 else ''})", err=True)
     if failed:
         sys.exit(1)

@@ -13,27 +13,37 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass, field
+from enum import Enum
 from pathlib import Path
 from typing import Any
 
-from pyoxigraph import Literal
-
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import Scenario
-from exsce_dsl.prov import compile_scenario
+from exsce_dsl.prov import DEFAULT_NAMESPACE, compile_scenario
 from exsce_dsl.prov.run import compile_run
 from exsce_dsl.runs.analyse import AnalysedRun, analyse_bag, content_hash, run_uuid
 from exsce_dsl.store.base import Store
+from exsce_dsl.store.queries import run_query
 from exsce_dsl.store.writing import add_prov
 
-_RUN_ID = "https://www.sesame-project.org/scenarios/run"
-_KNOWN = f"ASK WHERE {{ GRAPH ?g {{ ?run <{_RUN_ID}> ?id }} }}"
+
+class IngestStatus(str, Enum):
+    """What became of a bag."""
+
+    INGESTED = "ingested"
+    SKIPPED = "skipped"
+    """Its content is a run the store holds already."""
+    FAILED = "failed"
+    """Nothing of it was written; the message says why."""
+
+    def __str__(self) -> str:
+        return self.value
 
 
 @dataclass(frozen=True)
 class IngestResult:
     bag: Path
-    status: str  # ingested | skipped | failed
+    status: IngestStatus
     message: str
     run_id: str | None = None
     problems: tuple[str, ...] = field(default_factory=tuple)
@@ -41,7 +51,7 @@ class IngestResult:
 
     @property
     def failed(self) -> bool:
-        return self.status == "failed"
+        return self.status is IngestStatus.FAILED
 
 
 def _analyse(args: tuple[Path, Scenario, str | None]) -> AnalysedRun | ExsceError:
@@ -75,13 +85,14 @@ def ingest_bags(
     store: Store,
     jobs: int = 1,
     progress: Callable[[IngestResult], None] | None = None,
+    namespace: str = DEFAULT_NAMESPACE,
 ) -> list[IngestResult]:
     """Ingest each bag as a run of ``scenario``; the scenario itself is added to the store first.
 
     With ``jobs`` > 1, worker processes hash the bags, then read them and compute their metrics;
     this process alone compiles each run's PROV and writes it, one transaction per run.
     """
-    add_prov(store, compile_scenario(scenario))
+    add_prov(store, compile_scenario(scenario, namespace))
     results: list[IngestResult] = []
     todo: list[tuple[Path, str | None]] = []
     seen: set[str] = set()
@@ -89,14 +100,14 @@ def ingest_bags(
         digests = list(mapper(_digest, paths))
         for path, digest in zip(paths, digests, strict=True):
             known = digest is not None and (
-                digest in seen or store.ask(_KNOWN, {"id": Literal(run_uuid(digest))})
+                digest in seen or bool(run_query(store, "run_known", {"run": run_uuid(digest)}, namespace))
             )
             if digest is not None:
                 seen.add(digest)
             if known:
                 assert digest is not None
                 result = IngestResult(
-                    path, "skipped", f"{path}: already ingested (same content)", run_uuid(digest)
+                    path, IngestStatus.SKIPPED, f"{path}: already ingested (same content)", run_uuid(digest)
                 )
                 results.append(result)
                 if progress:
@@ -105,25 +116,27 @@ def ingest_bags(
                 todo.append((path, digest))
         outcomes = mapper(_analyse, [(path, scenario, digest) for path, digest in todo])
         for (path, _), outcome in zip(todo, outcomes, strict=True):
-            result = _write(path, outcome, scenario, store)
+            result = _write(path, outcome, scenario, store, namespace)
             results.append(result)
             if progress:
                 progress(result)
     return results
 
 
-def _write(path: Path, outcome: AnalysedRun | ExsceError, scenario: Scenario, store: Store) -> IngestResult:
+def _write(
+    path: Path, outcome: AnalysedRun | ExsceError, scenario: Scenario, store: Store, namespace: str
+) -> IngestResult:
     """Write an analysed run to the store (one transaction), or say why it could not be."""
     if isinstance(outcome, ExsceError):
         message = outcome.message if str(path) in outcome.message else f"{path}: {outcome.message}"
-        return IngestResult(path, "failed", message)
+        return IngestResult(path, IngestStatus.FAILED, message)
     try:
-        report = add_prov(store, compile_run(outcome.run, scenario))
+        report = add_prov(store, compile_run(outcome.run, scenario, namespace))
     except ExsceError as exc:
-        return IngestResult(path, "failed", f"{path}: {exc.message}")
+        return IngestResult(path, IngestStatus.FAILED, f"{path}: {exc.message}")
     return IngestResult(
         path,
-        "ingested",
+        IngestStatus.INGESTED,
         f"{path}: run {outcome.run.uuid} ({len(outcome.run.metrics)} metric values)",
         outcome.run.uuid,
         tuple(outcome.problems),

@@ -20,6 +20,7 @@ not exist yet finds it empty.
 from __future__ import annotations
 
 import os
+import time
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -37,6 +38,9 @@ from exsce_dsl.store.base import (
     replaced_names,
 )
 from exsce_dsl.store.sparql import bind, checked_quads, graph_node, write_update
+
+VIEW_ATTEMPTS = 5
+"""Times a read-only view is opened before a writer's compaction racing it is an error."""
 
 
 class EmbeddedStore(Store):
@@ -94,12 +98,22 @@ class EmbeddedStore(Store):
         return self._empty
 
     def _read_only_view(self) -> OxStore:
+        """A read-only view of a store another process writes.  The writer may compact while the
+        view opens, deleting a file the view's manifest still names (RocksDB says "Corruption: ...
+        No such file"): the view is then opened again on the newer manifest, a few times."""
         assert self.path is not None
-        try:
-            self._view = OxStore.read_only(str(self.path))
-        except OSError as exc:
-            raise StoreError(f"cannot read the store at {self.path}: {exc}") from None
-        return self._view
+        attempt = 0
+        while True:
+            try:
+                self._view = OxStore.read_only(str(self.path))
+                return self._view
+            except OSError as exc:
+                raise StoreError(f"cannot read the store at {self.path}: {exc}") from None
+            except RuntimeError as exc:  # pyoxigraph's error for RocksDB's Corruption status
+                attempt += 1
+                if "No such file" not in str(exc) or attempt == VIEW_ATTEMPTS:
+                    raise StoreError(f"cannot read the store at {self.path}: {exc}") from None
+                time.sleep(0.05 * attempt)
 
     def _writer(self) -> OxStore:
         return self._store if self._store is not None else self._open()

@@ -1,0 +1,102 @@
+"""The oracle workflows as the CLI, the Python API and the demo run them.
+
+:func:`build_baseline`: a scenario's oracles from its acceptance criteria and its stored runs,
+written to the store.  :func:`verify_runs`: runs (stored uuids, or bags ingested first) judged
+against every oracle of their scenario, the verdicts written to the store as provenance.
+"""
+
+from __future__ import annotations
+
+import datetime
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from exsce_dsl.errors import ExsceError
+from exsce_dsl.model import Scenario
+from exsce_dsl.model.document import Specification
+from exsce_dsl.model.oracles import Oracle
+from exsce_dsl.model.verdicts import Outcome, Verdict
+from exsce_dsl.oracles.baseline import baseline_oracles
+from exsce_dsl.oracles.verify import judge_runs
+from exsce_dsl.prov.oracle import compile_oracles
+from exsce_dsl.prov.verdicts import compile_verdicts
+from exsce_dsl.runs.ingest import ingest_bags
+from exsce_dsl.store.base import Store
+from exsce_dsl.store.writing import WriteReport, add_prov
+
+
+class IngestFailed(ExsceError):
+    """A bag given to :func:`verify_runs` could not be ingested, so nothing was judged."""
+
+
+@dataclass(frozen=True)
+class Baseline:
+    """The oracles built, and what writing them to the store did."""
+
+    scenario: Scenario
+    oracles: tuple[Oracle, ...]
+    written: WriteReport
+
+
+def build_baseline(store: Store, spec: Specification, scenario_id: str | None = None) -> Baseline:
+    """Build the oracles of a scenario of ``spec`` from its acceptance criteria and the runs in
+    ``store``, and write them there (the previous ones are kept as a revision)."""
+    scenario = spec.scenario(scenario_id)
+    acceptance = spec.acceptance_of(scenario.id)
+    if acceptance is None:
+        raise ExsceError(
+            f"{spec.root} gives no acceptance criteria for '{scenario.id}' "
+            f"(write 'acceptance for {scenario.id} {{...}}')"
+        )
+    oracles = baseline_oracles(store, acceptance, scenario, {s.id: s for s in spec.scenarios})
+    written = add_prov(store, compile_oracles(scenario.id, oracles), replace=True)
+    return Baseline(scenario, tuple(oracles), written)
+
+
+@dataclass(frozen=True)
+class Verification:
+    """Every verdict on the runs judged, run by run."""
+
+    scenario: Scenario
+    runs: tuple[str, ...]
+    verdicts: tuple[Verdict, ...]
+
+    def count(self, outcome: Outcome) -> int:
+        return sum(v.outcome is outcome for v in self.verdicts)
+
+    @property
+    def passed(self) -> bool:
+        """No oracle failed and every one was judged."""
+        return not self.count(Outcome.FAILED) and not self.count(Outcome.UNJUDGED)
+
+    @property
+    def exit_code(self) -> int:
+        """0 when every oracle passed, 1 when one failed, 2 when one could not be judged (none failed)."""
+        return 1 if self.count(Outcome.FAILED) else 2 if self.count(Outcome.UNJUDGED) else 0
+
+
+def verify_runs(
+    store: Store,
+    scenario: Scenario,
+    runs: Sequence[str | Path],
+    *,
+    record: bool = True,
+    now: datetime.datetime | None = None,
+) -> Verification:
+    """Judge ``runs`` (stored runs' uuids, or paths of bags, which are ingested first) against every
+    oracle of ``scenario``; with ``record``, write the verdicts to the store (at ``now``, UTC)."""
+    bags = [Path(r) for r in runs if isinstance(r, Path) or Path(r).exists()]
+    uuids = [str(r) for r in runs if not (isinstance(r, Path) or Path(r).exists())]
+    for result in ingest_bags(bags, scenario, store) if bags else []:
+        if result.failed or result.run_id is None:
+            raise IngestFailed(result.message)
+        uuids.append(result.run_id)
+    judged = tuple(dict.fromkeys(uuids))
+    verdicts = judge_runs(store, list(judged), scenario)
+    if record:
+        at = now or datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0)
+        for run in dict.fromkeys(v.run for v in verdicts):
+            mine = [v for v in verdicts if v.run == run]
+            add_prov(store, compile_verdicts(run, mine, at), replace=True)
+    return Verification(scenario, judged, tuple(verdicts))
