@@ -93,12 +93,11 @@ def derive(
           -t remove_robot --robot tiago2 --reassign tiago1 \\
           -t reverse_waypoint_order --task delivery_a -o scenario_c_alone.exsce
       exscec derive examples/brsu_building_c/scenario_c.exsce --id c_one \\
-          -t remove_robot --robot tiago2 --reassign tiago1 --expect --add-to-store
+          -t remove_robot --robot tiago2 --reassign tiago1 -o c_one.exsce --expect --add-to-store
     """
+    from exsce_dsl.derive.workflows import add_derivation, derive_spec
     from exsce_dsl.lang.build import load_spec
-    from exsce_dsl.lang.formatter import declared_poses, format_document
-    from exsce_dsl.transform.derivation import derive as apply_steps
-    from exsce_dsl.transform.derivation import derived_document
+    from exsce_dsl.store.open import open_store
     from exsce_dsl.transform.transformations import TRANSFORMATIONS
 
     if list_them:
@@ -106,52 +105,32 @@ def derive(
             arguments = " ".join([f"--{a} X" for a in t.required] + [f"[--{a} X]" for a in t.optional])
             click.echo(f"{t.name} {arguments}\n    {t.help}")
         return
-    loaded = load_spec(spec)
-    base = loaded.scenario(scenario_id)
-    derived = apply_steps(base, _requests(steps), new_id, {t.id: t for t in loaded.tasks})
-    target = Path(output) if output else Path(spec).with_name(f"{derived.scenario.id}.exsce")
-    document = derived_document(derived, Path(spec), target)
-    criteria = None
+    loaded, requests = load_spec(spec), _requests(steps)
     if with_expectations:
-        from dataclasses import replace
-
-        from exsce_dsl.derive.expect import metamorphic_acceptance
-        from exsce_dsl.store.open import open_store
-
         with open_store(store_url) as store:
-            criteria = metamorphic_acceptance(
-                store, base, derived.scenario, loaded.acceptance_of(base.id), tolerance
-            )
-        if criteria.criteria:
-            document = replace(document, declarations=(*document.declarations, criteria))
-        else:
+            made = derive_spec(
+                loaded, spec, requests, new_id=new_id, scenario_id=scenario_id, target=output,
+                expect_from=store, tolerance=tolerance,
+            )  # fmt: skip
+        if made.criteria is None:
             click.echo(
                 "no acceptance criteria: neither safety clauses to copy nor runs to expect from", err=True
             )
-    text = format_document(document, declared_poses(loaded.environments))
-    if output:
-        Path(output).write_text(text, encoding="utf-8")
-        load_spec(output)  # what we wrote must check clean
-        click.echo(f"wrote {output}: scenario {derived.scenario.id}", err=True)
     else:
-        click.echo(text, nl=False)
+        made = derive_spec(loaded, spec, requests, new_id=new_id, scenario_id=scenario_id, target=output)
+    if output:
+        Path(output).write_text(made.text, encoding="utf-8")
+        load_spec(output)  # what we wrote must check clean
+        click.echo(f"wrote {output}: scenario {made.scenario.id}", err=True)
+    else:
+        click.echo(made.text, nl=False)
     if add_to_store:
-        from exsce_dsl.prov import compile_scenario
-        from exsce_dsl.prov.derivation import compile_derivation
-        from exsce_dsl.store.open import open_store
-        from exsce_dsl.store.writing import add_prov
-
         with open_store(store_url) as store:
-            add_prov(store, compile_scenario(base))
-            click.echo(add_prov(store, compile_scenario(derived.scenario)).summary(), err=True)
-            click.echo(add_prov(store, compile_derivation(derived.derivation)).summary(), err=True)
-            if criteria is not None and criteria.criteria:
-                from exsce_dsl.oracles.baseline import baseline_oracles
-                from exsce_dsl.prov.oracle import compile_oracles
-
-                oracles = baseline_oracles(store, criteria, derived.scenario, {base.id: base})
-                written = add_prov(store, compile_oracles(derived.scenario.id, oracles), replace=True)
-                click.echo(f"{len(oracles)} oracles: {written.summary()}", err=True)
+            stored = add_derivation(store, made)
+        click.echo(stored.scenario.summary(), err=True)
+        click.echo(stored.generation.summary(), err=True)
+        if stored.oracles_written is not None:
+            click.echo(f"{len(stored.oracles)} oracles: {stored.oracles_written.summary()}", err=True)
 
 
 def _step_text(step: object) -> str:
@@ -175,7 +154,7 @@ def lineage(scenario: str, store_url: str | None) -> None:
 
     \b
     Example:
-      exscec lineage scenario_c_alone
+      exscec lineage c_one
     """
     from exsce_dsl.store.open import open_store
     from exsce_dsl.store.queries import derivation_of, derived_scenarios
@@ -212,6 +191,7 @@ def expect(spec: str, scenario_id: str | None, store_url: str | None) -> None:
 
     \b
     Example:
+      exscec expect c_one.exsce
       exscec expect examples/brsu_building_c/scenario_c_alone.exsce
     """
     from exsce_dsl.derive.expect import SUMMED, expected_metric

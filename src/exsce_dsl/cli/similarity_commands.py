@@ -69,14 +69,11 @@ def cluster(
 
     \b
     Example:
-      exscec cluster --k 3 --dendrogram clusters.svg
-      exscec cluster -s scenario_c -s scenario_c_alone -s scenario_d -w d4=2 --json
+      exscec cluster --k 2 --dendrogram clusters.svg
+      exscec cluster -s scenario_c -s c_one -w d4=2 --json
     """
-    from exsce_dsl.errors import ExsceError
-    from exsce_dsl.similarity.clustering import cluster as run_clustering
-    from exsce_dsl.similarity.facts import scenario_facts
+    from exsce_dsl.similarity.clustering import cluster_stored
     from exsce_dsl.store.open import open_store
-    from exsce_dsl.store.queries import scenario_ids
 
     if k is not None and threshold is not None:
         raise click.UsageError("give --k or --threshold, not both")
@@ -85,16 +82,8 @@ def cluster(
             raise click.BadParameter(
                 f"'{image}': write the dendrogram to a .png or .svg file", param_hint="--dendrogram"
             )
-    weighting = dict(_weight(w) for w in weights)
     with open_store(store_url) as store:
-        stored = scenario_ids(store)
-        chosen = list(scenarios) or stored
-        unknown = [s for s in chosen if s not in stored]
-        if unknown:
-            known = ", ".join(stored) or "none"
-            raise ExsceError(f"not in the store: {', '.join(unknown)} (stored: {known})")
-        facts = [scenario_facts(store, s) for s in chosen]
-    result = run_clustering(facts, method, k, threshold, weighting)
+        result = cluster_stored(store, scenarios, method, k, threshold, dict(_weight(w) for w in weights))
     if images:
         from exsce_dsl.similarity.dendrogram import save_dendrogram
 

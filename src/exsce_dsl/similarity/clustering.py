@@ -11,6 +11,9 @@ from scipy.spatial.distance import squareform
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.similarity.distances import Distances, Norms, ScenarioFacts, distances
+from exsce_dsl.similarity.facts import scenario_facts
+from exsce_dsl.store.base import Store
+from exsce_dsl.store.queries import scenario_ids
 
 METHODS = ("average", "complete", "single", "ward")
 
@@ -69,3 +72,22 @@ def cluster(
         renumbered.setdefault(int(label), len(renumbered) + 1)
     clusters = {s: renumbered[int(label)] for s, label in zip(ids, labels, strict=True)}
     return Clustering(ids, matrix, pairs, tree, clusters)
+
+
+def cluster_stored(
+    store: Store,
+    scenarios: Sequence[str] = (),
+    method: str = "average",
+    k: int | None = None,
+    threshold: float | None = None,
+    weights: Mapping[str, float] | None = None,
+) -> Clustering:
+    """:func:`cluster` of scenarios in ``store`` (all of them when ``scenarios`` is empty)."""
+    if k is not None and threshold is not None:
+        raise ExsceError("give k or threshold, not both")
+    stored = scenario_ids(store)
+    chosen = list(scenarios) or stored
+    unknown = [s for s in chosen if s not in stored]
+    if unknown:
+        raise ExsceError(f"not in the store: {', '.join(unknown)} (stored: {', '.join(stored) or 'none'})")
+    return cluster([scenario_facts(store, s) for s in chosen], method, k, threshold, weights)

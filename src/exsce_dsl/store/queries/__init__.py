@@ -68,6 +68,7 @@ __all__ = [
     "update_baseline",
     "violation_duration",
     "violation_durations",
+    "python_value",
     "waypoints_visited",
 ]
 
@@ -122,7 +123,7 @@ def _datetime(term: Term | None) -> datetime.datetime | None:
         return None
 
 
-def _python(term: Term | None) -> ParameterValue | None:
+def python_value(term: Term | None) -> ParameterValue | None:
     """A literal as the Python value it was written from (numbers, booleans, strings)."""
     if term is None:
         return None
@@ -492,7 +493,7 @@ def derivation_of(store: Store, scenario: str, namespace: str = DEFAULT_NAMESPAC
             continue
         number = _int(row["step"])
         _, parameters = steps.setdefault(number, (_text(row["transformation"]) or "", []))
-        key, value = _text(row["parameter"]), _python(row["value"])
+        key, value = _text(row["parameter"]), python_value(row["value"])
         if key is not None and value is not None:
             parameters.append((key, value))
     if not bases:

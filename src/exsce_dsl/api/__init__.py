@@ -1,0 +1,51 @@
+"""exsce from Python: the workflows of ``exscec``, with typed results, and the store's numbers as
+pandas DataFrames.  This is the entry module; ``docs/python.md`` walks through it.
+
+    from exsce_dsl import api as exsce
+
+    spec = exsce.load("examples/brsu_building_c/scenario_c.exsce")
+    with exsce.open_store("memory:") as store:
+        runs = exsce.simulate(spec, "runs", runs=3, seed=1)
+        exsce.ingest(store, spec, [r.bag for r in runs])
+        table = exsce.metrics(store, "scenario_c")
+
+Each function says which command it is; errors are :class:`~exsce_dsl.errors.ExsceError`\\ s with
+the same messages the command prints.
+"""
+
+from exsce_dsl.api.tables import metrics, query, rows_frame, segments, sparql, verdicts
+from exsce_dsl.api.workflows import (
+    add_derived,
+    baseline,
+    check,
+    cluster,
+    compile_prov,
+    derive,
+    expect,
+    ingest,
+    load,
+    open_store,
+    simulate,
+    verify,
+)
+
+__all__ = [
+    "add_derived",
+    "baseline",
+    "check",
+    "cluster",
+    "compile_prov",
+    "derive",
+    "expect",
+    "ingest",
+    "load",
+    "metrics",
+    "open_store",
+    "query",
+    "rows_frame",
+    "segments",
+    "simulate",
+    "sparql",
+    "verdicts",
+    "verify",
+]

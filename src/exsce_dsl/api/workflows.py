@@ -1,0 +1,146 @@
+"""The ``exscec`` workflows as Python functions, with typed results.
+
+Each function is what the command of the same name does, minus the printing: the CLI is a thin
+layer over the same library calls.  Functions that read or write runs take the store first (open
+one with :func:`open_store`, a context manager); specifications are loaded once with :func:`load`
+and passed on.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+from prov.model import ProvDocument
+
+from exsce_dsl.derive.expect import SUMMED, Expected, expected_metric
+from exsce_dsl.derive.workflows import DerivedSpec, StoredDerivation, add_derivation, derive_spec
+from exsce_dsl.lang.build import load_spec
+from exsce_dsl.model import Scenario
+from exsce_dsl.model.document import Specification
+from exsce_dsl.oracles.workflows import Baseline, Verification, build_baseline, verify_runs
+from exsce_dsl.prov.spec import compile_spec_scenario
+from exsce_dsl.rdf import serialize
+from exsce_dsl.rdf.spec_check import SpecCheck, check_spec
+from exsce_dsl.runs.ingest import IngestResult, ingest_bags
+from exsce_dsl.sim.executor import Fault
+from exsce_dsl.sim.run import SimulatedRun
+from exsce_dsl.sim.run import simulate as play
+from exsce_dsl.similarity.clustering import Clustering, cluster_stored
+from exsce_dsl.store import open as store_open
+from exsce_dsl.store.base import Store
+from exsce_dsl.transform.derivation import Request
+
+
+def load(path: str | Path) -> Specification:
+    """Parse, resolve and check a specification (its imports too); a :class:`SpecError` lists
+    every error found."""
+    return load_spec(path)
+
+
+def check(path: str | Path) -> SpecCheck:
+    """``exscec check``: every diagnostic of the language's checks, then of the SHACL shapes."""
+    return check_spec(path)
+
+
+def compile_prov(
+    spec: Specification, scenario: str | None = None, format: str | None = None
+) -> ProvDocument | str:
+    """``exscec compile``: the PROV of a scenario (and of its generation, when derived); as text in
+    ``format`` (``provn``, ``json``, ``xml``, ``ttl``, ``trig``, ``nq``, ``jsonld``) when given."""
+    document = compile_spec_scenario(spec, scenario)
+    return serialize(document, format) if format is not None else document
+
+
+def open_store(url: str | None = None) -> Store:
+    """The store ``url`` names (default: ``$EXSCE_STORE``, else ``.exsce/store`` here); use it in a
+    ``with`` block, which closes it."""
+    return store_open.open_store(url)
+
+
+def _scenario(spec: Specification | Scenario, scenario: str | None) -> Scenario:
+    return spec if isinstance(spec, Scenario) else spec.scenario(scenario)
+
+
+def simulate(
+    spec: Specification | Scenario,
+    out_dir: str | Path,
+    runs: int = 1,
+    *,
+    scenario: str | None = None,
+    format: str = "ros1",
+    seed: int = 0,
+    faults: Sequence[str] = (),
+    convention: str | None = None,
+) -> list[SimulatedRun]:
+    """``exscec simulate``: play a scenario ``runs`` times with the kinematic executor, one bag per
+    run in ``out_dir`` (``faults`` as on the command line: ``overspeed:tiago1``)."""
+    chosen = _scenario(spec, scenario)
+    parsed = tuple(Fault.parse(f) for f in faults)
+    return list(play(chosen, Path(out_dir), runs, format, seed, parsed, convention))
+
+
+def ingest(
+    store: Store, spec: Specification | Scenario, bags: Sequence[str | Path], *, scenario: str | None = None,
+    jobs: int = 1,
+) -> list[IngestResult]:  # fmt: skip
+    """``exscec ingest``: each bag's metrics and run PROV into ``store``, one transaction per run
+    (a bag that fails is reported in its result, and nothing of it is written)."""
+    return ingest_bags([Path(b) for b in bags], _scenario(spec, scenario), store, jobs)
+
+
+def baseline(store: Store, spec: Specification, scenario: str | None = None) -> Baseline:
+    """``exscec baseline``: the oracles of a scenario from its acceptance criteria and stored runs."""
+    return build_baseline(store, spec, scenario)
+
+
+def verify(
+    store: Store, spec: Specification | Scenario, runs: Sequence[str | Path], *, scenario: str | None = None,
+    record: bool = True,
+) -> Verification:  # fmt: skip
+    """``exscec verify``: judge runs (stored uuids, or bags, ingested first) against every oracle
+    of their scenario; the verdicts go to the store unless ``record`` is False."""
+    return verify_runs(store, _scenario(spec, scenario), runs, record=record)
+
+
+def derive(
+    spec: Specification,
+    steps: Sequence[Request],
+    *,
+    new_id: str | None = None,
+    scenario: str | None = None,
+    target: str | Path | None = None,
+    expect_from: Store | None = None,
+) -> DerivedSpec:
+    """``exscec derive``: a scenario of ``spec`` transformed by ``steps`` in order, e.g.
+    ``[("remove_robot", {"robot": "tiago2", "reassign": "tiago1"})]``; the result's ``text`` is
+    the new file (write it to ``result.target``).  With ``expect_from``, the file holds the
+    acceptance criteria the stored runs imply (``exscec derive --expect``)."""
+    return derive_spec(
+        spec, spec.root, steps, new_id=new_id, scenario_id=scenario, target=target, expect_from=expect_from
+    )
+
+
+def add_derived(store: Store, derived: DerivedSpec) -> StoredDerivation:
+    """``exscec derive --add-to-store``: the derived scenario, its generation and its oracles."""
+    return add_derivation(store, derived)
+
+
+def expect(store: Store, spec: Specification | Scenario, scenario: str | None = None) -> list[Expected]:
+    """``exscec expect``: each robot's expected distance travelled and task duration, and the path
+    segments each value comes from."""
+    chosen = _scenario(spec, scenario)
+    return [expected_metric(store, chosen, robot.id, metric) for robot in chosen.robots for metric in SUMMED]
+
+
+def cluster(
+    store: Store,
+    scenarios: Sequence[str] = (),
+    *,
+    method: str = "average",
+    k: int | None = None,
+    threshold: float | None = None,
+    weights: Mapping[str, float] | None = None,
+) -> Clustering:
+    """``exscec cluster``: stored scenarios clustered by the method's distances."""
+    return cluster_stored(store, scenarios, method, k, threshold, weights)

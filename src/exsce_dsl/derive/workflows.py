@@ -1,0 +1,97 @@
+"""Deriving a scenario as ``exscec derive`` does: the new file's text, its acceptance criteria
+from the store (``--expect``), and its scenario, generation and oracles added to the store.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from exsce_dsl.derive.expect import RELATIVE_TOLERANCE, metamorphic_acceptance
+from exsce_dsl.lang.formatter import declared_poses, format_document
+from exsce_dsl.model import Acceptance, Scenario
+from exsce_dsl.model.document import Specification
+from exsce_dsl.model.oracles import Oracle
+from exsce_dsl.oracles.baseline import baseline_oracles
+from exsce_dsl.prov import compile_scenario
+from exsce_dsl.prov.derivation import compile_derivation
+from exsce_dsl.prov.oracle import compile_oracles
+from exsce_dsl.store.base import Store
+from exsce_dsl.store.writing import WriteReport, add_prov
+from exsce_dsl.transform.derivation import Derived, Request, derive, derived_document
+
+
+@dataclass(frozen=True)
+class DerivedSpec:
+    """A derived scenario and the file that declares it."""
+
+    base: Scenario
+    derived: Derived
+    target: Path
+    """Where the file is meant to be written (its import of the base's file is relative to it)."""
+    text: str
+    """The new ``.exsce`` file, formatted."""
+    criteria: Acceptance | None
+    """Its acceptance criteria, when asked for and the store gave any."""
+
+    @property
+    def scenario(self) -> Scenario:
+        return self.derived.scenario
+
+
+def derive_spec(
+    spec: Specification,
+    spec_path: str | Path,
+    requests: Sequence[Request],
+    *,
+    new_id: str | None = None,
+    scenario_id: str | None = None,
+    target: str | Path | None = None,
+    expect_from: Store | None = None,
+    tolerance: float = RELATIVE_TOLERANCE,
+) -> DerivedSpec:
+    """A scenario of ``spec`` (read from ``spec_path``) transformed by ``requests`` in order
+    (``("remove_robot", {"robot": "tiago2", "reassign": "tiago1"})``), as the text of a new file
+    for ``target`` (default: beside ``spec_path``, named after the new scenario).  With
+    ``expect_from``, the file also holds the acceptance criteria the stored runs imply
+    (``tolerance``: percent of the expected change)."""
+    base = spec.scenario(scenario_id)
+    derived = derive(base, requests, new_id, {t.id: t for t in spec.tasks})
+    path = Path(spec_path)
+    where = Path(target) if target is not None else path.with_name(f"{derived.scenario.id}.exsce")
+    document = derived_document(derived, path, where)
+    criteria = None
+    if expect_from is not None:
+        found = metamorphic_acceptance(
+            expect_from, base, derived.scenario, spec.acceptance_of(base.id), tolerance
+        )
+        if found.criteria:
+            criteria = found
+            document = replace(document, declarations=(*document.declarations, found))
+    text = format_document(document, declared_poses(spec.environments))
+    return DerivedSpec(base, derived, where, text, criteria)
+
+
+@dataclass(frozen=True)
+class StoredDerivation:
+    """What adding a derived scenario to the store wrote."""
+
+    scenario: WriteReport
+    generation: WriteReport
+    oracles: tuple[Oracle, ...] = ()
+    oracles_written: WriteReport | None = None
+
+
+def add_derivation(store: Store, derived: DerivedSpec) -> StoredDerivation:
+    """Add the base and the derived scenario, the generation (one activity per step) and, when
+    the derived file has acceptance criteria, its oracles."""
+    add_prov(store, compile_scenario(derived.base))
+    scenario = add_prov(store, compile_scenario(derived.scenario))
+    generation = add_prov(store, compile_derivation(derived.derived.derivation))
+    if derived.criteria is None:
+        return StoredDerivation(scenario, generation)
+    base = derived.base
+    oracles = baseline_oracles(store, derived.criteria, derived.scenario, {base.id: base})
+    written = add_prov(store, compile_oracles(derived.scenario.id, oracles), replace=True)
+    return StoredDerivation(scenario, generation, tuple(oracles), written)

@@ -1,0 +1,99 @@
+"""The Python API: docs/python.md's worked session runs as written, and the API is the CLI's.
+
+The page's ``python`` blocks are run in order, in one namespace (as a notebook would), in a copy of
+the examples; their own assertions check the figures against what the session did.  Beside it,
+the API's answers are compared with the command line's on the same store.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+from pathlib import Path
+
+import pytest
+
+from conftest import EXAMPLES, run_exscec
+
+DOC = Path(__file__).resolve().parents[1] / "docs" / "python.md"
+
+
+def _blocks(text: str) -> list[str]:
+    return re.findall(r"```python\n(.*?)```", text, flags=re.DOTALL)
+
+
+@pytest.fixture(scope="module")
+def session(tmp_path_factory: pytest.TempPathFactory) -> dict[str, object]:
+    folder = tmp_path_factory.mktemp("notebook")
+    shutil.copytree(EXAMPLES, folder, dirs_exist_ok=True)
+    namespace: dict[str, object] = {}
+    with pytest.MonkeyPatch.context() as patch:
+        patch.chdir(folder)
+        for number, block in enumerate(_blocks(DOC.read_text(encoding="utf-8")), 1):
+            try:
+                exec(compile(block, f"{DOC.name}, block {number}", "exec"), namespace)  # noqa: S102
+            except Exception as exc:
+                raise AssertionError(f"docs/python.md block {number} failed: {exc!r}\n{block}") from exc
+    namespace["folder"] = folder
+    return namespace
+
+
+def test_the_page_has_the_whole_session() -> None:
+    blocks = _blocks(DOC.read_text(encoding="utf-8"))
+    assert len(blocks) >= 6
+    called = set(re.findall(r"exsce\.(\w+)\(", "\n".join(blocks)))
+    from exsce_dsl import api
+
+    assert set(api.__all__) - {"rows_frame"} <= called, "every public function is shown on the page"
+
+
+def test_the_worked_session_runs_as_written(session: dict[str, object]) -> None:
+    folder = session["folder"]
+    assert isinstance(folder, Path)
+    assert (folder / "brsu_building_c" / "scenario_c_solo.exsce").exists()
+    table = session["table"]
+    import pandas as pd
+
+    assert isinstance(table, pd.DataFrame) and set(table.columns) >= {
+        "run",
+        "robot",
+        "metric",
+        "value",
+        "unit",
+    }
+    assert table.run.nunique() == 4 and (table.scenario == "scenario_c").all()
+
+
+def test_the_api_answers_as_the_command_line_does(session: dict[str, object]) -> None:
+    folder = session["folder"]
+    assert isinstance(folder, Path)
+    store = str(folder / "store")
+    listed = run_exscec("query", "runs", "-p", "scenario=scenario_c", "-f", "json", "--store", store)
+    assert listed.returncode == 0, listed.stderr
+    cli_runs = {b["run"]["value"] for b in json.loads(listed.stdout)["results"]["bindings"]}
+    from exsce_dsl import api as exsce
+
+    with exsce.open_store(store) as opened:
+        api_runs = set(exsce.query(opened, "runs", scenario="scenario_c").run)
+        table = exsce.metrics(opened, "scenario_c")
+    assert api_runs == cli_runs and len(api_runs) == 4
+    # the API's values are the store's: one through the library query the CLI runs
+    some = table[(table.metric == "distance_travelled") & (table.robot == "tiago1")].iloc[0]
+    value = run_exscec(
+        "query", "run_metric", "-p", f"run={some.run}", "-p", "robot=tiago1", "-p",
+        "metric=distance_travelled", "-f", "json", "--store", store,
+    )  # fmt: skip
+    assert value.returncode == 0, value.stderr
+    [binding] = json.loads(value.stdout)["results"]["bindings"]
+    assert float(binding["value"]["value"]) == pytest.approx(some.value)
+
+
+def test_a_library_update_is_refused() -> None:
+    from exsce_dsl import api as exsce
+    from exsce_dsl.store.queries.library import query, query_names
+
+    updates = [n for n in query_names() if query(n).is_update]
+    assert updates, "the library has updates"
+    with exsce.open_store("memory:") as store, pytest.raises(ValueError, match="update"):
+        exsce.query(store, updates[0])
