@@ -52,7 +52,7 @@ from exsce_dsl.prov.run import compile_run
 from exsce_dsl.store import queries as q
 from exsce_dsl.store.base import GraphSet, Store
 from exsce_dsl.store.embedded import EmbeddedStore
-from exsce_dsl.store.queries import Aggregate, MetricSource, PathSegment, RobotFacts, ViolationDuration
+from exsce_dsl.store.queries import MetricSource, PathSegment, RobotFacts, ValueStats, ViolationDuration
 from exsce_dsl.store.remote import RemoteStore
 from exsce_dsl.store.writing import add_prov
 
@@ -234,7 +234,7 @@ def fresh_store() -> Store:
     return store
 
 
-def close(a: Aggregate | None, mean: float, std: float, count: int) -> bool:
+def close(a: ValueStats | None, mean: float, std: float, count: int) -> bool:
     return a is not None and a.count == count and math.isclose(a.mean, mean) and math.isclose(a.std, std, abs_tol=1e-9)
 
 

@@ -33,7 +33,7 @@ from exsce_dsl.model.acceptance import (
     When,
 )
 from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries import Aggregate, robot_metric_over_runs, segment_metric_between
+from exsce_dsl.store.queries import ValueStats, robot_metric_over_runs, segment_metric_between
 from exsce_dsl.store.queries import runs as stored_runs
 
 SUMMED = ("distance_travelled", "task_duration")
@@ -73,7 +73,7 @@ def robot_path(scenario: Scenario, robot_id: str) -> list[tuple[Pose, Pose]]:
 
 def _either_way(
     store: Store, metric: str, start: Pose, goal: Pose, held_out: frozenset[frozenset[str]] = frozenset()
-) -> tuple[Aggregate | None, bool]:
+) -> tuple[ValueStats | None, bool]:
     if frozenset((start.id, goal.id)) in held_out:
         return None, False
     found = segment_metric_between(store, metric, start, goal)

@@ -61,26 +61,14 @@ from __future__ import annotations
 import gc
 from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
-from typing import Any
 
 from prov.constants import (
-    PROV,
-    PROV_ATTR_COLLECTION,
-    PROV_ATTR_ENTITY,
-    PROV_ATTR_GENERATED_ENTITY,
-    PROV_ATTR_USED_ENTITY,
     PROV_ROLE,
     PROV_TYPE,
 )
-from prov.identifier import Namespace, QualifiedName
+from prov.identifier import QualifiedName
 from prov.model import (
-    ProvAgent,
-    ProvBundle,
-    ProvDerivation,
     ProvDocument,
-    ProvEntity,
-    ProvMembership,
-    ProvRecord,
 )
 
 from exsce_dsl.errors import ExsceError, SourceLocation
@@ -90,7 +78,8 @@ from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.scenario import Scenario
 from exsce_dsl.model.tasks import Task
 from exsce_dsl.prov import identifiers as ids
-from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, Namespaces, PrefixTable, Term
+from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, Namespaces
+from exsce_dsl.prov.records import Attributes, BundleWriter, DocumentWriter
 
 __all__ = ["compile_scenario"]
 
@@ -101,8 +90,6 @@ SOFTWARE_CONFIG = ids.SOFTWARE_CONFIG
 HARDWARE_CONFIG = ids.HARDWARE_CONFIG
 EULER_AXES = "sxyz"
 
-# Records of one bundle are attribute maps keyed by qualified name.
-_Attributes = dict[QualifiedName, Any]
 
 _DOCUMENT_PREFIXES = (ids.ROS, ids.EXSCE, ids.GEOM, ids.COORD, ids.ANGLE, ids.ORACLE)
 """The prefixes the published documents declare at document level."""
@@ -137,118 +124,16 @@ def _collector_paused() -> Iterator[None]:
             gc.enable()
 
 
-class _BundleWriter:
-    """One bundle of the document, with each namespace it uses registered once.
-
-    Records are built directly from names minted in the bundle's own
-    namespaces and from plain values, which is what prov's ``bundle.entity``,
-    ``bundle.membership``... would make of them after checking each attribute
-    (five times slower).  ``checked=True`` goes through prov's API instead; a
-    test keeps the two equal.
-    """
-
-    def __init__(self, compiler: _ScenarioCompiler, identifier: QualifiedName, checked: bool = False) -> None:
-        self._compiler = compiler
-        self.bundle: ProvBundle = compiler.document.bundle(identifier)
-        self._checked = checked
-        self._namespaces: dict[str, Namespace] = {}
-        self._written: set[QualifiedName] = set()
-
-    def namespace(self, prefix: str, iri: str) -> Namespace:
-        registered = self._namespaces.get(iri)
-        if registered is None:
-            registered = self.bundle.add_namespace(self._compiler.shared_namespace(prefix, iri))
-            self._namespaces[iri] = registered
-        return registered
-
-    def fixed(self, prefix: str) -> Namespace:
-        return self.namespace(prefix, self._compiler.names.fixed[prefix])
-
-    def of_element(self, element_id: str, iri: str, kind: str) -> Namespace:
-        """The namespace of an element's parts (``tiago1:``, ``mission_c:``...)."""
-        return self.namespace(self._compiler.prefixes.prefix(element_id, iri, kind), iri)
-
-    def term(self, term: Term) -> QualifiedName:
-        if term.prefix == "prov":
-            return PROV[term.local]
-        return self.fixed(term.prefix)[term.local]
-
-    def _add(
-        self,
-        kind: type[ProvRecord],
-        identifier: QualifiedName | None,
-        attributes: Iterable[tuple[QualifiedName, Any]],
-    ) -> None:
-        record = kind(self.bundle, identifier)
-        values = record._attributes
-        for name, value in attributes:
-            values[name].add(value)
-        self.bundle._add_record(record)
-
-    def entity(self, identifier: QualifiedName, attributes: _Attributes) -> None:
-        if self._checked:
-            self.bundle.entity(identifier, attributes)
-        else:
-            self._add(ProvEntity, identifier, attributes.items())
-
-    def agent(self, identifier: QualifiedName, attributes: _Attributes) -> None:
-        if self._checked:
-            self.bundle.agent(identifier, attributes)
-        else:
-            self._add(ProvAgent, identifier, attributes.items())
-
-    def entity_once(self, identifier: QualifiedName, attributes: _Attributes) -> bool:
-        """Write the entity unless the bundle has it; True if it was written."""
-        if identifier in self._written:
-            return False
-        self._written.add(identifier)
-        self.entity(identifier, attributes)
-        return True
-
-    def member(self, collection: QualifiedName, entity: QualifiedName) -> None:
-        if self._checked:
-            self.bundle.membership(collection, entity)
-        else:
-            self._add(
-                ProvMembership,
-                None,
-                ((PROV_ATTR_COLLECTION, collection), (PROV_ATTR_ENTITY, entity)),
-            )
-
-    def derivation(
-        self,
-        generated: QualifiedName,
-        used: QualifiedName,
-        attributes: _Attributes,
-        identifier: QualifiedName | None = None,
-    ) -> None:
-        if self._checked:
-            self.bundle.derivation(generated, used, identifier=identifier, other_attributes=attributes)
-        else:
-            self._add(
-                ProvDerivation,
-                identifier,
-                (
-                    (PROV_ATTR_GENERATED_ENTITY, generated),
-                    (PROV_ATTR_USED_ENTITY, used),
-                    *attributes.items(),
-                ),
-            )
-
-
 class _ScenarioCompiler:
     def __init__(self, scenario: Scenario, names: Namespaces, checked: bool = False) -> None:
         self.scenario = scenario
-        self.checked = checked
+        self.writer = DocumentWriter(names, checked)
         self.names = names
-        self.prefixes = PrefixTable(names)
-        self.document = ProvDocument()
-        self._shared_ns: dict[str, Namespace] = {}
+        self.prefixes = self.writer.prefixes
+        self.document = self.writer.document
         self._orientation_names: dict[Orientation, str] = {}
-        self._document_ns: dict[str, Namespace] = {}
         for prefix in _DOCUMENT_PREFIXES:
-            self._document_namespace(prefix)
-        self._bundle_owners: dict[QualifiedName, str] = {}
+            self.writer.document_namespace(prefix)
         self._positions: dict[str, Position] = {}
         self._tasks = {task.id: task for task in scenario.tasks}
         self._area_locations = {a.id: a.location for a in scenario.environment.areas}
@@ -270,21 +155,6 @@ class _ScenarioCompiler:
             self._task_bundle(task)
         return self.document
 
-    def _document_namespace(self, prefix: str) -> Namespace:
-        registered = self._document_ns.get(prefix)
-        if registered is None:
-            namespace = self.shared_namespace(prefix, self.names.fixed[prefix])
-            registered = self.document.add_namespace(namespace)
-            self._document_ns[prefix] = registered
-        return registered
-
-    def shared_namespace(self, prefix: str, iri: str) -> Namespace:
-        """One namespace object per IRI, so that its names are minted once for all bundles."""
-        namespace = self._shared_ns.get(iri)
-        if namespace is None:
-            namespace = self._shared_ns[iri] = Namespace(prefix, iri)
-        return namespace
-
     def pose_name(self, pose: Pose) -> str:
         """:func:`~exsce_dsl.prov.identifiers.pose_name`, each orientation formatted once."""
         name = self._orientation_names.get(pose.orientation)
@@ -294,17 +164,9 @@ class _ScenarioCompiler:
 
     def _bundle(
         self, prefix: str, element_id: str, what: str, location: SourceLocation | None
-    ) -> _BundleWriter:
-        identifier = self._document_namespace(prefix)[ids.bundle_name(element_id)]
-        owner = self._bundle_owners.get(identifier)
-        if owner is not None:
-            raise ExsceError(
-                f"{what} and {owner} would both be written to PROV bundle "
-                f"{identifier.provn_representation()}; rename one of them",
-                location,
-            )
-        self._bundle_owners[identifier] = what
-        return _BundleWriter(self, identifier, self.checked)
+    ) -> BundleWriter:
+        identifier = self.writer.document_namespace(prefix)[ids.bundle_name(element_id)]
+        return self.writer.bundle(identifier, what, location)
 
     def _place_poses(
         self,
@@ -341,10 +203,10 @@ class _ScenarioCompiler:
 
     # -- poses -------------------------------------------------------------
 
-    def _pose_id(self, writer: _BundleWriter, pose: Pose) -> QualifiedName:
+    def _pose_id(self, writer: BundleWriter, pose: Pose) -> QualifiedName:
         return writer.fixed(ids.POSE)[self.pose_name(pose)]
 
-    def _write_poses(self, writer: _BundleWriter, poses: Iterable[Pose]) -> None:
+    def _write_poses(self, writer: BundleWriter, poses: Iterable[Pose]) -> None:
         """Pose, point and orientation entities, and the pose's two memberships."""
         poses = list(poses)
         if not poses:
@@ -485,7 +347,7 @@ class _ScenarioCompiler:
         obstacles = []
         for obstacle in environment.obstacles:
             obstacle_id = parts[obstacle.id]
-            attributes: _Attributes = {PROV_TYPE: t(ids.OBSTACLE_TYPE)}
+            attributes: Attributes = {PROV_TYPE: t(ids.OBSTACLE_TYPE)}
             if obstacle.model is not None:
                 attributes[t(ids.OBSTACLE_MODEL)] = obstacle.model
             if obstacle.size is not None:
@@ -519,7 +381,7 @@ class _ScenarioCompiler:
         model = parts[ids.GAZEBO_MODEL]
         w.entity(robot_id, {PROV_TYPE: t(ids.ROBOT_TYPE_VALUE), t(ids.ROBOT_TYPE): robot.type.id})
         w.entity(software, {PROV_TYPE: SOFTWARE_CONFIG, t(ids.ROS_NAMESPACE): robot.namespace})
-        hardware_facts: _Attributes = {PROV_TYPE: HARDWARE_CONFIG}
+        hardware_facts: Attributes = {PROV_TYPE: HARDWARE_CONFIG}
         if robot.type.base is not None:
             hardware_facts[t(ids.BASE_TYPE)] = robot.type.base
         if robot.type.torso is not None:
@@ -557,10 +419,10 @@ class _ScenarioCompiler:
         self._write_poses(w, (p for p in task.waypoints() if p.area is None))
 
     @staticmethod
-    def _ros(w: _BundleWriter, source: RosResource | None) -> _Attributes:
+    def _ros(w: BundleWriter, source: RosResource | None) -> Attributes:
         if source is None:
             return {}
-        found: _Attributes = {w.term(ids.ROS_PKG): source.package}
+        found: Attributes = {w.term(ids.ROS_PKG): source.package}
         if source.path is not None:
             found[w.term(ids.ROS_RELATIVE_PATH)] = source.path
         return found

@@ -49,7 +49,7 @@ from prov.model import (
 )
 from prov.model.records import TypedValueSet
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import ExsceError, SourceLocation
 from exsce_dsl.prov.identifiers import Namespaces, PrefixTable, Term
 
 __all__ = ["Attributes", "BundleWriter", "DocumentWriter"]
@@ -95,20 +95,30 @@ class DocumentWriter:
         prefix = self.prefixes.prefix(element_id, iri, kind)
         return self.document.add_namespace(self.shared_namespace(prefix, iri))
 
-    def claim(self, identifier: QualifiedName, what: str) -> None:
-        """Record that ``what`` is written as ``identifier``; no two things may share one."""
+    def claim(self, identifier: QualifiedName, what: str, location: SourceLocation | None = None) -> None:
+        """Record that ``what`` is written as ``identifier``; no two things may share one
+        (``location``: where ``what`` is written in the specification, for the error)."""
         owner = self._owners.get(identifier)
         if owner is None:
             self._owners[identifier] = what
-        else:
-            same = " twice" if owner == what else f" and {owner}"
+        elif owner == what:
             raise ExsceError(
-                f"{what}{same} would be written as {identifier.provn_representation()}; "
-                "each needs an identifier of its own"
+                f"{what} twice would be written as {identifier.provn_representation()}; "
+                "each needs an identifier of its own",
+                location,
+            )
+        else:
+            raise ExsceError(
+                f"{what} and {owner} would both be written as {identifier.provn_representation()}; "
+                "rename one of them",
+                location,
             )
 
-    def bundle(self, identifier: QualifiedName, what: str) -> BundleWriter:
-        self.claim(identifier, what)
+    def bundle(
+        self, identifier: QualifiedName, what: str, location: SourceLocation | None = None
+    ) -> BundleWriter:
+        """The writer of a new bundle, claimed for ``what``."""
+        self.claim(identifier, what, location)
         return BundleWriter(self, identifier)
 
 
@@ -120,6 +130,7 @@ class BundleWriter:
         self.bundle: ProvBundle = writer.document.bundle(identifier)
         self._checked = writer.checked
         self._namespaces: dict[str, Namespace] = {}
+        self._written: set[QualifiedName] = set()
 
     def namespace(self, prefix: str, iri: str) -> Namespace:
         registered = self._namespaces.get(iri)
@@ -166,6 +177,14 @@ class BundleWriter:
             self.bundle.entity(identifier, attributes)
         else:
             self._add(ProvEntity, identifier, attributes.items())
+
+    def entity_once(self, identifier: QualifiedName, attributes: Attributes) -> bool:
+        """Write the entity unless this writer wrote it already; True if it was written."""
+        if identifier in self._written:
+            return False
+        self._written.add(identifier)
+        self.entity(identifier, attributes)
+        return True
 
     def activity(
         self,

@@ -14,7 +14,7 @@ from exsce_dsl.model.runs import Hotspot
 from exsce_dsl.model.verdicts import Outcome, Verdict
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE
 from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries import _float, _int, _text, run_query
+from exsce_dsl.store.queries.terms import float_of, int_of, run_query, text_of
 
 __all__ = ["RunHotspot", "hotspots", "pose_positions", "verdicts"]
 
@@ -25,26 +25,26 @@ def verdicts(store: Store, scenario: str | None = None, namespace: str = DEFAULT
     given = {} if scenario is None else {"scenario": scenario}
     found = []
     for row in run_query(store, "verdicts", given, namespace):
-        runs = _text(row["runs"])
+        runs = text_of(row["runs"])
         found.append(
             Verdict(
-                run=_text(row["run"]) or "",
-                scenario=_text(row["scenario"]) or "",
-                criterion=_text(row["criterion"]) or "",
-                oracle=_text(row["oracle"]) or "",
-                metric=_text(row["metric"]) or "",
-                robot=_text(row["robot"]),
-                relation=_text(row["relation"]) or "",
-                outcome=Outcome(_text(row["outcome"])),
-                observed=_float(row["observed"]),
-                expected=_float(row["expected"]),
-                limit=_float(row["limit"]),
-                delta=_float(row["delta"]),
-                tolerance=_float(row["tolerance"]),
-                margin=_float(row["margin"]),
-                window=_text(row["window"]),
+                run=text_of(row["run"]) or "",
+                scenario=text_of(row["scenario"]) or "",
+                criterion=text_of(row["criterion"]) or "",
+                oracle=text_of(row["oracle"]) or "",
+                metric=text_of(row["metric"]) or "",
+                robot=text_of(row["robot"]),
+                relation=text_of(row["relation"]) or "",
+                outcome=Outcome(text_of(row["outcome"])),
+                observed=float_of(row["observed"]),
+                expected=float_of(row["expected"]),
+                limit=float_of(row["limit"]),
+                delta=float_of(row["delta"]),
+                tolerance=float_of(row["tolerance"]),
+                margin=float_of(row["margin"]),
+                window=text_of(row["window"]),
                 sources=tuple(runs.split()) if runs else (),
-                reason=_text(row["reason"]) or "",
+                reason=text_of(row["reason"]) or "",
             )
         )
     return found
@@ -62,17 +62,17 @@ def hotspots(store: Store, runs: Sequence[str], namespace: str = DEFAULT_NAMESPA
         return []
     found = []
     for row in run_query(store, "hotspots", {"run": list(runs)}, namespace):
-        x, y = _float(row["x"]), _float(row["y"])
+        x, y = float_of(row["x"]), float_of(row["y"])
         if x is None or y is None:
             continue
         hotspot = Hotspot(
-            metric=_text(row["metric"]) or "",
+            metric=text_of(row["metric"]) or "",
             position=Position(x, y, 0.0),
-            violations=_int(row["violations"]),
-            duration=_float(row["duration"]) or 0.0,
-            robot=_text(row["robot"]),
+            violations=int_of(row["violations"]),
+            duration=float_of(row["duration"]) or 0.0,
+            robot=text_of(row["robot"]),
         )
-        found.append(RunHotspot(_text(row["run"]) or "", hotspot))
+        found.append(RunHotspot(text_of(row["run"]) or "", hotspot))
     return found
 
 
@@ -84,7 +84,7 @@ def pose_positions(
         return {}
     found = {}
     for row in run_query(store, "pose_positions", {"pose": list(dict.fromkeys(poses))}, namespace):
-        name, x, y = _text(row["name"]), _float(row["x"]), _float(row["y"])
+        name, x, y = text_of(row["name"]), float_of(row["x"]), float_of(row["y"])
         if name is not None and x is not None and y is not None:
             found[name] = (x, y)
     return found
