@@ -1,5 +1,5 @@
 """Output relations: the method's basic relations at, inside and outside their bounds, the
-registry with its plug-ins, and the complex relations (combined, aggregated, composed)."""
+registry with its plug-ins, and the complex relations (combined, aggregated)."""
 
 from __future__ import annotations
 
@@ -14,15 +14,12 @@ import pytest
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.oracles import relations
 from exsce_dsl.oracles.relations import (
-    TRANSFORMATION_RELATIONS,
     Judgement,
     Relation,
     RelationError,
     aggregate,
     all_of,
     any_of,
-    compose,
-    composed_relation,
     relation,
     relation_names,
 )
@@ -302,56 +299,3 @@ def test_aggregate_rejects_an_unknown_way_and_an_empty_fleet() -> None:
         aggregate(FLEET, "maen")
     with pytest.raises(RelationError, match="no robot values"):
         aggregate({}, "sum")
-
-
-@pytest.mark.parametrize(
-    ("chain", "expected"),
-    [
-        ([], "invariant"),
-        (["invariant"], "invariant"),
-        (["invariant", "invariant"], "invariant"),
-        (["increasing"], "increasing"),
-        (["increasing", "increasing"], "increasing"),
-        (["invariant", "increasing", "invariant"], "increasing"),
-        (["decreasing", "decreasing"], "decreasing"),
-        (["decreasing", "invariant"], "decreasing"),
-        (["increasing", "decreasing"], None),
-        (["decreasing", "increasing"], None),
-        (["increasing", "invariant", "decreasing"], None),
-    ],
-)
-def test_compose(chain: list[str], expected: str | None) -> None:
-    assert compose(chain) == expected
-
-
-def test_compose_rejects_a_relation_that_is_not_a_change() -> None:
-    with pytest.raises(RelationError, match="cannot compose 'below_max'"):
-        compose(["increasing", "below_max"])
-
-
-def test_transformation_relations_are_the_methods() -> None:
-    assert TRANSFORMATION_RELATIONS == {
-        "add_waypoint": {"distance_travelled": "increasing", "task_duration": "increasing"},
-        "remove_waypoint": {"distance_travelled": "decreasing", "task_duration": "decreasing"},
-        "reverse_waypoint_order": {"distance_travelled": "invariant", "task_duration": "invariant"},
-        "reverse_task_order": {"distance_travelled": "invariant", "task_duration": "invariant"},
-    }
-
-
-@pytest.mark.parametrize(
-    ("transformations", "metric", "expected"),
-    [
-        ([], "distance_travelled", "invariant"),
-        (["add_waypoint"], "distance_travelled", "increasing"),
-        (["add_waypoint", "add_waypoint"], "task_duration", "increasing"),
-        (["add_waypoint", "reverse_waypoint_order"], "distance_travelled", "increasing"),
-        (["remove_waypoint", "reverse_task_order"], "task_duration", "decreasing"),
-        (["reverse_waypoint_order", "reverse_task_order"], "distance_travelled", "invariant"),
-        (["add_waypoint", "remove_waypoint"], "distance_travelled", None),
-        (["swap_start_poses"], "distance_travelled", None),
-        (["add_waypoint", "swap_start_poses"], "task_duration", None),
-        (["add_waypoint"], "max_velocity", None),
-    ],
-)
-def test_composed_relation(transformations: list[str], metric: str, expected: str | None) -> None:
-    assert composed_relation(transformations, metric) == expected

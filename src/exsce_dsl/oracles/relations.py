@@ -3,9 +3,9 @@
 The method's basic relations, with its signatures: ``increasing(result, value, delta,
 tolerance)``, ``decreasing(...)``, ``invariant(result, value, tolerance)``,
 ``below_max(result, limit)``, ``above_min(result, limit)``.  Complex relations combine
-judgements (:func:`all_of`, :func:`any_of`), aggregate a fleet's values
-(:func:`aggregate`), or compose the relations that input transformations imply
-(:func:`compose`, :func:`composed_relation`).
+judgements (:func:`all_of`, :func:`any_of`) or aggregate a fleet's values
+(:func:`aggregate`).  What a derived scenario's metrics are expected to do comes from the
+stored runs (:mod:`exsce_dsl.derive.expect`), not from a table of transformations.
 
 Third-party packages add relations through the entry-point group ``exsce.relations``;
 a relation is never imported from a module name found in a data file.
@@ -18,7 +18,7 @@ import functools
 import math
 import warnings
 from abc import ABC, abstractmethod
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from importlib.metadata import entry_points
 
@@ -27,15 +27,12 @@ from exsce_dsl.suggest import did_you_mean
 
 __all__ = [
     "ENTRY_POINT_GROUP",
-    "TRANSFORMATION_RELATIONS",
     "Judgement",
     "Relation",
     "RelationError",
     "aggregate",
     "all_of",
     "any_of",
-    "compose",
-    "composed_relation",
     "relation",
     "relation_names",
 ]
@@ -234,33 +231,3 @@ def aggregate(values: Mapping[str, float], how: str) -> float:
     if any(math.isnan(x) for x in numbers):
         return math.nan
     return _AGGREGATES[how](numbers)
-
-
-TRANSFORMATION_RELATIONS: Mapping[str, Mapping[str, str]] = {
-    "add_waypoint": {"distance_travelled": "increasing", "task_duration": "increasing"},
-    "remove_waypoint": {"distance_travelled": "decreasing", "task_duration": "decreasing"},
-    "reverse_waypoint_order": {"distance_travelled": "invariant", "task_duration": "invariant"},
-    # of each robot's total over its tasks
-    "reverse_task_order": {"distance_travelled": "invariant", "task_duration": "invariant"},
-}
-"""What an input transformation does to a metric, where the method knows it (``swap_start_poses``
-has no known effect)."""
-
-
-def compose(relations: Sequence[str]) -> str | None:
-    """The relation of several changes in a row: invariant is neutral; the same direction
-    twice keeps it; opposite directions cannot be told apart without estimates (None)."""
-    unknown = sorted(set(relations) - {"increasing", "decreasing", "invariant"})
-    if unknown:
-        raise RelationError(f"cannot compose '{unknown[0]}' (only increasing, decreasing, invariant)")
-    directions = set(relations) - {"invariant"}
-    if not directions:
-        return "invariant"
-    return directions.pop() if len(directions) == 1 else None
-
-
-def composed_relation(transformations: Sequence[str], metric: str) -> str | None:
-    """The relation ``metric`` keeps through ``transformations`` (None if any effect is unknown)."""
-    implied = [TRANSFORMATION_RELATIONS.get(t, {}).get(metric) for t in transformations]
-    known = [r for r in implied if r is not None]
-    return compose(known) if len(known) == len(implied) else None
