@@ -41,7 +41,7 @@ SUMMED = ("distance_travelled", "task_duration")
 
 
 @dataclass(frozen=True)
-class SegmentValue:
+class ExpectedSegment:
     start: str
     goal: str
     value: float | None
@@ -55,7 +55,7 @@ class Expected:
     robot: str
     metric: str
     value: float | None
-    segments: tuple[SegmentValue, ...]
+    segments: tuple[ExpectedSegment, ...]
 
 
 def robot_path(scenario: Scenario, robot_id: str) -> list[tuple[Pose, Pose]]:
@@ -89,18 +89,18 @@ def segment_value(
     start: Pose,
     goal: Pose,
     held_out: frozenset[frozenset[str]] = frozenset(),
-) -> SegmentValue:
+) -> ExpectedSegment:
     """One segment's value; ``held_out`` pairs of pose ids are treated as never driven (either way),
     to measure the estimate against what was driven (bench/estimate.py)."""
     names = (start.id, goal.id)
     found, reverse = _either_way(store, metric, start, goal, held_out)
     if found is not None:
-        return SegmentValue(
+        return ExpectedSegment(
             *names, found.mean, "observed the other way" if reverse else "observed", found.count
         )
     near_start, near_goal = _area_poses(scenario, start, names), _area_poses(scenario, goal, names)
     if not near_start or not near_goal or math.dist(_xy(start), _xy(goal)) == 0:
-        return SegmentValue(*names, None, "no data, and no pose near it to estimate from")
+        return ExpectedSegment(*names, None, "no data, and no pose near it to estimate from")
     p3 = min(near_start, key=lambda p: math.dist(_xy(p), _xy(start)))  # in p1's area
     p4 = min(near_goal, key=lambda p: math.dist(_xy(p), _xy(goal)))  # in p2's area
     estimates, used, runs = [], [], 0
@@ -114,8 +114,8 @@ def segment_value(
             used.append(f"{i.id}–{j.id}")
             runs += near.count
     if not estimates:
-        return SegmentValue(*names, None, f"no data, nor for {p3.id} and {p4.id} near its ends")
-    return SegmentValue(
+        return ExpectedSegment(*names, None, f"no data, nor for {p3.id} and {p4.id} near its ends")
+    return ExpectedSegment(
         *names, math.fsum(estimates) / len(estimates), f"estimated from {', '.join(used)}", runs
     )
 
@@ -138,7 +138,9 @@ def _area_poses(scenario: Scenario, pose: Pose, leave_out: tuple[str, ...]) -> l
     return [p for p in area.poses if p.id not in leave_out] if area is not None else []
 
 
-def _fall_back(parts: tuple[SegmentValue, ...], path: list[tuple[Pose, Pose]]) -> tuple[SegmentValue, ...]:
+def _fall_back(
+    parts: tuple[ExpectedSegment, ...], path: list[tuple[Pose, Pose]]
+) -> tuple[ExpectedSegment, ...]:
     """Segments with no value and no neighbour data: their straight-line length times the
     robot's value per straight-line metre over the segments that have a value."""
     known = [

@@ -21,7 +21,7 @@ _WINDOW = re.compile(
 
 
 @dataclass(frozen=True)
-class SegmentValue:
+class ObservedSegment:
     action: str
     robot: str
     allocation: int
@@ -39,7 +39,7 @@ class RunValues:
 
     run: str
     whole: dict[tuple[str, str | None], list[float]] = field(default_factory=dict)
-    segments: list[SegmentValue] = field(default_factory=list)
+    segments: list[ObservedSegment] = field(default_factory=list)
 
 
 def run_values(store: Store, runs: Sequence[str]) -> dict[str, RunValues]:
@@ -56,7 +56,7 @@ def run_values(store: Store, runs: Sequence[str]) -> dict[str, RunValues]:
             continue
         numbers = (int(parts["task"]), int(parts["subtask"]), int(parts["waypoint"]))
         found[reading.run].segments.append(
-            SegmentValue(
+            ObservedSegment(
                 reading.action or "",
                 parts["robot"],
                 numbers[0],
@@ -111,7 +111,9 @@ def observe(
     return float(max(numbers) if info.combine is Combine.MAX else min(numbers)), ""
 
 
-def _in_window(segments: list[SegmentValue], window: Window, tasks: Sequence[str]) -> list[SegmentValue]:
+def _in_window(
+    segments: list[ObservedSegment], window: Window, tasks: Sequence[str]
+) -> list[ObservedSegment]:
     if window.task is not None:
         indices = [k for k, task in enumerate(tasks, start=1) if task == window.task]
         if not indices:
