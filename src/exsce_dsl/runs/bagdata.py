@@ -364,7 +364,8 @@ class _Ros1(_Reading):
             store = deserializer_for(self._catalogue(messages.msgtype, messages.definition), messages.msgtype)
             order = np.argsort(messages.times, kind="stable")
             read = functools.partial(store.deserialize_ros1, typename=messages.msgtype)
-            objects = deserialized(read, [messages.raws[i] for i in order.tolist()])
+            lazy = topic if self.wanted[topic].msgtype == OBJECTS else None
+            objects = deserialized(read, [messages.raws[i] for i in order.tolist()], lazy)
             self.add_whole(topic, messages.times[order] / 1e9, objects)
         return self.data(start / 1e9, end / 1e9, tuple(sorted(found)))
 
@@ -441,8 +442,9 @@ def _read_connection(
         times = np.asarray(stamps, dtype=np.int64)
         if store is not None:
             read = store.deserialize_cdr if cdr else store.deserialize_ros1
+            lazy = topic if reading.wanted[topic].msgtype == OBJECTS else None
             reading.add_whole(
-                topic, times / 1e9, deserialized(functools.partial(read, typename=msgtype), raws)
+                topic, times / 1e9, deserialized(functools.partial(read, typename=msgtype), raws, lazy)
             )
         else:
             reading.add(
@@ -450,17 +452,45 @@ def _read_connection(
             )
 
 
-def deserialized(read: Callable[[bytes], Any], raws: Sequence[bytes | memoryview]) -> list[Any]:
+def deserialized(
+    read: Callable[[bytes], Any], raws: Sequence[bytes | memoryview], lazy: str | None = None
+) -> list[Any]:
     """``read`` of each message, once per distinct message: a status array published once a
-    second is mostly the same bytes again (its objects are then shared, and only read)."""
+    second is mostly the same bytes again (its objects are then shared, and only read).  With
+    ``lazy`` (the topic's name), each is read when first used (:class:`LazyMessage`)."""
     seen: dict[bytes, Any] = {}
     found = []
     for raw in raws:
         key = bytes(raw)
         if key not in seen:
-            seen[key] = read(key)
+            seen[key] = LazyMessage(read, key, lazy) if lazy is not None else read(key)
         found.append(seen[key])
     return found
+
+
+class LazyMessage:
+    """A message deserialised when one of its fields is first read.  A navigation stack replans
+    about once a second, and each global plan is hundreds of poses; a goal's target needs only the
+    first plan of the goal, so the others are never deserialised.  A message that does not
+    deserialise is a :class:`BagError` naming its topic, when it is read."""
+
+    __slots__ = ("_read", "_raw", "_topic", "_value")
+
+    def __init__(self, read: Callable[[bytes], Any], raw: bytes, topic: str) -> None:
+        self._read, self._raw, self._topic = read, raw, topic
+        self._value: Any = None
+
+    @property
+    def value(self) -> Any:
+        if self._value is None:
+            try:
+                self._value = self._read(self._raw)
+            except Exception as exc:  # rosbags raises struct, index and its own errors on bad bytes
+                raise BagError(f"a message on {self._topic} does not deserialize: {exc}") from None
+        return self._value
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.value, name)
 
 
 def deserializer_for(catalogue: MessageCatalogue, msgtype: str) -> Any:

@@ -27,6 +27,7 @@ from exsce_dsl.messages.catalogue import (
 )
 from exsce_dsl.messages.user import configured_user_catalogue
 from exsce_dsl.runs.bagdata import (
+    OBJECTS,
     WHOLE,
     BagData,
     _Reading,
@@ -105,7 +106,8 @@ class Mcap(_Reading):
             all_times = np.concatenate([m.times for m in parts])
             order = np.argsort(all_times, kind="stable")
             read = functools.partial(store.deserialize_cdr, typename=msgtype)
-            objects = deserialized(read, [raws[i] for i in order.tolist()])
+            lazy = topic if self.wanted[topic].msgtype == OBJECTS else None
+            objects = deserialized(read, [raws[i] for i in order.tolist()], lazy)
             self.add_whole(topic, all_times[order] / 1e9, objects)
         return self.data(start / 1e9, end / 1e9, tuple(sorted(found)))
 
