@@ -37,11 +37,15 @@ def main(debug: bool, msg_paths: tuple[str, ...]) -> None:
     the definitions of other types come from --msg-path, $EXSCE_MSG_PATH, or
     the bag itself.
 
+    `exscec demo` runs the whole method on the shipped example, and
+    docs/tutorial.md walks it command by command.  Each command's --help ends
+    with examples that run as written, in a folder holding a copy of the
+    project's examples/, in the order of the tutorial.
+
     \b
     Example:
-      exscec check examples/brsu_building_c/scenario_c.exsce
+      exscec check examples/brsu_building_c
       exscec compile examples/brsu_building_c/scenario_c.exsce -f provn
-      exscec --msg-path ~/ws/src check spec.exsce
     """
     State.debug = debug
     if msg_paths:  # in the environment, so that worker processes see them too
@@ -57,6 +61,7 @@ def _register() -> None:
         derive_commands,
         generate_commands,
         lsp_commands,
+        mcp_commands,
         oracle_commands,
         query_commands,
         report_commands,
@@ -78,6 +83,7 @@ def _register() -> None:
         *generate_commands.COMMANDS,
         *demo_commands.COMMANDS,
         *lsp_commands.COMMANDS,
+        *mcp_commands.COMMANDS,
     ]:
         main.add_command(command)
 

@@ -20,7 +20,6 @@ from exsce_dsl.store.base import Rows, Term
 from exsce_dsl.tables import aligned
 
 FORMATS = ("table", "json", "csv")
-_XSD_STRING = "http://www.w3.org/2001/XMLSchema#string"
 _PREFIX_DECLARATION = re.compile(r"^\s*PREFIX\s+([A-Za-z][\w.-]*)?:", re.IGNORECASE | re.MULTILINE)
 _KIND_AFTER_PROLOGUE = re.compile(
     r"^(?:\s|#[^\n]*\n|PREFIX\s+[^\s:]*:\s*<[^>]*>|BASE\s*<[^>]*>)*\s*(SELECT|ASK|CONSTRUCT|DESCRIBE)\b",
@@ -51,24 +50,9 @@ def output_option(func: Any) -> Any:
 
 def results_json(rows: Rows) -> str:
     """SPARQL 1.1 Query Results JSON."""
+    from exsce_dsl.store.answers import results_json as answer
 
-    def term(t: Term) -> dict[str, str]:
-        if isinstance(t, NamedNode):
-            return {"type": "uri", "value": t.value}
-        if isinstance(t, BlankNode):
-            return {"type": "bnode", "value": t.value}
-        found = {"type": "literal", "value": t.value}
-        if t.language:
-            found["xml:lang"] = t.language
-        elif t.datatype.value != _XSD_STRING:
-            found["datatype"] = t.datatype.value
-        return found
-
-    bindings = [
-        {v: term(t) for v, t in zip(rows.variables, row, strict=True) if t is not None} for row in rows.rows
-    ]
-    answer = {"head": {"vars": list(rows.variables)}, "results": {"bindings": bindings}}
-    return json.dumps(answer, indent=2) + "\n"
+    return json.dumps(answer(rows), indent=2) + "\n"
 
 
 def results_csv(rows: Rows) -> str:
@@ -164,7 +148,8 @@ def query_command(
       exscec query runs -p scenario=scenario_c
       exscec query segment_metric_of_scenario -p scenario=scenario_c -p metric=distance_travelled \\
           -p start=classroom_c025-w001-R0.00_P0.00_Y0.00 -p goal=classroom_c022-w001-R0.00_P0.00_Y2.269
-      exscec query mission_metric_stats -p metric=mission_duration -p run=UUID1 -p run=UUID2 -f json
+      exscec query pose_positions -p pose=classroom_c025-w001-R0.00_P0.00_Y0.00 \\
+          -p pose=classroom_c022-w001-R0.00_P0.00_Y2.269 -f json
     """
     from exsce_dsl.store.queries import query, query_names, run_query
 
@@ -209,7 +194,7 @@ def sparql_command(text: str, fmt: str, output: str | None, store_url: str | Non
     \b
     Examples:
       exscec sparql 'SELECT ?run WHERE { GRAPH ?g { ?r a exsce:run ; exsce:run ?run } }'
-      exscec sparql @my-query.rq -f csv
+      echo 'ASK { GRAPH ?g { ?r a exsce:run } }' > any-runs.rq && exscec sparql @any-runs.rq -f csv
     """
     from exsce_dsl.store.open import open_store
     from exsce_dsl.store.queries import standard_prefixes

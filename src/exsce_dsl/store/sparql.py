@@ -84,6 +84,38 @@ _TOKEN = re.compile(
 _FORMS = frozenset({"SELECT", "ASK", "CONSTRUCT", "DESCRIBE", "INSERT", "DELETE", "WITH", "LOAD", "CLEAR"})
 
 
+_PROLOGUE = frozenset({"PREFIX", "BASE"})
+
+
+def query_keywords(text: str) -> list[str]:
+    """The bare words of a query, upper-cased, in order: outside comments, strings and IRIs, with
+    variables and prefixed names left out."""
+    found = []
+    for token in _TOKEN.finditer(text):
+        word = token.group("word")
+        if word is not None and ":" not in word and word[0] not in "?$":
+            found.append(word.upper())
+    return found
+
+
+def query_form(text: str) -> str:
+    """The query's form: its first keyword after the prologue (SELECT, ASK, CONSTRUCT, DESCRIBE,
+    or an update's INSERT, DELETE, LOAD, DROP...); empty if it has none."""
+    return next((w for w in query_keywords(text) if w not in _PROLOGUE), "")
+
+
+def declared_prefixes(text: str) -> set[str]:
+    """The prefixes a query declares (``PREFIX p: <...>``; the empty prefix as ``""``), comments
+    and strings not counted."""
+    tokens = [t for t in _TOKEN.finditer(text) if not (t.lastgroup == "other" and t.group().isspace())]
+    return {
+        name.group().split(":", 1)[0]
+        for keyword, name in zip(tokens, tokens[1:], strict=False)
+        if keyword.lastgroup == "word" and keyword.group().upper() == "PREFIX"
+        and name.lastgroup == "word" and ":" in name.group()
+    }  # fmt: skip
+
+
 def where_group(query: str) -> int | None:
     """The index of the ``{`` that opens the query's WHERE group, or None."""
     depth = 0

@@ -1,0 +1,74 @@
+"""``exscec mcp``: the store and the checker for MCP clients, on stdio."""
+
+from __future__ import annotations
+
+import click
+
+from exsce_dsl.cli.common import reports_errors
+from exsce_dsl.cli.store_commands import store_option
+from exsce_dsl.store.server import QUERY_TIMEOUT
+
+
+@click.command(name="mcp")
+@click.option(
+    "--timeout",
+    type=click.FloatRange(min=0.1),
+    default=QUERY_TIMEOUT,
+    show_default=True,
+    metavar="SECONDS",
+    help="How long a tool call or resource read may take (as exscec serve's query time limit).",
+)
+@click.option(
+    "--max-rows",
+    type=click.IntRange(min=1),
+    default=1000,
+    show_default=True,
+    metavar="N",
+    help="The most rows a query answer shows; a longer answer says how many rows it cut.",
+)
+@store_option
+@reports_errors
+def mcp(timeout: float, max_rows: int, store_url: str | None) -> None:
+    """Serve the store and the checker to an MCP client (Model Context Protocol), on stdio.
+
+    Read-only.  Tools: one per query of the query library (exscec query
+    --list), lineage, run_verdicts, check (exscec check of a specification's
+    text, diagnostics as file:line:col) and sparql (SELECT and ASK only; no
+    updates, no SERVICE).  Resources: exsce://scenarios, exsce://runs, and
+    exsce://scenarios/{id}, exsce://runs/{uuid}.  The store is opened for each
+    request, so ingests and other commands may use it in between.
+
+    MCP clients start the server themselves and talk to it on stdin and
+    stdout; give the store as an absolute --store (a client may start the
+    server in any folder).
+
+    \b
+    Example (a client's session, by hand):
+      exscec mcp --store ~/robots/project/.exsce/store
+    \b
+    Claude Desktop (claude_desktop_config.json), or any client's mcpServers:
+      {
+        "mcpServers": {
+          "exsce": {
+            "command": "/path/to/venv/bin/exscec",
+            "args": ["mcp", "--store", "/path/to/project/.exsce/store"]
+          }
+        }
+      }
+    \b
+    Claude Code:
+      claude mcp add exsce -- exscec mcp --store "$PWD/.exsce/store"
+    \b
+    Try it with the MCP Inspector:
+      npx @modelcontextprotocol/inspector exscec mcp
+    """
+    from exsce_dsl.mcp_server import Access, serve
+    from exsce_dsl.store import open as store_open
+
+    with store_open.open_store(store_url):  # a store URL that cannot work fails now, not at a request
+        pass
+    click.echo(f"exscec mcp: serving {store_open.store_url(store_url)} read-only on stdio", err=True)
+    serve(Access(store_url, timeout=timeout, max_rows=max_rows))
+
+
+COMMANDS = [mcp]

@@ -1,0 +1,89 @@
+"""The ``sparql`` tool: any SELECT or ASK query, read-only, with the endpoint's limits.
+
+What ``exscec serve`` does for a query, this tool does too: a query is at most
+:data:`~exsce_dsl.store.server.MAX_QUERY` long and runs within the time limit
+(:data:`~exsce_dsl.store.server.QUERY_TIMEOUT` by default), and it never
+updates: the query's form is read from its tokens (comments, strings and IRIs
+skipped) and anything but SELECT and ASK is refused before the store is
+touched; what is sent then goes to the store's query operation, whose parser
+takes no update either (Oxigraph's for the embedded store, the endpoint's for
+a remote one).  Further than the endpoint, ``SERVICE`` is refused: a model's
+query reads this store, and makes no requests to other servers.
+
+The library's prefixes (``exsce:``, ``run:``, ``pose:``, ``prov:``, ``xsd:``...)
+are declared for the query unless it declares them itself, as ``exscec sparql``
+does.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import mcp_types as types
+
+from exsce_dsl.errors import ExsceError
+from exsce_dsl.mcp_server.access import Access
+from exsce_dsl.mcp_server.answers import READ_ONLY, ToolEntry, results_json
+from exsce_dsl.mcp_server.arguments import ArgumentError, object_schema
+from exsce_dsl.store.queries import standard_prefixes
+from exsce_dsl.store.server import MAX_QUERY
+from exsce_dsl.store.sparql import declared_prefixes, query_form, query_keywords
+
+__all__ = ["read_only_query", "sparql_tool"]
+
+_READING = frozenset({"SELECT", "ASK"})
+
+
+def read_only_query(text: str) -> tuple[str, str]:
+    """The form (SELECT or ASK) of a query that may run here, and its text with the library's
+    prefixes it does not declare; an ExsceError saying why otherwise."""
+    if len(text.encode("utf-8")) > MAX_QUERY:
+        raise ArgumentError(f"a query is at most {MAX_QUERY // 1024} KiB")
+    words = query_keywords(text)
+    form = query_form(text)
+    if form not in _READING:
+        what = f"this is {form}" if form else "this is no query"
+        raise ExsceError(f"the sparql tool runs SELECT and ASK queries only, never updates: {what}")
+    if "SERVICE" in words:
+        raise ExsceError("SERVICE is refused: the sparql tool reads this store only, never another server")
+    declared = declared_prefixes(text)
+    prologue = "".join(
+        f"PREFIX {p}: <{iri}>\n" for p, iri in standard_prefixes().items() if p not in declared
+    )
+    return form, prologue + text
+
+
+def _answer(access: Access, arguments: Mapping[str, Any]) -> dict[str, Any]:
+    form, text = read_only_query(str(arguments["query"]))
+    with access.store() as store:
+        if form == "ASK":
+            return {"head": {}, "boolean": store.ask(text)}
+        return results_json(store.select(text), access.max_rows)
+
+
+def sparql_tool() -> ToolEntry:
+    prefixes = ", ".join(f"{p}:" for p in standard_prefixes())
+    tool = types.Tool(
+        name="sparql",
+        title="SPARQL query (read-only)",
+        description=(
+            "Run a SPARQL 1.1 SELECT or ASK query on the provenance store (updates and SERVICE are "
+            "refused).  Every PROV bundle is a named graph: match with GRAPH ?g { ... }.  These prefixes "
+            f"are declared unless the query declares them: {prefixes}.  Answers SPARQL 1.1 Query "
+            "Results JSON; long answers are cut (see 'truncated')."
+        ),
+        input_schema=object_schema(
+            {
+                "query": {
+                    "type": "string",
+                    "maxLength": MAX_QUERY,
+                    "description": "the query, e.g. SELECT ?run WHERE { GRAPH ?g { ?a a exsce:run ; "
+                    "exsce:run ?run } }",
+                }
+            },
+            ("query",),
+        ),
+        annotations=READ_ONLY,
+    )
+    return ToolEntry(tool, _answer)

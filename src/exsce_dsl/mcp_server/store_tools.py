@@ -1,0 +1,150 @@
+"""Tools over the store beyond single queries: a scenario's or a run's lineage, a run's verdicts.
+
+Both answer what the command line shows, from the same library functions:
+``lineage`` what ``exscec lineage`` prints (:func:`exsce_dsl.store.queries.lineage`,
+:func:`~exsce_dsl.store.queries.derived_scenarios`), ``run_verdicts`` what the
+store holds of a run's last ``exscec verify``
+(:func:`exsce_dsl.store.queries.results.verdicts`, as ``exscec verify --json``
+writes each verdict).
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping
+from typing import Any
+
+import mcp_types as types
+
+from exsce_dsl.errors import ExsceError
+from exsce_dsl.mcp_server.access import Access
+from exsce_dsl.mcp_server.answers import READ_ONLY, ToolEntry
+from exsce_dsl.mcp_server.arguments import NAME, RUN_UUID, ArgumentError, identifier, object_schema
+from exsce_dsl.model.derivation import Derivation
+from exsce_dsl.model.verdicts import Outcome
+from exsce_dsl.oracles.report import verdicts_json
+from exsce_dsl.store.base import Store
+from exsce_dsl.store.queries import StoredRun, derivation_of, derived_scenarios, lineage, runs, scenario_ids
+from exsce_dsl.store.queries.results import verdicts
+from exsce_dsl.suggest import did_you_mean
+
+__all__ = ["lineage_tool", "run_verdicts_tool", "stored_run", "stored_scenario"]
+
+
+# -- looking things up ----------------------------------------------------------------------
+
+
+def stored_scenario(store: Store, scenario: str) -> str:
+    """``scenario`` if the store holds it; an ExsceError with the nearest id otherwise."""
+    known = scenario_ids(store)
+    if scenario not in known:
+        raise ExsceError(f"no scenario '{scenario}' in the store{did_you_mean(scenario, known)}")
+    return scenario
+
+
+def stored_run(store: Store, run: str) -> StoredRun:
+    """The run with uuid ``run``; an ExsceError if the store has none."""
+    for found in runs(store):
+        if found.uuid.lower() == run.lower():
+            return found
+    raise ExsceError(f"no run '{run}' in the store (the runs tool lists them)")
+
+
+# -- lineage ----------------------------------------------------------------------------------
+
+
+def derivation_json(derivation: Derivation) -> dict[str, Any]:
+    return {
+        "scenario": derivation.new,
+        "base": derivation.base,
+        "steps": [
+            {"transformation": step.transformation, "parameters": dict(step.parameters)}
+            for step in derivation.steps
+        ],
+    }
+
+
+def _descendants(store: Store, parent: str, seen: frozenset[str]) -> list[dict[str, Any]]:
+    found = []
+    for child in derived_scenarios(store, parent):
+        if child in seen:
+            continue
+        derivation = derivation_of(store, child)
+        steps = derivation_json(derivation)["steps"] if derivation is not None else []
+        found.append(
+            {"scenario": child, "steps": steps, "derived": _descendants(store, child, seen | {child})}
+        )
+    return found
+
+
+def _lineage(access: Access, arguments: Mapping[str, Any]) -> dict[str, Any]:
+    scenario, run = arguments.get("scenario"), arguments.get("run")
+    if (scenario is None) == (run is None):
+        raise ArgumentError("give either a scenario or a run")
+    answer: dict[str, Any] = {}
+    with access.store() as store:
+        if run is not None:
+            found = stored_run(store, str(run))
+            answer["run"] = found.uuid
+            scenario = found.scenario
+        scenario = stored_scenario(store, str(scenario))
+        ancestry = lineage(store, scenario)
+        answer["scenario"] = scenario
+        answer["ancestors"] = [derivation_json(d) for d in reversed(ancestry)]
+        answer["descendants"] = _descendants(store, scenario, frozenset({scenario}))
+    return answer
+
+
+def lineage_tool() -> ToolEntry:
+    tool = types.Tool(
+        name="lineage",
+        title="Lineage of a scenario or run",
+        description=(
+            "Where a scenario (or the scenario of a run) comes from and what was derived from it, as "
+            "`exscec lineage` shows: 'ancestors' oldest first, each the derivation of a scenario from "
+            "its base with the transformations applied in order; 'descendants' a tree of the scenarios "
+            "derived from it.  Give either scenario or run."
+        ),
+        input_schema=object_schema(
+            {
+                "scenario": identifier(NAME, "the scenario, by id (e.g. scenario_c)"),
+                "run": identifier(RUN_UUID, "a run, by uuid: the lineage of its scenario"),
+            }
+        ),
+        annotations=READ_ONLY,
+    )
+    return ToolEntry(tool, _lineage)
+
+
+# -- verdicts ---------------------------------------------------------------------------------
+
+
+def _run_verdicts(access: Access, arguments: Mapping[str, Any]) -> dict[str, Any]:
+    with access.store() as store:
+        run = stored_run(store, str(arguments["run"]))
+        found = [v for v in verdicts(store, run.scenario) if v.run == run.uuid]
+    answer: dict[str, Any] = {
+        "run": run.uuid,
+        "scenario": run.scenario,
+        **{outcome.value: sum(v.outcome is outcome for v in found) for outcome in Outcome},
+        "verdicts": json.loads(verdicts_json(found)),
+    }
+    if not found:
+        answer["note"] = "the store holds no verdicts of this run: it was not verified (exscec verify RUN)"
+    return answer
+
+
+def run_verdicts_tool() -> ToolEntry:
+    tool = types.Tool(
+        name="run_verdicts",
+        title="Verdicts of a run",
+        description=(
+            "The verdicts of a run's last validation (`exscec verify`) as the store holds them: one per "
+            "oracle, failed ones first, each with the metric, robot, relation, observed and expected "
+            "values, limit, tolerance, margin, the runs the expectation came from and, when it could "
+            "not be judged, why; with the counts of passed, failed and unjudged oracles."
+        ),
+        input_schema=object_schema({"run": identifier(RUN_UUID, "the run, by uuid")}, ("run",)),
+        annotations=READ_ONLY,
+    )
+    return ToolEntry(tool, _run_verdicts)
