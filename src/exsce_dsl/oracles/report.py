@@ -16,7 +16,9 @@ def _number(value: float | None) -> str:
     return "" if value is None else f"{value:.4g}"
 
 
-def _expectation(v: Verdict) -> str:
+def expectation(v: Verdict) -> str:
+    """What ``v`` expected, as people read it: ``<= 1``, ``161.2 ± 10``, ``50.54 + 59.78 ± 16.55``
+    ('' when nothing was expected).  The verdict table, JUnit reports and the HTML report show it."""
     if v.limit is not None:
         return f"{'<=' if v.relation == 'below_max' else '>='} {_number(v.limit)}"
     if v.expected is None:
@@ -38,7 +40,7 @@ def verdict_table(verdicts: Sequence[Verdict]) -> str:
             v.oracle,
             v.relation,
             _number(v.observed),
-            _expectation(v),
+            expectation(v),
             _number(v.margin),
             _MARK[v.outcome] + (f": {v.reason}" if v.outcome is Outcome.UNJUDGED else ""),
             str(len(v.sources)) if v.sources else "",
@@ -97,7 +99,7 @@ def junit_xml(verdicts: Sequence[Verdict]) -> str:
                 suite, "testcase", classname=f"{v.scenario}.{v.criterion or 'oracles'}", name=v.description
             )
             details = (
-                f"observed {_number(v.observed) or 'nothing'}, expected {_expectation(v) or 'nothing'}"
+                f"observed {_number(v.observed) or 'nothing'}, expected {expectation(v) or 'nothing'}"
                 + (f", margin {_number(v.margin)}" if v.margin is not None else "")
                 + (f"; {v.reason}" if v.reason else "")
             )

@@ -9,7 +9,7 @@ was derived from.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -17,15 +17,26 @@ from exsce_dsl.errors import ExsceError
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.lang.occupancy import OccupancyGrid, load_occupancy_grid
 from exsce_dsl.model.derivation import Derivation
+from exsce_dsl.model.metrics import MetricDefinition
 from exsce_dsl.model.oracles import Oracle
 from exsce_dsl.model.runs import Hotspot
+from exsce_dsl.model.scenario import Scenario
 from exsce_dsl.model.verdicts import Outcome, Verdict
+from exsce_dsl.report.units import metric_units
 from exsce_dsl.similarity.clustering import Clustering, cluster
 from exsce_dsl.similarity.facts import scenario_facts
 from exsce_dsl.store import queries
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.queries import MetricReading, StoredRun
 from exsce_dsl.store.queries.results import hotspots, pose_positions, verdicts
+
+_RANK = {Outcome.FAILED: 0, Outcome.PASSED: 2}
+"""Where verdicts of each outcome go when failures come first; any other outcome goes between."""
+
+
+def failures_first(verdicts: Iterable[Verdict]) -> tuple[Verdict, ...]:
+    """``verdicts`` failed first, then those not judged, then the passed, each kept in its order."""
+    return tuple(sorted(verdicts, key=lambda v: _RANK.get(v.outcome, 1)))
 
 
 @dataclass(frozen=True)
@@ -70,7 +81,8 @@ class ScenarioContents:
 
     @property
     def verdicts(self) -> tuple[Verdict, ...]:
-        return tuple(v for r in self.runs for v in r.verdicts)
+        """The verdicts of all its runs, failures first (then run by run)."""
+        return failures_first(v for r in self.runs for v in r.verdicts)
 
 
 @dataclass(frozen=True)
@@ -82,6 +94,12 @@ class ReportContents:
     """Of all scenarios (None with fewer than two)."""
     notes: tuple[str, ...] = field(default=())
     """What could not be shown, and why."""
+    units: Mapping[str, str] = field(default_factory=dict)
+    """Metric name → the unit its numbers are shown with (see :mod:`.units`)."""
+
+    def unit(self, metric: str) -> str:
+        """The unit of ``metric``'s numbers ('' for a metric nothing declares)."""
+        return self.units.get(metric, "")
 
     def scenario(self, scenario_id: str) -> ScenarioContents:
         return next(s for s in self.scenarios if s.id == scenario_id)
@@ -89,14 +107,14 @@ class ReportContents:
     def roots(self) -> tuple[str, ...]:
         """Scenarios written by hand, or whose base is not in the store: the lineage trees' roots."""
         known = {s.id for s in self.scenarios}
-        return tuple(
-            s.id for s in self.scenarios if s.derivation is None or s.derivation.base not in known
-        )
+        return tuple(s.id for s in self.scenarios if s.derivation is None or s.derivation.base not in known)
 
 
 def gather(store: Store, specs: Sequence[Path] = ()) -> ReportContents:
-    """Read everything the report shows from ``store``; ``specs`` give occupancy grids."""
-    grids, notes = _grids(specs)
+    """Read everything the report shows from ``store``; ``specs`` give occupancy grids and the
+    units of the metrics they declare."""
+    declared = [scenario for spec in specs for scenario in load_spec(spec).scenarios]
+    grids, notes = _grids(declared)
     ids = queries.scenario_ids(store)
     all_verdicts = verdicts(store)
     derivations = {s: queries.derivation_of(store, s) for s in ids}
@@ -121,7 +139,8 @@ def gather(store: Store, specs: Sequence[Path] = ()) -> ReportContents:
                 derivation=derivations[scenario_id],
                 children=tuple(sorted(children.get(scenario_id, ()))),
                 runs=tuple(
-                    RunContents(r, tuple(judged.get(r.uuid, ())), tuple(spots.get(r.uuid, ()))) for r in runs
+                    RunContents(r, failures_first(judged.get(r.uuid, ())), tuple(spots.get(r.uuid, ())))
+                    for r in runs
                 ),
                 oracles=tuple(queries.oracles(store, scenario_id)),
                 values=tuple(queries.run_metric_values(store, uuids)),
@@ -134,7 +153,9 @@ def gather(store: Store, specs: Sequence[Path] = ()) -> ReportContents:
         clustering = cluster([scenario_facts(store, s) for s in ids])
     if not specs and any(s.waypoints for s in scenarios):
         notes.append("no occupancy grid: pass the scenarios' .exsce files with --spec to draw paths on a map")
-    return ReportContents(tuple(scenarios), tuple(all_verdicts), clustering, tuple(notes))
+    definitions: list[MetricDefinition] = [d for scenario in declared for d in scenario.metrics]
+    units = metric_units((v for s in scenarios for v in s.values), definitions)
+    return ReportContents(tuple(scenarios), failures_first(all_verdicts), clustering, tuple(notes), units)
 
 
 def _waypoints(store: Store, scenario_id: str) -> dict[str, tuple[tuple[str, float, float], ...]]:
@@ -149,24 +170,23 @@ def _waypoints(store: Store, scenario_id: str) -> dict[str, tuple[tuple[str, flo
     }
 
 
-def _grids(specs: Sequence[Path]) -> tuple[dict[str, OccupancyGrid], list[str]]:
-    """Scenario id → the occupancy grid of its environment, for every scenario of ``specs``."""
+def _grids(scenarios: Sequence[Scenario]) -> tuple[dict[str, OccupancyGrid], list[str]]:
+    """Scenario id → the occupancy grid of its environment, for every one of ``scenarios``."""
     grids: dict[str, OccupancyGrid] = {}
     loaded: dict[str, OccupancyGrid] = {}
     notes: list[str] = []
-    for spec in specs:
-        for scenario in load_spec(spec).scenarios:
-            map_model = scenario.environment.map
-            if map_model is None or map_model.file is None:
-                notes.append(f"scenario '{scenario.id}' names no map file: its paths are drawn without one")
+    for scenario in scenarios:
+        map_model = scenario.environment.map
+        if map_model is None or map_model.file is None:
+            notes.append(f"scenario '{scenario.id}' names no map file: its paths are drawn without one")
+            continue
+        if map_model.file not in loaded:
+            try:
+                loaded[map_model.file] = load_occupancy_grid(Path(map_model.file))
+            except ExsceError as exc:
+                notes.append(f"scenario '{scenario.id}': {exc.message}")
                 continue
-            if map_model.file not in loaded:
-                try:
-                    loaded[map_model.file] = load_occupancy_grid(Path(map_model.file))
-                except ExsceError as exc:
-                    notes.append(f"scenario '{scenario.id}': {exc.message}")
-                    continue
-            grids[scenario.id] = loaded[map_model.file]
+        grids[scenario.id] = loaded[map_model.file]
     return grids, notes
 
 

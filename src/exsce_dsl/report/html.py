@@ -21,6 +21,8 @@ from exsce_dsl import __version__
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.figures import save_figure
 from exsce_dsl.model.derivation import Derivation
+from exsce_dsl.model.verdicts import Verdict
+from exsce_dsl.oracles.report import expectation
 from exsce_dsl.report.contents import ReportContents, RunContents, ScenarioContents
 from exsce_dsl.report.plots import metrics_figure, trajectory_figure
 from exsce_dsl.resources import resource_dir
@@ -54,7 +56,8 @@ def _environment() -> jinja2.Environment:
         trim_blocks=True,
         lstrip_blocks=True,
     )
-    env.filters["number"] = _number
+    env.filters["measure"] = _measure
+    env.filters["expectation"] = _expectation
     env.filters["steps"] = _steps
     env.globals["scenario_page"] = lambda s: page_name("scenario", s) + ".html"
     env.globals["run_page"] = lambda r: page_name("run", r) + ".html"
@@ -63,6 +66,19 @@ def _environment() -> jinja2.Environment:
 
 def _number(value: float | None) -> str:
     return "" if value is None else f"{value:.4g}"
+
+
+def _measure(value: float | None, unit: str) -> str:
+    """``1.418 m/s``: a value with its unit ('' for no value)."""
+    if value is None:
+        return ""
+    return f"{_number(value)} {unit}" if unit else _number(value)
+
+
+def _expectation(verdict: Verdict, unit: str) -> str:
+    """What ``verdict`` expected, as ``exscec verify`` prints it, with the unit: ``50.5 + 59.8 ± 16.5 m``."""
+    text = expectation(verdict)
+    return f"{text} {unit}" if text and unit else text
 
 
 def _steps(derivation: Derivation) -> str:
@@ -97,7 +113,7 @@ def write_report(
     _write(env, "index.html.j2", folder / "index.html", dendrogram=dendrogram, **common)
     for scenario in contents.scenarios:
         metrics_image = None
-        metrics = metrics_figure(scenario)
+        metrics = metrics_figure(scenario, contents.units)
         if metrics is not None:
             metrics_image = f"images/{page_name('metrics', scenario.id)}.svg"
             save_figure(metrics, folder / metrics_image)
@@ -105,8 +121,15 @@ def write_report(
         _write(env, "scenario.html.j2", page, scenario=scenario, metrics_image=metrics_image, **common)
         for run in scenario.runs:
             image = _run_image(scenario, run, folder)
-            _write(env, "run.html.j2", folder / f"{page_name('run', run.run.uuid)}.html", scenario=scenario,
-                   run=run, image=image, **common)
+            _write(
+                env,
+                "run.html.j2",
+                folder / f"{page_name('run', run.run.uuid)}.html",
+                scenario=scenario,
+                run=run,
+                image=image,
+                **common,
+            )
             if progress is not None:
                 progress(1)
     return folder / "index.html"

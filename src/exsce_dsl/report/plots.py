@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
+from matplotlib.transforms import Bbox
 
 from exsce_dsl.lang.occupancy import OccupancyGrid
 from exsce_dsl.model.oracles import Oracle
@@ -14,20 +16,40 @@ from exsce_dsl.report.contents import RunContents, ScenarioContents
 from exsce_dsl.runs.trajectories import Trajectory
 from exsce_dsl.store.queries import MetricReading
 
-_MARGIN = 2.5  # metres of map shown around what is drawn
+MARGIN = 2.5
+"""Metres of map shown around what a run's figure draws."""
+_LONG_SIDE = 7.0  # inches of the map's longer side in a run's figure
+_SHORT_SIDE = 2.5  # inches at least of its shorter side
+_AROUND = (0.8, 0.2, 0.4, 0.55)
+"""Inches left, right, above and below the map: tick labels, axis labels and title."""
+_LEGEND_ROW = 0.2  # inches per row of the legend below the map
+_LEGEND_COLUMN = 2.3  # inches per column of it (its longest entries are ~2 inches long)
+_LABEL_POINTS = 7.0  # font size of the hotspots' numbers
+_LABEL_GAP = 1.5  # points kept free around a hotspot's number
+_RINGS = (2.0, 6.0, 11.0, 17.0, 24.0, 32.0, 41.0, 51.0, 62.0, 74.0, 87.0, 101.0)
+"""Points from a hotspot's marker to where its number may go, nearest first."""
+_DIRECTIONS = 24
 _STATUS_COLOURS = {"failed": "#c0392b", "unjudged": "#d68910", "passed": "#1e8449", "not verified": "#5d6d7e"}
 
+Box = tuple[float, float, float, float]
+"""x_min, x_max, y_min, y_max."""
 
-def trajectory_figure(
-    scenario: ScenarioContents, run: RunContents, paths: Sequence[Trajectory]
-) -> Figure:
-    """Each robot's path in ``run`` over the scenario's grid, its planned waypoints, and the hotspots."""
-    figure = Figure(figsize=(7.5, 6.0), layout="constrained")
-    axes = figure.add_subplot()
+
+def trajectory_figure(scenario: ScenarioContents, run: RunContents, paths: Sequence[Trajectory]) -> Figure:
+    """Each robot's path in ``run`` over the scenario's grid, its planned waypoints, and the hotspots,
+    numbered (as the run page's table) without two numbers overlapping.
+
+    The map shows what is drawn and :data:`MARGIN` around it (cut to the grid), at equal scale, and
+    the figure takes the shape of that area, so that the map fills it; a map too long and thin for
+    that shows more around it across its length.
+    """
     points = [p.xy for p in paths]
     points += [np.array([(x, y) for _, x, y in path]) for path in scenario.waypoints.values() if path]
     points += [np.array([(h.position.x, h.position.y) for h in run.hotspots])] if run.hotspots else []
-    box = _bounding_box(points)
+    box = fitted_box(points, scenario.grid) or (-MARGIN, MARGIN, -MARGIN, MARGIN)
+    markers = dict(zip(sorted({h.metric for h in run.hotspots}), "XDP^v*", strict=False))
+    entries = len(paths) + any(scenario.waypoints.values()) + len(markers)
+    figure, axes, box, columns = _map_figure(box, entries)
     if scenario.grid is not None:
         _draw_grid(axes, scenario.grid, box)
     colours = [f"C{i}" for i in range(10)]
@@ -35,44 +57,189 @@ def trajectory_figure(
         colour = colours[i % len(colours)]
         axes.plot(path.xy[:, 0], path.xy[:, 1], color=colour, linewidth=1.4, label=f"{path.topic} (driven)")
         axes.plot(*path.xy[0], marker="o", color=colour, markersize=6)
-    for i, (_, planned) in enumerate(sorted(scenario.waypoints.items())):
-        if not planned:
-            continue
+    planned_paths = [planned for _, planned in sorted(scenario.waypoints.items()) if planned]
+    for i, planned in enumerate(planned_paths):
         xy = np.array([(x, y) for _, x, y in planned])
-        axes.scatter(xy[1:, 0], xy[1:, 1], marker="s", s=18, color="#34495e", zorder=3,
-                     label="planned waypoints" if i == 0 else None)
-    markers = dict(zip(sorted({h.metric for h in run.hotspots}), "XDP^v*", strict=False))
+        axes.scatter(
+            xy[1:, 0],
+            xy[1:, 1],
+            marker="s",
+            s=18,
+            color="#34495e",
+            zorder=3,
+            label="planned waypoints" if i == 0 else None,
+        )
     labelled: set[str] = set()
-    for number, spot in enumerate(run.hotspots, start=1):
+    sizes = []
+    for spot in run.hotspots:
         label = None if spot.metric in labelled else f"hotspot: {spot.metric}"
         labelled.add(spot.metric)
-        axes.scatter([spot.position.x], [spot.position.y], s=60 + 30 * math.sqrt(spot.duration),
-                     marker=markers.get(spot.metric, "X"), color="#c0392b", edgecolor="white", linewidth=0.8,
-                     zorder=4, label=label)
-        axes.annotate(str(number), (spot.position.x, spot.position.y), textcoords="offset points",
-                      xytext=(5, 4), fontsize=7, color="#922b21", fontweight="bold")
-    if box is not None:
-        axes.set_xlim(box[0], box[1])
-        axes.set_ylim(box[2], box[3])
+        sizes.append(60 + 30 * math.sqrt(spot.duration))
+        axes.scatter(
+            [spot.position.x],
+            [spot.position.y],
+            s=sizes[-1],
+            marker=markers.get(spot.metric, "X"),
+            color="#c0392b",
+            edgecolor="white",
+            linewidth=0.8,
+            zorder=4,
+            label=label,
+        )
+    axes.set_xlim(box[0], box[1])
+    axes.set_ylim(box[2], box[3])
     axes.set_aspect("equal")
     axes.set_xlabel("x (m)")
     axes.set_ylabel("y (m)")
     axes.set_title(f"run {run.run.uuid[:8]} of {scenario.id}")
-    if axes.get_legend_handles_labels()[0]:
-        axes.legend(loc="best", fontsize=7, framealpha=0.85)
+    handles, labels = axes.get_legend_handles_labels()
+    if handles:  # below the map, not over it
+        figure.legend(
+            handles,
+            labels,
+            loc="lower center",
+            bbox_to_anchor=(0.5, 0.0),
+            ncols=columns,
+            fontsize=7,
+            frameon=False,
+        )
+    if run.hotspots:
+        positions = [(h.position.x, h.position.y) for h in run.hotspots]
+        _number_hotspots(axes, positions, sizes)
     return figure
 
 
-def _bounding_box(points: Sequence[np.ndarray]) -> tuple[float, float, float, float] | None:
+def _map_figure(box: Box, entries: int) -> tuple[Figure, Axes, Box, int]:
+    """A figure whose axes have the shape of ``box`` (its longer side :data:`_LONG_SIDE` long, its
+    shorter one at least :data:`_SHORT_SIDE`), with room around for labels and a legend of
+    ``entries`` below; ``box`` grown across where the shorter side had to be made longer; and how
+    many columns the legend fits in."""
+    width, height = box[1] - box[0], box[3] - box[2]
+    if width >= height:
+        inches = (_LONG_SIDE, max(_SHORT_SIDE, _LONG_SIDE * height / width))
+    else:
+        inches = (max(_SHORT_SIDE, _LONG_SIDE * width / height), _LONG_SIDE)
+    box = _grown(box, inches[0] / inches[1])
+    left, right, top, bottom = _AROUND
+    columns = max(1, min(entries, int((left + inches[0] + right) // _LEGEND_COLUMN)))
+    bottom += math.ceil(entries / columns) * _LEGEND_ROW
+    size = (left + inches[0] + right, bottom + inches[1] + top)
+    figure = Figure(figsize=size)
+    axes = figure.add_axes((left / size[0], bottom / size[1], inches[0] / size[0], inches[1] / size[1]))
+    return figure, axes, box, columns
+
+
+def _grown(box: Box, shape: float) -> Box:
+    """``box`` grown about its centre in one direction to the width / height ratio ``shape``."""
+    width, height = box[1] - box[0], box[3] - box[2]
+    if width < height * shape:
+        grow = (height * shape - width) / 2
+        return box[0] - grow, box[1] + grow, box[2], box[3]
+    grow = (width / shape - height) / 2
+    return box[0], box[1], box[2] - grow, box[3] + grow
+
+
+def fitted_box(points: Sequence[np.ndarray], grid: OccupancyGrid | None = None) -> Box | None:
+    """What ``points`` cover, and :data:`MARGIN` around them, but no more of the margin than the
+    ``grid`` has (beyond the map there is nothing to see); None when there are no points."""
     drawn = [p for p in points if p.size]
     if not drawn:
         return None
     every = np.vstack(drawn)
     (x0, y0), (x1, y1) = every.min(axis=0), every.max(axis=0)
-    return float(x0) - _MARGIN, float(x1) + _MARGIN, float(y0) - _MARGIN, float(y1) + _MARGIN
+    box = (float(x0) - MARGIN, float(x1) + MARGIN, float(y0) - MARGIN, float(y1) + MARGIN)
+    if grid is None:
+        return box
+    gx0, gx1, gy0, gy1 = grid.bounds()
+    return (
+        max(box[0], min(gx0, float(x0))),
+        min(box[1], max(gx1, float(x1))),
+        max(box[2], min(gy0, float(y0))),
+        min(box[3], max(gy1, float(y1))),
+    )
 
 
-def _draw_grid(axes: object, grid: OccupancyGrid, box: tuple[float, float, float, float] | None) -> None:
+def _number_hotspots(axes: Axes, positions: Sequence[tuple[float, float]], sizes: Sequence[float]) -> None:
+    """Write each hotspot's number (from 1) beside it where it covers no other number and no
+    hotspot: the nearest free place on rings around it, with a leader line when it had to go further.
+    (The figure's layout is fixed: what is measured here stays where it is.)"""
+    axes.apply_aspect()
+    pixels = axes.figure.dpi / 72.0
+    frame = axes.get_window_extent()
+    anchors = axes.transData.transform(np.asarray(positions, dtype=float))
+    radii = np.sqrt(np.asarray(sizes, dtype=float)) / 2 * pixels  # a marker of area s points² spans √s points
+    taken = np.column_stack(
+        [anchors[:, 0] - radii, anchors[:, 0] + radii, anchors[:, 1] - radii, anchors[:, 1] + radii]
+    )
+    for number, ((x, y), radius) in enumerate(zip(anchors, radii, strict=True), start=1):
+        text = axes.text(0, 0, str(number), fontsize=_LABEL_POINTS, fontweight="bold")
+        extent = text.get_window_extent()
+        text.remove()
+        half = (extent.width / 2 + _LABEL_GAP * pixels, extent.height / 2 + _LABEL_GAP * pixels)
+        places = _places(float(x), float(y), float(radius), half, pixels)
+        clashes = _covered(places, taken) + _outside(places, frame)
+        free = np.flatnonzero(clashes == 0)
+        chosen = int(free[0]) if free.size else int(np.argmin(clashes))  # else where it covers least
+        taken = np.vstack([taken, places[chosen]])
+        cx, cy = (places[chosen, 0] + places[chosen, 1]) / 2, (places[chosen, 2] + places[chosen, 3]) / 2
+        leader = chosen >= _DIRECTIONS  # not on the first ring, right by its marker
+        axes.annotate(
+            str(number),
+            positions[number - 1],
+            xytext=(float(cx - x) / pixels, float(cy - y) / pixels),
+            textcoords="offset points",
+            ha="center",
+            va="center",
+            fontsize=_LABEL_POINTS,
+            fontweight="bold",
+            color="#922b21",
+            zorder=5,
+            arrowprops=(
+                {
+                    "arrowstyle": "-",
+                    "color": "#922b21",
+                    "linewidth": 0.6,
+                    "shrinkA": 0,
+                    "shrinkB": float(radius) / pixels,
+                }
+                if leader
+                else None
+            ),
+        )
+
+
+def _places(x: float, y: float, radius: float, half: tuple[float, float], pixels: float) -> np.ndarray:
+    """Where a label of half-size ``half`` may go around a marker of ``radius`` at (x, y): boxes
+    (x0, x1, y0, y1) in pixels, nearest first, and on each ring up and to the right first."""
+    reach = radius + np.repeat(np.asarray(_RINGS), _DIRECTIONS) * pixels
+    angles = np.tile(math.pi / 4 + 2 * math.pi * np.arange(_DIRECTIONS) / _DIRECTIONS, len(_RINGS))
+    cx = x + np.cos(angles) * (reach + half[0])
+    cy = y + np.sin(angles) * (reach + half[1])
+    return np.column_stack([cx - half[0], cx + half[0], cy - half[1], cy + half[1]])
+
+
+def _covered(places: np.ndarray, taken: np.ndarray) -> np.ndarray:
+    """For each of ``places``, the area it shares with the boxes ``taken``."""
+    wide = np.minimum(places[:, None, 1], taken[None, :, 1]) - np.maximum(
+        places[:, None, 0], taken[None, :, 0]
+    )
+    high = np.minimum(places[:, None, 3], taken[None, :, 3]) - np.maximum(
+        places[:, None, 2], taken[None, :, 2]
+    )
+    shared: np.ndarray = (np.clip(wide, 0.0, None) * np.clip(high, 0.0, None)).sum(axis=1)
+    return shared
+
+
+def _outside(places: np.ndarray, frame: Bbox) -> np.ndarray:
+    """For each of ``places``, its area outside ``frame``."""
+    wide = np.minimum(places[:, 1], frame.x1) - np.maximum(places[:, 0], frame.x0)
+    high = np.minimum(places[:, 3], frame.y1) - np.maximum(places[:, 2], frame.y0)
+    whole = (places[:, 1] - places[:, 0]) * (places[:, 3] - places[:, 2])
+    outside: np.ndarray = whole - np.clip(wide, 0.0, None) * np.clip(high, 0.0, None)
+    return outside
+
+
+def _draw_grid(axes: Axes, grid: OccupancyGrid, box: Box | None) -> None:
     """The grid as a grey image, cut to ``box`` (drawing a whole building's map for every run is slow)."""
     x0, _, y0, _ = grid.bounds()
     res = grid.resolution
@@ -87,8 +254,16 @@ def _draw_grid(axes: object, grid: OccupancyGrid, box: tuple[float, float, float
     cells = grid.cells[grid.height - last_row : grid.height - first_row, first_col:last_col]
     image = cells if not grid.negate else 255 - cells
     extent = (x0 + first_col * res, x0 + last_col * res, y0 + first_row * res, y0 + last_row * res)
-    axes.imshow(image, cmap="gray", vmin=0, vmax=255, extent=extent, origin="upper",  # type: ignore[attr-defined]
-                interpolation="nearest", alpha=0.9)
+    axes.imshow(
+        image,
+        cmap="gray",
+        vmin=0,
+        vmax=255,
+        extent=extent,
+        origin="upper",
+        interpolation="nearest",
+        alpha=0.9,
+    )
 
 
 # -- metrics against their oracles -----------------------------------------------------------
@@ -118,9 +293,10 @@ def _row(value: MetricReading) -> str:
     return f"{who} · {value.safety}" if value.safety else who
 
 
-def metrics_figure(scenario: ScenarioContents) -> Figure | None:
+def metrics_figure(scenario: ScenarioContents, units: Mapping[str, str]) -> Figure | None:
     """One panel per metric: each run's value per robot (coloured by the run's verdict) over the
-    band of values the scenario's whole-run oracles accept."""
+    band of values the scenario's whole-run oracles accept; its axis says the metric's unit (from
+    ``units``, metric name → unit)."""
     status = {r.run.uuid: r.status for r in scenario.runs}
     judged = {o.metric for o in scenario.oracles if o.window is None}
     metrics = sorted({v.metric for v in scenario.values} | judged)
@@ -149,8 +325,9 @@ def metrics_figure(scenario: ScenarioContents) -> Figure | None:
             left, right = max(band[0], low), min(band[1], high)
             y = row_of[oracle.robot or "mission"]
             if right - left > (high - low) * 0.004:
-                axes.barh(y, right - left, left=left, height=0.7, color="#27ae60", alpha=0.16,
-                          edgecolor="#1e8449")
+                axes.barh(
+                    y, right - left, left=left, height=0.7, color="#27ae60", alpha=0.16, edgecolor="#1e8449"
+                )
             else:  # a single accepted value (invariant within 0): a bar too thin to see, so a line
                 axes.plot([left, left], [y - 0.35, y + 0.35], color="#1e8449", linewidth=2.5, alpha=0.6)
         for value in values:
@@ -159,7 +336,8 @@ def metrics_figure(scenario: ScenarioContents) -> Figure | None:
         axes.set_xlim(low, high)
         axes.set_yticks(range(len(rows)), rows, fontsize=8)
         axes.set_ylim(-0.6, len(rows) - 0.4)
-        axes.set_title(metric, fontsize=9, loc="left")
+        unit = units.get(metric)
+        axes.set_xlabel(f"{metric} ({unit})" if unit else metric, fontsize=8)
         axes.tick_params(axis="x", labelsize=8)
         axes.spines[["top", "right"]].set_visible(False)
     figure.suptitle(f"{scenario.id}: run values (dots) and what the oracles accept (green)", fontsize=10)
