@@ -180,3 +180,60 @@ def test_version_is_the_installed_distributions() -> None:
     assert result.returncode == 0 and result.stdout.strip() == f"exscec, version {version('exsce')}"
     changelog = (Path(__file__).resolve().parents[1] / "CHANGELOG.md").read_text(encoding="utf-8")
     assert f"## [{version('exsce')}]" in changelog  # every released version has its entry
+
+
+def test_check_a_folder_checks_every_exsce_file_below_it_in_sorted_order(in_tmp: Path) -> None:
+    project = in_tmp / "specs"
+    (project / "nested" / ".hidden").mkdir(parents=True)
+    (project / "b_good.exsce").write_text("robot type tiago {\n  base diff_drive\n}\n")
+    (project / "nested" / "a_bad.exsce").write_text("robot type tiago {\n  base\n}\n")
+    (project / "nested" / ".hidden" / "ignored.exsce").write_text("not exsce at all\n")
+    (project / "notes.txt").write_text("not a spec\n")
+    result = run_exscec("check", "specs")
+    assert result.returncode == 1
+    assert "Traceback" not in result.stderr
+    assert result.stderr.splitlines() == [
+        "specs/b_good.exsce: ok (0 scenarios)",
+        "specs/nested/a_bad.exsce:3:1: error: expected a name, found '}'",
+        "specs/nested/a_bad.exsce: 1 error",
+    ]
+    (project / "nested" / "a_bad.exsce").unlink()
+    assert run_exscec("check", "specs").returncode == 0
+
+
+def test_check_and_fmt_of_a_folder_without_specs_say_so(in_tmp: Path) -> None:
+    (in_tmp / "empty").mkdir()
+    for command in ("check", "fmt"):
+        result = run_exscec(command, "empty")
+        assert result.returncode == 2 and "empty is a folder without .exsce files" in result.stderr
+
+
+def test_fmt_check_of_a_folder_names_the_files_that_would_change(in_tmp: Path) -> None:
+    folder = _copy_examples(in_tmp)
+    assert run_exscec("fmt", "--check", "bc").returncode == 0
+    tasks = folder / "tasks" / "navigation.exsce"
+    tasks.write_text(tasks.read_text().replace("task navigate_home_1 {", "task   navigate_home_1{"))
+    result = run_exscec("fmt", "--check", "bc")
+    assert result.returncode == 1
+    assert result.stderr.splitlines() == ["would reformat bc/tasks/navigation.exsce"]
+
+
+def test_progress_leaves_no_blank_lines_or_escape_codes_when_stderr_is_not_a_terminal(in_tmp: Path) -> None:
+    """A CI log is not a terminal: no bar, only the lines, one per run (it was a bar label and blank
+    lines)."""
+    simulated = run_exscec("simulate", str(SCENARIO_C), "--runs", "2", "-o", "runs")
+    assert simulated.returncode == 0, simulated.stderr
+    bags = sorted((in_tmp / "runs").glob("*.bag"))
+    ingested = run_exscec("ingest", *map(str, bags), "--scenario", str(SCENARIO_C))
+    assert ingested.returncode == 0, ingested.stderr
+    reported = run_exscec("report", "-o", "report")
+    assert reported.returncode == 0, reported.stderr
+    for done in (simulated, ingested, reported):
+        lines = done.stderr.splitlines()
+        assert lines and all(line.strip() for line in lines), done.stderr
+        assert "\x1b" not in done.stderr and "\r" not in done.stderr, repr(done.stderr)
+    wrote = [line.split(" (")[0] for line in simulated.stderr.splitlines()]
+    assert wrote == [f"wrote runs/{bag.name}" for bag in bags]
+    assert len(ingested.stderr.splitlines()) == 3
+    assert ingested.stderr.endswith("2 ingested, 0 skipped, 0 failed\n")
+    assert reported.stderr.splitlines()[-1].startswith("wrote report/index.html")

@@ -12,7 +12,8 @@ from pathlib import Path
 
 import pytest
 
-from exsce_dsl.cli.demo_commands import STEPS
+from exsce_dsl.api.demo import STEPS, Step, command_hint, run_steps, set_up, summary_lines
+from exsce_dsl.cli.demo_commands import run_in_process
 from exsce_dsl.runs.bagdata import bag_topics
 
 from conftest import ROOT, run_exscec
@@ -65,9 +66,11 @@ def test_exscec_demo_shows_the_fault_run_failing_and_the_others_passing(tmp_path
     done = run_exscec("demo", "demo", cwd=tmp_path)
     assert done.returncode == 0, done.stderr[-3000:]
     summary = done.stderr[done.stderr.index("Summary"):]
-    assert re.search(r"passed\s+new run of scenario_c", summary)
-    assert re.search(r"FAILED\s+run of scenario_c with the over-speed fault", summary)
-    assert re.search(r"passed\s+run of derived c_one", summary)
+    assert summary.startswith("Summary") and "every step ended as expected" in summary.splitlines()[0]
+    assert re.search(r"passed, as expected\s+new run of scenario_c", summary)
+    assert re.search(r"failed, as expected\s+run of scenario_c with the over-speed fault", summary)
+    assert re.search(r"passed, as expected\s+run of derived c_one", summary)
+    assert "NOT" not in summary and "error" not in summary
     assert (tmp_path / "demo" / "report" / "index.html").is_file()
     assert f"[{len(STEPS)}/{len(STEPS)}]" in done.stderr and "$ exscec verify runs/faulty/" in done.stderr
     again = run_exscec("demo", "demo", cwd=tmp_path)
@@ -81,9 +84,9 @@ def test_the_whole_method_runs_on_a_navigation_stacks_runs(tmp_path: Path, conve
     done = run_exscec("demo", "demo", "--convention", convention, cwd=tmp_path)
     assert done.returncode == 0, done.stderr[-3000:]
     summary = done.stderr[done.stderr.index("Summary"):]
-    assert re.search(r"passed\s+new run of scenario_c", summary)
-    assert re.search(r"FAILED\s+run of scenario_c with the over-speed fault", summary)
-    assert re.search(r"passed\s+run of derived c_one", summary)
+    assert re.search(r"passed, as expected\s+new run of scenario_c", summary)
+    assert re.search(r"failed, as expected\s+run of scenario_c with the over-speed fault", summary)
+    assert re.search(r"passed, as expected\s+run of derived c_one", summary)
     project = tmp_path / "demo"
     assert f"convention {convention}" in (project / "scenarios" / "robots.exsce").read_text(encoding="utf-8")
     (bag,) = (project / "runs" / "new").glob("*.bag")
@@ -108,7 +111,102 @@ def test_the_demo_runs_unchanged_against_a_remote_sparql_endpoint(tmp_path: Path
         assert done.returncode == 0, done.stderr[-3000:]
         listed = run_exscec("runs", "--store", f"{server.url}/query", "-f", "csv", cwd=tmp_path)
     summary = done.stderr[done.stderr.index("Summary"):]
-    assert re.search(r"FAILED\s+run of scenario_c with the over-speed fault", summary)
-    assert f"store      {server.url}/query" in summary
+    assert re.search(r"failed, as expected\s+run of scenario_c with the over-speed fault", summary)
+    assert f"store: {server.url}/query" in summary
     assert not (tmp_path / "remote-demo" / ".exsce").exists()  # nothing went to an embedded store
     assert len(listed.stdout.strip().splitlines()) == 1 + 6  # the header and the six runs of the demo
+
+
+def test_a_verdict_other_than_expected_is_reported_and_the_demo_goes_on(tmp_path: Path) -> None:
+    """A verify step whose runs pass where they should fail: the outcome is named, the steps after it
+    still run, and the demo as a whole did not go as expected."""
+    folder = tmp_path / "demo"
+    set_up(folder)
+    good, missing = "exscec check scenarios/scenario_c.exsce", "exscec check scenarios/missing.exsce"
+    steps = (
+        Step("check", good),
+        Step("should fail", good, expected_exit=1, verdict="a good spec"),
+        Step("fails, as it should", missing, expected_exit=1, verdict="no spec"),
+    )
+    run = run_steps(folder, run_in_process, steps=steps)
+    assert [o.exit_code for o in run.outcomes] == [0, 0, 1]
+    assert run.unexpected == (run.outcomes[1],) and run.stopped is None and not run.as_expected
+    lines = summary_lines(run)
+    shown = "\n".join(lines)
+    assert lines[0].endswith("NOT every step ended as expected")
+    assert re.search(r"^  passed, NOT as expected \(expected: failed\)\s+a good spec$", shown, re.M)
+    assert re.search(r"^  failed, as expected\s+no spec$", shown, re.M)
+    assert lines[-1] == f"error: {good}: passed, NOT as expected (expected: failed)"
+
+
+def test_a_step_the_next_ones_need_stops_the_demo_when_it_fails(tmp_path: Path) -> None:
+    folder = tmp_path / "demo"
+    set_up(folder)
+    steps = (
+        Step("compile a missing file", "exscec compile scenarios/missing.exsce --store"),
+        Step("never run", "exscec check scenarios/scenario_c.exsce"),
+    )
+    run = run_steps(folder, run_in_process, steps=steps)
+    assert len(run.outcomes) == 1 and run.stopped == run.outcomes[0] and not run.as_expected
+    assert summary_lines(run)[-1] == (
+        "error: step 1 (exscec compile scenarios/missing.exsce --store): exited 1, NOT as expected "
+        "(expected: exited 0); the steps after it need it, so the demo stopped"
+    )
+
+
+def test_exscec_demo_exits_1_when_an_outcome_is_not_the_expected_one(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from click.testing import CliRunner
+
+    import exsce_dsl.api.demo as demo
+    from exsce_dsl.cli.main import main
+
+    monkeypatch.chdir(tmp_path)
+    command = "exscec check scenarios/scenario_c.exsce"
+    monkeypatch.setattr(demo, "STEPS", (Step("verify, as it were", command, verdict="the example"),))
+    passed = CliRunner().invoke(main, ["demo", "as-expected"])
+    assert passed.exit_code == 0, passed.output
+    assert re.search(r"passed, as expected\s+the example", passed.stderr)
+    monkeypatch.setattr(demo, "STEPS", (Step("verify, as it were", command, 1, verdict="the example"),))
+    failed = CliRunner().invoke(main, ["demo", "not-as-expected"])
+    assert failed.exit_code == 1, failed.output
+    assert "[1/1] verify, as it were" in failed.stderr
+    lines = failed.stderr.splitlines()
+    assert f"error: {command}: passed, NOT as expected (expected: failed)" in lines
+
+
+def test_the_demo_says_how_to_type_its_commands_when_exscec_is_not_on_path(tmp_path: Path) -> None:
+    """After the README's first command exscec is in .venv/bin, not on PATH: the demo says to activate
+    the environment, by the path that works from where the user is."""
+    exscec = Path(sys.executable).with_name("exscec")
+    here = exscec.parent.absolute()
+    elsewhere = [p for p in os.environ["PATH"].split(os.pathsep) if Path(p).absolute() != here]
+    for folder, path in (("without", elsewhere), ("with", [str(exscec.parent), *elsewhere])):
+        done = subprocess.run(
+            [str(exscec), "demo", folder, "--setup-only"], cwd=tmp_path, capture_output=True, text=True,
+            env={**os.environ, "PATH": os.pathsep.join(path)}, timeout=120,
+        )
+        assert done.returncode == 0, done.stderr
+        hinted = f"first run '. {here}/activate'" in done.stderr
+        assert hinted == (folder == "without"), done.stderr
+
+
+def test_the_hint_names_the_environment_relative_to_the_users_folder(tmp_path: Path) -> None:
+    scripts = tmp_path / ".venv" / "bin"
+    scripts.mkdir(parents=True)
+    (scripts / "exscec").write_text("#!/bin/sh\n")
+    (scripts / "exscec").chmod(0o755)
+    assert command_hint(tmp_path, search_path=str(scripts), bin_dir=scripts) is None
+    assert command_hint(tmp_path, search_path="", bin_dir=scripts) == (
+        f"exscec is not on your PATH: type {scripts / 'exscec'} instead of exscec"
+    )
+    (scripts / "activate").write_text("")
+    activate = "exscec is not on your PATH: to type the demo's commands yourself, first run"
+    assert str(command_hint(tmp_path, search_path="", bin_dir=scripts)).startswith(
+        f"{activate} '. .venv/bin/activate'"
+    )
+    assert str(command_hint(tmp_path / "elsewhere", search_path="", bin_dir=scripts)).startswith(
+        f"{activate} '. {scripts}/activate'"
+    )
+    assert command_hint(tmp_path, search_path="", bin_dir=tmp_path / "no-such-bin") is None

@@ -7,6 +7,7 @@ import os
 import sys
 from collections.abc import Callable, Iterable
 from pathlib import Path
+from types import TracebackType
 from typing import Any, TypeVar
 
 import click
@@ -77,3 +78,57 @@ def write_text(text: str, output: str | None) -> None:
     else:
         Path(output).write_text(text, encoding="utf-8")
         click.echo(f"wrote {output}", err=True)
+
+
+def spec_files(paths: Iterable[str]) -> list[str]:
+    """``paths`` with each folder replaced by the ``.exsce`` files below it, recursively and
+    sorted (hidden folders, such as ``.exsce`` or ``.venv``, left out)."""
+    found: list[str] = []
+    for given in paths:
+        folder = Path(given)
+        if not folder.is_dir():
+            found.append(given)
+            continue
+        inside = sorted(
+            (f for f in folder.rglob("*.exsce") if f.is_file()),
+            key=lambda f: f.relative_to(folder).parts,
+        )
+        inside = [f for f in inside if not any(part.startswith(".") for part in f.relative_to(folder).parts)]
+        if not inside:
+            raise click.UsageError(f"{given} is a folder without .exsce files")
+        found += [str(f) for f in inside]
+    return found
+
+
+class Progress:
+    """A progress bar on stderr when stderr is a terminal; anywhere else (a CI log, a file) no
+    bar, only the lines said through :meth:`say`, with no blank lines or escape codes."""
+
+    def __init__(self, length: int, label: str) -> None:
+        self._bar = (
+            click.progressbar(length=length, label=label, file=sys.stderr) if sys.stderr.isatty() else None
+        )
+
+    def __enter__(self) -> Progress:
+        if self._bar is not None:
+            self._bar.__enter__()
+        return self
+
+    def __exit__(
+        self, kind: type[BaseException] | None, error: BaseException | None, trace: TracebackType | None
+    ) -> None:
+        if self._bar is not None:
+            self._bar.__exit__(kind, error, trace)
+
+    def update(self, steps: int = 1) -> None:
+        if self._bar is not None:
+            self._bar.update(steps)
+
+    def say(self, line: str) -> None:
+        """Print a line on stderr (on a terminal: over the bar, which is drawn again below it)."""
+        if self._bar is None:
+            click.echo(line, err=True)
+            return
+        click.echo(f"\r\x1b[2K{line}", err=True)
+        self._bar._last_line = None  # click draws only a changed bar: this one was just erased
+        self._bar.render_progress()

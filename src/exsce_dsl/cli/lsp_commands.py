@@ -22,12 +22,12 @@ def lsp(tcp: str | None, stdio: bool) -> None:
     """Run the exsce language server: diagnostics (syntax, semantic, SHACL), completion,
     hover, go to definition, references, renaming, formatting and quick fixes.
 
-    Editors start it and talk to it on stdin and stdout.
+    Editors start it and talk to it on stdin and stdout (--tcp HOST:PORT
+    listens there instead, to debug the server).
 
     \b
     Example:
       exscec lsp
-      exscec lsp --tcp 127.0.0.1:2087
     """
     from exsce_dsl.lsp import serve
 

@@ -38,9 +38,10 @@ def main(debug: bool, msg_paths: tuple[str, ...]) -> None:
     the bag itself.
 
     `exscec demo` runs the whole method on the shipped example, and
-    docs/tutorial.md walks it command by command.  Each command's --help ends
-    with examples that run as written, in a folder holding a copy of the
-    project's examples/, in the order of the tutorial.
+    docs/tutorial.md walks it command by command.  The examples of every
+    command's --help run as written, one after the other, in a folder holding
+    a copy of the project's examples/ (check, compile, export and import
+    first, then simulate, ingest, baseline, verify, derive, the queries...).
 
     \b
     Example:

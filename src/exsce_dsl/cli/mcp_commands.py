@@ -44,7 +44,7 @@ def mcp(timeout: float, max_rows: int, store_url: str | None) -> None:
 
     \b
     Example (a client's session, by hand):
-      exscec mcp --store ~/robots/project/.exsce/store
+      exscec mcp --store "$PWD/.exsce/store"
     \b
     Claude Desktop (claude_desktop_config.json), or any client's mcpServers:
       {

@@ -88,6 +88,7 @@ def verify(
     \b
     Example:
       exscec verify runs/*.bag --scenario examples/brsu_building_c/scenario_c.exsce --junit verdicts.xml
+      exscec verify runs/faulty/*.bag --scenario examples/brsu_building_c/scenario_c.exsce  # exits 1
     """
     from exsce_dsl.lang.build import load_spec
     from exsce_dsl.model.verdicts import Outcome

@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import click
 
-from exsce_dsl.cli.common import reports_errors
+from exsce_dsl.cli.common import Progress, reports_errors
 from exsce_dsl.cli.store_commands import store_option
 
 
@@ -43,8 +42,8 @@ def report(output: str, specs: tuple[str, ...], store_url: str | None) -> None:
     with open_store(store_url) as store:
         contents = gather(store, [Path(s) for s in specs])
     runs = sum(len(s.runs) for s in contents.scenarios)
-    with click.progressbar(length=runs, label="drawing runs", file=sys.stderr) as bar:
-        index = write_report(contents, Path(output), bar.update)
+    with Progress(runs, "drawing runs") as progress:
+        index = write_report(contents, Path(output), progress.update)
     for note in contents.notes:
         click.echo(f"note: {note}", err=True)
     click.echo(f"wrote {index} ({len(contents.scenarios)} scenarios, {runs} runs)", err=True)

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import click
 
-from exsce_dsl.cli.common import bag_arguments, reports_errors
+from exsce_dsl.cli.common import Progress, bag_arguments, reports_errors
 from exsce_dsl.model.conventions import CONVENTIONS
 
 
@@ -81,8 +81,8 @@ def simulate(
     \b
     Example:
       exscec simulate examples/brsu_building_c/scenario_c.exsce --runs 3 -o runs/
-      exscec simulate examples/brsu_building_c/scenario_c.exsce --fault overspeed:tiago1
-      exscec simulate examples/brsu_building_c/scenario_d.exsce --convention nav2 --format mcap -o runs/
+      exscec simulate examples/brsu_building_c/scenario_c.exsce --fault overspeed:tiago1 -o runs/faulty/
+      exscec simulate examples/brsu_building_c/scenario_c.exsce --convention nav2 --format mcap -o runs/
     """
     from exsce_dsl.lang.build import load_spec
     from exsce_dsl.sim.executor import Fault
@@ -91,12 +91,10 @@ def simulate(
     scenario = load_spec(spec).scenario(scenario_id)
     parsed = tuple(Fault.parse(f) for f in faults)
     played = play(scenario, Path(out_dir), runs, fmt, seed, parsed, convention, cmd_vel_stamped)
-    with click.progressbar(length=runs, label=f"simulating {scenario.id}", file=sys.stderr) as bar:
+    with Progress(runs, f"simulating {scenario.id}") as progress:
         for run in played:
-            bar.update(1)
-            click.echo(
-                f"\nwrote {run.bag} ({run.messages} messages, {run.execution.duration:.1f} s)", err=True
-            )
+            progress.update()
+            progress.say(f"wrote {run.bag} ({run.messages} messages, {run.execution.duration:.1f} s)")
 
 
 @click.command()
@@ -128,27 +126,24 @@ def ingest(
       exscec ingest runs/*.bag --scenario examples/brsu_building_c/scenario_c.exsce
     """
     from exsce_dsl.lang.build import load_spec
-    from exsce_dsl.runs.ingest import IngestResult, ingest_bags
+    from exsce_dsl.runs.ingest import IngestResult, IngestStatus, ingest_bags
     from exsce_dsl.store.open import open_store
 
     scenario = load_spec(spec).scenario(scenario_id)
     paths = [Path(b) for b in bag_arguments(bags)]
     if not paths:
         raise click.UsageError("no bag among the files given")
-    with (
-        open_store(store_url) as store,
-        click.progressbar(length=len(paths), label="ingesting", file=sys.stderr) as bar,
-    ):
+    with open_store(store_url) as store, Progress(len(paths), "ingesting") as progress:
 
         def shown(result: IngestResult) -> None:
-            bar.update(1)
-            click.echo(f"\n{'error: ' if result.failed else ''}{result.message}", err=True)
+            progress.update()
+            progress.say(f"{'error: ' if result.failed else ''}{result.message}")
             for problem in result.problems:
-                click.echo(f"warning: {result.bag}: {problem}", err=True)
+                progress.say(f"warning: {result.bag}: {problem}")
 
         results = ingest_bags(paths, scenario, store, jobs, shown)
-    done = sum(r.status == "ingested" for r in results)
-    skipped = sum(r.status == "skipped" for r in results)
+    done = sum(r.status is IngestStatus.INGESTED for r in results)
+    skipped = sum(r.status is IngestStatus.SKIPPED for r in results)
     failed = sum(r.failed for r in results)
     click.echo(f"{done} ingested, {skipped} skipped, {failed} failed", err=True)
     if failed:

@@ -8,29 +8,31 @@ from pathlib import Path
 
 import click
 
-from exsce_dsl.cli.common import print_diagnostics, reports_errors, write_text
+from exsce_dsl.cli.common import print_diagnostics, reports_errors, spec_files, write_text
 
 PROV_FORMATS = ("provn", "json", "xml", "ttl", "trig", "nq", "jsonld")
 
 
 @click.command()
-@click.argument("specs", nargs=-1, required=True, type=click.Path(dir_okay=False))
+@click.argument("specs", nargs=-1, required=True, type=click.Path())
 @reports_errors
 def check(specs: tuple[str, ...]) -> None:
     """Parse and check SPEC files; report every error found, not only the first.
 
-    After the language's own checks pass, each scenario is compiled and its
-    PROV-O validated against exsce's SHACL shapes; a violation is reported
-    at the DSL element it concerns.
+    A folder stands for the .exsce files below it (recursively, in sorted
+    order).  After the language's own checks pass, each scenario is compiled
+    and its PROV-O validated against exsce's SHACL shapes; a violation is
+    reported at the DSL element it concerns.
 
     \b
     Example:
-      exscec check examples/scenario_c/scenario_c.exsce
+      exscec check examples/brsu_building_c/scenario_c.exsce
+      exscec check examples      # every .exsce file below the folder
     """
     from exsce_dsl.rdf.spec_check import check_spec
 
     failed = False
-    for spec in specs:
+    for spec in spec_files(specs):
         checked = check_spec(spec)
         print_diagnostics(list(checked.diagnostics))
         errors = len(checked.errors)
@@ -81,8 +83,8 @@ def compile_command(
 
     \b
     Example:
-      exscec compile examples/scenario_c/scenario_c.exsce -f json -o scenario_c.prov.json
-      exscec compile examples/scenario_c/scenario_c.exsce --store
+      exscec compile examples/brsu_building_c/scenario_c.exsce -f json -o scenario_c.prov.json
+      exscec compile examples/brsu_building_c/scenario_c.exsce --store
     """
     from exsce_dsl.lang.build import load_spec
     from exsce_dsl.prov.spec import compile_spec_scenario
@@ -105,7 +107,7 @@ def compile_command(
 
 
 @click.command()
-@click.argument("specs", nargs=-1, required=True, type=click.Path(dir_okay=False))
+@click.argument("specs", nargs=-1, required=True, type=click.Path())
 @click.option("--check", "check_only", is_flag=True, help="Change nothing; exit 1 if a file would change.")
 @click.option(
     "--diff", "show_diff", is_flag=True, help="Print what would change as a unified diff; change nothing."
@@ -114,12 +116,14 @@ def compile_command(
 def fmt(specs: tuple[str, ...], check_only: bool, show_diff: bool) -> None:
     """Rewrite SPEC files in canonical form.
 
-    The formatter prints the checked model, so a file must be valid to be
-    formatted.  Comments stay before the element that follows them.
+    A folder stands for the .exsce files below it.  The formatter prints the
+    checked model, so a file must be valid to be formatted.  Comments stay
+    before the element that follows them.
 
     \b
     Example:
-      exscec fmt --check examples/**/*.exsce
+      exscec fmt --check examples     # for CI: fails if a file below examples/ would change
+      exscec fmt specs/
     """
     from exsce_dsl.lang.build import load_spec
     from exsce_dsl.lang.formatter import format_spec_document
@@ -128,7 +132,7 @@ def fmt(specs: tuple[str, ...], check_only: bool, show_diff: bool) -> None:
     from exsce_dsl.textfiles import read_text
 
     changed = []
-    for spec_path in specs:
+    for spec_path in spec_files(specs):
         spec = load_spec(spec_path)
         original = read_text(spec_path, "specification")
         path = display_path(spec_path)
@@ -192,14 +196,15 @@ def import_command(
 
     Task files are found by their ROS package and path under each --tasks
     folder (and the scenario's own folder), or by file name.  An oracle file
-    (one with a baseline or metamorphic section) needs --spec; its criteria
-    are printed, or with -o written to <scenario>_acceptance.exsce, which
-    imports the spec.
+    (one with a baseline or metamorphic section, such as the method's
+    oracles/scenario_c.yaml) needs --spec, the .exsce file of its scenario;
+    its criteria are printed, or with -o written to
+    <scenario>_acceptance.exsce, which imports the spec.  The example reads
+    the files `exscec export --to yaml -o out/` writes.
 
     \b
     Example:
-      exscec import scenario_c.yaml -t config/tasks -o specs/
-      exscec import oracles/scenario_c.yaml --spec specs/scenario_c.exsce
+      exscec import out/scenarios/scenario_c.yaml -t out/config/tasks -o specs/
     """
     from exsce_dsl.lang.method_yaml import import_scenario_yaml
     from exsce_dsl.lang.oracle_yaml import is_oracle_yaml
@@ -261,13 +266,15 @@ def export_command(spec: str, target: str, out_dir: str, scenario_id: str | None
     each scenario to Gherkin (<scenario>.feature).
 
     An oracle file holds numbers: a clause that expects the mean of stored runs
-    (no 'around' or 'from' value) cannot be written without a baseline.
+    (no 'around' or 'from' value) cannot be written without a baseline, nor can
+    a clause about part of a run ('when tiago1 does delivery_a'); scenario_c's
+    criteria have both, so its oracle-yaml export fails and says where.
 
     \b
     Example:
-      exscec export examples/scenario_c/scenario_c.exsce --to yaml -o out/
-      exscec export examples/scenario_c/scenario_c.exsce --to oracle-yaml -o out/
-      exscec export examples/scenario_c/scenario_c.exsce --to gherkin -o features/
+      exscec export examples/brsu_building_c/scenario_c.exsce --to yaml -o out/
+      exscec export examples/brsu_building_c/scenario_c.exsce --to gherkin -o features/
+      exscec export examples/brsu_building_c/scenario_c.exsce --to oracle-yaml -o out/  # exits 1
     """
     from exsce_dsl.errors import ExportError
     from exsce_dsl.lang.build import load_spec

@@ -59,7 +59,8 @@ def info(store_url: str | None) -> None:
 
     \b
     Example:
-      exscec store info --store oxigraph+http://127.0.0.1:7878
+      exscec store info
+      exscec store info --store memory:
     """
     from exsce_dsl.store.embedded import EmbeddedStore
     from exsce_dsl.store.open import open_store
@@ -214,12 +215,14 @@ def serve(
     /update takes SPARQL updates that carry `Authorization: Bearer TOKEN`.
     While it runs, the server holds the store; other exscec commands on the
     same store go through it (writes only with --allow-updates and
-    EXSCE_STORE_TOKEN set to the token).
+    EXSCE_STORE_TOKEN set to the token).  The server's URL is the first line
+    on stdout: ask it with `curl 'URL/query?query=ASK%7B%7D'`, or from
+    another machine's exscec with --store URL/query.
 
     \b
     Example:
-      exscec serve --bind 127.0.0.1:7878
-      curl 'http://127.0.0.1:7878/query?query=ASK%7B%7D'
+      exscec serve                        # at http://127.0.0.1:7878/
+      exscec serve --bind 127.0.0.1:0     # on a free port, printed first
     """
     from exsce_dsl.store.embedded import EmbeddedStore
     from exsce_dsl.store.open import open_store
