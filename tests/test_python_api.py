@@ -97,3 +97,17 @@ def test_a_library_update_is_refused() -> None:
     assert updates, "the library has updates"
     with exsce.open_store("memory:") as store, pytest.raises(ValueError, match="update"):
         exsce.query(store, updates[0])
+
+
+def test_the_readme_example_runs_as_written(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
+    [block] = _blocks(readme)
+    shutil.copytree(EXAMPLES, tmp_path / "examples")
+    monkeypatch.chdir(tmp_path)
+    namespace: dict[str, object] = {}
+    exec(compile(block, "README.md", "exec"), namespace)  # noqa: S102
+    table = namespace["table"]
+    import pandas as pd
+
+    assert isinstance(table, pd.DataFrame) and table.run.nunique() == 3
+    assert len(list((tmp_path / "runs").glob("*.bag"))) == 3
