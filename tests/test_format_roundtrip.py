@@ -76,9 +76,9 @@ def test_formatting_keeps_comments_where_they_were(in_tmp: Path) -> None:
         "\n"
         "environment e {\n"
         "  area a {\n"
-        "    pose a-p1 at (1.0, 2.0)  /* the door */\n"
+        "    pose a-p1 at (1, 2)  /* the door */\n"
         "    // second pose\n"
-        "    pose a-p2 at (3.0, 4.0)\n"
+        "    pose a-p2 at (3, 4)\n"
         "  }\n"
         "}\n"
     )
@@ -93,7 +93,7 @@ def test_units_are_kept_as_written(in_tmp: Path) -> None:
     assert (pose.position.x, pose.position.y) == (1.5, 0.2)
     assert pose.orientation.yaw == math.pi / 2
     printed = format_spec_document(spec, "u.exsce")
-    assert "pose a-p at (150.0 cm, 20.0 cm) facing 90.0 deg" in printed
+    assert "pose a-p at (150 cm, 20 cm) facing 90 deg" in printed
 
 
 # ---------------------------------------------------------------- property test

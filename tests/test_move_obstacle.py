@@ -203,7 +203,7 @@ def test_the_derive_block_builds_the_moved_scenario_and_prints_back(folder: Path
         TransformationStep("move_obstacle", (("obstacle", "mast"), ("to", "4.0,2.5,0.5"))),
     )
     text = format_spec_document(spec)
-    assert text == MOVED.replace("(4.0, 2.5)", "(4.0, 2.5, 0.5)")  # in metres
+    assert text == MOVED.replace("(4.0, 2.5)", "(400 cm, 2.5 m, 0.5)")  # as written
     (folder / "again.exsce").write_text(text)
     again = load_spec(folder / "again.exsce")
     assert again.derived == spec.derived and format_spec_document(again) == text

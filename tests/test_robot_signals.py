@@ -224,7 +224,7 @@ def test_a_robots_override_is_formatted_back_to_the_same_model(tmp_path: Path) -
     source = display_path(path)
     printed = format_spec_document(spec, source, comments(path.read_text(), source))
     assert (
-        "    r1: rover starts at yard-a {\n      navigation none\n      arrival within 0.5 m\n    }\n"
+        "    r1: rover starts at yard-a {\n      navigation none\n      arrival within 50 cm\n    }\n"
         in printed
     )
     again = load_spec(path, overlay={source: printed})

@@ -3,12 +3,43 @@
 Library code raises these; only the CLI prints them and picks the exit code.
 An error may carry the source location it concerns, so that it can be printed
 as ``file:line:col: error: message`` and underlined by an editor.
+
+Every error class of the package is defined here, whatever layer raises it
+(this module imports nothing of exsce, so every layer can import it); the
+modules that raise them import them from here, so the old names still work
+(``exsce_dsl.store.base.StoreError`` is this module's :class:`StoreError`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
+from enum import Enum
+
+__all__ = [
+    "ArgumentError",
+    "BagError",
+    "DecodeError",
+    "Diagnostic",
+    "ExportError",
+    "ExsceError",
+    "ExsceSyntaxError",
+    "GenerationError",
+    "ImportFormatError",
+    "MessageTypeError",
+    "PlanningError",
+    "RelationError",
+    "RenameError",
+    "SegmentError",
+    "Severity",
+    "SourceLocation",
+    "SpecError",
+    "StoreConflictError",
+    "StoreError",
+    "StoreLockedError",
+    "TfError",
+    "TimeLimitError",
+]
 
 
 @dataclass(frozen=True, order=True)
@@ -25,19 +56,72 @@ class SourceLocation:
         return f"{self.file}:{self.line}:{self.column}"
 
 
-@dataclass(frozen=True)
+class Severity(str, Enum):
+    """How bad a diagnostic is; prints as its value (``f"{Severity.ERROR}"`` is ``error``).
+
+    Only errors make a specification invalid.  A note says something about another
+    diagnostic (errors that may follow from a syntax error, and were not shown).
+    """
+
+    ERROR = "error"
+    WARNING = "warning"
+    NOTE = "note"
+    INFO = "info"
+    HINT = "hint"
+
+    def __str__(self) -> str:
+        return self.value
+
+    def __format__(self, spec: str) -> str:
+        return format(self.value, spec)
+
+    @property
+    def rank(self) -> int:
+        """Errors first, then warnings, then the rest (to order diagnostics at one place)."""
+        return list(Severity).index(self)
+
+
+@dataclass(frozen=True, init=False)
 class Diagnostic:
-    """One problem found in a specification."""
+    """One problem found in a specification.
+
+    ``severity`` may be given as its text (``"warning"``); it is kept as a :class:`Severity`.
+    """
 
     message: str
     location: SourceLocation | None = None
-    severity: str = "error"
+    severity: Severity = Severity.ERROR
     code: str = "exsce"
     hint: str | None = field(default=None, compare=False)
+
+    def __init__(
+        self,
+        message: str,
+        location: SourceLocation | None = None,
+        severity: Severity | str = Severity.ERROR,
+        code: str = "exsce",
+        hint: str | None = None,
+    ) -> None:
+        object.__setattr__(self, "message", message)
+        object.__setattr__(self, "location", location)
+        object.__setattr__(self, "severity", Severity(severity))
+        object.__setattr__(self, "code", code)
+        object.__setattr__(self, "hint", hint)
+
+    @property
+    def is_error(self) -> bool:
+        return self.severity is Severity.ERROR
 
     def __str__(self) -> str:
         where = f"{self.location}: " if self.location else ""
         return f"{where}{self.severity}: {self.message}"
+
+
+def diagnostic_order(d: Diagnostic) -> tuple[str, int, int, int, str]:
+    """Diagnostics by file, line and column; at one place errors before notes about them."""
+    loc = d.location
+    where = (loc.file, loc.line, loc.column) if loc else ("", 0, 0)
+    return (*where, d.severity.rank, d.message)
 
 
 class ExsceError(Exception):
@@ -60,8 +144,9 @@ class SpecError(ExsceError):
     """A specification is not valid; holds every diagnostic that was found."""
 
     def __init__(self, diagnostics: Iterable[Diagnostic]) -> None:
-        found = tuple(sorted(diagnostics, key=_diagnostic_order))
-        first = found[0] if found else Diagnostic("invalid specification")
+        found = tuple(sorted(diagnostics, key=diagnostic_order))
+        first = next((d for d in found if d.is_error), found[0] if found else None)
+        first = first or Diagnostic("invalid specification")
         super().__init__(first.message, first.location)
         self._diagnostics = found
 
@@ -82,6 +167,75 @@ class ExportError(ExsceError):
     """A specification cannot be written in the requested format."""
 
 
-def _diagnostic_order(d: Diagnostic) -> tuple[str, int, int, str]:
-    loc = d.location
-    return (loc.file, loc.line, loc.column, d.message) if loc else ("", 0, 0, d.message)
+# ------------------------------------------------- errors of the upper layers
+# Defined here rather than re-exported: importing their modules from here would
+# make every layer import the store, the bag readers and the language server.
+
+
+class MessageTypeError(ExsceError):
+    """A message type that is unknown, or whose definition cannot be used (``messages``)."""
+
+
+class GenerationError(ExsceError):
+    """A model that cannot be turned into the requested code (templates, ``codegen``)."""
+
+
+class RelationError(ExsceError):
+    """A relation that does not exist, or was given the wrong parameters (``oracles``)."""
+
+
+class PlanningError(ExsceError):
+    """No path exists between two poses on the map (``sim``)."""
+
+
+class BagError(ExsceError):
+    """A bag that cannot be used: unreadable, truncated, empty, of an unexpected type (``runs``)."""
+
+
+class DecodeError(ExsceError):
+    """Raw bytes that are not the message type they claim to be (``runs``)."""
+
+
+class TfError(ExsceError):
+    """The TF data cannot give the pose asked for, or is not a tree (``runs``)."""
+
+
+class SegmentError(ExsceError):
+    """The dispatcher's statuses do not fit the scenario (``runs``)."""
+
+
+class StoreError(ExsceError):
+    """The store cannot do what was asked (unreachable, locked, refused, conflicting)."""
+
+
+class StoreLockedError(StoreError):
+    """An embedded store's folder is open in another process (RocksDB allows one)."""
+
+    def __init__(self, message: str, path: str) -> None:
+        super().__init__(message)
+        self.path = path
+
+
+class StoreConflictError(StoreError):
+    """A document differs from what the store holds under the same names."""
+
+    def __init__(self, message: str, graphs: Sequence[str]) -> None:
+        super().__init__(message)
+        self.graphs = tuple(graphs)
+        """The names of the graphs that differ."""
+
+
+class ArgumentError(ExsceError):
+    """A tool was called with arguments its input schema does not allow (``mcp_server``)."""
+
+
+class TimeLimitError(ExsceError):
+    """A request ran over the server's time limit (``mcp_server``)."""
+
+
+class RenameError(ValueError):
+    """A rename an editor asked for that cannot be done, and why (``lsp``).
+
+    A refusal sent back to the editor as it is (``str(error)`` is the reason), not a
+    problem of a specification: hence a ``ValueError`` rather than an :class:`ExsceError`.
+    """

@@ -21,14 +21,10 @@ import re
 
 import jinja2
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import GenerationError as GenerationError
 from exsce_dsl.resources import resource_dir
 
 _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
-
-
-class GenerationError(ExsceError):
-    """A model that cannot be turned into the requested code."""
 
 
 def python_name(name: str) -> str:

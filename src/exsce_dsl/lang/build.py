@@ -7,21 +7,21 @@ need the whole scenario live in :mod:`exsce_dsl.lang.checks`.
 
 from __future__ import annotations
 
-import math
-import re
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from exsce_dsl.errors import Diagnostic, SourceLocation, SpecError
+from exsce_dsl.errors import Diagnostic, Severity, SourceLocation, SpecError, diagnostic_order
 from exsce_dsl.lang.build_acceptance import build_all_acceptance
 from exsce_dsl.lang.build_derivation import build_derivations
 from exsce_dsl.lang.build_metrics import build_metric
 from exsce_dsl.lang.build_signals import build_signals
 from exsce_dsl.lang.checks import check_environment_map, check_scenario
-from exsce_dsl.lang.loader import load_files
+from exsce_dsl.lang.lexical import quantity_parts, read_angle, read_length
+from exsce_dsl.lang.loader import Parse, read_sources
 from exsce_dsl.lang.parser import ParsedFile
+from exsce_dsl.lang.references import UnknownNames, not_in_fleet
 from exsce_dsl.lang.standard_metrics import reserved_metric_names
 from exsce_dsl.model import (
     Acceptance,
@@ -49,10 +49,6 @@ from exsce_dsl.model import (
 from exsce_dsl.model.derived import DerivedScenario
 from exsce_dsl.model.metrics import MetricDefinition
 from exsce_dsl.model.robots import root_namespace
-from exsce_dsl.suggest import did_you_mean
-
-_LENGTH_SCALE = {None: 1.0, "m": 1.0, "cm": 0.01, "mm": 0.001}
-_QUANTITY = re.compile(r"(\S+?)\s*(mm|cm|m|rad|deg)?")
 
 _KIND_WORDS = {
     "RobotType": "robot type",
@@ -72,31 +68,43 @@ class Analysis:
 
     @property
     def errors(self) -> list[Diagnostic]:
-        return [d for d in self.diagnostics if d.severity == "error"]
+        return [d for d in self.diagnostics if d.is_error]
 
 
 def load_spec(path: str | Path, overlay: Mapping[str, str] | None = None) -> Specification:
-    """Parse, resolve and check a specification; raise :class:`SpecError` listing every error."""
+    """Parse, resolve and check a specification; raise :class:`SpecError` listing every error
+    (and the notes about them)."""
     analysis = analyse(path, overlay)
     if analysis.errors or analysis.spec is None:
-        raise SpecError(analysis.errors or analysis.diagnostics)
+        told = [d for d in analysis.diagnostics if d.is_error or d.severity is Severity.NOTE]
+        raise SpecError(told or analysis.diagnostics)
     return analysis.spec
 
 
 def analyse(path: str | Path, overlay: Mapping[str, str] | None = None) -> Analysis:
     """Like :func:`load_spec`, but return diagnostics instead of raising (for editors and ``check``)."""
-    files, diagnostics = load_files(path, overlay)
-    return analyse_files(files, diagnostics)
+    sources = read_sources(path, overlay)
+    return analyse_files(sources.files, sources.diagnostics, sources.broken)
 
 
-def analyse_files(files: list[ParsedFile], diagnostics: list[Diagnostic]) -> Analysis:
-    """:func:`analyse` of files already parsed (the root first), with the problems found reading them."""
+def analyse_files(
+    files: list[ParsedFile],
+    diagnostics: list[Diagnostic],
+    broken: Mapping[str, str] | None = None,
+    parse: Parse | None = None,
+) -> Analysis:
+    """:func:`analyse` of files already parsed (the root first), with the problems found reading
+    them; ``broken`` has the text of each file with a syntax error (the names they seem to
+    declare are not reported unknown: see :mod:`exsce_dsl.lang.references`), and ``parse``
+    reads the files not imported where an unknown name may be declared."""
     diagnostics = list(diagnostics)
-    builder = _Builder(files)
+    unknown = UnknownNames(files, broken, parse)
+    builder = _Builder(files, unknown)
     spec = builder.build() if files else None
     diagnostics.extend(builder.diagnostics)
-    unique = sorted(set(diagnostics), key=lambda d: (d.location or SourceLocation("", 0, 0), d.message))
-    has_errors = any(d.severity == "error" for d in unique)
+    diagnostics.extend(unknown.notes(diagnostics))
+    unique = sorted(set(diagnostics), key=diagnostic_order)
+    has_errors = any(d.is_error for d in unique)
     return Analysis(None if has_errors else spec, unique)
 
 
@@ -108,8 +116,9 @@ class _Declared:
 
 
 class _Builder:
-    def __init__(self, files: list[ParsedFile]) -> None:
+    def __init__(self, files: list[ParsedFile], unknown: UnknownNames) -> None:
         self.files = files
+        self.unknown = unknown
         self.diagnostics: list[Diagnostic] = []
         self.declared: dict[str, dict[str, _Declared]] = {k: {} for k in _KIND_WORDS}
         self.robot_types: dict[str, RobotType] = {}
@@ -129,13 +138,18 @@ class _Builder:
         self.diagnostics.append(Diagnostic(message, location, code=code))
 
     def warning(self, message: str, location: SourceLocation | None, code: str = "semantic") -> None:
-        self.diagnostics.append(Diagnostic(message, location, severity="warning", code=code))
+        self.diagnostics.append(Diagnostic(message, location, Severity.WARNING, code=code))
 
-    def metric_problem(self, message: str, location: SourceLocation | None, severity: str = "error") -> None:
-        if severity == "error":
-            self.error(message, location, code="metric")
-        else:
-            self.warning(message, location, code="metric")
+    def metric_problem(
+        self, message: str, location: SourceLocation | None, severity: Severity = Severity.ERROR
+    ) -> None:
+        self.diagnostics.append(Diagnostic(message, location, severity, code="metric"))
+
+    def unknown_name(self, kind: str, name: str, at: SourceLocation, known: Iterable[str]) -> None:
+        """Report that no file read declares ``name`` (unless a file with a syntax error may)."""
+        message = self.unknown.message(kind, name, at, known)
+        if message is not None:
+            self.error(message, at, code="reference")
 
     @staticmethod
     def name_span(pf: ParsedFile, obj: Any) -> SourceLocation:
@@ -209,6 +223,7 @@ class _Builder:
             self.tasks,
             lambda message, at: self.error(message, at, code="derivation"),
             lambda pf, decl: _Declared(decl, pf, self.name_span(pf, decl)),
+            self.unknown,
         )
 
     def _acceptance(self) -> None:
@@ -217,6 +232,7 @@ class _Builder:
             self.scenarios,
             self.declared["Scenario"],
             lambda message, at: self.error(message, at, code="acceptance"),
+            self.unknown,
         )
 
     def _document(self, pf: ParsedFile) -> Document:
@@ -332,9 +348,11 @@ class _Builder:
                     continue
                 obstacle_seen[member.name] = where
                 size = None
+                size_written: tuple[str, ...] = ()
                 if member.sx is not None:
                     dims = [member.sx, member.sy] + ([member.sz] if member.sz is not None else [])
-                    size = tuple(_length(v) for v in dims)
+                    size = tuple(read_length(v) for v in dims)
+                    size_written = tuple(dims)
                 pose = Pose(
                     member.name,
                     position_of(member.position),
@@ -342,7 +360,7 @@ class _Builder:
                     None,
                     where,
                 )
-                obstacles.append(Obstacle(member.name, pose, member.model or None, size, where))
+                obstacles.append(Obstacle(member.name, pose, member.model or None, size, where, size_written))
         return Environment(env.name, map_model, world, tuple(areas), tuple(obstacles), d.name_location)
 
     # ------------------------------------------------------------------ tasks
@@ -395,7 +413,7 @@ class _Builder:
         name = use.pose.name
         where = pf.span(use.pose)
         if name not in table:
-            self.error(f"unknown pose '{name}'{did_you_mean(name, table)}", where, code="reference")
+            self.unknown_name("pose", name, where, table)
             return None
         pose = table[name]
         if pose is None:
@@ -418,12 +436,7 @@ class _Builder:
         ok = True
         env = self.environments.get(sc.environment.name)
         if env is None:
-            self.error(
-                f"unknown environment '{sc.environment.name}'"
-                f"{did_you_mean(sc.environment.name, self.environments)}",
-                pf.span(sc.environment),
-                code="reference",
-            )
+            self.unknown_name("environment", sc.environment.name, pf.span(sc.environment), self.environments)
             ok = False
         env_poses: dict[str, Pose | None] = {p.id: p for p in env.poses()} if env else {}
 
@@ -442,11 +455,7 @@ class _Builder:
             robot_seen[decl.name] = where
             rtype = self.robot_types.get(decl.type.name)
             if rtype is None:
-                self.error(
-                    f"unknown robot type '{decl.type.name}'{did_you_mean(decl.type.name, self.robot_types)}",
-                    pf.span(decl.type),
-                    code="reference",
-                )
+                self.unknown_name("robot type", decl.type.name, pf.span(decl.type), self.robot_types)
                 ok = False
             start = None
             if decl.start is not None and env is not None:
@@ -494,20 +503,11 @@ class _Builder:
         for line in m.assignments:
             robot = line.robot.name
             if robot not in fleet:
-                self.error(
-                    f"robot '{robot}' is not in the fleet of scenario '{sc.name}'"
-                    f"{did_you_mean(robot, fleet)}",
-                    pf.span(line.robot),
-                    code="reference",
-                )
+                self.error(not_in_fleet(robot, sc.name, fleet), pf.span(line.robot), code="reference")
                 ok = False
             for ref in line.tasks:
                 if ref.name not in self.declared["Task"]:
-                    self.error(
-                        f"unknown task '{ref.name}'{did_you_mean(ref.name, self.declared['Task'])}",
-                        pf.span(ref),
-                        code="reference",
-                    )
+                    self.unknown_name("task", ref.name, pf.span(ref), self.declared["Task"])
                     ok = False
                 allocation.append(Assignment(robot, ref.name, pf.span(ref)))
         if not m.assignments:
@@ -524,34 +524,20 @@ def _ros(source: Any) -> RosResource | None:
     return RosResource(source.package, source.path or None)
 
 
-def _quantity(text: str) -> tuple[float, str | None]:
-    """Number and unit of a ``Length`` or ``Angle`` token such as ``150 cm`` or ``-0.5``."""
-    match = _QUANTITY.fullmatch(text)
-    assert match is not None, text  # the grammar only lets such tokens through
-    return float(match.group(1)), match.group(2)
-
-
-def _length(text: str) -> float:
-    value, unit = _quantity(text)
-    return value * _LENGTH_SCALE[unit]
-
-
 def position_of(pos: Any) -> Position:
-    """A parsed `(x, y[, z])` with units, in metres (the unit the author wrote kept for the formatter)."""
-    unit = _quantity(pos.x)[1] or "m"
-    z = _length(pos.z) if pos.z is not None else 0.0
-    return Position(_length(pos.x), _length(pos.y), z, unit)
-
-
-def _angle(text: str) -> float:
-    value, unit = _quantity(text)
-    return math.radians(value) if unit == "deg" else value
+    """A parsed `(x, y[, z])` with units, in metres (what the author wrote kept for the formatter)."""
+    unit = quantity_parts(pos.x)[1] or "m"
+    texts = [pos.x, pos.y] + ([pos.z] if pos.z is not None else [])
+    z = read_length(pos.z) if pos.z is not None else 0.0
+    return Position(read_length(pos.x), read_length(pos.y), z, unit, tuple(texts))
 
 
 def _orientation(orientation: Any) -> Orientation:
     if orientation is None:
         return Orientation()
-    unit = _quantity(orientation.yaw)[1] or "rad"
+    unit = quantity_parts(orientation.yaw)[1] or "rad"
     if orientation.__class__.__name__ == "Facing":
-        return Orientation(0.0, 0.0, _angle(orientation.yaw), unit)
-    return Orientation(_angle(orientation.roll), _angle(orientation.pitch), _angle(orientation.yaw), unit)
+        return Orientation(0.0, 0.0, read_angle(orientation.yaw), unit, (orientation.yaw,))
+    texts = (orientation.roll, orientation.pitch, orientation.yaw)
+    roll, pitch, yaw = (read_angle(t) for t in texts)
+    return Orientation(roll, pitch, yaw, unit, texts)

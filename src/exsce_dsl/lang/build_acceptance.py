@@ -9,11 +9,12 @@ its ``file:line:col`` and all of them at once.
 from __future__ import annotations
 
 import re
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import Any
 
 from exsce_dsl.errors import SourceLocation
 from exsce_dsl.lang.parser import ParsedFile
+from exsce_dsl.lang.references import UnknownNames, not_in_fleet
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.acceptance import (
     Acceptance,
@@ -43,6 +44,7 @@ def build_all_acceptance(
     scenarios: Mapping[str, Scenario],
     declared_scenarios: Mapping[str, object],
     report: Report,
+    unknown: UnknownNames,
 ) -> dict[int, Acceptance]:
     """Every acceptance block of ``files`` (one per scenario), by the id of its parse tree node."""
     first: dict[str, SourceLocation] = {}
@@ -60,7 +62,7 @@ def build_all_acceptance(
                 )
                 continue
             first[name] = where
-            acceptance = build_acceptance(pf, decl, scenarios, declared_scenarios, report)
+            acceptance = build_acceptance(pf, decl, scenarios, declared_scenarios, report, unknown)
             if acceptance is not None:
                 built[id(decl)] = acceptance
     return built
@@ -72,16 +74,18 @@ def build_acceptance(
     scenarios: Mapping[str, Scenario],
     declared_scenarios: Mapping[str, object],
     report: Report,
+    unknown: UnknownNames,
 ) -> Acceptance | None:
     """The criteria of one ``acceptance`` block, or None when it names no valid scenario."""
     name = tree.scenario.name
     scenario = scenarios.get(name)
     if scenario is None:
         if name not in declared_scenarios:
-            hint = did_you_mean(name, declared_scenarios)
-            report(f"unknown scenario '{name}'{hint}", pf.span(tree.scenario))
+            where = pf.span(tree.scenario)
+            if (message := unknown.message("scenario", name, where, declared_scenarios)) is not None:
+                report(message, where)
         return None  # a scenario with errors of its own: those are reported where it is
-    builder = _AcceptanceBuilder(pf, scenario, declared_scenarios, report)
+    builder = _AcceptanceBuilder(pf, scenario, declared_scenarios, report, unknown)
     criteria = tuple(builder.criterion(c) for c in tree.criteria)
     titles: dict[str, SourceLocation] = {}
     for criterion, node in zip(criteria, tree.criteria, strict=True):
@@ -103,9 +107,15 @@ def build_acceptance(
 
 class _AcceptanceBuilder:
     def __init__(
-        self, pf: ParsedFile, scenario: Scenario, declared: Mapping[str, object], report: Report
+        self,
+        pf: ParsedFile,
+        scenario: Scenario,
+        declared: Mapping[str, object],
+        report: Report,
+        unknown: UnknownNames,
     ) -> None:
         self.pf = pf
+        self.unknown = unknown
         self.scenario = scenario
         self.declared = declared
         self._report = report
@@ -115,6 +125,11 @@ class _AcceptanceBuilder:
     def error(self, message: str, where: SourceLocation | None) -> None:
         self.failed = True
         self._report(message, where)
+
+    def unknown_name(self, kind: str, name: str, where: SourceLocation, known: Iterable[str]) -> None:
+        self.failed = True
+        if (message := self.unknown.message(kind, name, where, known)) is not None:
+            self._report(message, where)
 
     def criterion(self, node: Any) -> Criterion:
         givens = tuple(g for g in (self.given(n) for n in node.givens) if g is not None)
@@ -154,11 +169,7 @@ class _AcceptanceBuilder:
 
     def robot(self, ref: Any) -> str | None:
         if ref.name not in self.robots:
-            self.error(
-                f"robot '{ref.name}' is not in the fleet of scenario '{self.scenario.id}'"
-                f"{did_you_mean(ref.name, self.robots)}",
-                self.pf.span(ref),
-            )
+            self.error(not_in_fleet(ref.name, self.scenario.id, self.robots), self.pf.span(ref))
             return None
         return str(ref.name)
 
@@ -187,10 +198,7 @@ class _AcceptanceBuilder:
         metrics = known_metrics(self.scenario)
         info = metrics.get(metric_ref.name)
         if info is None:
-            self.error(
-                f"unknown metric '{metric_ref.name}'{did_you_mean(metric_ref.name, metrics)}",
-                self.pf.span(metric_ref),
-            )
+            self.unknown_name("metric", metric_ref.name, self.pf.span(metric_ref), metrics)
             return None
         subject = Subject(Quantifier.MISSION) if node.subject is None else self.subject(node.subject)
         if subject is None:
@@ -279,9 +287,7 @@ class _AcceptanceBuilder:
             )
             return None
         if ref.name not in self.declared:
-            self.error(
-                f"unknown scenario '{ref.name}'{did_you_mean(ref.name, self.declared)}", self.pf.span(ref)
-            )
+            self.unknown_name("scenario", ref.name, self.pf.span(ref), self.declared)
             return None
         return str(ref.name)
 

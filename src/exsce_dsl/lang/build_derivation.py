@@ -9,10 +9,11 @@ from typing import Any
 
 from exsce_dsl.errors import ExsceError, SourceLocation
 from exsce_dsl.lang.checks import check_environment_map
+from exsce_dsl.lang.lexical import quantity_text
 from exsce_dsl.lang.parser import ParsedFile
+from exsce_dsl.lang.references import UnknownNames
 from exsce_dsl.model import Environment, Scenario, Task
 from exsce_dsl.model.derived import DerivedScenario, Step
-from exsce_dsl.suggest import did_you_mean
 from exsce_dsl.transform.derivation import derive
 
 Report = Callable[[str, SourceLocation | None], None]
@@ -67,6 +68,16 @@ def step_of(node: Any) -> tuple[str, dict[str, str | None]]:
     return "substitute_allocation", {"allocation": ",".join(entries)}
 
 
+def written_arguments(node: Any) -> tuple[tuple[str, str], ...]:
+    """The arguments of a step whose text is not their value's (see :attr:`Step.written`)."""
+    if node.__class__.__name__ == "MoveObstacle":
+        texts = [node.position.x, node.position.y] + (
+            [node.position.z] if node.position.z is not None else []
+        )
+        return (("to", ", ".join(quantity_text(t) for t in texts)),)
+    return ()
+
+
 def build_derivation(
     pf: ParsedFile,
     tree: Any,
@@ -74,17 +85,21 @@ def build_derivation(
     declared_scenarios: Mapping[str, object],
     tasks: Mapping[str, Task],
     report: Report,
+    unknown: UnknownNames,
 ) -> DerivedScenario | None:
     base = scenarios.get(tree.base.name)
     if base is None:
         if tree.base.name not in declared_scenarios:
-            hint = did_you_mean(tree.base.name, declared_scenarios)
-            report(f"unknown scenario '{tree.base.name}'{hint}", pf.span(tree.base))
+            where = pf.span(tree.base)
+            message = unknown.message("scenario", tree.base.name, where, declared_scenarios)
+            if message is not None:
+                report(message, where)
         return None  # a base with errors of its own: reported where it is
     steps = []
     for node in tree.steps:
         name, arguments = step_of(node)
-        steps.append(Step(name, tuple((k, v) for k, v in arguments.items() if v is not None), pf.span(node)))
+        given = tuple((k, v) for k, v in arguments.items() if v is not None)
+        steps.append(Step(name, given, pf.span(node), written_arguments(node)))
     done: list[Step] = []
     derived = None
     for step in steps:  # apply one more step at a time, to place an error at its step
@@ -125,6 +140,7 @@ def build_derivations(
     tasks: Mapping[str, Task],
     report: Report,
     declare: Callable[[ParsedFile, Any], Any],
+    unknown: UnknownNames,
 ) -> dict[int, DerivedScenario]:
     """Every derive block of ``files``, bases first (one may start from a derived scenario).
 
@@ -153,7 +169,7 @@ def build_derivations(
             break
         for pf, decl in ready:
             pending.remove((pf, decl))
-            derived = build_derivation(pf, decl, scenarios, declared, tasks, report)
+            derived = build_derivation(pf, decl, scenarios, declared, tasks, report, unknown)
             if derived is not None:
                 built[id(decl)] = derived
                 scenarios[derived.id] = derived.scenario

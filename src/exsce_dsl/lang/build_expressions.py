@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from exsce_dsl.lang.check_fields import FieldProblem, field_shape
+from exsce_dsl.lang.lexical import quantity_text
 from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.model.expressions import (
     AGGREGATES,
@@ -221,7 +222,7 @@ class ExpressionBuilder:
 
     def _literal(self, node: Any) -> Typed:
         quantity = read_quantity(node.quantity)
-        written = " ".join(node.quantity.split())
+        written = quantity_text(node.quantity)
         return Typed(Number(quantity[0], written, self.pf.span(node)), Kind.CONSTANT)
 
     def _windowvalue(self, node: Any) -> Typed:

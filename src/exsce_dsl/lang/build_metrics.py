@@ -23,7 +23,7 @@ import re
 from collections.abc import Mapping
 from typing import Any, Protocol
 
-from exsce_dsl.errors import SourceLocation
+from exsce_dsl.errors import Severity, SourceLocation
 from exsce_dsl.lang.build_expressions import ExpressionBuilder, Scope, Typed, read_quantity
 from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.messages.catalogue import MessageCatalogue, MessageTypeError
@@ -46,9 +46,11 @@ from exsce_dsl.suggest import did_you_mean
 
 
 class Report(Protocol):
-    """Where problems go: ``severity`` is ``error`` (the metric is not built) or ``warning``."""
+    """Where problems go: an error (the metric is not built) or a warning."""
 
-    def __call__(self, message: str, location: SourceLocation | None, severity: str = "error", /) -> None: ...
+    def __call__(
+        self, message: str, location: SourceLocation | None, severity: Severity = Severity.ERROR, /
+    ) -> None: ...
 
 
 _PYTHON_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
@@ -116,7 +118,7 @@ class _MetricBuilder:
         self.report(message, where)
 
     def warning(self, message: str, node: Any) -> None:
-        self.report(message, self.pf.span(node), "warning")
+        self.report(message, self.pf.span(node), Severity.WARNING)
 
     def catalogue(self) -> MessageCatalogue:
         if self._catalogue is None:
@@ -274,7 +276,7 @@ class _MetricBuilder:
                 tree.safety,
             )
             return None
-        return SafetyLimit(tree.safety.bound, number)
+        return SafetyLimit(tree.safety.bound, number, tree.safety.limit)
 
     def _combine(self, tree: Any, value: Typed | None, fallback: Typed | None) -> Combine | None:
         if value is None or not (tree.per_segment or self.subject is Subject.PAIRS):

@@ -127,4 +127,5 @@ def _tolerance(fact: Any, span: Span, error: Report) -> Tolerance:
     if position <= 0 or (heading is not None and heading <= 0):
         error("an arrival tolerance is a distance (and an angle) above zero", span(fact))
         return Tolerance()
-    return Tolerance(position, heading)
+    written = (fact.position,) + ((fact.heading,) if fact.heading is not None else ())
+    return Tolerance(position, heading, written)

@@ -10,7 +10,7 @@ import re
 from functools import lru_cache
 from pathlib import Path
 
-from exsce_dsl.errors import Diagnostic, ExsceError
+from exsce_dsl.errors import Diagnostic, ExsceError, Severity
 from exsce_dsl.lang.occupancy import FREE, OUTSIDE, OccupancyGrid, load_occupancy_grid
 from exsce_dsl.model import Environment, Pose, Scenario
 
@@ -67,7 +67,7 @@ def check_scenario(scenario: Scenario) -> list[Diagnostic]:
                 Diagnostic(
                     f"robot '{robot.id}' has no task in mission '{scenario.mission.id}'",
                     robot.location,
-                    severity="warning",
+                    severity=Severity.WARNING,
                 )
             )
 

@@ -22,9 +22,7 @@ DECLARATION_KEYWORDS = frozenset(
 # What nests: strings (either quote, may be unterminated), comments and braces.
 _STRUCTURE = re.compile(r'"(?:\\.|[^"\\])*"?|\'(?:\\.|[^\'\\])*\'?|//[^\n]*|/\*.*?(?:\*/|\Z)|[{}]', re.DOTALL)
 # Between those: words and runs of other characters.
-_PLAIN = re.compile(
-    r"[A-Za-z_][\w-]*|[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?|[^\s\w\"'/{}]+|[\w-]+|/"
-)
+_PLAIN = re.compile(r"[A-Za-z_][\w-]*|[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?|[^\s\w\"'/{}]+|[\w-]+|/")
 
 # A declaration written at the start of a line: where a declaration left open (a
 # missing `}`) most likely ends.  `scenario "title"` of acceptance criteria is not one.
@@ -156,3 +154,55 @@ def area_spans(text: str, chunk: Chunk) -> list[tuple[int, int]]:
             spans.append((opened, token.end))
             opened = None
     return [] if opened is not None else spans
+
+
+# A top-level declaration's keyword -> the kind of what it declares.
+_DECLARES = {
+    "environment": "environment",
+    "task": "task",
+    "scenario": "scenario",
+    "derive": "scenario",
+    "metric": "metric",
+}
+
+
+def declared_names(text: str) -> set[tuple[str, str]]:
+    """What ``text`` seems to declare, as (kind, name), read from its words alone: for a
+    file with a syntax error, whose parse tree (if any) lacks some of them.
+
+    Top-level declarations (``robot type``, ``environment``, ``task``, ``scenario``,
+    ``derive``, ``metric``), and an environment's areas, poses and obstacles.
+    """
+    words = [t for t in tokens(text) if t.kind != "comment"]
+    found: set[tuple[str, str]] = set()
+    within: str | None = None  # the keyword of the top-level declaration the words are in
+    for i, token in enumerate(words):
+        after = words[i + 1] if i + 1 < len(words) else None
+        then = words[i + 2] if i + 2 < len(words) else None
+        if token.depth == 0 and token.kind == "word":
+            within = token.text if token.text in DECLARATION_KEYWORDS else within
+        if after is None or after.kind != "word":
+            continue
+        if token.depth == 0 and token.text in _DECLARES:
+            found.add((_DECLARES[token.text], after.text))
+        elif token.depth == 0 and token.text == "robot" and after.text == "type":
+            if then is not None and then.kind == "word":
+                found.add(("robot type", then.text))
+        elif within == "environment" and token.depth > 0 and token.text in ("area", "pose", "obstacle"):
+            found.add((token.text, after.text))
+    return found
+
+
+def imported_paths(text: str) -> list[str]:
+    """The paths of the ``import "..."`` lines of ``text``, read from its words alone (for a
+    file with a syntax error)."""
+    found = []
+    previous: Token | None = None
+    for token in tokens(text, max_depth=0):
+        if token.kind == "comment":
+            continue
+        closed = len(token.text) > 1 and token.text[-1] == token.text[0]
+        if previous is not None and previous.text == "import" and token.kind == "string" and closed:
+            found.append(re.sub(r"\\(.)", r"\1", token.text[1:-1]))
+        previous = token if token.depth == 0 else None
+    return found

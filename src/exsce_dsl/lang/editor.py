@@ -17,7 +17,7 @@ from pathlib import Path
 from exsce_dsl.errors import Diagnostic
 from exsce_dsl.lang.build import Analysis, analyse_files
 from exsce_dsl.lang.incremental import ParseCache
-from exsce_dsl.lang.loader import load_files, parse_whole
+from exsce_dsl.lang.loader import parse_whole, read_sources
 from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.lang.symbols import FileIndex, index_file
 
@@ -59,8 +59,9 @@ def analyse_for_editor(
         read.append(FileRead(full, text, index, pf is not None and not errors))
         return pf, errors
 
-    files, problems = load_files(root, overlay, parse=parse)
-    return EditorAnalysis(analyse_files(files, problems), tuple(read))
+    sources = read_sources(root, overlay, parse=parse)
+    analysis = analyse_files(sources.files, sources.diagnostics, sources.broken, parse=cache.parse)
+    return EditorAnalysis(analysis, tuple(read))
 
 
 def index_text(text: str, path: str, cache: ParseCache | None = None) -> FileIndex | None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from exsce_dsl.errors import SourceLocation
+from exsce_dsl.lang.lexical import as_written, read_length
 from exsce_dsl.model.derived import DerivedScenario, Step
 
 INDENT = "  "
@@ -50,8 +51,12 @@ def step_text(step: Step) -> list[str]:
     if name == "remove_start_pose":
         return [f"remove start pose of {a('robot')}"]
     if name == "move_obstacle":  # metres, as x,y[,z]
-        position = ", ".join(repr(float(v)) for v in (a("to") or "").split(","))
-        return [f"move obstacle {a('obstacle')} to ({position})"]
+        metres = [float(v) for v in (a("to") or "").split(",")]
+        texts = [t for t in dict(step.written).get("to", "").split(",") if t.strip()]
+        if len(texts) == 3 and len(metres) == 2:  # a z of 0 written out
+            metres.append(0.0)
+        shown = as_written(metres, texts, read_length) or [repr(v) for v in metres]
+        return [f"move obstacle {a('obstacle')} to ({', '.join(shown)})"]
     assert name == "substitute_allocation", name
     runs: list[tuple[str, list[str]]] = []
     for entry in (a("allocation") or "").split(","):

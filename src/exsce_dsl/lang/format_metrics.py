@@ -1,6 +1,6 @@
 """The canonical text of ``metric`` declarations and their expressions (the formatter's part).
 
-Numbers print in SI without their unit (``0.8 m/s`` reads back as ``0.8``), and
+Numbers print as written, units included (``0.8 m/s``; a safety limit too), and
 parentheses only where precedence needs them, so parse → print → parse is stable.
 A field prints as written: ``tf.transforms[child_frame_id == "base_link"].transform``,
 ``scan.ranges[-1]``, ``len(diag.status)``.
@@ -9,6 +9,8 @@ A field prints as written: ``tf.transforms[child_frame_id == "base_link"].transf
 from __future__ import annotations
 
 from exsce_dsl.errors import SourceLocation
+from exsce_dsl.lang.build_expressions import read_quantity
+from exsce_dsl.lang.lexical import as_written
 from exsce_dsl.lang.lexical import number_text as _number
 from exsce_dsl.lang.lexical import string_literal as _string
 from exsce_dsl.model.expressions import Aggregate, Binary, Expression, Field, Number, Unary, WindowValue
@@ -37,7 +39,10 @@ def metric_lines(metric: MetricDefinition) -> list[Line]:
     if metric.unit:
         lines.append((f"{INDENT}unit {metric.unit}", None))
     if metric.safety is not None:
-        limit = f"{_number(metric.safety.limit)} {metric.unit}".rstrip()
+        written = as_written(
+            [metric.safety.limit], [metric.safety.written] if metric.safety.written else [], _si
+        )
+        limit = written[0] if written else f"{_number(metric.safety.limit)} {metric.unit}".rstrip()
         lines.append((f"{INDENT}safe {metric.safety.bound} {limit}", None))
     for read in metric.reads:
         source = f"robot {read.signal}" if read.signal else f"{read.msgtype} on {_string(read.topic)}"
@@ -47,6 +52,10 @@ def metric_lines(metric: MetricDefinition) -> list[Line]:
         lines.append((f"{INDENT}otherwise {expression_text(metric.fallback)}", None))
     lines.append(("}", None))
     return lines
+
+
+def _si(text: str) -> float:
+    return read_quantity(text)[0]
 
 
 def expression_text(expr: Expression) -> str:

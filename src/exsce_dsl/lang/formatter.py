@@ -2,7 +2,12 @@
 
 textX has no model-to-text, so we own one.  Printing a parsed file and
 parsing the result gives back an equal model (a tested round trip), and
-printing is idempotent.  Comments are not part of the model and are not kept.
+printing is idempotent.  Comments are kept where they were (see :func:`format_document`).
+
+Quantities print as their author wrote them, number and unit (``200 cm``, ``90 deg``,
+``7``; one space before the unit): the model keeps that text beside the SI value, and
+it is printed as long as it still reads as the value.  A value made otherwise (by an
+importer, a transformation) prints in SI, or in the unit the model says it was written in.
 """
 
 from __future__ import annotations
@@ -12,10 +17,11 @@ import os
 from collections.abc import Iterable, Mapping, Sequence
 
 from exsce_dsl.errors import SourceLocation
+from exsce_dsl.lang.build_expressions import read_quantity
 from exsce_dsl.lang.format_acceptance import acceptance_lines
 from exsce_dsl.lang.format_derivation import derivation_lines
 from exsce_dsl.lang.format_metrics import metric_lines
-from exsce_dsl.lang.lexical import Comment
+from exsce_dsl.lang.lexical import Comment, as_written, read_angle, read_length
 from exsce_dsl.lang.lexical import number_text as _number
 from exsce_dsl.lang.lexical import string_literal as _string
 from exsce_dsl.model import (
@@ -32,7 +38,7 @@ from exsce_dsl.model import (
     Specification,
     Task,
 )
-from exsce_dsl.model.conventions import CONVENTIONS, Signals
+from exsce_dsl.model.conventions import CONVENTIONS, Signals, Tolerance
 from exsce_dsl.model.derived import DerivedScenario
 from exsce_dsl.model.metrics import MetricDefinition
 
@@ -140,12 +146,21 @@ def signal_lines(signals: Signals | None, over: Signals | None = None) -> list[s
         actions = ", ".join(f'"{a}"' for a in signals.actions)
         lines.append(f"navigation {signals.navigation.value}" + (f" on {actions}" if actions else ""))
     if signals.tolerance != base.tolerance:
-        heading = signals.tolerance.heading
-        lines.append(
-            f"arrival within {_number(signals.tolerance.position)} m"
-            + (f" and {_number(heading)} rad" if heading is not None else "")
-        )
+        lines.append(_arrival(signals.tolerance))
     return lines
+
+
+def _arrival(tolerance: Tolerance) -> str:
+    heading = tolerance.heading
+    values = [tolerance.position] + ([heading] if heading is not None else [])
+    texts = as_written(values, tolerance.written, _si) or [
+        f"{_number(value)} {unit}" for value, unit in zip(values, ("m", "rad"), strict=False)
+    ]
+    return "arrival within " + " and ".join(texts)
+
+
+def _si(text: str) -> float:
+    return read_quantity(text)[0]
 
 
 def _environment(env: Environment) -> list[Line]:
@@ -181,7 +196,8 @@ def _environment(env: Environment) -> list[Line]:
             text += f" at {_position(ob.pose.position)}"
             text += _orientation(ob.pose.orientation, declared=Orientation())
             if ob.size is not None:
-                text += " size (" + ", ".join(_number(v) for v in ob.size) + ")"
+                size = as_written(ob.size, ob.size_written, read_length) or [_number(v) for v in ob.size]
+                text += " size (" + ", ".join(size) + ")"
             obstacles.append((text, ob.location))
         sections.append(obstacles)
     lines: list[Line] = [(f"environment {env.id} {{", env.location)]
@@ -266,6 +282,10 @@ def _pose_use(pose: Pose, poses: Mapping[str, Pose]) -> str:
 def _orientation(o: Orientation, declared: Orientation, always: bool = False) -> str:
     if o == declared and not always:
         return ""
+    if o.is_planar and (yaw := as_written([o.yaw], o.written, read_angle)) is not None:
+        return f" facing {yaw[0]}"
+    if (angles := as_written([o.roll, o.pitch, o.yaw], o.written, read_angle)) is not None:
+        return f" rpy ({', '.join(angles)})"
     unit = o.unit if o.unit in ("rad", "deg") else "rad"
     if o.is_planar:
         return f" facing {_angle(o.yaw, unit)}"
@@ -281,6 +301,9 @@ def _angle(value: float, unit: str) -> str:
 
 
 def _position(p: Position) -> str:
+    values = [p.x, p.y] + ([p.z] if p.z != 0.0 or len(p.written) == 3 else [])
+    if (written := as_written(values, p.written, read_length)) is not None:
+        return "(" + ", ".join(written) + ")"
     values = [p.x, p.y] + ([p.z] if p.z != 0.0 else [])
     scale = _LENGTH_UNITS.get(p.unit, 1.0)
     if scale != 1.0:

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import math
 import re
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from decimal import Decimal
 
@@ -52,3 +54,46 @@ def number_text(value: float) -> str:
 def string_literal(text: str) -> str:
     """``text`` as a quoted string of the language."""
     return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+# A quantity token of the grammar (``Length``, ``Angle``, ``Quantity``, ``MetricQuantity``): a
+# number and, after optional spaces, a unit.
+_QUANTITY = re.compile(r"([-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?)\s*(\S+)?")
+_LENGTH_SCALE = {None: 1.0, "m": 1.0, "cm": 0.01, "mm": 0.001}
+
+
+def quantity_parts(text: str) -> tuple[str, str | None]:
+    """The number and the unit (None if there is none) of a quantity token, as written."""
+    match = _QUANTITY.fullmatch(text.strip())
+    assert match is not None, text  # the grammar only lets such tokens through
+    return match.group(1), match.group(2)
+
+
+def quantity_text(text: str) -> str:
+    """A quantity token as the formatter writes it: as written, one space before its unit."""
+    number, unit = quantity_parts(text)
+    return f"{number} {unit}" if unit else number
+
+
+def read_length(text: str) -> float:
+    """A ``Length`` token (``150 cm``, ``-0.5``) in metres."""
+    number, unit = quantity_parts(text)
+    return float(number) * _LENGTH_SCALE[unit]
+
+
+def read_angle(text: str) -> float:
+    """An ``Angle`` token (``90 deg``, ``1.57``) in radians."""
+    number, unit = quantity_parts(text)
+    return math.radians(float(number)) if unit == "deg" else float(number)
+
+
+def as_written(
+    values: Sequence[float], written: Sequence[str], read: Callable[[str], float]
+) -> list[str] | None:
+    """The texts the author wrote for ``values`` (from the model), when they still read as
+    those values; None when the model was made otherwise, or changed since it was read."""
+    if len(written) != len(values) or not written:
+        return None
+    if any(read(text) != value for value, text in zip(values, written, strict=True)):
+        return None
+    return [quantity_text(text) for text in written]

@@ -9,10 +9,13 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from exsce_dsl.errors import Diagnostic, ExsceError, ExsceSyntaxError
+from exsce_dsl.lang.chunks import imported_paths
 from exsce_dsl.lang.parser import ParsedFile, parse_text
+from exsce_dsl.suggest import closest
 from exsce_dsl.textfiles import read_text
 
 Parse = Callable[[str, str], tuple[ParsedFile | None, Sequence[Diagnostic]]]
@@ -43,6 +46,17 @@ def import_target(importer: str, import_path: str) -> str:
     return display_path(os.path.join(os.path.dirname(importer), import_path))
 
 
+@dataclass
+class Sources:
+    """What :func:`read_sources` read: the files that parse (the root first), the problems
+    found reading them, and the text of each file that has a syntax error."""
+
+    files: list[ParsedFile] = field(default_factory=list)
+    diagnostics: list[Diagnostic] = field(default_factory=list)
+    broken: dict[str, str] = field(default_factory=dict)
+    """Path -> text of the files with syntax errors (their trees, if any, lack something)."""
+
+
 def load_files(
     root: str | Path, overlay: Mapping[str, str] | None = None, parse: Parse = parse_whole
 ) -> tuple[list[ParsedFile], list[Diagnostic]]:
@@ -51,9 +65,21 @@ def load_files(
     ``parse`` may keep what a syntax error leaves intact (the language server's
     :class:`~exsce_dsl.lang.incremental.ParseCache` does, declaration by declaration).
     """
+    sources = read_sources(root, overlay, parse)
+    return sources.files, sources.diagnostics
+
+
+def read_sources(
+    root: str | Path, overlay: Mapping[str, str] | None = None, parse: Parse = parse_whole
+) -> Sources:
+    """:func:`load_files`, also telling which files have syntax errors.
+
+    The imports of a file that does not parse at all are read from its words, so that
+    what they declare is still known.
+    """
     overlay = {display_path(k): v for k, v in (overlay or {}).items()}
-    parsed: list[ParsedFile] = []
-    diagnostics: list[Diagnostic] = []
+    sources = Sources()
+    parsed, diagnostics = sources.files, sources.diagnostics
     seen: set[str] = set()
     pending = [display_path(root)]
     while pending:
@@ -66,12 +92,18 @@ def load_files(
             try:
                 text = read_text(path, "specification")
             except ExsceError as exc:
-                if not parsed or exc.location is not None:  # imports are reported where they are written
-                    diagnostics.extend(exc.diagnostics)
+                if not parsed and not sources.broken or exc.location is not None:
+                    diagnostics.extend(exc.diagnostics)  # imports are reported where they are written
                 continue
         pf, problems = parse(text, path)
         diagnostics.extend(problems)
+        if problems:
+            sources.broken[path] = text
         if pf is None:
+            for imported in imported_paths(text):
+                target = import_target(path, imported)
+                if target in overlay or Path(target).is_file():
+                    pending.append(target)
             continue
         parsed.append(pf)
         for imp in pf.tree.imports:
@@ -79,11 +111,27 @@ def load_files(
             if target not in overlay and not Path(target).is_file():
                 diagnostics.append(
                     Diagnostic(
-                        f"imported file '{imp.path}' not found (looked for {target})",
+                        f"imported file '{imp.path}' not found (looked for {target})"
+                        f"{_closest_file(imp.path, target)}",
                         pf.span(imp),
                         code="import",
                     )
                 )
                 continue
             pending.append(target)
-    return parsed, diagnostics
+    return sources
+
+
+def _closest_file(written: str, target: str) -> str:
+    """``; did you mean 'tasks.exsce'?``: the ``.exsce`` file of the target's folder most like
+    the one not found, written as the import wrote its path."""
+    folder = Path(target).parent
+    try:
+        names = [p.name for p in folder.iterdir() if p.suffix == ".exsce" and p.is_file()]
+    except OSError:
+        return ""
+    match = closest(Path(written).name, names)
+    if match is None:
+        return ""
+    head, _, _ = written.rpartition("/")
+    return f"; did you mean '{head + '/' if head else ''}{match}'?"

@@ -47,8 +47,11 @@ Baseline = Mapping[tuple[str, str | None], tuple[float, float]]
 
 _LIMIT, _VALUE, _CHANGE = ("limit",), ("value", "tolerance"), ("value", "delta", "tolerance")
 _NUMBERS = {
-    Relation.BELOW_MAX: _LIMIT, Relation.ABOVE_MIN: _LIMIT, Relation.INVARIANT: _VALUE,
-    Relation.INCREASING: _CHANGE, Relation.DECREASING: _CHANGE,
+    Relation.BELOW_MAX: _LIMIT,
+    Relation.ABOVE_MIN: _LIMIT,
+    Relation.INVARIANT: _VALUE,
+    Relation.INCREASING: _CHANGE,
+    Relation.DECREASING: _CHANGE,
 }
 """The numbers each relation takes, in the order they are written; the first is required."""
 
@@ -116,8 +119,10 @@ class _OracleReader:
         try:
             id_node = root.get("id")
             if (file_id := id_node.ident("scenario")) != self.scenario.id:
-                self.report(f"these are oracles of scenario '{file_id}', not of '{self.scenario.id}'",
-                            id_node.location)
+                self.report(
+                    f"these are oracles of scenario '{file_id}', not of '{self.scenario.id}'",
+                    id_node.location,
+                )
             for key, section in root.items_of_mapping():
                 if key in SECTIONS:
                     criterion = self.section(section, {c.title for c in criteria})
@@ -148,14 +153,20 @@ class _OracleReader:
             elif key == "robots":
                 for robot, metrics in _entries(part):
                     if robot not in fleet:
-                        self.report(f"robot '{robot}' is not in the fleet of scenario '{self.scenario.id}'"
-                                    f"{did_you_mean(robot, fleet)}", _key_location(part, robot))
+                        self.report(
+                            f"robot '{robot}' is not in the fleet of scenario '{self.scenario.id}'"
+                            f"{did_you_mean(robot, fleet)}",
+                            _key_location(part, robot),
+                        )
                         continue
-                    expectations += [self.entry(metrics, metric, robot, against) for metric, _ in
-                                     _entries(metrics)]
+                    expectations += [
+                        self.entry(metrics, metric, robot, against) for metric, _ in _entries(metrics)
+                    ]
             elif key != "base_scenario":
-                self.report(f"unknown key '{key}' in {node.where}{did_you_mean(key, ('mission', 'robots'))}",
-                            _key_location(node, key))
+                self.report(
+                    f"unknown key '{key}' in {node.where}{did_you_mean(key, ('mission', 'robots'))}",
+                    _key_location(node, key),
+                )
         found = tuple(e for e in expectations if e is not None)
         if not expectations:
             self.report(f"{node.where} has no metrics under 'mission' or 'robots'", node.location)
@@ -184,15 +195,27 @@ class _OracleReader:
             return None
         subject = Subject(Quantifier.MISSION) if robot is None else Subject(Quantifier.ROBOT, robot)
         q = quantities.get
-        return Expectation(subject, metric, relation, limit=q("limit"), value=q("value"), delta=q("delta"),
-                           tolerance=q("tolerance"), against=against, location=node.location)
+        return Expectation(
+            subject,
+            metric,
+            relation,
+            limit=q("limit"),
+            value=q("value"),
+            delta=q("delta"),
+            tolerance=q("tolerance"),
+            against=against,
+            location=node.location,
+        )
 
     def metric(self, parent: YamlNode, metric: str, robot: str | None) -> MetricInfo | None:
         info = metric_info(metric, self.scenario)
         where = _key_location(parent, metric)
         if info is None:
-            hint = (f"; '{metric}' is a robot: put it under 'robots'" if self.scenario.robot(metric)
-                    else did_you_mean(metric, known_metrics(self.scenario)))
+            hint = (
+                f"; '{metric}' is a robot: put it under 'robots'"
+                if self.scenario.robot(metric)
+                else did_you_mean(metric, known_metrics(self.scenario))
+            )
             self.report(f"unknown metric '{metric}'{hint}", where)
         elif robot is None and info.per_robot and not info.also_mission:
             self.report(f"'{metric}' is measured per robot: put it under 'robots: <robot>:'", where)
@@ -228,25 +251,33 @@ class _OracleReader:
         texts = [item.text() for item in items]
         differ = [(item, text) for item, text in zip(items, texts, strict=True) if text not in expected]
         for item, text in differ:
-            self.report(f"topic '{text}' is not one exsce computes {metric} of {whose} from "
-                        f"({', '.join(expected)}); the DSL cannot override a metric's topics yet",
-                        item.location)
+            self.report(
+                f"topic '{text}' is not one exsce computes {metric} of {whose} from "
+                f"({', '.join(expected)}); the DSL cannot override a metric's topics yet",
+                item.location,
+            )
         missing = [t for t in expected if t not in texts]
         if missing and not differ:
-            self.report(f"the topics of {metric} of {whose} lack {', '.join(missing)}; exsce computes it "
-                        f"from {', '.join(expected)}, and the DSL cannot override a metric's topics yet",
-                        node.location)
+            self.report(
+                f"the topics of {metric} of {whose} lack {', '.join(missing)}; exsce computes it "
+                f"from {', '.join(expected)}, and the DSL cannot override a metric's topics yet",
+                node.location,
+            )
 
     def numbers(self, node: YamlNode, relation: Relation, info: MetricInfo) -> dict[str, Quantity] | None:
         """The relation's numbers as quantities in the metric's SI unit, by field name."""
         keys = _NUMBERS[relation]
         for key, _ in node.items_of_mapping():
             if key not in keys:
-                self.report(f"'{key}' does not go with '{relation.value}', which takes "
-                            f"{' and '.join(keys)}", _key_location(node, key))
+                self.report(
+                    f"'{key}' does not go with '{relation.value}', which takes {' and '.join(keys)}",
+                    _key_location(node, key),
+                )
         if node.opt(keys[0]) is None:
-            self.report(f"'{relation.value}' needs a {keys[0]}: add '{keys[0]}: <number>' to {node.where}",
-                        node.location)
+            self.report(
+                f"'{relation.value}' needs a {keys[0]}: add '{keys[0]}: <number>' to {node.where}",
+                node.location,
+            )
             return None
         quantities = {}
         for key in keys:
@@ -326,8 +357,10 @@ def oracles_to_yaml(
     metric and robot in a section.
     """
     if acceptance.scenario != scenario.id or not is_valid_name(scenario.id):
-        raise ExportError(f"the acceptance criteria of '{acceptance.scenario}' are not those of scenario "
-                          f"'{scenario.id}'", acceptance.location)
+        raise ExportError(
+            f"the acceptance criteria of '{acceptance.scenario}' are not those of scenario '{scenario.id}'",
+            acceptance.location,
+        )
     fleet = [r.id for r in scenario.robots]
     sections: dict[str, tuple[str, dict[str, Any], dict[str, dict[str, Any]]]] = {}
     written: dict[tuple[str, str, str | None], Expectation] = {}
@@ -338,15 +371,20 @@ def oracles_to_yaml(
             base = e.against or scenario.id
             _, mission, robots = sections.setdefault(key, (base, {}, {r: {} for r in fleet}))
             if sections[key][0] != base:
-                raise ExportError(f"'{expectation_text(e)}' compares with '{base}', but the method's oracle "
-                                  f"file has one metamorphic section (for '{sections[key][0]}' here)",
-                                  e.location)
+                raise ExportError(
+                    f"'{expectation_text(e)}' compares with '{base}', but the method's oracle "
+                    f"file has one metamorphic section (for '{sections[key][0]}' here)",
+                    e.location,
+                )
             for robot in fleet if e.subject.quantifier is Quantifier.EACH_ROBOT else [e.subject.robot]:
                 first = written.setdefault((key, e.metric, robot), e)
                 if first is not e:
-                    raise ExportError(f"'{expectation_text(e)}' and '{expectation_text(first)}' are both "
-                                      f"about {e.metric} of {robot or 'the mission'}; the method's oracle "
-                                      "file holds one oracle per metric and robot", e.location)
+                    raise ExportError(
+                        f"'{expectation_text(e)}' and '{expectation_text(first)}' are both "
+                        f"about {e.metric} of {robot or 'the mission'}; the method's oracle "
+                        "file holds one oracle per metric and robot",
+                        e.location,
+                    )
                 entry = _entry(e, robot, scenario, baseline)
                 (mission if robot is None else robots[robot])[e.metric] = entry
     data: dict[str, Any] = {"id": scenario.id}
@@ -368,8 +406,11 @@ def _check_whole_run(e: Expectation, criterion: Criterion, scenario: Scenario) -
     if window is None and when is not None and when.robot is not None and per_segment:
         window = f"during {when.task}, as 'when {when.text()}' says"
     if window is not None:
-        raise ExportError(f"'{expectation_text(e)}' looks at part of a run ({window}); the method's oracle "
-                          "files judge whole runs only", e.location)
+        raise ExportError(
+            f"'{expectation_text(e)}' looks at part of a run ({window}); the method's oracle "
+            "files judge whole runs only",
+            e.location,
+        )
 
 
 def _entry(
@@ -395,10 +436,16 @@ def _numbers(e: Expectation, robot: str | None, stats: tuple[float, float] | Non
     whose = f"{e.metric} of {robot or 'the mission'}"
     t = e.tolerance
     if stats is None and (e.value is None or (t is not None and t.unit == "std")):
-        needs, fix = (("the mean", "a value ('around <value>' or 'from <value>')") if e.value is None
-                      else ("the standard deviation", "a tolerance in the metric's unit"))
-        raise ExportError(f"'{expectation_text(e)}' needs {needs} of stored runs of {whose}, and no baseline "
-                          f"was given: write {fix}, or build the baseline first", e.location)
+        needs, fix = (
+            ("the mean", "a value ('around <value>' or 'from <value>')")
+            if e.value is None
+            else ("the standard deviation", "a tolerance in the metric's unit")
+        )
+        raise ExportError(
+            f"'{expectation_text(e)}' needs {needs} of stored runs of {whose}, and no baseline "
+            f"was given: write {fix}, or build the baseline first",
+            e.location,
+        )
     mean, std = stats or (0.0, 0.0)
     numbers = {"value": e.value.value if e.value is not None else mean}
     if e.delta is not None:

@@ -14,8 +14,12 @@ from typing import Any
 from textx import TextXSyntaxError, metamodel_from_file
 
 from exsce_dsl.errors import Diagnostic, ExsceSyntaxError, SourceLocation
+from exsce_dsl.lang.chunks import area_spans, declaration_chunks
 from exsce_dsl.lang.locations import LineIndex
+from exsce_dsl.model.metrics import UNITS
+from exsce_dsl.model.names import KEYWORDS
 from exsce_dsl.resources import grammar_file
+from exsce_dsl.suggest import closest, did_you_mean
 
 # How rules of the grammar are named in messages.
 _RULE_WORDS = {
@@ -30,6 +34,8 @@ _RULE_WORDS = {
     "Length": "a length (a number, in m unless followed by cm or mm)",
     "Angle": "an angle (a number, in rad unless followed by deg)",
 }
+# Environments this long (characters) are parsed an area at a time to try a correction.
+_LONG_PIECE = 4000
 
 
 def new_metamodel() -> Any:
@@ -81,12 +87,170 @@ def _syntax_diagnostic(exc: TextXSyntaxError, text: str, path: str) -> Diagnosti
 
 def syntax_diagnostic_at(line: int, col: int, rules: list[Any], text: str, path: str) -> Diagnostic:
     """The diagnostic of a syntax error at ``line``:``col`` of ``text``, where the grammar
-    expected ``rules`` (those of a textX syntax error)."""
-    expected = _expected_words(rules)
+    expected ``rules`` (those of a textX syntax error).
+
+    Two mistakes are told in their own words: a unit the language does not know
+    (``facing 180 degs``: the number parses without it, and the word after it does
+    not), and a misspelt keyword, either where the error is (``mision``) or just
+    before it, read as a name (``r1: turtle start at p``).
+    """
+    lines = LineIndex(path, text)
+    at = min(len(text), lines.offset(line, col))
     found = _token_at(text, line, col)
+    better = _unknown_unit(text, at, lines) or _misspelt_keyword(text, at, rules, lines)
+    if better is not None:
+        return better
+    expected = _expected_words(rules)
     message = f"expected {expected}, found {found}" if expected else f"syntax error near {found}"
     end_col = col + max(1, len(found) - 2 if found.startswith("'") else 1)
     return Diagnostic(message, SourceLocation(path, line, col, line, end_col), code="syntax")
+
+
+# --------------------------------------------------------------- unknown units
+@dataclass(frozen=True)
+class _UnitFamily:
+    """The units one kind of quantity token takes.  ``probe`` is one of them that no kind
+    tried after it takes: the first probe that parses in place of an unknown unit tells
+    which kind of quantity the grammar wanted there."""
+
+    probe: str
+    units: tuple[str, ...]
+
+
+_METRIC_UNITS = tuple(UNITS)
+# Tried in this order: each probe fits its own family and the ones before it only.
+_UNIT_FAMILIES = (
+    _UnitFamily("std", (*_METRIC_UNITS, "std", "%")),  # acceptance criteria: 1 std, 5 %
+    _UnitFamily("m/s", _METRIC_UNITS),  # metrics
+    _UnitFamily("m", ("m", "cm", "mm")),  # lengths: positions, sizes, tolerances
+    _UnitFamily("deg", ("deg", "rad")),  # angles: headings
+)
+# Units as people write them in words.
+_UNIT_WORDS = {
+    **dict.fromkeys(("meter", "meters", "metre", "metres", "mtr", "mt"), "m"),
+    **dict.fromkeys(("centimeter", "centimeters", "centimetre", "centimetres"), "cm"),
+    **dict.fromkeys(("millimeter", "millimeters", "millimetre", "millimetres"), "mm"),
+    **dict.fromkeys(("degree", "degrees", "degs", "grad"), "deg"),
+    **dict.fromkeys(("radian", "radians", "rads"), "rad"),
+    **dict.fromkeys(("sec", "secs", "second", "seconds"), "s"),
+    **dict.fromkeys(("minute", "minutes", "mins"), "min"),
+    **dict.fromkeys(("mps",), "m/s"),
+}
+_NUMBER_BEFORE = re.compile(r"(?<![\w.])[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?[ \t]*\Z")
+_UNIT_WORD = re.compile(r"[A-Za-z_%°][\w/%°]*")
+
+
+def _unknown_unit(text: str, at: int, lines: LineIndex) -> Diagnostic | None:
+    """``unknown unit 'degs'; expected deg or rad; did you mean 'deg'?`` when the error is at
+    a word right after a number, and a known unit there would have parsed."""
+    word = _UNIT_WORD.match(text, at)
+    if word is None or not _NUMBER_BEFORE.search(text, max(0, at - 40), at):
+        return None
+    written = word.group()
+    for family in _UNIT_FAMILIES:
+        if _parses_further(text, at, word.end(), family.probe, at):
+            units = family.units
+            listed = ", ".join(units[:-1]) + " or " + units[-1]
+            if written in _UNIT_FAMILIES[0].units:  # a unit, of another kind of quantity
+                message = f"unit '{written}' does not fit here; expected {listed}"
+            else:
+                guess = _UNIT_WORDS.get(written.lower())
+                hint = f"; did you mean '{guess}'?" if guess in units else did_you_mean(written, units)
+                message = f"unknown unit '{written}'; expected {listed}{hint}"
+            return Diagnostic(message, lines.span(at, word.end()), code="syntax")
+    return None
+
+
+# ------------------------------------------------------------ misspelt keywords
+_WORD_AT = re.compile(r"[A-Za-z_][\w-]*")
+_WORD_BEFORE = re.compile(r"(?<![\w-])([A-Za-z_][\w-]*)[ \t\r\n]*\Z")
+
+
+def _misspelt_keyword(text: str, at: int, rules: list[Any], lines: LineIndex) -> Diagnostic | None:
+    """A did-you-mean for a keyword written wrong: the word at the error, when it is close to a
+    keyword the grammar expected there; else the word before it, when it was read as a name
+    and a keyword close to it would have parsed further."""
+    word = _WORD_AT.match(text, at)
+    wanted = [w for w in (_keyword_of(r) for r in rules) if w is not None]
+    if word is not None and word.group() not in KEYWORDS:
+        match = closest(word.group(), wanted)
+        if match is not None:
+            message = f"expected {_expected_words(rules)}, found '{word.group()}'; did you mean '{match}'?"
+            return Diagnostic(message, lines.span(at, word.end()), code="syntax")
+    before = _WORD_BEFORE.search(text, max(0, at - 200), at)
+    if before is None or before.group(1) in KEYWORDS:  # a reserved word is never read as a name
+        return None
+    written, start, end = before.group(1), before.start(1), before.end(1)
+    for keyword in _close_keywords(written):
+        if _parses_further(text, start, end, keyword, at):
+            message = f"expected '{keyword}', found '{written}'; did you mean '{keyword}'?"
+            return Diagnostic(message, lines.span(start, end), code="syntax")
+    return None
+
+
+def _keyword_of(rule: Any) -> str | None:
+    literal = getattr(rule, "to_match", None)
+    name = getattr(rule, "rule_name", "") or ""
+    if isinstance(literal, str) and not name and _KEYWORD.fullmatch(literal):
+        return literal
+    return None
+
+
+def _close_keywords(word: str, most: int = 3) -> list[str]:
+    """Up to ``most`` keywords most like ``word``, the closest first."""
+    candidates = set(grammar_keywords()) - {word}
+    found: list[str] = []
+    while len(found) < most and (match := closest(word, candidates)) is not None:
+        found.append(match)
+        candidates.discard(match)
+    return found
+
+
+@functools.lru_cache(maxsize=1)
+def grammar_keywords() -> frozenset[str]:
+    """Every keyword of the grammar (``starts``, ``visit``, ``nav2``...)."""
+    found: set[str] = set()
+    seen: set[int] = set()
+    stack = [_shared_metamodel()._parser_blueprint.parser_model]
+    while stack:
+        node = stack.pop()
+        if id(node) in seen:
+            continue
+        seen.add(id(node))
+        keyword = _keyword_of(node)
+        if keyword is not None:
+            found.add(keyword)
+        stack.extend(getattr(node, "nodes", ()))
+    return frozenset(found)
+
+
+def _parses_further(text: str, start: int, end: int, replacement: str, error_at: int) -> bool:
+    """Whether ``text`` with ``text[start:end]`` replaced parses past ``error_at``, where its
+    syntax error is (the start of the replaced text, or after its end), and past the replacement.
+
+    Only the declaration around the change is parsed, up to the end of the error's line
+    (of a long environment, only the area it is in): it is enough to see the parse go on.
+    """
+    chunk = next((c for c in reversed(declaration_chunks(text)) if c.start <= start), None)
+    head, begin = "", chunk.start if chunk is not None else 0
+    if chunk is not None and chunk.keyword == "environment" and chunk.end - chunk.start > _LONG_PIECE:
+        area = next(((a, b) for a, b in area_spans(text, chunk) if a <= start and error_at < b), None)
+        if area is not None:
+            head, begin = "environment _ {\n", area[0]
+    line_end = text.find("\n", error_at)
+    line_end = len(text) if line_end < 0 else line_end
+    piece = head + text[begin:start] + replacement + text[end:line_end]
+    # where the original error is in the piece (the text after the change moved with it):
+    # the parse must get past it, and past the whole replacement
+    shift = len(replacement) - (end - start) if error_at >= end else 0
+    original = len(head) + error_at - begin + shift
+    replaced_end = len(head) + start - begin + len(replacement)
+    try:
+        _shared_metamodel().model_from_str(piece)
+    except TextXSyntaxError as exc:
+        reached = LineIndex("", piece).offset(exc.line or 1, exc.col or 1)
+        return reached > original and reached >= replaced_end
+    return True
 
 
 _KEYWORD = re.compile(r"[A-Za-z_][\w-]*")

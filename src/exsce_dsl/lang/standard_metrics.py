@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import functools
 
-from exsce_dsl.errors import Diagnostic, SourceLocation, SpecError
+from exsce_dsl.errors import Diagnostic, Severity, SourceLocation, SpecError
 from exsce_dsl.lang.build_metrics import build_metric
 from exsce_dsl.lang.parser import parse_text
 from exsce_dsl.messages.catalogue import standard_catalogue
@@ -24,7 +24,7 @@ def standard_metrics() -> tuple[MetricDefinition, ...]:
     pf = parse_text(source.read_text(encoding="utf-8"), str(source))
     problems: list[Diagnostic] = []
 
-    def report(message: str, at: SourceLocation | None, severity: str = "error") -> None:
+    def report(message: str, at: SourceLocation | None, severity: Severity = Severity.ERROR) -> None:
         problems.append(Diagnostic(message, at, severity))
 
     types = standard_catalogue()  # the method's types only, whatever the user defines

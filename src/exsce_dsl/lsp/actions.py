@@ -2,8 +2,8 @@
 
 The suggestion is read from the diagnostic's hint, or from its message
 (``unknown pose 'c025-w01'; did you mean 'classroom_c025-w001'?``); the unknown
-name (the message's first quoted word) is replaced where it is written inside
-the diagnostic's range.
+name (the word a syntax error found, else the message's first quoted word) is
+replaced where it is written inside the diagnostic's range.
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ from exsce_dsl.lsp.convert import TextLines
 
 _SUGGESTION = re.compile(r"did you mean '([^']+)'\?")
 _QUOTED = re.compile(r"'([^']+)'")
+_FOUND = re.compile(r"found '([^']+)'")  # a syntax error's word: `expected 'starts', found 'start'`
 
 
 def suggestion(diagnostic: types.Diagnostic) -> str | None:
@@ -33,7 +34,7 @@ def quick_fixes(uri: str, lines: TextLines, diagnostics: list[types.Diagnostic])
     actions = []
     for diagnostic in diagnostics:
         better = suggestion(diagnostic)
-        written = _QUOTED.search(diagnostic.message)
+        written = _FOUND.search(diagnostic.message) or _QUOTED.search(diagnostic.message)
         if better is None or written is None:
             continue
         where = _find(lines, diagnostic.range, written.group(1))

@@ -15,13 +15,14 @@ import re
 from lsprotocol import types
 from pygls.uris import from_fs_path, to_fs_path
 
-from exsce_dsl.errors import Diagnostic, SourceLocation
+from exsce_dsl.errors import Diagnostic, Severity, SourceLocation
 
 _SEVERITY = {
-    "error": types.DiagnosticSeverity.Error,
-    "warning": types.DiagnosticSeverity.Warning,
-    "info": types.DiagnosticSeverity.Information,
-    "hint": types.DiagnosticSeverity.Hint,
+    Severity.ERROR: types.DiagnosticSeverity.Error,
+    Severity.WARNING: types.DiagnosticSeverity.Warning,
+    Severity.NOTE: types.DiagnosticSeverity.Information,
+    Severity.INFO: types.DiagnosticSeverity.Information,
+    Severity.HINT: types.DiagnosticSeverity.Hint,
 }
 _NAME_AT = re.compile(r"[A-Za-z_][\w-]*")
 
@@ -125,7 +126,7 @@ def lsp_diagnostic(diagnostic: Diagnostic, lines: TextLines) -> types.Diagnostic
     return types.Diagnostic(
         range=where,
         message=diagnostic.message,
-        severity=_SEVERITY.get(diagnostic.severity, types.DiagnosticSeverity.Error),
+        severity=_SEVERITY[diagnostic.severity],
         code=diagnostic.code,
         source="exsce",
         data={"hint": diagnostic.hint} if diagnostic.hint else None,

@@ -136,7 +136,7 @@ def _editing(server: ExsceLanguageServer) -> None:
         if analysis is None or analysis.versions.get(path) != document.version:
             raise failed("the document is not analysed yet; try again")
         if analysis.spec is None:
-            errors = sum(d.severity == "error" for ds in analysis.diagnostics.values() for d in ds)
+            errors = sum(d.is_error for ds in analysis.diagnostics.values() for d in ds)
             raise failed(f"cannot format: the specification has {errors} error{'s' if errors != 1 else ''}")
         shown = display_path(path)
         text = document.source

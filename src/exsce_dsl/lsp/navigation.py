@@ -13,6 +13,7 @@ import os
 from collections.abc import Collection, Sequence
 from dataclasses import dataclass
 
+from exsce_dsl.errors import RenameError as RenameError
 from exsce_dsl.errors import SourceLocation
 from exsce_dsl.lang.symbols import SCOPED_KINDS, FileIndex, Reference, Symbol
 from exsce_dsl.model.names import is_valid_name
@@ -24,10 +25,6 @@ RENAMEABLE = frozenset(
     {"robot type", "environment", "area", "pose", "obstacle", "map", "world", "task", "scenario", "robot"}
     | {"mission", "metric"}
 )
-
-
-class RenameError(ValueError):
-    """A rename that cannot be done, and why."""
 
 
 @dataclass(frozen=True)

@@ -25,7 +25,7 @@ from typing import TypeVar
 import anyio
 import anyio.to_thread
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import TimeLimitError as TimeLimitError
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.server import QUERY_TIMEOUT
 
@@ -39,10 +39,6 @@ WORKERS = 2
 """Requests worked on at the same time."""
 MAX_WORKING = 4
 """Threads at work, those given up on included, beyond which requests are refused."""
-
-
-class TimeLimitError(ExsceError):
-    """A request ran over the server's time limit."""
 
 
 @dataclass

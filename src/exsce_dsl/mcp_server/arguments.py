@@ -20,7 +20,7 @@ import re
 from collections.abc import Mapping
 from typing import Any
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import ArgumentError as ArgumentError
 from exsce_dsl.model.names import NAME_PATTERN
 
 __all__ = [
@@ -50,10 +50,6 @@ _FORMS = {
     POSE_NAME: "a pose name with its heading (e.g. classroom_c025-w001-R0.00_P0.00_Y0.00)",
     RUN_UUID: "a run uuid",
 }
-
-
-class ArgumentError(ExsceError):
-    """A tool was called with arguments its input schema does not allow."""
 
 
 def identifier(pattern: str, description: str) -> dict[str, Any]:

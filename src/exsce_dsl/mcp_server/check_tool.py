@@ -23,7 +23,7 @@ from typing import Any
 
 import mcp_types as types
 
-from exsce_dsl.errors import Diagnostic
+from exsce_dsl.errors import Diagnostic, Severity
 from exsce_dsl.mcp_server.access import Access
 from exsce_dsl.mcp_server.answers import READ_ONLY, ToolEntry
 from exsce_dsl.mcp_server.arguments import ArgumentError, object_schema
@@ -65,11 +65,11 @@ def _check(text: str, base: Path, name: str) -> dict[str, Any]:
         diagnostics = list(analysis.diagnostics)
         if not analysis.errors and analysis.spec is not None:
             diagnostics.extend(check_spec_shapes(analysis.spec))
-    errors = sum(d.severity == "error" for d in diagnostics)
+    errors = sum(d.is_error for d in diagnostics)
     answer: dict[str, Any] = {
         "ok": errors == 0 and analysis.spec is not None,
         "errors": errors,
-        "warnings": sum(d.severity == "warning" for d in diagnostics),
+        "warnings": sum(d.severity is Severity.WARNING for d in diagnostics),
         "diagnostics": [_diagnostic_json(d, base) for d in diagnostics],
     }
     if analysis.spec is not None:

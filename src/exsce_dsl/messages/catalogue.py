@@ -16,7 +16,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import MessageTypeError as MessageTypeError
 from exsce_dsl.messages.typestore_cache import standard_fielddefs
 from exsce_dsl.model.messages import Fields, Leaf, MessageArray, Node, canonical_type
 
@@ -42,10 +42,6 @@ NUMERIC = {
     "float64": "f8",
 }
 """ROS primitive type → numpy type code (without byte order)."""
-
-
-class MessageTypeError(ExsceError):
-    """A message type that is unknown, or whose definition cannot be used."""
 
 
 @dataclass(frozen=True)

@@ -97,6 +97,8 @@ class Tolerance:
 
     position: float = 0.35
     heading: float | None = None
+    written: tuple[str, ...] = field(default=(), compare=False, repr=False)
+    """The position (and heading) as the author wrote them (``30 cm``, ``10 deg``), for the formatter."""
 
 
 @dataclass(frozen=True)

@@ -17,6 +17,9 @@ class Step:
     transformation: str
     arguments: tuple[tuple[str, str], ...]
     location: SourceLocation | None = field(default=None, compare=False, repr=False)
+    written: tuple[tuple[str, str], ...] = field(default=(), compare=False, repr=False)
+    """Arguments as the author wrote them where the text differs (a position with its units:
+    ``to`` is ``3 m, 200 cm`` where the argument is ``3.0,2.0``), for the formatter."""
 
     def argument(self, key: str) -> str | None:
         return dict(self.arguments).get(key)

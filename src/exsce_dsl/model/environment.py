@@ -52,6 +52,8 @@ class Obstacle:
     model: str | None = None
     size: tuple[float, ...] | None = None
     location: SourceLocation | None = field(default=None, compare=False, repr=False)
+    size_written: tuple[str, ...] = field(default=(), compare=False, repr=False)
+    """The size as the author wrote it (``50 cm``), for the formatter."""
 
 
 @dataclass(frozen=True)

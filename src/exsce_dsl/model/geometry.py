@@ -15,6 +15,9 @@ class Position:
     z: float = 0.0
     unit: str = field(default="m", compare=False)
     """How the author wrote it (m, cm, mm); only the formatter looks at it."""
+    written: tuple[str, ...] = field(default=(), compare=False, repr=False)
+    """x, y (and z if given) as the author wrote them, units included (``200 cm``, ``7``): the
+    formatter prints them as long as they read as these values."""
 
     def distance_to(self, other: Position) -> float:
         return math.dist((self.x, self.y, self.z), (other.x, other.y, other.z))
@@ -27,6 +30,9 @@ class Orientation:
     yaw: float = 0.0
     unit: str = field(default="rad", compare=False)
     """How the author wrote it (rad, deg); only the formatter looks at it."""
+    written: tuple[str, ...] = field(default=(), compare=False, repr=False)
+    """The yaw (``facing``), or roll, pitch and yaw (``rpy``), as the author wrote them
+    (``90 deg``, ``1.5 rad``, ``0.3``): the formatter prints them as long as they read as these values."""
 
     @property
     def is_planar(self) -> bool:

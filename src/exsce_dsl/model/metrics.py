@@ -85,9 +85,7 @@ METRICS: dict[str, MetricInfo] = {
         MetricInfo("task_duration", Dimension.TIME, True, Combine.SUM, meaning="time to complete its tasks"),
         MetricInfo("waypoints_visited", Dimension.COUNT, True, meaning="goals that succeeded"),
         MetricInfo("distance_travelled", Dimension.LENGTH, True, Combine.SUM, meaning="metres travelled"),
-        MetricInfo(
-            "distance_to_obstacles", Dimension.LENGTH, True, Combine.MIN, meaning="least laser range"
-        ),
+        MetricInfo("distance_to_obstacles", Dimension.LENGTH, True, Combine.MIN, meaning="least laser range"),
         MetricInfo("max_velocity", Dimension.SPEED, True, Combine.MAX, meaning="largest linear speed"),
         MetricInfo(
             "distance_between_robots", Dimension.LENGTH, False, meaning="least distance between two robots"
@@ -181,6 +179,8 @@ class SafetyLimit:
     bound: str
     limit: float
     """In the metric's SI unit."""
+    written: str = field(default="", compare=False, repr=False)
+    """The limit as the author wrote it (``50 cm/s``), for the formatter."""
 
 
 @dataclass(frozen=True)

@@ -22,7 +22,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from importlib.metadata import entry_points
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import RelationError as RelationError
 from exsce_dsl.suggest import did_you_mean
 
 __all__ = [
@@ -38,10 +38,6 @@ __all__ = [
 ]
 
 ENTRY_POINT_GROUP = "exsce.relations"
-
-
-class RelationError(ExsceError):
-    """A relation that does not exist, or was given the wrong parameters."""
 
 
 @dataclass(frozen=True)

@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 
 from pyoxigraph import Quad
 
-from exsce_dsl.errors import Diagnostic, ExsceError, SourceLocation
+from exsce_dsl.errors import Diagnostic, ExsceError, Severity, SourceLocation
 from exsce_dsl.model.document import Specification
 from exsce_dsl.model.scenario import Scenario
 from exsce_dsl.prov import compile_scenario, source_locations
@@ -234,7 +234,7 @@ def violation_diagnostics(
         where = next((locations[c] for c in candidates if c is not None and c in locations), fallback)
         subject = curie(v.focus) + (f" {curie(v.path)}" if v.path else "")
         value = f"; value {curie(v.value)}" if v.value is not None and v.value != v.focus else ""
-        severity = "error" if v.severity == "Violation" else "warning"
+        severity = Severity.ERROR if v.severity == "Violation" else Severity.WARNING
         message = f"{subject}: {v.message} (SHACL shape {curie(v.shape)}{value})"
         found.append(Diagnostic(message, where, severity=severity, code="shacl"))
     return found
@@ -249,7 +249,7 @@ class _Shortener:
             return spelt
         for prefix, iri in self._by_length:
             if spelt.startswith(iri) and len(spelt) > len(iri):
-                return f"{prefix}:{spelt[len(iri):]}"
+                return f"{prefix}:{spelt[len(iri) :]}"
         return f"<{spelt}>"
 
 

@@ -29,7 +29,7 @@ class SpecCheck:
 
     @property
     def errors(self) -> tuple[Diagnostic, ...]:
-        return tuple(d for d in self.diagnostics if d.severity == "error")
+        return tuple(d for d in self.diagnostics if d.is_error)
 
     @property
     def ok(self) -> bool:
@@ -47,5 +47,5 @@ def check_spec(
     if not analysis.errors and spec is not None:
         diagnostics.extend(check_spec_shapes(spec, namespace))
     found = tuple(diagnostics)
-    has_errors = any(d.severity == "error" for d in found)
+    has_errors = any(d.is_error for d in found)
     return SpecCheck(Path(path), found, None if has_errors else spec)

@@ -22,7 +22,7 @@ import numpy as np
 from rosbags.highlevel import AnyReader
 from rosbags.typesys import Stores, get_typestore
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import BagError as BagError
 from exsce_dsl.messages.catalogue import (
     MessageCatalogue,
     MessageTypeError,
@@ -46,10 +46,6 @@ OBJECTS = "**"
 """The expected type of topics kept as message objects (a navigation stack's goals and statuses:
 few messages, read by attribute): whatever the bag says, in :attr:`BagData.messages`."""
 WHOLE = (ANY, OBJECTS)
-
-
-class BagError(ExsceError):
-    """A bag that cannot be used: unreadable, truncated, empty, of an unexpected type."""
 
 
 @dataclass(frozen=True)

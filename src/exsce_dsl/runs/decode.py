@@ -41,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import DecodeError as DecodeError
 from exsce_dsl.lang.check_fields import FieldProblem, field_shape
 from exsce_dsl.messages.catalogue import ARRAY, BASE, NAME, NUMERIC, SEQUENCE, MessageCatalogue
 from exsce_dsl.model.messages import FieldPath, Index, Select, Step, canonical_type
@@ -52,10 +52,6 @@ TEXTS = "#texts"
 """Key of the strings that text paths' codes index."""
 _LENGTHS = "#lengths"
 """Key suffix, while decoding, of how many values each message's row holds (its width without padding)."""
-
-
-class DecodeError(ExsceError):
-    """Raw bytes that are not the message type they claim to be."""
 
 
 @dataclass(frozen=True)

@@ -12,16 +12,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import SegmentError as SegmentError
 from exsce_dsl.model import Pose, Scenario
 from exsce_dsl.runs.bagdata import StatusUpdate
 
 ACTIVE, SUCCEEDED = 1, 3
 FINAL = {2: "PREEMPTED", 3: "SUCCEEDED", 4: "ABORTED", 5: "REJECTED", 8: "RECALLED", 9: "LOST"}
-
-
-class SegmentError(ExsceError):
-    """The dispatcher's statuses do not fit the scenario."""
 
 
 @dataclass(frozen=True)

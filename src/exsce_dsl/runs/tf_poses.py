@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import TfError as TfError
 from exsce_dsl.suggest import did_you_mean
 
 MAX_EXTRAPOLATION = 0.5
@@ -35,10 +35,6 @@ _NLERP_ANGLE = 1e-6
 
 _CONJUGATE = np.array([-1.0, -1.0, -1.0, 1.0])
 _IDENTITY = np.array([0.0, 0.0, 0.0, 1.0])
-
-
-class TfError(ExsceError):
-    """The TF data cannot give the pose asked for, or is not a tree."""
 
 
 def _frame(name: str) -> str:

@@ -17,13 +17,10 @@ from scipy.sparse import coo_matrix, csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import PlanningError as PlanningError
 from exsce_dsl.lang.occupancy import OccupancyGrid
 
 Point = tuple[float, float]
-
-
-class PlanningError(ExsceError):
-    """No path exists between two poses on the map."""
 
 
 @dataclass(frozen=True)

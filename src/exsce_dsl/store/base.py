@@ -23,32 +23,13 @@ from dataclasses import dataclass
 
 from pyoxigraph import BlankNode, Literal, NamedNode, Quad
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import StoreConflictError as StoreConflictError
+from exsce_dsl.errors import StoreError as StoreError
+from exsce_dsl.errors import StoreLockedError as StoreLockedError
 
 Term = NamedNode | BlankNode | Literal
 Bindings = Mapping[str, Term | Sequence[Term]]
 """Query parameters: variable name (without ``?``) → one term, or several (a VALUES list)."""
-
-
-class StoreError(ExsceError):
-    """The store cannot do what was asked (unreachable, locked, refused, conflicting)."""
-
-
-class StoreLockedError(StoreError):
-    """An embedded store's folder is open in another process (RocksDB allows one)."""
-
-    def __init__(self, message: str, path: str) -> None:
-        super().__init__(message)
-        self.path = path
-
-
-class StoreConflictError(StoreError):
-    """A document differs from what the store holds under the same names."""
-
-    def __init__(self, message: str, graphs: Sequence[str]) -> None:
-        super().__init__(message)
-        self.graphs = tuple(graphs)
-        """The names of the graphs that differ."""
 
 
 @dataclass(frozen=True)
