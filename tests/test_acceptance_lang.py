@@ -12,10 +12,10 @@ from exsce_dsl.lang.formatter import format_spec_document
 from exsce_dsl.model.acceptance import (
     AtStartPose,
     BaselineRuns,
+    BasicRelation,
     Moment,
     Quantifier,
     Quantity,
-    Relation,
     Subject,
     When,
     Window,
@@ -104,11 +104,11 @@ def test_the_criteria_build_to_the_model_in_si_units(spec_folder: Path) -> None:
     r1 = Subject(Quantifier.ROBOT, "r1")
     duration, distance, speed = faster.expectations
     assert (duration.subject, duration.metric, duration.relation, duration.against) == (
-        r1, "task_duration", Relation.DECREASING, "s1"
+        r1, "task_duration", BasicRelation.DECREASING, "s1"
     )
     assert duration.delta == Quantity(0.5, "ms") and duration.tolerance == Quantity(1.0, "s")
-    assert distance.relation is Relation.INVARIANT and distance.tolerance == Quantity(10.0, "%")
-    assert speed.relation is Relation.BELOW_MAX and speed.limit == Quantity(0.9, "cm/s")
+    assert distance.relation is BasicRelation.INVARIANT and distance.tolerance == Quantity(10.0, "%")
+    assert speed.relation is BasicRelation.BELOW_MAX and speed.limit == Quantity(0.9, "cm/s")
     assert speed.window == Window(Moment.BEFORE, "r1", pose="room-p3")
     obstacles, visited, mission = on_the_way.expectations
     assert on_the_way.when == When(robot="r1", task="go_p3")
@@ -116,7 +116,7 @@ def test_the_criteria_build_to_the_model_in_si_units(spec_folder: Path) -> None:
     assert visited.value == Quantity(1.0, None) and visited.tolerance == Quantity(0.0, None)
     assert mission.subject.quantifier is Quantifier.MISSION
     assert (mission.relation, mission.value, mission.delta) == (
-        Relation.INCREASING, Quantity(60.0, "min"), Quantity(6.0, "s")
+        BasicRelation.INCREASING, Quantity(60.0, "min"), Quantity(6.0, "s")
     )
     assert mission.against is None
 

@@ -134,11 +134,11 @@ def test_the_derived_scenario_s_criteria_follow_from_the_expected_change() -> No
     from exsce_dsl.lang.format_acceptance import expectation_text
     from exsce_dsl.model.acceptance import (
         Acceptance,
+        BasicRelation,
         Criterion,
         Expectation,
         Quantifier,
         Quantity,
-        Relation,
         Subject,
     )
 
@@ -146,7 +146,7 @@ def test_the_derived_scenario_s_criteria_follow_from_the_expected_change() -> No
     add_prov(store, compile_scenario(BASE))
     for uuid, a_to_b in (("u1", 10.0), ("u2", 12.0)):
         add_prov(store, compile_run(run(uuid, a_to_b), BASE))
-    speed = Expectation(Subject(Quantifier.EACH_ROBOT), "max_velocity", Relation.BELOW_MAX, limit=Quantity(1.0, "m/s", "1.0"))
+    speed = Expectation(Subject(Quantifier.EACH_ROBOT), "max_velocity", BasicRelation.BELOW_MAX, limit=Quantity(1.0, "m/s", "1.0"))
     base_criteria = Acceptance("base", (Criterion("safe", (), None, (speed,)),))
     made = metamorphic_acceptance(store, BASE, LONGER, base_criteria)
     assert made.scenario == "longer"
@@ -195,14 +195,14 @@ def test_a_clause_between_robots_is_not_copied_to_a_scenario_of_one_robot() -> N
     from exsce_dsl.derive.expect import metamorphic_acceptance
     from exsce_dsl.model.acceptance import (
         Acceptance,
+        BasicRelation,
         Criterion,
         Expectation,
         Quantifier,
         Quantity,
-        Relation,
         Subject,
     )
 
-    apart = Expectation(Subject(Quantifier.MISSION), "distance_between_robots", Relation.ABOVE_MIN, limit=Quantity(0.1, "m", "0.1"))
+    apart = Expectation(Subject(Quantifier.MISSION), "distance_between_robots", BasicRelation.ABOVE_MIN, limit=Quantity(0.1, "m", "0.1"))
     made = metamorphic_acceptance(EmbeddedStore(None), BASE, LONGER, Acceptance("base", (Criterion("apart", (), None, (apart,)),)))
     assert made.criteria == ()  # one robot: nothing between robots to judge, and no runs to expect from

@@ -23,12 +23,12 @@ from exsce_dsl.model import (
 )
 from exsce_dsl.model.acceptance import (
     Acceptance,
+    BasicRelation,
     Criterion,
     Expectation,
     Moment,
     Quantifier,
     Quantity,
-    Relation,
     Subject,
     When,
     Window,
@@ -50,10 +50,10 @@ EACH, R1, MISSION = Subject(Quantifier.EACH_ROBOT), Subject(Quantifier.ROBOT, "r
 
 
 def test_each_robot_is_an_oracle_per_robot_and_a_when_task_windows_segment_metrics() -> None:
-    speed = Expectation(EACH, "max_velocity", Relation.BELOW_MAX, limit=Quantity(1.0, "m/s"))
-    r1_speed = Expectation(R1, "max_velocity", Relation.BELOW_MAX, limit=Quantity(0.5, "m/s"))
-    visited = Expectation(R1, "waypoints_visited", Relation.INVARIANT)
-    mission = Expectation(MISSION, "mission_duration", Relation.INVARIANT)
+    speed = Expectation(EACH, "max_velocity", BasicRelation.BELOW_MAX, limit=Quantity(1.0, "m/s"))
+    r1_speed = Expectation(R1, "max_velocity", BasicRelation.BELOW_MAX, limit=Quantity(0.5, "m/s"))
+    visited = Expectation(R1, "waypoints_visited", BasicRelation.INVARIANT)
+    mission = Expectation(MISSION, "mission_duration", BasicRelation.INVARIANT)
     acceptance = Acceptance(
         "s",
         (
@@ -72,11 +72,11 @@ def test_each_robot_is_an_oracle_per_robot_and_a_when_task_windows_segment_metri
 
 
 def test_tolerances_in_std_percent_or_absolute_and_the_defaults() -> None:
-    assert tolerance_of(Quantity(2.0, "std"), 10.0, 1.5, Relation.INVARIANT) == 3.0
-    assert tolerance_of(Quantity(10.0, "%"), -20.0, 1.5, Relation.INVARIANT) == 2.0
-    assert tolerance_of(Quantity(0.5, "s"), 10.0, 1.5, Relation.INVARIANT) == 0.5
-    assert tolerance_of(None, 10.0, 1.5, Relation.INVARIANT) == 1.5
-    assert tolerance_of(None, 10.0, 1.5, Relation.INCREASING) == 0.0
+    assert tolerance_of(Quantity(2.0, "std"), 10.0, 1.5, BasicRelation.INVARIANT) == 3.0
+    assert tolerance_of(Quantity(10.0, "%"), -20.0, 1.5, BasicRelation.INVARIANT) == 2.0
+    assert tolerance_of(Quantity(0.5, "s"), 10.0, 1.5, BasicRelation.INVARIANT) == 0.5
+    assert tolerance_of(None, 10.0, 1.5, BasicRelation.INVARIANT) == 1.5
+    assert tolerance_of(None, 10.0, 1.5, BasicRelation.INCREASING) == 0.0
 
 
 def test_default_topics_follow_the_robot_namespace() -> None:

@@ -32,12 +32,12 @@ from exsce_dsl.lang.oracle_yaml import (
 from exsce_dsl.model import Document, Scenario
 from exsce_dsl.model.acceptance import (
     Acceptance,
+    BasicRelation,
     Criterion,
     Expectation,
     Moment,
     Quantifier,
     Quantity,
-    Relation,
     Subject,
     When,
     Window,
@@ -101,17 +101,17 @@ def test_the_method_file_imports_as_these_criteria(scenario_c: Scenario) -> None
     assert (criterion.title, criterion.givens, criterion.when) == ("baseline", (), When(mission="mission_c"))
     t1 = [e for e in criterion.expectations if e.subject == TIAGO1]
     assert criterion.expectations[:2] == (
-        Expectation(MISSION, "mission_duration", Relation.INVARIANT, value=s(97.606, ""), tolerance=s(10.0, "")),
-        Expectation(MISSION, "distance_between_robots", Relation.ABOVE_MIN, limit=m(0.1, "")),
+        Expectation(MISSION, "mission_duration", BasicRelation.INVARIANT, value=s(97.606, ""), tolerance=s(10.0, "")),
+        Expectation(MISSION, "distance_between_robots", BasicRelation.ABOVE_MIN, limit=m(0.1, "")),
     )
     assert t1 == [
-        Expectation(TIAGO1, "task_duration", Relation.INVARIANT, value=s(97.606, ""), tolerance=s(5.0, "")),
-        Expectation(TIAGO1, "waypoints_visited", Relation.INVARIANT, value=Quantity(3.0)),
+        Expectation(TIAGO1, "task_duration", BasicRelation.INVARIANT, value=s(97.606, ""), tolerance=s(5.0, "")),
+        Expectation(TIAGO1, "waypoints_visited", BasicRelation.INVARIANT, value=Quantity(3.0)),
         Expectation(
-            TIAGO1, "distance_travelled", Relation.INVARIANT, value=m(50.702942669287076, ""), tolerance=m(2.0, "")
+            TIAGO1, "distance_travelled", BasicRelation.INVARIANT, value=m(50.702942669287076, ""), tolerance=m(2.0, "")
         ),
-        Expectation(TIAGO1, "distance_to_obstacles", Relation.ABOVE_MIN, limit=m(0.1, "")),
-        Expectation(TIAGO1, "max_velocity", Relation.BELOW_MAX, limit=Quantity(1.0, "m/s")),
+        Expectation(TIAGO1, "distance_to_obstacles", BasicRelation.ABOVE_MIN, limit=m(0.1, "")),
+        Expectation(TIAGO1, "max_velocity", BasicRelation.BELOW_MAX, limit=Quantity(1.0, "m/s")),
     ]
     assert len(criterion.expectations) == 12
     # the numbers are written as the file writes them
@@ -160,7 +160,7 @@ def test_a_metamorphic_section_compares_with_the_base_scenario(tmp_path: Path) -
     (criterion,) = acceptance.criteria
     assert criterion.title == "against scenario_b"
     assert criterion.expectations == (
-        Expectation(TIAGO1, "distance_travelled", Relation.INCREASING, value=m(50.7, ""), delta=m(47.5, ""),
+        Expectation(TIAGO1, "distance_travelled", BasicRelation.INCREASING, value=m(50.7, ""), delta=m(47.5, ""),
                     tolerance=m(0.0, ""), against="scenario_b"),
     )
     text = dsl_text(acceptance)
@@ -288,7 +288,7 @@ def criteria(*expectations: Expectation, when: When | None = None) -> Acceptance
 
 def test_each_robot_is_every_robot_in_fleet_order(scenario_c: Scenario) -> None:
     data = oracles_to_yaml(
-        criteria(Expectation(EACH, "max_velocity", Relation.BELOW_MAX, limit=Quantity(1.0, "m/s"))), scenario_c
+        criteria(Expectation(EACH, "max_velocity", BasicRelation.BELOW_MAX, limit=Quantity(1.0, "m/s"))), scenario_c
     )
     assert data == {
         "id": "scenario_c",
@@ -315,13 +315,13 @@ def test_each_robot_is_every_robot_in_fleet_order(scenario_c: Scenario) -> None:
 def test_a_clause_without_value_takes_the_baseline(
     scenario_c: Scenario, tolerance: Quantity | None, expected: float
 ) -> None:
-    clause = Expectation(MISSION, "mission_duration", Relation.INVARIANT, tolerance=tolerance)
+    clause = Expectation(MISSION, "mission_duration", BasicRelation.INVARIANT, tolerance=tolerance)
     data = oracles_to_yaml(criteria(clause), scenario_c, {("mission_duration", None): (100.0, 4.0)})
     assert data["baseline"]["mission"]["mission_duration"]["baseline"] == {"value": 100.0, "tolerance": expected}
 
 
 def test_a_change_without_value_starts_from_the_base_mean(scenario_c: Scenario) -> None:
-    clause = Expectation(TIAGO1, "waypoints_visited", Relation.INCREASING, delta=Quantity(2.0), against="scenario_b")
+    clause = Expectation(TIAGO1, "waypoints_visited", BasicRelation.INCREASING, delta=Quantity(2.0), against="scenario_b")
     data = oracles_to_yaml(criteria(clause), scenario_c, {("waypoints_visited", "tiago1"): (3.0, 0.0)})
     assert data["metamorphic"]["base_scenario"] == "scenario_b"
     entry = data["metamorphic"]["robots"]["tiago1"]["waypoints_visited"]
@@ -347,23 +347,23 @@ def test_a_clause_without_value_and_no_baseline_cannot_be_written(scenario_c: Sc
     ("acceptance", "message"),
     [
         (
-            criteria(Expectation(TIAGO1, "max_velocity", Relation.BELOW_MAX, limit=Quantity(0.8, "m/s"),
+            criteria(Expectation(TIAGO1, "max_velocity", BasicRelation.BELOW_MAX, limit=Quantity(0.8, "m/s"),
                                  window=Window(Moment.AFTER, "tiago1", pose="classroom_c022-w001"))),
             "'tiago1 max_velocity stays below 0.8 m/s after tiago1 reaches classroom_c022-w001' looks at part "
             "of a run",
         ),
         (
-            criteria(Expectation(TIAGO1, "max_velocity", Relation.BELOW_MAX, limit=Quantity(0.8, "m/s")),
+            criteria(Expectation(TIAGO1, "max_velocity", BasicRelation.BELOW_MAX, limit=Quantity(0.8, "m/s")),
                      when=When(robot="tiago1", task="delivery_a")),
             "looks at part of a run (during delivery_a, as 'when tiago1 does delivery_a' says)",
         ),
         (
-            criteria(Expectation(EACH, "max_velocity", Relation.BELOW_MAX, limit=Quantity(1.0, "m/s")),
-                     Expectation(TIAGO1, "max_velocity", Relation.BELOW_MAX, limit=Quantity(0.8, "m/s"))),
+            criteria(Expectation(EACH, "max_velocity", BasicRelation.BELOW_MAX, limit=Quantity(1.0, "m/s")),
+                     Expectation(TIAGO1, "max_velocity", BasicRelation.BELOW_MAX, limit=Quantity(0.8, "m/s"))),
             "are both about max_velocity of tiago1",
         ),
         (
-            criteria(Expectation(MISSION, "mission_duration", Relation.INVARIANT, value=s(97.6, "97.6"),
+            criteria(Expectation(MISSION, "mission_duration", BasicRelation.INVARIANT, value=s(97.6, "97.6"),
                                  tolerance=Quantity(1.0, "std"))),
             "'mission_duration is invariant around 97.6 s within 1 std' needs the standard deviation of stored "
             "runs of mission_duration of the mission, and no baseline was given: write a tolerance in the "
@@ -393,8 +393,8 @@ def test_export_then_import_gives_the_same_criteria(value: float, tolerance: flo
     acceptance = Acceptance(
         "scenario_c",
         (Criterion("baseline", (), When(mission="mission_c"), (
-            Expectation(MISSION, "mission_duration", Relation.INVARIANT, value=s(value, ""), tolerance=s(tolerance, "")),
-            Expectation(TIAGO1, "distance_to_obstacles", Relation.ABOVE_MIN, limit=m(limit, "")),
+            Expectation(MISSION, "mission_duration", BasicRelation.INVARIANT, value=s(value, ""), tolerance=s(tolerance, "")),
+            Expectation(TIAGO1, "distance_to_obstacles", BasicRelation.ABOVE_MIN, limit=m(limit, "")),
         )),),
     )
     with tempfile.TemporaryDirectory() as folder:

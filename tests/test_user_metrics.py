@@ -21,7 +21,7 @@ from exsce_dsl.errors import SpecError
 from exsce_dsl.lang.build import analyse, load_spec
 from exsce_dsl.lang.format_metrics import metric_lines
 from exsce_dsl.lang.standard_metrics import standard_metrics
-from exsce_dsl.model.metrics import METRICS, Subject
+from exsce_dsl.model.metrics import METRICS, ComputedFor
 from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
@@ -249,7 +249,7 @@ def test_the_standard_library_declares_the_builtin_metrics_as_the_method_describ
         "distance_to_obstacles": ("above", 0.1),
         "distance_between_robots": ("above", 0.1),
     }
-    assert declared["distance_between_robots"].subject is Subject.PAIRS
+    assert declared["distance_between_robots"].subject is ComputedFor.PAIRS
 
 
 def test_metric_declarations_print_back_to_the_same_model(tmp_path):

@@ -29,7 +29,7 @@ from exsce_dsl.lang.standard_metrics import standard_metrics
 from exsce_dsl.messages.catalogue import MessageTypeError
 from exsce_dsl.messages.user import configured_catalogue
 from exsce_dsl.model import Scenario, Specification
-from exsce_dsl.model.acceptance import Relation
+from exsce_dsl.model.acceptance import BasicRelation
 from exsce_dsl.model.expressions import Field, walk
 from exsce_dsl.model.messages import (
     FEEDBACK,
@@ -42,7 +42,7 @@ from exsce_dsl.model.messages import (
     Step,
     canonical_type,
 )
-from exsce_dsl.model.metrics import MetricDefinition, Subject, topic_name
+from exsce_dsl.model.metrics import ComputedFor, MetricDefinition, topic_name
 from exsce_dsl.oracles.plan import PlannedOracle, plan_oracles
 from exsce_dsl.prov.identifiers import oracle_name
 from exsce_dsl.resources import package_file
@@ -222,8 +222,8 @@ def live_oracles(
     acceptance = spec.acceptance_of(scenario.id)
     if acceptance is None:
         return [], []
-    robot_metrics = {m.name for m in metrics if m.subject is Subject.ROBOT}
-    mission_metrics = {m.name for m in metrics if m.subject is not Subject.ROBOT}
+    robot_metrics = {m.name for m in metrics if m.subject is ComputedFor.ROBOT}
+    mission_metrics = {m.name for m in metrics if m.subject is not ComputedFor.ROBOT}
     monitored = {r.id for r in scenario.robots if r.start_pose is not None}
     judged: list[LiveOracle] = []
     others: list[LiveOracle] = []
@@ -258,7 +258,7 @@ def _not_live(
     e = planned.expectation
     if planned.window is not None:
         return f"it looks at part of a run ({planned.window.text()}): only whole runs are judged live"
-    if e.relation in (Relation.INCREASING, Relation.DECREASING):
+    if e.relation in (BasicRelation.INCREASING, BasicRelation.DECREASING):
         return f"relation {e.relation.value}: only limits and invariants around a fixed value are judged live"
     fixed_value = e.value is not None and (e.tolerance is None or e.tolerance.unit != "std")
     if e.limit is None and not fixed_value:

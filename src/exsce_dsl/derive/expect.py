@@ -24,11 +24,11 @@ from dataclasses import dataclass, replace
 from exsce_dsl.model import Pose, Scenario
 from exsce_dsl.model.acceptance import (
     Acceptance,
+    BasicRelation,
     Criterion,
     Expectation,
     Quantifier,
     Quantity,
-    Relation,
     Subject,
     When,
 )
@@ -202,7 +202,7 @@ def metamorphic_acceptance(
             for c in base_acceptance.criteria
             if c.when is None or c.when.robot is None  # a task's criteria look at a part of the run
             for e in c.expectations
-            if e.relation in (Relation.BELOW_MAX, Relation.ABOVE_MIN)
+            if e.relation in (BasicRelation.BELOW_MAX, BasicRelation.ABOVE_MIN)
             and e.window is None
             and (e.subject.robot is None or e.subject.robot in robots)
             and (e.metric not in PAIRWISE or len(robots) > 1)
@@ -255,15 +255,17 @@ def _expected_clauses(
     own = Expectation(
         subject,
         metric,
-        Relation.INVARIANT,
+        BasicRelation.INVARIANT,
         value=quantity(expected),
         tolerance=Quantity(round(100.0 * allowance / abs(expected), 3), "%") if expected else quantity(0.0),
     )
     change = expected - base_mean
     if abs(change) <= allowance:
-        same = Expectation(subject, metric, Relation.INVARIANT, tolerance=quantity(allowance), against=base)
+        same = Expectation(
+            subject, metric, BasicRelation.INVARIANT, tolerance=quantity(allowance), against=base
+        )
         return [own, same]
-    direction = Relation.INCREASING if change > 0 else Relation.DECREASING
+    direction = BasicRelation.INCREASING if change > 0 else BasicRelation.DECREASING
     moved = Expectation(
         subject, metric, direction, delta=quantity(abs(change)), tolerance=quantity(allowance), against=base
     )

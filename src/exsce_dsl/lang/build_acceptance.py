@@ -20,13 +20,13 @@ from exsce_dsl.model.acceptance import (
     Acceptance,
     AtStartPose,
     BaselineRuns,
+    BasicRelation,
     Criterion,
     Expectation,
     Given,
     Moment,
     Quantifier,
     Quantity,
-    Relation,
     Subject,
     When,
     Window,
@@ -228,7 +228,7 @@ class _AcceptanceBuilder:
             limit = self.quantity(relation.limit, info, where)
             if limit is None:
                 return None
-            rel = Relation.BELOW_MAX if kind == "StaysBelow" else Relation.ABOVE_MIN
+            rel = BasicRelation.BELOW_MAX if kind == "StaysBelow" else BasicRelation.ABOVE_MIN
             window = self.window(node.window, info)
             if node.window is not None and window is None:
                 return None
@@ -241,9 +241,9 @@ class _AcceptanceBuilder:
             if tolerance is None:
                 return None
         if kind == "Invariant":
-            rel = Relation.INVARIANT
+            rel = BasicRelation.INVARIANT
         else:
-            rel = Relation.INCREASING if relation.direction == "increasing" else Relation.DECREASING
+            rel = BasicRelation.INCREASING if relation.direction == "increasing" else BasicRelation.DECREASING
             if relation.delta is not None and (delta := self.quantity(relation.delta, info, where)) is None:
                 return None
             if against is None and value is None:

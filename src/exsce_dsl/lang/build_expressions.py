@@ -32,7 +32,7 @@ from exsce_dsl.model.expressions import (
     WindowValue,
 )
 from exsce_dsl.model.messages import DISPATCHER, FEEDBACK, RESULT, FieldPath, Fields, Index, Select, Step
-from exsce_dsl.model.metrics import UNITS, Dimension, Subject, TopicRead
+from exsce_dsl.model.metrics import UNITS, ComputedFor, Dimension, TopicRead
 from exsce_dsl.suggest import did_you_mean
 
 _QUANTITY = re.compile(r"(\S+?)\s*([a-z/]+)?")
@@ -55,7 +55,7 @@ class Scope:
     """What a metric's expressions may name: its reads (with their types' fields, when known)
     and, for pairs of robots, the pair's binders."""
 
-    subject: Subject
+    subject: ComputedFor
     reads: dict[str, TopicRead]
     trees: dict[str, Fields]
     broken_reads: set[str]
@@ -234,7 +234,7 @@ class ExpressionBuilder:
                 f'(reads {which}: {needed} on "/{{ns}}/waypoint_dispatcher/{which}")',
                 node,
             )
-        if node.name == "succeeded" and self.scope.subject is not Subject.ROBOT:
+        if node.name == "succeeded" and self.scope.subject is not ComputedFor.ROBOT:
             raise self._fail("'succeeded' counts the waypoints of one robot: use it 'for each robot'", node)
         return Typed(WindowValue(node.name, self.pf.span(node)), Kind.VALUE)
 
@@ -245,7 +245,7 @@ class ExpressionBuilder:
         at = at or node
         parts = list(node.parts)
         robot = None
-        if self.scope.subject is Subject.MISSION:
+        if self.scope.subject is ComputedFor.MISSION:
             raise self._fail(
                 "a mission metric reads every robot's topics, so a field does not say whose: "
                 "use 'for each pair of robots (a, b)' and a.<topic>..., or 'elapsed'",

@@ -34,10 +34,10 @@ from exsce_dsl.model.metrics import (
     SIGNAL_TYPES,
     UNITS,
     Combine,
+    ComputedFor,
     Dimension,
     MetricDefinition,
     SafetyLimit,
-    Subject,
     TopicRead,
     signal_pattern,
 )
@@ -107,7 +107,7 @@ class _MetricBuilder:
         self.trees: dict[str, Fields] = {}
         """The fields of each read's type, if the catalogue knows it."""
         self.pair: tuple[str, str] | None = None
-        self.subject = Subject.ROBOT
+        self.subject = ComputedFor.ROBOT
         self._catalogue = catalogue
 
     def error(self, message: str, node: Any) -> None:
@@ -140,12 +140,12 @@ class _MetricBuilder:
         elif name in reserved:
             self.error(f"metric '{name}' {reserved[name]}; choose another name", tree)
         if tree.pairs is not None:
-            self.subject = Subject.PAIRS
+            self.subject = ComputedFor.PAIRS
             self.pair = (tree.pairs.first, tree.pairs.second)
             if self.pair[0] == self.pair[1]:
                 self.error(f"the two robots of a pair need two names, not '{self.pair[0]}' twice", tree.pairs)
         elif tree.mission:
-            self.subject = Subject.MISSION
+            self.subject = ComputedFor.MISSION
         for read in tree.reads:
             self._read(read)
         scope = Scope(self.subject, self.reads, self.trees, self.broken_reads, self.pair)
@@ -198,7 +198,7 @@ class _MetricBuilder:
                 read,
             )
             return
-        if self.subject is not Subject.MISSION and "{ns}" not in read.topic:
+        if self.subject is not ComputedFor.MISSION and "{ns}" not in read.topic:
             self.error(f"a topic of each robot needs '{{ns}}' in its name: '{read.topic}'", read)
             return
         self.reads[read.name] = TopicRead(read.name, msgtype, read.topic, self.pf.span(read))
@@ -214,7 +214,7 @@ class _MetricBuilder:
         if self.pair is not None and read.name in self.pair:
             self.error(f"'{read.name}' names a robot of the pair; give the signal another name", read)
             return
-        if self.subject is Subject.MISSION:
+        if self.subject is ComputedFor.MISSION:
             self.error(f"the robot's {read.signal} is read for each robot or each pair of robots", read)
             return
         msgtype = SIGNAL_TYPES[read.signal]
@@ -279,7 +279,7 @@ class _MetricBuilder:
         return SafetyLimit(tree.safety.bound, number, tree.safety.limit)
 
     def _combine(self, tree: Any, value: Typed | None, fallback: Typed | None) -> Combine | None:
-        if value is None or not (tree.per_segment or self.subject is Subject.PAIRS):
+        if value is None or not (tree.per_segment or self.subject is ComputedFor.PAIRS):
             return None
         combines = {_COMBINE.get(_top(t.expr) or "") for t in (value, fallback) if t is not None}
         top = _top(value.expr)

@@ -7,11 +7,11 @@ from exsce_dsl.model.acceptance import (
     Acceptance,
     AtStartPose,
     BaselineRuns,
+    BasicRelation,
     Criterion,
     Expectation,
     Given,
     Quantity,
-    Relation,
 )
 from exsce_dsl.model.metrics import UNITS
 
@@ -52,13 +52,17 @@ def given_text(given: Given) -> str:
 def expectation_text(e: Expectation) -> str:
     """``each robot max_velocity stays below 1.0 m/s``: a then clause as written."""
     words = [e.subject.text(), e.metric] if e.subject.text() else [e.metric]
-    if e.relation is Relation.BELOW_MAX or e.relation is Relation.ABOVE_MIN:
+    if e.relation is BasicRelation.BELOW_MAX or e.relation is BasicRelation.ABOVE_MIN:
         assert e.limit is not None
-        words += ["stays", "below" if e.relation is Relation.BELOW_MAX else "above", quantity_text(e.limit)]
+        words += [
+            "stays",
+            "below" if e.relation is BasicRelation.BELOW_MAX else "above",
+            quantity_text(e.limit),
+        ]
     else:
         words += ["is", e.relation.value]
         if e.value is not None:
-            words += ["around" if e.relation is Relation.INVARIANT else "from", quantity_text(e.value)]
+            words += ["around" if e.relation is BasicRelation.INVARIANT else "from", quantity_text(e.value)]
         if e.delta is not None:
             words += ["by", quantity_text(e.delta)]
         if e.tolerance is not None:

@@ -15,7 +15,7 @@ from exsce_dsl.lang.lexical import number_text as _number
 from exsce_dsl.lang.lexical import string_literal as _string
 from exsce_dsl.model.expressions import Aggregate, Binary, Expression, Field, Number, Unary, WindowValue
 from exsce_dsl.model.messages import Index
-from exsce_dsl.model.metrics import MetricDefinition, Subject
+from exsce_dsl.model.metrics import ComputedFor, MetricDefinition
 
 INDENT = "  "
 Line = tuple[str, SourceLocation | None]
@@ -27,7 +27,7 @@ _ATOM = 8
 
 
 def metric_lines(metric: MetricDefinition) -> list[Line]:
-    if metric.subject is Subject.PAIRS:
+    if metric.subject is ComputedFor.PAIRS:
         assert metric.pair is not None
         subject = f"each pair of robots ({metric.pair[0]}, {metric.pair[1]})"
     else:

@@ -24,11 +24,11 @@ from exsce_dsl.lang.yaml_import import YamlFile, YamlNode, child_node, node_loca
 from exsce_dsl.model import Document, Import, Scenario, Specification
 from exsce_dsl.model.acceptance import (
     Acceptance,
+    BasicRelation,
     Criterion,
     Expectation,
     Quantifier,
     Quantity,
-    Relation,
     Subject,
     When,
 )
@@ -47,11 +47,11 @@ Baseline = Mapping[tuple[str, str | None], tuple[float, float]]
 
 _LIMIT, _VALUE, _CHANGE = ("limit",), ("value", "tolerance"), ("value", "delta", "tolerance")
 _NUMBERS = {
-    Relation.BELOW_MAX: _LIMIT,
-    Relation.ABOVE_MIN: _LIMIT,
-    Relation.INVARIANT: _VALUE,
-    Relation.INCREASING: _CHANGE,
-    Relation.DECREASING: _CHANGE,
+    BasicRelation.BELOW_MAX: _LIMIT,
+    BasicRelation.ABOVE_MIN: _LIMIT,
+    BasicRelation.INVARIANT: _VALUE,
+    BasicRelation.INCREASING: _CHANGE,
+    BasicRelation.DECREASING: _CHANGE,
 }
 """The numbers each relation takes, in the order they are written; the first is required."""
 
@@ -225,7 +225,7 @@ class _OracleReader:
             return info
         return None
 
-    def relation(self, node: YamlNode) -> Relation | None:
+    def relation(self, node: YamlNode) -> BasicRelation | None:
         package = node.opt("package")
         if package is not None and package.text() != RELATIONSHIPS_PACKAGE:
             self.report(
@@ -237,9 +237,9 @@ class _OracleReader:
         name_node = node.get("name")
         name = name_node.text()
         try:
-            return Relation(name)
+            return BasicRelation(name)
         except ValueError:
-            names = [r.value for r in Relation]
+            names = [r.value for r in BasicRelation]
             hint = did_you_mean(name, names) or f"; the method's relations are {', '.join(names)}"
             self.report(f"unknown relationship '{name}'{hint}", name_node.location)
             return None
@@ -264,7 +264,9 @@ class _OracleReader:
                 node.location,
             )
 
-    def numbers(self, node: YamlNode, relation: Relation, info: MetricInfo) -> dict[str, Quantity] | None:
+    def numbers(
+        self, node: YamlNode, relation: BasicRelation, info: MetricInfo
+    ) -> dict[str, Quantity] | None:
         """The relation's numbers as quantities in the metric's SI unit, by field name."""
         keys = _NUMBERS[relation]
         for key, _ in node.items_of_mapping():
@@ -453,7 +455,7 @@ def _numbers(e: Expectation, robot: str | None, stats: tuple[float, float] | Non
     if t is not None:
         scale = {"std": std, "%": abs(numbers["value"]) / 100.0}.get(t.unit or "", 1.0)
         numbers["tolerance"] = t.value * scale
-    elif e.value is None and e.relation is Relation.INVARIANT:
+    elif e.value is None and e.relation is BasicRelation.INVARIANT:
         numbers["tolerance"] = std
     return numbers
 

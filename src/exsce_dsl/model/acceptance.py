@@ -53,7 +53,7 @@ class Quantity:
         return f"{number} {self.unit}" if self.unit else number
 
 
-class Relation(enum.Enum):
+class BasicRelation(enum.Enum):
     """The method's basic output relations."""
 
     BELOW_MAX = "below_max"
@@ -100,7 +100,7 @@ class Expectation:
 
     subject: Subject
     metric: str
-    relation: Relation
+    relation: BasicRelation
     limit: Quantity | None = None
     value: Quantity | None = None
     """A fixed expected value (``around 97.6 s``, ``from 40 s``); else the baseline's or base's mean."""

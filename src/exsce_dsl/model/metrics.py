@@ -144,7 +144,7 @@ TOPICS: dict[str, tuple[str, ...]] = {
 the standard library declares them with)."""
 
 
-class Subject(enum.Enum):
+class ComputedFor(enum.Enum):
     """What a declared metric is said of."""
 
     ROBOT = "each robot"
@@ -188,7 +188,7 @@ class MetricDefinition:
     """A metric as declared in the language (the standard library's or a user's)."""
 
     name: str
-    subject: Subject
+    subject: ComputedFor
     per_segment: bool
     dimension: Dimension
     reads: tuple[TopicRead, ...]
@@ -213,7 +213,7 @@ class MetricDefinition:
         return MetricInfo(
             self.name,
             self.dimension,
-            self.subject is Subject.ROBOT,
+            self.subject is ComputedFor.ROBOT,
             self.combine if self.per_segment else None,
             meaning=self.meaning,
         )

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import Scenario
-from exsce_dsl.model.acceptance import Acceptance, Relation
+from exsce_dsl.model.acceptance import Acceptance, BasicRelation
 from exsce_dsl.model.metrics import default_topics
 from exsce_dsl.model.oracles import Oracle
 from exsce_dsl.oracles.observe import RunValues, observe, run_values
@@ -117,7 +117,7 @@ def _numbers(oracle: PlannedOracle, stats: Statistics | None, scenario: Scenario
         return Oracle(**common, limit=e.limit.value)  # type: ignore[arg-type]
     # none written: one standard deviation around the runs' mean, but exactly a fixed value
     needs_std = (e.tolerance is not None and e.tolerance.unit == "std") or (
-        e.tolerance is None and e.relation is Relation.INVARIANT and e.value is None
+        e.tolerance is None and e.relation is BasicRelation.INVARIANT and e.value is None
     )
     if stats is None and (e.value is None or needs_std):
         where = f"'{e.against}'" if e.against else f"scenario '{scenario.id}'"
@@ -132,6 +132,8 @@ def _numbers(oracle: PlannedOracle, stats: Statistics | None, scenario: Scenario
     tolerance: float | None = tolerance_of(e.tolerance, value, std, e.relation)
     if e.tolerance is None and e.value is not None:
         tolerance = None
-    delta = e.delta.value if e.delta is not None else (0.0 if e.relation is not Relation.INVARIANT else None)
+    delta = (
+        e.delta.value if e.delta is not None else (0.0 if e.relation is not BasicRelation.INVARIANT else None)
+    )
     sources = stats.runs if stats is not None and (e.value is None or needs_std) else ()
     return Oracle(**common, value=value, delta=delta, tolerance=tolerance, sources=sources)  # type: ignore[arg-type]

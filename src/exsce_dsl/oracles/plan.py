@@ -12,11 +12,11 @@ from dataclasses import dataclass
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.acceptance import (
     Acceptance,
+    BasicRelation,
     Expectation,
     Moment,
     Quantifier,
     Quantity,
-    Relation,
     Window,
 )
 from exsce_dsl.model.metrics import metric_info
@@ -37,7 +37,7 @@ class PlannedOracle:
         return self.expectation.metric
 
     @property
-    def relation(self) -> Relation:
+    def relation(self) -> BasicRelation:
         return self.expectation.relation
 
     @property
@@ -82,11 +82,11 @@ def _robots(expectation: Expectation, scenario: Scenario) -> list[str | None]:
     return [robot.id for robot in scenario.robots]
 
 
-def tolerance_of(tolerance: Quantity | None, mean: float, std: float, relation: Relation) -> float:
+def tolerance_of(tolerance: Quantity | None, mean: float, std: float, relation: BasicRelation) -> float:
     """An absolute tolerance: ``k std`` of the runs, ``p %`` of their mean, as written, or (none
     written) one standard deviation for ``invariant`` and nothing for the others."""
     if tolerance is None:
-        return std if relation is Relation.INVARIANT else 0.0
+        return std if relation is BasicRelation.INVARIANT else 0.0
     if tolerance.unit == "std":
         return tolerance.value * std
     if tolerance.unit == "%":

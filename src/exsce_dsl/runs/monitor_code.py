@@ -24,7 +24,7 @@ from pathlib import Path
 from exsce_dsl.lang.format_metrics import expression_text
 from exsce_dsl.model.expressions import Aggregate, Expression, Field, WindowValue, walk
 from exsce_dsl.model.messages import FEEDBACK, RESULT
-from exsce_dsl.model.metrics import Combine, MetricDefinition, Subject
+from exsce_dsl.model.metrics import Combine, ComputedFor, MetricDefinition
 
 GENERATOR = "exscec generate monitors"
 TEMPLATE = "monitors/monitors.py.j2"
@@ -116,7 +116,7 @@ def _array_topic(aggregate: Aggregate, variables: dict[tuple[str | None, str], s
 
 
 def _code(metric: MetricDefinition) -> MetricCode:
-    pairs = _PAIR_COMBINE[metric.combine] if metric.subject is Subject.PAIRS and metric.combine else None
+    pairs = _PAIR_COMBINE[metric.combine] if metric.subject is ComputedFor.PAIRS and metric.combine else None
     return MetricCode(metric.name, metric.meaning, alternatives(metric), pairs)
 
 
@@ -125,8 +125,8 @@ def monitor_source(metrics: Sequence[MetricDefinition], source: str, core_import
 
     ``core_import``: how the module imports the core (ingestion's default: from exsce).
     """
-    robot = [_code(m) for m in metrics if m.subject is Subject.ROBOT]
-    mission = [_code(m) for m in metrics if m.subject is not Subject.ROBOT]
+    robot = [_code(m) for m in metrics if m.subject is ComputedFor.ROBOT]
+    mission = [_code(m) for m in metrics if m.subject is not ComputedFor.ROBOT]
     reducers = []
     for code in robot + mission:
         for alt in code.alternatives:

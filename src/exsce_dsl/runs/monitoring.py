@@ -19,7 +19,7 @@ import numpy as np
 
 from exsce_dsl.model.geometry import Position
 from exsce_dsl.model.messages import path_of
-from exsce_dsl.model.metrics import MetricDefinition, Subject
+from exsce_dsl.model.metrics import ComputedFor, MetricDefinition
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import ActionId, Hotspot, MetricScope, MetricValue
 from exsce_dsl.runs import monitor_core as core
@@ -51,7 +51,7 @@ def compute_metrics(
     hotspots: list[Hotspot] = []
     done = [(a, a.start, a.end) for a in actions if a.start is not None and a.end is not None]
     spans = [(s, e) for _, s, e in done] + list((whole_runs or {}).values())
-    by_subject = {s: [m for m in metrics if m.subject is s] for s in Subject}
+    by_subject = {s: [m for m in metrics if m.subject is s] for s in ComputedFor}
     for robot in robots:
         mine: list[Window] = [(a, s, e) for a, s, e in done if a.robot == robot.id]
         whole = (whole_runs or {}).get(robot.id)
@@ -60,7 +60,7 @@ def compute_metrics(
             continue
         start, end = (min(s for _, s, _ in mine), max(e for _, _, e in mine)) if mine else whole  # type: ignore[misc]
         monitor = monitors.RobotMetrics(robot.id, robot.namespace, topics, results.get(robot.id))
-        for metric in by_subject[Subject.ROBOT]:
+        for metric in by_subject[ComputedFor.ROBOT]:
             values += _robot_values(monitor, metric, robot, [(None, start, end), *mine], problems)
             if metric.safety is not None:
                 values += _robot_violations(monitor, metric, robot, start, end, topics, hotspots)
@@ -68,7 +68,7 @@ def compute_metrics(
         start, end = min(s for s, _ in spans), max(e for _, e in spans)
         fleet = [(r.id, r.namespace) for r in robots]
         monitor = monitors.MissionMetrics(fleet, topics)
-        for metric in by_subject[Subject.MISSION] + by_subject[Subject.PAIRS]:
+        for metric in by_subject[ComputedFor.MISSION] + by_subject[ComputedFor.PAIRS]:
             values += _mission_values(monitor, metric, robots, start, end, topics, hotspots, problems)
     return values, hotspots
 
@@ -185,7 +185,7 @@ def _mission_values(
     problems: list[str],
 ) -> list[MetricValue]:
     value = getattr(monitor, f"get_{metric.name}")(start, end)
-    if metric.subject is Subject.MISSION:
+    if metric.subject is ComputedFor.MISSION:
         if value is None:
             problems.append(f"{metric.name} of the mission is missing")
             return []
