@@ -7,7 +7,7 @@ changing this file or grammar/common.tx, run
 
     python3 editors/vscode/syntaxes/generate_grammar.py
 
-and commit both files; tests/test_vscode_extension.py fails while they disagree.
+and commit both files; tests/lsp/test_vscode_extension.py fails while they disagree.
 
 The grammar follows grammar/*.tx construct by construct: each declaration is a
 begin/end region (`meta.declaration.<kind>.exsce`) whose body only knows the

@@ -102,13 +102,13 @@ def read_sources(
         if pf is None:
             for imported in imported_paths(text):
                 target = import_target(path, imported)
-                if target in overlay or Path(target).is_file():
+                if target in overlay or _is_file(target):
                     pending.append(target)
             continue
         parsed.append(pf)
         for imp in pf.tree.imports:
             target = import_target(path, imp.path)
-            if target not in overlay and not Path(target).is_file():
+            if target not in overlay and not _is_file(target):
                 diagnostics.append(
                     Diagnostic(
                         f"imported file '{imp.path}' not found (looked for {target})"
@@ -122,13 +122,22 @@ def read_sources(
     return sources
 
 
+def _is_file(target: str) -> bool:
+    """Whether ``target`` names a file; a name no file can have (too long, a NUL byte: an import
+    string of a broken file) names none."""
+    try:
+        return Path(target).is_file()
+    except (OSError, ValueError):
+        return False
+
+
 def _closest_file(written: str, target: str) -> str:
     """``; did you mean 'tasks.exsce'?``: the ``.exsce`` file of the target's folder most like
     the one not found, written as the import wrote its path."""
     folder = Path(target).parent
     try:
         names = [p.name for p in folder.iterdir() if p.suffix == ".exsce" and p.is_file()]
-    except OSError:
+    except (OSError, ValueError):  # no such folder, or a name no folder can have
         return ""
     match = closest(Path(written).name, names)
     if match is None:

@@ -16,7 +16,7 @@ import pytest
 
 from conftest import EXAMPLES, run_exscec
 
-DOC = Path(__file__).resolve().parents[1] / "docs" / "python.md"
+DOC = Path(__file__).resolve().parents[2] / "docs" / "python.md"
 
 
 def _blocks(text: str) -> list[str]:
@@ -100,7 +100,7 @@ def test_a_library_update_is_refused() -> None:
 
 
 def test_the_readme_example_runs_as_written(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text(encoding="utf-8")
     [block] = _blocks(readme)
     shutil.copytree(EXAMPLES, tmp_path / "examples")
     monkeypatch.chdir(tmp_path)

@@ -160,7 +160,7 @@ def test_the_formatter_prints_what_parses_back_to_the_same_model(tmp_path: Path,
 
 def test_the_readmes_robot_types_check(tmp_path: Path) -> None:
     """The robot types "Your robot's bags" shows are valid, with the sources the README says."""
-    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
     section = readme[readme.index("### Your robot's bags") :]
     block = section.split("```")[1]
     robot_types = _types(tmp_path, block)

@@ -23,7 +23,7 @@ from pyoxigraph import NamedNode as OxNamedNode
 from pyoxigraph import Store as OxStore
 from rdflib import RDF, RDFS, Dataset, Graph, Literal, Namespace, URIRef
 from rdflib.compare import isomorphic
-from test_prov_compile import large_scenario, merged, scenario_c
+from scenario_builders import large_scenario, merged, scenario_c
 
 from exsce_dsl.errors import ExportError
 from exsce_dsl.lang.build import load_spec
@@ -65,9 +65,9 @@ def test_the_text_does_not_depend_on_the_process() -> None:
     script = textwrap.dedent(
         f"""
         import hashlib, sys
-        sys.path.insert(0, {str(Path(__file__).parent)!r})
+        sys.path[:0] = [{str(Path(__file__).parent)!r}, {str(Path(__file__).parents[1])!r}]
         from test_rdf import every_format
-        from test_prov_compile import scenario_c
+        from scenario_builders import scenario_c
         from exsce_dsl.prov import compile_scenario
         texts = every_format(compile_scenario(scenario_c()))
         print(hashlib.sha256(repr(sorted(texts.items())).encode()).hexdigest())

@@ -15,7 +15,7 @@ import pytest
 
 from exsce_dsl.resources import package_file
 
-GOLDEN = Path(__file__).parent / "golden"
+GOLDEN = Path(__file__).parents[1] / "golden"
 _TYPES = {"int", "float", "str", "bool", "bytes", "list", "tuple", "dict", "set", "frozenset", "type"}
 _BUILTIN_GENERICS = {"list", "tuple", "dict", "set", "frozenset", "type"}
 

@@ -25,7 +25,7 @@ from conftest import EXAMPLES, FIXTURES
 
 SCENARIO_C = EXAMPLES / "brsu_building_c" / "scenario_c.exsce"
 SCENARIO_D = EXAMPLES / "brsu_building_c" / "scenario_d.exsce"
-GOLDEN = Path(__file__).parent / "golden" / "dispatcher"
+GOLDEN = Path(__file__).parents[1] / "golden" / "dispatcher"
 METHOD_TASKS = FIXTURES / "tasks" / "brsu_building_c_with_doors"
 
 

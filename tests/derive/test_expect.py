@@ -90,7 +90,7 @@ def test_observed_segments_and_an_estimate_add_up() -> None:
     assert (ab.value, ab.how, ab.runs) == (11.0, "observed", 2)
     assert (bc.value, bc.how, bc.runs) == (5.0, "observed", 2)
     assert cd.value is not None and math.isclose(cd.value, 6.0)
-    assert cd.how == "estimated from room-c–room-b" and cd.runs == 2
+    assert cd.how == "estimated from room-c–room-b (straight-line lengths)" and cd.runs == 2  # no map
     assert expected.value is not None and math.isclose(expected.value, 22.0)
 
 

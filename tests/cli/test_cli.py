@@ -178,7 +178,7 @@ def test_version_is_the_installed_distributions() -> None:
 
     result = run_exscec("--version")
     assert result.returncode == 0 and result.stdout.strip() == f"exscec, version {version('exsce')}"
-    changelog = (Path(__file__).resolve().parents[1] / "CHANGELOG.md").read_text(encoding="utf-8")
+    changelog = (Path(__file__).resolve().parents[2] / "CHANGELOG.md").read_text(encoding="utf-8")
     assert f"## [{version('exsce')}]" in changelog  # every released version has its entry
 
 

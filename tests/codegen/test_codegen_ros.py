@@ -47,7 +47,7 @@ from conftest import EXAMPLES, run_exscec
 
 BUILDING = EXAMPLES / "brsu_building_c"
 SPEC = BUILDING / "scenario_c.exsce"
-GOLDEN = Path(__file__).parent / "golden"
+GOLDEN = Path(__file__).parents[1] / "golden"
 PACKAGE = "exsce_monitor_scenario_c"
 SHARED = ("monitors.py", "monitor_core.py", "monitor_runtime.py")
 """The modules both packages carry as exsce makes them (compared with their sources, not golden)."""

@@ -418,3 +418,15 @@ def test_every_error_class_is_in_the_errors_module() -> None:
 def test_an_error_keeps_its_old_name_and_is_the_errors_modules_class(module: str, name: str) -> None:
     old = getattr(importlib.import_module(module), name)
     assert old is getattr(errors_module, name)
+
+
+def test_a_broken_file_whose_import_string_no_file_can_have_gives_diagnostics(tmp_path: Path) -> None:
+    """Found by the parser fuzzer: the imports of a file that does not parse are read from its text,
+    and a quoted run of 300 characters across lines is no file name (the OS says 'too long')."""
+    from exsce_dsl.lang.build import analyse
+
+    spec = tmp_path / "broken.exsce"
+    spec.write_text('import "a\n' + "x" * 300 + '.exsce"\nimport "b\x00.exsce"\nscenario {\n')
+    analysis = analyse(spec)
+    assert analysis.spec is None and analysis.errors
+    assert all(d.location is not None and d.location.file.endswith("broken.exsce") for d in analysis.errors)

@@ -24,7 +24,7 @@ from exsce_dsl.sim.run import simulate
 
 from conftest import EXAMPLES, run_exscec
 
-GOLDEN = Path(__file__).parent / "golden" / "monitors" / "scenario_c"
+GOLDEN = Path(__file__).parents[1] / "golden" / "monitors" / "scenario_c"
 SPEC = EXAMPLES / "brsu_building_c" / "scenario_c.exsce"
 
 

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-PACKAGE = Path(__file__).resolve().parents[1] / "src" / "exsce_dsl"
+PACKAGE = Path(__file__).resolve().parents[2] / "src" / "exsce_dsl"
 
 LAYERS: list[set[str]] = [
     {"errors", "suggest", "resources", "textfiles", "tables", "templating", "figures"},  # the base
