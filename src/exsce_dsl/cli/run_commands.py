@@ -36,8 +36,13 @@ from exsce_dsl.model.conventions import CONVENTIONS
     "--fault",
     "faults",
     multiple=True,
-    metavar="KIND[:ROBOT[:N]]",
-    help="overspeed:R, slow:R, skip-waypoint:R[:N], near-collision (repeatable).",
+    metavar="NAME[:ARGS]",
+    help="A deliberate fault (repeatable). Shown in every run: overspeed:ROBOT, slow:ROBOT, "
+    "skip-waypoint:ROBOT[:N], near-collision. Shown only when the scenario has the trigger "
+    "(latent, for metamorphic campaigns): slow-area:AREA (40 % speed once in AREA, until the "
+    "waypoint), detour:FROM:TO (legs from area FROM to area TO go via the start pose), "
+    "deadlock-start:ROBOT:POSE (every robot stands 120 s when ROBOT starts at POSE), "
+    "overspeed-many-tasks:N (a robot with more than N tasks drives over 1 m/s).",
 )
 @click.option("--scenario", "scenario_id", help="Which scenario, when the file declares several.")
 @click.option(
@@ -77,6 +82,14 @@ def simulate(
                  status and feedback, one goal per waypoint
       move_base  the same robot topics and move_base's goal, status,
                  feedback and result
+
+    \b
+    Latent faults (--fault) stay hidden in scenario_c's runs and show in
+    one derivation of it:
+      slow-area:classroom_c069                   add_robot --start classroom_c069-w001
+      detour:classroom_c018:classroom_c022       reverse_waypoint_order --task delivery_a
+      deadlock-start:tiago1:classroom_c025-w002  swap_start_poses --robot tiago1 --with tiago2
+      overspeed-many-tasks:2                     remove_robot --robot tiago2 --reassign tiago1
 
     \b
     Example:

@@ -19,6 +19,16 @@ import numpy as np
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import MissionType, Pose, Scenario
+from exsce_dsl.sim.faults import (
+    DEADLOCK_WAIT,
+    Fault,
+    area_boxes,
+    check_faults,
+    deadlocked,
+    detour_via,
+    slow_in_areas,
+    speed_factor,
+)
 from exsce_dsl.sim.motion import DT, Limits, Trajectory, drive
 from exsce_dsl.sim.planner import PlanningGrid
 
@@ -31,31 +41,6 @@ class GoalStatus(enum.IntEnum):
     PREEMPTED = 2
     SUCCEEDED = 3
     ABORTED = 4
-
-
-@dataclass(frozen=True)
-class Fault:
-    """A deliberate fault: ``overspeed:R``, ``slow:R``, ``skip-waypoint:R[:N]``, ``near-collision``."""
-
-    kind: str
-    robot: str | None = None
-    index: int = 1
-
-    KINDS = ("overspeed", "slow", "skip-waypoint", "near-collision")
-
-    @classmethod
-    def parse(cls, text: str) -> Fault:
-        kind, _, rest = text.partition(":")
-        if kind not in cls.KINDS:
-            raise ExsceError(f"unknown fault '{kind}'; known faults: {', '.join(cls.KINDS)}")
-        robot, _, index = rest.partition(":")
-        if kind in ("overspeed", "slow", "skip-waypoint") and not robot:
-            raise ExsceError(f"fault '{kind}' needs a robot: {kind}:<robot>")
-        try:
-            n = int(index) if index else 1
-        except ValueError:
-            raise ExsceError(f"fault '{text}': '{index}' is not a waypoint number") from None
-        return cls(kind, robot or None, n)
 
 
 @dataclass(frozen=True)
@@ -135,12 +120,7 @@ def execute(
 ) -> Execution:
     limits = limits or Limits()
     rng = random.Random(seed)
-    robots = {r.id: r for r in scenario.robots}
-    for fault in faults:
-        if fault.robot is not None and fault.robot not in robots:
-            raise ExsceError(
-                f"fault '{fault.kind}' names robot '{fault.robot}', which is not in {scenario.id}"
-            )
+    check_faults(scenario, faults)
     timelines: dict[str, Timeline] = {}
     for robot in scenario.robots:
         if robot.start_pose is None:
@@ -153,16 +133,20 @@ def execute(
         )
         tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, int(rng.uniform(0.5, 1.0) * 50)))
         timelines[robot.id] = tl
-    speed = {r: limits.max_speed * rng.uniform(0.9, 1.0) * _speed_factor(r, faults) for r in timelines}
+    speed = {
+        r: limits.max_speed * rng.uniform(0.9, 1.0) * speed_factor(scenario, r, faults) for r in timelines
+    }
     skip = {(f.robot, f.index) for f in faults if f.kind == "skip-waypoint"}
     events: list[GoalEvent] = []
     actions: list[Action] = []
     last_pose = {r.id: r.start_pose for r in scenario.robots if r.start_pose is not None}
     task_numbers: dict[str, int] = {}
     waypoint_counts: dict[str, int] = {}
-    detour: dict[str, list[Trajectory]] = {}
+    approach: dict[str, list[Trajectory]] = {}
     if any(f.kind == "near-collision" for f in faults):
-        detour = _near_collision(scenario, timelines, grid, limits)
+        approach = _near_collision(scenario, timelines, grid, limits)
+    slow_boxes = area_boxes(scenario, faults)
+    stuck = deadlocked(scenario, faults)
     last_entry = {entry.robot: n for n, entry in enumerate(scenario.mission.allocation)}
     parked: dict[str, tuple[float, float]] = {}
     """Where robots that have done all their tasks stand: later paths go round them."""
@@ -188,17 +172,20 @@ def execute(
                 statuses[w_number - 1] = GoalStatus.ACTIVE
                 start_t = tl.now
                 events.append(GoalEvent(start_t, entry.robot, key, ids, tuple(statuses), False))
+                if stuck and waypoint_counts[entry.robot] == 1:  # deadlock-start: every robot waits
+                    tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, int(round(DEADLOCK_WAIT / DT))))
                 previous = last_pose[entry.robot]
                 if (entry.robot, waypoint_counts[entry.robot]) in skip:
                     path = _plan_around(grid, (tl.x, tl.y), (goal.position.x, goal.position.y), parked)
                     tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, 25))
                     status, length = GoalStatus.ABORTED, 0.0
                 else:
-                    for leg in detour.pop(entry.robot, []):  # the near-collision fault, inside the mission
+                    for leg in approach.pop(entry.robot, []):  # the near-collision fault, inside the mission
                         tl.append(leg)
-                    path = _plan_around(grid, (tl.x, tl.y), (goal.position.x, goal.position.y), parked)
+                    via = detour_via(scenario, entry.robot, previous, goal, faults)
+                    path, driven = _drive_to(grid, tl, goal, via, parked, robot_limits)
                     length = sum(math.dist(path[i], path[i + 1]) for i in range(len(path) - 1))
-                    tl.append(drive(path, tl.yaw, goal.orientation.yaw, robot_limits))
+                    tl.append(slow_in_areas(driven, slow_boxes) if slow_boxes else driven)
                     status = GoalStatus.SUCCEEDED
                     last_pose[entry.robot] = goal
                 statuses[w_number - 1] = status
@@ -235,6 +222,28 @@ def execute(
     }
     events.sort(key=lambda e: (e.t, e.robot))
     return Execution(trajectories, events, actions, end * DT)
+
+
+def _drive_to(
+    grid: PlanningGrid,
+    tl: Timeline,
+    goal: Pose,
+    via: tuple[float, float] | None,
+    parked: dict[str, tuple[float, float]],
+    limits: Limits,
+) -> tuple[list[tuple[float, float]], Trajectory]:
+    """The path from where ``tl`` stands to ``goal`` (by way of ``via``, stopping there to turn:
+    the detour fault) and the drive along it."""
+    target = (goal.position.x, goal.position.y)
+    if via is None:
+        path = _plan_around(grid, (tl.x, tl.y), target, parked)
+        return path, drive(path, tl.yaw, goal.orientation.yaw, limits)
+    there = _plan_around(grid, (tl.x, tl.y), via, parked)
+    on = _plan_around(grid, via, target, parked)
+    heading = math.atan2(on[1][1] - on[0][1], on[1][0] - on[0][0])
+    first = drive(there, tl.yaw, heading, limits)
+    second = drive(on, heading, goal.orientation.yaw, limits)
+    return there + on[1:], Trajectory.concat([first, second])
 
 
 SAFE_DISTANCE = 1.5  # metres between robot centres that robots keep when they can
@@ -350,16 +359,6 @@ def _last_move(trajectory: Trajectory) -> int:
     """The last sample at which the robot is still moving (0 if it never moves)."""
     moved = np.flatnonzero((np.abs(np.diff(trajectory.x)) > 1e-9) | (np.abs(np.diff(trajectory.y)) > 1e-9))
     return int(moved[-1]) + 1 if len(moved) else 0
-
-
-def _speed_factor(robot: str, faults: tuple[Fault, ...]) -> float:
-    factor = 1.0
-    for f in faults:
-        if f.robot == robot and f.kind == "overspeed":
-            factor *= 1.0 / 0.6 * 1.4 / 0.95  # well over 1 m/s whatever the seeded speed
-        if f.robot == robot and f.kind == "slow":
-            factor *= 0.5
-    return factor
 
 
 def _near_collision(

@@ -73,7 +73,7 @@ def simulate(
         run_id = str(
             uuid.uuid5(
                 _RUN_NAMESPACE,
-                f"{scenario.id}/{seed}/{index}/{','.join(f.kind + str(f.robot) for f in faults)}{variant}",
+                f"{scenario.id}/{seed}/{index}/{','.join(f.identity for f in faults)}{variant}",
             )
         )
         execution = execute(scenario, grid, run_seed, tuple(faults))
