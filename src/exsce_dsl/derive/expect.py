@@ -11,9 +11,13 @@ area to its ends p1, p2: from each of (p3, p2), (p1, p4), (p3, p4) that has data
 ``m_ij * dist(p1, p2) / dist(p_i, p_j)``, averaged.  (The method's report writes
 the ratio upside down, which makes a longer neighbour segment give a *longer*
 estimate for a shorter one; scaling by the distance ratio this way keeps the unit
-"per metre".)  Without neighbour data, the fallback is the segment's straight-line
-length times the robot's value per straight-line metre on its segments that have a
-value (observed or estimated); with no value anywhere, there is no expected value.
+"per metre".)  ``dist`` is the length of the shortest path on the environment's
+occupancy grid (round walls, through doorways: :mod:`exsce_dsl.derive.grid_lengths`) when the
+environment declares a map file that can be read and joins the poses, else the straight-line
+distance; the segment's ``how`` says which.  Without neighbour data, the fallback is the
+segment's length (measured the same way) times the robot's value per metre of such length on its
+segments that have a value (observed or estimated); with no value anywhere, there is no expected
+value.
 """
 
 from __future__ import annotations
@@ -21,6 +25,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
+from exsce_dsl.derive.grid_lengths import grid_lengths
+from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import Pose, Scenario
 from exsce_dsl.model.acceptance import (
     Acceptance,
@@ -38,6 +44,13 @@ from exsce_dsl.store.queries import runs as stored_runs
 
 SUMMED = ("distance_travelled", "task_duration")
 """The metrics a robot's value of is the sum of its segments' values."""
+
+DISTANCE = "distance_travelled"
+
+DETOUR = 0.2
+"""A neighbour segment driven more than this fraction longer than its path on the grid was not
+a plain drive (the robot gave way, waited, went round another robot): an estimate from it scales
+by the distance driven on it, not by its grid path length (the grid knows walls, not robots)."""
 
 
 @dataclass(frozen=True)
@@ -89,9 +102,15 @@ def segment_value(
     start: Pose,
     goal: Pose,
     held_out: frozenset[frozenset[str]] = frozenset(),
+    on_grid: bool = True,
+    detour: float = DETOUR,
 ) -> ExpectedSegment:
     """One segment's value; ``held_out`` pairs of pose ids are treated as never driven (either way),
-    to measure the estimate against what was driven (bench/estimate.py)."""
+    to measure the estimate against what was driven (bench/estimate.py).  An estimate scales by
+    path lengths on the environment's occupancy grid when it declares one (and ``on_grid``), else
+    by straight-line lengths; its ``how`` says which.  On the grid, a neighbour driven more than
+    ``detour`` (a fraction) longer than its grid path is scaled by the distance driven instead
+    (see :data:`DETOUR`; ``math.inf``: never)."""
     names = (start.id, goal.id)
     found, reverse = _either_way(store, metric, start, goal, held_out)
     if found is not None:
@@ -103,21 +122,77 @@ def segment_value(
         return ExpectedSegment(*names, None, "no data, and no pose near it to estimate from")
     p3 = min(near_start, key=lambda p: math.dist(_xy(p), _xy(start)))  # in p1's area
     p4 = min(near_goal, key=lambda p: math.dist(_xy(p), _xy(goal)))  # in p2's area
-    estimates, used, runs = [], [], 0
+    neighbours = []
     for i, j in ((p3, goal), (start, p4), (p3, p4)):
-        length = math.dist(_xy(i), _xy(j))
-        if length == 0:
-            continue
         near, _ = _either_way(store, metric, i, j, held_out)
         if near is not None:
-            estimates.append(near.mean * math.dist(_xy(start), _xy(goal)) / length)
-            used.append(f"{i.id}–{j.id}")
-            runs += near.count
+            neighbours.append((i, j, near))
+    if not neighbours:
+        return ExpectedSegment(*names, None, f"no data, nor for {p3.id} and {p4.id} near its ends")
+    lengths = _lengths(scenario, on_grid, [(start, goal)] + [(i, j) for i, j, _ in neighbours])
+    estimates, used, notes, runs = [], [], [], 0
+    for i, j, near in neighbours:
+        length = lengths.of(i, j)
+        if length == 0:
+            continue
+        if lengths.on_grid:  # a detour the grid does not know: scale by the distance driven instead
+            driven = near if metric == DISTANCE else _either_way(store, DISTANCE, i, j, held_out)[0]
+            if driven is not None and driven.mean > (1.0 + detour) * length:
+                longer = driven.mean / length - 1.0
+                notes.append(f"{i.id}–{j.id} per metre driven, {longer:.0%} longer than its grid path")
+                length = driven.mean
+        estimates.append(near.mean * lengths.of(start, goal) / length)
+        used.append(f"{i.id}–{j.id}")
+        runs += near.count
     if not estimates:
         return ExpectedSegment(*names, None, f"no data, nor for {p3.id} and {p4.id} near its ends")
     return ExpectedSegment(
-        *names, math.fsum(estimates) / len(estimates), f"estimated from {', '.join(used)}", runs
+        *names,
+        math.fsum(estimates) / len(estimates),
+        f"estimated from {', '.join(used)} ({'; '.join([lengths.words, *notes])})",
+        runs,
     )
+
+
+@dataclass(frozen=True)
+class _Lengths:
+    """Lengths between poses (by id), measured one way for a whole estimate (ratios of lengths
+    measured differently would mean nothing): on the occupancy grid, or in straight lines."""
+
+    measured: dict[tuple[str, str], float]
+    on_grid: bool
+    why: str = ""
+    """Why not on the grid, when the environment declares one."""
+
+    def of(self, a: Pose, b: Pose) -> float:
+        return self.measured[(a.id, b.id)]
+
+    @property
+    def words(self) -> str:
+        return (
+            "grid path lengths"
+            if self.on_grid
+            else "straight-line lengths" + (f": {self.why}" if self.why else "")
+        )
+
+
+def _lengths(scenario: Scenario, on_grid: bool, pairs: list[tuple[Pose, Pose]]) -> _Lengths:
+    """Path lengths on the environment's occupancy grid when it has one and every pair is joined on
+    it, else straight-line lengths, with the reason when a declared grid could not be used."""
+    straight = {(a.id, b.id): math.dist(_xy(a), _xy(b)) for a, b in pairs}
+    if not on_grid:
+        return _Lengths(straight, False)
+    try:
+        grid = grid_lengths(scenario)
+    except ExsceError as error:
+        return _Lengths(straight, False, f"its grid cannot be used ({error})")
+    if grid is None:
+        return _Lengths(straight, False)
+    on_map = {(a.id, b.id): grid.length(_xy(a), _xy(b)) for a, b in pairs}
+    for (a, b), length in on_map.items():
+        if length is None:
+            return _Lengths(straight, False, f"no path from {a} to {b} on its grid")
+    return _Lengths({k: v for k, v in on_map.items() if v is not None}, True)
 
 
 def expected_metric(store: Store, scenario: Scenario, robot: str, metric: str) -> Expected:
@@ -126,7 +201,8 @@ def expected_metric(store: Store, scenario: Scenario, robot: str, metric: str) -
         raise ValueError(f"'{metric}' is not a sum over path segments")
     path = robot_path(scenario, robot)
     parts = tuple(segment_value(store, scenario, metric, a, b) for a, b in path)
-    parts = _fall_back(parts, path)
+    if any(p.value is None for p in parts):
+        parts = _fall_back(parts, path, _lengths(scenario, True, path))
     values = [p.value for p in parts]
     total = math.fsum(v for v in values if v is not None) if parts and None not in values else None
     return Expected(robot, metric, total, parts)
@@ -139,26 +215,25 @@ def _area_poses(scenario: Scenario, pose: Pose, leave_out: tuple[str, ...]) -> l
 
 
 def _fall_back(
-    parts: tuple[ExpectedSegment, ...], path: list[tuple[Pose, Pose]]
+    parts: tuple[ExpectedSegment, ...], path: list[tuple[Pose, Pose]], lengths: _Lengths
 ) -> tuple[ExpectedSegment, ...]:
-    """Segments with no value and no neighbour data: their straight-line length times the
-    robot's value per straight-line metre over the segments that have a value."""
+    """Segments with no value and no neighbour data: their length (on the grid, or straight) times
+    the robot's value per metre of such length over the segments that have a value."""
     known = [
-        (p.value, math.dist(_xy(a), _xy(b)))
-        for p, (a, b) in zip(parts, path, strict=True)
-        if p.value is not None
+        (p.value, lengths.of(a, b)) for p, (a, b) in zip(parts, path, strict=True) if p.value is not None
     ]
     metres = math.fsum(d for _, d in known)
     if not known or metres == 0:
         return parts
     rate = math.fsum(v for v, _ in known) / metres
+    length = "grid path length" if lengths.on_grid else "straight length"
     return tuple(
         p
         if p.value is not None
         else replace(
             p,
-            value=rate * math.dist(_xy(a), _xy(b)),
-            how=f"{p.how}: its straight length × {rate:.3g} per metre, as on the robot's other segments",
+            value=rate * lengths.of(a, b),
+            how=f"{p.how}: its {length} × {rate:.3g} per metre, as on the robot's other segments",
         )
         for p, (a, b) in zip(parts, path, strict=True)
     )
