@@ -86,7 +86,21 @@ def test_ten_thousand_errors_give_bounded_output(tmp_path: Path) -> None:
     assert result.exit_code == 1 and "Traceback" not in said
     assert said.count("error:") >= 50  # several errors are shown ...
     assert len(said.splitlines()) <= 250 and len(said) < 60_000  # ... but not ten thousand of them
-    assert "more errors" in said
+    from exsce_dsl.lang.build import analyse
+
+    total = len(analyse(spec).diagnostics)
+    assert f"... and {total - 100} more errors (the first 100 are shown)" in said.splitlines()
+
+
+def test_hidden_diagnostics_are_counted_by_severity(capsys: pytest.CaptureFixture[str]) -> None:
+    from exsce_dsl.cli.common import SHOWN_DIAGNOSTICS, print_diagnostics
+    from exsce_dsl.errors import Diagnostic, Severity
+
+    shown = [Diagnostic(f"e{i}") for i in range(SHOWN_DIAGNOSTICS)]
+    hidden = [Diagnostic("late"), Diagnostic("why", severity=Severity.NOTE), Diagnostic("x", severity="note")]
+    print_diagnostics(shown + hidden)
+    last = capsys.readouterr().err.splitlines()[-1]
+    assert last == f"... and 3 more (1 error, 2 notes) (the first {SHOWN_DIAGNOSTICS} are shown)"
 
 
 def test_a_spec_that_is_not_valid_utf8_is_reported_at_its_file(tmp_path: Path) -> None:

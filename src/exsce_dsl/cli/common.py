@@ -5,6 +5,7 @@ from __future__ import annotations
 import functools
 import os
 import sys
+from collections import Counter
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from types import TracebackType
@@ -32,8 +33,14 @@ def print_diagnostics(diagnostics: Iterable[Diagnostic]) -> None:
     for d in found[:SHOWN_DIAGNOSTICS]:
         click.echo(str(d), err=True)
     if len(found) > SHOWN_DIAGNOSTICS:
-        hidden = len(found) - SHOWN_DIAGNOSTICS
-        click.echo(f"... and {hidden} more errors (the first {SHOWN_DIAGNOSTICS} are shown)", err=True)
+        hidden = Counter(str(d.severity) for d in found[SHOWN_DIAGNOSTICS:])
+        total = sum(hidden.values())
+        if set(hidden) == {"error"}:  # the usual case
+            said = f"{total} more error{'s' if total != 1 else ''}"
+        else:  # notes and warnings are not counted as errors
+            kinds = ", ".join(f"{n} {kind}{'s' if n != 1 else ''}" for kind, n in sorted(hidden.items()))
+            said = f"{total} more ({kinds})"
+        click.echo(f"... and {said} (the first {SHOWN_DIAGNOSTICS} are shown)", err=True)
 
 
 def reports_errors(func: F) -> F:
