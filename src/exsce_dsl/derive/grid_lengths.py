@@ -27,10 +27,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy import ndimage
-from scipy.sparse import coo_matrix, csr_matrix
+from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from exsce_dsl.model import Scenario
+from exsce_dsl.sim.planner import grid_graph
 
 if TYPE_CHECKING:
     from exsce_dsl.sim.planner import PlanningGrid
@@ -200,24 +201,9 @@ class GridLengths:
 
 
 def _free_space_graph(free: np.ndarray, node: np.ndarray, cell: float) -> csr_matrix:
-    """The 8-connected graph of the free cells, edges weighted by their length in metres."""
-    rows, cols = free.shape
-    sources, targets, weights = [], [], []
-    for dr, dc in ((0, 1), (1, 0), (1, 1), (1, -1)):
-        r0, r1 = max(0, -dr), rows - max(0, dr)
-        c0, c1 = max(0, -dc), cols - max(0, dc)
-        both = free[r0:r1, c0:c1] & free[r0 + dr : r1 + dr, c0 + dc : c1 + dc]
-        if dr and dc:  # no corner cutting: both cells beside the diagonal are free too
-            both &= free[r0 + dr : r1 + dr, c0:c1] & free[r0:r1, c0 + dc : c1 + dc]
-        sources.append(node[r0:r1, c0:c1][both])
-        targets.append(node[r0 + dr : r1 + dr, c0 + dc : c1 + dc][both])
-        weights.append(np.full(int(both.sum()), cell * math.hypot(dr, dc)))
-    src, dst, w = np.concatenate(sources), np.concatenate(targets), np.concatenate(weights)
-    n = int(free.sum())
-    graph = coo_matrix(
-        (np.concatenate([w, w]), (np.concatenate([src, dst]), np.concatenate([dst, src]))), (n, n)
-    )
-    return graph.tocsr()
+    """The 8-connected graph of the free cells, edges weighted by their length in metres (the
+    planner's graph without its wall penalty)."""
+    return grid_graph(free, cell, node=node)
 
 
 _LOADED: OrderedDict[str, GridLengths] = OrderedDict()

@@ -158,24 +158,36 @@ class PlanningGrid:
 
 
 def _grid_graph(free: np.ndarray, clearance: np.ndarray, cell: float, robot_radius: float) -> csr_matrix:
-    rows, cols = free.shape
-    index = np.arange(rows * cols).reshape(rows, cols)
     # cells near walls cost more, so paths keep some clearance (as a costmap would)
     penalty = 1.0 + 2.0 * np.clip(1.0 - (clearance - robot_radius) / 0.5, 0.0, 1.0)
+    return grid_graph(free, cell, penalty)
+
+
+def grid_graph(
+    free: np.ndarray, cell: float, penalty: np.ndarray | None = None, node: np.ndarray | None = None
+) -> csr_matrix:
+    """The 8-connected graph of the ``free`` cells (no corner cutting), each edge weighted by its
+    length in metres, times the mean ``penalty`` of its two cells when given.  ``node`` numbers the
+    cells (default: row by row, every cell a node)."""
+    rows, cols = free.shape
+    index = np.arange(rows * cols).reshape(rows, cols) if node is None else node
     sources, targets, weights = [], [], []
     for dr, dc in ((0, 1), (1, 0), (1, 1), (1, -1)):
         r0, r1 = max(0, -dr), rows - max(0, dr)
         c0, c1 = max(0, -dc), cols - max(0, dc)
         a = free[r0:r1, c0:c1] & free[r0 + dr : r1 + dr, c0 + dc : c1 + dc]
-        if dr and dc:  # no corner cutting
+        if dr and dc:  # no corner cutting: both cells beside the diagonal are free too
             a &= free[r0 + dr : r1 + dr, c0:c1] & free[r0:r1, c0 + dc : c1 + dc]
         step = cell * math.hypot(dr, dc)
-        cost = step * 0.5 * (penalty[r0:r1, c0:c1] + penalty[r0 + dr : r1 + dr, c0 + dc : c1 + dc])
+        if penalty is None:
+            weights.append(np.full(int(a.sum()), step))
+        else:
+            cost = step * 0.5 * (penalty[r0:r1, c0:c1] + penalty[r0 + dr : r1 + dr, c0 + dc : c1 + dc])
+            weights.append(cost[a])
         sources.append(index[r0:r1, c0:c1][a])
         targets.append(index[r0 + dr : r1 + dr, c0 + dc : c1 + dc][a])
-        weights.append(cost[a])
     src, dst, w = np.concatenate(sources), np.concatenate(targets), np.concatenate(weights)
-    n = rows * cols
+    n = int(index.max()) + 1
     graph = coo_matrix(
         (np.concatenate([w, w]), (np.concatenate([src, dst]), np.concatenate([dst, src]))), (n, n)
     )
