@@ -267,8 +267,10 @@ def metamorphic_acceptance(
       |E - B| within A of BASE`` (B the base's mean, A = P % of E), or ``is invariant within A of
       BASE`` when the change is within that allowance.
 
-    P is ``tolerance_percent``; waypoints are counted, so exactly.  Robots without an expected
-    value or without base runs get no performance clause."""
+    P is ``tolerance_percent``; waypoints are counted, so exactly.  A robot the base does not
+    have (``add_robot``, ``replace_robot``) gets its own-baseline clauses only: a slow-down of the
+    new robot is caught, and there is nothing of the base to relate it to.  Without an expected
+    value, or for a robot the base's runs do not show, there is no performance clause."""
     safety = []
     if base_acceptance is not None:
         robots = {r.id for r in derived.robots}
@@ -285,25 +287,25 @@ def metamorphic_acceptance(
     performance: list[Expectation] = []
     base_runs = [run.uuid for run in stored_runs(store, base.id)]
     for robot in derived.robots:
-        if base.robot(robot.id) is None:
-            continue
         subject = Subject(Quantifier.ROBOT, robot.id)
+        in_base = base.robot(robot.id) is not None
         for metric in SUMMED:
             expected = expected_metric(store, derived, robot.id, metric).value
-            before = robot_metric_over_runs(store, metric, robot.id, base_runs)
-            if expected is None or before is None:
+            if expected is None:
                 continue
+            before = robot_metric_over_runs(store, metric, robot.id, base_runs) if in_base else None
             unit = "m" if metric == "distance_travelled" else "s"
             allowance = abs(expected) * tolerance_percent / 100.0
             performance.extend(
-                _expected_clauses(subject, metric, expected, before.mean, allowance, unit, base.id)
+                _expected_clauses(subject, metric, expected, before, allowance, unit, base.id)
             )
         waypoints = len(robot_path(derived, robot.id))
-        before = robot_metric_over_runs(store, "waypoints_visited", robot.id, base_runs)
-        if before is not None:
-            performance.extend(
-                _expected_clauses(subject, "waypoints_visited", waypoints, before.mean, 0.0, None, base.id)
-            )
+        before = robot_metric_over_runs(store, "waypoints_visited", robot.id, base_runs) if in_base else None
+        if in_base and before is None:
+            continue  # the base's runs do not count this robot's waypoints: nothing to expect
+        performance.extend(
+            _expected_clauses(subject, "waypoints_visited", waypoints, before, 0.0, None, base.id)
+        )
     when = When(mission=derived.mission.id)  # empty criteria are left out: an empty block is an error
     criteria = []
     if safety:
@@ -317,12 +319,13 @@ def _expected_clauses(
     subject: Subject,
     metric: str,
     expected: float,
-    base_mean: float,
+    before: ValueStats | None,
     allowance: float,
     unit: str | None,
     base: str,
 ) -> list[Expectation]:
-    """The own-baseline clause and the metamorphic one for one expected value (see above)."""
+    """The own-baseline clause and the metamorphic one for one expected value (see above); a
+    robot the base does not have (``before`` None) has no relation to the base, only its own."""
 
     def quantity(value: float) -> Quantity:
         return Quantity(round(value, 3), unit)
@@ -334,7 +337,9 @@ def _expected_clauses(
         value=quantity(expected),
         tolerance=Quantity(round(100.0 * allowance / abs(expected), 3), "%") if expected else quantity(0.0),
     )
-    change = expected - base_mean
+    if before is None:
+        return [own]
+    change = expected - before.mean
     if abs(change) <= allowance:
         same = Expectation(
             subject, metric, BasicRelation.INVARIANT, tolerance=quantity(allowance), against=base

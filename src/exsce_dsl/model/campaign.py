@@ -1,0 +1,114 @@
+"""What an exploration campaign did, as it is written to the store and read back: the campaign
+itself, each derivation it tried (a *trial*) and each violation it shrank.
+
+A *relation* here is one oracle of a derived scenario, named by what it checks (robot, metric,
+relationship), not by the scenario: the same relation can then be looked for in a smaller
+derivation, whose scenario has another id.
+"""
+
+from __future__ import annotations
+
+import datetime
+from dataclasses import dataclass
+
+Request = tuple[str, dict[str, str]]
+"""A transformation step as ``derive`` takes it: ``("remove_robot", {"robot": "tiago2"})``."""
+
+
+@dataclass(frozen=True, order=True)
+class Relation:
+    """What an oracle checks: ``tiago1 task_duration invariant``."""
+
+    metric: str
+    robot: str | None
+    relationship: str
+
+    @property
+    def text(self) -> str:
+        return " ".join(p for p in (self.robot, self.metric, self.relationship) if p)
+
+    @classmethod
+    def parse(cls, text: str) -> Relation:
+        """The inverse of :attr:`text` (a robot-less relation has two words)."""
+        words = text.split()
+        if len(words) == 2:
+            return cls(words[0], None, words[1])
+        robot, metric, relationship = words
+        return cls(metric, robot, relationship)
+
+
+@dataclass(frozen=True)
+class CampaignPlan:
+    """How a campaign explores; its id comes from all of it but the budget (a larger budget, the
+    same command otherwise, goes on with the same campaign)."""
+
+    id: str
+    base: str
+    """The base scenario's id."""
+    budget: int
+    seed: int
+    runs_per_scenario: int
+    max_steps: int
+    transformations: tuple[str, ...]
+    """Only these transformations (empty: every one)."""
+    executor: str
+    """What executed the runs: ``simulator``, ``simulator --fault slow-area:classroom_c069``, a command."""
+    strategy: str
+    relations: bool
+    """Whether derived scenarios are checked against their metamorphic relations (else their
+    base's safety limits only)."""
+    tolerance: float
+    """Percent of an expected value a run may be off."""
+
+
+@dataclass(frozen=True)
+class Trial:
+    """One derivation tried: its scenario, its runs, and the relations checked and violated."""
+
+    campaign: str
+    number: int
+    """1, 2, ...: the order of the draws."""
+    scenario: str
+    steps: tuple[Request, ...]
+    runs: tuple[str, ...]
+    checked: tuple[Relation, ...]
+    violated: tuple[Relation, ...]
+    """Failed in more than half of the runs."""
+    failing_verdicts: tuple[tuple[str, str], ...] = ()
+    """``(run uuid, verdict local name)`` of every failed verdict of a violated relation."""
+
+    @property
+    def outcome(self) -> str:
+        return "violated" if self.violated else "passed" if self.checked else "unchecked"
+
+
+@dataclass(frozen=True)
+class ShrinkTry:
+    scenario: str
+    steps: tuple[Request, ...]
+    violated: bool
+
+
+@dataclass(frozen=True)
+class Shrinking:
+    """A violated relation, the trial it was found in and the smallest derivation that still violates it."""
+
+    campaign: str
+    number: int
+    relation: Relation
+    trial: int
+    original: str
+    """The scenario of the trial it was found in."""
+    minimal: str
+    minimal_steps: tuple[Request, ...]
+    tries: tuple[ShrinkTry, ...]
+
+
+@dataclass(frozen=True)
+class CampaignRecord:
+    """A campaign as the store holds it."""
+
+    plan: CampaignPlan
+    started: datetime.datetime | None
+    trials: tuple[Trial, ...]
+    shrinkings: tuple[Shrinking, ...]
