@@ -83,15 +83,17 @@ class StoredDerivation:
     oracles_written: WriteReport | None = None
 
 
-def add_derivation(store: Store, derived: DerivedSpec) -> StoredDerivation:
-    """Add the base and the derived scenario, the generation (one activity per step) and, when
-    the derived file has acceptance criteria, its oracles."""
+def add_derivation(store: Store, derived: DerivedSpec, generation: bool = True) -> StoredDerivation:
+    """Add the base and the derived scenario, the generation (one activity per step; not with
+    ``generation=False``: the store has another way to the same scenario) and, when the derived
+    file has acceptance criteria, its oracles."""
     add_prov(store, compile_scenario(derived.base))
     scenario = add_prov(store, compile_scenario(derived.scenario))
-    generation = add_prov(store, compile_derivation(derived.derived.derivation))
+    made = compile_derivation(derived.derived.derivation)
+    generated = add_prov(store, made) if generation else WriteReport(store.location)
     if derived.criteria is None:
-        return StoredDerivation(scenario, generation)
+        return StoredDerivation(scenario, generated)
     base = derived.base
     oracles = baseline_oracles(store, derived.criteria, derived.scenario, {base.id: base})
     written = add_prov(store, compile_oracles(derived.scenario.id, oracles), replace=True)
-    return StoredDerivation(scenario, generation, tuple(oracles), written)
+    return StoredDerivation(scenario, generated, tuple(oracles), written)

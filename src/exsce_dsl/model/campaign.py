@@ -9,32 +9,39 @@ derivation, whose scenario has another id.
 from __future__ import annotations
 
 import datetime
+from collections.abc import Mapping
 from dataclasses import dataclass
 
-Request = tuple[str, dict[str, str]]
+Request = tuple[str, Mapping[str, str]]
 """A transformation step as ``derive`` takes it: ``("remove_robot", {"robot": "tiago2"})``."""
 
 
-@dataclass(frozen=True, order=True)
+@dataclass(frozen=True)
 class Relation:
-    """What an oracle checks: ``tiago1 task_duration invariant``."""
+    """What an oracle checks: ``tiago1 task_duration invariant``, ``tiago1 task_duration
+    increasing vs scenario_c`` (a metamorphic relation to the base's runs)."""
 
     metric: str
     robot: str | None
     relationship: str
+    against: str | None = None
 
     @property
     def text(self) -> str:
-        return " ".join(p for p in (self.robot, self.metric, self.relationship) if p)
+        against = f"vs {self.against}" if self.against else None
+        return " ".join(p for p in (self.robot, self.metric, self.relationship, against) if p)
 
     @classmethod
     def parse(cls, text: str) -> Relation:
-        """The inverse of :attr:`text` (a robot-less relation has two words)."""
+        """The inverse of :attr:`text`."""
         words = text.split()
+        against = None
+        if len(words) >= 2 and words[-2] == "vs":
+            against, words = words[-1], words[:-2]
         if len(words) == 2:
-            return cls(words[0], None, words[1])
+            return cls(words[0], None, words[1], against)
         robot, metric, relationship = words
-        return cls(metric, robot, relationship)
+        return cls(metric, robot, relationship, against)
 
 
 @dataclass(frozen=True)

@@ -43,6 +43,9 @@ class Verdict:
     """The part of the run looked at (``during delivery_a``), None for the whole run."""
     sources: tuple[str, ...] = ()
     reason: str = ""
+    against: str | None = None
+    """For a metamorphic oracle, the base scenario whose runs it compares the run with (None:
+    the run's own scenario).  A derived scenario can have both about one metric."""
 
     @property
     def description(self) -> str:
@@ -51,4 +54,5 @@ class Verdict:
         bound = self.limit if self.limit is not None else self.expected
         shown = f" {bound:g}" if bound is not None else ""
         window = f" {self.window}" if self.window else ""
-        return f"{who}{self.metric} {self.relation}{shown}{window}"
+        against = f" of {self.against}" if self.against else ""
+        return f"{who}{self.metric} {self.relation}{shown}{against}{window}"

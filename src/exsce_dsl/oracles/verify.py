@@ -68,6 +68,7 @@ def _verdict(run: str, scenario: str, oracle: Oracle, observed: float | None, wh
         "tolerance": oracle.tolerance,
         "window": oracle.window,
         "sources": oracle.sources,
+        "against": oracle.base_scenario if oracle.base_scenario not in (None, scenario) else None,
     }
     if observed is None:
         return Verdict(**common, outcome=Outcome.UNJUDGED, reason=why)  # type: ignore[arg-type]

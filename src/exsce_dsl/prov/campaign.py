@@ -30,7 +30,14 @@ from exsce_dsl.prov import identifiers as ids
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, Namespaces, Term
 from exsce_dsl.prov.records import DocumentWriter
 
-__all__ = ["CAMPAIGN_TYPE", "SHRINK_TYPE", "TRIAL_TYPE", "compile_campaign", "compile_shrinking", "compile_trial"]
+__all__ = [
+    "CAMPAIGN_TYPE",
+    "SHRINK_TYPE",
+    "TRIAL_TYPE",
+    "compile_campaign",
+    "compile_shrinking",
+    "compile_trial",
+]
 
 CAMPAIGN_TYPE = Term(ids.EXSCE, "campaign")
 TRIAL_TYPE = Term(ids.EXSCE, "trial")
@@ -133,7 +140,9 @@ def compile_shrinking(shrinking: Shrinking, namespace: str = DEFAULT_NAMESPACE) 
     writer, names, iri = _writer(shrinking.campaign, namespace)
     parts = writer.element_namespace(shrinking.campaign, iri, "campaign")
     name = f"shrink_{shrinking.number:02d}"
-    w = writer.bundle(parts[f"{name}_bundle"], f"shrinking {shrinking.number} of campaign {shrinking.campaign}")
+    w = writer.bundle(
+        parts[f"{name}_bundle"], f"shrinking {shrinking.number} of campaign {shrinking.campaign}"
+    )
     t = w.term
     mine = w.of_element(shrinking.campaign, iri, "campaign")
     scenarios = w.fixed(ids.EXSCE)

@@ -312,6 +312,8 @@ ORACLE_RUNS = Term(ORACLE, "runs")
 ORACLE_OUTCOME = Term(ORACLE, "outcome")
 ORACLE_MARGIN = Term(ORACLE, "margin")
 ORACLE_REASON = Term(ORACLE, "reason")
+ORACLE_AGAINST = Term(ORACLE, "against")
+"""On a verdict of a metamorphic oracle: the base scenario it compared with."""
 VALIDATION_TYPE = Term(EXSCE, "validation")
 VERDICT_TYPE = Term(EXSCE, "verdict")
 VERDICTS_BUNDLE = "verdicts_bundle"

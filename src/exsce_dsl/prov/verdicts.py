@@ -5,7 +5,8 @@
 * the activity ``run_<uuid>:validation`` (``prov:type=exsce:validation``, ``exsce:run``,
   ended at the time of judging), informed by each oracle activity it applied
   (``<scenario>:<oracle>``, in the oracles' bundle);
-* per oracle, the entity ``run_<uuid>:verdict-<oracle>`` (``prov:type=exsce:verdict``,
+* per oracle, the entity ``run_<uuid>:verdict-<oracle>-<relation>`` (``-vs-<base>`` before the
+  relation for a metamorphic oracle, with ``oracle:against`` the base; ``prov:type=exsce:verdict``,
   ``oracle:outcome`` passed / failed / unjudged, ``prov:value`` the value observed,
   ``oracle:value`` / ``oracle:limit`` / ``oracle:delta`` / ``oracle:tolerance`` the
   expectation, ``oracle:margin``, ``oracle:runs`` the runs the expectation came from,
@@ -68,8 +69,9 @@ def compile_verdicts(
         if oracle not in informants:
             informants.append(oracle)
             w.informed(validation, oracle)
-        entity = parts[f"verdict-{verdict.oracle}-{verdict.relation}"]
-        writer.claim(entity, f"the verdict of '{verdict.oracle}' ({verdict.relation})")
+        against = "" if verdict.against is None else f"-vs-{ids.check_name(verdict.against, 'scenario id')}"
+        entity = parts[f"verdict-{verdict.oracle}{against}-{verdict.relation}"]
+        writer.claim(entity, f"the verdict of '{verdict.oracle}' ({verdict.relation}{against})")
         facts: Attributes = {
             PROV_TYPE: t(ids.VERDICT_TYPE),
             t(ids.ORACLE_OUTCOME): verdict.outcome.value,
@@ -96,6 +98,8 @@ def compile_verdicts(
             facts[t(ids.ORACLE_RUNS)] = " ".join(verdict.sources)
         if verdict.reason:
             facts[t(ids.ORACLE_REASON)] = verdict.reason
+        if verdict.against is not None:
+            facts[t(ids.ORACLE_AGAINST)] = verdict.against
         w.entity(entity, facts)
         w.generated(entity, validation)
         if verdict.window is None and verdict.observed is not None and verdict.metric != "violation_duration":

@@ -22,6 +22,7 @@ from exsce_dsl.model.oracles import Oracle
 from exsce_dsl.model.runs import Hotspot
 from exsce_dsl.model.scenario import Scenario
 from exsce_dsl.model.verdicts import Outcome, Verdict
+from exsce_dsl.report.campaigns import CampaignContents, gather_campaigns
 from exsce_dsl.report.units import metric_units
 from exsce_dsl.similarity.clustering import Clustering, cluster
 from exsce_dsl.similarity.facts import scenario_facts
@@ -96,6 +97,8 @@ class ReportContents:
     """What could not be shown, and why."""
     units: Mapping[str, str] = field(default_factory=dict)
     """Metric name → the unit its numbers are shown with (see :mod:`.units`)."""
+    campaigns: tuple[CampaignContents, ...] = field(default=())
+    """Every exploration campaign of the store, oldest first (see :mod:`.campaigns`)."""
 
     def unit(self, metric: str) -> str:
         """The unit of ``metric``'s numbers ('' for a metric nothing declares)."""
@@ -103,6 +106,10 @@ class ReportContents:
 
     def scenario(self, scenario_id: str) -> ScenarioContents:
         return next(s for s in self.scenarios if s.id == scenario_id)
+
+    def has_scenario(self, scenario_id: str) -> bool:
+        """Whether the report has a page of the scenario (the store holds it)."""
+        return any(s.id == scenario_id for s in self.scenarios)
 
     def roots(self) -> tuple[str, ...]:
         """Scenarios written by hand, or whose base is not in the store: the lineage trees' roots."""
@@ -155,7 +162,14 @@ def gather(store: Store, specs: Sequence[Path] = ()) -> ReportContents:
         notes.append("no occupancy grid: pass the scenarios' .exsce files with --spec to draw paths on a map")
     definitions: list[MetricDefinition] = [d for scenario in declared for d in scenario.metrics]
     units = metric_units((v for s in scenarios for v in s.values), definitions)
-    return ReportContents(tuple(scenarios), failures_first(all_verdicts), clustering, tuple(notes), units)
+    return ReportContents(
+        tuple(scenarios),
+        failures_first(all_verdicts),
+        clustering,
+        tuple(notes),
+        units,
+        gather_campaigns(store),
+    )
 
 
 def _waypoints(store: Store, scenario_id: str) -> dict[str, tuple[tuple[str, float, float], ...]]:

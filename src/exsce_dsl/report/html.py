@@ -24,7 +24,7 @@ from exsce_dsl.model.derivation import Derivation
 from exsce_dsl.model.verdicts import Verdict
 from exsce_dsl.oracles.report import expectation
 from exsce_dsl.report.contents import ReportContents, RunContents, ScenarioContents
-from exsce_dsl.report.plots import metrics_figure, trajectory_figure
+from exsce_dsl.report.plots import campaign_figure, metrics_figure, trajectory_figure
 from exsce_dsl.resources import resource_dir
 from exsce_dsl.runs.bagdata import BagError
 from exsce_dsl.runs.trajectories import Trajectory, trajectories
@@ -61,6 +61,7 @@ def _environment() -> jinja2.Environment:
     env.filters["steps"] = _steps
     env.globals["scenario_page"] = lambda s: page_name("scenario", s) + ".html"
     env.globals["run_page"] = lambda r: page_name("run", r) + ".html"
+    env.globals["campaign_page"] = lambda c: page_name("campaign", c) + ".html"
     return env
 
 
@@ -111,6 +112,11 @@ def write_report(
         save_figure(figure, folder / dendrogram)
         save_figure(figure, folder / "images" / "dendrogram.png")
     _write(env, "index.html.j2", folder / "index.html", dendrogram=dendrogram, **common)
+    for campaign in contents.campaigns:
+        chart = f"images/{page_name('campaign', campaign.id)}.svg"
+        save_figure(campaign_figure(campaign), folder / chart)
+        page = folder / f"{page_name('campaign', campaign.id)}.html"
+        _write(env, "campaign.html.j2", page, campaign=campaign, chart=chart, **common)
     for scenario in contents.scenarios:
         metrics_image = None
         metrics = metrics_figure(scenario, contents.units)

@@ -1,4 +1,5 @@
-"""The report's figures: a run's paths over its occupancy grid, and metric values against their oracles."""
+"""The report's figures: a run's paths over its occupancy grid, metric values against their oracles,
+and the violations a campaign found over its budget."""
 
 from __future__ import annotations
 
@@ -8,10 +9,12 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 from matplotlib.transforms import Bbox
 
 from exsce_dsl.lang.occupancy import OccupancyGrid
 from exsce_dsl.model.oracles import Oracle
+from exsce_dsl.report.campaigns import CampaignContents
 from exsce_dsl.report.contents import RunContents, ScenarioContents
 from exsce_dsl.runs.trajectories import Trajectory
 from exsce_dsl.store.queries import MetricReading
@@ -341,4 +344,64 @@ def metrics_figure(scenario: ScenarioContents, units: Mapping[str, str]) -> Figu
         axes.tick_params(axis="x", labelsize=8)
         axes.spines[["top", "right"]].set_visible(False)
     figure.suptitle(f"{scenario.id}: run values (dots) and what the oracles accept (green)", fontsize=10)
+    return figure
+
+
+# -- a campaign's violations over its budget ---------------------------------------------------
+
+
+def campaign_figure(campaign: CampaignContents) -> Figure:
+    """How many distinct relations the campaign had found violated after each derivation it tried:
+    a step line from (0, 0) (SVG id ``found-over-trials``), a dot where the count rose (SVG id
+    ``found-N``, N the count it rose to), labelled with the relations found there; the budget, when
+    it was not used up, as a dashed line."""
+    tried = len(campaign.trials)
+    found = campaign.found
+    figure = Figure(figsize=(9.0, 3.4), layout="constrained")
+    axes = figure.add_subplot()
+    axes.step(
+        range(tried + 1), (0, *found), where="post", color="#c0392b", linewidth=1.6, gid="found-over-trials"
+    )
+    budget = campaign.plan.budget
+    right = max(budget, tried, 1) + 0.5
+    count = 0
+    for tried_so_far, trial in enumerate(campaign.trials, start=1):
+        if not trial.new:
+            continue
+        count += len(trial.new)
+        axes.plot([tried_so_far], [count], marker="o", color="#c0392b", markersize=5, gid=f"found-{count}")
+        axes.annotate(
+            "\n".join(trial.new),
+            (tried_so_far, count),
+            # below and right of the dot the line never goes (it only rises, to the right); too
+            # near the right end, below and left
+            xytext=(5, -5) if tried_so_far < 0.75 * right else (-5, -5),
+            textcoords="offset points",
+            fontsize=7,
+            ha="left" if tried_so_far < 0.75 * right else "right",
+            va="top",
+            color="#922b21",
+        )
+    if budget > tried:
+        axes.axvline(budget, color="#5d6d7e", linestyle="--", linewidth=1.0)
+        axes.annotate(
+            f"budget: {budget} derivations",
+            (budget, 1.0),
+            xycoords=("data", "axes fraction"),
+            xytext=(-4, -2),
+            textcoords="offset points",
+            ha="right",
+            va="top",
+            fontsize=8,
+            color="#5d6d7e",
+        )
+    axes.set_xlim(0, right)
+    axes.set_ylim(0, max(count, 1) * 1.25 + 0.2)
+    axes.xaxis.set_major_locator(MaxNLocator(integer=True))
+    axes.yaxis.set_major_locator(MaxNLocator(integer=True))
+    axes.set_xlabel("derivations tried (count)", fontsize=9)
+    axes.set_ylabel("relations violated\n(distinct, count)", fontsize=9)
+    axes.tick_params(labelsize=8)
+    axes.spines[["top", "right"]].set_visible(False)
+    axes.set_title(f"campaign {campaign.id}: violations found over budget", fontsize=10)
     return figure

@@ -65,6 +65,14 @@ def _digest(path: Path) -> str | None:
     return content_hash(path) if path.exists() else None
 
 
+def stored_run(path: Path, store: Store, namespace: str = DEFAULT_NAMESPACE) -> str | None:
+    """The uuid of the run ``path`` holds when the store has it already (same content), else None."""
+    digest = _digest(path)
+    if digest is None or not run_query(store, "run_known", {"run": run_uuid(digest)}, namespace):
+        return None
+    return run_uuid(digest)
+
+
 Mapper = Callable[[Callable[[Any], Any], Iterable[Any]], Iterator[Any]]
 """``map``, or a process pool's."""
 

@@ -189,7 +189,8 @@ def _mission_values(
         if value is None:
             problems.append(f"{metric.name} of the mission is missing")
             return []
-        read = _topics(metric, 0, [r.namespace for r in robots])
+        # a robot without tasks (a derivation took them all) publishes nothing the mission reads
+        read = tuple(t for t in _topics(metric, 0, [r.namespace for r in robots]) if t in topics)
         return [MetricValue(metric.name, MetricScope.MISSION, value, read, unit=metric.unit or None)]
     if value is None:
         if len(robots) >= 2:

@@ -26,9 +26,10 @@ from exsce_dsl.sim.planner import PlanningGrid
 
 FORMATS = ("ros1", "ros2", "mcap")
 #: Runs of seed S start at this instant plus S days (modulo SEED_DAYS), one hour apart (no wall clock:
-#: same seed, same bytes).
+#: same seed, same bytes).  Some ROS 1 message fields are signed 32-bit seconds, so every start stays
+#: well before 2038-01-19.
 EPOCH = dt.datetime(2026, 1, 1, tzinfo=dt.timezone.utc)
-SEED_DAYS = 20_000
+SEED_DAYS = 4_000
 _RUN_NAMESPACE = uuid.UUID("7f0f3f5e-5a3c-4c1e-9d8e-6b0e2a1c9d41")
 
 
@@ -68,7 +69,7 @@ def simulate(
     out_dir.mkdir(parents=True, exist_ok=True)
     for index in range(runs):
         run_seed = seed * 1000 + index
-        # days wrap so that every seed gives a time ROS 1 can stamp (unsigned 32-bit seconds, until 2106)
+        # days wrap so that every seed gives a time ROS 1 can stamp (see SEED_DAYS)
         start = EPOCH + dt.timedelta(days=seed % SEED_DAYS, hours=index)
         run_id = str(
             uuid.uuid5(

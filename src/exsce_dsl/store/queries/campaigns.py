@@ -5,7 +5,15 @@ from __future__ import annotations
 import datetime
 import json
 
-from exsce_dsl.model.campaign import CampaignPlan, CampaignRecord, Relation, Request, Shrinking, ShrinkTry, Trial
+from exsce_dsl.model.campaign import (
+    CampaignPlan,
+    CampaignRecord,
+    Relation,
+    Request,
+    Shrinking,
+    ShrinkTry,
+    Trial,
+)
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.queries.terms import float_of, int_of, run_query, text_of
@@ -14,14 +22,19 @@ __all__ = ["campaign_record", "campaign_trials", "campaigns", "shrinkings"]
 
 
 def _steps(text: str | None) -> tuple[Request, ...]:
-    return tuple((str(name), {str(k): str(v) for k, v in arguments.items()}) for name, arguments in json.loads(text or "[]"))
+    return tuple(
+        (str(name), {str(k): str(v) for k, v in arguments.items()})
+        for name, arguments in json.loads(text or "[]")
+    )
 
 
 def _relations(text: str | None) -> tuple[Relation, ...]:
     return tuple(Relation.parse(part) for part in (text or "").split(";") if part.strip())
 
 
-def campaigns(store: Store, base: str | None = None, namespace: str = DEFAULT_NAMESPACE) -> list[CampaignPlan]:
+def campaigns(
+    store: Store, base: str | None = None, namespace: str = DEFAULT_NAMESPACE
+) -> list[CampaignPlan]:
     """Every campaign's plan (of the base scenario ``base`` only, when given), oldest first."""
     rows = run_query(store, "campaigns", {"scenario": base} if base else {}, namespace)
     plans = []
@@ -88,9 +101,13 @@ def shrinkings(store: Store, campaign: str, namespace: str = DEFAULT_NAMESPACE) 
             tries[number] = []
         if row["try_order"] is not None:
             violated = (text_of(row["try_violated"]) or "").lower() in ("true", "1")
-            tries[number].append(ShrinkTry(text_of(row["try_scenario"]) or "", _steps(text_of(row["try_steps"])), violated))
+            tries[number].append(
+                ShrinkTry(text_of(row["try_scenario"]) or "", _steps(text_of(row["try_steps"])), violated)
+            )
     return [
-        Shrinking(s.campaign, s.number, s.relation, s.trial, s.original, s.minimal, s.minimal_steps, tuple(tries[n]))
+        Shrinking(
+            s.campaign, s.number, s.relation, s.trial, s.original, s.minimal, s.minimal_steps, tuple(tries[n])
+        )
         for n, s in sorted(found.items())
     ]
 

@@ -45,6 +45,7 @@ def verdicts(store: Store, scenario: str | None = None, namespace: str = DEFAULT
                 window=text_of(row["window"]),
                 sources=tuple(runs.split()) if runs else (),
                 reason=text_of(row["reason"]) or "",
+                against=text_of(row["against"]),
             )
         )
     return found

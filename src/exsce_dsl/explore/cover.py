@@ -1,0 +1,87 @@
+"""Draws that cover the steps first: the campaign's default way of choosing derivations.
+
+Uniform draws (:mod:`exsce_dsl.explore.draw`) spend a small budget where steps are many: with
+89 single steps of ``scenario_c``, 24 of them ``add_task`` and one ``swap_start_poses``, forty
+uniform draws try the lone swap about half the time.  A fault hides behind one feature of a
+scenario, and which feature is what nobody knows, so these draws spread the budget over what
+can change: each derivation is built step by step, each step chosen among the applicable ones
+whose transformation has been used least so far, then, among those, whose own arguments have
+been used least; ties are broken by the seeded generator.  A derivation has ``max_steps``
+steps (fewer when nothing more applies), so one execution tries several steps at once, and
+shrinking (:mod:`exsce_dsl.explore.shrink`) finds which of them a violation needs.  Results
+equal to the base or to an earlier derivation (see :mod:`exsce_dsl.explore.fingerprint`) are
+drawn again with the next-least-used last step.
+"""
+
+from __future__ import annotations
+
+import random
+from collections import Counter
+from collections.abc import Collection, Mapping
+
+from exsce_dsl.errors import ExsceError
+from exsce_dsl.explore.draw import Candidate
+from exsce_dsl.explore.fingerprint import fingerprint
+from exsce_dsl.explore.steps import ProposedStep, applicable_steps
+from exsce_dsl.model import Scenario, Task
+from exsce_dsl.suggest import did_you_mean
+from exsce_dsl.transform.derivation import Request
+from exsce_dsl.transform.transformations import TRANSFORMATIONS, Applied
+
+ATTEMPTS = 20
+"""Draws per derivation asked for, at most, before the space counts as spent."""
+
+
+def covering_derivations(
+    base: Scenario,
+    tasks: Mapping[str, Task],
+    count: int,
+    seed: int,
+    max_steps: int = 2,
+    transformations: Collection[str] | None = None,
+) -> list[Candidate]:
+    """Up to ``count`` derivations of ``base`` with distinct results that spread over the
+    applicable steps (see the module's docstring); the same for the same seed."""
+    if max_steps < 1:
+        raise ExsceError("a derivation has at least one step: give max_steps of 1 or more")
+    unknown = sorted(set(transformations or ()) - TRANSFORMATIONS.keys())
+    if unknown:
+        raise ExsceError(f"unknown transformation '{unknown[0]}'{did_you_mean(unknown[0], TRANSFORMATIONS)}")
+    rng = random.Random(seed)
+    base_robots = frozenset(r.id for r in base.robots)
+    seen = {fingerprint(base, base_robots)}
+    by_name: Counter[str] = Counter()
+    by_step: Counter[str] = Counter()
+    steps_of: dict[str, list[ProposedStep]] = {}
+    drawn: list[Candidate] = []
+    for _ in range(count * ATTEMPTS):
+        if len(drawn) == count:
+            break
+        applied = Applied(base)
+        known = dict(tasks)
+        requests: list[Request] = []
+        for _depth in range(max_steps):
+            key = fingerprint(applied.scenario, base_robots) + repr(sorted(known))
+            if key not in steps_of:
+                steps_of[key] = applicable_steps(applied.scenario, known, transformations)
+            steps = steps_of[key]
+            if not steps:
+                break
+            step = min(steps, key=lambda s: (by_name[s.name], by_step[_step_key(s)], rng.random()))
+            by_name[step.name] += 1
+            by_step[_step_key(step)] += 1
+            applied = applied.then(step.applied)
+            known |= {t.id: t for t in step.applied.new_tasks}
+            requests.append(step.request)
+        if not requests:
+            break  # nothing applies to the base
+        reached = fingerprint(applied.scenario, base_robots)
+        if reached in seen:
+            continue
+        seen.add(reached)
+        drawn.append(Candidate(tuple(requests), applied.scenario, reached))
+    return drawn
+
+
+def _step_key(step: ProposedStep) -> str:
+    return f"{step.name}{step.arguments!r}"

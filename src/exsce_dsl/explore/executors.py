@@ -1,0 +1,160 @@
+"""Who runs a campaign's scenarios: the step of a campaign a user can replace.
+
+An :class:`Executor` is given a scenario (and the ``.exsce`` file that declares it) and hands
+back bags, one per run; the campaign ingests and judges them.  Three kinds:
+
+- :class:`SimulatorExecutor`, the default: exsce's kinematic executor (``exscec simulate``),
+  with the deliberate faults named on the command line (``--fault``);
+- :class:`CommandExecutor`: any program, run once per scenario with its arguments filled in
+  (``{scenario_file} {scenario} {runs} {seed} {out}``), which writes the bags into ``{out}``:
+  a user's own simulator, or a script that drives a real robot;
+- a plug-in: a package registers a factory under the entry-point group ``exsce.executors``
+  (called with no arguments, it returns an Executor), chosen by its name.
+
+A resumed campaign does not run a scenario again whose bags are all in its folder and in the
+store already (a run's uuid follows from its bag's content), whichever executor made them.
+"""
+
+from __future__ import annotations
+
+import shlex
+import subprocess
+from collections.abc import Sequence
+from dataclasses import dataclass
+from importlib.metadata import entry_points
+from pathlib import Path
+from typing import Protocol, runtime_checkable
+
+from exsce_dsl.errors import ExsceError
+from exsce_dsl.model import Scenario
+from exsce_dsl.sim.faults import Fault
+from exsce_dsl.sim.run import simulate
+from exsce_dsl.suggest import did_you_mean
+
+ENTRY_POINT_GROUP = "exsce.executors"
+PLACEHOLDERS = ("scenario_file", "scenario", "runs", "seed", "out")
+BAG_SUFFIXES = (".bag", ".mcap", ".db3")
+
+
+@runtime_checkable
+class Executor(Protocol):
+    """Runs scenarios and hands back their bags."""
+
+    @property
+    def name(self) -> str:
+        """What executed the runs, as the campaign's provenance records it."""
+        ...
+
+    def execute(
+        self, scenario: Scenario, scenario_file: Path, out_dir: Path, runs: int, seed: int
+    ) -> list[Path]:
+        """Run ``scenario`` ``runs`` times (``seed``: the same seed, the same runs where the
+        executor can) and return the bags, one per run, written under ``out_dir``."""
+        ...
+
+
+@dataclass(frozen=True)
+class SimulatorExecutor:
+    """exsce's kinematic executor, in the method's convention unless the robots name another."""
+
+    faults: tuple[Fault, ...] = ()
+    format: str = "ros1"
+
+    @classmethod
+    def with_faults(cls, faults: Sequence[str], format: str = "ros1") -> SimulatorExecutor:
+        return cls(tuple(Fault.parse(f) for f in faults), format)
+
+    @property
+    def name(self) -> str:
+        planted = " ".join(f"--fault {f.identity}" for f in self.faults)
+        return f"simulator {planted}".strip()
+
+    def execute(
+        self, scenario: Scenario, scenario_file: Path, out_dir: Path, runs: int, seed: int
+    ) -> list[Path]:
+        return [run.bag for run in simulate(scenario, out_dir, runs, self.format, seed, self.faults)]
+
+
+@dataclass(frozen=True)
+class CommandExecutor:
+    """A program run once per scenario: ``my-sim --scenario {scenario_file} --runs {runs}
+    --seed {seed} --out {out}``.  The command is split as a shell would (no shell runs it) and
+    each placeholder is filled in; it must exit 0 and leave ``runs`` bags in ``{out}``."""
+
+    command: str
+    timeout: float | None = None
+
+    def __post_init__(self) -> None:
+        try:
+            words = shlex.split(self.command)
+        except ValueError as error:
+            raise ExsceError(f"executor command '{self.command}': {error}") from None
+        if not words:
+            raise ExsceError("the executor command is empty")
+        for word in words:
+            try:
+                word.format(**{p: "" for p in PLACEHOLDERS})
+            except (KeyError, IndexError, ValueError) as error:
+                raise ExsceError(
+                    f"executor command '{self.command}': '{word}' is not a known placeholder or has a stray "
+                    f"brace ({error}); the placeholders are {', '.join('{' + p + '}' for p in PLACEHOLDERS)}"
+                ) from None
+
+    @property
+    def name(self) -> str:
+        return f"command: {self.command}"
+
+    def execute(
+        self, scenario: Scenario, scenario_file: Path, out_dir: Path, runs: int, seed: int
+    ) -> list[Path]:
+        out_dir.mkdir(parents=True, exist_ok=True)
+        values = {
+            "scenario_file": str(scenario_file),
+            "scenario": scenario.id,
+            "runs": str(runs),
+            "seed": str(seed),
+            "out": str(out_dir),
+        }
+        arguments = [word.format(**values) for word in shlex.split(self.command)]
+        try:
+            done = subprocess.run(
+                arguments, capture_output=True, text=True, timeout=self.timeout, check=False
+            )
+        except (OSError, subprocess.TimeoutExpired) as error:
+            raise ExsceError(
+                f"the executor command could not run scenario '{scenario.id}': {error}"
+            ) from None
+        if done.returncode != 0:
+            said = (done.stderr or done.stdout).strip().splitlines()[-5:]
+            raise ExsceError(
+                f"the executor command exited {done.returncode} on scenario '{scenario.id}'"
+                + (":\n  " + "\n  ".join(said) if said else "")
+            )
+        bags = sorted(p for p in out_dir.iterdir() if p.suffix in BAG_SUFFIXES or _is_rosbag2_folder(p))
+        if len(bags) != runs:
+            raise ExsceError(
+                f"the executor command left {len(bags)} bag(s) in {out_dir} for scenario '{scenario.id}', "
+                f"not the {runs} asked for"
+            )
+        return bags
+
+
+def _is_rosbag2_folder(path: Path) -> bool:
+    return path.is_dir() and (path / "metadata.yaml").is_file()
+
+
+def plugin_executor(name: str) -> Executor:
+    """The executor a package registered under ``exsce.executors`` as ``name``."""
+    found = {point.name: point for point in entry_points(group=ENTRY_POINT_GROUP)}
+    if name not in found:
+        known = ", ".join(sorted(found)) or "none is installed"
+        raise ExsceError(f"no executor plug-in '{name}'{did_you_mean(name, found)} (registered: {known})")
+    try:
+        made = found[name].load()()
+    except Exception as error:  # a third party's package: say which, whatever went wrong
+        raise ExsceError(
+            f"the executor plug-in '{name}' ({found[name].value}) cannot be loaded: {error!r}"
+        ) from None
+    if not isinstance(made, Executor):
+        raise ExsceError(f"the executor plug-in '{name}' ({found[name].value}) did not give an Executor")
+    return made
