@@ -55,6 +55,7 @@ WALK: tuple[tuple[str, ...], ...] = (
     ("derive",),  # c_one, with its oracles, into the store
     ("expect",),
     ("lineage",),
+    ("explore",),  # a campaign, and one that finds the planted detour
     ("query",),
     ("sparql",),
     ("runs",),

@@ -99,6 +99,12 @@ STEPS: tuple[Step, ...] = (
         verdict="run of derived c_one",
     ),
     Step("Where c_one comes from", "exscec lineage c_one"),
+    Step(
+        "Explore derivations with a planted deadlock: found, and shrunk to the one step it needs (exit 1)",
+        "exscec explore scenarios/scenario_c.exsce -n 2 -k 1 -t swap_start_poses -t reverse_task_order "
+        "--fault deadlock-start:tiago1:classroom_c025-w002 -o explore/deadlock --junit campaign.xml",
+        expected_exit=1,
+    ),
     Step("Cluster the stored scenarios, with a dendrogram", "exscec cluster --k 2 --dendrogram clusters.svg"),
     Step("Write the HTML report", "exscec report -o report --spec scenarios/scenario_c.exsce"),
 )

@@ -60,6 +60,7 @@ def _register() -> None:
     from exsce_dsl.cli import (
         demo_commands,
         derive_commands,
+        explore_commands,
         generate_commands,
         lsp_commands,
         mcp_commands,
@@ -79,6 +80,7 @@ def _register() -> None:
         *query_commands.COMMANDS,
         *oracle_commands.COMMANDS,
         *derive_commands.COMMANDS,
+        *explore_commands.COMMANDS,
         *similarity_commands.COMMANDS,
         *report_commands.COMMANDS,
         *generate_commands.COMMANDS,

@@ -78,6 +78,8 @@ class CampaignOptions:
     stop_at_violation: bool = False
     """End the draws at the first trial that violates a relation (benchmarks: executions to detection)."""
     shrink_tries: int = SHRINK_TRIES
+    jobs: int = 1
+    """Bags of one scenario analysed in parallel."""
 
 
 @dataclass
@@ -196,7 +198,7 @@ class _Campaign:
         bags = self.executor.execute(scenario, scenario_file, out, runs, self.seed_of(scenario.id))
         self.executions += len(bags)
         uuids = []
-        for result in ingest_bags(bags, scenario, self.store):
+        for result in ingest_bags(bags, scenario, self.store, self.options.jobs):
             if result.failed or result.run_id is None:
                 raise IngestFailed(result.message)
             uuids.append(result.run_id)

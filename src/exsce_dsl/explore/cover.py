@@ -10,7 +10,8 @@ been used least; ties are broken by the seeded generator.  A derivation has ``ma
 steps (fewer when nothing more applies), so one execution tries several steps at once, and
 shrinking (:mod:`exsce_dsl.explore.shrink`) finds which of them a violation needs.  Results
 equal to the base or to an earlier derivation (see :mod:`exsce_dsl.explore.fingerprint`) are
-drawn again with the next-least-used last step.
+drawn again with the next-least-used last step, and a step that would lead back to one of
+them is taken only when no other applies.
 """
 
 from __future__ import annotations
@@ -65,9 +66,14 @@ def covering_derivations(
             if key not in steps_of:
                 steps_of[key] = applicable_steps(applied.scenario, known, transformations)
             steps = steps_of[key]
-            if not steps:
+            # steps to a scenario not drawn yet (nor the base: reversing a task twice) come first;
+            # when there are none, a derivation that is new already stops here
+            fresh = [s for s in steps if fingerprint(s.applied.scenario, base_robots) not in seen]
+            if not steps or (
+                not fresh and requests and fingerprint(applied.scenario, base_robots) not in seen
+            ):
                 break
-            step = min(steps, key=lambda s: (by_name[s.name], by_step[_step_key(s)], rng.random()))
+            step = min(fresh or steps, key=lambda s: (by_name[s.name], by_step[_step_key(s)], rng.random()))
             by_name[step.name] += 1
             by_step[_step_key(step)] += 1
             applied = applied.then(step.applied)

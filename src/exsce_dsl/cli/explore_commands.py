@@ -1,0 +1,163 @@
+"""``exscec explore``: a metamorphic test campaign on a scenario, its violations shrunk."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import click
+
+from exsce_dsl.cli.common import Progress, reports_errors
+from exsce_dsl.cli.store_commands import store_option
+
+
+@click.command()
+@click.argument("spec", type=click.Path(dir_okay=False, exists=True))
+@click.option("--scenario-id", help="Which scenario, when the file declares several.")
+@click.option("--budget", "-n", required=True, type=click.IntRange(1), help="Derivations to try.")
+@click.option("--seed", default=0, show_default=True, type=int, help="Same seed, same derivations.")
+@click.option(
+    "--runs-per-scenario", "-k", default=3, show_default=True, type=click.IntRange(1),
+    help="Runs of each derived scenario; a relation is violated when it fails in more than half.",
+)  # fmt: skip
+@click.option(
+    "--transformations", "-t", multiple=True,
+    help="Only these transformations (repeatable) [default: every one].",
+)  # fmt: skip
+@click.option(
+    "--max-steps", default=2, show_default=True, type=click.IntRange(1), help="Steps per derivation."
+)
+@click.option(
+    "--strategy", type=click.Choice(["covering", "random"]), default="covering", show_default=True,
+    help="covering: spread the budget over the steps that apply; random: uniform draws.",
+)  # fmt: skip
+@click.option(
+    "--tolerance", default=25.0, show_default=True, type=click.FloatRange(0, min_open=True),
+    help="Percent of an expected value a run may be off.",
+)  # fmt: skip
+@click.option("--no-shrink", is_flag=True, help="Do not shrink the violations found.")
+@click.option(
+    "--fault", "faults", multiple=True,
+    help="Plant a fault in the simulator (repeatable), as exscec simulate --fault: to try a campaign.",
+)  # fmt: skip
+@click.option(
+    "--executor-command",
+    help="Run scenarios with this program instead of the simulator; placeholders {scenario_file} "
+    "{scenario} {runs} {seed} {out}; it must leave one bag per run in {out}.",
+)
+@click.option("--executor", "plugin", help="Run scenarios with this exsce.executors plug-in.")
+@click.option(
+    "--jobs", "-j", default=1, show_default=True, type=click.IntRange(1), help="Bags analysed in parallel."
+)
+@click.option(
+    "--output", "-o", type=click.Path(file_okay=False),
+    help="Folder of the campaign's files [default: explore/<campaign id>].",
+)  # fmt: skip
+@click.option("--junit", type=click.Path(dir_okay=False), help="Also write the campaign as JUnit XML.")
+@store_option
+@reports_errors
+def explore(
+    spec: str,
+    scenario_id: str | None,
+    budget: int,
+    seed: int,
+    runs_per_scenario: int,
+    transformations: tuple[str, ...],
+    max_steps: int,
+    strategy: str,
+    tolerance: float,
+    no_shrink: bool,
+    faults: tuple[str, ...],
+    executor_command: str | None,
+    plugin: str | None,
+    jobs: int,
+    output: str | None,
+    junit: str | None,
+    store_url: str | None,
+) -> None:
+    """Explore derivations of a scenario to find a fault, and shrink what fails.
+
+    Draws BUDGET derivations (compositions of up to --max-steps applicable
+    transformations, no two giving the same scenario), derives each with the
+    relations its runs must meet (exscec derive --expect), runs it, ingests
+    and verifies the runs, and records every trial as provenance in the
+    store.  Then each violated relation is shrunk to a smallest derivation
+    that still violates it, written to OUTPUT/minimal/ with its criteria.
+
+    The store is the campaign's state: the same command after a kill goes on
+    where it stopped, and a larger --budget goes on with the same campaign.
+    The base needs 3 stored runs (the campaign runs them if it has fewer).
+    Exit status: 0 when nothing was violated, 1 when a relation was.
+
+    \b
+    Examples:
+      exscec explore examples/brsu_building_c/scenario_c.exsce -n 2 -k 1 -t swap_start_poses -o explore/c
+      exscec explore examples/brsu_building_c/scenario_c.exsce -n 2 -k 1 -t reverse_waypoint_order \\
+        --fault detour:classroom_c018:classroom_c022 -o explore/detour --junit campaign.xml  # exits 1
+    """
+    from exsce_dsl.errors import ExsceError
+    from exsce_dsl.explore.campaign import CampaignEvents, CampaignOptions, run_campaign
+    from exsce_dsl.explore.executors import CommandExecutor, Executor, SimulatorExecutor, plugin_executor
+    from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.oracles.campaign_junit import campaign_junit, run_seconds
+    from exsce_dsl.store.open import open_store
+
+    if sum(bool(x) for x in (faults, executor_command, plugin)) > 1:
+        raise ExsceError("give one of --fault (the simulator), --executor-command and --executor")
+    executor: Executor
+    if executor_command:
+        executor = CommandExecutor(executor_command)
+    elif plugin:
+        executor = plugin_executor(plugin)
+    else:
+        executor = SimulatorExecutor.with_faults(faults)
+    options = CampaignOptions(
+        budget=budget,
+        seed=seed,
+        runs_per_scenario=runs_per_scenario,
+        max_steps=max_steps,
+        transformations=transformations,
+        strategy=strategy,
+        tolerance=tolerance,
+        shrink=not no_shrink,
+        jobs=jobs,
+    )
+    parsed = load_spec(spec)
+    with open_store(store_url) as store, Progress(budget, "Exploring") as progress:
+
+        def trial_done(trial: object, resumed: bool) -> None:
+            from exsce_dsl.model.campaign import Trial
+
+            assert isinstance(trial, Trial)
+            found = f": {'; '.join(r.text for r in trial.violated)}" if trial.violated else ""
+            done = " (done before)" if resumed else ""
+            progress.say(f"trial {trial.number}/{budget} {trial.scenario} {trial.outcome}{found}{done}")
+            progress.update()
+
+        events = CampaignEvents(said=progress.say, trial_done=trial_done)
+        result = run_campaign(
+            store, parsed, spec, options, executor, output, scenario_id=scenario_id, events=events
+        )
+        durations = run_seconds(store, result.record) if junit else {}
+    record = result.record
+    violated = {r.text for t in record.trials for r in t.violated}
+    tried = len(record.trials)
+    click.echo(f"campaign {record.plan.id}: {tried} derivations tried, {len(violated)} relations violated")
+    click.echo(f"  files: {result.folder}")
+    for shrinking in record.shrinkings:
+        file = result.minimal_files.get(shrinking.relation.text)
+        steps = " → ".join(
+            f"{name}({', '.join(f'{k}={v}' for k, v in arguments.items())})"
+            for name, arguments in shrinking.minimal_steps
+        )
+        click.echo(f"violated: {shrinking.relation.text} (trial {shrinking.trial})")
+        click.echo(f"  smallest derivation ({len(shrinking.minimal_steps)} steps): {steps}")
+        if file is not None:
+            bags = result.folder / "runs" / shrinking.minimal
+            click.echo(f"  reproduce: exscec verify {bags}/*.bag --scenario {file}")
+    if junit:
+        Path(junit).write_text(campaign_junit(record, durations), encoding="utf-8")
+    sys.exit(1 if violated else 0)
+
+
+COMMANDS = [explore]
