@@ -25,7 +25,6 @@ from exsce_dsl.errors import ExsceError
 from exsce_dsl.explore.cover import covering_derivations
 from exsce_dsl.explore.draw import Candidate, draw_derivations
 from exsce_dsl.explore.executors import Executor
-from exsce_dsl.explore.fingerprint import fingerprint
 from exsce_dsl.explore.shrink import MAX_TRIES, shrink
 from exsce_dsl.lang.formatter import declared_poses, format_document
 from exsce_dsl.model import Acceptance, Scenario
@@ -49,7 +48,7 @@ from exsce_dsl.store.queries import derivation_of
 from exsce_dsl.store.queries import runs as stored_runs
 from exsce_dsl.store.queries.campaigns import campaign_record
 from exsce_dsl.store.writing import add_prov
-from exsce_dsl.transform.derivation import derive, derived_document
+from exsce_dsl.transform.derivation import derived_document
 
 STRATEGIES = ("covering", "random")
 TOLERANCE = 25.0
@@ -375,11 +374,12 @@ def _verdict_name(verdict: Verdict) -> str:
 
 
 def _derived_id(spec: Specification, spec_path: Path, base: Scenario, requests: Sequence[Request]) -> str:
-    """The id of the scenario ``requests`` give: the base's and the scenario's fingerprint, so
-    that derivations giving the same scenario (say, a shrunk one and a drawn one) are one
-    scenario, with one set of runs."""
-    made = derive(base, requests, tasks={t.id: t for t in spec.tasks}).scenario
-    return f"{base.id}_{fingerprint(made, frozenset(r.id for r in base.robots))[:8]}"
+    """The id of the scenario ``requests`` give: the base's and a hash of the scenario as
+    written, so that derivations giving the same scenario (a shrunk one and a drawn one, say)
+    are one scenario, with one set of runs, and different scenarios never share an id."""
+    made = derive_spec(spec, spec_path, requests, scenario_id=base.id)
+    text = made.text.replace(made.scenario.id, "_")
+    return f"{base.id}_{hashlib.sha256(text.encode()).hexdigest()[:8]}"
 
 
 def _safety_only(made: DerivedSpec, spec: Specification, spec_path: Path) -> DerivedSpec:
