@@ -15,7 +15,7 @@ EXAMPLES = ROOT / "examples"
 FIXTURES = ROOT / "tests" / "fixtures" / "hbrs-sesame-models"
 
 
-def run_exscec(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
+def run_exscec(*args: str, cwd: Path | None = None, timeout: float = 120) -> subprocess.CompletedProcess[str]:
     """Run the real ``exscec`` console script of this environment."""
     exe = Path(sys.executable).with_name("exscec")
     return subprocess.run(
@@ -23,7 +23,7 @@ def run_exscec(*args: str, cwd: Path | None = None) -> subprocess.CompletedProce
         cwd=cwd,
         capture_output=True,
         text=True,
-        timeout=120,
+        timeout=timeout,
         env={**os.environ, "COLUMNS": "120"},
     )
 

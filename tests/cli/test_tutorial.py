@@ -63,13 +63,14 @@ def test_every_command_of_the_tutorial_works_as_written(tmp_path: Path) -> None:
 
 
 def test_exscec_demo_shows_the_fault_run_failing_and_the_others_passing(tmp_path: Path) -> None:
-    done = run_exscec("demo", "demo", cwd=tmp_path)
+    done = run_exscec("demo", "demo", cwd=tmp_path, timeout=600)  # the whole tutorial, a campaign too
     assert done.returncode == 0, done.stderr[-3000:]
     summary = done.stderr[done.stderr.index("Summary"):]
     assert summary.startswith("Summary") and "every step ended as expected" in summary.splitlines()[0]
     assert re.search(r"passed, as expected\s+new run of scenario_c", summary)
     assert re.search(r"failed, as expected\s+run of scenario_c with the over-speed fault", summary)
     assert re.search(r"passed, as expected\s+run of derived c_one", summary)
+    assert (tmp_path / "demo" / "campaign.xml").is_file() and list((tmp_path / "demo" / "explore").rglob("minimal/*.exsce"))
     assert "NOT" not in summary and "error" not in summary
     assert (tmp_path / "demo" / "report" / "index.html").is_file()
     assert f"[{len(STEPS)}/{len(STEPS)}]" in done.stderr and "$ exscec verify runs/faulty/" in done.stderr
@@ -87,6 +88,7 @@ def test_the_whole_method_runs_on_a_navigation_stacks_runs(tmp_path: Path, conve
     assert re.search(r"passed, as expected\s+new run of scenario_c", summary)
     assert re.search(r"failed, as expected\s+run of scenario_c with the over-speed fault", summary)
     assert re.search(r"passed, as expected\s+run of derived c_one", summary)
+    assert (tmp_path / "demo" / "campaign.xml").is_file() and list((tmp_path / "demo" / "explore").rglob("minimal/*.exsce"))
     project = tmp_path / "demo"
     assert f"convention {convention}" in (project / "scenarios" / "robots.exsce").read_text(encoding="utf-8")
     (bag,) = (project / "runs" / "new").glob("*.bag")

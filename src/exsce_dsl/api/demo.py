@@ -101,7 +101,7 @@ STEPS: tuple[Step, ...] = (
     Step("Where c_one comes from", "exscec lineage c_one"),
     Step(
         "Explore derivations with a planted deadlock: found, and shrunk to the one step it needs (exit 1)",
-        "exscec explore scenarios/scenario_c.exsce -n 2 -k 1 -t swap_start_poses -t reverse_task_order "
+        "exscec explore scenarios/scenario_c.exsce -n 1 -k 1 -t swap_start_poses -t reverse_task_order "
         "--fault deadlock-start:tiago1:classroom_c025-w002 -o explore/deadlock --junit campaign.xml",
         expected_exit=1,
     ),

@@ -151,7 +151,8 @@ def explore(
             for name, arguments in shrinking.minimal_steps
         )
         click.echo(f"violated: {shrinking.relation.text} (trial {shrinking.trial})")
-        click.echo(f"  smallest derivation ({len(shrinking.minimal_steps)} steps): {steps}")
+        count = len(shrinking.minimal_steps)
+        click.echo(f"  smallest derivation ({count} step{'' if count == 1 else 's'}): {steps}")
         if file is not None:
             bags = result.folder / "runs" / shrinking.minimal
             click.echo(f"  reproduce: exscec verify {bags}/*.bag --scenario {file}")
