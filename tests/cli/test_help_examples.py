@@ -55,7 +55,7 @@ WALK: tuple[tuple[str, ...], ...] = (
     ("derive",),  # c_one, with its oracles, into the store
     ("expect",),
     ("lineage",),
-    ("explore",),  # a campaign, and one that finds the planted detour
+    ("explore",),  # a campaign, and one that finds a planted deadlock
     ("query",),
     ("sparql",),
     ("runs",),

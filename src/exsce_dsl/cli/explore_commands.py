@@ -91,9 +91,9 @@ def explore(
 
     \b
     Examples:
-      exscec explore examples/brsu_building_c/scenario_c.exsce -n 2 -k 1 -t swap_start_poses -o explore/c
-      exscec explore examples/brsu_building_c/scenario_c.exsce -n 2 -k 1 -t reverse_waypoint_order \\
-        --fault detour:classroom_c018:classroom_c022 -o explore/detour --junit campaign.xml  # exits 1
+      exscec explore examples/brsu_building_c/scenario_c.exsce -n 2 -k 1 -t reverse_waypoint_order
+      exscec explore examples/brsu_building_c/scenario_c.exsce -n 1 -k 1 -t swap_start_poses \\
+        --fault deadlock-start:tiago1:classroom_c025-w002 -o explore/deadlock --junit campaign.xml  # exits 1
     """
     from exsce_dsl.errors import ExsceError
     from exsce_dsl.explore.campaign import CampaignEvents, CampaignOptions, run_campaign

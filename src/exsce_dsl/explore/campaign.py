@@ -8,7 +8,9 @@ or shrinking it was in: the draws are the same for the same seed, the trials the
 read back, and a scenario whose bags are all in its folder and in the store is not run again.
 
 A relation is *violated* by a derivation when it failed in more than half of its runs: one
-odd run of three does not send shrinking after noise.
+odd run of three does not send shrinking after noise.  A smaller derivation still violates it
+when it violates the same check (:meth:`~exsce_dsl.model.campaign.Relation.same_check`): an
+expected value missed either way counts, whatever direction the smaller one's estimate took.
 """
 
 from __future__ import annotations
@@ -254,7 +256,7 @@ class _Campaign:
 
         def still_fails(requests: tuple[Request, ...]) -> bool:
             made, runs, verdicts = self.judge(requests, "shrinking")
-            violated = relation in _violations(verdicts, len(runs))[1]
+            violated = any(relation.same_check(found) for found in _violations(verdicts, len(runs))[1])
             tried = ShrinkTry(made.scenario.id, requests, violated)
             tries.append(tried)
             self.events.shrink_try_done(tried)
@@ -323,8 +325,8 @@ def run_campaign(
     if options.shrink:
         for trial in trials:
             for relation in trial.violated:
-                if relation in shrunk:
-                    continue
+                if any(relation.same_check(done) for done in shrunk):
+                    continue  # found again, or its other direction: shrunk already
                 events.said(f"shrinking '{relation.text}' (found by trial {trial.number}: {trial.scenario})")
                 shrunk[relation] = campaign.shrinking(len(shrunk) + 1, relation, trial)
     files = {s.relation.text: _minimal_file(campaign, s) for s in shrunk.values()}

@@ -68,6 +68,8 @@ def covering_derivations(
             steps = steps_of[key]
             # steps to a scenario not drawn yet (nor the base: reversing a task twice) come first;
             # when there are none, a derivation that is new already stops here
+            here = fingerprint(applied.scenario, base_robots)
+            steps = [s for s in steps if fingerprint(s.applied.scenario, base_robots) != here]  # no no-ops
             fresh = [s for s in steps if fingerprint(s.applied.scenario, base_robots) not in seen]
             if not steps or (
                 not fresh and requests and fingerprint(applied.scenario, base_robots) not in seen

@@ -31,6 +31,16 @@ class Relation:
         against = f"vs {self.against}" if self.against else None
         return " ".join(p for p in (self.robot, self.metric, self.relationship, against) if p)
 
+    def same_check(self, other: Relation) -> bool:
+        """Whether ``other`` checks the same thing: the same metric of the same robot, against
+        the same scenario, by the same limit, or by an expected value whichever way it moved
+        (the direction, ``increasing`` or ``invariant``, comes from the estimate, which a
+        smaller derivation changes)."""
+        expected = {"invariant", "increasing", "decreasing"}
+        return (self.metric, self.robot, self.against) == (other.metric, other.robot, other.against) and (
+            self.relationship == other.relationship or {self.relationship, other.relationship} <= expected
+        )
+
     @classmethod
     def parse(cls, text: str) -> Relation:
         """The inverse of :attr:`text`."""

@@ -68,8 +68,10 @@ def compute_metrics(
         start, end = min(s for s, _ in spans), max(e for _, e in spans)
         fleet = [(r.id, r.namespace) for r in robots]
         monitor = monitors.MissionMetrics(fleet, topics)
+        # a robot without goals (a derivation took its tasks) adds nothing to what the mission read
+        acting = [r for r in robots if any(a.robot == r.id for a, _, _ in done) or r.id in (whole_runs or {})]
         for metric in by_subject[ComputedFor.MISSION] + by_subject[ComputedFor.PAIRS]:
-            values += _mission_values(monitor, metric, robots, start, end, topics, hotspots, problems)
+            values += _mission_values(monitor, metric, acting, start, end, topics, hotspots, problems)
     return values, hotspots
 
 
@@ -189,8 +191,7 @@ def _mission_values(
         if value is None:
             problems.append(f"{metric.name} of the mission is missing")
             return []
-        # a robot without tasks (a derivation took them all) publishes nothing the mission reads
-        read = tuple(t for t in _topics(metric, 0, [r.namespace for r in robots]) if t in topics)
+        read = _topics(metric, 0, [r.namespace for r in robots])
         return [MetricValue(metric.name, MetricScope.MISSION, value, read, unit=metric.unit or None)]
     if value is None:
         if len(robots) >= 2:
