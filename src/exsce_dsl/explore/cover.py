@@ -20,14 +20,12 @@ import random
 from collections import Counter
 from collections.abc import Collection, Mapping
 
-from exsce_dsl.errors import ExsceError
-from exsce_dsl.explore.draw import Candidate
+from exsce_dsl.explore.draw import Candidate, check_draw
 from exsce_dsl.explore.fingerprint import fingerprint
 from exsce_dsl.explore.steps import ProposedStep, applicable_steps
 from exsce_dsl.model import Scenario, Task
-from exsce_dsl.suggest import did_you_mean
 from exsce_dsl.transform.derivation import Request
-from exsce_dsl.transform.transformations import TRANSFORMATIONS, Applied
+from exsce_dsl.transform.transformations import Applied
 
 ATTEMPTS = 20
 """Draws per derivation asked for, at most, before the space counts as spent."""
@@ -43,11 +41,7 @@ def covering_derivations(
 ) -> list[Candidate]:
     """Up to ``count`` derivations of ``base`` with distinct results that spread over the
     applicable steps (see the module's docstring); the same for the same seed."""
-    if max_steps < 1:
-        raise ExsceError("a derivation has at least one step: give max_steps of 1 or more")
-    unknown = sorted(set(transformations or ()) - TRANSFORMATIONS.keys())
-    if unknown:
-        raise ExsceError(f"unknown transformation '{unknown[0]}'{did_you_mean(unknown[0], TRANSFORMATIONS)}")
+    check_draw(max_steps, transformations)
     rng = random.Random(seed)
     base_robots = frozenset(r.id for r in base.robots)
     seen = {fingerprint(base, base_robots)}

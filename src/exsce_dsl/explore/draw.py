@@ -62,11 +62,7 @@ def draw_derivations(
 ) -> list[Candidate]:
     """Up to ``count`` derivations of ``base`` with distinct results, the same for the same seed;
     ``tasks`` are those the spec declares; ``transformations`` keeps only steps of those names."""
-    if max_steps < 1:
-        raise ExsceError("a derivation has at least one step: give max_steps of 1 or more")
-    unknown = sorted(set(transformations or ()) - TRANSFORMATIONS.keys())
-    if unknown:
-        raise ExsceError(f"unknown transformation '{unknown[0]}'{did_you_mean(unknown[0], TRANSFORMATIONS)}")
+    check_draw(max_steps, transformations)
     base_robots = frozenset(r.id for r in base.robots)
     rng = random.Random(seed)
     root = _Node(0, Applied(base), dict(tasks), (), considered=True)
@@ -108,6 +104,15 @@ def draw_derivations(
                 parent = path[depth - 1]
                 parent.open = [i for i in parent.open if parent.made.get(i) is not node]
     return drawn
+
+
+def check_draw(max_steps: int, transformations: Collection[str] | None) -> None:
+    """Refuse draws of no steps, or of transformations that do not exist."""
+    if max_steps < 1:
+        raise ExsceError("a derivation has at least one step: give max_steps of 1 or more")
+    unknown = sorted(set(transformations or ()) - TRANSFORMATIONS.keys())
+    if unknown:
+        raise ExsceError(f"unknown transformation '{unknown[0]}'{did_you_mean(unknown[0], TRANSFORMATIONS)}")
 
 
 def _child(node: _Node, index: int, base_robots: frozenset[str], shallowest: dict[str, int]) -> _Node | None:
