@@ -264,8 +264,9 @@ def metamorphic_acceptance(
     * the expected value itself, as the new scenario's own baseline (``is invariant around E
       within P %``): a run far from it either way fails, so a slow-down or a detour is caught;
     * the relation to the base's runs the expected value implies: ``is increasing|decreasing by
-      |E - B| within A of BASE`` (B the base's mean, A = P % of E), or ``is invariant within A of
-      BASE`` when the change is within that allowance.
+      |E - B| within A of BASE`` (B the base's mean, A = P % of E), or, when the change is
+      within that allowance, ``is invariant within A + |E - B| of BASE`` (what a run within A
+      of E may differ from B).
 
     P is ``tolerance_percent``; waypoints are counted, so exactly.  A robot the base does not
     have (``add_robot``, ``replace_robot``) gets its own-baseline clauses only: a slow-down of the
@@ -296,9 +297,7 @@ def metamorphic_acceptance(
             before = robot_metric_over_runs(store, metric, robot.id, base_runs) if in_base else None
             unit = "m" if metric == "distance_travelled" else "s"
             allowance = abs(expected) * tolerance_percent / 100.0
-            performance.extend(
-                _expected_clauses(subject, metric, expected, before, allowance, unit, base.id)
-            )
+            performance.extend(_expected_clauses(subject, metric, expected, before, allowance, unit, base.id))
         waypoints = len(robot_path(derived, robot.id))
         before = robot_metric_over_runs(store, "waypoints_visited", robot.id, base_runs) if in_base else None
         if in_base and before is None:
@@ -341,8 +340,14 @@ def _expected_clauses(
         return [own]
     change = expected - before.mean
     if abs(change) <= allowance:
+        # the run is expected within the allowance of E, which is up to |E - B| from B: the
+        # relation to the base must allow both, or a run that meets its own clause fails this one
         same = Expectation(
-            subject, metric, BasicRelation.INVARIANT, tolerance=quantity(allowance), against=base
+            subject,
+            metric,
+            BasicRelation.INVARIANT,
+            tolerance=quantity(allowance + abs(change)),
+            against=base,
         )
         return [own, same]
     direction = BasicRelation.INCREASING if change > 0 else BasicRelation.DECREASING
