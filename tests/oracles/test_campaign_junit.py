@@ -6,9 +6,10 @@ import datetime
 import xml.etree.ElementTree as ET
 
 import pytest
+from campaign_samples import REMOVE, REVERSE, SHRINKINGS, sample_trials
 
 from exsce_dsl.lang.build import load_spec
-from exsce_dsl.model.campaign import CampaignPlan, CampaignRecord, Relation, Shrinking, ShrinkTry, Trial
+from exsce_dsl.model.campaign import CampaignPlan, CampaignRecord, Shrinking, Trial
 from exsce_dsl.model.runs import Bag, Run
 from exsce_dsl.oracles.campaign_junit import campaign_junit, run_seconds, steps_text
 from exsce_dsl.prov import compile_scenario
@@ -21,10 +22,6 @@ from exsce_dsl.transform.derivation import derive
 
 from conftest import EXAMPLES
 
-DURATION = Relation("task_duration", "tiago1", "increasing", "scenario_c")
-DISTANCE = Relation("distance_travelled", "tiago1", "invariant")
-REMOVE = ("remove_robot", {"robot": "tiago2", "reassign": "tiago1"})
-REVERSE = ("reverse_waypoint_order", {"task": "delivery_a"})
 STARTED = datetime.datetime(2025, 3, 1, 12, 0, tzinfo=datetime.timezone.utc)
 PLAN = CampaignPlan(
     "c_explore",
@@ -42,38 +39,13 @@ PLAN = CampaignPlan(
 
 
 def _trials() -> list[Trial]:
-    both = (DURATION, DISTANCE)
-    return [
-        Trial("c_explore", 1, "c_explore_0001", (REMOVE,), ("run1a", "run1b", "run1c"), both, (DURATION,)),
-        Trial("c_explore", 2, "c_explore_0002", (REVERSE,), ("run2a", "run2b", "run2c"), both, ()),
-        Trial("c_explore", 3, "c_explore_0003", (REVERSE, REMOVE), ("run3a", "run3b", "run3c"), both, both),
-        Trial("c_explore", 4, "c_explore_0004", (REVERSE,), (), (), ()),
-    ]
+    return list(
+        sample_trials((("run1a", "run1b", "run1c"), ("run2a", "run2b", "run2c"), ("run3a", "run3b", "run3c")))
+    )
 
 
 def _shrinkings() -> list[Shrinking]:
-    return [
-        Shrinking(
-            "c_explore",
-            1,
-            DURATION,
-            1,
-            "c_explore_0001",
-            "c_explore_0001",
-            (REMOVE,),
-            (ShrinkTry("scenario_c", (), False),),
-        ),
-        Shrinking(
-            "c_explore",
-            2,
-            DISTANCE,
-            3,
-            "c_explore_0003",
-            "c_explore_s2_1",
-            (REMOVE,),
-            (ShrinkTry("c_explore_s2_1", (REMOVE,), True), ShrinkTry("c_explore_s2_2", (REVERSE,), False)),
-        ),
-    ]
+    return list(SHRINKINGS)
 
 
 @pytest.fixture(scope="module")

@@ -13,10 +13,11 @@ from html.parser import HTMLParser
 from pathlib import Path
 
 import pytest
+from campaign_samples import DISTANCE, DURATION, REMOVE, SHRINKINGS, sample_trials
 from test_report import ARTIFACTS, _chromium
 
 from exsce_dsl.lang.build import load_spec
-from exsce_dsl.model.campaign import CampaignPlan, CampaignRecord, Relation, Shrinking, ShrinkTry, Trial
+from exsce_dsl.model.campaign import CampaignPlan, CampaignRecord, Trial
 from exsce_dsl.prov import compile_scenario
 from exsce_dsl.prov.campaign import compile_campaign, compile_shrinking, compile_trial
 from exsce_dsl.prov.derivation import compile_derivation
@@ -31,10 +32,6 @@ from exsce_dsl.transform.derivation import derive
 from conftest import EXAMPLES
 
 SPEC = EXAMPLES / "brsu_building_c" / "scenario_c.exsce"
-DURATION = Relation("task_duration", "tiago1", "increasing", "scenario_c")
-DISTANCE = Relation("distance_travelled", "tiago1", "invariant")
-REMOVE = ("remove_robot", {"robot": "tiago2", "reassign": "tiago1"})
-REVERSE = ("reverse_waypoint_order", {"task": "delivery_a"})
 PLAN = CampaignPlan(
     "c_explore",
     "scenario_c",
@@ -48,42 +45,7 @@ PLAN = CampaignPlan(
     True,
     10.0,
 )
-TRIALS = (
-    Trial("c_explore", 1, "c_explore_0001", (REMOVE,), ("r1", "r2", "r3"), (DURATION, DISTANCE), (DURATION,)),
-    Trial("c_explore", 2, "c_explore_0002", (REVERSE,), ("r4", "r5", "r6"), (DURATION, DISTANCE), ()),
-    Trial(
-        "c_explore",
-        3,
-        "c_explore_0003",
-        (REVERSE, REMOVE),
-        ("r7", "r8", "r9"),
-        (DURATION, DISTANCE),
-        (DURATION, DISTANCE),
-    ),
-    Trial("c_explore", 4, "c_explore_0004", (REVERSE,), (), (), ()),
-)
-SHRINKINGS = (
-    Shrinking(
-        "c_explore",
-        1,
-        DURATION,
-        1,
-        "c_explore_0001",
-        "c_explore_0001",
-        (REMOVE,),
-        (ShrinkTry("scenario_c", (), False),),
-    ),
-    Shrinking(
-        "c_explore",
-        2,
-        DISTANCE,
-        3,
-        "c_explore_0003",
-        "c_explore_s2_1",
-        (REMOVE,),
-        (ShrinkTry("c_explore_s2_1", (REMOVE,), True), ShrinkTry("c_explore_s2_2", (REVERSE,), False)),
-    ),
-)
+TRIALS = sample_trials((("r1", "r2", "r3"), ("r4", "r5", "r6"), ("r7", "r8", "r9")))
 STEPS_OF_3 = "reverse_waypoint_order(task=delivery_a) → remove_robot(robot=tiago2, reassign=tiago1)"
 
 

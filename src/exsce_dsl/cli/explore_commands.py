@@ -99,7 +99,8 @@ def explore(
     from exsce_dsl.explore.campaign import CampaignEvents, CampaignOptions, run_campaign
     from exsce_dsl.explore.executors import CommandExecutor, Executor, SimulatorExecutor, plugin_executor
     from exsce_dsl.lang.build import load_spec
-    from exsce_dsl.oracles.campaign_junit import campaign_junit, run_seconds
+    from exsce_dsl.model.campaign import Trial
+    from exsce_dsl.oracles.campaign_junit import campaign_junit, run_seconds, steps_text
     from exsce_dsl.store.open import open_store
 
     if sum(bool(x) for x in (faults, executor_command, plugin)) > 1:
@@ -125,10 +126,7 @@ def explore(
     parsed = load_spec(spec)
     with open_store(store_url) as store, Progress(budget, "Exploring") as progress:
 
-        def trial_done(trial: object, resumed: bool) -> None:
-            from exsce_dsl.model.campaign import Trial
-
-            assert isinstance(trial, Trial)
+        def trial_done(trial: Trial, resumed: bool) -> None:
             found = f": {'; '.join(r.text for r in trial.violated)}" if trial.violated else ""
             done = " (done before)" if resumed else ""
             progress.say(f"trial {trial.number}/{budget} {trial.scenario} {trial.outcome}{found}{done}")
@@ -146,10 +144,7 @@ def explore(
     click.echo(f"  files: {result.folder}")
     for shrinking in record.shrinkings:
         file = result.minimal_files.get(shrinking.relation.text)
-        steps = " → ".join(
-            f"{name}({', '.join(f'{k}={v}' for k, v in arguments.items())})"
-            for name, arguments in shrinking.minimal_steps
-        )
+        steps = steps_text(shrinking.minimal_steps)
         click.echo(f"violated: {shrinking.relation.text} (trial {shrinking.trial})")
         count = len(shrinking.minimal_steps)
         click.echo(f"  smallest derivation ({count} step{'' if count == 1 else 's'}): {steps}")

@@ -38,7 +38,7 @@ def of_campaign(names: Namespaces, campaign: str) -> str:
     return f"{names.base}campaigns/{campaign}/"
 
 
-def steps_text(steps: Sequence[Request]) -> str:
+def steps_json(steps: Sequence[Request]) -> str:
     """Steps as JSON: ``[["remove_robot", {"robot": "tiago2"}]]``."""
     return json.dumps([[name, dict(sorted(arguments.items()))] for name, arguments in steps])
 
@@ -105,7 +105,7 @@ def compile_trial(trial: Trial, namespace: str = DEFAULT_NAMESPACE) -> ProvDocum
             t(ids.CAMPAIGN_ID): trial.campaign,
             t(ids.ORDER): trial.number,
             t(ids.SCENARIO_ATTR): scenario,
-            t(ids.STEPS): steps_text(trial.steps),
+            t(ids.STEPS): steps_json(trial.steps),
             t(ids.TRIAL_RUNS): " ".join(trial.runs),
             t(ids.CHECKED): relations_text(trial.checked),
             t(ids.VIOLATED): relations_text(trial.violated),
@@ -142,7 +142,7 @@ def compile_shrinking(shrinking: Shrinking, namespace: str = DEFAULT_NAMESPACE) 
             t(ids.TRIAL): shrinking.trial,
             t(ids.ORDER): shrinking.number,
             t(ids.MINIMAL): ids.check_name(shrinking.minimal, "scenario id"),
-            t(ids.STEPS): steps_text(shrinking.minimal_steps),
+            t(ids.STEPS): steps_json(shrinking.minimal_steps),
         },
     )
     w.informed(activity, mine["campaign"])
@@ -158,7 +158,7 @@ def compile_shrinking(shrinking: Shrinking, namespace: str = DEFAULT_NAMESPACE) 
                 t(ids.SHRINK_NUMBER): shrinking.number,
                 t(ids.ORDER): number,
                 t(ids.SCENARIO_ATTR): ids.check_name(tried.scenario, "scenario id"),
-                t(ids.STEPS): steps_text(tried.steps),
+                t(ids.STEPS): steps_json(tried.steps),
                 t(ids.VIOLATED): tried.violated,
             },
         )

@@ -32,37 +32,37 @@ def _relations(text: str | None) -> tuple[Relation, ...]:
     return tuple(Relation.parse(part) for part in (text or "").split(";") if part.strip())
 
 
+def _plans(
+    store: Store, base: str | None, namespace: str
+) -> list[tuple[CampaignPlan, datetime.datetime | None]]:
+    """Every campaign's plan and start (of the base scenario ``base`` only, when given), oldest first."""
+    rows = run_query(store, "campaigns", {"scenario": base} if base else {}, namespace)
+    found = []
+    for row in rows:
+        transformations = text_of(row["transformations"]) or "all"
+        plan = CampaignPlan(
+            id=text_of(row["campaign"]) or "",
+            base=text_of(row["base"]) or "",
+            budget=int_of(row["budget"]),
+            seed=int_of(row["seed"]),
+            runs_per_scenario=int_of(row["runs_per_scenario"]),
+            max_steps=int_of(row["max_steps"]),
+            transformations=() if transformations == "all" else tuple(transformations.split()),
+            executor=text_of(row["executor"]) or "",
+            strategy=text_of(row["strategy"]) or "",
+            relations=(text_of(row["relations"]) or "").lower() in ("true", "1"),
+            tolerance=float_of(row["tolerance"]) or 0.0,
+        )
+        started = text_of(row["started"])
+        found.append((plan, datetime.datetime.fromisoformat(started) if started else None))
+    return found
+
+
 def campaigns(
     store: Store, base: str | None = None, namespace: str = DEFAULT_NAMESPACE
 ) -> list[CampaignPlan]:
     """Every campaign's plan (of the base scenario ``base`` only, when given), oldest first."""
-    rows = run_query(store, "campaigns", {"scenario": base} if base else {}, namespace)
-    plans = []
-    for row in rows:
-        transformations = text_of(row["transformations"]) or "all"
-        plans.append(
-            CampaignPlan(
-                id=text_of(row["campaign"]) or "",
-                base=text_of(row["base"]) or "",
-                budget=int_of(row["budget"]),
-                seed=int_of(row["seed"]),
-                runs_per_scenario=int_of(row["runs_per_scenario"]),
-                max_steps=int_of(row["max_steps"]),
-                transformations=() if transformations == "all" else tuple(transformations.split()),
-                executor=text_of(row["executor"]) or "",
-                strategy=text_of(row["strategy"]) or "",
-                relations=(text_of(row["relations"]) or "").lower() in ("true", "1"),
-                tolerance=float_of(row["tolerance"]) or 0.0,
-            )
-        )
-    return plans
-
-
-def _started(store: Store, campaign: str, namespace: str) -> datetime.datetime | None:
-    for row in run_query(store, "campaigns", {}, namespace):
-        if text_of(row["campaign"]) == campaign and row["started"] is not None:
-            return datetime.datetime.fromisoformat(text_of(row["started"]) or "")
-    return None
+    return [plan for plan, _ in _plans(store, base, namespace)]
 
 
 def campaign_trials(store: Store, campaign: str, namespace: str = DEFAULT_NAMESPACE) -> list[Trial]:
@@ -114,12 +114,13 @@ def shrinkings(store: Store, campaign: str, namespace: str = DEFAULT_NAMESPACE) 
 
 def campaign_record(store: Store, campaign: str, namespace: str = DEFAULT_NAMESPACE) -> CampaignRecord | None:
     """All the store holds of ``campaign`` (None when it holds nothing)."""
-    plans = [p for p in campaigns(store, None, namespace) if p.id == campaign]
-    if not plans:
+    found = [(plan, started) for plan, started in _plans(store, None, namespace) if plan.id == campaign]
+    if not found:
         return None
+    plan, started = found[-1]
     return CampaignRecord(
-        plans[-1],
-        _started(store, campaign, namespace),
+        plan,
+        started,
         tuple(campaign_trials(store, campaign, namespace)),
         tuple(shrinkings(store, campaign, namespace)),
     )
