@@ -165,8 +165,9 @@ def test_detour_shows_when_delivery_a_is_driven_backwards(
     assert travelled(without, "tiago1") == pytest.approx(base, rel=0.02)
     assert travelled(with_fault, "tiago1") > base * 1.1 + 3.0  # paths do not vary between runs
     assert driving_time(with_fault, "tiago1") > driving_time(without, "tiago1") + 10.0
-    # tiago2's path is its own; only giving way to tiago1 (backing up) may change its distance a little
-    assert travelled(with_fault, "tiago2") == pytest.approx(travelled(without, "tiago2"), rel=0.05)
+    # tiago2's path is its own; only giving way to tiago1 (backing up, or going round where
+    # tiago1 stands) may change its distance a little
+    assert travelled(with_fault, "tiago2") == pytest.approx(travelled(without, "tiago2"), rel=0.1)
 
 
 def test_deadlock_shows_when_the_start_poses_are_swapped(scenario_c: Scenario, grid: PlanningGrid) -> None:

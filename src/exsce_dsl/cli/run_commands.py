@@ -87,6 +87,7 @@ def simulate(
     Latent faults (--fault) stay hidden in scenario_c's runs and show in
     one derivation of it:
       slow-area:classroom_c069                   add_robot --start classroom_c069-w001
+                                                 --take_over tiago2, remove_start_pose
       detour:classroom_c018:classroom_c022       reverse_waypoint_order --task delivery_a
       deadlock-start:tiago1:classroom_c025-w002  swap_start_poses --robot tiago1 --with tiago2
       overspeed-many-tasks:2                     remove_robot --robot tiago2 --reassign tiago1

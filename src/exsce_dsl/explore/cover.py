@@ -11,7 +11,8 @@ steps (fewer when nothing more applies), so one execution tries several steps at
 shrinking (:mod:`exsce_dsl.explore.shrink`) finds which of them a violation needs.  Results
 equal to the base or to an earlier derivation (see :mod:`exsce_dsl.explore.fingerprint`) are
 drawn again with the next-least-used last step, and a step that would lead back to one of
-them is taken only when no other applies.
+them is taken only when no other applies.  Results no fleet could play
+(:mod:`exsce_dsl.explore.playable`) are not drawn; a step on the way may lead through one.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from collections.abc import Collection, Mapping
 
 from exsce_dsl.explore.draw import Candidate, check_draw
 from exsce_dsl.explore.fingerprint import fingerprint
+from exsce_dsl.explore.playable import standing_in_the_way
 from exsce_dsl.explore.steps import ProposedStep, applicable_steps
 from exsce_dsl.model import Scenario, Task
 from exsce_dsl.transform.derivation import Request
@@ -81,6 +83,8 @@ def covering_derivations(
         if reached in seen:
             continue
         seen.add(reached)
+        if standing_in_the_way(applied.scenario):  # no fleet could play it
+            continue
         drawn.append(Candidate(tuple(requests), applied.scenario, reached))
     return drawn
 

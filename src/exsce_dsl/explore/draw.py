@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.explore.fingerprint import fingerprint
+from exsce_dsl.explore.playable import standing_in_the_way
 from exsce_dsl.explore.steps import ProposedStep, applicable_steps
 from exsce_dsl.model import Scenario, Task
 from exsce_dsl.suggest import did_you_mean
@@ -84,7 +85,8 @@ def draw_derivations(
                 candidate = _candidate(base, tasks, node.requests, base_robots)
                 if candidate.fingerprint not in seen:
                     seen.add(candidate.fingerprint)
-                    drawn.append(candidate)
+                    if not standing_in_the_way(candidate.scenario):  # else no fleet could play it
+                        drawn.append(candidate)
                 break
             if not node.open:
                 break

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.explore.fingerprint import fingerprint
+from exsce_dsl.explore.playable import standing_in_the_way
 from exsce_dsl.model import Scenario, Task
 from exsce_dsl.transform.derivation import Request, derive
 from exsce_dsl.transform.transformations import TRANSFORMATIONS
@@ -103,4 +104,6 @@ def _applies(
         derived = derive(base, requests, tasks=tasks)
     except ExsceError:
         return False
-    return fingerprint(derived.scenario, base_robots) != base_print
+    if fingerprint(derived.scenario, base_robots) == base_print:
+        return False
+    return not standing_in_the_way(derived.scenario)  # else no fleet could play it

@@ -13,12 +13,14 @@ from __future__ import annotations
 import enum
 import math
 import random
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import MissionType, Pose, Scenario
+from exsce_dsl.sim.conflicts import CLEARANCE, MAX_REPAIRS, Leg, Repair, conflict_repairs
 from exsce_dsl.sim.faults import (
     DEADLOCK_WAIT,
     Fault,
@@ -30,7 +32,7 @@ from exsce_dsl.sim.faults import (
     speed_factor,
 )
 from exsce_dsl.sim.motion import DT, Limits, Trajectory, drive
-from exsce_dsl.sim.planner import PlanningGrid
+from exsce_dsl.sim.planner import PlanningError, PlanningGrid, Point
 
 
 class GoalStatus(enum.IntEnum):
@@ -118,9 +120,46 @@ def execute(
     faults: tuple[Fault, ...] = (),
     limits: Limits | None = None,
 ) -> Execution:
-    limits = limits or Limits()
-    rng = random.Random(seed)
+    """Play ``scenario``; where two robots would still touch after giving
+    way, the leg of the one driving into the other is planned again round the place where the
+    other was (sim.conflicts), and the whole run played again (as a fleet manager repairs a plan), at most
+    MAX_REPAIRS times.  ``near-collision`` is the fault of not doing so."""
     check_faults(scenario, faults)
+    avoid: dict[Leg, tuple[Point, ...]] = {}
+    execution = _play(scenario, grid, seed, faults, limits or Limits(), avoid)
+    if any(f.kind == "near-collision" for f in faults):
+        return execution
+    order = [r.id for r in scenario.robots]
+    for _ in range(MAX_REPAIRS):
+        repairs = conflict_repairs(execution.trajectories, execution.actions, order)
+        new = [r for r in repairs if _can_go_round(r, execution.actions, avoid)]
+        if not new:
+            break
+        avoid[new[0].leg] = avoid.get(new[0].leg, ()) + (new[0].place,)
+        execution = _play(scenario, grid, seed, faults, limits or Limits(), avoid)
+    return execution
+
+
+def _can_go_round(repair: Repair, actions: list[Action], avoid: dict[Leg, tuple[Point, ...]]) -> bool:
+    """The repair would change its leg: the place is not tried yet (nor one near it) and not
+    so near the leg's ends that its path cannot go round it."""
+    if any(math.dist(repair.place, p) < TRIED for p in avoid.get(repair.leg, ())):
+        return False
+    robot, number = repair.leg
+    leg = [a for a in actions if a.robot == robot][number - 1]
+    ends = (leg.path[0], leg.path[-1]) if leg.path else ()
+    return all(math.dist(repair.place, end) - END_ROOM >= MIN_RADIUS for end in ends)
+
+
+def _play(
+    scenario: Scenario,
+    grid: PlanningGrid,
+    seed: int,
+    faults: tuple[Fault, ...],
+    limits: Limits,
+    avoid: dict[Leg, tuple[Point, ...]],
+) -> Execution:
+    rng = random.Random(seed)
     timelines: dict[str, Timeline] = {}
     for robot in scenario.robots:
         if robot.start_pose is None:
@@ -175,15 +214,16 @@ def execute(
                 if stuck and waypoint_counts[entry.robot] == 1:  # deadlock-start: every robot waits
                     tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, int(round(DEADLOCK_WAIT / DT))))
                 previous = last_pose[entry.robot]
+                keep_clear = _standing(parked, avoid.get((entry.robot, waypoint_counts[entry.robot]), ()))
                 if (entry.robot, waypoint_counts[entry.robot]) in skip:
-                    path = _plan_around(grid, (tl.x, tl.y), (goal.position.x, goal.position.y), parked)
+                    path = _plan_around(grid, (tl.x, tl.y), (goal.position.x, goal.position.y), keep_clear)
                     tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, 25))
                     status, length = GoalStatus.ABORTED, 0.0
                 else:
                     for leg in approach.pop(entry.robot, []):  # the near-collision fault, inside the mission
                         tl.append(leg)
                     via = detour_via(scenario, entry.robot, previous, goal, faults)
-                    path, driven = _drive_to(grid, tl, goal, via, parked, robot_limits)
+                    path, driven = _drive_to(grid, tl, goal, via, keep_clear, robot_limits)
                     length = sum(math.dist(path[i], path[i + 1]) for i in range(len(path) - 1))
                     tl.append(slow_in_areas(driven, slow_boxes) if slow_boxes else driven)
                     status = GoalStatus.SUCCEEDED
@@ -229,7 +269,7 @@ def _drive_to(
     tl: Timeline,
     goal: Pose,
     via: tuple[float, float] | None,
-    parked: dict[str, tuple[float, float]],
+    parked: Mapping[str, Point],
     limits: Limits,
 ) -> tuple[list[tuple[float, float]], Trajectory]:
     """The path from where ``tl`` stands to ``goal`` (by way of ``via``, stopping there to turn:
@@ -248,6 +288,7 @@ def _drive_to(
 
 SAFE_DISTANCE = 1.5  # metres between robot centres that robots keep when they can
 MAX_WAIT = 10.0  # seconds a robot waits before it goes on (a real planner would detour)
+STANDING_WAIT = 30.0  # seconds a robot waits for one that stands in its way to leave
 RAMP = 1.2  # seconds to go from full progress to standing still (keeps accelerations bounded)
 
 
@@ -267,6 +308,7 @@ def _give_way(
     position = {r: 0.0 for r in order}  # fractional sample index along the robot's own trajectory
     rate = {r: 1.0 for r in order}
     waited = {r: 0 for r in order}
+    still = {r: True for r in order}
     last = {r: len(trajectories[r]) - 1 for r in order}
     shown: dict[str, list[float]] = {r: [] for r in order}
     previous: dict[str, tuple[float, float]] = {}
@@ -286,25 +328,33 @@ def _give_way(
         for r in order:
             here = at(r, position[r])
             look = at(r, min(position[r] + 1.0 + rate[r] * RAMP / DT / 2, last[r]))  # where braking would end
-            active = {h: p for h, p in placed.items() if position[h] < moving[h]}
+            # robots before r that drive, and every robot that stands (waiting, parked or not started)
+            active = {h: p for h, p in placed.items() if position[h] < moving[h] and not still[h]}
             threatened = any(
                 math.dist(p, here) < SAFE_DISTANCE
                 and math.dist(p, here) < math.dist(previous.get(h, p), here)
                 for h, p in active.items()
             )
+            standing = [p for h, p in (previous | placed).items() if h != r and still[h]]
             blocked = any(
                 math.dist(look, p) < SAFE_DISTANCE and math.dist(look, p) < math.dist(here, p)
                 for p in active.values()
             )
-            if not (threatened or blocked):
+            bumping = any(  # into a robot that stands, whatever its right of way: it may leave
+                math.dist(look, p) < CLEARANCE + 0.02 and math.dist(look, p) < math.dist(here, p)
+                for p in standing
+            )
+            if not (threatened or blocked or bumping):
                 target, waited[r] = 1.0, 0
-            elif waited[r] < MAX_WAIT / DT:  # give way
+            elif waited[r] < (STANDING_WAIT if bumping else MAX_WAIT) / DT:  # give way
                 target = -1.0 if threatened and position[r] > 0 else 0.0
                 waited[r] += 1
             else:  # waited long enough: go on until the conflict is over
                 target = 1.0
             rate[r] = min(rate[r] + step, target) if target > rate[r] else max(rate[r] - step, target)
+            before = position[r]
             position[r] = min(max(position[r] + rate[r], 0.0), float(last[r]))
+            still[r] = math.dist(at(r, before), at(r, position[r])) < 1e-9
             shown[r].append(position[r])
             placed[r] = at(r, position[r])
         previous = placed
@@ -382,22 +432,37 @@ def _plan_around(
     grid: PlanningGrid,
     start: tuple[float, float],
     goal: tuple[float, float],
-    parked: dict[str, tuple[float, float]],
+    parked: Mapping[str, Point],
 ) -> list[tuple[float, float]]:
     """A path that keeps clear of robots standing still (a real planner sees them in its costmap)."""
     path = grid.plan(start, goal)
     points = np.array(path)
+    room = {
+        p: min(PARKED_RADIUS, math.dist(goal, p) - END_ROOM, math.dist(start, p) - END_ROOM)
+        for p in parked.values()
+    }
     blockers = tuple(
-        (x, y, PARKED_RADIUS)
+        (x, y, room[x, y])
         for x, y in parked.values()
-        if _distance_to_polyline(points, (x, y)) < PARKED_RADIUS + 0.3
-        and math.dist(goal, (x, y)) > PARKED_RADIUS + 0.3
-        and math.dist(start, (x, y)) > PARKED_RADIUS + 0.3
+        if _distance_to_polyline(points, (x, y)) < room[x, y] + 0.3 and room[x, y] >= MIN_RADIUS
     )
-    return grid.with_discs(blockers).plan(start, goal) if blockers else path
+    if not blockers:
+        return path
+    try:
+        return grid.with_discs(blockers).plan(start, goal)
+    except PlanningError:  # no way round them: the plain path (the robot waits for them to move)
+        return path
 
 
 PARKED_RADIUS = 0.6  # metres: a robot standing still, with room to pass it
+MIN_RADIUS = 0.4  # metres: smaller where it stands near a leg's start or goal, down to this
+END_ROOM = 0.3  # metres a leg's start and goal keep from such a disc
+TRIED = 0.3  # metres within which a repair's place counts as one tried for the leg already
+
+
+def _standing(parked: dict[str, Point], avoid: tuple[Point, ...]) -> dict[str, Point]:
+    """What a leg keeps clear of: robots parked for good, and the places a repair moved it from."""
+    return parked | {f"avoid {n}": place for n, place in enumerate(avoid)} if avoid else parked
 
 
 def _distance_to_polyline(points: np.ndarray, p: tuple[float, float]) -> float:

@@ -1,0 +1,118 @@
+"""Where robots still meet after giving way, and which leg to plan again so they do not.
+
+Giving way (executor._give_way) only changes when robots drive, never where: two robots whose
+paths cross where neither can wait, or one that stands on the other's path, still meet.  A
+fleet manager repairs such a plan: the robot that drives into the other is sent round the
+place where the other was.  :func:`conflict_repairs` finds the first moment two robots are
+closer than the clearance and proposes the legs to plan again, best first.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+
+from exsce_dsl.sim.motion import DT, Trajectory
+from exsce_dsl.sim.planner import Point
+
+CLEARANCE = 0.7
+"""Metres between two robots' centres below which they touch (two 0.3 m robots, 0.1 m apart)."""
+MAX_REPAIRS = 12
+"""Legs planned again per run at most: the run is played once more for each."""
+MOVING = 0.05
+"""Metres a robot moves in the second round a moment for it to count as driving then."""
+
+STOOD = 3.0
+"""Seconds before the moment robots meet within which a robot that stood is sent round where
+it stood (when both were waiting for each other, the one that then moved on is met a little
+further on, where nobody can go round it)."""
+
+Leg = tuple[str, int]
+"""A robot's drive to one waypoint: the robot and the leg's number (from 1, over the run)."""
+
+
+class Timed(Protocol):
+    """What a repair needs of an executor's action: whose leg it is and when it was driven."""
+
+    @property
+    def robot(self) -> str: ...
+
+    @property
+    def start(self) -> float: ...
+
+    @property
+    def end(self) -> float: ...
+
+
+@dataclass(frozen=True)
+class Repair:
+    """Plan ``leg`` again round ``place``."""
+
+    leg: Leg
+    place: Point
+
+
+def conflict_repairs(
+    trajectories: Mapping[str, Trajectory],
+    actions: Sequence[Timed],
+    order: Sequence[str],
+    clearance: float = CLEARANCE,
+) -> list[Repair]:
+    """The repairs of the first moment two robots are closer than ``clearance``: the leg of a
+    robot driving then, round the other robot's place, a robot driving into one that stands
+    first, then the robot with less right of way (later in ``order``).  Empty when robots keep
+    clear all the run."""
+    robots = [r for r in order if r in trajectories]
+    if len(robots) < 2:
+        return []
+    n = min(len(trajectories[r]) for r in robots)
+    xs = np.stack([trajectories[r].x[:n] for r in robots])
+    ys = np.stack([trajectories[r].y[:n] for r in robots])
+    first: tuple[int, int, int] | None = None
+    for i in range(len(robots)):
+        distance = np.hypot(xs[i + 1 :] - xs[i], ys[i + 1 :] - ys[i])
+        close = np.argwhere(distance < clearance)
+        if len(close):
+            k = int(close[:, 1].min())
+            j = i + 1 + int(close[close[:, 1] == k][0, 0])
+            if first is None or k < first[0]:
+                first = (k, i, j)
+    if first is None:
+        return []
+    k, i, j = first
+    window = slice(max(0, k - int(0.5 / DT)), min(n, k + int(0.5 / DT) + 1))
+
+    def driving(a: int) -> bool:
+        x, y = xs[a, window], ys[a, window]
+        return bool(np.hypot(x - x[0], y - y[0]).max() > MOVING)
+
+    def place(a: int) -> Point:
+        """Where robot ``a`` stood last, a few seconds before the moment at most (the place the
+        other would have had to go round), else where it was then."""
+        since = max(0, k - int(STOOD / DT))
+        step = np.hypot(np.diff(xs[a, since : k + 1]), np.diff(ys[a, since : k + 1]))
+        stood = np.flatnonzero(step < 1e-9)
+        at = since + int(stood[-1]) if len(stood) else k
+        return float(xs[a, at]), float(ys[a, at])
+
+    repairs = []
+    for mover, other in sorted(((j, i), (i, j)), key=lambda pair: (not driving(pair[0]), pair[0] < pair[1])):
+        leg = _leg_at(actions, robots[mover], k * DT)
+        if leg is not None:
+            repairs.append(Repair(leg, place(other)))
+    return repairs
+
+
+def _leg_at(actions: Sequence[Timed], robot: str, t: float) -> Leg | None:
+    """The leg ``robot`` drives at ``t`` (or last drove, when it waits between legs)."""
+    number, found = 0, None
+    for action in actions:
+        if action.robot != robot:
+            continue
+        number += 1
+        if action.start <= t:
+            found = (robot, number)
+    return found
