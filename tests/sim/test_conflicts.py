@@ -107,3 +107,21 @@ def test_the_robot_that_drives_into_one_that_stands_goes_round_it() -> None:
 
     apart = {**trajectories, "first": Trajectory(still + 2.0, still + 2.0, still, still, still)}
     assert conflict_repairs(apart, actions, ["first", "second"]) == []
+
+
+def test_a_later_meeting_is_offered_after_the_first() -> None:
+    """When the first meeting cannot be repaired (say, at a leg's goal), the next one still can."""
+    n = 400
+    still = np.zeros(n)
+    there_and_back = np.concatenate([np.linspace(0.0, 4.0, n // 2), np.linspace(4.0, 0.0, n // 2)])
+    trajectories = {
+        "first": Trajectory(still + 2.0, still + 0.1, still, still, still),
+        "second": Trajectory(there_and_back, still, still, still + 0.5, still),  # passes it twice
+    }
+    actions = [
+        Drive("first", 0.0, 0.0),
+        Drive("second", 0.0, n / 2 * DT),
+        Drive("second", n / 2 * DT, n * DT),
+    ]
+    repairs = conflict_repairs(trajectories, actions, ["first", "second"])
+    assert [r.leg for r in repairs] == [("second", 1), ("first", 1), ("second", 2), ("first", 1)]

@@ -4,7 +4,8 @@ Giving way (executor._give_way) only changes when robots drive, never where: two
 paths cross where neither can wait, or one that stands on the other's path, still meet.  A
 fleet manager repairs such a plan: the robot that drives into the other is sent round the
 place where the other was.  :func:`conflict_repairs` finds the first moment two robots are
-closer than the clearance and proposes the legs to plan again, best first.
+closer than the clearance and proposes the legs to plan again, best first, then those of the
+next time, for when the first cannot be repaired.
 """
 
 from __future__ import annotations
@@ -61,28 +62,33 @@ def conflict_repairs(
     order: Sequence[str],
     clearance: float = CLEARANCE,
 ) -> list[Repair]:
-    """The repairs of the first moment two robots are closer than ``clearance``: the leg of a
-    robot driving then, round the other robot's place, a robot driving into one that stands
-    first, then the robot with less right of way (later in ``order``).  Empty when robots keep
-    clear all the run."""
+    """The repairs of each time two robots come closer than ``clearance``, earliest first: for
+    each, the leg of a robot driving then, round the other robot's place, a robot driving into
+    one that stands first, then the robot with less right of way (later in ``order``).  Empty
+    when robots keep clear all the run."""
     robots = [r for r in order if r in trajectories]
     if len(robots) < 2:
         return []
     n = min(len(trajectories[r]) for r in robots)
     xs = np.stack([trajectories[r].x[:n] for r in robots])
     ys = np.stack([trajectories[r].y[:n] for r in robots])
-    first: tuple[int, int, int] | None = None
+    meetings: list[tuple[int, int, int]] = []  # (first sample, robot, robot) of each time two meet
     for i in range(len(robots)):
-        distance = np.hypot(xs[i + 1 :] - xs[i], ys[i + 1 :] - ys[i])
-        close = np.argwhere(distance < clearance)
-        if len(close):
-            k = int(close[:, 1].min())
-            j = i + 1 + int(close[close[:, 1] == k][0, 0])
-            if first is None or k < first[0]:
-                first = (k, i, j)
-    if first is None:
-        return []
-    k, i, j = first
+        for j in range(i + 1, len(robots)):
+            close = np.hypot(xs[j] - xs[i], ys[j] - ys[i]) < clearance
+            starts = np.flatnonzero(close & ~np.concatenate(([False], close[:-1])))
+            meetings += [(int(k), i, j) for k in starts]
+    repairs = []
+    for k, i, j in sorted(meetings):
+        repairs += _repairs_of(xs, ys, k, i, j, robots, actions)
+    return repairs
+
+
+def _repairs_of(
+    xs: np.ndarray, ys: np.ndarray, k: int, i: int, j: int, robots: Sequence[str], actions: Sequence[Timed]
+) -> list[Repair]:
+    """The repairs of robots ``i`` and ``j`` meeting at sample ``k``, best first."""
+    n = xs.shape[1]
     window = slice(max(0, k - int(0.5 / DT)), min(n, k + int(0.5 / DT) + 1))
 
     def driving(a: int) -> bool:

@@ -126,7 +126,8 @@ def execute(
     MAX_REPAIRS times.  ``near-collision`` is the fault of not doing so."""
     check_faults(scenario, faults)
     avoid: dict[Leg, tuple[Point, ...]] = {}
-    execution = _play(scenario, grid, seed, faults, limits or Limits(), avoid)
+    plans: Plans = {}  # the same leg, planned round the same robots, in every replay
+    execution = _play(scenario, grid, seed, faults, limits or Limits(), avoid, plans)
     if any(f.kind == "near-collision" for f in faults):
         return execution
     order = [r.id for r in scenario.robots]
@@ -136,7 +137,7 @@ def execute(
         if not new:
             break
         avoid[new[0].leg] = avoid.get(new[0].leg, ()) + (new[0].place,)
-        execution = _play(scenario, grid, seed, faults, limits or Limits(), avoid)
+        execution = _play(scenario, grid, seed, faults, limits or Limits(), avoid, plans)
     return execution
 
 
@@ -158,6 +159,7 @@ def _play(
     faults: tuple[Fault, ...],
     limits: Limits,
     avoid: dict[Leg, tuple[Point, ...]],
+    plans: Plans,
 ) -> Execution:
     rng = random.Random(seed)
     timelines: dict[str, Timeline] = {}
@@ -216,14 +218,16 @@ def _play(
                 previous = last_pose[entry.robot]
                 keep_clear = _standing(parked, avoid.get((entry.robot, waypoint_counts[entry.robot]), ()))
                 if (entry.robot, waypoint_counts[entry.robot]) in skip:
-                    path = _plan_around(grid, (tl.x, tl.y), (goal.position.x, goal.position.y), keep_clear)
+                    path = _plan_around(
+                        grid, (tl.x, tl.y), (goal.position.x, goal.position.y), keep_clear, plans
+                    )
                     tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, 25))
                     status, length = GoalStatus.ABORTED, 0.0
                 else:
                     for leg in approach.pop(entry.robot, []):  # the near-collision fault, inside the mission
                         tl.append(leg)
                     via = detour_via(scenario, entry.robot, previous, goal, faults)
-                    path, driven = _drive_to(grid, tl, goal, via, keep_clear, robot_limits)
+                    path, driven = _drive_to(grid, tl, goal, via, keep_clear, robot_limits, plans)
                     length = sum(math.dist(path[i], path[i + 1]) for i in range(len(path) - 1))
                     tl.append(slow_in_areas(driven, slow_boxes) if slow_boxes else driven)
                     status = GoalStatus.SUCCEEDED
@@ -271,15 +275,16 @@ def _drive_to(
     via: tuple[float, float] | None,
     parked: Mapping[str, Point],
     limits: Limits,
+    plans: Plans,
 ) -> tuple[list[tuple[float, float]], Trajectory]:
     """The path from where ``tl`` stands to ``goal`` (by way of ``via``, stopping there to turn:
     the detour fault) and the drive along it."""
     target = (goal.position.x, goal.position.y)
     if via is None:
-        path = _plan_around(grid, (tl.x, tl.y), target, parked)
+        path = _plan_around(grid, (tl.x, tl.y), target, parked, plans)
         return path, drive(path, tl.yaw, goal.orientation.yaw, limits)
-    there = _plan_around(grid, (tl.x, tl.y), via, parked)
-    on = _plan_around(grid, via, target, parked)
+    there = _plan_around(grid, (tl.x, tl.y), via, parked, plans)
+    on = _plan_around(grid, via, target, parked, plans)
     heading = math.atan2(on[1][1] - on[0][1], on[1][0] - on[0][0])
     first = drive(there, tl.yaw, heading, limits)
     second = drive(on, heading, goal.orientation.yaw, limits)
@@ -325,14 +330,16 @@ def _give_way(
         if all(position[r] >= last[r] for r in order):
             break
         placed: dict[str, tuple[float, float]] = {}
+        braking: dict[str, tuple[float, float]] = {}
         for r in order:
             here = at(r, position[r])
             look = at(r, min(position[r] + 1.0 + rate[r] * RAMP / DT / 2, last[r]))  # where braking would end
             # robots before r that drive, and every robot that stands (waiting, parked or not started)
             active = {h: p for h, p in placed.items() if position[h] < moving[h] and not still[h]}
-            threatened = any(
+            threatened = any(  # a robot with right of way comes at r: where it would stop is too close
                 math.dist(p, here) < SAFE_DISTANCE
                 and math.dist(p, here) < math.dist(previous.get(h, p), here)
+                and _distance_to_polyline(np.array([p, braking[h]]), here) < CLEARANCE + 0.1
                 for h, p in active.items()
             )
             standing = [p for h, p in (previous | placed).items() if h != r and still[h]]
@@ -341,13 +348,20 @@ def _give_way(
                 for p in active.values()
             )
             bumping = any(  # into a robot that stands, whatever its right of way: it may leave
-                math.dist(look, p) < CLEARANCE + 0.02 and math.dist(look, p) < math.dist(here, p)
+                min(math.dist(look, p) + 0.08, math.dist(here, p)) < CLEARANCE + 0.1
+                and math.dist(look, p) < math.dist(here, p)
                 for p in standing
             )
             if not (threatened or blocked or bumping):
                 target, waited[r] = 1.0, 0
             elif waited[r] < (STANDING_WAIT if bumping else MAX_WAIT) / DT:  # give way
-                target = -1.0 if threatened and position[r] > 0 else 0.0
+                behind = at(r, max(position[r] - 1.0, 0.0))  # backing up must take r away from them
+                away = all(
+                    math.dist(behind, braking[h]) > math.dist(here, braking[h])
+                    for h in active
+                    if h in braking
+                )
+                target = -1.0 if threatened and position[r] > 0 and away else 0.0
                 waited[r] += 1
             else:  # waited long enough: go on until the conflict is over
                 target = 1.0
@@ -357,6 +371,7 @@ def _give_way(
             still[r] = math.dist(at(r, before), at(r, position[r])) < 1e-9
             shown[r].append(position[r])
             placed[r] = at(r, position[r])
+            braking[r] = at(r, min(position[r] + 1.0 + 2 * max(rate[r], 0.0) * RAMP / DT, last[r]))
         previous = placed
     new_index = {}
     for r in order:
@@ -433,8 +448,18 @@ def _plan_around(
     start: tuple[float, float],
     goal: tuple[float, float],
     parked: Mapping[str, Point],
+    plans: Plans,
 ) -> list[tuple[float, float]]:
     """A path that keeps clear of robots standing still (a real planner sees them in its costmap)."""
+    key = (start, goal, tuple(sorted(parked.values())))
+    if key not in plans:
+        plans[key] = _plan_round(grid, start, goal, parked)
+    return list(plans[key])
+
+
+def _plan_round(
+    grid: PlanningGrid, start: Point, goal: Point, parked: Mapping[str, Point]
+) -> list[tuple[float, float]]:
     path = grid.plan(start, goal)
     points = np.array(path)
     room = {
@@ -454,6 +479,8 @@ def _plan_around(
         return path
 
 
+Plans = dict[tuple[Point, Point, tuple[Point, ...]], list[Point]]
+"""Paths planned in one execution, by start, goal and the places kept clear of."""
 PARKED_RADIUS = 0.6  # metres: a robot standing still, with room to pass it
 MIN_RADIUS = 0.4  # metres: smaller where it stands near a leg's start or goal, down to this
 END_ROOM = 0.3  # metres a leg's start and goal keep from such a disc
