@@ -10,6 +10,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from exsce_dsl.lang.build import load_spec
+from exsce_dsl.model import Scenario, Task
+
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
 FIXTURES = ROOT / "tests" / "fixtures" / "hbrs-sesame-models"
@@ -51,3 +54,10 @@ def write_map(
 def in_tmp(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     monkeypatch.chdir(tmp_path)
     return tmp_path
+
+
+@pytest.fixture(scope="session")
+def spec_c() -> tuple[Scenario, dict[str, Task]]:
+    """The shipped scenario_c and the tasks its specification declares (loaded once)."""
+    spec = load_spec(EXAMPLES / "brsu_building_c" / "scenario_c.exsce")
+    return spec.scenario("scenario_c"), {t.id: t for t in spec.tasks}

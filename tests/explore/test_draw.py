@@ -3,25 +3,15 @@ without duplicates, and the fingerprint that decides what a duplicate is."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.explore.draw import Candidate, draw_derivations
 from exsce_dsl.explore.fingerprint import fingerprint
-from exsce_dsl.lang.build import load_spec
 from exsce_dsl.model import Scenario, Task
 from exsce_dsl.transform.derivation import derive
 
-SPEC = Path(__file__).resolve().parents[2] / "examples" / "brsu_building_c" / "scenario_c.exsce"
 BASE_ROBOTS = {"tiago1", "tiago2"}
-
-
-@pytest.fixture(scope="module")
-def spec_c() -> tuple[Scenario, dict[str, Task]]:
-    spec = load_spec(SPEC)
-    return spec.scenario("scenario_c"), {t.id: t for t in spec.tasks}
 
 
 def names(candidate: Candidate) -> list[str]:

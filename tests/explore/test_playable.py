@@ -4,7 +4,6 @@ named, and neither draw offers them."""
 from __future__ import annotations
 
 from collections.abc import Callable
-from pathlib import Path
 
 import pytest
 
@@ -12,23 +11,15 @@ from exsce_dsl.explore.cover import covering_derivations
 from exsce_dsl.explore.draw import Candidate, draw_derivations
 from exsce_dsl.explore.playable import standing_in_the_way
 from exsce_dsl.explore.steps import applicable_steps
-from exsce_dsl.lang.build import load_spec
 from exsce_dsl.model import Scenario, Task
 from exsce_dsl.transform.derivation import derive
 
-SPEC = Path(__file__).resolve().parents[2] / "examples" / "brsu_building_c" / "scenario_c.exsce"
 TAKE_OVER = (
     "add_robot",
     {"robot": "tiago3", "like": "tiago1", "start": "classroom_c069-w001", "take_over": "tiago2"},
 )
 """tiago2, left without tasks, stands at classroom_c025-w002: the goal of navigate_home_2,
 which tiago3 now drives."""
-
-
-@pytest.fixture(scope="module")
-def spec_c() -> tuple[Scenario, dict[str, Task]]:
-    spec = load_spec(SPEC)
-    return spec.scenario("scenario_c"), {t.id: t for t in spec.tasks}
 
 
 def test_a_robot_left_without_tasks_on_anothers_goal_is_named(

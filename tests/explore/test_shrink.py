@@ -5,16 +5,10 @@ from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Callable
-from pathlib import Path
-
-import pytest
 
 from exsce_dsl.explore.shrink import Shrunk, shrink
-from exsce_dsl.lang.build import load_spec
 from exsce_dsl.model import Scenario, Task
 from exsce_dsl.transform.derivation import Request, derive
-
-SPEC = Path(__file__).resolve().parents[2] / "examples" / "brsu_building_c" / "scenario_c.exsce"
 
 SWAP = ("swap_start_poses", {"robot": "tiago1", "with": "tiago2"})
 THREE: list[Request] = [
@@ -22,12 +16,6 @@ THREE: list[Request] = [
     SWAP,
     ("remove_task", {"task": "delivery_b"}),
 ]
-
-
-@pytest.fixture(scope="module")
-def spec_c() -> tuple[Scenario, dict[str, Task]]:
-    spec = load_spec(SPEC)
-    return spec.scenario("scenario_c"), {t.id: t for t in spec.tasks}
 
 
 def run(

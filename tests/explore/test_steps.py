@@ -3,19 +3,13 @@ apply to scenario_c is proposed."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
-import pytest
-
 from exsce_dsl.explore.fingerprint import fingerprint
 from exsce_dsl.explore.steps import PROPOSERS, applicable_steps, mint
-from exsce_dsl.lang.build import load_spec
 from exsce_dsl.model import Scenario, Task
 from exsce_dsl.model.names import is_valid_name
 from exsce_dsl.transform.derivation import derive
 from exsce_dsl.transform.transformations import TRANSFORMATIONS
 
-SPEC = Path(__file__).resolve().parents[2] / "examples" / "brsu_building_c" / "scenario_c.exsce"
 BASE_ROBOTS = {"tiago1", "tiago2"}
 
 # Written out by hand: both robots start somewhere (no add_start_pose) and have tasks (no
@@ -25,12 +19,6 @@ APPLY_TO_C = {
     "reverse_waypoint_order", "swap_start_poses", "substitute_allocation", "remove_robot",
     "add_robot", "replace_robot",
 }  # fmt: skip
-
-
-@pytest.fixture(scope="module")
-def spec_c() -> tuple[Scenario, dict[str, Task]]:
-    spec = load_spec(SPEC)
-    return spec.scenario("scenario_c"), {t.id: t for t in spec.tasks}
 
 
 def test_every_transformation_has_a_proposer() -> None:

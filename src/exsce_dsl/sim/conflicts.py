@@ -1,8 +1,8 @@
 """Where robots still meet after giving way, and which leg to plan again so they do not.
 
-Giving way (executor._give_way) only changes when robots drive, never where: two robots whose
-paths cross where neither can wait, or one that stands on the other's path, still meet.  A
-fleet manager repairs such a plan: the robot that drives into the other is sent round the
+Giving way (:mod:`exsce_dsl.sim.give_way`) only changes when robots drive, never where: two
+robots whose paths cross where neither can wait, or one that stands on the other's path, still
+meet.  A fleet manager repairs such a plan: the robot that drives into the other is sent round the
 place where the other was.  :func:`conflict_repairs` finds the first moment two robots are
 closer than the clearance and proposes the legs to plan again, best first, then those of the
 next time, for when the first cannot be repaired.

@@ -1,0 +1,161 @@
+"""Right of way between robots, replayed on their trajectories: paths stay, clocks warp.
+
+Each robot's trajectory is planned alone; :func:`give_way` then replays all of them together,
+each robot advancing along its own at a rate that changes gradually, so that robots wait for,
+back away from and never drive on into each other where they can.  Where they still meet, the
+executor plans a leg again (:mod:`exsce_dsl.sim.conflicts`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from exsce_dsl.model import Scenario
+from exsce_dsl.sim.actions import Action, GoalEvent
+from exsce_dsl.sim.conflicts import CLEARANCE
+from exsce_dsl.sim.motion import DT, Trajectory
+
+SAFE_DISTANCE = 1.5  # metres between robot centres that robots keep when they can
+MAX_WAIT = 10.0  # seconds a robot waits before it goes on (a real planner would detour)
+STANDING_WAIT = 30.0  # seconds a robot waits for one that stands in its way to leave
+RAMP = 1.2  # seconds to go from full progress to standing still (keeps accelerations bounded)
+
+
+def give_way(
+    scenario: Scenario, trajectories: dict[str, Trajectory], events: list[GoalEvent], actions: list[Action]
+) -> tuple[dict[str, Trajectory], list[GoalEvent], list[Action]]:
+    """Right of way by fleet order, replayed on the trajectories (paths unchanged, clocks warped).
+
+    Each robot advances along its own trajectory at a rate between -1 (backing up
+    the way it came) and 1 (as planned); the rate changes gradually.  A robot about
+    to come closer than SAFE_DISTANCE to a robot listed before it slows to a stop;
+    a robot that a robot with right of way drives towards backs up.
+    """
+    order = [r.id for r in scenario.robots if r.id in trajectories]
+    if len(order) < 2:
+        return trajectories, events, actions
+    position = {r: 0.0 for r in order}  # fractional sample index along the robot's own trajectory
+    rate = {r: 1.0 for r in order}
+    waited = {r: 0 for r in order}
+    still = {r: True for r in order}
+    last = {r: len(trajectories[r]) - 1 for r in order}
+    shown: dict[str, list[float]] = {r: [] for r in order}
+    previous: dict[str, tuple[float, float]] = {}
+    moving = {r: _last_move(trajectories[r]) for r in order}
+    """After this sample a robot stands still for good: others pass it on paths planned round it."""
+    step = DT / RAMP
+
+    def at(r: str, p: float) -> tuple[float, float]:
+        tr, k = trajectories[r], min(int(p), last[r])
+        k1, f = min(k + 1, last[r]), p - k
+        return (float(tr.x[k] + f * (tr.x[k1] - tr.x[k])), float(tr.y[k] + f * (tr.y[k1] - tr.y[k])))
+
+    for _ in range(10 * sum(last.values()) + 10):  # bounded: robots finish or stop waiting
+        if all(position[r] >= last[r] for r in order):
+            break
+        placed: dict[str, tuple[float, float]] = {}
+        braking: dict[str, tuple[float, float]] = {}
+        for r in order:
+            here = at(r, position[r])
+            look = at(r, min(position[r] + 1.0 + rate[r] * RAMP / DT / 2, last[r]))  # where braking would end
+            # robots before r that drive, and every robot that stands (waiting, parked or not started)
+            active = {h: p for h, p in placed.items() if position[h] < moving[h] and not still[h]}
+            threatened = any(  # a robot with right of way comes at r: where it would stop is too close
+                math.dist(p, here) < SAFE_DISTANCE
+                and math.dist(p, here) < math.dist(previous.get(h, p), here)
+                and distance_to_polyline(np.array([p, braking[h]]), here) < CLEARANCE + 0.1
+                for h, p in active.items()
+            )
+            standing = [p for h, p in (previous | placed).items() if h != r and still[h]]
+            blocked = any(
+                math.dist(look, p) < SAFE_DISTANCE and math.dist(look, p) < math.dist(here, p)
+                for p in active.values()
+            )
+            bumping = any(  # into a robot that stands, whatever its right of way: it may leave
+                min(math.dist(look, p) + 0.08, math.dist(here, p)) < CLEARANCE + 0.1
+                and math.dist(look, p) < math.dist(here, p)
+                for p in standing
+            )
+            if not (threatened or blocked or bumping):
+                target, waited[r] = 1.0, 0
+            elif waited[r] < (STANDING_WAIT if bumping else MAX_WAIT) / DT:  # give way
+                behind = at(r, max(position[r] - 1.0, 0.0))  # backing up must take r away from them
+                away = all(
+                    math.dist(behind, braking[h]) > math.dist(here, braking[h])
+                    for h in active
+                    if h in braking
+                )
+                target = -1.0 if threatened and position[r] > 0 and away else 0.0
+                waited[r] += 1
+            else:  # waited long enough: go on until the conflict is over
+                target = 1.0
+            rate[r] = min(rate[r] + step, target) if target > rate[r] else max(rate[r] - step, target)
+            before = position[r]
+            position[r] = min(max(position[r] + rate[r], 0.0), float(last[r]))
+            still[r] = math.dist(at(r, before), at(r, position[r])) < 1e-9
+            shown[r].append(position[r])
+            placed[r] = at(r, position[r])
+            braking[r] = at(r, min(position[r] + 1.0 + 2 * max(rate[r], 0.0) * RAMP / DT, last[r]))
+        previous = placed
+    new_index = {}
+    for r in order:
+        tr = trajectories[r]
+        p = np.asarray(shown[r])
+        k = np.minimum(p.astype(np.int64), last[r])
+        k1 = np.minimum(k + 1, last[r])
+        f = p - k
+        speed_scale = np.diff(p, prepend=0.0)  # progress per sample: -1..1
+        trajectories[r] = Trajectory(
+            tr.x[k] + f * (tr.x[k1] - tr.x[k]),
+            tr.y[k] + f * (tr.y[k1] - tr.y[k]),
+            tr.yaw[k] + f * (tr.yaw[k1] - tr.yaw[k]),
+            speed_scale * tr.v[k1],
+            speed_scale * tr.w[k1],
+        )
+        # original sample -> first new sample that reached it
+        first = np.searchsorted(np.maximum.accumulate(p), np.arange(last[r] + 2), side="left")
+        new_index[r] = np.minimum(first, len(p))
+
+    def moved(robot: str, t: float) -> float:
+        k = min(int(round(t / DT)), len(new_index[robot]) - 1)
+        return float(new_index[robot][k]) * DT
+
+    events = [
+        GoalEvent(moved(e.robot, e.t), e.robot, e.goal_key, e.waypoint_ids, e.statuses, e.final)
+        for e in events
+    ]
+    actions = [
+        Action(
+            a.robot,
+            a.task_number,
+            a.task,
+            a.subtask_number,
+            a.waypoint_number,
+            a.start_pose,
+            a.goal,
+            moved(a.robot, a.start),
+            moved(a.robot, a.end),
+            a.status,
+            a.path_length,
+            a.path,
+        )
+        for a in actions
+    ]
+    return trajectories, events, actions
+
+
+def _last_move(trajectory: Trajectory) -> int:
+    """The last sample at which the robot is still moving (0 if it never moves)."""
+    moved = np.flatnonzero((np.abs(np.diff(trajectory.x)) > 1e-9) | (np.abs(np.diff(trajectory.y)) > 1e-9))
+    return int(moved[-1]) + 1 if len(moved) else 0
+
+
+def distance_to_polyline(points: np.ndarray, p: tuple[float, float]) -> float:
+    a, b = points[:-1], points[1:]
+    ab = b - a
+    length2 = np.maximum((ab**2).sum(axis=1), 1e-12)
+    t = np.clip(((np.array(p) - a) * ab).sum(axis=1) / length2, 0.0, 1.0)
+    closest = a + t[:, None] * ab
+    return float(np.min(np.hypot(closest[:, 0] - p[0], closest[:, 1] - p[1]))) if len(a) else math.inf
