@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import math
 import random
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -84,9 +83,10 @@ def execute(
     other was (sim.conflicts), and the whole run played again (as a fleet manager repairs a plan), at most
     MAX_REPAIRS times.  ``near-collision`` is the fault of not doing so."""
     check_faults(scenario, faults)
+    limits = limits or Limits()
     avoid: dict[Leg, tuple[Point, ...]] = {}
     plans: Plans = {}  # the same leg, planned round the same robots, in every replay
-    execution = _play(scenario, grid, seed, faults, limits or Limits(), avoid, plans)
+    execution = _play(scenario, grid, seed, faults, limits, avoid, plans)
     if any(f.kind == "near-collision" for f in faults):
         return execution
     order = [r.id for r in scenario.robots]
@@ -96,7 +96,7 @@ def execute(
         if not new:
             break
         avoid[new[0].leg] = avoid.get(new[0].leg, ()) + (new[0].place,)
-        execution = _play(scenario, grid, seed, faults, limits or Limits(), avoid, plans)
+        execution = _play(scenario, grid, seed, faults, limits, avoid, plans)
     return execution
 
 
@@ -232,7 +232,7 @@ def _drive_to(
     tl: Timeline,
     goal: Pose,
     via: tuple[float, float] | None,
-    parked: Mapping[str, Point],
+    parked: tuple[Point, ...],
     limits: Limits,
     plans: Plans,
 ) -> tuple[list[tuple[float, float]], Trajectory]:
@@ -271,28 +271,27 @@ def _plan_around(
     grid: PlanningGrid,
     start: tuple[float, float],
     goal: tuple[float, float],
-    parked: Mapping[str, Point],
+    parked: tuple[Point, ...],
     plans: Plans,
 ) -> list[tuple[float, float]]:
     """A path that keeps clear of robots standing still (a real planner sees them in its costmap)."""
-    key = (start, goal, tuple(sorted(parked.values())))
+    key = (start, goal, tuple(sorted(parked)))
     if key not in plans:
         plans[key] = _plan_round(grid, start, goal, parked)
     return list(plans[key])
 
 
 def _plan_round(
-    grid: PlanningGrid, start: Point, goal: Point, parked: Mapping[str, Point]
+    grid: PlanningGrid, start: Point, goal: Point, parked: tuple[Point, ...]
 ) -> list[tuple[float, float]]:
     path = grid.plan(start, goal)
     points = np.array(path)
     room = {
-        p: min(PARKED_RADIUS, math.dist(goal, p) - END_ROOM, math.dist(start, p) - END_ROOM)
-        for p in parked.values()
+        p: min(PARKED_RADIUS, math.dist(goal, p) - END_ROOM, math.dist(start, p) - END_ROOM) for p in parked
     }
     blockers = tuple(
         (x, y, room[x, y])
-        for x, y in parked.values()
+        for x, y in parked
         if distance_to_polyline(points, (x, y)) < room[x, y] + 0.3 and room[x, y] >= MIN_RADIUS
     )
     if not blockers:
@@ -311,9 +310,9 @@ END_ROOM = 0.3  # metres a leg's start and goal keep from such a disc
 TRIED = 0.3  # metres within which a repair's place counts as one tried for the leg already
 
 
-def _standing(parked: dict[str, Point], avoid: tuple[Point, ...]) -> dict[str, Point]:
+def _standing(parked: dict[str, Point], avoid: tuple[Point, ...]) -> tuple[Point, ...]:
     """What a leg keeps clear of: robots parked for good, and the places a repair moved it from."""
-    return parked | {f"avoid {n}": place for n, place in enumerate(avoid)} if avoid else parked
+    return tuple(parked.values()) + avoid
 
 
 __all__ = ["Action", "Execution", "Fault", "GoalEvent", "GoalStatus", "execute", "np"]
