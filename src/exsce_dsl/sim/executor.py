@@ -297,9 +297,15 @@ def _plan_round(
     if not blockers:
         return path
     try:
-        return grid.with_discs(blockers).plan(start, goal)
+        around = grid.with_discs(blockers).plan(start, goal)
     except PlanningError:  # no way round them: the plain path (the robot waits for them to move)
         return path
+    # a fleet manager does not send a robot round the building to pass one that will move on
+    return around if _length(around) <= ROUND_AT_MOST * _length(path) + ROUND_EXTRA else path
+
+
+def _length(path: list[Point]) -> float:
+    return sum(math.dist(path[i], path[i + 1]) for i in range(len(path) - 1))
 
 
 Plans = dict[tuple[Point, Point, tuple[Point, ...]], list[Point]]
@@ -307,6 +313,7 @@ Plans = dict[tuple[Point, Point, tuple[Point, ...]], list[Point]]
 PARKED_RADIUS = 0.6  # metres: a robot standing still, with room to pass it
 MIN_RADIUS = 0.4  # metres: smaller where it stands near a leg's start or goal, down to this
 END_ROOM = 0.3  # metres a leg's start and goal keep from such a disc
+ROUND_AT_MOST, ROUND_EXTRA = 1.5, 3.0  # a way round a robot may be this much longer (factor, metres)
 TRIED = 0.3  # metres within which a repair's place counts as one tried for the leg already
 
 

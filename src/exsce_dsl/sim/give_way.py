@@ -20,6 +20,8 @@ from exsce_dsl.sim.motion import DT, Trajectory
 SAFE_DISTANCE = 1.5  # metres between robot centres that robots keep when they can
 MAX_WAIT = 10.0  # seconds a robot waits before it goes on (a real planner would detour)
 STANDING_WAIT = 30.0  # seconds a robot waits for one that stands in its way to leave
+GOAL_TAKEN = 0.5  # metres from a robot's goal within which a robot standing there takes it
+GOAL_WAIT = 1.1  # metres from a robot on its goal at which a robot waits for it to leave
 RAMP = 1.2  # seconds to go from full progress to standing still (keeps accelerations bounded)
 
 
@@ -46,6 +48,15 @@ def give_way(
     moving = {r: _last_move(trajectories[r]) for r in order}
     """After this sample a robot stands still for good: others pass it on paths planned round it."""
     step = DT / RAMP
+    leg_ends = {r: sorted((int(round(a.end / DT)), a.goal) for a in actions if a.robot == r) for r in order}
+
+    def keep_from(r: str, p: tuple[float, float]) -> float:
+        """How near r comes to a robot standing at p: farther when p is r's goal, so that the
+        robot there has room to leave round r."""
+        goal = next((g for end, g in leg_ends[r] if end >= position[r]), None)
+        if goal is not None and math.dist(p, (goal.position.x, goal.position.y)) < GOAL_TAKEN:
+            return GOAL_WAIT
+        return CLEARANCE + 0.1
 
     def at(r: str, p: float) -> tuple[float, float]:
         tr, k = trajectories[r], min(int(p), last[r])
@@ -62,19 +73,24 @@ def give_way(
             look = at(r, min(position[r] + 1.0 + rate[r] * RAMP / DT / 2, last[r]))  # where braking would end
             # robots before r that drive, and every robot that stands (waiting, parked or not started)
             active = {h: p for h, p in placed.items() if position[h] < moving[h] and not still[h]}
-            threatened = any(  # a robot with right of way comes at r: where it would stop is too close
-                math.dist(p, here) < SAFE_DISTANCE
+            threats = [  # robots with right of way coming at r: where they would stop is too close
+                p
+                for h, p in active.items()
+                if math.dist(p, here) < SAFE_DISTANCE
                 and math.dist(p, here) < math.dist(previous.get(h, p), here)
                 and distance_to_polyline(np.array([p, braking[h]]), here) < CLEARANCE + 0.1
-                for h, p in active.items()
-            )
-            standing = [p for h, p in (previous | placed).items() if h != r and still[h]]
+            ]
+            # driving on away from them is giving way too (a robot followed does not stop)
+            threatened = any(math.dist(look, p) <= math.dist(here, p) + 0.01 for p in threats)
+            # robots r must not drive into: standing ones, and any without right of way over r
+            # (they should yield, but may be unable to: at their start, or with nowhere to go)
+            standing = [p for h, p in (previous | placed).items() if h != r and (still[h] or h not in active)]
             blocked = any(
                 math.dist(look, p) < SAFE_DISTANCE and math.dist(look, p) < math.dist(here, p)
                 for p in active.values()
             )
             bumping = any(  # into a robot that stands, whatever its right of way: it may leave
-                min(math.dist(look, p) + 0.08, math.dist(here, p)) < CLEARANCE + 0.1
+                min(math.dist(look, p) + 0.08, math.dist(here, p)) < keep_from(r, p)
                 and math.dist(look, p) < math.dist(here, p)
                 for p in standing
             )
