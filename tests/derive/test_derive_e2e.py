@@ -5,8 +5,8 @@ runs of the derived scenario pass them; a slowed-down tiago1 fails them.
 The expectation comes from stored path segments only: tiago1 now drives tiago2's delivery too,
 segments that tiago2 drove in the base runs, and two that nobody drove (estimated from
 neighbouring poses, or per metre).  The allowance is 15 % of the expected value, not the default
-10 %: in the base runs tiago2 gives way to tiago1 (backing up along its path, ~13 m more
-than alone), so the segments it drove cost more than they do for a robot on its own.
+10 % (at most 10 % of the observed segments' distance): in the base runs tiago2 waits for tiago1,
+so the segments it drove took longer than they do for a robot on its own.
 """
 
 from __future__ import annotations

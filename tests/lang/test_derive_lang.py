@@ -25,7 +25,7 @@ derive every_step from scenario_c {
   add task delivery_a to tiago1 at 1
   remove task navigate_home_1 from tiago3
   substitute task navigate_home_2 by navigate_home_1
-  replace robot tiago1 by tiago4
+  replace robot tiago1 by tiago4 at classroom_c069-w001
   remove robot tiago3 reassign to tiago4
   reallocate {
     tiago4 does delivery_a_back then delivery_b
@@ -52,6 +52,7 @@ def test_every_step_form_builds_and_prints_back(folder: Path) -> None:
     spec = load_spec(folder / "derived.exsce")
     every = spec.scenario("every_step")
     assert [r.id for r in every.robots] == ["tiago2", "tiago4"]  # tiago2 gave its tasks to tiago3
+    assert every.robot("tiago4").start_pose.id == "classroom_c069-w001"  # type: ignore[union-attr]
     assert [(a.robot, a.task) for a in every.mission.allocation] == [("tiago4", "delivery_a_back"), ("tiago4", "delivery_b")]
     derived = {d.id: d for d in spec.derived}
     assert derived["every_step"].derivation is not None

@@ -41,10 +41,7 @@ class Planted:
 
 SLOW_AREA = Planted(
     "slow-area:classroom_c069",
-    (
-        "add_robot",
-        {"robot": "tiago3", "like": "tiago1", "start": "classroom_c069-w001", "take_over": "tiago2"},
-    ),
+    ("replace_robot", {"robot": "tiago2", "by": "tiago3", "start": "classroom_c069-w001"}),
 )
 DETOUR = Planted("detour:classroom_c018:classroom_c022", ("reverse_waypoint_order", {"task": "delivery_a"}))
 DEADLOCK = Planted(

@@ -124,6 +124,13 @@ def test_start_pose_and_robot_transformations(base: Scenario) -> None:
     assert [r.id for r in replaced.scenario.robots] == ["tiago1", "tiago9"]
     assert replaced.scenario.robot("tiago9").start_pose.id == "classroom_c025-w002"  # type: ignore[union-attr]
     assert [s.transformation for s in replaced.derivation.steps] == ["add_robot", "substitute_allocation", "remove_robot"]
+    elsewhere = derive(base, [("replace_robot", {"robot": "tiago2", "by": "tiago9", "start": "classroom_c069-w001"})],
+                       "elsewhere").scenario
+    assert [(r.id, r.start_pose.id) for r in elsewhere.robots if r.start_pose] == [
+        ("tiago1", "classroom_c025-w001"), ("tiago9", "classroom_c069-w001")]
+    assert ("tiago9", "delivery_b") in allocation(elsewhere)
+    with pytest.raises(ExsceError, match="'classroom_c025-w001' is another robot's start pose"):
+        derive(base, [("replace_robot", {"robot": "tiago2", "by": "tiago9", "start": "classroom_c025-w001"})], "x")
 
 
 def test_start_pose_and_allocation_transformations(base: Scenario) -> None:

@@ -86,8 +86,8 @@ def simulate(
     \b
     Latent faults (--fault) stay hidden in scenario_c's runs and show in
     one derivation of it:
-      slow-area:classroom_c069                   add_robot --start classroom_c069-w001
-                                                 --take_over tiago2, remove_start_pose
+      slow-area:classroom_c069                   replace_robot --robot tiago2 --by tiago3
+                                                 --start classroom_c069-w001
       detour:classroom_c018:classroom_c022       reverse_waypoint_order --task delivery_a
       deadlock-start:tiago1:classroom_c025-w002  swap_start_poses --robot tiago1 --with tiago2
       overspeed-many-tasks:2                     remove_robot --robot tiago2 --reassign tiago1

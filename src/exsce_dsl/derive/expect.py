@@ -247,6 +247,11 @@ def _xy(pose: Pose) -> tuple[float, float]:
 RELATIVE_TOLERANCE = 10.0
 """Percent of the expected change a derived scenario's performance clause allows, by default."""
 
+OBSERVED_DISTANCE = 10.0
+"""Percent of an observed segment's distance a run may differ by at most: between the same poses
+a path hardly varies, but a robot may go round another (the simulator's repairs add up to a few
+metres to a leg, a real planner as much)."""
+
 PAIRWISE = frozenset({"distance_between_robots"})
 """Mission metrics that need two robots at least."""
 
@@ -287,7 +292,8 @@ def metamorphic_acceptance(
       within that allowance, ``is invariant within A + |E - B| of BASE`` (what a run within A
       of E may differ from B).
 
-    P is ``tolerance_percent``; waypoints are counted, so exactly.  A robot the base does not
+    P is ``tolerance_percent`` (for distance, at most OBSERVED_DISTANCE % on the segments stored
+    runs observed: see :func:`_allowance`); waypoints are counted, so exactly.  A robot the base does not
     have (``add_robot``, ``replace_robot``) gets its own-baseline clauses only: a slow-down of the
     new robot is caught, and there is nothing of the base to relate it to.  Without an expected
     value, or for a robot the base's runs do not show, there is no performance clause."""
@@ -311,12 +317,13 @@ def metamorphic_acceptance(
         subject = Subject(Quantifier.ROBOT, robot.id)
         in_base = base.robot(robot.id) is not None
         for metric in SUMMED:
-            expected = expected_metric(store, derived, robot.id, metric).value
+            estimate = expected_metric(store, derived, robot.id, metric)
+            expected = estimate.value
             if expected is None:
                 continue
             before = robot_metric_over_runs(store, metric, robot.id, base_runs) if in_base else None
             unit = "m" if metric == "distance_travelled" else "s"
-            allowance = abs(expected) * tolerance_percent / 100.0
+            allowance = _allowance(estimate, tolerance_percent)
             performance.extend(_expected_clauses(subject, metric, expected, before, allowance, unit, base.id))
         waypoints = len(robot_path(derived, robot.id))
         before = robot_metric_over_runs(store, "waypoints_visited", robot.id, base_runs) if in_base else None
@@ -332,6 +339,20 @@ def metamorphic_acceptance(
     if performance:
         criteria.append(Criterion(f"as expected from {base.id}", (), when, tuple(performance)))
     return Acceptance(derived.id, tuple(criteria))
+
+
+def _allowance(expected: Expected, tolerance_percent: float) -> float:
+    """What a run may differ from ``expected`` by: ``tolerance_percent`` of it, but for distance
+    at most OBSERVED_DISTANCE percent of the segments observed in stored runs (the estimate's
+    error is in the estimated segments; a path between two poses hardly varies)."""
+    if expected.metric != DISTANCE:
+        return abs(expected.value or 0.0) * tolerance_percent / 100.0
+    observed = min(tolerance_percent, OBSERVED_DISTANCE)
+    return math.fsum(
+        abs(s.value) * (observed if s.how.startswith("observed") else tolerance_percent) / 100.0
+        for s in expected.segments
+        if s.value is not None
+    )
 
 
 def _expected_clauses(

@@ -1,18 +1,21 @@
 """Draws that cover the steps first: the campaign's default way of choosing derivations.
 
 Uniform draws (:mod:`exsce_dsl.explore.draw`) spend a small budget where steps are many: with
-89 single steps of ``scenario_c``, 24 of them ``add_task`` and one ``swap_start_poses``, forty
-uniform draws try the lone swap about half the time.  A fault hides behind one feature of a
-scenario, and which feature is what nobody knows, so these draws spread the budget over what
-can change: each derivation is built step by step, each step chosen among the applicable ones
-whose transformation has been used least so far, then, among those, whose own arguments have
-been used least; ties are broken by the seeded generator.  A derivation has ``max_steps``
-steps (fewer when nothing more applies), so one execution tries several steps at once, and
-shrinking (:mod:`exsce_dsl.explore.shrink`) finds which of them a violation needs.  Results
-equal to the base or to an earlier derivation (see :mod:`exsce_dsl.explore.fingerprint`) are
-drawn again with the next-least-used last step, and a step that would lead back to one of
-them is taken only when no other applies.  Results no fleet could play
-(:mod:`exsce_dsl.explore.playable`) are not drawn; a step on the way may lead through one.
+101 single steps of ``scenario_c``, 24 of them ``add_task`` and one ``swap_start_poses``, forty
+uniform draws often miss the lone swap.  A fault hides behind one feature of a scenario, and
+which feature is what nobody knows, so these draws spread the budget over what can change: each
+derivation is built step by step, each step chosen among the applicable ones whose
+transformation has been used least so far, then, among those, one that sends robots into areas
+of the environment no derivation drawn so far (nor the base) drives in (a start pose in another
+room: a robot's software is as likely to fail in a place as on a feature), then whose own
+arguments have been used least; ties are broken by the seeded generator.  A derivation has
+``max_steps`` steps (fewer when nothing more applies), so one execution tries several steps at
+once, and shrinking (:mod:`exsce_dsl.explore.shrink`) finds which of them a violation needs.
+Results equal to the base or to an earlier derivation (see
+:mod:`exsce_dsl.explore.fingerprint`) are drawn again with the next-least-used last step, and a
+step that would lead back to one of them is taken only when no other applies.  Results no fleet
+could play (:mod:`exsce_dsl.explore.playable`) are not drawn; a step on the way may lead
+through one.
 """
 
 from __future__ import annotations
@@ -51,6 +54,7 @@ def covering_derivations(
     by_step: Counter[str] = Counter()
     steps_of: dict[str, list[ProposedStep]] = {}
     drawn: list[Candidate] = []
+    covered = areas_driven(base)
     for _ in range(count * ATTEMPTS):
         if len(drawn) == count:
             break
@@ -71,7 +75,15 @@ def covering_derivations(
                 not fresh and requests and fingerprint(applied.scenario, base_robots) not in seen
             ):
                 break
-            step = min(fresh or steps, key=lambda s: (by_name[s.name], by_step[_step_key(s)], rng.random()))
+            step = min(
+                fresh or steps,
+                key=lambda s: (
+                    by_name[s.name],
+                    not areas_driven(s.applied.scenario) - covered,
+                    by_step[_step_key(s)],
+                    rng.random(),
+                ),
+            )
             by_name[step.name] += 1
             by_step[_step_key(step)] += 1
             applied = applied.then(step.applied)
@@ -86,7 +98,23 @@ def covering_derivations(
         if standing_in_the_way(applied.scenario):  # no fleet could play it
             continue
         drawn.append(Candidate(tuple(requests), applied.scenario, reached))
+        covered |= areas_driven(applied.scenario)
     return drawn
+
+
+def areas_driven(scenario: Scenario) -> set[str]:
+    """The areas whose poses robots with tasks start at or drive to."""
+    area_of = {p.id: a.id for a in scenario.environment.areas for p in a.poses}
+    poses = set()
+    for robot in scenario.robots:
+        tasks = scenario.mission.tasks_of(robot.id)
+        if not tasks or robot.start_pose is None:
+            continue
+        poses.add(robot.start_pose.id)
+        for task_id in tasks:
+            task = scenario.task(task_id)
+            poses.update(w.id for w in (task.waypoints() if task is not None else ()))
+    return {area_of[p] for p in poses if p in area_of}
 
 
 def _step_key(step: ProposedStep) -> str:

@@ -6,10 +6,10 @@ tried in this order, and the first that still fails is shrunk again from the sta
 
 1. each step dropped, one at a time, first step first;
 2. each step's arguments simplified, first step first: each optional argument it was given
-   dropped (a ``remove_robot`` without ``reassign``, an ``add_task`` at its default position, an
-   ``add_robot`` taking over no one, a ``replace_robot`` of the old robot's type, a reversed task
-   under its default id, a ``reverse_task_order`` of every robot, a ``remove_task`` of a task
-   from every robot or of every task of a robot).
+   dropped (a ``remove_robot`` without ``reassign``, an ``add_task`` at its default position,
+   an ``add_robot`` taking over no one, a ``replace_robot`` of the old robot's type or at its
+   start pose, a reversed task under its default id, a ``reverse_task_order`` of every robot, a
+   ``remove_task`` of a task from every robot or of every task of a robot).
 
 Only derivations that apply (``derive`` succeeds) and differ from the base are tried.
 """

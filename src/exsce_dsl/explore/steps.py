@@ -9,7 +9,9 @@ the arguments worth trying.  Bounds, so that a step's neighbours stay in the hun
   (``move_obstacle``'s ``to``) are at most :data:`MAX_POSES` of the environment's poses, spread
   evenly over the order they are declared (the free ones, for start poses);
 - ``add_robot`` is tried once per robot type of the fleet (``like`` its first robot), and mints
-  one id; ``replace_robot`` tries the robot's own type and each other type of the fleet;
+  one id; ``replace_robot`` tries the robot's own type and each other type of the fleet, at the
+  robot's start pose, and its own type at each of the free poses (a robot of the same kind that
+  starts elsewhere);
 - ``add_task`` puts a task at the end of a robot's tasks (the default) or first;
 - ``substitute_allocation`` tries two rotations of the current allocation: its entries one place
   on (the first last), and its robots one place on (each entry to the next robot of the fleet);
@@ -194,6 +196,7 @@ def _replace_robot(s: Scenario, tasks: Mapping[str, Task]) -> Iterator[Arguments
         for like in _one_per_type(s):
             if like.type.id != robot.type.id:
                 yield {"robot": robot.id, "by": new, "like": like.id}
+        yield from ({"robot": robot.id, "by": new, "start": p.id} for p in _free_poses(s))
 
 
 Proposer = Callable[[Scenario, Mapping[str, Task]], Iterator[Arguments]]

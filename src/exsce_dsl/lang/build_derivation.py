@@ -36,7 +36,12 @@ def step_of(node: Any) -> tuple[str, dict[str, str | None]]:
             "take_over": _name(node.donor),
         }
     if kind == "ReplaceRobot":
-        return "replace_robot", {"robot": _name(node.robot), "by": node.new, "like": _name(node.like)}
+        return "replace_robot", {
+            "robot": _name(node.robot),
+            "by": node.new,
+            "like": _name(node.like),
+            "start": _name(node.start),
+        }
     if kind in ("SwapTasks", "SwapStartPoses"):
         name = "swap_assignment" if kind == "SwapTasks" else "swap_start_poses"
         return name, {"robot": _name(node.robot), "with": _name(node.other)}

@@ -30,7 +30,8 @@ def step_text(step: Step) -> list[str]:
         text = f"add robot {a('robot')} like {a('like')} at {a('start')}"
         return [text + (f" taking over {a('take_over')}" if a("take_over") else "")]
     if name == "replace_robot":
-        return [f"replace robot {a('robot')} by {a('by')}" + (f" like {a('like')}" if a("like") else "")]
+        text = f"replace robot {a('robot')} by {a('by')}" + (f" like {a('like')}" if a("like") else "")
+        return [text + (f" at {a('start')}" if a("start") else "")]
     if name in ("swap_assignment", "swap_start_poses"):
         what = "tasks" if name == "swap_assignment" else "start poses"
         return [f"swap {what} of {a('robot')} and {a('with')}"]

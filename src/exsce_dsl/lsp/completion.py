@@ -184,7 +184,7 @@ def _in_derivation(before: Sequence[str], names: Names) -> list[Wanted]:
         return [task]
     if pair == ["move", "obstacle"] and n == 2:
         return [Wanted("obstacle", environment=environment)]
-    if last == "at" and (pair == ["add", "robot"] or head == "start"):
+    if last == "at" and (pair in (["add", "robot"], ["replace", "robot"]) or head == "start"):
         return [Wanted("pose", environment=environment)]
     robot_places = (
         (pair in (["remove", "robot"], ["replace", "robot"]) and n == 2)

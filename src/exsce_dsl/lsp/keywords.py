@@ -100,7 +100,8 @@ MEANINGS: dict[str, str] = {
     "remove": "`remove robot R [reassign to S]` (remove_robot), `remove task T [from R]` or "
     "`remove tasks of R` (remove_task), `remove start pose of R` (remove_start_pose).",
     "add": "`add robot NEW like R at POSE [taking over S]` (add_robot), `add task T to R [at N]` (add_task).",
-    "replace": "`replace robot R by NEW [like S]` (replace_robot): NEW takes R's place and tasks.",
+    "replace": "`replace robot R by NEW [like S] [at POSE]` (replace_robot): NEW takes R's tasks, and its "
+    "start pose or POSE.",
     "swap": "`swap tasks of R and S` (swap_assignment), `swap start poses of R and S` (swap_start_poses).",
     "reverse": "`reverse waypoints of T [as NEW]` (reverse_waypoint_order), `reverse task order [of R]` "
     "(reverse_task_order).",

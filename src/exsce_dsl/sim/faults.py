@@ -13,9 +13,8 @@ classroom_c018, and go home):
 - ``slow-area:AREA``: a robot whose leg (the drive to one waypoint) enters AREA's box (its
   poses' box, 1.5 m wider on each side) drives at 40 % from there to the waypoint, as a robot
   whose localisation is lost there and found again at the waypoint.  scenario_c never comes
-  near classroom_c069; ``add_robot --robot tiago3 --like tiago1 --start classroom_c069-w001
-  --take_over tiago2`` then ``remove_start_pose --robot tiago2`` (left idle, tiago2 would stand
-  on tiago3's way home) starts a robot there: ``slow-area:classroom_c069`` reveals it.
+  near classroom_c069; ``replace_robot --robot tiago2 --by tiago3 --start classroom_c069-w001``
+  starts a robot there with tiago2's tasks: ``slow-area:classroom_c069`` reveals it.
 - ``detour:FROM:TO``: a leg from a pose of area FROM to a pose of area TO (that way only)
   goes by way of the robot's start pose, as a planner reusing a stale route from home would
   (no detour when the start pose is within 1.5 m of either end).  scenario_c drives

@@ -305,17 +305,23 @@ def add_robot(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Ap
 
 
 def replace_robot(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
-    """Composite: add a robot like ``like`` at the old one's start pose... taking over its tasks,
-    then remove the old one."""
+    """Composite: add a robot like ``like`` at the old one's start pose (or at ``start``), taking
+    over its tasks, then remove the old one."""
     old = _robot(scenario, a["robot"])
-    if old.start_pose is None:
-        raise ExsceError(f"'{old.id}' has no start pose for its replacement to take")
+    start = a.get("start") or (old.start_pose.id if old.start_pose is not None else None)
+    if start is None:
+        raise ExsceError(f"'{old.id}' has no start pose for its replacement to take (give one with 'at')")
     parked = replace(
         scenario, robots=tuple(r if r.id != old.id else replace(r, start_pose=None) for r in scenario.robots)
     )
     added = add_robot(
         parked,
-        {"robot": a["by"], "like": a.get("like", old.id), "start": old.start_pose.id, "take_over": old.id},
+        {
+            "robot": a["by"],
+            "like": a.get("like", old.id),
+            "start": start,
+            "take_over": old.id,
+        },
         tasks,
     )
     removed = remove_robot(added.scenario, {"robot": old.id}, tasks)
@@ -399,9 +405,9 @@ TRANSFORMATIONS: dict[str, Transformation] = {
         Transformation(
             "replace_robot",
             ("robot", "by"),
-            ("like",),
+            ("like", "start"),
             replace_robot,
-            "BY (typed LIKE) takes ROBOT's place and tasks",
+            "BY (typed LIKE) takes ROBOT's tasks, and its place (or starts at START)",
         ),
     )
 }
