@@ -101,4 +101,4 @@ def test_credentials_go_as_basic_auth_or_a_bearer_token() -> None:
     basic, bearer = _Recorder.seen[-2:]
     assert basic["Authorization"] == "Basic YW5uOnBhOnNz"  # ann:pa:ss
     assert bearer["Authorization"] == "Bearer tok"
-    assert basic["Content-Type"] == "application/sparql-query"
+    assert basic["Content-Type"] == "application/x-www-form-urlencoded"  # a small query: a form

@@ -59,9 +59,24 @@ def test_one_update_drops_the_replaced_graphs_then_inserts_everything() -> None:
     )
     text = write_update(graphs, {g1.value})
     assert text.startswith("DROP SILENT GRAPH <http://example.org/g1> ;\nINSERT DATA {\n")
-    assert text.count("INSERT DATA") == 1 and "DROP SILENT GRAPH <http://example.org/g2>" not in text
+    assert text.count("INSERT DATA") == 1
+    assert "DROP SILENT GRAPH <http://example.org/g2>" not in text
     store = Store()
     store.update(text)
     assert len(store) == 2
+    assert isinstance(next(iter(store.quads_for_pattern(None, None, None, g2))).object, BlankNode)
+    plain = write_update(GraphSet({g1.value: [Quad(s, p, Literal("a"), g1)]}), False)
+    assert plain.startswith("INSERT DATA {\n") and plain.count("INSERT DATA") == 1
+    # for Virtuoso: g2, with a blank node, gets a template of its own
+    templated = write_update(graphs, {g1.value}, blank_node_templates=True)
+    assert templated.startswith("DROP SILENT GRAPH <http://example.org/g1> ;\nINSERT DATA {\nGRAPH <http://example.org/g1>")
+    assert templated.endswith("} WHERE {}\n") and templated.count("WHERE {}") == 1
+    store = Store()
+    store.update(templated)
+    assert isinstance(next(iter(store.quads_for_pattern(None, None, None, g2))).object, BlankNode)
+    shared = GraphSet({g1.value: [Quad(s, p, BlankNode("x"), g1)], g2.value: [Quad(s, p, BlankNode("x"), g2)]})
+    with pytest.raises(StoreError, match="blank node _:x is in graphs <http://example.org/g1> and <http://example.org/g2>"):
+        write_update(shared, False, blank_node_templates=True)
+    assert write_update(shared, False).count("_:x") == 2  # elsewhere one node, as INSERT DATA makes it
     assert write_update(GraphSet({g1.value: []}), True) == "DROP SILENT GRAPH <http://example.org/g1>\n"
     assert write_update(GraphSet({}), True) == ""

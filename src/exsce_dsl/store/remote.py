@@ -1,15 +1,16 @@
 """A store on any SPARQL 1.1 endpoint, over HTTP (standard library only).
 
-* Queries: SPARQL 1.1 Protocol, ``POST`` with ``application/sparql-query``
-  (or URL-encoded ``query=``, for endpoints that want a form), answers read as
-  SPARQL JSON results into pyoxigraph terms.
+* Queries: SPARQL 1.1 Protocol, ``POST`` URL-encoded (``query=``; a large query
+  as an ``application/sparql-query`` body, see FORM_QUERY_BYTES), answers read
+  as SPARQL JSON results into pyoxigraph terms.
 * Updates: ``POST`` with ``application/sparql-update`` (or ``update=``).  A
   :meth:`RemoteStore.write` is *one* update request (``DROP SILENT GRAPH`` for
   each replaced graph, then one ``INSERT DATA`` with a ``GRAPH`` block per
-  graph), so it is all or nothing wherever the endpoint runs a request in one
-  transaction (Oxigraph, Fuseki, GraphDB, Neptune; see ``docs/stores.md`` for
-  Virtuoso).  Writes are never split: a write bigger than the endpoint accepts
-  fails, whole, with the endpoint's message.
+  graph, or ``INSERT { ... } WHERE {}`` when it holds blank nodes), so it is
+  all or nothing wherever the endpoint runs a request in one transaction
+  (Oxigraph, Fuseki, GraphDB, Neptune; see ``docs/stores.md`` for Virtuoso).
+  Writes are never split: a write bigger than the endpoint accepts fails, whole,
+  with the endpoint's message.
 * Reading one graph: the Graph Store Protocol (``GET ?graph=``) when a GSP URL
   is known, else a ``CONSTRUCT``.
 
@@ -45,6 +46,12 @@ from exsce_dsl.store.base import Bindings, GraphSet, Replace, Rows, Store, Store
 from exsce_dsl.store.sparql import bind, graph_node, term_text, write_update
 
 RESULTS_JSON = "application/sparql-results+json"
+FORM_QUERY_BYTES = 64 * 1024
+"""Queries up to this size go URL-encoded (``query=``), which every SPARQL 1.1 endpoint takes
+(Virtuoso 7 never answers a query sent as an ``application/sparql-query`` body); larger ones
+go as a body, since web servers cap forms (Jetty, under Fuseki, at 200 kB)."""
+ASK_VIRTUOSO = "__ASK_RETVAL"
+"""Virtuoso answers ASK as a table with this one column: one row of 1 when true, none when false."""
 N_TRIPLES = "application/n-triples"
 
 
@@ -100,6 +107,8 @@ class RemoteStore(Store):
             credentials = f"{user}:{password or ''}".encode()
             self._headers["Authorization"] = "Basic " + base64.b64encode(credentials).decode("ascii")
         self._opener = urllib.request.build_opener(*handlers)
+        self._server: str | None = None
+        """The endpoint's ``Server`` header, once it has answered."""
 
     # -- HTTP ----------------------------------------------------------------
 
@@ -123,6 +132,7 @@ class RemoteStore(Store):
         shown = url.split("?", 1)[0]
         try:
             with self._opener.open(request, timeout=self.timeout) as answer:
+                self._server = answer.headers.get("Server", "")
                 return answer.read(), answer.headers.get("Content-Type", "")
         except urllib.error.HTTPError as exc:
             if missing_ok and exc.code == 404:
@@ -156,7 +166,7 @@ class RemoteStore(Store):
         return message
 
     def _post_sparql(self, url: str, kind: str, text: str, accept: str | None) -> tuple[bytes, str]:
-        if self.form:
+        if self.form or (kind == "query" and len(text) <= FORM_QUERY_BYTES):
             data = urllib.parse.urlencode({kind: text}).encode("utf-8")
             return self._request(
                 url, data=data, content_type="application/x-www-form-urlencoded", accept=accept
@@ -188,6 +198,8 @@ class RemoteStore(Store):
 
     def ask(self, query: str, bindings: Bindings | None = None) -> bool:
         result = self._query(query, bindings)
+        if isinstance(result, QuerySolutions) and [v.value for v in result.variables] == [ASK_VIRTUOSO]:
+            return any(row[0] is not None and row[0].value not in ("0", "false") for row in result)
         if not isinstance(result, QueryBoolean):
             raise StoreError("not an ASK query")
         return bool(result)
@@ -196,9 +208,16 @@ class RemoteStore(Store):
         self._post_sparql(self.update_url, "update", bind(update, bindings), None)
 
     def write(self, graphs: GraphSet, *, replace: Replace = False) -> None:
-        text = write_update(graphs, replace)
+        text = write_update(graphs, replace, blank_node_templates=self._is_virtuoso())
         if text:
             self._post_sparql(self.update_url, "update", text, None)
+
+    def _is_virtuoso(self) -> bool:
+        """Whether the endpoint is Virtuoso (by its ``Server`` header), which takes blank nodes
+        in update templates only (see :func:`~exsce_dsl.store.sparql.write_update`)."""
+        if self._server is None:
+            self.ask("ASK {}")
+        return "virtuoso" in (self._server or "").lower()
 
     def remove_graphs(self, names: Sequence[str]) -> None:
         if names:

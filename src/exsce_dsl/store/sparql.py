@@ -169,21 +169,41 @@ def checked_quads(quads: Iterable[object], name: str) -> list[Quad]:
     return checked
 
 
-def write_update(graphs: GraphSet, replace: Replace) -> str:
+def write_update(graphs: GraphSet, replace: Replace, *, blank_node_templates: bool = False) -> str:
     """One SPARQL Update that writes ``graphs``: ``DROP SILENT GRAPH`` for each replaced
     graph, then one ``INSERT DATA`` with a ``GRAPH`` block per graph.
 
-    One request, so one transaction wherever the endpoint makes a request
-    atomic.  Terms are written in N-Triples syntax by pyoxigraph.
+    One request, so one transaction wherever the endpoint makes a request atomic.  Terms are
+    written in N-Triples syntax by pyoxigraph.  With ``blank_node_templates`` (for Virtuoso,
+    which refuses blank nodes in ``INSERT DATA`` and fails, after inserting them, a template of
+    several graphs), each graph with blank nodes gets an ``INSERT { GRAPH ... } WHERE {}`` of
+    its own: the same quads, but a blank node may then not be in two graphs of one write (two
+    templates would make it two nodes; a StoreError says which).
     """
     parts = [f"DROP SILENT GRAPH {graph_node(name)} ;\n" for name in replaced_names(graphs, replace)]
-    blocks = []
+    plain: list[str] = []
+    templates: list[str] = []
+    graphs_of: dict[str, str] = {}  # blank node -> the graph it was first seen in
     for name, quads in graphs.graphs.items():
-        lines = [f"{q.subject} {q.predicate} {q.object} .\n" for q in checked_quads(quads, name)]
-        if lines:
-            blocks.append(f"GRAPH {graph_node(name)} {{\n{''.join(lines)}}}\n")
-    if blocks:
-        parts.append(f"INSERT DATA {{\n{''.join(blocks)}}}\n")
-    elif parts:
-        parts[-1] = parts[-1].replace(" ;\n", "\n")
+        checked = checked_quads(quads, name)
+        lines = [f"{q.subject} {q.predicate} {q.object} .\n" for q in checked]
+        if not lines:
+            continue
+        block = f"GRAPH {graph_node(name)} {{\n{''.join(lines)}}}\n"
+        blanks: set[str] = set()
+        if blank_node_templates:
+            blanks = {t.value for q in checked for t in (q.subject, q.object) if isinstance(t, BlankNode)}
+        for blank in blanks:
+            other = graphs_of.setdefault(blank, name)
+            if other != name:
+                raise StoreError(
+                    f"blank node _:{blank} is in graphs <{other}> and <{name}> of one write, "
+                    "which this endpoint (Virtuoso) cannot store as one node"
+                )
+        (templates if blanks else plain).append(block)
+    if plain:
+        parts.append(f"INSERT DATA {{\n{''.join(plain)}}} ;\n")
+    parts += [f"INSERT {{\n{block}}} WHERE {{}} ;\n" for block in templates]
+    if parts:
+        parts[-1] = parts[-1].removesuffix(" ;\n") + "\n"
     return "".join(parts)
