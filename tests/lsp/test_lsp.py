@@ -265,6 +265,15 @@ async def test_completion_of_transformations_in_a_derive_block(
     assert isinstance(result, types.CompletionList)
     assert {item.label for item in result.items} == {"tiago1", "tiago2"}  # the base's robots
     close_document(client, uri)
+    text = 'import "scenario_c.exsce"\n\nderive c_three from scenario_c {\n  replace robot tiago2 by tiago3 at \n}\n'
+    uri = open_document(client, workspace / "replaced.exsce", text)
+    result = await client.text_document_completion_async(
+        types.CompletionParams(types.TextDocumentIdentifier(uri), types.Position(3, 36))
+    )
+    assert isinstance(result, types.CompletionList)
+    poses = {item.label for item in result.items}
+    assert {"classroom_c069-w001", "classroom_c025-w002"} <= poses and "tiago1" not in poses  # where it starts
+    close_document(client, uri)
 
 
 async def test_completion_of_a_metric_s_fields_follows_the_path_before_the_point(
