@@ -232,7 +232,21 @@ def _fall_back_on_the_fleet(
         for a, b in theirs
         if (found := segment_value(store, scenario, metric, a, b)).value is not None
     ]
-    return _at_rate(parts, path, lengths, known, f"{', '.join(others)}'s segments")
+    metres = math.fsum(d for _, d in known)
+    if not known or metres == 0:
+        return parts
+    rate = math.fsum(v for v, _ in known) / metres
+    length = "grid path length" if lengths.on_grid else "straight length"
+    return tuple(
+        p
+        if p.value is not None
+        else replace(
+            p,
+            value=rate * lengths.of(a, b),
+            how=f"{p.how}: its {length} × {rate:.3g} per metre, as on {', '.join(others)}'s segments",
+        )
+        for p, (a, b) in zip(parts, path, strict=True)
+    )
 
 
 def _area_poses(scenario: Scenario, pose: Pose, leave_out: tuple[str, ...]) -> list[Pose]:
@@ -249,18 +263,6 @@ def _fall_back(
     known = [
         (p.value, lengths.of(a, b)) for p, (a, b) in zip(parts, path, strict=True) if p.value is not None
     ]
-    return _at_rate(parts, path, lengths, known, "the robot's other segments")
-
-
-def _at_rate(
-    parts: tuple[ExpectedSegment, ...],
-    path: list[tuple[Pose, Pose]],
-    lengths: _Lengths,
-    known: list[tuple[float, float]],
-    source: str,
-) -> tuple[ExpectedSegment, ...]:
-    """The segments without a value valued at the rate per metre of ``known`` (value, length)
-    pairs, which come from ``source``; unchanged when those cover no length."""
     metres = math.fsum(d for _, d in known)
     if not known or metres == 0:
         return parts
@@ -272,7 +274,7 @@ def _at_rate(
         else replace(
             p,
             value=rate * lengths.of(a, b),
-            how=f"{p.how}: its {length} × {rate:.3g} per metre, as on {source}",
+            how=f"{p.how}: its {length} × {rate:.3g} per metre, as on the robot's other segments",
         )
         for p, (a, b) in zip(parts, path, strict=True)
     )
