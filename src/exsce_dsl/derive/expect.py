@@ -204,49 +204,9 @@ def expected_metric(store: Store, scenario: Scenario, robot: str, metric: str) -
     parts = tuple(segment_value(store, scenario, metric, a, b) for a, b in path)
     if any(p.value is None for p in parts):
         parts = _fall_back(parts, path, _lengths(scenario, True, path))
-    if any(p.value is None for p in parts):
-        parts = _fall_back_on_the_fleet(store, scenario, robot, metric, parts, path)
     values = [p.value for p in parts]
     total = math.fsum(v for v in values if v is not None) if parts and None not in values else None
     return Expected(robot, metric, total, parts)
-
-
-def _fall_back_on_the_fleet(
-    store: Store,
-    scenario: Scenario,
-    robot: str,
-    metric: str,
-    parts: tuple[ExpectedSegment, ...],
-    path: list[tuple[Pose, Pose]],
-) -> tuple[ExpectedSegment, ...]:
-    """Segments still without a value (the robot has no segment with one: a new robot whose only
-    drive nobody made) get the rate per metre of the scenario's other robots of its type."""
-    own = scenario.robot(robot)
-    others = [r.id for r in scenario.robots if own is not None and r.id != robot and r.type.id == own.type.id]
-    theirs = [(a, b) for other in others for a, b in robot_path(scenario, other)]
-    if not theirs:
-        return parts
-    lengths = _lengths(scenario, True, theirs + path)
-    known = [
-        (found.value, lengths.of(a, b))
-        for a, b in theirs
-        if (found := segment_value(store, scenario, metric, a, b)).value is not None
-    ]
-    metres = math.fsum(d for _, d in known)
-    if not known or metres == 0:
-        return parts
-    rate = math.fsum(v for v, _ in known) / metres
-    length = "grid path length" if lengths.on_grid else "straight length"
-    return tuple(
-        p
-        if p.value is not None
-        else replace(
-            p,
-            value=rate * lengths.of(a, b),
-            how=f"{p.how}: its {length} × {rate:.3g} per metre, as on {', '.join(others)}'s segments",
-        )
-        for p, (a, b) in zip(parts, path, strict=True)
-    )
 
 
 def _area_poses(scenario: Scenario, pose: Pose, leave_out: tuple[str, ...]) -> list[Pose]:
