@@ -187,7 +187,7 @@ def _play(
                         tl.append(leg)
                     via = detour_via(scenario, entry.robot, previous, goal, faults)
                     path, driven = _drive_to(grid, tl, goal, via, keep_clear, robot_limits, plans)
-                    length = sum(math.dist(path[i], path[i + 1]) for i in range(len(path) - 1))
+                    length = _length(path)
                     tl.append(slow_in_areas(driven, slow_boxes) if slow_boxes else driven)
                     status = GoalStatus.SUCCEEDED
                     last_pose[entry.robot] = goal
