@@ -61,3 +61,59 @@ def spec_c() -> tuple[Scenario, dict[str, Task]]:
     """The shipped scenario_c and the tasks its specification declares (loaded once)."""
     spec = load_spec(EXAMPLES / "brsu_building_c" / "scenario_c.exsce")
     return spec.scenario("scenario_c"), {t.id: t for t in spec.tasks}
+
+
+# The yard of tests/oracles/test_verify_e2e (its docstring says what each fault should fail):
+# two robots whose paths never meet in a 10 m square (map: write_map(folder, size=200)).
+YARD_SPEC = """\
+robot type tiago {
+  base pmb2
+  torso yes
+}
+
+environment yard {
+  map yard file "map.yaml"
+  area field {
+    pose field-a at (1.0, 1.0)
+    pose field-b at (1.0, 8.0)
+    pose field-c at (8.0, 8.0)
+    pose field-d at (8.0, 1.0)
+    pose field-e at (4.5, 4.5)
+  }
+}
+
+task patrol_1 {
+  visit field-b, field-e
+}
+
+task patrol_2 {
+  visit field-c
+}
+
+scenario yard_run in yard {
+  robots {
+    r1: tiago starts at field-a
+    r2: tiago starts at field-d
+  }
+  mission yard_mission parallel {
+    r1 does patrol_1
+    r2 does patrol_2
+  }
+}
+
+acceptance for yard_run {
+  scenario "moves safely" {
+    when yard_mission runs
+    then each robot max_velocity stays below 1.0 m/s
+     and each robot distance_to_obstacles stays above 0.1 m
+     and distance_between_robots stays above 0.5 m
+  }
+  scenario "performs as before" {
+    given at least 4 baseline runs
+    when yard_mission runs
+    then each robot waypoints_visited is invariant within 0
+     and each robot task_duration is invariant within 20 %
+     and each robot distance_travelled is invariant within 10 %
+  }
+}
+"""

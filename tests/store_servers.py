@@ -162,6 +162,7 @@ def virtuoso_server(location: Path) -> Iterator[Server]:
     server at a free port (``/sparql``), the SPARQL user allowed to update (as an
     administrator would, with ``isql-vt``)."""
     sql_port, http_port = free_port(), free_port()
+    location.mkdir(parents=True, exist_ok=True)
     ini = location / "virtuoso.ini"
     ini.write_text(VIRTUOSO_INI.format(dir=location, sql_port=sql_port, http_port=http_port))
     process = subprocess.Popen(

@@ -27,60 +27,8 @@ from exsce_dsl.runs.bagdata import bag_topics
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
 
+from conftest import YARD_SPEC as SPEC
 from conftest import run_exscec, write_map
-
-SPEC = """\
-robot type tiago {
-  base pmb2
-  torso yes
-}
-
-environment yard {
-  map yard file "map.yaml"
-  area field {
-    pose field-a at (1.0, 1.0)
-    pose field-b at (1.0, 8.0)
-    pose field-c at (8.0, 8.0)
-    pose field-d at (8.0, 1.0)
-    pose field-e at (4.5, 4.5)
-  }
-}
-
-task patrol_1 {
-  visit field-b, field-e
-}
-
-task patrol_2 {
-  visit field-c
-}
-
-scenario yard_run in yard {
-  robots {
-    r1: tiago starts at field-a
-    r2: tiago starts at field-d
-  }
-  mission yard_mission parallel {
-    r1 does patrol_1
-    r2 does patrol_2
-  }
-}
-
-acceptance for yard_run {
-  scenario "moves safely" {
-    when yard_mission runs
-    then each robot max_velocity stays below 1.0 m/s
-     and each robot distance_to_obstacles stays above 0.1 m
-     and distance_between_robots stays above 0.5 m
-  }
-  scenario "performs as before" {
-    given at least 4 baseline runs
-    when yard_mission runs
-    then each robot waypoints_visited is invariant within 0
-     and each robot task_duration is invariant within 20 %
-     and each robot distance_travelled is invariant within 10 %
-  }
-}
-"""
 
 FAULTS = ("overspeed:r1", "slow:r1", "skip-waypoint:r1:2", "near-collision")
 SHOULD_FAIL = {
@@ -89,13 +37,24 @@ SHOULD_FAIL = {
     "slow:r1": {"r1-task_duration"},
     "skip-waypoint:r1:2": {"r1-waypoints_visited", "r1-distance_travelled", "r1-task_duration"},
     "near-collision": {
-        "distance_between_robots", "r2-distance_to_obstacles", "r2-distance_travelled", "r2-task_duration"
+        "distance_between_robots",
+        "r2-distance_to_obstacles",
+        "r2-distance_travelled",
+        "r2-task_duration",
     },
 }
 ORACLES = {
-    "r1-max_velocity", "r2-max_velocity", "r1-distance_to_obstacles", "r2-distance_to_obstacles",
-    "distance_between_robots", "r1-waypoints_visited", "r2-waypoints_visited", "r1-task_duration",
-    "r2-task_duration", "r1-distance_travelled", "r2-distance_travelled",
+    "r1-max_velocity",
+    "r2-max_velocity",
+    "r1-distance_to_obstacles",
+    "r2-distance_to_obstacles",
+    "distance_between_robots",
+    "r1-waypoints_visited",
+    "r2-waypoints_visited",
+    "r1-task_duration",
+    "r2-task_duration",
+    "r1-distance_travelled",
+    "r2-distance_travelled",
 }
 
 
@@ -122,7 +81,9 @@ def test_baseline_refuses_too_few_runs_then_builds_from_enough(
     assert three.returncode == 0, three.stderr
     refused = run_exscec("baseline", "spec.exsce", cwd=folder)
     assert refused.returncode == 1 and "Traceback" not in refused.stderr
-    assert "scenario 'yard_run' has 3 stored runs that no oracle failed; its baseline needs 4" in refused.stderr
+    assert (
+        "scenario 'yard_run' has 3 stored runs that no oracle failed; its baseline needs 4" in refused.stderr
+    )
     fourth = run_exscec("ingest", str(clean[3]), "--scenario", "spec.exsce", cwd=folder)
     assert fourth.returncode == 0, fourth.stderr
     built = run_exscec("baseline", "spec.exsce", cwd=folder)

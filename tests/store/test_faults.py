@@ -42,7 +42,9 @@ def _sizes(path: Path) -> Sizes:
 def _ingest(bags: list[Path], store: str) -> subprocess.Popen[str]:
     return subprocess.Popen(
         [EXSCEC, "ingest", *map(str, bags), "--scenario", str(SPEC), "--store", store],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
     )
 
 
@@ -78,7 +80,9 @@ def _state(sizes: Sizes, states: list[Sizes]) -> int:
     return states.index(sizes)
 
 
-def test_an_ingest_killed_at_random_points_leaves_each_run_wholly_or_not_at_all(setting: dict[str, object]) -> None:
+def test_an_ingest_killed_at_random_points_leaves_each_run_wholly_or_not_at_all(
+    setting: dict[str, object],
+) -> None:
     folder, empty = setting["folder"], setting["empty"]
     assert isinstance(folder, Path) and isinstance(empty, Path)
     bag: Path = setting["bags"][0]  # type: ignore[index]
@@ -133,7 +137,9 @@ def test_readers_during_an_ingest_see_whole_runs(setting: dict[str, object]) -> 
     assert _state(_sizes(store), states) == 3
     # and a reader through the command line works while a writer holds the store
     holder = _ingest([setting["bags"][0]], str(store))  # type: ignore[index]
-    listed = subprocess.run([EXSCEC, "runs", "--store", str(store)], capture_output=True, text=True, timeout=60)
+    listed = subprocess.run(
+        [EXSCEC, "runs", "--store", str(store)], capture_output=True, text=True, timeout=60
+    )
     holder.communicate(timeout=60)
     assert listed.returncode == 0 and "3 runs" in listed.stderr, listed.stderr
 

@@ -16,6 +16,7 @@ whose ids hold quotes, braces and ``#``.
 
 from __future__ import annotations
 
+import dataclasses
 import datetime
 import json
 import math
@@ -57,7 +58,7 @@ from exsce_dsl.store.remote import RemoteStore
 from exsce_dsl.store.writing import add_prov
 
 from conftest import run_exscec
-from store_servers import oxigraph_server
+from store_servers import oxigraph_server, virtuoso_server
 
 # -- the scenarios ---------------------------------------------------------------------------
 
@@ -79,7 +80,9 @@ S = Scenario(
     "s",
     ROOM,
     (Robot("r1", TIAGO, "r1", start_pose=A), Robot("r2", PMB2, "r2", start_pose=D)),
-    Mission("m", MissionType.PARALLEL, (Assignment("r1", "t1"), Assignment("r2", "t2"), Assignment("r1", "t3"))),
+    Mission(
+        "m", MissionType.PARALLEL, (Assignment("r1", "t1"), Assignment("r2", "t2"), Assignment("r1", "t3"))
+    ),
     (T1, T2, T3),
 )
 S_REV = Scenario(
@@ -118,11 +121,24 @@ def run_of_s(uuid: str, hour: int, a_to_b: float, mission: float, visited: float
         MetricValue(DIST, MetricScope.SEGMENT, 1000.0, dist2, action=r2[1].id),  # c → b: not b → a
         MetricValue(DIST, MetricScope.ROBOT, a_to_b + 15.0, dist1, robot="r1", unit="m"),
         MetricValue(DIST, MetricScope.ROBOT, 70.0, dist2, robot="r2"),
-        MetricValue("task_duration", MetricScope.SEGMENT, 999.0, ("/r1/waypoint_dispatcher/feedback",), action=r1[0].id),
-        MetricValue("mission_duration", MetricScope.MISSION, mission, ("/r1/waypoint_dispatcher/feedback",)),
-        MetricValue("waypoints_visited", MetricScope.ROBOT, visited, ("/r1/waypoint_dispatcher/feedback",), robot="r1"),
         MetricValue(
-            "violation_duration", MetricScope.ROBOT, violated, ("/r1/nav_vel",), robot="r1", safety_metric="max_velocity"
+            "task_duration",
+            MetricScope.SEGMENT,
+            999.0,
+            ("/r1/waypoint_dispatcher/feedback",),
+            action=r1[0].id,
+        ),
+        MetricValue("mission_duration", MetricScope.MISSION, mission, ("/r1/waypoint_dispatcher/feedback",)),
+        MetricValue(
+            "waypoints_visited", MetricScope.ROBOT, visited, ("/r1/waypoint_dispatcher/feedback",), robot="r1"
+        ),
+        MetricValue(
+            "violation_duration",
+            MetricScope.ROBOT,
+            violated,
+            ("/r1/nav_vel",),
+            robot="r1",
+            safety_metric="max_velocity",
         ),
     )
     return Run(
@@ -142,7 +158,12 @@ def hotspot(metric: str) -> Hotspot:
 
 RUNS_OF_S = (
     # run 3 is the oldest: runs come back by start time.
-    Run(**{**run_of_s(RUN_1, 10, 10.0, 90.0, 3.0, 1.0).__dict__, "hotspots": (hotspot("max_velocity"),) * 2 + (hotspot("distance_to_obstacles"),)}),
+    Run(
+        **{
+            **run_of_s(RUN_1, 10, 10.0, 90.0, 3.0, 1.0).__dict__,
+            "hotspots": (hotspot("max_velocity"),) * 2 + (hotspot("distance_to_obstacles"),),
+        }
+    ),
     run_of_s(RUN_2, 11, 12.0, 100.0, 3.0, 2.0),
     Run(**{**run_of_s(RUN_3, 9, 14.0, 110.0, 2.0, 6.0).__dict__, "hotspots": (hotspot("max_velocity"),)}),
 )
@@ -153,7 +174,11 @@ RUN_OF_S_REV = Run(
     datetime.datetime(2024, 5, 2, 8, 10),
     Bag(f"{RUN_REV}.bag", topics("r1")),
     (TaskExecution("r1", 1, (Action(ActionId("r1", 1, 1, 1), B, A),)),),
-    (MetricValue(DIST, MetricScope.SEGMENT, 100.0, ("/r1/distance_travelled",), action=ActionId("r1", 1, 1, 1)),),
+    (
+        MetricValue(
+            DIST, MetricScope.SEGMENT, 100.0, ("/r1/distance_travelled",), action=ActionId("r1", 1, 1, 1)
+        ),
+    ),
 )
 
 # -- oracles and derivations -----------------------------------------------------------------------
@@ -162,19 +187,58 @@ BASELINE, METAMORPHIC = OracleType.BASELINE, OracleType.METAMORPHIC
 FEEDBACK = ("/r1/waypoint_dispatcher/feedback", "/r2/waypoint_dispatcher/feedback")
 ORACLES_OF_S = [
     Oracle("mission_duration", None, "invariant", BASELINE, "s", FEEDBACK, value=100.0, tolerance=10.0),
-    Oracle("task_duration", "r1", "invariant", BASELINE, "s", ("/r1/waypoint_dispatcher/feedback",), value=50.0, tolerance=5.0),
-    Oracle("max_velocity", "r1", "below_max", BASELINE, "s", ("/r1/nav_vel",), limit=1.0, package="exsce.metamorphic.relationships"),
+    Oracle(
+        "task_duration",
+        "r1",
+        "invariant",
+        BASELINE,
+        "s",
+        ("/r1/waypoint_dispatcher/feedback",),
+        value=50.0,
+        tolerance=5.0,
+    ),
+    Oracle(
+        "max_velocity",
+        "r1",
+        "below_max",
+        BASELINE,
+        "s",
+        ("/r1/nav_vel",),
+        limit=1.0,
+        package="exsce.metamorphic.relationships",
+    ),
 ]
 ORACLES_OF_S_REV = [
-    Oracle("task_duration", "r1", "invariant", BASELINE, "s_rev", ("/r1/waypoint_dispatcher/feedback",), value=40.0, tolerance=4.0),
-    Oracle("task_duration", "r1", "decreasing", METAMORPHIC, "s", ("/r1/waypoint_dispatcher/feedback",), value=40.0, delta=10.0, tolerance=0.0),
+    Oracle(
+        "task_duration",
+        "r1",
+        "invariant",
+        BASELINE,
+        "s_rev",
+        ("/r1/waypoint_dispatcher/feedback",),
+        value=40.0,
+        tolerance=4.0,
+    ),
+    Oracle(
+        "task_duration",
+        "r1",
+        "decreasing",
+        METAMORPHIC,
+        "s",
+        ("/r1/waypoint_dispatcher/feedback",),
+        value=40.0,
+        delta=10.0,
+        tolerance=0.0,
+    ),
 ]
 S_REV_FROM_S = Derivation(
     "s_rev",
     "s",
     (
         TransformationStep("remove_robot", (("robot", "r2"), ("keep_tasks", False))),
-        TransformationStep("add_task", (("robot", "r1"), ("task", "t_back"), ("position", 1), ("scale", 0.5))),
+        TransformationStep(
+            "add_task", (("robot", "r1"), ("task", "t_back"), ("position", 1), ("scale", 0.5))
+        ),
     ),
 )
 S_REV2_FROM_S_REV = Derivation("s_rev2", "s_rev", (TransformationStep("reverse_task_order"),))
@@ -235,7 +299,12 @@ def fresh_store() -> Store:
 
 
 def close(a: ValueStats | None, mean: float, std: float, count: int) -> bool:
-    return a is not None and a.count == count and math.isclose(a.mean, mean) and math.isclose(a.std, std, abs_tol=1e-9)
+    return (
+        a is not None
+        and a.count == count
+        and math.isclose(a.mean, mean)
+        and math.isclose(a.std, std, abs_tol=1e-9)
+    )
 
 
 # -- runs and their metrics ----------------------------------------------------------------------
@@ -245,9 +314,16 @@ def test_the_runs_of_a_scenario_oldest_first(store: Store) -> None:
     found = q.runs(store, "s")
     assert [r.uuid for r in found] == [RUN_3, RUN_1, RUN_2]
     assert found[1].scenario == "s" and found[1].bag == f"{RUN_1}.bag"
-    assert found[1].start == datetime.datetime(2024, 5, 1, 10) and found[1].end == datetime.datetime(2024, 5, 1, 10, 30)
+    assert found[1].start == datetime.datetime(2024, 5, 1, 10) and found[1].end == datetime.datetime(
+        2024, 5, 1, 10, 30
+    )
     assert [r.uuid for r in q.runs(store, "s_rev")] == [RUN_REV]
-    assert {r.uuid: r.scenario for r in q.runs(store)} == {RUN_1: "s", RUN_2: "s", RUN_3: "s", RUN_REV: "s_rev"}
+    assert {r.uuid: r.scenario for r in q.runs(store)} == {
+        RUN_1: "s",
+        RUN_2: "s",
+        RUN_3: "s",
+        RUN_REV: "s_rev",
+    }
     assert q.runs(store, "nothing") == []
 
 
@@ -324,7 +400,10 @@ def test_hotspot_counts_per_run(store: Store) -> None:
 
 
 def test_the_robots_of_a_scenario(store: Store) -> None:
-    assert q.robots(store, "s") == [RobotFacts("r1", "tiago", "pmb2", True), RobotFacts("r2", "pmb2", "pmb2", False)]
+    assert q.robots(store, "s") == [
+        RobotFacts("r1", "tiago", "pmb2", True),
+        RobotFacts("r2", "pmb2", "pmb2", False),
+    ]
     assert q.robots(store, "s_rev") == [RobotFacts("r1", "tiago", "pmb2", True)]
 
 
@@ -346,7 +425,9 @@ def test_the_lineage_of_a_scenario(store: Store) -> None:
         "s",
         (
             TransformationStep("remove_robot", (("keep_tasks", False), ("robot", "r2"))),
-            TransformationStep("add_task", (("position", 1), ("robot", "r1"), ("scale", 0.5), ("task", "t_back"))),
+            TransformationStep(
+                "add_task", (("position", 1), ("robot", "r1"), ("scale", 0.5), ("task", "t_back"))
+            ),
         ),
     )
     lineage = q.lineage(store, "s_rev2")
@@ -387,7 +468,9 @@ def test_replaced_runs_leave_their_old_values_out(fresh_store: Store) -> None:
     report = add_prov(fresh_store, compile_run(faster, S), replace=True)
     assert report.revisions  # the old version is kept, as a revision graph
     assert close(q.segment_metric(fresh_store, DIST, A, B, scenario="s"), 14.0, math.sqrt(56 / 3), 3)
-    assert close(q.segment_metric(fresh_store, DIST, A, B, runs=[RUN_1, RUN_2, RUN_3]), 14.0, math.sqrt(56 / 3), 3)
+    assert close(
+        q.segment_metric(fresh_store, DIST, A, B, runs=[RUN_1, RUN_2, RUN_3]), 14.0, math.sqrt(56 / 3), 3
+    )
     assert [r.uuid for r in q.runs(fresh_store, "s")] == [RUN_3, RUN_1, RUN_2]
     assert q.run_metric(fresh_store, RUN_3, DIST, "r1") == 35.0
 
@@ -428,19 +511,39 @@ def test_exscec_query_prints_tables_json_and_csv(store_folder: Path) -> None:
     listed = run_exscec("query", "--list")
     assert listed.returncode == 0 and "segment_metric_of_scenario: Mean and variance" in listed.stdout
     as_json = run_exscec(
-        "query", "segment_metric", "-p", f"metric={DIST}", "-p", f"start={A_}", "-p", f"goal={B_}",
-        "-p", f"run={RUN_1}", "-p", f"run={RUN_2}", "-f", "json", "--store", folder,
+        "query",
+        "segment_metric",
+        "-p",
+        f"metric={DIST}",
+        "-p",
+        f"start={A_}",
+        "-p",
+        f"goal={B_}",
+        "-p",
+        f"run={RUN_1}",
+        "-p",
+        f"run={RUN_2}",
+        "-f",
+        "json",
+        "--store",
+        folder,
     )
     assert as_json.returncode == 0, as_json.stderr
     answer = json.loads(as_json.stdout)
     assert answer["head"]["vars"] == ["count", "mean", "variance"]
     (row,) = answer["results"]["bindings"]
-    assert row["count"] == {"type": "literal", "value": "2", "datatype": "http://www.w3.org/2001/XMLSchema#integer"}
+    assert row["count"] == {
+        "type": "literal",
+        "value": "2",
+        "datatype": "http://www.w3.org/2001/XMLSchema#integer",
+    }
     assert float(row["mean"]["value"]) == 11.0 and float(row["variance"]["value"]) == 1.0
     as_csv = run_exscec("runs", "s", "-f", "csv", "--store", folder)
     assert as_csv.returncode == 0, as_csv.stderr
     lines = as_csv.stdout.splitlines()  # (CRLF, read back as text)
-    assert lines[0] == "run,scenario_id,start,end,bag,path" and lines[1].startswith(f"{RUN_3},s,2024-05-01T09:00:00,")
+    assert lines[0] == "run,scenario_id,start,end,bag,path" and lines[1].startswith(
+        f"{RUN_3},s,2024-05-01T09:00:00,"
+    )
     table = run_exscec("query", "robots", "-p", "scenario=s", "--store", folder)
     assert table.stdout.splitlines() == [
         "robot  type   base  torso",
@@ -504,12 +607,34 @@ def every_answer(store: Store) -> list[object]:
     ]
 
 
-def test_a_sparql_endpoint_gives_the_same_answers(store: Store, tmp_path: Path) -> None:
+def to_12_digits(answer: object) -> object:
+    """``answer`` with every float to 12 significant digits: Virtuoso averages integers as
+    decimals (2.666666666666667 where Oxigraph's double is 2.6666666666666665)."""
+    if isinstance(answer, float):
+        return float(f"{answer:.12g}")
+    if dataclasses.is_dataclass(answer) and not isinstance(answer, type):
+        return (type(answer), *[to_12_digits(getattr(answer, f.name)) for f in dataclasses.fields(answer)])
+    if isinstance(answer, (list, tuple)):
+        return [to_12_digits(a) for a in answer]
+    if isinstance(answer, dict):
+        return {k: to_12_digits(v) for k, v in answer.items()}
+    return answer
+
+
+@pytest.mark.parametrize("server_kind", ["oxigraph", "virtuoso"])
+def test_a_sparql_endpoint_gives_the_same_answers(store: Store, tmp_path: Path, server_kind: str) -> None:
     expected = every_answer(store)
-    with oxigraph_server(tmp_path / "oxigraph") as server:
-        remote = RemoteStore(f"{server.url}/query", update_url=f"{server.url}/update", timeout=20)
+    started = oxigraph_server if server_kind == "oxigraph" else virtuoso_server
+    with started(tmp_path / server_kind) as server:
+        if server_kind == "oxigraph":
+            remote = RemoteStore(f"{server.url}/query", update_url=f"{server.url}/update", timeout=20)
+        else:
+            remote = RemoteStore(f"{server.url}/sparql", timeout=20)
         populate(remote)
-        assert every_answer(remote) == expected
+        if server_kind == "oxigraph":
+            assert every_answer(remote) == expected
+        else:
+            assert to_12_digits(every_answer(remote)) == to_12_digits(expected)
         q.update_baseline(remote, "s", "task_duration", "r1", 55.0, 6.0)
         changed = {o.metric: o for o in q.oracles(remote, "s")}["task_duration"]
         assert (changed.value, changed.tolerance) == (55.0, 6.0)
@@ -518,7 +643,9 @@ def test_a_sparql_endpoint_gives_the_same_answers(store: Store, tmp_path: Path) 
 def test_a_parameter_line_is_read_whole_and_an_unknown_kind_is_refused() -> None:
     from exsce_dsl.store.queries.library import _parse
 
-    parsed = _parse("x", "# About x.\n#\n# ?metric  metric_property  the metric\n# ?run run+ runs\nSELECT * {}", False)
+    parsed = _parse(
+        "x", "# About x.\n#\n# ?metric  metric_property  the metric\n# ?run run+ runs\nSELECT * {}", False
+    )
     assert [(p.name, p.kind, p.many, p.description) for p in parsed.parameters] == [
         ("metric", "metric_property", False, "the metric"),
         ("run", "run", True, "runs"),
@@ -536,4 +663,6 @@ def test_every_whole_run_value_of_some_runs(store: Store) -> None:
         (RUN_1, "waypoints_visited", "r1", 3.0),
         (RUN_1, "violation_duration", "r1", 1.0),
     }
-    assert {r.run for r in q.run_metric_values(store, [RUN_1, RUN_REV])} == {RUN_1}  # run-rev has segment values only
+    assert {r.run for r in q.run_metric_values(store, [RUN_1, RUN_REV])} == {
+        RUN_1
+    }  # run-rev has segment values only

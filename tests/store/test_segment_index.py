@@ -61,12 +61,18 @@ def run(uuid: str, values: tuple[float, ...], *, hour: int = 9) -> Run:
     legs = ((A, B), (B, A), (A, B))[: len(values)]
     actions = tuple(Action(ActionId("r1", 1, 1, w), start, goal) for w, (start, goal) in enumerate(legs, 1))
     metrics = tuple(
-        MetricValue("distance_travelled", MetricScope.SEGMENT, v, DIST, action=a.id) for a, v in zip(actions, values, strict=True)
+        MetricValue("distance_travelled", MetricScope.SEGMENT, v, DIST, action=a.id)
+        for a, v in zip(actions, values, strict=True)
     )
     start = datetime.datetime(2024, 6, 1, hour)
     return Run(
-        uuid, SCENARIO.id, start, start + datetime.timedelta(minutes=5), Bag(f"{uuid}.bag", DIST),
-        (TaskExecution("r1", 1, actions),), metrics,
+        uuid,
+        SCENARIO.id,
+        start,
+        start + datetime.timedelta(minutes=5),
+        Bag(f"{uuid}.bag", DIST),
+        (TaskExecution("r1", 1, actions),),
+        metrics,
     )
 
 
@@ -105,7 +111,11 @@ def test_each_segment_and_each_action_get_a_graph() -> None:
             (segment, f"{exsce}robot", Literal("r1")),
             (segment, f"{exsce}metrics/distance_travelled", Literal(value, datatype=double)),
         }
-    assert (NamedNode(b_to_a), f"{exsce}metrics/distance_travelled", Literal("5.5", datatype=double)) in triples(actions[1])
+    assert (
+        NamedNode(b_to_a),
+        f"{exsce}metrics/distance_travelled",
+        Literal("5.5", datatype=double),
+    ) in triples(actions[1])
 
 
 def test_a_spec_has_no_index() -> None:
@@ -137,7 +147,9 @@ def test_adding_a_run_again_writes_nothing_and_replacing_it_drops_actions_it_no_
     assert not again.changed and again.statements == 0
     shorter = add_prov(store, compile_run(run("u-1", (4.0,)), SCENARIO), replace=True)
     assert shorter.revisions  # the run's own old graphs are kept as revisions ...
-    assert not any("w_00" in name and "revision" in name for name in store.graph_names())  # ... its index is not
+    assert not any(
+        "w_00" in name and "revision" in name for name in store.graph_names()
+    )  # ... its index is not
     found = q.segment_metric(store, "distance_travelled", A, B, scenario="corridor_runs")
     assert found is not None and (found.count, found.mean) == (1, 4.0)
     assert q.segment_metric(store, "distance_travelled", B, A, scenario="corridor_runs") is None
@@ -149,7 +161,11 @@ def test_store_graphs_and_info_set_the_index_apart(tmp_path: Path) -> None:
         add_prov(store, compile_run(run("u-1", (5.0, 6.0, 5.0)), SCENARIO))
     listed = run_exscec("store", "graphs", cwd=tmp_path)
     assert listed.returncode == 0, listed.stderr
-    assert "/segments/" not in listed.stdout and "w_001" not in listed.stdout and "run_u-1_bundle" in listed.stdout
+    assert (
+        "/segments/" not in listed.stdout
+        and "w_001" not in listed.stdout
+        and "run_u-1_bundle" in listed.stdout
+    )
     assert "and 5 graphs of the segment index: --index lists them" in listed.stderr  # 2 segments, 3 actions
     everything = run_exscec("store", "graphs", "--index", cwd=tmp_path)
     assert everything.stdout.count("/segments/corridor_runs/") == 2 and everything.stdout.count("-w_00") == 3

@@ -6,13 +6,18 @@
 * Updates: ``POST`` with ``application/sparql-update`` (or ``update=``).  A
   :meth:`RemoteStore.write` is *one* update request (``DROP SILENT GRAPH`` for
   each replaced graph, then one ``INSERT DATA`` with a ``GRAPH`` block per
-  graph, or ``INSERT { ... } WHERE {}`` when it holds blank nodes), so it is
-  all or nothing wherever the endpoint runs a request in one transaction
-  (Oxigraph, Fuseki, GraphDB, Neptune; see ``docs/stores.md`` for Virtuoso).
-  Writes are never split: a write bigger than the endpoint accepts fails, whole,
-  with the endpoint's message.
+  graph), so it is all or nothing wherever the endpoint runs a request in one
+  transaction (Oxigraph, Fuseki, GraphDB, Neptune).  Writes are never split: a
+  write bigger than the endpoint accepts fails, whole, with the endpoint's message.
 * Reading one graph: the Graph Store Protocol (``GET ?graph=``) when a GSP URL
   is known, else a ``CONSTRUCT``.
+* Virtuoso (known by its ``Server`` header) differs: it takes no blank nodes in
+  ``INSERT DATA`` (they are written as Skolem IRIs, SKOLEM, and read back as
+  blank nodes), commits each operation of a request on its own (a write that
+  replaces graphs drops them, then inserts), writes doubles with six digits in
+  its SPARQL results (SELECTs and graphs are read as Turtle,
+  :mod:`exsce_dsl.store.virtuoso`), and holds graphs of its own, which are left
+  out and never dropped.
 
 Authentication: a bearer token (``token``; ``exscec serve`` and
 token-protected gateways), or a user and password (HTTP Basic, sent with
@@ -42,8 +47,9 @@ from pyoxigraph import (
 )
 
 from exsce_dsl import __version__
+from exsce_dsl.store import virtuoso
 from exsce_dsl.store.base import Bindings, GraphSet, Replace, Rows, Store, StoreError
-from exsce_dsl.store.sparql import bind, graph_node, term_text, write_update
+from exsce_dsl.store.sparql import bind, graph_node, query_form, term_text, write_update
 
 RESULTS_JSON = "application/sparql-results+json"
 FORM_QUERY_BYTES = 64 * 1024
@@ -53,6 +59,9 @@ go as a body, since web servers cap forms (Jetty, under Fuseki, at 200 kB)."""
 ASK_VIRTUOSO = "__ASK_RETVAL"
 """Virtuoso answers ASK as a table with this one column: one row of 1 when true, none when false."""
 N_TRIPLES = "application/n-triples"
+SKOLEM = "https://www.sesame-project.org/.well-known/genid/exsce/"
+"""Where the IRIs that stand for blank nodes on Virtuoso begin (RDF 1.1 Concepts, 3.5): written
+in their place, read back as blank nodes."""
 
 
 class RemoteStore(Store):
@@ -190,11 +199,21 @@ class RemoteStore(Store):
     # -- Store ---------------------------------------------------------------
 
     def select(self, query: str, bindings: Bindings | None = None) -> Rows:
+        if self.is_virtuoso():  # exact doubles come in Turtle only (see exsce_dsl.store.virtuoso)
+            if query_form(query) != "SELECT":
+                raise StoreError("not a SELECT query")
+            body, _ = self._post_sparql(self.url, "query", bind(query, bindings), virtuoso.TURTLE)
+            rows = virtuoso.result_set_rows(body, self.label)
+            return Rows(rows.variables, tuple(tuple(_unskolemised(t) for t in row) for row in rows.rows))
         result = self._query(query, bindings)
-        if not isinstance(result, QuerySolutions):
+        variables = tuple(v.value for v in result.variables) if isinstance(result, QuerySolutions) else ()
+        if not isinstance(result, QuerySolutions) or (
+            variables == (ASK_VIRTUOSO,) and query_form(query) == "ASK"
+        ):
             raise StoreError("not a SELECT query")
-        variables = tuple(v.value for v in result.variables)
-        return Rows(variables, tuple(tuple(solution[v] for v in variables) for solution in result))
+        return Rows(
+            variables, tuple(tuple(_unskolemised(solution[v]) for v in variables) for solution in result)
+        )
 
     def ask(self, query: str, bindings: Bindings | None = None) -> bool:
         result = self._query(query, bindings)
@@ -208,13 +227,14 @@ class RemoteStore(Store):
         self._post_sparql(self.update_url, "update", bind(update, bindings), None)
 
     def write(self, graphs: GraphSet, *, replace: Replace = False) -> None:
-        text = write_update(graphs, replace, blank_node_templates=self._is_virtuoso())
+        text = write_update(graphs, replace, skolem=SKOLEM if self.is_virtuoso() else None)
         if text:
             self._post_sparql(self.update_url, "update", text, None)
 
-    def _is_virtuoso(self) -> bool:
-        """Whether the endpoint is Virtuoso (by its ``Server`` header), which takes blank nodes
-        in update templates only (see :func:`~exsce_dsl.store.sparql.write_update`)."""
+    def is_virtuoso(self) -> bool:
+        """Whether the endpoint is Virtuoso (by its ``Server`` header), which takes no blank
+        nodes in ``INSERT DATA`` (see :func:`~exsce_dsl.store.sparql.write_update`) and holds
+        graphs of its own (:data:`~exsce_dsl.store.virtuoso.OWN_GRAPHS`)."""
         if self._server is None:
             self.ask("ASK {}")
         return "virtuoso" in (self._server or "").lower()
@@ -225,10 +245,36 @@ class RemoteStore(Store):
 
     def graph_names(self) -> set[str]:
         rows = self.select("SELECT DISTINCT ?g WHERE { GRAPH ?g { ?s ?p ?o } }")
-        return {g.value for (g,) in rows.rows if isinstance(g, NamedNode)}
+        return {g.value for (g,) in rows.rows if isinstance(g, NamedNode) and not self._servers_own(g.value)}
+
+    def graph_sizes(self) -> dict[str, int]:
+        return {g: n for g, n in super().graph_sizes().items() if not self._servers_own(g)}
+
+    def quads(self) -> list[Quad]:
+        if self.is_virtuoso():
+            return [q for quads in self.graphs(sorted(self.graph_names())).values() for q in quads]
+        return super().quads()
+
+    def clear(self) -> None:
+        """Remove every graph; on Virtuoso, every graph but the server's own
+        (:data:`~exsce_dsl.store.virtuoso.OWN_GRAPHS`)."""
+        if self.is_virtuoso():
+            self.remove_graphs(sorted(self.graph_names()))
+        else:
+            super().clear()
+
+    def _servers_own(self, graph: str) -> bool:
+        return self.is_virtuoso() and graph.startswith(virtuoso.OWN_GRAPHS)
 
     def graph(self, name: str) -> list[Quad]:
         graph = graph_node(name)
+        if self.is_virtuoso():
+            query = f"CONSTRUCT {{ ?s ?p ?o }} WHERE {{ GRAPH {term_text(graph)} {{ ?s ?p ?o }} }}"
+            body, _ = self._post_sparql(self.url, "query", query, virtuoso.TURTLE)
+            return [
+                Quad(_unskolemised(s), p, _unskolemised(o), graph)
+                for s, p, o in virtuoso.graph_triples(body, self.label)
+            ]
         if self.gsp_url is not None:
             separator = "&" if "?" in self.gsp_url else "?"
             url = f"{self.gsp_url}{separator}{urllib.parse.urlencode({'graph': name})}"
@@ -242,16 +288,19 @@ class RemoteStore(Store):
             return []
         format_ = RdfFormat.from_media_type(content_type.split(";")[0].strip()) or RdfFormat.N_TRIPLES
         try:
-            return [Quad(t.subject, t.predicate, t.object, graph) for t in parse(body, format=format_)]
+            triples = list(parse(body, format=format_))
         except (SyntaxError, ValueError) as exc:
             raise StoreError(
                 f"{self.label} sent graph <{name}> as unreadable {content_type}: {exc}"
             ) from None
+        return [Quad(_unskolemised(t.subject), t.predicate, _unskolemised(t.object), graph) for t in triples]
 
     def graphs(self, names: Sequence[str]) -> dict[str, list[Quad]]:
         found: dict[str, list[Quad]] = {name: [] for name in names}
         if not names:
             return found
+        if self.is_virtuoso():  # graph by graph, in Turtle (see exsce_dsl.store.virtuoso)
+            return {name: self.graph(name) for name in names}
         values = " ".join(term_text(graph_node(name)) for name in names)
         rows = self.select(f"SELECT ?g ?s ?p ?o WHERE {{ VALUES ?g {{ {values} }} GRAPH ?g {{ ?s ?p ?o }} }}")
         for g, s, p, o in rows.rows:
@@ -260,6 +309,13 @@ class RemoteStore(Store):
             if isinstance(s, (NamedNode, BlankNode)):
                 found.setdefault(g.value, []).append(Quad(s, p, o, g))
         return found
+
+
+def _unskolemised(term: Any) -> Any:
+    """``term``, or the blank node a Skolem IRI of exsce's (SKOLEM) stands for."""
+    if isinstance(term, NamedNode) and term.value.startswith(SKOLEM):
+        return BlankNode(term.value[len(SKOLEM) :])
+    return term
 
 
 def _split_credentials(url: str) -> tuple[str, str | None, str | None]:

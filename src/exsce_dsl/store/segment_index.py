@@ -85,9 +85,9 @@ def segment_index(graphs: Mapping[str, Sequence[Quad]]) -> dict[str, list[Quad]]
     for run in found.typed.get(run_type, ()):
         uuid = found.run_of.get(run)
         scenarios = [
-            iri[len(base):]
+            iri[len(base) :]
             for iri in found.used.get(run, ())
-            if iri.startswith(base) and "/" not in iri[len(base):]
+            if iri.startswith(base) and "/" not in iri[len(base) :]
         ]
         if uuid is not None and len(scenarios) == 1:
             scenario_of_run[uuid] = scenarios[0]

@@ -243,8 +243,13 @@ def make_server(
     """A server over ``store`` on ``host:port`` (0 picks a free port); updates need ``token``.
     A query may run ``query_timeout`` seconds and answer ``max_answer`` bytes."""
     return SparqlServer(
-        (host, port), store, token=token, union_default_graph=union_default_graph, log=log,
-        query_timeout=query_timeout, max_answer=max_answer,
+        (host, port),
+        store,
+        token=token,
+        union_default_graph=union_default_graph,
+        log=log,
+        query_timeout=query_timeout,
+        max_answer=max_answer,
     )
 
 

@@ -9,6 +9,7 @@ user text is pasted into a query.  Both stores use this one mechanism.
 from __future__ import annotations
 
 import re
+import uuid
 from collections.abc import Iterable, Sequence
 
 from pyoxigraph import BlankNode, Literal, NamedNode, Quad
@@ -169,41 +170,32 @@ def checked_quads(quads: Iterable[object], name: str) -> list[Quad]:
     return checked
 
 
-def write_update(graphs: GraphSet, replace: Replace, *, blank_node_templates: bool = False) -> str:
+def write_update(graphs: GraphSet, replace: Replace, *, skolem: str | None = None) -> str:
     """One SPARQL Update that writes ``graphs``: ``DROP SILENT GRAPH`` for each replaced
     graph, then one ``INSERT DATA`` with a ``GRAPH`` block per graph.
 
     One request, so one transaction wherever the endpoint makes a request atomic.  Terms are
-    written in N-Triples syntax by pyoxigraph.  With ``blank_node_templates`` (for Virtuoso,
-    which refuses blank nodes in ``INSERT DATA`` and fails, after inserting them, a template of
-    several graphs), each graph with blank nodes gets an ``INSERT { GRAPH ... } WHERE {}`` of
-    its own: the same quads, but a blank node may then not be in two graphs of one write (two
-    templates would make it two nodes; a StoreError says which).
+    written in N-Triples syntax by pyoxigraph.  With ``skolem`` (for Virtuoso, which refuses
+    blank nodes in ``INSERT DATA``), each blank node label of this write becomes one fresh IRI
+    starting with ``skolem`` (RDF 1.1 Concepts, 3.5 "Replacing Blank Nodes with IRIs"), the
+    same in every graph of the write, so the write stays one ``INSERT DATA``.
     """
     parts = [f"DROP SILENT GRAPH {graph_node(name)} ;\n" for name in replaced_names(graphs, replace)]
-    plain: list[str] = []
-    templates: list[str] = []
-    graphs_of: dict[str, str] = {}  # blank node -> the graph it was first seen in
+    blocks: list[str] = []
+    minted: dict[str, str] = {}  # blank node label -> its Skolem IRI, in N-Triples syntax
+
+    def text(term: object) -> str:
+        if skolem is not None and isinstance(term, BlankNode):
+            return minted.setdefault(term.value, f"<{skolem}{uuid.uuid4().hex}>")
+        return str(term)
+
     for name, quads in graphs.graphs.items():
         checked = checked_quads(quads, name)
-        lines = [f"{q.subject} {q.predicate} {q.object} .\n" for q in checked]
-        if not lines:
-            continue
-        block = f"GRAPH {graph_node(name)} {{\n{''.join(lines)}}}\n"
-        blanks: set[str] = set()
-        if blank_node_templates:
-            blanks = {t.value for q in checked for t in (q.subject, q.object) if isinstance(t, BlankNode)}
-        for blank in blanks:
-            other = graphs_of.setdefault(blank, name)
-            if other != name:
-                raise StoreError(
-                    f"blank node _:{blank} is in graphs <{other}> and <{name}> of one write, "
-                    "which this endpoint (Virtuoso) cannot store as one node"
-                )
-        (templates if blanks else plain).append(block)
-    if plain:
-        parts.append(f"INSERT DATA {{\n{''.join(plain)}}} ;\n")
-    parts += [f"INSERT {{\n{block}}} WHERE {{}} ;\n" for block in templates]
+        lines = [f"{text(q.subject)} {q.predicate} {text(q.object)} .\n" for q in checked]
+        if lines:
+            blocks.append(f"GRAPH {graph_node(name)} {{\n{''.join(lines)}}}\n")
+    if blocks:
+        parts.append(f"INSERT DATA {{\n{''.join(blocks)}}} ;\n")
     if parts:
         parts[-1] = parts[-1].removesuffix(" ;\n") + "\n"
     return "".join(parts)

@@ -1,0 +1,104 @@
+"""Reading Virtuoso's answers without losing digits.
+
+Virtuoso 7.2 writes ``xsd:double`` values with six significant digits in every SPARQL results
+format (JSON, XML, CSV, TSV) and in N-Triples and RDF/XML (``12.3456789012345`` comes back as
+``12.3457``; openlink/virtuoso-opensource#1006), and with 16 in RDF/JSON.  Only its Turtle is
+exact: a double is written with 20 digits (``0.30000000000000004441``), as a Turtle number.  So
+exsce asks Virtuoso for SELECT answers as a Turtle result set (the DAWG ``res:`` vocabulary)
+and for graphs as Turtle, and reads them here.
+
+In Turtle a number with a decimal point is an ``xsd:decimal``, so Virtuoso's doubles and
+decimals look alike.  exsce writes every number as an ``xsd:double`` or an integer, so a decimal
+read here is taken for a double (its nearest one, in canonical form); an exponent is a double
+in Turtle already.  A user's own ``xsd:decimal`` data therefore reads back as doubles from
+Virtuoso (the value, to a double's precision, not the type): ``docs/stores.md`` says so.
+Virtuoso keeps an ``xsd:integer`` as an ``xsd:int``: read back as the ``xsd:integer`` written.
+"""
+
+from __future__ import annotations
+
+from pyoxigraph import BlankNode, Literal, NamedNode, RdfFormat, Triple, parse
+
+from exsce_dsl.store.base import Rows, StoreError, Term
+
+OWN_GRAPHS = (
+    "http://www.openlinksw.com/schemas/virtrdf#",
+    "http://www.w3.org/ns/ldp#",
+    "http://localuriqaserver/",
+    "http://www.openlinksw.com/",
+)
+"""Graphs a new Virtuoso database holds for itself (its RDF views, LDP): not exsce's, so not
+listed, exported or cleared (dropping ``virtrdf#`` breaks the server)."""
+
+TURTLE = "text/turtle"
+
+_RES = "http://www.w3.org/2005/sparql-results#"
+_XSD = "http://www.w3.org/2001/XMLSchema#"
+_DECIMAL, _DOUBLE = NamedNode(_XSD + "decimal"), NamedNode(_XSD + "double")
+_INT, _INTEGER = NamedNode(_XSD + "int"), NamedNode(_XSD + "integer")
+
+
+def result_set_rows(body: bytes, source: str) -> Rows:
+    """The solutions of a SELECT answered as a Turtle result set, in the order written."""
+    triples = _parsed(body, source)
+    variables = [_text(t.object) for t in triples if t.predicate.value == _RES + "resultVariable"]
+    order: dict[str, int] = {}  # solution node -> its position (res:index, else first mention)
+    indexes: dict[str, int] = {}
+    bindings_of: dict[str, list[str]] = {}
+    variable_of: dict[str, str] = {}
+    value_of: dict[str, Term] = {}
+    for t in triples:
+        predicate = t.predicate.value
+        if predicate == _RES + "solution":
+            order.setdefault(_key(t.object), len(order))
+        elif predicate == _RES + "binding":
+            order.setdefault(_key(t.subject), len(order))
+            bindings_of.setdefault(_key(t.subject), []).append(_key(t.object))
+        elif predicate == _RES + "variable":
+            variable_of[_key(t.subject)] = _text(t.object)
+        elif predicate == _RES + "value":
+            value_of[_key(t.subject)] = _retyped(t.object)
+        elif predicate == _RES + "index" and isinstance(t.object, Literal):
+            indexes[_key(t.subject)] = int(t.object.value)
+    solutions = sorted(order, key=lambda s: (indexes.get(s, 0), order[s]))
+    rows = []
+    for solution in solutions:
+        values = {
+            variable_of[b]: value_of[b]
+            for b in bindings_of.get(solution, ())
+            if b in variable_of and b in value_of
+        }
+        rows.append(tuple(values.get(v) for v in variables))
+    return Rows(tuple(variables), tuple(rows))
+
+
+def graph_triples(body: bytes, source: str) -> list[tuple[Term, NamedNode, Term]]:
+    """The triples of a graph answered as Turtle, decimals read as doubles."""
+    return [(_retyped(t.subject), t.predicate, _retyped(t.object)) for t in _parsed(body, source)]
+
+
+def _parsed(body: bytes, source: str) -> list[Triple]:
+    try:
+        return list(parse(body, format=RdfFormat.TURTLE))
+    except (SyntaxError, ValueError) as exc:
+        raise StoreError(f"{source} answered with Turtle that cannot be read: {exc}") from None
+
+
+def _retyped(term: Term | Triple) -> Term:
+    if isinstance(term, Triple):
+        raise StoreError("Virtuoso answered with an RDF-star triple term, which exsce does not read")
+    if isinstance(term, Literal) and term.datatype == _DECIMAL:
+        return Literal(repr(float(term.value)), datatype=_DOUBLE)
+    if isinstance(term, Literal) and term.datatype == _INT:  # how Virtuoso keeps an xsd:integer
+        return Literal(term.value, datatype=_INTEGER)
+    return term
+
+
+def _text(term: Term | Triple) -> str:
+    if isinstance(term, Triple):
+        raise StoreError("Virtuoso answered with an RDF-star triple term, which exsce does not read")
+    return term.value
+
+
+def _key(term: Term | Triple) -> str:
+    return f"_:{term.value}" if isinstance(term, BlankNode) else str(term)
