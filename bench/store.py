@@ -15,8 +15,12 @@ to RDF included; building them with ``compile_run`` is timed apart), and as a
 ratio to pyoxigraph's own transactional insert of the same quads, measured in
 the same run: the floor under any atomic write path.
 
+Then it times every library query the report and the oracles use (p50, p95): those over a
+list of runs must not grow with the store.
+
     python bench/store.py                 # N = 100, 1,000 and 10,000
     python bench/store.py --sizes 100,1000
+    python bench/store.py --sizes 100,1000,10000,100000   # on request: ~2 h, ~40 GB of disk
 
 Prints figures; never a unit test.
 """
@@ -70,12 +74,13 @@ from exsce_dsl.model.runs import (
     TaskExecution,
 )
 from exsce_dsl.prov import compile_scenario
-from exsce_dsl.prov.identifiers import pose_name
+from exsce_dsl.prov.identifiers import point_name, pose_name
 from exsce_dsl.prov.run import compile_run
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.queries import query as library_query
+from exsce_dsl.store.queries import query_names, segment_metric
 from exsce_dsl.store.queries import runs as list_runs
-from exsce_dsl.store.queries import segment_metric
+from exsce_dsl.store.queries.terms import run_query
 from exsce_dsl.store.sparql import bind
 from exsce_dsl.store.writing import add_prov, stored_graphs
 
@@ -288,6 +293,66 @@ def raw_oxigraph_insert(scenario: Scenario, folder: Path) -> float:
     return sum(map(len, quads)) / (time.perf_counter() - t0)
 
 
+NOT_TIMED = ("campaign_shrinkings", "campaign_trials", "update_baseline", "update_mission_baseline")
+"""Library queries the table leaves out: the campaigns' (no campaign in these stores) and updates."""
+METRIC_OF = {
+    "hotspot_counts": "max_velocity",
+    "violation_durations": "max_velocity",
+    "violation_duration_stats": "max_velocity",
+    "mission_metric_stats": "mission_duration",
+    "run_mission_metric": "mission_duration",
+}
+
+
+def library_parameters(name: str, scenario: Scenario, some_runs: list[str]) -> tuple[dict[str, object], str]:
+    """Parameters for library query ``name`` on the synthetic store, and what it reads."""
+    start_pose = scenario.robots[0].start_pose
+    first_task = scenario.task(scenario.mission.tasks_of(ROBOTS[0])[0])
+    assert start_pose is not None and first_task is not None
+    goal_pose = next(first_task.waypoints())
+    by_kind: dict[str, object] = {
+        "scenario": scenario.id,
+        "id": scenario.id,
+        "robot": ROBOTS[0],
+        "metric": METRIC_OF.get(name, "task_duration"),
+        "metric_property": "distance_travelled",
+    }
+    given: dict[str, object] = {}
+    scope = "the store"
+    for parameter in library_query(name).parameters:
+        if parameter.kind in ("run", "run_activity"):
+            given[parameter.name] = some_runs if parameter.many else some_runs[0]
+            scope = f"{len(some_runs)} runs" if parameter.many else "1 run"
+        elif parameter.kind == "pose":
+            poses = [pose_name(start_pose), pose_name(goal_pose)]
+            given[parameter.name] = poses if parameter.many else poses[parameter.name == "goal"]
+        elif parameter.kind == "point":
+            given[parameter.name] = point_name(start_pose if parameter.name == "from" else goal_pose)
+        else:
+            given[parameter.name] = by_kind[parameter.kind]
+            if parameter.kind in ("scenario", "id") and scope == "the store":
+                scope = "the scenario"
+    return given, scope
+
+
+def time_library(store: EmbeddedStore, scenario: Scenario, some_runs: list[str], repeat: int) -> list[str]:
+    """p50 and p95 of every library query the report and the oracles use, as table lines."""
+    lines = []
+    for name in query_names():
+        if name in NOT_TIMED:
+            continue
+        given, scope = library_parameters(name, scenario, some_runs)
+
+        def call(name: str = name, given: dict[str, object] = given) -> object:
+            return run_query(store, name, given)  # type: ignore[arg-type]
+
+        rows = len(call().rows)  # type: ignore[attr-defined]
+        samples = timed(call, repeat)
+        p50, p95 = percentile(samples, 0.5), percentile(samples, 0.95)
+        lines.append(f"    {name:28s} {scope:14s} {p50 * 1e3:9,.2f} {p95 * 1e3:9,.2f} {rows:7,d}")
+    return lines
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
@@ -303,6 +368,7 @@ def main() -> None:
         "seconds at N = 100, minutes at N = 1,000)",
     )
     parser.add_argument("--rdflib-repeat", type=int, default=3, help="timed rdflib queries (no warm-up)")
+    parser.add_argument("--library-repeat", type=int, default=10, help="timed calls of each library query")
     options = parser.parse_args()
     sizes = [int(s) for s in options.sizes.split(",") if s]
 
@@ -375,6 +441,10 @@ def main() -> None:
             l50, l95 = percentile(samples, 0.5), percentile(samples, 0.95)
             timing = f"p50 {l50 * 1e3:,.2f} ms, p95 {l95 * 1e3:,.2f} ms"
             print(f"  the same over a list of {len(some_runs)} runs, Oxigraph: {timing}   {listed}")
+            print(f"  every library query (Oxigraph; 'the scenario': over its {size:,} runs):")
+            print(f"    {'query':28s} {'reads':14s} {'p50 ms':>9s} {'p95 ms':>9s} {'rows':>7s}")
+            for line in time_library(store, scenario, some_runs, options.library_repeat):
+                print(line)
             if dataset is not None and size > options.rdflib_query_max:
                 limit = options.rdflib_query_max
                 print(f"  segment query, rdflib:   not run above N = {limit} (--rdflib-query-max)")

@@ -59,13 +59,41 @@ def bind(query: str, bindings: Bindings | None) -> str:
     IRIs skipped): the ``{`` after a top-level ``WHERE``, else the first
     top-level group (``ASK { ... }``, ``SELECT * { ... }``), or the second one
     for ``CONSTRUCT { template } { pattern }``.
+
+    A query may say where a parameter's values go instead, with ``VALUES ?name { UNDEF }``
+    (valid SPARQL on its own: the variable left free) in the group that should start from
+    them, a subquery for instance: Oxigraph evaluates a subquery first and joins the rest
+    to its few solutions, where it would otherwise join a list given at the top last.
     """
     if not bindings:
+        return query
+    placed = _placeholders(query)
+    for name in sorted(set(placed) & set(bindings), key=lambda n: -placed[n][0]):
+        start, end = placed[name]
+        query = f"{query[:start]}{values_block({name: bindings[name]})}{query[end:]}"
+    rest = {name: value for name, value in bindings.items() if name not in placed}
+    if not rest:
         return query
     at = where_group(query)
     if at is None:
         raise StoreError("a query with parameters needs a WHERE { ... } group to bind them in")
-    return f"{query[: at + 1]} {values_block(bindings)}\n{query[at + 1 :]}"
+    return f"{query[: at + 1]} {values_block(rest)}\n{query[at + 1 :]}"
+
+
+def _placeholders(query: str) -> dict[str, tuple[int, int]]:
+    """Where the query holds ``VALUES ?name { UNDEF }``: variable name -> (start, end)."""
+    tokens = [t for t in _TOKEN.finditer(query) if not (t.lastgroup == "other" and t.group().isspace())]
+    found = {}
+    for i in range(len(tokens) - 4):
+        values, variable, opening, undef, closing = tokens[i : i + 5]
+        if (
+            values.lastgroup == "word" and values.group().upper() == "VALUES"
+            and variable.lastgroup == "word" and variable.group()[0] in "?$"
+            and opening.lastgroup == "open" and undef.group().upper() == "UNDEF"
+            and closing.lastgroup == "close"
+        ):  # fmt: skip
+            found[variable.group()[1:]] = (values.start(), closing.end())
+    return found
 
 
 _TOKEN = re.compile(

@@ -66,6 +66,7 @@ KINDS: Mapping[str, Callable[[Namespaces, str], Term]] = {
     "point": lambda names, text: _iri(names, ids.POINT, text, "pose"),
     "id": lambda names, text: Literal(text),
     "run": lambda names, text: Literal(text),
+    "run_activity": lambda names, text: _iri(names, ids.RUN, ids.run_name(text), "run uuid"),
     "robot": lambda names, text: Literal(text),
     "metric": lambda names, text: Literal(text),
     "metric_property": lambda names, text: _iri(names, ids.METRIC, text, "metric"),
@@ -74,10 +75,11 @@ KINDS: Mapping[str, Callable[[Namespaces, str], Term]] = {
 }
 """How a parameter's text becomes a term: ``scenario`` → ``exsce:<id>``, ``pose`` →
 ``pose:<pose name>`` (``classroom_c025-w001-R0.00_P0.00_Y0.00``), ``point`` → ``point:<pose id>``
-(the position of every heading of the pose), ``double`` → an
-``xsd:double``, ``metric_property`` → ``metric:<name>`` (the segment index's property
-for the metric), and ``id``, ``run`` (a uuid), ``robot``, ``metric``, ``string`` → a
-plain literal."""
+(the position of every heading of the pose), ``double`` → an ``xsd:double``,
+``metric_property`` → ``metric:<name>`` (the segment index's property for the metric),
+``run_activity`` → ``run:run_<uuid>`` (the run's activity, given by its uuid: a query starts
+from it with a look-up, where the uuid literal is one of every run entity's), and ``id``,
+``run`` (a uuid), ``robot``, ``metric``, ``string`` → a plain literal."""
 
 
 @dataclass(frozen=True)
