@@ -82,11 +82,12 @@ def simulate(
 
 def ingest(
     store: Store, spec: Specification | Scenario, bags: Sequence[str | Path], *, scenario: str | None = None,
-    jobs: int = 1,
+    jobs: int = 1, cluster: str | None = None,
 ) -> list[IngestResult]:  # fmt: skip
     """``exscec ingest``: each bag's metrics and run PROV into ``store``, one transaction per run
-    (a bag that fails is reported in its result, and nothing of it is written)."""
-    return ingest_bags([Path(b) for b in bags], _scenario(spec, scenario), store, jobs)
+    (a bag that fails is reported in its result, and nothing of it is written); the bags are
+    analysed by ``jobs`` processes, or on the Dask cluster whose scheduler is at ``cluster``."""
+    return ingest_bags([Path(b) for b in bags], _scenario(spec, scenario), store, jobs, cluster=cluster)
 
 
 def baseline(store: Store, spec: Specification, scenario: str | None = None) -> Baseline:

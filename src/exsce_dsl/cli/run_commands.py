@@ -124,16 +124,32 @@ def simulate(
 @click.option(
     "--jobs", "-j", default=1, show_default=True, type=click.IntRange(1), help="Bags analysed in parallel."
 )
+@click.option(
+    "--cluster",
+    metavar="ADDRESS",
+    envvar="EXSCE_DASK_SCHEDULER",
+    help="A Dask scheduler (tcp://host:8786): its workers read the bags and compute their metrics "
+    "instead of --jobs processes; the bags' paths must be the same on every worker (a shared "
+    "filesystem).  Default: $EXSCE_DASK_SCHEDULER.",
+)
 @click.option("--store", "store_url", envvar="EXSCE_STORE", help="Store URL (default: .exsce/store).")
 @reports_errors
 def ingest(
-    bags: tuple[str, ...], spec: str, scenario_id: str | None, jobs: int, store_url: str | None
+    bags: tuple[str, ...],
+    spec: str,
+    scenario_id: str | None,
+    jobs: int,
+    cluster: str | None,
+    store_url: str | None,
 ) -> None:
     """Compute the metrics of bags and add each run's provenance to the store.
 
     Each bag is one transaction: a bag that cannot be used is reported and
     nothing of it is written, and the other bags still ingest.  A bag already
-    ingested (same content) is skipped.  Exits 1 if any bag failed.
+    ingested (same content) is skipped.  Exits 1 if any bag failed.  With
+    --cluster, a Dask cluster's workers analyse the bags (a task is tried
+    twice; a killed worker's tasks go to another) and exscec writes each
+    run, as with --jobs.
 
     \b
     Example:
@@ -155,7 +171,7 @@ def ingest(
             for problem in result.problems:
                 progress.say(f"warning: {result.bag}: {problem}")
 
-        results = ingest_bags(paths, scenario, store, jobs, shown)
+        results = ingest_bags(paths, scenario, store, jobs, shown, cluster=cluster or None)
     done = sum(r.status is IngestStatus.INGESTED for r in results)
     skipped = sum(r.status is IngestStatus.SKIPPED for r in results)
     failed = sum(r.failed for r in results)

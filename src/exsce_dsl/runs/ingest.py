@@ -22,6 +22,7 @@ from exsce_dsl.model import Scenario
 from exsce_dsl.prov import DEFAULT_NAMESPACE, compile_scenario
 from exsce_dsl.prov.run import compile_run
 from exsce_dsl.runs.analyse import AnalysedRun, analyse_bag, content_hash, run_uuid
+from exsce_dsl.runs.cluster import cluster_mapper
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.queries import run_query
 from exsce_dsl.store.writing import add_prov
@@ -78,8 +79,13 @@ Mapper = Callable[[Callable[[Any], Any], Iterable[Any]], Iterator[Any]]
 
 
 @contextmanager
-def _workers(jobs: int, tasks: int) -> Iterator[Mapper]:
-    """``map`` in this process (one job), or over a pool of ``jobs`` processes kept for every phase."""
+def _workers(jobs: int, tasks: int, cluster: str | None = None) -> Iterator[Mapper]:
+    """``map`` on the Dask cluster at ``cluster``, in this process (one job), or over a pool of
+    ``jobs`` processes kept for every phase."""
+    if cluster is not None:
+        with cluster_mapper(cluster) as mapper:
+            yield mapper
+        return
     if jobs <= 1 or tasks <= 1:
         yield map
         return
@@ -94,18 +100,22 @@ def ingest_bags(
     jobs: int = 1,
     progress: Callable[[IngestResult], None] | None = None,
     namespace: str = DEFAULT_NAMESPACE,
+    cluster: str | None = None,
 ) -> list[IngestResult]:
     """Ingest each bag as a run of ``scenario``; the scenario itself is added to the store first.
 
     With ``jobs`` > 1, worker processes hash the bags, then read them and compute their metrics;
-    this process alone compiles each run's PROV and writes it, one transaction per run.
+    with ``cluster`` (a Dask scheduler's address) the cluster's workers do, and ``jobs`` is not
+    used (see :mod:`exsce_dsl.runs.cluster`).  This process alone compiles each run's PROV and
+    writes it, one transaction per run.
     """
     add_prov(store, compile_scenario(scenario, namespace))
     results: list[IngestResult] = []
     todo: list[tuple[Path, str | None]] = []
     seen: set[str] = set()
-    with _workers(jobs, len(paths)) as mapper:
-        digests = list(mapper(_digest, paths))
+    with _workers(jobs, len(paths), cluster) as mapper:
+        # a digest the cluster could not compute is None: the bag's analysis then says what is wrong
+        digests = [d if isinstance(d, str) else None for d in mapper(_digest, paths)]
         for path, digest in zip(paths, digests, strict=True):
             known = digest is not None and (
                 digest in seen or bool(run_query(store, "run_known", {"run": run_uuid(digest)}, namespace))
