@@ -35,6 +35,7 @@ _KIND_SCHEMAS: dict[str, dict[str, Any]] = {
     "point": {"type": "string", "pattern": NAME},
     "pose": {"type": "string", "pattern": POSE_NAME},
     "run": {"type": "string", "pattern": RUN_UUID},
+    "run_activity": {"type": "string", "pattern": RUN_UUID},  # given as its uuid, like "run"
     "string": {"type": "string"},
     "double": {"type": "number"},
 }
