@@ -413,6 +413,12 @@ def report_fault(
     ]
     for text, met in targets:
         print(f"  {'PASS' if met else 'FAIL'}  {text}")
+    runs_per_derivation = min((c.unit.runs for c in campaigns), default=0)
+    if baselines and median_baseline <= runs_per_derivation < median_campaign:
+        print(
+            f"        (the baseline's median, {median_baseline:g}, is its first derivation's runs: "
+            "no campaign can take fewer, only as few)"
+        )
     return targets
 
 
