@@ -99,16 +99,20 @@ def to_quads(document: ProvDocument) -> list[Quad]:
     return quads_of_lines(nquad_lines(document))
 
 
-def nquad_lines(document: ProvDocument) -> list[str]:
+def nquad_lines(document: ProvDocument, blank_prefix: str = "q") -> list[str]:
     """The document in PROV-O as N-Quads lines (each ending in a newline), each once.
 
+    Blank nodes are labelled ``_:<blank_prefix><n>``: a prefix of its own for each document
+    keeps two documents' blank nodes apart when their lines are loaded together.
     Raises :class:`~exsce_dsl.errors.ExportError` for a name that is not an
     absolute IRI (RDF cannot hold it).
     """
     was_enabled = gc.isenabled()
     gc.disable()  # tens of thousands of strings that all stay alive: nothing to collect
     try:
-        mapper = _Mapper()
+        if not blank_prefix.isalnum() or not blank_prefix.isascii():
+            raise ValueError(f"a blank node prefix is letters and digits, not {blank_prefix!r}")
+        mapper = _Mapper(blank_prefix)
         mapper.document(document)
         return list(dict.fromkeys(mapper.out))
     finally:
@@ -187,10 +191,11 @@ _LANGUAGE_TAG = re.compile(r"[A-Za-z]{1,8}(?:-[A-Za-z0-9]{1,8})*")
 class _Terms:
     """N-Triples spellings of names and values, each made (and checked) once."""
 
-    def __init__(self) -> None:
+    def __init__(self, blank_prefix: str = "q") -> None:
         self._iris: dict[str, str] = {}
         self._literals: dict[tuple[type, Any], str] = {}
         self._blank = 0
+        self._blank_label = f"_:{blank_prefix}"
 
     def iri(self, qname: Identifier) -> str:
         uri = qname._uri
@@ -203,7 +208,7 @@ class _Terms:
 
     def blank(self) -> str:
         self._blank += 1
-        return f"_:q{self._blank}"
+        return f"{self._blank_label}{self._blank}"
 
     def value(self, value: Any) -> str:
         if isinstance(value, QualifiedName):
@@ -336,9 +341,9 @@ class _Mapper:
     than all the rest.  The values and their order are the same.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, blank_prefix: str = "q") -> None:
         self.out: list[str] = []
-        self.terms = _Terms()
+        self.terms = _Terms(blank_prefix)
         self._kinds: dict[type, str | _RelationForm] = {}
 
     def document(self, document: ProvDocument) -> None:

@@ -1,4 +1,4 @@
-"""Ingest bags: metrics and run provenance into the store, one transaction per run.
+"""Ingest bags: metrics and run provenance into the store, each run wholly or not at all.
 
 A bag that cannot be used (unreadable, truncated, empty, from another
 scenario) is reported and nothing of it is written; the other bags of the
@@ -15,7 +15,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 from enum import Enum
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import Scenario
@@ -24,6 +24,7 @@ from exsce_dsl.prov.run import compile_run
 from exsce_dsl.runs.analyse import AnalysedRun, analyse_bag, content_hash, run_uuid
 from exsce_dsl.runs.cluster import cluster_mapper
 from exsce_dsl.store.base import Store
+from exsce_dsl.store.batch_writing import RunWriter, Written
 from exsce_dsl.store.queries import run_query
 from exsce_dsl.store.writing import add_prov
 
@@ -107,7 +108,8 @@ def ingest_bags(
     With ``jobs`` > 1, worker processes hash the bags, then read them and compute their metrics;
     with ``cluster`` (a Dask scheduler's address) the cluster's workers do, and ``jobs`` is not
     used (see :mod:`exsce_dsl.runs.cluster`).  This process alone compiles each run's PROV and
-    writes it, one transaction per run.
+    writes it, each run wholly or not at all, in group commits when the runs come faster than the
+    store takes them one by one (:mod:`exsce_dsl.store.batch_writing`).
     """
     add_prov(store, compile_scenario(scenario, namespace))
     results: list[IngestResult] = []
@@ -133,30 +135,41 @@ def ingest_bags(
             else:
                 todo.append((path, digest))
         outcomes = mapper(_analyse, [(path, scenario, digest) for path, digest in todo])
-        for (path, _), outcome in zip(todo, outcomes, strict=True):
-            result = _write(path, outcome, scenario, store, namespace)
+
+        def written(done: Written) -> None:
+            bag, analysed = cast(tuple[Path, AnalysedRun | None], done.key)
+            result = _result(bag, analysed, done)
             results.append(result)
             if progress:
                 progress(result)
+
+        with RunWriter(store, written) as writer:
+            for (path, _), outcome in zip(todo, outcomes, strict=True):
+                if isinstance(outcome, ExsceError):
+                    writer.flush()  # the bags before it are told first
+                    written(Written((path, None), None, outcome))
+                    continue
+                try:
+                    document = compile_run(outcome.run, scenario, namespace)
+                except ExsceError as exc:
+                    writer.flush()
+                    written(Written((path, outcome), None, exc))
+                    continue
+                writer.add(document, (path, outcome))
     return results
 
 
-def _write(
-    path: Path, outcome: AnalysedRun | ExsceError, scenario: Scenario, store: Store, namespace: str
-) -> IngestResult:
-    """Write an analysed run to the store (one transaction), or say why it could not be."""
-    if isinstance(outcome, ExsceError):
-        message = outcome.message if str(path) in outcome.message else f"{path}: {outcome.message}"
-        return IngestResult(path, IngestStatus.FAILED, message)
-    try:
-        report = add_prov(store, compile_run(outcome.run, scenario, namespace))
-    except ExsceError as exc:
-        return IngestResult(path, IngestStatus.FAILED, f"{path}: {exc.message}")
+def _result(path: Path, analysed: AnalysedRun | None, done: Written) -> IngestResult:
+    """What became of a bag, once its run was written (or not)."""
+    if done.error is not None or done.report is None or analysed is None:
+        message = done.error.message if done.error is not None else "not written"
+        named = message if str(path) in message else f"{path}: {message}"
+        return IngestResult(path, IngestStatus.FAILED, named)
     return IngestResult(
         path,
         IngestStatus.INGESTED,
-        f"{path}: run {outcome.run.uuid} ({len(outcome.run.metrics)} metric values)",
-        outcome.run.uuid,
-        tuple(outcome.problems),
-        report.statements,
+        f"{path}: run {analysed.run.uuid} ({len(analysed.run.metrics)} metric values)",
+        analysed.run.uuid,
+        tuple(analysed.problems),
+        done.report.statements,
     )

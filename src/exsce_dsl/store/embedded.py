@@ -24,7 +24,7 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
-from pyoxigraph import BlankNode, NamedNode, Quad, QueryBoolean, QuerySolutions
+from pyoxigraph import BlankNode, NamedNode, Quad, QueryBoolean, QuerySolutions, RdfFormat
 from pyoxigraph import Store as OxStore
 
 from exsce_dsl.store.base import (
@@ -147,6 +147,17 @@ class EmbeddedStore(Store):
         try:
             self._writer().extend(quads)
         except OSError as exc:
+            raise StoreError(f"cannot write to the store at {self.location}: {exc}") from None
+
+    def bulk_write(self, nquads: bytes) -> None:
+        """Add N-Quads through Oxigraph's bulk loader: all of them or none (Oxigraph 0.5 commits a
+        bulk load in one step), without Python's lock held while Oxigraph parses and indexes.
+        The caller has checked what it loads (:mod:`exsce_dsl.store.batch_writing`)."""
+        try:
+            self._writer().bulk_load(nquads, format=RdfFormat.N_QUADS, lenient=True)
+        except SyntaxError as exc:
+            raise StoreError(f"invalid N-Quads for the store at {self.location}: {exc}") from None
+        except (OSError, RuntimeError, ValueError) as exc:
             raise StoreError(f"cannot write to the store at {self.location}: {exc}") from None
 
     def update(self, update: str, bindings: Bindings | None = None) -> None:
