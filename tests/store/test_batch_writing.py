@@ -143,7 +143,7 @@ WRITER = textwrap.dedent(
     store = EmbeddedStore(sys.argv[2])
     store.graph_names()
     print("ready", flush=True)
-    with RunWriter(store) as writer:
+    with RunWriter(store, bulk_from=int(sys.argv[3])) as writer:
         for document in documents:
             writer.add(document)
     print("done", flush=True)
@@ -151,8 +151,9 @@ WRITER = textwrap.dedent(
 )
 
 
+@pytest.mark.parametrize("bulk_from", [1, 10**9], ids=["bulk-loads", "transactions"])
 def test_a_writer_killed_at_random_points_leaves_each_run_wholly_or_not_at_all(
-    scenario: Scenario, documents: list[ProvDocument], tmp_path: Path
+    scenario: Scenario, documents: list[ProvDocument], tmp_path: Path, bulk_from: int
 ) -> None:
     given = tmp_path / "documents.pickle"
     given.write_bytes(pickle.dumps(documents))
@@ -167,11 +168,11 @@ def test_a_writer_killed_at_random_points_leaves_each_run_wholly_or_not_at_all(
         with EmbeddedStore(folder) as store:
             _with_scenario(store, scenario)
         writer = subprocess.Popen(
-            [sys.executable, "-c", WRITER, str(given), str(folder)], stdout=subprocess.PIPE, text=True
+            [sys.executable, "-c", WRITER, str(given), str(folder), str(bulk_from)], stdout=subprocess.PIPE, text=True
         )
         assert writer.stdout is not None and writer.stdout.readline() == "ready\n"
-        # five runs take a tenth of a second or two to write: kill anywhere in that time
-        signal_after = chance.uniform(0.0, 0.25)
+        # five runs take a tenth of a second or a few to write: kill anywhere in that time
+        signal_after = chance.uniform(0.0, 0.25 if bulk_from > 1 else 0.4)
         try:
             writer.wait(timeout=signal_after)
         except subprocess.TimeoutExpired:

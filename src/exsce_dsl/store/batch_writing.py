@@ -6,26 +6,28 @@ folder, or a campaign, writes run after run; :class:`RunWriter` takes them as th
 come and commits them in groups:
 
 * the caller's thread turns each PROV document into N-Quads and derives its segment
-  index (Python's work); a loader thread hands each group to Oxigraph's bulk loader
-  (:meth:`~exsce_dsl.store.embedded.EmbeddedStore.bulk_write`), which parses and
-  indexes without Python's lock, so the two overlap;
+  index (Python's work); a loader thread hands each group to Oxigraph
+  (:meth:`~exsce_dsl.store.embedded.EmbeddedStore.load_nquads`), which parses and
+  indexes without Python's lock, so the two overlap: a group of :data:`BULK_FROM`
+  statements or more through the bulk loader, a smaller one in one transaction;
 * a group is what arrived while the group before it was loading (a group commit).
   When runs come slower than the store takes them (a real bag takes longer to
   analyse than to write), each run is committed alone as soon as it is ready; when
   they come faster, groups grow, up to :data:`MAX_GROUP_QUADS`.
 
-**Crash semantics.**  Oxigraph 0.5's bulk loader commits a load in one step: it
-builds the sorted files of every index and adds them to RocksDB together at the
-end (``oxigraph load``: "either the file is fully loaded into the store or not at
-all").  A run is never split between groups.  So every group, hence every run, is
-in the store wholly or not at all, after a crash too, and a reader (a read-only view
-in another process) sees whole groups.  A killed writer loses the group being
-loaded and the runs not yet handed over: they are absent, and the same ingest again
-writes them (a bag's run is known by its content).  No journal is needed, as it
-would be around a loader that commits piece by piece; ``tests/store/test_faults.py``
-kills writers at random points and checks that each run is whole or absent.
+**Crash semantics.**  Each group is one transaction, or one bulk load, which
+Oxigraph 0.5 commits in one step too: it builds the sorted files of every index
+and adds them to RocksDB together at the end (``oxigraph load``: "either the file
+is fully loaded into the store or not at all").  A run is never split between
+groups.  So every group, hence every run, is in the store wholly or not at all,
+after a crash too, and a reader (a read-only view in another process) sees whole
+groups.  A killed writer loses the group being loaded and the runs not yet handed
+over: they are absent, and the same ingest again writes them (a bag's run is known
+by its content).  No journal is needed, as it would be around a loader that
+commits piece by piece; ``tests/store/test_batch_writing.py`` kills writers at
+random points, through either path, and checks that each run is whole or absent.
 
-What does not fit a bulk load goes through :func:`add_prov` (its merge and conflict
+What does not fit goes through :func:`add_prov` (its merge and conflict
 rules), after every group before it has been committed, so that order is kept: a
 document with statements outside its bundles, and one whose graphs the store (or a
 group in flight) holds already.  On a store other than the embedded one every
@@ -51,7 +53,12 @@ from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.segment_index import segment_index
 from exsce_dsl.store.writing import WriteReport, add_prov
 
-__all__ = ["MAX_GROUP_QUADS", "RunWriter", "Written"]
+__all__ = ["BULK_FROM", "MAX_GROUP_QUADS", "RunWriter", "Written"]
+
+BULK_FROM = 15_000
+"""Statements of a group (about eight runs) from which it goes through the bulk loader.  Each bulk
+load costs about as much as writing a run in a transaction, before its statements; a smaller group
+is one transaction (``Store.load``: all or nothing too)."""
 
 MAX_GROUP_QUADS = 250_000
 """Statements of a group at most (about 130 runs): bounds memory, and keeps each load one batch of
@@ -79,10 +86,14 @@ class _Prepared:
 class RunWriter:
     """Writes PROV documents (runs) to ``store`` in group commits; ``on_written`` hears of each
     document once it is committed (or failed), in the order given, on the caller's thread (during
-    :meth:`add` and :meth:`close`).  Use it in a ``with`` block."""
+    :meth:`add` and :meth:`close`).  Groups of ``bulk_from`` statements or more go through the
+    bulk loader.  Use it in a ``with`` block."""
 
-    def __init__(self, store: Store, on_written: Callable[[Written], None] | None = None) -> None:
+    def __init__(
+        self, store: Store, on_written: Callable[[Written], None] | None = None, *, bulk_from: int = BULK_FROM
+    ) -> None:
         self._store = store
+        self._bulk_from = bulk_from
         self._bulk = store if isinstance(store, EmbeddedStore) else None
         self._on_written = on_written
         self._lock = threading.Condition()
@@ -195,7 +206,8 @@ class RunWriter:
                 self._lock.notify_all()
             error: StoreError | None = None
             try:
-                self._bulk.bulk_write(b"".join(run.nquads for run in group))
+                bulk = sum(_size(run) for run in group) >= self._bulk_from
+                self._bulk.load_nquads(b"".join(run.nquads for run in group), bulk=bulk)
             except StoreError as exc:
                 error = exc
             with self._lock:

@@ -149,12 +149,14 @@ class EmbeddedStore(Store):
         except OSError as exc:
             raise StoreError(f"cannot write to the store at {self.location}: {exc}") from None
 
-    def bulk_write(self, nquads: bytes) -> None:
-        """Add N-Quads through Oxigraph's bulk loader: all of them or none (Oxigraph 0.5 commits a
-        bulk load in one step), without Python's lock held while Oxigraph parses and indexes.
-        The caller has checked what it loads (:mod:`exsce_dsl.store.batch_writing`)."""
+    def load_nquads(self, nquads: bytes, *, bulk: bool) -> None:
+        """Add N-Quads, all of them or none, without Python's lock held while Oxigraph parses and
+        indexes: through the bulk loader (which Oxigraph 0.5 commits in one step; fast for many
+        runs, with a cost of its own for each call) or in one transaction.  The caller has
+        checked what it loads (:mod:`exsce_dsl.store.batch_writing`)."""
+        load = self._writer().bulk_load if bulk else self._writer().load
         try:
-            self._writer().bulk_load(nquads, format=RdfFormat.N_QUADS, lenient=True)
+            load(nquads, format=RdfFormat.N_QUADS, lenient=True)
         except SyntaxError as exc:
             raise StoreError(f"invalid N-Quads for the store at {self.location}: {exc}") from None
         except (OSError, RuntimeError, ValueError) as exc:
