@@ -190,3 +190,16 @@ def test_a_writer_killed_at_random_points_leaves_each_run_wholly_or_not_at_all(
         counts.append(stored)
     print(f"runs stored after each of 12 kills: {counts}")
     assert len(set(counts)) >= 2, "the kills should fall at different points of the writes"
+
+
+def test_a_name_rdf_cannot_hold_is_told_for_its_document_and_the_others_still_go_in(
+    documents: list[ProvDocument],
+) -> None:
+    document = ProvDocument()
+    document.add_namespace("ex", "relative/")
+    document.bundle("ex:bundle").entity("ex:inside")
+    store = EmbeddedStore()
+    first, bad, last = _write_all(store, [documents[0], document, documents[1]])
+    assert first.report is not None and last.report is not None
+    assert bad.report is None and bad.error is not None and "not an absolute IRI" in bad.error.message
+    assert len(store.quads()) == first.report.statements + last.report.statements

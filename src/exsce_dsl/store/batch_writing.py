@@ -114,7 +114,13 @@ class RunWriter:
         """Write ``document`` (its bundles as named graphs, with its segment index) in a coming
         group; a document the bulk path cannot take is written through :func:`add_prov` now."""
         self._tell()
-        prepared = self._prepared(document, key) if self._bulk is not None else None
+        try:
+            prepared = self._prepared(document, key) if self._bulk is not None else None
+        except ExsceError as exc:  # a name RDF cannot hold, a store that cannot be read
+            self.flush()
+            self._finish(Written(key, None, exc))
+            self._tell()
+            return
         if prepared is None:
             self.flush()
             try:
@@ -210,6 +216,8 @@ class RunWriter:
                 self._bulk.load_nquads(b"".join(run.nquads for run in group), bulk=bulk)
             except StoreError as exc:
                 error = exc
+            except Exception as exc:  # noqa: BLE001 - the group's failure, told for each of its runs
+                error = StoreError(f"cannot write to the store at {self._store.location}: {exc}")
             with self._lock:
                 for run in group:
                     self._finished.append(
