@@ -50,6 +50,14 @@ from exsce_dsl.cli.store_commands import store_option
     "--jobs", "-j", default=1, show_default=True, type=click.IntRange(1), help="Bags analysed in parallel."
 )
 @click.option(
+    "--cluster",
+    metavar="ADDRESS",
+    help="A Dask scheduler (tcp://host:8786): the simulator's runs are played and every bag is "
+    "analysed on its workers, which must see the campaign's folder (--output) at the same path "
+    "(a shared filesystem); --executor-command and --executor still run here.  The same campaign "
+    "as without.  Default: $EXSCE_DASK_SCHEDULER.",
+)
+@click.option(
     "--output", "-o", type=click.Path(file_okay=False),
     help="Folder of the campaign's files [default: explore/<campaign id>].",
 )  # fmt: skip
@@ -71,6 +79,7 @@ def explore(
     executor_command: str | None,
     plugin: str | None,
     jobs: int,
+    cluster: str | None,
     output: str | None,
     junit: str | None,
     store_url: str | None,
@@ -89,6 +98,11 @@ def explore(
     The base needs 3 stored runs (the campaign runs them if it has fewer).
     Exit status: 0 when nothing was violated, 1 when a relation was.
 
+    With --cluster, a Dask cluster's workers play the simulator's runs (one
+    task a run, writing the bags into the campaign's folder) and analyse
+    every bag; exscec writes the store.  The campaign, its derivations and
+    its verdicts are those it has without --cluster.
+
     \b
     Examples:
       exscec explore examples/brsu_building_c/scenario_c.exsce -n 2 -k 1 -t reverse_waypoint_order
@@ -101,17 +115,19 @@ def explore(
     from exsce_dsl.lang.build import load_spec
     from exsce_dsl.model.campaign import Trial
     from exsce_dsl.oracles.campaign_junit import campaign_junit, run_seconds, steps_text
+    from exsce_dsl.runs.cluster import cluster_address
     from exsce_dsl.store.open import open_store
 
     if sum(bool(x) for x in (faults, executor_command, plugin)) > 1:
         raise ExsceError("give one of --fault (the simulator), --executor-command and --executor")
+    address = cluster_address(cluster)
     executor: Executor
     if executor_command:
         executor = CommandExecutor(executor_command)
     elif plugin:
         executor = plugin_executor(plugin)
     else:
-        executor = SimulatorExecutor.with_faults(faults)
+        executor = SimulatorExecutor.with_faults(faults, cluster=address)
     options = CampaignOptions(
         budget=budget,
         seed=seed,
@@ -122,6 +138,7 @@ def explore(
         tolerance=tolerance,
         shrink=not no_shrink,
         jobs=jobs,
+        cluster=address,
     )
     parsed = load_spec(spec)
     with open_store(store_url) as store, Progress(budget, "Exploring") as progress:

@@ -56,6 +56,13 @@ from exsce_dsl.model.conventions import CONVENTIONS
     is_flag=True,
     help="nav2, move_base: cmd_vel as TwistStamped (Nav2 from Jazzy on), not Twist.",
 )
+@click.option(
+    "--cluster",
+    metavar="ADDRESS",
+    help="A Dask scheduler (tcp://host:8786): each run is one task on its workers, which write the "
+    "bags into --output themselves, so --output (and the map files) must be the same path on every "
+    "worker (a shared filesystem).  The same bags as without.  Default: $EXSCE_DASK_SCHEDULER.",
+)
 @reports_errors
 def simulate(
     spec: str,
@@ -67,6 +74,7 @@ def simulate(
     scenario_id: str | None,
     convention: str | None,
     cmd_vel_stamped: bool,
+    cluster: str | None,
 ) -> None:
     """Play a scenario with the kinematic executor and write one bag per run.
 
@@ -92,6 +100,11 @@ def simulate(
       deadlock-start:tiago1:classroom_c025-w002  swap_start_poses --robot tiago1 --with tiago2
       overspeed-many-tasks:2                     remove_robot --robot tiago2 --reassign tiago1
 
+    With --cluster, each run is played by a Dask cluster's worker, which
+    writes its bag and .prov.json into --output (a task is tried twice; a
+    killed worker's runs go to another).  A run that failed even so is named
+    by its index at the end, and the exit status is 1.
+
     \b
     Example:
       exscec simulate examples/brsu_building_c/scenario_c.exsce --runs 3 -o runs/
@@ -99,12 +112,16 @@ def simulate(
       exscec simulate examples/brsu_building_c/scenario_c.exsce --convention nav2 --format mcap -o runs/
     """
     from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.runs.cluster import cluster_address
     from exsce_dsl.sim.executor import Fault
     from exsce_dsl.sim.run import simulate as play
+    from exsce_dsl.sim.run import simulate_on_cluster
 
     scenario = load_spec(spec).scenario(scenario_id)
     parsed = tuple(Fault.parse(f) for f in faults)
-    played = play(scenario, Path(out_dir), runs, fmt, seed, parsed, convention, cmd_vel_stamped)
+    arguments = (scenario, Path(out_dir), runs, fmt, seed, parsed, convention, cmd_vel_stamped)
+    address = cluster_address(cluster)
+    played = simulate_on_cluster(address, *arguments) if address else play(*arguments)
     with Progress(runs, f"simulating {scenario.id}") as progress:
         for run in played:
             progress.update()
@@ -144,8 +161,9 @@ def ingest(
 ) -> None:
     """Compute the metrics of bags and add each run's provenance to the store.
 
-    Each bag is one transaction: a bag that cannot be used is reported and
-    nothing of it is written, and the other bags still ingest.  A bag already
+    Each run is stored wholly or not at all (runs that come faster than one
+    by one are committed in groups): a bag that cannot be used is reported
+    and nothing of it is written, and the other bags still ingest.  A bag already
     ingested (same content) is skipped.  Exits 1 if any bag failed.  With
     --cluster, a Dask cluster's workers analyse the bags (a task is tried
     twice; a killed worker's tasks go to another) and exscec writes each

@@ -81,6 +81,10 @@ class CampaignOptions:
     shrink_tries: int = SHRINK_TRIES
     jobs: int = 1
     """Bags of one scenario analysed in parallel."""
+    cluster: str | None = None
+    """A Dask scheduler's address: the bags are analysed on its workers (``jobs`` is then not used),
+    which open them by their absolute paths (a shared filesystem).  Where the runs are played is
+    the executor's business (:class:`~exsce_dsl.explore.executors.SimulatorExecutor`'s ``cluster``)."""
 
 
 @dataclass
@@ -199,7 +203,10 @@ class _Campaign:
         bags = self.executor.execute(scenario, scenario_file, out, runs, self.seed_of(scenario.id))
         self.executions += len(bags)
         uuids = []
-        for result in ingest_bags(bags, scenario, self.store, self.options.jobs):
+        if self.options.cluster is not None:  # a worker's working folder is not ours
+            bags = [bag.absolute() for bag in bags]
+        cluster = self.options.cluster
+        for result in ingest_bags(bags, scenario, self.store, self.options.jobs, cluster=cluster):
             if result.failed or result.run_id is None:
                 raise IngestFailed(result.message)
             uuids.append(result.run_id)

@@ -4,12 +4,17 @@ An :class:`Executor` is given a scenario (and the ``.exsce`` file that declares 
 back bags, one per run; the campaign ingests and judges them.  Three kinds:
 
 - :class:`SimulatorExecutor`, the default: exsce's kinematic executor (``exscec simulate``),
-  with the deliberate faults named on the command line (``--fault``);
+  with the deliberate faults named on the command line (``--fault``), in this process or, given
+  a Dask scheduler's address, one run per task on the cluster's workers (``exscec simulate
+  --cluster``: the campaign's folder must then be the same path on every worker);
 - :class:`CommandExecutor`: any program, run once per scenario with its arguments filled in
   (``{scenario_file} {scenario} {runs} {seed} {out}``), which writes the bags into ``{out}``:
   a user's own simulator, or a script that drives a real robot;
 - a plug-in: a package registers a factory under the entry-point group ``exsce.executors``
   (called with no arguments, it returns an Executor), chosen by its name.
+
+A command and a plug-in run where the campaign runs, whether or not the campaign's bags are
+analysed on a cluster (``exscec explore --cluster``): exsce does not know what they need.
 
 A resumed campaign does not run a scenario again whose bags are all in its folder and in the
 store already (a run's uuid follows from its bag's content), whichever executor made them.
@@ -28,7 +33,7 @@ from typing import Protocol, runtime_checkable
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import Scenario
 from exsce_dsl.sim.faults import Fault
-from exsce_dsl.sim.run import simulate
+from exsce_dsl.sim.run import simulate, simulate_on_cluster
 from exsce_dsl.suggest import did_you_mean
 
 ENTRY_POINT_GROUP = "exsce.executors"
@@ -55,24 +60,33 @@ class Executor(Protocol):
 
 @dataclass(frozen=True)
 class SimulatorExecutor:
-    """exsce's kinematic executor, in the method's convention unless the robots name another."""
+    """exsce's kinematic executor, in the method's convention unless the robots name another;
+    with ``cluster`` (a Dask scheduler's address), each run is played by one of its workers, which
+    write the bags under ``out_dir``: the same path on every worker (a shared filesystem)."""
 
     faults: tuple[Fault, ...] = ()
     format: str = "ros1"
+    cluster: str | None = None
 
     @classmethod
-    def with_faults(cls, faults: Sequence[str], format: str = "ros1") -> SimulatorExecutor:
-        return cls(tuple(Fault.parse(f) for f in faults), format)
+    def with_faults(
+        cls, faults: Sequence[str], format: str = "ros1", cluster: str | None = None
+    ) -> SimulatorExecutor:
+        return cls(tuple(Fault.parse(f) for f in faults), format, cluster)
 
     @property
     def name(self) -> str:
+        """The faults, not where the runs were played: a cluster writes the same bags."""
         planted = " ".join(f"--fault {f.identity}" for f in self.faults)
         return f"simulator {planted}".strip()
 
     def execute(
         self, scenario: Scenario, scenario_file: Path, out_dir: Path, runs: int, seed: int
     ) -> list[Path]:
-        return [run.bag for run in simulate(scenario, out_dir, runs, self.format, seed, self.faults)]
+        arguments = (scenario, out_dir, runs, self.format, seed, self.faults)
+        if self.cluster is not None:
+            return [run.bag for run in simulate_on_cluster(self.cluster, *arguments)]
+        return [run.bag for run in simulate(*arguments)]
 
 
 @dataclass(frozen=True)

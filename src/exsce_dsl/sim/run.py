@@ -1,12 +1,24 @@
-"""``simulate``: scenario in, bag files out (one per run), deterministic per seed."""
+"""``simulate``: scenario in, bag files out (one per run), deterministic per seed.
+
+Each run is played by :func:`play_run` from what every run of the call shares (:class:`RunPlan`)
+and its index: the run's seed, start, id and bag name follow from those alone, so a run gives the
+same bytes wherever it is played.  :func:`simulate` plays the runs one after the other in this
+process; :func:`simulate_on_cluster` plays each as one task on a Dask cluster's workers
+(``exscec simulate --cluster``), which write the bags into the output folder themselves: that
+folder must be the same path on every worker (a shared filesystem), as must the map files the
+scenario names.  A bag is written in a hidden folder beside its place and moved there when it is
+whole, so a worker killed half-way leaves no truncated bag under a run's name: the run's task goes
+to another worker, which writes it again.
+"""
 
 from __future__ import annotations
 
 import datetime as dt
+import os
 import shutil
 import uuid
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 from pathlib import Path
 
@@ -19,6 +31,7 @@ from exsce_dsl.model.conventions import Signals
 from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Bag, Run, TaskExecution
 from exsce_dsl.prov import serialize_prov
 from exsce_dsl.prov.run import compile_run
+from exsce_dsl.runs.cluster import cluster_mapper
 from exsce_dsl.sim.bag import write_bag
 from exsce_dsl.sim.conventions import convention_writer
 from exsce_dsl.sim.executor import Execution, Fault, GoalStatus, execute
@@ -43,6 +56,43 @@ class SimulatedRun:
     messages: int
 
 
+@dataclass(frozen=True)
+class RunPlan:
+    """What every run of one ``simulate`` call shares; with a run's index, all a run needs."""
+
+    scenario: Scenario
+    out_dir: Path
+    fmt: str
+    seed: int
+    faults: tuple[Fault, ...]
+    convention: Signals | str
+    twist_stamped: bool
+
+    @classmethod
+    def of(
+        cls,
+        scenario: Scenario,
+        out_dir: Path,
+        fmt: str = "ros1",
+        seed: int = 0,
+        faults: Sequence[Fault] = (),
+        convention: Signals | str | None = None,
+        twist_stamped: bool = False,
+    ) -> RunPlan:
+        """The plan of ``simulate``'s arguments: the format checked, the convention chosen."""
+        if fmt not in FORMATS:
+            raise ExsceError(f"unknown bag format '{fmt}'; use one of {', '.join(FORMATS)}")
+        chosen = convention or scenario_convention(scenario)
+        return cls(scenario, out_dir, fmt, seed, tuple(faults), chosen, twist_stamped)
+
+    @property
+    def variant(self) -> str:
+        """What the run ids of another convention than the method's add, so that their bags can
+        share a folder with the method's."""
+        written = convention_writer(self.convention).name
+        return "" if written == "method" else f"/{written}" + ("/stamped" if self.twist_stamped else "")
+
+
 def simulate(
     scenario: Scenario,
     out_dir: Path,
@@ -60,37 +110,109 @@ def simulate(
     method's if they name none); ``twist_stamped`` makes the
     navigation stacks' ``cmd_vel`` a TwistStamped (Nav2 from Jazzy on).  Runs in another
     convention than the method's get other run ids, so their bags can share a folder."""
-    if fmt not in FORMATS:
-        raise ExsceError(f"unknown bag format '{fmt}'; use one of {', '.join(FORMATS)}")
-    convention = convention or scenario_convention(scenario)
-    written = convention_writer(convention).name
-    variant = "" if written == "method" else f"/{written}" + ("/stamped" if twist_stamped else "")
+    plan = RunPlan.of(scenario, out_dir, fmt, seed, faults, convention, twist_stamped)
     grid = planning_grid(scenario)
     out_dir.mkdir(parents=True, exist_ok=True)
     for index in range(runs):
-        run_seed = seed * 1000 + index
-        # days wrap so that every seed gives a time ROS 1 can stamp (see SEED_DAYS)
-        start = EPOCH + dt.timedelta(days=seed % SEED_DAYS, hours=index)
-        run_id = str(
-            uuid.uuid5(
-                _RUN_NAMESPACE,
-                f"{scenario.id}/{seed}/{index}/{','.join(f.identity for f in faults)}{variant}",
-            )
+        yield play_run(plan, index, grid)
+
+
+def simulate_on_cluster(
+    address: str,
+    scenario: Scenario,
+    out_dir: Path,
+    runs: int = 1,
+    fmt: str = "ros1",
+    seed: int = 0,
+    faults: Sequence[Fault] = (),
+    convention: Signals | str | None = None,
+    twist_stamped: bool = False,
+) -> Iterator[SimulatedRun]:
+    """:func:`simulate`, each run played as one task on the Dask cluster whose scheduler is at
+    ``address``: the same run ids and the same bytes as :func:`simulate` gives, in run order.
+
+    The workers write the bags: ``out_dir`` (made absolute here) and the scenario's map file must
+    be the same paths on every worker (a shared filesystem).  A task is tried twice, and a killed
+    worker's task goes to another worker; a run that failed even so does not stop the others:
+    when they are done, an :class:`ExsceError` names each failed run by its index."""
+    shared = _with_absolute_map(scenario)
+    plan = RunPlan.of(shared, out_dir.absolute(), fmt, seed, faults, convention, twist_stamped)
+    plan.out_dir.mkdir(parents=True, exist_ok=True)
+    failed: list[str] = []
+    with cluster_mapper(address) as mapper:
+        for index, played in enumerate(mapper(_play_task, [(plan, index) for index in range(runs)])):
+            if isinstance(played, SimulatedRun):
+                yield replace(played, bag=out_dir / played.bag.name)
+            else:
+                why = played.message if isinstance(played, ExsceError) else str(played)
+                failed.append(f"run {index} (seed {seed * 1000 + index}): {why}")
+    if failed:
+        verb = "was" if len(failed) == 1 else "were"
+        raise ExsceError(
+            f"{len(failed)} of {runs} runs of scenario '{scenario.id}' {verb} not written on the cluster "
+            "(the others were):\n  " + "\n  ".join(failed)
         )
-        execution = execute(scenario, grid, run_seed, tuple(faults))
-        name = f"{start.strftime('%Y-%m-%dT%H-%M-%S')}_{scenario.id}_run-{run_id[:8]}"
-        bag = out_dir / (name + ".bag" if fmt == "ros1" else name)
-        if bag.exists():
-            shutil.rmtree(bag) if bag.is_dir() else bag.unlink()
+
+
+def _with_absolute_map(scenario: Scenario) -> Scenario:
+    """``scenario`` with its map file named from the root: a worker's working folder is its own."""
+    env = scenario.environment
+    if env.map is None or env.map.file is None:
+        return scenario
+    found = replace(env.map, file=str(Path(env.map.file).absolute()))
+    return replace(scenario, environment=replace(env, map=found))
+
+
+def _play_task(task: tuple[RunPlan, int]) -> SimulatedRun:
+    """One run on a cluster's worker (a map file's planning grid is read once per worker process)."""
+    plan, index = task
+    return play_run(plan, index)
+
+
+def play_run(plan: RunPlan, index: int, grid: PlanningGrid | None = None) -> SimulatedRun:
+    """Play run ``index`` of ``plan`` and write its bag and its ``.prov.json`` into the plan's
+    folder (a bag already there under the run's name is replaced); ``grid``: the scenario's
+    planning grid, when the caller has it already."""
+    scenario = plan.scenario
+    run_seed = plan.seed * 1000 + index
+    # days wrap so that every seed gives a time ROS 1 can stamp (see SEED_DAYS)
+    start = EPOCH + dt.timedelta(days=plan.seed % SEED_DAYS, hours=index)
+    run_id = str(
+        uuid.uuid5(
+            _RUN_NAMESPACE,
+            f"{scenario.id}/{plan.seed}/{index}/{','.join(f.identity for f in plan.faults)}{plan.variant}",
+        )
+    )
+    grid = planning_grid(scenario) if grid is None else grid
+    execution = execute(scenario, grid, run_seed, plan.faults)
+    name = f"{start.strftime('%Y-%m-%dT%H-%M-%S')}_{scenario.id}_run-{run_id[:8]}"
+    bag_name = name + ".bag" if plan.fmt == "ros1" else name
+    partial = plan.out_dir / f".{name}.partial"  # the run's own: a retry clears what a killed try left
+    _remove(partial)
+    partial.mkdir(parents=True)
+    bag = plan.out_dir / bag_name
+    try:
         start_ns = int(start.timestamp()) * 1_000_000_000
         count = write_bag(
-            bag, fmt, scenario, execution, grid, start_ns, run_seed, None, convention, twist_stamped
-        )
+            partial / bag_name, plan.fmt, scenario, execution, grid, start_ns, run_seed, None,
+            plan.convention, plan.twist_stamped,
+        )  # fmt: skip
         recorder = _recorded_run(run_id, scenario, execution, start, bag)
-        out_dir.joinpath(name + ".prov.json").write_text(
-            serialize_prov(compile_run(recorder, scenario), "json"), encoding="utf-8"
-        )
-        yield SimulatedRun(run_id, bag, start, run_seed, execution, count)
+        recorded = partial / (name + ".prov.json")
+        recorded.write_text(serialize_prov(compile_run(recorder, scenario), "json"), encoding="utf-8")
+        os.replace(recorded, plan.out_dir / recorded.name)
+        _remove(bag)
+        os.replace(partial / bag_name, bag)  # last: a bag in its place is a whole run
+    finally:
+        _remove(partial)
+    return SimulatedRun(run_id, bag, start, run_seed, execution, count)
+
+
+def _remove(path: Path) -> None:
+    if path.is_dir():
+        shutil.rmtree(path)
+    elif path.exists():
+        path.unlink()
 
 
 def _recorded_run(
