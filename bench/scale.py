@@ -8,7 +8,13 @@ speed-up over 1 job measured in the same run.  Then it runs every query of the
 library (`exscec query --list`) against the store holding the N runs, 20 times
 each, and prints p50 and p95 per query.
 
-    python bench/scale.py [--bags 200] [--keep DIR]   (a kept DIR's bags are reused)
+With --cluster it compares instead `ingest --jobs 1`, `--jobs 2` and `ingest
+--cluster` on a Dask LocalCluster it starts on 127.0.0.1 with 1, then 2 worker
+processes (one thread each), on the same bags: bags/s and the speed-up over
+1 job measured in the same run (the cluster's start is not timed; connecting
+to it and its workers' first imports are, as a pool's are for --jobs).
+
+    python bench/scale.py [--bags 200] [--keep DIR] [--cluster]   (a kept DIR's bags are reused)
 """
 
 from __future__ import annotations
@@ -46,7 +52,7 @@ def make_bags(folder: Path, count: int) -> list[Path]:
         return sorted(p for part in parts for p in part)
 
 
-def ingest(bags: list[Path], store_path: Path, jobs: int) -> float:
+def ingest(bags: list[Path], store_path: Path, jobs: int, cluster: str | None = None) -> float:
     from exsce_dsl.lang.build import load_spec
     from exsce_dsl.runs.ingest import ingest_bags
     from exsce_dsl.store.embedded import EmbeddedStore
@@ -55,7 +61,7 @@ def ingest(bags: list[Path], store_path: Path, jobs: int) -> float:
     shutil.rmtree(store_path, ignore_errors=True)
     started = time.perf_counter()
     with EmbeddedStore(store_path) as store:
-        results = ingest_bags(bags, scenario, store, jobs)
+        results = ingest_bags(bags, scenario, store, jobs, cluster=cluster)
     seconds = time.perf_counter() - started
     failed = [r.message for r in results if r.failed]
     if failed:
@@ -116,12 +122,41 @@ def query_latencies(store_path: Path, repeats: int = 20) -> list[tuple[str, floa
     return found
 
 
+def compare_with_cluster(bags: list[Path], folder: Path, size: float) -> None:
+    """--jobs 1 and 2 against a local Dask cluster of 1 and 2 worker processes, on ``bags``."""
+    from distributed import LocalCluster
+
+    seconds: dict[str, float] = {}
+
+    def show(label: str) -> None:
+        took = seconds[label]
+        print(
+            f"{label:22} {took:6.1f} s  {len(bags) / took:5.2f} bags/s  {size / took:5.1f} MB/s  "
+            f"speed-up {seconds['ingest --jobs 1'] / took:.2f}×"
+        )
+
+    for jobs in (1, 2):
+        label = f"ingest --jobs {jobs}"
+        seconds[label] = ingest(bags, folder / f"store-jobs-{jobs}", jobs)
+        show(label)
+    for workers in (1, 2):
+        with LocalCluster(
+            n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None
+        ) as cluster:
+            label = f"cluster, {workers} worker{'s' if workers > 1 else ''}"
+            seconds[label] = ingest(bags, folder / f"store-cluster-{workers}", 1, cluster.scheduler_address)
+        show(label)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
     parser.add_argument("--bags", type=int, default=200)
     parser.add_argument("--keep", type=Path, help="Keep the bags and stores in this folder.")
+    parser.add_argument(
+        "--cluster", action="store_true", help="Compare --jobs 1/2 with a local Dask cluster of 1, 2 workers."
+    )
     args = parser.parse_args()
     folder = args.keep or Path(tempfile.mkdtemp(prefix="exsce-scale-"))
     folder.mkdir(parents=True, exist_ok=True)
@@ -132,6 +167,9 @@ def main() -> None:
         took = time.perf_counter() - started
         cpus = os.cpu_count()
         print(f"{len(bags)} bags of scenario_c, {size:.0f} MB, simulated in {took:.0f} s ({cpus} CPUs)")
+        if args.cluster:
+            compare_with_cluster(bags, folder, size)
+            return
         jobs_list = sorted({1, 2, os.cpu_count() or 1})
         seconds = {}
         for jobs in jobs_list:
