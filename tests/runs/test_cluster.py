@@ -14,13 +14,11 @@ import shutil
 import signal
 import subprocess
 import sys
-import threading
-import time
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from distributed import Client, LocalCluster
+from distributed import LocalCluster
 from pyoxigraph import CanonicalizationAlgorithm, Dataset
 
 from exsce_dsl.lang.build import load_spec
@@ -29,15 +27,14 @@ from exsce_dsl.sim.run import simulate
 from exsce_dsl.store.embedded import EmbeddedStore
 
 from conftest import YARD_SPEC, run_exscec, write_map
+from dask_cluster import a_worker_killed_while_running, local_cluster
 
 BAGS = 6
 
 
 @pytest.fixture(scope="module")
 def cluster() -> Iterator[LocalCluster]:
-    with LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None
-    ) as started:
+    with local_cluster() as started:
         yield started
 
 
@@ -92,29 +89,12 @@ def test_a_worker_killed_in_the_middle_of_a_bag_loses_no_run(
 ) -> None:
     folder, bags, reference = yard
     scenario = load_spec(folder / "spec.exsce").scenario()
-    killed: list[int] = []
-    with Client(cluster.scheduler_address, set_as_default=False) as watcher:
-        pids = watcher.run(os.getpid)  # worker address -> its process
-
-        def kill_a_busy_worker() -> None:
-            deadline = time.monotonic() + 60
-            while time.monotonic() < deadline and not killed:
-                for worker, keys in watcher.processing().items():
-                    if any("_analyse" in str(key) for key in keys):
-                        os.kill(pids[worker], signal.SIGKILL)
-                        killed.append(pids[worker])
-                        return
-                time.sleep(0.005)
-
-        killer = threading.Thread(target=kill_a_busy_worker)
-        killer.start()
+    with a_worker_killed_while_running(cluster, "_analyse") as killed:
         with EmbeddedStore(tmp_path / "store") as store:
             results = ingest_bags(bags, scenario, store, cluster=cluster.scheduler_address)
-        killer.join()
     assert killed, "no worker was seen analysing a bag"
     assert [r.status for r in results] == [IngestStatus.INGESTED] * BAGS, [r.message for r in results]
     assert canonical(tmp_path / "store") == canonical(reference)
-    cluster.wait_for_workers(2, timeout=60)  # the nanny has started a new worker
 
 
 def test_a_client_killed_in_the_middle_of_a_batch_stores_whole_runs(

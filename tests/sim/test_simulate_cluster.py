@@ -14,11 +14,8 @@ from __future__ import annotations
 import hashlib
 import os
 import shutil
-import signal
 import subprocess
 import sys
-import threading
-import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -32,6 +29,7 @@ from exsce_dsl.store.open import open_store
 from exsce_dsl.store.queries.campaigns import campaign_record, campaigns
 
 from conftest import YARD_SPEC, run_exscec, write_map
+from dask_cluster import a_worker_killed_while_running, local_cluster
 
 RUNS = 4
 SEED = 3
@@ -40,9 +38,7 @@ EXSCEC = str(Path(sys.executable).with_name("exscec"))
 
 @pytest.fixture(scope="module")
 def cluster() -> Iterator[LocalCluster]:
-    with LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None
-    ) as started:
+    with local_cluster() as started:
         yield started
 
 
@@ -121,28 +117,11 @@ def test_a_worker_killed_in_the_middle_of_a_run_loses_no_bag(
 ) -> None:
     folder, reference = yard
     scenario = load_spec(folder / "spec.exsce").scenario()
-    killed: list[int] = []
-    with Client(cluster.scheduler_address, set_as_default=False) as watcher:
-        pids = watcher.run(os.getpid)  # worker address -> its process
-
-        def kill_a_busy_worker() -> None:
-            deadline = time.monotonic() + 60
-            while time.monotonic() < deadline and not killed:
-                for worker, keys in watcher.processing().items():
-                    if any("_play_task" in str(key) for key in keys):
-                        os.kill(pids[worker], signal.SIGKILL)
-                        killed.append(pids[worker])
-                        return
-                time.sleep(0.005)
-
-        killer = threading.Thread(target=kill_a_busy_worker)
-        killer.start()
+    with a_worker_killed_while_running(cluster, "_play_task") as killed:
         played = list(simulate_on_cluster(cluster.scheduler_address, scenario, tmp_path / "runs", RUNS, seed=SEED))
-        killer.join()
     assert killed, "no worker was seen playing a run"
     assert [r.bag.name for r in played] == sorted(n for n in reference if n.endswith(".bag"))
     assert hashes(tmp_path / "runs") == reference  # each bag once and whole, nothing half-written left
-    cluster.wait_for_workers(2, timeout=60)  # the nanny has started a new worker
 
 
 def test_a_campaign_explored_on_the_cluster_is_the_campaign_explored_here(
