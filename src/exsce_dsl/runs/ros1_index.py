@@ -15,6 +15,7 @@ Uncompressed, bz2 and lz4 chunks are read; anything unexpected raises
 from __future__ import annotations
 
 import bz2
+import gc
 import mmap
 import struct
 import traceback
@@ -90,7 +91,22 @@ def mapped(path: Path) -> Iterator[mmap.mmap]:
             traceback.clear_frames(exc.__traceback__)
             raise
         finally:
+            _close(data)
+
+
+def _close(data: mmap.mmap) -> None:
+    """Unmap, once no numpy view of the map is left.  A view caught in a reference cycle lives
+    until the collector runs, which a Dask worker runs rarely (it throttles collections): collect
+    and try again; a view still alive then unmaps the file when it goes (the map is read-only, the
+    file closed), rather than failing a bag whose reading succeeded."""
+    try:
+        data.close()
+    except BufferError:
+        gc.collect()
+        try:
             data.close()
+        except BufferError:
+            pass
 
 
 def read_topics(path: Path, topics: set[str], decoder: Decoder) -> dict[str, Messages]:
