@@ -7,8 +7,12 @@ derivation that reveals it in brackets) and each seed, on a fresh in-memory stor
 - slow-area:classroom_c069 (add_robot starting in classroom_c069),
 - detour:classroom_c018:classroom_c022 (reverse_waypoint_order --task delivery_a),
 - deadlock-start:tiago1:classroom_c025-w002 (swap_start_poses --robot tiago1 --with tiago2),
-- overspeed-many-tasks:2 (remove_robot --robot tiago2 --reassign tiago1, or any step that
-  gives a robot a third task),
+- overspeed-reassigned:delivery_a:tiago1 (swap_assignment --robot tiago1 --with tiago2, or any
+  step that gives delivery_a to another robot),
+
+and, when --faults names it, overspeed-many-tasks:2 (remove_robot --robot tiago2 --reassign
+tiago1, or any step that gives a robot a third task: half of all two-step derivations do, so
+random draws find it as fast as any way of drawing; see MEASURED),
 
 three campaigns are run with the same budget (derivations) and runs per derived scenario:
 
@@ -89,9 +93,15 @@ FAULTS = {
     "slow-area:classroom_c069": "add_robot starting in classroom_c069",
     "detour:classroom_c018:classroom_c022": "reverse_waypoint_order --task delivery_a",
     "deadlock-start:tiago1:classroom_c025-w002": "swap_start_poses --robot tiago1 --with tiago2",
+    "overspeed-reassigned:delivery_a:tiago1": "delivery_a to another robot (swap_assignment, remove_robot "
+    "--robot tiago1 --reassign tiago2, substitute_task ... --with delivery_a, ...)",
     "overspeed-many-tasks:2": "a robot with a third task (remove_robot --reassign, add_task, ...)",
 }
-"""The latent faults measured, and the derivation that reveals each (sim/faults.py)."""
+"""The latent faults that can be measured, and the derivations that reveal each (sim/faults.py)."""
+MEASURED = list(FAULTS)[:4]
+"""The faults measured unless --faults names others: overspeed-many-tasks is left out, as half of
+all two-step derivations give a robot a third task (random draws find it with their first
+derivation in 4 of 5 seeds; no way of drawing can do better than tie)."""
 FOUND_SHARE = 0.8
 """Target: found in at least this share of the seeds (4 of 5)."""
 MAX_SHRUNK = 2
@@ -455,7 +465,8 @@ def main() -> None:
     parser.add_argument("--runs", type=int, default=2, help="runs per derived scenario (default 2)")
     parser.add_argument("--max-steps", type=int, default=2, help="steps per drawn derivation (default 2)")
     parser.add_argument(
-        "--faults", nargs="+", default=list(FAULTS), metavar="FAULT", help="a subset of the faults"
+        "--faults", nargs="+", default=MEASURED, metavar="FAULT",
+        help="the faults to measure (default: all but overspeed-many-tasks)",
     )
     parser.add_argument("--quick", action="store_true", help="1 seed, budget 8")
     parser.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1), help="campaigns run at once")

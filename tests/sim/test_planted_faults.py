@@ -48,7 +48,10 @@ DEADLOCK = Planted(
     "deadlock-start:tiago1:classroom_c025-w002", ("swap_start_poses", {"robot": "tiago1", "with": "tiago2"})
 )
 MANY_TASKS = Planted("overspeed-many-tasks:2", ("remove_robot", {"robot": "tiago2", "reassign": "tiago1"}))
-PLANTED = (SLOW_AREA, DETOUR, DEADLOCK, MANY_TASKS)
+REASSIGNED = Planted(
+    "overspeed-reassigned:delivery_a:tiago1", ("swap_assignment", {"robot": "tiago1", "with": "tiago2"})
+)
+PLANTED = (SLOW_AREA, DETOUR, DEADLOCK, MANY_TASKS, REASSIGNED)
 
 
 @pytest.fixture(scope="module")
@@ -189,6 +192,24 @@ def test_overspeed_shows_when_one_robot_takes_all_tasks(
     assert travelled(with_fault, "tiago1") == pytest.approx(travelled(without, "tiago1"), abs=0.05)
 
 
+def test_overspeed_shows_when_delivery_a_goes_to_the_other_robot(
+    scenario_c: Scenario, grid: PlanningGrid, plain_runs: dict[int, Execution]
+) -> None:
+    derived = _derived(scenario_c, REASSIGNED)
+    assert ("tiago2", "delivery_a") in {(e.robot, e.task) for e in derived.mission.allocation}
+    without, with_fault = _played(derived, grid, REASSIGNED)
+    limit = 0.6  # the executor's speed limit
+    assert top_speed(without, "tiago2") < limit + 0.02
+    assert top_speed(with_fault, "tiago2") > 1.0
+    assert top_speed(with_fault, "tiago1") < limit + 0.02  # delivery_b, not its own task, is no trigger
+    # a task of the same name driven backwards is another task: no trigger either
+    backwards = derive(
+        scenario_c, [("reverse_waypoint_order", {"task": "delivery_a"}), REASSIGNED.step], "backwards"
+    ).scenario
+    fault = (Fault.parse(REASSIGNED.fault),)
+    assert max(top_speed(execute(backwards, grid, 1, fault), r) for r in ("tiago1", "tiago2")) < limit + 0.02
+
+
 @pytest.mark.parametrize("planted", PLANTED, ids=lambda p: p.fault)
 def test_a_latent_fault_plays_the_same_twice(
     planted: Planted, scenario_c: Scenario, grid: PlanningGrid
@@ -220,6 +241,8 @@ def test_fault_arguments_are_checked(scenario_c: Scenario, grid: PlanningGrid) -
         Fault.parse("detour:classroom_c018")
     with pytest.raises(ExsceError, match="'two' is not a number of tasks"):
         Fault.parse("overspeed-many-tasks:two")
+    with pytest.raises(ExsceError, match="needs a task and a robot: overspeed-reassigned:TASK:ROBOT"):
+        Fault.parse("overspeed-reassigned:delivery_a")
     with pytest.raises(ExsceError, match="too many arguments"):
         Fault.parse("slow-area:classroom_c069:classroom_c018")
     with pytest.raises(ExsceError, match="area 'classroom_c96'.*did you mean 'classroom_c069'"):

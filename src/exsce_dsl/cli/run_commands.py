@@ -42,7 +42,8 @@ from exsce_dsl.model.conventions import CONVENTIONS
     "(latent, for metamorphic campaigns): slow-area:AREA (40 % speed once in AREA, until the "
     "waypoint), detour:FROM:TO (legs from area FROM to area TO go via the start pose), "
     "deadlock-start:ROBOT:POSE (every robot stands 120 s when ROBOT starts at POSE), "
-    "overspeed-many-tasks:N (a robot with more than N tasks drives over 1 m/s).",
+    "overspeed-many-tasks:N (a robot with more than N tasks drives over 1 m/s), "
+    "overspeed-reassigned:TASK:ROBOT (a robot other than ROBOT given TASK drives over 1 m/s).",
 )
 @click.option("--scenario", "scenario_id", help="Which scenario, when the file declares several.")
 @click.option(
@@ -99,6 +100,7 @@ def simulate(
       detour:classroom_c018:classroom_c022       reverse_waypoint_order --task delivery_a
       deadlock-start:tiago1:classroom_c025-w002  swap_start_poses --robot tiago1 --with tiago2
       overspeed-many-tasks:2                     remove_robot --robot tiago2 --reassign tiago1
+      overspeed-reassigned:delivery_a:tiago1     swap_assignment --robot tiago1 --with tiago2
 
     With --cluster, each run is played by a Dask cluster's worker, which
     writes its bag and .prov.json into --output (a task is tried twice; a

@@ -27,9 +27,17 @@ classroom_c018, and go home):
 - ``overspeed-many-tasks:N``: a robot allocated more than N tasks ignores its speed limit
   (well over 1 m/s, as ``overspeed``).  scenario_c gives each robot 2 tasks; ``remove_robot
   --robot tiago2 --reassign tiago1`` gives tiago1 4: ``overspeed-many-tasks:2`` reveals it.
+  Half of all two-step derivations give some robot a third task, so random draws find it as
+  fast as any strategy can: it measures little.
+- ``overspeed-reassigned:TASK:ROBOT``: a robot other than ROBOT that is allocated TASK ignores
+  its speed limit (well over 1 m/s), as a fleet manager would whose speed profiles are
+  configured per task for the robot planned to do it, and lost when the task is reassigned.
+  scenario_c gives delivery_a to tiago1; ``swap_assignment --robot tiago1 --with tiago2``
+  gives it to tiago2: ``overspeed-reassigned:delivery_a:tiago1`` reveals it.
 
 Latent faults never refuse a scenario for lacking their trigger (a derivation may have
-removed ROBOT); they do refuse an AREA or POSE the environment does not have.
+removed ROBOT, and a TASK: the executor sees the tasks the scenario allocates, not those a
+spec declares); they do refuse an AREA or POSE the environment does not have.
 """
 
 from __future__ import annotations
@@ -113,6 +121,14 @@ FAULT_KINDS: dict[str, FaultKind] = {
             "a robot with more than N tasks drives well over 1 m/s",
             latent=True,
         ),
+        FaultKind(
+            "overspeed-reassigned",
+            ("task", "robot"),
+            2,
+            "overspeed-reassigned:TASK:ROBOT",
+            "a robot other than ROBOT allocated TASK drives well over 1 m/s",
+            latent=True,
+        ),
     )
 }
 
@@ -122,6 +138,7 @@ _NOUNS = {
     "area": "an area",
     "to_area": "a second area",
     "pose": "a pose",
+    "task": "a task",
 }
 
 
@@ -133,7 +150,8 @@ class Fault:
     (half speed), ``skip-waypoint:ROBOT[:N]`` (its N-th waypoint aborts), ``near-collision``
     (the second robot drives up to the first).  Latent faults show only when the played
     scenario has their trigger (see the module's table): ``slow-area:AREA``,
-    ``detour:FROM:TO``, ``deadlock-start:ROBOT:POSE``, ``overspeed-many-tasks:N``.
+    ``detour:FROM:TO``, ``deadlock-start:ROBOT:POSE``, ``overspeed-many-tasks:N``,
+    ``overspeed-reassigned:TASK:ROBOT``.
     """
 
     kind: str
@@ -146,6 +164,8 @@ class Fault:
     """detour: the area the leg ends in."""
     pose: str | None = None
     """deadlock-start: the start pose that triggers it."""
+    task: str | None = None
+    """overspeed-reassigned: the task whose speed limit is lost with another robot."""
 
     KINDS = tuple(FAULT_KINDS)
 
@@ -214,6 +234,7 @@ def check_faults(scenario: Scenario, faults: tuple[Fault, ...]) -> None:
 def speed_factor(scenario: Scenario, robot: str, faults: tuple[Fault, ...]) -> float:
     """How much faster (or slower) than its seeded speed ``robot`` drives."""
     tasks = Counter(e.robot for e in scenario.mission.allocation)
+    own_tasks = {e.task for e in scenario.mission.allocation if e.robot == robot}
     factor = 1.0
     for f in faults:
         if f.robot == robot and f.kind == "overspeed":
@@ -221,6 +242,8 @@ def speed_factor(scenario: Scenario, robot: str, faults: tuple[Fault, ...]) -> f
         if f.robot == robot and f.kind == "slow":
             factor *= SLOW
         if f.kind == "overspeed-many-tasks" and tasks[robot] > f.index:
+            factor *= OVERSPEED
+        if f.kind == "overspeed-reassigned" and f.robot != robot and f.task in own_tasks:
             factor *= OVERSPEED
     return factor
 
