@@ -72,16 +72,31 @@ def conflict_repairs(
     n = min(len(trajectories[r]) for r in robots)
     xs = np.stack([trajectories[r].x[:n] for r in robots])
     ys = np.stack([trajectories[r].y[:n] for r in robots])
-    meetings: list[tuple[int, int, int]] = []  # (first sample, robot, robot) of each time two meet
+    index = {r: i for i, r in enumerate(robots)}
+    repairs = []
+    for k, a, b in meetings(trajectories, order, clearance):
+        repairs += _repairs_of(xs, ys, k, index[a], index[b], robots, actions)
+    return repairs
+
+
+def meetings(
+    trajectories: Mapping[str, Trajectory], order: Sequence[str], clearance: float = CLEARANCE
+) -> list[tuple[int, str, str]]:
+    """Each time two robots come closer than ``clearance``: its first sample and the two robots
+    (in ``order``), earliest first."""
+    robots = [r for r in order if r in trajectories]
+    if len(robots) < 2:
+        return []
+    n = min(len(trajectories[r]) for r in robots)
+    xs = np.stack([trajectories[r].x[:n] for r in robots])
+    ys = np.stack([trajectories[r].y[:n] for r in robots])
+    found: list[tuple[int, int, int]] = []
     for i in range(len(robots)):
         for j in range(i + 1, len(robots)):
             close = np.hypot(xs[j] - xs[i], ys[j] - ys[i]) < clearance
             starts = np.flatnonzero(close & ~np.concatenate(([False], close[:-1])))
-            meetings += [(int(k), i, j) for k in starts]
-    repairs = []
-    for k, i, j in sorted(meetings):
-        repairs += _repairs_of(xs, ys, k, i, j, robots, actions)
-    return repairs
+            found += [(int(k), i, j) for k in starts]
+    return [(k, robots[i], robots[j]) for k, i, j in sorted(found)]
 
 
 def _repairs_of(
@@ -106,13 +121,13 @@ def _repairs_of(
 
     repairs = []
     for mover, other in sorted(((j, i), (i, j)), key=lambda pair: (not driving(pair[0]), pair[0] < pair[1])):
-        leg = _leg_at(actions, robots[mover], k * DT)
+        leg = leg_at(actions, robots[mover], k * DT)
         if leg is not None:
             repairs.append(Repair(leg, place(other)))
     return repairs
 
 
-def _leg_at(actions: Sequence[Timed], robot: str, t: float) -> Leg | None:
+def leg_at(actions: Sequence[Timed], robot: str, t: float) -> Leg | None:
     """The leg ``robot`` drives at ``t`` (or last drove, when it waits between legs)."""
     number, found = 0, None
     for action in actions:

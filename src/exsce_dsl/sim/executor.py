@@ -19,7 +19,7 @@ import numpy as np
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import MissionType, Pose, Scenario
 from exsce_dsl.sim.actions import Action, GoalEvent, GoalStatus
-from exsce_dsl.sim.conflicts import MAX_REPAIRS, Leg, Repair, conflict_repairs
+from exsce_dsl.sim.conflicts import MAX_REPAIRS, Leg, Repair, conflict_repairs, meetings
 from exsce_dsl.sim.faults import (
     DEADLOCK_WAIT,
     Fault,
@@ -32,6 +32,7 @@ from exsce_dsl.sim.faults import (
 )
 from exsce_dsl.sim.give_way import distance_to_polyline, give_way
 from exsce_dsl.sim.motion import DT, Limits, Trajectory, drive
+from exsce_dsl.sim.passing import Wait, head_on_wait
 from exsce_dsl.sim.planner import PlanningError, PlanningGrid, Point
 
 
@@ -78,25 +79,34 @@ def execute(
     faults: tuple[Fault, ...] = (),
     limits: Limits | None = None,
 ) -> Execution:
-    """Play ``scenario``; where two robots would still touch after giving
-    way, the leg of the one driving into the other is planned again round the place where the
-    other was (sim.conflicts), and the whole run played again (as a fleet manager repairs a plan), at most
-    MAX_REPAIRS times.  ``near-collision`` is the fault of not doing so."""
+    """Play ``scenario``; where two robots would still touch after giving way, the whole run is
+    played again (as a fleet manager repairs a plan), at most MAX_REPAIRS times: when they had
+    stopped facing each other, the one with less right of way waits beside the other's path
+    (sim.passing); else the leg of the one driving into the other is planned again round the
+    place where the other was (sim.conflicts).  ``near-collision`` is the fault of not doing so."""
     check_faults(scenario, faults)
     limits = limits or Limits()
     avoid: dict[Leg, tuple[Point, ...]] = {}
+    waits: dict[Leg, Wait] = {}
     plans: Plans = {}  # the same leg, planned round the same robots, in every replay
-    execution = _play(scenario, grid, seed, faults, limits, avoid, plans)
+    execution = _play(scenario, grid, seed, faults, limits, avoid, plans, waits)
     if any(f.kind == "near-collision" for f in faults):
         return execution
     order = [r.id for r in scenario.robots]
     for _ in range(MAX_REPAIRS):
-        repairs = conflict_repairs(execution.trajectories, execution.actions, order)
-        new = [r for r in repairs if _can_go_round(r, execution.actions, avoid)]
-        if not new:
+        met = meetings(execution.trajectories, order)
+        if not met:
             break
-        avoid[new[0].leg] = avoid.get(new[0].leg, ()) + (new[0].place,)
-        execution = _play(scenario, grid, seed, faults, limits, avoid, plans)
+        wait = head_on_wait(execution.trajectories, execution.actions, order, grid, met[0])
+        if wait is not None and wait.leg not in waits:
+            waits[wait.leg] = wait
+        else:
+            repairs = conflict_repairs(execution.trajectories, execution.actions, order)
+            new = [r for r in repairs if _can_go_round(r, execution.actions, avoid)]
+            if not new:
+                break
+            avoid[new[0].leg] = avoid.get(new[0].leg, ()) + (new[0].place,)
+        execution = _play(scenario, grid, seed, faults, limits, avoid, plans, waits)
     return execution
 
 
@@ -119,6 +129,7 @@ def _play(
     limits: Limits,
     avoid: dict[Leg, tuple[Point, ...]],
     plans: Plans,
+    waits: dict[Leg, Wait],
 ) -> Execution:
     rng = random.Random(seed)
     timelines: dict[str, Timeline] = {}
@@ -186,7 +197,11 @@ def _play(
                     for leg in approach.pop(entry.robot, []):  # the near-collision fault, inside the mission
                         tl.append(leg)
                     via = detour_via(scenario, entry.robot, previous, goal, faults)
-                    path, driven = _drive_to(grid, tl, goal, via, keep_clear, robot_limits, plans)
+                    wait = waits.get((entry.robot, waypoint_counts[entry.robot])) if via is None else None
+                    if wait is not None:
+                        via = wait.place
+                    until = int(round(wait.until / DT)) if wait is not None else None
+                    path, driven = _drive_to(grid, tl, goal, via, keep_clear, robot_limits, plans, until)
                     length = _length(path)
                     tl.append(slow_in_areas(driven, slow_boxes) if slow_boxes else driven)
                     status = GoalStatus.SUCCEEDED
@@ -235,9 +250,11 @@ def _drive_to(
     parked: tuple[Point, ...],
     limits: Limits,
     plans: Plans,
+    until: int | None = None,
 ) -> tuple[list[tuple[float, float]], Trajectory]:
     """The path from where ``tl`` stands to ``goal`` (by way of ``via``, stopping there to turn:
-    the detour fault) and the drive along it."""
+    the detour fault; and waiting there until sample ``until``: a head-on wait) and the drive
+    along it."""
     target = (goal.position.x, goal.position.y)
     if via is None:
         path = _plan_around(grid, (tl.x, tl.y), target, parked, plans)
@@ -247,7 +264,12 @@ def _drive_to(
     heading = math.atan2(on[1][1] - on[0][1], on[1][0] - on[0][0])
     first = drive(there, tl.yaw, heading, limits)
     second = drive(on, heading, goal.orientation.yaw, limits)
-    return there + on[1:], Trajectory.concat([first, second])
+    parts = [first, second]
+    if until is not None and until > tl.samples + len(first):
+        end = first if len(first) else Trajectory.hold(tl.x, tl.y, heading, 1)
+        x, y, yaw = float(end.x[-1]), float(end.y[-1]), float(end.yaw[-1])
+        parts.insert(1, Trajectory.hold(x, y, yaw, until - tl.samples - len(first)))
+    return there + on[1:], Trajectory.concat(parts)
 
 
 def _near_collision(

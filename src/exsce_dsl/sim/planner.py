@@ -139,6 +139,10 @@ class PlanningGrid:
                     return rr, cc
         return None
 
+    def in_sight(self, a: Point, b: Point) -> bool:
+        """A robot drives from ``a`` to ``b`` in a straight line without touching the map's walls."""
+        return self._visible(a, b, self.robot_radius)
+
     def _visible(self, a: Point, b: Point, robot_radius: float) -> bool:
         n = max(2, int(math.dist(a, b) / (self.map_resolution / 2)) + 1)
         pts = np.linspace(a, b, n)
