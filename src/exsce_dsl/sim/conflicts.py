@@ -69,9 +69,7 @@ def conflict_repairs(
     robots = [r for r in order if r in trajectories]
     if len(robots) < 2:
         return []
-    n = min(len(trajectories[r]) for r in robots)
-    xs = np.stack([trajectories[r].x[:n] for r in robots])
-    ys = np.stack([trajectories[r].y[:n] for r in robots])
+    xs, ys = _positions(trajectories, robots)
     index = {r: i for i, r in enumerate(robots)}
     repairs = []
     for k, a, b in meetings(trajectories, order, clearance):
@@ -87,9 +85,7 @@ def meetings(
     robots = [r for r in order if r in trajectories]
     if len(robots) < 2:
         return []
-    n = min(len(trajectories[r]) for r in robots)
-    xs = np.stack([trajectories[r].x[:n] for r in robots])
-    ys = np.stack([trajectories[r].y[:n] for r in robots])
+    xs, ys = _positions(trajectories, robots)
     found: list[tuple[int, int, int]] = []
     for i in range(len(robots)):
         for j in range(i + 1, len(robots)):
@@ -97,6 +93,15 @@ def meetings(
             starts = np.flatnonzero(close & ~np.concatenate(([False], close[:-1])))
             found += [(int(k), i, j) for k in starts]
     return [(k, robots[i], robots[j]) for k, i, j in sorted(found)]
+
+
+def _positions(
+    trajectories: Mapping[str, Trajectory], robots: Sequence[str]
+) -> tuple[np.ndarray, np.ndarray]:
+    """The robots' x and y, one row each, over the samples they all have."""
+    n = min(len(trajectories[r]) for r in robots)
+    xs = np.stack([trajectories[r].x[:n] for r in robots])
+    return xs, np.stack([trajectories[r].y[:n] for r in robots])
 
 
 def _repairs_of(

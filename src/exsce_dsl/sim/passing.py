@@ -19,7 +19,7 @@ from typing import Protocol
 
 import numpy as np
 
-from exsce_dsl.sim.conflicts import CLEARANCE, STOOD, Leg, leg_at
+from exsce_dsl.sim.conflicts import CLEARANCE, STOOD, Leg, Timed, leg_at
 from exsce_dsl.sim.motion import DT, Trajectory
 from exsce_dsl.sim.planner import PlanningGrid, Point
 
@@ -35,17 +35,8 @@ STILL = 1e-9
 """Metres a robot moves in a sample at most to count as standing."""
 
 
-class Driven(Protocol):
+class Driven(Timed, Protocol):
     """What a wait needs of an executor's action: whose leg it is, when, and its planned path."""
-
-    @property
-    def robot(self) -> str: ...
-
-    @property
-    def start(self) -> float: ...
-
-    @property
-    def end(self) -> float: ...
 
     @property
     def path(self) -> tuple[Point, ...]: ...
