@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 import random
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -81,7 +81,8 @@ def execute(
 ) -> Execution:
     """Play ``scenario``; where two robots would still touch after giving way, the whole run is
     played again (as a fleet manager repairs a plan), at most MAX_REPAIRS times: when they had
-    stopped facing each other, the one with less right of way waits beside the other's path
+    stopped facing each other, the one with less right of way drives by way of a place beside the
+    other's path, and if that is not enough waits there until the other has gone by
     (sim.passing); else the leg of the one driving into the other is planned again round the
     place where the other was (sim.conflicts).  ``near-collision`` is the fault of not doing so."""
     check_faults(scenario, faults)
@@ -99,6 +100,8 @@ def execute(
             break
         wait = head_on_wait(execution.trajectories, execution.actions, order, grid, met[0])
         if wait is not None and wait.leg not in waits:
+            waits[wait.leg] = replace(wait, until=None)  # by way of the place first: may be enough
+        elif wait is not None and waits[wait.leg].until is None:
             waits[wait.leg] = wait
         else:
             repairs = conflict_repairs(execution.trajectories, execution.actions, order)
@@ -200,7 +203,8 @@ def _play(
                     wait = waits.get((entry.robot, waypoint_counts[entry.robot])) if via is None else None
                     if wait is not None:
                         via = wait.place
-                    until = int(round(wait.until / DT)) if wait is not None else None
+                    hold = wait.until if wait is not None else None
+                    until = int(round(hold / DT)) if hold is not None else None
                     path, driven = _drive_to(grid, tl, goal, via, keep_clear, robot_limits, plans, until)
                     length = _length(path)
                     tl.append(slow_in_areas(driven, slow_boxes) if slow_boxes else driven)

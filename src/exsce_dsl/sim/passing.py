@@ -13,6 +13,7 @@ plays the leg again through it.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Protocol
@@ -31,6 +32,10 @@ GONE_BY = 1.5
 """Metres past the waiting robot the other has to be before it drives on."""
 MARGIN = 1.0
 """Seconds added to the time the other is expected to have gone by (speeds vary)."""
+LONGEST = 15.0
+"""Seconds a robot waits beside the path at most: longer, the other is not just going by."""
+ENDS = 1.0
+"""Metres from a leg's start or goal within which a standing robot is at a waypoint, not on its way."""
 STILL = 1e-9
 """Metres a robot moves in a sample at most to count as standing."""
 
@@ -45,11 +50,11 @@ class Driven(Timed, Protocol):
 @dataclass(frozen=True)
 class Wait:
     """Drive ``leg`` by way of ``place`` and wait there until ``until`` (seconds on the run's
-    clock) before driving on to its goal."""
+    clock; None: do not wait) before driving on to its goal."""
 
     leg: Leg
     place: Point
-    until: float
+    until: float | None
 
 
 def head_on_wait(
@@ -62,28 +67,34 @@ def head_on_wait(
     """The wait that keeps the robots of ``meeting`` (the first sample they are closer than the
     clearance, and the two robots) apart, when both had stopped facing each other just before:
     the robot later in ``order`` waits beside the other's path.  None when they had not both
-    stopped, or when no place near enough is free, in sight and clear of the other's path."""
+    stopped on their way (one waiting at a waypoint is not a head-on meeting), when no place
+    near enough is free, in sight and clear of the other's path, or when the other would not
+    have gone by within LONGEST seconds."""
     k, a, b = meeting
     mover, other = sorted((a, b), key=order.index, reverse=True)
-    stops = {r: _stood_since(trajectories[r], k) for r in (mover, other)}
-    if any(s is None for s in stops.values()):
-        return None
-    leg = leg_at(actions, mover, k * DT)
-    passing = leg_at(actions, other, k * DT)
-    if leg is None or passing is None:
-        return None
     tm, to = trajectories[mover], trajectories[other]
+    mover_stop, other_stop = _stood_since(tm, k), _stood_since(to, k)
+    leg, passing = leg_at(actions, mover, k * DT), leg_at(actions, other, k * DT)
+    if mover_stop is None or other_stop is None or leg is None or passing is None:
+        return None
     stood: Point = (float(tm.x[k - 1]), float(tm.y[k - 1]))
     at: Point = (float(to.x[k - 1]), float(to.y[k - 1]))
+    if not (_mid_leg(actions, leg, stood) and _mid_leg(actions, passing, at)):
+        return None  # one waits at a waypoint: not two robots nose to nose on their way
     ahead = _path_ahead(actions, passing, at)
     place = _place_aside(grid, stood, ahead)
     if place is None:
         return None
-    along = _along(ahead, place)
     speed = float(np.max(np.abs(to.v))) or 0.5
-    stop = stops[other]
-    assert stop is not None
-    return Wait(leg, place, stop * DT + (along + GONE_BY) / speed + MARGIN)
+    until = other_stop * DT + (_along(ahead, place) + GONE_BY) / speed + MARGIN
+    return Wait(leg, place, until) if until - mover_stop * DT <= LONGEST else None
+
+
+def _mid_leg(actions: Sequence[Driven], leg: Leg, point: Point) -> bool:
+    """``point`` is on the way: farther than ENDS from both ends of the leg's path."""
+    robot, number = leg
+    path = [x for x in actions if x.robot == robot][number - 1].path
+    return bool(path) and all(math.dist(point, end) > ENDS for end in (path[0], path[-1]))
 
 
 def _stood_since(trajectory: Trajectory, k: int) -> int | None:
