@@ -24,7 +24,7 @@ from distributed import Client, LocalCluster, get_task_stream
 
 from exsce_dsl.api import workflows
 from exsce_dsl.lang.build import load_spec
-from exsce_dsl.sim.run import simulate, simulate_on_cluster
+from exsce_dsl.sim.run import simulate
 from exsce_dsl.store.open import open_store
 from exsce_dsl.store.queries.campaigns import campaign_record, campaigns
 
@@ -118,7 +118,7 @@ def test_a_worker_killed_in_the_middle_of_a_run_loses_no_bag(
     folder, reference = yard
     scenario = load_spec(folder / "spec.exsce").scenario()
     with a_worker_killed_while_running(cluster, "_play_task") as killed:
-        played = list(simulate_on_cluster(cluster.scheduler_address, scenario, tmp_path / "runs", RUNS, seed=SEED))
+        played = list(simulate(scenario, tmp_path / "runs", RUNS, seed=SEED, cluster=cluster.scheduler_address))
     assert killed, "no worker was seen playing a run"
     assert [r.bag.name for r in played] == sorted(n for n in reference if n.endswith(".bag"))
     assert hashes(tmp_path / "runs") == reference  # each bag once and whole, nothing half-written left

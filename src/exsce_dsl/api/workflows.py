@@ -24,7 +24,7 @@ from exsce_dsl.rdf import serialize
 from exsce_dsl.rdf.spec_check import SpecCheck, check_spec
 from exsce_dsl.runs.ingest import IngestResult, ingest_bags
 from exsce_dsl.sim.executor import Fault
-from exsce_dsl.sim.run import SimulatedRun, simulate_on_cluster
+from exsce_dsl.sim.run import SimulatedRun
 from exsce_dsl.sim.run import simulate as play
 from exsce_dsl.similarity.clustering import Clustering, cluster_stored
 from exsce_dsl.store import open as store_open
@@ -80,8 +80,7 @@ def simulate(
     into ``out_dir``: the same path on every worker (a shared filesystem); the same bytes as here."""
     chosen = _scenario(spec, scenario)
     parsed = tuple(Fault.parse(f) for f in faults)
-    arguments = (chosen, Path(out_dir), runs, format, seed, parsed, convention)
-    return list(simulate_on_cluster(cluster, *arguments) if cluster is not None else play(*arguments))
+    return list(play(chosen, Path(out_dir), runs, format, seed, parsed, convention, cluster=cluster))
 
 
 def ingest(

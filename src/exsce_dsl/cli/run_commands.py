@@ -117,13 +117,11 @@ def simulate(
     from exsce_dsl.runs.cluster import cluster_address
     from exsce_dsl.sim.executor import Fault
     from exsce_dsl.sim.run import simulate as play
-    from exsce_dsl.sim.run import simulate_on_cluster
 
     scenario = load_spec(spec).scenario(scenario_id)
     parsed = tuple(Fault.parse(f) for f in faults)
-    arguments = (scenario, Path(out_dir), runs, fmt, seed, parsed, convention, cmd_vel_stamped)
     address = cluster_address(cluster)
-    played = simulate_on_cluster(address, *arguments) if address else play(*arguments)
+    played = play(scenario, Path(out_dir), runs, fmt, seed, parsed, convention, cmd_vel_stamped, address)
     with Progress(runs, f"simulating {scenario.id}") as progress:
         for run in played:
             progress.update()

@@ -33,7 +33,7 @@ from typing import Protocol, runtime_checkable
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import Scenario
 from exsce_dsl.sim.faults import Fault
-from exsce_dsl.sim.run import simulate, simulate_on_cluster
+from exsce_dsl.sim.run import simulate
 from exsce_dsl.suggest import did_you_mean
 
 ENTRY_POINT_GROUP = "exsce.executors"
@@ -83,10 +83,8 @@ class SimulatorExecutor:
     def execute(
         self, scenario: Scenario, scenario_file: Path, out_dir: Path, runs: int, seed: int
     ) -> list[Path]:
-        arguments = (scenario, out_dir, runs, self.format, seed, self.faults)
-        if self.cluster is not None:
-            return [run.bag for run in simulate_on_cluster(self.cluster, *arguments)]
-        return [run.bag for run in simulate(*arguments)]
+        played = simulate(scenario, out_dir, runs, self.format, seed, self.faults, cluster=self.cluster)
+        return [run.bag for run in played]
 
 
 @dataclass(frozen=True)

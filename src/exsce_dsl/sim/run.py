@@ -3,12 +3,12 @@
 Each run is played by :func:`play_run` from what every run of the call shares (:class:`RunPlan`)
 and its index: the run's seed, start, id and bag name follow from those alone, so a run gives the
 same bytes wherever it is played.  :func:`simulate` plays the runs one after the other in this
-process; :func:`simulate_on_cluster` plays each as one task on a Dask cluster's workers
-(``exscec simulate --cluster``), which write the bags into the output folder themselves: that
-folder must be the same path on every worker (a shared filesystem), as must the map files the
-scenario names.  A bag is written in a hidden folder beside its place and moved there when it is
-whole, so a worker killed half-way leaves no truncated bag under a run's name: the run's task goes
-to another worker, which writes it again.
+process, or each as one task on a Dask cluster's workers (``exscec simulate --cluster``), which
+write the bags into the output folder themselves: that folder must be the same path on every
+worker (a shared filesystem), as must the map files the scenario names.  A bag is written in a
+hidden folder beside its place and moved there when it is whole, so a worker killed half-way
+leaves no truncated bag under a run's name: the run's task goes to another worker, which writes
+it again.
 """
 
 from __future__ import annotations
@@ -102,42 +102,39 @@ def simulate(
     faults: Sequence[Fault] = (),
     convention: Signals | str | None = None,
     twist_stamped: bool = False,
+    cluster: str | None = None,
 ) -> Iterator[SimulatedRun]:
-    """Play ``scenario`` ``runs`` times and write one bag per run into ``out_dir``.
+    """Play ``scenario`` ``runs`` times and write one bag per run into ``out_dir``, in run order.
 
     ``convention`` (a name or a robot type's :class:`Signals`) says which topics the robots
     publish: the method's, Nav2's or move_base's; None: the one the robots' types name (the
     method's if they name none); ``twist_stamped`` makes the
     navigation stacks' ``cmd_vel`` a TwistStamped (Nav2 from Jazzy on).  Runs in another
-    convention than the method's get other run ids, so their bags can share a folder."""
+    convention than the method's get other run ids, so their bags can share a folder.
+
+    With ``cluster`` (a Dask scheduler's address) each run is one task on the cluster's workers,
+    with the same run ids and the same bytes.  The workers write the bags: ``out_dir`` (made
+    absolute here) and the scenario's map file must be the same paths on every worker (a shared
+    filesystem).  A task is tried twice, and a killed worker's task goes to another worker; a run
+    that failed even so does not stop the others: when they are done, an :class:`ExsceError`
+    names each failed run by its index."""
+    if cluster is not None:
+        shared = _with_absolute_map(scenario)
+        plan = RunPlan.of(shared, out_dir.absolute(), fmt, seed, faults, convention, twist_stamped)
+        plan.out_dir.mkdir(parents=True, exist_ok=True)
+        return _on_cluster(cluster, plan, runs, out_dir)
     plan = RunPlan.of(scenario, out_dir, fmt, seed, faults, convention, twist_stamped)
-    grid = planning_grid(scenario)
     out_dir.mkdir(parents=True, exist_ok=True)
+    return _here(plan, runs)
+
+
+def _here(plan: RunPlan, runs: int) -> Iterator[SimulatedRun]:
+    grid = planning_grid(plan.scenario)
     for index in range(runs):
         yield play_run(plan, index, grid)
 
 
-def simulate_on_cluster(
-    address: str,
-    scenario: Scenario,
-    out_dir: Path,
-    runs: int = 1,
-    fmt: str = "ros1",
-    seed: int = 0,
-    faults: Sequence[Fault] = (),
-    convention: Signals | str | None = None,
-    twist_stamped: bool = False,
-) -> Iterator[SimulatedRun]:
-    """:func:`simulate`, each run played as one task on the Dask cluster whose scheduler is at
-    ``address``: the same run ids and the same bytes as :func:`simulate` gives, in run order.
-
-    The workers write the bags: ``out_dir`` (made absolute here) and the scenario's map file must
-    be the same paths on every worker (a shared filesystem).  A task is tried twice, and a killed
-    worker's task goes to another worker; a run that failed even so does not stop the others:
-    when they are done, an :class:`ExsceError` names each failed run by its index."""
-    shared = _with_absolute_map(scenario)
-    plan = RunPlan.of(shared, out_dir.absolute(), fmt, seed, faults, convention, twist_stamped)
-    plan.out_dir.mkdir(parents=True, exist_ok=True)
+def _on_cluster(address: str, plan: RunPlan, runs: int, out_dir: Path) -> Iterator[SimulatedRun]:
     failed: list[str] = []
     with cluster_mapper(address) as mapper:
         for index, played in enumerate(mapper(_play_task, [(plan, index) for index in range(runs)])):
@@ -145,12 +142,12 @@ def simulate_on_cluster(
                 yield replace(played, bag=out_dir / played.bag.name)
             else:
                 why = played.message if isinstance(played, ExsceError) else str(played)
-                failed.append(f"run {index} (seed {seed * 1000 + index}): {why}")
+                failed.append(f"run {index} (seed {plan.seed * 1000 + index}): {why}")
     if failed:
         verb = "was" if len(failed) == 1 else "were"
         raise ExsceError(
-            f"{len(failed)} of {runs} runs of scenario '{scenario.id}' {verb} not written on the cluster "
-            "(the others were):\n  " + "\n  ".join(failed)
+            f"{len(failed)} of {runs} runs of scenario '{plan.scenario.id}' {verb} not written on the "
+            "cluster (the others were):\n  " + "\n  ".join(failed)
         )
 
 
