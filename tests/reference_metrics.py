@@ -15,8 +15,8 @@ import numpy as np
 
 from exsce_dsl.model.geometry import Position
 from exsce_dsl.model.runs import ActionId, Hotspot, MetricScope, MetricValue
-from exsce_dsl.runs.bagdata import BagData, Series
-from exsce_dsl.runs.segments import Segment
+from exsce_dsl.runs.bags.reading import BagData, Series
+from exsce_dsl.runs.segments.dispatcher import Segment
 
 HOTSPOT_RADIUS = 1.0  # metres: violations closer than this to a hotspot belong to it
 
@@ -344,8 +344,8 @@ def metrics_of_bag(path, scenario) -> tuple[list[MetricValue], list[Hotspot]]:  
     """The hand-written path's values and hotspots for a bag of ``scenario``: the bag read with
     every field kept, the dispatcher's statuses segmented, then :func:`compute_metrics`."""
     from exsce_dsl.runs.analyse import run_metrics, wanted_topics
-    from exsce_dsl.runs.bagdata import read_bag
-    from exsce_dsl.runs.segments import SUCCEEDED, segments
+    from exsce_dsl.runs.bags.reading import read_bag
+    from exsce_dsl.runs.segments.dispatcher import SUCCEEDED, segments
 
     robots = [r for r in scenario.robots if r.start_pose is not None]
     data = read_bag(path, wanted_topics(run_metrics(scenario), robots))

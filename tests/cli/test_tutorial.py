@@ -16,7 +16,7 @@ import pytest
 
 from exsce_dsl.api.demo import STEPS, Step, command_hint, run_steps, set_up, summary_lines
 from exsce_dsl.cli.demo_commands import run_in_process
-from exsce_dsl.runs.bagdata import bag_topics
+from exsce_dsl.runs.bags.reading import bag_topics
 
 from conftest import ROOT, run_exscec
 

@@ -19,7 +19,7 @@ from exsce_dsl.lang.build import load_spec
 from exsce_dsl.lang.standard_metrics import standard_metrics
 from exsce_dsl.resources import package_file
 from exsce_dsl.runs.analyse import analyse_bag, run_metrics, wanted_topics
-from exsce_dsl.runs.bagdata import read_bag
+from exsce_dsl.runs.bags.reading import read_bag
 from exsce_dsl.sim.run import simulate
 
 from conftest import EXAMPLES, run_exscec
@@ -32,11 +32,11 @@ def test_the_generated_module_is_the_golden_file():
     files = monitor_files(load_spec(SPEC))
     for name in ("exsce_monitors/__init__.py", "exsce_monitors/monitors.py"):
         assert files[name] == (GOLDEN / name).read_text(), f"{name} changed: review it, then update the golden file"
-    assert files["exsce_monitors/monitor_core.py"] == package_file("runs", "monitor_core.py").read_text()
+    assert files["exsce_monitors/monitor_core.py"] == package_file("monitor_kit", "monitor_core.py").read_text()
 
 
 def test_the_core_imports_nothing_of_exsce():
-    core = package_file("runs", "monitor_core.py").read_text()
+    core = package_file("monitor_kit", "monitor_core.py").read_text()
     assert "exsce_dsl" not in core.replace('"""', "").split("from __future__")[1]
 
 
@@ -88,7 +88,7 @@ def test_a_spec_file_name_cannot_break_out_of_the_generated_comment(tmp_path):
 
 
 def test_ingest_keeps_the_rendered_monitors_in_the_cache_folder(tmp_path, monkeypatch):
-    from exsce_dsl.runs import monitor_code
+    from exsce_dsl.runs.metrics import monitor_code
 
     metrics = tuple(standard_metrics()) + load_spec(SPEC).metrics
     monkeypatch.setenv("EXSCE_CACHE", str(tmp_path / "cache"))

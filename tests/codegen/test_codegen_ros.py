@@ -35,9 +35,10 @@ from exsce_dsl.codegen.ros_monitor import (
 )
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.lang.standard_metrics import standard_metrics
+from exsce_dsl.monitor_kit import monitor_runtime
 from exsce_dsl.oracles.relations import relation
 from exsce_dsl.resources import package_file
-from exsce_dsl.runs import analyse, monitor_runtime
+from exsce_dsl.runs import analyse
 from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
@@ -70,11 +71,11 @@ def test_the_generated_package_is_the_golden_files(ros: int) -> None:
         assert files[name] == text, f"{name} changed: review it, then update the golden file"
     assert files[f"{PYTHON[ros]}/monitors.py"] == monitor_files(spec)["exsce_monitors/monitors.py"]
     for name in SHARED[1:]:
-        assert files[f"{PYTHON[ros]}/{name}"] == package_file("runs", name).read_text()
+        assert files[f"{PYTHON[ros]}/{name}"] == package_file("monitor_kit", name).read_text()
 
 
 def test_the_runtime_imports_nothing_of_exsce() -> None:
-    text = package_file("runs", "monitor_runtime.py").read_text()
+    text = package_file("monitor_kit", "monitor_runtime.py").read_text()
     code = text.split("from __future__ import annotations")[1]
     assert "exsce_dsl" not in code and "from ." not in code
 

@@ -21,7 +21,7 @@ _BUILTIN_GENERICS = {"list", "tuple", "dict", "set", "frozenset", "type"}
 
 
 def _sources() -> list[tuple[str, str]]:
-    found = [(f"runs/{name}", package_file("runs", name).read_text()) for name in
+    found = [(f"monitor_kit/{name}", package_file("monitor_kit", name).read_text()) for name in
              ("monitor_core.py", "monitor_runtime.py")]
     for folder in ("monitors", "ros1_monitor", "ros2_monitor"):
         for path in sorted((GOLDEN / folder).rglob("*")):

@@ -24,7 +24,7 @@ from exsce_dsl.messages.catalogue import MessageTypeError, Source, parse_definit
 from exsce_dsl.messages.user import configured_catalogue, user_catalogue
 from exsce_dsl.model.expressions import Aggregate, Field
 from exsce_dsl.model.messages import FieldPath, Index, Select
-from exsce_dsl.runs import monitor_runtime
+from exsce_dsl.monitor_kit import monitor_runtime
 
 from conftest import run_exscec
 

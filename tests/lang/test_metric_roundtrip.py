@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.lang.format_metrics import expression_text
 from exsce_dsl.lang.lexical import number_text, string_literal
-from exsce_dsl.runs.monitor_code import monitor_source
+from exsce_dsl.runs.metrics.monitor_code import monitor_source
 
 HEADER = """metric m for each robot {{
   reads vel: geometry_msgs/msg/Twist on "/{{ns}}/nav_vel"

@@ -16,8 +16,8 @@ PACKAGE = Path(__file__).resolve().parents[2] / "src" / "exsce_dsl"
 LAYERS: list[set[str]] = [
     {"errors", "suggest", "resources", "textfiles", "tables", "templating", "figures"},  # the base
     {"model"},
+    {"messages", "monitor_kit", "parallel"},
     {"transform"},
-    {"messages"},
     {"lang"},
     {"prov"},
     {"rdf"},
@@ -33,9 +33,24 @@ LAYERS: list[set[str]] = [
 RANK = {name: rank for rank, names in enumerate(LAYERS) for name in names}
 
 
+STEPS: dict[str, list[set[str]]] = {
+    "runs": [{"bags"}, {"signals"}, {"segments"}, {"metrics"}, {"analyse", "ingest", "robots"}],
+}
+"""Inside a layer that has steps, the same rule between its subpackages and modules."""
+
+
 def _layer(module: str) -> str:
     """``exsce_dsl.runs.ingest`` → ``runs``; ``exsce_dsl.errors`` → ``errors``."""
     return module.split(".")[1]
+
+
+def _step(layer: str, module: str) -> int | None:
+    """The rank of ``module``'s step inside ``layer`` (None: the layer has no steps)."""
+    parts = module.split(".")
+    if layer not in STEPS or len(parts) < 3:
+        return None
+    ranks = {name: rank for rank, names in enumerate(STEPS[layer]) for name in names}
+    return ranks[parts[2].removesuffix(".py")]
 
 
 def _imports(path: Path) -> list[tuple[str, int]]:
@@ -69,6 +84,29 @@ def test_imports_go_down(path: Path) -> None:
         if RANK.get(_layer(name), -1) > RANK[mine]
     ]
     assert not upward, "\n".join(upward)
+
+
+@pytest.mark.parametrize("layer", sorted(STEPS))
+def test_steps_inside_a_layer_go_down(layer: str) -> None:
+    upward = []
+    for path in sorted((PACKAGE / layer).rglob("*.py")):
+        inside = path.relative_to(PACKAGE).with_suffix("").parts
+        if len(inside) < 2 or inside[1] == "__init__":
+            continue
+        mine = _step(layer, ".".join(("exsce_dsl", *inside)))
+        for name, line in _imports(path):
+            theirs = _step(layer, name) if _layer(name) == layer else None
+            if theirs is not None and mine is not None and theirs > mine:
+                upward.append(f"{path.relative_to(PACKAGE)}:{line}: imports {name} (a later step of {layer})")
+    assert not upward, "\n".join(upward)
+
+
+def test_every_step_is_known() -> None:
+    for layer, steps in STEPS.items():
+        named = {name for names in steps for name in names}
+        present = {p.name.removesuffix(".py") for p in (PACKAGE / layer).iterdir() if p.name != "__init__.py"}
+        present = {name for name in present if not name.startswith("__")}
+        assert present <= named, f"place these in STEPS[{layer!r}] (and DESIGN.md): {sorted(present - named)}"
 
 
 def test_the_checker_sees_an_upward_import(tmp_path: Path) -> None:

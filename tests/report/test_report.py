@@ -28,7 +28,7 @@ from exsce_dsl.report.contents import ReportContents, RunContents, ScenarioConte
 from exsce_dsl.report.html import page_name, write_report
 from exsce_dsl.report.plots import MARGIN, trajectory_figure
 from exsce_dsl.report.units import metric_units
-from exsce_dsl.runs.trajectories import Trajectory, trajectories
+from exsce_dsl.runs.signals.trajectories import Trajectory, trajectories
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
 from exsce_dsl.store.embedded import EmbeddedStore

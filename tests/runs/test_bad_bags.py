@@ -21,9 +21,9 @@ from hypothesis import strategies as st
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.prov import compile_scenario
 from exsce_dsl.runs.analyse import analyse_bag
-from exsce_dsl.runs.bagdata import BagError
-from exsce_dsl.runs.bagfiles import check_bag_file
-from exsce_dsl.runs.ros1_index import UnsupportedBag, read_topics
+from exsce_dsl.runs.bags.files import check_bag_file
+from exsce_dsl.runs.bags.reading import BagError
+from exsce_dsl.runs.bags.ros1_index import UnsupportedBag, read_topics
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.writing import add_prov
 

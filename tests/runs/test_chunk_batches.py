@@ -18,8 +18,8 @@ from rosbags.highlevel import AnyReader
 
 from exsce_dsl.messages.catalogue import standard_catalogue, standard_ros1_catalogue
 from exsce_dsl.model.messages import path_of
-from exsce_dsl.runs import chunk_batches, mcap_index, ros1_index
-from exsce_dsl.runs.decode import RawMessages, decode
+from exsce_dsl.runs.bags import chunk_batches, mcap_index, ros1_index
+from exsce_dsl.runs.bags.decode import RawMessages, decode
 
 
 def _bag(tmp_path: Path, fmt: str) -> factory.WrittenBag:

@@ -1,4 +1,4 @@
-"""The vectorised message decoder (:mod:`exsce_dsl.runs.decode`) against rosbags' own deserialiser.
+"""The vectorised message decoder (:mod:`exsce_dsl.runs.bags.decode`) against rosbags' own deserialiser.
 
 Every reference value here is read from the message objects that rosbags gives
 back for the bytes it serialised (``deserialize_ros1``, ``deserialize_cdr``),
@@ -48,7 +48,7 @@ from exsce_dsl.messages.catalogue import (
     standard_ros1_catalogue,
 )
 from exsce_dsl.model.messages import FieldPath, Index, Select
-from exsce_dsl.runs.decode import PRESENT, DecodeError, RawMessages, decode
+from exsce_dsl.runs.bags.decode import PRESENT, DecodeError, RawMessages, decode
 
 FORMATS = ("ros1", "cdr", "cdr_be")
 """ROS 1 serialization, CDR little-endian, CDR big-endian."""

@@ -16,8 +16,8 @@ from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 from exsce_dsl.messages.catalogue import standard_catalogue, standard_ros1_catalogue
 from exsce_dsl.model.messages import FieldPath, Index, path_of
-from exsce_dsl.runs.bagdata import Wanted, read_bag
-from exsce_dsl.runs.decode import TEXTS, DecodeError, RawMessages, decode, decode_slowly
+from exsce_dsl.runs.bags.decode import TEXTS, DecodeError, RawMessages, decode, decode_slowly
+from exsce_dsl.runs.bags.reading import Wanted, read_bag
 
 TF = "tf2_msgs/msg/TFMessage"
 FRAMES = [("map", "odom"), ("odom", "base_link"), ("base_link", "laser"), ("odom", "base_füßprint")]

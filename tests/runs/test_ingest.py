@@ -14,9 +14,9 @@ from rosbags.rosbag1 import Writer as Ros1Writer
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.model.runs import MetricScope, MetricValue
 from exsce_dsl.runs.analyse import analyse_bag
-from exsce_dsl.runs.bagdata import BagError
+from exsce_dsl.runs.bags.reading import BagError
 from exsce_dsl.runs.ingest import ingest_bags
-from exsce_dsl.runs.segments import SegmentError
+from exsce_dsl.runs.segments.dispatcher import SegmentError
 from exsce_dsl.sim.executor import Fault, GoalStatus
 from exsce_dsl.sim.messages import typestore
 from exsce_dsl.sim.run import planning_grid, simulate

@@ -7,7 +7,7 @@ from __future__ import annotations
 import pytest
 from rosbags.typesys import Stores, get_typestore
 
-from exsce_dsl.runs.bagdata import BagError, LazyMessage, deserialized
+from exsce_dsl.runs.bags.reading import BagError, LazyMessage, deserialized
 
 STORE = get_typestore(Stores.ROS2_HUMBLE)
 

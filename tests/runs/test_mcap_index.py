@@ -30,12 +30,12 @@ from rosbags.rosbag2 import CompressionFormat, CompressionMode, StoragePlugin, W
 from rosbags.typesys import Stores, get_typestore
 
 from exsce_dsl.model.messages import path_of
-from exsce_dsl.runs import bagdata
-from exsce_dsl.runs.bagdata import ANY, Wanted, read_bag
-from exsce_dsl.runs.decode import RawMessages
-from exsce_dsl.runs.mcap_index import read_topics, schemas
-from exsce_dsl.runs.mcap_reading import mcap_files
-from exsce_dsl.runs.ros1_index import UnsupportedBag
+from exsce_dsl.runs.bags import reading as bagdata
+from exsce_dsl.runs.bags.decode import RawMessages
+from exsce_dsl.runs.bags.mcap_index import read_topics, schemas
+from exsce_dsl.runs.bags.mcap_reading import mcap_files
+from exsce_dsl.runs.bags.reading import ANY, Wanted, read_bag
+from exsce_dsl.runs.bags.ros1_index import UnsupportedBag
 from exsce_dsl.sim.messages import FEEDBACK
 from exsce_dsl.sim.messages import typestore as sim_typestore
 

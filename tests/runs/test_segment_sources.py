@@ -16,10 +16,11 @@ import pytest
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.model import Pose, Position, Scenario
 from exsce_dsl.model.conventions import Tolerance
-from exsce_dsl.runs.arrival_segments import arrival_segments
-from exsce_dsl.runs.goal_segments import Goal, goal_segments
-from exsce_dsl.runs.segmentation import Segmentation, Track, near, planned_waypoints
-from exsce_dsl.runs.segments import SegmentError
+from exsce_dsl.runs.segments.arrival import arrival_segments
+from exsce_dsl.runs.segments.dispatcher import SegmentError
+from exsce_dsl.runs.segments.goals import goal_segments
+from exsce_dsl.runs.segments.track import Segmentation, Track, near, planned_waypoints
+from exsce_dsl.runs.signals.navigation_goals import Goal
 
 from conftest import EXAMPLES
 

@@ -21,9 +21,15 @@ from yard_spec import yard_text
 
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.model import Scenario
-from exsce_dsl.runs.bagdata import bag_topics, read_bag
-from exsce_dsl.runs.signals import RobotSources, choose_sources, signal_topic, signal_topics, signals_wanted
-from exsce_dsl.runs.trajectories import trajectories
+from exsce_dsl.runs.bags.reading import bag_topics, read_bag
+from exsce_dsl.runs.signals.sources import (
+    RobotSources,
+    choose_sources,
+    signal_topic,
+    signal_topics,
+    signals_wanted,
+)
+from exsce_dsl.runs.signals.trajectories import trajectories
 from exsce_dsl.sim.run import simulate
 
 

@@ -22,7 +22,7 @@ from exsce_dsl.model import Scenario
 from exsce_dsl.prov.run import compile_run
 from exsce_dsl.prov.serialize import serialize_prov
 from exsce_dsl.runs.analyse import AnalysedRun, analyse_bag
-from exsce_dsl.runs.bagdata import bag_topics
+from exsce_dsl.runs.bags.reading import bag_topics
 from exsce_dsl.sim.run import simulate
 
 

@@ -20,7 +20,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.runs.tf_poses import (
+from exsce_dsl.runs.signals.tf_poses import (
     EdgeSeries,
     FrameTree,
     Poses,

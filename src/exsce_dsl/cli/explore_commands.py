@@ -115,7 +115,7 @@ def explore(
     from exsce_dsl.lang.build import load_spec
     from exsce_dsl.model.campaign import Trial
     from exsce_dsl.oracles.campaign_junit import campaign_junit, run_seconds, steps_text
-    from exsce_dsl.runs.cluster import cluster_address
+    from exsce_dsl.parallel.cluster import cluster_address
     from exsce_dsl.store.open import open_store
 
     if sum(bool(x) for x in (faults, executor_command, plugin)) > 1:

@@ -114,7 +114,7 @@ def simulate(
       exscec simulate examples/brsu_building_c/scenario_c.exsce --convention nav2 --format mcap -o runs/
     """
     from exsce_dsl.lang.build import load_spec
-    from exsce_dsl.runs.cluster import cluster_address
+    from exsce_dsl.parallel.cluster import cluster_address
     from exsce_dsl.sim.executor import Fault
     from exsce_dsl.sim.run import simulate as play
 

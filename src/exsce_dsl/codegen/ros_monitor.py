@@ -6,7 +6,7 @@ topics the metrics read, computes the metrics live and publishes the verdicts
 of the scenario's oracles that the specification alone decides.  Almost all of
 it is plain Python shared with exsce and tested here without ROS: the
 generated monitor classes (``monitors.py``, the code ingestion runs), a copy
-of the metric core and of :mod:`exsce_dsl.runs.monitor_runtime`, and a
+of the metric core and of :mod:`exsce_dsl.monitor_kit.monitor_runtime`, and a
 generated ``config.py`` (robots, topics, oracles).  Only the node, a few
 dozen lines of rospy or rclpy, differs between the two.
 """
@@ -46,7 +46,7 @@ from exsce_dsl.model.metrics import ComputedFor, MetricDefinition, topic_name
 from exsce_dsl.oracles.plan import PlannedOracle, plan_oracles
 from exsce_dsl.prov.identifiers import oracle_name
 from exsce_dsl.resources import package_file
-from exsce_dsl.runs.monitor_code import monitor_source
+from exsce_dsl.runs.metrics.monitor_code import monitor_source
 from exsce_dsl.templating import GenerationError, python_name, python_string, render
 
 FEEDBACK_TOPIC = "/{ns}/waypoint_dispatcher/feedback"
@@ -314,7 +314,7 @@ def _context(spec: Specification, scenario_id: str | None, ros: int) -> tuple[di
 
 
 def _copied() -> dict[str, str]:
-    return {name: package_file("runs", name).read_text(encoding="utf-8") for name in _COPIED}
+    return {name: package_file("monitor_kit", name).read_text(encoding="utf-8") for name in _COPIED}
 
 
 def ros1_monitor_files(spec: Specification, scenario_id: str | None) -> dict[str, str]:

@@ -26,8 +26,8 @@ from exsce_dsl.oracles.report import expectation
 from exsce_dsl.report.contents import ReportContents, RunContents, ScenarioContents
 from exsce_dsl.report.plots import campaign_figure, metrics_figure, trajectory_figure
 from exsce_dsl.resources import resource_dir
-from exsce_dsl.runs.bagdata import BagError
-from exsce_dsl.runs.trajectories import Trajectory, trajectories
+from exsce_dsl.runs.bags.reading import BagError
+from exsce_dsl.runs.signals.trajectories import Trajectory, trajectories
 from exsce_dsl.similarity.dendrogram import dendrogram_figure
 
 _SAFE = re.compile(r"[A-Za-z0-9_.-]+")

@@ -16,7 +16,7 @@ from exsce_dsl.lang.occupancy import OccupancyGrid
 from exsce_dsl.model.oracles import Oracle
 from exsce_dsl.report.campaigns import CampaignContents
 from exsce_dsl.report.contents import RunContents, ScenarioContents
-from exsce_dsl.runs.trajectories import Trajectory
+from exsce_dsl.runs.signals.trajectories import Trajectory
 from exsce_dsl.store.queries import MetricReading
 
 MARGIN = 2.5

@@ -19,12 +19,21 @@ from exsce_dsl.model.messages import DISPATCHER, POSE, FieldPath, Fields
 from exsce_dsl.model.metrics import MetricDefinition
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Bag, Run, TaskExecution
-from exsce_dsl.runs.bagdata import ANY, BagError, Check, Reduce, StatusUpdate, Wanted, bag_topics, read_bag
-from exsce_dsl.runs.monitor_code import load_monitors
-from exsce_dsl.runs.monitor_core import Compute, Topic, reducer, topic_name
-from exsce_dsl.runs.monitoring import HOTSPOT_PATHS, POSE_TOPIC, compute_metrics
-from exsce_dsl.runs.segments import SUCCEEDED, Segment, segments
-from exsce_dsl.runs.stack_runs import DISPATCHER_SOURCE, SERVED, segment_robot, stack_robots
+from exsce_dsl.monitor_kit.monitor_core import Compute, Topic, reducer, topic_name
+from exsce_dsl.runs.bags.reading import (
+    ANY,
+    BagError,
+    Check,
+    Reduce,
+    StatusUpdate,
+    Wanted,
+    bag_topics,
+    read_bag,
+)
+from exsce_dsl.runs.metrics.compute import HOTSPOT_PATHS, POSE_TOPIC, compute_metrics
+from exsce_dsl.runs.metrics.monitor_code import load_monitors
+from exsce_dsl.runs.robots import DISPATCHER_SOURCE, SERVED, segment_robot, stack_robots
+from exsce_dsl.runs.segments.dispatcher import SUCCEEDED, Segment, segments
 
 _RUN_NAMESPACE = uuid.UUID("5b8f9a52-3f0c-4a8e-8f0e-2d6c1b7e4a90")
 _FEEDBACK = "/{ns}/waypoint_dispatcher/feedback"
@@ -72,7 +81,7 @@ def wanted_topics(metrics: tuple[MetricDefinition, ...], robots: list[Robot]) ->
         for metric in metrics:
             read_paths = fields_read(metric)
             for read in metric.reads:
-                if read.signal:  # a signal: read from the sources runs/signals.py chooses
+                if read.signal:  # a signal: read from the sources runs/signals chooses
                     continue
                 topic = topic_name(read.topic, ns)
                 types.setdefault(topic, ANY if read.msgtype in DISPATCHER else read.msgtype)

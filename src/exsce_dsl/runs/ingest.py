@@ -19,10 +19,10 @@ from typing import Any, cast
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import Scenario
+from exsce_dsl.parallel.cluster import cluster_mapper
 from exsce_dsl.prov import DEFAULT_NAMESPACE, compile_scenario
 from exsce_dsl.prov.run import compile_run
 from exsce_dsl.runs.analyse import AnalysedRun, analyse_bag, content_hash, run_uuid
-from exsce_dsl.runs.cluster import cluster_mapper
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.batch_writing import RunWriter, Written
 from exsce_dsl.store.queries import run_query
@@ -107,7 +107,7 @@ def ingest_bags(
 
     With ``jobs`` > 1, worker processes hash the bags, then read them and compute their metrics;
     with ``cluster`` (a Dask scheduler's address) the cluster's workers do, and ``jobs`` is not
-    used (see :mod:`exsce_dsl.runs.cluster`).  This process alone compiles each run's PROV and
+    used (see :mod:`exsce_dsl.parallel.cluster`).  This process alone compiles each run's PROV and
     writes it, each run wholly or not at all, in group commits when the runs come faster than the
     store takes them one by one (:mod:`exsce_dsl.store.batch_writing`).
     """

@@ -29,9 +29,9 @@ from exsce_dsl.lang.occupancy import OccupancyGrid, load_occupancy_grid
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.conventions import Signals
 from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Bag, Run, TaskExecution
+from exsce_dsl.parallel.cluster import cluster_mapper
 from exsce_dsl.prov import serialize_prov
 from exsce_dsl.prov.run import compile_run
-from exsce_dsl.runs.cluster import cluster_mapper
 from exsce_dsl.sim.bag import write_bag
 from exsce_dsl.sim.conventions import convention_writer
 from exsce_dsl.sim.executor import Execution, Fault, GoalStatus, execute

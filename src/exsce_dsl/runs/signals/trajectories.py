@@ -15,8 +15,8 @@ from pathlib import Path
 import numpy as np
 
 from exsce_dsl.model.conventions import POSE_TYPES, TfSource
-from exsce_dsl.runs.bagdata import bag_topics, read_bag
-from exsce_dsl.runs.signals import (
+from exsce_dsl.runs.bags.reading import bag_topics, read_bag
+from exsce_dsl.runs.signals.sources import (
     TF_MESSAGE,
     Chosen,
     RobotSources,

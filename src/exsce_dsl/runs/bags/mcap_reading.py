@@ -1,9 +1,9 @@
 """The fast path for MCAP bags (ROS 2): the file's own index, numpy gathers, no per-message Python.
 
-:func:`~exsce_dsl.runs.bagdata.read_bag` reads MCAP bags (an ``.mcap`` file,
+:func:`~exsce_dsl.runs.bags.reading.read_bag` reads MCAP bags (an ``.mcap`` file,
 or a ROS 2 bag folder whose ``metadata.yaml`` says ``storage_identifier:
-mcap``) with :class:`Mcap`, over :mod:`exsce_dsl.runs.mcap_index`, and with
-rosbags when that raises :class:`~exsce_dsl.runs.ros1_index.UnsupportedBag`.
+mcap``) with :class:`Mcap`, over :mod:`exsce_dsl.runs.bags.mcap_index`, and with
+rosbags when that raises :class:`~exsce_dsl.runs.bags.ros1_index.UnsupportedBag`.
 A type's definition comes from the channel's schema (``ros2msg`` or
 ``ros2idl``), else from the user's files, else from rosbags' standard
 typestores.  (A module of its own, beside ``bagdata``'s ROS 1 reader, to keep
@@ -26,7 +26,9 @@ from exsce_dsl.messages.catalogue import (
     standard_catalogue,
 )
 from exsce_dsl.messages.user import configured_user_catalogue
-from exsce_dsl.runs.bagdata import (
+from exsce_dsl.runs.bags.decode import RawMessages
+from exsce_dsl.runs.bags.mcap_index import Schema, read_topics, schemas
+from exsce_dsl.runs.bags.reading import (
     OBJECTS,
     WHOLE,
     BagData,
@@ -34,9 +36,7 @@ from exsce_dsl.runs.bagdata import (
     deserialized,
     deserializer_for,
 )
-from exsce_dsl.runs.decode import RawMessages
-from exsce_dsl.runs.mcap_index import Schema, read_topics, schemas
-from exsce_dsl.runs.ros1_index import Messages, UnsupportedBag
+from exsce_dsl.runs.bags.ros1_index import Messages, UnsupportedBag
 
 IDL_SEPARATOR = "=" * 80 + "\n"
 """Between the ``.idl`` files of a ``ros2idl`` schema, each then headed ``IDL: pkg/msg/Name``."""

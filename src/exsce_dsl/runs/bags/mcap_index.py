@@ -1,8 +1,8 @@
 """Read messages of chosen channels straight from an MCAP file's index, with numpy.
 
-The MCAP counterpart of :mod:`exsce_dsl.runs.ros1_index`, with the same
-:data:`~exsce_dsl.runs.ros1_index.Decoder` and
-:class:`~exsce_dsl.runs.ros1_index.Messages`.  An indexed MCAP file (what
+The MCAP counterpart of :mod:`exsce_dsl.runs.bags.ros1_index`, with the same
+:data:`~exsce_dsl.runs.bags.ros1_index.Decoder` and
+:class:`~exsce_dsl.runs.bags.ros1_index.Messages`.  An indexed MCAP file (what
 rosbag2 and rosbags write) ends with a summary section: its schemas and
 channels, and a chunk index per chunk that gives, per channel, where the
 chunk's message index record for that channel is.  A message index lists the
@@ -45,8 +45,8 @@ from pathlib import Path
 import numpy as np
 
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.runs.chunk_batches import ChunkBatch
-from exsce_dsl.runs.ros1_index import Decoder, Messages, UnsupportedBag, mapped
+from exsce_dsl.runs.bags.chunk_batches import ChunkBatch
+from exsce_dsl.runs.bags.ros1_index import Decoder, Messages, UnsupportedBag, mapped
 
 MAGIC = b"\x89MCAP0\r\n"
 OP_FOOTER = 0x02

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 from exsce_dsl.errors import SegmentError as SegmentError
 from exsce_dsl.model import Pose, Scenario
-from exsce_dsl.runs.bagdata import StatusUpdate
+from exsce_dsl.runs.bags.reading import StatusUpdate
 
 ACTIVE, SUCCEEDED = 1, 3
 FINAL = {2: "PREEMPTED", 3: "SUCCEEDED", 4: "ABORTED", 5: "REJECTED", 8: "RECALLED", 9: "LOST"}

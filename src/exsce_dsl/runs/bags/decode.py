@@ -45,7 +45,7 @@ from exsce_dsl.errors import DecodeError as DecodeError
 from exsce_dsl.lang.check_fields import FieldProblem, field_shape
 from exsce_dsl.messages.catalogue import ARRAY, BASE, NAME, NUMERIC, SEQUENCE, MessageCatalogue
 from exsce_dsl.model.messages import FieldPath, Index, Select, Step, canonical_type
-from exsce_dsl.runs.monitor_core import PRESENT
+from exsce_dsl.monitor_kit.monitor_core import PRESENT
 
 _UNVECTORISED = ("wstring", "float128")
 TEXTS = "#texts"

@@ -5,7 +5,7 @@ here).  A ROS 1 bag (format 2.0) indexes every message: after each chunk come
 index-data records giving, per connection, each message's time and offset in
 the chunk.  So for each chunk we read the index as arrays, find each message's
 data with a vectorised gather, and hand a connection's messages of a batch of
-chunks (:mod:`exsce_dsl.runs.chunk_batches`) to a decoder as one buffer with
+chunks (:mod:`exsce_dsl.runs.bags.chunk_batches`) to a decoder as one buffer with
 their offsets: Python work per batch, none per message.
 
 Uncompressed, bz2 and lz4 chunks are read; anything unexpected raises
@@ -26,8 +26,8 @@ from pathlib import Path
 
 import numpy as np
 
-from exsce_dsl.runs.chunk_batches import ChunkBatch
-from exsce_dsl.runs.decode import RawMessages
+from exsce_dsl.runs.bags.chunk_batches import ChunkBatch
+from exsce_dsl.runs.bags.decode import RawMessages
 
 MAGIC = b"#ROSBAG V2.0\n"
 OP_MSG, OP_BAG, OP_INDEX, OP_CHUNK, OP_CHUNK_INFO, OP_CONN = 0x02, 0x03, 0x04, 0x05, 0x06, 0x07

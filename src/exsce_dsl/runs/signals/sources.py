@@ -45,10 +45,10 @@ from exsce_dsl.model.conventions import (
 from exsce_dsl.model.messages import FieldPath, canonical_type, path_of
 from exsce_dsl.model.metrics import signal_pattern, topic_name
 from exsce_dsl.model.robots import Robot
-from exsce_dsl.runs.bagdata import BagData, Series, Wanted
-from exsce_dsl.runs.decode import TEXTS
-from exsce_dsl.runs.monitor_core import Topic
-from exsce_dsl.runs.tf_poses import (
+from exsce_dsl.monitor_kit.monitor_core import Topic
+from exsce_dsl.runs.bags.decode import TEXTS
+from exsce_dsl.runs.bags.reading import BagData, Series, Wanted
+from exsce_dsl.runs.signals.tf_poses import (
     EdgeSeries,
     FrameTree,
     TfError,

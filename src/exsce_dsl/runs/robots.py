@@ -4,7 +4,7 @@ The standard library's metrics are declared over the method's topics
 (``/{ns}/robot_pose``, ``/{ns}/nav_vel``, ``/{ns}/scan``,
 ``/{ns}/distance_travelled``) and its dispatcher's windows.  For a robot whose
 type says otherwise, ingestion reads the signals from the sources chosen in the
-bag (:mod:`~exsce_dsl.runs.signals`) and serves them to the monitors under
+bag (:mod:`~exsce_dsl.runs.signals.sources`) and serves them to the monitors under
 those names, with the fields the method's types have there; the metrics' sources
 in the run's PROV then name the topics the values really came from.  Its path
 segments come from the first source that gives any: the method's dispatcher, the
@@ -26,14 +26,20 @@ from exsce_dsl.model.messages import FieldPath
 from exsce_dsl.model.metrics import topic_name
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import MetricValue
-from exsce_dsl.runs.arrival_segments import arrival_segments
-from exsce_dsl.runs.bagdata import BagData, Wanted
-from exsce_dsl.runs.goal_segments import goal_segments
-from exsce_dsl.runs.monitor_core import Topic
-from exsce_dsl.runs.navigation_goals import goal_wanted, read_goals
-from exsce_dsl.runs.segmentation import Track
-from exsce_dsl.runs.segments import Segment
-from exsce_dsl.runs.signals import RobotSources, choose_sources, signal_topic, signal_topics, signals_wanted
+from exsce_dsl.monitor_kit.monitor_core import Topic
+from exsce_dsl.runs.bags.reading import BagData, Wanted
+from exsce_dsl.runs.segments.arrival import arrival_segments
+from exsce_dsl.runs.segments.dispatcher import Segment
+from exsce_dsl.runs.segments.goals import goal_segments
+from exsce_dsl.runs.segments.track import Track
+from exsce_dsl.runs.signals.navigation_goals import goal_wanted, read_goals
+from exsce_dsl.runs.signals.sources import (
+    RobotSources,
+    choose_sources,
+    signal_topic,
+    signal_topics,
+    signals_wanted,
+)
 
 DISPATCHER_SOURCE = "the waypoint dispatcher"
 FEEDBACK = "/{ns}/waypoint_dispatcher/feedback"

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from exsce_dsl.runs.decode import RawMessages
+from exsce_dsl.runs.bags.decode import RawMessages
 
 BATCH_BYTES = 8 << 20
 """Bytes of chunks (decompressed) a batch gathers before it is decoded: large enough that the

@@ -1,7 +1,7 @@
 """Read the topics a run's metrics need from a bag (ROS 1, ROS 2 sqlite3, MCAP).
 
 Only the needed connections are read, and of their messages only the fields
-the metrics read (:mod:`exsce_dsl.runs.decode`, a decoder driven by the
+the metrics read (:mod:`exsce_dsl.runs.bags.decode`, a decoder driven by the
 message definition).  A type's definition comes from the bag itself (a ROS 1
 connection's definition, an MCAP schema, a ROS 2 bag's type descriptions),
 else from the user's ``.msg``/``.idl`` files, else from rosbags' standard
@@ -33,9 +33,9 @@ from exsce_dsl.messages.catalogue import (
 )
 from exsce_dsl.messages.user import configured_user_catalogue
 from exsce_dsl.model.messages import FieldPath, Fields, canonical_type
-from exsce_dsl.runs.decode import TEXTS, DecodeError, RawMessages, decode, decode_slowly, vectorisable
-from exsce_dsl.runs.mcap_index import CorruptBag
-from exsce_dsl.runs.ros1_index import UnsupportedBag, connections, read_topics
+from exsce_dsl.runs.bags.decode import TEXTS, DecodeError, RawMessages, decode, decode_slowly, vectorisable
+from exsce_dsl.runs.bags.mcap_index import CorruptBag
+from exsce_dsl.runs.bags.ros1_index import UnsupportedBag, connections, read_topics
 
 _PROGRESS = {0: 0, 1: 1}  # PENDING, ACTIVE; every other status is final
 BLOCK = 4096
@@ -134,7 +134,7 @@ def read_bag(
             except UnsupportedBag:
                 pass  # rosbags reads what our index reader does not (and reports what is broken)
         # MCAP's own index, read with numpy like ROS 1's; its reading class builds on this module's
-        from exsce_dsl.runs.mcap_reading import Mcap, mcap_files
+        from exsce_dsl.runs.bags.mcap_reading import Mcap, mcap_files
 
         files = mcap_files(path)
         if files is not None:
@@ -152,9 +152,9 @@ def read_bag(
 
 
 def _check_once(path: Path) -> None:
-    """:func:`~exsce_dsl.runs.bagfiles.check_bag_file`, once per file as it is (ingest lists a
+    """:func:`~exsce_dsl.runs.bags.files.check_bag_file`, once per file as it is (ingest lists a
     bag's topics, then reads it: 80 ms a check on a 100 MB bag)."""
-    from exsce_dsl.runs.bagfiles import check_bag_file  # here: bagfiles imports this module's BagError
+    from exsce_dsl.runs.bags.files import check_bag_file  # here: bagfiles imports this module's BagError
 
     if not path.is_file():
         check_bag_file(path)

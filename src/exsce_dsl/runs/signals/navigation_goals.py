@@ -1,8 +1,8 @@
 """A robot's navigation goals as its stack recorded them: Nav2's actions and ROS 1 move_base's.
 
 Few messages (a status array a second and at each change), so they are read as
-message objects (:data:`~exsce_dsl.runs.bagdata.OBJECTS`, each distinct one once)
-and walked here into :class:`~exsce_dsl.runs.goal_segments.Goal`\\ s, in receive
+message objects (:data:`~exsce_dsl.runs.bags.reading.OBJECTS`, each distinct one once)
+and walked here into :class:`Goal`\\ s, in receive
 time.  (A global plan is long, but rosbags deserializes its poses faster than the
 vectorised decoder walks them one element index at a time, for a plan a chunk.)
 
@@ -20,15 +20,44 @@ vectorised decoder walks them one element index at a time, for a plan a chunk.)
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from exsce_dsl.model.conventions import Navigation, Signals
 from exsce_dsl.model.metrics import topic_name
-from exsce_dsl.runs.bagdata import OBJECTS, BagData, Wanted
-from exsce_dsl.runs.goal_segments import Goal
-from exsce_dsl.runs.tf_poses import yaw_from_quaternion
+from exsce_dsl.runs.bags.reading import OBJECTS, BagData, Wanted
+from exsce_dsl.runs.signals.tf_poses import yaw_from_quaternion
+
+XYYaw = tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class Goal:
+    """One navigation goal of a robot, as read from its bag (times in seconds since the epoch)."""
+
+    key: str  # the goal's id (a Nav2 UUID as hex, a move_base goal id string)
+    accepted: float | None  # first seen (accepted / pending)
+    started: float | None  # became active / executing
+    ended: float | None  # reached a final status
+    status: str  # final: SUCCEEDED, ABORTED, CANCELED, PREEMPTED, REJECTED, ... or ACTIVE (never ended)
+    target: XYYaw | None = None  # x, y, yaw of a one-pose goal, when the bag says it
+    progress: tuple[tuple[int, float], ...] = ()
+    """follow_waypoints: each ``current_waypoint`` the feedback reported and when it first did."""
+    targets: tuple[XYYaw | None, ...] = ()
+    """follow_waypoints: the goal's poses by index, where the bag says them."""
+    missed: tuple[int, ...] = ()
+    """follow_waypoints: the result's missed waypoint indices."""
+
+    @property
+    def first_seen(self) -> float | None:
+        return next((t for t in (self.accepted, self.started, self.ended) if t is not None), None)
+
+    @property
+    def follows_waypoints(self) -> bool:
+        return bool(self.progress or self.targets)
+
 
 NAV2_STATUS = {1: "ACCEPTED", 2: "EXECUTING", 3: "CANCELING", 4: "SUCCEEDED", 5: "CANCELED", 6: "ABORTED"}
 NAV2_FINAL = {4, 5, 6}

@@ -23,7 +23,7 @@ from typing import Any
 import yaml
 from rosbags.typesys import TypesysError, get_types_from_idl, get_types_from_msg
 
-from exsce_dsl.runs.bagdata import BagError
+from exsce_dsl.runs.bags.reading import BagError
 
 ROS1_MAGIC = b"#ROSBAG V2.0\n"
 MCAP_MAGIC = b"\x89MCAP0\r\n"

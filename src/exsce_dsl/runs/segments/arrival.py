@@ -32,7 +32,7 @@ import numpy as np
 
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.conventions import Tolerance
-from exsce_dsl.runs.segmentation import (
+from exsce_dsl.runs.segments.track import (
     DEFAULT_TOLERANCE,
     SUCCEEDED,
     Outcome,

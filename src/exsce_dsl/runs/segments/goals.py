@@ -45,7 +45,7 @@ from dataclasses import dataclass
 
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.conventions import Tolerance
-from exsce_dsl.runs.segmentation import (
+from exsce_dsl.runs.segments.track import (
     DEFAULT_TOLERANCE,
     SUCCEEDED,
     Outcome,
@@ -57,34 +57,7 @@ from exsce_dsl.runs.segmentation import (
     matches,
     planned_waypoints,
 )
-
-XYYaw = tuple[float, float, float]
-
-
-@dataclass(frozen=True)
-class Goal:
-    """One navigation goal of a robot, as read from its bag (times in seconds since the epoch)."""
-
-    key: str  # the goal's id (a Nav2 UUID as hex, a move_base goal id string)
-    accepted: float | None  # first seen (accepted / pending)
-    started: float | None  # became active / executing
-    ended: float | None  # reached a final status
-    status: str  # final: SUCCEEDED, ABORTED, CANCELED, PREEMPTED, REJECTED, ... or ACTIVE (never ended)
-    target: XYYaw | None = None  # x, y, yaw of a one-pose goal, when the bag says it
-    progress: tuple[tuple[int, float], ...] = ()
-    """follow_waypoints: each ``current_waypoint`` the feedback reported and when it first did."""
-    targets: tuple[XYYaw | None, ...] = ()
-    """follow_waypoints: the goal's poses by index, where the bag says them."""
-    missed: tuple[int, ...] = ()
-    """follow_waypoints: the result's missed waypoint indices."""
-
-    @property
-    def first_seen(self) -> float | None:
-        return next((t for t in (self.accepted, self.started, self.ended) if t is not None), None)
-
-    @property
-    def follows_waypoints(self) -> bool:
-        return bool(self.progress or self.targets)
+from exsce_dsl.runs.signals.navigation_goals import Goal, XYYaw
 
 
 @dataclass(frozen=True)

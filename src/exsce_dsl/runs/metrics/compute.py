@@ -2,7 +2,7 @@
 
 Windows come from the waypoint dispatcher (the mission, each robot's part of
 it, each path segment); the values inside them from ``RobotMetrics`` and
-``MissionMetrics`` (:mod:`exsce_dsl.runs.monitor_code`).  A metric that is
+``MissionMetrics`` (:mod:`exsce_dsl.runs.metrics.monitor_code`).  A metric that is
 ``safe below|above`` a limit also gets its ``violation_duration`` and its
 hotspots, from the per-message values its monitor prepared.  A metric whose
 topics are missing from the bag is *missing* (no value, and a problem is
@@ -22,9 +22,9 @@ from exsce_dsl.model.messages import path_of
 from exsce_dsl.model.metrics import ComputedFor, MetricDefinition
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import ActionId, Hotspot, MetricScope, MetricValue
-from exsce_dsl.runs import monitor_core as core
-from exsce_dsl.runs.monitor_code import reads_used
-from exsce_dsl.runs.segments import Segment
+from exsce_dsl.monitor_kit import monitor_core as core
+from exsce_dsl.runs.metrics.monitor_code import reads_used
+from exsce_dsl.runs.segments.dispatcher import Segment
 
 HOTSPOT_RADIUS = 1.0  # metres: violations closer than this to a hotspot belong to it
 POSE_TOPIC = "/{ns}/robot_pose"

@@ -2,7 +2,7 @@
 
 The code comes from ``templates/monitors/monitors.py.j2``: a ``RobotMetrics``
 and a ``MissionMetrics`` class whose ``get_<metric>(start, end)`` methods call
-:mod:`exsce_dsl.runs.monitor_core`.  Ingestion renders it for the standard
+:mod:`exsce_dsl.monitor_kit.monitor_core`.  Ingestion renders it for the standard
 library's metrics and the specification's own and executes that text (kept in
 the user's cache folder like ``__pycache__``, never loaded by a name from a
 data file); ``exscec generate monitors`` writes the same text to a file.
@@ -141,7 +141,7 @@ def monitor_source(metrics: Sequence[MetricDefinition], source: str, core_import
         TEMPLATE,
         generator=GENERATOR,
         source=source,
-        core_import=core_import or "from exsce_dsl.runs import monitor_core as core",
+        core_import=core_import or "from exsce_dsl.monitor_kit import monitor_core as core",
         robot_metrics=robot,
         mission_metrics=mission,
         reducers=reducers,

@@ -1,0 +1,2 @@
+"""The monitors' numpy core and runtime: numpy and the standard library only, because
+``exscec generate`` copies them into ROS nodes."""

@@ -1,0 +1,1 @@
+"""Work spread over processes: the Dask client that ingest, simulate and explore share."""

@@ -1,0 +1,1 @@
+"""Step 1 of a run: reading bags (ROS 1, MCAP, rosbags' readers) into numpy columns over raw bytes."""

@@ -1,0 +1,1 @@
+"""Step 4 of a run: the monitors, over signals and segments."""
