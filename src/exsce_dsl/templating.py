@@ -22,6 +22,7 @@ import re
 import jinja2
 
 from exsce_dsl.errors import GenerationError as GenerationError
+from exsce_dsl.model.expressions import is_constant
 from exsce_dsl.resources import resource_dir
 
 _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
@@ -98,6 +99,7 @@ def environment() -> jinja2.Environment:
         unwrap=unwrap,
     )
     env.tests["node"] = _is_node
+    env.tests["constant"] = is_constant  # an expression with one number for every window
     return env
 
 

@@ -163,6 +163,10 @@ ERRORS = [
     ("value duration where vel.linear.x", 3, 9, "needs a condition per message"),
     ("value succeeded", 3, 9, "comes from the waypoint dispatcher: read its result topic"),
     ("value abs(1, 2)", 3, 9, "abs(...) takes one value"),
+    ("value max(derivative(vel.linear.x))", 3, 13, "unknown function 'derivative' (the functions: min, max, "
+     "mean, sum, first, last, integral, change, path_length, norm, abs, sqrt)"),
+    ("value 2 * max(norml(vel.linear.x))", 3, 17, "unknown function 'norml'; did you mean 'norm'?"),
+    ("value count(vel.linear.x > 1)", 3, 9, "'count' is written without parentheses: count where <condition>"),
 ]
 
 
@@ -219,6 +223,16 @@ def test_check_prints_a_metric_error_as_file_line_col(tmp_path):
     done = run_exscec("check", "m.exsce", cwd=tmp_path)
     assert done.returncode == 1 and "Traceback" not in done.stderr
     assert "m.exsce:3:14: error: vel (geometry_msgs/msg/Twist) has no field 'linar'" in done.stderr
+
+
+def test_check_names_an_unknown_function_at_its_place_with_the_functions_there_are(tmp_path):
+    (tmp_path / "m.exsce").write_text(_HEADER + "  value max(vel.linear.x) - min(absl(vel.linear.x))\n}\n")
+    done = run_exscec("check", "m.exsce", cwd=tmp_path)
+    assert done.returncode == 1 and "Traceback" not in done.stderr
+    assert "m.exsce:3:33: error: unknown function 'absl'; did you mean 'abs'? (the functions: min," in (
+        done.stderr
+    )
+    assert "expected" not in done.stderr  # not a syntax error listing tokens
 
 
 def test_a_clause_on_a_user_metric_checks_its_unit_and_scope(tmp_path):

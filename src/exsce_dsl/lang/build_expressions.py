@@ -21,6 +21,9 @@ from exsce_dsl.lang.lexical import quantity_text
 from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.model.expressions import (
     AGGREGATES,
+    CONDITION_AGGREGATES,
+    FUNCTIONS,
+    SERIES,
     Aggregate,
     Binary,
     Call,
@@ -289,9 +292,13 @@ class ExpressionBuilder:
 
     def _call(self, node: Any) -> Typed:
         func = node.func
+        if func not in FUNCTIONS:
+            raise self._fail(_unknown_function(func), node)
         if func in AGGREGATES:
             return self._aggregate(node)
         args = [self._argument(a, allow_where=False) for a in node.args]
+        if func in SERIES:
+            return self._series(node, args)
         if func in ("abs", "sqrt") and len(args) != 1:
             raise self._fail(f"{func}(...) takes one value, not {len(args)}", node)
         for arg in args:
@@ -306,6 +313,23 @@ class ExpressionBuilder:
                 raise self._fail(f"{func}(...) mixes one number per window with values per message", node)
             return Typed(expr, Kind.VALUE)
         return self._elementwise(expr, args, node)
+
+    def _series(self, node: Any, args: list[Typed]) -> Typed:
+        """``speed(x, y[, z])``, ``derivative(v)``: a number per message of one topic, over time."""
+        func = node.func
+        speed = func == "speed"
+        if len(args) not in ((2, 3) if speed else (1,)):
+            wanted = "two or three coordinates (x, y[, z])" if speed else "one value"
+            raise self._fail(f"{func}(...) takes {wanted}, not {len(args)}", node)
+        for arg in args:
+            if arg.kind is not Kind.NUMBERS:
+                raise self._fail(
+                    f"{func}(...) is over a number per message, in time, but this is {arg.kind.value}", node
+                )
+        if len({a.clock for a in args}) > 1:
+            raise self._fail(f"{func}(...) needs its values on one topic", node)
+        expr = Call(func, tuple(a.expr for a in args), self.pf.span(node))
+        return Typed(expr, Kind.NUMBERS, args[0].clock)
 
     def _argument(self, arg: Any, allow_where: bool) -> Typed:
         if arg.condition is not None and not allow_where:
@@ -366,6 +390,12 @@ class ExpressionBuilder:
                 node,
             )
         return Typed(Aggregate(node.func, (), condition.expr, self.pf.span(node)), Kind.VALUE)
+
+
+def _unknown_function(name: str) -> str:
+    if name in CONDITION_AGGREGATES:
+        return f"'{name}' is written without parentheses: {name} where <condition>"
+    return f"unknown function '{name}'{did_you_mean(name, FUNCTIONS)} (the functions: {', '.join(FUNCTIONS)})"
 
 
 def _steps(part: Any) -> list[Step]:

@@ -75,7 +75,8 @@ class Binary:
 
 @dataclass(frozen=True)
 class Call:
-    """An element-wise function: ``norm``, ``abs``, ``sqrt``."""
+    """A function per message: element-wise ``norm``, ``abs``, ``sqrt``, or over the series of
+    one topic, ``speed`` (of positions) and ``derivative`` (of a number), per second."""
 
     func: str
     args: tuple[Expression, ...]
@@ -107,7 +108,17 @@ Expression = Number | Field | Unary | Binary | Call | Aggregate | WindowValue
 AGGREGATES = ("min", "max", "mean", "sum", "first", "last", "integral", "change", "path_length")
 CONDITION_AGGREGATES = ("duration", "count")
 ELEMENTWISE = ("norm", "abs", "sqrt")
+SERIES = ("speed", "derivative")
+"""Functions of a topic's values over time, one value per message (see ``monitor_core.speed``)."""
+FUNCTIONS = (*AGGREGATES, *ELEMENTWISE)
+"""Every function written ``name(...)`` (``duration`` and ``count`` are written ``... where``)."""
 WINDOW_VALUES = ("elapsed", "succeeded")
+
+
+def is_constant(expr: Expression) -> bool:
+    """Whether ``expr`` is the same number in every window (``-1``, ``(0 - 100) * 2``): it reads
+    no field, aggregates nothing and names no window value."""
+    return not any(isinstance(n, (Field, Aggregate, WindowValue)) for n in walk(expr))
 
 
 def walk(expr: Expression) -> list[Expression]:
