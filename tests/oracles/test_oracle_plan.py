@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import pytest
@@ -84,6 +85,13 @@ def test_default_topics_follow_the_robot_namespace() -> None:
     assert default_topics(SCENARIO, "mission_duration", None) == (
         "/r1/waypoint_dispatcher/feedback", "/ns2/waypoint_dispatcher/feedback"
     )
+
+
+def test_default_topics_of_a_robot_at_the_root_have_no_empty_level() -> None:
+    """``exscec baseline`` of a robot with ``namespace ""`` failed on '//nav_vel'."""
+    at_root = dataclasses.replace(SCENARIO, robots=(dataclasses.replace(SCENARIO.robots[0], namespace=""),))
+    assert default_topics(at_root, "max_velocity", "r1") == ("/nav_vel",)
+    assert default_topics(at_root, "violation_duration", None) == ("/robot_pose",)
 
 
 def segment(allocation: int, waypoint: int, goal: str, value: float, metric: str = "distance_travelled") -> ObservedSegment:

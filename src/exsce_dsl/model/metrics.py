@@ -249,4 +249,4 @@ def default_topics(scenario: Scenario, metric: str, robot: str | None) -> tuple[
     leaves = TOPICS.get(metric, ())
     if robot is None and metric == "violation_duration":
         leaves = (_POSE,)  # the mission's violations are of the distance between robots
-    return tuple(f"/{r.namespace.strip('/')}/{leaf}" for r in robots for leaf in leaves)
+    return tuple(topic_name(f"/{{ns}}/{leaf}", r.namespace) for r in robots for leaf in leaves)

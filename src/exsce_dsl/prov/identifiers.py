@@ -23,6 +23,7 @@ import re
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from typing import NamedTuple
+from urllib.parse import unquote_to_bytes
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model.geometry import Orientation, Pose
@@ -394,11 +395,56 @@ def action_name(robot_id: str, allocation: int, subtask: int, waypoint: int) -> 
     return f"{task}-{subtask_role(subtask)}-{waypoint_relation_name(waypoint)}"
 
 
+# A name from outside (a bag's topic, a bag file's name) becomes a local name by escaping:
+# what a PROV-N local name and an IRI path segment both allow stays, anything else is
+# percent-encoded (UTF-8), so that any name has an identifier and the identifier gives the
+# name back.  '/' stays in topics; '.' and '-' cannot start a local name, a '.' cannot end one
+# nor start a path segment (``a/./b`` would lose a level when an IRI is resolved).
+_KEPT = frozenset("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_-.")
+_RELATIVE = "@"
+"""Starts the local name of a topic not written ``/name``: ``groundtruth`` is ``topic:@groundtruth``."""
+
+
+def escape_name(name: str, keep_slash: bool = False) -> str:
+    """``name`` as a local name and a path segment (``/`` kept with ``keep_slash``); see
+    :func:`unescape_name`."""
+    out: list[str] = []
+    for i, char in enumerate(name):
+        segment_start = i == 0 or name[i - 1] == "/"
+        kept = char in _KEPT or (keep_slash and char == "/")
+        if char == "." and (segment_start or i == len(name) - 1) or char == "-" and i == 0:
+            kept = False
+        out.append(char if kept else "".join(f"%{b:02X}" for b in char.encode("utf-8", "surrogatepass")))
+    return "".join(out)
+
+
+def unescape_name(local: str) -> str:
+    """The name :func:`escape_name` made ``local`` of."""
+    return unquote_to_bytes(local).decode("utf-8", "surrogatepass")
+
+
 def topic_name(topic: str) -> str:
-    """The local name in ``topic:`` of a ROS topic: the absolute name without its first ``/``."""
-    if not topic.startswith("/") or topic == "/" or "//" in topic or any(c.isspace() for c in topic):
-        raise ExsceError(f"'{topic}' is not an absolute ROS topic name (such as '/tiago1/nav_vel')")
-    return topic[1:]
+    """The local name in ``topic:`` of a topic, as a bag spells it, whatever its characters.
+
+    An absolute name loses its first ``/`` (``/tiago1/nav_vel`` is ``topic:tiago1/nav_vel``,
+    the IRI ``<base>topics/tiago1/nav_vel``); any other name (``groundtruth``, ``/``,
+    ``//x``) starts with ``@``; characters an identifier cannot hold are percent-encoded
+    (``ORB SLAM`` is ``@ORB%20SLAM``).  :func:`topic_of_name` reverses it."""
+    if topic.startswith("/") and len(topic) > 1 and topic[1] != "/":
+        return escape_name(topic[1:], keep_slash=True)
+    return _RELATIVE + escape_name(topic, keep_slash=True)
+
+
+def topic_of_name(local: str) -> str:
+    """The topic whose local name in ``topic:`` is ``local`` (see :func:`topic_name`)."""
+    if local.startswith(_RELATIVE):
+        return unescape_name(local[len(_RELATIVE) :])
+    return "/" + unescape_name(local)
+
+
+def bag_name(file_name: str) -> str:
+    """The local name of a bag, from its file's name (escaped as :func:`escape_name` says)."""
+    return escape_name(file_name)
 
 
 def metric_value_name(metric: str, subject: str | None) -> str:

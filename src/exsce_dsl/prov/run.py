@@ -40,7 +40,9 @@ Where exsce differs from the method's published run and its report, on purpose:
   ``xsd:double`` alike); every ``prov:type`` naming a class is a qualified name;
 * topics are ``topic:tiago1/nav_vel`` (the name without its first ``/``, so that
   the IRI is ``<base>topics/tiago1/nav_vel``), where the report wrote
-  ``topic:/tiago1/nav_vel``;
+  ``topic:/tiago1/nav_vel``; a name as a bag may hold it otherwise (relative, with
+  spaces...) is escaped (``topic:@groundtruth``, see :func:`ids.topic_name`), as is the
+  bag file's name;
 * additions: each action's start and end time and ``exsce:status``
   (``SUCCEEDED``/``ABORTED``); ``exsce:unit`` on a value when known;
   ``exsce:metric`` on a ``violation_duration`` value (the safety metric, as the
@@ -155,7 +157,7 @@ class _RunCompiler:
         w.entity(parameters, parameter_facts)
         w.used(run_id, parameters)
         w.used(run_id, w.fixed(ids.EXSCE)[scenario.id])
-        w.generated(parts[ids.check_name(run.bag.file_name, "bag file name")], run_id)
+        w.generated(parts[ids.bag_name(run.bag.file_name)], run_id)
 
         task_type = {PROV_TYPE: t(ids.TASK_EXECUTION_TYPE), uuid_attr: run.uuid}
         action_type = t(ids.ACTION_TYPE)
@@ -211,9 +213,10 @@ class _RunCompiler:
         run, writer = self.run, self.writer
         bag = run.bag
         exsce = writer.document_namespace(ids.EXSCE)
-        w = writer.bundle(exsce[f"{bag.file_name}_bundle"], f"the bundle of bag {bag.file_name}")
+        name = ids.bag_name(bag.file_name)
+        w = writer.bundle(exsce[f"{name}_bundle"], f"the bundle of bag {bag.file_name}")
         t = w.term
-        bag_id = self._parts(w)[bag.file_name]
+        bag_id = self._parts(w)[name]
         writer.claim(bag_id, f"bag {bag.file_name}")
         facts: Attributes = {PROV_TYPE: t(ids.ROS_BAGS)}
         if bag.path is not None:

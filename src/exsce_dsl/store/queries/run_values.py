@@ -7,7 +7,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE
+from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, topic_of_name, unescape_name
 from exsce_dsl.store.base import Rows, Store
 from exsce_dsl.store.queries.segment_stats import ValueStats, stats_of
 from exsce_dsl.store.queries.terms import (
@@ -91,9 +91,9 @@ def metric_sources(
     """Each value of ``metric`` in ``run``, with the topics and the bag it was computed from."""
     grouped: dict[tuple[str | None, str | None, float, str], list[str]] = {}
     for row in run_query(store, "metric_sources", {"run": run, "metric": metric}, namespace):
-        value, bag = float_of(row["value"]) or 0.0, text_of(row["bag"]) or ""
+        value, bag = float_of(row["value"]) or 0.0, unescape_name(text_of(row["bag"]) or "")
         key = (text_of(row["robot"]), text_of(row["segment"]), value, bag)
-        grouped.setdefault(key, []).append(text_of(row["topic"]) or "")
+        grouped.setdefault(key, []).append(topic_of_name(text_of(row["topic_id"]) or ""))
     return [
         MetricSource(robot, segment, value, tuple(sorted(set(topics))), bag)
         for (robot, segment, value, bag), topics in grouped.items()

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model.oracles import Oracle, OracleType
-from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE
+from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, topic_of_name
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.queries.terms import (
     float_of,
@@ -35,7 +35,7 @@ def oracles(store: Store, scenario: str, namespace: str = DEFAULT_NAMESPACE) -> 
     """The oracles that judge runs of ``scenario``: one per metric, robot, window, type and relation."""
     found = []
     for row in run_query(store, "oracles", {"scenario": scenario}, namespace):
-        topics = tuple(sorted((text_of(row["topics"]) or "").split()))
+        topics = tuple(sorted(topic_of_name(n) for n in (text_of(row["topic_ids"]) or "").split()))
         type_text = text_of(row["type"]) or ""
         try:
             oracle_type = OracleType(type_text)
