@@ -188,8 +188,6 @@ DECLARATION_ERRORS = [
      1, 8, "must be letters, digits and '_'"),
     ('metric m for each robot {\n  reads v: std_msgs/Float64 on "/{ns}/v\\"; x"\n  value max(v.data)\n}\n',
      2, 3, "is not a ROS topic name"),
-    ('metric m for each robot {\n  reads v: std_msgs/Float64 on "/v"\n  value max(v.data)\n}\n',
-     2, 3, "needs '{ns}' in its name"),
     ('metric m for each robot per segment {\n  reads v: std_msgs/Float64 on "/{ns}/v"\n  value mean(v.data)\n}\n',
      1, 8, "so that its values over path segments make one value"),
     ('metric m for each robot {\n  unit cm\n  reads v: std_msgs/Float64 on "/{ns}/v"\n  value max(v.data)\n}\n',

@@ -198,9 +198,7 @@ class _MetricBuilder:
                 read,
             )
             return
-        if self.subject is not ComputedFor.MISSION and "{ns}" not in read.topic:
-            self.error(f"a topic of each robot needs '{{ns}}' in its name: '{read.topic}'", read)
-            return
+        # a topic of each robot without '{ns}': only robots at the root may read it (checks.py)
         self.reads[read.name] = TopicRead(read.name, msgtype, read.topic, self.pf.span(read))
         if tree is not None:
             self.trees[read.name] = tree

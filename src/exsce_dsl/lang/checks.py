@@ -13,6 +13,7 @@ from pathlib import Path
 from exsce_dsl.errors import Diagnostic, ExsceError, Severity
 from exsce_dsl.lang.occupancy import FREE, OUTSIDE, OccupancyGrid, load_occupancy_grid
 from exsce_dsl.model import Environment, Pose, Scenario
+from exsce_dsl.model.metrics import ComputedFor
 
 # ROS graph resource names (namespaces): letters, digits, _ and / separators.
 _ROS_NAMESPACE = re.compile(r"(/?[A-Za-z][A-Za-z0-9_]*(/[A-Za-z][A-Za-z0-9_]*)*)?")  # "": the root
@@ -92,7 +93,29 @@ def check_scenario(scenario: Scenario) -> list[Diagnostic]:
                         problem = _pose_problem(grid, waypoint, env.map.name)
                         if problem:
                             found.append(Diagnostic(problem, waypoint.location))
-    return found
+    return found + check_metric_topics(scenario)
+
+
+def check_metric_topics(scenario: Scenario) -> list[Diagnostic]:
+    """A metric of each robot reads each robot's own topics, so its topics name the robot's
+    namespace (``"/{ns}/odom"``); one that does not (``"groundtruth"``) is the same topic for
+    every robot, which only a robot at the root (``namespace ""``) may read as its own."""
+    namespaced = [r for r in scenario.robots if r.namespace.strip("/")]
+    if not namespaced:
+        return []
+    robot = namespaced[0]
+    return [
+        Diagnostic(
+            f"a topic of each robot needs '{{ns}}' in its name: '{read.topic}' (robot '{robot.id}' of "
+            f"scenario '{scenario.id}' is in namespace '{robot.namespace}'; only a robot at the root, "
+            'namespace "", may read a topic without it)',
+            read.location,
+        )
+        for metric in scenario.metrics
+        if metric.subject is not ComputedFor.MISSION
+        for read in metric.reads
+        if not read.signal and "{ns}" not in read.topic
+    ]
 
 
 def check_environment_map(env: Environment) -> list[Diagnostic]:

@@ -181,7 +181,7 @@ def analyse_bag(path: Path, scenario: Scenario, digest: str | None = None) -> An
     values, hotspots = compute_metrics(
         monitors, metrics, robots, topics, actions, results, problems, whole_runs
     )
-    values = [stacks.with_real_sources(v) for v in values]
+    values = [data.spelt(stacks.with_real_sources(v)) for v in values]
     run = Run(
         uuid=run_uuid(digest),
         scenario=scenario.id,

@@ -38,7 +38,7 @@ import importlib
 import mmap
 import struct
 import zlib
-from collections.abc import Callable
+from collections.abc import Callable, Container
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -146,7 +146,7 @@ DECOMPRESSORS: dict[str, Callable[[bytes], bytes]] = {"": _stored, "zstd": _zstd
 """Chunk compression (as the chunk names it) → how its records are decompressed."""
 
 
-def read_topics(path: Path, topics: set[str], decoder: Decoder) -> dict[str, Messages]:
+def read_topics(path: Path, topics: Container[str], decoder: Decoder) -> dict[str, Messages]:
     """The messages of ``topics``, handed to ``decoder`` a batch of chunks and a channel at a time,
     so only what it keeps stays in memory, never the whole bag's chunks.
 
@@ -306,7 +306,7 @@ _RECORD_NAMES = {
 }
 
 
-def _wanted(summary: _Summary, topics: set[str]) -> dict[int, _Channel]:
+def _wanted(summary: _Summary, topics: Container[str]) -> dict[int, _Channel]:
     wanted = {cid: c for cid, c in sorted(summary.channels.items()) if c.topic in topics}
     first: dict[str, Schema | None] = {}
     for channel in wanted.values():
@@ -321,7 +321,7 @@ def _wanted(summary: _Summary, topics: set[str]) -> dict[int, _Channel]:
     return wanted
 
 
-def _read_topics(data: mmap.mmap, topics: set[str], decoder: Decoder) -> dict[str, Messages]:
+def _read_topics(data: mmap.mmap, topics: Container[str], decoder: Decoder) -> dict[str, Messages]:
     summary = _summary(data)
     wanted = _wanted(summary, topics)
     times_of: dict[int, list[np.ndarray]] = {c: [] for c in wanted}

@@ -28,14 +28,8 @@ from exsce_dsl.messages.catalogue import (
 from exsce_dsl.messages.user import configured_user_catalogue
 from exsce_dsl.runs.bags.decode import RawMessages
 from exsce_dsl.runs.bags.mcap_index import Schema, read_topics, schemas
-from exsce_dsl.runs.bags.reading import (
-    OBJECTS,
-    WHOLE,
-    BagData,
-    _Reading,
-    deserialized,
-    deserializer_for,
-)
+from exsce_dsl.runs.bags.objects import deserialized, deserializer_for
+from exsce_dsl.runs.bags.reading import OBJECTS, WHOLE, BagData, _Reading
 from exsce_dsl.runs.bags.ros1_index import Messages, UnsupportedBag
 
 IDL_SEPARATOR = "=" * 80 + "\n"
@@ -90,7 +84,7 @@ class Mcap(_Reading):
         found: dict[str, list[Messages]] = {}
         for file in files:
             self.schemas = schemas(file)
-            for topic, messages in read_topics(file, set(self.wanted), self._decoder).items():
+            for topic, messages in read_topics(file, self.match, self._decoder).items():
                 found.setdefault(topic, []).append(messages)
         if not found:
             raise UnsupportedBag("none of the topics")  # rosbags then says whether the bag is empty
@@ -106,7 +100,7 @@ class Mcap(_Reading):
             all_times = np.concatenate([m.times for m in parts])
             order = np.argsort(all_times, kind="stable")
             read = functools.partial(store.deserialize_cdr, typename=msgtype)
-            lazy = topic if self.wanted[topic].msgtype == OBJECTS else None
+            lazy = topic if self.wanted_for(topic).msgtype == OBJECTS else None
             objects = deserialized(read, [raws[i] for i in order.tolist()], lazy)
             self.add_whole(topic, all_times[order] / 1e9, objects)
         return self.data(start / 1e9, end / 1e9, tuple(sorted(found)))
@@ -126,7 +120,7 @@ class Mcap(_Reading):
         if not self.accepts(topic, msgtype):
             return True  # nothing kept
         catalogue = self._catalogue(topic, msgtype, definition)
-        if self.wanted[topic].msgtype in WHOLE:
+        if self.wanted_for(topic).msgtype in WHOLE:
             return False
         self.prepare(topic, msgtype, catalogue)
         self.add(topic, msgtype, times, self.decode(topic, msgtype, catalogue, messages, cdr=True))

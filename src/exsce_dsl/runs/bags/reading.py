@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Callable, Iterator, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -33,8 +33,12 @@ from exsce_dsl.messages.catalogue import (
 )
 from exsce_dsl.messages.user import configured_user_catalogue
 from exsce_dsl.model.messages import FieldPath, Fields, canonical_type
+from exsce_dsl.model.runs import MetricValue
 from exsce_dsl.runs.bags.decode import TEXTS, DecodeError, RawMessages, decode, decode_slowly, vectorisable
 from exsce_dsl.runs.bags.mcap_index import CorruptBag
+from exsce_dsl.runs.bags.names import BagTopics, TopicMatch
+from exsce_dsl.runs.bags.objects import LazyMessage as LazyMessage
+from exsce_dsl.runs.bags.objects import deserialized, deserializer_for
 from exsce_dsl.runs.bags.ros1_index import UnsupportedBag, connections, read_topics
 
 _PROGRESS = {0: 0, 1: 1}  # PENDING, ACTIVE; every other status is final
@@ -96,6 +100,16 @@ class BagData:
     messages: dict[str, list[tuple[float, Any]]] = field(default_factory=dict)
     """Topics wanted as :data:`OBJECTS`: (receive time, rosbags message object), in time order."""
     problems: list[str] = field(default_factory=list)
+    spellings: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    """A wanted name → the bag's topics read for it, as the bag spells them (see ``bags.names``)."""
+
+    def spelt(self, value: MetricValue) -> MetricValue:
+        """``value`` with its topics named as the bag spells them (``groundtruth`` for a
+        specification's ``/groundtruth``)."""
+        if all(self.spellings.get(t, (t,)) == (t,) for t in value.topics):
+            return value
+        named = [real for t in value.topics for real in self.spellings.get(t, (t,))]
+        return replace(value, topics=tuple(dict.fromkeys(named)))
 
 
 def typestore_for(path: Path):  # type: ignore[no-untyped-def]
@@ -170,19 +184,20 @@ _CHECKED: set[tuple[str, int, int]] = set()
 """Bag files that passed :func:`_check_once`, by path, size and modification time."""
 
 
-def bag_topics(path: Path) -> dict[str, str]:
-    """Topic → its message type (ROS 2 spelling), from the bag's own index (nothing decoded)."""
+def bag_topics(path: Path) -> BagTopics:
+    """Topic → its message type (ROS 2 spelling), from the bag's own index (nothing decoded); a
+    topic is found by any name that reads it (:mod:`~exsce_dsl.runs.bags.names`)."""
     if not path.exists():
         raise BagError(f"{path}: no such bag")
     _check_once(path)
     if _is_ros1(path):
         try:  # the bag's own index: rosbags would read every chunk's index first
-            return {topic: canonical_type(msgtype) for topic, msgtype in connections(path).items()}
+            return BagTopics({topic: canonical_type(msgtype) for topic, msgtype in connections(path).items()})
         except UnsupportedBag:
             pass  # rosbags reads what the index reader does not, and says what is broken
     try:
         with AnyReader([path], default_typestore=typestore_for(path)) as reader:
-            return {c.topic: canonical_type(c.msgtype) for c in reader.connections}
+            return BagTopics({c.topic: canonical_type(c.msgtype) for c in reader.connections})
     except Exception as exc:  # rosbags' readers raise their own errors for corrupt and truncated files
         raise BagError(f"{path}: cannot read the bag: {type(exc).__name__}: {exc}") from None
 
@@ -248,7 +263,10 @@ def _kept(
 
 
 class _Reading:
-    """What reading one bag needs, whatever its format: which topics, how to decode and check."""
+    """What reading one bag needs, whatever its format: which topics, how to decode and check.
+
+    The bag's topics are read for the wanted names that name them (:class:`TopicMatch`): the
+    readers hand in the bag's names, the data goes under the wanted ones."""
 
     def __init__(
         self,
@@ -259,6 +277,7 @@ class _Reading:
     ) -> None:
         self.path = path
         self.wanted = wanted
+        self.match = TopicMatch(wanted)
         self.reduce = reduce
         self.check = check
         self.topics: dict[str, _Topic] = {}
@@ -266,24 +285,47 @@ class _Reading:
         self.objects: dict[str, list[tuple[float, Any]]] = {}
         self.problems: list[str] = []
         self.checked: set[tuple[str, str]] = set()
+        self.spellings: dict[str, list[str]] = {}
+        self._wanted_for: dict[str, Wanted] = {}
+
+    def wanted_for(self, topic: str) -> Wanted:
+        """What is read of the bag's ``topic``: what the names that read it want, together."""
+        found = self._wanted_for.get(topic)
+        if found is None:
+            names = self.match.read_for(topic)
+            found = self.wanted[names[0]]
+            for name in names[1:]:
+                more = self.wanted[name]
+                found = Wanted(
+                    found.msgtype,
+                    tuple(dict.fromkeys([*found.paths, *more.paths])),
+                    tuple(dict.fromkeys([*found.texts, *more.texts])),
+                    found.rows or more.rows,
+                )
+            self._wanted_for[topic] = found
+        return found
 
     def accepts(self, topic: str, msgtype: str) -> bool:
         """Whether the connection of ``topic`` with ``msgtype`` is read (a problem says why not)."""
-        expected = self.wanted[topic].msgtype
+        expected = self.wanted_for(topic).msgtype
         msgtype = canonical_type(msgtype)
         if expected not in WHOLE and msgtype != canonical_type(expected):
             problem = f"topic {topic} carries {msgtype}, not {expected}: its metrics are missing"
             if problem not in self.problems:
                 self.problems.append(problem)
             return False
-        found = self.topics.get(topic)
-        if found is not None and found.msgtype != msgtype:
-            raise BagError(f"{self.path}: topic {topic} carries both {found.msgtype} and {msgtype}")
+        for name in self.match.read_for(topic):
+            found = self.topics.get(name)
+            if found is not None and found.msgtype != msgtype:
+                raise BagError(f"{self.path}: topic {topic} carries both {found.msgtype} and {msgtype}")
+            spelt = self.spellings.setdefault(name, [])
+            if topic not in spelt:
+                spelt.append(topic)
         return True
 
     def prepare(self, topic: str, msgtype: str, catalogue: MessageCatalogue) -> None:
         """Check the fields the metrics read of ``topic`` against the type's definition, once."""
-        if (topic, msgtype) in self.checked or self.wanted[topic].msgtype in WHOLE:
+        if (topic, msgtype) in self.checked or self.wanted_for(topic).msgtype in WHOLE:
             return
         lacking = catalogue.missing(msgtype)
         if lacking:
@@ -293,7 +335,9 @@ class _Reading:
                 "of message packages"
             )
         if self.check is not None:
-            self.check(topic, canonical_type(msgtype), catalogue.tree(msgtype), catalogue.source_of(msgtype))
+            tree, source = catalogue.tree(msgtype), catalogue.source_of(msgtype)
+            for name in self.match.read_for(topic):
+                self.check(name, canonical_type(msgtype), tree, source)
         self.checked.add((topic, msgtype))
 
     def add(
@@ -304,17 +348,19 @@ class _Reading:
         fields: dict[str, np.ndarray],
     ) -> None:
         msgtype = canonical_type(msgtype)
-        found = self.topics.setdefault(topic, _Topic(topic, msgtype))
-        text_keys = [p.key for p in self.wanted[topic].texts]
-        kept = fields if self.wanted[topic].rows else _kept(fields, topic, self.reduce, text_keys)
-        found.add(times, kept, text_keys)
+        wanted = self.wanted_for(topic)
+        text_keys = [p.key for p in wanted.texts]
+        for name in self.match.read_for(topic):
+            found = self.topics.setdefault(name, _Topic(name, msgtype))
+            kept = dict(fields) if wanted.rows else _kept(dict(fields), name, self.reduce, text_keys)
+            found.add(times, kept, text_keys)
 
     def decode(
         self, topic: str, msgtype: str, catalogue: MessageCatalogue, messages: RawMessages, cdr: bool
     ) -> dict[str, np.ndarray]:
         """The wanted fields of one block of ``topic``'s messages: vectorised, or by rosbags
         where :func:`decode` cannot (``wstring`` and ``float128`` fields)."""
-        wanted = self.wanted[topic]
+        wanted = self.wanted_for(topic)
         if vectorisable(catalogue, msgtype):
             return decode(catalogue, msgtype, messages, wanted.paths, cdr, wanted.texts)
         store = deserializer_for(catalogue, msgtype)
@@ -325,14 +371,17 @@ class _Reading:
     def add_whole(self, topic: str, times: np.ndarray, objects: Sequence[Any]) -> None:
         """Messages of a topic wanted whole (``times`` in seconds): the dispatcher's statuses, or
         the objects themselves."""
-        if self.wanted[topic].msgtype == OBJECTS:
-            self.objects.setdefault(topic, []).extend(zip(times.tolist(), objects, strict=True))
+        if self.wanted_for(topic).msgtype == OBJECTS:
+            for name in self.match.read_for(topic):
+                self.objects.setdefault(name, []).extend(zip(times.tolist(), objects, strict=True))
         else:
             updates = [_status_update(m, t, topic) for m, t in zip(objects, times.tolist(), strict=True)]
-            self.updates.setdefault(topic, []).extend(updates)
+            for name in self.match.read_for(topic):
+                self.updates.setdefault(name, []).extend(updates)
 
     def data(self, start: float, end: float, topics: tuple[str, ...]) -> BagData:
         data = BagData(self.path, start, end, topics, problems=self.problems)
+        data.spellings = {name: tuple(spelt) for name, spelt in self.spellings.items()}
         for topic, found in sorted(self.topics.items()):
             data.series[topic] = found.series()
         for topic, updates in sorted(self.updates.items()):
@@ -349,7 +398,7 @@ class _Ros1(_Reading):
 
     def read(self) -> BagData:
         self.catalogues: dict[str, MessageCatalogue] = {}
-        found = read_topics(self.path, set(self.wanted), self._decoder)
+        found = read_topics(self.path, self.match, self._decoder)
         if not found:
             raise UnsupportedBag("none of the topics")  # rosbags then says whether the bag is empty
         start = min(int(m.times.min()) for m in found.values())
@@ -360,7 +409,7 @@ class _Ros1(_Reading):
             store = deserializer_for(self._catalogue(messages.msgtype, messages.definition), messages.msgtype)
             order = np.argsort(messages.times, kind="stable")
             read = functools.partial(store.deserialize_ros1, typename=messages.msgtype)
-            lazy = topic if self.wanted[topic].msgtype == OBJECTS else None
+            lazy = topic if self.wanted_for(topic).msgtype == OBJECTS else None
             objects = deserialized(read, [messages.raws[i] for i in order.tolist()], lazy)
             self.add_whole(topic, messages.times[order] / 1e9, objects)
         return self.data(start / 1e9, end / 1e9, tuple(sorted(found)))
@@ -380,7 +429,7 @@ class _Ros1(_Reading):
         """Decode one chunk's messages of a topic; False: keep their bytes (the dispatcher's)."""
         if not self.accepts(topic, msgtype):
             return True  # nothing kept
-        if self.wanted[topic].msgtype in WHOLE:
+        if self.wanted_for(topic).msgtype in WHOLE:
             return False
         catalogue = self._catalogue(msgtype, definition)
         self.prepare(topic, msgtype, catalogue)
@@ -406,7 +455,7 @@ def _read_with_rosbags(
         cdr = not _is_ros1(path)
         by_topic: dict[str, list[Any]] = {}
         for conn in reader.connections:
-            if conn.topic in wanted and reading.accepts(conn.topic, conn.msgtype):
+            if conn.topic in reading.match and reading.accepts(conn.topic, conn.msgtype):
                 by_topic.setdefault(conn.topic, []).append(conn)
         for _, conns in sorted(by_topic.items()):
             for conn in conns:
@@ -429,7 +478,7 @@ def _read_connection(
     reader: AnyReader, reading: _Reading, conn: Any, catalogue: MessageCatalogue, cdr: bool
 ) -> None:
     topic, msgtype = conn.topic, canonical_type(conn.msgtype)
-    whole = reading.wanted[topic].msgtype in WHOLE
+    whole = reading.wanted_for(topic).msgtype in WHOLE
     if not whole:
         reading.prepare(topic, msgtype, catalogue)
     store = deserializer_for(catalogue, msgtype) if whole else None
@@ -438,7 +487,7 @@ def _read_connection(
         times = np.asarray(stamps, dtype=np.int64)
         if store is not None:
             read = store.deserialize_cdr if cdr else store.deserialize_ros1
-            lazy = topic if reading.wanted[topic].msgtype == OBJECTS else None
+            lazy = topic if reading.wanted_for(topic).msgtype == OBJECTS else None
             reading.add_whole(
                 topic, times / 1e9, deserialized(functools.partial(read, typename=msgtype), raws, lazy)
             )
@@ -446,54 +495,6 @@ def _read_connection(
             reading.add(
                 topic, msgtype, times, reading.decode(topic, msgtype, catalogue, RawMessages.join(raws), cdr)
             )
-
-
-def deserialized(
-    read: Callable[[bytes], Any], raws: Sequence[bytes | memoryview], lazy: str | None = None
-) -> list[Any]:
-    """``read`` of each message, once per distinct message: a status array published once a
-    second is mostly the same bytes again (its objects are then shared, and only read).  With
-    ``lazy`` (the topic's name), each is read when first used (:class:`LazyMessage`)."""
-    seen: dict[bytes, Any] = {}
-    found = []
-    for raw in raws:
-        key = bytes(raw)
-        if key not in seen:
-            seen[key] = LazyMessage(read, key, lazy) if lazy is not None else read(key)
-        found.append(seen[key])
-    return found
-
-
-class LazyMessage:
-    """A message deserialised when one of its fields is first read.  A navigation stack replans
-    about once a second, and each global plan is hundreds of poses; a goal's target needs only the
-    first plan of the goal, so the others are never deserialised.  A message that does not
-    deserialise is a :class:`BagError` naming its topic, when it is read."""
-
-    __slots__ = ("_read", "_raw", "_topic", "_value")
-
-    def __init__(self, read: Callable[[bytes], Any], raw: bytes, topic: str) -> None:
-        self._read, self._raw, self._topic = read, raw, topic
-        self._value: Any = None
-
-    @property
-    def value(self) -> Any:
-        if self._value is None:
-            try:
-                self._value = self._read(self._raw)
-            except Exception as exc:  # rosbags raises struct, index and its own errors on bad bytes
-                raise BagError(f"a message on {self._topic} does not deserialize: {exc}") from None
-        return self._value
-
-    def __getattr__(self, name: str) -> Any:
-        return getattr(self.value, name)
-
-
-def deserializer_for(catalogue: MessageCatalogue, msgtype: str) -> Any:
-    """A rosbags typestore that knows ``msgtype`` (and only what it needs: registering costs)."""
-    store = get_typestore(Stores.EMPTY)
-    store.register(catalogue.needed(msgtype))
-    return store
 
 
 def _blocks(messages: Iterator[tuple[Any, int, bytes]]) -> Iterator[tuple[list[int], list[bytes]]]:

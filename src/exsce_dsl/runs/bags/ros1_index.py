@@ -19,7 +19,7 @@ import gc
 import mmap
 import struct
 import traceback
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Container, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -109,7 +109,7 @@ def _close(data: mmap.mmap) -> None:
             pass
 
 
-def read_topics(path: Path, topics: set[str], decoder: Decoder) -> dict[str, Messages]:
+def read_topics(path: Path, topics: Container[str], decoder: Decoder) -> dict[str, Messages]:
     """The messages of ``topics``, handed to ``decoder`` a batch of chunks at a time, so only what
     it keeps stays in memory, never the whole bag's chunks."""
     with mapped(path) as data:
@@ -124,7 +124,7 @@ def connections(path: Path) -> dict[str, str]:
 
 
 def _connections(
-    data: mmap.mmap, topics: set[str] | None
+    data: mmap.mmap, topics: Container[str] | None
 ) -> tuple[dict[int, tuple[str, str, str]], int, int]:
     """Connection id → (topic, type, message definition) of ``topics`` (all if None); and where
     the chunk infos start, and how many there are."""
@@ -155,7 +155,7 @@ def _connections(
     return found, pos, chunk_count
 
 
-def _read_topics(data: mmap.mmap, topics: set[str], decoder: Decoder) -> dict[str, Messages]:
+def _read_topics(data: mmap.mmap, topics: Container[str], decoder: Decoder) -> dict[str, Messages]:
     wanted, pos, chunk_count = _connections(data, topics)
     chunks = []
     for _ in range(chunk_count):

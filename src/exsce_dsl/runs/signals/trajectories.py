@@ -9,6 +9,7 @@ from the map).  A robot is a namespace with any of these.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -39,7 +40,7 @@ class Trajectory:
     """Positions, shape (n, 2), in the map frame."""
 
 
-def pose_sources(available: dict[str, str]) -> list[RobotSources]:
+def pose_sources(available: Mapping[str, str]) -> list[RobotSources]:
     """Per namespace of the bag (topic → type) that says where a robot is, its preferred source."""
     spaces: dict[str, list[str]] = {}
     for topic, msgtype in sorted(available.items()):
