@@ -11,6 +11,7 @@ rosbags' own deserialisation of the ground truth."""
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -157,6 +158,20 @@ def bags(request: pytest.FixtureRequest, scenario: Scenario, tmp_path_factory: p
     return run.bag, target
 
 
+def broken_copy(bag: Path) -> Path:
+    """``bag`` copied with its largest file cut in half (a recording stopped short)."""
+    target = bag.with_name(f"broken_{bag.name}")
+    if bag.is_dir():
+        shutil.copytree(bag, target)
+        files = sorted(target.iterdir(), key=lambda f: f.stat().st_size)
+        cut = files[-1]
+    else:
+        shutil.copy(bag, target)
+        cut = target
+    cut.write_bytes(cut.read_bytes()[: cut.stat().st_size // 2])
+    return target
+
+
 def ground_truth_x(path: Path) -> np.ndarray:
     """The ground truth's x on both spellings, as rosbags deserialises it."""
     with AnyReader([path], default_typestore=typestore_for("ros1" if path.suffix == ".bag" else "sqlite3")) as reader:
@@ -202,5 +217,10 @@ def test_the_run_prov_and_the_store_name_topics_as_the_bag_does(bags: tuple[Path
         assert not result.failed, result.message
         sources = q.metric_sources(store, result.run_id, "ground_x")
         velocity = q.metric_sources(store, result.run_id, "max_velocity")
+        alone = store.graph_sizes()
+    with EmbeddedStore(None) as store:  # beside a bag that fails, nothing of that one goes in
+        done, failed = ingest_bags([real, broken_copy(real)], scenario, store)
+        assert not done.failed and failed.failed
+        assert store.graph_sizes() == alone
     assert [s.topics for s in sources] == [("/groundtruth", "groundtruth")]
     assert {s.topics for s in velocity} == {("cmd_vel",)} and {s.bag for s in velocity} == {real.name}
