@@ -163,8 +163,15 @@ ERRORS = [
     ("value duration where vel.linear.x", 3, 9, "needs a condition per message"),
     ("value succeeded", 3, 9, "comes from the waypoint dispatcher: read its result topic"),
     ("value abs(1, 2)", 3, 9, "abs(...) takes one value"),
-    ("value max(derivative(vel.linear.x))", 3, 13, "unknown function 'derivative' (the functions: min, max, "
-     "mean, sum, first, last, integral, change, path_length, norm, abs, sqrt)"),
+    ("value max(derivate(vel.linear.x))", 3, 13, "unknown function 'derivate'; did you mean 'derivative'? (the "
+     "functions: min, max, mean, sum, first, last, integral, change, path_length, norm, abs, sqrt, speed, "
+     "derivative)"),
+    ("value max(speed(vel.linear.x))", 3, 13, "speed(...) takes two or three coordinates (x, y[, z]), not 1"),
+    ("value max(derivative(vel.linear.x, vel.linear.y))", 3, 13, "derivative(...) takes one value, not 2"),
+    ("value max(derivative(2))", 3, 13, "derivative(...) is over a number per message, in time, but this is a "
+     "constant"),
+    ("value derivative(max(vel.linear.x))", 3, 9, "derivative(...) is over a number per message, in time, but "
+     "this is one number per window"),
     ("value 2 * max(norml(vel.linear.x))", 3, 17, "unknown function 'norml'; did you mean 'norm'?"),
     ("value count(vel.linear.x > 1)", 3, 9, "'count' is written without parentheses: count where <condition>"),
 ]

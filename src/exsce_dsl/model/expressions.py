@@ -110,7 +110,7 @@ CONDITION_AGGREGATES = ("duration", "count")
 ELEMENTWISE = ("norm", "abs", "sqrt")
 SERIES = ("speed", "derivative")
 """Functions of a topic's values over time, one value per message (see ``monitor_core.speed``)."""
-FUNCTIONS = (*AGGREGATES, *ELEMENTWISE)
+FUNCTIONS = (*AGGREGATES, *ELEMENTWISE, *SERIES)
 """Every function written ``name(...)`` (``duration`` and ``count`` are written ``... where``)."""
 WINDOW_VALUES = ("elapsed", "succeeded")
 
