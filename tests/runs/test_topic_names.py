@@ -32,6 +32,7 @@ from exsce_dsl.prov import serialize_prov
 from exsce_dsl.prov.run import compile_run
 from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.runs.ingest import ingest_bags
+from exsce_dsl.runs.signals.trajectories import trajectories
 from exsce_dsl.sim.run import simulate
 from exsce_dsl.store import queries as q
 from exsce_dsl.store.embedded import EmbeddedStore
@@ -224,3 +225,11 @@ def test_the_run_prov_and_the_store_name_topics_as_the_bag_does(bags: tuple[Path
         assert store.graph_sizes() == alone
     assert [s.topics for s in sources] == [("/groundtruth", "groundtruth")]
     assert {s.topics for s in velocity} == {("cmd_vel",)} and {s.bag for s in velocity} == {real.name}
+
+
+def test_the_report_draws_the_same_paths_from_relative_names(bags: tuple[Path, Path]) -> None:
+    written, real = bags
+    before, after = trajectories(written), trajectories(real)
+    assert len(after) == len(before) >= 1  # the root robot's TF path; 'tf', not '/tf'
+    for a, b in zip(after, before, strict=True):
+        np.testing.assert_array_equal(a.xy, b.xy)

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from exsce_dsl.model.conventions import POSE_TYPES, TfSource
+from exsce_dsl.runs.bags.names import topic_key
 from exsce_dsl.runs.bags.reading import bag_topics, read_bag
 from exsce_dsl.runs.signals.sources import (
     TF_MESSAGE,
@@ -44,11 +45,12 @@ def pose_sources(available: Mapping[str, str]) -> list[RobotSources]:
     """Per namespace of the bag (topic → type) that says where a robot is, its preferred source."""
     spaces: dict[str, list[str]] = {}
     for topic, msgtype in sorted(available.items()):
-        if msgtype in POSE_TYPES or (msgtype == TF_MESSAGE and topic.endswith("/tf")):
-            spaces.setdefault(topic.rsplit("/", 1)[0], []).append(topic)
+        absolute = topic_key(topic)  # a bag's relative 'tf' is at the root, as '/tf' is
+        if msgtype in POSE_TYPES or (msgtype == TF_MESSAGE and absolute.endswith("/tf")):
+            spaces.setdefault(absolute.rsplit("/", 1)[0], []).append(topic)
     found = []
     for ns, topics in sorted(spaces.items()):
-        names = {t.rsplit("/", 1)[1]: t for t in topics}
+        names = {topic_key(t).rsplit("/", 1)[1]: t for t in topics}
         order = [*_PREFERRED, *sorted(set(names) - {*_PREFERRED, *_LAST, "tf"}), *_LAST]
         chosen = [
             Chosen("pose", names[n], available[names[n]])
