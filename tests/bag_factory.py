@@ -34,6 +34,8 @@ from rosbags.rosbag2 import Writer as Ros2Writer
 from rosbags.rosbag2.enums import CompressionFormat, CompressionMode
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
+from exsce_dsl.messages.navigation import ros2_message_definition
+
 TURTLE_POSE = "turtlesim/msg/Pose"
 TURTLE_POSE_MSG = """\
 float32 x
@@ -219,7 +221,11 @@ def _write_ros2(
     with writer:
         connections = [
             writer.add_connection(
-                topic.name, topic.msgtype, typestore=store, offered_qos_profiles=[_qos(10 + topic.publisher)]
+                topic.name,
+                topic.msgtype,
+                typestore=store,
+                offered_qos_profiles=[_qos(10 + topic.publisher)],
+                **_action_definition(store, topic.msgtype),
             )
             for topic in topics
         ]
@@ -232,6 +238,13 @@ def _write_ros2(
                 and storage.chunk.bio.tell() > chunk_bytes
             ):
                 storage.close_chunk()
+
+
+def _action_definition(store: Any, msgtype: str) -> dict[str, str]:
+    """An action type's definition and hash, which rosbags' generator does not write."""
+    if "/action/" not in msgtype:
+        return {}
+    return {"msgdef": ros2_message_definition(store, msgtype), "rihs01": store.hash_rihs01(msgtype)}
 
 
 # ------------------------------------------------------------------ messages

@@ -293,7 +293,7 @@ def test_a_topic_of_an_unexpected_type_is_reported(scenario_c, runs_c, tmp_path:
 
     analysed = analyse_bag(_rewrite(runs_c["ros1"].bag, tmp_path / "retyped.bag", retype), scenario_c)
     assert not any(v.metric == "max_velocity" and v.robot == "tiago1" for v in analysed.run.metrics)
-    assert any("/tiago1/nav_vel carries std_msgs/msg/String" in p for p in analysed.problems)
+    assert any("/tiago1/nav_vel, which carries std_msgs/msg/String" in p for p in analysed.problems), analysed.problems
 
 
 def test_statuses_in_the_bag_are_the_executors(runs_c) -> None:

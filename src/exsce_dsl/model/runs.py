@@ -152,6 +152,17 @@ class Hotspot:
 
 
 @dataclass(frozen=True)
+class RunClock:
+    """The clock one source of a run's bag was timed by: ``log time``, ``header stamps`` or
+    ``transform stamps``; simulated or the wall clock; its stamps' median offset to log time (s)."""
+
+    topic: str
+    clock: str
+    simulated: bool
+    offset: float = 0.0
+
+
+@dataclass(frozen=True)
 class Run:
     """One execution of scenario ``scenario``, identified by its ``uuid``."""
 
@@ -166,6 +177,10 @@ class Run:
     hotspots: tuple[Hotspot, ...] = ()
     parameters: str | None = None
     """The file the run's ROS parameters were saved to, if any."""
+    clocks: tuple[RunClock, ...] = ()
+    """Which clock each of the bag's sources was timed by (the run's timeline)."""
+    conventions: tuple[tuple[str, str, tuple[str, ...]], ...] = ()
+    """(robot, convention, the topics it was detected from) of robots whose type names none."""
 
     def actions(self) -> Iterator[Action]:
         for task in self.tasks:

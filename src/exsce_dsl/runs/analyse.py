@@ -5,9 +5,12 @@ from __future__ import annotations
 import datetime as dt
 import hashlib
 import uuid
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
+
+import numpy as np
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.lang.check_fields import check_fields
@@ -18,7 +21,7 @@ from exsce_dsl.model.expressions import Field, walk
 from exsce_dsl.model.messages import DISPATCHER, POSE, FieldPath, Fields
 from exsce_dsl.model.metrics import MetricDefinition
 from exsce_dsl.model.robots import Robot
-from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Bag, Run, TaskExecution
+from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Bag, Run, RunClock, TaskExecution
 from exsce_dsl.monitor_kit.monitor_core import Compute, Topic, reducer, topic_name
 from exsce_dsl.runs.bags.reading import (
     ANY,
@@ -34,6 +37,14 @@ from exsce_dsl.runs.metrics.compute import HOTSPOT_PATHS, POSE_TOPIC, compute_me
 from exsce_dsl.runs.metrics.monitor_code import load_monitors
 from exsce_dsl.runs.robots import DISPATCHER_SOURCE, SERVED, segment_robot, stack_robots
 from exsce_dsl.runs.segments.dispatcher import SUCCEEDED, Segment, segments
+from exsce_dsl.runs.signals.detect import Detected, pose_like_topics, with_detected_conventions
+from exsce_dsl.runs.signals.timeline import (
+    Timeline,
+    decide_timeline,
+    on_timeline,
+    stamp_catalogue,
+    with_stamps,
+)
 
 _RUN_NAMESPACE = uuid.UUID("5b8f9a52-3f0c-4a8e-8f0e-2d6c1b7e4a90")
 _FEEDBACK = "/{ns}/waypoint_dispatcher/feedback"
@@ -45,6 +56,10 @@ class AnalysedRun:
     run: Run
     content_hash: str
     problems: list[str] = field(default_factory=list)
+    timeline: Timeline | None = None
+    """The run's timeline: which clock each source was timed by."""
+    detected: list[Detected] = field(default_factory=list)
+    """The conventions detected for robots whose type names none."""
 
 
 def content_hash(path: Path) -> str:
@@ -128,19 +143,26 @@ def reductions(monitors: ModuleType, robots: list[Robot]) -> dict[str, Reduce]:
 
 def analyse_bag(path: Path, scenario: Scenario, digest: str | None = None) -> AnalysedRun:
     """The metrics of the bag at ``path`` as a run of ``scenario``; ``digest`` is the bag's
-    :func:`content_hash` when the caller has it already."""
+    :func:`content_hash` when the caller has it already.
+
+    Every robot goes through the same steps: its signals from the sources its convention names
+    (detected from the bag when its type names none), every series on the run's one timeline,
+    then its path segments, then the metrics over both."""
     if digest is None:
         digest = content_hash(path) if path.exists() else ""
-    robots = [r for r in scenario.robots if r.start_pose is not None]
     metrics = run_metrics(scenario)
     source = scenario.location.file if scenario.location else scenario.id
     monitors = load_monitors(metrics, source)
-    declared = [r for r in robots if r.declares_signals]
-    signalled = robots if any(read.signal for m in metrics for read in m.reads) else declared
-    stacks = stack_robots(signalled, bag_topics(path) if signalled else {}, {r.id for r in declared})
-    wanted = stacks.adapt(wanted_topics(metrics, robots), robots)
-    data = read_bag(path, wanted, reductions(monitors, robots), field_checker(metrics, robots))
-    problems = list(data.problems)
+    types = bag_topics(path)
+    robots, detected = with_detected_conventions(
+        [r for r in scenario.robots if r.start_pose is not None], types
+    )
+    stacks = stack_robots(robots, types, {r.id for r in robots})
+    wanted = with_stamps(stacks.adapt(wanted_topics(metrics, robots), robots), types, stamp_catalogue())
+    recorded = read_bag(path, wanted, reductions(monitors, robots), field_checker(metrics, robots))
+    timeline = decide_timeline(recorded)
+    data = on_timeline(recorded, timeline)
+    problems = list(data.problems) + list(timeline.notes)
     for sources in stacks.sources.values():
         problems += sources.notes
     topics = {name: Topic(name, s.t, s.fields) for name, s in data.series.items()}
@@ -154,14 +176,6 @@ def analyse_bag(path: Path, scenario: Scenario, digest: str | None = None) -> An
         feedback, result = topic_name(_FEEDBACK, ns), topic_name(_RESULT, ns)
         updates = data.feedback.get(feedback)
         dispatched = segments(scenario, robot.id, updates) if updates is not None else None
-        if robot.id not in stacks.serves:
-            if dispatched is None:
-                problems.append(f"topic {feedback} is missing: no path segments for '{robot.id}'")
-                results[robot.id] = None
-                continue
-            actions.extend(dispatched)
-            results[robot.id] = _succeeded(data.results.get(result))
-            continue
         found = segment_robot(scenario, robot, data, stacks.track(robot, topics), dispatched)
         problems += found.problems
         actions.extend(found.segments)
@@ -174,25 +188,39 @@ def analyse_bag(path: Path, scenario: Scenario, digest: str | None = None) -> An
             stacks.real_topics[feedback] = stacks.real_topics[result] = (
                 found.topics or stacks.real_topics.get(topic_name(SERVED["pose"], ns), ())
             )
-        if not found.segments:
-            whole_runs[robot.id] = (data.start, data.end)
-    if not any(a.start is not None for a in actions) and not whole_runs:
-        raise BagError(f"{path}: no waypoint goal of scenario '{scenario.id}' became active in this bag")
+        if not found.segments and scenario.mission.tasks_of(robot.id):
+            span = stacks.recorded_span(robot, topics)
+            if span is None:
+                raise BagError(_nothing_of(path, robot, types))
+            whole_runs[robot.id] = span
     values, hotspots = compute_metrics(
         monitors, metrics, robots, topics, actions, results, problems, whole_runs
     )
     values = [data.spelt(stacks.with_real_sources(v)) for v in values]
+    wall = timeline.to_wall
     run = Run(
         uuid=run_uuid(digest),
         scenario=scenario.id,
-        start=_time(data.start),
-        end=_time(data.end),
+        start=_time(recorded.start),
+        end=_time(recorded.end),
         bag=Bag(path.name, data.topics, str(path.resolve())),
-        tasks=_task_executions(actions, segmented_by),
+        tasks=_task_executions(actions, segmented_by, wall),
         metrics=tuple(values),
         hotspots=tuple(hotspots),
+        clocks=tuple(RunClock(c.topic, c.clock, c.simulated, c.offset) for c in timeline.clocks),
+        conventions=tuple((d.robot, d.convention, d.evidence) for d in detected),
     )
-    return AnalysedRun(run, digest, problems)
+    return AnalysedRun(run, digest, problems, timeline, detected)
+
+
+def _nothing_of(path: Path, robot: Robot, types: Mapping[str, str]) -> str:
+    """Why a bag cannot be a run of a scenario with ``robot``: nothing places it."""
+    listed = "; ".join(pose_like_topics(types)) or "none"
+    return (
+        f"{path}: robot '{robot.id}' has no navigation goals and no pose in this bag (namespace "
+        f"'{robot.namespace or '/'}'); the bag's pose-like topics: {listed}. Say where its pose is "
+        'in its robot type (pose on "TOPIC" or pose from tf FIXED -> BODY)'
+    )
 
 
 def _succeeded(final: list[StatusUpdate] | None) -> int | None:
@@ -204,7 +232,10 @@ def _time(seconds: float) -> dt.datetime:
     return dt.datetime.fromtimestamp(seconds, tz=dt.timezone.utc)
 
 
-def _task_executions(actions: list[Segment], segmented_by: dict[str, str]) -> tuple[TaskExecution, ...]:
+def _task_executions(
+    actions: list[Segment], segmented_by: dict[str, str], wall: Callable[[np.ndarray], np.ndarray]
+) -> tuple[TaskExecution, ...]:
+    """The robots' tasks as executed, with their actions' times as the wall clock had them."""
     started = [
         a
         for a in actions
@@ -219,8 +250,8 @@ def _task_executions(actions: list[Segment], segmented_by: dict[str, str]) -> tu
                 a.start_pose,
                 a.goal,
                 ActionStatus(a.status),
-                _time(a.start),  # type: ignore[arg-type]
-                _time(a.end),  # type: ignore[arg-type]
+                _time(float(wall(np.array([a.start]))[0])),
+                _time(float(wall(np.array([a.end]))[0])),
             )
         )
     return tuple(

@@ -101,7 +101,7 @@ class StackRobots:
             signals = signal_topics(robot, data, problems)
             for name, series in signals.items():
                 found[name] = series
-                self.real_topics[name] = robot.chosen[name.rsplit("~", 1)[1]].topics
+                self.real_topics[name] = robot.used[name.rsplit("~", 1)[1]].topics
             if robot.robot not in self.serves:
                 continue
             for signal, pattern in SERVED.items():
@@ -110,7 +110,7 @@ class StackRobots:
                     continue
                 name = topic_name(pattern, robot.namespace)
                 found[name] = _as_method_fields(name, signal, topic)
-                self.real_topics[name] = robot.chosen[signal].topics
+                self.real_topics[name] = robot.used[signal].topics
         return found
 
     def with_real_sources(self, value: MetricValue) -> MetricValue:
@@ -119,6 +119,16 @@ class StackRobots:
             return value
         named = [real for t in value.topics for real in self.real_topics.get(t, (t,))]
         return replace(value, topics=tuple(dict.fromkeys(named)))
+
+    def recorded_span(self, robot: Robot, topics: Mapping[str, Topic]) -> tuple[float, float] | None:
+        """From the first to the last message of the robot's signals (None: it has none)."""
+        found = [
+            topics.get(signal_topic(s, robot.namespace)) for s in ("pose", "velocity", "scan", "distance")
+        ]
+        times = [t.t for t in found if t is not None and len(t)]
+        if not times:
+            return None
+        return min(float(t[0]) for t in times), max(float(t[-1]) for t in times)
 
     def track(self, robot: Robot, topics: Mapping[str, Topic]) -> Track:
         """The robot's pose signal, for segmentation (empty if the bag has none)."""

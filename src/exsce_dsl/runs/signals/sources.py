@@ -24,7 +24,7 @@ source:
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -91,11 +91,18 @@ class Chosen:
     msgtype: str = ""
     tf: TfSource | None = None
     tf_topics: tuple[str, ...] = ()
+    fallbacks: tuple[Chosen, ...] = ()
+    """For a TF chain: the sources after it that the bag has, tried in order when the bag's
+    transforms do not compose the chain (its frames are not there)."""
 
     @property
     def topics(self) -> tuple[str, ...]:
         """The bag's topics it is read from (what a metric's sources name)."""
         return self.tf_topics if self.tf is not None else (self.topic,)
+
+    def with_all(self) -> tuple[Chosen, ...]:
+        """This source and its fallbacks, in order."""
+        return (replace(self, fallbacks=()), *self.fallbacks)
 
 
 @dataclass(frozen=True)
@@ -107,6 +114,8 @@ class RobotSources:
     chosen: Mapping[str, Chosen]
     notes: tuple[str, ...] = ()
     """Why a signal has no source, for the run's problems."""
+    used: dict[str, Chosen] = field(default_factory=dict)
+    """The source each signal was read from, once read (a TF chain's fallback, maybe)."""
 
 
 def choose_sources(robot: Robot, available: Mapping[str, str]) -> RobotSources:
@@ -127,7 +136,7 @@ def choose_sources(robot: Robot, available: Mapping[str, str]) -> RobotSources:
         if found is not None:
             chosen[signal] = found
         elif sources:
-            tried = ", ".join(_described(s, ns) for s in sources)
+            tried = ", ".join(_described(s, ns, types, available) for s in sources)
             notes.append(f"robot '{robot.id}' has no {signal} in this bag (looked for {tried})")
     return RobotSources(robot.id, ns, chosen, tuple(notes))
 
@@ -139,27 +148,45 @@ def _first_present(
     ns: str,
     available: Mapping[str, str],
 ) -> Chosen | None:
-    for source in sources:
-        if isinstance(source, TfSource):
-            tf, static = topic_name(source.tf, ns), topic_name(source.tf_static, ns)
-            if available.get(tf) == TF_MESSAGE:
-                topics = (tf, static) if available.get(static) == TF_MESSAGE else (tf,)
-                return Chosen(signal, tf=source, tf_topics=topics)
-            continue
-        topic = topic_name(source.topic, ns)
-        msgtype = available.get(topic)
-        if msgtype is None or msgtype not in types:
-            continue
-        if source.msgtype is not None and canonical_type(source.msgtype) != msgtype:
-            continue
-        return Chosen(signal, topic, msgtype)
-    return None
+    present = [c for source in sources if (c := _present(signal, source, types, ns, available)) is not None]
+    if not present:
+        return None
+    first = present[0]
+    if first.tf is None:
+        return first
+    return replace(first, fallbacks=tuple(dict.fromkeys(present[1:])))
 
 
-def _described(source: TopicSource | TfSource, ns: str) -> str:
+def _present(
+    signal: str, source: TopicSource | TfSource, types: tuple[str, ...], ns: str, available: Mapping[str, str]
+) -> Chosen | None:
+    if isinstance(source, TfSource):
+        tf, static = topic_name(source.tf, ns), topic_name(source.tf_static, ns)
+        if available.get(tf) != TF_MESSAGE:
+            return None
+        topics = (tf, static) if available.get(static) == TF_MESSAGE else (tf,)
+        return Chosen(signal, tf=source, tf_topics=topics)
+    topic = topic_name(source.topic, ns)
+    msgtype = available.get(topic)
+    if msgtype is None or msgtype not in types:
+        return None
+    if source.msgtype is not None and canonical_type(source.msgtype) != msgtype:
+        return None
+    return Chosen(signal, topic, msgtype)
+
+
+def _described(
+    source: TopicSource | TfSource, ns: str, types: tuple[str, ...], available: Mapping[str, str]
+) -> str:
+    """A source looked for, and what the bag has there instead when it has the topic."""
     if isinstance(source, TfSource):
         return f"TF {source.fixed} -> {source.body} on {topic_name(source.tf, ns)}"
-    return topic_name(source.topic, ns)
+    topic = topic_name(source.topic, ns)
+    there = available.get(topic)
+    expected = (canonical_type(source.msgtype),) if source.msgtype else types
+    if there is None or there in expected:
+        return topic
+    return f"{topic}, which carries {there}, not {' or '.join(expected)}"
 
 
 def signals_wanted(sources: Iterable[RobotSources], scan_paths: Iterable[FieldPath]) -> dict[str, Wanted]:
@@ -174,7 +201,7 @@ def signals_wanted(sources: Iterable[RobotSources], scan_paths: Iterable[FieldPa
         wanted[topic] = Wanted(msgtype, merged_paths, merged_texts, rows=bool(merged_texts))
 
     for robot in sources:
-        for chosen in robot.chosen.values():
+        for chosen in (c for first in robot.chosen.values() for c in first.with_all()):
             if chosen.tf is not None:
                 for topic in chosen.tf_topics:
                     want(topic, TF_MESSAGE, _TF_NUMBERS, _TF_TEXTS)
@@ -205,34 +232,56 @@ def _velocity_paths(msgtype: str) -> list[FieldPath]:
 
 def signal_topics(robot: RobotSources, data: BagData, problems: list[str] | None = None) -> dict[str, Topic]:
     """The robot's signals as topics (:func:`signal_topic` names), from what the bag gave; a TF
-    chain the bag's transforms cannot compose leaves the pose out, and ``problems`` says why."""
+    chain the bag's transforms cannot compose passes to the next source, and when none is left
+    the signal is left out and ``problems`` says why (without ``problems``: :class:`TfError`).
+    ``robot.used`` records the source each signal came from."""
     found: dict[str, Topic] = {}
-    for signal, chosen in robot.chosen.items():
+    for signal, first in robot.chosen.items():
         name = signal_topic(signal, robot.namespace)
-        if chosen.tf is not None:
+        failures: list[tuple[Chosen, str]] = []
+        for chosen in first.with_all():
             try:
-                found[name] = _tf_pose(name, chosen, data)
+                topic = _signal(name, signal, chosen, data)
             except TfError as exc:
-                if problems is None:
-                    raise
-                problems.append(
-                    f"robot '{robot.robot}': no {signal} from TF on {chosen.topics[0]}: {exc.message}"
-                )
+                failures.append((chosen, exc.message))
+                continue
+            if topic is not None:
+                found[name] = topic
+                robot.used[signal] = chosen
+            break
+        if name in found or not failures:
             continue
-        series = data.series.get(chosen.topic)
-        if series is None:
-            continue
-        if signal == "pose":
-            found[name] = _pose(name, series, _POSE_AT[chosen.msgtype])
-        elif signal == "velocity":
-            prefix = ".".join(_VELOCITY_AT[chosen.msgtype])
-            fields = {key: series.fields[f"{prefix}.{key}" if prefix else key] for key in _VELOCITY_KEYS}
-            found[name] = Topic(name, series.t, fields)
-        elif signal == "distance" and chosen.msgtype != FLOAT64:
-            found[name] = _distance(name, series, _POSE_AT[chosen.msgtype])
-        else:
-            found[name] = Topic(name, series.t, dict(series.fields))
+        said = _tf_failures(failures)
+        if problems is None:
+            raise TfError(said)
+        problems.append(f"robot '{robot.robot}': no {signal} from TF on {said}")
     return found
+
+
+def _tf_failures(failures: list[tuple[Chosen, str]]) -> str:
+    """``/tf: no frame ...``, or each chain that was tried with why it failed."""
+    topic = failures[0][0].topics[0]
+    if len(failures) == 1:
+        return f"{topic}: {failures[0][1]}"
+    return topic + ": " + "; ".join(f"{c.tf.clause() if c.tf else c.topic}: {why}" for c, why in failures)
+
+
+def _signal(name: str, signal: str, chosen: Chosen, data: BagData) -> Topic | None:
+    """One signal from one source (None: the bag gave none of its topic's messages)."""
+    if chosen.tf is not None:
+        return _tf_pose(name, chosen, data)
+    series = data.series.get(chosen.topic)
+    if series is None:
+        return None
+    if signal == "pose":
+        return _pose(name, series, _POSE_AT[chosen.msgtype])
+    if signal == "velocity":
+        prefix = ".".join(_VELOCITY_AT[chosen.msgtype])
+        fields = {key: series.fields[f"{prefix}.{key}" if prefix else key] for key in _VELOCITY_KEYS}
+        return Topic(name, series.t, fields)
+    if signal == "distance" and chosen.msgtype != FLOAT64:
+        return _distance(name, series, _POSE_AT[chosen.msgtype])
+    return Topic(name, series.t, dict(series.fields))
 
 
 def _distance(name: str, series: Series, prefix: tuple[str, ...]) -> Topic:

@@ -1,0 +1,150 @@
+"""A robot's convention, detected from its bag when its type names none.
+
+A robot type that says nothing of where its signals are gets them from what the bag holds under
+the robot's namespace, in this order (the first that matches wins):
+
+1. the method's waypoint dispatcher (``/{ns}/waypoint_dispatcher/feedback``): ``method``;
+2. Nav2's actions (``/{ns}/navigate_to_pose/_action/status``, ``follow_waypoints``,
+   ``navigate_through_poses``): ``nav2``;
+3. move_base's actionlib topics (``/{ns}/move_base/status``): ``move_base``;
+4. else no goals (segments by arrival at the planned waypoints, or the whole recording), with the
+   signals found: the pose from TF (``map`` or ``odom`` → ``base_link`` or ``base_footprint``, on
+   ``/{ns}/tf``), else ``/{ns}/amcl_pose``, else an odometry under the namespace (``/{ns}/odom``
+   first, then any other such as ``/jackal_velocity_controller/odom``), else the namespace's only
+   PoseStamped or PoseWithCovarianceStamped topic; the velocity from ``/{ns}/cmd_vel``, else the
+   odometry's twist (else, later, from the poses); the distance along the odometry; the scan on
+   ``/{ns}/scan``, else the namespace's only LaserScan.
+
+"Under the namespace" is every topic below ``/{ns}/`` (every topic, for a robot at the root).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
+
+from exsce_dsl.model.conventions import (
+    LASER_SCAN,
+    METHOD,
+    MOVE_BASE,
+    NAV2,
+    ODOMETRY,
+    POSE_STAMPED,
+    POSE_WITH_COVARIANCE,
+    TWIST,
+    TWIST_STAMPED,
+    Navigation,
+    PoseSource,
+    Signals,
+    TfSource,
+    TopicSource,
+)
+from exsce_dsl.model.metrics import topic_name
+from exsce_dsl.model.robots import Robot
+
+TF_CHAINS = tuple(
+    TfSource(fixed, body) for fixed in ("map", "odom") for body in ("base_link", "base_footprint")
+)
+"""The TF chains a detected pose is read from, in order of preference."""
+
+
+@dataclass(frozen=True)
+class Detected:
+    """The convention picked for one robot and the topics that showed it."""
+
+    robot: str
+    convention: str
+    evidence: tuple[str, ...]
+
+    def describe(self) -> str:
+        shown = ", ".join(self.evidence) if self.evidence else "nothing of its namespace"
+        return f"robot '{self.robot}': convention {self.convention} (detected from {shown})"
+
+
+def with_detected_conventions(
+    robots: list[Robot], types: Mapping[str, str]
+) -> tuple[list[Robot], list[Detected]]:
+    """``robots`` with the convention of each whose type names none detected from the bag's
+    topics (``types``: topic → message type), and what was picked."""
+    found: list[Robot] = []
+    picked: list[Detected] = []
+    for robot in robots:
+        if robot.declares_signals:
+            found.append(robot)
+            continue
+        signals, detected = detect_convention(robot, types)
+        found.append(replace(robot, declared_signals=signals))
+        picked.append(detected)
+    return found, picked
+
+
+def detect_convention(robot: Robot, types: Mapping[str, str]) -> tuple[Signals, Detected]:
+    """The signals of ``robot`` as its bag has them (the rules of this module's docstring)."""
+    ns = robot.namespace
+    dispatcher = topic_name("/{ns}/waypoint_dispatcher/feedback", ns)
+    if dispatcher in types:
+        return METHOD, Detected(robot.id, "method", (dispatcher,))
+    for action in NAV2.actions:
+        status = topic_name(f"{action}/_action/status", ns)
+        if status in types:
+            return NAV2, Detected(robot.id, "nav2", (status,))
+    move_base = topic_name(f"{MOVE_BASE.actions[0]}/status", ns)
+    if move_base in types:
+        return MOVE_BASE, Detected(robot.id, "move_base", (move_base,))
+    return _without_goals(robot, types)
+
+
+def _without_goals(robot: Robot, types: Mapping[str, str]) -> tuple[Signals, Detected]:
+    ns = robot.namespace
+    mine = {t: m for t, m in types.items() if under_namespace(t, ns)}
+    odometry = _odometries(mine, ns)
+    poses: list[PoseSource] = []
+    evidence: list[str] = []
+    tf = topic_name("/{ns}/tf", ns)
+    if types.get(tf) == "tf2_msgs/msg/TFMessage":
+        poses += TF_CHAINS
+        evidence.append(tf)
+    amcl = topic_name("/{ns}/amcl_pose", ns)
+    if mine.get(amcl) == POSE_WITH_COVARIANCE:
+        poses.append(TopicSource(amcl, POSE_WITH_COVARIANCE))
+        evidence.append(amcl)
+    poses += [TopicSource(t, ODOMETRY) for t in odometry]
+    evidence += odometry
+    streams = [t for t, m in mine.items() if m in (POSE_STAMPED, POSE_WITH_COVARIANCE) and t != amcl]
+    if len(streams) == 1:
+        poses.append(TopicSource(streams[0], mine[streams[0]]))
+        evidence.append(streams[0])
+    cmd_vel = topic_name("/{ns}/cmd_vel", ns)
+    velocity = [TopicSource(cmd_vel)] if mine.get(cmd_vel) in (TWIST, TWIST_STAMPED) else []
+    velocity += [TopicSource(t, ODOMETRY) for t in odometry]
+    scans = sorted(t for t, m in mine.items() if m == LASER_SCAN)
+    scan_topic = topic_name("/{ns}/scan", ns)
+    scan = [scan_topic] if scan_topic in scans else scans[:1] if len(scans) == 1 else []
+    signals = Signals(
+        convention="detected",
+        pose=tuple(poses),
+        velocity=tuple(velocity),
+        scan=tuple(TopicSource(t, LASER_SCAN) for t in scan),
+        distance=tuple(TopicSource(t, ODOMETRY) for t in odometry[:1]),
+        navigation=Navigation.NONE,
+    )
+    return signals, Detected(robot.id, "none (no navigation goals)", tuple(evidence))
+
+
+def _odometries(mine: Mapping[str, str], ns: str) -> list[str]:
+    """The namespace's odometry topics, ``/{ns}/odom`` first, then the others by name."""
+    own = topic_name("/{ns}/odom", ns)
+    found = sorted(t for t, m in mine.items() if m == ODOMETRY)
+    return sorted(found, key=lambda t: t != own)
+
+
+def under_namespace(topic: str, namespace: str) -> bool:
+    """Whether ``topic`` is below ``namespace`` (every topic is below the root)."""
+    ns = namespace.strip("/")
+    return not ns or topic.lstrip("/").startswith(f"{ns}/")
+
+
+def pose_like_topics(types: Mapping[str, str]) -> list[str]:
+    """The bag's topics a pose could be read from, for a message that found none."""
+    kinds = (ODOMETRY, POSE_STAMPED, POSE_WITH_COVARIANCE, "tf2_msgs/msg/TFMessage")
+    return sorted(f"{t} ({m})" for t, m in types.items() if m in kinds)

@@ -1,0 +1,92 @@
+"""Bags on two clocks, as Gazebo and Isaac robots record them: log time from the wall clock, the
+stamps inside messages (headers, TF transforms, goal stamps) in simulated time.
+
+:func:`restamp` rewrites a bag the executor wrote (where stamps equal log times) with every stamp
+moved onto a simulated clock, ``sim = SIM_START + (stamp - first log time) * rate``, log times
+left as they were; with ``clock_hz`` it also records ``/clock`` (rosgraph_msgs/msg/Clock) as
+Gazebo publishes it.  The robots drove the same paths, so every distance, speed limit and count
+of the restamped bag equals the original's; durations scale by ``rate``.  Messages are rewritten
+through rosbags' own deserialisation, so nothing of exsce's reading is used to make them.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+from typing import Any
+
+from rosbags.highlevel import AnyReader
+from tests.bag_factory import FORMATS, Topic, typestore_for, write_bag
+
+SIM_START = 931.25
+"""Simulated seconds at the first message: a Gazebo world started a quarter of an hour ago."""
+CLOCK = "/clock"
+CLOCK_TYPE = "rosgraph_msgs/msg/Clock"
+
+
+def restamp(
+    source: Path,
+    target: Path,
+    fmt: str,
+    rate: float = 1.0,
+    clock_hz: float | None = None,
+    lag: dict[str, float] | None = None,
+    shift_to_simulated: bool = True,
+) -> Path:
+    """Write ``source`` to ``target`` (format ``fmt`` of :data:`FORMATS`) with its stamps on a
+    simulated clock (unless not ``shift_to_simulated``); ``lag``: topic → seconds its stamps are
+    further behind (a late publisher)."""
+    with AnyReader([source]) as reader:
+        first = reader.start_time
+        messages: dict[tuple[str, str], list[tuple[int, Any]]] = {}
+        store = typestore_for(fmt)
+        store.register({k: v for k, v in reader.typestore.fielddefs.items() if k not in store.fielddefs})
+        for connection, time_ns, raw in reader.messages():
+            message = reader.deserialize(raw, connection.msgtype)
+            behind = (lag or {}).get(connection.topic, 0.0)
+            if shift_to_simulated:
+                moved = _moved(message, lambda s, b=behind: SIM_START + (s - first * 1e-9) * rate - b, store)
+            else:
+                moved = _moved(message, lambda s, b=behind: s - b, store) if behind else message
+            messages.setdefault((connection.topic, connection.msgtype), []).append((time_ns, moved))
+    topics = [Topic(topic, msgtype, found) for (topic, msgtype), found in messages.items()]
+    if clock_hz is not None:
+        topics.append(
+            _clock(store, first, max(t for found in messages.values() for t, _ in found), rate, clock_hz)
+        )
+    write_bag(target, FORMATS[fmt], topics, store)
+    return target
+
+
+def sim_time(wall_ns: int, first_ns: int, rate: float = 1.0) -> float:
+    """The simulated time :func:`restamp` gives a stamp of ``wall_ns``."""
+    return SIM_START + (wall_ns - first_ns) * 1e-9 * rate
+
+
+def _clock(store: Any, first: int, last: int, rate: float, hz: float) -> Topic:
+    clock_type = store.types[CLOCK_TYPE]
+    period = int(1e9 / hz)
+    found = []
+    for time_ns in range(first, last + period, period):
+        found.append((time_ns, clock_type(clock=_time(store, sim_time(time_ns, first, rate)))))
+    return Topic(CLOCK, CLOCK_TYPE, found)
+
+
+def _time(store: Any, seconds: float) -> Any:
+    sec = int(seconds // 1)
+    return store.types["builtin_interfaces/msg/Time"](
+        sec=sec, nanosec=int(round((seconds - sec) * 1e9)) % 10**9
+    )
+
+
+def _moved(value: Any, move: Any, store: Any) -> Any:
+    """``value`` with every builtin_interfaces/msg/Time in it moved by ``move`` (seconds → seconds)."""
+    if isinstance(value, list | tuple):
+        return type(value)(_moved(v, move, store) for v in value)
+    if not dataclasses.is_dataclass(value) or isinstance(value, type):
+        return value
+    if type(value).__name__.endswith("builtin_interfaces__msg__Time"):
+        stamp = value.sec + value.nanosec * 1e-9
+        return _time(store, move(stamp)) if stamp > 0 else value
+    changes = {f.name: _moved(getattr(value, f.name), move, store) for f in dataclasses.fields(value)}
+    return dataclasses.replace(value, **changes)
