@@ -16,7 +16,16 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from bag_factory import ODOMETRY, POSE_STAMPED, odometry, pose_stamped, typestore_for
+from bag_factory import (
+    ODOMETRY,
+    POSE_STAMPED,
+    Topic,
+    odometry,
+    pose_stamped,
+    series,
+    typestore_for,
+    write_bag,
+)
 from rosbags.highlevel import AnyReader
 from rosbags.rosbag1 import Reader as Ros1Reader
 from rosbags.rosbag1 import Writer as Ros1Writer
@@ -26,11 +35,13 @@ from rosbags.rosbag2 import Writer as Ros2Writer
 
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.model import Scenario
+from exsce_dsl.model.messages import path_of
 from exsce_dsl.model.runs import MetricScope, Run
 from exsce_dsl.prov import identifiers as ids
 from exsce_dsl.prov import serialize_prov
 from exsce_dsl.prov.run import compile_run
 from exsce_dsl.runs.analyse import analyse_bag
+from exsce_dsl.runs.bags.reading import Wanted, bag_topics, read_bag
 from exsce_dsl.runs.ingest import ingest_bags
 from exsce_dsl.runs.signals.trajectories import trajectories
 from exsce_dsl.sim.run import simulate
@@ -233,3 +244,20 @@ def test_the_report_draws_the_same_paths_from_relative_names(bags: tuple[Path, P
     assert len(after) == len(before) >= 1  # the root robot's TF path; 'tf', not '/tf'
     for a, b in zip(after, before, strict=True):
         np.testing.assert_array_equal(a.xy, b.xy)
+
+
+def test_a_ros1_name_that_is_not_utf8_does_not_stop_the_bag(tmp_path: Path) -> None:
+    """ROS 1 records any bytes as a topic's name: one that is not UTF-8 is listed with its bytes
+    written out (it stopped bag_topics and read_bag with a UnicodeDecodeError)."""
+    store = typestore_for("ros1")
+    bag = tmp_path / "odd.bag"
+    odom = series(store, ODOMETRY, 5)
+    write_bag(bag, "ros1", [Topic("/odom", ODOMETRY, odom), Topic("gt\u00e9", ODOMETRY, series(store, ODOMETRY, 5))])
+    raw = bag.read_bytes()
+    assert raw.count("gt\u00e9".encode()) > 0
+    bag.write_bytes(raw.replace("gt\u00e9".encode(), b"gt\xff\xfe"))  # as long: the records stay whole
+    assert dict(bag_topics(bag)) == {"/odom": ODOMETRY, "gt\\xff\\xfe": ODOMETRY}
+    data = read_bag(bag, {"odom": Wanted(ODOMETRY, (path_of("pose", "pose", "position", "x"),))})
+    x = [m.pose.pose.position.x for _, m in odom]
+    np.testing.assert_array_equal(data.series["odom"].fields["pose.pose.position.x"], x)
+    assert data.spellings == {"odom": ("/odom",)}

@@ -144,13 +144,14 @@ def _connections(
         fields, data_at, pos = _record(data, pos)
         if fields.get("op") != bytes([OP_CONN]):
             raise UnsupportedBag("connection record expected")
-        topic = fields["topic"].decode()
+        # ROS 1 records any bytes as a name: one that is not UTF-8 keeps its bytes written out
+        topic = fields["topic"].decode(errors="backslashreplace")
         conn_fields, _ = _header_at(data, data_at)  # the data of a connection record is a header too
         if topics is None or topic in topics:
             found[struct.unpack("<I", fields["conn"])[0]] = (
                 topic,
-                conn_fields.get("type", b"").decode(),
-                conn_fields.get("message_definition", b"").decode(),
+                conn_fields.get("type", b"").decode(errors="backslashreplace"),
+                conn_fields.get("message_definition", b"").decode(errors="backslashreplace"),
             )
     return found, pos, chunk_count
 
