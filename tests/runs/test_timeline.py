@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from pyoxigraph import Store
 from rosbags.highlevel import AnyReader
 from tests.bag_factory import Topic, typestore_for, write_bag
 from tests.clock_bags import CLOCK, CLOCK_TYPE, restamp
@@ -23,6 +24,8 @@ from tests.clock_bags import CLOCK, CLOCK_TYPE, restamp
 from exsce_dsl.errors import BagError
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.model import Scenario
+from exsce_dsl.prov.run import compile_run
+from exsce_dsl.rdf import to_quads, validate
 from exsce_dsl.runs.analyse import AnalysedRun, analyse_bag
 from exsce_dsl.sim.run import simulate
 
@@ -214,3 +217,52 @@ def test_stamps_a_few_hundred_milliseconds_behind_are_the_same_clock(
     for key, value in expected.items():
         if key[0] == "distance_travelled":
             assert found[key] == pytest.approx(value, rel=1e-6), key
+
+
+def test_the_runs_prov_says_each_clock_and_each_detected_convention(
+    scenario: Scenario, analysed: dict[str, tuple[AnalysedRun, AnalysedRun]]
+) -> None:
+    """Written out by hand: the bag's timeline, /tiago1/odom timed by simulated header stamps and
+    /tiago1/cmd_vel by log time, tiago1's convention derived from its Nav2 status topic; and the
+    run's graphs conform to the run shapes."""
+    _, simulated = analysed["mcap-nav2-clock-half-speed"]
+    quads = list(to_quads(compile_run(simulated.run, scenario)))
+    graph = Store()
+    graph.extend(quads)
+    exsce, prov = "https://www.sesame-project.org/scenarios/", "http://www.w3.org/ns/prov#"
+    query = f"""
+        PREFIX exsce: <{exsce}> PREFIX prov: <{prov}>
+        SELECT ?topic ?clock ?simulated WHERE {{
+          ?c a exsce:source_clock ; exsce:clock ?clock ; exsce:simulated_time ?simulated ;
+             prov:wasDerivedFrom ?topic .
+        }}"""
+    found = {
+        (str(row["topic"].value).rsplit("topics/", 1)[1], row["clock"].value, row["simulated"].value)
+        for row in graph.query(query, use_default_graph_as_union=True)
+    }
+    assert ("tiago1/odom", "header stamps", "true") in found
+    assert ("tiago1/cmd_vel", "log time", "true") in found
+    assert ("tiago2/tf", "transform stamps", "true") in found
+    conventions = f"""
+        PREFIX exsce: <{exsce}> PREFIX prov: <{prov}>
+        SELECT ?robot ?convention ?topic WHERE {{
+          ?d a exsce:detected_convention ; exsce:robot ?robot ; exsce:convention ?convention ;
+             prov:wasDerivedFrom ?topic .
+        }}"""
+    rows = {
+        (row["robot"].value, row["convention"].value, str(row["topic"].value).rsplit("topics/", 1)[1])
+        for row in graph.query(conventions, use_default_graph_as_union=True)
+    }
+    assert rows == {
+        ("tiago1", "nav2", "tiago1/navigate_to_pose/_action/status"),
+        ("tiago2", "nav2", "tiago2/navigate_to_pose/_action/status"),
+    }
+    timelines = {
+        row["t"].value
+        for row in graph.query(
+            f"PREFIX exsce: <{exsce}> SELECT ?t WHERE {{ ?b exsce:timeline ?t }}",
+            use_default_graph_as_union=True,
+        )
+    }
+    assert timelines == {"simulated time"}
+    assert validate(quads, ["runs"]) == []

@@ -149,6 +149,9 @@ def simulate(
     "instead of --jobs processes; the bags' paths must be the same on every worker (a shared "
     "filesystem).  Default: $EXSCE_DASK_SCHEDULER.",
 )
+@click.option(
+    "--verbose", "-v", is_flag=True, help="Also say which clock each of a bag's topics was timed by."
+)
 @click.option("--store", "store_url", envvar="EXSCE_STORE", help="Store URL (default: .exsce/store).")
 @reports_errors
 def ingest(
@@ -157,6 +160,7 @@ def ingest(
     scenario_id: str | None,
     jobs: int,
     cluster: str | None,
+    verbose: bool,
     store_url: str | None,
 ) -> None:
     """Compute the metrics of bags and add each run's provenance to the store.
@@ -164,7 +168,9 @@ def ingest(
     Each run is stored wholly or not at all (runs that come faster than one
     by one are committed in groups): a bag that cannot be used is reported
     and nothing of it is written, and the other bags still ingest.  A bag already
-    ingested (same content) is skipped.  Exits 1 if any bag failed.  With
+    ingested (same content) is skipped.  It says the convention it detected for
+    each robot whose type names none, and the run's timeline when its stamps are
+    simulated time (-v: the clock of every topic).  Exits 1 if any bag failed.  With
     --cluster, a Dask cluster's workers analyse the bags (a task is tried
     twice; a killed worker's tasks go to another) and exscec writes each
     run, as with --jobs.
@@ -186,6 +192,8 @@ def ingest(
         def shown(result: IngestResult) -> None:
             progress.update()
             progress.say(f"{'error: ' if result.failed else ''}{result.message}")
+            for line in result.picked + (result.clocks if verbose else ()):
+                progress.say(f"  {line}")
             for problem in result.problems:
                 progress.say(f"warning: {result.bag}: {problem}")
 

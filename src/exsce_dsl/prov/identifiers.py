@@ -291,6 +291,17 @@ STATUS = Term(EXSCE, "status")
 SEGMENTED_BY = Term(EXSCE, "segmented_by")
 """On a task execution: what its actions (path segments) were found from, when not the method's
 dispatcher (a navigation stack's goals, arrival at the planned waypoints)."""
+TIMELINE = Term(EXSCE, "timeline")
+"""On a bag: the clock of the run's timeline, ``simulated time`` or ``wall clock``."""
+SOURCE_CLOCK_TYPE = Term(EXSCE, "source_clock")
+"""The clock one topic of a bag was timed by in a run (derived from the topic)."""
+CLOCK = Term(EXSCE, "clock")
+SIMULATED_TIME = Term(EXSCE, "simulated_time")
+CLOCK_OFFSET = Term(EXSCE, "clock_offset")
+DETECTED_CONVENTION_TYPE = Term(EXSCE, "detected_convention")
+"""Where a robot's signals were found in a run's bag, when its type named no convention
+(derived from the topics that showed it)."""
+CONVENTION = Term(EXSCE, "convention")
 UNIT = Term(EXSCE, "unit")
 METRIC_ATTR = Term(EXSCE, "metric")
 """On a ``violation_duration`` value: the safety metric whose limit was violated."""
@@ -445,6 +456,16 @@ def topic_of_name(local: str) -> str:
 def bag_name(file_name: str) -> str:
     """The local name of a bag, from its file's name (escaped as :func:`escape_name` says)."""
     return escape_name(file_name)
+
+
+def clock_name(topic: str) -> str:
+    """``clock-<topic>``, in the run's namespace: which clock the bag's ``topic`` was timed by."""
+    return f"clock-{topic_name(topic)}"
+
+
+def convention_name(robot_id: str) -> str:
+    """``<robot>-convention``, in the run's namespace: the convention detected for the robot."""
+    return f"{robot_id}-convention"
 
 
 def metric_value_name(metric: str, subject: str | None) -> str:

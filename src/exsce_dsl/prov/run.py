@@ -221,6 +221,10 @@ class _RunCompiler:
         facts: Attributes = {PROV_TYPE: t(ids.ROS_BAGS)}
         if bag.path is not None:
             facts[t(ids.FILE_PATH)] = bag.path
+        if run.clocks:
+            facts[t(ids.TIMELINE)] = (
+                "simulated time" if any(c.simulated for c in run.clocks) else "wall clock"
+            )
         w.entity(bag_id, facts)
         topic_ns = w.fixed(ids.TOPIC)
         topic_type = {PROV_TYPE: t(ids.ROS_TOPICS)}
@@ -228,6 +232,45 @@ class _RunCompiler:
             topic_id = topic_ns[ids.topic_name(topic)]
             w.entity(topic_id, topic_type)
             w.member(bag_id, topic_id)
+        self._clocks(w, set(bag.topics))
+        self._conventions(w, set(bag.topics))
+
+    def _clocks(self, w: BundleWriter, held: set[str]) -> None:
+        """Which clock each topic was timed by on the run's timeline (derived from the topic)."""
+        t, parts, topic_ns = w.term, self._parts(w), w.fixed(ids.TOPIC)
+        for clock in self.run.clocks:
+            if clock.topic not in held:
+                continue
+            clock_id = parts[ids.clock_name(clock.topic)]
+            self.writer.claim(clock_id, f"the clock of topic {clock.topic}")
+            facts: Attributes = {
+                PROV_TYPE: t(ids.SOURCE_CLOCK_TYPE),
+                t(ids.CLOCK): clock.clock,
+                t(ids.SIMULATED_TIME): bool(clock.simulated),
+                t(ids.CLOCK_OFFSET): float(clock.offset),
+            }
+            w.entity(clock_id, facts)
+            w.derivation(clock_id, topic_ns[ids.topic_name(clock.topic)], {})
+
+    def _conventions(self, w: BundleWriter, held: set[str]) -> None:
+        """The convention detected for each robot whose type names none, and the topics it was
+        detected from."""
+        t, parts, topic_ns = w.term, self._parts(w), w.fixed(ids.TOPIC)
+        for robot, convention, evidence in self.run.conventions:
+            self._check_robot(robot, "a detected convention")
+            found = parts[ids.convention_name(robot)]
+            self.writer.claim(found, f"the convention of '{robot}'")
+            w.entity(
+                found,
+                {
+                    PROV_TYPE: t(ids.DETECTED_CONVENTION_TYPE),
+                    t(ids.ROBOT_ATTR): robot,
+                    t(ids.CONVENTION): convention,
+                },
+            )
+            for topic in evidence:
+                if topic in held:
+                    w.derivation(found, topic_ns[ids.topic_name(topic)], {})
 
     def _metric_bundles(self, actions: dict[ActionId, QualifiedName]) -> None:
         by_metric: dict[str, list[MetricValue]] = {}

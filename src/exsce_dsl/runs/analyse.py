@@ -61,6 +61,21 @@ class AnalysedRun:
     detected: list[Detected] = field(default_factory=list)
     """The conventions detected for robots whose type names none."""
 
+    def picked(self) -> list[str]:
+        """What ingestion decided for this bag: each detected convention, and the timeline when
+        it is not simply the wall clock."""
+        said = [d.describe() for d in self.detected]
+        if self.timeline is not None and self.timeline.simulated:
+            said.append(f"timeline: {self.timeline.describe()}")
+        return said
+
+    def clocks(self) -> list[str]:
+        """Which clock each source was timed by, on the run's timeline."""
+        if self.timeline is None:
+            return []
+        said = [] if self.timeline.simulated else [f"timeline: {self.timeline.describe()}"]
+        return said + [f"clock of {c.describe()}" for c in self.timeline.clocks]
+
 
 def content_hash(path: Path) -> str:
     """sha256 of the bag's bytes (all files of a ROS 2 bag folder, in name order)."""
@@ -207,7 +222,11 @@ def analyse_bag(path: Path, scenario: Scenario, digest: str | None = None) -> An
         tasks=_task_executions(actions, segmented_by, wall),
         metrics=tuple(values),
         hotspots=tuple(hotspots),
-        clocks=tuple(RunClock(c.topic, c.clock, c.simulated, c.offset) for c in timeline.clocks),
+        clocks=tuple(
+            RunClock(spelt, c.clock, c.simulated, c.offset)
+            for c in timeline.clocks
+            for spelt in data.spellings.get(c.topic, (c.topic,))
+        ),
         conventions=tuple((d.robot, d.convention, d.evidence) for d in detected),
     )
     return AnalysedRun(run, digest, problems, timeline, detected)

@@ -50,6 +50,10 @@ class IngestResult:
     run_id: str | None = None
     problems: tuple[str, ...] = field(default_factory=tuple)
     statements: int = 0
+    picked: tuple[str, ...] = field(default_factory=tuple)
+    """What ingestion picked for the run: conventions detected, a simulated timeline."""
+    clocks: tuple[str, ...] = field(default_factory=tuple)
+    """Which clock each of the bag's sources was timed by (``exscec ingest -v``)."""
 
     @property
     def failed(self) -> bool:
@@ -172,4 +176,6 @@ def _result(path: Path, analysed: AnalysedRun | None, done: Written) -> IngestRe
         analysed.run.uuid,
         tuple(analysed.problems),
         done.report.statements,
+        tuple(analysed.picked()),
+        tuple(analysed.clocks()),
     )
