@@ -302,8 +302,17 @@ def reducer(
     return reduce
 
 
+def overlaps(t: np.ndarray, start: float, end: float) -> bool:
+    """Whether the window ``[start, end]`` meets the span of times ``t`` (sorted)."""
+    return len(t) > 0 and start <= float(t[-1]) and end >= float(t[0])
+
+
 def value_in(p: Prepared, start: float, end: float) -> float | None:
-    """The aggregate over ``[start, end]``; None when the window has nothing to aggregate."""
+    """The aggregate over ``[start, end]``; None when the window has nothing to aggregate, and
+    when it does not overlap the series at all (a sum, count or path length there is not 0:
+    the series says nothing of that time)."""
+    if not overlaps(p.t, start, end):
+        return None
     w = window(p.t, start, end)
     v = p.v[w]
     if p.func == "duration":
@@ -311,8 +320,6 @@ def value_in(p: Prepared, start: float, end: float) -> float | None:
     if p.func == "count":
         return float(np.count_nonzero(v))
     if p.func == "change":
-        if len(p.t) == 0:
-            return None
         ends = np.interp([start, end], p.t, p.v)
         return float(ends[1] - ends[0])
     if p.func == "path_length":

@@ -89,14 +89,33 @@ def _topics(metric: MetricDefinition, alternative: int, namespaces: Sequence[str
     return tuple(found)
 
 
-def _missing(metric: MetricDefinition, robot: Robot, topics: Mapping[str, core.Topic]) -> str:
+def _missing(
+    metric: MetricDefinition, robot: Robot, topics: Mapping[str, core.Topic], start: float, end: float
+) -> str:
     wanted = _topics(metric, 0, [robot.namespace])
     absent = [t for t in wanted if t not in topics or not len(topics[t])]  # dispatcher topics never are
-    return (
-        f"topic {', '.join(absent)} is missing: {metric.name} of '{robot.id}' is missing"
-        if absent
-        else f"{metric.name} of '{robot.id}' is missing"
-    )
+    what = f"{metric.name} of '{robot.id}'" + (" and its violation duration" if metric.safety else "")
+    verb = "are" if metric.safety else "is"
+    if absent:
+        return f"topic {', '.join(absent)} is missing: {what} {verb} missing"
+    outside = _outside(wanted, topics, start, end)
+    return f"{what} {verb} missing" + (f": {outside}" if outside else "")
+
+
+def _outside(wanted: Sequence[str], topics: Mapping[str, core.Topic], start: float, end: float) -> str:
+    """Which of the ``wanted`` topics have no message near the window, with both time ranges."""
+    found = [
+        f"{name} ({_span(topic.t[0], topic.t[-1])})"
+        for name in wanted
+        if (topic := topics.get(name)) is not None and len(topic) and not core.overlaps(topic.t, start, end)
+    ]
+    if not found:
+        return ""
+    return f"the window {_span(start, end)} does not overlap {', '.join(found)}"
+
+
+def _span(start: float, end: float) -> str:
+    return f"{start:.3f}..{end:.3f} s"
 
 
 def _robot_values(
@@ -104,23 +123,32 @@ def _robot_values(
 ) -> list[MetricValue]:
     prepared = monitor.prepared(metric.name)
     if prepared is None:
-        problems.append(_missing(metric, robot, monitor.topics))
+        problems.append(_missing(metric, robot, monitor.topics, windows[0][1], windows[0][2]))
         return []
     getter = getattr(monitor, f"get_{metric.name}")
     unit = metric.unit or None  # a count has no unit
     topics = _topics(metric, prepared[0], [robot.namespace])  # one alternative for the whole run
     found: list[MetricValue] = []
+    lacking: list[tuple[float, float]] = []
     for action, start, end in windows if metric.per_segment else windows[:1]:
         value = getter(start, end)
         if value is None:
             if action is None:
-                problems.append(_missing(metric, robot, monitor.topics))
+                problems.append(_missing(metric, robot, monitor.topics, start, end))
+            else:
+                lacking.append((start, end))
             continue
         if action is None:
             found.append(MetricValue(metric.name, MetricScope.ROBOT, value, topics, robot.id, unit=unit))
         else:
             aid = ActionId(robot.id, action.allocation, action.subtask, action.waypoint)
             found.append(MetricValue(metric.name, MetricScope.SEGMENT, value, topics, None, aid, unit))
+    if lacking:
+        outside = _outside(topics, monitor.topics, *lacking[0])
+        problems.append(
+            f"{metric.name} of '{robot.id}' is missing for {len(lacking)} of {len(windows) - 1} path segments"
+            + (f" (the first: {outside})" if outside else "")
+        )
     return found
 
 
@@ -151,8 +179,8 @@ def _robot_violations(
     hotspots: list[Hotspot],
 ) -> list[MetricValue]:
     prepared = monitor.prepared(metric.name)
-    if prepared is None:
-        return []
+    if prepared is None or getattr(monitor, f"get_{metric.name}")(start, end) is None:
+        return []  # the metric is missing, so are its violations and hotspots
     choice, aggregates = prepared
     t, held, over = _violations(aggregates[0], metric, start, end)
     source = _topics(metric, choice, [robot.namespace])
@@ -195,8 +223,7 @@ def _mission_values(
         return [MetricValue(metric.name, MetricScope.MISSION, value, read, unit=metric.unit or None)]
     if value is None:
         if len(robots) >= 2:
-            needed = ", ".join(r.topic for r in metric.reads)
-            problems.append(f"{needed} of fewer than two robots: {metric.name} is missing")
+            problems.append(_pairs_missing(monitor, metric, start, end))
         return []
     source: list[str] = []
     violation = 0.0
@@ -230,6 +257,20 @@ def _mission_values(
             )
         )
     return found
+
+
+def _pairs_missing(monitor: Any, metric: MetricDefinition, start: float, end: float) -> str:
+    """Why a metric over pairs of robots is missing: the pairs that have no value."""
+    lacking = []
+    for first, second in monitor.pairs():
+        if getattr(monitor, f"_{metric.name}")(start, end, first, second) is not None:
+            continue
+        read = _topics(metric, 0, [first[1], second[1]])
+        absent = [t for t in read if t not in monitor.topics or not len(monitor.topics[t])]
+        why = f"no {', '.join(absent)}" if absent else _outside(read, monitor.topics, start, end)
+        lacking.append(f"{first[0]} and {second[0]}" + (f" ({why})" if why else ""))
+    what = f"{metric.name} of the mission" + (" and its violation duration are" if metric.safety else " is")
+    return f"{what} missing: no value for {'; '.join(lacking)}"
 
 
 def _pose(topics: Mapping[str, core.Topic], namespace: str) -> core.Topic | None:

@@ -308,8 +308,9 @@ class MissionMetrics:
     def get_distance_between_robots(self, start: float, end: float) -> float | None:
         "least distance between two robots"
         values = [self._distance_between_robots(start, end, first, second) for first, second in self.pairs()]
+        # over every pair, or none: a pair without a value may hold the min
         known = [v for v in values if v is not None]
-        self.distance_between_robots = min(known) if known else None
+        self.distance_between_robots = min(known) if known and len(known) == len(values) else None
         return self.distance_between_robots
 
     def _distance_between_robots(
