@@ -18,11 +18,12 @@ import json
 import keyword
 import math
 import re
+from collections.abc import Callable, Mapping
+from typing import Any
 
 import jinja2
 
 from exsce_dsl.errors import GenerationError as GenerationError
-from exsce_dsl.model.expressions import is_constant
 from exsce_dsl.resources import resource_dir
 
 _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
@@ -99,10 +100,12 @@ def environment() -> jinja2.Environment:
         unwrap=unwrap,
     )
     env.tests["node"] = _is_node
-    env.tests["constant"] = is_constant  # an expression with one number for every window
     return env
 
 
-def render(template: str, **context: object) -> str:
-    """Render ``templates/<template>`` with ``context``."""
-    return environment().get_template(template).render(**context)
+def render(template: str, tests: Mapping[str, Callable[[Any], bool]] | None = None, **context: object) -> str:
+    """Render ``templates/<template>`` with ``context``; ``tests``: Jinja tests the template uses
+    beyond this module's (a layer above passes what only it knows, such as its model's)."""
+    env = environment()
+    env.tests.update(tests or {})
+    return env.get_template(template).render(**context)

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from exsce_dsl.lang.format_metrics import expression_text
-from exsce_dsl.model.expressions import Aggregate, Expression, Field, WindowValue, walk
+from exsce_dsl.model.expressions import Aggregate, Expression, Field, WindowValue, is_constant, walk
 from exsce_dsl.model.messages import FEEDBACK, RESULT
 from exsce_dsl.model.metrics import Combine, ComputedFor, MetricDefinition
 
@@ -139,6 +139,7 @@ def monitor_source(metrics: Sequence[MetricDefinition], source: str, core_import
 
     return render(
         TEMPLATE,
+        tests={"constant": is_constant},  # an expression with one number for every window
         generator=GENERATOR,
         source=source,
         core_import=core_import or "from exsce_dsl.monitor_kit import monitor_core as core",
