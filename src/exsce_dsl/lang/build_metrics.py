@@ -41,7 +41,7 @@ from exsce_dsl.model.metrics import (
     TopicRead,
     signal_pattern,
 )
-from exsce_dsl.model.names import is_topic_pattern
+from exsce_dsl.model.names import TOPIC_RULE, is_topic_pattern
 from exsce_dsl.suggest import did_you_mean
 
 
@@ -193,8 +193,7 @@ class _MetricBuilder:
         tree = self._tree(read, msgtype)
         if not is_topic_pattern(read.topic):
             self.error(
-                f"'{read.topic}' is not a ROS topic name (letters, digits, '_' and '/'; "
-                "'{ns}' for the robot's namespace)",
+                f"'{read.topic}' is not a ROS topic name ({TOPIC_RULE})",
                 read,
             )
             return

@@ -29,7 +29,7 @@ from exsce_dsl.model.conventions import (
     TopicSource,
 )
 from exsce_dsl.model.messages import canonical_type
-from exsce_dsl.model.names import is_topic_pattern
+from exsce_dsl.model.names import TOPIC_RULE, is_topic_pattern
 
 _SIGNAL_FACTS = ("ConventionFact", "PoseFact", "VelocityFact", "ScanFact", "NavigationFact", "ArrivalFact")
 _ACTIONS = {
@@ -114,8 +114,7 @@ def _check_topic(topic: str, where: SourceLocation, error: Report) -> bool:
     if is_topic_pattern(topic):
         return True
     error(
-        f"'{topic}' is not a ROS topic name (letters, digits, '_' and '/'; '{{ns}}' for the robot's "
-        "namespace)",
+        f"'{topic}' is not a ROS topic name ({TOPIC_RULE})",
         where,
     )
     return False

@@ -33,9 +33,16 @@ def is_valid_name(text: str) -> bool:
     return bool(_NAME_RE.fullmatch(text)) and text not in KEYWORDS
 
 
-_TOPIC_RE = re.compile(r"/?(?:[A-Za-z0-9_]|\{ns\})+(?:/(?:[A-Za-z0-9_]|\{ns\})+)*")
+_NOT_IN_TOPICS = re.compile(r'[\s"\\{}]')
+TOPIC_RULE = "any characters but spaces, quotes, backslashes and braces; '{ns}' for the robot's namespace"
+"""What :func:`is_topic_pattern` takes, for error messages."""
 
 
 def is_topic_pattern(text: str) -> bool:
-    """True if ``text`` is a ROS topic name, ``{ns}`` standing for a robot's namespace."""
-    return bool(_TOPIC_RE.fullmatch(text)) and "{" not in text.replace("{ns}", "")
+    """True if ``text`` names a topic as a bag may hold it, ``{ns}`` standing for a robot's
+    namespace: ROS names (``/tiago1/odom``, relative ``groundtruth``) and the names recorders write
+    that ROS 2 would refuse (``ORB-SLAM``, non-ASCII); not one empty or of slashes only, nor one
+    with spaces, quotes, backslashes or braces other than ``{ns}`` (which the language's strings
+    and the generated monitors could not hold as they are)."""
+    rest = text.replace("{ns}", "")
+    return bool(text.replace("/", "")) and text.isprintable() and not _NOT_IN_TOPICS.search(rest)
