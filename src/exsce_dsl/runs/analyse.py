@@ -209,7 +209,7 @@ def analyse_bag(path: Path, scenario: Scenario, digest: str | None = None) -> An
                 raise BagError(_nothing_of(path, robot, types))
             whole_runs[robot.id] = span
     values, hotspots = compute_metrics(
-        monitors, metrics, robots, topics, actions, results, problems, whole_runs
+        monitors, metrics, robots, topics, actions, results, problems, whole_runs, stacks.named(robots)
     )
     values = [data.spelt(stacks.with_real_sources(v)) for v in values]
     wall = timeline.to_wall

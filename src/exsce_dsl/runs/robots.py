@@ -21,7 +21,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from exsce_dsl.model import Scenario
-from exsce_dsl.model.conventions import METHOD, Navigation
+from exsce_dsl.model.conventions import METHOD, Navigation, TfSource, TopicSource
 from exsce_dsl.model.messages import FieldPath
 from exsce_dsl.model.metrics import topic_name
 from exsce_dsl.model.robots import Robot
@@ -120,6 +120,45 @@ class StackRobots:
         named = [real for t in value.topics for real in self.real_topics.get(t, (t,))]
         return replace(value, topics=tuple(dict.fromkeys(named)))
 
+    def named(self, robots: list[Robot]) -> dict[str, str]:
+        """How the run's problems name what the monitors read of these robots: a signal by the
+        bag's topics it was read from, else ``no velocity (looked for /cmd_vel, /odom)``; the
+        dispatcher's topics, of a robot segmented otherwise, by what it was segmented from."""
+        found: dict[str, str] = {}
+        for robot in robots:
+            mine = self.sources.get(robot.id)
+            if mine is None:
+                continue
+            ns, signals = robot.namespace, robot.signals
+            for signal, sources in (
+                ("pose", signals.pose),
+                ("velocity", signals.velocity),
+                ("scan", signals.scan),
+                ("distance", signals.distance),
+            ):
+                served = topic_name(SERVED[signal], ns)
+                chosen = mine.used.get(signal) or mine.chosen.get(signal)
+                looked = [_looked_for(s, ns) for s in sources]
+                if chosen is not None:
+                    said = ", ".join(chosen.topics)
+                elif looked == [served]:
+                    said = served  # the method's own topic: its name says what was looked for
+                elif looked:
+                    said = f"no {signal} (looked for {', '.join(looked)})"
+                else:
+                    said = f"no {signal} (none detected in the bag)"
+                names = [signal_topic(signal, ns)] + ([served] if robot.id in self.serves else [])
+                found.update(dict.fromkeys(names, said))
+            if signals.navigation is not Navigation.DISPATCHER:
+                actions = ", ".join(topic_name(a, ns) for a in signals.actions)
+                said = (
+                    f"no navigation goals (looked for {actions})"
+                    if actions
+                    else "no path segments (no navigation goals, and no arrival at its planned waypoints)"
+                )
+                found.update(dict.fromkeys((topic_name(FEEDBACK, ns), topic_name(RESULT, ns)), said))
+        return found
+
     def recorded_span(self, robot: Robot, topics: Mapping[str, Topic]) -> tuple[float, float] | None:
         """From the first to the last message of the robot's signals (None: it has none)."""
         found = [
@@ -142,6 +181,12 @@ def stack_robots(robots: list[Robot], available: Mapping[str, str], serves: set[
     """``robots``' signals, from the sources the bag (``available``) has; ``serves``: the robots
     whose signals are served under the method's topic names."""
     return StackRobots({r.id: choose_sources(r, available) for r in robots}, serves)
+
+
+def _looked_for(source: TopicSource | TfSource, ns: str) -> str:
+    if isinstance(source, TfSource):
+        return f"TF {source.fixed} -> {source.body} on {topic_name(source.tf, ns)}"
+    return topic_name(source.topic, ns)
 
 
 def _as_method_fields(name: str, signal: str, topic: Topic) -> Topic:

@@ -44,9 +44,14 @@ def compute_metrics(
     results: Mapping[str, int | None],
     problems: list[str],
     whole_runs: Mapping[str, tuple[float, float]] | None = None,
+    named: Mapping[str, str] | None = None,
 ) -> tuple[list[MetricValue], list[Hotspot]]:
     """Every metric of ``metrics`` for a run. ``results``: robot → waypoints SUCCEEDED (None: no topic);
-    ``whole_runs``: robot → the run's span, for robots without path segments (whole-run values only)."""
+    ``whole_runs``: robot → the run's span, for robots without path segments (whole-run values only);
+    ``named``: a topic the monitors read → how the run's problems name it: the bag's topics it was
+    read from, or the sources looked for (a robot's signals are read where its convention puts
+    them, not from the method's topics the metrics are declared over)."""
+    named = named or {}
     values: list[MetricValue] = []
     hotspots: list[Hotspot] = []
     done = [(a, a.start, a.end) for a in actions if a.start is not None and a.end is not None]
@@ -61,7 +66,7 @@ def compute_metrics(
         start, end = (min(s for _, s, _ in mine), max(e for _, _, e in mine)) if mine else whole  # type: ignore[misc]
         monitor = monitors.RobotMetrics(robot.id, robot.namespace, topics, results.get(robot.id))
         for metric in by_subject[ComputedFor.ROBOT]:
-            values += _robot_values(monitor, metric, robot, [(None, start, end), *mine], problems)
+            values += _robot_values(monitor, metric, robot, [(None, start, end), *mine], problems, named)
             if metric.safety is not None:
                 values += _robot_violations(monitor, metric, robot, start, end, topics, hotspots)
     if spans:
@@ -71,7 +76,7 @@ def compute_metrics(
         # a robot without goals (a derivation took its tasks) adds nothing to what the mission read
         acting = [r for r in robots if any(a.robot == r.id for a, _, _ in done) or r.id in (whole_runs or {})]
         for metric in by_subject[ComputedFor.MISSION] + by_subject[ComputedFor.PAIRS]:
-            values += _mission_values(monitor, metric, acting, start, end, topics, hotspots, problems)
+            values += _mission_values(monitor, metric, acting, start, end, topics, hotspots, problems, named)
     return values, hotspots
 
 
@@ -90,22 +95,42 @@ def _topics(metric: MetricDefinition, alternative: int, namespaces: Sequence[str
 
 
 def _missing(
-    metric: MetricDefinition, robot: Robot, topics: Mapping[str, core.Topic], start: float, end: float
+    metric: MetricDefinition,
+    robot: Robot,
+    topics: Mapping[str, core.Topic],
+    start: float,
+    end: float,
+    named: Mapping[str, str],
 ) -> str:
     wanted = _topics(metric, 0, [robot.namespace])
     absent = [t for t in wanted if t not in topics or not len(topics[t])]  # dispatcher topics never are
     what = f"{metric.name} of '{robot.id}'" + (" and its violation duration" if metric.safety else "")
     verb = "are" if metric.safety else "is"
     if absent:
-        return f"topic {', '.join(absent)} is missing: {what} {verb} missing"
-    outside = _outside(wanted, topics, start, end)
+        return f"{_absent(absent, named)}: {what} {verb} missing"
+    outside = _outside(wanted, topics, start, end, named)
     return f"{what} {verb} missing" + (f": {outside}" if outside else "")
 
 
-def _outside(wanted: Sequence[str], topics: Mapping[str, core.Topic], start: float, end: float) -> str:
+def _absent(absent: Sequence[str], named: Mapping[str, str]) -> str:
+    """``topic /a, /b is missing``, or what was looked for instead where ``named`` says (``no
+    velocity (looked for /cmd_vel, /odom)``)."""
+    said = list(dict.fromkeys(named.get(t, t) for t in absent))
+    if not any(s.startswith("no ") for s in said):
+        return f"topic {', '.join(said)} is missing"
+    return "; ".join(s if s.startswith("no ") else f"no topic {s}" for s in said)
+
+
+def _outside(
+    wanted: Sequence[str],
+    topics: Mapping[str, core.Topic],
+    start: float,
+    end: float,
+    named: Mapping[str, str],
+) -> str:
     """Which of the ``wanted`` topics have no message near the window, with both time ranges."""
     found = [
-        f"{name} ({_span(topic.t[0], topic.t[-1])})"
+        f"{named.get(name, name)} ({_span(topic.t[0], topic.t[-1])})"
         for name in wanted
         if (topic := topics.get(name)) is not None and len(topic) and not core.overlaps(topic.t, start, end)
     ]
@@ -119,11 +144,16 @@ def _span(start: float, end: float) -> str:
 
 
 def _robot_values(
-    monitor: Any, metric: MetricDefinition, robot: Robot, windows: list[Window], problems: list[str]
+    monitor: Any,
+    metric: MetricDefinition,
+    robot: Robot,
+    windows: list[Window],
+    problems: list[str],
+    named: Mapping[str, str],
 ) -> list[MetricValue]:
     prepared = monitor.prepared(metric.name)
     if prepared is None:
-        problems.append(_missing(metric, robot, monitor.topics, windows[0][1], windows[0][2]))
+        problems.append(_missing(metric, robot, monitor.topics, windows[0][1], windows[0][2], named))
         return []
     getter = getattr(monitor, f"get_{metric.name}")
     unit = metric.unit or None  # a count has no unit
@@ -134,7 +164,7 @@ def _robot_values(
         value = getter(start, end)
         if value is None:
             if action is None:
-                problems.append(_missing(metric, robot, monitor.topics, start, end))
+                problems.append(_missing(metric, robot, monitor.topics, start, end, named))
             else:
                 lacking.append((start, end))
             continue
@@ -144,7 +174,7 @@ def _robot_values(
             aid = ActionId(robot.id, action.allocation, action.subtask, action.waypoint)
             found.append(MetricValue(metric.name, MetricScope.SEGMENT, value, topics, None, aid, unit))
     if lacking:
-        outside = _outside(topics, monitor.topics, *lacking[0])
+        outside = _outside(topics, monitor.topics, *lacking[0], named)
         problems.append(
             f"{metric.name} of '{robot.id}' is missing for {len(lacking)} of {len(windows) - 1} path segments"
             + (f" (the first: {outside})" if outside else "")
@@ -213,6 +243,7 @@ def _mission_values(
     topics: Mapping[str, core.Topic],
     hotspots: list[Hotspot],
     problems: list[str],
+    named: Mapping[str, str],
 ) -> list[MetricValue]:
     value = getattr(monitor, f"get_{metric.name}")(start, end)
     if metric.subject is ComputedFor.MISSION:
@@ -223,7 +254,7 @@ def _mission_values(
         return [MetricValue(metric.name, MetricScope.MISSION, value, read, unit=metric.unit or None)]
     if value is None:
         if len(robots) >= 2:
-            problems.append(_pairs_missing(monitor, metric, start, end))
+            problems.append(_pairs_missing(monitor, metric, start, end, named))
         return []
     source: list[str] = []
     violation = 0.0
@@ -259,7 +290,9 @@ def _mission_values(
     return found
 
 
-def _pairs_missing(monitor: Any, metric: MetricDefinition, start: float, end: float) -> str:
+def _pairs_missing(
+    monitor: Any, metric: MetricDefinition, start: float, end: float, named: Mapping[str, str]
+) -> str:
     """Why a metric over pairs of robots is missing: the pairs that have no value."""
     lacking = []
     for first, second in monitor.pairs():
@@ -267,7 +300,9 @@ def _pairs_missing(monitor: Any, metric: MetricDefinition, start: float, end: fl
             continue
         read = _topics(metric, 0, [first[1], second[1]])
         absent = [t for t in read if t not in monitor.topics or not len(monitor.topics[t])]
-        why = f"no {', '.join(absent)}" if absent else _outside(read, monitor.topics, start, end)
+        said = list(dict.fromkeys(named.get(t, t) for t in absent))
+        lacked = "; ".join(s if s.startswith("no ") else f"no {s}" for s in said)
+        why = lacked if absent else _outside(read, monitor.topics, start, end, named)
         lacking.append(f"{first[0]} and {second[0]}" + (f" ({why})" if why else ""))
     what = f"{metric.name} of the mission" + (" and its violation duration are" if metric.safety else " is")
     return f"{what} missing: no value for {'; '.join(lacking)}"
