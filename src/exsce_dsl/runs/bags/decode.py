@@ -46,6 +46,7 @@ from exsce_dsl.lang.check_fields import FieldProblem, field_shape
 from exsce_dsl.messages.catalogue import ARRAY, BASE, NAME, NUMERIC, SEQUENCE, MessageCatalogue
 from exsce_dsl.model.messages import FieldPath, Index, Select, Step, canonical_type
 from exsce_dsl.monitor_kit.monitor_core import PRESENT
+from exsce_dsl.runs.bags.gather import distinct_rows, gather_values, text_words
 
 _UNVECTORISED = ("wstring", "float128")
 TEXTS = "#texts"
@@ -196,10 +197,7 @@ class _Walker:
                 table = self.buffer[first : first + len(rows) * self.width].reshape(len(rows), self.width)
                 values = table[:, at : at + size * many].view(code)
                 return values[:, 0] if count is None else values
-        at_bytes = pos[:, None] + np.arange(size * many, dtype=np.int64)
-        raw = self.buffer[at_bytes]
-        values = raw.view(code)
-        return values[:, 0] if count is None else values
+        return gather_values(self.buffer, np.dtype(code), pos, count)
 
     def _code(self, basetype: str) -> str:
         kind = NUMERIC[basetype]
@@ -310,10 +308,9 @@ class _Walker:
         rows of bytes, the distinct rows found with numpy, and only those decoded."""
         sizes = np.maximum(lengths - (1 if self.cdr else 0), 0)  # CDR counts the terminating NUL
         width = int(sizes.max(initial=0))
-        inside = np.arange(width) < sizes[:, None]
-        table = np.where(inside, self.buffer[np.where(inside, pos[:, None] + np.arange(width), 0)], 0)
-        rows = np.concatenate([table.astype(np.uint8), sizes.astype("<u4").view(np.uint8).reshape(-1, 4)], 1)
-        first, inverse = _distinct_rows(rows)
+        table = text_words(self.buffer, pos, sizes, -(-width // 8)).view(np.uint8)[:, :width]
+        rows = np.concatenate([table, sizes.astype("<u4").view(np.uint8).reshape(-1, 4)], 1)
+        first, inverse = distinct_rows(rows)
         codes = np.empty(len(first), dtype=np.float64)
         for i, row in enumerate(rows[first]):
             raw = bytes(row)
@@ -495,27 +492,6 @@ def _element(counts: np.ndarray, index: Index) -> np.ndarray:
     if index.position < 0:
         which = counts + index.position
     return np.where((which >= 0) & (which < counts), which, -1)
-
-
-def _distinct_rows(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The distinct rows of a uint8 table: the index of each one's first occurrence, and which of
-    them every row is.  Rows are keyed by a 64-bit hash of their bytes, so numpy sorts integers, not
-    byte strings; a collision (rows with one key that differ) falls back to sorting the bytes."""
-    n, width = rows.shape
-    words = np.zeros((n, -(-width // 8) * 8), dtype=np.uint8)
-    words[:, :width] = rows
-    keys = np.zeros(n, dtype=np.uint64)
-    for column in words.view("<u8").T:  # FNV-style mixing, one 8-byte word at a time
-        keys = (keys ^ column) * np.uint64(0x100000001B3)
-        keys ^= keys >> np.uint64(29)
-    _, first, inverse = np.unique(keys, return_index=True, return_inverse=True)
-    inverse = inverse.ravel()
-    if not np.array_equal(rows[first][inverse], rows):
-        _, first, inverse = np.unique(
-            np.ascontiguousarray(rows).view(f"V{width}").ravel(), return_index=True, return_inverse=True
-        )
-        inverse = inverse.ravel()
-    return first, inverse
 
 
 def _spread(values: np.ndarray, active: np.ndarray, n: int) -> np.ndarray:

@@ -243,13 +243,15 @@ def _concatenate(parts: Sequence[np.ndarray]) -> np.ndarray:
     """Blocks of one field joined; rows of arrays padded with NaN to the widest block."""
     if len(parts) == 1:
         return parts[0]
-    if parts[0].ndim == 2:
-        width = max(p.shape[1] for p in parts)
-        parts = [
-            p if p.shape[1] == width else np.pad(p, ((0, 0), (0, width - p.shape[1])), constant_values=np.nan)
-            for p in parts
-        ]
-    return np.concatenate(parts)
+    if parts[0].ndim != 2 or all(p.shape[1] == parts[0].shape[1] for p in parts):
+        return np.concatenate(parts)
+    width = max(p.shape[1] for p in parts)  # one copy into the padded table, not a padded copy a block
+    joined = np.full((sum(len(p) for p in parts), width), np.nan, dtype=np.result_type(*parts))
+    at = 0
+    for part in parts:
+        joined[at : at + len(part), : part.shape[1]] = part
+        at += len(part)
+    return joined
 
 
 def _kept(

@@ -28,6 +28,7 @@ import numpy as np
 
 from exsce_dsl.runs.bags.chunk_batches import ChunkBatch
 from exsce_dsl.runs.bags.decode import RawMessages
+from exsce_dsl.runs.bags.gather import gather_values
 
 MAGIC = b"#ROSBAG V2.0\n"
 OP_MSG, OP_BAG, OP_INDEX, OP_CHUNK, OP_CHUNK_INFO, OP_CONN = 0x02, 0x03, 0x04, 0x05, 0x06, 0x07
@@ -277,9 +278,7 @@ def _header_at(data: Buffer, data_at: int) -> tuple[dict[str, bytes], int]:
 def _u32(chunk: np.ndarray, offsets: np.ndarray) -> np.ndarray:
     if len(offsets) and int(offsets.max()) + 4 > len(chunk):
         raise UnsupportedBag("an index points outside its chunk")
-    b = chunk[offsets[:, None] + np.arange(4)].astype(np.int64)
-    value: np.ndarray = b[:, 0] | (b[:, 1] << 8) | (b[:, 2] << 16) | (b[:, 3] << 24)
-    return value
+    return gather_values(chunk, np.dtype("<u4"), offsets, None).astype(np.int64)
 
 
 def _ros2_name(msgtype: str) -> str:

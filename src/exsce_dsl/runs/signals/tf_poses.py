@@ -91,14 +91,18 @@ class EdgeSeries:
             & np.isfinite(rotation).all(axis=1)
             & (norm > 1e-12)
         )
-        order = np.argsort(times[keep], kind="stable")
-        times = times[keep][order]
-        translation = translation[keep][order]
-        rotation = (rotation[keep] / norm[keep, None])[order]
-        if len(times) > 1:
+        if not keep.all():
+            times, translation, rotation, norm = times[keep], translation[keep], rotation[keep], norm[keep]
+        rotation = rotation / norm[:, None]
+        if len(times) > 1 and not np.all(times[1:] >= times[:-1]):  # a stable sort of sorted rows keeps them
+            order = np.argsort(times, kind="stable")
+            times, translation, rotation = times[order], translation[order], rotation[order]
+        if len(times) > 1:  # the gathers copy the caller's arrays
             last_of_stamp = np.append(times[1:] != times[:-1], True)
             times, translation = times[last_of_stamp], translation[last_of_stamp]
             rotation = rotation[last_of_stamp]
+        else:
+            times, translation = times.copy(), translation.copy()
         if len(rotation) > 1:
             dots = np.einsum("ij,ij->i", rotation[1:], rotation[:-1])
             rotation[1:] *= np.cumprod(np.where(dots < 0.0, -1.0, 1.0))[:, None]
