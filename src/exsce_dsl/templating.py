@@ -103,9 +103,14 @@ def environment() -> jinja2.Environment:
     return env
 
 
-def render(template: str, tests: Mapping[str, Callable[[Any], bool]] | None = None, **context: object) -> str:
-    """Render ``templates/<template>`` with ``context``; ``tests``: Jinja tests the template uses
-    beyond this module's (a layer above passes what only it knows, such as its model's)."""
+def render(template: str, **context: object) -> str:
+    """Render ``templates/<template>`` with ``context``."""
+    return environment().get_template(template).render(**context)
+
+
+def render_with_tests(template: str, tests: Mapping[str, Callable[[Any], bool]], **context: object) -> str:
+    """:func:`render` with Jinja tests the template uses beyond this module's (a layer above
+    passes what only it knows, such as its model's)."""
     env = environment()
-    env.tests.update(tests or {})
+    env.tests.update(tests)
     return env.get_template(template).render(**context)

@@ -293,6 +293,33 @@ CASES = [
         1,
         "imported file 'taskz.exsce' not found (looked for taskz.exsce); did you mean 'tasks.exsce'?",
     ),
+    (
+        "window-stated-twice",
+        "scenario.exsce",
+        "  torso yes\n",
+        "  torso yes\n  window goals\n  window whole recording\n",
+        8,
+        3,
+        "robot type 'tiago' states its window twice",
+    ),
+    (
+        "motion-stated-twice",
+        "scenario.exsce",
+        "  torso yes\n",
+        "  torso yes\n  motion 3d\n  motion planar\n",
+        8,
+        3,
+        "robot type 'tiago' states its motion twice",
+    ),
+    (
+        "unknown-motion",
+        "scenario.exsce",
+        "  torso yes\n",
+        "  torso yes\n  motion flying\n",
+        7,
+        10,
+        "expected 'planar' or '3d', found 'flying'",
+    ),
 ]
 
 

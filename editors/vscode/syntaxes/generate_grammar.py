@@ -239,8 +239,9 @@ def repository() -> dict[str, Rule]:
             keywords("torso"),
             keywords("yes no", "constant.language.boolean" + S),
             # where its signals are: convention nav2, pose from tf map -> base_link, velocity on "..." TYPE
-            keywords("convention pose velocity scan navigation arrival from tf on within and"),
+            keywords("convention pose velocity scan navigation arrival from tf on within and motion window"),
             keywords("method nav2 move_base dispatcher none", "constant.language.convention" + S),
+            keywords("planar 3d goals whole recording", "constant.language.motion" + S),
             match(MESSAGE_TYPE, "support.type.message" + S),
             include("topic-strings"),
             include("quantity"),
@@ -533,7 +534,7 @@ def repository() -> dict[str, Rule]:
             ),
             match(
                 METRIC_BEFORE
-                + r"(min|max|mean|sum|first|last|integral|change|path_length|norm|abs|sqrt|len)(?=\s*\()",
+                + r"(min|max|mean|sum|first|last|integral|change|path_length|norm|abs|sqrt|len|speed|derivative)(?=\s*\()",
                 None,
                 _1="support.function.builtin" + S,
             ),

@@ -265,21 +265,24 @@ class _Builder:
     def _robot_type(self, d: _Declared) -> RobotType:
         base: str | None = None
         torso: bool | None = None
+        motion = "planar"
         seen: set[str] = set()
+        words = {"BaseFact": "base", "TorsoFact": "torso", "MotionFact": "motion"}
         for fact in d.obj.facts:
             kind = fact.__class__.__name__
-            if kind not in ("BaseFact", "TorsoFact"):
+            if kind not in words:
                 continue  # where its signals are: build_signals
             if kind in seen:
-                word = "base" if kind == "BaseFact" else "torso"
-                self.error(f"robot type '{d.obj.name}' states its {word} twice", d.file.span(fact))
+                self.error(f"robot type '{d.obj.name}' states its {words[kind]} twice", d.file.span(fact))
             seen.add(kind)
             if kind == "BaseFact":
                 base = fact.base
-            else:
+            elif kind == "TorsoFact":
                 torso = fact.torso == "yes"
+            else:
+                motion = fact.motion
         signals = build_signals(f"robot type '{d.obj.name}'", d.obj.facts, d.file.span, self.error)
-        return RobotType(d.obj.name, base, torso, d.name_location, signals)
+        return RobotType(d.obj.name, base, torso, d.name_location, signals, motion)
 
     # ----------------------------------------------------------- environments
     def _environment(self, d: _Declared) -> Environment:

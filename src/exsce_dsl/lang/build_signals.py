@@ -3,7 +3,8 @@
 ``convention nav2`` takes Nav2's sources; each ``pose``, ``velocity``, ``scan``,
 ``navigation`` or ``arrival`` line replaces the convention's for that signal
 (several ``pose`` lines are a list of preference, tried in order at ingest).
-A robot type that says none of this follows the method's convention.
+A robot type that names no convention has it detected from each bag at ingest, and its own lines
+win over what is detected (``Signals.said``); one that says none of this at all likewise.
 """
 
 from __future__ import annotations
@@ -27,11 +28,20 @@ from exsce_dsl.model.conventions import (
     TfSource,
     Tolerance,
     TopicSource,
+    Window,
 )
 from exsce_dsl.model.messages import canonical_type
 from exsce_dsl.model.names import TOPIC_RULE, is_topic_pattern
 
-_SIGNAL_FACTS = ("ConventionFact", "PoseFact", "VelocityFact", "ScanFact", "NavigationFact", "ArrivalFact")
+_SIGNAL_FACTS = (
+    "ConventionFact",
+    "PoseFact",
+    "VelocityFact",
+    "ScanFact",
+    "NavigationFact",
+    "ArrivalFact",
+    "WindowFact",
+)
 _ACTIONS = {
     Navigation.DISPATCHER: METHOD.actions,
     Navigation.NAV2: NAV2.actions,
@@ -39,6 +49,8 @@ _ACTIONS = {
     Navigation.NONE: (),
 }
 
+_ONCE = {"NavigationFact": "navigation", "ArrivalFact": "arrival tolerance", "WindowFact": "window"}
+"""The facts a robot type states once, by the word an error calls them."""
 Report = Callable[[str, SourceLocation], None]
 Span = Callable[[Any], SourceLocation]
 
@@ -72,9 +84,9 @@ def build_signals(
         elif kind == "ScanFact":
             if (source := _topic(fact.source, (LASER_SCAN,), "a laser scan", span, error)) is not None:
                 scans.append(source)
-        elif kind in ("NavigationFact", "ArrivalFact"):
+        elif kind in ("NavigationFact", "ArrivalFact", "WindowFact"):
             if kind in said:
-                word = "navigation" if kind == "NavigationFact" else "arrival tolerance"
+                word = _ONCE[kind]
                 error(f"{type_name} states its {word} twice", span(fact))
             said[kind] = fact
     changes: dict[str, Any] = {}
@@ -93,8 +105,14 @@ def build_signals(
         changes["navigation"], changes["actions"] = navigation, actions
     if "ArrivalFact" in said:
         changes["tolerance"] = _tolerance(said["ArrivalFact"], span, error)
+    if "WindowFact" in said:
+        changes["window"] = Window.RECORDING if said["WindowFact"].recording else Window.GOALS
     location = span(conventions[0] if conventions else mine[0])
-    return signals.overridden(**changes, location=location)
+    named = bool(conventions) or (base.named and base is not METHOD)
+    own = frozenset(changes) - {"actions"}
+    return signals.overridden(
+        **changes, location=location, named=named, said=own if conventions else base.said | own
+    )
 
 
 def _topic(source: Any, allowed: tuple[str, ...], what: str, span: Span, error: Report) -> TopicSource | None:

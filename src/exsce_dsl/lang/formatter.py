@@ -38,7 +38,7 @@ from exsce_dsl.model import (
     Specification,
     Task,
 )
-from exsce_dsl.model.conventions import CONVENTIONS, Signals, Tolerance
+from exsce_dsl.model.conventions import CONVENTIONS, METHOD, Signals, Tolerance
 from exsce_dsl.model.derived import DerivedScenario
 from exsce_dsl.model.metrics import MetricDefinition
 
@@ -119,6 +119,8 @@ def _robot_type(rtype: RobotType) -> list[Line]:
         facts.append((f"{INDENT}base {rtype.base}", None))
     if rtype.torso is not None:
         facts.append((f"{INDENT}torso {'yes' if rtype.torso else 'no'}", None))
+    if rtype.motion != "planar":
+        facts.append((f"{INDENT}motion {rtype.motion}", None))
     facts += [(f"{INDENT}{line}", None) for line in signal_lines(rtype.declared_signals)]
     if not facts:
         return [(f"robot type {rtype.id} {{ }}", rtype.location)]
@@ -132,8 +134,9 @@ def signal_lines(signals: Signals | None, over: Signals | None = None) -> list[s
         return []
     lines = []
     if over is None or over.convention != signals.convention:
-        base = CONVENTIONS[signals.convention]
-        lines.append(f"convention {signals.convention}")
+        base = CONVENTIONS[signals.convention] if signals.convention in CONVENTIONS else METHOD
+        if signals.named:
+            lines.append(f"convention {signals.convention}")
     else:
         base = over
     if signals.pose != base.pose:
@@ -147,6 +150,8 @@ def signal_lines(signals: Signals | None, over: Signals | None = None) -> list[s
         lines.append(f"navigation {signals.navigation.value}" + (f" on {actions}" if actions else ""))
     if signals.tolerance != base.tolerance:
         lines.append(_arrival(signals.tolerance))
+    if signals.window != base.window:
+        lines.append(f"window {signals.window.value}")
     return lines
 
 

@@ -10,9 +10,15 @@ MEANINGS: dict[str, str] = {
     "base": "`base NAME`: the robot type's mobile base (e.g. pmb2, omni_base).",
     "torso": "`torso yes|no`: whether the robot type has a torso.",
     "convention": "`convention method|nav2|move_base`: where the robot type's signals are in its bags: "
-    "the method's topics (the default), Nav2's (pose from TF map -> base_link, else amcl_pose, else "
-    "odom; velocity on cmd_vel) or move_base's; each `pose`, `velocity`, `scan`, `navigation` or "
-    "`arrival` line overrides one.",
+    "the method's topics, Nav2's (pose from TF map -> base_link, else amcl_pose, else "
+    "odom; velocity on cmd_vel) or move_base's; named by none, it is detected from each bag. Each "
+    "`pose`, `velocity`, `scan`, `navigation` or `arrival` line overrides one.",
+    "motion": "`motion planar|3d`: a robot type's motion; `3d` (a drone's) measures its path lengths in "
+    "x-y-z and makes arrival compare heights (planar, the default: x-y).",
+    "window": "`window goals|whole recording`: what the robot's whole-run metrics cover: its first "
+    "goal's start to its last goal's end (the default), or the whole recording of its signals.",
+    "recording": "`window whole recording`: whole-run metrics over the whole recording of the robot's "
+    "signals.",
     "velocity": '`velocity on "/{ns}/cmd_vel" [TYPE]`: where the robot\'s velocity is (Twist, TwistStamped '
     "or an Odometry's twist); several lines are tried in order. In a metric, `reads vel: robot "
     "velocity` reads it (`vel.linear.x` ... `vel.angular.z`).",

@@ -45,6 +45,16 @@ class Navigation(Enum):
     """No goals in the bags: segments come from arrival at the planned waypoints."""
 
 
+class Window(Enum):
+    """What a robot's whole-run metrics cover."""
+
+    GOALS = "goals"
+    """Its first goal's start to its last goal's end (without goals: the whole recording of its
+    signals), as the method's dispatcher measures a mission."""
+    RECORDING = "whole recording"
+    """The whole recording of its signals, goals or not."""
+
+
 @dataclass(frozen=True)
 class TopicSource:
     """A signal read from one topic; ``msgtype`` None: whatever type of the signal's the bag has."""
@@ -117,11 +127,26 @@ class Signals:
     actions: tuple[str, ...] = ()
     """The navigation interface's action (or dispatcher) names, patterns with ``{ns}``."""
     tolerance: Tolerance = field(default_factory=Tolerance)
+    window: Window = Window.GOALS
+    """What a robot's whole-run metrics cover (see :class:`Window`)."""
+    named: bool = True
+    """Whether the author named the convention; if not, ingestion detects it from each bag, and
+    only what ``said`` lists is the author's."""
+    said: frozenset[str] = frozenset()
+    """The fields the author's own lines set (``pose``, ``velocity``, ``scan``, ``navigation``,
+    ``tolerance``, ``window``): they win over a convention detected from the bag."""
     location: SourceLocation | None = field(default=None, compare=False, repr=False)
 
     def overridden(self, **sources: object) -> Signals:
         """These signals with some replaced (a robot type's own ``pose``, ``velocity``...)."""
         return replace(self, **sources)  # type: ignore[arg-type]
+
+    def over(self, detected: Signals) -> Signals:
+        """``detected`` (a convention found in a bag) with what the author said of these signals."""
+        said = {name: getattr(self, name) for name in self.said}
+        if "navigation" in said:
+            said["actions"] = self.actions
+        return detected.overridden(**said, said=self.said, named=False)
 
 
 METHOD = Signals(

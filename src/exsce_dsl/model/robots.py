@@ -19,6 +19,8 @@ class RobotType:
     torso: bool | None = None
     location: SourceLocation | None = field(default=None, compare=False, repr=False)
     declared_signals: Signals | None = None
+    motion: str = "planar"
+    """``planar`` (ground robots: path lengths in x-y) or ``3d`` (drones: in x-y-z)."""
 
     @property
     def signals(self) -> Signals:
@@ -50,3 +52,13 @@ class Robot:
     def declares_signals(self) -> bool:
         """Whether the robot or its type says where its signals are (else: the method's topics)."""
         return self.declared_signals is not None or self.type.declared_signals is not None
+
+    @property
+    def names_convention(self) -> bool:
+        """Whether the robot or its type names its convention (else ingestion detects it)."""
+        return self.declares_signals and self.signals.named
+
+    @property
+    def three_d(self) -> bool:
+        """Whether the robot moves in 3-D (its type says ``motion 3d``)."""
+        return self.type.motion == "3d"

@@ -118,6 +118,9 @@ class MetricValue:
     action: ActionId | None = None
     unit: str | None = None
     safety_metric: str | None = None
+    estimated_from: str | None = None
+    """What the value was estimated from where the bag lacked its signal (``pose``: a speed
+    computed from the robot's positions, its bag having no velocity)."""
 
     def __post_init__(self) -> None:
         scope = self.scope

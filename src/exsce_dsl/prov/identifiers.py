@@ -302,6 +302,8 @@ DETECTED_CONVENTION_TYPE = Term(EXSCE, "detected_convention")
 """Where a robot's signals were found in a run's bag, when its type named no convention
 (derived from the topics that showed it)."""
 CONVENTION = Term(EXSCE, "convention")
+ESTIMATED_FROM = Term(EXSCE, "estimated_from")
+"""On a metric value: the signal it was estimated from where the bag lacked its own (``pose``)."""
 UNIT = Term(EXSCE, "unit")
 METRIC_ATTR = Term(EXSCE, "metric")
 """On a ``violation_duration`` value: the safety metric whose limit was violated."""

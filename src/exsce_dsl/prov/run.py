@@ -352,6 +352,8 @@ class _RunCompiler:
                 facts[unit_attr] = value.unit
             if value.safety_metric is not None:
                 facts[safety_attr] = value.safety_metric
+            if value.estimated_from is not None:
+                facts[t(ids.ESTIMATED_FROM)] = value.estimated_from
             w.entity(value_id, facts)
             if known is not None:
                 w.derivation(value_id, known[1], primary_source)

@@ -17,6 +17,7 @@ from exsce_dsl.lang.check_fields import check_fields
 from exsce_dsl.lang.standard_metrics import standard_metrics
 from exsce_dsl.messages.catalogue import Source
 from exsce_dsl.model import Scenario
+from exsce_dsl.model.conventions import Window
 from exsce_dsl.model.expressions import Field, walk
 from exsce_dsl.model.messages import DISPATCHER, POSE, FieldPath, Fields
 from exsce_dsl.model.metrics import MetricDefinition
@@ -203,11 +204,13 @@ def analyse_bag(path: Path, scenario: Scenario, digest: str | None = None) -> An
             stacks.real_topics[feedback] = stacks.real_topics[result] = (
                 found.topics or stacks.real_topics.get(topic_name(SERVED["pose"], ns), ())
             )
-        if not found.segments and scenario.mission.tasks_of(robot.id):
+        recording = robot.signals.window is Window.RECORDING
+        if (not found.segments or recording) and scenario.mission.tasks_of(robot.id):
             span = stacks.recorded_span(robot, topics)
-            if span is None:
+            if span is None and not found.segments:
                 raise BagError(_nothing_of(path, robot, types))
-            whole_runs[robot.id] = span
+            if span is not None:
+                whole_runs[robot.id] = span
     values, hotspots = compute_metrics(
         monitors, metrics, robots, topics, actions, results, problems, whole_runs, stacks.named(robots)
     )

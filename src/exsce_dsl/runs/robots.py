@@ -63,6 +63,8 @@ class StackRobots:
     serves: set[str] = field(default_factory=set)
     real_topics: dict[str, tuple[str, ...]] = field(default_factory=dict)
     """A served topic name → the bag's topics its values came from."""
+    estimated: dict[str, str] = field(default_factory=dict)
+    """A served topic name → what it was estimated from (``pose``), where the bag lacked it."""
 
     def adapt(self, wanted: Mapping[str, Wanted], robots: list[Robot]) -> dict[str, Wanted]:
         """``wanted`` with the served topics of these robots replaced by their sources, and
@@ -101,7 +103,10 @@ class StackRobots:
             signals = signal_topics(robot, data, problems)
             for name, series in signals.items():
                 found[name] = series
-                self.real_topics[name] = robot.used[name.rsplit("~", 1)[1]].topics
+                used = robot.used[name.rsplit("~", 1)[1]]
+                self.real_topics[name] = used.topics
+                if used.from_pose:
+                    self.estimated[name] = "pose"
             if robot.robot not in self.serves:
                 continue
             for signal, pattern in SERVED.items():
@@ -109,16 +114,20 @@ class StackRobots:
                 if topic is None:
                     continue
                 name = topic_name(pattern, robot.namespace)
-                found[name] = _as_method_fields(name, signal, topic)
+                found[name] = _as_method_fields(name, signal, topic, robot.three_d)
                 self.real_topics[name] = robot.used[signal].topics
+                if robot.used[signal].from_pose:
+                    self.estimated[name] = "pose"
         return found
 
     def with_real_sources(self, value: MetricValue) -> MetricValue:
-        """``value`` with the topics it came from named as the bag has them."""
+        """``value`` with the topics it came from named as the bag has them, and what it was
+        estimated from where the bag lacked its signal."""
         if not any(t in self.real_topics for t in value.topics):
             return value
         named = [real for t in value.topics for real in self.real_topics.get(t, (t,))]
-        return replace(value, topics=tuple(dict.fromkeys(named)))
+        estimated = next((self.estimated[t] for t in value.topics if t in self.estimated), None)
+        return replace(value, topics=tuple(dict.fromkeys(named)), estimated_from=estimated)
 
     def named(self, robots: list[Robot]) -> dict[str, str]:
         """How the run's problems name what the monitors read of these robots: a signal by the
@@ -174,7 +183,8 @@ class StackRobots:
         pose = topics.get(signal_topic("pose", robot.namespace))
         if pose is None or not len(pose):
             return Track.empty()
-        return Track(pose.t, pose.fields["x"], pose.fields["y"], pose.fields["yaw"])
+        fields = pose.fields
+        return Track(pose.t, fields["x"], fields["y"], fields["yaw"], fields.get("z"), robot.three_d)
 
 
 def stack_robots(robots: list[Robot], available: Mapping[str, str], serves: set[str]) -> StackRobots:
@@ -189,7 +199,11 @@ def _looked_for(source: TopicSource | TfSource, ns: str) -> str:
     return topic_name(source.topic, ns)
 
 
-def _as_method_fields(name: str, signal: str, topic: Topic) -> Topic:
+def _as_method_fields(name: str, signal: str, topic: Topic, three_d: bool) -> Topic:
+    """A signal with the fields of the method's type for it; a planar robot's velocity without
+    its vertical part (the method's max_velocity is the norm of the linear velocity)."""
+    if signal == "velocity" and not three_d:
+        return Topic(name, topic.t, {**topic.fields, "linear.z": np.zeros(len(topic.t))})
     if signal != "pose":
         return Topic(name, topic.t, dict(topic.fields))
     yaw = topic.fields["yaw"]

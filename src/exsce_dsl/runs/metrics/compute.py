@@ -47,7 +47,8 @@ def compute_metrics(
     named: Mapping[str, str] | None = None,
 ) -> tuple[list[MetricValue], list[Hotspot]]:
     """Every metric of ``metrics`` for a run. ``results``: robot → waypoints SUCCEEDED (None: no topic);
-    ``whole_runs``: robot → the run's span, for robots without path segments (whole-run values only);
+    ``whole_runs``: robot → the span its whole-run values cover, where it is not its path
+    segments' (a robot without segments, or whose window is its whole recording);
     ``named``: a topic the monitors read → how the run's problems name it: the bag's topics it was
     read from, or the sources looked for (a robot's signals are read where its convention puts
     them, not from the method's topics the metrics are declared over)."""
@@ -63,7 +64,8 @@ def compute_metrics(
         if not mine and whole is None:
             problems.append(f"robot '{robot.id}' started no waypoint goal: its metrics are missing")
             continue
-        start, end = (min(s for _, s, _ in mine), max(e for _, _, e in mine)) if mine else whole  # type: ignore[misc]
+        # the robot's whole-run window: its goals' (first start to last end), unless told otherwise
+        start, end = whole if whole is not None else (min(s for _, s, _ in mine), max(e for _, _, e in mine))
         monitor = monitors.RobotMetrics(robot.id, robot.namespace, topics, results.get(robot.id))
         for metric in by_subject[ComputedFor.ROBOT]:
             values += _robot_values(monitor, metric, robot, [(None, start, end), *mine], problems, named)

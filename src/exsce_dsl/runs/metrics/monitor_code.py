@@ -135,11 +135,12 @@ def monitor_source(metrics: Sequence[MetricDefinition], source: str, core_import
                 if var is not None and names is not None:
                     reducers.append({"name": names[0], "key": names[1], "var": var, "pattern": patterns[var],
                                      "aggregate": agg, "vars": alt.vars})
-    from exsce_dsl.templating import render  # Jinja2 is imported only when there is something to render
+    # Jinja2 is imported only when there is something to render
+    from exsce_dsl.templating import render_with_tests
 
-    return render(
+    return render_with_tests(
         TEMPLATE,
-        tests={"constant": is_constant},  # an expression with one number for every window
+        {"constant": is_constant},  # an expression with one number for every window
         generator=GENERATOR,
         source=source,
         core_import=core_import or "from exsce_dsl.monitor_kit import monitor_core as core",

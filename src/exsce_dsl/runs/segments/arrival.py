@@ -3,14 +3,15 @@
 For a robot whose bag holds no goals at all, only its pose track.  The rules:
 
 1. **Departure.**  The robot's first tracked pose is where it started.  It moved when it first
-   went farther than the position tolerance from there; the first segment starts at the last
-   sample before that at which it was still at its first pose (within `STILL_POSITION` and
-   `STILL_HEADING`, a stationary localisation's noise): the moment it set off, not the start of
-   the recording (a bag often begins well before the mission).  If it set off at once, that is
-   the track's first sample.  A robot that never moved: every segment NOT_STARTED, with a
-   warning.
+   went farther than the position tolerance from there (in 3-D where arrival compares heights);
+   the first segment starts at the last sample before that at which it was still at its first
+   pose (within `STILL_POSITION` and `STILL_HEADING`, a stationary localisation's noise): the
+   moment it set off, not the start of the recording (a bag often begins well before the
+   mission).  If it set off at once, that is the track's first sample.  A robot that never
+   moved: every segment NOT_STARTED, with a warning.
 2. **Arrival.**  Segment k ends at the first sample, at or after segment k-1's end (the first
-   one: its start), where the robot is within the `Tolerance` of waypoint k; it starts when
+   one: its start), where the robot is within the `Tolerance` of waypoint k (in 3-D when the
+   waypoint gives a height or the robot's type says ``motion 3d``: see `track.near`); it starts when
    segment k-1 ended, so the time spent at a waypoint counts to the next segment, as the
    dispatcher's next goal starts only once the previous one is done.  Order matters: passing
    through a later waypoint before an earlier one counts for nothing; passing through the
@@ -63,6 +64,8 @@ def arrival_segments(
     warnings: list[str] = []
     x0, y0, yaw0 = float(track.x[0]), float(track.y[0]), float(track.yaw[0])
     from_start = np.hypot(track.x - x0, track.y - y0)
+    if track.z is not None and (track.three_d or any(p.pose.position.z != 0 for p in plan)):
+        from_start = np.hypot(from_start, track.z - track.z[0])  # a climb is a departure too
     away = np.flatnonzero(from_start > tolerance.position)
     if not away.size:
         warnings.append(f"robot {robot} never moved: it stayed within {tolerance.position} m of {at(x0, y0)}")
@@ -75,7 +78,16 @@ def arrival_segments(
     index = int(np.flatnonzero(still)[-1])  # the first sample is at the first pose
     outcomes = []
     for k, planned in enumerate(plan):
-        close = near(tolerance, planned.pose, track.x[index:], track.y[index:], track.yaw[index:])
+        heights = track.z[index:] if track.z is not None else None
+        close = near(
+            tolerance,
+            planned.pose,
+            track.x[index:],
+            track.y[index:],
+            track.yaw[index:],
+            heights,
+            track.three_d,
+        )
         arrival = int(np.argmax(close))
         if not close[arrival]:
             later = len(plan) - k - 1

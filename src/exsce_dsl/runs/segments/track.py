@@ -41,13 +41,25 @@ Flags = npt.NDArray[np.bool_]
 SUCCEEDED = "SUCCEEDED"
 
 
-def near(tolerance: Tolerance, pose: Pose, x: Floats, y: Floats, yaw: Floats) -> Flags:
-    """Which of the poses (x, y, yaw) are within ``tolerance`` of ``pose``."""
+def near(
+    tolerance: Tolerance,
+    pose: Pose,
+    x: Floats,
+    y: Floats,
+    yaw: Floats,
+    z: Floats | None = None,
+    three_d: bool = False,
+) -> Flags:
+    """Which of the poses (x, y, yaw) are within ``tolerance`` of ``pose``; in 3-D (``z`` too)
+    when the track has heights and the pose gives one (not 0) or the robot moves in 3-D."""
     if not tolerance.position > 0 or (tolerance.heading is not None and not tolerance.heading > 0):
         raise SegmentError(
             f"tolerances must be positive, not {tolerance.position} m, {tolerance.heading} rad"
         )
-    close: Flags = np.hypot(x - pose.position.x, y - pose.position.y) <= tolerance.position
+    distance = np.hypot(x - pose.position.x, y - pose.position.y)
+    if z is not None and len(z) == len(x) and (three_d or pose.position.z != 0):
+        distance = np.hypot(distance, z - pose.position.z)
+    close: Flags = distance <= tolerance.position
     if tolerance.heading is not None:
         close &= angle_between(yaw, pose.orientation.yaw) <= tolerance.heading
     return close
@@ -75,6 +87,10 @@ class Track:
     x: Floats
     y: Floats
     yaw: Floats
+    z: Floats | None = None
+    """Heights, where the pose source has them (arrival compares them: see :func:`near`)."""
+    three_d: bool = False
+    """Whether the robot moves in 3-D (a drone): arrival then always compares heights."""
 
     def __post_init__(self) -> None:
         columns = [np.asarray(c, dtype=np.float64) for c in (self.times, self.x, self.y, self.yaw)]

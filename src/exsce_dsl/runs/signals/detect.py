@@ -1,7 +1,8 @@
 """A robot's convention, detected from its bag when its type names none.
 
-A robot type that says nothing of where its signals are gets them from what the bag holds under
-the robot's namespace, in this order (the first that matches wins):
+A robot type that names no convention gets its signals from what the bag holds under the robot's
+namespace, in this order (the first that matches wins), and the lines it does have (a ``pose``
+source, an ``arrival`` tolerance, a ``window``) win over what is detected:
 
 1. the method's waypoint dispatcher (``/{ns}/waypoint_dispatcher/feedback``): ``method``;
 2. Nav2's actions (``/{ns}/navigate_to_pose/_action/status``, ``follow_waypoints``,
@@ -69,10 +70,12 @@ def with_detected_conventions(
     found: list[Robot] = []
     picked: list[Detected] = []
     for robot in robots:
-        if robot.declares_signals:
+        if robot.names_convention:
             found.append(robot)
             continue
         signals, detected = detect_convention(robot, types)
+        if robot.declares_signals:  # its own lines (a pose source, a window...) win
+            signals = robot.signals.over(signals)
         found.append(replace(robot, declared_signals=signals))
         picked.append(detected)
     return found, picked

@@ -45,7 +45,7 @@ from exsce_dsl.model.conventions import (
 from exsce_dsl.model.messages import FieldPath, canonical_type, path_of
 from exsce_dsl.model.metrics import signal_pattern, topic_name
 from exsce_dsl.model.robots import Robot
-from exsce_dsl.monitor_kit.monitor_core import Topic
+from exsce_dsl.monitor_kit.monitor_core import Signal, Topic, speed
 from exsce_dsl.runs.bags.decode import TEXTS
 from exsce_dsl.runs.bags.reading import BagData, Series, Wanted
 from exsce_dsl.runs.signals.tf_poses import (
@@ -94,6 +94,9 @@ class Chosen:
     fallbacks: tuple[Chosen, ...] = ()
     """For a TF chain: the sources after it that the bag has, tried in order when the bag's
     transforms do not compose the chain (its frames are not there)."""
+    from_pose: bool = False
+    """Estimated from the robot's pose (its source's topics are the pose's), the bag having
+    nothing of this signal: a velocity, or a distance travelled."""
 
     @property
     def topics(self) -> tuple[str, ...]:
@@ -116,6 +119,8 @@ class RobotSources:
     """Why a signal has no source, for the run's problems."""
     used: dict[str, Chosen] = field(default_factory=dict)
     """The source each signal was read from, once read (a TF chain's fallback, maybe)."""
+    three_d: bool = False
+    """Whether the robot moves in 3-D: its paths are then measured in x-y-z."""
 
 
 def choose_sources(robot: Robot, available: Mapping[str, str]) -> RobotSources:
@@ -135,10 +140,21 @@ def choose_sources(robot: Robot, available: Mapping[str, str]) -> RobotSources:
         found = _first_present(signal, sources, types, ns, available)
         if found is not None:
             chosen[signal] = found
-        elif sources:
+            continue
+        pose = chosen.get("pose")
+        if pose is not None and signal in ("velocity", "distance"):
+            chosen[signal] = replace(pose, signal=signal, from_pose=True)
+        estimated = signal == "velocity" and signal in chosen
+        if sources and not estimated and signal not in chosen:
             tried = ", ".join(_described(s, ns, types, available) for s in sources)
             notes.append(f"robot '{robot.id}' has no {signal} in this bag (looked for {tried})")
-    return RobotSources(robot.id, ns, chosen, tuple(notes))
+        elif estimated:
+            tried = ", ".join(_described(s, ns, types, available) for s in sources) or "none named"
+            notes.append(
+                f"robot '{robot.id}' has no velocity in this bag (looked for {tried}): its speed is "
+                "estimated from its pose"
+            )
+    return RobotSources(robot.id, ns, chosen, tuple(notes), three_d=robot.three_d)
 
 
 def _first_present(
@@ -202,6 +218,8 @@ def signals_wanted(sources: Iterable[RobotSources], scan_paths: Iterable[FieldPa
 
     for robot in sources:
         for chosen in (c for first in robot.chosen.values() for c in first.with_all()):
+            if chosen.from_pose:
+                continue  # computed from the pose, which is read for itself
             if chosen.tf is not None:
                 for topic in chosen.tf_topics:
                     want(topic, TF_MESSAGE, _TF_NUMBERS, _TF_TEXTS)
@@ -241,7 +259,7 @@ def signal_topics(robot: RobotSources, data: BagData, problems: list[str] | None
         failures: list[tuple[Chosen, str]] = []
         for chosen in first.with_all():
             try:
-                topic = _signal(name, signal, chosen, data)
+                topic = _signal(name, signal, chosen, data, found, robot.three_d)
             except TfError as exc:
                 failures.append((chosen, exc.message))
                 continue
@@ -266,8 +284,16 @@ def _tf_failures(failures: list[tuple[Chosen, str]]) -> str:
     return topic + ": " + "; ".join(f"{c.tf.clause() if c.tf else c.topic}: {why}" for c, why in failures)
 
 
-def _signal(name: str, signal: str, chosen: Chosen, data: BagData) -> Topic | None:
-    """One signal from one source (None: the bag gave none of its topic's messages)."""
+def _signal(
+    name: str, signal: str, chosen: Chosen, data: BagData, found: Mapping[str, Topic], three_d: bool
+) -> Topic | None:
+    """One signal from one source (None: the bag gave none of its topic's messages); ``found``:
+    the signals computed so far (the pose, for what is estimated from it)."""
+    if chosen.from_pose:
+        pose = found.get(name.rsplit("~", 1)[0] + "~pose")
+        if pose is None:
+            return None
+        return _speed(name, pose, three_d) if signal == "velocity" else _path(name, pose, three_d)
     if chosen.tf is not None:
         return _tf_pose(name, chosen, data)
     series = data.series.get(chosen.topic)
@@ -280,15 +306,35 @@ def _signal(name: str, signal: str, chosen: Chosen, data: BagData) -> Topic | No
         fields = {key: series.fields[f"{prefix}.{key}" if prefix else key] for key in _VELOCITY_KEYS}
         return Topic(name, series.t, fields)
     if signal == "distance" and chosen.msgtype != FLOAT64:
-        return _distance(name, series, _POSE_AT[chosen.msgtype])
+        return _distance(name, series, _POSE_AT[chosen.msgtype], three_d)
     return Topic(name, series.t, dict(series.fields))
 
 
-def _distance(name: str, series: Series, prefix: tuple[str, ...]) -> Topic:
+def _distance(name: str, series: Series, prefix: tuple[str, ...], three_d: bool) -> Topic:
     """The distance travelled so far along a pose topic's path (``data``, as the method's Float64)."""
     at = ".".join(prefix)
-    steps = np.hypot(np.diff(series.fields[f"{at}.position.x"]), np.diff(series.fields[f"{at}.position.y"]))
-    return Topic(name, series.t, {"data": np.concatenate([[0.0], np.cumsum(steps)])})
+    position = {a: series.fields[f"{at}.position.{a}"] for a in _AXES}
+    return _path(name, Topic(name, series.t, position), three_d)
+
+
+def _path(name: str, pose: Topic, three_d: bool) -> Topic:
+    """The distance travelled so far along ``pose``'s positions, in x-y (x-y-z when ``three_d``)."""
+    axes = _AXES if three_d else _AXES[:2]
+    steps = np.sqrt(sum(np.square(np.diff(pose.fields[a])) for a in axes))
+    return Topic(name, pose.t, {"data": np.concatenate([[0.0], np.cumsum(steps)])})
+
+
+def _speed(name: str, pose: Topic, three_d: bool) -> Topic:
+    """A velocity estimated from ``pose``: ``linear.x`` the speed along the path (the monitors'
+    ``speed``: the straight distance between the positions 0.25 s before and after, over that
+    time, so that a centimetre of pose noise costs centimetres per second, not metres); the other
+    components 0."""
+    axes = _AXES if three_d else _AXES[:2]
+    moving = speed(*(Signal(pose.t, pose.fields[a]) for a in axes))
+    zeros = np.zeros(len(pose.t))
+    fields = {key: zeros for key in _VELOCITY_KEYS}
+    fields["linear.x"] = moving.v  # no value (NaN) where the pose has a single time
+    return Topic(name, pose.t, fields)
 
 
 def _pose(name: str, series: Series, prefix: tuple[str, ...]) -> Topic:

@@ -185,13 +185,13 @@ class RobotMetrics:
         return core.finite(a[0])
 
     def _prepare_max_velocity(self) -> tuple[int, list[core.Prepared]] | None:
-        # the value: max(norm(vel.linear.x, vel.linear.y))
+        # the value: max(norm(vel.linear.x, vel.linear.y, vel.linear.z))
         topic_0 = self.topic("/{ns}/nav_vel")
         if topic_0 is not None:
             return 0, [
                 core.prepare(
                     "max",
-                    core.norm(topic_0.field("linear.x"), topic_0.field("linear.y")),
+                    core.norm(topic_0.field("linear.x"), topic_0.field("linear.y"), topic_0.field("linear.z")),
                     None,
                 ),
             ]
