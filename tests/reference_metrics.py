@@ -16,7 +16,7 @@ import numpy as np
 from exsce_dsl.model.geometry import Position
 from exsce_dsl.model.runs import ActionId, Hotspot, MetricScope, MetricValue
 from exsce_dsl.runs.bags.reading import BagData, Series
-from exsce_dsl.runs.segments.dispatcher import Segment
+from exsce_dsl.runs.segments.segment import Segment
 
 HOTSPOT_RADIUS = 1.0  # metres: violations closer than this to a hotspot belong to it
 

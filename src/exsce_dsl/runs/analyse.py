@@ -36,8 +36,10 @@ from exsce_dsl.runs.bags.reading import (
 )
 from exsce_dsl.runs.metrics.compute import HOTSPOT_PATHS, POSE_TOPIC, compute_metrics
 from exsce_dsl.runs.metrics.monitor_code import load_monitors
-from exsce_dsl.runs.robots import DISPATCHER_SOURCE, SERVED, segment_robot, stack_robots
-from exsce_dsl.runs.segments.dispatcher import SUCCEEDED, Segment, segments
+from exsce_dsl.runs.robots import SERVED, stack_robots
+from exsce_dsl.runs.segments.dispatcher import SUCCEEDED, segments
+from exsce_dsl.runs.segments.segment import Segment
+from exsce_dsl.runs.segments.sources import DISPATCHER_SOURCE, segment_robot
 from exsce_dsl.runs.signals.detect import Detected, pose_like_topics, with_detected_conventions
 from exsce_dsl.runs.signals.timeline import (
     Timeline,

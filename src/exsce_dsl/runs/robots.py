@@ -20,7 +20,6 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from exsce_dsl.model import Scenario
 from exsce_dsl.model.conventions import METHOD, Navigation, TfSource, TopicSource
 from exsce_dsl.model.messages import FieldPath
 from exsce_dsl.model.metrics import topic_name
@@ -28,11 +27,8 @@ from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import MetricValue
 from exsce_dsl.monitor_kit.monitor_core import Topic
 from exsce_dsl.runs.bags.reading import BagData, Wanted
-from exsce_dsl.runs.segments.arrival import arrival_segments
-from exsce_dsl.runs.segments.dispatcher import Segment
-from exsce_dsl.runs.segments.goals import goal_segments
 from exsce_dsl.runs.segments.track import Track
-from exsce_dsl.runs.signals.navigation_goals import goal_wanted, read_goals
+from exsce_dsl.runs.signals.navigation_goals import goal_wanted
 from exsce_dsl.runs.signals.sources import (
     RobotSources,
     choose_sources,
@@ -41,7 +37,6 @@ from exsce_dsl.runs.signals.sources import (
     signals_wanted,
 )
 
-DISPATCHER_SOURCE = "the waypoint dispatcher"
 FEEDBACK = "/{ns}/waypoint_dispatcher/feedback"
 RESULT = "/{ns}/waypoint_dispatcher/result"
 SERVED = {
@@ -211,62 +206,3 @@ def _as_method_fields(name: str, signal: str, topic: Topic, three_d: bool) -> To
     fields["pose.pose.orientation.x"] = fields["pose.pose.orientation.y"] = np.zeros_like(yaw)
     fields["pose.pose.orientation.z"], fields["pose.pose.orientation.w"] = np.sin(yaw / 2), np.cos(yaw / 2)
     return Topic(name, topic.t, fields)
-
-
-@dataclass(frozen=True)
-class RobotSegments:
-    """One robot's segments, what segmented them, and what it could not make sense of."""
-
-    segments: list[Segment]
-    source: str
-    succeeded: int | None
-    topics: tuple[str, ...] = ()
-    """The bag's topics the segments came from."""
-    problems: tuple[str, ...] = ()
-
-
-def segment_robot(
-    scenario: Scenario, robot: Robot, data: BagData, track: Track, dispatcher: list[Segment] | None
-) -> RobotSegments:
-    """The robot's segments from the first source that gives any (see the module's docstring);
-    ``dispatcher``: its segments from the method's dispatcher, if its bag has that."""
-    signals = robot.signals
-    if dispatcher is not None and any(s.start is not None for s in dispatcher):
-        return RobotSegments(dispatcher, DISPATCHER_SOURCE, None)
-    problems: list[str] = []
-    if signals.navigation in (Navigation.NAV2, Navigation.MOVE_BASE):
-        goals, used = read_goals(signals, robot.namespace, data)
-        if goals:
-            found = goal_segments(scenario, robot.id, goals, track, signals.tolerance)
-            problems += [f"robot '{robot.id}': {w}" for w in found.warnings]
-            if any(s.start is not None for s in found.segments):
-                done = _succeeded(found.segments)
-                return RobotSegments(
-                    list(found.segments),
-                    f"{signals.navigation.value} goals",
-                    done,
-                    tuple(used),
-                    tuple(problems),
-                )
-        else:
-            problems.append(f"robot '{robot.id}': no {signals.navigation.value} goals in this bag")
-    if len(track):
-        found = arrival_segments(scenario, robot.id, track, signals.tolerance)
-        problems += [f"robot '{robot.id}': {w}" for w in found.warnings]
-        if any(s.start is not None for s in found.segments):
-            return RobotSegments(
-                list(found.segments),
-                "arrival at the planned waypoints",
-                _succeeded(found.segments),
-                (),
-                tuple(problems),
-            )
-    problems.append(
-        f"robot '{robot.id}': no path segments (no navigation goals, and no pose that reaches its planned "
-        "waypoints): its metrics are of the whole run only"
-    )
-    return RobotSegments([], "", None, (), tuple(problems))
-
-
-def _succeeded(segments: tuple[Segment, ...]) -> int:
-    return sum(s.status == "SUCCEEDED" for s in segments)

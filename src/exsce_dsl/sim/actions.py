@@ -3,20 +3,10 @@ statuses and the path segments driven."""
 
 from __future__ import annotations
 
-import enum
 from dataclasses import dataclass
 
 from exsce_dsl.model import Pose
-
-
-class GoalStatus(enum.IntEnum):
-    """actionlib_msgs/GoalStatus values."""
-
-    PENDING = 0
-    ACTIVE = 1
-    PREEMPTED = 2
-    SUCCEEDED = 3
-    ABORTED = 4
+from exsce_dsl.model.goals import GoalStatus as GoalStatus
 
 
 @dataclass(frozen=True)

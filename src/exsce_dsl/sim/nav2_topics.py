@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from exsce_dsl.messages.navigation import stored_name
+from exsce_dsl.model.goals import ActionGoalStatus
 from exsce_dsl.sim.goals import NavigationGoal, Phase, listed, navigation_goals, status_samples
 from exsce_dsl.sim.localisation import Localisation, localise
 from exsce_dsl.sim.motion import DT
@@ -31,8 +32,13 @@ ACTION = "navigate_to_pose"
 FEEDBACK = "nav2_msgs/action/NavigateToPose_FeedbackMessage"
 FEEDBACK_FIELDS = "nav2_msgs/action/NavigateToPose_Feedback"
 STATUS = "action_msgs/msg/GoalStatusArray"
-CODES = {Phase.ACCEPTED: 1, Phase.EXECUTING: 2, Phase.SUCCEEDED: 4, Phase.ABORTED: 6}
-"""action_msgs/GoalStatus values (CANCELED = 5 is never reached: the executor cancels nothing)."""
+CODES = {
+    Phase.ACCEPTED: ActionGoalStatus.ACCEPTED,
+    Phase.EXECUTING: ActionGoalStatus.EXECUTING,
+    Phase.SUCCEEDED: ActionGoalStatus.SUCCEEDED,
+    Phase.ABORTED: ActionGoalStatus.ABORTED,
+}
+"""action_msgs/GoalStatus values (CANCELED is never reached: the executor cancels nothing)."""
 STATUS_EVERY, FEEDBACK_EVERY = 50, 10  # samples of the 50 Hz clock: 1 Hz, 5 Hz
 RESULT_TIMEOUT = 900.0
 """Seconds a finished goal stays in the status list (rcl_action's default result timeout)."""

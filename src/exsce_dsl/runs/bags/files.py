@@ -20,7 +20,6 @@ from dataclasses import dataclass
 from pathlib import Path, PurePath
 from typing import Any
 
-import yaml
 from rosbags.typesys import TypesysError, get_types_from_idl, get_types_from_msg
 
 from exsce_dsl.runs.bags.reading import BagError
@@ -527,6 +526,8 @@ def _check_ros2_folder(folder: Path) -> None:
             f"it with `ros2 bag reindex {folder}`"
             + (f", or ingest {folder / storage[0]} itself" if storage[0].endswith(".mcap") else "")
         )
+    import yaml  # here: only a ROS 2 bag folder needs it
+
     try:
         info = _bag_information(yaml.safe_load(meta.read_text(encoding="utf-8")))
     except (yaml.YAMLError, UnicodeDecodeError) as exc:

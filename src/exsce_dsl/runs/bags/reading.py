@@ -19,8 +19,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from rosbags.highlevel import AnyReader
-from rosbags.typesys import Stores, get_typestore
 
 from exsce_dsl.errors import BagError as BagError
 from exsce_dsl.messages.catalogue import (
@@ -113,6 +111,8 @@ class BagData:
 
 
 def typestore_for(path: Path):  # type: ignore[no-untyped-def]
+    from rosbags.typesys import Stores, get_typestore
+
     ros2 = path.is_dir() or path.suffix in (".db3", ".mcap")
     return get_typestore(Stores.ROS2_HUMBLE if ros2 else Stores.ROS1_NOETIC)
 
@@ -195,6 +195,8 @@ def bag_topics(path: Path) -> BagTopics:
             return BagTopics({topic: canonical_type(msgtype) for topic, msgtype in connections(path).items()})
         except UnsupportedBag:
             pass  # rosbags reads what the index reader does not, and says what is broken
+    from rosbags.highlevel import AnyReader  # here: the index readers need none of rosbags' readers
+
     try:
         with AnyReader([path], default_typestore=typestore_for(path)) as reader:
             return BagTopics({c.topic: canonical_type(c.msgtype) for c in reader.connections})
@@ -442,6 +444,8 @@ class _Ros1(_Reading):
 def _read_with_rosbags(
     path: Path, wanted: Mapping[str, Wanted], reduce: Mapping[str, Reduce] | None, check: Check | None
 ) -> BagData:
+    from rosbags.highlevel import AnyReader
+
     try:
         reader = AnyReader([path], default_typestore=typestore_for(path))
         reader.open()
@@ -477,7 +481,7 @@ def _read_with_rosbags(
 
 
 def _read_connection(
-    reader: AnyReader, reading: _Reading, conn: Any, catalogue: MessageCatalogue, cdr: bool
+    reader: Any, reading: _Reading, conn: Any, catalogue: MessageCatalogue, cdr: bool
 ) -> None:
     topic, msgtype = conn.topic, canonical_type(conn.msgtype)
     whole = reading.wanted_for(topic).msgtype in WHOLE

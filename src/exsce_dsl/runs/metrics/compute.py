@@ -24,7 +24,7 @@ from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import ActionId, Hotspot, MetricScope, MetricValue
 from exsce_dsl.monitor_kit import monitor_core as core
 from exsce_dsl.runs.metrics.monitor_code import reads_used
-from exsce_dsl.runs.segments.dispatcher import Segment
+from exsce_dsl.runs.segments.segment import Segment
 
 HOTSPOT_RADIUS = 1.0  # metres: violations closer than this to a hotspot belong to it
 POSE_TOPIC = "/{ns}/robot_pose"

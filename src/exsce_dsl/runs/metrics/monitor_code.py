@@ -133,8 +133,16 @@ def monitor_source(metrics: Sequence[MetricDefinition], source: str, core_import
             patterns = {var: pattern for var, _, pattern in alt.reads}
             for agg, var, names in zip(alt.aggregates, alt.blocks, alt.reducers, strict=True):
                 if var is not None and names is not None:
-                    reducers.append({"name": names[0], "key": names[1], "var": var, "pattern": patterns[var],
-                                     "aggregate": agg, "vars": alt.vars})
+                    reducers.append(
+                        {
+                            "name": names[0],
+                            "key": names[1],
+                            "var": var,
+                            "pattern": patterns[var],
+                            "aggregate": agg,
+                            "vars": alt.vars,
+                        }
+                    )
     # Jinja2 is imported only when there is something to render
     from exsce_dsl.templating import render_with_tests
 

@@ -10,28 +10,14 @@ robot: a bag whose waypoint ids differ is from another scenario.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from exsce_dsl.errors import SegmentError as SegmentError
 from exsce_dsl.model import Pose, Scenario
+from exsce_dsl.model.goals import ACTIONLIB_FINAL, GoalStatus, actionlib_names
 from exsce_dsl.runs.bags.reading import StatusUpdate
+from exsce_dsl.runs.segments.segment import Segment
 
-ACTIVE, SUCCEEDED = 1, 3
-FINAL = {2: "PREEMPTED", 3: "SUCCEEDED", 4: "ABORTED", 5: "REJECTED", 8: "RECALLED", 9: "LOST"}
-
-
-@dataclass(frozen=True)
-class Segment:
-    robot: str
-    allocation: int  # the robot's n-th task, from 1
-    task: str
-    subtask: int
-    waypoint: int
-    start_pose: Pose
-    goal: Pose
-    start: float | None  # became ACTIVE (seconds since the epoch); None if never
-    end: float | None  # reached a final status
-    status: str  # SUCCEEDED, ABORTED, ... or NOT_STARTED
+ACTIVE, SUCCEEDED = GoalStatus.ACTIVE, GoalStatus.SUCCEEDED
+FINAL = {code: name for code, name in actionlib_names().items() if code in ACTIONLIB_FINAL}
 
 
 def segments(scenario: Scenario, robot: str, updates: list[StatusUpdate]) -> list[Segment]:

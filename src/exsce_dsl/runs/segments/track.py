@@ -33,7 +33,8 @@ import numpy.typing as npt
 
 from exsce_dsl.model import Orientation, Pose, Position, Scenario
 from exsce_dsl.model.conventions import Tolerance
-from exsce_dsl.runs.segments.dispatcher import Segment, SegmentError, planned_goals
+from exsce_dsl.runs.segments.dispatcher import SegmentError, planned_goals
+from exsce_dsl.runs.segments.segment import Segment
 
 Floats = npt.NDArray[np.float64]
 Flags = npt.NDArray[np.bool_]

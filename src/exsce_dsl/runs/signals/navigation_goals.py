@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from exsce_dsl.model.conventions import Navigation, Signals
+from exsce_dsl.model.goals import ACTION_FINAL, ACTIONLIB_FINAL, action_names, actionlib_names
 from exsce_dsl.model.metrics import topic_name
 from exsce_dsl.runs.bags.reading import OBJECTS, BagData, Wanted
 from exsce_dsl.runs.signals.tf_poses import yaw_from_quaternion
@@ -59,21 +60,10 @@ class Goal:
         return bool(self.progress or self.targets)
 
 
-NAV2_STATUS = {1: "ACCEPTED", 2: "EXECUTING", 3: "CANCELING", 4: "SUCCEEDED", 5: "CANCELED", 6: "ABORTED"}
-NAV2_FINAL = {4, 5, 6}
-MOVE_BASE_STATUS = {
-    0: "PENDING",
-    1: "ACTIVE",
-    2: "PREEMPTED",
-    3: "SUCCEEDED",
-    4: "ABORTED",
-    5: "REJECTED",
-    6: "PREEMPTING",
-    7: "RECALLING",
-    8: "RECALLED",
-    9: "LOST",
-}
-MOVE_BASE_FINAL = {2, 3, 4, 5, 8, 9}
+NAV2_STATUS = action_names()
+NAV2_FINAL: set[int] = {int(s) for s in ACTION_FINAL}
+MOVE_BASE_STATUS = actionlib_names()
+MOVE_BASE_FINAL: set[int] = {int(s) for s in ACTIONLIB_FINAL}
 PLAN = "/{ns}/plan"
 
 Messages = Sequence[tuple[float, Any]]
