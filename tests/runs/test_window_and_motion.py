@@ -17,6 +17,7 @@ import pytest
 from rosbags.highlevel import AnyReader
 from tests.bag_factory import POSE_STAMPED, Topic, header, point, quaternion, typestore_for, write_bag
 
+from exsce_dsl.errors import BagError
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.lang.formatter import format_spec_document
 from exsce_dsl.model import Scenario
@@ -193,3 +194,32 @@ def test_the_formatter_keeps_motion_and_window(tmp_path: Path) -> None:
     assert types["quad"].motion == "3d"
     rover = types["rover"].declared_signals
     assert rover is not None and not rover.named and rover.said == {"pose", "window"}
+
+
+def test_a_robot_with_tasks_and_nothing_to_place_it_is_refused_with_the_bags_pose_like_topics(
+    tmp_path: Path,
+) -> None:
+    """The drone's pose recorded under another name than its namespace, and only its battery under
+    it: no goals and no signal of drone1; the error names the robot and lists the pose-like topics
+    there are.  (A robot with a velocity or a scan but no pose is not refused: those metrics are
+    computed over the whole recording, the others are missing.)"""
+    store = typestore_for("mcap")
+    track = _drone_track()[:40]
+    poses, battery = [], []
+    for i, (t, x, y, z) in enumerate(track):
+        time_ns = START_NS + int(round(t * 1e9))
+        pose = store.types["geometry_msgs/msg/Pose"](
+            position=point(store, (x, y, z)), orientation=quaternion(store, 0.0)
+        )
+        poses.append((time_ns, store.types[POSE_STAMPED](header=header(store, time_ns, "map", i), pose=pose)))
+        battery.append((time_ns, store.types["std_msgs/msg/Float64"](data=0.9)))
+    topics = [
+        Topic("/other_drone/pose", POSE_STAMPED, poses),
+        Topic("/drone1/battery", "std_msgs/msg/Float64", battery),
+    ]
+    bag = write_bag(tmp_path / "elsewhere", "mcap", topics, store).path
+    with pytest.raises(
+        BagError,
+        match=r"robot 'drone1' has no navigation goals and no pose .*/other_drone/pose \(geometry_msgs/msg/PoseStamped\)",
+    ):
+        analyse_bag(bag, _scenario(tmp_path, "motion 3d"))
