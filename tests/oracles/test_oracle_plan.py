@@ -103,6 +103,7 @@ def segment(allocation: int, waypoint: int, goal: str, value: float, metric: str
 VALUES = RunValues(
     "u",
     whole={("distance_travelled", "r1"): [10.0], ("violation_duration", "r1"): [1.0, 2.5]},
+    violations={"r1": {"max_velocity", "distance_to_obstacles"}},
     segments=[
         segment(1, 1, "b", 2.0), segment(1, 2, "c", 3.0), segment(2, 1, "a", 5.0),
         segment(1, 1, "b", 0.5, "max_velocity"), segment(1, 2, "c", 0.9, "max_velocity"),
@@ -135,6 +136,15 @@ def test_an_empty_window_or_a_missing_value_says_why() -> None:
         None, "run u has no path segment of 'r1' before t1"
     )
     assert observe(VALUES, "max_velocity", "r2", None, SCENARIO) == (None, "run u has no value of 'max_velocity' of robot 'r2'")
+
+
+def test_a_violation_total_without_one_safety_metric_is_missing_not_the_sum_of_the_others() -> None:
+    without_scan = RunValues(
+        "u", whole={("violation_duration", "r1"): [1.0]}, violations={"r1": {"max_velocity"}}
+    )
+    assert observe(without_scan, "violation_duration", "r1", None, SCENARIO) == (
+        None, "run u has no violation duration of 'distance_to_obstacles' of robot 'r1': the total is missing"
+    )
 
 
 def test_windows_read_back_from_their_text() -> None:

@@ -8,9 +8,10 @@ import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
+from exsce_dsl.lang.standard_metrics import standard_metrics
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.acceptance import Moment, Window
-from exsce_dsl.model.metrics import Combine, metric_info
+from exsce_dsl.model.metrics import Combine, ComputedFor, metric_info
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.queries import run_metric_values, run_segment_values
 
@@ -40,6 +41,8 @@ class RunValues:
     run: str
     whole: dict[tuple[str, str | None], list[float]] = field(default_factory=dict)
     segments: list[ObservedSegment] = field(default_factory=list)
+    violations: dict[str | None, set[str]] = field(default_factory=dict)
+    """Robot (None: the mission) → the safety metrics whose violation durations the run has."""
 
 
 def run_values(store: Store, runs: Sequence[str]) -> dict[str, RunValues]:
@@ -50,6 +53,8 @@ def run_values(store: Store, runs: Sequence[str]) -> dict[str, RunValues]:
     for reading in run_metric_values(store, runs):
         if reading.run in found:
             found[reading.run].whole.setdefault((reading.metric, reading.robot), []).append(reading.value)
+            if reading.safety is not None:
+                found[reading.run].violations.setdefault(reading.robot, set()).add(reading.safety)
     for reading in run_segment_values(store, runs):
         parts = _ACTION.search(reading.action or "")
         if parts is None or reading.run not in found or reading.goal is None:
@@ -91,7 +96,13 @@ def observe(
         if not found:
             who = f" of robot '{robot}'" if robot else " of the mission"
             return None, f"run {values.run} has no value of '{metric}'{who}"
-        # violation_duration has one value per safety metric: the total is what a clause says
+        if metric == "violation_duration":  # one value per safety metric: a clause says the total
+            lacking = sorted(_safety_metrics(scenario, robot) - values.violations.get(robot, set()))
+            if lacking:
+                who = f" of robot '{robot}'" if robot else " of the mission"
+                listed = ", ".join(f"'{m}'" for m in lacking)
+                why = f"run {values.run} has no violation duration of {listed}{who}: the total is missing"
+                return None, why
         return (sum(found) if len(found) > 1 else found[0]), ""
     if info is None or info.combine is None:
         return None, f"'{metric}' has no value per path segment"
@@ -109,6 +120,12 @@ def observe(
     if info.combine is Combine.SUM:
         return float(sum(numbers)), ""
     return float(max(numbers) if info.combine is Combine.MAX else min(numbers)), ""
+
+
+def _safety_metrics(scenario: Scenario, robot: str | None) -> set[str]:
+    """The safety metrics whose violation durations make up a robot's (None: the mission's) total."""
+    wanted = {ComputedFor.ROBOT} if robot is not None else {ComputedFor.MISSION, ComputedFor.PAIRS}
+    return {m.name for m in (*standard_metrics(), *scenario.metrics) if m.safety and m.subject in wanted}
 
 
 def _in_window(
