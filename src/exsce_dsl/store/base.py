@@ -27,6 +27,9 @@ from exsce_dsl.errors import StoreConflictError as StoreConflictError
 from exsce_dsl.errors import StoreError as StoreError
 from exsce_dsl.errors import StoreLockedError as StoreLockedError
 
+QUERY_TIMEOUT = 60.0
+"""Seconds a query may take, evaluation and serialization, by default (``exscec serve``, ``exscec mcp``)."""
+
 Term = NamedNode | BlankNode | Literal
 Bindings = Mapping[str, Term | Sequence[Term]]
 """Query parameters: variable name (without ``?``) → one term, or several (a VALUES list)."""

@@ -58,6 +58,7 @@ from pyoxigraph import (
 )
 
 from exsce_dsl import __version__
+from exsce_dsl.store.base import QUERY_TIMEOUT as QUERY_TIMEOUT
 from exsce_dsl.store.base import StoreError
 from exsce_dsl.store.embedded import EmbeddedStore
 
@@ -67,8 +68,6 @@ MAX_BODY = 256 * 1024 * 1024
 """The largest request body accepted (bytes)."""
 MAX_QUERY = 1024 * 1024
 """The longest query text accepted (bytes)."""
-QUERY_TIMEOUT = 60.0
-"""Seconds a query may take, evaluation and serialization, by default."""
 MAX_ANSWER = 256 * 1024 * 1024
 """The largest answer sent (bytes), by default."""
 
