@@ -6,8 +6,9 @@ dispatcher's windows, the robot's pose signal, and a topic the bag lacks):
 arithmetic with signed constants nested at any depth, every function the
 README lists, conditions, aggregates over arrays, pairs of robots.  Each
 declaration must pass ``check``, and ingesting the run must then give each of
-its values as a finite number or no value, never an internal error: the only
-exception allowed is a located ``ExsceError``.
+its values (for the run and, per segment, for each path segment) as a finite
+number or no value, never an internal error: the only exception allowed is a
+located ``ExsceError``.
 """
 
 from __future__ import annotations
@@ -186,8 +187,8 @@ def per_window(draw: st.DrawFn, depth: int) -> str:
     if choice == 8:
         return draw(st.sampled_from(CONSTANTS)) + f" * {func}({draw(values)})"
     inner = per_window(depth - 1)
-    if choice == 9:
-        return f"{draw(inner)} {draw(st.sampled_from(ARITHMETIC))} {_paren(draw(inner))}"
+    if choice == 9:  # in parentheses: 'duration where' would take what follows into its condition
+        return f"{_paren(draw(inner))} {draw(st.sampled_from(ARITHMETIC))} {_paren(draw(inner))}"
     if choice == 10:
         return f"-{_paren(draw(inner))}"
     if choice == 11:
@@ -204,12 +205,30 @@ def pair_values(draw: st.DrawFn) -> str:
     return f"{func}({a} {draw(st.sampled_from(ARITHMETIC))} {b})"
 
 
-def _declaration(number: int, value: str, pair: bool) -> str:
+@st.composite
+def per_segment(draw: st.DrawFn) -> str:
+    """A value that combines over path segments (a sum, min or max of it), over short windows."""
+    topic = draw(st.sampled_from(sorted(FIELDS)))
+    values = numbers(topic, draw(st.integers(0, 2)))
+    choice = draw(st.integers(0, 3))
+    if choice == 0:
+        return f"{draw(st.sampled_from(['min', 'max', 'sum']))}({draw(values)})"
+    if choice == 1:
+        return f"{draw(st.sampled_from(['duration', 'count']))} where {draw(conditions(topic, 1))}"
+    if choice == 2:
+        return f"path_length({draw(values)}, {draw(values)})"
+    return f"{draw(st.sampled_from(['integral', 'change']))}({draw(values)})"
+
+
+def _declaration(number: int, value: str, pair: bool, segments: bool = False, otherwise: bool = False) -> str:
     subject = "each pair of robots (a, b)" if pair else "each robot"
     reads = READS
     if pair:  # a pair's values are aligned fields: the dispatcher's windows are a robot's
         reads = "".join(line + "\n" for line in READS.splitlines() if "dispatcher" not in line)
-    return f"metric m{number} for {subject} {{\n{reads}{SIGNAL_READ}  value {value}\n}}\n"
+    if otherwise:  # the value reads a topic the bag lacks: the run has what 'otherwise' gives
+        value = f"max(ghost.data)\n  otherwise {value}"
+    segment = " per segment" if segments else ""
+    return f"metric m{number} for {subject}{segment} {{\n{reads}{SIGNAL_READ}  value {value}\n}}\n"
 
 
 @pytest.fixture(scope="module")
@@ -226,13 +245,15 @@ def executor_run(tmp_path_factory):
     suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
 )
 @given(
-    robot=st.lists(per_window(2), min_size=1, max_size=3),
+    robot=st.lists(st.tuples(per_window(2), st.booleans()), min_size=1, max_size=3),
+    segments=st.lists(per_segment(), max_size=2),
     pairs=st.lists(pair_values(), max_size=1),
 )
-def test_every_checked_expression_computes_a_finite_value_or_none(executor_run, robot, pairs):
+def test_every_checked_expression_computes_a_finite_value_or_none(executor_run, robot, segments, pairs):
     folder, bag = executor_run
-    declared = [_declaration(k, v, False) for k, v in enumerate(robot)]
-    declared += [_declaration(len(robot) + k, v, True) for k, v in enumerate(pairs)]
+    declared = [_declaration(k, v, False, otherwise=o) for k, (v, o) in enumerate(robot)]
+    declared += [_declaration(len(declared) + k, v, False, segments=True) for k, v in enumerate(segments)]
+    declared += [_declaration(len(declared) + k, v, True) for k, v in enumerate(pairs)]
     spec = folder / "metrics_spec.exsce"
     spec.write_text(IMPORTS + "".join(declared) + SCENARIO)
     errors = analyse(spec).errors
