@@ -56,10 +56,13 @@ class Detected:
     robot: str
     convention: str
     evidence: tuple[str, ...]
+    own: tuple[str, ...] = ()
+    """What the robot's type said itself, which wins over the detected (``pose``, ``window``...)."""
 
     def describe(self) -> str:
         shown = ", ".join(self.evidence) if self.evidence else "nothing of its namespace"
-        return f"robot '{self.robot}': convention {self.convention} (detected from {shown})"
+        said = f"; its own {', '.join(self.own)}" if self.own else ""
+        return f"robot '{self.robot}': convention {self.convention} (detected from {shown}{said})"
 
 
 def with_detected_conventions(
@@ -76,6 +79,7 @@ def with_detected_conventions(
         signals, detected = detect_convention(robot, types)
         if robot.declares_signals:  # its own lines (a pose source, a window...) win
             signals = robot.signals.over(signals)
+            detected = replace(detected, own=tuple(sorted(robot.signals.said)))
         found.append(replace(robot, declared_signals=signals))
         picked.append(detected)
     return found, picked
