@@ -147,6 +147,17 @@ def test_a_violation_total_without_one_safety_metric_is_missing_not_the_sum_of_t
     )
 
 
+def test_a_window_with_a_segment_that_lacks_the_metric_is_missing_not_the_rest_combined() -> None:
+    # r1's second segment of t1 (b→c) has a distance, but no max_velocity: its 0.9 might be the max
+    lacking = RunValues("u", segments=[s for s in VALUES.segments if (s.metric, s.goal) != ("max_velocity", "room-c-R0.00_P0.00_Y0.00")])
+    during_t1 = Window(Moment.DURING, "r1", task="t1")
+    assert observe(lacking, "max_velocity", "r1", during_t1, SCENARIO) == (
+        None, "run u has no value of 'max_velocity' for 1 of the 2 path segments of 'r1' during t1"
+    )
+    assert observe(lacking, "distance_travelled", "r1", during_t1, SCENARIO) == (5.0, "")
+    assert observe(lacking, "max_velocity", "r1", Window(Moment.AFTER, "r1", task="t1"), SCENARIO) == (0.7, "")
+
+
 def test_windows_read_back_from_their_text() -> None:
     assert parse_window("during t1") == Window(Moment.DURING, "", task="t1")
     assert parse_window("before r1 reaches room-b") == Window(Moment.BEFORE, "r1", pose="room-b")

@@ -107,16 +107,21 @@ def observe(
     if info is None or info.combine is None:
         return None, f"'{metric}' has no value per path segment"
     owner = robot or window.robot
-    picked = _in_window(
-        sorted(
-            (s for s in values.segments if s.robot == owner and s.metric == metric), key=lambda s: s.order
-        ),
-        window,
-        scenario.mission.tasks_of(owner),
-    )
+    mine = [s for s in values.segments if s.robot == owner]
+    # the window's path segments are those the run has any value of: one without a value of this
+    # metric makes the combination missing (the others' sum, min or max is not the window's)
+    segments = sorted({s.action: s for s in mine}.values(), key=lambda s: s.order)
+    picked = _in_window(segments, window, scenario.mission.tasks_of(owner))
     if not picked:
         return None, f"run {values.run} has no path segment of '{owner}' {window.text()}"
-    numbers = [s.value for s in picked]
+    found_values = {s.action: s.value for s in mine if s.metric == metric}
+    without = [s for s in picked if s.action not in found_values]
+    if without:
+        return None, (
+            f"run {values.run} has no value of '{metric}' for {len(without)} of the {len(picked)} "
+            f"path segments of '{owner}' {window.text()}"
+        )
+    numbers = [found_values[s.action] for s in picked]
     if info.combine is Combine.SUM:
         return float(sum(numbers)), ""
     return float(max(numbers) if info.combine is Combine.MAX else min(numbers)), ""
