@@ -292,7 +292,10 @@ def test_a_topic_of_an_unexpected_type_is_reported(scenario_c, runs_c, tmp_path:
         return [(topic, msgtype, t, raw)]
 
     analysed = analyse_bag(_rewrite(runs_c["ros1"].bag, tmp_path / "retyped.bag", retype), scenario_c)
-    assert not any(v.metric == "max_velocity" and v.robot == "tiago1" for v in analysed.run.metrics)
+    # no velocity to read: tiago1's speed is estimated from its pose, and the value says so
+    estimated = [v for v in analysed.run.metrics if v.metric == "max_velocity" and v.robot == "tiago1"]
+    assert estimated and all(v.estimated_from == "pose" for v in estimated)
+    assert all(v.topics == ("/tiago1/robot_pose",) for v in estimated)
     assert any("/tiago1/nav_vel, which carries std_msgs/msg/String" in p for p in analysed.problems), analysed.problems
 
 

@@ -38,7 +38,7 @@ from typing import Any
 
 import numpy as np
 
-# actionlib's status codes, as exsce_dsl.model.goals defines them: this module imports nothing of exsce
+# actionlib's status codes, as the model's goals module defines them (this module imports nothing)
 ACTIVE, SUCCEEDED = 1, 3
 FINAL = frozenset({2, 3, 4, 5, 8, 9})
 """PREEMPTED, SUCCEEDED, ABORTED, REJECTED, RECALLED, LOST: a waypoint's goal is over."""

@@ -227,14 +227,19 @@ def analyse_bag(path: Path, scenario: Scenario, digest: str | None = None) -> An
         tasks=_task_executions(actions, segmented_by, wall),
         metrics=tuple(values),
         hotspots=tuple(hotspots),
-        clocks=tuple(
-            RunClock(spelt, c.clock, c.simulated, c.offset)
-            for c in timeline.clocks
-            for spelt in data.spellings.get(c.topic, (c.topic,))
-        ),
+        clocks=_run_clocks(timeline, data.spellings),
         conventions=tuple((d.robot, d.convention, d.evidence) for d in detected),
     )
     return AnalysedRun(run, digest, problems, timeline, detected)
+
+
+def _run_clocks(timeline: Timeline, spellings: Mapping[str, tuple[str, ...]]) -> tuple[RunClock, ...]:
+    """Each bag topic's clock, named as the bag spells it (once: two names may read one topic)."""
+    found: dict[str, RunClock] = {}
+    for c in timeline.clocks:
+        for spelt in spellings.get(c.topic, (c.topic,)):
+            found.setdefault(spelt, RunClock(spelt, c.clock, c.simulated, c.offset))
+    return tuple(found.values())
 
 
 def _nothing_of(path: Path, robot: Robot, types: Mapping[str, str]) -> str:
