@@ -66,6 +66,8 @@ def _per_message(depth: int, fields: st.SearchStrategy[str]) -> st.SearchStrateg
         inner.map(lambda e: f"-({e})"),
         inner.map(lambda e: f"abs({e})"),
         st.tuples(inner, inner).map(lambda p: f"norm({p[0]}, {p[1]})"),
+        st.tuples(inner, inner).map(lambda p: f"speed({p[0]}, {p[1]})"),
+        inner.map(lambda e: f"derivative({e})"),
     )
 
 
