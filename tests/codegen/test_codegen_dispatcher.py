@@ -180,7 +180,7 @@ def test_a_task_given_twice_is_one_file_listed_twice() -> None:
 
 
 @pytest.mark.parametrize(
-    "namespace", ["../evil", "/fleet/tiago1", "tiago 1", "tiago1/", ".hidden", "", "1tiago"]
+    "namespace", ["../evil", "/fleet/tiago1", "tiago 1", "tiago1/", ".hidden", "1tiago"]
 )
 def test_a_namespace_that_is_not_a_plain_ros_name_is_refused(tmp_path: Path, namespace: str) -> None:
     scenario = _scenario_c()
@@ -244,3 +244,15 @@ def test_a_file_is_either_read_back_as_the_model_or_refused(waypoint_id: str, x:
     waypoint = yaml.safe_load(files["tiago1/delivery_a.yaml"])["task"][0]["waypoints"][0]
     assert waypoint["id"] == waypoint_id
     assert waypoint["x"] == x and math.copysign(1.0, waypoint["x"]) == math.copysign(1.0, x)
+
+
+def test_a_robot_at_the_root_has_its_task_files_in_a_folder_named_after_it(tmp_path: Path) -> None:
+    """namespace "": its topics are /waypoint_dispatcher/...; its files go in tiago1/."""
+    scenario = _scenario_c()
+    robots = (dataclasses.replace(scenario.robots[0], namespace=""), *scenario.robots[1:])
+    generate_dispatcher_config(_spec_of(dataclasses.replace(scenario, robots=robots)), None, tmp_path / "out")
+    mission = yaml.safe_load((tmp_path / "out" / "mission.yaml").read_text())
+    root = next(r for r in mission["robots"] if r["robot_id"] == "tiago1")
+    assert root["robot_namespace"] == ""
+    assert root["task_files"] == ["tiago1/delivery_a.yaml", "tiago1/navigate_home_1.yaml"]
+    assert (tmp_path / "out" / "tiago1" / "delivery_a.yaml").is_file()

@@ -223,3 +223,38 @@ def test_a_robot_with_tasks_and_nothing_to_place_it_is_refused_with_the_bags_pos
         match=r"robot 'drone1' has no navigation goals and no pose .*/other_drone/pose \(geometry_msgs/msg/PoseStamped\)",
     ):
         analyse_bag(bag, _scenario(tmp_path, "motion 3d"))
+
+
+def test_a_user_metric_reads_more_of_the_methods_pose_topic_than_the_signal_does(tmp_path: Path) -> None:
+    """Every robot's signals are served under the method's names; a metric that reads another
+    field of the very topic its pose comes from (the covariance of /tiago1/robot_pose) still gets
+    it: the largest x variance the bag holds, as rosbags reads it."""
+    folder = tmp_path / "brsu"
+    shutil.copytree(EXAMPLE, folder)
+    spec = folder / "scenario_c.exsce"
+    spec.write_text(
+        spec.read_text()
+        + """
+metric pose_variance for each robot {
+  "largest x variance of the localised pose"
+  unit m
+  reads pose: geometry_msgs/msg/PoseWithCovarianceStamped on "/{ns}/robot_pose"
+  value max(pose.pose.covariance[0])
+}
+""",
+        encoding="utf-8",
+    )
+    scenario = load_spec(spec).scenario("scenario_c")
+    (run,) = simulate(scenario, tmp_path / "runs", seed=3)
+    analysed = analyse_bag(run.bag, scenario)
+    tiago1 = [a for a in analysed.run.actions() if a.id.robot == "tiago1"]
+    start, end = min(a.start for a in tiago1 if a.start), max(a.end for a in tiago1 if a.end)
+    with AnyReader([run.bag]) as reader:
+        connections = [c for c in reader.connections if c.topic == "/tiago1/robot_pose"]
+        variances = [
+            reader.deserialize(raw, c.msgtype).pose.covariance[0]
+            for c, t, raw in reader.messages(connections=connections)
+            if start.timestamp() - 1e-6 <= t * 1e-9 <= end.timestamp() + 1e-6
+        ]
+    assert _whole(analysed, "pose_variance", "tiago1") == pytest.approx(max(variances), rel=1e-9)
+    assert max(variances) > 0

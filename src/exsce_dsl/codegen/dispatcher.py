@@ -39,19 +39,21 @@ def generate_dispatcher_config(
 def dispatcher_files(scenario: Scenario, source: str) -> dict[str, str]:
     """The files (relative POSIX path → text) for ``scenario``; ``source`` names the spec file in headers."""
     header = {"source": source, "scenario": scenario.id}
-    namespaces = {robot.id: _namespace(robot) for robot in scenario.robots}
+    folders = {robot.id: _folder(robot) for robot in scenario.robots}
     files: dict[str, str] = {}
     allocation = []
     for entry in scenario.mission.allocation:
         task = scenario.task(entry.task)
-        if entry.robot not in namespaces or task is None:
+        if entry.robot not in folders or task is None:
             raise GenerationError(
                 f"scenario '{scenario.id}' allocates task '{entry.task}' to robot '{entry.robot}', "
                 "but does not hold both",
                 entry.location,
             )
-        namespace = namespaces[entry.robot]
-        path = _task_file(namespace, task)
+        robot = scenario.robot(entry.robot)
+        assert robot is not None  # folders holds it
+        namespace = robot.namespace
+        path = _task_file(folders[entry.robot], task)
         if path not in files:
             content = task_to_yaml(task)
             text = render(
@@ -85,15 +87,17 @@ def dispatcher_files(scenario: Scenario, source: str) -> dict[str, str]:
     return {MISSION_FILE: _read_back(MISSION_FILE, text, mission), **files}
 
 
-def _namespace(robot: Robot) -> str:
-    if not _PLAIN_ROS_NAME.fullmatch(robot.namespace):
+def _folder(robot: Robot) -> str:
+    """The folder of a robot's task files: its namespace, or its id for a robot at the root."""
+    folder = robot.namespace or robot.id
+    if not _PLAIN_ROS_NAME.fullmatch(folder):
         raise GenerationError(
             f"namespace '{robot.namespace}' of robot '{robot.id}' is not a plain ROS name "
             "(a letter, then letters, digits or '_'); the dispatcher's files of a robot go "
-            "in a folder named after its namespace",
+            "in a folder named after its namespace (after its id, at the root)",
             robot.location,
         )
-    return robot.namespace
+    return folder
 
 
 def _task_file(namespace: str, task: Task) -> str:

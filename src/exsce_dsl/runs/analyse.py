@@ -184,7 +184,12 @@ def analyse_bag(path: Path, scenario: Scenario, digest: str | None = None) -> An
     for sources in stacks.sources.values():
         problems += sources.notes
     topics = {name: Topic(name, s.t, s.fields) for name, s in data.series.items()}
-    topics.update(stacks.served_topics(data, problems))
+    for name, served in stacks.served_topics(data, problems).items():
+        read = topics.get(name)
+        # a signal served under the very topic it was read from keeps every field the bag gave
+        # (a user metric may read more of it than the method's fields: pose.pose.covariance)
+        same = read is not None and len(read) == len(served) and np.array_equal(read.t, served.t)
+        topics[name] = Topic(name, served.t, {**served.fields, **read.fields}) if same and read else served
     actions: list[Segment] = []
     results: dict[str, int | None] = {}
     whole_runs: dict[str, tuple[float, float]] = {}

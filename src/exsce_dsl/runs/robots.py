@@ -66,11 +66,15 @@ class StackRobots:
         their navigation goals' topics added (as message objects)."""
         adapted = dict(wanted)
         scan_paths: list[FieldPath] = []
+        popped: dict[str, Wanted] = {}
         for robot in robots:
             if robot.id not in self.serves:
                 continue
             for signal, pattern in SERVED.items():
-                served = adapted.pop(topic_name(pattern, robot.namespace), None)
+                name = topic_name(pattern, robot.namespace)
+                served = adapted.pop(name, None)
+                if served is not None:
+                    popped[name] = served
                 if served is not None and signal == "scan":
                     scan_paths += served.paths
             signals = robot.signals
@@ -79,7 +83,9 @@ class StackRobots:
                     adapted.pop(topic_name(pattern, robot.namespace), None)
             adapted.update(goal_wanted(signals, robot.namespace))
         for topic, more in signals_wanted(self.sources.values(), scan_paths).items():
-            before = adapted.get(topic)
+            # a source that is a served topic itself (the method's robot_pose) keeps what the
+            # metrics read of it beyond the signal (a user metric's pose.pose.covariance)
+            before = adapted.get(topic) or popped.get(topic)
             if before is not None and before.msgtype == more.msgtype:
                 more = Wanted(
                     more.msgtype,
