@@ -14,7 +14,8 @@ import pytest
 PACKAGE = Path(__file__).resolve().parents[2] / "src" / "exsce_dsl"
 
 LAYERS: list[set[str]] = [
-    {"errors", "suggest", "resources", "textfiles", "tables", "templating", "figures"},  # the base
+    # the base
+    {"errors", "suggest", "resources", "textfiles", "tables", "templating", "figures", "user_cache"},
     {"model"},
     {"messages", "monitor_kit", "parallel"},
     {"transform"},
@@ -57,7 +58,9 @@ def _imports(path: Path) -> list[tuple[str, int]]:
     found = []
     for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
         if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
-            names = [node.module] if node.module != "exsce_dsl" else [f"exsce_dsl.{a.name}" for a in node.names]
+            names = (
+                [node.module] if node.module != "exsce_dsl" else [f"exsce_dsl.{a.name}" for a in node.names]
+            )
         elif isinstance(node, ast.Import):
             names = [a.name for a in node.names]
         else:

@@ -179,11 +179,11 @@ def ingest(
     Example:
       exscec ingest runs/*.bag --scenario examples/brsu_building_c/scenario_c.exsce
     """
-    from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.lang.spec_cache import load_spec_cached
     from exsce_dsl.runs.ingest import IngestResult, IngestStatus, ingest_bags
     from exsce_dsl.store.open import open_store
 
-    scenario = load_spec(spec).scenario(scenario_id)
+    scenario = load_spec_cached(spec).scenario(scenario_id)
     paths = [Path(b) for b in bag_arguments(bags)]
     if not paths:
         raise click.UsageError("no bag among the files given")

@@ -74,11 +74,20 @@ class Analysis:
 def load_spec(path: str | Path, overlay: Mapping[str, str] | None = None) -> Specification:
     """Parse, resolve and check a specification; raise :class:`SpecError` listing every error
     (and the notes about them)."""
-    analysis = analyse(path, overlay)
+    return load_spec_reading(path, overlay)[0]
+
+
+def load_spec_reading(
+    path: str | Path, overlay: Mapping[str, str] | None = None
+) -> tuple[Specification, tuple[str, ...]]:
+    """:func:`load_spec`, also naming the ``.exsce`` files it read (the root first), for
+    :mod:`exsce_dsl.lang.spec_cache`."""
+    sources = read_sources(path, overlay)
+    analysis = analyse_files(sources.files, sources.diagnostics, sources.broken)
     if analysis.errors or analysis.spec is None:
         told = [d for d in analysis.diagnostics if d.is_error or d.severity is Severity.NOTE]
         raise SpecError(told or analysis.diagnostics)
-    return analysis.spec
+    return analysis.spec, tuple(f.path for f in sources.files)
 
 
 def analyse(path: str | Path, overlay: Mapping[str, str] | None = None) -> Analysis:

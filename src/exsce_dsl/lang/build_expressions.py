@@ -14,11 +14,10 @@ from __future__ import annotations
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from exsce_dsl.lang.check_fields import FieldProblem, field_shape
 from exsce_dsl.lang.lexical import quantity_text
-from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.model.expressions import (
     AGGREGATES,
     CONDITION_AGGREGATES,
@@ -37,6 +36,9 @@ from exsce_dsl.model.expressions import (
 from exsce_dsl.model.messages import DISPATCHER, FEEDBACK, RESULT, FieldPath, Fields, Index, Select, Step
 from exsce_dsl.model.metrics import UNITS, ComputedFor, Dimension, TopicRead
 from exsce_dsl.suggest import did_you_mean
+
+if TYPE_CHECKING:  # parse trees come in; the parser (and textX) is not needed to read them
+    from exsce_dsl.lang.parser import ParsedFile
 
 _QUANTITY = re.compile(r"(\S+?)\s*([a-z/]+)?")
 _NUMERIC = (Kind.CONSTANT, Kind.NUMBERS, Kind.ARRAYS, Kind.VALUE)

@@ -11,7 +11,7 @@ from functools import lru_cache
 from pathlib import Path
 
 from exsce_dsl.errors import Diagnostic, ExsceError, Severity
-from exsce_dsl.lang.occupancy import FREE, OUTSIDE, OccupancyGrid, load_occupancy_grid
+from exsce_dsl.lang.occupancy import FREE, OUTSIDE, OccupancyGrid, load_occupancy_grid, map_image
 from exsce_dsl.model import Environment, Pose, Scenario
 from exsce_dsl.model.metrics import ComputedFor
 
@@ -158,9 +158,26 @@ def _bounds(grid: OccupancyGrid) -> str:
     return f" (x from {x0:.2f} to {x1:.2f}, y from {y0:.2f} to {y1:.2f})"
 
 
-@lru_cache(maxsize=8)
 def _grid(path: str) -> OccupancyGrid:
+    """The map at ``path``, read again when its YAML or image changed (an editor's session
+    outlives many edits of a map)."""
+    return _read_grid(path, _map_signature(path))
+
+
+@lru_cache(maxsize=8)
+def _read_grid(path: str, signature: tuple[tuple[str, int, int], ...]) -> OccupancyGrid:
     return load_occupancy_grid(Path(path))
+
+
+def _map_signature(path: str) -> tuple[tuple[str, int, int], ...]:
+    found = []
+    for file in (Path(path), map_image(Path(path))):
+        try:
+            stat = file.stat() if file is not None else None
+        except OSError:
+            stat = None
+        found.append((str(file), stat.st_mtime_ns if stat else -1, stat.st_size if stat else -1))
+    return tuple(found)
 
 
 def _grid_or_none(path: str) -> OccupancyGrid | None:

@@ -61,6 +61,17 @@ class OccupancyGrid:
         return UNKNOWN
 
 
+def map_image(yaml_path: Path) -> Path | None:
+    """The image a map_server YAML names, or None when the YAML cannot be read or names none."""
+    try:
+        meta = yaml.safe_load(yaml_path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, yaml.YAMLError):
+        return None
+    if not isinstance(meta, dict) or "image" not in meta:
+        return None
+    return yaml_path.parent / str(meta["image"])
+
+
 def load_occupancy_grid(yaml_path: Path) -> OccupancyGrid:
     """Read a map_server YAML and its PGM image (binary P5 or ASCII P2)."""
     try:

@@ -10,16 +10,23 @@ from __future__ import annotations
 import functools
 
 from exsce_dsl.errors import Diagnostic, Severity, SourceLocation, SpecError
-from exsce_dsl.lang.build_metrics import build_metric
-from exsce_dsl.lang.parser import parse_text
-from exsce_dsl.messages.catalogue import standard_catalogue
+from exsce_dsl.lang.spec_cache import cached_standard_metrics
 from exsce_dsl.model.metrics import METRICS, MetricDefinition
-from exsce_dsl.resources import package_file
 
 
 @functools.cache
 def standard_metrics() -> tuple[MetricDefinition, ...]:
-    """The standard library's metrics, in the order it declares them."""
+    """The standard library's metrics, in the order it declares them (parsed once per
+    installation: see :mod:`exsce_dsl.lang.spec_cache`)."""
+    return cached_standard_metrics(_parse_standard_metrics)
+
+
+def _parse_standard_metrics() -> tuple[MetricDefinition, ...]:
+    from exsce_dsl.lang.build_metrics import build_metric
+    from exsce_dsl.lang.parser import parse_text
+    from exsce_dsl.messages.catalogue import standard_catalogue
+    from exsce_dsl.resources import package_file
+
     source = package_file("lang", "stdlib", "metrics.exsce")
     pf = parse_text(source.read_text(encoding="utf-8"), str(source))
     problems: list[Diagnostic] = []

@@ -30,6 +30,12 @@ def msg_path_folders() -> list[Path]:
     return [Path(entry) for entry in os.environ.get(MSG_PATH, "").split(os.pathsep) if entry]
 
 
+def msg_path_files() -> list[Path]:
+    """Every definition file the folders of ``EXSCE_MSG_PATH`` hold, folder by folder (what
+    :func:`configured_catalogue` reads)."""
+    return [path for folder in msg_path_folders() for path in _definition_files(folder)]
+
+
 def user_catalogue(folders: Iterable[str | Path]) -> MessageCatalogue:
     """The definitions of every ``.msg`` and ``.idl`` file below ``folders``; a file that does not
     parse is a :class:`~exsce_dsl.messages.catalogue.MessageTypeError` naming it."""

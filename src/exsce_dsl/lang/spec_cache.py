@@ -1,0 +1,205 @@
+"""Checked specifications and the parsed standard library, kept in the user's cache folder.
+
+Parsing and checking a specification needs textX, whose metamodel of the
+grammar takes longer to build than the rest of a short ingest; the result, a
+:class:`~exsce_dsl.model.Specification` of plain frozen dataclasses, is pure
+and pickles.  So :func:`load_spec_cached` keeps it in the user's cache folder
+(:mod:`exsce_dsl.user_cache`) and reuses it only while everything it was made
+from is unchanged:
+
+- exsce's code and resources (every file of the package and its grammar,
+  by size and modification time, and its version), Python's version, and the
+  installed textX, Arpeggio, rosbags (whose typestores are the standard message
+  types) and PyYAML (which reads maps) — :func:`code_fingerprint`;
+- the working folder (diagnostics and locations name files relative to it)
+  and the root file's path;
+- the content (sha256) of every ``.exsce`` file read, the root and all it
+  imports, and of every map the checks read (the map_server YAML and its image);
+- ``$EXSCE_MSG_PATH``: its folders, the list of definition files below
+  them, and the content of each.
+
+The first three name the entry; the last two are recorded in it and
+compared, file by file, each time it is found.  Only a specification that
+loads without errors is kept (an error is always reported afresh); with an
+overlay (an editor's unsaved text) nothing is cached.  ``$EXSCE_CACHE`` set
+empty turns the cache off.  The entries are pickles, read only from the
+user's own cache folder, as Python reads ``__pycache__``.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import os
+import pickle
+import sys
+from collections.abc import Callable, Iterator
+from dataclasses import fields, is_dataclass
+from importlib.util import find_spec
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, TypeVar
+
+from exsce_dsl.user_cache import cache_folder, read_cached, write_cached
+
+if TYPE_CHECKING:
+    from exsce_dsl.model import Specification
+    from exsce_dsl.model.metrics import MetricDefinition
+
+FORMAT = b"exsce spec cache 1"
+"""Changes whenever what an entry holds changes shape."""
+
+LIBRARIES = ("textx", "arpeggio", "rosbags", "yaml")
+"""Installed packages whose version changes what loading a specification gives."""
+
+T = TypeVar("T")
+Dependencies = tuple[tuple[str, str | None], ...]
+"""(path, sha256 of its content, None when it did not exist) of each file an entry was made from."""
+
+
+def load_spec_cached(path: str | Path) -> Specification:
+    """:func:`~exsce_dsl.lang.build.load_spec`, from the user's cache folder when nothing it
+    depends on has changed (see the module's description); raises the same errors."""
+    folder = cache_folder()
+    if folder is None:
+        from exsce_dsl.lang.build import load_spec
+
+        return load_spec(path)
+    entry = folder / "specs" / f"{_entry_name(path)}.pickle"
+    found = _valid_entry(read_cached(entry))
+    if found is not None:
+        return found
+    from exsce_dsl.lang.build import load_spec_reading
+
+    spec, read = load_spec_reading(path)
+    dependencies = tuple((p, _digest(p)) for p in [*read, *_map_files(spec)])
+    definitions = _msg_path_dependencies()
+    write_cached(entry, FORMAT + pickle.dumps((dependencies, definitions, spec), pickle.HIGHEST_PROTOCOL))
+    return spec
+
+
+def cached_standard_metrics(make: Callable[[], tuple[MetricDefinition, ...]]) -> tuple[MetricDefinition, ...]:
+    """The standard library's metrics, parsed by ``make`` once per installation of exsce (the
+    library ships in the package, and its types are rosbags')."""
+    return _cached_by_code("stdlib-metrics", make)
+
+
+def _cached_by_code(name: str, make: Callable[[], T]) -> T:
+    folder = cache_folder()
+    if folder is None:
+        return make()
+    entry = folder / "specs" / f"{name}-{code_fingerprint().hex()[:32]}.pickle"
+    data = read_cached(entry)
+    if data is not None and data.startswith(FORMAT):
+        try:
+            value: T = pickle.loads(data[len(FORMAT) :])  # noqa: S301 - the user's own cache folder
+            return value
+        except Exception:  # noqa: BLE001 - a damaged entry is made again
+            pass
+    value = make()
+    write_cached(entry, FORMAT + pickle.dumps(value, pickle.HIGHEST_PROTOCOL))
+    return value
+
+
+@functools.lru_cache(maxsize=1)
+def code_fingerprint() -> bytes:
+    """A digest of exsce's code and resources (each file's path, size and modification time, as
+    Python decides whether a ``.pyc`` is current), exsce's and Python's versions, and where and
+    when the libraries that parsing and checking use were installed."""
+    from exsce_dsl import __version__
+    from exsce_dsl.resources import resource_dir
+
+    digest = hashlib.sha256()
+    _add(digest, FORMAT, __version__, sys.version)
+    package = Path(__file__).resolve().parents[1]
+    for root in (package, resource_dir("grammar")):
+        for dirpath, dirnames, filenames in os.walk(root):
+            dirnames[:] = sorted(d for d in dirnames if d != "__pycache__")
+            for name in sorted(filenames):
+                if name.endswith((".pyc", ".tmp")):
+                    continue
+                stat = os.stat(os.path.join(dirpath, name))
+                _add(digest, os.path.join(dirpath, name), str(stat.st_size), str(stat.st_mtime_ns))
+    for library in LIBRARIES:
+        spec = find_spec(library)
+        origin = spec.origin if spec is not None else None
+        stat_of = os.stat(origin) if origin else None
+        _add(digest, library, str(origin), str(stat_of.st_mtime_ns if stat_of else None))
+    return digest.digest()
+
+
+def _entry_name(path: str | Path) -> str:
+    digest = hashlib.sha256()
+    _add(digest, code_fingerprint().hex(), os.getcwd(), str(path), os.path.abspath(path))
+    return digest.hexdigest()[:40]
+
+
+def _valid_entry(data: bytes | None) -> Specification | None:
+    """The specification an entry holds, if every file it depends on is as it was."""
+    if data is None or not data.startswith(FORMAT):
+        return None
+    try:
+        dependencies, definitions, spec = pickle.loads(data[len(FORMAT) :])  # noqa: S301 - own cache
+    except Exception:  # noqa: BLE001 - a damaged entry is made again
+        return None
+    if definitions != _msg_path_dependencies():
+        return None
+    if any(_digest(p) != digest for p, digest in dependencies):
+        return None
+    found: Specification = spec
+    return found
+
+
+def _msg_path_dependencies() -> tuple[tuple[str, ...], Dependencies]:
+    """``$EXSCE_MSG_PATH``'s folders, and each definition file below them with its digest."""
+    from exsce_dsl.messages.user import msg_path_files, msg_path_folders
+
+    folders = tuple(str(f) for f in msg_path_folders())
+    return folders, tuple((str(p), _digest(str(p))) for p in msg_path_files())
+
+
+def _digest(path: str) -> str | None:
+    try:
+        return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    except OSError:
+        return None
+
+
+def _map_files(spec: Specification) -> list[str]:
+    """The files the map checks read: each map_server YAML and the image it names."""
+    from exsce_dsl.lang.occupancy import map_image
+    from exsce_dsl.model import MapModel
+
+    found: list[str] = []
+    for map_model in _instances(spec, MapModel):
+        if map_model.file is None or map_model.file in found:
+            continue
+        found.append(map_model.file)
+        image = map_image(Path(map_model.file))
+        if image is not None:
+            found.append(str(image))
+    return found
+
+
+def _instances(root: object, kind: type[T]) -> Iterator[T]:
+    """Every ``kind`` inside ``root``, a tree of dataclasses, tuples, lists and dicts."""
+    seen: set[int] = set()
+    pending: list[Any] = [root]
+    while pending:
+        item = pending.pop()
+        if id(item) in seen or isinstance(item, (str, bytes, int, float, bool, type(None))):
+            continue
+        seen.add(id(item))
+        if isinstance(item, kind):
+            yield item
+        if is_dataclass(item) and not isinstance(item, type):
+            pending.extend(getattr(item, f.name) for f in fields(item))
+        elif isinstance(item, (tuple, list, set, frozenset)):
+            pending.extend(item)
+        elif isinstance(item, dict):
+            pending.extend(item.values())
+
+
+def _add(digest: Any, *parts: str | bytes) -> None:
+    for part in parts:
+        data = part.encode("utf-8", "surrogateescape") if isinstance(part, str) else part
+        digest.update(len(data).to_bytes(8, "little") + data)
