@@ -146,7 +146,8 @@ def test_textx_generators_write_prov(in_tmp: Path) -> None:
     for target, name in (("provjson", "c.prov.json"), ("provn", "c.provn")):
         done = subprocess.run(
             [str(textx), "generate", str(folder / "scenario_c.exsce"), "--target", target, "-o", name],
-            capture_output=True, text=True,
+            capture_output=True,
+            text=True,
         )
         assert done.returncode == 0, done.stderr
     assert "exsce:scenario_c_bundle" in json.loads((in_tmp / "c.prov.json").read_text())["bundle"]
@@ -163,7 +164,8 @@ def test_textx_generate_and_exscec_compile_write_the_same_prov_for_a_derived_sce
     textx = Path(sys.executable).with_name("textx")
     done = subprocess.run(
         [str(textx), "generate", str(derived), "--target", "provjson", "-o", "by_textx.json"],
-        capture_output=True, text=True,
+        capture_output=True,
+        text=True,
     )
     assert done.returncode == 0, done.stderr
     compiled = run_exscec("compile", str(derived), "-f", "json", "-o", "by_exscec.json")
@@ -234,6 +236,14 @@ def test_progress_leaves_no_blank_lines_or_escape_codes_when_stderr_is_not_a_ter
         assert "\x1b" not in done.stderr and "\r" not in done.stderr, repr(done.stderr)
     wrote = [line.split(" (")[0] for line in simulated.stderr.splitlines()]
     assert wrote == [f"wrote runs/{bag.name}" for bag in bags]
-    assert len(ingested.stderr.splitlines()) == 3
+    # a line per bag, what ingestion detected (said once for both bags: the same), the summary
+    lines = ingested.stderr.splitlines()
+    assert [line.split(": run ")[0] for line in lines if ": run " in line] == [str(b) for b in bags]
+    detected = [line.strip() for line in lines if line.startswith("  ")]
+    assert detected == [
+        f"robot '{r}': convention method (detected from /{r}/waypoint_dispatcher/feedback)"
+        for r in ("tiago1", "tiago2")
+    ]
+    assert len(lines) == 5
     assert ingested.stderr.endswith("2 ingested, 0 skipped, 0 failed\n")
     assert reported.stderr.splitlines()[-1].startswith("wrote report/index.html")

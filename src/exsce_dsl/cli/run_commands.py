@@ -170,7 +170,8 @@ def ingest(
     and nothing of it is written, and the other bags still ingest.  A bag already
     ingested (same content) is skipped.  It says the convention it detected for
     each robot whose type names none, and the run's timeline when its stamps are
-    simulated time (-v: the clock of every topic).  Exits 1 if any bag failed.  With
+    simulated time, once for all the bags that share them (-v: for each bag, and
+    the clock of every topic).  Exits 1 if any bag failed.  With
     --cluster, a Dask cluster's workers analyse the bags (a task is tried
     twice; a killed worker's tasks go to another) and exscec writes each
     run, as with --jobs.
@@ -187,13 +188,16 @@ def ingest(
     paths = [Path(b) for b in bag_arguments(bags)]
     if not paths:
         raise click.UsageError("no bag among the files given")
+    said: set[str] = set()
     with open_store(store_url) as store, Progress(len(paths), "ingesting") as progress:
 
         def shown(result: IngestResult) -> None:
             progress.update()
             progress.say(f"{'error: ' if result.failed else ''}{result.message}")
             for line in result.picked + (result.clocks if verbose else ()):
-                progress.say(f"  {line}")
+                if verbose or line not in said:  # what every bag shares is said once
+                    progress.say(f"  {line}")
+                    said.add(line)
             for problem in result.problems:
                 progress.say(f"warning: {result.bag}: {problem}")
 
