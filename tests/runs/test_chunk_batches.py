@@ -18,8 +18,10 @@ from rosbags.highlevel import AnyReader
 
 from exsce_dsl.messages.catalogue import standard_catalogue, standard_ros1_catalogue
 from exsce_dsl.model.messages import path_of
-from exsce_dsl.runs.bags import chunk_batches, mcap_index, ros1_index
-from exsce_dsl.runs.bags.decode import RawMessages, decode
+from exsce_dsl.runs.bags import chunk_batches, mcap_index, ros1
+from exsce_dsl.runs.bags.buffers import mapped
+from exsce_dsl.runs.bags.decode import decode
+from exsce_dsl.runs.bags.raw_messages import RawMessages
 
 
 def _bag(tmp_path: Path, fmt: str) -> factory.WrittenBag:
@@ -38,14 +40,14 @@ def _bag(tmp_path: Path, fmt: str) -> factory.WrittenBag:
     return factory.write_bag(tmp_path / name, fmt, topics, store, chunk_bytes=2_000)
 
 
-def _chunks(path: Path, ros1: bool) -> int:
+def _chunks(path: Path, is_ros1: bool) -> int:
     """How many chunks the bag has, counted from its chunk records (op 0x05 in ROS 1, 0x06 in MCAP)."""
-    if ros1:
-        with ros1_index.mapped(path) as data:
-            _, pos, count = ros1_index._connections(data, None)
+    if is_ros1:
+        with mapped(path) as data:
+            _, pos, count = ros1._connections(data, None)
         return count
     [file] = path.glob("*.mcap")
-    with mcap_index.mapped(file) as data:
+    with mapped(file) as data:
         return len(mcap_index._summary(data).chunks)
 
 
@@ -54,7 +56,7 @@ def test_batches_of_chunks_give_the_messages_rosbags_reads(
     tmp_path: Path, fmt: str, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     written = _bag(tmp_path, fmt)
-    ros1 = fmt.startswith("ros1")
+    is_ros1 = fmt.startswith("ros1")
     monkeypatch.setattr(chunk_batches, "BATCH_BYTES", 10_000)
     x = path_of("pose", "pose", "position", "x")
     calls: list[tuple[str, int]] = []
@@ -64,16 +66,16 @@ def test_batches_of_chunks_give_the_messages_rosbags_reads(
         calls.append((topic, len(messages)))
         if topic == "/tf":
             return False  # keep the raw bytes
-        catalogue = standard_ros1_catalogue() if ros1 else standard_catalogue()
-        out = decode(catalogue, msgtype, messages, [x], cdr=not ros1)
+        catalogue = standard_ros1_catalogue() if is_ros1 else standard_catalogue()
+        out = decode(catalogue, msgtype, messages, [x], cdr=not is_ros1)
         decoded.append(out[x.key])
         return True
 
-    reader = ros1_index if ros1 else mcap_index
-    path = written.path if ros1 else next(written.path.glob("*.mcap"))
+    reader = ros1 if is_ros1 else mcap_index
+    path = written.path if is_ros1 else next(written.path.glob("*.mcap"))
     found = reader.read_topics(path, {"/odom", "/tf"}, decoder)
 
-    chunks = _chunks(written.path, ros1)
+    chunks = _chunks(written.path, is_ros1)
     odom_calls = [n for topic, n in calls if topic == "/odom"]
     assert 1 < len(odom_calls) < chunks  # several batches, each joining several chunks
     expected: dict[str, list[tuple[int, Any, bytes]]] = {"/odom": [], "/tf": []}
@@ -92,13 +94,13 @@ def test_a_view_of_the_map_left_in_a_cycle_does_not_fail_a_read_that_succeeded(t
     path = tmp_path / "some.bag"
     path.write_bytes(b"#ROSBAG V2.0\n" + bytes(4096))
     cycle: list[object] = []
-    with ros1_index.mapped(path) as data:
+    with mapped(path) as data:
         cycle.extend([np.frombuffer(data, dtype=np.uint8, count=16), cycle])
         first = bytes(data[:13])
     assert first == b"#ROSBAG V2.0\n"  # and leaving the block raised nothing
     gc.disable()
     try:
-        with ros1_index.mapped(path) as data:
+        with mapped(path) as data:
             kept = np.frombuffer(data, dtype=np.uint8, count=16)  # alive after the block: still no error
         assert kept[:8].tobytes() == b"#ROSBAG "
     finally:

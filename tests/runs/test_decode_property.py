@@ -48,7 +48,8 @@ from exsce_dsl.messages.catalogue import (
     standard_ros1_catalogue,
 )
 from exsce_dsl.model.messages import FieldPath, Index, Select
-from exsce_dsl.runs.bags.decode import PRESENT, DecodeError, RawMessages, decode
+from exsce_dsl.runs.bags.decode import PRESENT, DecodeError, decode
+from exsce_dsl.runs.bags.raw_messages import RawMessages
 
 FORMATS = ("ros1", "cdr", "cdr_be")
 """ROS 1 serialization, CDR little-endian, CDR big-endian."""

@@ -16,7 +16,8 @@ from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 from exsce_dsl.messages.catalogue import standard_catalogue, standard_ros1_catalogue
 from exsce_dsl.model.messages import FieldPath, Index, path_of
-from exsce_dsl.runs.bags.decode import TEXTS, DecodeError, RawMessages, decode, decode_slowly
+from exsce_dsl.runs.bags.decode import TEXTS, DecodeError, decode, decode_slowly
+from exsce_dsl.runs.bags.raw_messages import RawMessages
 from exsce_dsl.runs.bags.reading import Wanted, read_bag
 
 TF = "tf2_msgs/msg/TFMessage"

@@ -1,5 +1,5 @@
 """Messages wanted whole as objects (a Nav2 robot's global plans, action statuses) are deserialised
-when first read (runs.bagdata.LazyMessage): a stack that replans once a second publishes hundreds
+when first read (runs.bags.objects.LazyMessage): a stack that replans once a second publishes hundreds
 of plans, of which a goal's target needs one."""
 
 from __future__ import annotations
@@ -7,7 +7,8 @@ from __future__ import annotations
 import pytest
 from rosbags.typesys import Stores, get_typestore
 
-from exsce_dsl.runs.bags.reading import BagError, LazyMessage, deserialized
+from exsce_dsl.runs.bags.objects import deserialized
+from exsce_dsl.runs.bags.reading import BagError, LazyMessage
 
 STORE = get_typestore(Stores.ROS2_HUMBLE)
 

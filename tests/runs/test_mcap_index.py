@@ -1,4 +1,4 @@
-"""The MCAP index reader (``runs/mcap_index.py``) and the MCAP fast path (``runs/mcap_reading.py``).
+"""The MCAP index reader (``runs/bags/mcap_index.py``) and the MCAP reader (``runs/bags/mcap.py``).
 
 Bags are written with rosbags' writer and read back two ways: by our reader,
 and by rosbags' AnyReader, one message at a time (an independent path).  Per
@@ -31,11 +31,12 @@ from rosbags.typesys import Stores, get_typestore
 
 from exsce_dsl.model.messages import path_of
 from exsce_dsl.runs.bags import reading as bagdata
-from exsce_dsl.runs.bags.decode import RawMessages
+from exsce_dsl.runs.bags.mcap import mcap_files
 from exsce_dsl.runs.bags.mcap_index import read_topics, schemas
-from exsce_dsl.runs.bags.mcap_reading import mcap_files
+from exsce_dsl.runs.bags.raw_messages import RawMessages
+from exsce_dsl.runs.bags.reader import UnsupportedBag
 from exsce_dsl.runs.bags.reading import ANY, Wanted, read_bag
-from exsce_dsl.runs.bags.ros1_index import UnsupportedBag
+from exsce_dsl.runs.bags.rosbags_fallback import read_with_rosbags
 from exsce_dsl.sim.messages import FEEDBACK
 from exsce_dsl.sim.messages import typestore as sim_typestore
 
@@ -624,7 +625,7 @@ def test_channel_not_in_cdr_raises(tmp_path: Path) -> None:
 # ------------------------------------------------------------------ the map always closes
 @pytest.mark.parametrize("layout", ["uncompressed-small-chunks", "zstd", "lz4-small-chunks"])
 def test_decoder_error_is_not_hidden_by_buffer_error(bags: dict[str, Path], layout: str) -> None:
-    """ros1_index's bug: an error while a view of the map existed became ``BufferError: cannot close
+    """The ROS 1 index reader's bug: an error while a view of the map existed became ``BufferError: cannot close
     exported pointers exist``.  Here the decoder's own error comes out, whatever the chunks."""
     calls = []
 
@@ -717,7 +718,7 @@ def _dispatcher_bag(tmp_path: Path, written: list[Written]) -> tuple[Path, dict[
 def test_read_bag_reads_what_rosbags_reads(tmp_path: Path, written: list[Written]) -> None:
     bag, wanted = _dispatcher_bag(tmp_path, written)
     ours = read_bag(bag, wanted)
-    theirs = bagdata._read_with_rosbags(bag, wanted, None, None)
+    theirs = read_with_rosbags(bag, wanted, None, None)
     _same_data(ours, theirs)
     assert len(ours.series["/odom"]) == len([w for w in written if w[0] == "/odom"])
     assert len(ours.feedback["/wd/feedback"]) == (len(written) + 49) // 50

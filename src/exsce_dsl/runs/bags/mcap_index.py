@@ -1,8 +1,8 @@
 """Read messages of chosen channels straight from an MCAP file's index, with numpy.
 
-The MCAP counterpart of :mod:`exsce_dsl.runs.bags.ros1_index`, with the same
-:data:`~exsce_dsl.runs.bags.ros1_index.Decoder` and
-:class:`~exsce_dsl.runs.bags.ros1_index.Messages`.  An indexed MCAP file (what
+The MCAP counterpart of :mod:`exsce_dsl.runs.bags.ros1`'s index reader, with the same
+:data:`~exsce_dsl.runs.bags.chunk_batches.Decoder` and
+:class:`~exsce_dsl.runs.bags.chunk_batches.Messages`.  An indexed MCAP file (what
 rosbag2 and rosbags write) ends with a summary section: its schemas and
 channels, and a chunk index per chunk that gives, per channel, where the
 chunk's message index record for that channel is.  A message index lists the
@@ -28,8 +28,9 @@ about as long again as decompressing it) and a mismatch is :class:`CorruptBag`.
 Chunks stored uncompressed, with ``zstd`` or with ``lz4`` are read.  A file
 without a summary, a chunk index or message indexes (written so, or not closed:
 a truncated file has lost its summary), another compression, or a record that
-does not fit where it is said to be raises :class:`UnsupportedBag`, and the
-caller falls back to rosbags, which reads what it can and reports the rest.
+does not fit where it is said to be raises :class:`UnsupportedBag`, and
+:data:`~exsce_dsl.runs.bags.mcap.MCAP` passes the bag to rosbags, which reads
+what it can and reports the rest.
 """
 
 from __future__ import annotations
@@ -45,10 +46,12 @@ from pathlib import Path
 import numpy as np
 
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.runs.bags.chunk_batches import ChunkBatch
-from exsce_dsl.runs.bags.ros1_index import Decoder, Messages, UnsupportedBag, mapped
+from exsce_dsl.runs.bags.buffers import mapped, release
+from exsce_dsl.runs.bags.chunk_batches import ChunkBatch, Decoder, Gathered, Messages
+from exsce_dsl.runs.bags.reader import UnsupportedBag
 
 MAGIC = b"\x89MCAP0\r\n"
+OP_HEADER = 0x01
 OP_FOOTER = 0x02
 OP_SCHEMA = 0x03
 OP_CHANNEL = 0x04
@@ -71,6 +74,9 @@ MESSAGE_HEADER = np.dtype(
 )
 """A message record up to its data (31 bytes, packed)."""
 _HEADER_BYTES = np.arange(MESSAGE_HEADER.itemsize, dtype=np.int64)
+
+IDL_SEPARATOR = "=" * 80 + "\n"
+"""Between the ``.idl`` files of a ``ros2idl`` schema, each then headed ``IDL: pkg/msg/Name``."""
 
 MESSAGE_ENCODINGS = ("cdr",)
 """The message encodings the decoders read (ROS 2's)."""
@@ -324,17 +330,11 @@ def _wanted(summary: _Summary, topics: Container[str]) -> dict[int, _Channel]:
 def _read_topics(data: mmap.mmap, topics: Container[str], decoder: Decoder) -> dict[str, Messages]:
     summary = _summary(data)
     wanted = _wanted(summary, topics)
-    times_of: dict[int, list[np.ndarray]] = {c: [] for c in wanted}
-    raws_of: dict[int, list[bytes]] = {c: [] for c in wanted}
-
-    def decode(batch: ChunkBatch) -> None:
-        for cid, times, messages in batch.messages():
-            channel = wanted[cid]
-            assert channel.schema is not None  # _wanted checked it
-            if not decoder(channel.topic, channel.schema.name, channel.schema.text, times, messages):
-                raws_of[cid].extend(messages.raws())
-            times_of[cid].append(times)
-
+    names = {}
+    for cid, channel in wanted.items():
+        assert channel.schema is not None  # _wanted checked it
+        names[cid] = (channel.topic, channel.schema.name, channel.schema.text)
+    gathered = Gathered(names, decoder)
     batch, batch_from, batch_to = ChunkBatch(), 0, 0
     for index in summary.chunks:
         if not index.message_indexes:
@@ -354,33 +354,21 @@ def _read_topics(data: mmap.mmap, topics: Container[str], decoder: Decoder) -> d
         batch.close_chunk(chunk)
         batch_to = index.start + index.length + index.message_index_length
         if batch.full:
-            decode(batch)
+            gathered.decode(batch)
             batch = ChunkBatch()
-            _release(data, batch_from, batch_to)
-    decode(batch)
+            release(data, batch_from, batch_to)
+    gathered.decode(batch)
     del batch
     if summary.message_counts is not None:
         for cid, channel in wanted.items():
-            found = sum(len(t) for t in times_of[cid])
+            found = gathered.count(cid)
             expected = summary.message_counts.get(cid, 0)
             if found != expected:
                 raise UnsupportedBag(
                     f"the message indexes of topic {channel.topic} list {found} messages, "
                     f"its statistics {expected}"
                 )
-    out: dict[str, Messages] = {}
-    for cid, channel in wanted.items():
-        if not times_of[cid]:
-            continue
-        times = np.concatenate(times_of[cid])
-        assert channel.schema is not None
-        known = out.get(channel.topic)
-        if known is not None:  # several channels on one topic: one topic, its messages merged
-            times = np.concatenate([known.times, times])
-            out[channel.topic] = Messages(known.msgtype, known.definition, times, known.raws + raws_of[cid])
-        else:
-            out[channel.topic] = Messages(channel.schema.name, channel.schema.text, times, raws_of[cid])
-    return out
+    return gathered.by_topic()
 
 
 def _chunk_records(data: mmap.mmap, index: _ChunkIndex) -> bytes:
@@ -450,13 +438,3 @@ def _message_data(
     if int(ends.max()) > len(chunk):
         raise UnsupportedBag("a message runs past the end of its chunk")
     return at + MESSAGE_HEADER.itemsize, ends
-
-
-def _release(data: mmap.mmap, start: int, end: int) -> None:
-    """Let the kernel drop the pages of a chunk already read (keeps resident memory low)."""
-    page = mmap.PAGESIZE
-    first = start // page * page
-    try:
-        data.madvise(mmap.MADV_DONTNEED, first, max(0, end - first) // page * page)
-    except (AttributeError, OSError, ValueError):  # not on this platform: only memory is lost
-        pass

@@ -1,0 +1,133 @@
+"""Every other bag, with rosbags' readers: ROS 2 sqlite3 bags, and what the index readers pass
+on (an MCAP file without a summary, a ROS 1 bag without an index, whole-file compression).
+
+rosbags hands out one message at a time: they are joined into blocks of :data:`BLOCK` and each
+block decoded at once.  Its readers raise their own errors for corrupt and truncated files:
+they are said as :class:`~exsce_dsl.errors.BagError`\\ s.  A type's definition comes from the
+bag (the types rosbags read of it), else from the user's files, else from rosbags' standard
+typestores.
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Iterator, Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from exsce_dsl.errors import BagError, DecodeError
+from exsce_dsl.messages.catalogue import MessageCatalogue, MessageTypeError, Source, standard_catalogue
+from exsce_dsl.messages.user import configured_user_catalogue
+from exsce_dsl.model.messages import canonical_type
+from exsce_dsl.runs.bags.data import OBJECTS, WHOLE, BagData, Check, Reduce, Wanted
+from exsce_dsl.runs.bags.names import BagTopics
+from exsce_dsl.runs.bags.objects import deserialized, deserializer_for
+from exsce_dsl.runs.bags.raw_messages import RawMessages
+from exsce_dsl.runs.bags.reader import BagReader
+from exsce_dsl.runs.bags.reading_base import Reading
+
+BLOCK = 4096
+"""Messages decoded at a time from readers that hand out one message at a time (rosbags')."""
+
+
+def typestore_for(path: Path):  # type: ignore[no-untyped-def]
+    from rosbags.typesys import Stores, get_typestore
+
+    ros2 = path.is_dir() or path.suffix in (".db3", ".mcap")
+    return get_typestore(Stores.ROS2_HUMBLE if ros2 else Stores.ROS1_NOETIC)
+
+
+def read_with_rosbags(
+    path: Path, wanted: Mapping[str, Wanted], reduce: Mapping[str, Reduce] | None, check: Check | None
+) -> BagData:
+    """The ``wanted`` topics of the bag, read by rosbags' readers."""
+    from rosbags.highlevel import AnyReader  # here: the index readers need none of rosbags' readers
+
+    try:
+        reader = AnyReader([path], default_typestore=typestore_for(path))
+        reader.open()
+    except Exception as exc:  # rosbags' readers raise their own errors for corrupt and truncated files
+        raise BagError(f"{path}: cannot read the bag: {type(exc).__name__}: {exc}") from None
+    try:
+        if reader.message_count == 0:
+            raise BagError(f"{path}: the bag holds no messages")
+        reading = Reading(path, wanted, reduce, check)
+        bag_types = MessageCatalogue()
+        bag_types.add(reader.typestore.fielddefs, Source(f"the bag {path.name}"))
+        catalogue = bag_types.layered(configured_user_catalogue(), standard_catalogue())
+        cdr = not _is_ros1(path)
+        by_topic: dict[str, list[Any]] = {}
+        for conn in reader.connections:
+            if conn.topic in reading.match and reading.accepts(conn.topic, conn.msgtype):
+                by_topic.setdefault(conn.topic, []).append(conn)
+        for _, conns in sorted(by_topic.items()):
+            for conn in conns:
+                _read_connection(reader, reading, conn, catalogue, cdr)
+        data = reading.data(
+            reader.start_time / 1e9,
+            reader.end_time / 1e9,
+            tuple(sorted({c.topic for c in reader.connections})),
+        )
+    except (BagError, DecodeError, MessageTypeError):
+        raise
+    except Exception as exc:  # rosbags' readers raise their own errors for corrupt and truncated files
+        raise BagError(f"{path}: cannot read the bag: {type(exc).__name__}: {exc}") from None
+    finally:
+        reader.close()
+    return data
+
+
+def _read_connection(
+    reader: Any, reading: Reading, conn: Any, catalogue: MessageCatalogue, cdr: bool
+) -> None:
+    topic, msgtype = conn.topic, canonical_type(conn.msgtype)
+    whole = reading.wanted_for(topic).msgtype in WHOLE
+    if not whole:
+        reading.prepare(topic, msgtype, catalogue)
+    store = deserializer_for(catalogue, msgtype) if whole else None
+
+    for stamps, raws in _blocks(reader.messages(connections=[conn])):
+        times = np.asarray(stamps, dtype=np.int64)
+        if store is not None:
+            read = store.deserialize_cdr if cdr else store.deserialize_ros1
+            lazy = topic if reading.wanted_for(topic).msgtype == OBJECTS else None
+            reading.add_whole(
+                topic, times / 1e9, deserialized(functools.partial(read, typename=msgtype), raws, lazy)
+            )
+        else:
+            reading.add(
+                topic, msgtype, times, reading.decode(topic, msgtype, catalogue, RawMessages.join(raws), cdr)
+            )
+
+
+def _blocks(messages: Iterator[tuple[Any, int, bytes]]) -> Iterator[tuple[list[int], list[bytes]]]:
+    stamps: list[int] = []
+    raws: list[bytes] = []
+    for _, timestamp, raw in messages:
+        stamps.append(timestamp)
+        raws.append(raw)
+        if len(raws) == BLOCK:
+            yield stamps, raws
+            stamps, raws = [], []
+    if raws:
+        yield stamps, raws
+
+
+def _is_ros1(path: Path) -> bool:
+    return path.is_file() and path.suffix == ".bag"
+
+
+def _topics(path: Path) -> BagTopics:
+    from rosbags.highlevel import AnyReader  # here: the index readers need none of rosbags' readers
+
+    try:
+        with AnyReader([path], default_typestore=typestore_for(path)) as reader:
+            return BagTopics({c.topic: canonical_type(c.msgtype) for c in reader.connections})
+    except Exception as exc:  # rosbags' readers raise their own errors for corrupt and truncated files
+        raise BagError(f"{path}: cannot read the bag: {type(exc).__name__}: {exc}") from None
+
+
+ROSBAGS = BagReader("rosbags", claims=lambda path: True, read=read_with_rosbags, topics=_topics)
+"""Every bag, by rosbags' readers: the last of the readers, which says what is broken."""
