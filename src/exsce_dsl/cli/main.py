@@ -1,11 +1,14 @@
 """``exscec``: the command line, a thin click layer over the library.
 
-The group lives here; each family of commands is a module of its own that
-adds its commands to :data:`main`.
+The group lives here; each family of commands is a module of its own, whose
+``COMMANDS`` the group lists in :data:`COMMAND_MODULES`.  A module is imported
+when one of its commands runs (or ``--help`` lists them all), not for every
+command: ``exscec ingest`` does not pay for the imports of ``exscec report``.
 """
 
 from __future__ import annotations
 
+import importlib
 import os
 
 import click
@@ -13,8 +16,50 @@ import click
 from exsce_dsl import __version__
 from exsce_dsl.cli.common import State
 
+COMMAND_MODULES: dict[str, str] = {
+    "check": "spec_commands",
+    "compile": "spec_commands",
+    "fmt": "spec_commands",
+    "import": "spec_commands",
+    "export": "spec_commands",
+    "simulate": "run_commands",
+    "ingest": "run_commands",
+    "store": "store_commands",
+    "serve": "store_commands",
+    "query": "query_commands",
+    "sparql": "query_commands",
+    "runs": "query_commands",
+    "baseline": "oracle_commands",
+    "verify": "oracle_commands",
+    "derive": "derive_commands",
+    "lineage": "derive_commands",
+    "expect": "derive_commands",
+    "explore": "explore_commands",
+    "cluster": "similarity_commands",
+    "report": "report_commands",
+    "generate": "generate_commands",
+    "demo": "demo_commands",
+    "lsp": "lsp_commands",
+    "mcp": "mcp_commands",
+}
+"""Each command of ``exscec`` and the module of ``exsce_dsl.cli`` whose ``COMMANDS`` holds it."""
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+
+class LazyGroup(click.Group):
+    """A group whose commands are imported when they are used (click's lazy loading)."""
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        return sorted(set(COMMAND_MODULES) | set(self.commands))
+
+    def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
+        if cmd_name not in self.commands and cmd_name in COMMAND_MODULES:
+            module = importlib.import_module(f"exsce_dsl.cli.{COMMAND_MODULES[cmd_name]}")
+            for command in module.COMMANDS:
+                self.add_command(command)
+        return self.commands.get(cmd_name)
+
+
+@click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(__version__, prog_name="exscec")
 @click.option("--debug", is_flag=True, help="Show Python tracebacks for errors.")
 @click.option(
@@ -54,41 +99,3 @@ def main(debug: bool, msg_paths: tuple[str, ...]) -> None:
 
         folders = [os.path.abspath(p) for p in msg_paths]
         os.environ[MSG_PATH] = os.pathsep.join([*folders, *filter(None, [os.environ.get(MSG_PATH)])])
-
-
-def _register() -> None:
-    from exsce_dsl.cli import (
-        demo_commands,
-        derive_commands,
-        explore_commands,
-        generate_commands,
-        lsp_commands,
-        mcp_commands,
-        oracle_commands,
-        query_commands,
-        report_commands,
-        run_commands,
-        similarity_commands,
-        spec_commands,
-        store_commands,
-    )
-
-    for command in [
-        *spec_commands.COMMANDS,
-        *run_commands.COMMANDS,
-        *store_commands.COMMANDS,
-        *query_commands.COMMANDS,
-        *oracle_commands.COMMANDS,
-        *derive_commands.COMMANDS,
-        *explore_commands.COMMANDS,
-        *similarity_commands.COMMANDS,
-        *report_commands.COMMANDS,
-        *generate_commands.COMMANDS,
-        *demo_commands.COMMANDS,
-        *lsp_commands.COMMANDS,
-        *mcp_commands.COMMANDS,
-    ]:
-        main.add_command(command)
-
-
-_register()

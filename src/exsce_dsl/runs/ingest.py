@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable, Iterable, Iterator, Sequence
-from concurrent.futures import ProcessPoolExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from enum import Enum
@@ -19,7 +18,6 @@ from typing import Any, cast
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import Scenario
-from exsce_dsl.parallel.cluster import cluster_mapper
 from exsce_dsl.prov import DEFAULT_NAMESPACE, compile_scenario
 from exsce_dsl.prov.run import compile_run
 from exsce_dsl.runs.analyse import AnalysedRun, analyse_bag, content_hash, run_uuid
@@ -88,12 +86,16 @@ def _workers(jobs: int, tasks: int, cluster: str | None = None) -> Iterator[Mapp
     """``map`` on the Dask cluster at ``cluster``, in this process (one job), or over a pool of
     ``jobs`` processes kept for every phase."""
     if cluster is not None:
+        from exsce_dsl.parallel.cluster import cluster_mapper
+
         with cluster_mapper(cluster) as mapper:
             yield mapper
         return
     if jobs <= 1 or tasks <= 1:
         yield map
         return
+    from concurrent.futures import ProcessPoolExecutor
+
     with ProcessPoolExecutor(max_workers=min(jobs, tasks, os.cpu_count() or 1)) as pool:
         yield pool.map
 

@@ -37,10 +37,13 @@ import os
 import urllib.parse
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from exsce_dsl.store.base import Store, StoreError
 from exsce_dsl.store.embedded import EmbeddedStore
-from exsce_dsl.store.remote import RemoteStore
+
+if TYPE_CHECKING:  # imported when a URL names an endpoint: urllib.request and http.client are slow
+    from exsce_dsl.store.remote import RemoteStore
 
 __all__ = ["DEFAULT_STORE", "PRESETS", "STORE_ENV", "TOKEN_ENV", "Preset", "open_store", "store_url"]
 
@@ -101,6 +104,8 @@ def open_store(url: str | None = None, *, token: str | None = None, timeout: flo
 
 
 def _endpoint_store(url: str, token: str | None, timeout: float) -> RemoteStore:
+    from exsce_dsl.store.remote import RemoteStore
+
     parts = urllib.parse.urlsplit(url)
     params = urllib.parse.parse_qsl(parts.query, keep_blank_values=True)
     own = {"update", "gsp", "store", "form", "auth"}
@@ -128,6 +133,8 @@ def _endpoint_store(url: str, token: str | None, timeout: float) -> RemoteStore:
 
 
 def _preset_store(preset: Preset, url: str, token: str | None, timeout: float) -> RemoteStore:
+    from exsce_dsl.store.remote import RemoteStore
+
     parts = urllib.parse.urlsplit(url)
     base = parts.path.rstrip("/")
     for suffix in preset.strip:
@@ -152,6 +159,7 @@ def _embedded_store(path: Path, token: str | None, timeout: float) -> Store:
     embedded = EmbeddedStore(path)
     if not embedded.held_elsewhere:
         return embedded
+    from exsce_dsl.store.remote import RemoteStore
     from exsce_dsl.store.server import read_serve_info
 
     info = read_serve_info(path)
