@@ -15,7 +15,6 @@ from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
-import yaml
 
 from exsce_dsl.messages.catalogue import MessageCatalogue, Source, parse_definition, standard_catalogue
 from exsce_dsl.runs.bags.chunk_batches import Messages
@@ -25,8 +24,6 @@ from exsce_dsl.runs.bags.objects import deserialized, deserializer_for
 from exsce_dsl.runs.bags.reader import BagReader, UnsupportedBag
 from exsce_dsl.runs.bags.reading_base import IndexReading
 
-_YAML_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml's: ten times faster
-
 
 def mcap_files(path: Path) -> list[Path] | None:
     """The MCAP files of the bag at ``path``, in order: the file itself, or those a ROS 2 bag
@@ -34,9 +31,12 @@ def mcap_files(path: Path) -> list[Path] | None:
     files or messages compressed whole, which only rosbags reads)."""
     if path.is_file():
         return [path] if path.suffix == ".mcap" else None
+    import yaml  # here: only a ROS 2 bag folder needs it
+
+    loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml's: ten times faster
     try:
         text = (path / "metadata.yaml").read_text()
-        info = yaml.load(text, Loader=_YAML_LOADER)["rosbag2_bagfile_information"]
+        info = yaml.load(text, Loader=loader)["rosbag2_bagfile_information"]
         storage, mode = info.get("storage_identifier"), info.get("compression_mode") or ""
         files = [path / str(name) for name in info.get("relative_file_paths") or ()]
     except (OSError, UnicodeDecodeError, yaml.YAMLError, KeyError, TypeError, AttributeError):
