@@ -181,15 +181,17 @@ def ingest(
       exscec ingest runs/*.bag --scenario examples/brsu_building_c/scenario_c.exsce
     """
     from exsce_dsl.lang.spec_cache import load_spec_cached
-    from exsce_dsl.runs.ingest import IngestResult, IngestStatus, ingest_bags
-    from exsce_dsl.store.open import open_store
+    from exsce_dsl.store.open import StoreOpening
 
     scenario = load_spec_cached(spec).scenario(scenario_id)
     paths = [Path(b) for b in bag_arguments(bags)]
     if not paths:
         raise click.UsageError("no bag among the files given")
+    opening = StoreOpening(store_url)  # the store opens while what reads the bags is imported
+    from exsce_dsl.runs.ingest import IngestResult, IngestStatus, ingest_bags
+
     said: set[str] = set()
-    with open_store(store_url) as store, Progress(len(paths), "ingesting") as progress:
+    with opening.store() as store, Progress(len(paths), "ingesting") as progress:
 
         def shown(result: IngestResult) -> None:
             progress.update()

@@ -118,6 +118,15 @@ class EmbeddedStore(Store):
     def _writer(self) -> OxStore:
         return self._store if self._store is not None else self._open()
 
+    def open_for_writing(self) -> None:
+        """Open (or make) the store folder now rather than at the first write; when it cannot be
+        opened, the first write says why, as it would have."""
+        if self.path is not None:
+            try:
+                self._writer()
+            except StoreError:
+                pass
+
     @property
     def held_elsewhere(self) -> bool:
         """The folder is a store that another process (or another EmbeddedStore) has open."""

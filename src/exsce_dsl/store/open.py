@@ -34,6 +34,7 @@ what that process had committed and writes fail saying who holds it.
 from __future__ import annotations
 
 import os
+import threading
 import urllib.parse
 from dataclasses import dataclass
 from pathlib import Path
@@ -45,7 +46,16 @@ from exsce_dsl.store.embedded import EmbeddedStore
 if TYPE_CHECKING:  # imported when a URL names an endpoint: urllib.request and http.client are slow
     from exsce_dsl.store.remote import RemoteStore
 
-__all__ = ["DEFAULT_STORE", "PRESETS", "STORE_ENV", "TOKEN_ENV", "Preset", "open_store", "store_url"]
+__all__ = [
+    "DEFAULT_STORE",
+    "PRESETS",
+    "STORE_ENV",
+    "TOKEN_ENV",
+    "Preset",
+    "StoreOpening",
+    "open_store",
+    "store_url",
+]
 
 DEFAULT_STORE = Path(".exsce") / "store"
 """The project's embedded store, relative to the current folder."""
@@ -101,6 +111,34 @@ def open_store(url: str | None = None, *, token: str | None = None, timeout: flo
     if spec.startswith("file:"):
         spec = urllib.parse.unquote(urllib.parse.urlsplit(spec).path)
     return _embedded_store(Path(spec), token, timeout)
+
+
+class StoreOpening:
+    """:func:`open_store` on a thread of its own, started at once, for a caller that will write:
+    an embedded store's folder is opened (or made) there too.  Oxigraph opens its database
+    without Python's lock, so the caller's own work (importing what it needs) goes on meanwhile.
+    :meth:`store` waits for the store, or raises what opening it raised."""
+
+    def __init__(self, url: str | None = None, *, token: str | None = None, timeout: float = 60.0) -> None:
+        self._opened: Store | None = None
+        self._error: BaseException | None = None
+        self._thread = threading.Thread(target=self._open, args=(url, token, timeout), daemon=True)
+        self._thread.start()
+
+    def _open(self, url: str | None, token: str | None, timeout: float) -> None:
+        try:
+            self._opened = open_store(url, token=token, timeout=timeout)
+            if isinstance(self._opened, EmbeddedStore):
+                self._opened.open_for_writing()
+        except BaseException as exc:  # noqa: BLE001 - given to the caller by store()
+            self._error = exc
+
+    def store(self) -> Store:
+        self._thread.join()
+        if self._error is not None:
+            raise self._error
+        assert self._opened is not None
+        return self._opened
 
 
 def _endpoint_store(url: str, token: str | None, timeout: float) -> RemoteStore:
