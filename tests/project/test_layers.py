@@ -35,7 +35,13 @@ RANK = {name: rank for rank, names in enumerate(LAYERS) for name in names}
 
 
 STEPS: dict[str, list[set[str]]] = {
-    "runs": [{"bags"}, {"signals"}, {"segments"}, {"metrics"}, {"analyse", "ingest", "robots"}],
+    "runs": [
+        {"bags"},
+        {"signals"},
+        {"segments"},
+        {"metrics"},
+        {"analyse", "ingest", "robots", "bag_identity"},
+    ],
 }
 """Inside a layer that has steps, the same rule between its subpackages and modules."""
 

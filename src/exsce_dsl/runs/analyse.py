@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import datetime as dt
-import hashlib
-import uuid
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -24,6 +22,7 @@ from exsce_dsl.model.metrics import MetricDefinition
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Bag, Run, RunClock, TaskExecution
 from exsce_dsl.monitor_kit.monitor_core import Compute, Topic, reducer, topic_name
+from exsce_dsl.runs.bag_identity import content_hash, run_uuid
 from exsce_dsl.runs.bags.reading import (
     ANY,
     BagError,
@@ -49,7 +48,6 @@ from exsce_dsl.runs.signals.timeline import (
     with_stamps,
 )
 
-_RUN_NAMESPACE = uuid.UUID("5b8f9a52-3f0c-4a8e-8f0e-2d6c1b7e4a90")
 _FEEDBACK = "/{ns}/waypoint_dispatcher/feedback"
 _RESULT = "/{ns}/waypoint_dispatcher/result"
 
@@ -78,22 +76,6 @@ class AnalysedRun:
             return []
         said = [] if self.timeline.simulated else [f"timeline: {self.timeline.describe()}"]
         return said + [f"clock of {c.describe()}" for c in self.timeline.clocks]
-
-
-def content_hash(path: Path) -> str:
-    """sha256 of the bag's bytes (all files of a ROS 2 bag folder, in name order)."""
-    digest = hashlib.sha256()
-    files = [path] if path.is_file() else sorted(p for p in path.rglob("*") if p.is_file())
-    for file in files:
-        with file.open("rb") as stream:
-            for block in iter(lambda: stream.read(1 << 20), b""):
-                digest.update(block)
-    return digest.hexdigest()
-
-
-def run_uuid(digest: str) -> str:
-    """A run's id follows from its bag's content, so ingesting a bag twice is recognised."""
-    return str(uuid.uuid5(_RUN_NAMESPACE, digest))
 
 
 def run_metrics(scenario: Scenario) -> tuple[MetricDefinition, ...]:

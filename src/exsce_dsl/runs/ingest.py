@@ -8,23 +8,32 @@ same run id) is skipped.
 
 from __future__ import annotations
 
+import importlib
 import os
+import threading
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from enum import Enum
 from pathlib import Path
-from typing import Any, cast
+from typing import TYPE_CHECKING, Any, cast
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import Scenario
 from exsce_dsl.prov import DEFAULT_NAMESPACE, compile_scenario
 from exsce_dsl.prov.run import compile_run
-from exsce_dsl.runs.analyse import AnalysedRun, analyse_bag, content_hash, run_uuid
+from exsce_dsl.runs.bag_identity import content_hash, run_uuid
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.batch_writing import RunWriter, Written
 from exsce_dsl.store.queries import run_query
 from exsce_dsl.store.writing import add_prov
+
+if TYPE_CHECKING:
+    from exsce_dsl.runs.analyse import AnalysedRun
+
+ANALYSIS = "exsce_dsl.runs.analyse"
+"""What reads a bag and computes its metrics (numpy, rosbags, the monitors): imported while the
+bags are hashed, when this process reads them itself."""
 
 
 class IngestStatus(str, Enum):
@@ -59,6 +68,8 @@ class IngestResult:
 
 
 def _analyse(args: tuple[Path, Scenario, str | None]) -> AnalysedRun | ExsceError:
+    from exsce_dsl.runs.analyse import analyse_bag
+
     try:
         return analyse_bag(*args)
     except ExsceError as exc:
@@ -121,9 +132,17 @@ def ingest_bags(
     results: list[IngestResult] = []
     todo: list[tuple[Path, str | None]] = []
     seen: set[str] = set()
+    in_process = cluster is None and (jobs <= 1 or len(paths) <= 1)
+    # in this process, what reads the bags is imported while they are hashed (hashing lets go of
+    # Python's lock); for worker processes, before they start (forked, they have it)
+    importing = _Importing(ANALYSIS) if in_process else None
+    if importing is None:
+        importlib.import_module(ANALYSIS)
     with _workers(jobs, len(paths), cluster) as mapper:
         # a digest the cluster could not compute is None: the bag's analysis then says what is wrong
         digests = [d if isinstance(d, str) else None for d in mapper(_digest, paths)]
+        if importing is not None:
+            importing.wait()
         for path, digest in zip(paths, digests, strict=True):
             known = digest is not None and (
                 digest in seen or bool(run_query(store, "run_known", {"run": run_uuid(digest)}, namespace))
@@ -143,7 +162,7 @@ def ingest_bags(
         outcomes = mapper(_analyse, [(path, scenario, digest) for path, digest in todo])
 
         def written(done: Written) -> None:
-            bag, analysed = cast(tuple[Path, AnalysedRun | None], done.key)
+            bag, analysed = cast("tuple[Path, AnalysedRun | None]", done.key)
             result = _result(bag, analysed, done)
             results.append(result)
             if progress:
@@ -163,6 +182,27 @@ def ingest_bags(
                     continue
                 writer.add(document, (path, outcome))
     return results
+
+
+class _Importing:
+    """Import a module on a thread of its own; :meth:`wait` for it (an import error is raised
+    there, as the import would have raised it)."""
+
+    def __init__(self, name: str) -> None:
+        self._error: BaseException | None = None
+        self._thread = threading.Thread(target=self._run, args=(name,), daemon=True)
+        self._thread.start()
+
+    def _run(self, name: str) -> None:
+        try:
+            importlib.import_module(name)
+        except BaseException as exc:  # noqa: BLE001 - raised again by wait()
+            self._error = exc
+
+    def wait(self) -> None:
+        self._thread.join()
+        if self._error is not None:
+            raise self._error
 
 
 def _result(path: Path, analysed: AnalysedRun | None, done: Written) -> IngestResult:
