@@ -95,7 +95,7 @@ def main(debug: bool, msg_paths: tuple[str, ...]) -> None:
     """
     State.debug = debug
     if msg_paths:  # in the environment, so that worker processes see them too
-        from exsce_dsl.messages.user import MSG_PATH
+        from exsce_dsl.messages.msg_path import MSG_PATH
 
         folders = [os.path.abspath(p) for p in msg_paths]
         os.environ[MSG_PATH] = os.pathsep.join([*folders, *filter(None, [os.environ.get(MSG_PATH)])])

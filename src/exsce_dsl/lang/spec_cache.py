@@ -106,12 +106,12 @@ def code_fingerprint() -> bytes:
     Python decides whether a ``.pyc`` is current), exsce's and Python's versions, and where and
     when the libraries that parsing and checking use were installed."""
     from exsce_dsl import __version__
-    from exsce_dsl.resources import resource_dir
 
     digest = hashlib.sha256()
     _add(digest, FORMAT, __version__, sys.version)
     package = Path(__file__).resolve().parents[1]
-    for root in (package, resource_dir("grammar")):
+    # the grammar ships in the package (a wheel) or beside it (a checkout: see exsce_dsl.resources)
+    for root in (package, package.parents[1] / "grammar"):
         for dirpath, dirnames, filenames in os.walk(root):
             dirnames[:] = sorted(d for d in dirnames if d != "__pycache__")
             for name in sorted(filenames):
@@ -151,7 +151,7 @@ def _valid_entry(data: bytes | None) -> Specification | None:
 
 def _msg_path_dependencies() -> tuple[tuple[str, ...], Dependencies]:
     """``$EXSCE_MSG_PATH``'s folders, and each definition file below them with its digest."""
-    from exsce_dsl.messages.user import msg_path_files, msg_path_folders
+    from exsce_dsl.messages.msg_path import msg_path_files, msg_path_folders
 
     folders = tuple(str(f) for f in msg_path_folders())
     return folders, tuple((str(p), _digest(str(p))) for p in msg_path_files())

@@ -10,7 +10,6 @@ packages'.
 from __future__ import annotations
 
 import functools
-import os
 from collections.abc import Iterable
 from pathlib import Path
 
@@ -21,19 +20,10 @@ from exsce_dsl.messages.catalogue import (
     parse_definition,
     standard_catalogue,
 )
-
-MSG_PATH = "EXSCE_MSG_PATH"
-
-
-def msg_path_folders() -> list[Path]:
-    """The folders of ``EXSCE_MSG_PATH``, in order (empty entries left out)."""
-    return [Path(entry) for entry in os.environ.get(MSG_PATH, "").split(os.pathsep) if entry]
-
-
-def msg_path_files() -> list[Path]:
-    """Every definition file the folders of ``EXSCE_MSG_PATH`` hold, folder by folder (what
-    :func:`configured_catalogue` reads)."""
-    return [path for folder in msg_path_folders() for path in _definition_files(folder)]
+from exsce_dsl.messages.msg_path import MSG_PATH as MSG_PATH
+from exsce_dsl.messages.msg_path import definition_files as _definition_files
+from exsce_dsl.messages.msg_path import msg_path_files as msg_path_files
+from exsce_dsl.messages.msg_path import msg_path_folders as msg_path_folders
 
 
 def user_catalogue(folders: Iterable[str | Path]) -> MessageCatalogue:
@@ -82,12 +72,6 @@ def _catalogues(
 ) -> tuple[MessageCatalogue, MessageCatalogue]:
     user = user_catalogue(folders)
     return user, user.layered(standard_catalogue()) if user.definitions else standard_catalogue()
-
-
-def _definition_files(folder: Path) -> list[Path]:
-    if not folder.is_dir():
-        return []
-    return sorted(p for p in folder.rglob("*") if p.suffix in (".msg", ".idl") and p.is_file())
 
 
 def _msg_type(path: Path) -> str:
