@@ -15,16 +15,15 @@ from __future__ import annotations
 
 import functools
 import hashlib
-import os
 import types
 from collections.abc import Sequence
 from dataclasses import dataclass
-from pathlib import Path
 
 from exsce_dsl.lang.format_metrics import expression_text
 from exsce_dsl.model.expressions import Aggregate, Expression, Field, WindowValue, is_constant, walk
 from exsce_dsl.model.messages import FEEDBACK, RESULT
 from exsce_dsl.model.metrics import Combine, ComputedFor, MetricDefinition
+from exsce_dsl.user_cache import cache_folder, read_cached, write_cached
 
 GENERATOR = "exscec generate monitors"
 TEMPLATE = "monitors/monitors.py.j2"
@@ -177,12 +176,17 @@ def load_monitors(metrics: Sequence[MetricDefinition], source: str = "the specif
     template compilation cost more than the metrics of a short bag.
     """
     digest = _inputs_digest(metrics, source)
-    folder = _cache_folder()
+    folder = cache_folder()
     cached = folder / f"monitors-{digest}.py" if folder is not None else None
-    text = _read_cached(cached)
+    found = read_cached(cached) if cached is not None else None
+    try:
+        text = found.decode("utf-8") if found is not None else None
+    except UnicodeDecodeError:
+        text = None
     if text is None:
         text = monitor_source(metrics, source)
-        _write_cached(cached, text)
+        if cached is not None:
+            write_cached(cached, text.encode("utf-8"))
     return _load(text)
 
 
@@ -195,34 +199,6 @@ def _inputs_digest(metrics: Sequence[MetricDefinition], source: str) -> str:
     for part in (__version__.encode(), template, repr(tuple(metrics)).encode(), source.encode()):
         digest.update(len(part).to_bytes(8, "little") + part)
     return digest.hexdigest()
-
-
-def _cache_folder() -> Path | None:
-    """``$EXSCE_CACHE``, else ``$XDG_CACHE_HOME/exsce`` (``~/.cache/exsce``); empty: no cache."""
-    configured = os.environ.get("EXSCE_CACHE")
-    if configured is not None:
-        return Path(configured) if configured else None
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "exsce"
-
-
-def _read_cached(path: Path | None) -> str | None:
-    try:
-        return path.read_text(encoding="utf-8") if path is not None else None
-    except (OSError, UnicodeDecodeError):
-        return None
-
-
-def _write_cached(path: Path | None, text: str) -> None:
-    if path is None:
-        return
-    try:
-        path.parent.mkdir(mode=0o700, parents=True, exist_ok=True)
-        partial = path.with_suffix(f".{os.getpid()}.tmp")
-        partial.write_text(text, encoding="utf-8")
-        partial.replace(path)  # atomic: a reader never sees half a file
-    except OSError:
-        pass  # no cache, only slower
 
 
 def reads_used(metric: MetricDefinition, alternative: int) -> list[tuple[str | None, str]]:
