@@ -49,6 +49,8 @@ WALK: tuple[tuple[str, ...], ...] = (
     ("generate", "ros1-monitor"),
     ("generate", "ros2-monitor"),
     ("simulate",),  # baseline runs, a faulty run, a Nav2 run
+    ("bag", "info"),  # what a Nav2 bag holds
+    ("bag",),
     ("ingest",),
     ("baseline",),
     ("verify",),  # the baseline runs pass, the faulty run fails

@@ -24,6 +24,7 @@ COMMAND_MODULES: dict[str, str] = {
     "export": "spec_commands",
     "simulate": "run_commands",
     "ingest": "run_commands",
+    "bag": "bag_commands",
     "store": "store_commands",
     "serve": "store_commands",
     "query": "query_commands",

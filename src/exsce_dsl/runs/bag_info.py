@@ -1,0 +1,197 @@
+"""What a bag holds, for a user who arrives with bags and no specification (``exscec bag info``).
+
+From the bag's own index and metadata: its format, size, time span, and per topic its type,
+message count and rate.  From a sample of each topic's first messages (at most :data:`SAMPLE`,
+deserialised by rosbags): which clock its stamps are (the recorder's wall clock or a
+simulation's, and their offset to log time), the TF tree's edges (static or not), and, read
+whole because they are few, the navigation actions' goals and how they ended.  Last, per
+namespace, the convention ingestion would detect and the topics that show it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from exsce_dsl.errors import BagError
+from exsce_dsl.model.conventions import LASER_SCAN, POSE_TYPES, VELOCITY_TYPES
+from exsce_dsl.model.goals import action_names, actionlib_names
+from exsce_dsl.model.robots import Robot, RobotType
+from exsce_dsl.runs.bags.reading import bag_topics
+from exsce_dsl.runs.bags.rosbags_fallback import typestore_for
+from exsce_dsl.runs.signals.detect import detect_convention
+from exsce_dsl.runs.signals.timeline import SAME_CLOCK, SIMULATED_BEFORE
+
+SAMPLE = 50
+"""Messages of a topic read for its stamps (and of a TF topic for its edges)."""
+_TF = "tf2_msgs/msg/TFMessage"
+_STATUS = {
+    "action_msgs/msg/GoalStatusArray": action_names,
+    "actionlib_msgs/msg/GoalStatusArray": actionlib_names,
+}
+
+
+@dataclass(frozen=True)
+class TopicInfo:
+    name: str
+    msgtype: str
+    messages: int
+    rate: float | None
+    """Messages per second over the topic's own span (None: fewer than two)."""
+    clock: str
+    """``log time`` (no stamps), ``wall clock`` or ``simulated`` (its stamps')."""
+    offset: float | None = None
+    """Median of log time minus stamp over the sample, in seconds."""
+
+
+@dataclass(frozen=True)
+class BagInfo:
+    path: str
+    format: str
+    size: int
+    start: float
+    end: float
+    topics: tuple[TopicInfo, ...]
+    tf_edges: tuple[tuple[str, str, bool], ...] = ()
+    """(parent, child, static) of the transforms in the sample."""
+    goals: Mapping[str, Mapping[str, int]] = field(default_factory=dict)
+    """A navigation status topic → final status → goals."""
+    conventions: tuple[str, ...] = ()
+    """Per namespace, the convention ingestion would detect and from what."""
+
+    @property
+    def timeline(self) -> str:
+        simulated = any(t.clock == "simulated" for t in self.topics) or any(
+            t.name.lstrip("/") == "clock" for t in self.topics
+        )
+        return "simulated time (stamps of a simulation)" if simulated else "wall clock"
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "path": self.path,
+            "format": self.format,
+            "size_bytes": self.size,
+            "start": self.start,
+            "end": self.end,
+            "duration_s": self.end - self.start,
+            "timeline": self.timeline,
+            "topics": [t.__dict__ for t in self.topics],
+            "tf": [{"parent": p, "child": c, "static": s} for p, c, s in self.tf_edges],
+            "goals": {topic: dict(ends) for topic, ends in self.goals.items()},
+            "conventions": list(self.conventions),
+        }
+
+
+def bag_info(path: Path) -> BagInfo:
+    """What the bag at ``path`` holds (see the module's docstring)."""
+    from rosbags.highlevel import AnyReader
+
+    types = bag_topics(path)  # checks the file first, with exsce's messages for broken ones
+    try:
+        with AnyReader([path], default_typestore=typestore_for(path)) as reader:
+            topics, edges, goals = _read(reader)
+            start, end = reader.start_time * 1e-9, reader.end_time * 1e-9
+    except BagError:
+        raise
+    except Exception as exc:  # rosbags' readers raise their own errors for corrupt files
+        raise BagError(f"{path}: cannot read the bag: {type(exc).__name__}: {exc}") from None
+    size = sum(p.stat().st_size for p in ([path] if path.is_file() else path.rglob("*")) if p.is_file())
+    return BagInfo(str(path), _format(path), size, start, end, topics, edges, goals, _conventions(types))
+
+
+def _format(path: Path) -> str:
+    if path.is_file():
+        return {".bag": "ROS 1", ".mcap": "MCAP"}.get(path.suffix, path.suffix)
+    return "ROS 2 (MCAP)" if any(path.glob("*.mcap")) else "ROS 2 (sqlite3)"
+
+
+def _read(
+    reader: Any,
+) -> tuple[tuple[TopicInfo, ...], tuple[tuple[str, str, bool], ...], dict[str, dict[str, int]]]:
+    by_topic: dict[str, list[Any]] = {}
+    for connection in reader.connections:
+        by_topic.setdefault(connection.topic, []).append(connection)
+    topics: list[TopicInfo] = []
+    edges: dict[tuple[str, str], bool] = {}
+    goals: dict[str, dict[str, str]] = {}
+    for name, connections in sorted(by_topic.items()):
+        msgtype = connections[0].msgtype
+        count = sum(c.msgcount for c in connections)
+        logs, stamps = [], []
+        for index, (connection, time_ns, raw) in enumerate(reader.messages(connections=connections)):
+            whole = msgtype in _STATUS
+            if index >= SAMPLE and not whole:
+                break
+            try:
+                message = reader.deserialize(raw, connection.msgtype)
+            except Exception:  # a type rosbags cannot read: its count and rate are still known
+                break
+            logs.append(time_ns * 1e-9)
+            stamp = _stamp(message)
+            if stamp is not None:
+                stamps.append(time_ns * 1e-9 - stamp)
+            if msgtype == _TF:
+                for transform in message.transforms:
+                    edges[(transform.header.frame_id, transform.child_frame_id)] = name.endswith("tf_static")
+            if whole:
+                _goals(goals.setdefault(name, {}), message, _STATUS[msgtype]())
+        topics.append(_topic(name, msgtype, count, logs, stamps))
+    ended = {topic: _ends(found) for topic, found in goals.items()}
+    return tuple(topics), tuple((p, c, s) for (p, c), s in sorted(edges.items())), ended
+
+
+def _stamp(message: Any) -> float | None:
+    header = getattr(message, "header", None)
+    if header is None and getattr(message, "transforms", None):
+        header = message.transforms[0].header
+    stamp = getattr(header, "stamp", None)
+    if stamp is None:
+        return None
+    seconds = float(stamp.sec) + float(stamp.nanosec) * 1e-9
+    return seconds if seconds > 0 else None
+
+
+def _topic(name: str, msgtype: str, count: int, logs: list[float], offsets: list[float]) -> TopicInfo:
+    rate = (len(logs) - 1) / (logs[-1] - logs[0]) if len(logs) > 1 and logs[-1] > logs[0] else None
+    if not offsets:
+        return TopicInfo(name, msgtype, count, rate, "log time")
+    offset = float(np.median(offsets))
+    stamp = logs[0] - offset
+    simulated = stamp < SIMULATED_BEFORE <= logs[0]
+    clock = "simulated" if simulated else "wall clock" if abs(offset) <= SAME_CLOCK else "wall clock (offset)"
+    return TopicInfo(name, msgtype, count, rate, clock, offset)
+
+
+def _goals(found: dict[str, str], message: Any, names: dict[int, str]) -> None:
+    for status in message.status_list:
+        info = getattr(status, "goal_info", None)
+        key = bytes(info.goal_id.uuid).hex() if info is not None else str(status.goal_id.id)
+        found[key] = names.get(int(status.status), str(status.status))
+
+
+def _ends(found: dict[str, str]) -> dict[str, int]:
+    ends: dict[str, int] = {}
+    for status in found.values():
+        ends[status] = ends.get(status, 0) + 1
+    return ends
+
+
+def _conventions(types: Mapping[str, str]) -> tuple[str, ...]:
+    """For the root and each first level of the topics' names: what ingestion would detect."""
+    namespaces = sorted({t.lstrip("/").split("/")[0] for t in types if "/" in t.lstrip("/")})
+    robot_types = (*POSE_TYPES, *VELOCITY_TYPES, LASER_SCAN, _TF)
+    at_root = any("/" not in t.lstrip("/") and m in robot_types for t, m in types.items()) or any(
+        f"/{action}/_action/status" in types for action in ("navigate_to_pose", "follow_waypoints")
+    )
+    said = []
+    for namespace in ([""] if at_root else []) + namespaces:
+        robot = Robot(namespace or "root", RobotType("unknown"), namespace)
+        signals, detected = detect_convention(robot, types)
+        if detected.evidence or signals.pose:
+            shown = ", ".join(detected.evidence) or "its topics"
+            said.append(f"namespace '{namespace or '/'}': convention {detected.convention} (from {shown})")
+    return tuple(said)
