@@ -138,16 +138,16 @@ def test_segment_boundaries_are_marked_on_paths(project: Path) -> None:
 
 def test_the_report_says_no_spec_was_given_when_none_was(project: Path) -> None:
     page = _run_page(project, "plain")
-    assert "no --spec was given" in page and "exscec report --spec" in page
+    assert "no <code>--spec</code> was given: pass the scenario's file to <code>exscec report --spec" in page
     assert "has no map" not in page
     assert "note: no occupancy grid: no --spec was given" in (project / "plain.stderr").read_text("utf-8")
 
 
 def test_the_report_says_the_scenario_has_no_map_when_spec_was_given(project: Path) -> None:
     page = _run_page(project, "nomap")
-    assert "scenario &#39;scenario_c&#39; has no map" in page
-    assert "environment &#39;brsu_building_c_with_doors&#39; names no map file" in page
-    assert "no --spec was given" not in page and "pass the scenario&#39;s file" not in page
+    assert 'scenario <span class="id">scenario_c</span> has no map' in page
+    assert 'environment <span class="id">brsu_building_c_with_doors</span> names no map file' in page
+    assert "was given" not in page and "pass the scenario's file" not in page
     with_map = _run_page(project, "out")
     assert "No occupancy grid" not in with_map
 

@@ -87,6 +87,42 @@ class RunContents:
         return "failed" if self.failed else "unjudged" if self.unjudged else "passed"
 
 
+NO_SPEC = (
+    "no --spec was given: pass the scenarios' files with exscec report --spec FILE.exsce "
+    "to draw paths on their maps"
+)
+
+
+@dataclass(frozen=True)
+class MissingMap:
+    """Why a scenario's paths are drawn without a map: ``kind`` is ``no_spec`` (no --spec given),
+    ``no_map`` (its specification names no map file), ``not_given`` (no --spec file declares it or
+    a scenario it was derived from) or ``unreadable`` (its map file could not be read)."""
+
+    kind: str
+    scenario: str
+    """The scenario whose specification was looked at (itself, or the one it was derived from)."""
+    environment: str = ""
+    detail: str = ""
+
+    @property
+    def text(self) -> str:
+        """What to tell the user, and what to do about it."""
+        if self.kind == "no_spec":
+            return f"no occupancy grid: {NO_SPEC}"
+        if self.kind == "no_map":
+            return (
+                f"no occupancy grid: scenario '{self.scenario}' has no map: its environment "
+                f"'{self.environment}' names no map file; give its map line a file (the map_server YAML)"
+            )
+        if self.kind == "unreadable":
+            return f"no occupancy grid: cannot read the map of scenario '{self.scenario}': {self.detail}"
+        return (
+            f"no occupancy grid: no file given with --spec declares scenario '{self.scenario}' "
+            "(or one it was derived from): add its file to exscec report --spec"
+        )
+
+
 @dataclass(frozen=True)
 class ScenarioContents:
     id: str
@@ -100,8 +136,8 @@ class ScenarioContents:
     waypoints: Mapping[str, tuple[tuple[str, float, float], ...]]
     """Robot → its planned path: (pose name, x, y) from its start pose on."""
     grid: OccupancyGrid | None = None
-    map_note: str = ""
-    """Why there is no ``grid`` and what to do about it ('' when there is one)."""
+    missing_map: MissingMap | None = None
+    """Why there is no ``grid`` (None when there is one)."""
 
     @property
     def verdicts(self) -> tuple[Verdict, ...]:
@@ -182,14 +218,14 @@ def gather(store: Store, specs: Sequence[Path] = ()) -> ReportContents:
                 values=tuple(queries.run_metric_values(store, uuids)),
                 waypoints=_waypoints(store, scenario_id),
                 grid=_grid_of(scenario_id, derivations, grids),
-                map_note=_map_note(scenario_id, derivations, grids, missing, given=bool(specs)),
+                missing_map=_missing_map(scenario_id, derivations, grids, missing, given=bool(specs)),
             )
         )
     clustering = None
     if len(ids) >= 2:
         clustering = cluster([scenario_facts(store, s) for s in ids])
     if not specs and any(s.waypoints for s in scenarios):
-        notes.append(f"no occupancy grid: {NO_SPEC}")
+        notes.append(MissingMap("no_spec", "").text)
     definitions: list[MetricDefinition] = [d for scenario in declared for d in scenario.metrics]
     units = metric_units((v for s in scenarios for v in s.values), definitions)
     return ReportContents(
@@ -214,59 +250,48 @@ def _waypoints(store: Store, scenario_id: str) -> dict[str, tuple[tuple[str, flo
     }
 
 
-def _grids(scenarios: Sequence[Scenario]) -> tuple[dict[str, OccupancyGrid], dict[str, str], list[str]]:
+def _grids(
+    scenarios: Sequence[Scenario],
+) -> tuple[dict[str, OccupancyGrid], dict[str, MissingMap], list[str]]:
     """Scenario id → the occupancy grid of its environment, for every one of ``scenarios``; for
     those without one, scenario id → why; and the notes the report prints."""
     grids: dict[str, OccupancyGrid] = {}
-    missing: dict[str, str] = {}
+    missing: dict[str, MissingMap] = {}
     loaded: dict[str, OccupancyGrid] = {}
     notes: list[str] = []
     for scenario in scenarios:
         map_model = scenario.environment.map
         if map_model is None or map_model.file is None:
-            where = f"environment '{scenario.environment.id}'"
-            missing[scenario.id] = (
-                f"scenario '{scenario.id}' has no map: its {where} names no map file "
-                f'(give its map line a file "maps/NAME.yaml", the map_server YAML of the occupancy grid)'
-            )
+            missing[scenario.id] = MissingMap("no_map", scenario.id, scenario.environment.id)
             notes.append(f"scenario '{scenario.id}' names no map file: its paths are drawn without one")
             continue
         if map_model.file not in loaded:
             try:
                 loaded[map_model.file] = load_occupancy_grid(Path(map_model.file))
             except ExsceError as exc:
-                missing[scenario.id] = f"the map of scenario '{scenario.id}' could not be read: {exc.message}"
+                missing[scenario.id] = MissingMap("unreadable", scenario.id, detail=exc.message)
                 notes.append(f"scenario '{scenario.id}': {exc.message}")
                 continue
         grids[scenario.id] = loaded[map_model.file]
     return grids, missing, notes
 
 
-NO_SPEC = (
-    "no --spec was given: pass the scenario's file to exscec report --spec FILE.exsce "
-    "to draw the paths on its map"
-)
-
-
-def _map_note(
+def _missing_map(
     scenario_id: str,
     derivations: Mapping[str, Derivation | None],
     grids: Mapping[str, OccupancyGrid],
-    missing: Mapping[str, str],
+    missing: Mapping[str, MissingMap],
     given: bool,
-) -> str:
-    """Why the scenario's paths have no map under them, and what to do ('' when they have one)."""
+) -> MissingMap | None:
+    """Why the scenario's paths have no map under them (None when they have one)."""
     if _grid_of(scenario_id, derivations, grids) is not None:
-        return ""
+        return None
     if not given:
-        return f"No occupancy grid: {NO_SPEC}."
+        return MissingMap("no_spec", scenario_id)
     for known in _lineage(scenario_id, derivations):
         if known in missing:
-            return f"No occupancy grid: {missing[known]}."
-    return (
-        f"No occupancy grid: no file given with --spec declares scenario '{scenario_id}' (or one it "
-        "was derived from): add its file to exscec report --spec."
-    )
+            return missing[known]
+    return MissingMap("not_given", scenario_id)
 
 
 def _lineage(scenario_id: str, derivations: Mapping[str, Derivation | None]) -> list[str]:
