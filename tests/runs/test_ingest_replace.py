@@ -177,7 +177,9 @@ def test_a_replaced_run_loses_its_verdicts_and_is_verified_again(bags, project) 
     run = result.run_id
     assert run is not None
     api.baseline(store, spec)
-    verify_runs(store, spec.scenario(), [run], now=datetime.datetime(2026, 1, 9, tzinfo=datetime.timezone.utc))
+    verify_runs(
+        store, spec.scenario(), [run], now=datetime.datetime(2026, 1, 9, tzinfo=datetime.timezone.utc)
+    )
     later = datetime.datetime(2026, 1, 10, tzinfo=datetime.timezone.utc)
     verify_runs(store, spec.scenario(), [run], now=later)  # again: the first verdicts become a revision
     graphs = store.graph_names()
@@ -212,7 +214,9 @@ def test_the_same_bag_is_a_run_of_two_scenarios(bags, project) -> None:
     # each run has its own values, and they agree: one bag, the same robots and mission
     assert _values(store, of_c.run_id) == _values(store, of_c2.run_id)  # type: ignore[arg-type]
     # ingested again under either scenario: skipped, each naming its own
-    again_c, again_c2 = (ingest_bags([bag], _scenario(project, s), store)[0] for s in ("scenario_c", "scenario_c2"))
+    again_c, again_c2 = (
+        ingest_bags([bag], _scenario(project, s), store)[0] for s in ("scenario_c", "scenario_c2")
+    )
     assert (again_c.status, again_c.run_id) == (IngestStatus.SKIPPED, of_c.run_id)
     assert (again_c2.status, again_c2.run_id) == (IngestStatus.SKIPPED, of_c2.run_id)
     assert "already a run of scenario 'scenario_c2'" in again_c2.message
@@ -261,3 +265,26 @@ def test_the_skip_message_names_the_scenario_and_replace(bags, project) -> None:
     assert replaced.stderr.splitlines()[-1] == "0 ingested, 1 replaced, 0 skipped, 0 failed"
     listed = run_exscec("runs", "--store", store, cwd=project.parent)
     assert listed.stdout.count(run) == 1 and "scenario_c" in listed.stdout
+
+
+def test_a_run_is_replaced_on_a_sparql_server_as_in_the_embedded_store(bags, project, tmp_path: Path) -> None:
+    from exsce_dsl.store.open import open_store
+
+    from store_servers import oxigraph_server
+
+    bag = bags[0]
+    embedded = EmbeddedStore()
+    with oxigraph_server(tmp_path / "oxigraph") as server, open_store(f"oxigraph+{server.url}") as remote:
+        for store in (embedded, remote):
+            ingest_bags([bag], _scenario(project), store)
+        _add_a_metric(project)
+        newer = _scenario(project)
+        before = _values(remote, _bag_id(bag))
+        for store in (embedded, remote):
+            [replaced] = ingest_bags([bag], newer, store, replace=True)
+            assert replaced.status is IngestStatus.REPLACED, replaced.message
+        after = _values(remote, _bag_id(bag))
+        assert {key[0] for key in after} - {key[0] for key in before} == {"mean_forward_speed"}
+        assert after == pytest.approx(_values(embedded, _bag_id(bag)), rel=1e-12)
+        assert remote.graph_sizes() == embedded.graph_sizes()
+        assert [r.uuid for r in runs(remote)] == [_bag_id(bag)]

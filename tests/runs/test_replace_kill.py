@@ -162,7 +162,9 @@ def test_a_killed_replace_leaves_the_old_run_or_the_new_one(setting, tmp_path: P
         # where the kill landed, by what the child said before it died
         when = "before" if "writing" not in said else "during" if "written" not in said else "after"
         state = _state(store_dir)
-        assert state in (old, new), f"killed {when} the write ({wait_for} +{delay * 1000:.1f} ms): a mixed store"
+        assert state in (old, new), (
+            f"killed {when} the write ({wait_for} +{delay * 1000:.1f} ms): a mixed store"
+        )
         seen[when].add("old" if state == old else "new")
     assert seen["before"] == {"old"} and seen["after"] == {"new"}, seen
     assert seen["during"], f"no kill landed inside the write: {seen}"
