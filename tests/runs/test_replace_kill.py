@@ -18,11 +18,12 @@ At least one kill must land between the two lines.
 from __future__ import annotations
 
 import os
-import select
+import queue
 import shutil
 import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -92,35 +93,46 @@ def _state(store_dir: Path) -> State:
         return store.graph_sizes(), metrics, len(stored)
 
 
-def _start(setting: tuple[Path, Path, Path], store_dir: Path) -> subprocess.Popen[str]:
-    project, bag, _ = setting
-    args = ["ingest", "--replace", str(bag), "--scenario", str(project / "scenario_c.exsce")]
-    return subprocess.Popen(
-        [sys.executable, str(project.parent / "child.py"), *args, "--store", str(store_dir)],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.DEVNULL,
-        text=True,
-        env={**os.environ, "PYTHONUNBUFFERED": "1"},
-    )
+class _Child:
+    """``exscec ingest --replace`` in a child process; its lines as they come (a thread reads them)."""
 
+    def __init__(self, setting: tuple[Path, Path, Path], store_dir: Path) -> None:
+        project, bag, _ = setting
+        args = ["ingest", "--replace", str(bag), "--scenario", str(project / "scenario_c.exsce")]
+        self.process = subprocess.Popen(
+            [sys.executable, str(project.parent / "child.py"), *args, "--store", str(store_dir)],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.DEVNULL,
+            text=True,
+        )
+        self.lines: queue.Queue[str] = queue.Queue()
+        self.reader = threading.Thread(target=self._read, daemon=True)
+        self.reader.start()
 
-def _line(child: subprocess.Popen[str], timeout: float = 120.0) -> str:
-    assert child.stdout is not None
-    ready, _, _ = select.select([child.stdout], [], [], timeout)
-    assert ready, "the child said nothing"
-    return child.stdout.readline()
+    def _read(self) -> None:
+        assert self.process.stdout is not None
+        for line in self.process.stdout:
+            self.lines.put(line)
+        self.process.stdout.close()
 
+    def line(self) -> str:
+        return self.lines.get(timeout=120)
 
-def _killed(child: subprocess.Popen[str], may_have_ended: bool = False) -> str:
-    """Kill the child (a child that ended is a zombie until waited for: the kill is harmless);
-    what it said after the kill's moment."""
-    os.kill(child.pid, signal.SIGKILL)
-    child.wait(timeout=30)
-    assert child.returncode == -signal.SIGKILL or (may_have_ended and child.returncode == 0)
-    assert child.stdout is not None
-    rest = child.stdout.read()
-    child.stdout.close()
-    return rest
+    def wait(self) -> int:
+        code = self.process.wait(timeout=120)
+        self.reader.join(timeout=30)
+        return code
+
+    def killed(self, may_have_ended: bool = False) -> str:
+        """Kill the child (one that ended is a zombie until waited for: the kill is harmless);
+        what it said after the kill's moment."""
+        os.kill(self.process.pid, signal.SIGKILL)
+        code = self.wait()
+        assert code == -signal.SIGKILL or (may_have_ended and code == 0)
+        rest = []
+        while not self.lines.empty():
+            rest.append(self.lines.get())
+        return "".join(rest)
 
 
 def test_a_killed_replace_leaves_the_old_run_or_the_new_one(setting, tmp_path: Path) -> None:
@@ -132,12 +144,10 @@ def test_a_killed_replace_leaves_the_old_run_or_the_new_one(setting, tmp_path: P
     whole = tmp_path / "whole"
     shutil.copytree(base, whole)
     started = time.monotonic()
-    child = _start(setting, whole)
-    writing = float(_line(child).split()[1])
-    written = float(_line(child).split()[1])
-    assert child.wait(timeout=120) == 0
-    assert child.stdout is not None
-    child.stdout.close()
+    child = _Child(setting, whole)
+    writing = float(child.line().split()[1])
+    written = float(child.line().split()[1])
+    assert child.wait() == 0
     new = _state(whole)
     assert new[1] == old[1] | {"mean_forward_speed"} and new[2] == 1
     assert set(old[0]) <= set(new[0]) and new[0] != old[0]
@@ -151,14 +161,14 @@ def test_a_killed_replace_leaves_the_old_run_or_the_new_one(setting, tmp_path: P
     for number, (wait_for, delay) in enumerate(plans):
         store_dir = tmp_path / f"store_{number}"
         shutil.copytree(base, store_dir)
-        child = _start(setting, store_dir)
+        child = _Child(setting, store_dir)
         said = ""
         if wait_for != "start":
-            said += _line(child)
+            said += child.line()
         if wait_for == "written":
-            said += _line(child)
+            said += child.line()
         time.sleep(delay)
-        said += _killed(child, may_have_ended=wait_for == "written")
+        said += child.killed(may_have_ended=wait_for == "written")
         # where the kill landed, by what the child said before it died
         when = "before" if "writing" not in said else "during" if "written" not in said else "after"
         state = _state(store_dir)
