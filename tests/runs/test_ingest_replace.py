@@ -267,14 +267,18 @@ def test_the_skip_message_names_the_scenario_and_replace(bags, project) -> None:
     assert listed.stdout.count(run) == 1 and "scenario_c" in listed.stdout
 
 
-def test_a_run_is_replaced_on_a_sparql_server_as_in_the_embedded_store(bags, project, tmp_path: Path) -> None:
+@pytest.mark.parametrize("server", ["oxigraph", "virtuoso"])
+def test_a_run_is_replaced_on_a_sparql_server_as_in_the_embedded_store(
+    bags, project, tmp_path: Path, server: str
+) -> None:
     from exsce_dsl.store.open import open_store
 
-    from store_servers import oxigraph_server
+    from store_servers import oxigraph_server, virtuoso_server
 
     bag = bags[0]
     embedded = EmbeddedStore()
-    with oxigraph_server(tmp_path / "oxigraph") as server, open_store(f"oxigraph+{server.url}") as remote:
+    serve = oxigraph_server if server == "oxigraph" else virtuoso_server
+    with serve(tmp_path / server) as running, open_store(f"{server}+{running.url}", timeout=20) as remote:
         for store in (embedded, remote):
             ingest_bags([bag], _scenario(project), store)
         _add_a_metric(project)
