@@ -50,6 +50,20 @@ def runs(store: Store, scenario: str | None = None, namespace: str = DEFAULT_NAM
     return found
 
 
+def run_scenarios(
+    store: Store, runs: Sequence[str], namespace: str = DEFAULT_NAMESPACE
+) -> dict[str, tuple[str, ...]]:
+    """The scenario (by id) of each of ``runs`` (uuids) the store holds; runs it lacks are left out."""
+    if not runs:
+        return {}
+    found: dict[str, tuple[str, ...]] = {}
+    for row in run_query(store, "run_scenarios", {"run": list(dict.fromkeys(runs))}, namespace):
+        run, scenario = text_of(row["run"]), text_of(row["scenario_id"])
+        if run is not None and scenario:
+            found[run] = (*found.get(run, ()), scenario)
+    return found
+
+
 def run_metric(
     store: Store, run: str, metric: str, robot: str, namespace: str = DEFAULT_NAMESPACE
 ) -> float | None:
