@@ -18,12 +18,10 @@ from typing import Any
 import numpy as np
 
 from exsce_dsl.errors import BagError
-from exsce_dsl.model.conventions import LASER_SCAN, POSE_TYPES, VELOCITY_TYPES
 from exsce_dsl.model.goals import action_names, actionlib_names
-from exsce_dsl.model.robots import Robot, RobotType
 from exsce_dsl.runs.bags.reading import bag_topics
 from exsce_dsl.runs.bags.rosbags_fallback import typestore_for
-from exsce_dsl.runs.signals.detect import detect_convention
+from exsce_dsl.runs.signals.detect import robot_namespaces
 from exsce_dsl.runs.signals.timeline import SAME_CLOCK, SIMULATED_BEFORE
 
 SAMPLE = 50
@@ -182,16 +180,8 @@ def _ends(found: dict[str, str]) -> dict[str, int]:
 
 def _conventions(types: Mapping[str, str]) -> tuple[str, ...]:
     """For the root and each first level of the topics' names: what ingestion would detect."""
-    namespaces = sorted({t.lstrip("/").split("/")[0] for t in types if "/" in t.lstrip("/")})
-    robot_types = (*POSE_TYPES, *VELOCITY_TYPES, LASER_SCAN, _TF)
-    at_root = any("/" not in t.lstrip("/") and m in robot_types for t, m in types.items()) or any(
-        f"/{action}/_action/status" in types for action in ("navigate_to_pose", "follow_waypoints")
-    )
     said = []
-    for namespace in ([""] if at_root else []) + namespaces:
-        robot = Robot(namespace or "root", RobotType("unknown"), namespace)
-        signals, detected = detect_convention(robot, types)
-        if detected.evidence or signals.pose:
-            shown = ", ".join(detected.evidence) or "its topics"
-            said.append(f"namespace '{namespace or '/'}': convention {detected.convention} (from {shown})")
+    for namespace, _, detected in robot_namespaces(types):
+        shown = ", ".join(detected.evidence) or "its topics"
+        said.append(f"namespace '{namespace or '/'}': convention {detected.convention} (from {shown})")
     return tuple(said)
