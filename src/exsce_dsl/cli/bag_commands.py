@@ -1,4 +1,5 @@
-"""``exscec bag info``: what a bag holds, before any specification is written."""
+"""``exscec bag info`` and ``exscec init --from-bag``: what a bag holds, and a starting specification
+from it, before any specification is written."""
 
 from __future__ import annotations
 
@@ -88,4 +89,47 @@ def _table(info: object) -> str:
     return "\n".join(lines)
 
 
-COMMANDS = [bag]
+@click.command("init")
+@click.option(
+    "--from-bag",
+    "bag_path",
+    required=True,
+    type=click.Path(),
+    metavar="BAG",
+    help="The bag (a ROS 1 .bag, a ROS 2 folder or an .mcap file) to draft the specification from.",
+)
+@click.option(
+    "-o",
+    "--output",
+    type=click.Path(dir_okay=False),
+    help="The specification to write.  [default: <bag stem>.exsce in the current folder]",
+)
+@click.option("--force", is_flag=True, help="Replace the specification and its map files if they exist.")
+@reports_errors
+def init(bag_path: str, output: str | None, force: bool) -> None:
+    """Write a starting specification from a bag, which checks and ingests as written: a robot
+    type per convention detected, a robot per namespace (namespace "" at the root), an environment
+    whose poses are the navigation goals' targets in recorded order (without goals: the start,
+    farthest point and end of each robot's path), a task per goal and a mission of them in that
+    order, the bag's OccupancyGrid as a map_server YAML and PGM beside it, and the method's safety
+    limits as acceptance criteria.  Its comments say what was detected from which topics.
+
+    \b
+    Example:
+      exscec simulate examples/brsu_building_c/scenario_c.exsce -o nav2_runs/ --convention nav2
+      exscec init --from-bag nav2_runs/*.bag -o from_bag.exsce
+      exscec check from_bag.exsce
+    """
+    from exsce_dsl.api.drafts import init_from_bag
+
+    draft = init_from_bag(Path(bag_path), output, force)
+    robots = ", ".join(f"{rid} ({ns or '/'}, {convention})" for rid, ns, convention in draft.robots)
+    click.echo(f"wrote {draft.spec}: robots {robots}")
+    for written in draft.map_files:
+        click.echo(f"wrote {written}")
+    for note in draft.notes:
+        click.echo(f"note: {note}", err=True)
+    click.echo(f"next: exscec check {draft.spec} && exscec ingest {bag_path} --scenario {draft.spec}")
+
+
+COMMANDS = [bag, init]
