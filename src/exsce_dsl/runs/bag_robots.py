@@ -27,6 +27,7 @@ from exsce_dsl.errors import BagError
 from exsce_dsl.model.conventions import Navigation, Signals
 from exsce_dsl.model.goals import GoalStatus
 from exsce_dsl.model.metrics import topic_name
+from exsce_dsl.model.names import is_ros_namespace
 from exsce_dsl.model.robots import Robot, RobotType
 from exsce_dsl.runs.bags.reading import ANY, OBJECTS, BagData, Wanted, bag_topics, read_bag
 from exsce_dsl.runs.robots import FEEDBACK, StackRobots
@@ -95,6 +96,8 @@ class BagContents:
     robots: tuple[BagRobot, ...]
     map: BagMap | None
     other_maps: tuple[str, ...] = ()
+    skipped: tuple[str, ...] = ()
+    """Why robots found in the bag are left out."""
 
 
 def bag_contents(path: Path) -> BagContents:
@@ -107,7 +110,12 @@ def bag_contents(path: Path) -> BagContents:
             f"{path}: no robot found: no topic of a robot's pose, velocity or scan, no TF and no "
             f"navigation goals (its pose-like topics: {listed})"
         )
-    robots = [BagRobot(ns, signals, detected) for ns, signals, detected in found]
+    skipped = tuple(
+        f"namespace {ns!r} is not a valid ROS name: its robot is left out"
+        for ns, _, _ in found
+        if not is_ros_namespace(ns)
+    )
+    robots = [BagRobot(ns, signals, detected) for ns, signals, detected in found if is_ros_namespace(ns)]
     models = [_model(r) for r in robots]
     sources = {m.id: choose_sources(m, types) for m in models}
     sources = {
@@ -141,6 +149,7 @@ def bag_contents(path: Path) -> BagContents:
         tuple(robots),
         grid,
         tuple(t for t in grids if t not in maps),
+        skipped,
     )
 
 

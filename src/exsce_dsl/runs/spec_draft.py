@@ -171,6 +171,7 @@ class _Drafter:
     def document(self, map_file: str | None) -> tuple[Document, dict[str, Pose]]:
         c = self.contents
         self.taken.add(self.scenario)
+        self.notes += c.skipped
         for robot in c.robots:
             self.ids[_name(robot.namespace or "root_robot", self.taken, "robot")] = robot
         header = [

@@ -177,7 +177,8 @@ NOT_ROBOTS = frozenset(
     }
 )
 """First levels of topic names that are a root robot's interfaces or the graph's, never a robot."""
-_ROBOT_TYPES = (*POSE_TYPES, *VELOCITY_TYPES, LASER_SCAN, "tf2_msgs/msg/TFMessage")
+_BODY_TYPES = (*POSE_TYPES, *VELOCITY_TYPES, LASER_SCAN)
+_ROBOT_TYPES = (*_BODY_TYPES, "tf2_msgs/msg/TFMessage")
 
 
 def robot_namespaces(types: Mapping[str, str]) -> list[tuple[str, Signals, Detected]]:
@@ -185,8 +186,10 @@ def robot_namespaces(types: Mapping[str, str]) -> list[tuple[str, Signals, Detec
     (``""``) first, each with the signals detected there and what showed them: the root when a
     topic at the root is a robot's (a pose, a velocity, a scan, TF) or a navigation interface is
     there; each first level of the topics' names that shows a convention or a pose (but not the
-    names of navigation interfaces, :data:`NOT_ROBOTS`).  A root whose every piece of evidence is
-    another robot's topic is not a robot of its own."""
+    names of navigation interfaces, :data:`NOT_ROBOTS`).  A root with a robot's topics of its own (a
+    velocity, a scan, a pose) takes in the namespaces that show nothing it does not (a Jackal's
+    ``/cmd_vel`` with its ``/jackal_velocity_controller/odom``); a root without, whose every piece of
+    evidence is another robot's topic (a fleet's global ``/tf``), is not a robot of its own."""
     levels = {t.lstrip("/").split("/")[0] for t in types if "/" in t.lstrip("/")}
     namespaces = sorted(levels - NOT_ROBOTS)
     interfaces = [f"{action}/_action/status" for action in NAV2.actions]
@@ -200,9 +203,12 @@ def robot_namespaces(types: Mapping[str, str]) -> list[tuple[str, Signals, Detec
         signals, detected = detect_convention(robot, types)
         if detected.evidence or signals.pose:
             found.append((namespace, signals, detected))
-    others = [ns for ns, _, _ in found if ns]
-    if found and not found[0][0] and others:
-        evidence = found[0][2].evidence
-        if evidence and all(any(under_namespace(t, ns) for ns in others) for t in evidence):
-            found.pop(0)
+    if not found or found[0][0]:
+        return found
+    root = set(found[0][2].evidence)
+    if any("/" not in t.lstrip("/") and m in _BODY_TYPES for t, m in types.items()):
+        return found[:1] + [f for f in found[1:] if not set(f[2].evidence) <= root]
+    others = [ns for ns, _, _ in found[1:]]
+    if root and others and all(any(under_namespace(t, ns) for ns in others) for t in root):
+        found.pop(0)
     return found
