@@ -7,7 +7,7 @@ drafted from the bag (``exscec init --from-bag``) and the run ingested under it 
   when each waypoint first SUCCEEDED;
 - ``duration`` and ``distance``: from the first goal that went active to the last goal's first
   SUCCEEDED (log times), the odometry's path length in that window (the method: the change of
-  ``distance_travelled``); without goals, the span and path length of the robot's whole recording.
+  ``distance_travelled``, interpolated at the window's ends); without goals, the span and path length of the robot's whole recording.
 """
 
 from __future__ import annotations
@@ -104,8 +104,9 @@ def _method(topics: dict[str, list[tuple[float, Any]]], ns: str) -> Reference:
     for t in sorted(succeeded.values()):
         latest = [m for u, m in poses if u <= t][-1]
         targets.append(_xy(latest.pose.pose))
-    travelled = [m.data for m in _window(topics[_name(ns, "distance_travelled")], start, end)]
-    return Reference(targets, end - start, float(travelled[-1] - travelled[0]))
+    travelled = topics[_name(ns, "distance_travelled")]  # the change: its values at the ends, interpolated
+    ends = np.interp([start, end], [t for t, _ in travelled], [m.data for _, m in travelled])
+    return Reference(targets, end - start, float(ends[1] - ends[0]))
 
 
 def whole_path(bag: Path, pose_topic: str, signal_topics: list[str]) -> Reference:
