@@ -13,5 +13,5 @@ def init_from_bag(bag: str | Path, out: str | Path | None = None, force: bool = 
     in ``bag``); ``out`` defaults to ``<bag stem>.exsce`` in the current folder.  An existing file
     is replaced only with ``force``."""
     path = Path(bag)
-    target = Path(out) if out is not None else default_spec_path(path, Path.cwd())
+    target = Path(out) if out is not None else default_spec_path(path, Path("."))
     return draft_spec(path, target, force)
