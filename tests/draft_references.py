@@ -35,7 +35,9 @@ def read(bag: Path) -> dict[str, list[tuple[float, Any]]]:
     found: dict[str, list[tuple[float, Any]]] = {}
     with AnyReader([bag]) as reader:
         for connection, t, raw in reader.messages():
-            found.setdefault(connection.topic, []).append((t * 1e-9, reader.deserialize(raw, connection.msgtype)))
+            found.setdefault(connection.topic, []).append(
+                (t * 1e-9, reader.deserialize(raw, connection.msgtype))
+            )
     return found
 
 
@@ -97,7 +99,9 @@ def _method(topics: dict[str, list[tuple[float, Any]]], ns: str) -> Reference:
             if s.status == ACTIONLIB_SUCCEEDED:
                 succeeded.setdefault(s.goal_id.id, t)
     start = min(
-        t for t, m in feedback if any(s.status == ACTIONLIB_ACTIVE for s in m.feedback.goal_status.status_list)
+        t
+        for t, m in feedback
+        if any(s.status == ACTIONLIB_ACTIVE for s in m.feedback.goal_status.status_list)
     )
     end = max(succeeded.values())
     targets = []

@@ -40,8 +40,18 @@ def _yard_bag(folder: Path, convention: str, fmt: str) -> Path:
 
 
 def _stored(run: str, metric: str, robot: str) -> float:
-    table = _ok("query", "run_metric", "-p", f"run={run}", "-p", f"metric={metric}", "-p", f"robot={robot}",
-                "--format", "csv")
+    table = _ok(
+        "query",
+        "run_metric",
+        "-p",
+        f"run={run}",
+        "-p",
+        f"metric={metric}",
+        "-p",
+        f"robot={robot}",
+        "--format",
+        "csv",
+    )
     return float(table.splitlines()[1].split(",")[0])
 
 
@@ -68,7 +78,9 @@ def test_from_a_bag_to_a_report_in_four_commands(
         assert _stored(run, "waypoints_visited", robot) == len(expected.targets)
 
 
-def test_init_says_what_is_wrong_with_its_input(in_tmp: Path, tmp_path_factory: pytest.TempPathFactory) -> None:
+def test_init_says_what_is_wrong_with_its_input(
+    in_tmp: Path, tmp_path_factory: pytest.TempPathFactory
+) -> None:
     missing = run_exscec("init", "--from-bag", "no_such.bag")
     assert missing.returncode != 0 and "no_such.bag: no such bag" in missing.stderr
     bag = _yard_bag(tmp_path_factory.mktemp("recorded"), "nav2", "ros1")

@@ -17,7 +17,7 @@ from rosbags.highlevel import AnyReader
 from tests.bag_factory import ODOMETRY, Topic, header, quaternion, typestore_for, write_bag
 from tests.clock_bags import restamp
 from tests.draft_references import reference, whole_path
-from tests.real_shapes import SHAPES, pose_topic, ROUTE
+from tests.real_shapes import ROUTE, SHAPES, pose_topic
 from yard_spec import yard_text
 
 from exsce_dsl.errors import ExportError
@@ -124,9 +124,11 @@ def test_a_draft_of_a_bag_without_goals_spans_each_robots_whole_path(
         assert start == (0.0, 0.0, 0.0) and far == end
         return
     expected = whole_path(bag, pose, [pose, *signals])
-    places = expected.targets[1:] if np.hypot(*np.subtract(expected.targets[1], expected.targets[2])) > 0.7 else [
-        expected.targets[2]
-    ]
+    places = (
+        expected.targets[1:]
+        if np.hypot(*np.subtract(expected.targets[1], expected.targets[2])) > 0.7
+        else [expected.targets[2]]
+    )
     assert _places(spec, robot) == pytest.approx(_flat(places), abs=1e-4)
     assert values[("distance_travelled", robot)] == pytest.approx(expected.distance, rel=1e-9)
     assert values[("task_duration", robot)] == pytest.approx(expected.duration, abs=0.05)
@@ -178,7 +180,8 @@ def test_a_bags_occupancy_grid_is_written_as_the_map_the_draft_checks_against(tm
 def test_namespaces_that_are_keywords_become_ids_and_invalid_ones_are_said(tmp_path: Path) -> None:
     store = typestore_for("mcap")
     topics = [
-        pose_topic(store, f"/{ns}/odom", ODOMETRY, ROUTE, 20.0, frame="odom") for ns in ("robot", "type", "2nd-bot")
+        pose_topic(store, f"/{ns}/odom", ODOMETRY, ROUTE, 20.0, frame="odom")
+        for ns in ("robot", "type", "2nd-bot")
     ]
     bag = tmp_path / "odd names!"
     write_bag(bag, "mcap", topics, store)

@@ -34,6 +34,7 @@ from exsce_dsl.model import (
     Acceptance,
     Area,
     Assignment,
+    Declaration,
     Document,
     Environment,
     MapModel,
@@ -196,7 +197,13 @@ class _Drafter:
         all_tasks = tuple(t for robot_tasks in tasks.values() for t in robot_tasks)
         scenario = Scenario(self.scenario, env, robots, mission, all_tasks, location)
         used = {types[r.id].id: types[r.id] for r in robots}
-        declarations = (*used.values(), env, *all_tasks, scenario, self._acceptance(mission_id, robots))
+        declarations: tuple[Declaration, ...] = (
+            *used.values(),
+            env,
+            *all_tasks,
+            scenario,
+            self._acceptance(mission_id, robots),
+        )
         return Document(self.file, (), declarations), declared_poses([env])
 
     def _robot_types(self, header: list[str]) -> dict[str, RobotType]:
