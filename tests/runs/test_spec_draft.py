@@ -135,11 +135,11 @@ def test_a_draft_of_a_bag_without_goals_spans_each_robots_whole_path(
     assert ('namespace ""' in text) == (robot == "root_robot")
 
 
-def _grid_message(store: object) -> object:
+def _grid_message(store: object, fill: int = 0) -> object:
     """400 x 300 cells of 5 cm from (-5, -5): free, an occupied border, an unknown block at
     x 10..12, y 5..8 (away from the route), as a SLAM node publishes it."""
     t = store.types  # type: ignore[attr-defined]
-    data = np.zeros((300, 400), dtype=np.int8)
+    data = np.full((300, 400), fill, dtype=np.int8)
     data[0, :] = data[-1, :] = data[:, 0] = data[:, -1] = 100
     data[200:260, 300:340] = -1  # rows from the origin's row: y = -5 + row * 0.05
     info = t["nav_msgs/msg/MapMetaData"](
@@ -207,3 +207,18 @@ def test_a_draft_never_overwrites_unless_forced(tmp_path: Path) -> None:
     assert target.read_text() == "// the user's own\n"
     draft_spec(bag, target, force=True)
     assert "robot type detected_robot" in target.read_text()
+
+
+def test_a_map_whose_free_space_misses_the_places_is_written_but_not_referenced(tmp_path: Path) -> None:
+    store = typestore_for("ros1")
+    odom = pose_topic(store, "/odom", ODOMETRY, ROUTE, 20.0, frame="odom")
+    grid = Topic("/map", "nav_msgs/msg/OccupancyGrid", [(odom.messages[0][0], _grid_message(store, fill=-1))])
+    bag = tmp_path / "elsewhere.bag"
+    write_bag(bag, "ros1", [odom, grid], store)
+    draft = draft_spec(bag, tmp_path / "draft.exsce")
+    assert draft.map_files == (tmp_path / "draft_map.yaml", tmp_path / "draft_map.pgm")
+    # its start and its end (the farthest point from its start): both in unknown space
+    assert draft.notes == ("draft_map.yaml written but not referenced: 2 place(s) off its free space",)
+    (env,) = load_spec(draft.spec).environments  # checks: no pose is held against the map
+    assert env.map is None and "draft_map.yaml is not referenced" in draft.text
+    assert load_occupancy_grid(tmp_path / "draft_map.yaml").state_at(0.0, 0.0) == UNKNOWN

@@ -29,7 +29,7 @@ from pathlib import Path
 from exsce_dsl.errors import ExportError, SourceLocation
 from exsce_dsl.lang.formatter import declared_poses, format_document
 from exsce_dsl.lang.lexical import Comment
-from exsce_dsl.lang.occupancy import grid_from_ros, save_occupancy_grid
+from exsce_dsl.lang.occupancy import FREE, OccupancyGrid, grid_from_ros, save_occupancy_grid
 from exsce_dsl.model import (
     Acceptance,
     Area,
@@ -100,16 +100,13 @@ def draft_spec(bag: Path, out: Path, force: bool = False) -> SpecDraft:
     existing = [str(t) for t in targets if t.exists()]
     if existing and not force:
         raise ExportError(f"would overwrite {', '.join(existing)}; use --force to replace")
-    drafter = _Drafter(contents, out.name, _name(_file_stem(bag), set(), "bag"))
+    m = contents.map
+    grid = grid_from_ros(m.values, m.width, m.height, m.resolution, m.origin) if m is not None else None
+    drafter = _Drafter(contents, out.name, _name(_file_stem(bag), set(), "bag"), grid=grid)
     document, poses = drafter.document(map_yaml.name if map_yaml else None)
     text = format_document(document, poses, drafter.comments)
     out.parent.mkdir(parents=True, exist_ok=True)
-    written: tuple[Path, ...] = ()
-    if map_yaml is not None and contents.map is not None:
-        m = contents.map
-        written = save_occupancy_grid(
-            grid_from_ros(m.values, m.width, m.height, m.resolution, m.origin), map_yaml
-        )
+    written = save_occupancy_grid(grid, map_yaml) if grid is not None and map_yaml is not None else ()
     out.write_text(text, encoding="utf-8")
     robots = tuple((rid, r.namespace, r.convention or "detected") for rid, r in drafter.ids.items())
     return SpecDraft(out, text, written, robots, tuple(drafter.notes))
@@ -151,6 +148,7 @@ class _Drafter:
     comments: list[Comment] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     ids: dict[str, BagRobot] = field(default_factory=dict)
+    grid: OccupancyGrid | None = None
     taken: set[str] = field(default_factory=set)
     """Every id given so far: ids are unique across kinds."""
     _line: int = 0
@@ -251,6 +249,16 @@ class _Drafter:
                 f"The map: the last of {m.messages} OccupancyGrid message(s) on {m.topic}, "
                 f"{m.width} x {m.height} cells of {m.resolution:g} m.",
             )
+            outside = self._off_the_map()
+            if outside:
+                said[1:1] = [
+                    f"{map_file} is not referenced: {outside} place(s) lie outside its free space (a path",
+                    "from odometry is in another frame than the map). Move them and add: map NAME file ...",
+                ]
+                self.notes.append(
+                    f"{map_file} written but not referenced: {outside} place(s) off its free space"
+                )
+                map_file = None
         elif c.other_maps:
             said.insert(0, f"Occupancy grids not used as the map: {', '.join(c.other_maps)}.")
         env_id = _name(f"{self.scenario}_environment", self.taken, "environment")
@@ -291,6 +299,17 @@ class _Drafter:
             tasks[rid] = mine
             areas.append(Area(area, tuple(poses), area_location))
         return Environment(env_id, map_model, None, tuple(areas), (), env_location), starts, tasks
+
+    def _off_the_map(self) -> int:
+        """How many of the robots' places the bag's map does not have in free space."""
+        if self.grid is None:
+            return 0
+        places = [
+            p
+            for r in self.ids.values()
+            for p in ([r.start] if r.start else []) + [q for t in r.tasks for q in t]
+        ]
+        return sum(self.grid.state_at(p.x, p.y) != FREE for p in places)
 
     def _pose(self, wanted: str, place: Place, area: str) -> Pose:
         name = _name(wanted, self.taken, "pose")
