@@ -35,10 +35,11 @@ def bag() -> None:
 )
 @reports_errors
 def info(bags: tuple[str, ...], fmt: str) -> None:
-    """What each bag holds: format, size, time span; per topic its type, messages, rate and the
-    clock of its stamps (wall clock or a simulation's, from a sample of its first messages); the
-    TF tree; the navigation goals and how they ended; and per namespace the convention ingestion
-    would detect.
+    """What each bag holds: format, size, time span; per topic its type, where the type's definition
+    comes from (the bag, $EXSCE_MSG_PATH or rosbags' typestore), messages, rate and the clock of
+    its stamps (wall clock or a simulation's, from a sample of its first messages); the TF tree
+    with each edge's rate; the navigation goals and how they ended; and per namespace the
+    convention ingestion would detect.
 
     \b
     Example:
@@ -71,15 +72,15 @@ def _table(info: object) -> str:
         f"timeline  {info.timeline}",
         "",
     ]
-    rows = [("topic", "type", "messages", "rate (Hz)", "stamps", "log - stamp (s)")]
+    rows = [("topic", "type", "definition", "messages", "rate (Hz)", "stamps", "log - stamp (s)")]
     for t in info.topics:
         rate = f"{t.rate:.1f}" if t.rate is not None else "-"
         offset = f"{t.offset:+.3f}" if t.offset is not None else "-"
-        rows.append((t.name, t.msgtype, str(t.messages), rate, t.clock, offset))
+        rows.append((t.name, t.msgtype, t.definition, str(t.messages), rate, t.clock, offset))
     widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
     lines += ["  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True)).rstrip() for r in rows]
     if info.tf_edges:
-        edges = ", ".join(f"{p} -> {c}{' (static)' if s else ''}" for p, c, s in info.tf_edges)
+        edges = ", ".join(f"{p} -> {c} ({_edge_rate(info, p, c, s)})" for p, c, s in info.tf_edges)
         lines += ["", f"tf        {edges}"]
     for topic, ends in info.goals.items():
         counted = ", ".join(f"{n} {status}" for status, n in sorted(ends.items()))
@@ -130,6 +131,14 @@ def init(bag_path: str, output: str | None, force: bool) -> None:
     for note in draft.notes:
         click.echo(f"note: {note}", err=True)
     click.echo(f"next: exscec check {draft.spec} && exscec ingest {bag_path} --scenario {draft.spec}")
+
+
+def _edge_rate(info: object, parent: str, child: str, static: bool) -> str:
+    from exsce_dsl.runs.bag_info import BagInfo
+
+    assert isinstance(info, BagInfo)
+    rate = info.tf_rates.get((parent, child))
+    return "static" if static else f"{rate:.1f} Hz" if rate is not None else "once"
 
 
 COMMANDS = [bag, init]
