@@ -14,13 +14,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 from rosbags.highlevel import AnyReader
-from tests.bag_factory import ODOMETRY, Topic, header, quaternion, typestore_for, write_bag
+from tests.bag_factory import ODOMETRY, START_NS, Topic, header, quaternion, typestore_for, write_bag
 from tests.clock_bags import restamp
 from tests.draft_references import reference, whole_path
 from tests.real_shapes import ROUTE, SHAPES, pose_topic
 from yard_spec import yard_text
 
-from exsce_dsl.errors import ExportError
+from exsce_dsl.errors import BagError, ExportError
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.lang.occupancy import FREE, OCCUPIED, UNKNOWN, load_occupancy_grid
 from exsce_dsl.model import Specification
@@ -222,3 +222,13 @@ def test_a_map_whose_free_space_misses_the_places_is_written_but_not_referenced(
     (env,) = load_spec(draft.spec).environments  # checks: no pose is held against the map
     assert env.map is None and "draft_map.yaml is not referenced" in draft.text
     assert load_occupancy_grid(tmp_path / "draft_map.yaml").state_at(0.0, 0.0) == UNKNOWN
+
+
+def test_a_bag_without_a_robot_says_so_and_writes_nothing(tmp_path: Path) -> None:
+    store = typestore_for("ros1")
+    battery = [(START_NS + i * 10**9, store.types["std_msgs/msg/Float32"](data=24.0 - i)) for i in range(5)]
+    bag = tmp_path / "battery.bag"
+    write_bag(bag, "ros1", [Topic("/battery", "std_msgs/msg/Float32", battery)], store)
+    with pytest.raises(BagError, match=r"battery.bag: no robot found: .*its pose-like topics: none"):
+        draft_spec(bag, tmp_path / "draft.exsce")
+    assert not (tmp_path / "draft.exsce").exists()
