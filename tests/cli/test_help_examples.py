@@ -51,6 +51,7 @@ WALK: tuple[tuple[str, ...], ...] = (
     ("simulate",),  # baseline runs, a faulty run, a Nav2 run
     ("bag", "info"),  # what a Nav2 bag holds
     ("bag",),
+    ("init",),  # a specification drafted from a Nav2 bag, which checks
     ("ingest",),
     ("baseline",),
     ("verify",),  # the baseline runs pass, the faulty run fails

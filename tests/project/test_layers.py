@@ -40,7 +40,8 @@ STEPS: dict[str, list[set[str]]] = {
         {"signals"},
         {"segments"},
         {"metrics"},
-        {"analyse", "ingest", "robots", "bag_identity", "bag_info", "bag_runs"},
+        {"analyse", "ingest", "robots", "bag_identity", "bag_info", "bag_robots", "bag_runs"},
+        {"spec_draft"},
     ],
 }
 """Inside a layer that has steps, the same rule between its subpackages and modules."""

@@ -11,7 +11,9 @@ from pathlib import Path
 
 import pytest
 from rosbags.highlevel import AnyReader
+from tests.bag_factory import typestore_for, write_bag
 from tests.clock_bags import restamp
+from tests.real_shapes import SHAPES
 
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.runs.bag_info import bag_info
@@ -76,3 +78,16 @@ def test_a_file_that_is_no_bag_is_named_with_the_reason(tmp_path: Path) -> None:
     junk.write_bytes(b"not a bag at all")
     found = run_exscec("bag", "info", str(junk), cwd=tmp_path)
     assert found.returncode != 0 and "junk.bag" in found.stderr and "Traceback" not in found.stderr
+
+
+def test_each_tf_edge_has_its_rate_and_static_ones_none(tmp_path: Path) -> None:
+    store = typestore_for("mcap")
+    bag = tmp_path / "tf_only"
+    write_bag(bag, "mcap", SHAPES["tf_only"](store), store)
+    info = bag_info(bag)
+    # the shape publishes map -> odom at 10 Hz and odom -> base_link at 30 Hz, the laser mount once
+    assert dict(info.tf_rates) == pytest.approx({("map", "odom"): 10.0, ("odom", "base_link"): 30.0})
+    assert ("base_link", "base_laser_link", True) in info.tf_edges
+    assert {t.definition for t in info.topics} == {"the bag"}  # rosbags' writers always keep them
+    table = run_exscec("bag", "info", str(bag), cwd=tmp_path).stdout
+    assert "map -> odom (10.0 Hz)" in table and "base_link -> base_laser_link (static)" in table

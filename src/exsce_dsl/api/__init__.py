@@ -13,6 +13,7 @@ Each function says which command it is; errors are :class:`~exsce_dsl.errors.Exs
 the same messages the command prints.
 """
 
+from exsce_dsl.api.drafts import init_from_bag
 from exsce_dsl.api.tables import metrics, query, rows_frame, segments, sparql, verdicts
 from exsce_dsl.api.workflows import (
     add_derived,
@@ -38,6 +39,7 @@ __all__ = [
     "derive",
     "expect",
     "ingest",
+    "init_from_bag",
     "load",
     "metrics",
     "open_store",

@@ -1,4 +1,5 @@
-"""``exscec bag info``: what a bag holds, before any specification is written."""
+"""``exscec bag info`` and ``exscec init --from-bag``: what a bag holds, and a starting specification
+from it, before any specification is written."""
 
 from __future__ import annotations
 
@@ -34,10 +35,11 @@ def bag() -> None:
 )
 @reports_errors
 def info(bags: tuple[str, ...], fmt: str) -> None:
-    """What each bag holds: format, size, time span; per topic its type, messages, rate and the
-    clock of its stamps (wall clock or a simulation's, from a sample of its first messages); the
-    TF tree; the navigation goals and how they ended; and per namespace the convention ingestion
-    would detect.
+    """What each bag holds: format, size, time span; per topic its type, where the type's definition
+    comes from (the bag, $EXSCE_MSG_PATH or rosbags' typestore), messages, rate and the clock of
+    its stamps (wall clock or a simulation's, from a sample of its first messages); the TF tree
+    with each edge's rate; the navigation goals and how they ended; and per namespace the
+    convention ingestion would detect.
 
     \b
     Example:
@@ -70,15 +72,15 @@ def _table(info: object) -> str:
         f"timeline  {info.timeline}",
         "",
     ]
-    rows = [("topic", "type", "messages", "rate (Hz)", "stamps", "log - stamp (s)")]
+    rows = [("topic", "type", "definition", "messages", "rate (Hz)", "stamps", "log - stamp (s)")]
     for t in info.topics:
         rate = f"{t.rate:.1f}" if t.rate is not None else "-"
         offset = f"{t.offset:+.3f}" if t.offset is not None else "-"
-        rows.append((t.name, t.msgtype, str(t.messages), rate, t.clock, offset))
+        rows.append((t.name, t.msgtype, t.definition, str(t.messages), rate, t.clock, offset))
     widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
     lines += ["  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True)).rstrip() for r in rows]
     if info.tf_edges:
-        edges = ", ".join(f"{p} -> {c}{' (static)' if s else ''}" for p, c, s in info.tf_edges)
+        edges = ", ".join(f"{p} -> {c} ({_edge_rate(info, p, c, s)})" for p, c, s in info.tf_edges)
         lines += ["", f"tf        {edges}"]
     for topic, ends in info.goals.items():
         counted = ", ".join(f"{n} {status}" for status, n in sorted(ends.items()))
@@ -88,4 +90,55 @@ def _table(info: object) -> str:
     return "\n".join(lines)
 
 
-COMMANDS = [bag]
+@click.command("init")
+@click.option(
+    "--from-bag",
+    "bag_path",
+    required=True,
+    type=click.Path(),
+    metavar="BAG",
+    help="The bag (a ROS 1 .bag, a ROS 2 folder or an .mcap file) to draft the specification from.",
+)
+@click.option(
+    "-o",
+    "--output",
+    type=click.Path(dir_okay=False),
+    help="The specification to write.  [default: <bag stem>.exsce in the current folder]",
+)
+@click.option("--force", is_flag=True, help="Replace the specification and its map files if they exist.")
+@reports_errors
+def init(bag_path: str, output: str | None, force: bool) -> None:
+    """Write a starting specification from a bag, which checks and ingests as written: a robot
+    type per convention detected, a robot per namespace (namespace "" at the root), an environment
+    whose poses are the navigation goals' targets in recorded order (without goals: the start,
+    farthest point and end of each robot's path), a task per goal and a mission of them in that
+    order, the bag's OccupancyGrid as a map_server YAML and PGM beside it, and the method's safety
+    limits as acceptance criteria.  Its comments say what was detected from which topics.
+
+    \b
+    Example:
+      exscec simulate examples/brsu_building_c/scenario_c.exsce -o nav2_runs/ --convention nav2
+      exscec init --from-bag nav2_runs/*.bag -o from_bag.exsce
+      exscec check from_bag.exsce
+    """
+    from exsce_dsl.api.drafts import init_from_bag
+
+    draft = init_from_bag(Path(bag_path), output, force)
+    robots = ", ".join(f"{rid} ({ns or '/'}, {convention})" for rid, ns, convention in draft.robots)
+    click.echo(f"wrote {draft.spec}: robots {robots}")
+    for written in draft.map_files:
+        click.echo(f"wrote {written}")
+    for note in draft.notes:
+        click.echo(f"note: {note}", err=True)
+    click.echo(f"next: exscec check {draft.spec} && exscec ingest {bag_path} --scenario {draft.spec}")
+
+
+def _edge_rate(info: object, parent: str, child: str, static: bool) -> str:
+    from exsce_dsl.runs.bag_info import BagInfo
+
+    assert isinstance(info, BagInfo)
+    rate = info.tf_rates.get((parent, child))
+    return "static" if static else f"{rate:.1f} Hz" if rate is not None else "once"
+
+
+COMMANDS = [bag, init]

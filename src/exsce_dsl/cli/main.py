@@ -25,6 +25,7 @@ COMMAND_MODULES: dict[str, str] = {
     "simulate": "run_commands",
     "ingest": "run_commands",
     "bag": "bag_commands",
+    "init": "bag_commands",
     "store": "store_commands",
     "serve": "store_commands",
     "query": "query_commands",

@@ -6,7 +6,6 @@ every problem it finds.
 
 from __future__ import annotations
 
-import re
 from functools import lru_cache
 from pathlib import Path
 
@@ -14,9 +13,9 @@ from exsce_dsl.errors import Diagnostic, ExsceError, Severity
 from exsce_dsl.lang.occupancy import FREE, OUTSIDE, OccupancyGrid, load_occupancy_grid, map_image
 from exsce_dsl.model import Environment, Pose, Scenario
 from exsce_dsl.model.metrics import ComputedFor
+from exsce_dsl.model.names import is_ros_namespace
 
 # ROS graph resource names (namespaces): letters, digits, _ and / separators.
-_ROS_NAMESPACE = re.compile(r"(/?[A-Za-z][A-Za-z0-9_]*(/[A-Za-z][A-Za-z0-9_]*)*)?")  # "": the root
 
 
 def check_scenario(scenario: Scenario) -> list[Diagnostic]:
@@ -28,7 +27,7 @@ def check_scenario(scenario: Scenario) -> list[Diagnostic]:
     namespaces: dict[str, str] = {}
     starts: dict[str, str] = {}
     for robot in scenario.robots:
-        if not _ROS_NAMESPACE.fullmatch(robot.namespace):
+        if not is_ros_namespace(robot.namespace):
             found.append(
                 Diagnostic(
                     f"namespace '{robot.namespace}' of robot '{robot.id}' is not a valid ROS name",

@@ -123,3 +123,39 @@ def _read_pgm(path: Path) -> np.ndarray:
         raise ExsceError(f"map image {path} is truncated")
     scaled = values * 255 // maxval if maxval != 255 else values
     return scaled.astype(np.uint8).reshape(height, width)
+
+
+FREE_GREY, OCCUPIED_GREY, UNKNOWN_GREY = 254, 0, 205
+"""The grey levels map_saver writes for free, occupied and unknown cells."""
+FREE_BELOW, OCCUPIED_FROM = 25, 65
+"""map_saver's thresholds on a nav_msgs/OccupancyGrid's values (0-100, -1 unknown)."""
+
+
+def grid_from_ros(
+    values: np.ndarray, width: int, height: int, resolution: float, origin: tuple[float, float, float]
+) -> OccupancyGrid:
+    """An occupancy grid from a nav_msgs/OccupancyGrid's ``data`` (row-major from the origin's
+    row, -1 unknown, 0-100 occupied in percent), trinary as map_saver saves it."""
+    data = np.asarray(values, dtype=np.int16).reshape(height, width)
+    cells = np.full(data.shape, UNKNOWN_GREY, dtype=np.uint8)
+    cells[(data >= 0) & (data <= FREE_BELOW)] = FREE_GREY
+    cells[data >= OCCUPIED_FROM] = OCCUPIED_GREY
+    return OccupancyGrid(np.flipud(cells).copy(), resolution, origin, 0.65, 0.196, False)
+
+
+def save_occupancy_grid(grid: OccupancyGrid, yaml_path: Path) -> tuple[Path, Path]:
+    """Write ``grid`` as map_server reads it: ``yaml_path`` and a binary PGM beside it, of the
+    same stem; returns both paths."""
+    image = yaml_path.with_suffix(".pgm")
+    header = f"P5\n{grid.width} {grid.height}\n255\n".encode("ascii")
+    image.write_bytes(header + np.ascontiguousarray(grid.cells, dtype=np.uint8).tobytes())
+    meta = {
+        "image": image.name,
+        "resolution": grid.resolution,
+        "origin": [float(v) for v in grid.origin],
+        "negate": int(grid.negate),
+        "occupied_thresh": grid.occupied_thresh,
+        "free_thresh": grid.free_thresh,
+    }
+    yaml_path.write_text(yaml.safe_dump(meta, sort_keys=False), encoding="utf-8")
+    return yaml_path, image

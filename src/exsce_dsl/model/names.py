@@ -33,6 +33,14 @@ def is_valid_name(text: str) -> bool:
     return bool(_NAME_RE.fullmatch(text)) and text not in KEYWORDS
 
 
+_ROS_NAMESPACE = re.compile(r"(/?[A-Za-z][A-Za-z0-9_]*(/[A-Za-z][A-Za-z0-9_]*)*)?")
+
+
+def is_ros_namespace(text: str) -> bool:
+    """True if ``text`` is a ROS namespace a robot may have (``""``: the root)."""
+    return bool(_ROS_NAMESPACE.fullmatch(text))
+
+
 _NOT_IN_TOPICS = re.compile(r'[\s"\\{}]')
 TOPIC_RULE = "any characters but spaces, quotes, backslashes and braces; '{ns}' for the robot's namespace"
 """What :func:`is_topic_pattern` takes, for error messages."""

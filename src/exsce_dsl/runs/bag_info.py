@@ -11,23 +11,25 @@ namespace, the convention ingestion would detect and the topics that show it.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from exsce_dsl.errors import BagError
-from exsce_dsl.model.conventions import LASER_SCAN, POSE_TYPES, VELOCITY_TYPES
+from exsce_dsl.messages.catalogue import standard_catalogue
+from exsce_dsl.messages.user import configured_user_catalogue
 from exsce_dsl.model.goals import action_names, actionlib_names
-from exsce_dsl.model.robots import Robot, RobotType
 from exsce_dsl.runs.bags.reading import bag_topics
 from exsce_dsl.runs.bags.rosbags_fallback import typestore_for
-from exsce_dsl.runs.signals.detect import detect_convention
+from exsce_dsl.runs.signals.detect import robot_namespaces
 from exsce_dsl.runs.signals.timeline import SAME_CLOCK, SIMULATED_BEFORE
 
 SAMPLE = 50
-"""Messages of a topic read for its stamps (and of a TF topic for its edges)."""
+"""Messages of a topic read for its stamps."""
+TF_SAMPLE = 1000
+"""Messages of a TF topic read for its edges and their rates (small ones, many edges at many rates)."""
 _TF = "tf2_msgs/msg/TFMessage"
 _STATUS = {
     "action_msgs/msg/GoalStatusArray": action_names,
@@ -46,6 +48,9 @@ class TopicInfo:
     """``log time`` (no stamps), ``wall clock`` or ``simulated`` (its stamps')."""
     offset: float | None = None
     """Median of log time minus stamp over the sample, in seconds."""
+    definition: str = ""
+    """Where its type's definition comes from: :data:`BAG_OWN`, :data:`USER_OWN`, :data:`TYPESTORE`
+    or :data:`UNKNOWN`, in the order ingestion looks."""
 
 
 @dataclass(frozen=True)
@@ -58,6 +63,9 @@ class BagInfo:
     topics: tuple[TopicInfo, ...]
     tf_edges: tuple[tuple[str, str, bool], ...] = ()
     """(parent, child, static) of the transforms in the sample."""
+    tf_rates: Mapping[tuple[str, str], float] = field(default_factory=dict)
+    """(parent, child) → transforms a second over the sample (not for static edges, nor for an
+    edge seen once)."""
     goals: Mapping[str, Mapping[str, int]] = field(default_factory=dict)
     """A navigation status topic → final status → goals."""
     conventions: tuple[str, ...] = ()
@@ -80,7 +88,10 @@ class BagInfo:
             "duration_s": self.end - self.start,
             "timeline": self.timeline,
             "topics": [t.__dict__ for t in self.topics],
-            "tf": [{"parent": p, "child": c, "static": s} for p, c, s in self.tf_edges],
+            "tf": [
+                {"parent": p, "child": c, "static": s, "rate": self.tf_rates.get((p, c))}
+                for p, c, s in self.tf_edges
+            ],
             "goals": {topic: dict(ends) for topic, ends in self.goals.items()},
             "conventions": list(self.conventions),
         }
@@ -93,14 +104,16 @@ def bag_info(path: Path) -> BagInfo:
     types = bag_topics(path)  # checks the file first, with exsce's messages for broken ones
     try:
         with AnyReader([path], default_typestore=typestore_for(path)) as reader:
-            topics, edges, goals = _read(reader)
+            topics, edges, rates, goals = _read(reader)
             start, end = reader.start_time * 1e-9, reader.end_time * 1e-9
     except BagError:
         raise
     except Exception as exc:  # rosbags' readers raise their own errors for corrupt files
         raise BagError(f"{path}: cannot read the bag: {type(exc).__name__}: {exc}") from None
     size = sum(p.stat().st_size for p in ([path] if path.is_file() else path.rglob("*")) if p.is_file())
-    return BagInfo(str(path), _format(path), size, start, end, topics, edges, goals, _conventions(types))
+    return BagInfo(
+        str(path), _format(path), size, start, end, topics, edges, rates, goals, _conventions(types)
+    )
 
 
 def _format(path: Path) -> str:
@@ -111,12 +124,18 @@ def _format(path: Path) -> str:
 
 def _read(
     reader: Any,
-) -> tuple[tuple[TopicInfo, ...], tuple[tuple[str, str, bool], ...], dict[str, dict[str, int]]]:
+) -> tuple[
+    tuple[TopicInfo, ...],
+    tuple[tuple[str, str, bool], ...],
+    dict[tuple[str, str], float],
+    dict[str, dict[str, int]],
+]:
     by_topic: dict[str, list[Any]] = {}
     for connection in reader.connections:
         by_topic.setdefault(connection.topic, []).append(connection)
     topics: list[TopicInfo] = []
     edges: dict[tuple[str, str], bool] = {}
+    seen: dict[tuple[str, str], list[float]] = {}
     goals: dict[str, dict[str, str]] = {}
     for name, connections in sorted(by_topic.items()):
         msgtype = connections[0].msgtype
@@ -124,7 +143,7 @@ def _read(
         logs, stamps = [], []
         for index, (connection, time_ns, raw) in enumerate(reader.messages(connections=connections)):
             whole = msgtype in _STATUS
-            if index >= SAMPLE and not whole:
+            if index >= (TF_SAMPLE if msgtype == _TF else SAMPLE) and not whole:
                 break
             try:
                 message = reader.deserialize(raw, connection.msgtype)
@@ -136,12 +155,34 @@ def _read(
                 stamps.append(time_ns * 1e-9 - stamp)
             if msgtype == _TF:
                 for transform in message.transforms:
-                    edges[(transform.header.frame_id, transform.child_frame_id)] = name.endswith("tf_static")
+                    edge = (transform.header.frame_id, transform.child_frame_id)
+                    edges[edge] = name.endswith("tf_static")
+                    seen.setdefault(edge, []).append(time_ns * 1e-9)
             if whole:
                 _goals(goals.setdefault(name, {}), message, _STATUS[msgtype]())
-        topics.append(_topic(name, msgtype, count, logs, stamps))
+        info = _topic(name, msgtype, count, logs, stamps)
+        topics.append(replace(info, definition=_definition(msgtype, connections)))
     ended = {topic: _ends(found) for topic, found in goals.items()}
-    return tuple(topics), tuple((p, c, s) for (p, c), s in sorted(edges.items())), ended
+    rates = {edge: r for edge, times in seen.items() if not edges[edge] and (r := _rate(times)) is not None}
+    return tuple(topics), tuple((p, c, s) for (p, c), s in sorted(edges.items())), rates, ended
+
+
+BAG_OWN, USER_OWN, TYPESTORE, UNKNOWN = "the bag", "EXSCE_MSG_PATH", "rosbags' typestore", "unknown"
+
+
+def _definition(msgtype: str, connections: list[Any]) -> str:
+    """Where ingestion finds the definition of ``msgtype``: the bag's own (a ROS 1 connection's,
+    an MCAP schema, a ROS 2 bag's type description), else the user's files, else rosbags'
+    standard typestores."""
+    if any(getattr(getattr(c, "msgdef", None), "data", "").strip() for c in connections):
+        return BAG_OWN
+    if msgtype in configured_user_catalogue().definitions:
+        return USER_OWN
+    return TYPESTORE if msgtype in standard_catalogue().definitions else UNKNOWN
+
+
+def _rate(times: list[float]) -> float | None:
+    return (len(times) - 1) / (times[-1] - times[0]) if len(times) > 1 and times[-1] > times[0] else None
 
 
 def _stamp(message: Any) -> float | None:
@@ -156,7 +197,7 @@ def _stamp(message: Any) -> float | None:
 
 
 def _topic(name: str, msgtype: str, count: int, logs: list[float], offsets: list[float]) -> TopicInfo:
-    rate = (len(logs) - 1) / (logs[-1] - logs[0]) if len(logs) > 1 and logs[-1] > logs[0] else None
+    rate = _rate(logs)
     if not offsets:
         return TopicInfo(name, msgtype, count, rate, "log time")
     offset = float(np.median(offsets))
@@ -182,16 +223,8 @@ def _ends(found: dict[str, str]) -> dict[str, int]:
 
 def _conventions(types: Mapping[str, str]) -> tuple[str, ...]:
     """For the root and each first level of the topics' names: what ingestion would detect."""
-    namespaces = sorted({t.lstrip("/").split("/")[0] for t in types if "/" in t.lstrip("/")})
-    robot_types = (*POSE_TYPES, *VELOCITY_TYPES, LASER_SCAN, _TF)
-    at_root = any("/" not in t.lstrip("/") and m in robot_types for t, m in types.items()) or any(
-        f"/{action}/_action/status" in types for action in ("navigate_to_pose", "follow_waypoints")
-    )
     said = []
-    for namespace in ([""] if at_root else []) + namespaces:
-        robot = Robot(namespace or "root", RobotType("unknown"), namespace)
-        signals, detected = detect_convention(robot, types)
-        if detected.evidence or signals.pose:
-            shown = ", ".join(detected.evidence) or "its topics"
-            said.append(f"namespace '{namespace or '/'}': convention {detected.convention} (from {shown})")
+    for namespace, _, detected in robot_namespaces(types):
+        shown = ", ".join(detected.evidence) or "its topics"
+        said.append(f"namespace '{namespace or '/'}': convention {detected.convention} (from {shown})")
     return tuple(said)

@@ -23,7 +23,7 @@ FINAL = {code: name for code, name in actionlib_names().items() if code in ACTIO
 def segments(scenario: Scenario, robot: str, updates: list[StatusUpdate]) -> list[Segment]:
     """The actions of ``robot`` in a run, from its dispatcher feedback ``updates`` (time order)."""
     plan = planned_goals(scenario, robot)
-    goals = _split_goals(updates)
+    goals = dispatcher_goals(updates)
     if len(goals) > len(plan):
         raise SegmentError(
             f"robot '{robot}' ran {len(goals)} dispatcher goals but scenario '{scenario.id}' "
@@ -79,7 +79,7 @@ def planned_goals(scenario: Scenario, robot: str) -> list[tuple[int, str, int, t
     return plan
 
 
-def _split_goals(updates: list[StatusUpdate]) -> list[list[StatusUpdate]]:
+def dispatcher_goals(updates: list[StatusUpdate]) -> list[list[StatusUpdate]]:
     """Group updates by goal: a new goal starts when the goal id or the waypoint list changes."""
     goals: list[list[StatusUpdate]] = []
     for update in updates:

@@ -61,7 +61,9 @@ from exsce_dsl.runs.signals.navigation_goals import Goal, XYYaw
 
 
 @dataclass(frozen=True)
-class _Leg:
+class Leg:
+    """One leg of a robot's goals: to one pose, from ``start`` to ``end`` with a final ``status``."""
+
     label: str
     start: float | None
     end: float | None
@@ -83,7 +85,7 @@ def goal_segments(
         return Segmentation((), (f"robot {robot} has no planned waypoints in scenario {scenario.id}",))
     if not goals:
         return Segmentation((), (f"robot {robot} has no navigation goals: no segments from goals",))
-    legs = _legs(goals, track, warnings)
+    legs = goal_legs(goals, track, warnings)
     outcomes: list[Outcome | None] = [None] * len(plan)
     following, last = 0, -1  # the next planned waypoint to look at; the last one matched
     for leg in legs:
@@ -123,12 +125,13 @@ def goal_segments(
     return build_segmentation(scenario, robot, plan, filled, track, tolerance, warnings)
 
 
-def _matches(planned: PlannedWaypoint, leg: _Leg, tolerance: Tolerance) -> bool:
+def _matches(planned: PlannedWaypoint, leg: Leg, tolerance: Tolerance) -> bool:
     assert leg.target is not None
     return matches(tolerance, planned.pose, *leg.target)
 
 
-def _legs(goals: Sequence[Goal], track: Track, warnings: list[str]) -> list[_Leg]:
+def goal_legs(goals: Sequence[Goal], track: Track, warnings: list[str]) -> list[Leg]:
+    """The legs of ``goals`` in the order they were first seen, with their targets (rules 1-3)."""
     timed = []
     for goal in goals:
         if goal.first_seen is None:
@@ -136,7 +139,7 @@ def _legs(goals: Sequence[Goal], track: Track, warnings: list[str]) -> list[_Leg
         else:
             timed.append(goal)
     timed.sort(key=lambda g: g.first_seen or 0.0)  # stable: goals seen at once keep their order
-    legs: list[_Leg] = []
+    legs: list[Leg] = []
     for goal in timed:
         if goal.follows_waypoints:
             legs.extend(_waypoint_legs(goal, track, warnings))
@@ -144,11 +147,11 @@ def _legs(goals: Sequence[Goal], track: Track, warnings: list[str]) -> list[_Leg
         start = goal.started if goal.started is not None else goal.accepted
         end = None if goal.status == "ACTIVE" else goal.ended
         target = goal.target or _reached_at(track, goal.status, end)
-        legs.append(_Leg(f"goal {goal.key}", start, end, goal.status, target))
+        legs.append(Leg(f"goal {goal.key}", start, end, goal.status, target))
     return legs
 
 
-def _waypoint_legs(goal: Goal, track: Track, warnings: list[str]) -> list[_Leg]:
+def _waypoint_legs(goal: Goal, track: Track, warnings: list[str]) -> list[Leg]:
     """The legs of a follow_waypoints goal: one per waypoint index its feedback reported."""
     progress: list[tuple[int, float]] = []
     for index, t in goal.progress:
@@ -162,7 +165,7 @@ def _waypoint_legs(goal: Goal, track: Track, warnings: list[str]) -> list[_Leg]:
     if not progress:
         warnings.append(f"goal {goal.key} ({goal.status}) never reported a current waypoint: ignored")
         return []
-    legs: list[_Leg] = []
+    legs: list[Leg] = []
     for k, (index, t) in enumerate(progress):
         final = k == len(progress) - 1
         if final:
@@ -186,7 +189,7 @@ def _waypoint_legs(goal: Goal, track: Track, warnings: list[str]) -> list[_Leg]:
             given = goal.targets[j] if j < len(goal.targets) else None
             # the track knows only where the robot was when the last of these was done
             target = given or (_reached_at(track, status, end) if j == reached[-1] else None)
-            legs.append(_Leg(f"goal {goal.key}[{j}]", t if j == index else end, end, status, target))
+            legs.append(Leg(f"goal {goal.key}[{j}]", t if j == index else end, end, status, target))
     return legs
 
 

@@ -31,9 +31,11 @@ from exsce_dsl.model.conventions import (
     NAV2,
     ODOMETRY,
     POSE_STAMPED,
+    POSE_TYPES,
     POSE_WITH_COVARIANCE,
     TWIST,
     TWIST_STAMPED,
+    VELOCITY_TYPES,
     Navigation,
     PoseSource,
     Signals,
@@ -41,7 +43,7 @@ from exsce_dsl.model.conventions import (
     TopicSource,
 )
 from exsce_dsl.model.metrics import topic_name
-from exsce_dsl.model.robots import Robot
+from exsce_dsl.model.robots import Robot, RobotType
 
 TF_CHAINS = tuple(
     TfSource(fixed, body) for fixed in ("map", "odom") for body in ("base_link", "base_footprint")
@@ -155,3 +157,58 @@ def pose_like_topics(types: Mapping[str, str]) -> list[str]:
     """The bag's topics a pose could be read from, for a message that found none."""
     kinds = (ODOMETRY, POSE_STAMPED, POSE_WITH_COVARIANCE, "tf2_msgs/msg/TFMessage")
     return sorted(f"{t} ({m})" for t, m in types.items() if m in kinds)
+
+
+NOT_ROBOTS = frozenset(
+    {
+        "move_base",
+        "move_base_simple",
+        "navigate_to_pose",
+        "navigate_through_poses",
+        "follow_waypoints",
+        "waypoint_dispatcher",
+        "tf",
+        "tf_static",
+        "clock",
+        "rosout",
+        "rosout_agg",
+        "parameter_events",
+        "diagnostics",
+    }
+)
+"""First levels of topic names that are a root robot's interfaces or the graph's, never a robot."""
+_BODY_TYPES = (*POSE_TYPES, *VELOCITY_TYPES, LASER_SCAN)
+_ROBOT_TYPES = (*_BODY_TYPES, "tf2_msgs/msg/TFMessage")
+
+
+def robot_namespaces(types: Mapping[str, str]) -> list[tuple[str, Signals, Detected]]:
+    """The namespaces of a bag (``types``: topic → message type) that hold a robot, the root
+    (``""``) first, each with the signals detected there and what showed them: the root when a
+    topic at the root is a robot's (a pose, a velocity, a scan, TF) or a navigation interface is
+    there; each first level of the topics' names that shows a convention or a pose (but not the
+    names of navigation interfaces, :data:`NOT_ROBOTS`).  A root with a robot's topics of its own (a
+    velocity, a scan, a pose) takes in the namespaces that show nothing it does not (a Jackal's
+    ``/cmd_vel`` with its ``/jackal_velocity_controller/odom``); a root without, whose every piece of
+    evidence is another robot's topic (a fleet's global ``/tf``), is not a robot of its own."""
+    levels = {t.lstrip("/").split("/")[0] for t in types if "/" in t.lstrip("/")}
+    namespaces = sorted(levels - NOT_ROBOTS)
+    interfaces = [f"{action}/_action/status" for action in NAV2.actions]
+    interfaces += [f"{MOVE_BASE.actions[0]}/status", "/{ns}/waypoint_dispatcher/feedback"]
+    at_root = any("/" not in t.lstrip("/") and m in _ROBOT_TYPES for t, m in types.items()) or any(
+        topic_name(i, "") in types for i in interfaces
+    )
+    found: list[tuple[str, Signals, Detected]] = []
+    for namespace in ([""] if at_root else []) + namespaces:
+        robot = Robot(namespace or "root", RobotType("unknown"), namespace)
+        signals, detected = detect_convention(robot, types)
+        if detected.evidence or signals.pose:
+            found.append((namespace, signals, detected))
+    if not found or found[0][0]:
+        return found
+    root = set(found[0][2].evidence)
+    if any("/" not in t.lstrip("/") and m in _BODY_TYPES for t, m in types.items()):
+        return found[:1] + [f for f in found[1:] if not set(f[2].evidence) <= root]
+    others = [ns for ns, _, _ in found[1:]]
+    if root and others and all(any(under_namespace(t, ns) for ns in others) for t in root):
+        found.pop(0)
+    return found
