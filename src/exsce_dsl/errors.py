@@ -26,6 +26,7 @@ __all__ = [
     "ExsceSyntaxError",
     "GenerationError",
     "ImportFormatError",
+    "IncompleteRunError",
     "MessageTypeError",
     "PlanningError",
     "RelationError",
@@ -190,6 +191,10 @@ class PlanningError(ExsceError):
 
 class BagError(ExsceError):
     """A bag that cannot be used: unreadable, truncated, empty, of an unexpected type (``runs``)."""
+
+
+class IncompleteRunError(BagError):
+    """A run that would lack a metric value, which ``exscec ingest --strict`` does not store."""
 
 
 class DecodeError(ExsceError):

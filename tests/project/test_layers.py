@@ -40,7 +40,7 @@ STEPS: dict[str, list[set[str]]] = {
         {"signals"},
         {"segments"},
         {"metrics"},
-        {"analyse", "ingest", "robots", "bag_identity", "bag_info"},
+        {"analyse", "ingest", "robots", "bag_identity", "bag_info", "missing"},
     ],
 }
 """Inside a layer that has steps, the same rule between its subpackages and modules."""

@@ -85,12 +85,14 @@ def simulate(
 
 def ingest(
     store: Store, spec: Specification | Scenario, bags: Sequence[str | Path], *, scenario: str | None = None,
-    jobs: int = 1, cluster: str | None = None,
+    jobs: int = 1, cluster: str | None = None, strict: bool = False,
 ) -> list[IngestResult]:  # fmt: skip
     """``exscec ingest``: each bag's metrics and run PROV into ``store``, one transaction per run
     (a bag that fails is reported in its result, and nothing of it is written); the bags are
-    analysed by ``jobs`` processes, or on the Dask cluster whose scheduler is at ``cluster``."""
-    return ingest_bags([Path(b) for b in bags], _scenario(spec, scenario), store, jobs, cluster=cluster)
+    analysed by ``jobs`` processes, or on the Dask cluster whose scheduler is at ``cluster``;
+    ``strict``: a bag whose run would lack a metric value fails (``exscec ingest --strict``)."""
+    chosen = _scenario(spec, scenario)
+    return ingest_bags([Path(b) for b in bags], chosen, store, jobs, cluster=cluster, strict=strict)
 
 
 def baseline(store: Store, spec: Specification, scenario: str | None = None) -> Baseline:

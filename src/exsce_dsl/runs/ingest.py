@@ -67,7 +67,7 @@ class IngestResult:
         return self.status is IngestStatus.FAILED
 
 
-def _analyse(args: tuple[Path, Scenario, str | None]) -> AnalysedRun | ExsceError:
+def _analyse(args: tuple[Path, Scenario, str | None, bool]) -> AnalysedRun | ExsceError:
     from exsce_dsl.runs.analyse import analyse_bag
 
     try:
@@ -119,6 +119,7 @@ def ingest_bags(
     progress: Callable[[IngestResult], None] | None = None,
     namespace: str = DEFAULT_NAMESPACE,
     cluster: str | None = None,
+    strict: bool = False,
 ) -> list[IngestResult]:
     """Ingest each bag as a run of ``scenario``; the scenario itself is added to the store first.
 
@@ -127,6 +128,9 @@ def ingest_bags(
     used (see :mod:`exsce_dsl.parallel.cluster`).  This process alone compiles each run's PROV and
     writes it, each run wholly or not at all, in group commits when the runs come faster than the
     store takes them one by one (:mod:`exsce_dsl.store.batch_writing`).
+
+    ``strict``: a bag whose run would lack a metric value fails (nothing of it is written), its
+    message saying which values and why.
     """
     add_prov(store, compile_scenario(scenario, namespace))
     results: list[IngestResult] = []
@@ -159,7 +163,7 @@ def ingest_bags(
                     progress(result)
             else:
                 todo.append((path, digest))
-        outcomes = mapper(_analyse, [(path, scenario, digest) for path, digest in todo])
+        outcomes = mapper(_analyse, [(path, scenario, digest, strict) for path, digest in todo])
 
         def written(done: Written) -> None:
             bag, analysed = cast("tuple[Path, AnalysedRun | None]", done.key)
