@@ -6,6 +6,10 @@ from collections.abc import Callable, Iterable, Sequence
 from difflib import SequenceMatcher
 
 
+MARGIN = 0.1
+"""How much less like a name than the closest a further suggestion may be."""
+
+
 def likeness(name: str, candidate: str) -> float:
     """How much ``candidate`` looks like ``name``, from 0 to 1 (case left out).
 
@@ -37,7 +41,8 @@ def closest_several(
     cutoff: float = 0.6,
     forms: Callable[[str], Sequence[str]] | None = None,
 ) -> list[str]:
-    """Up to ``limit`` candidates like ``name``, the closest first (ties in name order).
+    """Up to ``limit`` candidates like ``name``, the closest first (ties in name order), each
+    nearly as close as the closest (:data:`MARGIN`).
 
     ``forms`` gives the spellings a name is compared by, pairwise and each weaker than the one
     before (a topic: its name without the leading ``/``, then its last part, so that a relative
@@ -52,7 +57,8 @@ def closest_several(
         score = max((likeness(a, b) * 0.9**k for k, (a, b) in enumerate(pairs)), default=0.0)
         if score > cutoff:
             scored.append((-score, candidate))
-    return [candidate for _, candidate in sorted(scored)[:limit]]
+    ranked = sorted(scored)[:limit]
+    return [candidate for score, candidate in ranked if -score >= -ranked[0][0] - MARGIN]
 
 
 def did_you_mean(name: str, candidates: Iterable[str]) -> str:

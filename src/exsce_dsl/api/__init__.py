@@ -14,6 +14,7 @@ the same messages the command prints.
 """
 
 from exsce_dsl.api.tables import metrics, query, rows_frame, segments, sparql, verdicts
+from exsce_dsl.store.queries.stored_names import UnknownNameWarning
 from exsce_dsl.api.workflows import (
     add_derived,
     baseline,
@@ -30,6 +31,7 @@ from exsce_dsl.api.workflows import (
 )
 
 __all__ = [
+    "UnknownNameWarning",
     "add_derived",
     "baseline",
     "check",
