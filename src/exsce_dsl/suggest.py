@@ -5,7 +5,6 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable, Sequence
 from difflib import SequenceMatcher
 
-
 MARGIN = 0.1
 """How much less like a name than the closest a further suggestion may be."""
 

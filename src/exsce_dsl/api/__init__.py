@@ -14,7 +14,6 @@ the same messages the command prints.
 """
 
 from exsce_dsl.api.tables import metrics, query, rows_frame, segments, sparql, verdicts
-from exsce_dsl.store.queries.stored_names import UnknownNameWarning
 from exsce_dsl.api.workflows import (
     add_derived,
     baseline,
@@ -29,6 +28,7 @@ from exsce_dsl.api.workflows import (
     simulate,
     verify,
 )
+from exsce_dsl.store.queries.stored_names import UnknownNameWarning
 
 __all__ = [
     "UnknownNameWarning",

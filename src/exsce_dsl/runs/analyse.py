@@ -142,7 +142,9 @@ def reductions(monitors: ModuleType, robots: list[Robot]) -> dict[str, Reduce]:
     return {topic: reducer(found) for topic, found in entries.items()}
 
 
-def analyse_bag(path: Path, scenario: Scenario, digest: str | None = None, strict: bool = False) -> AnalysedRun:
+def analyse_bag(
+    path: Path, scenario: Scenario, digest: str | None = None, strict: bool = False
+) -> AnalysedRun:
     """The metrics of the bag at ``path`` as a run of ``scenario``; ``digest`` is the bag's
     :func:`content_hash` when the caller has it already; ``strict``: a metric value that would be
     missing is an :class:`IncompleteRunError` (saying why, as the run's problems would).
@@ -160,8 +162,8 @@ def analyse_bag(path: Path, scenario: Scenario, digest: str | None = None, stric
         [r for r in scenario.robots if r.start_pose is not None], types
     )
     stacks = stack_robots(robots, types, {r.id for r in robots})
-    served = [topic_name(p, r.namespace) for r in robots if r.id in stacks.serves for p in SERVED.values()]
-    unread = unread_topics(scenario.metrics, robots, types, served)
+    serving = [topic_name(p, r.namespace) for r in robots if r.id in stacks.serves for p in SERVED.values()]
+    unread = unread_topics(scenario.metrics, robots, types, serving)
     wanted = with_stamps(stacks.adapt(wanted_topics(metrics, robots), robots), types, stamp_catalogue())
     recorded = read_bag(path, wanted, reductions(monitors, robots), field_checker(metrics, robots))
     timeline = decide_timeline(recorded)
@@ -241,9 +243,10 @@ def _run_clocks(timeline: Timeline, spellings: Mapping[str, tuple[str, ...]]) ->
 def _incomplete(path: Path, lacking: list[str], problems: list[str]) -> str:
     """Why ``--strict`` refuses a run: the values it would lack, then the run's problems."""
     why = "".join(f"\n  {p}" for p in dict.fromkeys(problems))
+    values = f"{len(lacking)} metric value{'s' if len(lacking) != 1 else ''}"
     return (
-        f"{path}: {len(lacking)} metric value{'s' if len(lacking) != 1 else ''} would be missing "
-        f"({'; '.join(lacking)}), and --strict stores no run with a missing metric" + (f":{why}" if why else "")
+        f"{path}: {values} would be missing ({'; '.join(lacking)}), and --strict stores no run "
+        "with a missing metric" + (f":{why}" if why else "")
     )
 
 

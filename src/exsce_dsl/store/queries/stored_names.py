@@ -20,7 +20,11 @@ __all__ = ["UnknownNameWarning", "stored_names", "unknown_names"]
 
 NAMED = {"metric": "metric", "metric_property": "metric", "robot": "robot", "scenario": "scenario"}
 """A parameter's kind → what its value names."""
-LISTING = {"metric": ("metric_names", "metric"), "robot": ("robot_names", "robot"), "scenario": ("scenarios", "scenario")}
+LISTING = {
+    "metric": ("metric_names", "metric"),
+    "robot": ("robot_names", "robot"),
+    "scenario": ("scenarios", "scenario"),
+}
 """What names → the library query that lists the store's names of it, and its column."""
 SHOWN = 8
 """Names listed at most when none is close."""
@@ -43,7 +47,7 @@ def stored_names(store: Store, what: str, namespace: str = DEFAULT_NAMESPACE) ->
     listing, column = LISTING[what]
     rows = run_query(store, listing, {}, namespace)
     at = rows.variables.index(column)
-    return [row[at].value for row in rows.rows if row[at] is not None]
+    return [term.value for row in rows.rows if (term := row[at]) is not None]
 
 
 def unknown_names(store: Store, name: str, given: Given, namespace: str = DEFAULT_NAMESPACE) -> list[str]:
