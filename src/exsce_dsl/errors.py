@@ -40,6 +40,7 @@ __all__ = [
     "StoreLockedError",
     "TfError",
     "TimeLimitError",
+    "UnknownNameWarning",
 ]
 
 
@@ -244,3 +245,8 @@ class RenameError(ValueError):
     A refusal sent back to the editor as it is (``str(error)`` is the reason), not a
     problem of a specification: hence a ``ValueError`` rather than an :class:`ExsceError`.
     """
+
+
+class UnknownNameWarning(UserWarning):
+    """A query's parameter names a metric, robot or scenario the store does not hold (``store``;
+    ``api.query`` warns with it, ``exscec query`` prints it)."""

@@ -22,6 +22,7 @@ from rosbags.highlevel import AnyReader
 from rosbags.rosbag1 import Reader, Writer
 
 from exsce_dsl import api as exsce
+from exsce_dsl.errors import UnknownNameWarning
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.sim.run import simulate
 
@@ -219,7 +220,7 @@ def test_a_misspelt_metric_parameter_warns_with_did_you_mean(
 def test_a_misspelt_parameter_warns_through_the_api(stored: tuple[str, str]) -> None:
     store_path, run = stored
     with exsce.open_store(store_path) as store:
-        with pytest.warns(exsce.UnknownNameWarning, match=r"no metric 'distance_travelld'; did you mean 'distance_travelled'\?"):
+        with pytest.warns(UnknownNameWarning, match=r"no metric 'distance_travelld'; did you mean 'distance_travelled'\?"):
             table = exsce.query(store, "run_metric", run=run, metric="distance_travelld", robot="bot")
         assert table.empty
         with warnings.catch_warnings():

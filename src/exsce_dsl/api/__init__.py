@@ -28,10 +28,8 @@ from exsce_dsl.api.workflows import (
     simulate,
     verify,
 )
-from exsce_dsl.store.queries.stored_names import UnknownNameWarning
 
 __all__ = [
-    "UnknownNameWarning",
     "add_derived",
     "baseline",
     "check",

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+from exsce_dsl.errors import UnknownNameWarning
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.queries.library import Parameter, query
@@ -28,10 +29,6 @@ LISTING = {
 """What names → the library query that lists the store's names of it, and its column."""
 SHOWN = 8
 """Names listed at most when none is close."""
-
-
-class UnknownNameWarning(UserWarning):
-    """A query's parameter names a metric, robot or scenario the store does not hold."""
 
 
 def named_by(parameter: Parameter) -> str | None:
