@@ -226,3 +226,23 @@ def test_a_misspelt_parameter_warns_through_the_api(stored: tuple[str, str]) -> 
         with warnings.catch_warnings():
             warnings.simplefilter("error")
             assert len(exsce.query(store, "run_metric", run=run, metric="distance_travelled", robot="bot")) == 1
+
+
+def test_a_misspelt_metric_parameter_warns_on_virtuoso_too(bag: Path, tmp_path: Path) -> None:
+    """The store's names come from SPARQL the store evaluates: Virtuoso 7 answers the same."""
+    from store_servers import virtuoso_server
+
+    (tmp_path / "gt.exsce").write_text(spec("/groundtruth"))
+    with virtuoso_server(tmp_path / "virtuoso") as server:
+        store = f"virtuoso+{server.url}"
+        done = run_exscec("ingest", str(bag), "--scenario", str(tmp_path / "gt.exsce"), "--store", store,
+                          timeout=300)  # fmt: skip
+        assert done.returncode == 0, done.stderr
+        (row,) = runs_in(store)
+        done = run_exscec("query", "run_metric", "-p", f"run={row['run']['value']}", "-p", "metric=distance_travelld",
+                          "-p", "robot=bott", "-f", "csv", "--store", store)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert done.stderr.splitlines() == [
+        "warning: the store holds no metric 'distance_travelld'; did you mean 'distance_travelled'?",
+        "warning: the store holds no robot 'bott'; did you mean 'bot'?",
+    ]
