@@ -26,6 +26,7 @@ __all__ = [
     "ExsceSyntaxError",
     "GenerationError",
     "ImportFormatError",
+    "IncompleteRunError",
     "MessageTypeError",
     "PlanningError",
     "RelationError",
@@ -39,6 +40,7 @@ __all__ = [
     "StoreLockedError",
     "TfError",
     "TimeLimitError",
+    "UnknownNameWarning",
 ]
 
 
@@ -192,6 +194,10 @@ class BagError(ExsceError):
     """A bag that cannot be used: unreadable, truncated, empty, of an unexpected type (``runs``)."""
 
 
+class IncompleteRunError(BagError):
+    """A run that would lack a metric value, which ``exscec ingest --strict`` does not store."""
+
+
 class DecodeError(ExsceError):
     """Raw bytes that are not the message type they claim to be (``runs``)."""
 
@@ -239,3 +245,8 @@ class RenameError(ValueError):
     A refusal sent back to the editor as it is (``str(error)`` is the reason), not a
     problem of a specification: hence a ``ValueError`` rather than an :class:`ExsceError`.
     """
+
+
+class UnknownNameWarning(UserWarning):
+    """A query's parameter names a metric, robot or scenario the store does not hold (``store``;
+    ``api.query`` warns with it, ``exscec query`` prints it)."""

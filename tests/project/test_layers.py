@@ -40,7 +40,7 @@ STEPS: dict[str, list[set[str]]] = {
         {"signals"},
         {"segments"},
         {"metrics"},
-        {"analyse", "ingest", "robots", "bag_identity", "bag_info", "bag_robots", "bag_runs"},
+        {"analyse", "ingest", "robots", "bag_identity", "bag_info", "bag_robots", "bag_runs", "missing"},
         {"spec_draft"},
     ],
 }

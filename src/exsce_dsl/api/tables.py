@@ -7,15 +7,18 @@ values="value")`` is the runs × robots × metrics table.  pandas is imported wh
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from dataclasses import asdict
 from typing import TYPE_CHECKING, Any
 
+from exsce_dsl.errors import UnknownNameWarning
 from exsce_dsl.store import queries
 from exsce_dsl.store.base import Rows, Store
 from exsce_dsl.store.queries.library import query as library_query
 from exsce_dsl.store.queries.results import pose_positions
 from exsce_dsl.store.queries.results import verdicts as stored_verdicts
+from exsce_dsl.store.queries.stored_names import unknown_names
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -102,10 +105,16 @@ def rows_frame(rows: Rows) -> pd.DataFrame:
 
 
 def query(store: Store, name: str, **parameters: str | Sequence[str]) -> pd.DataFrame:
-    """``exscec query NAME -p k=v``: a query of the library, its parameters bound as RDF terms."""
+    """``exscec query NAME -p k=v``: a query of the library, its parameters bound as RDF terms.
+    A metric, robot or scenario the store does not hold is an
+    :class:`~exsce_dsl.errors.UnknownNameWarning` naming the store's closest names (the answer
+    is then empty)."""
     if library_query(name).is_update:
         raise ValueError(f"'{name}' is an update; the Python API runs the library's queries only")
-    return rows_frame(queries.run_query(store, name, parameters))
+    rows = queries.run_query(store, name, parameters)
+    for warning in unknown_names(store, name, parameters):
+        warnings.warn(warning, UnknownNameWarning, stacklevel=2)
+    return rows_frame(rows)
 
 
 def sparql(store: Store, text: str) -> pd.DataFrame:

@@ -140,7 +140,9 @@ def query_command(
     """Run a query of the library by NAME, its parameters given with -p.
 
     Parameters are bound as RDF terms, never pasted into the query.  A
-    parameter that takes a list (runs) is given once per value.
+    parameter that takes a list (runs) is given once per value.  A metric,
+    robot or scenario the store does not hold is a warning naming the store's
+    closest names (the answer is then empty, and the exit status 0).
 
     \b
     Examples:
@@ -150,8 +152,10 @@ def query_command(
           -p start=classroom_c025-w001-R0.00_P0.00_Y0.00 -p goal=classroom_c022-w001-R0.00_P0.00_Y2.269
       exscec query pose_positions -p pose=classroom_c025-w001-R0.00_P0.00_Y0.00 \\
           -p pose=classroom_c022-w001-R0.00_P0.00_Y2.269 -f json
+      exscec query metric_names
     """
     from exsce_dsl.store.queries import query, query_names, run_query
+    from exsce_dsl.store.queries.stored_names import unknown_names
 
     if list_queries:
         lines = []
@@ -172,6 +176,9 @@ def query_command(
     library_query.bindings(given)  # check the parameters before opening the store
     with open_store(store_url) as store:
         rows = run_query(store, name, given)
+        unknown = [] if library_query.is_update else unknown_names(store, name, given)
+    for warning in unknown:
+        click.echo(f"warning: {warning}", err=True)
     if library_query.is_update:
         click.echo(f"{name}: done", err=True)
         return
@@ -238,10 +245,14 @@ def runs_command(scenario: str | None, fmt: str, output: str | None, store_url: 
     """
     from exsce_dsl.store.open import open_store
     from exsce_dsl.store.queries import run_query
+    from exsce_dsl.store.queries.stored_names import unknown_names
 
     given = {} if scenario is None else {"scenario": scenario}
     with open_store(store_url) as store:
         rows = run_query(store, "runs", given)
+        unknown = unknown_names(store, "runs", given) if not rows else []
+    for warning in unknown:
+        click.echo(f"warning: {warning}", err=True)
     write_text(render(rows, fmt), output)
     if fmt == "table":
         click.echo(f"{len(rows)} run{'s' if len(rows) != 1 else ''}", err=True)

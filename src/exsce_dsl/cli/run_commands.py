@@ -158,6 +158,12 @@ def simulate(
     help="Analyse bags the store holds as runs of this scenario again, under this spec, and replace "
     "each such run (its graphs, in one transaction; its verdicts are dropped).",
 )
+@click.option(
+    "--strict",
+    is_flag=True,
+    help="A bag whose run would lack a metric value (a topic not in the bag, no pose, a window "
+    "without data) fails, and nothing of it is stored.",
+)
 @click.option("--store", "store_url", envvar="EXSCE_STORE", help="Store URL (default: .exsce/store).")
 @reports_errors
 def ingest(
@@ -168,6 +174,7 @@ def ingest(
     cluster: str | None,
     verbose: bool,
     replace: bool,
+    strict: bool,
     store_url: str | None,
 ) -> None:
     """Compute the metrics of bags and add each run's provenance to the store.
@@ -184,12 +191,14 @@ def ingest(
     the clock of every topic).  Exits 1 if any bag failed.  With
     --cluster, a Dask cluster's workers analyse the bags (a task is tried
     twice; a killed worker's tasks go to another) and exscec writes each
-    run, as with --jobs.
+    run, as with --jobs.  With --strict, a run that would lack a metric value
+    is an error (which values, and why) and is not stored.
 
     \b
-    Example:
+    Examples:
       exscec ingest runs/*.bag --scenario examples/brsu_building_c/scenario_c.exsce
       exscec ingest --replace runs/*.bag --scenario examples/brsu_building_c/scenario_c.exsce
+      exscec ingest runs/*.bag --scenario examples/brsu_building_c/scenario_c.exsce --strict
     """
     from exsce_dsl.lang.spec_cache import load_spec_cached
     from exsce_dsl.store.open import StoreOpening
@@ -214,7 +223,7 @@ def ingest(
             for problem in result.problems:
                 progress.say(f"warning: {result.bag}: {problem}")
 
-        results = ingest_bags(paths, scenario, store, jobs, shown, cluster=cluster or None, replace=replace)
+        results = ingest_bags(paths, scenario, store, jobs, shown, cluster=cluster or None, replace=replace, strict=strict)
     done = sum(r.status is IngestStatus.INGESTED for r in results)
     skipped = sum(r.status is IngestStatus.SKIPPED for r in results)
     failed = sum(r.failed for r in results)

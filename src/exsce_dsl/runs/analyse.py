@@ -10,7 +10,7 @@ from types import ModuleType
 
 import numpy as np
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import ExsceError, IncompleteRunError
 from exsce_dsl.lang.check_fields import check_fields
 from exsce_dsl.lang.standard_metrics import standard_metrics
 from exsce_dsl.messages.catalogue import Source
@@ -35,6 +35,7 @@ from exsce_dsl.runs.bags.reading import (
 )
 from exsce_dsl.runs.metrics.compute import HOTSPOT_PATHS, POSE_TOPIC, compute_metrics
 from exsce_dsl.runs.metrics.monitor_code import load_monitors
+from exsce_dsl.runs.missing import missing_metrics, unread_topics
 from exsce_dsl.runs.robots import SERVED, stack_robots
 from exsce_dsl.runs.segments.dispatcher import SUCCEEDED, segments
 from exsce_dsl.runs.segments.segment import Segment
@@ -142,11 +143,17 @@ def reductions(monitors: ModuleType, robots: list[Robot]) -> dict[str, Reduce]:
 
 
 def analyse_bag(
-    path: Path, scenario: Scenario, digest: str | None = None, run_id: str | None = None
+    path: Path,
+    scenario: Scenario,
+    digest: str | None = None,
+    run_id: str | None = None,
+    strict: bool = False,
 ) -> AnalysedRun:
     """The metrics of the bag at ``path`` as a run of ``scenario``; ``digest`` is the bag's
     :func:`content_hash` when the caller has it already, ``run_id`` the run's id when it is not
-    the bag's own (:func:`~exsce_dsl.runs.bag_identity.run_uuid`).
+    the bag's own (:func:`~exsce_dsl.runs.bag_identity.run_uuid`); ``strict``: a metric value
+    that would be missing is an :class:`IncompleteRunError` (saying why, as the run's problems
+    would).
 
     Every robot goes through the same steps: its signals from the sources its convention names
     (detected from the bag when its type names none), every series on the run's one timeline,
@@ -161,11 +168,13 @@ def analyse_bag(
         [r for r in scenario.robots if r.start_pose is not None], types
     )
     stacks = stack_robots(robots, types, {r.id for r in robots})
+    serving = [topic_name(p, r.namespace) for r in robots if r.id in stacks.serves for p in SERVED.values()]
+    unread = unread_topics(scenario.metrics, robots, types, serving)
     wanted = with_stamps(stacks.adapt(wanted_topics(metrics, robots), robots), types, stamp_catalogue())
     recorded = read_bag(path, wanted, reductions(monitors, robots), field_checker(metrics, robots))
     timeline = decide_timeline(recorded)
     data = on_timeline(recorded, timeline)
-    problems = list(data.problems) + list(timeline.notes)
+    problems = unread + list(data.problems) + list(timeline.notes)
     for sources in stacks.sources.values():
         problems += sources.notes
     topics = {name: Topic(name, s.t, s.fields) for name, s in data.series.items()}
@@ -200,13 +209,18 @@ def analyse_bag(
         if (not found.segments or recording) and scenario.mission.tasks_of(robot.id):
             span = stacks.recorded_span(robot, topics)
             if span is None and not found.segments:
-                raise BagError(_nothing_of(path, robot, types))
+                raise BagError("\n  ".join([_nothing_of(path, robot, types), *unread]))
             if span is not None:
                 whole_runs[robot.id] = span
     values, hotspots = compute_metrics(
         monitors, metrics, robots, topics, actions, results, problems, whole_runs, stacks.named(robots)
     )
     values = [data.spelt(stacks.with_real_sources(v)) for v in values]
+    if strict:
+        acting = [r.id for r in robots if scenario.mission.tasks_of(r.id)]
+        lacking = missing_metrics(metrics, robots, acting, actions, values)
+        if lacking:
+            raise IncompleteRunError(_incomplete(path, lacking, problems))
     wall = timeline.to_wall
     run = Run(
         uuid=run_id or run_uuid(digest),
@@ -230,6 +244,16 @@ def _run_clocks(timeline: Timeline, spellings: Mapping[str, tuple[str, ...]]) ->
         for spelt in spellings.get(c.topic, (c.topic,)):
             found.setdefault(spelt, RunClock(spelt, c.clock, c.simulated, c.offset))
     return tuple(found.values())
+
+
+def _incomplete(path: Path, lacking: list[str], problems: list[str]) -> str:
+    """Why ``--strict`` refuses a run: the values it would lack, then the run's problems."""
+    why = "".join(f"\n  {p}" for p in dict.fromkeys(problems))
+    values = f"{len(lacking)} metric value{'s' if len(lacking) != 1 else ''}"
+    return (
+        f"{path}: {values} would be missing ({'; '.join(lacking)}), and --strict stores no run "
+        "with a missing metric" + (f":{why}" if why else "")
+    )
 
 
 def _nothing_of(path: Path, robot: Robot, types: Mapping[str, str]) -> str:

@@ -73,7 +73,7 @@ class IngestResult:
         return self.status is IngestStatus.FAILED
 
 
-def _analyse(args: tuple[Path, Scenario, str | None, str | None]) -> AnalysedRun | ExsceError:
+def _analyse(args: tuple[Path, Scenario, str | None, str | None, bool]) -> AnalysedRun | ExsceError:
     from exsce_dsl.runs.analyse import analyse_bag
 
     try:
@@ -139,6 +139,7 @@ def ingest_bags(
     namespace: str = DEFAULT_NAMESPACE,
     cluster: str | None = None,
     replace: bool = False,
+    strict: bool = False,
 ) -> list[IngestResult]:
     """Ingest each bag as a run of ``scenario``; the scenario itself is added to the store first.
 
@@ -149,6 +150,9 @@ def ingest_bags(
     store takes them one by one (:mod:`exsce_dsl.store.batch_writing`).  With ``replace``, a bag
     the store holds as a run of ``scenario`` is analysed again and its run's graphs replaced in
     one write, its verdicts dropped (:func:`~exsce_dsl.store.run_replacing.replace_run`).
+
+    ``strict``: a bag whose run would lack a metric value fails (nothing of it is written), its
+    message saying which values and why.
     """
     add_prov(store, compile_scenario(scenario, namespace))
     results: list[IngestResult] = []
@@ -176,7 +180,7 @@ def ingest_bags(
                     progress(skipped)
             else:
                 todo.append(_Todo(path, digest, run, replace and run is not None and run.stored))
-        outcomes = mapper(_analyse, [(t.path, scenario, t.digest, t.run_id) for t in todo])
+        outcomes = mapper(_analyse, [(t.path, scenario, t.digest, t.run_id, strict) for t in todo])
 
         def written(done: Written) -> None:
             bag, analysed = cast("tuple[_Todo, AnalysedRun | None]", done.key)
