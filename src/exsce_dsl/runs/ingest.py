@@ -133,6 +133,9 @@ def ingest_bags(
     todo: list[tuple[Path, str | None]] = []
     seen: set[str] = set()
     in_process = cluster is None and (jobs <= 1 or len(paths) <= 1)
+    # what the workers open: on a cluster, from the root (a worker's working folder is its own);
+    # messages name the paths as given
+    opened = dict(zip(paths, _shared_paths(paths) if cluster is not None else paths, strict=True))
     # in this process, what reads the bags is imported while they are hashed (hashing lets go of
     # Python's lock); for worker processes, before they start (forked, they have it)
     importing = _Importing(ANALYSIS) if in_process else None
@@ -140,7 +143,7 @@ def ingest_bags(
         importlib.import_module(ANALYSIS)
     with _workers(jobs, len(paths), cluster) as mapper:
         # a digest the cluster could not compute is None: the bag's analysis then says what is wrong
-        digests = [d if isinstance(d, str) else None for d in mapper(_digest, paths)]
+        digests = [d if isinstance(d, str) else None for d in mapper(_digest, [opened[p] for p in paths])]
         if importing is not None:
             importing.wait()
         for path, digest in zip(paths, digests, strict=True):
@@ -159,7 +162,7 @@ def ingest_bags(
                     progress(result)
             else:
                 todo.append((path, digest))
-        outcomes = mapper(_analyse, [(path, scenario, digest) for path, digest in todo])
+        outcomes = mapper(_analyse, [(opened[path], scenario, digest) for path, digest in todo])
 
         def written(done: Written) -> None:
             bag, analysed = cast("tuple[Path, AnalysedRun | None]", done.key)
@@ -182,6 +185,12 @@ def ingest_bags(
                     continue
                 writer.add(document, (path, outcome))
     return results
+
+
+def _shared_paths(paths: Sequence[Path]) -> list[Path]:
+    from exsce_dsl.parallel.cluster import shared_paths
+
+    return shared_paths(paths)
 
 
 class _Importing:
