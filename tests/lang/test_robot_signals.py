@@ -158,11 +158,11 @@ def test_the_formatter_prints_what_parses_back_to_the_same_model(tmp_path: Path,
     assert format_spec_document(again, source, comments(printed, source)) == printed
 
 
-def test_the_readmes_robot_types_check(tmp_path: Path) -> None:
-    """The robot types "Your robot's bags" shows are valid, with the sources the README says."""
-    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
-    section = readme[readme.index("### Your robot's bags") :]
-    block = section.split("```")[1]
+def test_the_bags_pages_robot_types_check(tmp_path: Path) -> None:
+    """The robot types docs/bags.md shows are valid, with the sources the page says."""
+    page = (Path(__file__).resolve().parents[2] / "docs" / "bags.md").read_text()
+    section = page[page.index("## Conventions") :]
+    block = section.split("```")[1].removeprefix("exsce\n")
     robot_types = _types(tmp_path, block)
     husky = robot_types["husky"].signals  # type: ignore[attr-defined]
     assert husky.navigation is Navigation.MOVE_BASE and husky.tolerance.position == 0.5

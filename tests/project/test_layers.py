@@ -15,7 +15,7 @@ PACKAGE = Path(__file__).resolve().parents[2] / "src" / "exsce_dsl"
 
 LAYERS: list[set[str]] = [
     # the base
-    {"errors", "suggest", "resources", "textfiles", "tables", "templating", "figures", "user_cache"},
+    {"errors", "suggest", "resources", "textfiles", "tables", "templating", "figures", "user_cache", "wording"},
     {"model"},
     {"messages", "monitor_kit", "parallel"},
     {"transform"},
@@ -40,7 +40,7 @@ STEPS: dict[str, list[set[str]]] = {
         {"signals"},
         {"segments"},
         {"metrics"},
-        {"analyse", "ingest", "robots", "bag_identity", "bag_info"},
+        {"analyse", "ingest", "robots", "bag_identity", "bag_info", "bag_runs"},
     ],
 }
 """Inside a layer that has steps, the same rule between its subpackages and modules."""

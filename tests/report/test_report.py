@@ -24,7 +24,14 @@ from exsce_dsl.lang.build import load_spec
 from exsce_dsl.model.geometry import Position
 from exsce_dsl.model.runs import Hotspot
 from exsce_dsl.model.verdicts import Outcome, Verdict
-from exsce_dsl.report.contents import ReportContents, RunContents, ScenarioContents, failures_first, gather
+from exsce_dsl.report.contents import (
+    ReportContents,
+    RunContents,
+    RunSegment,
+    ScenarioContents,
+    failures_first,
+    gather,
+)
 from exsce_dsl.report.html import page_name, write_report
 from exsce_dsl.report.plots import MARGIN, trajectory_figure
 from exsce_dsl.report.units import metric_units
@@ -442,16 +449,20 @@ def _drawn(figure: Figure) -> tuple[Axes, RendererAgg]:
 
 
 def _label_boxes(axes: Axes, renderer: RendererAgg) -> list[Bbox]:
-    """The hotspots' numbers, as drawn (the text only, not its leader line)."""
+    """The hotspots' numbers and the segments' labels, as drawn (the text only, not its leader line)."""
     labels = [t for t in axes.texts if isinstance(t, Annotation)]
     for label in labels:
         label.update_positions(renderer)
     return [Text.get_window_extent(label, renderer) for label in labels]
 
 
-def _assert_numbers_apart(axes: Axes, renderer: RendererAgg, spots: list[tuple[float, float]]) -> None:
+def _assert_numbers_apart(
+    axes: Axes, renderer: RendererAgg, spots: list[tuple[float, float]], segments: int = 0
+) -> None:
+    """No two labels overlap (the hotspots' numbers and the ``segments`` labels S1, S2...), none
+    covers a hotspot, and all are inside the map."""
     boxes = _label_boxes(axes, renderer)
-    assert len(boxes) == len(spots)
+    assert len(boxes) == len(spots) + segments
     for a, b in itertools.combinations(boxes, 2):
         shared = max(0.0, min(a.x1, b.x1) - max(a.x0, b.x0)) * max(0.0, min(a.y1, b.y1) - max(a.y0, b.y0))
         assert shared < 0.5, f"numbers overlap: {a} and {b}"
@@ -492,13 +503,15 @@ def test_the_run_figure_numbers_hotspots_apart_and_fits_the_axes_to_the_paths(pr
     figure = trajectory_figure(scenario, run, paths)
     axes, renderer = _drawn(figure)
     spots = [(h.position.x, h.position.y) for h in run.hotspots]
-    _assert_numbers_apart(axes, renderer, spots)
+    assert len(run.segments) == 6  # two robots, three segments each
+    _assert_numbers_apart(axes, renderer, spots, segments=len(run.segments))
     planned = [(x, y) for path in scenario.waypoints.values() for _, x, y in path]
     _assert_fitted(figure, axes, np.vstack([*(p.xy for p in paths), np.array(planned), np.array(spots)]))
 
 
 def test_a_crowd_of_hotspots_gets_numbers_that_do_not_overlap() -> None:
-    """Thirty hotspots within a metre, on a long straight corridor (a wide figure) without a map."""
+    """Thirty hotspots within a metre, on a long straight corridor (a wide figure) without a map,
+    with a path segment starting among them (its label S2 must find room too)."""
     rng = np.random.default_rng(7)
     crowd = rng.uniform(0.0, 1.0, size=(30, 2)) + (20.0, 2.0)
     spots = tuple(
@@ -506,15 +519,20 @@ def test_a_crowd_of_hotspots_gets_numbers_that_do_not_overlap() -> None:
         for (x, y), d in zip(crowd, rng.uniform(0.0, 3.0, 30), strict=True)
     )
     xy = np.column_stack([np.linspace(0.0, 40.0, 200), np.linspace(2.0, 3.0, 200)])
+    starts = [("start", 0.0, 2.0), ("middle", 20.5, 2.5), ("late", 30.0, 2.75)]
+    segments = tuple(
+        RunSegment("r1", f"r1-task_01-subtask_001-w_00{i}", n, "end", x, y, ())
+        for i, (n, x, y) in enumerate(starts, 1)
+    )
     run = RunContents(
-        StoredRun("0fcc1782-0c63-5500-b8af-3de8573bc05f", "s", None, None, None, None), (), spots
+        StoredRun("0fcc1782-0c63-5500-b8af-3de8573bc05f", "s", None, None, None, None), (), spots, segments
     )
     scenario = ScenarioContents(
         "s", None, (), (run,), (), (), {"r1": (("start", 0.0, 2.0), ("end", 40.0, 3.0))}
     )
     figure = trajectory_figure(scenario, run, [Trajectory("/r1/robot_pose", np.linspace(0, 60, 200), xy)])
     axes, renderer = _drawn(figure)
-    _assert_numbers_apart(axes, renderer, [(h.position.x, h.position.y) for h in spots])
+    _assert_numbers_apart(axes, renderer, [(h.position.x, h.position.y) for h in spots], segments=3)
     # a corridor gets a wide figure, as wide as the corridor and the margin (its height has a minimum)
     assert axes.get_xlim() == pytest.approx((0.0 - MARGIN, 40.0 + MARGIN), abs=0.01)
     assert axes.get_window_extent().width >= 0.8 * figure.bbox.width

@@ -4,7 +4,7 @@ Hypothesis writes random well-typed metric declarations over the topics of an
 executor run of two robots (velocity, pose, laser scan, distance, the
 dispatcher's windows, the robot's pose signal, and a topic the bag lacks):
 arithmetic with signed constants nested at any depth, every function the
-README lists, conditions, aggregates over arrays, pairs of robots.  Each
+docs/language.md lists, conditions, aggregates over arrays, pairs of robots.  Each
 declaration must pass ``check``, and ingesting the run must then give each of
 its values (for the run and, per segment, for each path segment) as a finite
 number or no value, never an internal error: the only exception allowed is a

@@ -1,4 +1,4 @@
-"""Every function the README lists computes, at ingest, what it says (issue 32, item 7).
+"""Every function docs/language.md lists computes, at ingest, what it says (issue 32, item 7).
 
 One executor run of one robot; a metric per function, signed constants and
 nested arithmetic among them.  Each value is compared with the same quantity

@@ -10,7 +10,7 @@ truth and two visual odometries, PoseStamped on relative names, ``ORB-SLAM`` amo
 with TF only, one PoseStamped stream under a namespace stamped in simulated time beside wall-clock
 log times (no ``/clock``), a drone climbing; and the executor's Nav2 robot at the root, with its
 goals and with them removed.  Where a plan's waypoints are on the recorded path, the robot is
-segmented by arrival (the window: from setting off to arriving at the last waypoint, README's
+segmented by arrival (the window: from setting off to arriving at the last waypoint, docs/bags.md's
 rule, recomputed here); where they are not (``survey``: a pose 50 m away), its metrics are of its
 whole recording.
 """
@@ -48,7 +48,7 @@ PLAN = ((8.0, 0.0), (8.0, 6.0))
 TOLERANCE = 0.35
 """The default arrival tolerance (m)."""
 STILL = 0.01
-"""Metres within which a robot has not yet set off (README, arrival)."""
+"""Metres within which a robot has not yet set off (docs/bags.md, arrival)."""
 
 SPEC = """
 environment farm {
@@ -266,7 +266,7 @@ def positions(messages: list[tuple[float, float, Any]], pose: Callable[[Any], An
 
 
 def arrival_window(t: np.ndarray, x: np.ndarray, y: np.ndarray) -> tuple[int, int]:
-    """README's arrival rule: from the last sample still at the first pose before the robot went
+    """docs/bags.md's arrival rule: from the last sample still at the first pose before the robot went
     farther than the tolerance, to the first sample within it of each planned waypoint in turn."""
     away = np.hypot(x - x[0], y - y[0])
     departure = int(np.flatnonzero(away > TOLERANCE)[0])
@@ -278,7 +278,7 @@ def arrival_window(t: np.ndarray, x: np.ndarray, y: np.ndarray) -> tuple[int, in
 
 
 def chord_speed(t: np.ndarray, x: np.ndarray, y: np.ndarray) -> float:
-    """The largest speed of positions over 0.5 s about each sample (README's ``speed``), held at
+    """The largest speed of positions over 0.5 s about each sample (docs/language.md's ``speed``), held at
     the ends."""
     before, after = np.clip(t - 0.25, t[0], t[-1]), np.clip(t + 0.25, t[0], t[-1])
     moved = np.hypot(
@@ -294,7 +294,7 @@ Expected = tuple[dict[str, float], set[str]]
 def pose_velocity(
     expected: dict[str, float], missing: set[str], pose: dict[str, np.ndarray], window: slice
 ) -> None:
-    """max_velocity of a robot with a pose only: the poses' speed (README's ``speed``), never 0."""
+    """max_velocity of a robot with a pose only: the poses' speed (docs/language.md's ``speed``), never 0."""
     t, x, y = pose["t"][window], pose["x"][window], pose["y"][window]
     expected["max_velocity"] = chord_speed(t, x, y)
     missing.discard("max_velocity")

@@ -21,7 +21,8 @@ from pyoxigraph import BlankNode, CanonicalizationAlgorithm, Dataset, Literal, N
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
-from exsce_dsl.store.base import GraphSet, StoreError
+from exsce_dsl.store import queries
+from exsce_dsl.store.base import GraphSet, Store, StoreError
 from exsce_dsl.store.open import open_store
 from exsce_dsl.store.remote import RemoteStore
 
@@ -192,6 +193,16 @@ def test_ingest_baseline_verify_and_report_give_the_embedded_stores_answers(
             a, b = {str(q) for q in there}, {str(q) for q in here}
             print("ONLY VIRT", sorted(a - b)[:4], "\nONLY EMB", sorted(b - a)[:4], len(a), len(b))
         assert there == here, name
+    # each segment value with its unit and start pose (an OPTIONAL across graphs), as on Oxigraph
+    uuids = [r.uuid for r in queries.runs(folder_store)]
+
+    def segment_values(store: Store) -> list[tuple[object, ...]]:
+        found = queries.run_segment_values(store, uuids)
+        return sorted((r.run, r.action, r.metric, round(r.value, 9), r.unit, r.start) for r in found)
+
+    here_values = segment_values(folder_store)
+    assert here_values and all(unit and start for *_, unit, start in here_values)
+    assert segment_values(virtuoso_store) == here_values
     folder_store.close()
 
 

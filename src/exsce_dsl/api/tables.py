@@ -15,13 +15,16 @@ from exsce_dsl.store import queries
 from exsce_dsl.store.base import Rows, Store
 from exsce_dsl.store.literals import canonical_rows, literal_value
 from exsce_dsl.store.queries.library import query as library_query
+from exsce_dsl.store.queries.results import pose_positions
 from exsce_dsl.store.queries.results import verdicts as stored_verdicts
 
 if TYPE_CHECKING:
     import pandas as pd
 
 METRIC_COLUMNS = ("run", "scenario", "robot", "metric", "safety", "value", "unit")
-SEGMENT_COLUMNS = ("run", "scenario", "robot", "action", "goal", "metric", "value")
+SEGMENT_COLUMNS = (
+    "run", "scenario", "robot", "action", "start", "start_x", "start_y", "goal", "metric", "value", "unit",
+)  # fmt: skip
 
 
 def _frame(records: Sequence[dict[str, Any]], columns: Sequence[str]) -> pd.DataFrame:
@@ -54,17 +57,29 @@ def metrics(store: Store, scenario: str | None = None, runs: Sequence[str] | Non
 
 def segments(store: Store, scenario: str | None = None, runs: Sequence[str] | None = None) -> pd.DataFrame:
     """Every path-segment metric value of the runs: columns run, scenario, robot, action (the
-    segment's activity IRI), goal (the goal pose), metric and value."""
+    action's id in the run, ``tiago1-task_01-subtask_001-w_001``: the robot's first task, its first
+    subtask's first waypoint), start (the pose the segment started from, with its heading),
+    start_x and start_y (where that pose is, in metres, in the map's frame), goal (the goal pose),
+    metric, value and unit (as the store holds it; None for a count)."""
     scenario_of = _runs(store, scenario, runs)
     readings = queries.run_segment_values(store, list(scenario_of))
+    where = pose_positions(store, [r.start for r in readings if r.start is not None])
+    nowhere = (None, None)
     return _frame(
         [
-            {"run": r.run, "scenario": scenario_of.get(r.run, ""), "robot": r.robot, "action": r.action,
-             "goal": r.goal, "metric": r.metric, "value": r.value}
+            {"run": r.run, "scenario": scenario_of.get(r.run, ""), "robot": r.robot,
+             "action": _action_id(r.action), "start": r.start,
+             "start_x": where.get(r.start or "", nowhere)[0], "start_y": where.get(r.start or "", nowhere)[1],
+             "goal": r.goal, "metric": r.metric, "value": r.value, "unit": r.unit}
             for r in readings
         ],
         SEGMENT_COLUMNS,
     )  # fmt: skip
+
+
+def _action_id(action: str | None) -> str | None:
+    """The action's id in its run: the last part of its IRI."""
+    return None if action is None else action.rsplit("/", 1)[-1]
 
 
 def verdicts(store: Store, scenario: str | None = None) -> pd.DataFrame:

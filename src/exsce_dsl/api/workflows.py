@@ -85,12 +85,15 @@ def simulate(
 
 def ingest(
     store: Store, spec: Specification | Scenario, bags: Sequence[str | Path], *, scenario: str | None = None,
-    jobs: int = 1, cluster: str | None = None,
+    jobs: int = 1, cluster: str | None = None, replace: bool = False,
 ) -> list[IngestResult]:  # fmt: skip
     """``exscec ingest``: each bag's metrics and run PROV into ``store``, one transaction per run
     (a bag that fails is reported in its result, and nothing of it is written); the bags are
-    analysed by ``jobs`` processes, or on the Dask cluster whose scheduler is at ``cluster``."""
-    return ingest_bags([Path(b) for b in bags], _scenario(spec, scenario), store, jobs, cluster=cluster)
+    analysed by ``jobs`` processes, or on the Dask cluster whose scheduler is at ``cluster``.
+    With ``replace``, a bag already stored as a run of the scenario is analysed again and its run
+    replaced in one transaction (its verdicts dropped), as ``exscec ingest --replace``."""
+    chosen = _scenario(spec, scenario)
+    return ingest_bags([Path(b) for b in bags], chosen, store, jobs, cluster=cluster, replace=replace)
 
 
 def baseline(store: Store, spec: Specification, scenario: str | None = None) -> Baseline:

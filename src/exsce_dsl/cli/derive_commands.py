@@ -8,6 +8,7 @@ import click
 
 from exsce_dsl.cli.common import reports_errors
 from exsce_dsl.cli.store_commands import store_option
+from exsce_dsl.wording import counted
 
 
 def _requests(words: tuple[str, ...]) -> list[tuple[str, dict[str, str]]]:
@@ -130,7 +131,8 @@ def derive(
         click.echo(stored.scenario.summary(), err=True)
         click.echo(stored.generation.summary(), err=True)
         if stored.oracles_written is not None:
-            click.echo(f"{len(stored.oracles)} oracles: {stored.oracles_written.summary()}", err=True)
+            oracles = counted(len(stored.oracles), "oracle")
+            click.echo(f"{oracles}: {stored.oracles_written.summary()}", err=True)
 
 
 def _step_text(step: object) -> str:

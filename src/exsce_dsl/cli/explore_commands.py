@@ -9,6 +9,7 @@ import click
 
 from exsce_dsl.cli.common import Progress, reports_errors
 from exsce_dsl.cli.store_commands import store_option
+from exsce_dsl.wording import counted
 
 
 @click.command()
@@ -157,14 +158,15 @@ def explore(
     record = result.record
     violated = {r.text for t in record.trials for r in t.violated}
     tried = len(record.trials)
-    click.echo(f"campaign {record.plan.id}: {tried} derivations tried, {len(violated)} relations violated")
+    found = f"{counted(tried, 'derivation')} tried, {counted(len(violated), 'relation')} violated"
+    click.echo(f"campaign {record.plan.id}: {found}")
     click.echo(f"  files: {result.folder}")
     for shrinking in record.shrinkings:
         file = result.minimal_files.get(shrinking.relation.text)
         steps = steps_text(shrinking.minimal_steps)
         click.echo(f"violated: {shrinking.relation.text} (trial {shrinking.trial})")
         count = len(shrinking.minimal_steps)
-        click.echo(f"  smallest derivation ({count} step{'' if count == 1 else 's'}): {steps}")
+        click.echo(f"  smallest derivation ({counted(count, 'step')}): {steps}")
         if file is not None:
             bags = result.folder / "runs" / shrinking.minimal
             click.echo(f"  reproduce: exscec verify {bags}/*.bag --scenario {file}")

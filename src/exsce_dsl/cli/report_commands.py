@@ -8,6 +8,7 @@ import click
 
 from exsce_dsl.cli.common import Progress, reports_errors
 from exsce_dsl.cli.store_commands import store_option
+from exsce_dsl.wording import counted
 
 
 @click.command()
@@ -46,7 +47,8 @@ def report(output: str, specs: tuple[str, ...], store_url: str | None) -> None:
         index = write_report(contents, Path(output), progress.update)
     for note in contents.notes:
         click.echo(f"note: {note}", err=True)
-    click.echo(f"wrote {index} ({len(contents.scenarios)} scenarios, {runs} runs)", err=True)
+    shown = f"{counted(len(contents.scenarios), 'scenario')}, {counted(runs, 'run')}"
+    click.echo(f"wrote {index} ({shown})", err=True)
 
 
 COMMANDS = [report]

@@ -152,6 +152,12 @@ def simulate(
 @click.option(
     "--verbose", "-v", is_flag=True, help="Also say which clock each of a bag's topics was timed by."
 )
+@click.option(
+    "--replace",
+    is_flag=True,
+    help="Analyse bags the store holds as runs of this scenario again, under this spec, and replace "
+    "each such run (its graphs, in one transaction; its verdicts are dropped).",
+)
 @click.option("--store", "store_url", envvar="EXSCE_STORE", help="Store URL (default: .exsce/store).")
 @reports_errors
 def ingest(
@@ -161,6 +167,7 @@ def ingest(
     jobs: int,
     cluster: str | None,
     verbose: bool,
+    replace: bool,
     store_url: str | None,
 ) -> None:
     """Compute the metrics of bags and add each run's provenance to the store.
@@ -168,7 +175,10 @@ def ingest(
     Each run is stored wholly or not at all (runs that come faster than one
     by one are committed in groups): a bag that cannot be used is reported
     and nothing of it is written, and the other bags still ingest.  A bag already
-    ingested (same content) is skipped.  It says the convention it detected for
+    ingested as a run of this scenario (same content) is skipped, unless --replace:
+    then it is analysed again (a spec with a new metric, a fixed convention) and its
+    run replaced, keeping its id; the run's verdicts are dropped (verify it again).
+    A bag may be a run of several scenarios, one run each.  It says the convention it detected for
     each robot whose type names none, and the run's timeline when its stamps are
     simulated time, once for all the bags that share them (-v: for each bag, and
     the clock of every topic).  Exits 1 if any bag failed.  With
@@ -179,6 +189,7 @@ def ingest(
     \b
     Example:
       exscec ingest runs/*.bag --scenario examples/brsu_building_c/scenario_c.exsce
+      exscec ingest --replace runs/*.bag --scenario examples/brsu_building_c/scenario_c.exsce
     """
     from exsce_dsl.lang.spec_cache import load_spec_cached
     from exsce_dsl.store.open import StoreOpening
@@ -203,11 +214,13 @@ def ingest(
             for problem in result.problems:
                 progress.say(f"warning: {result.bag}: {problem}")
 
-        results = ingest_bags(paths, scenario, store, jobs, shown, cluster=cluster or None)
+        results = ingest_bags(paths, scenario, store, jobs, shown, cluster=cluster or None, replace=replace)
     done = sum(r.status is IngestStatus.INGESTED for r in results)
     skipped = sum(r.status is IngestStatus.SKIPPED for r in results)
     failed = sum(r.failed for r in results)
-    click.echo(f"{done} ingested, {skipped} skipped, {failed} failed", err=True)
+    replaced = sum(r.status is IngestStatus.REPLACED for r in results)
+    again = f"{replaced} replaced, " if replace else ""
+    click.echo(f"{done} ingested, {again}{skipped} skipped, {failed} failed", err=True)
     if failed:
         sys.exit(1)
 

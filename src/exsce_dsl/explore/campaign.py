@@ -196,7 +196,7 @@ class _Campaign:
         store, else executed now and ingested (one transaction per run)."""
         if out.is_dir():
             bags = sorted(p for p in out.iterdir() if not p.name.endswith(".prov.json"))
-            known = [stored_run(bag, self.store) for bag in bags]
+            known = [stored_run(bag, self.store, scenario.id) for bag in bags]
             if len(bags) == runs and all(known):
                 return [k for k in known if k is not None]
             shutil.rmtree(out)  # a run cut short: start the scenario again

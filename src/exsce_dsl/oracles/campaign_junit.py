@@ -17,6 +17,7 @@ from exsce_dsl.model.campaign import CampaignRecord, Relation, Request, Shrinkin
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.queries import runs as stored_runs
 from exsce_dsl.transform.transformations import TRANSFORMATIONS
+from exsce_dsl.wording import counted
 
 __all__ = ["campaign_junit", "run_seconds", "step_text", "steps_text"]
 
@@ -66,7 +67,10 @@ def _failure(trial: Trial, shrinkings: Sequence[Shrinking]) -> tuple[str, str]:
     text (the same, a line per relation, after the scenario and its runs)."""
     found = [(r.text, _shrunk(r, trial.number, shrinkings)) for r in trial.violated]
     message = "violated " + "; ".join(f"{r}: {', '.join(where)}" for r, where in found)
-    lines = [f"scenario {trial.scenario}, {len(trial.runs)} runs, {len(trial.checked)} relations checked"]
+    lines = [
+        f"scenario {trial.scenario}, {counted(len(trial.runs), 'run')}, "
+        f"{counted(len(trial.checked), 'relation')} checked"
+    ]
     lines += [f"violated {r}: {where}" for r, shrunk in found for where in shrunk]
     return message, "\n".join(lines)
 

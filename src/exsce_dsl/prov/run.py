@@ -71,7 +71,12 @@ _DOCUMENT_PREFIXES = (ids.ROS, ids.EXSCE, ids.RUN, ids.TOPIC)
 
 
 def compile_run(
-    run: Run, scenario: Scenario, namespace: str = DEFAULT_NAMESPACE, *, checked: bool = False
+    run: Run,
+    scenario: Scenario,
+    namespace: str = DEFAULT_NAMESPACE,
+    *,
+    checked: bool = False,
+    own_bag_graph: bool = False,
 ) -> ProvDocument:
     """The PROV document of ``run``, a run of ``scenario``: run, bag and metric bundles.
 
@@ -79,18 +84,23 @@ def compile_run(
     scenario (another scenario, an unknown robot, a task the mission does not
     allocate, a metric of an unknown action or from a topic the bag lacks) or two
     of its parts would share an identifier.  ``checked`` builds every record
-    through prov's API (slower; for tests).
+    through prov's API (slower; for tests).  ``own_bag_graph`` names the bag's bundle in the
+    run's namespace (``R:<bag file>_bundle``): for a bag that is a run of another scenario too,
+    whose run holds ``exsce:<bag file>_bundle``.
     """
-    return _RunCompiler(run, scenario, Namespaces(namespace), checked).compile()
+    return _RunCompiler(run, scenario, Namespaces(namespace), checked, own_bag_graph).compile()
 
 
 class _RunCompiler:
-    def __init__(self, run: Run, scenario: Scenario, names: Namespaces, checked: bool) -> None:
+    def __init__(
+        self, run: Run, scenario: Scenario, names: Namespaces, checked: bool, own_bag_graph: bool = False
+    ) -> None:
         if run.scenario != scenario.id:
             raise ExsceError(f"run {run.uuid} is a run of '{run.scenario}', not of '{scenario.id}'")
         self.run = run
         self.scenario = scenario
         self.names = names
+        self.own_bag_graph = own_bag_graph
         self.writer = DocumentWriter(names, checked)
         for prefix in _DOCUMENT_PREFIXES:
             self.writer.document_namespace(prefix)
@@ -212,9 +222,9 @@ class _RunCompiler:
     def _bag_bundle(self) -> None:
         run, writer = self.run, self.writer
         bag = run.bag
-        exsce = writer.document_namespace(ids.EXSCE)
         name = ids.bag_name(bag.file_name)
-        w = writer.bundle(exsce[f"{name}_bundle"], f"the bundle of bag {bag.file_name}")
+        graphs = self.run_parts if self.own_bag_graph else writer.document_namespace(ids.EXSCE)
+        w = writer.bundle(graphs[f"{name}_bundle"], f"the bundle of bag {bag.file_name}")
         t = w.term
         bag_id = self._parts(w)[name]
         writer.claim(bag_id, f"bag {bag.file_name}")

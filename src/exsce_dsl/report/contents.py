@@ -41,10 +41,31 @@ def failures_first(verdicts: Iterable[Verdict]) -> tuple[Verdict, ...]:
 
 
 @dataclass(frozen=True)
+class RunSegment:
+    """One path segment a robot drove in a run (one action of the run), where it started, and
+    the values measured over it."""
+
+    robot: str
+    action: str
+    """Its id in the run: ``tiago1-task_01-subtask_001-w_001``."""
+    start: str
+    goal: str
+    x: float
+    """Where the start pose is (m, map frame)."""
+    y: float
+    values: tuple[MetricReading, ...]
+
+    def value(self, metric: str) -> MetricReading | None:
+        return next((v for v in self.values if v.metric == metric), None)
+
+
+@dataclass(frozen=True)
 class RunContents:
     run: StoredRun
     verdicts: tuple[Verdict, ...]
     hotspots: tuple[Hotspot, ...]
+    segments: tuple[RunSegment, ...] = ()
+    """Its path segments, by robot then in the order it drove them (the report numbers them S1, S2...)."""
 
     @property
     def failed(self) -> int:
@@ -66,6 +87,42 @@ class RunContents:
         return "failed" if self.failed else "unjudged" if self.unjudged else "passed"
 
 
+NO_SPEC = (
+    "no --spec was given: pass the scenarios' files with exscec report --spec FILE.exsce "
+    "to draw paths on their maps"
+)
+
+
+@dataclass(frozen=True)
+class MissingMap:
+    """Why a scenario's paths are drawn without a map: ``kind`` is ``no_spec`` (no --spec given),
+    ``no_map`` (its specification names no map file), ``not_given`` (no --spec file declares it or
+    a scenario it was derived from) or ``unreadable`` (its map file could not be read)."""
+
+    kind: str
+    scenario: str
+    """The scenario whose specification was looked at (itself, or the one it was derived from)."""
+    environment: str = ""
+    detail: str = ""
+
+    @property
+    def text(self) -> str:
+        """What to tell the user, and what to do about it."""
+        if self.kind == "no_spec":
+            return f"no occupancy grid: {NO_SPEC}"
+        if self.kind == "no_map":
+            return (
+                f"no occupancy grid: scenario '{self.scenario}' has no map: its environment "
+                f"'{self.environment}' names no map file; give its map line a file (the map_server YAML)"
+            )
+        if self.kind == "unreadable":
+            return f"no occupancy grid: cannot read the map of scenario '{self.scenario}': {self.detail}"
+        return (
+            f"no occupancy grid: no file given with --spec declares scenario '{self.scenario}' "
+            "(or one it was derived from): add its file to exscec report --spec"
+        )
+
+
 @dataclass(frozen=True)
 class ScenarioContents:
     id: str
@@ -79,6 +136,8 @@ class ScenarioContents:
     waypoints: Mapping[str, tuple[tuple[str, float, float], ...]]
     """Robot → its planned path: (pose name, x, y) from its start pose on."""
     grid: OccupancyGrid | None = None
+    missing_map: MissingMap | None = None
+    """Why there is no ``grid`` (None when there is one)."""
 
     @property
     def verdicts(self) -> tuple[Verdict, ...]:
@@ -121,7 +180,7 @@ def gather(store: Store, specs: Sequence[Path] = ()) -> ReportContents:
     """Read everything the report shows from ``store``; ``specs`` give occupancy grids and the
     units of the metrics they declare."""
     declared = [scenario for spec in specs for scenario in load_spec(spec).scenarios]
-    grids, notes = _grids(declared)
+    grids, missing, notes = _grids(declared)
     ids = queries.scenario_ids(store)
     all_verdicts = verdicts(store)
     derivations = {s: queries.derivation_of(store, s) for s in ids}
@@ -136,6 +195,7 @@ def gather(store: Store, specs: Sequence[Path] = ()) -> ReportContents:
         spots: dict[str, list[Hotspot]] = {}
         for found in hotspots(store, uuids):
             spots.setdefault(found.run, []).append(found.hotspot)
+        driven = _segments(store, uuids)
         judged: dict[str, list[Verdict]] = {}
         for verdict in all_verdicts:
             if verdict.scenario == scenario_id:
@@ -146,20 +206,26 @@ def gather(store: Store, specs: Sequence[Path] = ()) -> ReportContents:
                 derivation=derivations[scenario_id],
                 children=tuple(sorted(children.get(scenario_id, ()))),
                 runs=tuple(
-                    RunContents(r, failures_first(judged.get(r.uuid, ())), tuple(spots.get(r.uuid, ())))
+                    RunContents(
+                        r,
+                        failures_first(judged.get(r.uuid, ())),
+                        tuple(spots.get(r.uuid, ())),
+                        tuple(driven.get(r.uuid, ())),
+                    )
                     for r in runs
                 ),
                 oracles=tuple(queries.oracles(store, scenario_id)),
                 values=tuple(queries.run_metric_values(store, uuids)),
                 waypoints=_waypoints(store, scenario_id),
                 grid=_grid_of(scenario_id, derivations, grids),
+                missing_map=_missing_map(scenario_id, derivations, grids, missing, given=bool(specs)),
             )
         )
     clustering = None
     if len(ids) >= 2:
         clustering = cluster([scenario_facts(store, s) for s in ids])
     if not specs and any(s.waypoints for s in scenarios):
-        notes.append("no occupancy grid: pass the scenarios' .exsce files with --spec to draw paths on a map")
+        notes.append(MissingMap("no_spec", "").text)
     definitions: list[MetricDefinition] = [d for scenario in declared for d in scenario.metrics]
     units = metric_units((v for s in scenarios for v in s.values), definitions)
     return ReportContents(
@@ -184,36 +250,89 @@ def _waypoints(store: Store, scenario_id: str) -> dict[str, tuple[tuple[str, flo
     }
 
 
-def _grids(scenarios: Sequence[Scenario]) -> tuple[dict[str, OccupancyGrid], list[str]]:
-    """Scenario id → the occupancy grid of its environment, for every one of ``scenarios``."""
+def _grids(
+    scenarios: Sequence[Scenario],
+) -> tuple[dict[str, OccupancyGrid], dict[str, MissingMap], list[str]]:
+    """Scenario id → the occupancy grid of its environment, for every one of ``scenarios``; for
+    those without one, scenario id → why; and the notes the report prints."""
     grids: dict[str, OccupancyGrid] = {}
+    missing: dict[str, MissingMap] = {}
     loaded: dict[str, OccupancyGrid] = {}
     notes: list[str] = []
     for scenario in scenarios:
         map_model = scenario.environment.map
         if map_model is None or map_model.file is None:
+            missing[scenario.id] = MissingMap("no_map", scenario.id, scenario.environment.id)
             notes.append(f"scenario '{scenario.id}' names no map file: its paths are drawn without one")
             continue
         if map_model.file not in loaded:
             try:
                 loaded[map_model.file] = load_occupancy_grid(Path(map_model.file))
             except ExsceError as exc:
+                missing[scenario.id] = MissingMap("unreadable", scenario.id, detail=exc.message)
                 notes.append(f"scenario '{scenario.id}': {exc.message}")
                 continue
         grids[scenario.id] = loaded[map_model.file]
-    return grids, notes
+    return grids, missing, notes
+
+
+def _missing_map(
+    scenario_id: str,
+    derivations: Mapping[str, Derivation | None],
+    grids: Mapping[str, OccupancyGrid],
+    missing: Mapping[str, MissingMap],
+    given: bool,
+) -> MissingMap | None:
+    """Why the scenario's paths have no map under them (None when they have one)."""
+    if _grid_of(scenario_id, derivations, grids) is not None:
+        return None
+    if not given:
+        return MissingMap("no_spec", scenario_id)
+    for known in _lineage(scenario_id, derivations):
+        if known in missing:
+            return missing[known]
+    return MissingMap("not_given", scenario_id)
+
+
+def _lineage(scenario_id: str, derivations: Mapping[str, Derivation | None]) -> list[str]:
+    """The scenario, the one it was derived from, and so on."""
+    found: list[str] = []
+    current: str | None = scenario_id
+    while current is not None and current not in found:
+        found.append(current)
+        derivation = derivations.get(current)
+        current = derivation.base if derivation is not None else None
+    return found
+
+
+def _segments(store: Store, runs: Sequence[str]) -> dict[str, list[RunSegment]]:
+    """Run uuid → the path segments its robots drove, by robot then in order, each at its start pose."""
+    readings = queries.run_segment_values(store, runs)
+    where = pose_positions(store, [r.start for r in readings if r.start is not None])
+    by_action: dict[tuple[str, str], list[MetricReading]] = {}
+    for reading in readings:
+        if reading.action is not None and reading.start in where:
+            by_action.setdefault((reading.run, reading.action), []).append(reading)
+    found: dict[str, list[RunSegment]] = {}
+    for (run, action), values in sorted(by_action.items(), key=lambda item: (item[0][0], _order(item[1][0]))):
+        first = values[0]
+        x, y = where[first.start or ""]
+        name = action.rsplit("/", 1)[-1]
+        robot = first.robot or name.split("-task_", 1)[0]
+        found.setdefault(run, []).append(
+            RunSegment(robot, name, first.start or "", first.goal or "", x, y, tuple(values))
+        )
+    return found
+
+
+def _order(reading: MetricReading) -> tuple[str, str]:
+    """Robot, then the action's id (its task, subtask and waypoint numbers are zero-padded)."""
+    action = (reading.action or "").rsplit("/", 1)[-1]
+    return reading.robot or action.split("-task_", 1)[0], action
 
 
 def _grid_of(
     scenario_id: str, derivations: Mapping[str, Derivation | None], grids: Mapping[str, OccupancyGrid]
 ) -> OccupancyGrid | None:
     """The grid of the scenario, or of the nearest scenario it was derived from that has one."""
-    seen: set[str] = set()
-    current: str | None = scenario_id
-    while current is not None and current not in seen:
-        if current in grids:
-            return grids[current]
-        seen.add(current)
-        derivation = derivations.get(current)
-        current = derivation.base if derivation is not None else None
-    return None
+    return next((grids[s] for s in _lineage(scenario_id, derivations) if s in grids), None)

@@ -29,6 +29,7 @@ from exsce_dsl.resources import resource_dir
 from exsce_dsl.runs.bags.reading import BagError
 from exsce_dsl.runs.signals.trajectories import Trajectory, trajectories
 from exsce_dsl.similarity.dendrogram import dendrogram_figure
+from exsce_dsl.wording import counted, noun
 
 _SAFE = re.compile(r"[A-Za-z0-9_.-]+")
 
@@ -59,6 +60,8 @@ def _environment() -> jinja2.Environment:
     env.filters["measure"] = _measure
     env.filters["expectation"] = _expectation
     env.filters["steps"] = _steps
+    env.filters["counted"] = counted
+    env.filters["noun"] = noun
     env.globals["scenario_page"] = lambda s: page_name("scenario", s) + ".html"
     env.globals["run_page"] = lambda r: page_name("run", r) + ".html"
     env.globals["campaign_page"] = lambda c: page_name("campaign", c) + ".html"

@@ -18,6 +18,7 @@ from exsce_dsl.report.campaigns import CampaignContents
 from exsce_dsl.report.contents import RunContents, ScenarioContents
 from exsce_dsl.runs.signals.trajectories import Trajectory
 from exsce_dsl.store.queries import MetricReading
+from exsce_dsl.wording import counted
 
 MARGIN = 2.5
 """Metres of map shown around what a run's figure draws."""
@@ -32,6 +33,8 @@ _LABEL_GAP = 1.5  # points kept free around a hotspot's number
 _RINGS = (2.0, 6.0, 11.0, 17.0, 24.0, 32.0, 41.0, 51.0, 62.0, 74.0, 87.0, 101.0)
 """Points from a hotspot's marker to where its number may go, nearest first."""
 _DIRECTIONS = 24
+_SEGMENT_SIZE = 70.0  # points² of the ring where a path segment starts
+_SEGMENT_COLOUR = "#6c3483"
 _STATUS_COLOURS = {"failed": "#c0392b", "unjudged": "#d68910", "passed": "#1e8449", "not verified": "#5d6d7e"}
 
 Box = tuple[float, float, float, float]
@@ -39,8 +42,9 @@ Box = tuple[float, float, float, float]
 
 
 def trajectory_figure(scenario: ScenarioContents, run: RunContents, paths: Sequence[Trajectory]) -> Figure:
-    """Each robot's path in ``run`` over the scenario's grid, its planned waypoints, and the hotspots,
-    numbered (as the run page's table) without two numbers overlapping.
+    """Each robot's path in ``run`` over the scenario's grid, its planned waypoints, where each of
+    its path segments starts (S1, S2...), and the hotspots, numbered (as the run page's tables)
+    without two labels overlapping.
 
     The map shows what is drawn and :data:`MARGIN` around it (cut to the grid), at equal scale, and
     the figure takes the shape of that area, so that the map fills it; a map too long and thin for
@@ -49,9 +53,10 @@ def trajectory_figure(scenario: ScenarioContents, run: RunContents, paths: Seque
     points = [p.xy for p in paths]
     points += [np.array([(x, y) for _, x, y in path]) for path in scenario.waypoints.values() if path]
     points += [np.array([(h.position.x, h.position.y) for h in run.hotspots])] if run.hotspots else []
+    points += [np.array([(s.x, s.y) for s in run.segments])] if run.segments else []
     box = fitted_box(points, scenario.grid) or (-MARGIN, MARGIN, -MARGIN, MARGIN)
     markers = dict(zip(sorted({h.metric for h in run.hotspots}), "XDP^v*", strict=False))
-    entries = len(paths) + any(scenario.waypoints.values()) + len(markers)
+    entries = len(paths) + any(scenario.waypoints.values()) + len(markers) + bool(run.segments)
     figure, axes, box, columns = _map_figure(box, entries)
     if scenario.grid is not None:
         _draw_grid(axes, scenario.grid, box)
@@ -72,6 +77,7 @@ def trajectory_figure(scenario: ScenarioContents, run: RunContents, paths: Seque
             zorder=3,
             label="planned waypoints" if i == 0 else None,
         )
+    _mark_segment_starts(axes, run)
     labelled: set[str] = set()
     sizes = []
     for spot in run.hotspots:
@@ -106,10 +112,35 @@ def trajectory_figure(scenario: ScenarioContents, run: RunContents, paths: Seque
             fontsize=7,
             frameon=False,
         )
+    # hotspots' numbers first, nearest their markers; then the segments' labels, around both
+    starts = [(seg.x, seg.y) for seg in run.segments]
+    taken = _marker_boxes(axes, starts, [_SEGMENT_SIZE] * len(starts))
     if run.hotspots:
         positions = [(h.position.x, h.position.y) for h in run.hotspots]
-        _number_hotspots(axes, positions, sizes)
+        numbers = [str(i) for i in range(1, len(positions) + 1)]
+        taken = _place_labels(axes, positions, sizes, numbers, "#922b21", taken)
+    if run.segments:
+        labels = [f"S{i}" for i in range(1, len(starts) + 1)]
+        _place_labels(axes, starts, [_SEGMENT_SIZE] * len(starts), labels, _SEGMENT_COLOUR, taken)
     return figure
+
+
+def _mark_segment_starts(axes: Axes, run: RunContents) -> None:
+    """A ring where each of the run's path segments starts (its start pose), SVG id
+    ``segment-start-N`` (N as in the run page's table of segments)."""
+    for number, segment in enumerate(run.segments, start=1):
+        axes.scatter(
+            [segment.x],
+            [segment.y],
+            s=_SEGMENT_SIZE,
+            marker="o",
+            facecolor="none",
+            edgecolor=_SEGMENT_COLOUR,
+            linewidth=1.3,
+            zorder=4,
+            gid=f"segment-start-{number}",
+            label="segment start (S1, S2... as in the table)" if number == 1 else None,
+        )
 
 
 def _map_figure(box: Box, entries: int) -> tuple[Figure, Axes, Box, int]:
@@ -162,20 +193,27 @@ def fitted_box(points: Sequence[np.ndarray], grid: OccupancyGrid | None = None) 
     )
 
 
-def _number_hotspots(axes: Axes, positions: Sequence[tuple[float, float]], sizes: Sequence[float]) -> None:
-    """Write each hotspot's number (from 1) beside it where it covers no other number and no
-    hotspot: the nearest free place on rings around it, with a leader line when it had to go further.
-    (The figure's layout is fixed: what is measured here stays where it is.)"""
-    axes.apply_aspect()
+def _place_labels(
+    axes: Axes,
+    positions: Sequence[tuple[float, float]],
+    sizes: Sequence[float],
+    texts: Sequence[str],
+    colour: str,
+    taken: np.ndarray | None = None,
+) -> np.ndarray:
+    """Write each of ``texts`` beside its marker (at ``positions``, of area ``sizes`` in points²)
+    where it covers no other label, no marker and nothing in ``taken`` (pixel boxes x0, x1, y0,
+    y1): the nearest free place on rings around it, with a leader line when it had to go further.
+    Returns the boxes now taken.  (The figure's layout is fixed: what is measured here stays where
+    it is.)"""
     pixels = axes.figure.dpi / 72.0
     frame = axes.get_window_extent()
+    markers = _marker_boxes(axes, positions, sizes)
+    taken = markers if taken is None else np.vstack([taken, markers])
     anchors = axes.transData.transform(np.asarray(positions, dtype=float))
-    radii = np.sqrt(np.asarray(sizes, dtype=float)) / 2 * pixels  # a marker of area s points² spans √s points
-    taken = np.column_stack(
-        [anchors[:, 0] - radii, anchors[:, 0] + radii, anchors[:, 1] - radii, anchors[:, 1] + radii]
-    )
-    for number, ((x, y), radius) in enumerate(zip(anchors, radii, strict=True), start=1):
-        text = axes.text(0, 0, str(number), fontsize=_LABEL_POINTS, fontweight="bold")
+    radii = (markers[:, 1] - markers[:, 0]) / 2
+    for index, ((x, y), radius) in enumerate(zip(anchors, radii, strict=True)):
+        text = axes.text(0, 0, texts[index], fontsize=_LABEL_POINTS, fontweight="bold")
         extent = text.get_window_extent()
         text.remove()
         half = (extent.width / 2 + _LABEL_GAP * pixels, extent.height / 2 + _LABEL_GAP * pixels)
@@ -187,20 +225,20 @@ def _number_hotspots(axes: Axes, positions: Sequence[tuple[float, float]], sizes
         cx, cy = (places[chosen, 0] + places[chosen, 1]) / 2, (places[chosen, 2] + places[chosen, 3]) / 2
         leader = chosen >= _DIRECTIONS  # not on the first ring, right by its marker
         axes.annotate(
-            str(number),
-            positions[number - 1],
+            texts[index],
+            positions[index],
             xytext=(float(cx - x) / pixels, float(cy - y) / pixels),
             textcoords="offset points",
             ha="center",
             va="center",
             fontsize=_LABEL_POINTS,
             fontweight="bold",
-            color="#922b21",
+            color=colour,
             zorder=5,
             arrowprops=(
                 {
                     "arrowstyle": "-",
-                    "color": "#922b21",
+                    "color": colour,
                     "linewidth": 0.6,
                     "shrinkA": 0,
                     "shrinkB": float(radius) / pixels,
@@ -209,6 +247,22 @@ def _number_hotspots(axes: Axes, positions: Sequence[tuple[float, float]], sizes
                 else None
             ),
         )
+    return taken
+
+
+def _marker_boxes(
+    axes: Axes, positions: Sequence[tuple[float, float]], sizes: Sequence[float]
+) -> np.ndarray:
+    """The pixel boxes (x0, x1, y0, y1) of markers of area ``sizes`` (points²) at ``positions``."""
+    axes.apply_aspect()
+    if not positions:
+        return np.empty((0, 4))
+    pixels = axes.figure.dpi / 72.0
+    anchors = axes.transData.transform(np.asarray(positions, dtype=float))
+    radii = np.sqrt(np.asarray(sizes, dtype=float)) / 2 * pixels  # a marker of area s points² spans √s points
+    return np.column_stack(
+        [anchors[:, 0] - radii, anchors[:, 0] + radii, anchors[:, 1] - radii, anchors[:, 1] + radii]
+    )
 
 
 def _places(x: float, y: float, radius: float, half: tuple[float, float], pixels: float) -> np.ndarray:
@@ -385,7 +439,7 @@ def campaign_figure(campaign: CampaignContents) -> Figure:
     if budget > tried:
         axes.axvline(budget, color="#5d6d7e", linestyle="--", linewidth=1.0)
         axes.annotate(
-            f"budget: {budget} derivations",
+            f"budget: {counted(budget, 'derivation')}",
             (budget, 1.0),
             xycoords=("data", "axes fraction"),
             xytext=(-4, -2),

@@ -141,9 +141,12 @@ def reductions(monitors: ModuleType, robots: list[Robot]) -> dict[str, Reduce]:
     return {topic: reducer(found) for topic, found in entries.items()}
 
 
-def analyse_bag(path: Path, scenario: Scenario, digest: str | None = None) -> AnalysedRun:
+def analyse_bag(
+    path: Path, scenario: Scenario, digest: str | None = None, run_id: str | None = None
+) -> AnalysedRun:
     """The metrics of the bag at ``path`` as a run of ``scenario``; ``digest`` is the bag's
-    :func:`content_hash` when the caller has it already.
+    :func:`content_hash` when the caller has it already, ``run_id`` the run's id when it is not
+    the bag's own (:func:`~exsce_dsl.runs.bag_identity.run_uuid`).
 
     Every robot goes through the same steps: its signals from the sources its convention names
     (detected from the bag when its type names none), every series on the run's one timeline,
@@ -206,7 +209,7 @@ def analyse_bag(path: Path, scenario: Scenario, digest: str | None = None) -> An
     values = [data.spelt(stacks.with_real_sources(v)) for v in values]
     wall = timeline.to_wall
     run = Run(
-        uuid=run_uuid(digest),
+        uuid=run_id or run_uuid(digest),
         scenario=scenario.id,
         start=_time(recorded.start),
         end=_time(recorded.end),

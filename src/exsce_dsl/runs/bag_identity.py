@@ -27,3 +27,9 @@ def content_hash(path: Path) -> str:
 def run_uuid(digest: str) -> str:
     """A run's id follows from its bag's content, so ingesting a bag twice is recognised."""
     return str(uuid.uuid5(_RUN_NAMESPACE, digest))
+
+
+def scenario_run_uuid(digest: str, scenario_iri: str) -> str:
+    """The id of a bag's run under a scenario other than the one the store first held it as: the
+    bag's content and the scenario's IRI (:func:`run_uuid` stays the bag's first run's)."""
+    return str(uuid.uuid5(_RUN_NAMESPACE, f"{digest} {scenario_iri}"))

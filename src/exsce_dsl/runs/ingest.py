@@ -2,8 +2,11 @@
 
 A bag that cannot be used (unreadable, truncated, empty, from another
 scenario) is reported and nothing of it is written; the other bags of the
-same call still ingest.  A bag already in the store (same content, hence the
-same run id) is skipped.
+same call still ingest.  A bag the store holds as a run of the scenario already
+(same content, hence the same run id) is skipped, unless ``replace`` is given:
+then it is analysed again and its run replaced in one write
+(:mod:`exsce_dsl.store.run_replacing`).  A bag may be a run of several scenarios
+(:mod:`exsce_dsl.runs.bag_runs`).
 """
 
 from __future__ import annotations
@@ -22,11 +25,12 @@ from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import Scenario
 from exsce_dsl.prov import DEFAULT_NAMESPACE, compile_scenario
 from exsce_dsl.prov.run import compile_run
-from exsce_dsl.runs.bag_identity import content_hash, run_uuid
+from exsce_dsl.runs.bag_identity import content_hash
+from exsce_dsl.runs.bag_runs import BagRun, bag_runs
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.batch_writing import RunWriter, Written
-from exsce_dsl.store.queries import run_query
-from exsce_dsl.store.writing import add_prov
+from exsce_dsl.store.run_replacing import replace_run, verdict_graphs
+from exsce_dsl.store.writing import WriteReport, add_prov
 
 if TYPE_CHECKING:
     from exsce_dsl.runs.analyse import AnalysedRun
@@ -41,7 +45,9 @@ class IngestStatus(str, Enum):
 
     INGESTED = "ingested"
     SKIPPED = "skipped"
-    """Its content is a run the store holds already."""
+    """Its content is a run of the scenario the store holds already."""
+    REPLACED = "replaced"
+    """Its run was analysed again and replaced (``replace``)."""
     FAILED = "failed"
     """Nothing of it was written; the message says why."""
 
@@ -67,7 +73,7 @@ class IngestResult:
         return self.status is IngestStatus.FAILED
 
 
-def _analyse(args: tuple[Path, Scenario, str | None]) -> AnalysedRun | ExsceError:
+def _analyse(args: tuple[Path, Scenario, str | None, str | None]) -> AnalysedRun | ExsceError:
     from exsce_dsl.runs.analyse import analyse_bag
 
     try:
@@ -80,12 +86,25 @@ def _digest(path: Path) -> str | None:
     return content_hash(path) if path.exists() else None
 
 
-def stored_run(path: Path, store: Store, namespace: str = DEFAULT_NAMESPACE) -> str | None:
-    """The uuid of the run ``path`` holds when the store has it already (same content), else None."""
-    digest = _digest(path)
-    if digest is None or not run_query(store, "run_known", {"run": run_uuid(digest)}, namespace):
-        return None
-    return run_uuid(digest)
+def stored_run(path: Path, store: Store, scenario_id: str, namespace: str = DEFAULT_NAMESPACE) -> str | None:
+    """The uuid of the run of ``scenario_id`` that ``path`` holds when the store has it already
+    (same content), else None."""
+    (found,) = bag_runs(store, [_digest(path)], scenario_id, namespace)
+    return found.run_id if found is not None and found.stored else None
+
+
+@dataclass(frozen=True)
+class _Todo:
+    """A bag to analyse, and what its run is in the store."""
+
+    path: Path
+    digest: str | None
+    run: BagRun | None
+    replacing: bool
+
+    @property
+    def run_id(self) -> str | None:
+        return self.run.run_id if self.run is not None else None
 
 
 Mapper = Callable[[Callable[[Any], Any], Iterable[Any]], Iterator[Any]]
@@ -119,6 +138,7 @@ def ingest_bags(
     progress: Callable[[IngestResult], None] | None = None,
     namespace: str = DEFAULT_NAMESPACE,
     cluster: str | None = None,
+    replace: bool = False,
 ) -> list[IngestResult]:
     """Ingest each bag as a run of ``scenario``; the scenario itself is added to the store first.
 
@@ -126,12 +146,14 @@ def ingest_bags(
     with ``cluster`` (a Dask scheduler's address) the cluster's workers do, and ``jobs`` is not
     used (see :mod:`exsce_dsl.parallel.cluster`).  This process alone compiles each run's PROV and
     writes it, each run wholly or not at all, in group commits when the runs come faster than the
-    store takes them one by one (:mod:`exsce_dsl.store.batch_writing`).
+    store takes them one by one (:mod:`exsce_dsl.store.batch_writing`).  With ``replace``, a bag
+    the store holds as a run of ``scenario`` is analysed again and its run's graphs replaced in
+    one write, its verdicts dropped (:func:`~exsce_dsl.store.run_replacing.replace_run`).
     """
     add_prov(store, compile_scenario(scenario, namespace))
     results: list[IngestResult] = []
-    todo: list[tuple[Path, str | None]] = []
-    seen: set[str] = set()
+    todo: list[_Todo] = []
+    seen: dict[str, Path] = {}
     in_process = cluster is None and (jobs <= 1 or len(paths) <= 1)
     # what the workers open: on a cluster, from the root (a worker's working folder is its own);
     # messages name the paths as given
@@ -146,44 +168,45 @@ def ingest_bags(
         digests = [d if isinstance(d, str) else None for d in mapper(_digest, [opened[p] for p in paths])]
         if importing is not None:
             importing.wait()
-        for path, digest in zip(paths, digests, strict=True):
-            known = digest is not None and (
-                digest in seen or bool(run_query(store, "run_known", {"run": run_uuid(digest)}, namespace))
-            )
+        stored = bag_runs(store, digests, scenario.id, namespace)
+        for path, digest, run in zip(paths, digests, stored, strict=True):
+            skipped = _skipped(path, digest, run, seen, scenario.id, replace)
             if digest is not None:
-                seen.add(digest)
-            if known:
-                assert digest is not None
-                result = IngestResult(
-                    path, IngestStatus.SKIPPED, f"{path}: already ingested (same content)", run_uuid(digest)
-                )
-                results.append(result)
+                seen.setdefault(digest, path)
+            if skipped is not None:
+                results.append(skipped)
                 if progress:
-                    progress(result)
+                    progress(skipped)
             else:
-                todo.append((path, digest))
-        outcomes = mapper(_analyse, [(opened[path], scenario, digest) for path, digest in todo])
+                todo.append(_Todo(path, digest, run, replace and run is not None and run.stored))
+        outcomes = mapper(_analyse, [(opened[t.path], scenario, t.digest, t.run_id) for t in todo])
 
         def written(done: Written) -> None:
-            bag, analysed = cast("tuple[Path, AnalysedRun | None]", done.key)
+            bag, analysed = cast("tuple[_Todo, AnalysedRun | None]", done.key)
             result = _result(bag, analysed, done)
             results.append(result)
             if progress:
                 progress(result)
 
         with RunWriter(store, written) as writer:
-            for (path, _), outcome in zip(todo, outcomes, strict=True):
+            for bag, outcome in zip(todo, outcomes, strict=True):
                 if isinstance(outcome, ExsceError):
                     writer.flush()  # the bags before it are told first
-                    written(Written((path, None), None, outcome))
+                    written(Written((bag, None), None, outcome))
                     continue
                 try:
-                    document = compile_run(outcome.run, scenario, namespace)
+                    own_bag_graph = bag.run is not None and not bag.run.own_id
+                    document = compile_run(outcome.run, scenario, namespace, own_bag_graph=own_bag_graph)
+                    if bag.replacing:
+                        writer.flush()
+                        report = replace_run(store, document, outcome.run.uuid, namespace)
+                        written(Written((bag, outcome), report))
+                        continue
                 except ExsceError as exc:
                     writer.flush()
-                    written(Written((path, outcome), None, exc))
+                    written(Written((bag, outcome), None, exc))
                     continue
-                writer.add(document, (path, outcome))
+                writer.add(document, (bag, outcome))
     return results
 
 
@@ -214,19 +237,52 @@ class _Importing:
             raise self._error
 
 
-def _result(path: Path, analysed: AnalysedRun | None, done: Written) -> IngestResult:
+def _skipped(
+    path: Path, digest: str | None, run: BagRun | None, seen: dict[str, Path], scenario_id: str, replace: bool
+) -> IngestResult | None:
+    """The result of a bag that is not analysed (its run is stored, or an earlier bag of the call
+    has its content), else None."""
+    if digest is None or run is None:
+        return None
+    if digest in seen:
+        message = f"{path}: same content as {seen[digest]} (run {run.run_id}); skipped"
+        return IngestResult(path, IngestStatus.SKIPPED, message, run.run_id)
+    if not run.stored or replace:
+        return None
+    message = (
+        f"{path}: already a run of scenario '{scenario_id}' (run {run.run_id}); "
+        "pass --replace to analyse it again under this spec"
+    )
+    return IngestResult(path, IngestStatus.SKIPPED, message, run.run_id)
+
+
+def _result(bag: _Todo, analysed: AnalysedRun | None, done: Written) -> IngestResult:
     """What became of a bag, once its run was written (or not)."""
+    path = bag.path
     if done.error is not None or done.report is None or analysed is None:
         message = done.error.message if done.error is not None else "not written"
         named = message if str(path) in message else f"{path}: {message}"
         return IngestResult(path, IngestStatus.FAILED, named)
     return IngestResult(
         path,
-        IngestStatus.INGESTED,
-        f"{path}: run {analysed.run.uuid} ({len(analysed.run.metrics)} metric values)",
+        IngestStatus.REPLACED if bag.replacing else IngestStatus.INGESTED,
+        f"{path}: run {analysed.run.uuid} {_what_was_done(bag, len(analysed.run.metrics), done.report)}",
         analysed.run.uuid,
         tuple(analysed.problems),
         done.report.statements,
         tuple(analysed.picked()),
         tuple(analysed.clocks()),
     )
+
+
+def _what_was_done(bag: _Todo, values: int, report: WriteReport) -> str:
+    """``(51 metric values)``, and what else a reader should know of the run."""
+    said = f"({values} metric values)"
+    if bag.replacing:
+        said = f"analysed again {said}, in place of the stored one"
+        dropped = verdict_graphs(report.replaced)
+        if dropped:
+            said += "; its verdicts were dropped (exscec verify judges it again)"
+    if bag.run is not None and bag.run.others:
+        said += f"; the bag is also a run of scenario {', '.join(repr(s) for s in bag.run.others)}"
+    return said

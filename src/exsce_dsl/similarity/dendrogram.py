@@ -9,6 +9,7 @@ from scipy.cluster.hierarchy import dendrogram
 
 from exsce_dsl.figures import save_figure
 from exsce_dsl.similarity.clustering import Clustering
+from exsce_dsl.wording import counted
 
 
 def dendrogram_figure(result: Clustering) -> Figure:
@@ -28,7 +29,8 @@ def dendrogram_figure(result: Clustering) -> Figure:
     )
     axes.axvline(cut, color="#c0392b", linestyle="--", linewidth=1)
     axes.set_xlabel("combined distance (0 = alike, 1 = as far apart as the stored scenarios go)")
-    axes.set_title(f"{len(result.scenarios)} scenarios, {len(set(result.clusters.values()))} clusters")
+    clusters = len(set(result.clusters.values()))
+    axes.set_title(f"{counted(len(result.scenarios), 'scenario')}, {counted(clusters, 'cluster')}")
     axes.spines[["top", "right"]].set_visible(False)
     return figure
 

@@ -50,6 +50,20 @@ def runs(store: Store, scenario: str | None = None, namespace: str = DEFAULT_NAM
     return found
 
 
+def run_scenarios(
+    store: Store, runs: Sequence[str], namespace: str = DEFAULT_NAMESPACE
+) -> dict[str, tuple[str, ...]]:
+    """The scenario (by id) of each of ``runs`` (uuids) the store holds; runs it lacks are left out."""
+    if not runs:
+        return {}
+    found: dict[str, tuple[str, ...]] = {}
+    for row in run_query(store, "run_scenarios", {"run": list(dict.fromkeys(runs))}, namespace):
+        run, scenario = text_of(row["run"]), text_of(row["scenario_id"])
+        if run is not None and scenario:
+            found[run] = (*found.get(run, ()), scenario)
+    return found
+
+
 def run_metric(
     store: Store, run: str, metric: str, robot: str, namespace: str = DEFAULT_NAMESPACE
 ) -> float | None:
@@ -140,7 +154,8 @@ def violation_duration(
 @dataclass(frozen=True)
 class MetricReading:
     """One metric value of a run: a whole-run value (``action`` None), or one action's
-    (``action`` its IRI, ``goal`` the goal pose's name with its heading)."""
+    (``action`` its IRI, ``start`` and ``goal`` the names of the poses it went between, with
+    their headings)."""
 
     run: str
     metric: str
@@ -152,6 +167,8 @@ class MetricReading:
     """For a ``violation_duration``: the safety metric whose limit was violated."""
     unit: str | None = None
     """The value's unit (None for a count)."""
+    start: str | None = None
+    """For an action's value: the pose it started from."""
 
 
 def run_metric_values(
@@ -185,11 +202,20 @@ def run_segment_values(
     found = []
     for row in run_query(store, "run_segment_values", {"run": list(runs)}, namespace):
         run, metric, value = text_of(row["run"]), text_of(row["metric"]), float_of(row["value"])
-        action, goal = text_of(row["action"]), text_of(row["goal"])
+        action, goal, start = text_of(row["action"]), text_of(row["goal"]), text_of(row["start"])
         if None not in (run, metric, value, action, goal):
             assert run is not None and metric is not None and value is not None and goal is not None
-            pose = goal.rsplit("/", 1)[-1]
-            found.append(MetricReading(run, metric, text_of(row["robot"]), value, action, pose))
+            reading = MetricReading(
+                run,
+                metric,
+                text_of(row["robot"]),
+                value,
+                action,
+                goal.rsplit("/", 1)[-1],
+                unit=text_of(row["unit"]),
+                start=start.rsplit("/", 1)[-1] if start is not None else None,
+            )
+            found.append(reading)
     return found
 
 
