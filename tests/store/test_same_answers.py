@@ -121,6 +121,7 @@ def _commands(stores: Stores) -> dict[str, tuple[str, ...]]:
         "run_metric": ("-p", f"run={runs[0]}", *distance, "-p", "robot=r1"),
         "run_metric_values": every_run,
         "run_mission_metric": ("-p", f"run={runs[0]}", "-p", "metric=mission_duration"),
+        "run_scenarios": every_run,
         "run_segment_values": every_run,
         "runs": ("-p", "scenario=yard_run"),
         "safety_metrics": ("-p", "scenario=yard_run"),
