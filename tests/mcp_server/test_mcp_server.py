@@ -9,6 +9,7 @@ it and asks what a client would, comparing with what ``exscec`` itself answers.
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import sys
 from collections.abc import Awaitable, Callable
@@ -18,7 +19,7 @@ from typing import Any, TypeVar
 import anyio
 import pytest
 from mcp.client.session import ClientSession
-from mcp.client.stdio import StdioServerParameters, stdio_client
+from mcp.client.stdio import StdioServerParameters, get_default_environment, stdio_client
 from mcp.shared.exceptions import MCPError
 from mcp_types import CallToolResult, TextContent, TextResourceContents
 
@@ -84,7 +85,9 @@ def in_session(folder: Path, work: Callable[[ClientSession], Awaitable[T]], *opt
     """``work`` with a client session of ``exscec mcp OPTIONS`` started in ``folder``."""
 
     async def main() -> T:
-        server = StdioServerParameters(command=str(EXSCEC), args=["mcp", *options], cwd=str(folder))
+        # the server runs the package the tests run (the client passes few variables on)
+        env = get_default_environment() | {k: v for k, v in os.environ.items() if k == "PYTHONPATH"}
+        server = StdioServerParameters(command=str(EXSCEC), args=["mcp", *options], cwd=str(folder), env=env)
         with open(folder / "mcp-server.log", "a", encoding="utf-8") as errlog:
             async with stdio_client(server, errlog=errlog) as (read, write):
                 async with ClientSession(read, write) as session:

@@ -4,12 +4,16 @@ worker processes on 127.0.0.1, started here), runs written by the client.
 What must hold: the store holds the same quads as after ``--jobs 1``; a bag that cannot be used
 is reported by name; a worker killed in the middle of a bag loses no run; and a client killed
 in the middle of a batch leaves every run wholly stored or not at all, and the same command
-then finishes the batch.
+then finishes the batch; and bags named relative to the caller's folder are found, though the
+workers' working folder is another.
 """
 
 from __future__ import annotations
 
+import json
+import math
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -18,7 +22,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from distributed import LocalCluster
+from distributed import Client, LocalCluster
 from pyoxigraph import CanonicalizationAlgorithm, Dataset
 
 from exsce_dsl.lang.build import load_spec
@@ -82,6 +86,49 @@ def test_the_cluster_stores_what_one_job_stores_and_names_a_bad_bag(
         env={**os.environ, "EXSCE_DASK_SCHEDULER": cluster.scheduler_address},
     )  # fmt: skip
     assert again.returncode == 0 and f"0 ingested, {BAGS} skipped, 0 failed" in again.stderr
+
+
+def test_ingest_on_a_cluster_takes_paths_relative_to_the_callers_folder(
+    cluster: LocalCluster, yard: tuple[Path, list[Path], Path]
+) -> None:
+    """``exscec ingest ../runs/*.bag --cluster`` failed with 'no such bag' for every bag: the
+    workers opened the relative paths in their own working folder."""
+    folder, bags, reference = yard
+    caller = folder / "caller"
+    caller.mkdir()
+    relative = [os.path.relpath(bag, caller) for bag in bags]
+    assert all(name.startswith("../runs/") for name in relative)
+    with Client(cluster.scheduler_address, set_as_default=False) as watcher:
+        worker_folders = set(watcher.run(os.getcwd).values())
+    assert str(caller) not in worker_folders
+    assert not any((Path(where) / name).exists() for where in worker_folders for name in relative)
+    done = run_exscec(
+        "ingest", *relative, "--scenario", "../spec.exsce",
+        "--cluster", cluster.scheduler_address, "--store", "store", cwd=caller,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert f"{BAGS} ingested, 0 skipped, 0 failed" in done.stderr
+    assert "no such bag" not in done.stderr and relative[0] in done.stderr  # named as given
+    assert canonical(caller / "store") == canonical(reference)
+    # the values, by hand: r1 drives field-a (1,1) -> field-b (1,8) -> field-e (4.5,4.5) in the
+    # open yard, r2 field-d (8,1) -> field-c (8,8); each reaches all its waypoints
+    runs = [a for run in _run_ids(done.stderr) for a in ("-p", f"run={run}")]
+    assert len(runs) == 2 * BAGS
+    values = run_exscec("query", "run_metric_values", *runs, "-f", "json", "--store", "store", cwd=caller)
+    assert values.returncode == 0, values.stderr
+    found: dict[tuple[str, str], list[float]] = {}
+    for row in json.loads(values.stdout)["results"]["bindings"]:
+        if "robot" in row and row["metric"]["value"] in ("distance_travelled", "waypoints_visited"):
+            key = (row["robot"]["value"], row["metric"]["value"])
+            found.setdefault(key, []).append(float(row["value"]["value"]))
+    assert found[("r1", "distance_travelled")] == pytest.approx([7 + 3.5 * math.sqrt(2)] * BAGS, rel=1e-6)
+    assert found[("r2", "distance_travelled")] == pytest.approx([7.0] * BAGS, rel=1e-6)
+    assert found[("r1", "waypoints_visited")] == [2.0] * BAGS
+    assert found[("r2", "waypoints_visited")] == [1.0] * BAGS
+
+
+def _run_ids(said: str) -> list[str]:
+    return re.findall(r": run ([0-9a-f-]{36}) ", said)
 
 
 def test_a_worker_killed_in_the_middle_of_a_bag_loses_no_run(

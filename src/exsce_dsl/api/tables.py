@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 from exsce_dsl.errors import UnknownNameWarning
 from exsce_dsl.store import queries
 from exsce_dsl.store.base import Rows, Store
+from exsce_dsl.store.literals import canonical_rows, literal_value
 from exsce_dsl.store.queries.library import query as library_query
 from exsce_dsl.store.queries.results import pose_positions
 from exsce_dsl.store.queries.results import verdicts as stored_verdicts
@@ -99,8 +100,9 @@ def verdicts(store: Store, scenario: str | None = None) -> pd.DataFrame:
 
 
 def rows_frame(rows: Rows) -> pd.DataFrame:
-    """A SELECT's answer with each literal as the Python value it holds (IRIs as their text)."""
-    values = [[queries.python_value(term) for term in row] for row in rows.rows]
+    """A SELECT's answer with each literal as the Python value it holds, whatever the store wrote
+    (numbers, booleans, date-times aware of their zone; IRIs as their text)."""
+    values = [[literal_value(term) for term in row] for row in canonical_rows(rows).rows]
     return _frame([dict(zip(rows.variables, v, strict=True)) for v in values], rows.variables)
 
 

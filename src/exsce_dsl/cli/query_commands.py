@@ -11,12 +11,13 @@ from pathlib import Path
 from typing import Any
 
 import click
-from pyoxigraph import BlankNode, NamedNode
+from pyoxigraph import BlankNode, Literal, NamedNode
 
 from exsce_dsl.cli.common import reports_errors, write_text
 from exsce_dsl.cli.store_commands import store_option
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.store.base import Rows, Term
+from exsce_dsl.store.literals import literal_text
 from exsce_dsl.tables import aligned
 
 FORMATS = ("table", "json", "csv")
@@ -56,7 +57,7 @@ def results_json(rows: Rows) -> str:
 
 
 def results_csv(rows: Rows) -> str:
-    """SPARQL 1.1 Query Results CSV: lexical forms, CRLF line ends."""
+    """SPARQL 1.1 Query Results CSV: lexical forms (each literal in its one form), CRLF line ends."""
     out = io.StringIO()
     writer = csv.writer(out, lineterminator="\r\n")
     writer.writerow(rows.variables)
@@ -68,11 +69,14 @@ def results_csv(rows: Rows) -> str:
 def _csv_text(t: Term | None) -> str:
     if t is None:
         return ""
+    if isinstance(t, Literal):
+        return literal_text(t)
     return f"_:{t.value}" if isinstance(t, BlankNode) else t.value
 
 
 def results_table(rows: Rows, prefixes: Mapping[str, str]) -> str:
-    """Aligned columns, IRIs shortened with the library's prefixes, literals as their text."""
+    """Aligned columns, IRIs shortened with the library's prefixes, literals as their text (in
+    their one form, doubles to 15 significant digits: :mod:`exsce_dsl.store.literals`)."""
     namespaces = sorted(((iri, p) for p, iri in prefixes.items()), key=lambda item: -len(item[0]))
 
     def show(t: Term | None) -> str:
@@ -85,7 +89,7 @@ def results_table(rows: Rows, prefixes: Mapping[str, str]) -> str:
             return f"<{t.value}>"
         if isinstance(t, BlankNode):
             return f"_:{t.value}"
-        return t.value
+        return literal_text(t)
 
     cells = [list(rows.variables)] + [[show(t) for t in row] for row in rows.rows]
     if not rows.variables:

@@ -13,7 +13,9 @@ reported by name.
 
 Bags are read where they are: the workers open the paths the client gives, so the
 paths must name the same files on every worker (a shared filesystem: NFS, a mounted
-bucket, the same machine).  URLs are not opened.
+bucket, the same machine).  A worker's working folder is its own, so a relative path
+is made absolute first, against the client's working folder (:func:`shared_paths`).
+URLs are not opened.
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ from __future__ import annotations
 import os
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
+from pathlib import Path
 from typing import Any
 
 from exsce_dsl.errors import ExsceError
@@ -34,6 +37,13 @@ CONNECT_SECONDS = 20.0
 def cluster_address(given: str | None) -> str | None:
     """The scheduler's address: ``given``, else $EXSCE_DASK_SCHEDULER, else None."""
     return given or os.environ.get(CLUSTER_ENV) or None
+
+
+def shared_paths(paths: Iterable[Path]) -> list[Path]:
+    """``paths`` as a worker must be given them: from the root, a relative one taken from this
+    process's working folder (``exscec ingest ../runs/*.bag`` names the caller's bags, not
+    files under the worker's folder)."""
+    return [path.absolute() for path in paths]
 
 
 @contextmanager
@@ -65,4 +75,4 @@ def cluster_mapper(address: str) -> Iterator[Callable[[Callable[[Any], Any], Ite
         client.close()  # type: ignore[no-untyped-call]
 
 
-__all__ = ["CLUSTER_ENV", "cluster_address", "cluster_mapper"]
+__all__ = ["CLUSTER_ENV", "cluster_address", "cluster_mapper", "shared_paths"]

@@ -159,6 +159,9 @@ def ingest_bags(
     todo: list[_Todo] = []
     seen: dict[str, Path] = {}
     in_process = cluster is None and (jobs <= 1 or len(paths) <= 1)
+    # what the workers open: on a cluster, from the root (a worker's working folder is its own);
+    # messages name the paths as given
+    opened = dict(zip(paths, _shared_paths(paths) if cluster is not None else paths, strict=True))
     # in this process, what reads the bags is imported while they are hashed (hashing lets go of
     # Python's lock); for worker processes, before they start (forked, they have it)
     importing = _Importing(ANALYSIS) if in_process else None
@@ -166,7 +169,7 @@ def ingest_bags(
         importlib.import_module(ANALYSIS)
     with _workers(jobs, len(paths), cluster) as mapper:
         # a digest the cluster could not compute is None: the bag's analysis then says what is wrong
-        digests = [d if isinstance(d, str) else None for d in mapper(_digest, paths)]
+        digests = [d if isinstance(d, str) else None for d in mapper(_digest, [opened[p] for p in paths])]
         if importing is not None:
             importing.wait()
         stored = bag_runs(store, digests, scenario.id, namespace)
@@ -180,7 +183,7 @@ def ingest_bags(
                     progress(skipped)
             else:
                 todo.append(_Todo(path, digest, run, replace and run is not None and run.stored))
-        outcomes = mapper(_analyse, [(t.path, scenario, t.digest, t.run_id, strict) for t in todo])
+        outcomes = mapper(_analyse, [(opened[t.path], scenario, t.digest, t.run_id, strict) for t in todo])
 
         def written(done: Written) -> None:
             bag, analysed = cast("tuple[_Todo, AnalysedRun | None]", done.key)
@@ -209,6 +212,12 @@ def ingest_bags(
                     continue
                 writer.add(document, (bag, outcome))
     return results
+
+
+def _shared_paths(paths: Sequence[Path]) -> list[Path]:
+    from exsce_dsl.parallel.cluster import shared_paths
+
+    return shared_paths(paths)
 
 
 class _Importing:

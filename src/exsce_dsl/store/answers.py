@@ -1,5 +1,7 @@
 """Answers to SELECT queries as SPARQL 1.1 Query Results JSON, as every reader of the store gets
-them: ``exscec query`` and ``exscec sparql`` with ``--format json``, and the MCP server's tools."""
+them: ``exscec query`` and ``exscec sparql`` with ``--format json``, and the MCP server's tools.
+Literals are in their one form, doubles to 15 significant digits (:mod:`exsce_dsl.store.literals`),
+so every store gives the same text."""
 
 from __future__ import annotations
 
@@ -8,6 +10,7 @@ from typing import Any
 from pyoxigraph import BlankNode, NamedNode
 
 from exsce_dsl.store.base import Rows, Term
+from exsce_dsl.store.literals import canonical_literal, literal_text
 
 _XSD_STRING = "http://www.w3.org/2001/XMLSchema#string"
 
@@ -18,7 +21,8 @@ def term_json(term: Term) -> dict[str, str]:
         return {"type": "uri", "value": term.value}
     if isinstance(term, BlankNode):
         return {"type": "bnode", "value": term.value}
-    found = {"type": "literal", "value": term.value}
+    term = canonical_literal(term)
+    found = {"type": "literal", "value": literal_text(term)}
     if term.language:
         found["xml:lang"] = term.language
     elif term.datatype.value != _XSD_STRING:

@@ -54,6 +54,7 @@ from pyoxigraph import (
 
 from exsce_dsl.prov.identifiers import PROV_NAMESPACE, ROBOT_SCHEMA, XSD_NAMESPACE
 from exsce_dsl.store.base import GraphSet, Store, StoreConflictError, StoreError
+from exsce_dsl.store.literals import INTEGER_TYPES
 from exsce_dsl.store.segment_index import segment_index, stale_index_graphs
 
 __all__ = [
@@ -258,24 +259,7 @@ def add_graphs(
 
 # -- comparing graphs ------------------------------------------------------------
 
-_INTEGER_TYPES = frozenset(
-    XSD_NAMESPACE + local
-    for local in (
-        "integer",
-        "int",
-        "long",
-        "short",
-        "byte",
-        "nonNegativeInteger",
-        "positiveInteger",
-        "nonPositiveInteger",
-        "negativeInteger",
-        "unsignedLong",
-        "unsignedInt",
-        "unsignedShort",
-        "unsignedByte",
-    )
-)
+
 _XSD_INTEGER = NamedNode(XSD_NAMESPACE + "integer")
 
 
@@ -287,7 +271,7 @@ def _normal_literal(literal: Literal) -> Literal:
     datatype = literal.datatype.value
     text = literal.value.strip()
     try:
-        if datatype in _INTEGER_TYPES:
+        if datatype in INTEGER_TYPES:
             return Literal(str(int(text)), datatype=_XSD_INTEGER)
         local = datatype.removeprefix(XSD_NAMESPACE) if datatype.startswith(XSD_NAMESPACE) else ""
         if local == "decimal":

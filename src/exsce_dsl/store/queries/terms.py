@@ -5,13 +5,12 @@ from __future__ import annotations
 import datetime
 from collections.abc import Mapping, Sequence
 
-from pyoxigraph import Literal
-
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model.derivation import ParameterValue
 from exsce_dsl.model.geometry import Pose
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, pose_name
 from exsce_dsl.store.base import Rows, Store, Term
+from exsce_dsl.store.literals import canonical_rows, literal_value, parse_datetime
 from exsce_dsl.store.queries.library import query
 
 Given = Mapping[str, str | Sequence[str]]
@@ -19,14 +18,15 @@ Given = Mapping[str, str | Sequence[str]]
 
 
 def run_query(store: Store, name: str, given: Given, namespace: str = DEFAULT_NAMESPACE) -> Rows:
-    """Run library query ``name`` with parameters given as text; its rows (SELECT) or none (update)."""
+    """Run library query ``name`` with parameters given as text; its rows (SELECT), each literal in
+    its one form whatever the store (:mod:`exsce_dsl.store.literals`), or none (update)."""
     q = query(name)
     as_lists = {k: [v] if isinstance(v, str) else list(v) for k, v in given.items()}
     bindings = q.bindings(as_lists, namespace)
     if q.is_update:
         store.update(q.sparql(namespace), bindings)
         return Rows((), ())
-    return store.select(q.sparql(namespace), bindings)
+    return canonical_rows(store.select(q.sparql(namespace), bindings))
 
 
 # -- plain values of terms -----------------------------------------------------------
@@ -60,24 +60,17 @@ def datetime_of(term: Term | None) -> datetime.datetime | None:
     if term is None:
         return None
     try:
-        return datetime.datetime.fromisoformat(term.value.replace("Z", "+00:00"))
+        return parse_datetime(term.value)
     except ValueError:
         return None
 
 
 def python_value(term: Term | None) -> ParameterValue | None:
     """A literal as the Python value it was written from (numbers, booleans, strings)."""
-    if term is None:
-        return None
-    if isinstance(term, Literal):
-        datatype = term.datatype.value.rsplit("#", 1)[-1]
-        if datatype == "boolean":
-            return term.value in ("true", "1")
-        if datatype in ("int", "integer", "long", "short", "byte"):
-            return int(term.value)
-        if datatype in ("double", "float", "decimal"):
-            return float(term.value)
-    return term.value
+    value = literal_value(term)
+    if value is None or isinstance(value, str | int | float | bool):
+        return value
+    return term.value if term is not None else None
 
 
 def pose_local_name(pose: Pose | str) -> str:
