@@ -223,7 +223,9 @@ def ingest(
             for problem in result.problems:
                 progress.say(f"warning: {result.bag}: {problem}")
 
-        results = ingest_bags(paths, scenario, store, jobs, shown, cluster=cluster or None, replace=replace, strict=strict)
+        results = ingest_bags(
+            paths, scenario, store, jobs, shown, cluster=cluster or None, replace=replace, strict=strict
+        )
     done = sum(r.status is IngestStatus.INGESTED for r in results)
     skipped = sum(r.status is IngestStatus.SKIPPED for r in results)
     failed = sum(r.failed for r in results)
