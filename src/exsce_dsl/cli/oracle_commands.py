@@ -78,8 +78,9 @@ def verify(
 ) -> None:
     """Judge runs against every oracle of their scenario.
 
-    RUNS are stored runs (their uuids, as `exscec runs` lists them) or bag
-    files, which are ingested first.  For each oracle: the value observed, the
+    RUNS are stored runs (their uuids, or any unique prefix of one of 4
+    characters or more, such as the 8 that `exscec runs` prints, or a run's
+    IRI) or bag files, which are ingested first.  For each oracle: the value observed, the
     expectation, the margin and the verdict, and the runs the expectation came
     from.  The verdicts are written to the store as provenance.  Exits 0 when
     every oracle passed, 1 when one failed, 2 when one could not be judged (and

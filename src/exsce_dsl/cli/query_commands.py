@@ -140,7 +140,9 @@ def query_command(
     """Run a query of the library by NAME, its parameters given with -p.
 
     Parameters are bound as RDF terms, never pasted into the query.  A
-    parameter that takes a list (runs) is given once per value.
+    parameter that takes a list (runs) is given once per value.  A run is
+    given by its uuid, any unique prefix of it (4 characters or more: the 8
+    that tables print will do) or its IRI.
 
     \b
     Examples:

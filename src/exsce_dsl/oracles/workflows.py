@@ -23,6 +23,7 @@ from exsce_dsl.prov.oracle import compile_oracles
 from exsce_dsl.prov.verdicts import compile_verdicts
 from exsce_dsl.runs.ingest import ingest_bags
 from exsce_dsl.store.base import Store
+from exsce_dsl.store.queries import resolve_runs
 from exsce_dsl.store.writing import WriteReport, add_prov
 
 
@@ -84,10 +85,12 @@ def verify_runs(
     record: bool = True,
     now: datetime.datetime | None = None,
 ) -> Verification:
-    """Judge ``runs`` (stored runs' uuids, or paths of bags, which are ingested first) against every
+    """Judge ``runs`` (stored runs' uuids, unique prefixes of them or their IRIs, or paths of bags,
+    which are ingested first) against every
     oracle of ``scenario``; with ``record``, write the verdicts to the store (at ``now``, UTC)."""
     bags = [Path(r) for r in runs if isinstance(r, Path) or Path(r).exists()]
-    uuids = [str(r) for r in runs if not (isinstance(r, Path) or Path(r).exists())]
+    given = [str(r) for r in runs if not (isinstance(r, Path) or Path(r).exists())]
+    uuids = resolve_runs(store, given)  # prefixes and IRIs as well as whole uuids
     for result in ingest_bags(bags, scenario, store) if bags else []:
         if result.failed or result.run_id is None:
             raise IngestFailed(result.message)

@@ -12,7 +12,8 @@ from exsce_dsl.model.derivation import ParameterValue
 from exsce_dsl.model.geometry import Pose
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, pose_name
 from exsce_dsl.store.base import Rows, Store, Term
-from exsce_dsl.store.queries.library import query
+from exsce_dsl.store.queries.library import Query, query
+from exsce_dsl.store.queries.run_ids import is_full_uuid, resolve_run
 
 Given = Mapping[str, str | Sequence[str]]
 """Parameters as text: name → one value or several."""
@@ -22,11 +23,29 @@ def run_query(store: Store, name: str, given: Given, namespace: str = DEFAULT_NA
     """Run library query ``name`` with parameters given as text; its rows (SELECT) or none (update)."""
     q = query(name)
     as_lists = {k: [v] if isinstance(v, str) else list(v) for k, v in given.items()}
+    as_lists = _runs_resolved(store, q, as_lists, namespace)
     bindings = q.bindings(as_lists, namespace)
     if q.is_update:
         store.update(q.sparql(namespace), bindings)
         return Rows((), ())
     return store.select(q.sparql(namespace), bindings)
+
+
+RUN_KINDS = ("run", "run_activity")
+"""The kinds of parameter that name a run, by uuid."""
+
+
+def _runs_resolved(
+    store: Store, q: Query, given: dict[str, list[str]], namespace: str
+) -> dict[str, list[str]]:
+    """``given`` with each run parameter's value that is not a whole uuid (a prefix, an IRI)
+    replaced by the uuid of the one run it names (:func:`~.run_ids.resolve_run`)."""
+    resolved = {}
+    for name, values in given.items():
+        if q.parameter(name).kind in RUN_KINDS:
+            values = [v if is_full_uuid(v) else resolve_run(store, v, namespace) for v in values]
+        resolved[name] = values
+    return resolved
 
 
 # -- plain values of terms -----------------------------------------------------------
