@@ -335,7 +335,7 @@ def test_check_answers_located_diagnostics_as_exscec_check(project: Project) -> 
     column = len("    tiago2 does ") + 1
     (project.folder / "scenarios" / "broken.exsce").write_text(broken, encoding="utf-8")
     cli = run_exscec("check", "scenarios/broken.exsce", cwd=project.folder)
-    assert cli.returncode == 1
+    assert cli.returncode == 2
 
     async def work(session: ClientSession) -> list[Any]:
         calls = [
@@ -492,4 +492,4 @@ def test_the_help_shows_a_client_configuration_that_works(tmp_path: Path) -> Non
     assert config["mcpServers"]["exsce"]["args"][:2] == ["mcp", "--store"]
     assert "exscec mcp --store" in text
     refused = run_exscec("mcp", "--store", "bogus://host/x", cwd=tmp_path)
-    assert refused.returncode == 1 and "cannot open a store at 'bogus://host/x'" in refused.stderr
+    assert refused.returncode == 2 and "cannot open a store at 'bogus://host/x'" in refused.stderr

@@ -93,7 +93,7 @@ def query(store: Store, name: str, **parameters: str | Sequence[str]) -> pd.Data
     run given by a unique prefix of its uuid, as tables print it, or its IRI)."""
     if library_query(name).is_update:
         raise ValueError(f"'{name}' is an update; the Python API runs the library's queries only")
-    return rows_frame(queries.run_query(store, name, parameters))
+    return rows_frame(queries.run_query(store, name, parameters, check_runs=True))
 
 
 def sparql(store: Store, text: str) -> pd.DataFrame:

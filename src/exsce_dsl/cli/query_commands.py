@@ -173,7 +173,7 @@ def query_command(
     given = _parameters(params)
     library_query.bindings(given)  # check the parameters before opening the store
     with open_store(store_url) as store:
-        rows = run_query(store, name, given)
+        rows = run_query(store, name, given, check_runs=True)
     if library_query.is_update:
         click.echo(f"{name}: done", err=True)
         return

@@ -91,7 +91,7 @@ def _answer_of(name: str) -> Answer:
     def answer(access: Access, arguments: Mapping[str, Any]) -> dict[str, Any]:
         given = {key: _texts(value) for key, value in arguments.items()}
         with access.store() as store:
-            rows = run_query(store, name, given)
+            rows = run_query(store, name, given, check_runs=True)
         return results_json(rows, access.max_rows)
 
     return answer

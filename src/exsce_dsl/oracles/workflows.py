@@ -24,7 +24,11 @@ from exsce_dsl.prov.verdicts import compile_verdicts
 from exsce_dsl.runs.ingest import ingest_bags
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.queries import resolve_runs
+from exsce_dsl.store.queries.run_ids import names_a_prefix
 from exsce_dsl.store.writing import WriteReport, add_prov
+
+_BAG_SUFFIXES = (".bag", ".mcap", ".db3")
+"""What a bag's name ends with: such a name that is not a file is a missing bag, not a run id."""
 
 
 class IngestFailed(ExsceError):
@@ -71,11 +75,6 @@ class Verification:
         """No oracle failed and every one was judged."""
         return not self.count(Outcome.FAILED) and not self.count(Outcome.UNJUDGED)
 
-    @property
-    def exit_code(self) -> int:
-        """0 when every oracle passed, 1 when one failed, 2 when one could not be judged (none failed)."""
-        return 1 if self.count(Outcome.FAILED) else 2 if self.count(Outcome.UNJUDGED) else 0
-
 
 def verify_runs(
     store: Store,
@@ -90,6 +89,9 @@ def verify_runs(
     oracle of ``scenario``; with ``record``, write the verdicts to the store (at ``now``, UTC)."""
     bags = [Path(r) for r in runs if isinstance(r, Path) or Path(r).exists()]
     given = [str(r) for r in runs if not (isinstance(r, Path) or Path(r).exists())]
+    for text in given:
+        if not names_a_prefix(text) and ("/" in text or Path(text).suffix in _BAG_SUFFIXES):  # a path
+            raise ExsceError(f"no bag or bag folder {text} (nor is it a run id)")
     uuids = resolve_runs(store, given)  # prefixes and IRIs as well as whole uuids
     for result in ingest_bags(bags, scenario, store) if bags else []:
         if result.failed or result.run_id is None:

@@ -28,6 +28,7 @@ __all__ = [
     "RunCandidate",
     "UnknownRunError",
     "is_full_uuid",
+    "names_a_prefix",
     "resolve_run",
     "resolve_runs",
     "run_id_text",
@@ -78,14 +79,18 @@ def is_full_uuid(text: str) -> bool:
     return _UUID.fullmatch(text) is not None
 
 
+def names_a_prefix(text: str) -> bool:
+    """Whether ``text`` must be resolved to be a stored run's id: a run's IRI, or uuid characters
+    that are not a whole uuid (a prefix).  Anything else is an id as it is (or no id at all)."""
+    return _RUN_IRI.fullmatch(text.strip()) is not None or (
+        _ID_CHARACTERS.fullmatch(text.lower()) is not None and not is_full_uuid(text)
+    )
+
+
 def run_id_text(given: str) -> str:
     """The uuid, or prefix of one, that ``given`` (a uuid, a prefix or a run's IRI) stands for,
     in lower case; an :class:`ExsceError` for anything else, or a prefix that is too short."""
-    text = given.strip()
-    iri = _RUN_IRI.fullmatch(text)
-    if iri is not None:
-        text = iri.group(1)
-    text = text.lower()
+    text = _without_iri(given).lower()
     if not _ID_CHARACTERS.fullmatch(text):
         raise ExsceError(
             f"'{given}' is not a run id: give a run's uuid, a prefix of it ({MIN_PREFIX} characters "
@@ -99,14 +104,26 @@ def run_id_text(given: str) -> str:
     return text
 
 
+def _without_iri(given: str) -> str:
+    text = given.strip()
+    iri = _RUN_IRI.fullmatch(text)
+    return text if iri is None else iri.group(1)
+
+
 def resolve_run(store: Store, given: str, namespace: str = DEFAULT_NAMESPACE) -> str:
-    """The uuid of the one stored run ``given`` names: its uuid, a unique prefix of it, or its IRI.
+    """The id of the one stored run ``given`` names: its uuid (or whole id), a unique prefix of
+    its uuid, or its IRI.
 
     Raises :class:`AmbiguousRunError` (listing the runs, with their scenario and bag) when several
     runs start with the prefix, :class:`UnknownRunError` (with the closest ids) when none does.
     """
+    whole = _without_iri(given)
+    found = _candidates(store, whole, namespace) if whole else []
+    if any(c.uuid == whole for c in found):
+        return whole  # a stored id as it is (also one that is not a uuid, as the method's may be)
     prefix = run_id_text(given)
-    found = _candidates(store, prefix, namespace)
+    if prefix != whole:
+        found = _candidates(store, prefix, namespace)
     uuids = sorted({c.uuid for c in found})
     if len(uuids) == 1:
         return uuids[0]

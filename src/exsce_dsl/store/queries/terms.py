@@ -13,18 +13,26 @@ from exsce_dsl.model.geometry import Pose
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, pose_name
 from exsce_dsl.store.base import Rows, Store, Term
 from exsce_dsl.store.queries.library import Query, query
-from exsce_dsl.store.queries.run_ids import is_full_uuid, resolve_run
+from exsce_dsl.store.queries.run_ids import names_a_prefix, resolve_run
 
 Given = Mapping[str, str | Sequence[str]]
 """Parameters as text: name → one value or several."""
 
 
-def run_query(store: Store, name: str, given: Given, namespace: str = DEFAULT_NAMESPACE) -> Rows:
-    """Run library query ``name`` with parameters given as text; its rows (SELECT) or none (update)."""
+def run_query(
+    store: Store, name: str, given: Given, namespace: str = DEFAULT_NAMESPACE, *, check_runs: bool = False
+) -> Rows:
+    """Run library query ``name`` with parameters given as text; its rows (SELECT) or none (update).
+
+    A run parameter given as a prefix of a uuid or as a run's IRI is the one stored run it names
+    (:func:`~.run_ids.resolve_run`); a whole uuid is taken as it is, unless ``check_runs`` (what
+    people type: the CLI, the MCP server, the Python API), which makes every run given one the
+    store holds, or an error."""
     q = query(name)
     as_lists = {k: [v] if isinstance(v, str) else list(v) for k, v in given.items()}
-    as_lists = _runs_resolved(store, q, as_lists, namespace)
-    bindings = q.bindings(as_lists, namespace)
+    bindings = q.bindings(as_lists, namespace)  # the parameters checked before any look-up
+    if any(q.parameter(name).kind in RUN_KINDS for name in as_lists):
+        bindings = q.bindings(_runs_resolved(store, q, as_lists, namespace, check_runs), namespace)
     if q.is_update:
         store.update(q.sparql(namespace), bindings)
         return Rows((), ())
@@ -36,14 +44,15 @@ RUN_KINDS = ("run", "run_activity")
 
 
 def _runs_resolved(
-    store: Store, q: Query, given: dict[str, list[str]], namespace: str
+    store: Store, q: Query, given: dict[str, list[str]], namespace: str, check_runs: bool
 ) -> dict[str, list[str]]:
-    """``given`` with each run parameter's value that is not a whole uuid (a prefix, an IRI)
-    replaced by the uuid of the one run it names (:func:`~.run_ids.resolve_run`)."""
+    """``given`` with each run parameter's value that is a prefix or an IRI (each value, with
+    ``check_runs``) replaced by the id of the one run it names (:func:`~.run_ids.resolve_run`)."""
     resolved = {}
     for name, values in given.items():
         if q.parameter(name).kind in RUN_KINDS:
-            values = [v if is_full_uuid(v) else resolve_run(store, v, namespace) for v in values]
+            asked = check_runs
+            values = [resolve_run(store, v, namespace) if asked or names_a_prefix(v) else v for v in values]
         resolved[name] = values
     return resolved
 
