@@ -147,3 +147,26 @@ def test_an_ambiguous_run_prefix_lists_the_candidates(twins: tuple[Path, dict[st
         assert {c.uuid for c in raised.value.candidates} == set(list(uuids.values())[:2])
         with pytest.raises(api.UnknownRunError):
             api.query(store, "run_metric_values", run="ffff")
+
+
+def test_verifying_a_run_of_the_baseline_warns(yard: tuple[Path, Path]) -> None:
+    """The baseline was built from the four runs ingested first (A); the fifth (B) is new."""
+    folder, new_bag = yard
+    stored = _stored_runs(folder)
+    a = next(uuid for bag, uuid in sorted(stored.items()) if bag != new_bag.name)
+    b = stored[new_bag.name]
+    own = run_exscec("verify", a[:8], "--scenario", "spec.exsce", "--no-record", cwd=folder)
+    assert own.returncode == 0, own.stderr  # it passes, as a run of its own mean does
+    warned = [line for line in own.stderr.splitlines() if line.startswith("warning:")]
+    assert warned == [
+        f"warning: run {a[:8]} is one of the 4 runs the baseline of 'yard_run' was built from: "
+        "its verdicts against that baseline say little (judge runs the baseline did not use)"
+    ]
+    new = run_exscec("verify", b, "--scenario", "spec.exsce", "--no-record", cwd=folder)
+    assert new.returncode == 0 and "warning" not in new.stderr, new.stderr
+
+    with api.open_store(str(folder / ".exsce" / "store")) as store:
+        spec = load_spec(folder / "spec.exsce")
+        both = api.verify(store, spec, [a, b], record=False)
+        assert len(both.warnings) == 1 and both.warnings[0].startswith(f"run {a[:8]} is one of the 4 runs")
+        assert api.verify(store, spec, [b], record=False).warnings == ()

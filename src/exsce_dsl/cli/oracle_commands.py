@@ -86,12 +86,14 @@ def verify(
     """Judge runs against every oracle of their scenario.
 
     RUNS are stored runs (their uuids, or any unique prefix of one of 4
-    characters or more, such as the 8 that `exscec runs` prints, or a run's
-    IRI) or bag files, which are ingested first.  For each oracle: the value observed, the
-    expectation, the margin and the verdict, and the runs the expectation came
-    from.  The verdicts are written to the store as provenance.  Exits 0 when
-    every oracle passed, 1 when one failed, 3 when one could not be judged (and
-    none failed), 2 when nothing could be judged (bad input: see below).
+    characters or more, such as the 8 that the verdict table prints, or a
+    run's IRI) or bag files, which are ingested first.  For each oracle: the
+    value observed, the expectation, the margin and the verdict, and the runs
+    the expectation came from.  The verdicts are written to the store as
+    provenance.  A run the scenario's baseline was built from is judged with
+    a warning: it is part of the mean it is compared with.  Exits 0 when
+    every oracle passed, 1 when one failed, 3 when one could not be judged
+    (and none failed), 2 when nothing could be judged (bad input: below).
 
     \b
     Example:
@@ -114,6 +116,8 @@ def verify(
             click.echo(f"error: {exc.message}", err=True)
             sys.exit(ExitCode.BAD_INPUT)
     verdicts = list(verification.verdicts)
+    for warning in verification.warnings:
+        click.echo(f"warning: {warning}", err=True)
     click.echo(verdicts_json(verdicts) if as_json else verdict_table(verdicts))
     if junit:
         write_text(junit_xml(verdicts), junit)

@@ -66,6 +66,9 @@ class Verification:
     scenario: Scenario
     runs: tuple[str, ...]
     verdicts: tuple[Verdict, ...]
+    warnings: tuple[str, ...] = ()
+    """What makes verdicts say less than they seem to: a run judged against a baseline built
+    from it (:func:`own_baseline_warnings`)."""
 
     def count(self, outcome: Outcome) -> int:
         return sum(v.outcome is outcome for v in self.verdicts)
@@ -104,4 +107,20 @@ def verify_runs(
         for run in dict.fromkeys(v.run for v in verdicts):
             mine = [v for v in verdicts if v.run == run]
             add_prov(store, compile_verdicts(run, mine, at), replace=True)
-    return Verification(scenario, judged, tuple(verdicts))
+    return Verification(scenario, judged, tuple(verdicts), own_baseline_warnings(verdicts))
+
+
+def own_baseline_warnings(verdicts: Sequence[Verdict]) -> tuple[str, ...]:
+    """A warning for each judged run that is one of the runs its oracles' expectations came from
+    (the runs a baseline records in the store, ``oracle:runs`` of its PROV): a run compared with a
+    mean it is part of passes more easily than a new run would."""
+    baselines: dict[str, dict[str, int]] = {}
+    for v in verdicts:
+        if v.run in v.sources:
+            baselines.setdefault(v.run, {})[v.against or v.scenario] = len(v.sources)
+    return tuple(
+        f"run {run[:8]} is one of the {count} runs the baseline of '{scenario}' was built from: "
+        "its verdicts against that baseline say little (judge runs the baseline did not use)"
+        for run, built in baselines.items()
+        for scenario, count in built.items()
+    )
