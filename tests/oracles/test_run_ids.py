@@ -13,6 +13,7 @@ import json
 from pathlib import Path
 
 import pytest
+from prov.model import ProvDocument
 
 from exsce_dsl import api
 from exsce_dsl.lang.build import load_spec
@@ -20,10 +21,14 @@ from exsce_dsl.mcp_server.store_tools import stored_run
 from exsce_dsl.prov.run import compile_run
 from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.sim.run import simulate
+from exsce_dsl.store.base import Store
 from exsce_dsl.store.open import open_store
+from exsce_dsl.store.queries import AmbiguousRunError, UnknownRunError, resolve_run
+from exsce_dsl.store.remote import RemoteStore
 from exsce_dsl.store.writing import add_prov
 
 from conftest import YARD_SPEC, run_exscec, write_map
+from store_servers import virtuoso_server
 
 RUN_IRI = "https://www.sesame-project.org/scenarios/runs/run_{}"
 
@@ -92,7 +97,7 @@ def test_verify_takes_the_eight_characters_tables_print(yard: tuple[Path, Path])
 
 
 @pytest.fixture(scope="module")
-def twins(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, str]]:
+def twin_runs(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, str], list[ProvDocument]]:
     """A store holding three runs of two bags whose uuids share their first four characters
     (``abcd``, and ``abcd1``): real analyses of the executor's bags, stored under chosen uuids."""
     folder = tmp_path_factory.mktemp("twins")
@@ -105,11 +110,19 @@ def twins(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, str
         bags[1].name: "abcd1299-0000-4000-8000-000000000002",
         bags[2].name: "abcd5678-0000-4000-8000-000000000003",
     }
+    documents = [
+        compile_run(dataclasses.replace(analyse_bag(bag, scenario).run, uuid=uuids[bag.name]), scenario)
+        for bag in bags
+    ]
     with open_store(str(folder / ".exsce" / "store")) as store:
-        for bag in bags:
-            run = dataclasses.replace(analyse_bag(bag, scenario).run, uuid=uuids[bag.name])
-            add_prov(store, compile_run(run, scenario))
-    return folder, uuids
+        for document in documents:
+            add_prov(store, document)
+    return folder, uuids, documents
+
+
+@pytest.fixture(scope="module")
+def twins(twin_runs: tuple[Path, dict[str, str], list[ProvDocument]]) -> tuple[Path, dict[str, str]]:
+    return twin_runs[0], twin_runs[1]
 
 
 def test_an_ambiguous_run_prefix_lists_the_candidates(twins: tuple[Path, dict[str, str]]) -> None:
@@ -170,3 +183,32 @@ def test_verifying_a_run_of_the_baseline_warns(yard: tuple[Path, Path]) -> None:
         both = api.verify(store, spec, [a, b], record=False)
         assert len(both.warnings) == 1 and both.warnings[0].startswith(f"run {a[:8]} is one of the 4 runs")
         assert api.verify(store, spec, [b], record=False).warnings == ()
+
+
+def test_virtuoso_resolves_run_prefixes_as_the_embedded_store_does(
+    twin_runs: tuple[Path, dict[str, str], list[ProvDocument]], tmp_path: Path
+) -> None:
+    folder, uuids, documents = twin_runs
+    with open_store(str(folder / ".exsce" / "store")) as store:
+        embedded = _resolutions(store)
+    with virtuoso_server(tmp_path / "virtuoso") as server:
+        remote = RemoteStore(f"{server.url}/sparql", timeout=20)
+        for document in documents:
+            add_prov(remote, document)
+        assert _resolutions(remote) == embedded
+    assert embedded[0] == "abcd5678-0000-4000-8000-000000000003" == embedded[1]
+    assert embedded[2] == sorted(uuids.values()) and embedded[3] == sorted(uuids.values())[:2]
+
+
+def _resolutions(store: Store) -> tuple[object, ...]:
+    """What the resolver makes of a unique prefix, an IRI, an ambiguous prefix, a wrong one."""
+    with pytest.raises(AmbiguousRunError) as ambiguous:
+        resolve_run(store, "abcd")
+    with pytest.raises(UnknownRunError) as unknown:
+        resolve_run(store, "abce")
+    return (
+        resolve_run(store, "ABCD5"),
+        resolve_run(store, RUN_IRI.format("abcd5678-0000-4000-8000-000000000003")),
+        sorted(c.uuid for c in ambiguous.value.candidates),
+        sorted(c.uuid for c in unknown.value.closest)[:2],
+    )

@@ -114,7 +114,15 @@ def reports_errors(func: F) -> F:
                 traceback.print_exc()
             print_diagnostics(exc.diagnostics)
             sys.exit(ExitCode.BAD_INPUT)
-        except (click.ClickException, click.exceptions.Exit, click.Abort, SystemExit):
+        except click.UsageError:  # exit 2, with the usage line
+            raise
+        except click.ClickException as exc:  # click's other errors exit 1: a failed verdict's code
+            exc.show()
+            sys.exit(ExitCode.BAD_INPUT)
+        except click.Abort:  # a prompt answered with Ctrl-C or Ctrl-D
+            click.echo("Aborted!", err=True)
+            sys.exit(ExitCode.INTERRUPTED)
+        except (click.exceptions.Exit, SystemExit):
             raise
         except KeyboardInterrupt:
             click.echo("interrupted", err=True)

@@ -151,9 +151,14 @@ def resolve_runs(store: Store, given: Sequence[str], namespace: str = DEFAULT_NA
 
 
 def _candidates(store: Store, prefix: str, namespace: str) -> list[RunCandidate]:
-    # run_query resolves run ids with this function, so the query is run without it
-    library = query("run_ids")
-    rows = store.select(library.sparql(namespace), library.bindings({"prefix": [prefix]}, namespace))
+    return _rows(store, "run_ids", {"prefix": [prefix]}, namespace)
+
+
+def _rows(store: Store, name: str, given: dict[str, list[str]], namespace: str) -> list[RunCandidate]:
+    """The runs library query ``name`` answers (run_query resolves run ids with this module, so
+    the query is run without it)."""
+    library = query(name)
+    rows = store.select(library.sparql(namespace), library.bindings(given, namespace))
     return [
         RunCandidate(_text(row["run"]), _text(row["scenario_id"]), _text(row["bag"]) or None) for row in rows
     ]
@@ -166,7 +171,7 @@ def _text(term: Term | None) -> str:
 def _closest(store: Store, prefix: str, namespace: str, count: int = 3) -> list[RunCandidate]:
     """The stored runs whose uuids start most like ``prefix``: the longest shared start, then the
     fewest differing characters over the prefix's length."""
-    every = _candidates(store, "", namespace)
+    every = _rows(store, "runs", {}, namespace)  # not a prefix of "": Virtuoso starts no string with it
 
     def distance(candidate: RunCandidate) -> tuple[int, int, str]:
         start = candidate.uuid[: len(prefix)]
