@@ -83,7 +83,7 @@ def test_ten_thousand_errors_give_bounded_output(tmp_path: Path) -> None:
     (tmp_path / "robots.exsce").write_text((EXAMPLES / "brsu_building_c" / "robots.exsce").read_text())
     result = CliRunner().invoke(main, ["check", str(spec)])
     said = result.output
-    assert result.exit_code == 1 and "Traceback" not in said
+    assert result.exit_code == 2 and "Traceback" not in said
     assert said.count("error:") >= 50  # several errors are shown ...
     assert len(said.splitlines()) <= 250 and len(said) < 60_000  # ... but not ten thousand of them
     from exsce_dsl.lang.build import analyse
@@ -107,7 +107,7 @@ def test_a_spec_that_is_not_valid_utf8_is_reported_at_its_file(tmp_path: Path) -
     spec = tmp_path / "latin1.exsce"
     spec.write_bytes("// caf\xe9\n".encode("latin-1"))
     result = CliRunner().invoke(main, ["check", str(spec)])
-    assert result.exit_code == 1 and str(spec) in result.output and "UTF-8" in result.output
+    assert result.exit_code == 2 and str(spec) in result.output and "UTF-8" in result.output
 
 
 def test_no_command_reads_from_a_fifo_forever(tmp_path: Path) -> None:

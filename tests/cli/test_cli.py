@@ -47,14 +47,14 @@ def test_compile_writes_prov_json_to_a_file(in_tmp: Path) -> None:
     assert "robot:tiago2_bundle" in bundles
 
 
-def test_check_reports_every_error_as_file_line_col_and_exits_1(in_tmp: Path) -> None:
+def test_check_reports_every_error_as_file_line_col_and_exits_2(in_tmp: Path) -> None:
     folder = _copy_examples(in_tmp)
     text = (folder / "scenario_c.exsce").read_text()
     text = text.replace("tiago2: tiago", "tiago2: tiagoo").replace("then navigate_home_1", "")
     text = text.replace("tiago1 does navigate_home_1", "tiago3 does navigate_home_1")
     (folder / "scenario_c.exsce").write_text(text)
     result = run_exscec("check", "bc/scenario_c.exsce")
-    assert result.returncode == 1
+    assert result.returncode == 2
     assert "Traceback" not in result.stderr
     lines = result.stderr.splitlines()
     assert "bc/scenario_c.exsce:10:13: error: unknown robot type 'tiagoo'; did you mean 'tiago'?" in lines
@@ -68,7 +68,7 @@ def test_check_reports_every_error_as_file_line_col_and_exits_1(in_tmp: Path) ->
 def test_syntax_error_is_worded_and_has_no_traceback(in_tmp: Path) -> None:
     (in_tmp / "bad.exsce").write_text("robot type tiago {\n  base\n}\n")
     result = run_exscec("compile", "bad.exsce")
-    assert result.returncode == 1
+    assert result.returncode == 2
     assert result.stderr.strip() == "bad.exsce:3:1: error: expected a name, found '}'"
     assert result.stdout == ""
 
@@ -76,7 +76,7 @@ def test_syntax_error_is_worded_and_has_no_traceback(in_tmp: Path) -> None:
 def test_debug_shows_the_traceback(in_tmp: Path) -> None:
     (in_tmp / "bad.exsce").write_text("robot type tiago {\n  base\n}\n")
     result = run_exscec("--debug", "compile", "bad.exsce")
-    assert result.returncode == 1
+    assert result.returncode == 2  # the exit status it has without --debug
     assert "Traceback" in result.stderr
 
 
@@ -87,7 +87,7 @@ def test_usage_errors_exit_2(in_tmp: Path) -> None:
 
 def test_missing_file_is_an_error_not_a_crash(in_tmp: Path) -> None:
     result = run_exscec("check", "nope.exsce")
-    assert result.returncode == 1
+    assert result.returncode == 2
     assert "cannot read nope.exsce" in result.stderr
     assert "Traceback" not in result.stderr
 
@@ -114,7 +114,7 @@ def test_import_then_compile_and_export(in_tmp: Path) -> None:
     again = run_exscec(
         "import", str(FIXTURES / "scenarios" / "scenario_d.yaml"), "-t", str(FIXTURES / "tasks"), "-o", "spec"
     )
-    assert again.returncode == 1 and "use --force" in again.stderr
+    assert again.returncode == 2 and "use --force" in again.stderr
     exported = run_exscec("export", "spec/scenario_d.exsce", "--to", "yaml", "-o", "out")
     assert exported.returncode == 0, exported.stderr
     data = yaml.safe_load((in_tmp / "out" / "scenarios" / "scenario_d.yaml").read_text())
@@ -192,7 +192,7 @@ def test_check_a_folder_checks_every_exsce_file_below_it_in_sorted_order(in_tmp:
     (project / "nested" / ".hidden" / "ignored.exsce").write_text("not exsce at all\n")
     (project / "notes.txt").write_text("not a spec\n")
     result = run_exscec("check", "specs")
-    assert result.returncode == 1
+    assert result.returncode == 2
     assert "Traceback" not in result.stderr
     assert result.stderr.splitlines() == [
         "specs/b_good.exsce: ok (0 scenarios)",

@@ -18,7 +18,7 @@ def test_simulate_ingest_and_query(in_tmp: Path) -> None:
     broken = in_tmp / "runs" / "broken.bag"
     broken.write_bytes(Path(bags[0]).read_bytes()[:4000])
     done = run_exscec("ingest", *sorted(str(p) for p in (in_tmp / "runs").iterdir()), "--scenario", SPEC)
-    assert done.returncode == 1  # the broken bag failed...
+    assert done.returncode == 2  # the broken bag failed...
     assert "broken.bag" in done.stderr and "Traceback" not in done.stderr
     assert "2 ingested, 0 skipped, 1 failed" in done.stderr  # ...the others went in
     again = run_exscec("ingest", *bags, "--scenario", SPEC)

@@ -63,7 +63,7 @@ def test_compile_to_a_sparql_endpoint_refuses_a_changed_scenario_then_replaces_i
     spec = in_tmp / "bc" / "scenario_c.exsce"
     spec.write_text(spec.read_text().replace("tiago2 does navigate_home_2", "tiago1 does navigate_home_2"))
     refused = run_exscec("compile", "bc/scenario_c.exsce", "--store", url)
-    assert refused.returncode == 1
+    assert refused.returncode == 2
     lines = refused.stderr.splitlines()
     assert lines[0] == (
         f"error: {oxigraph.url}/query already holds another version of scenario exsce:scenario_c: 1 graph differs"
@@ -81,7 +81,7 @@ def test_an_unreachable_endpoint_is_named(in_tmp: Path) -> None:
 
     url = f"http://127.0.0.1:{free_port()}/sparql"
     result = run_exscec("store", "graphs", "--store", url)
-    assert result.returncode == 1
+    assert result.returncode == 2
     assert (
         f"cannot reach the SPARQL endpoint {url}" in result.stderr and "connection refused" in result.stderr
     )

@@ -77,7 +77,7 @@ def test_exscec_demo_shows_the_fault_run_failing_and_the_others_passing(tmp_path
     assert (tmp_path / "demo" / "report" / "index.html").is_file()
     assert f"[{len(STEPS)}/{len(STEPS)}]" in done.stderr and "$ exscec verify runs/faulty/" in done.stderr
     again = run_exscec("demo", "demo", cwd=tmp_path)
-    assert again.returncode == 1 and "is not empty" in again.stderr and "Traceback" not in again.stderr
+    assert again.returncode == 2 and "is not empty" in again.stderr and "Traceback" not in again.stderr
 
 
 @pytest.mark.parametrize("convention", ["nav2", "move_base"])
@@ -134,16 +134,16 @@ def test_a_verdict_other_than_expected_is_reported_and_the_demo_goes_on(tmp_path
     steps = (
         Step("check", good),
         Step("should fail", good, expected_exit=1, verdict="a good spec"),
-        Step("fails, as it should", missing, expected_exit=1, verdict="no spec"),
+        Step("refused, as it should", missing, expected_exit=2, verdict="no spec"),
     )
     run = run_steps(folder, run_in_process, steps=steps)
-    assert [o.exit_code for o in run.outcomes] == [0, 0, 1]
+    assert [o.exit_code for o in run.outcomes] == [0, 0, 2]
     assert run.unexpected == (run.outcomes[1],) and run.stopped is None and not run.as_expected
     lines = summary_lines(run)
     shown = "\n".join(lines)
     assert lines[0].endswith("NOT every step ended as expected")
     assert re.search(r"^  passed, NOT as expected \(expected: failed\)\s+a good spec$", shown, re.M)
-    assert re.search(r"^  failed, as expected\s+no spec$", shown, re.M)
+    assert re.search(r"^  refused \(bad input\), as expected\s+no spec$", shown, re.M)
     assert lines[-1] == f"error: {good}: passed, NOT as expected (expected: failed)"
 
 
@@ -157,7 +157,7 @@ def test_a_step_the_next_ones_need_stops_the_demo_when_it_fails(tmp_path: Path) 
     run = run_steps(folder, run_in_process, steps=steps)
     assert len(run.outcomes) == 1 and run.stopped == run.outcomes[0] and not run.as_expected
     assert summary_lines(run)[-1] == (
-        "error: step 1 (exscec compile scenarios/missing.exsce --store): exited 1, NOT as expected "
+        "error: step 1 (exscec compile scenarios/missing.exsce --store): exited 2, NOT as expected "
         "(expected: exited 0); the steps after it need it, so the demo stopped"
     )
 

@@ -63,7 +63,7 @@ def test_existing_files_are_kept_without_force(in_tmp: Path) -> None:
     assert run_exscec("generate", "dispatcher-config", str(SCENARIO_C), "-o", "out").returncode == 0
     (in_tmp / "out" / "mission.yaml").write_text("mine\n")
     again = run_exscec("generate", "dispatcher-config", str(SCENARIO_C), "-o", "out")
-    assert again.returncode == 1
+    assert again.returncode == 2
     assert again.stderr.startswith("error: would overwrite out/mission.yaml")
     assert (in_tmp / "out" / "mission.yaml").read_text() == "mine\n"
     forced = run_exscec("generate", "dispatcher-config", str(SCENARIO_C), "-o", "out", "--force")
@@ -75,7 +75,7 @@ def test_an_unknown_scenario_is_an_error_without_traceback(in_tmp: Path) -> None
     result = run_exscec(
         "generate", "dispatcher-config", str(SCENARIO_C), "-o", "out", "--scenario", "scenario_z"
     )
-    assert result.returncode == 1
+    assert result.returncode == 2
     assert result.stderr.strip() == f"error: no scenario 'scenario_z' in {SCENARIO_C}"
     assert "Traceback" not in result.stderr
     assert not (in_tmp / "out").exists()

@@ -178,5 +178,5 @@ def test_each_mistake_is_reported_at_its_line_and_column(spec_folder: Path, case
 def test_check_prints_acceptance_errors_as_file_line_col(spec_folder: Path) -> None:
     (spec_folder / "spec.exsce").write_text(SPEC.replace("r1 distance_travelled", "r1 distance_travel"))
     result = run_exscec("check", "spec.exsce", cwd=spec_folder)
-    assert result.returncode == 1 and "Traceback" not in result.stderr
+    assert result.returncode == 2 and "Traceback" not in result.stderr
     assert "spec.exsce:49:13: error: unknown metric 'distance_travel'" in result.stdout + result.stderr

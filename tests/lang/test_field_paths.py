@@ -373,7 +373,7 @@ def test_msg_path_goes_in_front_of_the_environment_s_folders(tmp_path, monkeypat
     (tmp_path / "m.exsce").write_text(TURTLE)
     monkeypatch.setenv("EXSCE_MSG_PATH", str(tmp_path / "b"))
     from_b = run_exscec("check", "m.exsce", cwd=tmp_path)
-    assert from_b.returncode == 1 and "m.exsce:3:29: error: turtle (turtlesim/msg/Pose) has no field" in from_b.stderr
+    assert from_b.returncode == 2 and "m.exsce:3:29: error: turtle (turtlesim/msg/Pose) has no field" in from_b.stderr
     from_a = run_exscec("--msg-path", "a", "check", "m.exsce", cwd=tmp_path)
     assert from_a.returncode == 0 and "warning" not in from_a.stderr, from_a.stderr
     helped = run_exscec("--help")

@@ -431,7 +431,7 @@ def test_cli_oracle_import_needs_the_spec_and_export_says_which_clause(tmp_path:
     assert "name the spec of its scenario with --spec" in no_spec.stderr
 
     no_baseline = run_exscec("export", str(EXAMPLE / "scenario_c.exsce"), "--to", "oracle-yaml", "-o", str(tmp_path))
-    assert no_baseline.returncode == 1
+    assert no_baseline.returncode == 2
     assert "scenario_c.exsce:35:10: error: 'each robot task_duration is invariant within 3 std' needs the mean" in (
         no_baseline.stderr
     )

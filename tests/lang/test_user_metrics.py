@@ -226,14 +226,14 @@ def test_declaration_errors_are_reported_at_their_line_and_column(tmp_path, text
 def test_check_prints_a_metric_error_as_file_line_col(tmp_path):
     (tmp_path / "m.exsce").write_text(_HEADER + "  value mean(vel.linar.x)\n}\n")
     done = run_exscec("check", "m.exsce", cwd=tmp_path)
-    assert done.returncode == 1 and "Traceback" not in done.stderr
+    assert done.returncode == 2 and "Traceback" not in done.stderr
     assert "m.exsce:3:14: error: vel (geometry_msgs/msg/Twist) has no field 'linar'" in done.stderr
 
 
 def test_check_names_an_unknown_function_at_its_place_with_the_functions_there_are(tmp_path):
     (tmp_path / "m.exsce").write_text(_HEADER + "  value max(vel.linear.x) - min(absl(vel.linear.x))\n}\n")
     done = run_exscec("check", "m.exsce", cwd=tmp_path)
-    assert done.returncode == 1 and "Traceback" not in done.stderr
+    assert done.returncode == 2 and "Traceback" not in done.stderr
     assert "m.exsce:3:33: error: unknown function 'absl'; did you mean 'abs'? (the functions: min," in (
         done.stderr
     )

@@ -450,7 +450,7 @@ def test_exscec_check_reports_what_only_the_compiler_finds(in_tmp: Path) -> None
         )
     )
     result = run_exscec("check", "spec.exsce")
-    assert result.returncode == 1
+    assert result.returncode == 2
     assert "spec.exsce:3:8: error: area 'lab' and environment 'lab' would both be written" in result.stderr
     assert "Traceback" not in result.stderr
 

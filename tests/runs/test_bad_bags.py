@@ -120,7 +120,7 @@ def test_a_bad_bag_is_refused_with_its_reason_and_nothing_is_written(
     before = _contents(store)
     done = _ingest([bag], store, optimised)
     said = done.stderr + done.stdout
-    assert done.returncode == 1, said
+    assert done.returncode == 2, said
     assert f"error: {bag}: " in said, said  # the bag, by the name it was given
     for reason in REASONS[kind]:
         assert reason in said, said
@@ -137,7 +137,7 @@ def test_a_bad_bag_does_not_stop_the_good_ones(
     store = tmp_path / "store"
     shutil.copytree(scenario_store, store)
     done = _ingest([bad, small["ros1"]], store, optimised=True)
-    assert done.returncode == 1 and "1 ingested, 0 skipped, 1 failed" in done.stderr, done.stderr
+    assert done.returncode == 2 and "1 ingested, 0 skipped, 1 failed" in done.stderr, done.stderr
     assert f"error: {bad}: not a standard ROS 1 bag" in done.stderr
 
 

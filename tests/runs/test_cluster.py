@@ -74,7 +74,7 @@ def test_the_cluster_stores_what_one_job_stores_and_names_a_bad_bag(
         "ingest", *map(str, bags), str(broken), "--scenario", "spec.exsce",
         "--cluster", cluster.scheduler_address, "--store", "on-cluster", cwd=folder,
     )  # fmt: skip
-    assert done.returncode == 1 and "Traceback" not in done.stderr
+    assert done.returncode == 2 and "Traceback" not in done.stderr
     assert f"error: {broken}" in done.stderr  # reported by name
     assert f"{BAGS} ingested, 0 skipped, 1 failed" in done.stderr
     assert canonical(folder / "on-cluster") == canonical(reference)  # nothing of the broken bag

@@ -102,7 +102,7 @@ def test_a_run_that_fails_on_the_cluster_is_named_by_its_index(
         cwd=folder, capture_output=True, text=True, timeout=120,
         env={**os.environ, "EXSCE_DASK_SCHEDULER": cluster.scheduler_address},
     )  # fmt: skip
-    assert done.returncode == 1 and "Traceback" not in done.stderr
+    assert done.returncode == 2 and "Traceback" not in done.stderr
     assert f"1 of {RUNS} runs of scenario 'yard_run' was not written on the cluster" in done.stderr
     assert f"run 1 (seed {SEED * 1000 + 1}): failed on the cluster" in done.stderr
     written = hashes(out)

@@ -129,7 +129,7 @@ def test_cli_cluster_prints_the_table_and_the_json(project):
     data = json.loads(out.stdout)
     assert data["scenarios"] == ["scenario_c", "c_one"] and data["pairs"][0]["d1"] == 0.5
     unknown = run_exscec("cluster", "-s", "nope", "-s", "c_one", cwd=project)
-    assert unknown.returncode == 1 and "not in the store: nope" in unknown.stderr and "Traceback" not in unknown.stderr
+    assert unknown.returncode == 2 and "not in the store: nope" in unknown.stderr and "Traceback" not in unknown.stderr
     bad = run_exscec("cluster", "-w", "d9=1", cwd=project)
     assert bad.returncode == 2 and "write NAME=W" in bad.stderr
 

@@ -162,7 +162,7 @@ def test_a_remote_store_that_goes_away_gives_a_clear_error_and_no_partial_run(
         server.process.send_signal(signal.SIGKILL)  # the first run is in; the others are being read
         server.process.wait(timeout=10)
         _, err = ingest.communicate(timeout=120)
-    assert ingest.returncode == 1 and "Traceback" not in err and "internal error" not in err, err
+    assert ingest.returncode == 2 and "Traceback" not in err and "internal error" not in err, err
     assert "1 ingested, 0 skipped, 2 failed" in err and server.url.removeprefix("http://") in err, err
     with oxigraph_server(data) as again:  # the same data, served again
         store = RemoteStore(f"{again.url}/query")

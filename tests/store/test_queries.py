@@ -574,9 +574,9 @@ def test_csv_answers_end_lines_with_crlf_and_quote_as_rfc_4180() -> None:
 
 def test_exscec_query_reports_mistakes(store_folder: Path) -> None:
     missing = run_exscec("query", "run_metric", "-p", f"run={RUN_1}", "--store", str(store_folder))
-    assert missing.returncode == 1 and "error: query 'run_metric' needs metric, robot" in missing.stderr
+    assert missing.returncode == 2 and "error: query 'run_metric' needs metric, robot" in missing.stderr
     unknown = run_exscec("query", "rnus", "--store", str(store_folder))
-    assert unknown.returncode == 1 and "no query called 'rnus'; did you mean 'runs'?" in unknown.stderr
+    assert unknown.returncode == 2 and "no query called 'rnus'; did you mean 'runs'?" in unknown.stderr
     malformed = run_exscec("query", "runs", "-p", "scenario", "--store", str(store_folder))
     assert malformed.returncode == 2 and "a parameter is NAME=VALUE" in malformed.stderr
 

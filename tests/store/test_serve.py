@@ -256,19 +256,19 @@ def test_cli_reads_through_a_read_only_server_and_cannot_write(endpoint: Server,
     assert listed.returncode == 0, listed.stderr
     assert len(listed.stdout.splitlines()) == 14
     refused = run_exscec("compile", str(SCENARIO_A), "--store", cwd=project)
-    assert refused.returncode == 1
+    assert refused.returncode == 2
     assert f"held by exscec serve, pid {endpoint.process.pid}, read-only" in refused.stderr
     assert "403" in refused.stderr and "--allow-updates" in refused.stderr
     assert "Traceback" not in refused.stderr
     served = run_exscec("serve", "--bind", "127.0.0.1:0", cwd=project)
-    assert served.returncode == 1 and f"served already (pid {endpoint.process.pid})" in served.stderr
+    assert served.returncode == 2 and f"served already (pid {endpoint.process.pid})" in served.stderr
 
 
 def test_cli_writes_through_a_server_that_allows_updates(writable: tuple[Server, Path]) -> None:
     server, folder = writable
     without = {k: v for k, v in os.environ.items() if k != "EXSCE_STORE_TOKEN"}
     refused = run_exscec_env(["compile", str(SCENARIO_C), "--store"], folder, without)
-    assert refused.returncode == 1 and "401" in refused.stderr and "EXSCE_STORE_TOKEN" in refused.stderr
+    assert refused.returncode == 2 and "401" in refused.stderr and "EXSCE_STORE_TOKEN" in refused.stderr
     added = run_exscec_env(
         ["compile", str(SCENARIO_C), "--store"], folder, {**without, "EXSCE_STORE_TOKEN": TOKEN}
     )

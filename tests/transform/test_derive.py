@@ -240,7 +240,7 @@ def test_exscec_derive_writes_a_file_that_checks_clean_and_stores_the_generation
     assert "then each robot max_velocity stays below 1.0 m/s" in criteria.stdout
     assert "0.8 m/s" not in criteria.stdout  # that limit was for a part of a run only
     bad = run_exscec("derive", "c/scenario_c.exsce", "-t", "remove_robot", "--robot", "tiago5")
-    assert bad.returncode == 1 and "has no robot 'tiago5'; did you mean" in bad.stderr and "Traceback" not in bad.stderr
+    assert bad.returncode == 2 and "has no robot 'tiago5'; did you mean" in bad.stderr and "Traceback" not in bad.stderr
 
 
 def test_a_reversed_task_and_its_generation_validate_together(base: Scenario) -> None:

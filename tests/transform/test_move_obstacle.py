@@ -294,7 +294,7 @@ def test_exscec_derive_writes_a_derive_block_that_checks_and_compiles(in_tmp: Pa
     assert "hadMember(exsce:yard_moved, env:yard_moved_environment)" in compiled.stdout
     assert 'exsce:to="4.0,2.5"' in compiled.stdout and "bundle yard_moved:scenario_generation" in compiled.stdout
     bad = run_exscec("derive", "yard.exsce", "-t", "move_obstacle", "--obstacle", "mats", "--to", "4,2.5")
-    assert bad.returncode == 1 and "has no obstacle 'mats'; did you mean 'mast'?" in bad.stderr
+    assert bad.returncode == 2 and "has no obstacle 'mats'; did you mean 'mast'?" in bad.stderr
     assert "Traceback" not in bad.stderr
 
 

@@ -29,8 +29,11 @@ from exsce_dsl.api.workflows import (
     simulate,
     verify,
 )
+from exsce_dsl.store.queries.run_ids import AmbiguousRunError, UnknownRunError, resolve_run
 
 __all__ = [
+    "AmbiguousRunError",
+    "UnknownRunError",
     "add_derived",
     "baseline",
     "check",
@@ -44,6 +47,7 @@ __all__ = [
     "metrics",
     "open_store",
     "query",
+    "resolve_run",
     "rows_frame",
     "segments",
     "simulate",

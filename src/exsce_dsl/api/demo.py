@@ -109,8 +109,8 @@ STEPS: tuple[Step, ...] = (
     Step("Write the HTML report", "exscec report -o report --spec scenarios/scenario_c.exsce"),
 )
 
-_ENDINGS = {0: "passed", 1: "failed", 2: "not judged"}
-"""What a verify step's exit status says of the runs it judged."""
+_ENDINGS = {0: "passed", 1: "failed", 2: "refused (bad input)", 3: "not judged"}
+"""What a verify step's exit status says of the runs it judged (the codes of ``exscec --help``)."""
 
 
 @dataclass(frozen=True)

@@ -37,13 +37,15 @@ def _frame(records: Sequence[dict[str, Any]], columns: Sequence[str]) -> pd.Data
 
 
 def _runs(store: Store, scenario: str | None, runs: Sequence[str] | None) -> dict[str, str]:
-    """Run uuid → its scenario, for the runs asked for (all of ``scenario``'s, or every run)."""
+    """Run uuid → its scenario, for the runs asked for (all of ``scenario``'s, or every run; each
+    given as its uuid, a unique prefix of it or its IRI)."""
     known = {r.uuid: r.scenario for r in queries.runs(store, scenario)}
-    return known if runs is None else {r: known.get(r, "") for r in runs}
+    return known if runs is None else {r: known.get(r, "") for r in queries.resolve_runs(store, runs)}
 
 
 def metrics(store: Store, scenario: str | None = None, runs: Sequence[str] | None = None) -> pd.DataFrame:
-    """Every whole-run metric value of the runs (of ``scenario``, or those given, or all): columns
+    """Every whole-run metric value of the runs (of ``scenario``, or those given by uuid or unique
+    prefix, or all): columns
     run, scenario, robot (None for the mission's), metric, safety (the safety metric a
     ``violation_duration`` is about), value and unit (None for a count)."""
     scenario_of = _runs(store, scenario, runs)
@@ -107,13 +109,13 @@ def rows_frame(rows: Rows) -> pd.DataFrame:
 
 
 def query(store: Store, name: str, **parameters: str | Sequence[str]) -> pd.DataFrame:
-    """``exscec query NAME -p k=v``: a query of the library, its parameters bound as RDF terms.
-    A metric, robot or scenario the store does not hold is an
-    :class:`~exsce_dsl.errors.UnknownNameWarning` naming the store's closest names (the answer
-    is then empty)."""
+    """``exscec query NAME -p k=v``: a query of the library, its parameters bound as RDF terms (a
+    run given by a unique prefix of its uuid, as tables print it, or its IRI).  A metric, robot or
+    scenario the store does not hold is an :class:`~exsce_dsl.errors.UnknownNameWarning` naming
+    the store's closest names (the answer is then empty)."""
     if library_query(name).is_update:
         raise ValueError(f"'{name}' is an update; the Python API runs the library's queries only")
-    rows = queries.run_query(store, name, parameters)
+    rows = queries.run_query(store, name, parameters, check_runs=True)
     for warning in unknown_names(store, name, parameters):
         warnings.warn(warning, UnknownNameWarning, stacklevel=2)
     return rows_frame(rows)

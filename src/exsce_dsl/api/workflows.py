@@ -108,7 +108,8 @@ def verify(
     store: Store, spec: Specification | Scenario, runs: Sequence[str | Path], *, scenario: str | None = None,
     record: bool = True,
 ) -> Verification:  # fmt: skip
-    """``exscec verify``: judge runs (stored uuids, or bags, ingested first) against every oracle
+    """``exscec verify``: judge runs (stored uuids or unique prefixes of them, or bags, ingested
+    first) against every oracle
     of their scenario; the verdicts go to the store unless ``record`` is False."""
     return verify_runs(store, _scenario(spec, scenario), runs, record=record)
 

@@ -5,8 +5,10 @@ from __future__ import annotations
 import functools
 import os
 import sys
+import traceback
 from collections import Counter
 from collections.abc import Callable, Iterable
+from enum import IntEnum
 from pathlib import Path
 from types import TracebackType
 from typing import Any, TypeVar
@@ -16,6 +18,62 @@ import click
 from exsce_dsl.errors import Diagnostic, ExsceError
 
 F = TypeVar("F", bound=Callable[..., Any])
+
+
+class ExitCode(IntEnum):
+    """The exit status of every exscec command: one meaning each, whatever the command.
+
+    A command that judges nothing exits 0 or 2 (or 70); ``exscec fmt --check`` exits 1 when a
+    file would change, as black does (a check of the files that failed).
+    """
+
+    PASSED = 0
+    """Done, and every verdict passed."""
+    FAILED = 1
+    """A verdict failed: an oracle of ``verify``, a metamorphic relation of ``explore``."""
+    BAD_INPUT = 2
+    """Bad input or usage: a specification error, a scenario without oracles, an unknown run, a
+    bag that cannot be read, a store that cannot be opened, a wrong option (click's own usage
+    errors exit 2 too)."""
+    INCONCLUSIVE = 3
+    """No verdict failed, but one could not be made (the data a clause needs is missing or cut
+    short): the run is neither passed nor failed."""
+    INTERNAL_ERROR = 70
+    """A bug of exsce (``EX_SOFTWARE`` of sysexits.h): an error it did not expect."""
+    INTERRUPTED = 130
+    """Stopped with Ctrl-C (128 + SIGINT, as shells report it)."""
+    BROKEN_PIPE = 141
+    """The reader of the output went away (``| head``): 128 + SIGPIPE, as shells report it."""
+
+
+_MEANINGS = {
+    ExitCode.PASSED: "done",
+    ExitCode.FAILED: "a verdict failed",
+    ExitCode.BAD_INPUT: "bad input or usage (a spec error, no oracles, an unknown run, an unreadable bag)",
+    ExitCode.INCONCLUSIVE: "a judgement could not be made (none failed)",
+    ExitCode.INTERNAL_ERROR: "an internal error (a bug of exsce: please report it)",
+    ExitCode.INTERRUPTED: "interrupted (Ctrl-C)",
+    ExitCode.BROKEN_PIPE: "the reader of the output went away (| head)",
+}
+
+
+def exit_status_table() -> str:
+    """Every exit status and its meaning: the ``Exit status`` paragraph of ``exscec --help``."""
+    lines = [f"  {int(code):<3} {meaning}" for code, meaning in _MEANINGS.items()]
+    title = "Exit status, the same in every command (each command's --help says which it uses):"
+    return "\b\n" + "\n".join([title, *lines])
+
+
+def exit_status(**meanings: str) -> str:
+    """The ``Exit status`` paragraph of a command's ``--help`` (its epilog): 0, then the codes the
+    command uses with what they mean for it (``passed=``, ``failed=``, ``inconclusive=``; each
+    code's general meaning when given as ''), then 2 and 70, which every command may exit with."""
+    said = {ExitCode[name.upper()]: text for name, text in meanings.items()}
+    said.setdefault(ExitCode.PASSED, _MEANINGS[ExitCode.PASSED])
+    said.setdefault(ExitCode.BAD_INPUT, "")
+    said.setdefault(ExitCode.INTERNAL_ERROR, "")
+    lines = [f"  {int(code):<3} {said[code] or _MEANINGS[code]}" for code in sorted(said)]
+    return "\b\nExit status (the same codes in every exscec command):\n" + "\n".join(lines)
 
 
 class State:
@@ -44,30 +102,42 @@ def print_diagnostics(diagnostics: Iterable[Diagnostic]) -> None:
 
 
 def reports_errors(func: F) -> F:
-    """Turn library errors into ``file:line:col: error: message`` and exit status 1."""
+    """Turn library errors into ``file:line:col: error: message`` and exit status 2 (bad input);
+    an unexpected exception is a bug of ours: exit status 70 (see :class:`ExitCode`)."""
 
     @functools.wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
         try:
             return func(*args, **kwargs)
         except ExsceError as exc:
-            if State.debug:
-                raise
+            if State.debug:  # the traceback, and the exit status it has without --debug
+                traceback.print_exc()
             print_diagnostics(exc.diagnostics)
-            sys.exit(1)
-        except (click.ClickException, click.exceptions.Exit, click.Abort, SystemExit):
+            sys.exit(ExitCode.BAD_INPUT)
+        except click.UsageError:  # exit 2, with the usage line
             raise
+        except click.ClickException as exc:  # click's other errors exit 1: a failed verdict's code
+            exc.show()
+            sys.exit(ExitCode.BAD_INPUT)
+        except click.Abort:  # a prompt answered with Ctrl-C or Ctrl-D
+            click.echo("Aborted!", err=True)
+            sys.exit(ExitCode.INTERRUPTED)
+        except (click.exceptions.Exit, SystemExit):
+            raise
+        except KeyboardInterrupt:
+            click.echo("interrupted", err=True)
+            sys.exit(ExitCode.INTERRUPTED)
         except BrokenPipeError:  # the reader went away (`| head`): stop quietly, as Unix tools do
             devnull = os.open(os.devnull, os.O_WRONLY)
             os.dup2(devnull, sys.stdout.fileno())
-            sys.exit(1)
+            sys.exit(ExitCode.BROKEN_PIPE)
         except Exception as exc:  # a bug of ours: say so briefly, trace with --debug
             if State.debug:
-                raise
+                traceback.print_exc()
             click.echo(
                 f"internal error: {type(exc).__name__}: {exc} (run with --debug for a traceback)", err=True
             )
-            sys.exit(1)
+            sys.exit(ExitCode.INTERNAL_ERROR)
 
     return wrapper  # type: ignore[return-value]
 

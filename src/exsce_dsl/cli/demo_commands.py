@@ -13,7 +13,7 @@ from pathlib import Path
 
 import click
 
-from exsce_dsl.cli.common import reports_errors
+from exsce_dsl.cli.common import ExitCode, exit_status, reports_errors
 
 
 def run_in_process(argv: Sequence[str]) -> int:
@@ -30,7 +30,7 @@ def run_in_process(argv: Sequence[str]) -> int:
     return 0
 
 
-@click.command()
+@click.command(epilog=exit_status(failed="a step did not end as expected"))
 @click.argument("folder", default="exsce-demo", type=click.Path(file_okay=False))
 @click.option(
     "--store", "store_url", help="Use this store instead of the folder's own (e.g. a SPARQL endpoint)."
@@ -94,7 +94,7 @@ def demo(folder: str, store_url: str | None, setup_only: bool, convention: str) 
     if hint:
         click.echo(f"  {hint}", err=True)
     if not run.as_expected:
-        sys.exit(1)
+        sys.exit(ExitCode.FAILED)
 
 
 COMMANDS = [demo]

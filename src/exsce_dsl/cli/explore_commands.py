@@ -7,12 +7,14 @@ from pathlib import Path
 
 import click
 
-from exsce_dsl.cli.common import Progress, reports_errors
+from exsce_dsl.cli.common import ExitCode, Progress, exit_status, reports_errors
 from exsce_dsl.cli.store_commands import store_option
 from exsce_dsl.wording import counted
 
 
-@click.command()
+@click.command(
+    epilog=exit_status(passed="no relation was violated", failed="a metamorphic relation was violated")
+)
 @click.argument("spec", type=click.Path(dir_okay=False, exists=True))
 @click.option("--scenario-id", help="Which scenario, when the file declares several.")
 @click.option("--budget", "-n", required=True, type=click.IntRange(1), help="Derivations to try.")
@@ -172,7 +174,7 @@ def explore(
             click.echo(f"  reproduce: exscec verify {bags}/*.bag --scenario {file}")
     if junit:
         Path(junit).write_text(campaign_junit(record, durations), encoding="utf-8")
-    sys.exit(1 if violated else 0)
+    sys.exit(ExitCode.FAILED if violated else ExitCode.PASSED)
 
 
 COMMANDS = [explore]

@@ -14,7 +14,7 @@ import os
 import click
 
 from exsce_dsl import __version__
-from exsce_dsl.cli.common import State
+from exsce_dsl.cli.common import State, exit_status_table
 
 COMMAND_MODULES: dict[str, str] = {
     "check": "spec_commands",
@@ -61,7 +61,9 @@ class LazyGroup(click.Group):
         return self.commands.get(cmd_name)
 
 
-@click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
+@click.group(
+    cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]}, epilog=exit_status_table()
+)
 @click.version_option(__version__, prog_name="exscec")
 @click.option("--debug", is_flag=True, help="Show Python tracebacks for errors.")
 @click.option(

@@ -7,11 +7,11 @@ from pathlib import Path
 
 import click
 
-from exsce_dsl.cli.common import bag_arguments, reports_errors, write_text
+from exsce_dsl.cli.common import ExitCode, bag_arguments, exit_status, reports_errors, write_text
 from exsce_dsl.cli.store_commands import store_option
 
 
-@click.command()
+@click.command(epilog=exit_status(bad_input="bad input: a spec error, too few runs, no acceptance criteria"))
 @click.argument("spec", type=click.Path(dir_okay=False))
 @click.option("--scenario-id", help="Which scenario, when the file declares several.")
 @store_option
@@ -52,7 +52,14 @@ def baseline(spec: str, scenario_id: str | None, store_url: str | None) -> None:
     click.echo(report.summary(), err=True)
 
 
-@click.command()
+@click.command(
+    epilog=exit_status(
+        passed="every oracle passed",
+        failed="an oracle failed",
+        bad_input="bad input: no oracles yet, an unknown or ambiguous run, a spec error, a bad bag",
+        inconclusive="an oracle could not be judged (its data missing or cut short), and none failed",
+    )
+)
 @click.argument("runs", nargs=-1, required=True)
 @click.option(
     "--scenario",
@@ -78,12 +85,15 @@ def verify(
 ) -> None:
     """Judge runs against every oracle of their scenario.
 
-    RUNS are stored runs (their uuids, as `exscec runs` lists them) or bag
-    files, which are ingested first.  For each oracle: the value observed, the
-    expectation, the margin and the verdict, and the runs the expectation came
-    from.  The verdicts are written to the store as provenance.  Exits 0 when
-    every oracle passed, 1 when one failed, 2 when one could not be judged (and
-    none failed).
+    RUNS are stored runs (their uuids, or any unique prefix of one of 4
+    characters or more, such as the 8 that the verdict table prints, or a
+    run's IRI) or bag files, which are ingested first.  For each oracle: the
+    value observed, the expectation, the margin and the verdict, and the runs
+    the expectation came from.  The verdicts are written to the store as
+    provenance.  A run the scenario's baseline was built from is judged with
+    a warning: it is part of the mean it is compared with.  Exits 0 when
+    every oracle passed, 1 when one failed, 3 when one could not be judged
+    (and none failed), 2 when nothing could be judged (bad input: below).
 
     \b
     Example:
@@ -104,8 +114,10 @@ def verify(
             verification = verify_runs(store, scenario, [*uuids, *bags], record=not no_record)
         except IngestFailed as exc:
             click.echo(f"error: {exc.message}", err=True)
-            sys.exit(2)
+            sys.exit(ExitCode.BAD_INPUT)
     verdicts = list(verification.verdicts)
+    for warning in verification.warnings:
+        click.echo(f"warning: {warning}", err=True)
     click.echo(verdicts_json(verdicts) if as_json else verdict_table(verdicts))
     if junit:
         write_text(junit_xml(verdicts), junit)
@@ -114,7 +126,7 @@ def verify(
     click.echo(
         f"{len(verdicts) - failed - unjudged} passed, {failed} failed, {unjudged} not judged", err=True
     )
-    sys.exit(verification.exit_code)
+    sys.exit(ExitCode.FAILED if failed else ExitCode.INCONCLUSIVE if unjudged else ExitCode.PASSED)
 
 
 COMMANDS = [baseline, verify]

@@ -144,9 +144,11 @@ def query_command(
     """Run a query of the library by NAME, its parameters given with -p.
 
     Parameters are bound as RDF terms, never pasted into the query.  A
-    parameter that takes a list (runs) is given once per value.  A metric,
-    robot or scenario the store does not hold is a warning naming the store's
-    closest names (the answer is then empty, and the exit status 0).
+    parameter that takes a list (runs) is given once per value.  A run is
+    given by its uuid, any unique prefix of it (4 characters or more: the 8
+    that tables print will do) or its IRI.  A metric, robot or scenario the
+    store does not hold is a warning naming the store's closest names (the
+    answer is then empty, and the exit status 0).
 
     \b
     Examples:
@@ -179,7 +181,7 @@ def query_command(
     given = _parameters(params)
     library_query.bindings(given)  # check the parameters before opening the store
     with open_store(store_url) as store:
-        rows = run_query(store, name, given)
+        rows = run_query(store, name, given, check_runs=True)
         unknown = [] if library_query.is_update else unknown_names(store, name, given)
     for warning in unknown:
         click.echo(f"warning: {warning}", err=True)

@@ -7,11 +7,11 @@ from pathlib import Path
 
 import click
 
-from exsce_dsl.cli.common import Progress, bag_arguments, reports_errors
+from exsce_dsl.cli.common import ExitCode, Progress, bag_arguments, exit_status, reports_errors
 from exsce_dsl.model.conventions import CONVENTIONS
 
 
-@click.command()
+@click.command(epilog=exit_status(bad_input="bad input, or a run that could not be played"))
 @click.argument("spec", type=click.Path(dir_okay=False))
 @click.option("--runs", "-n", default=1, show_default=True, type=click.IntRange(1), help="How many runs.")
 @click.option(
@@ -105,7 +105,7 @@ def simulate(
     With --cluster, each run is played by a Dask cluster's worker, which
     writes its bag and .prov.json into --output (a task is tried twice; a
     killed worker's runs go to another).  A run that failed even so is named
-    by its index at the end, and the exit status is 1.
+    by its index at the end, and the exit status is 2.
 
     \b
     Example:
@@ -128,7 +128,7 @@ def simulate(
             progress.say(f"wrote {run.bag} ({run.messages} messages, {run.execution.duration:.1f} s)")
 
 
-@click.command()
+@click.command(epilog=exit_status(bad_input="a bag could not be ingested (the others were), or bad input"))
 @click.argument("bags", nargs=-1, required=True, type=click.Path())
 @click.option(
     "--scenario",
@@ -188,7 +188,7 @@ def ingest(
     A bag may be a run of several scenarios, one run each.  It says the convention it detected for
     each robot whose type names none, and the run's timeline when its stamps are
     simulated time, once for all the bags that share them (-v: for each bag, and
-    the clock of every topic).  Exits 1 if any bag failed.  With
+    the clock of every topic).  Exits 2 if any bag failed.  With
     --cluster, a Dask cluster's workers analyse the bags (a task is tried
     twice; a killed worker's tasks go to another) and exscec writes each
     run, as with --jobs.  With --strict, a run that would lack a metric value
@@ -233,7 +233,7 @@ def ingest(
     again = f"{replaced} replaced, " if replace else ""
     click.echo(f"{done} ingested, {again}{skipped} skipped, {failed} failed", err=True)
     if failed:
-        sys.exit(1)
+        sys.exit(ExitCode.BAD_INPUT)
 
 
 COMMANDS = [simulate, ingest]

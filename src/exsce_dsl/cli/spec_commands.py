@@ -8,12 +8,19 @@ from pathlib import Path
 
 import click
 
-from exsce_dsl.cli.common import print_diagnostics, reports_errors, spec_files, write_text
+from exsce_dsl.cli.common import (
+    ExitCode,
+    exit_status,
+    print_diagnostics,
+    reports_errors,
+    spec_files,
+    write_text,
+)
 
 PROV_FORMATS = ("provn", "json", "xml", "ttl", "trig", "nq", "jsonld")
 
 
-@click.command()
+@click.command(epilog=exit_status(bad_input="a file has errors (or cannot be read)"))
 @click.argument("specs", nargs=-1, required=True, type=click.Path())
 @reports_errors
 def check(specs: tuple[str, ...]) -> None:
@@ -43,7 +50,7 @@ def check(specs: tuple[str, ...]) -> None:
             n = len(checked.spec.scenarios)
             click.echo(f"{spec}: ok ({n} scenario{'s' if n != 1 else ''})", err=True)
     if failed:
-        sys.exit(1)
+        sys.exit(ExitCode.BAD_INPUT)
 
 
 @click.command(name="compile")
@@ -106,7 +113,7 @@ def compile_command(
     write_text(text, output)
 
 
-@click.command()
+@click.command(epilog=exit_status(failed="--check: a file would change (as black exits)"))
 @click.argument("specs", nargs=-1, required=True, type=click.Path())
 @click.option("--check", "check_only", is_flag=True, help="Change nothing; exit 1 if a file would change.")
 @click.option(
@@ -158,7 +165,7 @@ def fmt(specs: tuple[str, ...], check_only: bool, show_diff: bool) -> None:
             Path(spec_path).write_text(formatted, encoding="utf-8")
             click.echo(f"reformatted {spec_path}", err=True)
     if check_only and changed:
-        sys.exit(1)
+        sys.exit(ExitCode.FAILED)
 
 
 @click.command(name="import")
@@ -274,7 +281,7 @@ def export_command(spec: str, target: str, out_dir: str, scenario_id: str | None
     Example:
       exscec export examples/brsu_building_c/scenario_c.exsce --to yaml -o out/
       exscec export examples/brsu_building_c/scenario_c.exsce --to gherkin -o features/
-      exscec export examples/brsu_building_c/scenario_c.exsce --to oracle-yaml -o out/  # exits 1
+      exscec export examples/brsu_building_c/scenario_c.exsce --to oracle-yaml -o out/  # exits 2
     """
     from exsce_dsl.errors import ExportError
     from exsce_dsl.lang.build import load_spec

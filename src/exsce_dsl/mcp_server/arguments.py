@@ -26,7 +26,7 @@ from exsce_dsl.model.names import NAME_PATTERN
 __all__ = [
     "NAME",
     "POSE_NAME",
-    "RUN_UUID",
+    "RUN_ID",
     "ArgumentError",
     "checked_arguments",
     "identifier",
@@ -38,8 +38,9 @@ NAME = f"^{NAME_PATTERN}$"
 """A DSL id: scenario, robot, metric, task or pose id."""
 POSE_NAME = f"^{NAME_PATTERN}-R{_ANGLE}_P{_ANGLE}_Y{_ANGLE}$"
 """A pose's name with its heading, as the store names pose entities."""
-RUN_UUID = "^[0-9a-fA-F]{8}-[0-9a-fA-F]{4}-[0-9a-fA-F]{4}-[0-9a-fA-F]{4}-[0-9a-fA-F]{12}$"
-"""A run's uuid, as ``exscec runs`` lists them."""
+RUN_ID = "^[0-9a-fA-F][0-9a-fA-F-]{3,35}$"
+"""A run's uuid, or a unique prefix of it of 4 characters or more (tables print 8), as ``exscec
+verify`` takes them (:func:`~exsce_dsl.store.queries.resolve_run` says which run it is)."""
 MAX_TEXT = 10_000
 """The longest free text a query parameter may hold."""
 MAX_VALUES = 1_000
@@ -48,13 +49,13 @@ MAX_VALUES = 1_000
 _FORMS = {
     NAME: "an id (letters, digits, _ and inner -)",
     POSE_NAME: "a pose name with its heading (e.g. classroom_c025-w001-R0.00_P0.00_Y0.00)",
-    RUN_UUID: "a run uuid",
+    RUN_ID: "a run uuid or a prefix of one (4 characters or more)",
 }
 
 
 def identifier(pattern: str, description: str) -> dict[str, Any]:
     """The schema of a string of the form ``pattern`` (one of :data:`NAME`, :data:`POSE_NAME`,
-    :data:`RUN_UUID`)."""
+    :data:`RUN_ID`)."""
     return {"type": "string", "pattern": pattern, "maxLength": 200, "description": description}
 
 

@@ -19,7 +19,7 @@ import mcp_types as types
 
 from exsce_dsl.mcp_server.access import Access
 from exsce_dsl.mcp_server.answers import READ_ONLY, ToolEntry, results_json
-from exsce_dsl.mcp_server.arguments import MAX_TEXT, MAX_VALUES, NAME, POSE_NAME, RUN_UUID, object_schema
+from exsce_dsl.mcp_server.arguments import MAX_TEXT, MAX_VALUES, NAME, POSE_NAME, RUN_ID, object_schema
 from exsce_dsl.store.queries import Parameter, Query, query, query_names, run_query
 
 __all__ = ["library_tools", "parameter_schema", "query_tool"]
@@ -34,8 +34,8 @@ _KIND_SCHEMAS: dict[str, dict[str, Any]] = {
     "metric_property": {"type": "string", "pattern": NAME},
     "point": {"type": "string", "pattern": NAME},
     "pose": {"type": "string", "pattern": POSE_NAME},
-    "run": {"type": "string", "pattern": RUN_UUID},
-    "run_activity": {"type": "string", "pattern": RUN_UUID},  # given as its uuid, like "run"
+    "run": {"type": "string", "pattern": RUN_ID},
+    "run_activity": {"type": "string", "pattern": RUN_ID},  # given as its uuid, like "run"
     "string": {"type": "string"},
     "double": {"type": "number"},
 }
@@ -91,7 +91,7 @@ def _answer_of(name: str) -> Answer:
     def answer(access: Access, arguments: Mapping[str, Any]) -> dict[str, Any]:
         given = {key: _texts(value) for key, value in arguments.items()}
         with access.store() as store:
-            rows = run_query(store, name, given)
+            rows = run_query(store, name, given, check_runs=True)
         return results_json(rows, access.max_rows)
 
     return answer

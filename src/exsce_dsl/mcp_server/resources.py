@@ -27,7 +27,7 @@ import mcp_types as types
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.mcp_server.access import Access
-from exsce_dsl.mcp_server.arguments import NAME, RUN_UUID
+from exsce_dsl.mcp_server.arguments import NAME, RUN_ID
 from exsce_dsl.mcp_server.store_tools import derivation_json, stored_run, stored_scenario
 from exsce_dsl.model.verdicts import Outcome
 from exsce_dsl.store.base import Store
@@ -81,8 +81,8 @@ def resource_templates() -> list[types.ResourceTemplate]:
             name="run",
             title="A run in the store",
             uri_template=f"{RUNS}/{{run}}",
-            description="A run by uuid: its scenario, times, bag, whole-run metric values and the "
-            "counts of its verdicts.",
+            description="A run by uuid (or a unique prefix of it): its scenario, times, bag, whole-run "
+            "metric values and the counts of its verdicts.",
             mime_type=JSON,
         ),
     ]
@@ -137,8 +137,8 @@ def read_resource(access: Access, uri: str) -> str:
     if match is None:
         raise ResourceNotFound(f"no resource {uri!r}: the URIs are {SCENARIOS}[/ID] and {RUNS}[/UUID]")
     kind, key = match.groups()
-    if key is not None and not re.fullmatch(NAME if kind == "scenarios" else RUN_UUID, key):
-        what = "a scenario id" if kind == "scenarios" else "a run uuid"
+    if key is not None and not re.fullmatch(NAME if kind == "scenarios" else RUN_ID, key):
+        what = "a scenario id" if kind == "scenarios" else "a run uuid (or a prefix of one)"
         raise ResourceNotFound(f"no resource {uri!r}: {key!r} is not {what}")
     with access.store() as store:
         if kind == "scenarios":

@@ -19,12 +19,20 @@ import mcp_types as types
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.mcp_server.access import Access
 from exsce_dsl.mcp_server.answers import READ_ONLY, ToolEntry
-from exsce_dsl.mcp_server.arguments import NAME, RUN_UUID, ArgumentError, identifier, object_schema
+from exsce_dsl.mcp_server.arguments import NAME, RUN_ID, ArgumentError, identifier, object_schema
 from exsce_dsl.model.derivation import Derivation
 from exsce_dsl.model.verdicts import Outcome
 from exsce_dsl.oracles.report import verdicts_json
 from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries import StoredRun, derivation_of, derived_scenarios, lineage, runs, scenario_ids
+from exsce_dsl.store.queries import (
+    StoredRun,
+    derivation_of,
+    derived_scenarios,
+    lineage,
+    resolve_run,
+    runs,
+    scenario_ids,
+)
 from exsce_dsl.store.queries.results import verdicts
 from exsce_dsl.suggest import did_you_mean
 
@@ -43,9 +51,11 @@ def stored_scenario(store: Store, scenario: str) -> str:
 
 
 def stored_run(store: Store, run: str) -> StoredRun:
-    """The run with uuid ``run``; an ExsceError if the store has none."""
+    """The run whose uuid is ``run`` or starts with it (a unique prefix); an ExsceError if the store
+    has none, or several runs start with it (listed)."""
+    uuid = resolve_run(store, run)
     for found in runs(store):
-        if found.uuid.lower() == run.lower():
+        if found.uuid == uuid:
             return found
     raise ExsceError(f"no run '{run}' in the store (the runs tool lists them)")
 
@@ -108,7 +118,7 @@ def lineage_tool() -> ToolEntry:
         input_schema=object_schema(
             {
                 "scenario": identifier(NAME, "the scenario, by id (e.g. scenario_c)"),
-                "run": identifier(RUN_UUID, "a run, by uuid: the lineage of its scenario"),
+                "run": identifier(RUN_ID, "a run, by uuid or unique prefix: the lineage of its scenario"),
             }
         ),
         annotations=READ_ONLY,
@@ -144,7 +154,9 @@ def run_verdicts_tool() -> ToolEntry:
             "values, limit, tolerance, margin, the runs the expectation came from and, when it could "
             "not be judged, why; with the counts of passed, failed and unjudged oracles."
         ),
-        input_schema=object_schema({"run": identifier(RUN_UUID, "the run, by uuid")}, ("run",)),
+        input_schema=object_schema(
+            {"run": identifier(RUN_ID, "the run, by uuid or a unique prefix of it")}, ("run",)
+        ),
         annotations=READ_ONLY,
     )
     return ToolEntry(tool, _run_verdicts)

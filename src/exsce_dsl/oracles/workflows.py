@@ -23,7 +23,12 @@ from exsce_dsl.prov.oracle import compile_oracles
 from exsce_dsl.prov.verdicts import compile_verdicts
 from exsce_dsl.runs.ingest import ingest_bags
 from exsce_dsl.store.base import Store
+from exsce_dsl.store.queries import resolve_runs
+from exsce_dsl.store.queries.run_ids import names_a_prefix
 from exsce_dsl.store.writing import WriteReport, add_prov
+
+_BAG_SUFFIXES = (".bag", ".mcap", ".db3")
+"""What a bag's name ends with: such a name that is not a file is a missing bag, not a run id."""
 
 
 class IngestFailed(ExsceError):
@@ -61,6 +66,9 @@ class Verification:
     scenario: Scenario
     runs: tuple[str, ...]
     verdicts: tuple[Verdict, ...]
+    warnings: tuple[str, ...] = ()
+    """What makes verdicts say less than they seem to: a run judged against a baseline built
+    from it (:func:`own_baseline_warnings`)."""
 
     def count(self, outcome: Outcome) -> int:
         return sum(v.outcome is outcome for v in self.verdicts)
@@ -69,11 +77,6 @@ class Verification:
     def passed(self) -> bool:
         """No oracle failed and every one was judged."""
         return not self.count(Outcome.FAILED) and not self.count(Outcome.UNJUDGED)
-
-    @property
-    def exit_code(self) -> int:
-        """0 when every oracle passed, 1 when one failed, 2 when one could not be judged (none failed)."""
-        return 1 if self.count(Outcome.FAILED) else 2 if self.count(Outcome.UNJUDGED) else 0
 
 
 def verify_runs(
@@ -84,10 +87,15 @@ def verify_runs(
     record: bool = True,
     now: datetime.datetime | None = None,
 ) -> Verification:
-    """Judge ``runs`` (stored runs' uuids, or paths of bags, which are ingested first) against every
+    """Judge ``runs`` (stored runs' uuids, unique prefixes of them or their IRIs, or paths of bags,
+    which are ingested first) against every
     oracle of ``scenario``; with ``record``, write the verdicts to the store (at ``now``, UTC)."""
     bags = [Path(r) for r in runs if isinstance(r, Path) or Path(r).exists()]
-    uuids = [str(r) for r in runs if not (isinstance(r, Path) or Path(r).exists())]
+    given = [str(r) for r in runs if not (isinstance(r, Path) or Path(r).exists())]
+    for text in given:
+        if not names_a_prefix(text) and ("/" in text or Path(text).suffix in _BAG_SUFFIXES):  # a path
+            raise ExsceError(f"no bag or bag folder {text} (nor is it a run id)")
+    uuids = resolve_runs(store, given)  # prefixes and IRIs as well as whole uuids
     for result in ingest_bags(bags, scenario, store) if bags else []:
         if result.failed or result.run_id is None:
             raise IngestFailed(result.message)
@@ -99,4 +107,20 @@ def verify_runs(
         for run in dict.fromkeys(v.run for v in verdicts):
             mine = [v for v in verdicts if v.run == run]
             add_prov(store, compile_verdicts(run, mine, at), replace=True)
-    return Verification(scenario, judged, tuple(verdicts))
+    return Verification(scenario, judged, tuple(verdicts), own_baseline_warnings(verdicts))
+
+
+def own_baseline_warnings(verdicts: Sequence[Verdict]) -> tuple[str, ...]:
+    """A warning for each judged run that is one of the runs its oracles' expectations came from
+    (the runs a baseline records in the store, ``oracle:runs`` of its PROV): a run compared with a
+    mean it is part of passes more easily than a new run would."""
+    baselines: dict[str, dict[str, int]] = {}
+    for v in verdicts:
+        if v.run in v.sources:
+            baselines.setdefault(v.run, {})[v.against or v.scenario] = len(v.sources)
+    return tuple(
+        f"run {run[:8]} is one of the {count} runs the baseline of '{scenario}' was built from: "
+        "its verdicts against that baseline say little (judge runs the baseline did not use)"
+        for run, built in baselines.items()
+        for scenario, count in built.items()
+    )

@@ -15,6 +15,14 @@ PROV entity (``classroom_c025-w001-R0.00_P0.00_Y0.00``).
 from __future__ import annotations
 
 from exsce_dsl.store.queries.library import KINDS, Parameter, Query, query, query_names, standard_prefixes
+from exsce_dsl.store.queries.run_ids import (
+    MIN_PREFIX,
+    AmbiguousRunError,
+    RunCandidate,
+    UnknownRunError,
+    resolve_run,
+    resolve_runs,
+)
 from exsce_dsl.store.queries.run_values import *  # noqa: F403
 from exsce_dsl.store.queries.run_values import (
     MetricReading,
@@ -75,6 +83,8 @@ from exsce_dsl.store.queries.terms import (
 )
 
 __all__ = [
+    "MIN_PREFIX",
+    "AmbiguousRunError",
     "Given",
     "KINDS",
     "MetricReading",
@@ -83,8 +93,10 @@ __all__ = [
     "PathSegment",
     "Query",
     "RobotFacts",
+    "RunCandidate",
     "StoredRun",
     "ValueStats",
+    "UnknownRunError",
     "ViolationDuration",
     "bool_of",
     "datetime_of",
@@ -105,6 +117,8 @@ __all__ = [
     "python_value",
     "query",
     "query_names",
+    "resolve_run",
+    "resolve_runs",
     "robot_metric_over_runs",
     "robots",
     "run_metric",

@@ -11,22 +11,50 @@ from exsce_dsl.model.geometry import Pose
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, pose_name
 from exsce_dsl.store.base import Rows, Store, Term
 from exsce_dsl.store.literals import canonical_rows, literal_value, parse_datetime
-from exsce_dsl.store.queries.library import query
+from exsce_dsl.store.queries.library import Query, query
+from exsce_dsl.store.queries.run_ids import names_a_prefix, resolve_run
 
 Given = Mapping[str, str | Sequence[str]]
 """Parameters as text: name → one value or several."""
 
 
-def run_query(store: Store, name: str, given: Given, namespace: str = DEFAULT_NAMESPACE) -> Rows:
+def run_query(
+    store: Store, name: str, given: Given, namespace: str = DEFAULT_NAMESPACE, *, check_runs: bool = False
+) -> Rows:
     """Run library query ``name`` with parameters given as text; its rows (SELECT), each literal in
-    its one form whatever the store (:mod:`exsce_dsl.store.literals`), or none (update)."""
+    its one form whatever the store (:mod:`exsce_dsl.store.literals`), or none (update).
+
+    A run parameter given as a prefix of a uuid or as a run's IRI is the one stored run it names
+    (:func:`~.run_ids.resolve_run`); a whole uuid is taken as it is, unless ``check_runs`` (what
+    people type: the CLI, the MCP server, the Python API), which makes every run given one the
+    store holds, or an error."""
     q = query(name)
     as_lists = {k: [v] if isinstance(v, str) else list(v) for k, v in given.items()}
-    bindings = q.bindings(as_lists, namespace)
+    bindings = q.bindings(as_lists, namespace)  # the parameters checked before any look-up
+    if any(q.parameter(name).kind in RUN_KINDS for name in as_lists):
+        bindings = q.bindings(_runs_resolved(store, q, as_lists, namespace, check_runs), namespace)
     if q.is_update:
         store.update(q.sparql(namespace), bindings)
         return Rows((), ())
     return canonical_rows(store.select(q.sparql(namespace), bindings))
+
+
+RUN_KINDS = ("run", "run_activity")
+"""The kinds of parameter that name a run, by uuid."""
+
+
+def _runs_resolved(
+    store: Store, q: Query, given: dict[str, list[str]], namespace: str, check_runs: bool
+) -> dict[str, list[str]]:
+    """``given`` with each run parameter's value that is a prefix or an IRI (each value, with
+    ``check_runs``) replaced by the id of the one run it names (:func:`~.run_ids.resolve_run`)."""
+    resolved = {}
+    for name, values in given.items():
+        if q.parameter(name).kind in RUN_KINDS:
+            asked = check_runs
+            values = [resolve_run(store, v, namespace) if asked or names_a_prefix(v) else v for v in values]
+        resolved[name] = values
+    return resolved
 
 
 # -- plain values of terms -----------------------------------------------------------
