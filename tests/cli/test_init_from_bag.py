@@ -82,10 +82,10 @@ def test_init_says_what_is_wrong_with_its_input(
     in_tmp: Path, tmp_path_factory: pytest.TempPathFactory
 ) -> None:
     missing = run_exscec("init", "--from-bag", "no_such.bag")
-    assert missing.returncode != 0 and "no_such.bag: no such bag" in missing.stderr
+    assert missing.returncode == 2 and "no_such.bag: no such bag" in missing.stderr
     bag = _yard_bag(tmp_path_factory.mktemp("recorded"), "nav2", "ros1")
     _ok("init", "--from-bag", str(bag), "-o", "mine.exsce")
     again = run_exscec("init", "--from-bag", str(bag), "-o", "mine.exsce")
-    assert again.returncode != 0 and "would overwrite mine.exsce; use --force to replace" in again.stderr
+    assert again.returncode == 2 and "would overwrite mine.exsce; use --force to replace" in again.stderr
     _ok("init", "--from-bag", str(bag), "-o", "mine.exsce", "--force")
     _ok("check", "mine.exsce")

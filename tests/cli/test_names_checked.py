@@ -147,7 +147,7 @@ def test_strict_ingest_refuses_a_missing_metric_and_stores_nothing(bag: Path, tm
     store = str(tmp_path / "store")
     done = run_exscec("ingest", str(bag), "--scenario", str(tmp_path / "gt.exsce"), "--store", store, "--strict",
                       timeout=300)  # fmt: skip
-    assert done.returncode != 0, done.stderr
+    assert done.returncode == 2, done.stderr
     assert f"error: {bag}: 1 metric value would be missing (gt_path of 'bot')" in done.stderr, done.stderr
     assert "did you mean /groundtruth?" in done.stderr
     assert "0 ingested, 0 skipped, 1 failed" in done.stderr

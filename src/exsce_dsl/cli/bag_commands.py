@@ -9,7 +9,7 @@ from pathlib import Path
 
 import click
 
-from exsce_dsl.cli.common import bag_arguments, reports_errors
+from exsce_dsl.cli.common import bag_arguments, exit_status, reports_errors
 
 
 @click.group()
@@ -22,7 +22,7 @@ def bag() -> None:
     """
 
 
-@bag.command("info")
+@bag.command("info", epilog=exit_status(bad_input="a bag that cannot be read (named), or bad input"))
 @click.argument("bags", nargs=-1, required=True, type=click.Path())
 @click.option(
     "--format",
@@ -90,7 +90,9 @@ def _table(info: object) -> str:
     return "\n".join(lines)
 
 
-@click.command("init")
+@click.command(
+    "init", epilog=exit_status(bad_input="a bag that cannot be read, no robot in it, or a file in the way")
+)
 @click.option(
     "--from-bag",
     "bag_path",
