@@ -110,4 +110,7 @@ def test_the_readme_example_runs_as_written(tmp_path: Path, monkeypatch: pytest.
     import pandas as pd
 
     assert isinstance(table, pd.DataFrame) and table.run.nunique() == 3
+    wide = namespace["wide"]  # stumble: the README's pivot dropped the mission's values
+    assert isinstance(wide, pd.DataFrame)
+    assert wide["mission"]["mission_duration"].notna().all().all() and len(wide) == 3
     assert len(list((tmp_path / "runs").glob("*.bag"))) == 3

@@ -173,3 +173,31 @@ def test_every_link_between_pages_finds_its_page_and_heading(page: Path) -> None
         if anchor:
             headings = re.findall(r"^#+ (.+)$", linked.read_text(encoding="utf-8"), flags=re.M)
             assert anchor in {_anchor(h) for h in headings}, f"{page.name}: no heading #{anchor} in {linked.name}"
+
+
+def test_the_readme_is_short_and_starts_where_users_start() -> None:
+    """Stumble: the README was 830 lines and "Your robot's bags" began at line 479."""
+    lines = (ROOT / "README.md").read_text(encoding="utf-8").splitlines()
+    assert len(lines) <= 300
+    first_screen = "\n".join(lines[:50])
+    assert ".venv/bin/exscec demo" in first_screen and ".venv/bin/python -m pytest" in first_screen
+    assert "## Start from your bag" in first_screen
+    linked = set(re.findall(r"\]\(docs/(\w+)\.md", "\n".join(lines)))
+    assert linked == {p.stem for p in (ROOT / "docs").glob("*.md")}, "every docs page is in the index"
+
+
+def test_the_language_page_lists_every_function_with_its_arguments() -> None:
+    """Stumble: the README never said how many arguments path_length takes, which plane the
+    built-in distance uses, or that a metric of each robot names its topics with {ns}."""
+    from exsce_dsl.model.expressions import CONDITION_AGGREGATES, FUNCTIONS, WINDOW_VALUES
+
+    page = (ROOT / "docs" / "language.md").read_text(encoding="utf-8")
+    section = page[page.index("## Every function"):]
+    rows = re.findall(r"^\| (.+?) \| (.+?) \| (.+?) \|$", section, flags=re.M)
+    named = {name for cell, _, _ in rows for name in re.findall(r"`(\w+)[( ]", cell + " ")}
+    missing = (set(FUNCTIONS) | set(CONDITION_AGGREGATES)) - named
+    assert not missing, f"functions without a row: {sorted(missing)}"
+    assert set(WINDOW_VALUES) <= set(re.findall(r"`(\w+)`", section))
+    [path_length] = [args for cell, args, _ in rows if "path_length" in cell]
+    assert "two or three" in path_length
+    assert "x-y plane" in section and "{ns}" in section
