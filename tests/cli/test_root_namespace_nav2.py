@@ -119,8 +119,11 @@ def test_a_nav2_robot_at_the_root_goes_through_the_whole_method(in_tmp: Path) ->
     assert len(bags) == 3
     ok("ingest", *bags, "--scenario", "at_root.exsce")
     ok("baseline", "at_root.exsce")
-    verdicts = json.loads(ok("verify", *bags, "--scenario", "at_root.exsce", "--json"))
-    assert len(verdicts) == 3 * 7 and all(v["verdict"] == "passed" for v in verdicts), verdicts
+    # a run the baseline did not use (verifying its own runs warns: they are in its mean)
+    ok("simulate", "at_root.exsce", "--runs", "1", "-o", "new", "--seed", "6", "--convention", "nav2")
+    [new] = sorted(str(p) for p in Path("new").glob("*.bag"))
+    verdicts = json.loads(ok("verify", new, "--scenario", "at_root.exsce", "--json"))
+    assert len(verdicts) == 7 and all(v["verdict"] == "passed" for v in verdicts), verdicts
     runs = json.loads(ok("runs", "--format", "json"))["results"]["bindings"]
     for row in runs:
         expected = by_rosbags(Path(row["path"]["value"]))
