@@ -119,6 +119,7 @@ def _commands(stores: Stores) -> dict[str, tuple[str, ...]]:
         "robot_metric_stats": ("-p", "metric=task_duration", "-p", "robot=r1", *every_run),
         "robot_names": (),
         "robots": ("-p", "scenario=yard_run"),
+        "run_ids": ("-p", f"prefix={runs[0][:8]}"),
         "run_known": ("-p", f"run={runs[0]}"),
         "run_metric": ("-p", f"run={runs[0]}", *distance, "-p", "robot=r1"),
         "run_metric_values": every_run,
