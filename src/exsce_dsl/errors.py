@@ -15,8 +15,10 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from enum import Enum
+from typing import Any
 
 __all__ = [
+    "AmbiguousRunError",
     "ArgumentError",
     "BagError",
     "DecodeError",
@@ -41,6 +43,7 @@ __all__ = [
     "TfError",
     "TimeLimitError",
     "UnknownNameWarning",
+    "UnknownRunError",
 ]
 
 
@@ -229,6 +232,24 @@ class StoreConflictError(StoreError):
         super().__init__(message)
         self.graphs = tuple(graphs)
         """The names of the graphs that differ."""
+
+
+class UnknownRunError(ExsceError):
+    """No stored run has this id (``exsce_dsl.store.queries.run_ids``)."""
+
+    def __init__(self, message: str, closest: Sequence[Any] = ()) -> None:
+        super().__init__(message)
+        self.closest = tuple(closest)
+        """The stored runs whose ids are closest (``RunCandidate``: uuid, scenario, bag)."""
+
+
+class AmbiguousRunError(ExsceError):
+    """Several stored runs start with this prefix (``exsce_dsl.store.queries.run_ids``)."""
+
+    def __init__(self, message: str, candidates: Sequence[Any]) -> None:
+        super().__init__(message)
+        self.candidates = tuple(candidates)
+        """The runs it may mean (``RunCandidate``: uuid, scenario, bag)."""
 
 
 class ArgumentError(ExsceError):

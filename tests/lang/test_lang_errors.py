@@ -406,6 +406,8 @@ def test_every_error_class_is_in_the_errors_module() -> None:
         ("exsce_dsl.store.base", "StoreError"),
         ("exsce_dsl.store.base", "StoreLockedError"),
         ("exsce_dsl.store.base", "StoreConflictError"),
+        ("exsce_dsl.store.queries.run_ids", "UnknownRunError"),
+        ("exsce_dsl.store.queries.run_ids", "AmbiguousRunError"),
         ("exsce_dsl.messages.catalogue", "MessageTypeError"),
         ("exsce_dsl.runs.bags.reading", "BagError"),
         ("exsce_dsl.runs.signals.tf_poses", "TfError"),

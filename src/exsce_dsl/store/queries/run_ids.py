@@ -17,7 +17,7 @@ import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import AmbiguousRunError, ExsceError, UnknownRunError
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE
 from exsce_dsl.store.base import Store, Term
 from exsce_dsl.store.queries.library import query
@@ -56,22 +56,6 @@ class RunCandidate:
 
     def __str__(self) -> str:
         return f"{self.uuid}  {self.scenario}  {self.bag or '(no bag)'}"
-
-
-class UnknownRunError(ExsceError):
-    """No stored run has this id."""
-
-    def __init__(self, message: str, closest: Sequence[RunCandidate] = ()) -> None:
-        super().__init__(message)
-        self.closest = tuple(closest)
-
-
-class AmbiguousRunError(ExsceError):
-    """Several stored runs start with this prefix."""
-
-    def __init__(self, message: str, candidates: Sequence[RunCandidate]) -> None:
-        super().__init__(message)
-        self.candidates = tuple(candidates)
 
 
 def is_full_uuid(text: str) -> bool:
