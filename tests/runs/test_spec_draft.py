@@ -218,7 +218,7 @@ def test_a_map_whose_free_space_misses_the_places_is_written_but_not_referenced(
     draft = draft_spec(bag, tmp_path / "draft.exsce")
     assert draft.map_files == (tmp_path / "draft_map.yaml", tmp_path / "draft_map.pgm")
     # its start and its end (the farthest point from its start): both in unknown space
-    assert draft.notes == ("draft_map.yaml written but not referenced: 2 place(s) off its free space",)
+    assert draft.notes == ("draft_map.yaml written but not referenced: 2 places off its free space",)
     (env,) = load_spec(draft.spec).environments  # checks: no pose is held against the map
     assert env.map is None and "draft_map.yaml is not referenced" in draft.text
     assert load_occupancy_grid(tmp_path / "draft_map.yaml").state_at(0.0, 0.0) == UNKNOWN

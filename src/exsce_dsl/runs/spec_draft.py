@@ -61,6 +61,7 @@ from exsce_dsl.model.acceptance import (
 from exsce_dsl.model.conventions import CONVENTIONS, METHOD, Window
 from exsce_dsl.model.names import KEYWORDS, is_valid_name
 from exsce_dsl.runs.bag_robots import BagContents, BagRobot, Place, bag_contents
+from exsce_dsl.wording import counted
 
 SAFETY_LIMITS: tuple[tuple[str, BasicRelation, float, str], ...] = (
     ("max_velocity", BasicRelation.BELOW_MAX, 1.0, "m/s"),
@@ -175,7 +176,7 @@ class _Drafter:
             self.ids[_name(robot.namespace or "root_robot", self.taken, "robot")] = robot
         header = [
             f"Drafted by `exscec init --from-bag` from {c.path.name}: {c.topics} topics, "
-            f"{c.end - c.start:.1f} s, {len(c.robots)} robot(s) found.",
+            f"{c.end - c.start:.1f} s, {counted(len(c.robots), 'robot')} found.",
             f"Next: exscec check {self.file}; exscec ingest {c.path.name} --scenario {self.file}",
             "",
         ]
@@ -246,17 +247,18 @@ class _Drafter:
             m = c.map
             said.insert(
                 0,
-                f"The map: the last of {m.messages} OccupancyGrid message(s) on {m.topic}, "
+                f"The map: the last of {counted(m.messages, 'OccupancyGrid message')} on {m.topic}, "
                 f"{m.width} x {m.height} cells of {m.resolution:g} m.",
             )
             outside = self._off_the_map()
             if outside:
                 said[1:1] = [
-                    f"{map_file} is not referenced: {outside} place(s) lie outside its free space (a path",
-                    "from odometry is in another frame than the map). Move them and add: map NAME file ...",
+                    f"{map_file} is not referenced: {counted(outside, 'place')} outside its free space",
+                    "(a path from odometry is in another frame than the map). Move them and add: "
+                    "map NAME file ...",
                 ]
                 self.notes.append(
-                    f"{map_file} written but not referenced: {outside} place(s) off its free space"
+                    f"{map_file} written but not referenced: {counted(outside, 'place')} off its free space"
                 )
                 map_file = None
         elif c.other_maps:
@@ -276,8 +278,8 @@ class _Drafter:
                 continue
             where = ", ".join(robot.goals_from) or ", ".join(robot.pose_from) or "its path"
             area = _name(f"{rid}_places", self.taken, "area")
-            counted = f"{len(robot.tasks)} goal(s)" if robot.goals_from else "its path"
-            area_location = self.at(f"{rid}: {counted}, from {where}", *robot.notes[:5])
+            counted_goals = counted(len(robot.tasks), "goal") if robot.goals_from else "its path"
+            area_location = self.at(f"{rid}: {counted_goals}, from {where}", *robot.notes[:5])
             start = self._pose(f"{rid}-start", robot.start, area)
             poses: list[Pose] = [start]
             starts[rid] = start
