@@ -74,7 +74,7 @@ def _table(info: object) -> str:
     ]
     rows = [("topic", "type", "definition", "messages", "rate (Hz)", "stamps", "log - stamp (s)")]
     for t in info.topics:
-        rate = f"{t.rate:.1f}" if t.rate is not None else "-"
+        rate = _hertz(t.rate) if t.rate is not None else "-"
         offset = f"{t.offset:+.3f}" if t.offset is not None else "-"
         rows.append((t.name, t.msgtype, t.definition, str(t.messages), rate, t.clock, offset))
     widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
@@ -140,7 +140,13 @@ def _edge_rate(info: object, parent: str, child: str, static: bool) -> str:
 
     assert isinstance(info, BagInfo)
     rate = info.tf_rates.get((parent, child))
-    return "static" if static else f"{rate:.1f} Hz" if rate is not None else "once"
+    return "static" if static else f"{_hertz(rate)} Hz" if rate is not None else "once"
 
 
 COMMANDS = [bag, init]
+
+
+def _hertz(rate: float) -> str:
+    """A rate to one decimal, or to two significant digits below 1 Hz (a plan sent four times in
+    ten minutes is 0.0069 Hz, not 0.0)."""
+    return f"{rate:.1f}" if rate >= 1 else f"{rate:.2g}"
