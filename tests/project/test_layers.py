@@ -26,6 +26,7 @@ LAYERS: list[set[str]] = [
     {"sim", "runs"},
     {"oracles"},
     {"derive"},
+    {"execute"},
     {"similarity", "explore", "codegen"},
     {"report", "lsp", "mcp_server"},
     {"api"},
