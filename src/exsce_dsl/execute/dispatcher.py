@@ -71,6 +71,7 @@ class _Dispatch:
         self.active: dict[int, _Active] = {}
         self.records: list[GoalRecord] = []
         self.numbers = 0
+        self.skipped = 0
         self.status = MissionStatus.COMPLETED
 
     def run(self) -> MissionRun:
@@ -95,7 +96,7 @@ class _Dispatch:
                     self._next(done.lane)
                 else:
                     self._failed(finished.goal, finished.outcome, finished.time)
-        not_sent = sum(len(lane) for lane in self.lanes)
+        not_sent = self.skipped + sum(len(lane) for lane in self.lanes)
         return MissionRun(self.status, tuple(self.records), start, self.clock.now(), not_sent)
 
     def _send(self, lane: int, goal: Goal, first_start: float | None, attempts: int) -> None:
@@ -149,6 +150,7 @@ class _Dispatch:
             lane = self.lanes[done.lane]
             while lane and lane[0].task_key == done.goal.task_key:
                 lane.popleft()
+                self.skipped += 1
         self._next(done.lane)
 
     def _cancel_all(self) -> None:
