@@ -271,3 +271,20 @@ def test_sequential_on_the_map_one_robot_at_a_time_in_allocation_order(scenario_
         a.end == b.start for a, b in zip(run.records, run.records[1:], strict=False)
     )  # never two at once
     assert run.status is MissionStatus.COMPLETED and {r.outcome for r in run.records} == {S}
+
+
+def test_a_rejected_goal_is_skipped_by_the_default_policy(open_floor):
+    scenario, grid = open_floor
+    clock = SimulatedClock()
+    nav = KinematicNavigator(scenario, grid, clock, {"tiago1": V, "tiago2": V}, rejects=[FIRST])
+    run = dispatch(schedule(scenario), nav, clock)
+    t2 = leg("c025-w001", "c018-w001")
+    assert _rows(run)[:2] == [
+        ("tiago1", "delivery_a", 1, 1, 1, "c022-w001", 0.0, 0.0, Outcome.REJECTED, 1),
+        ("tiago1", "delivery_a", 1, 1, 2, "c018-w001", 0.0, t2, S, 1),
+    ]
+
+
+def test_a_mission_cancelled_before_it_starts_sends_nothing(open_floor):
+    run, nav = _run(open_floor, cancelled=lambda clock: True)
+    assert (run.status, run.records, run.not_sent, nav.sent) == (MissionStatus.CANCELLED, (), 6, [])

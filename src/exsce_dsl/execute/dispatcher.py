@@ -5,9 +5,10 @@ goal to end (or the earliest timeout), records it, and sends that lane its next 
 sleeps on a wall clock: all waiting is the navigator's ``next_finished``, against the clock the
 caller gives, so a simulated clock runs a mission as fast as the navigator can play it.
 
-Cancellation: ``cancelled`` is asked after every wake-up (at least every ``poll`` seconds of the
-clock); once it says yes, every active goal is cancelled (recorded as CANCELLED), no more goals
-are sent, and the run ends as ``cancelled``.  A ROS adapter sets it from SIGINT or SIGTERM.
+Cancellation: ``cancelled`` is asked before the first goal is sent (yes: nothing is sent) and
+after every wake-up (at least every ``poll`` seconds of the clock); once it says yes, every
+active goal is cancelled (recorded as CANCELLED), no more goals are sent, and the run ends as
+``cancelled``.  A ROS adapter sets it from SIGINT or SIGTERM.
 """
 
 from __future__ import annotations
@@ -20,7 +21,6 @@ from exsce_dsl.execute.mission import Goal, Schedule
 from exsce_dsl.execute.navigator import Clock, Navigator
 from exsce_dsl.execute.outcomes import (
     DEFAULT_POLICY,
-    FAILED,
     GoalRecord,
     MissionRun,
     MissionStatus,
@@ -76,6 +76,8 @@ class _Dispatch:
 
     def run(self) -> MissionRun:
         start = self.clock.now()
+        if self.cancelled is not None and self.cancelled():
+            self.status = MissionStatus.CANCELLED
         for lane in range(len(self.lanes)):
             self._next(lane)
         while self.active and self.status is MissionStatus.COMPLETED:
@@ -136,7 +138,8 @@ class _Dispatch:
                 self._failed(number, Outcome.TIMED_OUT, now)
 
     def _failed(self, number: int, outcome: Outcome, end: float) -> None:
-        assert outcome in FAILED
+        """A goal that did not succeed: aborted, rejected, timed out, or cancelled by another
+        client of the robot's stack (preempted): ``policy`` says what comes next."""
         done = self.active.pop(number)
         if self.policy is Policy.RETRY_ONCE and done.attempts == 1:
             self._send(done.lane, done.goal, done.first_start, 2)

@@ -2,11 +2,11 @@
 
 Each goal is planned from where its robot stands to the goal's position (the kinematic
 executor's planner, :mod:`exsce_dsl.sim.planner`) and driven at the robot's constant speed
-limit; it succeeds when the robot arrives.  Tests can make chosen goals fail: a goal named in
-``aborts`` is aborted ``ABORT_AFTER`` seconds after it was sent (the robot does not move), as many
-times as given; one named in ``silent`` is accepted and never answered (the robot does not move).
-A goal is named by its robot and its pose id.  Cancelling a goal leaves its robot where it was
-on the path at that time.
+limit; it succeeds when the robot arrives.  Tests can make chosen goals fail, named by robot and
+pose id: one in ``aborts`` is aborted ``ABORT_AFTER`` seconds after it was sent, as many times as
+given; one in ``rejects`` is rejected at once; one in ``silent`` is accepted and never answered
+(in all three the robot does not move).  Cancelling a goal leaves its robot where it was on the
+path at that time.
 """
 
 from __future__ import annotations
@@ -64,11 +64,13 @@ class KinematicNavigator:
         speeds: Mapping[str, float] | None = None,
         aborts: Mapping[GoalName, int] | None = None,
         silent: Iterable[GoalName] = (),
+        rejects: Iterable[GoalName] = (),
     ) -> None:
         self.grid, self.clock = grid, clock
         self.speeds = dict(speeds or {})
         self.aborts = dict(aborts or {})
         self.silent = set(silent)
+        self.rejects = set(rejects)
         self.where: dict[str, Point] = {
             r.id: (r.start_pose.position.x, r.start_pose.position.y)
             for r in scenario.robots
@@ -88,6 +90,8 @@ class KinematicNavigator:
         name, here = (robot, pose.id), self.where[robot]
         if name in self.silent:
             self.active[goal] = _Drive(robot, name, (here,), now, None, Outcome.ABORTED)
+        elif name in self.rejects:
+            self.active[goal] = _Drive(robot, name, (here,), now, now, Outcome.REJECTED)
         elif self.aborts.get(name, 0) > 0:
             self.aborts[name] -= 1
             self.active[goal] = _Drive(robot, name, (here,), now, now + ABORT_AFTER, Outcome.ABORTED)

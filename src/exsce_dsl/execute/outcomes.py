@@ -26,7 +26,8 @@ class Outcome(enum.Enum):
 
 
 FAILED = frozenset({Outcome.ABORTED, Outcome.REJECTED, Outcome.TIMED_OUT})
-"""The outcomes that a :class:`Policy` handles."""
+"""The outcomes that a :class:`Policy` handles (and CANCELLED when another client of the robot's
+stack cancelled the goal, not the dispatcher)."""
 
 
 class Policy(enum.Enum):
