@@ -48,12 +48,12 @@ class Block:
 
 def _blocks(page: Path) -> list[Block]:
     found = []
-    for match in re.finditer(r"^([ \t]*)```(\w*)([^\n]*)\n(.*?)^\1```", page.read_text(encoding="utf-8"),
-                             flags=re.S | re.M):
+    whole = page.read_text(encoding="utf-8")
+    for match in re.finditer(r"^([ \t]*)```(\w*)([^\n]*)\n(.*?)^\1```", whole, flags=re.S | re.M):
         indent = len(match.group(1))
         text = "\n".join(line[indent:] for line in match.group(4).splitlines())
         info = dict(word.split("=", 1) for word in match.group(3).split() if "=" in word)
-        line = page.read_text(encoding="utf-8")[: match.start()].count("\n") + 1
+        line = whole[: match.start()].count("\n") + 1
         found.append(Block(page, line, match.group(2), info, text))
     return found
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import datetime as dt
 import json
+from collections.abc import Mapping
 from pathlib import Path
 
 import click
@@ -80,7 +81,7 @@ def _table(info: object) -> str:
     widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
     lines += ["  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True)).rstrip() for r in rows]
     if info.tf_edges:
-        edges = ", ".join(f"{p} -> {c} ({_edge_rate(info, p, c, s)})" for p, c, s in info.tf_edges)
+        edges = ", ".join(f"{p} -> {c} ({_edge_rate(info.tf_rates, p, c, s)})" for p, c, s in info.tf_edges)
         lines += ["", f"tf        {edges}"]
     for topic, ends in info.goals.items():
         counted = ", ".join(f"{n} {status}" for status, n in sorted(ends.items()))
@@ -135,11 +136,8 @@ def init(bag_path: str, output: str | None, force: bool) -> None:
     click.echo(f"next: exscec check {draft.spec} && exscec ingest {bag_path} --scenario {draft.spec}")
 
 
-def _edge_rate(info: object, parent: str, child: str, static: bool) -> str:
-    from exsce_dsl.runs.bag_info import BagInfo
-
-    assert isinstance(info, BagInfo)
-    rate = info.tf_rates.get((parent, child))
+def _edge_rate(rates: Mapping[tuple[str, str], float], parent: str, child: str, static: bool) -> str:
+    rate = rates.get((parent, child))
     return "static" if static else f"{_hertz(rate)} Hz" if rate is not None else "once"
 
 
