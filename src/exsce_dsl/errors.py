@@ -33,6 +33,7 @@ __all__ = [
     "PlanningError",
     "RelationError",
     "RenameError",
+    "RosGraphError",
     "SegmentError",
     "Severity",
     "SourceLocation",
@@ -258,6 +259,12 @@ class ArgumentError(ExsceError):
 
 class TimeLimitError(ExsceError):
     """A request ran over the server's time limit (``mcp_server``)."""
+
+
+class RosGraphError(ExsceError):
+    """A live ROS graph cannot do what a run needs (``execute``): no master at the URI, no Python
+    with rospy, an action server that never answered, a node of ours that died; the message names
+    what is missing."""
 
 
 class RenameError(ValueError):
