@@ -1,0 +1,194 @@
+"""The live ROS 2 part: Nav2 action clients behind the core's ``Navigator`` and ``Clock``.
+
+NOT RUN IN THIS PROJECT'S CI: rclpy cannot be installed here (it comes with a ROS 2 distro, built
+for that distro's Python), so nothing below has met a live ROS 2 graph; what it sends is built
+and tested in :mod:`.nav2`, how the bag is recorded in :mod:`.recorder`.  rclpy and nav2_msgs are
+imported inside :func:`require_rclpy` only, so that importing this module works without them.
+
+One rclpy node (``exsce_dispatcher``) holds a ``NavigateToPose`` action client per robot; an
+executor spins it on a thread of its own, where the clients' callbacks run: a goal's acceptance,
+then its result, put on a queue that :meth:`Ros2Navigator.next_finished` reads.  Time is the
+node's clock: the wall clock, or ``/clock`` with ``use_sim_time``.
+"""
+
+from __future__ import annotations
+
+import queue
+import threading
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from types import ModuleType
+from typing import Any
+
+from exsce_dsl.errors import RosGraphError
+from exsce_dsl.execute.dispatcher import dispatch
+from exsce_dsl.execute.mission import schedule
+from exsce_dsl.execute.navigator import Finished
+from exsce_dsl.execute.outcomes import DEFAULT_POLICY, MissionRun, Outcome, Policy
+from exsce_dsl.execute.ros2.nav2 import goal_outcome, nav2_actions, stamped_pose
+from exsce_dsl.execute.ros2.recorder import SOURCE_HINT, Ros2Recorder
+from exsce_dsl.model import Pose, Scenario
+
+NODE_NAME = "exsce_dispatcher"
+SERVER_WAIT = 10.0
+"""Seconds an action server has to show up before the run fails naming it."""
+WAIT_SLICE = 0.05
+"""Wall seconds between two looks at the clock while waiting for a goal to end."""
+
+
+@dataclass(frozen=True)
+class Ros2Modules:
+    """What the adapter uses of a ROS 2 installation."""
+
+    rclpy: ModuleType
+    context: ModuleType
+    """``rclpy.context`` (Context: this run's own, shut down at its end)."""
+    action: ModuleType
+    """``rclpy.action`` (ActionClient)."""
+    executors: ModuleType
+    parameter: ModuleType
+    """``rclpy.parameter`` (Parameter, for ``use_sim_time``)."""
+    nav2: ModuleType
+    """``nav2_msgs.action`` (NavigateToPose)."""
+
+
+def require_rclpy() -> Ros2Modules:
+    """rclpy and nav2_msgs, or :class:`RosGraphError` saying how to get them."""
+    try:
+        import nav2_msgs.action as nav2
+        import rclpy
+        import rclpy.action as action
+        import rclpy.context as context
+        import rclpy.executors as executors
+        import rclpy.parameter as parameter
+    except ImportError as exc:
+        raise RosGraphError(
+            f"the ROS 2 adapter needs rclpy and nav2_msgs, which this Python cannot import ({exc}): "
+            f"{SOURCE_HINT} in the shell that runs exscec, with a Python of the distro's version "
+            "(3.10 for Humble, 3.12 for Jazzy); rclpy is not installed with pip"
+        ) from None
+    return Ros2Modules(rclpy, context, action, executors, parameter, nav2)
+
+
+class Ros2Clock:
+    """The node's clock, in seconds (simulated time under ``use_sim_time``)."""
+
+    def __init__(self, node: Any) -> None:
+        self.node = node
+
+    def now(self) -> float:
+        return float(self.node.get_clock().now().nanoseconds) / 1e9
+
+
+class Ros2Navigator:
+    """The core's :class:`~exsce_dsl.execute.navigator.Navigator` over Nav2's ``NavigateToPose``:
+    ``clients`` maps each robot to its action client."""
+
+    def __init__(self, modules: Ros2Modules, clients: Mapping[str, Any], clock: Ros2Clock) -> None:
+        self.modules, self.clients, self.clock = modules, dict(clients), clock
+        self._ended: queue.Queue[Finished] = queue.Queue()
+        self._lock = threading.Lock()
+        self._handles: dict[int, Any] = {}
+        self._cancelled: set[int] = set()
+
+    def send(self, goal: int, robot: str, pose: Pose) -> None:
+        message = self.modules.nav2.NavigateToPose.Goal()
+        stamped = stamped_pose(pose)
+        message.pose.header.frame_id = stamped.frame_id
+        message.pose.header.stamp = self.clock.node.get_clock().now().to_msg()
+        position, orientation = message.pose.pose.position, message.pose.pose.orientation
+        position.x, position.y, position.z = stamped.position
+        orientation.x, orientation.y, orientation.z, orientation.w = stamped.orientation
+        future = self.clients[robot].send_goal_async(message)
+        future.add_done_callback(lambda done: self._accepted(goal, done))
+
+    def cancel(self, goal: int) -> None:
+        with self._lock:
+            self._cancelled.add(goal)
+            handle = self._handles.get(goal)
+        if handle is not None:
+            handle.cancel_goal_async()
+
+    def next_finished(self, deadline: float) -> Finished | None:
+        while True:
+            left = deadline - self.clock.now()
+            if left <= 0:
+                return None
+            try:
+                return self._ended.get(timeout=min(left, WAIT_SLICE))
+            except queue.Empty:
+                continue
+
+    def _accepted(self, goal: int, future: Any) -> None:
+        handle = future.result()
+        if not handle.accepted:
+            self._end(goal, Outcome.REJECTED)
+            return
+        with self._lock:
+            self._handles[goal] = handle
+            cancelled = goal in self._cancelled
+        if cancelled:  # cancelled while its acceptance was on the way
+            handle.cancel_goal_async()
+            return
+        handle.get_result_async().add_done_callback(lambda done: self._result(goal, done))
+
+    def _result(self, goal: int, future: Any) -> None:
+        outcome = goal_outcome(int(future.result().status))
+        self._end(goal, Outcome.ABORTED if outcome is None else outcome)
+
+    def _end(self, goal: int, outcome: Outcome) -> None:
+        with self._lock:
+            if goal in self._cancelled:  # the dispatcher's own cancel: not reported
+                return
+        self._ended.put(Finished(goal, outcome, self.clock.now()))
+
+
+def execute_ros2(
+    scenario: Scenario,
+    bag: Path,
+    topics: Sequence[str],
+    policy: Policy = DEFAULT_POLICY,
+    timeout: float | None = None,
+    speeds: Mapping[str, float] | None = None,
+    use_sim_time: bool = False,
+    cancelled: Callable[[], bool] | None = None,
+) -> MissionRun:
+    """Run ``scenario``'s mission on a live ROS 2 graph through each robot's Nav2, with
+    ``ros2 bag record`` of ``topics`` into the MCAP bag folder ``bag`` from before the first goal
+    to after the last.  Raises :class:`RosGraphError` when rclpy is missing (before anything
+    starts) or a robot's ``navigate_to_pose`` server does not answer within :data:`SERVER_WAIT`."""
+    modules = require_rclpy()
+    plan = schedule(scenario, speeds, timeout)
+    robots = {r.id: r for r in scenario.robots}
+    actions = {robot: nav2_actions(robots[robot]).navigate_to_pose for robot in {g.robot for g in plan.goals}}
+    rclpy = modules.rclpy
+    context = modules.context.Context()
+    rclpy.init(context=context)
+    try:
+        sim_time = modules.parameter.Parameter("use_sim_time", value=use_sim_time)
+        node = rclpy.create_node(NODE_NAME, context=context, parameter_overrides=[sim_time])
+        executor = modules.executors.SingleThreadedExecutor(context=context)
+        executor.add_node(node)
+        spinner = threading.Thread(target=executor.spin, name="exsce-ros2-executor", daemon=True)
+        spinner.start()
+        try:
+            clients = {
+                robot: modules.action.ActionClient(node, modules.nav2.NavigateToPose, name)
+                for robot, name in sorted(actions.items())
+            }
+            for robot, client in clients.items():
+                if not client.wait_for_server(timeout_sec=SERVER_WAIT):
+                    raise RosGraphError(
+                        f"no NavigateToPose action server at {actions[robot]} (robot '{robot}') "
+                        f"after {SERVER_WAIT:g} s: is Nav2 running in that namespace?"
+                    )
+            navigator = Ros2Navigator(modules, clients, Ros2Clock(node))
+            with Ros2Recorder(bag, topics, use_sim_time):
+                return dispatch(plan, navigator, navigator.clock, policy, cancelled)
+        finally:
+            executor.shutdown()
+            node.destroy_node()
+            spinner.join(timeout=5.0)
+    finally:
+        context.try_shutdown()
