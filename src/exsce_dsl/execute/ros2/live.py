@@ -5,16 +5,18 @@ for that distro's Python), so nothing below has met a live ROS 2 graph; what it 
 and tested in :mod:`.nav2`, how the bag is recorded in :mod:`.recorder`.  rclpy and nav2_msgs are
 imported inside :func:`require_rclpy` only, so that importing this module works without them.
 
-One rclpy node (``exsce_dispatcher``) holds a ``NavigateToPose`` action client per robot; an
-executor spins it on a thread of its own, where the clients' callbacks run: a goal's acceptance,
-then its result, put on a queue that :meth:`Ros2Navigator.next_finished` reads.  Time is the
-node's clock: the wall clock, or ``/clock`` with ``use_sim_time``.
+One rclpy node (``exsce_dispatcher``) holds a ``NavigateToPose`` action client per robot.  It is
+spun in the dispatcher's own thread, a slice at a time while :meth:`Ros2Navigator.next_finished`
+waits: goals are sent, and their acceptances and results handled, in that one thread.  (An
+executor spinning on a thread of its own would race ``send_goal_async``, which in Humble's
+rclpy registers a goal's future only after the request is out, without a lock: a fast answer
+would be dropped.)  Time is the node's clock: the wall clock, or ``/clock`` with ``use_sim_time``.
 """
 
 from __future__ import annotations
 
-import queue
-import threading
+import time
+from collections import deque
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -33,6 +35,10 @@ from exsce_dsl.model import Pose, Scenario
 NODE_NAME = "exsce_dispatcher"
 SERVER_WAIT = 10.0
 """Seconds an action server has to show up before the run fails naming it."""
+CANCEL_WAIT = 2.0
+"""Wall seconds a run that stops on an error waits for goals still unanswered, to cancel them."""
+RECORDER_NODE = "rosbag2_recorder"
+"""The node name of ``ros2 bag record``'s recorder (its default)."""
 WAIT_SLICE = 0.05
 """Wall seconds between two looks at the clock while waiting for a goal to end."""
 
@@ -83,14 +89,17 @@ class Ros2Clock:
 
 class Ros2Navigator:
     """The core's :class:`~exsce_dsl.execute.navigator.Navigator` over Nav2's ``NavigateToPose``:
-    ``clients`` maps each robot to its action client."""
+    ``clients`` maps each robot to its action client, ``executor`` spins their node."""
 
-    def __init__(self, modules: Ros2Modules, clients: Mapping[str, Any], clock: Ros2Clock) -> None:
-        self.modules, self.clients, self.clock = modules, dict(clients), clock
-        self._ended: queue.Queue[Finished] = queue.Queue()
-        self._lock = threading.Lock()
+    def __init__(
+        self, modules: Ros2Modules, executor: Any, clients: Mapping[str, Any], clock: Ros2Clock
+    ) -> None:
+        self.modules, self.executor, self.clients, self.clock = modules, executor, dict(clients), clock
+        self._ended: deque[Finished] = deque()
         self._handles: dict[int, Any] = {}
         self._cancelled: set[int] = set()
+        self._unanswered: set[int] = set()
+        """Goals sent whose acceptance or rejection has not come yet."""
 
     def send(self, goal: int, robot: str, pose: Pose) -> None:
         message = self.modules.nav2.NavigateToPose.Goal()
@@ -101,47 +110,79 @@ class Ros2Navigator:
         position.x, position.y, position.z = stamped.position
         orientation.x, orientation.y, orientation.z, orientation.w = stamped.orientation
         future = self.clients[robot].send_goal_async(message)
+        self._unanswered.add(goal)
         future.add_done_callback(lambda done: self._accepted(goal, done))
 
     def cancel(self, goal: int) -> None:
-        with self._lock:
-            self._cancelled.add(goal)
-            handle = self._handles.get(goal)
-        if handle is not None:
+        self._cancelled.add(goal)
+        handle = self._handles.get(goal)
+        if handle is not None:  # else: cancelled when its acceptance comes
             handle.cancel_goal_async()
 
     def next_finished(self, deadline: float) -> Finished | None:
-        while True:
+        while not self._ended:
             left = deadline - self.clock.now()
             if left <= 0:
                 return None
-            try:
-                return self._ended.get(timeout=min(left, WAIT_SLICE))
-            except queue.Empty:
-                continue
+            self.executor.spin_once(timeout_sec=min(left, WAIT_SLICE))
+        return self._ended.popleft()
 
     def _accepted(self, goal: int, future: Any) -> None:
+        self._unanswered.discard(goal)
         handle = future.result()
         if not handle.accepted:
             self._end(goal, Outcome.REJECTED)
             return
-        with self._lock:
-            self._handles[goal] = handle
-            cancelled = goal in self._cancelled
-        if cancelled:  # cancelled while its acceptance was on the way
+        if goal in self._cancelled:  # cancelled while its acceptance was on the way
             handle.cancel_goal_async()
             return
+        self._handles[goal] = handle
         handle.get_result_async().add_done_callback(lambda done: self._result(goal, done))
 
+    def cancel_active(self) -> None:
+        """Cancel every goal sent and not ended (a run left by an exception, Ctrl-C among them),
+        waiting up to :data:`CANCEL_WAIT` for the acceptances still on their way."""
+        for goal in sorted(set(self._handles) | self._unanswered):
+            self.cancel(goal)
+        deadline = time.monotonic() + CANCEL_WAIT
+        while self._unanswered and time.monotonic() < deadline:
+            self.executor.spin_once(timeout_sec=WAIT_SLICE)
+
     def _result(self, goal: int, future: Any) -> None:
+        self._handles.pop(goal, None)
         outcome = goal_outcome(int(future.result().status))
         self._end(goal, Outcome.ABORTED if outcome is None else outcome)
 
     def _end(self, goal: int, outcome: Outcome) -> None:
-        with self._lock:
-            if goal in self._cancelled:  # the dispatcher's own cancel: not reported
-                return
-        self._ended.put(Finished(goal, outcome, self.clock.now()))
+        if goal not in self._cancelled:  # the dispatcher's own cancels are not reported
+            self._ended.append(Finished(goal, outcome, self.clock.now()))
+
+
+def wait_for_clock(executor: Any, clock: Ros2Clock, timeout: float = SERVER_WAIT) -> None:
+    """Spin until ``clock`` has a time (under ``use_sim_time``: the first ``/clock`` message)."""
+    deadline = time.monotonic() + timeout
+    while clock.now() <= 0:
+        if time.monotonic() > deadline:
+            raise RosGraphError(f"no time on /clock after {timeout:g} s: is the simulator running?")
+        executor.spin_once(timeout_sec=WAIT_SLICE)
+
+
+def wait_for_recorder(node: Any, executor: Any, topics: Sequence[str], timeout: float = SERVER_WAIT) -> None:
+    """Spin until the recorder (node :data:`RECORDER_NODE`) subscribes to every topic of ``topics``
+    that has a publisher, so that it misses nothing of the first goal."""
+    deadline = time.monotonic() + timeout
+    while True:
+        published = [t for t in topics if node.count_publishers(t) > 0]
+        missing = [
+            t
+            for t in published
+            if not any(i.node_name == RECORDER_NODE for i in node.get_subscriptions_info_by_topic(t))
+        ]
+        if not missing:
+            return
+        if time.monotonic() > deadline:
+            raise RosGraphError(f"ros2 bag record did not subscribe to {missing} within {timeout:g} s")
+        executor.spin_once(timeout_sec=WAIT_SLICE)
 
 
 def execute_ros2(
@@ -170,8 +211,6 @@ def execute_ros2(
         node = rclpy.create_node(NODE_NAME, context=context, parameter_overrides=[sim_time])
         executor = modules.executors.SingleThreadedExecutor(context=context)
         executor.add_node(node)
-        spinner = threading.Thread(target=executor.spin, name="exsce-ros2-executor", daemon=True)
-        spinner.start()
         try:
             clients = {
                 robot: modules.action.ActionClient(node, modules.nav2.NavigateToPose, name)
@@ -183,12 +222,18 @@ def execute_ros2(
                         f"no NavigateToPose action server at {actions[robot]} (robot '{robot}') "
                         f"after {SERVER_WAIT:g} s: is Nav2 running in that namespace?"
                     )
-            navigator = Ros2Navigator(modules, clients, Ros2Clock(node))
+            clock = Ros2Clock(node)
+            wait_for_clock(executor, clock)
+            navigator = Ros2Navigator(modules, executor, clients, clock)
             with Ros2Recorder(bag, topics, use_sim_time):
-                return dispatch(plan, navigator, navigator.clock, policy, cancelled)
+                wait_for_recorder(node, executor, topics)
+                try:
+                    return dispatch(plan, navigator, clock, policy, cancelled)
+                except BaseException:
+                    navigator.cancel_active()  # no robot drives on after we stop
+                    raise
         finally:
             executor.shutdown()
             node.destroy_node()
-            spinner.join(timeout=5.0)
     finally:
         context.try_shutdown()
