@@ -327,3 +327,23 @@ def test_the_recorder_stops_with_sigint_and_waits_for_the_closed_bag(
     assert overrides == qos_overrides(TOPICS) and list(overrides) == ["/tf_static"]
     with pytest.raises(RosGraphError, match="exists"):
         Ros2Recorder(bag, TOPICS).start()
+
+
+def test_a_recorder_that_fails_to_start_is_named_with_its_log(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A stand-in ``ros2`` that fails as Humble's does without the MCAP storage plugin."""
+    tools = tmp_path / "bin"
+    tools.mkdir()
+    (tools / "ros2").write_text("#!/bin/sh\necho \"storage plugin 'mcap' is not available\" >&2\nexit 1\n")
+    (tools / "ros2").chmod(0o755)
+    monkeypatch.setenv("PATH", f"{tools}{os.pathsep}{os.environ['PATH']}")
+    monkeypatch.setenv("ROS_DISTRO", "humble")
+    recorder = Ros2Recorder(tmp_path / "run_1", ["/tf"])
+    recorder.start()
+    assert recorder.process is not None and recorder.process.wait(10) == 1
+    with pytest.raises(RosGraphError, match=r"not running \(exit 1\).*run_1\.record\.log"):
+        recorder.check_running()
+    assert "'mcap' is not available" in recorder.log.read_text()
+    with pytest.raises(RosGraphError, match="ended early"):
+        recorder.stop()

@@ -167,12 +167,13 @@ def wait_for_clock(executor: Any, clock: Ros2Clock, timeout: float = SERVER_WAIT
         executor.spin_once(timeout_sec=WAIT_SLICE)
 
 
-def wait_for_recorder(node: Any, executor: Any, topics: Sequence[str], timeout: float = SERVER_WAIT) -> None:
-    """Spin until the recorder (node :data:`RECORDER_NODE`) subscribes to every topic of ``topics``
-    that has a publisher, so that it misses nothing of the first goal."""
+def wait_for_recorder(node: Any, executor: Any, recorder: Ros2Recorder, timeout: float = SERVER_WAIT) -> None:
+    """Spin until the recorder (node :data:`RECORDER_NODE`) subscribes to every topic it records
+    that has a publisher, so that it misses nothing of the first goal; an error if it stopped."""
     deadline = time.monotonic() + timeout
     while True:
-        published = [t for t in topics if node.count_publishers(t) > 0]
+        recorder.check_running()
+        published = [t for t in recorder.topics if node.count_publishers(t) > 0]
         missing = [
             t
             for t in published
@@ -225,8 +226,8 @@ def execute_ros2(
             clock = Ros2Clock(node)
             wait_for_clock(executor, clock)
             navigator = Ros2Navigator(modules, executor, clients, clock)
-            with Ros2Recorder(bag, topics, use_sim_time):
-                wait_for_recorder(node, executor, topics)
+            with Ros2Recorder(bag, topics, use_sim_time) as recorder:
+                wait_for_recorder(node, executor, recorder)
                 try:
                     return dispatch(plan, navigator, clock, policy, cancelled)
                 except BaseException:

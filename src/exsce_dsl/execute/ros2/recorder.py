@@ -110,6 +110,8 @@ class Ros2Recorder:
         check_topics(topics)
         self.output, self.topics, self.use_sim_time = output, tuple(topics), use_sim_time
         self.process: subprocess.Popen[bytes] | None = None
+        self.log = output.with_name(output.name + ".record.log")
+        """What the recorder printed."""
 
     def start(self) -> None:
         distro = os.environ.get("ROS_DISTRO", "")
@@ -124,11 +126,17 @@ class Ros2Recorder:
             overrides = self.output.with_name(self.output.name + ".qos.yaml")
             overrides.write_text(yaml.safe_dump(latched, sort_keys=True), encoding="utf-8")
         command = record_command(self.output, self.topics, distro, self.use_sim_time, overrides)
-        log = self.output.with_name(self.output.name + ".record.log").open("wb")
-        with log:
+        with self.log.open("wb") as log:
             self.process = subprocess.Popen(
                 command, stdout=log, stderr=subprocess.STDOUT, start_new_session=True
             )
+
+    def check_running(self) -> None:
+        """Raise :class:`RosGraphError` if the recorder is not running (it failed to start:
+        an unknown storage, a folder it cannot write...)."""
+        if self.process is None or self.process.poll() is not None:
+            code = None if self.process is None else self.process.returncode
+            raise RosGraphError(f"ros2 bag record is not running (exit {code}): see {self.log}")
 
     def stop(self) -> Path:
         """Stop the recorder as Ctrl-C does and wait for the bag to be closed; the bag folder."""
@@ -136,7 +144,7 @@ class Ros2Recorder:
         if process is None:
             raise RosGraphError("the ROS 2 recorder was not started")
         if process.poll() is not None:
-            raise RosGraphError(f"ros2 bag record ended early (exit {process.returncode}): see its log")
+            raise RosGraphError(f"ros2 bag record ended early (exit {process.returncode}): see {self.log}")
         process.send_signal(signal.SIGINT)
         try:
             process.wait(STOP_WAIT)
