@@ -39,7 +39,7 @@ from exsce_dsl.execute.ros2 import (
 )
 from exsce_dsl.execute.ros2.nav2 import quaternion
 from exsce_dsl.lang.build import load_spec
-from exsce_dsl.model.conventions import MOVE_BASE, NAV2
+from exsce_dsl.model.conventions import METHOD, MOVE_BASE, NAV2, TopicSource
 from exsce_dsl.model.scenario import Assignment
 
 from conftest import EXAMPLES
@@ -131,10 +131,22 @@ def test_a_robot_at_the_root_and_a_robot_naming_its_actions(scenario_c) -> None:
     )
 
 
-def test_a_robot_that_takes_move_base_goals_is_refused(scenario_c) -> None:
+def test_a_robot_that_takes_move_base_or_dispatcher_goals_is_refused(scenario_c) -> None:
     robot = replace(scenario_c.robots[0], declared_signals=MOVE_BASE)
     with pytest.raises(ExsceError, match="tiago1.*move_base.*Nav2"):
         nav2_actions(robot)
+    method = replace(scenario_c.robots[0], declared_signals=METHOD)  # 'convention method'
+    with pytest.raises(ExsceError, match="tiago1.*dispatcher.*Nav2"):
+        nav2_actions(method)
+
+
+def test_a_robot_that_names_no_convention_gets_nav2s_actions(scenario_c) -> None:
+    # its type overrides its pose only: the convention is detected per bag, the navigation unsaid
+    pose_only = METHOD.overridden(
+        pose=(TopicSource("/{ns}/ground_truth"),), named=False, said=frozenset({"pose"})
+    )
+    robot = replace(scenario_c.robots[0], declared_signals=pose_only)
+    assert nav2_actions(robot).navigate_to_pose == "/tiago1/navigate_to_pose"
 
 
 def test_follow_waypoints_goals_hold_one_subtask_each(scenario_c) -> None:

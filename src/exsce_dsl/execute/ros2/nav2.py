@@ -97,10 +97,12 @@ class FollowWaypointsGoal:
 def nav2_actions(robot: Robot) -> Nav2Actions:
     """``robot``'s Nav2 actions: those its convention names (``navigation nav2 on ...``), else
     Nav2's defaults.  An action named neither ``follow_waypoints`` nor ``navigate_through_poses``
-    is taken for ``NavigateToPose``.  A robot that declares the move_base convention or the
-    method's dispatcher is refused: its stack takes other goals than Nav2's."""
+    is taken for ``NavigateToPose``.  A robot whose author names the move_base convention or the
+    method's dispatcher (as its convention or its navigation) is refused: its stack takes other
+    goals than Nav2's.  One that names none (its convention detected from each bag) gets Nav2's."""
     signals = robot.signals
-    if robot.declares_signals and signals.navigation in {Navigation.MOVE_BASE, Navigation.DISPATCHER}:
+    said = robot.declares_signals and (signals.named or "navigation" in signals.said)
+    if said and signals.navigation in {Navigation.MOVE_BASE, Navigation.DISPATCHER}:
         raise ExsceError(
             f"robot '{robot.id}' takes its goals through {signals.navigation.value}: the ROS 2 adapter "
             "sends Nav2 goals (write 'convention nav2' or 'navigation nav2' in its robot type)"
