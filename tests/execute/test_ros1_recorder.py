@@ -16,10 +16,13 @@ from rosbags.highlevel import AnyReader
 from tests.ros1_graph import Graph, Process, ros1_graph
 
 from exsce_dsl.errors import RosGraphError
+from exsce_dsl.execute.ros1 import recorder as recorder_module
 from exsce_dsl.execute.ros1.graph import free_port
 from exsce_dsl.execute.ros1.recorder import Recorder
 
-PUBLISHER = Path(__file__).resolve().parents[1] / "fixtures" / "ros1" / "counting_publisher.py"
+FIXTURES = Path(__file__).resolve().parents[1] / "fixtures" / "ros1"
+PUBLISHER = FIXTURES / "counting_publisher.py"
+CLOCK = FIXTURES / "clock_publisher.py"
 GO = "/exsce_test/go"
 RECORDED = ["/exsce_test/a", "/exsce_test/b", "/exsce_test/silent"]
 """Listed: two topics the publisher publishes, one nobody publishes."""
@@ -133,3 +136,54 @@ def test_what_record_cannot_be_given_is_refused_before_it_runs(
 ) -> None:
     with pytest.raises(RosGraphError, match=said):
         Recorder("http://127.0.0.1:1", topics, tmp_path / bag, tmp_path / "r.log")
+
+
+def test_a_missing_record_program_says_what_to_install(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(recorder_module, "RECORD_PROGRAMS", (tmp_path / "lib" / "rosbag" / "record",))
+    recorder = Recorder("http://127.0.0.1:1", RECORDED, tmp_path / "run.bag", tmp_path / "r.log")
+    with pytest.raises(RosGraphError, match=r"rosbag's record program is missing .*scripts/install-ros1"):
+        recorder.start(timeout=1)
+    assert recorder.process is None and not list(tmp_path.glob("run.bag*"))
+
+
+def test_on_simulated_time_recording_starts_with_the_clock_and_keeps_every_message(tmp_path: Path) -> None:
+    with ros1_graph(tmp_path / "ros", sim_time=True) as graph:
+        graph.run_python("clock", CLOCK, "1000", "100")
+        source = publisher(graph, count=40, hz=200)
+        bag = tmp_path / "run.bag"
+        with Recorder(graph.uri, [*RECORDED, "/clock"], bag, tmp_path / "record.log") as recorder:
+            recorder.start(timeout=30)
+            graph.set_param(GO, True)
+            graph.wait_until(
+                lambda: "published 40" in source.output(), "the publisher to finish", 30, [source]
+            )
+    recorded = numbers_and_times(bag)
+    for topic in ("/exsce_test/a", "/exsce_test/b"):
+        data, times = recorded[topic]
+        assert data == list(range(40)), topic
+        assert all(1000 <= t < 1100 for t in times), f"{topic}: log time is not the simulated clock"
+
+
+def test_on_simulated_time_without_a_clock_start_says_so(tmp_path: Path) -> None:
+    with ros1_graph(tmp_path / "ros", sim_time=True) as graph:
+        recorder = Recorder(graph.uri, RECORDED, tmp_path / "run.bag", tmp_path / "record.log")
+        with pytest.raises(
+            RosGraphError, match=r"has not opened the bag.*/use_sim_time is set and nothing publishes /clock"
+        ):
+            recorder.start(timeout=3)
+        assert recorder.process is not None and recorder.process.poll() is not None
+        assert not list(tmp_path.glob("run.bag*"))
+
+
+def numbers_and_times(bag: Path) -> dict[str, tuple[list[int], list[float]]]:
+    """Topic → the ``data`` of its UInt32 messages and their log times (s), read by rosbags."""
+    found: dict[str, tuple[list[int], list[float]]] = {}
+    with AnyReader([bag]) as reader:
+        for connection, stamp, raw in reader.messages():
+            if connection.msgtype == "std_msgs/msg/UInt32":
+                data, times = found.setdefault(connection.topic, ([], []))
+                data.append(reader.deserialize(raw, connection.msgtype).data)
+                times.append(stamp / 1e9)
+    return found

@@ -137,17 +137,22 @@ class Recorder:
             if time.monotonic() > deadline:
                 listed = ", ".join(lacking)
                 raise RosGraphError(
-                    f"rosbag record did not receive {listed} within {timeout:g} s:\n{self._log_tail()}"
+                    f"rosbag record did not receive {listed} within {timeout:g} s{_no_clock(master)}:\n"
+                    f"{self._log_tail()}"
                 )
             time.sleep(POLL)
 
     def _not_receiving(self, master: Master) -> list[str]:
-        """The listed topics that ``record`` does not receive yet (all of them until its node is
-        registered; those it does not subscribe to; those a publisher has no connection to it for)."""
+        """What ``record`` does not receive yet: every listed topic until its node is registered;
+        those it does not subscribe to; those a publisher has no connection to it for; and
+        anything until it has opened the bag (it waits for a valid time first: on simulated time,
+        for the first ``/clock``, and drops what comes before)."""
         if master.lookup_node(self.node) is None:
             return list(self.topics)
         subscribed = master.subscribers()
         lacking = [t for t in self.topics if self.node not in subscribed.get(t, set())]
+        if not self.active.exists():
+            lacking.append("anything (it has not opened the bag)")
         publishers = master.publishers()
         connected: dict[str, set[str] | None] = {}
         for topic in self.topics:
@@ -227,6 +232,16 @@ def _outbound(master: Master, publisher: str, subscriber: str) -> set[str] | Non
     if code != 1:
         return None
     return {str(c[4]) for c in connections if len(c) > 4 and c[2] == "o" and c[1] == subscriber}
+
+
+def _no_clock(master: Master) -> str:
+    """Why ``record`` may wait for ever: the graph runs on simulated time and has no clock."""
+    try:
+        simulated = master.has_param("/use_sim_time") and bool(master.get_param("/use_sim_time"))
+        clockless = simulated and "/clock" not in master.publishers()
+    except RosGraphError:
+        return ""
+    return " (/use_sim_time is set and nothing publishes /clock)" if clockless else ""
 
 
 class _Patient(xmlrpc.client.Transport):
