@@ -4,13 +4,14 @@
 that script forwards the signal and then raises at once, while ``record`` is still closing the
 bag) in a process group of its own, so that Ctrl-C in the terminal reaches exsce, which stops
 the recording in order.  :meth:`Recorder.start` returns once ``record`` receives every listed
-topic that is published now: its node is registered, it subscribes to each topic, and each
+topic that is published now: its node is registered, it subscribes to each topic, each
 publisher of a published one lists a connection to it (the publisher's own ``getBusInfo``: a
-message published after that is recorded).  :meth:`Recorder.stop` sends SIGINT and waits for
-``record`` to write the bag's index and rename ``<bag>.active`` to ``<bag>``; after a timeout it
-kills ``record``, removes the unfinished ``.active`` file and raises, saying the bag may be
-incomplete.  No ``.active`` file is ever left behind.  It records into the path the caller gives
-(a run's hidden folder, :mod:`exsce_dsl.execute.run_files`).
+message published after that is recorded), and it has opened the bag (on simulated time it waits
+for the first ``/clock`` to do so, dropping what comes before).  :meth:`Recorder.stop` sends
+SIGINT and waits for ``record`` to write the bag's index and rename ``<bag>.active`` to ``<bag>``;
+after a timeout it kills ``record``, removes the unfinished ``.active`` file and raises, saying
+the bag may be incomplete.  No ``.active`` file is ever left behind.  It records into the path
+the caller gives (a run's hidden folder, :mod:`exsce_dsl.execute.run_files`).
 """
 
 from __future__ import annotations
@@ -108,6 +109,7 @@ class Recorder:
         program = record_program()
         self.bag_path.parent.mkdir(parents=True, exist_ok=True)
         self.log.parent.mkdir(parents=True, exist_ok=True)
+        self._removed_active()  # an earlier try's: its presence says when this record has opened the bag
         argv = [str(program), "-O", str(self.bag_path), *self.topics, f"__name:={self.node.lstrip('/')}"]
         with self.log.open("wb") as out:
             self.process = subprocess.Popen(
