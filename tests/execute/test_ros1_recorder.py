@@ -35,6 +35,17 @@ def graph(tmp_path: Path) -> Iterator[Graph]:
         yield running
 
 
+@pytest.fixture
+def recorders() -> Iterator[list[Recorder]]:
+    """The recorders a test starts: killed after it if still running, also when it fails."""
+    started: list[Recorder] = []
+    yield started
+    for recorder in started:
+        if recorder.process is not None and recorder.process.poll() is None:
+            os.killpg(recorder.process.pid, signal.SIGKILL)
+            recorder.process.wait(5)
+
+
 def publisher(graph: Graph, count: int, hz: float) -> Process:
     """The counting publisher, up with its topics advertised at the master, not publishing yet."""
     process = graph.run_python("publisher", PUBLISHER, str(count), str(hz), GO, *PUBLISHED)
@@ -59,11 +70,12 @@ def numbers(bag: Path) -> dict[str, list[int]]:
 
 
 def test_record_holds_exactly_the_listed_topics_that_were_published_every_message(
-    graph: Graph, tmp_path: Path
+    graph: Graph, tmp_path: Path, recorders: list[Recorder]
 ) -> None:
     source = publisher(graph, count=60, hz=200)
     bag = tmp_path / "out" / "run.bag"
     recorder = Recorder(graph.uri, RECORDED, bag, tmp_path / "record.log")
+    recorders.append(recorder)
     recorder.start(timeout=30)
     subscribed = {t for t, nodes in graph.system_state().subscribers.items() if recorder.node in nodes}
     assert subscribed == set(RECORDED)
@@ -77,10 +89,13 @@ def test_record_holds_exactly_the_listed_topics_that_were_published_every_messag
         assert {c.msgtype for c in reader.connections} == {"std_msgs/msg/UInt32"}
 
 
-def test_a_bag_stopped_while_messages_flow_is_whole(graph: Graph, tmp_path: Path) -> None:
+def test_a_bag_stopped_while_messages_flow_is_whole(
+    graph: Graph, tmp_path: Path, recorders: list[Recorder]
+) -> None:
     publisher(graph, count=0, hz=500)
     bag = tmp_path / "run.bag"
     with Recorder(graph.uri, RECORDED, bag, tmp_path / "record.log") as recorder:
+        recorders.append(recorder)
         recorder.start(timeout=30)
         graph.set_param(GO, True)
         graph.wait_until(
@@ -96,10 +111,11 @@ def test_a_bag_stopped_while_messages_flow_is_whole(graph: Graph, tmp_path: Path
 
 
 def test_a_record_that_does_not_close_is_killed_and_leaves_no_active_file(
-    graph: Graph, tmp_path: Path
+    graph: Graph, tmp_path: Path, recorders: list[Recorder]
 ) -> None:
     bag = tmp_path / "run.bag"
     recorder = Recorder(graph.uri, RECORDED, bag, tmp_path / "record.log")
+    recorders.append(recorder)
     recorder.start(timeout=30)
     assert recorder.process is not None
     graph.wait_until(recorder.active.exists, "the bag to be opened", 10)
@@ -112,8 +128,11 @@ def test_a_record_that_does_not_close_is_killed_and_leaves_no_active_file(
     assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith("run.bag")) == []
 
 
-def test_no_master_is_an_error_and_record_is_not_left_running(tmp_path: Path) -> None:
+def test_no_master_is_an_error_and_record_is_not_left_running(
+    tmp_path: Path, recorders: list[Recorder]
+) -> None:
     recorder = Recorder(f"http://127.0.0.1:{free_port()}", RECORDED, tmp_path / "run.bag", tmp_path / "r.log")
+    recorders.append(recorder)
     with pytest.raises(RosGraphError, match="no ROS master answers"):
         recorder.start(timeout=2)
     assert recorder.process is not None and recorder.process.poll() is not None
@@ -139,21 +158,25 @@ def test_what_record_cannot_be_given_is_refused_before_it_runs(
 
 
 def test_a_missing_record_program_says_what_to_install(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, recorders: list[Recorder]
 ) -> None:
     monkeypatch.setattr(recorder_module, "RECORD_PROGRAMS", (tmp_path / "lib" / "rosbag" / "record",))
     recorder = Recorder("http://127.0.0.1:1", RECORDED, tmp_path / "run.bag", tmp_path / "r.log")
+    recorders.append(recorder)
     with pytest.raises(RosGraphError, match=r"rosbag's record program is missing .*scripts/install-ros1"):
         recorder.start(timeout=1)
     assert recorder.process is None and not list(tmp_path.glob("run.bag*"))
 
 
-def test_on_simulated_time_recording_starts_with_the_clock_and_keeps_every_message(tmp_path: Path) -> None:
+def test_on_simulated_time_recording_starts_with_the_clock_and_keeps_every_message(
+    tmp_path: Path, recorders: list[Recorder]
+) -> None:
     with ros1_graph(tmp_path / "ros", sim_time=True) as graph:
         graph.run_python("clock", CLOCK, "1000", "100")
         source = publisher(graph, count=40, hz=200)
         bag = tmp_path / "run.bag"
         with Recorder(graph.uri, [*RECORDED, "/clock"], bag, tmp_path / "record.log") as recorder:
+            recorders.append(recorder)
             recorder.start(timeout=30)
             graph.set_param(GO, True)
             graph.wait_until(
@@ -166,9 +189,10 @@ def test_on_simulated_time_recording_starts_with_the_clock_and_keeps_every_messa
         assert all(1000 <= t < 1100 for t in times), f"{topic}: log time is not the simulated clock"
 
 
-def test_on_simulated_time_without_a_clock_start_says_so(tmp_path: Path) -> None:
+def test_on_simulated_time_without_a_clock_start_says_so(tmp_path: Path, recorders: list[Recorder]) -> None:
     with ros1_graph(tmp_path / "ros", sim_time=True) as graph:
         recorder = Recorder(graph.uri, RECORDED, tmp_path / "run.bag", tmp_path / "record.log")
+        recorders.append(recorder)
         with pytest.raises(
             RosGraphError, match=r"has not opened the bag.*/use_sim_time is set and nothing publishes /clock"
         ):
