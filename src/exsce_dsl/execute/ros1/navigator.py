@@ -52,7 +52,9 @@ def move_base_actions(scenario: Scenario) -> dict[str, str]:
     for robot in scenario.robots:
         signals = robot.signals
         if signals.navigation is Navigation.NAV2:
-            raise RosGraphError(f"robot '{robot.id}' navigates with Nav2 (ROS 2): ROS 1 sends move_base goals")
+            raise RosGraphError(
+                f"robot '{robot.id}' navigates with Nav2 (ROS 2); ROS 1 sends move_base goals"
+            )
         pattern = signals.actions[0] if signals.navigation is Navigation.MOVE_BASE else MOVE_BASE_ACTION
         name = topic_name(pattern, robot.namespace)
         if not _NAME.match(name):
@@ -74,7 +76,8 @@ class DispatcherNode:
         ros_home: Path | None = None,
     ) -> None:
         args = ["--actions", json.dumps(dict(actions)), "--server-timeout", f"{server_timeout:g}"]
-        self.channel = NodeChannel("dispatcher", [*args, "--prov-topic", prov_topic], master_uri, log, ros_home)
+        args += ["--prov-topic", prov_topic]
+        self.channel = NodeChannel("dispatcher", args, master_uri, log, ros_home)
         self.pending: deque[Message] = deque()
         self._ids = count(1)
         try:
@@ -98,7 +101,8 @@ class DispatcherNode:
             if message.get("event") == reply and message.get("id") == ident:
                 return message
             self.pending.append(message)
-        raise RosGraphError(f"the dispatcher node did not answer '{command.get('command')}' within {REPLY_TIMEOUT:g} s")
+        what = command.get("command")
+        raise RosGraphError(f"the dispatcher node did not answer '{what}' within {REPLY_TIMEOUT:g} s")
 
     def next_event(self, timeout: float) -> Message | None:
         """The next event not asked for, waiting at most ``timeout`` wall seconds."""

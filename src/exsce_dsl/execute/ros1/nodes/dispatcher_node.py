@@ -79,7 +79,7 @@ def move_base_goal(pose):
 
 class Dispatcher:
     def __init__(self, actions, prov_topic):
-        self.clients = {robot: actionlib.ActionClient(name, MoveBaseAction) for robot, name in actions.items()}
+        self.clients = {r: actionlib.ActionClient(name, MoveBaseAction) for r, name in actions.items()}
         self.actions = actions
         self.prov = rospy.Publisher(prov_topic, String, queue_size=1, latch=True)
         self.lock = threading.RLock()  # held while sending: a fast end waits for the handle
