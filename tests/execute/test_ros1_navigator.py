@@ -13,6 +13,7 @@ from dataclasses import replace
 from pathlib import Path
 
 import pytest
+from ros1_graph import Graph, ros1_graph
 
 from exsce_dsl.errors import RosGraphError
 from exsce_dsl.execute.dispatcher import dispatch
@@ -23,7 +24,6 @@ from exsce_dsl.lang.build import load_spec
 from exsce_dsl.model import MissionType
 
 from conftest import EXAMPLES
-from ros1_graph import Graph, ros1_graph
 
 SERVER = Path(__file__).resolve().parents[1] / "fixtures" / "ros1" / "move_base_server.py"
 # environment.exsce, by hand: x, y, yaw in degrees
