@@ -28,7 +28,7 @@ from exsce_dsl.errors import ExsceError
 from exsce_dsl.lang.occupancy import OccupancyGrid, load_occupancy_grid
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.conventions import Signals
-from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Bag, Run, TaskExecution
+from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Bag, Run, TaskExecution, run_name
 from exsce_dsl.parallel.cluster import cluster_mapper
 from exsce_dsl.prov import serialize_prov
 from exsce_dsl.prov.run import compile_run
@@ -182,7 +182,7 @@ def play_run(plan: RunPlan, index: int, grid: PlanningGrid | None = None) -> Sim
     )
     grid = planning_grid(scenario) if grid is None else grid
     execution = execute(scenario, grid, run_seed, plan.faults)
-    name = f"{start.strftime('%Y-%m-%dT%H-%M-%S')}_{scenario.id}_run-{run_id[:8]}"
+    name = run_name(start, scenario.id, run_id)
     bag_name = name + ".bag" if plan.fmt == "ros1" else name
     partial = plan.out_dir / f".{name}.partial"  # the run's own: a retry clears what a killed try left
     _remove(partial)
