@@ -21,13 +21,12 @@ from typing import Any
 from exsce_dsl.errors import RosGraphError
 from exsce_dsl.execute.navigator import Finished
 from exsce_dsl.execute.outcomes import Outcome
+from exsce_dsl.execute.recording import PROV_TOPIC
 from exsce_dsl.execute.ros1.channel import Message, NodeChannel
 from exsce_dsl.model import Pose, Scenario
 from exsce_dsl.model.conventions import Navigation
 from exsce_dsl.model.metrics import topic_name
 
-PROV_TOPIC = "/exsce/prov"
-"""Where the dispatcher publishes the run-time PROV (``std_msgs/String``, PROV-JSON, latched)."""
 MOVE_BASE_ACTION = "/{ns}/move_base"
 STARTUP = 30.0
 """Wall seconds the node may take to start (rospy's imports, registering with the master) on
