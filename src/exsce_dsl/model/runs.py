@@ -37,6 +37,17 @@ class ActionStatus(enum.Enum):
     ABORTED = "ABORTED"
 
 
+class RunStatus(enum.Enum):
+    """How the mission of a run ended."""
+
+    COMPLETED = "completed"
+    """Every robot worked through its tasks (some goals may have been aborted and skipped)."""
+    STOPPED = "stopped"
+    """A failed goal stopped the mission: the goals after it were never sent."""
+    CANCELLED = "cancelled"
+    """The mission was cancelled (Ctrl-C, SIGTERM) before it completed."""
+
+
 class MetricScope(enum.Enum):
     """What a metric value covers."""
 
@@ -74,6 +85,17 @@ class Action:
     """When the goal became active."""
     end: datetime.datetime | None = None
     """When the goal reached its final status."""
+    outcome: str | None = None
+    """Why an ABORTED goal ended when its stack did not abort it: ``rejected``, ``timed out`` (the
+    dispatcher cancelled it) or ``cancelled`` (the mission was); None otherwise."""
+    attempts: int = 1
+    """How many times the goal was sent (a retried goal: 2)."""
+
+    def __post_init__(self) -> None:
+        if self.outcome is not None and self.status is not ActionStatus.ABORTED:
+            raise ExsceError(f"action {self.id} {self.outcome} cannot have status {self.status.value}")
+        if self.attempts < 1:
+            raise ExsceError(f"action {self.id} was sent {self.attempts} times: at least once")
 
     @property
     def robot(self) -> str:
@@ -190,6 +212,8 @@ class Run:
     """Which clock each of the bag's sources was timed by (the run's timeline)."""
     conventions: tuple[tuple[str, str, tuple[str, ...]], ...] = ()
     """(robot, convention, the topics it was detected from) of robots whose type names none."""
+    status: RunStatus = RunStatus.COMPLETED
+    """Whether the mission completed; a cancelled or stopped run is incomplete."""
 
     def actions(self) -> Iterator[Action]:
         for task in self.tasks:
