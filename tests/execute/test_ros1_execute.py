@@ -94,8 +94,9 @@ def test_a_missing_action_server_exits_2_naming_it_and_leaves_no_bag(
     assert not list(tmp_path.rglob("*.bag*"))
 
 
-def test_sigint_mid_mission_cancels_the_goals_and_keeps_the_run_apart(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+def test_an_interruption_mid_mission_cancels_the_goals_and_keeps_the_run_apart(
+    sig: signal.Signals, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     out = tmp_path / "live"
     log = tmp_path / "goals.jsonl"
@@ -122,7 +123,7 @@ def test_sigint_mid_mission_cancels_the_goals_and_keeps_the_run_apart(
                 )
                 time.sleep(0.05)
             time.sleep(0.3)
-            execute.send_signal(signal.SIGINT)
+            execute.send_signal(sig)
             _, stderr = execute.communicate(timeout=60)
         finally:
             if execute.poll() is None:
@@ -140,3 +141,32 @@ def test_sigint_mid_mission_cancels_the_goals_and_keeps_the_run_apart(
     with Reader(bag) as reader:  # closed: it has its index
         assert "/exsce/prov" in {c.topic for c in reader.connections}
     assert "cancelled" in bag.with_suffix(".prov.json").read_text()
+
+
+def test_verify_ingests_the_recorded_bag_and_judges_it_as_verify_does(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A baseline from three simulated runs (about 120 s of mission); the test server ends each
+    goal after 0.2 s, so the live run's durations fail their oracles, while each robot's three
+    goals SUCCEEDED (read from move_base's recorded result topic) pass waypoints_visited."""
+    monkeypatch.chdir(tmp_path)
+    assert run_exscec("simulate", SPEC, "--runs", "3", "-o", "sim").returncode == 0
+    assert (
+        run_exscec(
+            "ingest", *map(str, sorted((tmp_path / "sim").glob("*.bag"))), "--scenario", SPEC
+        ).returncode
+        == 0
+    )
+    assert run_exscec("baseline", SPEC).returncode == 0
+    with ros1_graph(tmp_path / "ros", sim_time=False) as graph:
+        on_graph(graph, monkeypatch)
+        start_server(graph, tmp_path / "goals.jsonl", "tiago1,tiago2", "--duration", "0.2")
+        done = run_exscec("execute", SPEC, "--ros1", "-o", "live", "--verify", "--junit", "verdicts.xml")
+    assert done.returncode == 1, done.stderr
+    rows = {line.split()[1]: line for line in done.stdout.splitlines() if line.strip()}
+    for robot in ("tiago1", "tiago2"):
+        assert rows[f"{robot}-waypoints_visited"].split()[3:5] == ["3", "3"]
+        assert "pass" in rows[f"{robot}-waypoints_visited"]
+        assert "FAIL" in rows[f"{robot}-task_duration"]
+    assert "FAIL" in rows["mission_duration"]
+    assert "<failure" in (tmp_path / "verdicts.xml").read_text()
