@@ -273,11 +273,16 @@ class ExecutionInterrupted(ExsceError):
     """A run on a live graph was cut short (Ctrl-C, SIGTERM): its goals were cancelled and its
     files kept apart from the whole runs (``execute``); the CLI exits 130."""
 
-    def __init__(self, incomplete: Path, complete: Sequence[Path] = ()) -> None:
-        super().__init__(
-            f"interrupted: the goals were cancelled; the run cut short is kept apart in {incomplete.parent} "
-            f"({incomplete.name}, its .prov.json and .rosparams), which ingest DIR/*.bag does not take"
-        )
+    def __init__(self, incomplete: Path | None, complete: Sequence[Path] = ()) -> None:
+        if incomplete is None:
+            said = "interrupted before the run began: no goal was sent and no bag written"
+        else:
+            said = (
+                f"interrupted: the goals were cancelled; the run cut short is kept apart in "
+                f"{incomplete.parent} ({incomplete.name}, its .prov.json and .rosparams), where "
+                "ingest DIR/*.bag does not take it"
+            )
+        super().__init__(said)
         self.incomplete = incomplete
         self.complete = tuple(complete)
 

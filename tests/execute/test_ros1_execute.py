@@ -54,29 +54,31 @@ def test_a_run_leaves_the_methods_three_files_and_its_prov_is_in_the_bag(
         start_server(
             graph, tmp_path / "goals.jsonl", "tiago1,tiago2", "--duration", "0.2", "--aborts", "tiago2:2"
         )
-        done = run_exscec("execute", SPEC, "--ros1", "-o", str(out), timeout=90)
+        done = run_exscec("execute", SPEC, "--ros1", "-o", str(out), "--runs", "2", timeout=90)
     assert done.returncode == 0, done.stderr
     names = everything_under(out)
-    assert len(names) == 3, names
+    assert len(names) == 6, names
     stems = {n.split(".")[0] for n in names}
-    assert len(stems) == 1 and RUN_NAME.match(stems.pop()), names
-    bag = next(out.glob("*.bag"))
-    assert sorted(p.name[len(bag.stem) :] for p in out.glob(bag.stem + ".*")) == [
-        ".bag",
-        ".prov.json",
-        ".rosparams",
-    ]
-    assert "5 succeeded" in done.stderr and "1 aborted" in done.stderr
-    with Reader(bag) as reader:
-        prov = [c for c in reader.connections if c.topic == "/exsce/prov"]
-        assert [c.msgtype for c in prov] == ["std_msgs/msg/String"]
-        store = get_typestore(Stores.ROS1_NOETIC)
-        texts = [
-            store.deserialize_ros1(raw, "std_msgs/msg/String").data for _, _, raw in reader.messages(prov)
+    assert len(stems) == 2 and all(RUN_NAME.match(s) for s in stems), names
+    for stem in stems:
+        assert sorted(p.name[len(stem) :] for p in out.glob(stem + ".*")) == [
+            ".bag",
+            ".prov.json",
+            ".rosparams",
         ]
-    assert texts == [bag.with_suffix(".prov.json").read_text()]
-    parameters = yaml.safe_load(bag.with_suffix(".rosparams").read_text())
-    assert "scenario" in parameters
+    assert done.stderr.count("(mission completed: 1 aborted, 5 succeeded)") == 1  # tiago2's 2nd goal, once
+    assert done.stderr.count("(mission completed: 6 succeeded)") == 1
+    store = get_typestore(Stores.ROS1_NOETIC)
+    for bag in out.glob("*.bag"):  # each bag holds its own run's PROV, once (not the run before's)
+        with Reader(bag) as reader:
+            prov = [c for c in reader.connections if c.topic == "/exsce/prov"]
+            assert [c.msgtype for c in prov] == ["std_msgs/msg/String"]
+            texts = [
+                store.deserialize_ros1(raw, "std_msgs/msg/String").data for _, _, raw in reader.messages(prov)
+            ]
+        assert texts == [bag.with_suffix(".prov.json").read_text()]
+        parameters = yaml.safe_load(bag.with_suffix(".rosparams").read_text())
+        assert "scenario" in parameters
 
 
 def test_a_missing_action_server_exits_2_naming_it_and_leaves_no_bag(
@@ -170,3 +172,18 @@ def test_verify_ingests_the_recorded_bag_and_judges_it_as_verify_does(
         assert "FAIL" in rows[f"{robot}-task_duration"]
     assert "FAIL" in rows["mission_duration"]
     assert "<failure" in (tmp_path / "verdicts.xml").read_text()
+
+
+def test_interrupted_before_the_run_began_sends_nothing_and_writes_no_bag(tmp_path: Path) -> None:
+    """From Python: ``execute_ros1`` with ``interrupted`` already saying yes."""
+    from exsce_dsl.api import execute_ros1, load
+    from exsce_dsl.errors import ExecutionInterrupted
+
+    log = tmp_path / "goals.jsonl"
+    with ros1_graph(tmp_path / "ros", sim_time=False) as graph:
+        start_server(graph, log, "tiago1,tiago2")
+        with pytest.raises(ExecutionInterrupted) as stop:
+            execute_ros1(load(SPEC), tmp_path / "live", master_uri=graph.uri, interrupted=lambda: True)
+    assert stop.value.incomplete is None and stop.value.complete == ()
+    assert seen(log) == []
+    assert not list(tmp_path.rglob("*.bag*"))

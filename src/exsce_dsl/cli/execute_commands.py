@@ -115,7 +115,8 @@ def execute(
         )
     except ExecutionInterrupted as stop:
         click.echo(f"error: {stop.message}", err=True)
-        click.echo(f"kept apart: {stop.incomplete}", err=True)
+        if stop.incomplete is not None:
+            click.echo(f"kept apart: {stop.incomplete}", err=True)
         for bag in stop.complete:
             click.echo(f"wrote {bag}", err=True)
         sys.exit(ExitCode.INTERRUPTED)

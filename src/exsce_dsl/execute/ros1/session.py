@@ -3,8 +3,8 @@
 For each run: the scenario goes on the parameter server; ``rosbag record`` starts on the run's
 topics (:func:`~exsce_dsl.execute.recording.recorded_topics`) into the run's hidden folder and
 returns once it receives them; the mission core dispatches the schedule through the dispatcher
-node (started once, before the first recording: a missing action server stops everything before
-any bag exists); the run-time PROV is published on the PROV topic (recorded) and written to
+node (started for each run before its recording, so that a missing action server stops the run
+before any bag exists, and the PROV latched for one run never reaches the next one's bag); the run-time PROV is published on the PROV topic (recorded) and written to
 ``.prov.json``; the recorder is stopped (the bag closed); the parameters are dumped to
 ``.rosparams``; then the three files are moved into place, the bag last.
 
@@ -118,28 +118,24 @@ def execute_runs(
     logs = out / LOGS
     logs.mkdir(parents=True, exist_ok=True)
     plan = schedule(scenario, options.speeds, options.timeout)
-    node = DispatcherNode(
-        move_base_actions(scenario), master_uri, logs / "dispatcher.log", options.server_timeout, PROV_TOPIC
-    )
+    move_base_actions(scenario)  # a robot ROS 1 cannot send goals to: before anything starts
     done: list[ExecutedRun] = []
-    try:
-        for _ in range(runs):
-            run = _one_run(scenario, master, node, out, plan, options.policy, interrupted)
-            done.append(run)
-            if not run.complete:
-                raise ExecutionInterrupted(run.files.bag, [r.files.bag for r in done[:-1]])
-    finally:
-        node.close()
+    for _ in range(runs):
+        if interrupted is not None and interrupted():
+            raise ExecutionInterrupted(None, [r.files.bag for r in done])
+        run = _one_run(scenario, master, out, plan, options, interrupted)
+        done.append(run)
+        if not run.complete:
+            raise ExecutionInterrupted(run.files.bag, [r.files.bag for r in done[:-1]])
     return done
 
 
 def _one_run(
     scenario: Scenario,
     master: Master,
-    node: DispatcherNode,
     out: Path,
     plan: Schedule,
-    policy: Policy,
+    options: Options,
     interrupted: Callable[[], bool] | None,
 ) -> ExecutedRun:
     run_id = str(uuid.uuid4())
@@ -149,11 +145,18 @@ def _one_run(
     try:
         load_scenario(master, scenario)
         with ExitStack() as stack:
-            log = out / LOGS / f"record-{run_id[:8]}.log"
-            recorder = stack.enter_context(Recorder(master.uri, recorded_topics(scenario), staged.bag, log))
+            # a node per run: its latched PROV must not reach the next run's bag
+            logs = out / LOGS
+            actions = move_base_actions(scenario)
+            node = DispatcherNode(
+                actions, master.uri, logs / f"dispatcher-{run_id[:8]}.log", options.server_timeout, PROV_TOPIC
+            )
+            stack.callback(node.close)
+            bag, log = staged.bag, logs / f"record-{run_id[:8]}.log"
+            recorder = stack.enter_context(Recorder(master.uri, recorded_topics(scenario), bag, log))
             recorder.start()
             navigator = Ros1Navigator(node, interrupted)
-            mission = dispatch(plan, navigator, RosClock(node), policy, interrupted)
+            mission = dispatch(plan, navigator, RosClock(node), options.policy, interrupted)
             prov = mission_prov_json(mission, scenario, run_id, start, files.bag.name)
             staged.prov.write_text(prov, encoding="utf-8")
             node.publish(prov)
