@@ -93,10 +93,15 @@ def execute(
     run in DIR/incomplete/ (its PROV says cancelled), where DIR/*.bag does not
     reach it; the exit status is 130.
 
+    On your robot's graph (roscore and each robot's move_base up, and
+    $ROS_MASTER_URI exported), three judged runs are
+    exscec execute SPEC --ros1 --runs 3 --verify --junit verdicts.xml.
+
     \b
     Example:
-      exscec execute examples/brsu_building_c/scenario_c.exsce --ros1 --start-master \\
-          --server-timeout 1 -o live/  # exits 2: no robot's move_base answers
+      exscec execute examples/brsu_building_c/scenario_c.exsce --ros1 --start-master --runs 3 \\
+          --policy retry-once --verify --junit verdicts.xml --server-timeout 1 \\
+          -o live/  # exits 2: no robot's move_base answers
     """
     from exsce_dsl.api.execution import execute_ros1
     from exsce_dsl.errors import ExecutionInterrupted

@@ -1,10 +1,11 @@
 """N runs of a scenario on a live ROS 1 graph, each leaving the method's three files.
 
-For each run: the scenario goes on the parameter server; ``rosbag record`` starts on the run's
-topics (:func:`~exsce_dsl.execute.recording.recorded_topics`) into the run's hidden folder and
-returns once it receives them; the mission core dispatches the schedule through the dispatcher
-node (started for each run before its recording, so that a missing action server stops the run
-before any bag exists, and the PROV latched for one run never reaches the next one's bag); the run-time PROV is published on the PROV topic (recorded) and written to
+For each run: the scenario goes on the parameter server; the dispatcher node starts (one per
+run, before the recording: a missing action server stops the run before any bag exists, and
+the PROV latched for one run never reaches the next one's bag); ``rosbag record`` starts on the
+run's topics (:func:`~exsce_dsl.execute.recording.recorded_topics`) into the run's hidden
+folder and returns once it receives them; the mission core dispatches the schedule through the
+node; the run-time PROV is published on the PROV topic (recorded) and written to
 ``.prov.json``; the recorder is stopped (the bag closed); the parameters are dumped to
 ``.rosparams``; then the three files are moved into place, the bag last.
 
