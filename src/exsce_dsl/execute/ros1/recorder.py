@@ -4,13 +4,14 @@
 that script forwards the signal and then raises at once, while ``record`` is still closing the
 bag) in a process group of its own, so that Ctrl-C in the terminal reaches exsce, which stops
 the recording in order.  :meth:`Recorder.start` returns once ``record`` receives every listed
-topic that is published now: its node is registered, it subscribes to each topic, and each
+topic that is published now: its node is registered, it subscribes to each topic, each
 publisher of a published one lists a connection to it (the publisher's own ``getBusInfo``: a
-message published after that is recorded).  :meth:`Recorder.stop` sends SIGINT and waits for
-``record`` to write the bag's index and rename ``<bag>.active`` to ``<bag>``; after a timeout it
-kills ``record``, removes the unfinished ``.active`` file and raises, saying the bag may be
-incomplete.  No ``.active`` file is ever left behind.  It records into the path the caller gives
-(a run's hidden folder, :mod:`exsce_dsl.execute.run_files`).
+message published after that is recorded), and it has opened the bag (on simulated time it waits
+for the first ``/clock`` to do so, dropping what comes before).  :meth:`Recorder.stop` sends
+SIGINT and waits for ``record`` to write the bag's index and rename ``<bag>.active`` to ``<bag>``;
+after a timeout it kills ``record``, removes the unfinished ``.active`` file and raises, saying
+the bag may be incomplete.  No ``.active`` file is ever left behind.  It records into the path
+the caller gives (a run's hidden folder, :mod:`exsce_dsl.execute.run_files`).
 """
 
 from __future__ import annotations
@@ -108,6 +109,7 @@ class Recorder:
         program = record_program()
         self.bag_path.parent.mkdir(parents=True, exist_ok=True)
         self.log.parent.mkdir(parents=True, exist_ok=True)
+        self._removed_active()  # an earlier try's: its presence says when this record has opened the bag
         argv = [str(program), "-O", str(self.bag_path), *self.topics, f"__name:={self.node.lstrip('/')}"]
         with self.log.open("wb") as out:
             self.process = subprocess.Popen(
@@ -137,17 +139,22 @@ class Recorder:
             if time.monotonic() > deadline:
                 listed = ", ".join(lacking)
                 raise RosGraphError(
-                    f"rosbag record did not receive {listed} within {timeout:g} s:\n{self._log_tail()}"
+                    f"rosbag record did not receive {listed} within {timeout:g} s{_no_clock(master)}:\n"
+                    f"{self._log_tail()}"
                 )
             time.sleep(POLL)
 
     def _not_receiving(self, master: Master) -> list[str]:
-        """The listed topics that ``record`` does not receive yet (all of them until its node is
-        registered; those it does not subscribe to; those a publisher has no connection to it for)."""
+        """What ``record`` does not receive yet: every listed topic until its node is registered;
+        those it does not subscribe to; those a publisher has no connection to it for; and
+        anything until it has opened the bag (it waits for a valid time first: on simulated time,
+        for the first ``/clock``, and drops what comes before)."""
         if master.lookup_node(self.node) is None:
             return list(self.topics)
         subscribed = master.subscribers()
         lacking = [t for t in self.topics if self.node not in subscribed.get(t, set())]
+        if not self.active.exists():
+            lacking.append("anything (it has not opened the bag)")
         publishers = master.publishers()
         connected: dict[str, set[str] | None] = {}
         for topic in self.topics:
@@ -227,6 +234,16 @@ def _outbound(master: Master, publisher: str, subscriber: str) -> set[str] | Non
     if code != 1:
         return None
     return {str(c[4]) for c in connections if len(c) > 4 and c[2] == "o" and c[1] == subscriber}
+
+
+def _no_clock(master: Master) -> str:
+    """Why ``record`` may wait for ever: the graph runs on simulated time and has no clock."""
+    try:
+        simulated = master.has_param("/use_sim_time") and bool(master.get_param("/use_sim_time"))
+        clockless = simulated and "/clock" not in master.publishers()
+    except RosGraphError:
+        return ""
+    return " (/use_sim_time is set and nothing publishes /clock)" if clockless else ""
 
 
 class _Patient(xmlrpc.client.Transport):
