@@ -40,10 +40,11 @@ def execute_ros1(
     (``master_uri``, else ``$ROS_MASTER_URI``; ``start_master``: a roscore of our own, stopped at
     the end), each run leaving ``<date>_<scenario>_run-<id>.bag``, ``.prov.json`` and
     ``.rosparams`` in ``out_dir``.  Failed goals go to ``policy`` (``skip-waypoint``,
-    ``retry-once``, ``skip-task``, ``stop-mission``); ``timeout`` (ROS seconds) replaces every
-    goal's default timeout.  Ctrl-C and SIGTERM (or ``interrupted()`` saying yes, when given)
-    cancel the goals and raise :class:`~exsce_dsl.errors.ExecutionInterrupted`, the run cut short
-    kept in ``out_dir/incomplete``.  A missing action server is a
+    ``retry-once``, ``skip-task``, ``stop-mission``); ``timeout`` (ROS seconds) is the timeout of
+    the goals whose task and mission give none (else one from the distance and speed limit).
+    Ctrl-C and SIGTERM (or ``interrupted()`` saying yes, when given) cancel the goals and raise
+    :class:`~exsce_dsl.errors.ExecutionInterrupted`, the run cut short kept in
+    ``out_dir/incomplete``.  A missing action server is a
     :class:`~exsce_dsl.errors.RosGraphError` naming it, after ``server_timeout`` wall seconds."""
     chosen = spec if isinstance(spec, Scenario) else spec.scenario(scenario)
     out = Path(out_dir)

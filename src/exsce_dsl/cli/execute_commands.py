@@ -56,7 +56,8 @@ POLICIES = ("skip-waypoint", "retry-once", "skip-task", "stop-mission")
     "--goal-timeout",
     type=click.FloatRange(min=0, min_open=True),
     metavar="S",
-    help="ROS seconds a goal may take [default: 3x the straight line at the speed limit, at least 60].",
+    help="ROS seconds a goal may take when its task and mission say no 'timeout' "
+    "[default: 3x the straight line at the speed limit, at least 60].",
 )
 @click.option("--verify", "judge", is_flag=True, help="Ingest each run's bag and judge it, as exscec verify.")
 @click.option("--junit", type=click.Path(dir_okay=False), help="With --verify: a JUnit XML report.")
