@@ -542,7 +542,7 @@ def test_exscec_query_prints_tables_json_and_csv(store_folder: Path) -> None:
     as_csv = run_exscec("runs", "s", "-f", "csv", "--store", folder)
     assert as_csv.returncode == 0, as_csv.stderr
     lines = as_csv.stdout.splitlines()  # (CRLF, read back as text)
-    assert lines[0] == "run,scenario_id,start,end,bag,path" and lines[1].startswith(
+    assert lines[0] == "run,scenario_id,start,end,bag,path,mission_status" and lines[1].startswith(
         f"{RUN_3},s,2024-05-01T09:00:00.000,"  # one precision (no zone: none made up)
     )
     table = run_exscec("query", "robots", "-p", "scenario=s", "--store", folder)

@@ -30,10 +30,12 @@ from exsce_dsl.api.workflows import (
     simulate,
     verify,
 )
+from exsce_dsl.errors import RosGraphError
 from exsce_dsl.store.queries.run_ids import AmbiguousRunError, UnknownRunError, resolve_run
 
 __all__ = [
     "AmbiguousRunError",
+    "RosGraphError",
     "UnknownRunError",
     "add_derived",
     "baseline",
