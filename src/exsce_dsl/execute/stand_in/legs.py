@@ -1,0 +1,300 @@
+"""The stand-in's robots as this process keeps them: where each stands, and the leg of each goal.
+
+A goal arrives as a target pose; the robot's leg is planned from where it stands on the
+scenario's occupancy grid and driven with its limits, as the kinematic executor drives a leg
+(:mod:`exsce_dsl.sim.executor`), with the executor's faults (:mod:`exsce_dsl.sim.faults`):
+
+- ``overspeed``, ``slow``, ``overspeed-many-tasks``, ``overspeed-reassigned``: the robot's speed
+  limit, seeded as the executor seeds it, times :func:`~exsce_dsl.sim.faults.speed_factor`;
+- ``skip-waypoint:ROBOT[:N]``: the robot's N-th goal (counted from 1, every goal it gets) is
+  aborted after half a second, the robot standing still;
+- ``slow-area``, ``detour``: as the executor (a goal within ``MATCH`` of a pose of the scenario
+  is that pose, so its area is known);
+- ``deadlock-start``: when it holds, every robot stands ``DEADLOCK_WAIT`` s before its first goal.
+
+``near-collision`` is not played (it is a scripted drive inside the executor's mission, not an
+answer to a goal), nor the executor's giving way between robots: here the robots drive their
+legs whatever the other does.  The leg's samples (50 Hz) hold the odometry, which drifts and
+goes on from leg to leg, the localiser's estimate, the correction ``map → odom``, the velocities
+measured and commanded, and a scan every fifth sample against the map and the other robots
+where they stood, or drove, when the goal came (:mod:`exsce_dsl.sim.localisation`,
+:mod:`exsce_dsl.sim.scan`).
+"""
+
+from __future__ import annotations
+
+import base64
+import math
+import random
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from exsce_dsl.errors import ExsceError
+from exsce_dsl.model import Orientation, Pose, Position, Scenario
+from exsce_dsl.sim.faults import (
+    DEADLOCK_WAIT,
+    Fault,
+    area_boxes,
+    check_faults,
+    deadlocked,
+    detour_via,
+    slow_in_areas,
+    speed_factor,
+)
+from exsce_dsl.sim.localisation import Odometry, Poses, localise
+from exsce_dsl.sim.motion import DT, Limits, Trajectory, drive
+from exsce_dsl.sim.planner import PlanningError, PlanningGrid, Point
+from exsce_dsl.sim.scan import ROBOT_RADIUS, SCAN_EVERY, Laser, scan_ranges
+
+MATCH = 0.05
+"""Metres: a goal this close to a pose of the scenario is that pose."""
+ABORT_AFTER = 25
+"""Samples a goal the robot aborts takes (0.5 s, as the executor's ``skip-waypoint``)."""
+FIELDS = 13
+"""Values per sample sent to the node, in this order: odometry x, y, yaw; estimate x, y, yaw;
+correction x, y, yaw; measured speed and turn rate; commanded speed and turn rate."""
+
+
+@dataclass
+class Standing:
+    """Where a robot is: its true pose and its odometry's pose (``odom → base_link``)."""
+
+    truth: tuple[float, float, float]
+    odom: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    previous: Pose | None = None
+    """The last goal it reached (its start pose at first): where a leg leaves from, for ``detour``."""
+
+
+@dataclass(frozen=True)
+class Leg:
+    """One goal's drive, sample by sample (or a robot's start: one sample, no goal)."""
+
+    robot: str
+    goal: str | None
+    succeeded: bool
+    start: float
+    """Simulated seconds when the goal came."""
+    truth: Poses
+    odom: Poses
+    estimate: Poses
+    correction: Poses
+    v: np.ndarray
+    w: np.ndarray
+    command_v: np.ndarray
+    command_w: np.ndarray
+    scans: np.ndarray
+    """One row of ranges (float32) per SCAN_EVERY samples."""
+
+    def __len__(self) -> int:
+        return len(self.truth.x)
+
+    def standing(self, k: int, previous: Pose | None) -> Standing:
+        """Where the robot stands after sample ``k`` (a negative ``k`` counts from the end)."""
+        t, o = self.truth, self.odom
+        return Standing(
+            (float(t.x[k]), float(t.y[k]), float(t.yaw[k])), (float(o.x[k]), float(o.y[k]), float(o.yaw[k])), previous
+        )
+
+    def position_at(self, time: float) -> Point:
+        k = min(max(int((time - self.start) / DT), 0), len(self) - 1)
+        return float(self.truth.x[k]), float(self.truth.y[k])
+
+    def command(self) -> dict[str, Any]:
+        """The node's ``leg`` command: the arrays base64-encoded, little-endian."""
+        values = np.column_stack(
+            [
+                *(getattr(self.odom, a) for a in ("x", "y", "yaw")),
+                *(getattr(self.estimate, a) for a in ("x", "y", "yaw")),
+                *(getattr(self.correction, a) for a in ("x", "y", "yaw")),
+                self.v,
+                self.w,
+                self.command_v,
+                self.command_w,
+            ]
+        ).astype("<f8")
+        return {
+            "command": "leg",
+            "robot": self.robot,
+            "goal": self.goal,
+            "outcome": "succeeded" if self.succeeded else "aborted",
+            "samples": len(self),
+            "poses": base64.b64encode(values.tobytes()).decode("ascii"),
+            "beams": int(self.scans.shape[1]),
+            "scans": base64.b64encode(self.scans.astype("<f4").tobytes()).decode("ascii"),
+        }
+
+
+@dataclass
+class Robot:
+    name: str
+    namespace: str
+    limits: Limits
+    drift: Odometry
+    rng: np.random.Generator
+    at: Standing
+    goals: int = 0
+    """How many goals it has had."""
+    legs: dict[str, tuple[Leg, Standing]] = field(default_factory=dict)
+    """Each goal's leg and where the robot stood before it."""
+    current: Leg | None = None
+
+
+class Fleet:
+    """The scenario's robots, answering goals with legs."""
+
+    def __init__(
+        self,
+        scenario: Scenario,
+        grid: PlanningGrid,
+        seed: int = 0,
+        faults: tuple[Fault, ...] = (),
+        limits: Limits | None = None,
+        laser: Laser | None = None,
+    ) -> None:
+        check_faults(scenario, faults)
+        self.scenario, self.grid, self.faults = scenario, grid, faults
+        self.laser = laser or Laser()
+        limits = limits or Limits()
+        speeds = random.Random(seed)
+        self.robots: dict[str, Robot] = {}
+        for index, robot in enumerate(scenario.robots):
+            start = robot.start_pose
+            if start is None:
+                raise ExsceError(f"robot '{robot.id}' has no start pose: the stand-in cannot place it")
+            speed = limits.max_speed * speeds.uniform(0.9, 1.0) * speed_factor(scenario, robot.id, faults)
+            rng = np.random.default_rng([seed, index])
+            self.robots[robot.id] = Robot(
+                robot.id,
+                robot.namespace,
+                Limits(speed, limits.max_accel, limits.max_turn_rate),
+                Odometry.seeded(rng),
+                rng,
+                Standing((start.position.x, start.position.y, start.orientation.yaw), previous=start),
+            )
+        self.skip = {(f.robot, f.index) for f in faults if f.kind == "skip-waypoint"}
+        self.boxes = area_boxes(scenario, faults)
+        self.stuck = deadlocked(scenario, faults)
+        self.poses = [*scenario.environment.poses(), *(w for t in scenario.tasks for w in t.waypoints())]
+
+    def start_legs(self) -> list[Leg]:
+        """Each robot standing at its start: a leg of one sample without a goal."""
+        legs = []
+        for robot in self.robots.values():
+            x, y, yaw = robot.at.truth
+            legs.append(self._leg(robot, None, True, 0.0, Trajectory.hold(x, y, yaw, 1)))
+        return legs
+
+    def leg(self, name: str, goal: str, x: float, y: float, yaw: float, time: float) -> Leg:
+        """The leg of goal ``goal`` (target ``x, y, yaw`` in the map) that ``name`` got at ``time``."""
+        robot = self.robots.get(name)
+        if robot is None:
+            raise ExsceError(f"the stand-in has no robot '{name}'")
+        robot.goals += 1
+        target = self._pose(x, y, yaw)
+        trajectory, succeeded = self._drive(robot, target)
+        leg = self._leg(robot, goal, succeeded, time, trajectory)
+        before = robot.at
+        robot.legs[goal] = (leg, before)
+        robot.at = leg.standing(-1, target if succeeded else before.previous)
+        robot.current = leg
+        return leg
+
+    def stopped(self, name: str, goal: str, sample: int) -> None:
+        """The node stopped ``name``'s goal after the leg's ``sample`` (-1: before it moved)."""
+        robot = self.robots[name]
+        found = robot.legs.get(goal)
+        if found is None:
+            return
+        leg, before = found
+        robot.at = before if sample < 0 else leg.standing(min(sample, len(leg) - 1), before.previous)
+        robot.current = None
+
+    def _pose(self, x: float, y: float, yaw: float) -> Pose:
+        near = [p for p in self.poses if math.dist((p.position.x, p.position.y), (x, y)) <= MATCH]
+        if near:
+            found = min(near, key=lambda p: math.dist((p.position.x, p.position.y), (x, y)))
+            return found.with_orientation(Orientation(yaw=yaw))
+        return Pose("goal", Position(x, y), Orientation(yaw=yaw))
+
+    def _drive(self, robot: Robot, target: Pose) -> tuple[Trajectory, bool]:
+        x, y, yaw = robot.at.truth
+        parts = []
+        if self.stuck and robot.goals == 1:
+            parts.append(Trajectory.hold(x, y, yaw, int(round(DEADLOCK_WAIT / DT))))
+        aborted = Trajectory.concat([*parts, Trajectory.hold(x, y, yaw, ABORT_AFTER)])
+        if (robot.name, robot.goals) in self.skip:
+            return aborted, False
+        goal = (target.position.x, target.position.y)
+        via = detour_via(self.scenario, robot.name, robot.at.previous, target, self.faults)
+        try:
+            if via is None:
+                driven = drive(self.grid.plan((x, y), goal), yaw, target.orientation.yaw, robot.limits)
+            else:
+                there, on = self.grid.plan((x, y), via), self.grid.plan(via, goal)
+                heading = math.atan2(on[1][1] - on[0][1], on[1][0] - on[0][0]) if len(on) > 1 else yaw
+                driven = Trajectory.concat(
+                    [drive(there, yaw, heading, robot.limits), drive(on, heading, target.orientation.yaw, robot.limits)]
+                )
+        except PlanningError:
+            return aborted, False
+        if self.boxes:
+            driven = slow_in_areas(driven, self.boxes)
+        parts.append(driven if len(driven) else Trajectory.hold(x, y, yaw, 1))
+        return Trajectory.concat(parts), True
+
+    def _leg(self, robot: Robot, goal: str | None, succeeded: bool, time: float, trajectory: Trajectory) -> Leg:
+        x, y, yaw = robot.at.truth
+        # the leg's frames from where the robot stands (sample 0, dropped): its odometry goes on
+        frames = localise(Trajectory.concat([Trajectory.hold(x, y, yaw, 1), trajectory]), robot.rng, robot.drift)
+        n = len(trajectory)
+        ox, oy, oyaw = robot.at.odom
+        standing = Poses(np.full(n, ox), np.full(n, oy), np.full(n, oyaw))
+        odom = standing.compose(_tail(frames.odom))
+        estimate = _tail(frames.estimate)
+        idx = np.arange(0, n, SCAN_EVERY)
+        others = [
+            (np.full(len(idx), px), np.full(len(idx), py))
+            for other in self.robots.values()
+            if other is not robot
+            for px, py in [self._where(other, time)]
+        ]
+        scans = scan_ranges(
+            self.grid,
+            self.laser,
+            trajectory.x[idx],
+            trajectory.y[idx],
+            trajectory.yaw[idx],
+            others,
+            ROBOT_RADIUS,
+            robot.rng,
+        )
+        return Leg(
+            robot.name,
+            goal,
+            succeeded,
+            time,
+            Poses(trajectory.x, trajectory.y, trajectory.yaw),
+            odom,
+            estimate,
+            estimate.compose(odom.inverse()),
+            frames.v[1:],
+            frames.w[1:],
+            trajectory.v,
+            trajectory.w,
+            scans,
+        )
+
+    @staticmethod
+    def _where(robot: Robot, time: float) -> Point:
+        if robot.current is not None:
+            return robot.current.position_at(time)
+        return robot.at.truth[0], robot.at.truth[1]
+
+
+def _tail(poses: Poses) -> Poses:
+    return Poses(poses.x[1:], poses.y[1:], poses.yaw[1:])
+
+
+__all__ = ["FIELDS", "Fleet", "Leg", "Standing"]
