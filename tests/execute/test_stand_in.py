@@ -101,7 +101,9 @@ class Recorded:
             return [(t, reader.deserialize(raw, c.msgtype)) for c, t, raw in reader.messages(connections)]
 
 
-def drive(tmp_path: Path, goals: Sequence[str], faults: Sequence[str] = (), cancel_after: float | None = None) -> Recorded:
+def drive(
+    tmp_path: Path, goals: Sequence[str], faults: Sequence[str] = (), cancel_after: float | None = None
+) -> Recorded:
     """Drive the floor's rover to ``goals`` (``x,y,yaw``) and record it all."""
     spec = tmp_path / "floor.exsce"
     spec.write_text(FLOOR)
@@ -112,7 +114,9 @@ def drive(tmp_path: Path, goals: Sequence[str], faults: Sequence[str] = (), canc
         with start_stand_in(scenario, graph.uri, faults=parsed, log_dir=tmp_path / "stand_in") as stand_in:
             started = time.monotonic()
             recorder = graph.record(bag, TOPICS)
-            graph.wait_until(lambda: connected(graph.uri, "/exsce_record"), "the recorder's connections", 30.0, [recorder])
+            graph.wait_until(
+                lambda: connected(graph.uri, "/exsce_record"), "the recorder's connections", 30.0, [recorder]
+            )
             extra = ["--cancel-after", str(cancel_after)] if cancel_after is not None else []
             client = graph.run_python("client", CLIENT, stand_in.actions["rover"], *goals, *extra)
             graph.wait_until(lambda: not client.running(), "the client's goals to end", 60.0, [])

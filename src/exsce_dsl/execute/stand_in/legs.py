@@ -94,7 +94,9 @@ class Leg:
         """Where the robot stands after sample ``k`` (a negative ``k`` counts from the end)."""
         t, o = self.truth, self.odom
         return Standing(
-            (float(t.x[k]), float(t.y[k]), float(t.yaw[k])), (float(o.x[k]), float(o.y[k]), float(o.yaw[k])), previous
+            (float(t.x[k]), float(t.y[k]), float(t.yaw[k])),
+            (float(o.x[k]), float(o.y[k]), float(o.yaw[k])),
+            previous,
         )
 
     def position_at(self, time: float) -> Point:
@@ -235,7 +237,10 @@ class Fleet:
                 there, on = self.grid.plan((x, y), via), self.grid.plan(via, goal)
                 heading = math.atan2(on[1][1] - on[0][1], on[1][0] - on[0][0]) if len(on) > 1 else yaw
                 driven = Trajectory.concat(
-                    [drive(there, yaw, heading, robot.limits), drive(on, heading, target.orientation.yaw, robot.limits)]
+                    [
+                        drive(there, yaw, heading, robot.limits),
+                        drive(on, heading, target.orientation.yaw, robot.limits),
+                    ]
                 )
         except PlanningError:
             return aborted, False
@@ -244,10 +249,14 @@ class Fleet:
         parts.append(driven if len(driven) else Trajectory.hold(x, y, yaw, 1))
         return Trajectory.concat(parts), True
 
-    def _leg(self, robot: Robot, goal: str | None, succeeded: bool, time: float, trajectory: Trajectory) -> Leg:
+    def _leg(
+        self, robot: Robot, goal: str | None, succeeded: bool, time: float, trajectory: Trajectory
+    ) -> Leg:
         x, y, yaw = robot.at.truth
         # the leg's frames from where the robot stands (sample 0, dropped): its odometry goes on
-        frames = localise(Trajectory.concat([Trajectory.hold(x, y, yaw, 1), trajectory]), robot.rng, robot.drift)
+        frames = localise(
+            Trajectory.concat([Trajectory.hold(x, y, yaw, 1), trajectory]), robot.rng, robot.drift
+        )
         n = len(trajectory)
         ox, oy, oyaw = robot.at.odom
         standing = Poses(np.full(n, ox), np.full(n, oy), np.full(n, oyaw))

@@ -147,7 +147,9 @@ class StandIn:
 
     def _ended(self, message: Message, outcome: str) -> None:
         with self._lock:
-            self.ended.append(GoalEnd(str(message["robot"]), str(message["goal"]), outcome, float(message["time"])))
+            self.ended.append(
+                GoalEnd(str(message["robot"]), str(message["goal"]), outcome, float(message["time"]))
+            )
 
     def close(self) -> None:
         self._closing = True

@@ -59,8 +59,8 @@ class Leg:
     """A leg the venv computed: FIELDS values per sample, a scan every SCAN_EVERY samples."""
 
     def __init__(self, command: Dict[str, Any]) -> None:
-        self.goal = command.get("goal")  # type: Optional[str]
-        self.outcome = command.get("outcome")  # type: Optional[str]
+        self.goal: Optional[str] = command.get("goal")
+        self.outcome: Optional[str] = command.get("outcome")
         self.samples = int(command["samples"])
         self.values = array.array("d", base64.b64decode(command["poses"]))
         self.beams = int(command["beams"])
@@ -82,25 +82,25 @@ class Robot:
     def __init__(self, name: str, ns: str) -> None:
         self.name, self.ns = name, ns
         self.held = [0.0] * FIELDS  # where it stands between goals
-        self.held_scan = None  # type: Any
-        self.leg = None  # type: Optional[Leg]
-        self.active = None  # type: Any  # the goal handle being driven (or awaiting its leg)
-        self.active_id = None  # type: Optional[str]
-        self.server = None  # type: Any
-        self.pubs = {}  # type: Dict[str, Any]
+        self.held_scan: Any = None
+        self.leg: Optional[Leg] = None
+        self.active: Any = None  # the goal handle being driven (or awaiting its leg)
+        self.active_id: Optional[str] = None
+        self.server: Any = None
+        self.pubs: Dict[str, Any] = {}
 
 
 class StandIn:
     def __init__(self) -> None:
         self.lock = threading.RLock()
-        self.robots = {}  # type: Dict[str, Robot]
+        self.robots: Dict[str, Robot] = {}
         self.setup_done = threading.Event()
         self.running = True
         self.speed_up = 10.0
-        self.laser = {}  # type: Dict[str, float]
+        self.laser: Dict[str, float] = {}
         self.start_ns = 0
         self.published = 0  # the last global sample published
-        self.counts = {}  # type: Dict[str, int]
+        self.counts: Dict[str, int] = {}
         self.wall_start = 0.0
 
     # -- commands (from the venv) ------------------------------------------------------------
@@ -178,7 +178,13 @@ class StandIn:
                 robot.held[9:] = [0.0, 0.0, 0.0, 0.0]
                 robot.held_scan = leg.scan(k)
         robot.active.set_canceled(MoveBaseResult(), why)
-        emit("stopped", robot=robot.name, goal=robot.active_id, sample=k, time=self.time_of(self.published) / 1e9)
+        emit(
+            "stopped",
+            robot=robot.name,
+            goal=robot.active_id,
+            sample=k,
+            time=self.time_of(self.published) / 1e9,
+        )
         robot.leg, robot.active, robot.active_id = None, None, None
 
     # -- the graph -----------------------------------------------------------------------------
@@ -195,7 +201,9 @@ class StandIn:
                 "odom": rospy.Publisher(topic(ns, "odom"), Odometry, queue_size=QUEUE),
                 "tf": rospy.Publisher(topic(ns, "tf"), TFMessage, queue_size=QUEUE),
                 "tf_static": rospy.Publisher(topic(ns, "tf_static"), TFMessage, queue_size=10, latch=True),
-                "amcl_pose": rospy.Publisher(topic(ns, "amcl_pose"), PoseWithCovarianceStamped, queue_size=QUEUE),
+                "amcl_pose": rospy.Publisher(
+                    topic(ns, "amcl_pose"), PoseWithCovarianceStamped, queue_size=QUEUE
+                ),
                 "cmd_vel": rospy.Publisher(topic(ns, "cmd_vel"), Twist, queue_size=QUEUE),
                 "scan": rospy.Publisher(topic(ns, "scan"), LaserScan, queue_size=QUEUE),
             }
@@ -343,7 +351,9 @@ def diagonal(values: List[float]) -> List[float]:
 
 
 ODOM_COVARIANCE = diagonal([1e-3, 1e-3, 1e6, 1e6, 1e6, 1e-3])
-AMCL_COVARIANCE = diagonal([LOCALISATION_NOISE**2, LOCALISATION_NOISE**2, 0.0, 0.0, 0.0, LOCALISATION_YAW_NOISE**2])
+AMCL_COVARIANCE = diagonal(
+    [LOCALISATION_NOISE**2, LOCALISATION_NOISE**2, 0.0, 0.0, 0.0, LOCALISATION_YAW_NOISE**2]
+)
 
 
 def main() -> None:
