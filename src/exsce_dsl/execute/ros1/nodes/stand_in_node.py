@@ -8,7 +8,8 @@ the correction ``map -> odom``, the measured and commanded velocities, and a sca
 sample, as base64 arrays.  The node plays the leg from the next sample on, then ends the goal
 (succeeded or aborted).  A cancel, or a new goal while one is active, stops the robot where it is
 (``stopped`` event with the leg's sample).  Between goals the robots stand still and every topic
-keeps publishing.
+keeps publishing.  While a goal awaits its leg, simulated time stands still (as a simulator's does
+while its physics steps), so that how long the venv takes to plan does not show in the run.
 
 Commands: ``setup`` (speed-up, robots, laser), ``leg``, ``stats``.  Events: ``ready``, ``goal``,
 ``stopped``, ``finished``, ``stats``.
@@ -39,6 +40,7 @@ CMD_VEL_PERIOD_NS = 50_000_000  # 20 Hz
 TICK = 0.01  # wall seconds between publishing rounds
 MAX_LAG_NS = 500_000_000  # simulated time runs no further ahead of what was published
 QUEUE = 2000
+LEG_WAIT = 10.0  # wall seconds simulated time waits for a leg at most
 LOCALISATION_NOISE, LOCALISATION_YAW_NOISE = 0.02, 0.01
 FOOTPRINT_HEIGHT, LASER_HEIGHT = 0.1, 0.2
 
@@ -86,6 +88,7 @@ class Robot:
         self.leg: Optional[Leg] = None
         self.active: Any = None  # the goal handle being driven (or awaiting its leg)
         self.active_id: Optional[str] = None
+        self.awaiting: Optional[float] = None  # wall time since when its goal awaits its leg
         self.server: Any = None
         self.pubs: Dict[str, Any] = {}
 
@@ -139,7 +142,7 @@ class StandIn:
             if robot.active_id != leg.goal or robot.leg is not None:
                 return  # cancelled meanwhile
             leg.start = self.published + 1
-            robot.leg = leg
+            robot.leg, robot.awaiting = leg, None
 
     # -- actionlib (rospy's threads) -----------------------------------------------------------
 
@@ -152,7 +155,7 @@ class StandIn:
             q = target.orientation
             yaw = math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z))
             goal_id = handle.get_goal_id().id
-            robot.active, robot.active_id = handle, goal_id
+            robot.active, robot.active_id, robot.awaiting = handle, goal_id, time.monotonic()
             emit(
                 "goal",
                 robot=robot.name,
@@ -185,7 +188,7 @@ class StandIn:
             sample=k,
             time=self.time_of(self.published) / 1e9,
         )
-        robot.leg, robot.active, robot.active_id = None, None, None
+        robot.leg, robot.active, robot.active_id, robot.awaiting = None, None, None, None
 
     # -- the graph -----------------------------------------------------------------------------
 
@@ -237,8 +240,12 @@ class StandIn:
         try:
             while self.running and not rospy.is_shutdown():
                 now = time.monotonic()
-                target = base_sim + int(self.speed_up * (now - base_wall) * 1e9)
                 published_ns = self.time_of(self.published)
+                if self.planning(now):  # simulated time stands still while a leg is planned
+                    base_wall, base_sim = now, published_ns
+                    time.sleep(TICK)
+                    continue
+                target = base_sim + int(self.speed_up * (now - base_wall) * 1e9)
                 if target - published_ns > MAX_LAG_NS:  # behind: simulated time waits for us
                     target = published_ns + MAX_LAG_NS
                     base_wall, base_sim = now, target
@@ -252,6 +259,11 @@ class StandIn:
         except Exception as e:  # the node is useless without its clock: say why and end
             self.running = False
             emit("error", message="the stand-in's clock stopped: %s: %s" % (type(e).__name__, e))
+
+    def planning(self, now: float) -> bool:
+        """Whether a robot's goal awaits its leg (for at most LEG_WAIT wall seconds)."""
+        with self.lock:
+            return any(r.awaiting is not None and now - r.awaiting < LEG_WAIT for r in self.robots.values())
 
     def publish_sample(self, n: int) -> None:
         t = self.time_of(n)
@@ -303,7 +315,7 @@ class StandIn:
             command = Twist()
             command.linear.x, command.angular.z = v[11], v[12]
             self.publish(robot, "cmd_vel", command)
-        if (k % SCAN_EVERY == 0) if k >= 0 else (n % SCAN_EVERY == 0):
+        if n % SCAN_EVERY == 0:  # a leg's latest scan (computed every SCAN_EVERY of its samples)
             laser = self.laser
             message = LaserScan(
                 angle_min=laser["angle_min"],
