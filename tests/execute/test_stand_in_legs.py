@@ -6,6 +6,7 @@ lengths and ends are hand calculations.
 
 from __future__ import annotations
 
+import base64
 import math
 from pathlib import Path
 
@@ -94,8 +95,6 @@ def test_odometry_goes_on_from_leg_to_leg_and_the_frames_compose_to_the_estimate
 def test_the_command_carries_every_sample(floor: Scenario) -> None:
     leg = fleet(floor).leg("rover", "g1", 5.0, 0.0, 0.0, 0.0)
     command = leg.command()
-    import base64
-
     values = np.frombuffer(base64.b64decode(command["poses"]), dtype="<f8").reshape(-1, FIELDS)
     assert command["samples"] == len(leg) == len(values)
     assert values[-1, 0] == leg.odom.x[-1] and values[-1, 11] == leg.command_v[-1]

@@ -53,6 +53,15 @@ MATCH = 0.05
 ABORT_AFTER = 25
 """Samples a goal the robot aborts takes (0.5 s, as the executor's ``skip-waypoint``)."""
 FIELDS = 13
+CLEARANCE = 2 * ROBOT_RADIUS + 0.2
+"""Metres between two robots' centres that a leg keeps: it waits until the other has gone by."""
+WAIT_STEP, MAX_WAIT = 0.5, 60.0
+"""Seconds: how a leg's start is put off to let another robot go by, and for how long at most
+(then it goes anyway: the other stands in its way for good)."""
+STANDING_RADIUS = 0.6
+"""Metres round a robot standing in a leg's way that its path goes round (as the executor's)."""
+END_ROOM = 0.3
+"""Metres that such a disc keeps from the leg's start and goal (else the robot cannot get there)."""
 """Values per sample sent to the node, in this order: odometry x, y, yaw; estimate x, y, yaw;
 correction x, y, yaw; measured speed and turn rate; commanded speed and turn rate."""
 
@@ -98,10 +107,6 @@ class Leg:
             (float(o.x[k]), float(o.y[k]), float(o.yaw[k])),
             previous,
         )
-
-    def position_at(self, time: float) -> Point:
-        k = min(max(int((time - self.start) / DT), 0), len(self) - 1)
-        return float(self.truth.x[k]), float(self.truth.y[k])
 
     def command(self) -> dict[str, Any]:
         """The node's ``leg`` command: the arrays base64-encoded, little-endian."""
@@ -196,6 +201,8 @@ class Fleet:
         robot.goals += 1
         target = self._pose(x, y, yaw)
         trajectory, succeeded = self._drive(robot, target)
+        if succeeded:
+            trajectory = self._let_pass(robot, trajectory, time)
         leg = self._leg(robot, goal, succeeded, time, trajectory)
         before = robot.at
         robot.legs[goal] = (leg, before)
@@ -232,7 +239,8 @@ class Fleet:
         via = detour_via(self.scenario, robot.name, robot.at.previous, target, self.faults)
         try:
             if via is None:
-                driven = drive(self.grid.plan((x, y), goal), yaw, target.orientation.yaw, robot.limits)
+                path = self._plan_round(robot, (x, y), goal)
+                driven = drive(path, yaw, target.orientation.yaw, robot.limits)
             else:
                 there, on = self.grid.plan((x, y), via), self.grid.plan(via, goal)
                 heading = math.atan2(on[1][1] - on[0][1], on[1][0] - on[0][0]) if len(on) > 1 else yaw
@@ -249,6 +257,47 @@ class Fleet:
         parts.append(driven if len(driven) else Trajectory.hold(x, y, yaw, 1))
         return Trajectory.concat(parts), True
 
+    def _plan_round(self, robot: Robot, start: Point, goal: Point) -> list[Point]:
+        """The grid's path, round the robots that stand in its way once their legs are done."""
+        path = self.grid.plan(start, goal)
+        discs = []
+        for other in self.robots.values():
+            if other is robot:
+                continue
+            spot = other.at.truth[:2]  # where its leg ends
+            room = min(STANDING_RADIUS, math.dist(spot, start) - END_ROOM, math.dist(spot, goal) - END_ROOM)
+            if room >= ROBOT_RADIUS and _distance_to(np.asarray(path), spot) < room + ROBOT_RADIUS:
+                discs.append((spot[0], spot[1], room))
+        if not discs:
+            return path
+        try:
+            return self.grid.with_discs(tuple(discs)).plan(start, goal)
+        except PlanningError:  # no way round: the plain path
+            return path
+
+    def _let_pass(self, robot: Robot, trajectory: Trajectory, time: float) -> Trajectory:
+        """``trajectory`` put off until it keeps CLEARANCE from the other robots as they drive their
+        legs (by MAX_WAIT at most, then as it is)."""
+        x, y, yaw = robot.at.truth
+        for wait in np.arange(0.0, MAX_WAIT + WAIT_STEP, WAIT_STEP):
+            held = int(round(wait / DT))
+            times = time + (held + np.arange(len(trajectory))) * DT
+            others = [self._where_over(o, times) for o in self.robots.values() if o is not robot]
+            if all(np.hypot(trajectory.x - ox, trajectory.y - oy).min() >= CLEARANCE for ox, oy in others):
+                return (
+                    Trajectory.concat([Trajectory.hold(x, y, yaw, held), trajectory]) if held else trajectory
+                )
+        return trajectory
+
+    @staticmethod
+    def _where_over(robot: Robot, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Where ``robot`` is at each of ``times``: on its leg, else where it stands."""
+        leg = robot.current
+        if leg is None:
+            return np.full(len(times), robot.at.truth[0]), np.full(len(times), robot.at.truth[1])
+        k = np.clip(((times - leg.start) / DT).astype(np.int64), 0, len(leg) - 1)
+        return leg.truth.x[k], leg.truth.y[k]
+
     def _leg(
         self, robot: Robot, goal: str | None, succeeded: bool, time: float, trajectory: Trajectory
     ) -> Leg:
@@ -263,12 +312,7 @@ class Fleet:
         odom = standing.compose(_tail(frames.odom))
         estimate = _tail(frames.estimate)
         idx = np.arange(0, n, SCAN_EVERY)
-        others = [
-            (np.full(len(idx), px), np.full(len(idx), py))
-            for other in self.robots.values()
-            if other is not robot
-            for px, py in [self._where(other, time)]
-        ]
+        others = [self._where_over(o, time + idx * DT) for o in self.robots.values() if o is not robot]
         scans = scan_ranges(
             self.grid,
             self.laser,
@@ -295,11 +339,17 @@ class Fleet:
             scans,
         )
 
-    @staticmethod
-    def _where(robot: Robot, time: float) -> Point:
-        if robot.current is not None:
-            return robot.current.position_at(time)
-        return robot.at.truth[0], robot.at.truth[1]
+
+def _distance_to(path: np.ndarray, point: Point) -> float:
+    """The distance from ``point`` to the polyline ``path``."""
+    if len(path) < 2:
+        return math.dist(point, (float(path[0][0]), float(path[0][1])))
+    a, b = path[:-1], path[1:]
+    ab = b - a
+    lengths = np.maximum((ab**2).sum(axis=1), 1e-12)
+    f = np.clip(((np.asarray(point) - a) * ab).sum(axis=1) / lengths, 0.0, 1.0)
+    nearest = a + f[:, None] * ab
+    return float(np.hypot(*(nearest - np.asarray(point)).T).min())
 
 
 def _tail(poses: Poses) -> Poses:
