@@ -164,13 +164,15 @@ class Fleet:
         self.scenario, self.grid, self.faults = scenario, grid, faults
         self.laser = laser or Laser()
         limits = limits or Limits()
-        speeds = random.Random(seed)
+        unplaced = [r.id for r in scenario.robots if r.start_pose is None]
+        if unplaced:
+            raise ExsceError(f"robot '{unplaced[0]}' has no start pose: the stand-in cannot place it")
+        speeds = _executor_speeds(scenario, seed, limits, faults)
         self.robots: dict[str, Robot] = {}
         for index, robot in enumerate(scenario.robots):
             start = robot.start_pose
-            if start is None:
-                raise ExsceError(f"robot '{robot.id}' has no start pose: the stand-in cannot place it")
-            speed = limits.max_speed * speeds.uniform(0.9, 1.0) * speed_factor(scenario, robot.id, faults)
+            assert start is not None
+            speed = speeds[robot.id]
             rng = np.random.default_rng([seed, index])
             self.robots[robot.id] = Robot(
                 robot.id,
@@ -338,6 +340,20 @@ class Fleet:
             trajectory.w,
             scans,
         )
+
+
+def _executor_speeds(
+    scenario: Scenario, seed: int, limits: Limits, faults: tuple[Fault, ...]
+) -> dict[str, float]:
+    """Each robot's speed limit as the executor draws it for run 0 of ``exscec simulate --seed``:
+    its random numbers in its order (a start's wait per robot, then a speed per robot)."""
+    draws = random.Random(seed * 1000)
+    for _ in scenario.robots:
+        draws.uniform(0.5, 1.0)
+    return {
+        r.id: limits.max_speed * draws.uniform(0.9, 1.0) * speed_factor(scenario, r.id, faults)
+        for r in scenario.robots
+    }
 
 
 def _distance_to(path: np.ndarray, point: Point) -> float:
