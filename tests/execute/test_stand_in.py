@@ -10,6 +10,11 @@ the straight distance) or rosbags' own reading of the bag.
 from __future__ import annotations
 
 import math
+import os
+import select
+import signal
+import subprocess
+import sys
 import time
 import xmlrpc.client
 from collections.abc import Sequence
@@ -19,7 +24,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from ros1_graph import ros1_graph
+from ros1_graph import require_ros1, ros1_graph
 from rosbags.highlevel import AnyReader
 
 from exsce_dsl.execute.stand_in import GoalEnd, Stats, start_stand_in
@@ -229,3 +234,69 @@ def test_a_cancelled_goal_stops_the_robot_where_it_is(tmp_path: Path) -> None:
     assert np.all(v[after] == 0.0)
     commanded = [m.linear.x for t, m in recorded.messages("/rover/cmd_vel") if t * 1e-9 > cancelled_at]
     assert commanded and all(c == 0.0 for c in commanded)
+
+
+def test_the_command_serves_until_sigterm_then_stops_the_node_and_its_master(tmp_path: Path) -> None:
+    require_ros1()
+    spec = tmp_path / "floor.exsce"
+    spec.write_text(FLOOR)
+    exscec = Path(sys.executable).with_name("exscec")
+    argv = [
+        str(exscec),
+        "stand-in",
+        str(spec),
+        "--ros1",
+        "--start-master",
+        "--log-dir",
+        str(tmp_path / "logs"),
+    ]
+    process = subprocess.Popen(
+        argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True
+    )
+    try:
+        assert process.stdout is not None
+        ready, _, _ = select.select([process.stdout], [], [], 60.0)
+        assert ready, "no first line within 60 s"
+        first = process.stdout.readline().strip()
+        assert first.startswith("ROS_MASTER_URI=http://127.0.0.1:"), first
+        uri = first.split("=", 1)[1]
+        master = xmlrpc.client.ServerProxy(uri)
+        code, _, node_uri = master.lookupNode("/exsce_tests", NODE)
+        assert code == 1
+        _, _, node_pid = xmlrpc.client.ServerProxy(node_uri).getPid("/exsce_tests")
+        _, _, master_pid = master.getPid("/exsce_tests")
+        publishers = {topic for topic, _ in master.getSystemState("/exsce_tests")[2][0]}
+        assert {"/clock", "/rover/move_base/result", "/rover/odom", "/rover/scan"} <= publishers
+        assert master.getParam("/exsce_tests", "/use_sim_time")[2] is True
+        process.send_signal(signal.SIGTERM)
+        assert process.wait(30.0) == 0, process.stderr.read() if process.stderr else ""
+        deadline = time.monotonic() + 10.0
+        while not (gone(node_pid) and gone(master_pid)) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert gone(node_pid) and gone(master_pid)
+    finally:
+        if process.poll() is None:
+            os.killpg(process.pid, signal.SIGKILL)
+            process.wait()
+
+
+def gone(pid: int) -> bool:
+    """Whether process ``pid`` has ended (or is a zombie its parent has yet to reap)."""
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return True
+    return state in ("Z", "X")
+
+
+def test_the_command_wants_ros1_and_a_master(tmp_path: Path) -> None:
+    spec = tmp_path / "floor.exsce"
+    spec.write_text(FLOOR)
+    without = run_exscec("stand-in", str(spec))
+    assert without.returncode == 2 and "--ros1" in without.stderr
+    env = {k: v for k, v in os.environ.items() if k != "ROS_MASTER_URI"}
+    exscec = Path(sys.executable).with_name("exscec")
+    unset = subprocess.run(
+        [str(exscec), "stand-in", str(spec), "--ros1"], env=env, capture_output=True, text=True, timeout=60
+    )
+    assert unset.returncode == 2 and "ROS_MASTER_URI is not set" in unset.stderr

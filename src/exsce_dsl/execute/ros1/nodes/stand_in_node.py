@@ -262,9 +262,19 @@ class StandIn:
             emit("error", message="the stand-in's clock stopped: %s: %s" % (type(e).__name__, e))
 
     def planning(self, now: float) -> bool:
-        """Whether a robot's goal awaits its leg (for at most LEG_WAIT wall seconds)."""
+        """Whether a robot's goal awaits its leg; one that waited LEG_WAIT wall seconds is aborted."""
         with self.lock:
-            return any(r.awaiting is not None and now - r.awaiting < LEG_WAIT for r in self.robots.values())
+            for robot in self.robots.values():
+                if robot.awaiting is not None and now - robot.awaiting >= LEG_WAIT:
+                    handle, goal_id = robot.active, robot.active_id
+                    robot.active, robot.active_id, robot.awaiting = None, None, None
+                    handle.set_aborted(MoveBaseResult(), "No plan came for the goal.")
+                    when = self.published_time()
+                    emit("finished", robot=robot.name, goal=goal_id, outcome="aborted", time=when)
+            return any(r.awaiting is not None for r in self.robots.values())
+
+    def published_time(self) -> float:
+        return self.time_of(self.published) / 1e9
 
     def publish_sample(self, n: int) -> None:
         t = self.time_of(n)
