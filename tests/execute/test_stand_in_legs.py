@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from exsce_dsl.errors import ExsceError
 from exsce_dsl.execute.stand_in.legs import FIELDS, Fleet, Leg
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.model import Scenario
@@ -154,3 +155,10 @@ def test_a_stopped_goal_leaves_the_robot_where_the_node_stopped_it(floor: Scenar
     )
     robots.stopped("rover", "g2", -1)  # stopped before it moved: where it stood before the goal
     assert robots.robots["rover"].at.truth[:2] == pytest.approx((leg.truth.x[100], leg.truth.y[100]))
+
+
+def test_faults_the_stand_in_cannot_play_or_that_name_nothing_are_refused(floor: Scenario) -> None:
+    with pytest.raises(ExsceError, match="near-collision"):
+        fleet(floor, "near-collision")
+    with pytest.raises(ExsceError, match="robot 'robber'"):
+        fleet(floor, "overspeed:robber")

@@ -161,6 +161,8 @@ class Fleet:
         laser: Laser | None = None,
     ) -> None:
         check_faults(scenario, faults)
+        if any(f.kind == "near-collision" for f in faults):
+            raise ExsceError("the stand-in does not play fault 'near-collision' (exscec simulate does)")
         self.scenario, self.grid, self.faults = scenario, grid, faults
         self.laser = laser or Laser()
         limits = limits or Limits()
