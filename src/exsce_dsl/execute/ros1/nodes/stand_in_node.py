@@ -18,6 +18,7 @@ Commands: ``setup`` (speed-up, robots, laser), ``leg``, ``stats``.  Events: ``re
 import array
 import base64
 import math
+import queue
 import threading
 import time
 from typing import Any, Dict, List, Optional
@@ -106,6 +107,7 @@ class StandIn:
         self.published = 0  # the last global sample published
         self.counts: Dict[str, int] = {}
         self.wall_start = 0.0
+        self.requests = queue.Queue()  # (kind, robot, goal handle) from actionlib
 
     # -- commands (from the venv) ------------------------------------------------------------
 
@@ -145,7 +147,20 @@ class StandIn:
             leg.start = self.published + 1
             robot.leg, robot.awaiting = leg, None
 
-    # -- actionlib (rospy's threads) -----------------------------------------------------------
+    # -- actionlib ------------------------------------------------------------------------------
+    # actionlib calls back holding its server's lock, which its goal handles take too: the callbacks
+    # only queue what came, and the clock thread handles it (holding our lock, then actionlib's)
+
+    def handle_requests(self) -> None:
+        while True:
+            try:
+                kind, robot, handle = self.requests.get_nowait()
+            except queue.Empty:
+                return
+            if kind == "goal":
+                self.on_goal(robot, handle)
+            else:
+                self.on_cancel(robot, handle)
 
     def on_goal(self, robot: Robot, handle: Any) -> None:
         with self.lock:
@@ -214,8 +229,8 @@ class StandIn:
             robot.server = actionlib.ActionServer(
                 topic(ns, "move_base"),
                 MoveBaseAction,
-                lambda h, r=robot: self.on_goal(r, h),
-                lambda h, r=robot: self.on_cancel(r, h),
+                lambda h, r=robot: self.requests.put(("goal", r, h)),
+                lambda h, r=robot: self.requests.put(("cancel", r, h)),
                 auto_start=False,
             )
         self.start_ns = int(time.time()) * 1_000_000_000
@@ -240,6 +255,7 @@ class StandIn:
         base_wall, base_sim = time.monotonic(), self.start_ns
         try:
             while self.running and not rospy.is_shutdown():
+                self.handle_requests()
                 now = time.monotonic()
                 published_ns = self.time_of(self.published)
                 if self.planning(now):  # simulated time stands still while a leg is planned
