@@ -15,6 +15,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from enum import Enum
+from pathlib import Path
 from typing import Any
 
 __all__ = [
@@ -23,6 +24,7 @@ __all__ = [
     "BagError",
     "DecodeError",
     "Diagnostic",
+    "ExecutionInterrupted",
     "ExportError",
     "ExsceError",
     "ExsceSyntaxError",
@@ -265,6 +267,24 @@ class RosGraphError(ExsceError):
     """A live ROS graph cannot do what a run needs (``execute``): no master at the URI, no Python
     with rospy, an action server that never answered, a node of ours that died; the message names
     what is missing."""
+
+
+class ExecutionInterrupted(ExsceError):
+    """A run on a live graph was cut short (Ctrl-C, SIGTERM): its goals were cancelled and its
+    files kept apart from the whole runs (``execute``); the CLI exits 130."""
+
+    def __init__(self, incomplete: Path | None, complete: Sequence[Path] = ()) -> None:
+        if incomplete is None:
+            said = "interrupted before the run began: no goal was sent and no bag written"
+        else:
+            said = (
+                f"interrupted: the goals were cancelled; the run cut short is kept apart in "
+                f"{incomplete.parent} ({incomplete.name}, its .prov.json and .rosparams), where "
+                "ingest DIR/*.bag does not take it"
+            )
+        super().__init__(said)
+        self.incomplete = incomplete
+        self.complete = tuple(complete)
 
 
 class RenameError(ValueError):

@@ -54,6 +54,7 @@ WALK: tuple[tuple[str, ...], ...] = (
     ("bag",),
     ("init",),  # a specification drafted from a Nav2 bag, which checks
     ("ingest",),
+    ("execute",),  # no robot answers: exit 2, no bag
     ("baseline",),
     ("verify",),  # the baseline runs pass, the faulty run fails
     ("derive",),  # c_one, with its oracles, into the store

@@ -93,3 +93,68 @@ def test_a_timeout_or_speed_not_above_zero_is_an_error(scenario_c, bad):
         schedule(scenario_c, timeout=bad)
     with pytest.raises(ExsceError, match="speed limit must be above 0 m/s"):
         goal_timeout(10.0, bad)
+
+
+def _with_timeouts(scenario, task_timeouts, mission_timeout):
+    tasks = tuple(replace(t, timeout=task_timeouts.get(t.id)) for t in scenario.tasks)
+    return replace(scenario, tasks=tasks, mission=replace(scenario.mission, timeout=mission_timeout))
+
+
+def test_a_tasks_timeout_wins_over_its_missions_and_the_missions_over_the_default(scenario_c):
+    home = 3 * math.hypot(48.26420974731445 - 44.80387496948242, 24.618297576904297 - 37.15502166748047) / 0.6
+
+    def timeouts(scenario, given=None):
+        return {(g.robot, g.pose.id): g.timeout for g in schedule(scenario, timeout=given).goals}
+
+    both = timeouts(_with_timeouts(scenario_c, {"delivery_a": 100.0}, 200.0))
+    assert both == {
+        ("tiago1", "classroom_c022-w001"): 100.0,
+        ("tiago1", "classroom_c018-w001"): 100.0,
+        ("tiago1", "classroom_c025-w001"): 200.0,
+        ("tiago2", "classroom_c022-w002"): 200.0,
+        ("tiago2", "classroom_c018-w002"): 200.0,
+        ("tiago2", "classroom_c025-w002"): 200.0,
+    }
+    task_only = timeouts(_with_timeouts(scenario_c, {"delivery_a": 100.0}, None))
+    assert task_only["tiago1", "classroom_c018-w001"] == 100.0
+    assert task_only["tiago1", "classroom_c025-w001"] == pytest.approx(home)  # the default
+    first = (
+        3 * math.hypot(54.497589111328125 - 43.432926177978516, 31.52023696899414 - 38.493873596191406) / 0.6
+    )
+    assert (
+        task_only["tiago2", "classroom_c022-w002"] == pytest.approx(first) == pytest.approx(65.39, abs=0.01)
+    )
+    # the caller's timeout replaces only the default
+    given = timeouts(_with_timeouts(scenario_c, {"delivery_a": 100.0}, None), 120.0)
+    assert given["tiago1", "classroom_c022-w001"] == 100.0 and given["tiago1", "classroom_c025-w001"] == 120.0
+    assert timeouts(_with_timeouts(scenario_c, {}, 200.0), 120.0)["tiago2", "classroom_c025-w002"] == 200.0
+
+
+def test_the_timeouts_written_in_the_spec_reach_the_schedule(tmp_path):
+    (tmp_path / "s.exsce").write_text(
+        "robot type r { }\n"
+        "environment e { area a { pose a-p at (0, 0)  pose a-q at (300, 400) } }\n"
+        "task out { timeout 2 min visit a-q }\n"
+        "task back { visit a-p }\n"
+        "task far { visit a-q }\n"
+        "scenario s in e {\n"
+        "  robots { r1: r starts at a-p  r2: r starts at a-q }\n"
+        "  mission m parallel { r1 does out then back  r2 does far }\n"
+        "}\n"
+        "scenario s2 in e {\n"
+        "  robots { r1: r starts at a-p }\n"
+        "  mission m2 sequential { timeout 1.5 h  r1 does out then back }\n"
+        "}\n"
+    )
+    spec = load_spec(tmp_path / "s.exsce")
+    goals = [(g.robot, g.task, g.timeout) for g in schedule(spec.scenario("s")).goals]
+    # back: 500 m at 0.6 m/s, three times over: 2500 s; far: a goal where r2 already is: the floor
+    assert goals == [("r1", "out", 120.0), ("r1", "back", pytest.approx(2500.0)), ("r2", "far", 60.0)]
+    assert [g.timeout for g in schedule(spec.scenario("s2")).goals] == [120.0, 5400.0]
+
+
+def test_a_timeout_in_the_model_not_above_zero_is_an_error(scenario_c):
+    with pytest.raises(ExsceError, match="goal timeout of task 'delivery_a' must be above 0 s, not -1"):
+        schedule(_with_timeouts(scenario_c, {"delivery_a": -1.0}, None))
+    with pytest.raises(ExsceError, match="goal timeout of mission 'mission_c' must be above 0 s, not 0"):
+        schedule(_with_timeouts(scenario_c, {}, 0.0))

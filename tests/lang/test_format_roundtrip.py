@@ -96,12 +96,34 @@ def test_units_are_kept_as_written(in_tmp: Path) -> None:
     assert "pose a-p at (150 cm, 20 cm) facing 90 deg" in printed
 
 
+def test_timeouts_are_kept_as_written_and_read_in_seconds(in_tmp: Path) -> None:
+    (in_tmp / "t.exsce").write_text(
+        "robot type r { }\n"
+        "environment e { area a { pose a-p at (1, 2) } }\n"
+        "task t { timeout 2 min visit a-p }\n"
+        "task u { visit a-p }\n"
+        "scenario s in e { robots { r1: r starts at a-p } mission m parallel { timeout   90s r1 does t then u } }\n"
+    )
+    spec = load_spec("t.exsce")
+    scenario = spec.scenario("s")
+    assert (scenario.task("t").timeout, scenario.task("u").timeout, scenario.mission.timeout) == (
+        120.0,
+        None,
+        90.0,
+    )
+    printed = format_spec_document(spec, "t.exsce")
+    assert "task t {\n  timeout 2 min\n  visit a-p\n}" in printed
+    assert "mission m parallel {\n    timeout 90 s\n    r1 does t then u\n  }" in printed
+    assert "timeout" not in printed.split("task u {")[1].split("}")[0]
+
+
 # ---------------------------------------------------------------- property test
 _names = st.from_regex(r"[a-z][a-z0-9_]{0,6}(-[a-z0-9]{1,3})?", fullmatch=True).filter(
     lambda n: n not in KEYWORDS
 )
 _coordinates = st.floats(-1e5, 1e5, allow_nan=False, allow_infinity=False)
 _degrees = st.integers(-3600, 3600).map(lambda tenths: tenths / 10)
+_timeouts = st.none() | st.integers(1, 10**5).map(float) | st.floats(1e-3, 1e6, allow_nan=False)
 
 
 @st.composite
@@ -143,7 +165,9 @@ def documents(draw: st.DrawFn) -> Document:
             )
             subtasks.append(Subtask(waypoints))
         source = RosResource(draw(_names), draw(st.none() | st.just("config/x.yaml")))
-        tasks.append(Task(t, tuple(subtasks), source if draw(st.booleans()) else None))
+        tasks.append(
+            Task(t, tuple(subtasks), source if draw(st.booleans()) else None, timeout=draw(_timeouts))
+        )
     robots = (
         Robot(other[4], rtype, "ns_" + other[4].replace("-", "_"), poses[0]),
         Robot(
@@ -162,7 +186,7 @@ def documents(draw: st.DrawFn) -> Document:
     ) + tuple(Assignment(r.id, tasks[0].id) for r in robots)
     first_use = list(dict.fromkeys(a.task for a in allocation))
     used = tuple(sorted((t for t in tasks if t.id in first_use), key=lambda t: first_use.index(t.id)))
-    mission = Mission(other[6], draw(st.sampled_from(list(MissionType))), allocation)
+    mission = Mission(other[6], draw(st.sampled_from(list(MissionType))), allocation, timeout=draw(_timeouts))
     scenario = Scenario(other[7], env, robots, mission, used)
     return Document("gen.exsce", (), (rtype, env, *tasks, scenario))
 

@@ -291,6 +291,46 @@ def test_task_without_source_is_exported_under_tasks(tmp_path: Path) -> None:
     assert written[1] == tmp_path / "tasks" / "delivery_a.yaml"
 
 
+def test_goal_timeouts_are_exported_under_exsce_s_own_key_and_imported_back(tmp_path: Path) -> None:
+    from dataclasses import replace
+
+    scenario = scenario_of(import_fixture("scenario_d"))
+    timed = tuple(replace(t, timeout=120.0) if t.id == "delivery_b" else t for t in scenario.tasks)
+    scenario = replace(scenario, tasks=timed, mission=replace(scenario.mission, timeout=90.0))
+    written = export_yaml(scenario, tmp_path)
+    mission = load(written[0])["mission"]
+    assert list(mission) == ["id", "type", "allocation", "goal_timeout"] and mission["goal_timeout"] == 90.0
+    files = {path.stem: load(path) for path in written[1:]}
+    assert files["delivery_b"]["goal_timeout"] == 120.0 and list(files["delivery_b"]) == [
+        "task",
+        "goal_timeout",
+    ]
+    assert "goal_timeout" not in files["delivery_a"]
+    again = scenario_of(import_scenario_yaml(written[0], [tmp_path]))
+    assert again.mission.timeout == 90.0
+    assert {t.id: t.timeout for t in again.tasks} == {
+        "delivery_a": None,
+        "delivery_b": 120.0,
+        "navigate_home_1": None,
+    }
+
+
+@pytest.mark.parametrize(
+    ("value", "expected"),
+    [
+        ("-5", "is a goal timeout in seconds: it must be above 0, not -5"),
+        ("soon", "goal_timeout should be a number, not str 'soon'"),
+    ],
+)
+def test_a_goal_timeout_that_is_not_a_positive_number_is_an_import_error(
+    value: str, expected: str, tmp_path: Path
+) -> None:
+    task = write(tmp_path / "t.yaml", SMALL_TASK.format(pose="lab-p1", x=1.0) + f"goal_timeout: {value}\n")
+    with pytest.raises(ImportFormatError, match=expected) as caught:
+        import_task_yaml(task)
+    assert f"{task}:" in str(caught.value) and "goal_timeout" in str(caught.value)
+
+
 # -- task file search ---------------------------------------------------------------------
 
 SMALL_SCENARIO = """\
@@ -517,8 +557,9 @@ planar_waypoints = st.builds(
     finite,
 )
 tasks = st.builds(
-    lambda subtasks: Task("t", tuple(Subtask(tuple(s)) for s in subtasks)),
+    lambda subtasks, timeout: Task("t", tuple(Subtask(tuple(s)) for s in subtasks), timeout=timeout),
     st.lists(st.lists(planar_waypoints, min_size=1, max_size=4), min_size=1, max_size=3),
+    st.none() | st.floats(1e-3, 1e7, allow_nan=False),
 )
 
 

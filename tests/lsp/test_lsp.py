@@ -406,3 +406,28 @@ async def test_completion_of_a_robot_types_signal_lines(client: LanguageClient, 
         i.label for i in result.items
     }
     close_document(client, uri)
+
+
+async def test_timeout_is_completed_in_a_task_and_a_mission_and_shown_on_hover(
+    client: LanguageClient, workspace: Path
+) -> None:
+    tasks = workspace / "tasks" / "deliveries.exsce"
+    text = tasks.read_text().replace("task delivery_a {\n", "task delivery_a {\n  timeout 2 min\n", 1)
+    text = text.replace("task delivery_b {\n", "task delivery_b {\n  ti\n", 1)
+    uri = open_document(client, tasks, text)
+    result = await client.text_document_completion_async(
+        types.CompletionParams(types.TextDocumentIdentifier(uri), position(text, "{\n  ti", len("{\n  ti")))
+    )
+    assert isinstance(result, types.CompletionList)
+    assert "timeout" in {item.label for item in result.items}
+    keyword = await hover_at(client, uri, position(text, "timeout 2 min", 2))
+    assert keyword.startswith("**timeout** (keyword)") and "each navigation goal" in keyword
+    close_document(client, uri)
+    scenario = workspace / "scenario_c.exsce"
+    text = scenario.read_text().replace(
+        "mission_c parallel {\n", "mission_c parallel {\n    timeout 90 s\n", 1
+    )
+    uri = open_document(client, scenario, text)
+    mission = await hover_at(client, uri, position(text, "mission_c parallel", 3))
+    assert "- goal timeout: `90 s`" in mission
+    close_document(client, uri)

@@ -9,8 +9,10 @@ fifth passes, an over-speed run fails, and a copy of a clean run without r2's la
 
 from __future__ import annotations
 
+import datetime as dt
 import json
 import shutil
+import uuid
 from pathlib import Path
 
 import click
@@ -20,6 +22,9 @@ from rosbags.rosbag1 import Reader, Writer
 
 from exsce_dsl.cli.common import ExitCode, reports_errors
 from exsce_dsl.lang.build import load_spec
+from exsce_dsl.model import Scenario
+from exsce_dsl.model.runs import Action, ActionId, ActionStatus, RunStatus
+from exsce_dsl.prov.recorder import recorded_prov_json, recorded_run
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
 
@@ -136,6 +141,49 @@ def test_the_other_commands_use_the_same_codes(yard: tuple[Path, dict[str, Path]
     usage = run_exscec("verify", "--scenario", "spec.exsce", cwd=folder)  # click's own: no RUNS
     assert usage.returncode == 2 and "Missing argument" in usage.stderr
     shutil.rmtree(store)
+
+
+def _cut_short(bag: Path, folder: Path, scenario: Scenario) -> Path:
+    """``bag`` copied into ``folder`` with the run-time PROV of a mission cancelled half-way
+    beside it, as ``exscec execute`` leaves an interrupted run (its first goal only)."""
+    folder.mkdir()
+    copy = folder / bag.name
+    shutil.copyfile(bag, copy)
+    start = dt.datetime(2026, 1, 1, tzinfo=dt.timezone.utc)
+    robot = scenario.robots[0]
+    assert robot.start_pose is not None  # the goal does not matter here: only the run's status does
+    action = Action(ActionId(robot.id, 1, 1, 1), robot.start_pose, robot.start_pose, ActionStatus.ABORTED,
+                    start, start + dt.timedelta(seconds=5), outcome="cancelled")  # fmt: skip
+    run = recorded_run(str(uuid.uuid4()), scenario.id, start, start + dt.timedelta(seconds=5), copy.name,
+                       [action], RunStatus.CANCELLED)  # fmt: skip
+    copy.with_suffix(".prov.json").write_text(recorded_prov_json(run, scenario), encoding="utf-8")
+    return copy
+
+
+def test_a_run_cut_short_is_never_passed(yard: tuple[Path, dict[str, Path]], tmp_path: Path) -> None:
+    """A run whose .prov.json says its mission was cancelled: what it met is not judged, what it
+    broke fails; the store says it is incomplete."""
+    folder, bags = yard
+    scenario = load_spec(folder / "spec.exsce").scenario()
+    clean = next(iter(simulate(scenario, tmp_path / "runs", 1, seed=3))).bag
+    cut = _cut_short(clean, tmp_path / "cut", scenario)
+    overspeed = (Fault.parse("overspeed:r1"),)
+    fast = next(iter(simulate(scenario, tmp_path / "fast", 1, seed=4, faults=overspeed))).bag
+    fast_cut = _cut_short(fast, tmp_path / "fast_cut", scenario)  # a bag of its own: not stored yet
+    shutil.copytree(folder / ".exsce" / "store", tmp_path / "store")  # the yard's runs and baseline
+    store = ["--store", str(tmp_path / "store"), "--no-record"]
+    judged = run_exscec("verify", str(cut), "--scenario", "spec.exsce", *store, cwd=folder)
+    assert judged.returncode == ExitCode.INCONCLUSIVE, judged.stdout + judged.stderr
+    assert "pass" not in judged.stdout.replace("passed", "")
+    assert "the run is incomplete (its mission was cancelled)" in judged.stdout, judged.stdout
+    judged = run_exscec("verify", str(fast_cut), "--scenario", "spec.exsce", *store, cwd=folder)
+    assert judged.returncode == ExitCode.FAILED and "FAIL" in judged.stdout, judged.stdout + judged.stderr
+    listed = json.loads(run_exscec("runs", "-f", "json", *store[:2], cwd=folder).stdout)
+    statuses = {
+        row["bag"]["value"]: row.get("mission_status", {}).get("value")
+        for row in listed["results"]["bindings"]
+    }
+    assert statuses[cut.name] == statuses[fast_cut.name] == "cancelled", statuses
 
 
 def test_a_bug_exits_70_with_a_word_and_no_traceback() -> None:

@@ -282,7 +282,7 @@ def repository() -> dict[str, Rule]:
         TOP_LEVEL,
     )
 
-    # task NAME { source ...  subtask { visit ... }  visit a, b facing 1.0, (x, y) }
+    # task NAME { source ...  timeout 2 min  subtask { visit ... }  visit a, b facing 1.0, (x, y) }
     waypoints = [keywords("visit"), include("coordinates"), name_as(ref("pose"))]
     r["task"] = region(
         "task",
@@ -291,13 +291,14 @@ def repository() -> dict[str, Rule]:
         [],
         [
             include("ros-source"),
+            keywords("timeout"),
             region("subtask", kw("subtask"), ("storage.type.subtask" + S,), [], waypoints, "subtask|visit"),
             *waypoints,
         ],
         TOP_LEVEL,
     )
 
-    # scenario NAME in ENV { robots { r: TYPE namespace "n" starts at POSE }  mission ... }
+    # scenario NAME in ENV { robots { r: TYPE namespace "n" starts at POSE }  mission M K { timeout 90 s ... } }
     r["assignments"] = {  # ROBOT does TASK then TASK
         "patterns": [
             match(rf"{BEFORE}({NAME})(?=\s+does{AFTER})", None, _1=ref("robot")),
@@ -337,7 +338,7 @@ def repository() -> dict[str, Rule]:
                 then_name(kw("mission")),
                 ("storage.type.mission" + S, "entity.name.function.mission" + S),
                 [keywords("parallel sequential", "storage.modifier.mission-kind" + S)],
-                [include("assignments")],
+                [keywords("timeout"), include("quantity"), include("assignments")],
                 "robots|mission",
             ),
         ],

@@ -14,6 +14,7 @@ the same messages the command prints.
 """
 
 from exsce_dsl.api.drafts import init_from_bag
+from exsce_dsl.api.execution import execute_ros1
 from exsce_dsl.api.stand_in import stand_in
 from exsce_dsl.api.tables import metrics, query, rows_frame, segments, sparql, verdicts
 from exsce_dsl.api.workflows import (
@@ -41,6 +42,7 @@ __all__ = [
     "cluster",
     "compile_prov",
     "derive",
+    "execute_ros1",
     "expect",
     "ingest",
     "init_from_bag",

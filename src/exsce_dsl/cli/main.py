@@ -24,6 +24,7 @@ COMMAND_MODULES: dict[str, str] = {
     "export": "spec_commands",
     "simulate": "run_commands",
     "ingest": "run_commands",
+    "execute": "execute_commands",
     "bag": "bag_commands",
     "init": "bag_commands",
     "store": "store_commands",

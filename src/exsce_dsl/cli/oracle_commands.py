@@ -4,11 +4,15 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import click
 
 from exsce_dsl.cli.common import ExitCode, bag_arguments, exit_status, reports_errors, write_text
 from exsce_dsl.cli.store_commands import store_option
+
+if TYPE_CHECKING:
+    from exsce_dsl.oracles.workflows import Verification
 
 
 @click.command(epilog=exit_status(bad_input="bad input: a spec error, too few runs, no acceptance criteria"))
@@ -101,8 +105,6 @@ def verify(
       exscec verify runs/faulty/*.bag --scenario examples/brsu_building_c/scenario_c.exsce  # exits 1
     """
     from exsce_dsl.lang.build import load_spec
-    from exsce_dsl.model.verdicts import Outcome
-    from exsce_dsl.oracles.report import junit_xml, verdict_table, verdicts_json
     from exsce_dsl.oracles.workflows import IngestFailed, verify_runs
     from exsce_dsl.store.open import open_store
 
@@ -115,6 +117,15 @@ def verify(
         except IngestFailed as exc:
             click.echo(f"error: {exc.message}", err=True)
             sys.exit(ExitCode.BAD_INPUT)
+    sys.exit(report_verification(verification, as_json, junit))
+
+
+def report_verification(verification: Verification, as_json: bool, junit: str | None) -> ExitCode:
+    """Print the verdicts (a table, or JSON), write the JUnit report, count them on stderr; the
+    exit status they give: 1 if one failed, 3 if one was not judged (and none failed), else 0."""
+    from exsce_dsl.model.verdicts import Outcome
+    from exsce_dsl.oracles.report import junit_xml, verdict_table, verdicts_json
+
     verdicts = list(verification.verdicts)
     for warning in verification.warnings:
         click.echo(f"warning: {warning}", err=True)
@@ -126,7 +137,7 @@ def verify(
     click.echo(
         f"{len(verdicts) - failed - unjudged} passed, {failed} failed, {unjudged} not judged", err=True
     )
-    sys.exit(ExitCode.FAILED if failed else ExitCode.INCONCLUSIVE if unjudged else ExitCode.PASSED)
+    return ExitCode.FAILED if failed else ExitCode.INCONCLUSIVE if unjudged else ExitCode.PASSED
 
 
 COMMANDS = [baseline, verify]

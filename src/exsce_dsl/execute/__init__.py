@@ -1,12 +1,15 @@
-"""Running a scenario's mission on a robot stack: the pure mission core (DESIGN.md §2, ``execute``).
+"""Running a scenario's mission on a robot stack (DESIGN.md §2, ``execute``).
 
-What is here: the mission as a schedule of navigation goals per robot (:mod:`.mission`), what a
-goal's outcome leads to (:mod:`.outcomes`), the dispatcher that drives a schedule through any
-:class:`~.navigator.Navigator` on a clock the caller gives (:mod:`.dispatcher`), and a kinematic
-navigator on a simulated clock for tests (:mod:`.kinematic`).  No middleware is imported here.
+The mission core, without middleware: the mission as a schedule of navigation goals per robot
+(:mod:`.mission`, with the goal timeouts of the spec or a default from distance and speed
+limit), what a goal's outcome leads to (:mod:`.outcomes`), the dispatcher that drives a schedule
+through any :class:`~.navigator.Navigator` on a clock the caller gives (:mod:`.dispatcher`), the
+run-time PROV of a mission run (:mod:`.provenance`), what a run records (:mod:`.recording`) and
+its files under the method's names (:mod:`.run_files`), and a kinematic navigator on a simulated
+clock for tests (:mod:`.kinematic`).
 
-Not built yet (issue 34, items 2-7): the ROS 1 (rospy/actionlib, move_base and the method's
-dispatcher) and ROS 2 (Nav2) adapters, the scenario on the parameter server, publishing the
-run-time PROV of tasks, allocation and actions, the recorder (``rosbag record``), the
-``exscec execute`` command and the stand-in robot on a live graph.
+Adapters: :mod:`.ros1` (rospy's Python runs exsce's nodes — the dispatcher's actionlib clients
+for move_base and the stand-in robot — and this process talks to them and to the master; the
+real ``rosbag record``; tested on a real roscore) and :mod:`.ros2` (rclpy and Nav2, imported only
+where rclpy exists; not run on a live ROS 2 graph in exsce's CI).
 """

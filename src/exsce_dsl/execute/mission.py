@@ -4,11 +4,13 @@ A ``parallel`` mission has one lane per robot: each robot works through its own 
 entries in order, the robots side by side.  A ``sequential`` mission has one lane: the allocation
 in its written order, one robot at a time.  A lane has at most one goal active at any time.
 
-Every goal has a timeout: the one given, or by default ``max(TIMEOUT_FLOOR, TIMEOUT_FACTOR *
-distance / speed)`` where ``distance`` is the straight line from the robot's previous waypoint
-(its start pose for its first goal) to the goal and ``speed`` the robot's speed limit
-(``speeds[robot]``, else ``DEFAULT_SPEED``, the kinematic executor's).  A path round walls is
-longer than the straight line; the factor leaves room for it and for turning on the spot.
+Every goal has a timeout, the first of: its task's (``timeout 120 s`` in the task), its
+mission's (``timeout 2 min`` in the mission), the one the caller gives, or by default
+``max(TIMEOUT_FLOOR, TIMEOUT_FACTOR * distance / speed)`` where ``distance`` is the straight
+line from the robot's previous waypoint (its start pose for its first goal) to the goal and
+``speed`` the robot's speed limit (``speeds[robot]``, else ``DEFAULT_SPEED``, the kinematic
+executor's).  A path round walls is longer than the straight line; the factor leaves room for it
+and for turning on the spot.
 """
 
 from __future__ import annotations
@@ -77,10 +79,17 @@ def schedule(
     speeds: Mapping[str, float] | None = None,
     timeout: float | None = None,
 ) -> Schedule:
-    """The schedule of ``scenario``'s mission; ``timeout`` (seconds) replaces every default timeout."""
+    """The schedule of ``scenario``'s mission; ``timeout`` (seconds) replaces the default timeout
+    of goals whose task and mission give none."""
     if timeout is not None and timeout <= 0:
         raise ExsceError(f"a goal timeout must be above 0 s, not {timeout:g}")
     speeds = speeds or {}
+    mission_timeout = scenario.mission.timeout
+    for given, whose in [(mission_timeout, f"mission '{scenario.mission.id}'")] + [
+        (t.timeout, f"task '{t.id}'") for t in scenario.tasks
+    ]:
+        if given is not None and given <= 0:
+            raise ExsceError(f"the goal timeout of {whose} must be above 0 s, not {given:g}")
     previous: dict[str, Pose | None] = {r.id: r.start_pose for r in scenario.robots}
     numbers: dict[str, int] = {}
     entries: list[tuple[str, tuple[Goal, ...]]] = []
@@ -94,7 +103,7 @@ def schedule(
         for s_number, subtask in enumerate(task.subtasks, start=1):
             for w_number, pose in enumerate(subtask.waypoints, start=1):
                 before = previous[robot]
-                limit = timeout
+                limit = next((t for t in (task.timeout, mission_timeout, timeout) if t is not None), None)
                 if limit is None:
                     distance = 0.0 if before is None else before.position.distance_to(pose.position)
                     limit = goal_timeout(distance, speeds.get(robot, DEFAULT_SPEED))

@@ -18,7 +18,7 @@ from exsce_dsl.lang.build_derivation import build_derivations
 from exsce_dsl.lang.build_metrics import build_metric
 from exsce_dsl.lang.build_signals import build_signals
 from exsce_dsl.lang.checks import check_environment_map, check_scenario
-from exsce_dsl.lang.lexical import quantity_parts, read_angle, read_length
+from exsce_dsl.lang.lexical import quantity_parts, quantity_text, read_angle, read_duration, read_length
 from exsce_dsl.lang.loader import Parse, read_sources
 from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.lang.references import UnknownNames, not_in_fleet
@@ -409,9 +409,10 @@ class _Builder:
         if not task.subtasks:
             self.error(f"task '{task.name}' has no waypoints; add 'visit <pose>'", d.name_location)
             ok = False
-        if not ok:
+        timeout, written, fine = self._timeout(pf, task.timeout, f"task '{task.name}'")
+        if not ok or not fine:
             return None
-        return Task(task.name, tuple(subtasks), _ros(task.source), d.name_location)
+        return Task(task.name, tuple(subtasks), _ros(task.source), d.name_location, timeout, written)
 
     def _task_pose_candidates(self) -> dict[str, Pose | None]:
         """Pose ids a task may name: unambiguous ones map to their pose."""
@@ -525,9 +526,27 @@ class _Builder:
         if not m.assignments:
             self.error(f"mission '{m.name}' allocates no task", self.name_span(pf, m))
             ok = False
-        if not ok:
+        timeout, written, fine = self._timeout(pf, m.timeout, f"mission '{m.name}'")
+        if not ok or not fine:
             return None
-        return Mission(m.name, MissionType(m.kind), tuple(allocation), self.name_span(pf, m))
+        kind, where = MissionType(m.kind), self.name_span(pf, m)
+        return Mission(m.name, kind, tuple(allocation), where, timeout, written)
+
+    def _timeout(self, pf: ParsedFile, node: Any, whose: str) -> tuple[float | None, str | None, bool]:
+        """A ``timeout`` in seconds and as written (None, None: none given); False: it was wrong,
+        and reported at its number."""
+        if node is None:
+            return None, None, True
+        text = node.duration
+        where = pf.lines.span(node._tx_position_end - len(text), node._tx_position_end)
+        seconds = read_duration(text)
+        if seconds is None:
+            self.error(f"the timeout of {whose} has no unit; write '{text} s' or '{text} min'", where)
+            return None, None, False
+        if not seconds > 0:
+            self.error(f"the timeout of {whose} must be above 0 s, not {quantity_text(text)}", where)
+            return None, None, False
+        return seconds, text, True
 
 
 def _ros(source: Any) -> RosResource | None:

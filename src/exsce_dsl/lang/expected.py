@@ -33,6 +33,7 @@ _OTHER_RULES = {
     "STRICTFLOAT": "number",
     "Length": "number",
     "Angle": "number",
+    "Duration": "number",
     "Quantity": "number",
     "MetricQuantity": "number",
     "MetricUnit": "unit",

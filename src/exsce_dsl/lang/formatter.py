@@ -21,7 +21,7 @@ from exsce_dsl.lang.build_expressions import read_quantity
 from exsce_dsl.lang.format_acceptance import acceptance_lines
 from exsce_dsl.lang.format_derivation import derivation_lines
 from exsce_dsl.lang.format_metrics import metric_lines
-from exsce_dsl.lang.lexical import Comment, as_written, read_angle, read_length
+from exsce_dsl.lang.lexical import Comment, as_written, duration_text, read_angle, read_length
 from exsce_dsl.lang.lexical import number_text as _number
 from exsce_dsl.lang.lexical import string_literal as _string
 from exsce_dsl.model import (
@@ -226,6 +226,8 @@ def _task(task: Task, poses: Mapping[str, Pose]) -> list[Line]:
     lines: list[Line] = [(f"task {task.id} {{", task.location)]
     if task.source is not None:
         lines.append((f"{INDENT}source{_ros(task.source)}", None))
+    if task.timeout is not None:
+        lines.append((f"{INDENT}timeout {duration_text(task.timeout, task.timeout_written)}", None))
     if len(task.subtasks) == 1:
         lines.extend((f"{INDENT}visit {_waypoint(w, poses)}", w.location) for w in task.subtasks[0].waypoints)
     else:
@@ -258,6 +260,8 @@ def _scenario(sc: Scenario, poses: Mapping[str, Pose]) -> list[Line]:
     lines.append((f"{INDENT}}}", None))
     m = sc.mission
     lines.append((f"{INDENT}mission {m.id} {m.type.value} {{", m.location))
+    if m.timeout is not None:
+        lines.append((f"{INDENT * 2}timeout {duration_text(m.timeout, m.timeout_written)}", None))
     runs: list[list[Assignment]] = []
     for entry in m.allocation:
         if runs and runs[-1][0].robot == entry.robot:

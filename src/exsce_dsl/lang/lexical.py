@@ -60,6 +60,8 @@ def string_literal(text: str) -> str:
 # number and, after optional spaces, a unit.
 _QUANTITY = re.compile(r"([-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?)\s*(\S+)?")
 _LENGTH_SCALE = {None: 1.0, "m": 1.0, "cm": 0.01, "mm": 0.001}
+DURATION_SCALE = {"ms": 0.001, "s": 1.0, "min": 60.0, "h": 3600.0}
+"""Seconds per unit of a ``Duration`` token."""
 
 
 def quantity_parts(text: str) -> tuple[str, str | None]:
@@ -85,6 +87,20 @@ def read_angle(text: str) -> float:
     """An ``Angle`` token (``90 deg``, ``1.57``) in radians."""
     number, unit = quantity_parts(text)
     return math.radians(float(number)) if unit == "deg" else float(number)
+
+
+def read_duration(text: str) -> float | None:
+    """A ``Duration`` token (``2 min``) in seconds; None when it has no unit."""
+    number, unit = quantity_parts(text)
+    return None if unit is None else float(number) * DURATION_SCALE[unit]
+
+
+def duration_text(seconds: float, written: str | None = None) -> str:
+    """A duration as the formatter writes it: as the author wrote it while that still reads as
+    ``seconds``, else in seconds (``90 s``, ``0.5 s``)."""
+    if written is not None and read_duration(written) == seconds:
+        return quantity_text(written)
+    return f"{int(seconds) if float(seconds).is_integer() else seconds!r} s"
 
 
 def as_written(

@@ -33,6 +33,7 @@ _RULE_WORDS = {
     "EOF": "the end of the file",
     "Length": "a length (a number, in m unless followed by cm or mm)",
     "Angle": "an angle (a number, in rad unless followed by deg)",
+    "Duration": "a duration (a number followed by s, min, h or ms)",
 }
 # Environments this long (characters) are parsed an area at a time to try a correction.
 _LONG_PIECE = 4000

@@ -17,6 +17,7 @@ from typing import Any
 from exsce_dsl.errors import SourceLocation
 from exsce_dsl.lang.build import position_of
 from exsce_dsl.lang.build_derivation import step_of
+from exsce_dsl.lang.lexical import quantity_text
 from exsce_dsl.lang.parser import ParsedFile
 
 # The references each construct of the grammar holds: attribute -> kind of what it names.
@@ -245,6 +246,8 @@ class _Reader:
             facts.append((label, ", ".join(waypoints)))
         if decl.source is not None:
             facts.append(("source", self.text(decl.source)))
+        if decl.timeout is not None:
+            facts.append(("goal timeout", quantity_text(decl.timeout.duration)))
         return self.symbol("task", decl, facts=facts)
 
     def _scenario(self, decl: Any) -> Symbol:
@@ -264,6 +267,8 @@ class _Reader:
                 f"{a.robot.name}: {' then '.join(t.name for t in a.tasks)}" for a in mission.assignments
             ]
             mission_facts = [("type", mission.kind), ("allocation", "; ".join(allocation))]
+            if mission.timeout is not None:
+                mission_facts.append(("goal timeout", quantity_text(mission.timeout.duration)))
             children.append(self.symbol("mission", mission, scope=decl.name, facts=mission_facts))
             facts.append(("mission", f"{mission.name} ({mission.kind})"))
         return self.symbol("scenario", decl, facts=facts, children=children)

@@ -3,6 +3,11 @@
 The shapes and key order are those of the method's own files, so that its tools read
 what exsce writes. The method's files hold no areas or obstacles (those came from the
 floor plan), so only what the scenario uses is written.
+
+One key is exsce's own: a goal timeout (``timeout 2 min`` in a mission or a task), which
+the method's files have no place for, is written as ``goal_timeout`` (seconds) in the
+scenario file's mission and at the top of the task file, after the method's keys, where
+the method's tools, which read the keys they know, pass over it; the import reads it back.
 """
 
 from __future__ import annotations
@@ -18,6 +23,8 @@ from exsce_dsl.model.names import is_valid_name
 
 #: The package named in a scenario file for a task that came from no ROS package.
 DEFAULT_TASK_PACKAGE = "exsce"
+#: exsce's own key for a mission's or a task's goal timeout, in seconds (see the module).
+GOAL_TIMEOUT = "goal_timeout"
 
 
 def scenario_to_yaml(scenario: Scenario) -> dict[str, Any]:
@@ -28,15 +35,18 @@ def scenario_to_yaml(scenario: Scenario) -> dict[str, Any]:
         models["map"] = _model("map_name", environment.map)
     if environment.world is not None:
         models["gazebo_world"] = _model("model_name", environment.world)
+    mission: dict[str, Any] = {
+        "id": scenario.mission.id,
+        "type": scenario.mission.type.value,
+        "allocation": [
+            {"robot": a.robot, **_task_reference(scenario, a.task)} for a in scenario.mission.allocation
+        ],
+    }
+    if scenario.mission.timeout is not None:
+        mission[GOAL_TIMEOUT] = scenario.mission.timeout
     return {
         "id": scenario.id,
-        "mission": {
-            "id": scenario.mission.id,
-            "type": scenario.mission.type.value,
-            "allocation": [
-                {"robot": a.robot, **_task_reference(scenario, a.task)} for a in scenario.mission.allocation
-            ],
-        },
+        "mission": mission,
         "environment": {
             "id": environment.id,
             "models": models,
@@ -65,7 +75,12 @@ def task_to_yaml(task: Task) -> dict[str, Any]:
                 "make the waypoint planar to export it",
                 waypoint.location,
             )
-    return {"task": [{"waypoints": [_waypoint(w) for w in subtask.waypoints]} for subtask in task.subtasks]}
+    content: dict[str, Any] = {
+        "task": [{"waypoints": [_waypoint(w) for w in subtask.waypoints]} for subtask in task.subtasks]
+    }
+    if task.timeout is not None:
+        content[GOAL_TIMEOUT] = task.timeout
+    return content
 
 
 def export_yaml(scenario: Scenario, out_dir: Path) -> list[Path]:

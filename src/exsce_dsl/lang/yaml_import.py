@@ -19,6 +19,7 @@ from pathlib import Path
 import yaml
 
 from exsce_dsl.errors import ExsceError, ImportFormatError, SourceLocation
+from exsce_dsl.lang.yaml_export import GOAL_TIMEOUT
 from exsce_dsl.model import (
     Area,
     Assignment,
@@ -154,6 +155,7 @@ def import_scenario_yaml(path: Path, task_search_path: Sequence[Path] = ()) -> t
         type=mission_type,
         allocation=tuple(allocation),
         location=mission_node.location,
+        timeout=_goal_timeout(mission_node),
     )
     scenario = Scenario(scenario_id, environment, robots, mission, tuple(tasks.values()), root.location)
 
@@ -404,7 +406,18 @@ def _read_task(file: YamlFile, task_id: str, source: RosResource | None) -> Task
         )
         for entry in root.get("task").items_of_list()
     )
-    return Task(task_id, subtasks, source, root.location)
+    return Task(task_id, subtasks, source, root.location, _goal_timeout(root))
+
+
+def _goal_timeout(node: YamlNode) -> float | None:
+    """exsce's ``goal_timeout`` key (seconds; see :mod:`.yaml_export`), if there is one."""
+    found = node.opt(GOAL_TIMEOUT)
+    if found is None:
+        return None
+    seconds = found.number()
+    if not seconds > 0:
+        raise found.error(f"{found.where} is a goal timeout in seconds: it must be above 0, not {seconds:g}")
+    return seconds
 
 
 def _read_pose(node: YamlNode) -> Pose:

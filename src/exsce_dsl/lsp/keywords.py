@@ -59,6 +59,9 @@ MEANINGS: dict[str, str] = {
     "subtask": "`subtask { visit ... }`: one part of a task, its waypoints in order.",
     "visit": "`visit POSE, POSE, (x, y)`: waypoints, in order: poses of an environment or coordinates.",
     "source": '`source package "P" path "F"`: the method\'s task file this task came from.',
+    "timeout": "`timeout 120 s` (or `2 min`): how long each navigation goal may take before the "
+    "dispatcher cancels it as timed out; in a task, for its goals; in a mission, for every goal whose "
+    "task gives none. Without either, max(60 s, 3 x the straight leg / the robot's speed limit).",
     "scenario": "`scenario NAME in ENVIRONMENT { robots { ... } mission ... }`: robots with start poses, an "
     'environment and a mission; in acceptance criteria, `scenario "title" { given when then }`.',
     "in": "`scenario NAME in ENVIRONMENT`: the environment the scenario happens in.",

@@ -17,11 +17,17 @@ from __future__ import annotations
 
 import datetime
 import enum
+import re
+import uuid
 from collections.abc import Iterator
 from dataclasses import dataclass
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model.geometry import Pose, Position
+from exsce_dsl.model.names import NAME_PATTERN
+
+RUN_NAME_TIME = "%Y-%m-%dT%H-%M-%S"
+"""How a run's files write its start: ISO 8601 in UTC, with ``-`` for ``:`` (file-safe)."""
 
 
 class ActionStatus(enum.Enum):
@@ -29,6 +35,17 @@ class ActionStatus(enum.Enum):
 
     SUCCEEDED = "SUCCEEDED"
     ABORTED = "ABORTED"
+
+
+class RunStatus(enum.Enum):
+    """How the mission of a run ended."""
+
+    COMPLETED = "completed"
+    """Every robot worked through its tasks (some goals may have been aborted and skipped)."""
+    STOPPED = "stopped"
+    """A failed goal stopped the mission: the goals after it were never sent."""
+    CANCELLED = "cancelled"
+    """The mission was cancelled (Ctrl-C, SIGTERM) before it completed."""
 
 
 class MetricScope(enum.Enum):
@@ -68,6 +85,17 @@ class Action:
     """When the goal became active."""
     end: datetime.datetime | None = None
     """When the goal reached its final status."""
+    outcome: str | None = None
+    """Why an ABORTED goal ended when its stack did not abort it: ``rejected``, ``timed out`` (the
+    dispatcher cancelled it) or ``cancelled`` (the mission was); None otherwise."""
+    attempts: int = 1
+    """How many times the goal was sent (a retried goal: 2)."""
+
+    def __post_init__(self) -> None:
+        if self.outcome is not None and self.status is not ActionStatus.ABORTED:
+            raise ExsceError(f"action {self.id} {self.outcome} cannot have status {self.status.value}")
+        if self.attempts < 1:
+            raise ExsceError(f"action {self.id} was sent {self.attempts} times: at least once")
 
     @property
     def robot(self) -> str:
@@ -184,7 +212,30 @@ class Run:
     """Which clock each of the bag's sources was timed by (the run's timeline)."""
     conventions: tuple[tuple[str, str, tuple[str, ...]], ...] = ()
     """(robot, convention, the topics it was detected from) of robots whose type names none."""
+    status: RunStatus = RunStatus.COMPLETED
+    """Whether the mission completed; a cancelled or stopped run is incomplete."""
 
     def actions(self) -> Iterator[Action]:
         for task in self.tasks:
             yield from task.actions
+
+
+def run_name(start: datetime.datetime, scenario: str, run_id: str) -> str:
+    """The name the method gives a run's files, before their extension:
+    ``<ISO date>_<scenario>_run-<first 8 of the run's uuid>``
+    (``2023-06-13T15-48-07_scenario_c_run-e30df0b6``), the start in UTC.
+
+    The scenario id must be written as the language writes ids (letters, digits, ``_`` and
+    inner ``-``): such an id is safe in a file name; anything else (a path, spaces) is an :class:`ExsceError`,
+    as is a run id that is not a uuid or a start without a time zone."""
+    if not re.fullmatch(NAME_PATTERN, scenario):
+        raise ExsceError(
+            f"scenario id {scenario!r} cannot name a run's files: use letters, digits, '_' and '-'"
+        )
+    try:
+        hexed = str(uuid.UUID(run_id))
+    except ValueError:
+        raise ExsceError(f"run id {run_id!r} is not a uuid") from None
+    if start.tzinfo is None or start.utcoffset() is None:
+        raise ExsceError(f"the start of run {hexed} has no time zone ({start.isoformat()})")
+    return f"{start.astimezone(datetime.timezone.utc).strftime(RUN_NAME_TIME)}_{scenario}_run-{hexed[:8]}"

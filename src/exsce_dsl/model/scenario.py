@@ -35,6 +35,10 @@ class Mission:
     allocation: tuple[Assignment, ...]
     """In execution order; per robot, the order of its tasks."""
     location: SourceLocation | None = field(default=None, compare=False, repr=False)
+    timeout: float | None = None
+    """Seconds each goal may take unless its task gives its own (``timeout 2 min``)."""
+    timeout_written: str | None = field(default=None, compare=False, repr=False)
+    """The timeout as the author wrote it, for the formatter."""
 
     def tasks_of(self, robot_id: str) -> tuple[str, ...]:
         return tuple(a.task for a in self.allocation if a.robot == robot_id)

@@ -24,6 +24,10 @@ class Task:
     subtasks: tuple[Subtask, ...]
     source: RosResource | None = None
     location: SourceLocation | None = field(default=None, compare=False, repr=False)
+    timeout: float | None = None
+    """Seconds each of its goals may take (``timeout 120 s``); wins over the mission's."""
+    timeout_written: str | None = field(default=None, compare=False, repr=False)
+    """The timeout as the author wrote it (``2 min``), for the formatter."""
 
     def waypoints(self) -> Iterator[Pose]:
         for subtask in self.subtasks:

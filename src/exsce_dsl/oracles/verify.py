@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import replace
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import Scenario
@@ -19,6 +20,10 @@ from exsce_dsl.store.queries import runs as stored_runs
 
 def judge_runs(store: Store, runs: Sequence[str], scenario: Scenario) -> list[Verdict]:
     """The verdicts of every oracle of ``scenario`` on each of ``runs`` (uuids), run by run.
+
+    A run whose mission did not complete (cancelled or stopped: its recording does not cover the
+    whole mission) is never passed: a clause it met is unjudged, saying so; one it broke fails,
+    for what was recorded did break it.
 
     Raises :class:`ExsceError` for a run the store does not hold, a run of another
     scenario, or a scenario without oracles (no baseline built yet).
@@ -40,7 +45,12 @@ def judge_runs(store: Store, runs: Sequence[str], scenario: Scenario) -> list[Ve
     for run in runs:
         for oracle in oracles:
             observed, why = observe(values[run], oracle.metric, oracle.robot, _window(oracle), scenario)
-            verdicts.append(_verdict(run, scenario.id, oracle, observed, why))
+            verdict = _verdict(run, scenario.id, oracle, observed, why)
+            incomplete = known[run].mission_status
+            if incomplete and verdict.outcome is Outcome.PASSED:
+                reason = f"the run is incomplete (its mission was {incomplete}): it was not seen to the end"
+                verdict = replace(verdict, outcome=Outcome.UNJUDGED, reason=reason, margin=None)
+            verdicts.append(verdict)
     return verdicts
 
 

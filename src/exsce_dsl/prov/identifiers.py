@@ -288,6 +288,12 @@ ROS_TOPICS = Term(ROS, "Topics")
 FILE_PATH = Term(EXSCE, "file_path")
 ROBOT_ATTR = Term(EXSCE, "robot")
 STATUS = Term(EXSCE, "status")
+GOAL_OUTCOME = Term(EXSCE, "goal_outcome")
+"""On an ABORTED action that its stack did not abort: ``rejected``, ``timed out`` or ``cancelled``."""
+ATTEMPTS = Term(EXSCE, "attempts")
+"""On an action whose goal was sent more than once: how many times."""
+MISSION_STATUS = Term(EXSCE, "mission_status")
+"""On a run whose mission did not complete: ``cancelled`` or ``stopped`` (incomplete)."""
 SEGMENTED_BY = Term(EXSCE, "segmented_by")
 """On a task execution: what its actions (path segments) were found from, when not the method's
 dispatcher (a navigation stack's goals, arrival at the planned waypoints)."""

@@ -44,7 +44,10 @@ Where exsce differs from the method's published run and its report, on purpose:
   spaces...) is escaped (``topic:@groundtruth``, see :func:`ids.topic_name`), as is the
   bag file's name;
 * additions: each action's start and end time and ``exsce:status``
-  (``SUCCEEDED``/``ABORTED``); ``exsce:unit`` on a value when known;
+  (``SUCCEEDED``/``ABORTED``), with ``exsce:goal_outcome`` (``rejected``, ``timed out``,
+  ``cancelled``) on an ABORTED action that its stack did not abort and ``exsce:attempts`` on a
+  goal sent more than once; ``exsce:mission_status`` (``cancelled``, ``stopped``) on a run whose
+  mission did not complete; ``exsce:unit`` on a value when known;
   ``exsce:metric`` on a ``violation_duration`` value (the safety metric, as the
   report's Listing 46 queries it); hotspots.
 
@@ -59,7 +62,7 @@ from prov.model import ProvDocument
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model.geometry import Pose
-from exsce_dsl.model.runs import ActionId, MetricScope, MetricValue, Run
+from exsce_dsl.model.runs import ActionId, MetricScope, MetricValue, Run, RunStatus
 from exsce_dsl.model.scenario import Scenario
 from exsce_dsl.prov import identifiers as ids
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, Namespaces
@@ -158,7 +161,10 @@ class _RunCompiler:
         robot_ns, pose_ns = w.fixed(ids.ROBOT), w.fixed(ids.POSE)
         mission_ns = w.of_element(mission.id, names.of_mission(mission.id), "mission")
 
-        w.activity(run_id, {PROV_TYPE: t(ids.RUN_TYPE), uuid_attr: run.uuid}, run.start, run.end)
+        run_facts: Attributes = {PROV_TYPE: t(ids.RUN_TYPE), uuid_attr: run.uuid}
+        if run.status is not RunStatus.COMPLETED:
+            run_facts[t(ids.MISSION_STATUS)] = run.status.value
+        w.activity(run_id, run_facts, run.start, run.end)
         parameters = parts[ids.PARAMETER_SERVER]
         writer.claim(parameters, "the run's parameter server")
         parameter_facts: Attributes = {PROV_TYPE: t(ids.ROS_PARAMETER_SERVER)}
@@ -203,12 +209,12 @@ class _RunCompiler:
                 action_id = parts[name]
                 writer.claim(action_id, f"action {name}")
                 actions[a] = action_id
-                w.activity(
-                    action_id,
-                    {PROV_TYPE: action_type, uuid_attr: run.uuid, status: action.status.value},
-                    action.start,
-                    action.end,
-                )
+                facts: Attributes = {PROV_TYPE: action_type, uuid_attr: run.uuid, status: action.status.value}
+                if action.outcome is not None:
+                    facts[t(ids.GOAL_OUTCOME)] = action.outcome
+                if action.attempts > 1:
+                    facts[t(ids.ATTEMPTS)] = action.attempts
+                w.activity(action_id, facts, action.start, action.end)
                 w.ended(action_id, pose_ns[self._pose_name(action.goal_pose)], attributes=goal)
                 w.started(action_id, pose_ns[self._pose_name(action.start_pose)])
                 w.associated(action_id, agent)

@@ -28,10 +28,9 @@ from exsce_dsl.errors import ExsceError
 from exsce_dsl.lang.occupancy import OccupancyGrid, load_occupancy_grid
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.conventions import Signals
-from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Bag, Run, TaskExecution
+from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Run, run_name
 from exsce_dsl.parallel.cluster import cluster_mapper
-from exsce_dsl.prov import serialize_prov
-from exsce_dsl.prov.run import compile_run
+from exsce_dsl.prov.recorder import recorded_prov_json, recorded_run
 from exsce_dsl.sim.bag import write_bag
 from exsce_dsl.sim.conventions import convention_writer
 from exsce_dsl.sim.executor import Execution, Fault, GoalStatus, execute
@@ -182,7 +181,7 @@ def play_run(plan: RunPlan, index: int, grid: PlanningGrid | None = None) -> Sim
     )
     grid = planning_grid(scenario) if grid is None else grid
     execution = execute(scenario, grid, run_seed, plan.faults)
-    name = f"{start.strftime('%Y-%m-%dT%H-%M-%S')}_{scenario.id}_run-{run_id[:8]}"
+    name = run_name(start, scenario.id, run_id)
     bag_name = name + ".bag" if plan.fmt == "ros1" else name
     partial = plan.out_dir / f".{name}.partial"  # the run's own: a retry clears what a killed try left
     _remove(partial)
@@ -196,7 +195,7 @@ def play_run(plan: RunPlan, index: int, grid: PlanningGrid | None = None) -> Sim
         )  # fmt: skip
         recorder = _recorded_run(run_id, scenario, execution, start, bag)
         recorded = partial / (name + ".prov.json")
-        recorded.write_text(serialize_prov(compile_run(recorder, scenario), "json"), encoding="utf-8")
+        recorded.write_text(recorded_prov_json(recorder, scenario), encoding="utf-8")
         os.replace(recorded, plan.out_dir / recorded.name)
         _remove(bag)
         os.replace(partial / bag_name, bag)  # last: a bag in its place is a whole run
@@ -220,21 +219,18 @@ def _recorded_run(
     def at(seconds: float) -> dt.datetime:
         return start + dt.timedelta(seconds=seconds)
 
-    grouped: dict[tuple[str, int], list[Action]] = {}
-    for a in execution.actions:
-        status = ActionStatus.SUCCEEDED if a.status == GoalStatus.SUCCEEDED else ActionStatus.ABORTED
-        grouped.setdefault((a.robot, a.task_number), []).append(
-            Action(
-                ActionId(a.robot, a.task_number, a.subtask_number, a.waypoint_number),
-                a.start_pose,
-                a.goal,
-                status,
-                at(a.start),
-                at(a.end),
-            )
+    actions = (
+        Action(
+            ActionId(a.robot, a.task_number, a.subtask_number, a.waypoint_number),
+            a.start_pose,
+            a.goal,
+            ActionStatus.SUCCEEDED if a.status == GoalStatus.SUCCEEDED else ActionStatus.ABORTED,
+            at(a.start),
+            at(a.end),
         )
-    tasks = tuple(TaskExecution(robot, n, tuple(acts)) for (robot, n), acts in grouped.items())
-    return Run(run_id, scenario.id, start, at(execution.duration), Bag(bag.name), tasks)
+        for a in execution.actions
+    )
+    return recorded_run(run_id, scenario.id, start, at(execution.duration), bag.name, actions)
 
 
 def scenario_convention(scenario: Scenario) -> str:

@@ -157,7 +157,8 @@ def reverse_waypoint_order(scenario: Scenario, a: Arguments, tasks: Mapping[str,
     if new_id in tasks or scenario.task(new_id) is not None:
         raise ExsceError(f"there is a task '{new_id}' already; name the reversed one with 'as'")
     subtasks = tuple(replace(s, waypoints=tuple(reversed(s.waypoints))) for s in reversed(old.subtasks))
-    reversed_task = Task(new_id, subtasks)  # not the source file of the old task any more
+    # not the source file of the old task any more; the same time for each goal
+    reversed_task = Task(new_id, subtasks, timeout=old.timeout, timeout_written=old.timeout_written)
     allocation = [replace(e, task=new_id) if e.task == old.id else e for e in scenario.mission.allocation]
     new = _with_allocation(scenario, allocation, {new_id: reversed_task})
     step = _step("reverse_waypoint_order", task=old.id, to=new_id)

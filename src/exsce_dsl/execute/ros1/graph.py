@@ -126,6 +126,20 @@ class Master:
         publishers, _, _ = self._call("getSystemState")
         return {topic: set(nodes) for topic, nodes in publishers}
 
+    def subscribers(self) -> dict[str, set[str]]:
+        """Topic → the nodes that subscribe to it."""
+        _, subscribers, _ = self._call("getSystemState")
+        return {topic: set(nodes) for topic, nodes in subscribers}
+
+    def lookup_node(self, name: str) -> str | None:
+        """The XML-RPC URI of node ``name``; None if the master does not know it."""
+        try:
+            answer: Any = self._proxy.lookupNode(CALLER, name)
+        except (OSError, xmlrpc.client.Error) as e:
+            raise RosGraphError(f"no ROS master answers at {self.uri} ({e})") from e
+        code, _, uri = answer
+        return str(uri) if code == 1 else None
+
     def topic_types(self) -> dict[str, str]:
         """Topic → its type, for every topic published now."""
         return dict(self._call("getTopicTypes"))

@@ -30,6 +30,9 @@ class StoredRun:
     """The bag file's name."""
     path: str | None = None
     """Where the bag file was when it was ingested."""
+    mission_status: str | None = None
+    """``cancelled`` or ``stopped`` when the run's mission did not complete (its recording does not
+    cover the whole mission); None when it completed."""
 
 
 def runs(store: Store, scenario: str | None = None, namespace: str = DEFAULT_NAMESPACE) -> list[StoredRun]:
@@ -45,6 +48,7 @@ def runs(store: Store, scenario: str | None = None, namespace: str = DEFAULT_NAM
                 end=datetime_of(row["end"]),
                 bag=text_of(row["bag"]) or None,
                 path=text_of(row["path"]),
+                mission_status=text_of(row["mission_status"]),
             )
         )
     return found

@@ -1,0 +1,59 @@
+"""``exscec execute --ros1``: a scenario's mission on a live ROS 1 graph, as a Python function."""
+
+from __future__ import annotations
+
+import contextlib
+from collections.abc import Callable
+from pathlib import Path
+
+from exsce_dsl.execute.outcomes import DEFAULT_POLICY, Policy
+from exsce_dsl.execute.ros1.graph import master_uri as environment_master_uri
+from exsce_dsl.execute.ros1.graph import start_master as start_roscore
+from exsce_dsl.execute.ros1.session import (
+    DEFAULT_SERVER_TIMEOUT,
+    LOGS,
+    ExecutedRun,
+    Interruption,
+    Options,
+    execute_runs,
+)
+from exsce_dsl.model import Scenario
+from exsce_dsl.model.document import Specification
+
+__all__ = ["ExecutedRun", "Policy", "execute_ros1"]
+
+
+def execute_ros1(
+    spec: Specification | Scenario,
+    out_dir: str | Path,
+    runs: int = 1,
+    *,
+    scenario: str | None = None,
+    master_uri: str | None = None,
+    start_master: bool = False,
+    policy: Policy | str = DEFAULT_POLICY,
+    server_timeout: float = DEFAULT_SERVER_TIMEOUT,
+    timeout: float | None = None,
+    interrupted: Callable[[], bool] | None = None,
+) -> list[ExecutedRun]:
+    """``exscec execute --ros1``: run the scenario's mission ``runs`` times on a live ROS 1 graph
+    (``master_uri``, else ``$ROS_MASTER_URI``; ``start_master``: a roscore of our own, stopped at
+    the end), each run leaving ``<date>_<scenario>_run-<id>.bag``, ``.prov.json`` and
+    ``.rosparams`` in ``out_dir``.  Failed goals go to ``policy`` (``skip-waypoint``,
+    ``retry-once``, ``skip-task``, ``stop-mission``); ``timeout`` (ROS seconds) is the timeout of
+    the goals whose task and mission give none (else one from the distance and speed limit).
+    Ctrl-C and SIGTERM (or ``interrupted()`` saying yes, when given) cancel the goals and raise
+    :class:`~exsce_dsl.errors.ExecutionInterrupted`, the run cut short kept in
+    ``out_dir/incomplete``.  A missing action server is a
+    :class:`~exsce_dsl.errors.RosGraphError` naming it, after ``server_timeout`` wall seconds."""
+    chosen = spec if isinstance(spec, Scenario) else spec.scenario(scenario)
+    out = Path(out_dir)
+    options = Options(Policy(policy), server_timeout, timeout)
+    with contextlib.ExitStack() as stack:
+        if interrupted is None:
+            interrupted = stack.enter_context(Interruption())
+        if start_master:
+            uri = stack.enter_context(start_roscore(out / LOGS / "ros")).uri
+        else:
+            uri = master_uri or environment_master_uri()
+        return execute_runs(chosen, uri, out, runs, options, interrupted)

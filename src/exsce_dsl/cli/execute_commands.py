@@ -1,0 +1,145 @@
+"""``exscec execute``: a scenario's mission on a live robot stack, recorded, and judged."""
+
+from __future__ import annotations
+
+import sys
+from collections import Counter
+
+import click
+
+from exsce_dsl.cli.common import ExitCode, exit_status, reports_errors
+from exsce_dsl.cli.store_commands import store_option
+
+POLICIES = ("skip-waypoint", "retry-once", "skip-task", "stop-mission")
+"""``Policy`` values (``exsce_dsl.execute.outcomes``), spelled here so that ``--help`` imports nothing."""
+
+
+@click.command(
+    epilog=exit_status(
+        passed="every run done (with --verify: every oracle passed)",
+        failed="--verify: an oracle failed",
+        inconclusive="--verify: an oracle could not be judged, and none failed",
+        bad_input="bad input, no ROS master, or an action server that never answered (no bag is left)",
+        interrupted="Ctrl-C or SIGTERM: the goals cancelled, the run cut short kept in -o DIR/incomplete/",
+    )
+)
+@click.argument("spec", type=click.Path(dir_okay=False))
+@click.option("--ros1", is_flag=True, required=True, help="Run on a ROS 1 graph (rospy, actionlib, rosbag).")
+@click.option("--scenario", "scenario_id", help="Which scenario, when the file declares several.")
+@click.option("--runs", "-n", default=1, show_default=True, type=click.IntRange(1), help="How many runs.")
+@click.option(
+    "-o",
+    "--output",
+    "out_dir",
+    type=click.Path(file_okay=False),
+    default="runs",
+    show_default=True,
+    help="Folder for each run's .bag, .prov.json and .rosparams.",
+)
+@click.option("--start-master", is_flag=True, help="Start a roscore of our own (else: $ROS_MASTER_URI).")
+@click.option(
+    "--policy",
+    type=click.Choice(POLICIES),
+    default="skip-waypoint",
+    show_default=True,
+    help="What a goal that is aborted, rejected or timed out leads to.",
+)
+@click.option(
+    "--server-timeout",
+    type=click.FloatRange(min=0, min_open=True),
+    default=10.0,
+    show_default=True,
+    metavar="S",
+    help="Wall seconds to wait for every robot's action server.",
+)
+@click.option(
+    "--goal-timeout",
+    type=click.FloatRange(min=0, min_open=True),
+    metavar="S",
+    help="ROS seconds a goal may take when its task and mission say no 'timeout' "
+    "[default: 3x the straight line at the speed limit, at least 60].",
+)
+@click.option("--verify", "judge", is_flag=True, help="Ingest each run's bag and judge it, as exscec verify.")
+@click.option("--junit", type=click.Path(dir_okay=False), help="With --verify: a JUnit XML report.")
+@store_option
+@reports_errors
+def execute(
+    spec: str,
+    ros1: bool,
+    scenario_id: str | None,
+    runs: int,
+    out_dir: str,
+    start_master: bool,
+    policy: str,
+    server_timeout: float,
+    goal_timeout: float | None,
+    judge: bool,
+    junit: str | None,
+    store_url: str | None,
+) -> None:
+    """Run a scenario's mission on a live ROS graph, record each run, judge it.
+
+    The scenario goes on the parameter server (/scenario); one actionlib
+    client per robot sends its waypoints as move_base goals
+    (move_base_msgs/MoveBaseAction on /<namespace>/move_base, in the map
+    frame), all robots at once (parallel) or one at a time (sequential);
+    rosbag record runs from before the first goal to after the last, on the
+    topics the metrics and the robots' conventions need, /tf, /tf_static,
+    /clock and /exsce/prov, where the run-time PROV is published (latched).
+    Each run leaves <date>_<scenario>_run-<id>.bag, .prov.json and
+    .rosparams in -o DIR, moved there only when whole.  Goal times are ROS
+    times: simulated time under /use_sim_time.
+
+    Ctrl-C or SIGTERM cancels the active goals, closes the bag and keeps the
+    run in DIR/incomplete/ (its PROV says cancelled), where DIR/*.bag does not
+    reach it; the exit status is 130.
+
+    On your robot's graph (roscore and each robot's move_base up, and
+    $ROS_MASTER_URI exported), three judged runs are
+    exscec execute SPEC --ros1 --runs 3 --verify --junit verdicts.xml.
+
+    \b
+    Example:
+      exscec execute examples/brsu_building_c/scenario_c.exsce --ros1 --start-master --runs 3 \\
+          --policy retry-once --verify --junit verdicts.xml --server-timeout 1 \\
+          -o live/  # exits 2: no robot's move_base answers
+    """
+    from exsce_dsl.api.execution import execute_ros1
+    from exsce_dsl.errors import ExecutionInterrupted
+    from exsce_dsl.lang.build import load_spec
+
+    scenario = load_spec(spec).scenario(scenario_id)
+    try:
+        done = execute_ros1(
+            scenario,
+            out_dir,
+            runs,
+            start_master=start_master,
+            policy=policy,
+            server_timeout=server_timeout,
+            timeout=goal_timeout,
+        )
+    except ExecutionInterrupted as stop:
+        click.echo(f"error: {stop.message}", err=True)
+        if stop.incomplete is not None:
+            click.echo(f"kept apart: {stop.incomplete}", err=True)
+        for bag in stop.complete:
+            click.echo(f"wrote {bag}", err=True)
+        sys.exit(ExitCode.INTERRUPTED)
+    for run in done:
+        counts = Counter(r.outcome.value for r in run.mission.records)
+        said = ", ".join(f"{n} {outcome}" for outcome, n in sorted(counts.items()))
+        click.echo(
+            f"wrote {run.files.bag} (mission {run.mission.status.value}: {said or 'no goal'})", err=True
+        )
+    if judge:
+        from exsce_dsl.api.workflows import verify
+        from exsce_dsl.cli.oracle_commands import report_verification
+        from exsce_dsl.store.open import open_store
+
+        with open_store(store_url) as store:
+            verification = verify(store, scenario, [r.files.bag for r in done])
+        sys.exit(report_verification(verification, False, junit))
+
+
+COMMANDS = [execute]

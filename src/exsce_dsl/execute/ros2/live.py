@@ -1,0 +1,240 @@
+"""The live ROS 2 part: Nav2 action clients behind the core's ``Navigator`` and ``Clock``.
+
+NOT RUN IN THIS PROJECT'S CI: rclpy cannot be installed here (it comes with a ROS 2 distro, built
+for that distro's Python), so nothing below has met a live ROS 2 graph; what it sends is built
+and tested in :mod:`.nav2`, how the bag is recorded in :mod:`.recorder`.  rclpy and nav2_msgs are
+imported inside :func:`require_rclpy` only, so that importing this module works without them.
+
+One rclpy node (``exsce_dispatcher``) holds a ``NavigateToPose`` action client per robot.  It is
+spun in the dispatcher's own thread, a slice at a time while :meth:`Ros2Navigator.next_finished`
+waits: goals are sent, and their acceptances and results handled, in that one thread.  (An
+executor spinning on a thread of its own would race ``send_goal_async``, which in Humble's
+rclpy registers a goal's future only after the request is out, without a lock: a fast answer
+would be dropped.)  Time is the node's clock: the wall clock, or ``/clock`` with ``use_sim_time``.
+"""
+
+from __future__ import annotations
+
+import time
+from collections import deque
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from types import ModuleType
+from typing import Any
+
+from exsce_dsl.errors import RosGraphError
+from exsce_dsl.execute.dispatcher import dispatch
+from exsce_dsl.execute.mission import schedule
+from exsce_dsl.execute.navigator import Finished
+from exsce_dsl.execute.outcomes import DEFAULT_POLICY, MissionRun, Outcome, Policy
+from exsce_dsl.execute.ros2.nav2 import goal_outcome, nav2_actions, stamped_pose
+from exsce_dsl.execute.ros2.recorder import SOURCE_HINT, Ros2Recorder
+from exsce_dsl.model import Pose, Scenario
+
+NODE_NAME = "exsce_dispatcher"
+SERVER_WAIT = 10.0
+"""Seconds an action server has to show up before the run fails naming it."""
+CANCEL_WAIT = 2.0
+"""Wall seconds a run that stops on an error waits for goals still unanswered, to cancel them."""
+RECORDER_NODE = "rosbag2_recorder"
+"""The node name of ``ros2 bag record``'s recorder (its default)."""
+WAIT_SLICE = 0.05
+"""Wall seconds between two looks at the clock while waiting for a goal to end."""
+
+
+@dataclass(frozen=True)
+class Ros2Modules:
+    """What the adapter uses of a ROS 2 installation."""
+
+    rclpy: ModuleType
+    context: ModuleType
+    """``rclpy.context`` (Context: this run's own, shut down at its end)."""
+    action: ModuleType
+    """``rclpy.action`` (ActionClient)."""
+    executors: ModuleType
+    parameter: ModuleType
+    """``rclpy.parameter`` (Parameter, for ``use_sim_time``)."""
+    nav2: ModuleType
+    """``nav2_msgs.action`` (NavigateToPose)."""
+
+
+def require_rclpy() -> Ros2Modules:
+    """rclpy and nav2_msgs, or :class:`RosGraphError` saying how to get them."""
+    try:
+        import nav2_msgs.action as nav2
+        import rclpy
+        import rclpy.action as action
+        import rclpy.context as context
+        import rclpy.executors as executors
+        import rclpy.parameter as parameter
+    except ImportError as exc:
+        raise RosGraphError(
+            f"the ROS 2 adapter needs rclpy and nav2_msgs, which this Python cannot import ({exc}): "
+            f"{SOURCE_HINT} in the shell that runs exscec, with a Python of the distro's version "
+            "(3.10 for Humble, 3.12 for Jazzy); rclpy is not installed with pip"
+        ) from None
+    return Ros2Modules(rclpy, context, action, executors, parameter, nav2)
+
+
+class Ros2Clock:
+    """The node's clock, in seconds (simulated time under ``use_sim_time``)."""
+
+    def __init__(self, node: Any) -> None:
+        self.node = node
+
+    def now(self) -> float:
+        return float(self.node.get_clock().now().nanoseconds) / 1e9
+
+
+class Ros2Navigator:
+    """The core's :class:`~exsce_dsl.execute.navigator.Navigator` over Nav2's ``NavigateToPose``:
+    ``clients`` maps each robot to its action client, ``executor`` spins their node."""
+
+    def __init__(
+        self, modules: Ros2Modules, executor: Any, clients: Mapping[str, Any], clock: Ros2Clock
+    ) -> None:
+        self.modules, self.executor, self.clients, self.clock = modules, executor, dict(clients), clock
+        self._ended: deque[Finished] = deque()
+        self._handles: dict[int, Any] = {}
+        self._cancelled: set[int] = set()
+        self._unanswered: set[int] = set()
+        """Goals sent whose acceptance or rejection has not come yet."""
+
+    def send(self, goal: int, robot: str, pose: Pose) -> None:
+        message = self.modules.nav2.NavigateToPose.Goal()
+        stamped = stamped_pose(pose)
+        message.pose.header.frame_id = stamped.frame_id
+        message.pose.header.stamp = self.clock.node.get_clock().now().to_msg()
+        position, orientation = message.pose.pose.position, message.pose.pose.orientation
+        position.x, position.y, position.z = stamped.position
+        orientation.x, orientation.y, orientation.z, orientation.w = stamped.orientation
+        future = self.clients[robot].send_goal_async(message)
+        self._unanswered.add(goal)
+        future.add_done_callback(lambda done: self._accepted(goal, done))
+
+    def cancel(self, goal: int) -> None:
+        self._cancelled.add(goal)
+        handle = self._handles.get(goal)
+        if handle is not None:  # else: cancelled when its acceptance comes
+            handle.cancel_goal_async()
+
+    def next_finished(self, deadline: float) -> Finished | None:
+        while not self._ended:
+            left = deadline - self.clock.now()
+            if left <= 0:
+                return None
+            self.executor.spin_once(timeout_sec=min(left, WAIT_SLICE))
+        return self._ended.popleft()
+
+    def _accepted(self, goal: int, future: Any) -> None:
+        self._unanswered.discard(goal)
+        handle = future.result()
+        if not handle.accepted:
+            self._end(goal, Outcome.REJECTED)
+            return
+        if goal in self._cancelled:  # cancelled while its acceptance was on the way
+            handle.cancel_goal_async()
+            return
+        self._handles[goal] = handle
+        handle.get_result_async().add_done_callback(lambda done: self._result(goal, done))
+
+    def cancel_active(self) -> None:
+        """Cancel every goal sent and not ended (a run left by an exception, Ctrl-C among them),
+        waiting up to :data:`CANCEL_WAIT` for the acceptances still on their way."""
+        for goal in sorted(set(self._handles) | self._unanswered):
+            self.cancel(goal)
+        deadline = time.monotonic() + CANCEL_WAIT
+        while self._unanswered and time.monotonic() < deadline:
+            self.executor.spin_once(timeout_sec=WAIT_SLICE)
+
+    def _result(self, goal: int, future: Any) -> None:
+        self._handles.pop(goal, None)
+        outcome = goal_outcome(int(future.result().status))
+        self._end(goal, Outcome.ABORTED if outcome is None else outcome)
+
+    def _end(self, goal: int, outcome: Outcome) -> None:
+        if goal not in self._cancelled:  # the dispatcher's own cancels are not reported
+            self._ended.append(Finished(goal, outcome, self.clock.now()))
+
+
+def wait_for_clock(executor: Any, clock: Ros2Clock, timeout: float = SERVER_WAIT) -> None:
+    """Spin until ``clock`` has a time (under ``use_sim_time``: the first ``/clock`` message)."""
+    deadline = time.monotonic() + timeout
+    while clock.now() <= 0:
+        if time.monotonic() > deadline:
+            raise RosGraphError(f"no time on /clock after {timeout:g} s: is the simulator running?")
+        executor.spin_once(timeout_sec=WAIT_SLICE)
+
+
+def wait_for_recorder(node: Any, executor: Any, recorder: Ros2Recorder, timeout: float = SERVER_WAIT) -> None:
+    """Spin until the recorder (node :data:`RECORDER_NODE`) subscribes to every topic it records
+    that has a publisher, so that it misses nothing of the first goal; an error if it stopped."""
+    deadline = time.monotonic() + timeout
+    while True:
+        recorder.check_running()
+        published = [t for t in recorder.topics if node.count_publishers(t) > 0]
+        missing = [
+            t
+            for t in published
+            if not any(i.node_name == RECORDER_NODE for i in node.get_subscriptions_info_by_topic(t))
+        ]
+        if not missing:
+            return
+        if time.monotonic() > deadline:
+            raise RosGraphError(f"ros2 bag record did not subscribe to {missing} within {timeout:g} s")
+        executor.spin_once(timeout_sec=WAIT_SLICE)
+
+
+def execute_ros2(
+    scenario: Scenario,
+    bag: Path,
+    topics: Sequence[str],
+    policy: Policy = DEFAULT_POLICY,
+    timeout: float | None = None,
+    speeds: Mapping[str, float] | None = None,
+    use_sim_time: bool = False,
+    cancelled: Callable[[], bool] | None = None,
+) -> MissionRun:
+    """Run ``scenario``'s mission on a live ROS 2 graph through each robot's Nav2, with
+    ``ros2 bag record`` of ``topics`` into the MCAP bag folder ``bag`` from before the first goal
+    to after the last.  Raises :class:`RosGraphError` when rclpy is missing (before anything
+    starts) or a robot's ``navigate_to_pose`` server does not answer within :data:`SERVER_WAIT`."""
+    modules = require_rclpy()
+    plan = schedule(scenario, speeds, timeout)
+    robots = {r.id: r for r in scenario.robots}
+    actions = {robot: nav2_actions(robots[robot]).navigate_to_pose for robot in {g.robot for g in plan.goals}}
+    rclpy = modules.rclpy
+    context = modules.context.Context()
+    rclpy.init(context=context)
+    try:
+        sim_time = modules.parameter.Parameter("use_sim_time", value=use_sim_time)
+        node = rclpy.create_node(NODE_NAME, context=context, parameter_overrides=[sim_time])
+        executor = modules.executors.SingleThreadedExecutor(context=context)
+        executor.add_node(node)
+        try:
+            clients = {
+                robot: modules.action.ActionClient(node, modules.nav2.NavigateToPose, name)
+                for robot, name in sorted(actions.items())
+            }
+            for robot, client in clients.items():
+                if not client.wait_for_server(timeout_sec=SERVER_WAIT):
+                    raise RosGraphError(
+                        f"no NavigateToPose action server at {actions[robot]} (robot '{robot}') "
+                        f"after {SERVER_WAIT:g} s: is Nav2 running in that namespace?"
+                    )
+            clock = Ros2Clock(node)
+            wait_for_clock(executor, clock)
+            navigator = Ros2Navigator(modules, executor, clients, clock)
+            with Ros2Recorder(bag, topics, use_sim_time) as recorder:
+                wait_for_recorder(node, executor, recorder)
+                try:
+                    return dispatch(plan, navigator, clock, policy, cancelled)
+                except BaseException:
+                    navigator.cancel_active()  # no robot drives on after we stop
+                    raise
+        finally:
+            executor.shutdown()
+            node.destroy_node()
+    finally:
+        context.try_shutdown()
