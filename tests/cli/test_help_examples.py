@@ -24,6 +24,7 @@ import subprocess
 import sys
 import time
 import urllib.request
+import xmlrpc.client
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -72,12 +73,13 @@ WALK: tuple[tuple[str, ...], ...] = (
     ("serve",),
     ("lsp",),
     ("mcp",),
+    ("stand-in",),  # scenario_c's robots on a roscore of their own, stopped with Ctrl-C
     ("demo",),
     ("store", "clear"),  # last: it empties the store the others use
 )
 """The commands whose examples are run, in this order (each command's examples in theirs)."""
 
-SERVERS = {("serve",), ("lsp",), ("mcp",)}
+SERVERS = {("serve",), ("lsp",), ("mcp",), ("stand-in",)}
 """Commands that run until stopped."""
 
 _HEADER = re.compile(r"Examples?\b[^:]*:")
@@ -186,6 +188,8 @@ def test_every_help_example_runs_as_written(tmp_path: Path) -> None:
                 _lsp(example, scratch, env)
             elif path == ("mcp",):
                 _mcp(example, scratch, env)
+            elif path == ("stand-in",):
+                _stand_in(example, scratch, env)
             else:
                 done = subprocess.run(
                     ["bash", "-c", example.line],
@@ -342,4 +346,19 @@ def _mcp(example: Example, cwd: Path, env: dict[str, str]) -> None:
         assert answer["id"] == 1 and "serverInfo" in answer["result"], answer
     finally:
         process.stdin.close()  # the client goes away: the server ends
+    _stopped(process, example)
+
+
+def _stand_in(example: Example, cwd: Path, env: dict[str, str]) -> None:
+    process = _start(example.line, cwd, env)
+    try:
+        first = _Reader(process).until(b"\n").decode().strip()  # ROS_MASTER_URI=...
+        assert first.startswith("ROS_MASTER_URI=http://"), first
+        master = xmlrpc.client.ServerProxy(first.split("=", 1)[1])
+        code, _, (publishers, _, _) = master.getSystemState("/exsce_help_examples")
+        published = {topic for topic, _ in publishers}
+        assert code == 1 and {"/clock", "/tiago1/move_base/result", "/tiago2/move_base/result"} <= published
+    finally:
+        if process.poll() is None:
+            os.killpg(process.pid, signal.SIGINT)  # Ctrl-C, as the help says
     _stopped(process, example)

@@ -15,6 +15,7 @@ the same messages the command prints.
 
 from exsce_dsl.api.drafts import init_from_bag
 from exsce_dsl.api.execution import execute_ros1
+from exsce_dsl.api.stand_in import stand_in
 from exsce_dsl.api.tables import metrics, query, rows_frame, segments, sparql, verdicts
 from exsce_dsl.api.workflows import (
     add_derived,
@@ -56,6 +57,7 @@ __all__ = [
     "segments",
     "simulate",
     "sparql",
+    "stand_in",
     "verdicts",
     "verify",
 ]

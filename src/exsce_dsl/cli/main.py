@@ -38,6 +38,7 @@ COMMAND_MODULES: dict[str, str] = {
     "lineage": "derive_commands",
     "expect": "derive_commands",
     "explore": "explore_commands",
+    "stand-in": "stand_in_commands",
     "cluster": "similarity_commands",
     "report": "report_commands",
     "generate": "generate_commands",

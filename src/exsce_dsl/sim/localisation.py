@@ -94,9 +94,10 @@ class Localisation:
     drift: Odometry
 
 
-def localise(trajectory: Trajectory, rng: np.random.Generator) -> Localisation:
-    """The odometry, estimate and correction of a robot that drove ``trajectory`` (seeded)."""
-    drift = Odometry.seeded(rng)
+def localise(trajectory: Trajectory, rng: np.random.Generator, drift: Odometry | None = None) -> Localisation:
+    """The odometry, estimate and correction of a robot that drove ``trajectory`` (seeded);
+    ``drift``: its odometry's, else drawn from ``rng`` (a robot driving leg after leg keeps one)."""
+    drift = Odometry.seeded(rng) if drift is None else drift
     truth = Poses(trajectory.x, trajectory.y, trajectory.yaw)
     odom = _odometry(truth, drift)
     estimate = Poses(

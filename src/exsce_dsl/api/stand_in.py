@@ -1,0 +1,44 @@
+"""``exscec stand-in`` from Python: the kinematic executor as live ROS 1 robots."""
+
+from __future__ import annotations
+
+import tempfile
+from collections.abc import Iterator, Sequence
+from contextlib import ExitStack, contextmanager
+from pathlib import Path
+
+from exsce_dsl.execute.ros1.graph import master_uri as environment_master_uri
+from exsce_dsl.execute.ros1.graph import start_master as start_roscore
+from exsce_dsl.execute.stand_in import StandIn, start_stand_in
+from exsce_dsl.model import Scenario
+from exsce_dsl.model.document import Specification
+from exsce_dsl.sim.faults import Fault
+
+
+@contextmanager
+def stand_in(
+    spec: Specification | Scenario,
+    *,
+    scenario: str | None = None,
+    master_uri: str | None = None,
+    start_master: bool = False,
+    seed: int = 0,
+    faults: Sequence[str] = (),
+    speed_up: float = 10.0,
+    log_dir: str | Path | None = None,
+) -> Iterator[StandIn]:
+    """``exscec stand-in --ros1``: the scenario's robots as move_base servers on the ROS 1 master at
+    ``master_uri`` (else ``$ROS_MASTER_URI``; ``start_master``: a roscore of its own, stopped at the
+    end), with ``faults`` as on the command line (``overspeed:tiago1``), simulated time
+    ``speed_up`` times faster than wall time; logs in ``log_dir`` (else a new temporary folder)."""
+    chosen = spec if isinstance(spec, Scenario) else spec.scenario(scenario)
+    parsed = tuple(Fault.parse(f) for f in faults)
+    logs = Path(log_dir) if log_dir is not None else Path(tempfile.mkdtemp(prefix="exsce-stand-in-"))
+    with ExitStack() as stack:
+        if start_master:
+            uri = stack.enter_context(start_roscore(logs / "ros")).uri
+        else:
+            uri = master_uri or environment_master_uri()
+        yield stack.enter_context(
+            start_stand_in(chosen, uri, seed=seed, faults=parsed, speed_up=speed_up, log_dir=logs)
+        )

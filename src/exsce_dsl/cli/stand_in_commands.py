@@ -1,0 +1,106 @@
+"""``exscec stand-in``: the kinematic executor as live ROS 1 robots, until stopped."""
+
+from __future__ import annotations
+
+import signal
+from types import FrameType
+
+import click
+
+from exsce_dsl.cli.common import exit_status, reports_errors
+
+
+@click.command("stand-in", epilog=exit_status(passed="stopped with Ctrl-C or SIGTERM"))
+@click.argument("spec", type=click.Path(dir_okay=False))
+@click.option("--ros1", is_flag=True, help="On a ROS 1 graph (the only one the stand-in plays on yet).")
+@click.option("--scenario", "scenario_id", help="Which scenario, when the file declares several.")
+@click.option("--seed", default=0, show_default=True, type=int, help="Seeds the speeds, drift and noise.")
+@click.option(
+    "--fault",
+    "faults",
+    multiple=True,
+    metavar="NAME[:ARGS]",
+    help="A deliberate fault, as exscec simulate's (repeatable): overspeed:ROBOT, slow:ROBOT, "
+    "skip-waypoint:ROBOT[:N] (its N-th goal aborts), slow-area:AREA, detour:FROM:TO, "
+    "deadlock-start:ROBOT:POSE, overspeed-many-tasks:N, overspeed-reassigned:TASK:ROBOT "
+    "(near-collision is not played).",
+)
+@click.option(
+    "--speed-up",
+    default=10.0,
+    show_default=True,
+    type=click.FloatRange(min=0.0, min_open=True),
+    help="Simulated time (/clock) runs this many times faster than wall time.",
+)
+@click.option(
+    "--start-master",
+    is_flag=True,
+    help="Start a roscore of its own on a free port (printed first), stopped at the end; "
+    "else the one at $ROS_MASTER_URI.",
+)
+@click.option(
+    "--log-dir",
+    type=click.Path(file_okay=False),
+    help="Folder for the node's log (and the roscore's) [default: a new temporary folder].",
+)
+@reports_errors
+def stand_in(
+    spec: str,
+    ros1: bool,
+    scenario_id: str | None,
+    seed: int,
+    faults: tuple[str, ...],
+    speed_up: float,
+    start_master: bool,
+    log_dir: str | None,
+) -> None:
+    """Play a scenario's robots on a live ROS 1 graph, as move_base robots.
+
+    Per robot namespace: a move_base_msgs/MoveBaseAction server on
+    move_base (a goal is planned on the environment's occupancy grid from
+    where the robot stands, driven, and succeeds or aborts, with status,
+    feedback and result; a cancel stops the robot where it is), odom, tf
+    (odom -> base_link, map -> odom, with the odometry's drift),
+    tf_static, amcl_pose, scan and cmd_vel, as `exscec simulate
+    --convention move_base` writes them.  Between goals the robots stand
+    still and every topic keeps publishing.  Time is simulated: the
+    stand-in sets /use_sim_time and publishes /clock, --speed-up times
+    faster than wall time (slower if it cannot keep up).
+
+    The first line on stdout is ROS_MASTER_URI=URI; it runs until Ctrl-C
+    or SIGTERM.  Drive it with any actionlib client, or exscec execute.
+
+    \b
+    Example:
+      exscec stand-in examples/brsu_building_c/scenario_c.exsce --ros1 --start-master
+      exscec stand-in examples/brsu_building_c/scenario_c.exsce --ros1 --start-master \\
+          --fault overspeed:tiago1 --speed-up 20
+    """
+    from exsce_dsl.api.stand_in import stand_in as play
+    from exsce_dsl.lang.build import load_spec
+
+    if not ros1:
+        raise click.UsageError("say --ros1: the stand-in plays on ROS 1 only (yet)")
+    loaded = load_spec(spec)
+
+    def terminated(signum: int, frame: FrameType | None) -> None:
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGTERM, terminated)
+    try:
+        with play(
+            loaded, scenario=scenario_id, start_master=start_master, seed=seed, faults=faults,
+            speed_up=speed_up, log_dir=log_dir,
+        ) as running:  # fmt: skip
+            click.echo(f"ROS_MASTER_URI={running.master_uri}")
+            servers = ", ".join(f"{robot} ({action})" for robot, action in running.actions.items())
+            click.echo(f"stand-in: {servers} at {speed_up:g}x wall time; Ctrl-C to stop", err=True)
+            try:
+                running.wait()
+            except KeyboardInterrupt:
+                click.echo("stand-in: stopping", err=True)
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+COMMANDS = [stand_in]
