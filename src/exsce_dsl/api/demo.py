@@ -109,6 +109,38 @@ STEPS: tuple[Step, ...] = (
     Step("Write the HTML report", "exscec report -o report --spec scenarios/scenario_c.exsce"),
 )
 
+LIVE_SCENARIO = "scenarios/scenario_c.exsce"
+LIVE_STEPS: tuple[Step, ...] = (
+    Step("Check the scenario", f"exscec check {LIVE_SCENARIO}"),
+    Step(
+        "Compile it to PROV and add it to the store",
+        f"exscec compile {LIVE_SCENARIO} -f provn -o scenario_c.provn --store",
+    ),
+    Step(
+        "Execute three baseline runs on the live ROS 1 graph: exsce's stand-in robots serve the move_base "
+        "goals, rosbag record records each run",
+        f"exscec execute {LIVE_SCENARIO} --ros1 --stand-in --seed 1 --runs 3 -o runs/baseline",
+    ),
+    Step("Ingest them", f"exscec ingest runs/baseline/*.bag --scenario {LIVE_SCENARIO} --jobs 2"),
+    Step("Build the baseline oracles", f"exscec baseline {LIVE_SCENARIO}"),
+    Step(
+        "Execute a new run and judge it (it passes)",
+        f"exscec execute {LIVE_SCENARIO} --ros1 --stand-in --seed 7 -o runs/new --verify "
+        "--junit verdicts-new.xml",
+        verdict="new run of scenario_c on the live graph",
+    ),
+    Step(
+        "Execute a run where tiago1's stand-in drives too fast, and judge it (it fails: exit 1)",
+        f"exscec execute {LIVE_SCENARIO} --ros1 --stand-in --seed 8 --fault overspeed:tiago1 "
+        "-o runs/faulty --verify",
+        expected_exit=1,
+        verdict="live run with the over-speed fault",
+    ),
+    Step("Write the HTML report", f"exscec report -o report --spec {LIVE_SCENARIO}"),
+)
+"""``exscec demo --ros1``: the method's loop on a live ROS 1 graph (a roscore of the demo's own),
+the robots played by the stand-in in move_base's convention; ``docs/live.md`` has the same steps."""
+
 _ENDINGS = {0: "passed", 1: "failed", 2: "refused (bad input)", 3: "not judged"}
 """What a verify step's exit status says of the runs it judged (the codes of ``exscec --help``)."""
 
@@ -231,6 +263,24 @@ def _inside(folder: Path, store_url: str | None) -> Iterator[None]:
                 os.environ["EXSCE_STORE"] = store_before
 
 
+@contextmanager
+def live_graph(folder: Path) -> Iterator[str]:
+    """A roscore of the demo's own (its logs in ``folder/.exsce-ros``), exported as
+    ``$ROS_MASTER_URI`` while the block runs; the master's URI."""
+    from exsce_dsl.execute.ros1.graph import start_master
+
+    before = os.environ.get("ROS_MASTER_URI")
+    with start_master(folder.absolute() / ".exsce-ros") as master:
+        os.environ["ROS_MASTER_URI"] = master.uri
+        try:
+            yield master.uri
+        finally:
+            if before is None:
+                os.environ.pop("ROS_MASTER_URI", None)
+            else:
+                os.environ["ROS_MASTER_URI"] = before
+
+
 def run_steps(
     folder: Path,
     run_command: Callable[[list[str]], int],
@@ -259,7 +309,7 @@ def run_steps(
     return DemoRun(folder, store_of(folder, store_url), chosen, tuple(outcomes), time.monotonic() - started)
 
 
-def summary_lines(run: DemoRun) -> list[str]:
+def summary_lines(run: DemoRun, walkthrough: str = "docs/tutorial.md") -> list[str]:
     """The summary: how each verify step ended against what it should, where the results are,
     and, when something went otherwise, what."""
     verdict = "every step ended as expected" if run.as_expected else "NOT every step ended as expected"
@@ -270,7 +320,7 @@ def summary_lines(run: DemoRun) -> list[str]:
             lines.append(f"  {outcome.text:{width}}  {outcome.step.verdict}")
     lines.append(f"  store: {run.store}")
     lines.append(f"  report: {run.folder / 'report' / 'index.html'}")
-    lines.append("  tutorial: docs/tutorial.md runs the same commands by hand")
+    lines.append(f"  tutorial: {walkthrough} runs the same commands by hand")
     stopped = run.stopped
     if stopped is not None:
         number = len(run.outcomes)

@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import contextlib
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
+from exsce_dsl.errors import ExsceError
 from exsce_dsl.execute.outcomes import DEFAULT_POLICY, Policy
 from exsce_dsl.execute.ros1.graph import master_uri as environment_master_uri
 from exsce_dsl.execute.ros1.graph import start_master as start_roscore
@@ -17,8 +18,10 @@ from exsce_dsl.execute.ros1.session import (
     Options,
     execute_runs,
 )
+from exsce_dsl.execute.stand_in import start_stand_in
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.document import Specification
+from exsce_dsl.sim.faults import Fault
 
 __all__ = ["ExecutedRun", "Policy", "execute_ros1"]
 
@@ -35,6 +38,10 @@ def execute_ros1(
     server_timeout: float = DEFAULT_SERVER_TIMEOUT,
     timeout: float | None = None,
     interrupted: Callable[[], bool] | None = None,
+    stand_in: bool = False,
+    seed: int = 0,
+    faults: Sequence[str] = (),
+    speed_up: float = 10.0,
 ) -> list[ExecutedRun]:
     """``exscec execute --ros1``: run the scenario's mission ``runs`` times on a live ROS 1 graph
     (``master_uri``, else ``$ROS_MASTER_URI``; ``start_master``: a roscore of our own, stopped at
@@ -45,10 +52,17 @@ def execute_ros1(
     Ctrl-C and SIGTERM (or ``interrupted()`` saying yes, when given) cancel the goals and raise
     :class:`~exsce_dsl.errors.ExecutionInterrupted`, the run cut short kept in
     ``out_dir/incomplete``.  A missing action server is a
-    :class:`~exsce_dsl.errors.RosGraphError` naming it, after ``server_timeout`` wall seconds."""
+    :class:`~exsce_dsl.errors.RosGraphError` naming it, after ``server_timeout`` wall seconds.
+
+    ``stand_in``: exsce's stand-in robots (``exscec stand-in``) serve the goals, started afresh
+    for each run on simulated time ``speed_up`` times faster than wall time, run ``i`` driving as
+    run ``i`` of ``exscec simulate --seed SEED`` does, with ``faults`` as on the command line."""
     chosen = spec if isinstance(spec, Scenario) else spec.scenario(scenario)
     out = Path(out_dir)
     options = Options(Policy(policy), server_timeout, timeout)
+    if not stand_in and (faults or seed):
+        raise ExsceError("faults and a seed are the stand-in's: give stand_in=True (--stand-in) with them")
+    planted = tuple(Fault.parse(f) for f in faults)
     with contextlib.ExitStack() as stack:
         if interrupted is None:
             interrupted = stack.enter_context(Interruption())
@@ -56,4 +70,13 @@ def execute_ros1(
             uri = stack.enter_context(start_roscore(out / LOGS / "ros")).uri
         else:
             uri = master_uri or environment_master_uri()
-        return execute_runs(chosen, uri, out, runs, options, interrupted)
+        around_run = None
+        if stand_in:
+
+            def around_run(run: int) -> contextlib.AbstractContextManager[object]:
+                logs = out / LOGS / "stand-in"
+                return start_stand_in(
+                    chosen, uri, seed=seed, faults=planted, speed_up=speed_up, log_dir=logs, run=run
+                )
+
+        return execute_runs(chosen, uri, out, runs, options, interrupted, around_run)

@@ -46,8 +46,15 @@ def run_in_process(argv: Sequence[str]) -> int:
     help="Whose topics the robots publish: the example's robot types are given this convention, so "
     "every step runs on Nav2's (or move_base's) topics and types.",
 )
+@click.option(
+    "--ros1",
+    is_flag=True,
+    help="The loop on a live ROS 1 graph instead: a roscore of the demo's own, exsce's stand-in robots "
+    "serving move_base goals, exscec execute recording and judging each run (needs ROS 1: "
+    "sh scripts/install-ros1).",
+)
 @reports_errors
-def demo(folder: str, store_url: str | None, setup_only: bool, convention: str) -> None:
+def demo(folder: str, store_url: str | None, setup_only: bool, convention: str, ros1: bool) -> None:
     """Run the whole method on the shipped example, in a new FOLDER.
 
     Copies the example (building C of the method, scenario_c with two TIAGo
@@ -58,6 +65,13 @@ def demo(folder: str, store_url: str | None, setup_only: bool, convention: str) 
     simulates and verifies it, clusters the scenarios and writes the HTML
     report (open FOLDER/report/index.html in a browser).  Each step prints
     the command it runs: docs/tutorial.md walks the same path by hand.
+
+    With --ros1 the runs are executed on a live ROS 1 graph instead
+    (docs/live.md walks it by hand): a roscore of the demo's own, the robots
+    played by exsce's stand-in in move_base's convention, each run's mission
+    dispatched as move_base goals and recorded by rosbag record, baseline
+    runs ingested, a new run and one with tiago1 driving too fast executed
+    and judged.
     Exits 0 when every step ended as expected (the faulty run failing, the
     others passing), 1 otherwise.
 
@@ -65,29 +79,53 @@ def demo(folder: str, store_url: str | None, setup_only: bool, convention: str) 
     Example:
       exscec demo exsce-demo
       exscec demo my-project --setup-only   # only copy the example, to follow docs/tutorial.md
+      exscec demo live-demo --ros1   # on a live ROS 1 graph (about two minutes)
     """
-    from exsce_dsl.api.demo import STEPS, Step, command_hint, run_steps, set_up, summary_lines
+    from exsce_dsl.api.demo import (
+        LIVE_STEPS,
+        STEPS,
+        Step,
+        command_hint,
+        live_graph,
+        run_steps,
+        set_up,
+        summary_lines,
+    )
 
+    if ros1 and convention != "method":
+        raise click.UsageError("--ros1 plays the robots in move_base's convention: leave out --convention")
     target = Path(folder)
-    set_up(target, convention)
+    set_up(target, "move_base" if ros1 else convention)
     hint = command_hint(Path.cwd())
     if setup_only:
         click.echo(f"copied the example scenarios into {target / 'scenarios'}", err=True)
         if hint:
             click.echo(hint, err=True)
         return
-    shown = "" if convention == "method" else f" (robots on {convention}'s topics)"
+    steps = LIVE_STEPS if ros1 else STEPS
+    shown = (
+        " on a live ROS 1 graph"
+        if ros1
+        else ""
+        if convention == "method"
+        else f" (robots on {convention}'s topics)"
+    )
     click.secho(f"exsce demo in {target.resolve()}{shown}", bold=True, err=True)
     if hint:
         click.echo(f"{hint}, then 'cd {folder}'", err=True)
 
     def announce(number: int, step: Step) -> None:
-        click.secho(f"\n[{number}/{len(STEPS)}] {step.title}", bold=True, err=True)
+        click.secho(f"\n[{number}/{len(steps)}] {step.title}", bold=True, err=True)
         click.secho(f"$ {step.command}", fg="cyan", err=True)
         sys.stdout.flush()
 
-    run = run_steps(target, run_in_process, store_url, on_step=announce)
-    lines = summary_lines(run)
+    if ros1:
+        with live_graph(target) as uri:
+            click.echo(f"ROS_MASTER_URI={uri}", err=True)
+            run = run_steps(target, run_in_process, store_url, steps, on_step=announce)
+    else:
+        run = run_steps(target, run_in_process, store_url, steps, on_step=announce)
+    lines = summary_lines(run, "docs/live.md" if ros1 else "docs/tutorial.md")
     click.secho(f"\n{lines[0]}", bold=True, err=True)
     for line in lines[1:]:
         click.echo(line, err=True)

@@ -59,6 +59,34 @@ POLICIES = ("skip-waypoint", "retry-once", "skip-task", "stop-mission")
     help="ROS seconds a goal may take when its task and mission say no 'timeout' "
     "[default: 3x the straight line at the speed limit, at least 60].",
 )
+@click.option(
+    "--stand-in",
+    "stand_in",
+    is_flag=True,
+    help="Serve the goals with exsce's stand-in robots (exscec stand-in), started for each run: "
+    "the whole loop without a robot.",
+)
+@click.option(
+    "--seed",
+    type=int,
+    default=0,
+    show_default=True,
+    help="With --stand-in: run i drives as run i of exscec simulate --seed SEED.",
+)
+@click.option(
+    "--fault",
+    "faults",
+    multiple=True,
+    metavar="FAULT",
+    help="With --stand-in: a fault of exscec simulate planted in the stand-in (overspeed:tiago1, ...).",
+)
+@click.option(
+    "--speed-up",
+    type=click.FloatRange(min=0, min_open=True),
+    default=10.0,
+    show_default=True,
+    help="With --stand-in: simulated time runs this many times faster than wall time.",
+)
 @click.option("--verify", "judge", is_flag=True, help="Ingest each run's bag and judge it, as exscec verify.")
 @click.option("--junit", type=click.Path(dir_okay=False), help="With --verify: a JUnit XML report.")
 @store_option
@@ -73,6 +101,10 @@ def execute(
     policy: str,
     server_timeout: float,
     goal_timeout: float | None,
+    stand_in: bool,
+    seed: int,
+    faults: tuple[str, ...],
+    speed_up: float,
     judge: bool,
     junit: str | None,
     store_url: str | None,
@@ -97,9 +129,14 @@ def execute(
     On your robot's graph (roscore and each robot's move_base up, and
     $ROS_MASTER_URI exported), three judged runs are
     exscec execute SPEC --ros1 --runs 3 --verify --junit verdicts.xml.
+    Without a robot, --stand-in serves the goals with exsce's stand-in
+    robots (exscec stand-in: move_base servers, odometry, TF, scans, on
+    simulated time), started afresh for each run, with --fault planted.
 
     \b
-    Example:
+    Examples:
+      exscec execute examples/brsu_building_c/scenario_c.exsce --ros1 --start-master --stand-in \\
+          --fault overspeed:tiago1 --speed-up 20 -o live-fault/
       exscec execute examples/brsu_building_c/scenario_c.exsce --ros1 --start-master --runs 3 \\
           --policy retry-once --verify --junit verdicts.xml --server-timeout 1 \\
           -o live/  # exits 2: no robot's move_base answers
@@ -118,6 +155,10 @@ def execute(
             policy=policy,
             server_timeout=server_timeout,
             timeout=goal_timeout,
+            stand_in=stand_in,
+            seed=seed,
+            faults=faults,
+            speed_up=speed_up,
         )
     except ExecutionInterrupted as stop:
         click.echo(f"error: {stop.message}", err=True)

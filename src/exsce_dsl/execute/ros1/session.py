@@ -23,7 +23,7 @@ import signal
 import time
 import uuid
 from collections.abc import Callable, Mapping
-from contextlib import ExitStack
+from contextlib import AbstractContextManager, ExitStack, nullcontext
 from dataclasses import dataclass
 from pathlib import Path
 from types import FrameType, TracebackType
@@ -109,10 +109,13 @@ def execute_runs(
     runs: int = 1,
     options: Options | None = None,
     interrupted: Callable[[], bool] | None = None,
+    around_run: Callable[[int], AbstractContextManager[object]] | None = None,
 ) -> list[ExecutedRun]:
     """Run ``scenario`` ``runs`` times on the graph of ``master_uri``; the runs' files in ``out``.
     A run cut short by ``interrupted`` raises :class:`ExecutionInterrupted` (its files in
-    ``out/incomplete``); the runs before it are whole, in ``out``."""
+    ``out/incomplete``); the runs before it are whole, in ``out``.  ``around_run(i)``, when given,
+    is entered before run ``i`` (from 0) starts and left after it ended: the stand-in robots of
+    that run, say."""
     options = options or Options()
     master = Master(master_uri)
     master.wait(5.0)
@@ -124,7 +127,8 @@ def execute_runs(
     for _ in range(runs):
         if interrupted is not None and interrupted():
             raise ExecutionInterrupted(None, [r.files.bag for r in done])
-        run = _one_run(scenario, master, out, plan, options, interrupted)
+        with around_run(len(done)) if around_run is not None else nullcontext():
+            run = _one_run(scenario, master, out, plan, options, interrupted)
         done.append(run)
         if not run.complete:
             raise ExecutionInterrupted(run.files.bag, [r.files.bag for r in done[:-1]])

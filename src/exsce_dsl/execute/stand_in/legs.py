@@ -159,7 +159,10 @@ class Fleet:
         faults: tuple[Fault, ...] = (),
         limits: Limits | None = None,
         laser: Laser | None = None,
+        run: int = 0,
     ) -> None:
+        """``seed`` and ``run``: the robots' speed limits are those of run ``run`` of ``exscec
+        simulate --seed SEED`` (their noise is seeded by both too)."""
         check_faults(scenario, faults)
         if any(f.kind == "near-collision" for f in faults):
             raise ExsceError("the stand-in does not play fault 'near-collision' (exscec simulate does)")
@@ -169,13 +172,13 @@ class Fleet:
         unplaced = [r.id for r in scenario.robots if r.start_pose is None]
         if unplaced:
             raise ExsceError(f"robot '{unplaced[0]}' has no start pose: the stand-in cannot place it")
-        speeds = _executor_speeds(scenario, seed, limits, faults)
+        speeds = _executor_speeds(scenario, seed, limits, faults, run)
         self.robots: dict[str, Robot] = {}
         for index, robot in enumerate(scenario.robots):
             start = robot.start_pose
             assert start is not None
             speed = speeds[robot.id]
-            rng = np.random.default_rng([seed, index])
+            rng = np.random.default_rng([seed, index] if run == 0 else [seed, index, run])
             self.robots[robot.id] = Robot(
                 robot.id,
                 robot.namespace,
@@ -345,11 +348,11 @@ class Fleet:
 
 
 def _executor_speeds(
-    scenario: Scenario, seed: int, limits: Limits, faults: tuple[Fault, ...]
+    scenario: Scenario, seed: int, limits: Limits, faults: tuple[Fault, ...], run: int = 0
 ) -> dict[str, float]:
-    """Each robot's speed limit as the executor draws it for run 0 of ``exscec simulate --seed``:
-    its random numbers in its order (a start's wait per robot, then a speed per robot)."""
-    draws = random.Random(seed * 1000)
+    """Each robot's speed limit as the executor draws it for run ``run`` of ``exscec simulate
+    --seed``: its random numbers in its order (a start's wait per robot, then a speed per robot)."""
+    draws = random.Random(seed * 1000 + run)
     for _ in scenario.robots:
         draws.uniform(0.5, 1.0)
     return {

@@ -167,17 +167,19 @@ def start_stand_in(
     faults: Sequence[Fault] = (),
     speed_up: float = 10.0,
     log_dir: Path,
+    run: int = 0,
 ) -> Iterator[StandIn]:
     """The stand-in robots of ``scenario`` on the master at ``master_uri``, up when the block
-    starts, stopped when it ends; the node's log in ``log_dir``."""
+    starts, stopped when it ends; the node's log in ``log_dir``.  ``seed`` and ``run``: the
+    robots drive as in run ``run`` of ``exscec simulate --seed SEED`` (their speed limits)."""
     if not speed_up > 0:
         raise ExsceError(f"the stand-in's speed-up must be above 0, not {speed_up:g}")
-    fleet = Fleet(scenario, planning_grid(scenario), seed, tuple(faults))
+    fleet = Fleet(scenario, planning_grid(scenario), seed, tuple(faults), run=run)
     master = Master(master_uri)
     master.wait(10.0)
     master.set_param("/use_sim_time", True)  # before the node starts: it reads it at its start
     log_dir.mkdir(parents=True, exist_ok=True)
-    channel = NodeChannel("stand_in", [], master_uri, log_dir / "stand_in.log", log_dir / "ros")
+    channel = NodeChannel("stand_in", [], master_uri, log_dir / f"stand_in-{run}.log", log_dir / "ros")
     stand_in = StandIn(fleet, channel, master_uri)
     try:
         channel.send(_setup(fleet, speed_up))
