@@ -22,6 +22,7 @@ max speed equal, distances within 4 %, durations within 2 %):
 from __future__ import annotations
 
 import math
+import re
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -30,6 +31,7 @@ import pytest
 from tests.ros1_graph import require_ros1
 
 from exsce_dsl import api as exsce
+from exsce_dsl.api.demo import LIVE_STEPS
 from exsce_dsl.execute.outcomes import Outcome
 from exsce_dsl.execute.ros1.graph import start_master
 from exsce_dsl.sim.run import simulate
@@ -139,3 +141,15 @@ def test_a_goal_the_server_aborts_is_an_aborted_segment_and_the_next_goal_goes(t
         )
     counted = dict(zip(found.status, found.n, strict=True))
     assert counted == {"ABORTED": 1, "SUCCEEDED": 5}, counted
+
+
+def test_the_live_page_walks_the_steps_of_demo_ros1() -> None:
+    page = (EXAMPLES.parent / "docs" / "live.md").read_text(encoding="utf-8")
+    section = page[page.index("## The whole loop, by hand") :]
+    block = section[section.index("```sh\n") + 6 : section.index("```", section.index("```sh\n") + 6)]
+    lines = [line for line in block.splitlines() if line.startswith("exscec ")]
+    assert lines[0] == "exscec demo my-live --setup-only --convention move_base"
+    commands = [re.sub(r"\s+#.*$", "", line) for line in lines[1:]]
+    exits = [int(m.group(1)) if (m := re.search(r"#\s*exits (\d+)", line)) else 0 for line in lines[1:]]
+    assert commands == [step.command for step in LIVE_STEPS]
+    assert exits == [step.expected_exit for step in LIVE_STEPS]

@@ -71,7 +71,8 @@ def demo(folder: str, store_url: str | None, setup_only: bool, convention: str, 
     played by exsce's stand-in in move_base's convention, each run's mission
     dispatched as move_base goals and recorded by rosbag record, baseline
     runs ingested, a new run and one with tiago1 driving too fast executed
-    and judged.
+    and judged: exscec demo live-demo --ros1 (about two minutes; the test
+    suite runs it in tests/execute/test_live_loop.py).
     Exits 0 when every step ended as expected (the faulty run failing, the
     others passing), 1 otherwise.
 
@@ -79,7 +80,6 @@ def demo(folder: str, store_url: str | None, setup_only: bool, convention: str, 
     Example:
       exscec demo exsce-demo
       exscec demo my-project --setup-only   # only copy the example, to follow docs/tutorial.md
-      exscec demo live-demo --ros1   # on a live ROS 1 graph (about two minutes)
     """
     from exsce_dsl.api.demo import (
         LIVE_STEPS,
