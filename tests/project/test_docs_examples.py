@@ -145,6 +145,7 @@ def test_the_readmes_start_from_your_bag_runs_as_written(tmp_path: Path) -> None
 
     readme = (ROOT / "README.md").read_text(encoding="utf-8")
     section = readme[readme.index("## Start from your bag"):]
+    section = section[: section.index("\n## ", 3)]  # up to the next section
     [block] = [b for b in _blocks(ROOT / "README.md") if b.language == "sh" and b.text in section]
     spec = load_spec(EXAMPLES / "brsu_building_c" / "scenario_a.exsce")
     [run] = simulate(spec.scenario(None), tmp_path / "sim", fmt="ros1", seed=3, convention="nav2")
