@@ -351,7 +351,8 @@ def report(figures: list[RunFigures]) -> None:
                 f"  {outside:>18}  {tail:>4}"
             )
             if r.missing.get(topic):
-                print(f"      samples missing in the bag: {ranges(r.missing[topic])} (window {r.window[0] + 1}-{r.window[1]})")
+                window = f"{r.window[0] + 1}-{r.window[1]}"
+                print(f"      samples missing in the bag: {ranges(r.missing[topic])} (window {window})")
     ratios = [r.whole_wall / r.executor_wall for r in figures if r.executor_wall]
     print("\nsummary")
     targets = []
@@ -362,7 +363,9 @@ def report(figures: list[RunFigures]) -> None:
             f"median {statistics.median(rtfs):.1f}x ({speed_up and statistics.median(rtfs) / speed_up:.0%} "
             "of the speed-up asked)"
         )
-        targets.append((f"RTF >= {RTF_TARGET:g}x at speed-up {speed_up:g} (every run)", min(rtfs) >= RTF_TARGET))
+        targets.append(
+            (f"RTF >= {RTF_TARGET:g}x at speed-up {speed_up:g} (every run)", min(rtfs) >= RTF_TARGET)
+        )
     print(f"  whole run / simulate of the same run: median {statistics.median(ratios):.1f}x")
     targets += [
         (f"dispatch latency p95 < {LATENCY_TARGET * 1e3:g} ms", quantile(latencies, 0.95) < LATENCY_TARGET),
@@ -373,7 +376,9 @@ def report(figures: list[RunFigures]) -> None:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("--runs", type=int, default=2, help="runs per speed-up (default 2)")
     parser.add_argument(
         "--speed-up", type=float, nargs="+", default=[10.0, 20.0], metavar="X",
@@ -396,7 +401,9 @@ def main() -> None:
         folder = Path(name)
         with start_master(folder / "ros") as master:
             for speed_up in speed_ups:
-                figures += execute_speed_up(scenario, master.uri, folder, options.runs, speed_up, options.seed)
+                figures += execute_speed_up(
+                    scenario, master.uri, folder, options.runs, speed_up, options.seed
+                )
                 print(f"  speed-up {speed_up:g}: {options.runs} run(s) done", flush=True)
     report(figures)
     print(f"\nwall time {time.perf_counter() - began:.0f} s")
