@@ -34,7 +34,7 @@ per run, run ``i`` driving as run ``i`` of ``exscec simulate --seed S``), and it
    stops; the session waits 0.5 s for the PROV before stopping it).  Target: none lost at the
    default rates.
 
-    python bench/execute.py                       # 2 runs at speed-up 10 and 20 (about 3 min)
+    python bench/execute.py                       # 3 runs at speed-up 10 and 20 (about 2 min)
     python bench/execute.py --quick               # 1 run at speed-up 10
     python bench/execute.py --runs 3 --speed-up 10 20 40
 
@@ -379,7 +379,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
-    parser.add_argument("--runs", type=int, default=2, help="runs per speed-up (default 2)")
+    parser.add_argument("--runs", type=int, default=3, help="runs per speed-up (default 3)")
     parser.add_argument(
         "--speed-up", type=float, nargs="+", default=[10.0, 20.0], metavar="X",
         help="the stand-in's speed-ups measured besides the default 10 (default: 10 20)",
