@@ -78,6 +78,8 @@ TOPICS = [
 ]  # fmt: skip
 SUCCEEDED, ABORTED, PREEMPTED = 3, 4, 2
 """actionlib_msgs/GoalStatus codes."""
+SAMPLE = 0.02
+"""Simulated seconds between two samples of the stand-in's clock (50 Hz)."""
 ARRIVED = 0.1
 """Metres from the goal where a succeeded goal leaves the robot's estimate: the localiser's
 noise (2 cm standard deviation) and float rounding, nothing of the planner's."""
@@ -94,6 +96,11 @@ class Recorded:
     """What the client printed: each goal's x, y and final status."""
     ended: list[GoalEnd]
     stats: Stats
+    """The node's figures once the client is done (half a second before the recording stops)."""
+    counted_from: Stats
+    """Its figures once the recorder was connected to every topic."""
+    clock_start: float
+    """Simulated seconds of the node's first sample."""
     wall: float
     """Wall seconds the recording lasted."""
 
@@ -119,18 +126,19 @@ def drive(
             graph.wait_until(
                 lambda: connected(graph.uri, "/exsce_record"), "the recorder's connections", 30.0, [recorder]
             )
+            counted_from = stand_in.stats()
             extra = ["--cancel-after", str(cancel_after)] if cancel_after is not None else []
             client = graph.run_python("client", CLIENT, stand_in.actions["rover"], *goals, *extra)
             graph.wait_until(lambda: not client.running(), "the client's goals to end", 60.0, [])
             assert client.popen.returncode == 0, client.output()
-            time.sleep(0.5)  # the robot stands: a few more samples after the last goal
             stats = stand_in.stats()
+            time.sleep(0.5)  # the robot stands: a few more samples, and those counted reach the bag
             graph.stop_recording(recorder, bag)
             wall = time.monotonic() - started
             ended = stand_in.goals_ended()
     lines = [line.split() for line in client.output().splitlines() if len(line.split()) == 3]
     printed = [(float(x), float(y), int(status)) for x, y, status in lines]
-    return Recorded(bag, spec, printed, ended, stats, wall)
+    return Recorded(bag, spec, printed, ended, stats, counted_from, stand_in.start, wall)
 
 
 def connected(master_uri: str, subscriber: str) -> bool:
@@ -192,6 +200,26 @@ def test_a_goal_on_an_open_floor_is_reached_along_the_straight_line_on_simulated
     distance = table[(table.metric == "distance_travelled") & (table.robot == "rover")].value
     assert len(distance) == 1
     assert float(distance.iloc[0]) == pytest.approx(path_length(x, y), rel=1e-3)
+
+
+def test_every_message_the_stand_in_counts_while_recording_is_in_the_bag(tmp_path: Path) -> None:
+    recorded = drive(tmp_path, ["5,0,0"])
+    first, last = (round(s.sim_time / SAMPLE) for s in (recorded.counted_from, recorded.stats))
+    assert last - first > 100  # a drive of > 8 simulated seconds was counted
+    # each stamped topic is due at every sample, every 25th (2 Hz) or every 5th (10 Hz) of the
+    # node's 50 Hz clock, counted from its start: those between the two counts must all be in the bag
+    for name, every in (("odom", 1), ("tf", 1), ("amcl_pose", 25), ("scan", 5)):
+        topic = f"/rover/{name}"
+        messages = [m.transforms[0] if name == "tf" else m for _, m in recorded.messages(topic)]
+        samples = sorted(round((stamp(m) - recorded.clock_start) / SAMPLE) for m in messages)
+        due = [n for n in range(first + 1, last + 1) if n % every == 0]
+        assert [n for n in samples if first < n <= last] == due, topic
+        published = recorded.stats.published[topic] - recorded.counted_from.published[topic]
+        assert published == len(due), topic
+    # cmd_vel (no stamp) at 20 Hz: the node's count is the hand calculation's, and none is missing
+    published = recorded.stats.published["/rover/cmd_vel"] - recorded.counted_from.published["/rover/cmd_vel"]
+    assert abs(published - (last - first) * SAMPLE / 0.05) <= 1
+    assert len(recorded.messages("/rover/cmd_vel")) >= published
 
 
 def test_overspeed_drives_well_over_one_metre_per_second(tmp_path: Path) -> None:

@@ -340,7 +340,8 @@ class StandIn:
             set_yaw(amcl.pose.pose.orientation, v[5])
             amcl.pose.covariance = AMCL_COVARIANCE
             self.publish(robot, "amcl_pose", amcl)
-        for _ in range(t // CMD_VEL_PERIOD_NS, (t + DT_NS - 1) // CMD_VEL_PERIOD_NS):  # 20 Hz
+        # 20 Hz: one per multiple of the period in [t, t + DT_NS), ceilings both (floors lost half)
+        for _ in range(-(-t // CMD_VEL_PERIOD_NS), -(-(t + DT_NS) // CMD_VEL_PERIOD_NS)):
             command = Twist()
             command.linear.x, command.angular.z = v[11], v[12]
             self.publish(robot, "cmd_vel", command)
