@@ -19,6 +19,7 @@ from exsce_dsl.execute.ros1.session import (
     execute_runs,
 )
 from exsce_dsl.execute.stand_in import start_stand_in
+from exsce_dsl.execute.stand_in.session import DEFAULT_SPEED_UP
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.document import Specification
 from exsce_dsl.sim.faults import Fault
@@ -41,7 +42,7 @@ def execute_ros1(
     stand_in: bool = False,
     seed: int = 0,
     faults: Sequence[str] = (),
-    speed_up: float = 10.0,
+    speed_up: float = DEFAULT_SPEED_UP,
 ) -> list[ExecutedRun]:
     """``exscec execute --ros1``: run the scenario's mission ``runs`` times on a live ROS 1 graph
     (``master_uri``, else ``$ROS_MASTER_URI``; ``start_master``: a roscore of our own, stopped at

@@ -10,6 +10,7 @@ from pathlib import Path
 from exsce_dsl.execute.ros1.graph import master_uri as environment_master_uri
 from exsce_dsl.execute.ros1.graph import start_master as start_roscore
 from exsce_dsl.execute.stand_in import StandIn, start_stand_in
+from exsce_dsl.execute.stand_in.session import DEFAULT_SPEED_UP
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.document import Specification
 from exsce_dsl.sim.faults import Fault
@@ -24,7 +25,7 @@ def stand_in(
     start_master: bool = False,
     seed: int = 0,
     faults: Sequence[str] = (),
-    speed_up: float = 10.0,
+    speed_up: float = DEFAULT_SPEED_UP,
     log_dir: str | Path | None = None,
 ) -> Iterator[StandIn]:
     """``exscec stand-in --ros1``: the scenario's robots as move_base servers on the ROS 1 master at

@@ -83,7 +83,7 @@ POLICIES = ("skip-waypoint", "retry-once", "skip-task", "stop-mission")
 @click.option(
     "--speed-up",
     type=click.FloatRange(min=0, min_open=True),
-    default=10.0,
+    default=20.0,  # execute.stand_in.session.DEFAULT_SPEED_UP
     show_default=True,
     help="With --stand-in: simulated time runs this many times faster than wall time.",
 )

@@ -13,11 +13,18 @@ from exsce_dsl.wording import counted
 
 @click.command()
 @click.option(
-    "--output", "-o", default="report", show_default=True, type=click.Path(file_okay=False),
+    "--output",
+    "-o",
+    default="report",
+    show_default=True,
+    type=click.Path(file_okay=False),
     help="The folder to write the report into.",
 )
 @click.option(
-    "--spec", "specs", multiple=True, type=click.Path(dir_okay=False, exists=True),
+    "--spec",
+    "specs",
+    multiple=True,
+    type=click.Path(dir_okay=False, exists=True),
     help="A scenario file whose map to draw paths on (repeatable; derived scenarios use their base's).",
 )
 @store_option

@@ -190,12 +190,20 @@ def clear(store_url: str | None) -> None:
 @click.option("--union-default-graph", is_flag=True, help="Queries without GRAPH see every named graph.")
 @click.option("--log", "log_requests", is_flag=True, help="Print each request on stderr.")
 @click.option(
-    "--query-timeout", type=click.FloatRange(min=0, min_open=True), default=60.0, show_default=True,
-    metavar="SECONDS", help="Answer 503 to a query that runs longer.",
+    "--query-timeout",
+    type=click.FloatRange(min=0, min_open=True),
+    default=60.0,
+    show_default=True,
+    metavar="SECONDS",
+    help="Answer 503 to a query that runs longer.",
 )
 @click.option(
-    "--max-answer-mb", type=click.FloatRange(min=0, min_open=True), default=256.0, show_default=True,
-    metavar="MIB", help="Answer 503 instead of a larger answer.",
+    "--max-answer-mb",
+    type=click.FloatRange(min=0, min_open=True),
+    default=256.0,
+    show_default=True,
+    metavar="MIB",
+    help="Answer 503 instead of a larger answer.",
 )
 @reports_errors
 def serve(

@@ -115,7 +115,6 @@ def _read_back(path: str, text: str, content: object) -> str:
     """
     if yaml.safe_load(text) != content:
         raise GenerationError(
-            f"{path}: the generated YAML does not read back as the model "
-            "; please report this"
+            f"{path}: the generated YAML does not read back as the model ; please report this"
         )
     return text

@@ -53,9 +53,7 @@ def cluster_mapper(address: str) -> Iterator[Callable[[Callable[[Any], Any], Ite
     try:
         from distributed import Client
     except ImportError:
-        raise ExsceError(
-            "--cluster needs Dask's distributed package: pip install 'exsce[dask]'"
-        ) from None
+        raise ExsceError("--cluster needs Dask's distributed package: pip install 'exsce[dask]'") from None
     try:
         client = Client(address, timeout=CONNECT_SECONDS, set_as_default=False)  # type: ignore[no-untyped-call]
     except (OSError, TimeoutError, ValueError) as exc:

@@ -250,9 +250,7 @@ def _place_labels(
     return taken
 
 
-def _marker_boxes(
-    axes: Axes, positions: Sequence[tuple[float, float]], sizes: Sequence[float]
-) -> np.ndarray:
+def _marker_boxes(axes: Axes, positions: Sequence[tuple[float, float]], sizes: Sequence[float]) -> np.ndarray:
     """The pixel boxes (x0, x1, y0, y1) of markers of area ``sizes`` (points²) at ``positions``."""
     axes.apply_aspect()
     if not positions:

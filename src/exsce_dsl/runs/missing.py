@@ -156,9 +156,7 @@ def missing_metrics(
                     lacking.append(f"{metric.name} of '{robot.id}'")
                     continue
                 mine = [s for s in timed if s.robot == robot.id] if metric.per_segment else []
-                gaps = sum(
-                    (metric.name, MetricScope.SEGMENT, None, _action(s)) not in held for s in mine
-                )
+                gaps = sum((metric.name, MetricScope.SEGMENT, None, _action(s)) not in held for s in mine)
                 if gaps:
                     lacking.append(f"{metric.name} of '{robot.id}' for {gaps} of {len(mine)} path segments")
         elif metric.subject is ComputedFor.MISSION or len(acting) >= 2:
