@@ -14,7 +14,11 @@ from exsce_dsl.wording import counted
 
 
 @click.command(
-    epilog=exit_status(passed="no relation was violated", failed="a metamorphic relation was violated")
+    epilog=exit_status(
+        passed="no relation was violated",
+        failed="a metamorphic relation was violated",
+        interrupted="Ctrl-C (and SIGTERM with --executor ros1): the same command goes on where it stopped",
+    )
 )
 @click.argument("spec", type=click.Path(dir_okay=False, exists=True))
 @click.option("--scenario-id", help="Which scenario, when the file declares several.")
