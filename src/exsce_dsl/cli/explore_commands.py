@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+from contextlib import AbstractContextManager, nullcontext
 from pathlib import Path
 
 import click
@@ -13,7 +14,11 @@ from exsce_dsl.wording import counted
 
 
 @click.command(
-    epilog=exit_status(passed="no relation was violated", failed="a metamorphic relation was violated")
+    epilog=exit_status(
+        passed="no relation was violated",
+        failed="a metamorphic relation was violated",
+        interrupted="Ctrl-C (and SIGTERM with --executor ros1): the same command goes on where it stopped",
+    )
 )
 @click.argument("spec", type=click.Path(dir_okay=False, exists=True))
 @click.option("--scenario-id", help="Which scenario, when the file declares several.")
@@ -41,14 +46,34 @@ from exsce_dsl.wording import counted
 @click.option("--no-shrink", is_flag=True, help="Do not shrink the violations found.")
 @click.option(
     "--fault", "faults", multiple=True,
-    help="Plant a fault in the simulator (repeatable), as exscec simulate --fault: to try a campaign.",
+    help="Plant a fault in the simulator, or in the stand-in robots of --executor ros1 --stand-in "
+    "(repeatable), as exscec simulate --fault: to try a campaign.",
 )  # fmt: skip
 @click.option(
     "--executor-command",
     help="Run scenarios with this program instead of the simulator; placeholders {scenario_file} "
     "{scenario} {runs} {seed} {out}; it must leave one bag per run in {out}.",
 )
-@click.option("--executor", "plugin", help="Run scenarios with this exsce.executors plug-in.")
+@click.option(
+    "--executor", "plugin",
+    help="Run scenarios with this executor: ros1 (built in: a live ROS 1 graph, with --stand-in) "
+    "or an exsce.executors plug-in.",
+)  # fmt: skip
+@click.option(
+    "--stand-in", is_flag=True,
+    help="With --executor ros1: exsce's stand-in robots serve the goals, started for each run "
+    "(the only robots it drives for now).",
+)  # fmt: skip
+@click.option(
+    "--start-master", is_flag=True,
+    help="With --executor ros1: a roscore of the campaign's own, stopped at its end "
+    "[default: $ROS_MASTER_URI, else a roscore of its own].",
+)  # fmt: skip
+@click.option(
+    "--speed-up", type=click.FloatRange(0, min_open=True),
+    help="With --executor ros1: the stand-in's simulated time runs this many times faster "
+    "than wall time [default: 10].",
+)  # fmt: skip
 @click.option(
     "--jobs", "-j", default=1, show_default=True, type=click.IntRange(1), help="Bags analysed in parallel."
 )
@@ -81,6 +106,9 @@ def explore(
     faults: tuple[str, ...],
     executor_command: str | None,
     plugin: str | None,
+    stand_in: bool,
+    start_master: bool,
+    speed_up: float | None,
     jobs: int,
     cluster: str | None,
     output: str | None,
@@ -106,31 +134,54 @@ def explore(
     every bag; exscec writes the store.  The campaign, its derivations and
     its verdicts are those it has without --cluster.
 
+    With --executor ros1 --stand-in, every run is played on a live ROS 1
+    graph as exscec execute --ros1 --stand-in plays it: move_base goals
+    from the dispatcher node, the bag written by rosbag record, exsce's
+    stand-in robots (started for each run, run i of a scenario driving as
+    run i of exscec simulate with that scenario's seed) serving the goals
+    with --fault planted.  The graph is $ROS_MASTER_URI's, else (or with
+    --start-master) a roscore the campaign starts once and stops at its
+    end.  It drives only the stand-in for now: exsce cannot yet move a real
+    stack's robots to each derived scenario's start poses between runs (a
+    script that resets your simulator and runs exscec execute --ros1 can
+    be an --executor-command).
+
     \b
     Examples:
       exscec explore examples/brsu_building_c/scenario_c.exsce -n 2 -k 1 -t reverse_waypoint_order
       exscec explore examples/brsu_building_c/scenario_c.exsce -n 1 -k 1 -t swap_start_poses \\
         --fault deadlock-start:tiago1:classroom_c025-w002 -o explore/deadlock --junit campaign.xml  # exits 1
+      exscec explore examples/brsu_building_c/scenario_c.exsce -n 1 -k 1 -t swap_start_poses \
+        --executor ros1 --stand-in --start-master --speed-up 20 --no-shrink \
+        --fault deadlock-start:tiago1:classroom_c025-w002 -o explore/live  # exits 1
     """
-    from exsce_dsl.errors import ExsceError
+    from exsce_dsl.errors import ExecutionInterrupted, ExsceError
     from exsce_dsl.explore.campaign import CampaignEvents, CampaignOptions, run_campaign
-    from exsce_dsl.explore.executors import CommandExecutor, Executor, SimulatorExecutor, plugin_executor
+    from exsce_dsl.explore.executors import (
+        CommandExecutor,
+        Executor,
+        ExecutorOptions,
+        SimulatorExecutor,
+        named_executor,
+    )
     from exsce_dsl.lang.build import load_spec
     from exsce_dsl.model.campaign import Trial
     from exsce_dsl.oracles.campaign_junit import campaign_junit, run_seconds, steps_text
     from exsce_dsl.parallel.cluster import cluster_address
     from exsce_dsl.store.open import open_store
 
-    if sum(bool(x) for x in (faults, executor_command, plugin)) > 1:
+    if executor_command and (faults or plugin):
         raise ExsceError("give one of --fault (the simulator), --executor-command and --executor")
+    if (stand_in or start_master or speed_up is not None) and not plugin:
+        raise ExsceError("--stand-in, --start-master and --speed-up go with --executor ros1")
     address = cluster_address(cluster)
-    executor: Executor
+    chosen: AbstractContextManager[Executor]
     if executor_command:
-        executor = CommandExecutor(executor_command)
+        chosen = nullcontext(CommandExecutor(executor_command))
     elif plugin:
-        executor = plugin_executor(plugin)
+        chosen = named_executor(plugin, ExecutorOptions(faults, stand_in, start_master, None, speed_up))
     else:
-        executor = SimulatorExecutor.with_faults(faults, cluster=address)
+        chosen = nullcontext(SimulatorExecutor.with_faults(faults, cluster=address))
     options = CampaignOptions(
         budget=budget,
         seed=seed,
@@ -144,7 +195,7 @@ def explore(
         cluster=address,
     )
     parsed = load_spec(spec)
-    with open_store(store_url) as store, Progress(budget, "Exploring") as progress:
+    with chosen as executor, open_store(store_url) as store, Progress(budget, "Exploring") as progress:
 
         def trial_done(trial: Trial, resumed: bool) -> None:
             found = f": {'; '.join(r.text for r in trial.violated)}" if trial.violated else ""
@@ -153,9 +204,13 @@ def explore(
             progress.update()
 
         events = CampaignEvents(said=progress.say, trial_done=trial_done)
-        result = run_campaign(
-            store, parsed, spec, options, executor, output, scenario_id=scenario_id, events=events
-        )
+        try:
+            result = run_campaign(
+                store, parsed, spec, options, executor, output, scenario_id=scenario_id, events=events
+            )
+        except ExecutionInterrupted as stop:  # the campaign goes on where it stopped, run again
+            click.echo(f"error: {stop.message}", err=True)
+            sys.exit(ExitCode.INTERRUPTED)
         durations = run_seconds(store, result.record) if junit else {}
     record = result.record
     violated = {r.text for t in record.trials for r in t.violated}

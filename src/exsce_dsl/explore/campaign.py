@@ -26,7 +26,7 @@ from exsce_dsl.derive.workflows import DerivedSpec, add_derivation, derive_spec
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.explore.cover import covering_derivations
 from exsce_dsl.explore.draw import Candidate, draw_derivations
-from exsce_dsl.explore.executors import Executor
+from exsce_dsl.explore.executors import Executor, bags_in
 from exsce_dsl.explore.shrink import MAX_TRIES, shrink
 from exsce_dsl.lang.formatter import declared_poses, format_document
 from exsce_dsl.model import Acceptance, Scenario
@@ -195,7 +195,7 @@ class _Campaign:
         """The uuids of ``runs`` stored runs of ``scenario``: those already in ``out`` and the
         store, else executed now and ingested (one transaction per run)."""
         if out.is_dir():
-            bags = sorted(p for p in out.iterdir() if not p.name.endswith(".prov.json"))
+            bags = bags_in(out)  # not the .prov.json, .rosparams and logs beside them
             known = [stored_run(bag, self.store, scenario.id) for bag in bags]
             if len(bags) == runs and all(known):
                 return [k for k in known if k is not None]

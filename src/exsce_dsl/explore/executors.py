@@ -10,8 +10,12 @@ back bags, one per run; the campaign ingests and judges them.  Three kinds:
 - :class:`CommandExecutor`: any program, run once per scenario with its arguments filled in
   (``{scenario_file} {scenario} {runs} {seed} {out}``), which writes the bags into ``{out}``:
   a user's own simulator, or a script that drives a real robot;
+- a built-in executor chosen by its name (:data:`BUILT_IN_EXECUTORS`): ``ros1`` runs the
+  scenarios on a live ROS 1 graph against exsce's stand-in robots, faults planted in them
+  (:mod:`exsce_dsl.explore.ros1_executor`);
 - a plug-in: a package registers a factory under the entry-point group ``exsce.executors``
-  (called with no arguments, it returns an Executor), chosen by its name.
+  (called with no arguments, it returns an Executor), chosen by its name.  A built-in name is
+  looked up first: a plug-in of the same name is never chosen.
 
 A command and a plug-in run where the campaign runs, whether or not the campaign's bags are
 analysed on a cluster (``exscec explore --cluster``): exsce does not know what they need.
@@ -24,13 +28,15 @@ from __future__ import annotations
 
 import shlex
 import subprocess
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from contextlib import AbstractContextManager, nullcontext
 from dataclasses import dataclass
 from importlib.metadata import entry_points
 from pathlib import Path
 from typing import Protocol, runtime_checkable
 
 from exsce_dsl.errors import ExsceError
+from exsce_dsl.explore.ros1_executor import DEFAULT_SPEED_UP, ros1_executor
 from exsce_dsl.model import Scenario
 from exsce_dsl.sim.faults import Fault
 from exsce_dsl.sim.run import simulate
@@ -142,7 +148,7 @@ class CommandExecutor:
                 f"the executor command exited {done.returncode} on scenario '{scenario.id}'"
                 + (":\n  " + "\n  ".join(said) if said else "")
             )
-        bags = sorted(p for p in out_dir.iterdir() if p.suffix in BAG_SUFFIXES or _is_rosbag2_folder(p))
+        bags = bags_in(out_dir)
         if len(bags) != runs:
             raise ExsceError(
                 f"the executor command left {len(bags)} bag(s) in {out_dir} for scenario '{scenario.id}', "
@@ -151,8 +157,71 @@ class CommandExecutor:
         return bags
 
 
+def bags_in(folder: Path) -> list[Path]:
+    """The bags in ``folder``, by name: files of :data:`BAG_SUFFIXES` and rosbag2 folders (not
+    the ``.prov.json`` or ``.rosparams`` beside them, nor a hidden folder of logs)."""
+    return sorted(p for p in folder.iterdir() if p.suffix in BAG_SUFFIXES or _is_rosbag2_folder(p))
+
+
 def _is_rosbag2_folder(path: Path) -> bool:
     return path.is_dir() and (path / "metadata.yaml").is_file()
+
+
+@dataclass(frozen=True)
+class ExecutorOptions:
+    """What the command line says of a named executor besides its name: faults to plant, the
+    stand-in, the ROS master (an address, or one to start), the stand-in's speed-up."""
+
+    faults: tuple[str, ...] = ()
+    stand_in: bool = False
+    start_master: bool = False
+    master_uri: str | None = None
+    speed_up: float | None = None
+
+
+@dataclass(frozen=True)
+class BuiltInExecutor:
+    """An executor exsce ships, chosen by ``name``: ``start(options)`` gives it for a block
+    (what it runs on is started when the block begins and stopped when it ends)."""
+
+    name: str
+    summary: str
+    start: Callable[[ExecutorOptions], AbstractContextManager[Executor]]
+
+
+def _ros1(options: ExecutorOptions) -> AbstractContextManager[Executor]:
+    speed_up = DEFAULT_SPEED_UP if options.speed_up is None else options.speed_up
+    return ros1_executor(
+        stand_in=options.stand_in,
+        faults=options.faults,
+        speed_up=speed_up,
+        master_uri=options.master_uri,
+        start_master=options.start_master,
+    )
+
+
+BUILT_IN_EXECUTORS: dict[str, BuiltInExecutor] = {
+    e.name: e
+    for e in (
+        BuiltInExecutor("ros1", "a live ROS 1 graph, exsce's stand-in robots serving the goals", _ros1),
+    )
+}
+"""The executors chosen by name before the plug-ins."""
+
+
+def named_executor(name: str, options: ExecutorOptions | None = None) -> AbstractContextManager[Executor]:
+    """The executor called ``name`` for a block: a built-in one, else a plug-in (which takes
+    none of ``options``)."""
+    options = options or ExecutorOptions()
+    if name in BUILT_IN_EXECUTORS:
+        return BUILT_IN_EXECUTORS[name].start(options)
+    if options != ExecutorOptions():
+        built_in = ", ".join(BUILT_IN_EXECUTORS)
+        raise ExsceError(
+            f"--fault, --stand-in, --start-master and --speed-up are for the built-in executors "
+            f"({built_in}), not the plug-in '{name}'"
+        )
+    return nullcontext(plugin_executor(name))
 
 
 def plugin_executor(name: str) -> Executor:
@@ -160,7 +229,11 @@ def plugin_executor(name: str) -> Executor:
     found = {point.name: point for point in entry_points(group=ENTRY_POINT_GROUP)}
     if name not in found:
         known = ", ".join(sorted(found)) or "none is installed"
-        raise ExsceError(f"no executor plug-in '{name}'{did_you_mean(name, found)} (registered: {known})")
+        built_in = ", ".join(BUILT_IN_EXECUTORS)
+        raise ExsceError(
+            f"no executor '{name}'{did_you_mean(name, [*BUILT_IN_EXECUTORS, *found])} "
+            f"(built in: {built_in}; plug-ins registered: {known})"
+        )
     try:
         made = found[name].load()()
     except Exception as error:  # a third party's package: say which, whatever went wrong

@@ -314,12 +314,11 @@ def _time(seconds: float) -> dt.datetime:
 def _task_executions(
     actions: list[Segment], segmented_by: dict[str, str], wall: Callable[[np.ndarray], np.ndarray]
 ) -> tuple[TaskExecution, ...]:
-    """The robots' tasks as executed, with their actions' times as the wall clock had them."""
-    started = [
-        a
-        for a in actions
-        if a.start is not None and a.end is not None and a.status in ("SUCCEEDED", "ABORTED")
-    ]
+    """The robots' tasks as executed, with their actions' times as the wall clock had them.  A
+    segment that started and ended is an action (its metric values need one): ABORTED when its
+    goal ended other than SUCCEEDED (aborted, or cancelled: PREEMPTED, CANCELED, as the
+    dispatcher cancels a goal that timed out)."""
+    started = [a for a in actions if a.start is not None and a.end is not None]
     started.sort(key=lambda a: (a.start or 0.0, a.robot))
     grouped: dict[tuple[str, int], list[Action]] = {}
     for a in started:
@@ -328,7 +327,7 @@ def _task_executions(
                 ActionId(a.robot, a.allocation, a.subtask, a.waypoint),
                 a.start_pose,
                 a.goal,
-                ActionStatus(a.status),
+                ActionStatus.SUCCEEDED if a.status == "SUCCEEDED" else ActionStatus.ABORTED,
                 _time(float(wall(np.array([a.start]))[0])),
                 _time(float(wall(np.array([a.end]))[0])),
             )
