@@ -199,7 +199,11 @@ def test_a_goal_on_an_open_floor_is_reached_along_the_straight_line_on_simulated
         table = api.metrics(opened, "floor_run")
     distance = table[(table.metric == "distance_travelled") & (table.robot == "rover")].value
     assert len(distance) == 1
-    assert float(distance.iloc[0]) == pytest.approx(path_length(x, y), rel=1e-3)
+    # the whole odometry path against ingest's goal window: the window's ends fall on the node's
+    # 50 Hz ticks, and under load the sample of the goal's (or result's) tick may fall either side
+    # of it: at most two 20 ms samples at the leg's speed limit (< 0.6 m/s) apart, 2.4 cm (a
+    # loaded CI measured 1.05 cm)
+    assert float(distance.iloc[0]) == pytest.approx(path_length(x, y), abs=0.024)
 
 
 def test_every_message_the_stand_in_counts_while_recording_is_in_the_bag(tmp_path: Path) -> None:
