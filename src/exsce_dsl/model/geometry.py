@@ -8,6 +8,20 @@ from dataclasses import dataclass, field
 from exsce_dsl.errors import SourceLocation
 
 
+def quaternion(roll: float, pitch: float, yaw: float) -> tuple[float, float, float, float]:
+    """The unit quaternion (x, y, z, w) of a rotation by ``roll``, ``pitch`` and ``yaw`` (radians,
+    applied about the fixed x, y and z axes in that order: ROS's ``rpy``)."""
+    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
+    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
+    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
+    return (
+        sr * cp * cy - cr * sp * sy,
+        cr * sp * cy + sr * cp * sy,
+        cr * cp * sy - sr * sp * cy,
+        cr * cp * cy + sr * sp * sy,
+    )
+
+
 @dataclass(frozen=True)
 class Position:
     x: float

@@ -25,6 +25,7 @@ from exsce_dsl.execute.recording import PROV_TOPIC
 from exsce_dsl.execute.ros1.channel import Message, NodeChannel
 from exsce_dsl.model import Pose, Scenario
 from exsce_dsl.model.conventions import Navigation
+from exsce_dsl.model.geometry import quaternion
 from exsce_dsl.model.metrics import topic_name
 
 MOVE_BASE_ACTION = "/{ns}/move_base"
@@ -144,9 +145,8 @@ class Ros1Navigator:
     def send(self, goal: int, robot: str, pose: Pose) -> None:
         p, o = pose.position, pose.orientation
         self.sent.append((goal, robot, pose))
-        self.node.send(
-            {"command": "send", "goal": goal, "robot": robot, "pose": [p.x, p.y, p.z, o.roll, o.pitch, o.yaw]}
-        )
+        target = [p.x, p.y, p.z, *quaternion(o.roll, o.pitch, o.yaw)]
+        self.node.send({"command": "send", "goal": goal, "robot": robot, "pose": target})
 
     def cancel(self, goal: int) -> None:
         self.node.send({"command": "cancel", "goal": goal})

@@ -23,7 +23,6 @@ ends.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterable
 from dataclasses import dataclass
 
@@ -32,6 +31,7 @@ from exsce_dsl.execute.mission import Goal, Schedule
 from exsce_dsl.execute.outcomes import Outcome
 from exsce_dsl.model import Pose, Scenario
 from exsce_dsl.model.conventions import NAV2, Navigation
+from exsce_dsl.model.geometry import quaternion
 from exsce_dsl.model.metrics import topic_name
 from exsce_dsl.model.robots import Robot
 
@@ -114,20 +114,6 @@ def nav2_actions(robot: Robot) -> Nav2Actions:
     return Nav2Actions(
         topic_name((to_pose or [defaults["navigate_to_pose"]])[0], robot.namespace),
         topic_name((waypoints or [defaults["follow_waypoints"]])[0], robot.namespace),
-    )
-
-
-def quaternion(roll: float, pitch: float, yaw: float) -> tuple[float, float, float, float]:
-    """The unit quaternion (x, y, z, w) of a rotation by ``roll``, ``pitch`` and ``yaw`` (radians,
-    applied about the fixed x, y and z axes in that order: ROS's ``rpy``)."""
-    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
-    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
-    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
-    return (
-        sr * cp * cy - cr * sp * sy,
-        cr * sp * cy + sr * cp * sy,
-        cr * cp * sy - sr * sp * cy,
-        cr * cp * cy + sr * sp * sy,
     )
 
 

@@ -8,7 +8,7 @@ Arguments: ``--actions JSON`` (robot → its move_base action, ``{"tiago1": "/ti
 Once every server answers it says ``ready``; else it fails naming each action that did not.
 
 Commands (one JSON object a line):
-- ``{"command": "send", "goal": N, "robot": R, "pose": [x, y, z, roll, pitch, yaw]}``: a
+- ``{"command": "send", "goal": N, "robot": R, "pose": [x, y, z, qx, qy, qz, qw]}``: a
   ``MoveBaseGoal`` in the ``map`` frame to R's server;
 - ``{"command": "cancel", "goal": N}``: cancel it (its end is not reported);
 - ``{"command": "time", "id": K}``: answered by ``{"event": "time", "id": K, "time": T}``;
@@ -23,7 +23,6 @@ The end of input cancels the goals still active, then ends the node.
 
 import argparse
 import json
-import math
 import threading
 import time
 
@@ -51,21 +50,8 @@ def ros_now():
     return rospy.get_rostime().to_sec()
 
 
-def quaternion(roll, pitch, yaw):
-    """(x, y, z, w) of the rotation roll, pitch, yaw (radians, fixed axes x, y, z)."""
-    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
-    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
-    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
-    return (
-        sr * cp * cy - cr * sp * sy,
-        cr * sp * cy + sr * cp * sy,
-        cr * cp * sy - sr * sp * cy,
-        cr * cp * cy + sr * sp * sy,
-    )
-
-
 def move_base_goal(pose):
-    x, y, z, roll, pitch, yaw = (float(v) for v in pose)
+    x, y, z, qx, qy, qz, qw = (float(v) for v in pose)
     goal = MoveBaseGoal()
     goal.target_pose.header.frame_id = FRAME
     goal.target_pose.header.stamp = rospy.Time.now()
@@ -73,7 +59,7 @@ def move_base_goal(pose):
     goal.target_pose.pose.position.y = y
     goal.target_pose.pose.position.z = z
     q = goal.target_pose.pose.orientation
-    q.x, q.y, q.z, q.w = quaternion(roll, pitch, yaw)
+    q.x, q.y, q.z, q.w = qx, qy, qz, qw
     return goal
 
 
