@@ -418,7 +418,7 @@ def test_lineage_and_verdicts_are_what_exscec_shows(project: Project) -> None:
     ]
     for g, e in zip(got, expected, strict=True):
         assert g["run"] == project.verified and g["observed"] == pytest.approx(e["observed"])
-    assert verdicts["passed"] == len(expected) > 10 and verdicts["failed"] == verdicts["unjudged"] == 0
+    assert verdicts["passed"] == len(expected) > 10 and verdicts["failed"] == verdicts["inconclusive"] == 0
     assert none["verdicts"] == [] and none["passed"] == 0 and "not verified" in none["note"]
     assert "the store holds no run 00000000-0000-0000-0000-000000000000; the closest ids" in no_run
 
@@ -471,7 +471,7 @@ def test_resources_are_the_scenarios_and_runs_of_the_store(project: Project) -> 
 
     assert run["run"] == project.verified and run["scenario"] == "scenario_c"
     assert run["bag"].endswith(".bag") and run["start"] < run["end"]
-    assert run["verdicts"] == {"passed": len(project.verified_json), "failed": 0, "unjudged": 0}
+    assert run["verdicts"] == {"passed": len(project.verified_json), "failed": 0, "inconclusive": 0}
     visited = {(m["robot"], m["value"]) for m in run["metrics"] if m["metric"] == "waypoints_visited"}
     assert visited == {("tiago1", 3.0), ("tiago2", 3.0)}
 

@@ -133,7 +133,7 @@ def test_the_store_gives_lineage_runs_verdicts_hotspots_and_maps(project: Path) 
     fault = failed[0]
     assert fault.hotspots and all(h.metric for h in fault.hotspots)
     assert any(h.metric == "max_velocity" and h.robot == "tiago1" for h in fault.hotspots)
-    rank = [Outcome.FAILED, Outcome.UNJUDGED, Outcome.PASSED].index
+    rank = [Outcome.FAILED, Outcome.INCONCLUSIVE, Outcome.PASSED].index
     for verdicts in (contents.verdicts, base.verdicts, *(r.verdicts for r in base.runs)):
         outcomes = [v.outcome for v in verdicts]
         assert outcomes == sorted(outcomes, key=rank)
@@ -251,7 +251,7 @@ _COUNT_HEADERS = {
     "violations",
 }
 """Columns of counts, whose header says what they count."""
-_RANK = {"failed": 0, "unjudged": 1, "passed": 2}
+_RANK = {"failed": 0, "inconclusive": 1, "passed": 2}
 
 
 def _cells(tables: list[dict[str, Any]]) -> Iterator[tuple[str, bool, str]]:
@@ -415,7 +415,7 @@ def test_a_scenario_lists_its_runs_verdicts_failures_first_and_keeps_their_order
     second = StoredRun("b", "s", None, None, "b.bag", None)
     p1, p2 = _verdict("a", "p1", Outcome.PASSED), _verdict("a", "p2", Outcome.PASSED)
     p3, f1 = _verdict("b", "p3", Outcome.PASSED), _verdict("b", "f1", Outcome.FAILED)
-    u1, f2 = _verdict("b", "u1", Outcome.UNJUDGED), _verdict("b", "f2", Outcome.FAILED)
+    u1, f2 = _verdict("b", "u1", Outcome.INCONCLUSIVE), _verdict("b", "f2", Outcome.FAILED)
     runs = (RunContents(first, (p1, p2), ()), RunContents(second, (p3, f1, u1, f2), ()))
     scenario = ScenarioContents("s", None, (), runs, (), (), {})
     assert [v.oracle for v in scenario.verdicts] == ["f1", "f2", "u1", "p1", "p2", "p3"]

@@ -133,11 +133,11 @@ def report_verification(verification: Verification, as_json: bool, junit: str | 
     if junit:
         write_text(junit_xml(verdicts), junit)
     failed = sum(v.outcome is Outcome.FAILED for v in verdicts)
-    unjudged = sum(v.outcome is Outcome.UNJUDGED for v in verdicts)
+    inconclusive = sum(v.outcome is Outcome.INCONCLUSIVE for v in verdicts)
     click.echo(
-        f"{len(verdicts) - failed - unjudged} passed, {failed} failed, {unjudged} not judged", err=True
+        f"{len(verdicts) - failed - inconclusive} passed, {failed} failed, {inconclusive} inconclusive", err=True
     )
-    return ExitCode.FAILED if failed else ExitCode.INCONCLUSIVE if unjudged else ExitCode.PASSED
+    return ExitCode.FAILED if failed else ExitCode.INCONCLUSIVE if inconclusive else ExitCode.PASSED
 
 
 COMMANDS = [baseline, verify]

@@ -152,7 +152,7 @@ def run_verdicts_tool() -> ToolEntry:
             "The verdicts of a run's last validation (`exscec verify`) as the store holds them: one per "
             "oracle, failed ones first, each with the metric, robot, relation, observed and expected "
             "values, limit, tolerance, margin, the runs the expectation came from and, when it could "
-            "not be judged, why; with the counts of passed, failed and unjudged oracles."
+            "not be judged, why; with the counts of passed, failed and inconclusive oracles."
         ),
         input_schema=object_schema(
             {"run": identifier(RUN_ID, "the run, by uuid or a unique prefix of it")}, ("run",)

@@ -23,6 +23,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 
 from exsce_dsl.errors import ExsceError
+from exsce_dsl.model.coverage import CoverageGap, TopicRate
 from exsce_dsl.model.geometry import Pose, Position
 from exsce_dsl.model.names import NAME_PATTERN
 
@@ -214,6 +215,10 @@ class Run:
     """(robot, convention, the topics it was detected from) of robots whose type names none."""
     status: RunStatus = RunStatus.COMPLETED
     """Whether the mission completed; a cancelled or stopped run is incomplete."""
+    coverage: tuple[CoverageGap, ...] = ()
+    """What the recording does not cover (cut short, gaps, thinned topics, clock jumps)."""
+    topic_rates: tuple[TopicRate, ...] = ()
+    """How densely each topic a metric reads was recorded."""
 
     def actions(self) -> Iterator[Action]:
         for task in self.tasks:

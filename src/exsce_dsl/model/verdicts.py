@@ -9,8 +9,14 @@ from dataclasses import dataclass
 class Outcome(enum.Enum):
     PASSED = "passed"
     FAILED = "failed"
-    UNJUDGED = "unjudged"
-    """Could not be judged (no value for the metric in the run, no baseline yet...): ``reason`` says why."""
+    INCONCLUSIVE = "inconclusive"
+    """Could not be judged: the data the clause needs is missing, too sparse, cut short or on a broken
+    clock, or the oracle has no expectation yet; ``reason`` says why.  Never a pass."""
+
+    @classmethod
+    def _missing_(cls, value: object) -> Outcome | None:
+        # stores written before the outcome was named 'inconclusive' say 'unjudged'
+        return cls.INCONCLUSIVE if value == "unjudged" else None
 
 
 @dataclass(frozen=True)

@@ -9,7 +9,7 @@ from collections.abc import Sequence
 from exsce_dsl.model.verdicts import Outcome, Verdict
 from exsce_dsl.tables import aligned
 
-_MARK = {Outcome.PASSED: "pass", Outcome.FAILED: "FAIL", Outcome.UNJUDGED: "n/a"}
+_MARK = {Outcome.PASSED: "pass", Outcome.FAILED: "FAIL", Outcome.INCONCLUSIVE: "n/a"}
 
 
 def _number(value: float | None) -> str:
@@ -42,7 +42,7 @@ def verdict_table(verdicts: Sequence[Verdict]) -> str:
             _number(v.observed),
             expectation(v),
             _number(v.margin),
-            _MARK[v.outcome] + (f": {v.reason}" if v.outcome is Outcome.UNJUDGED else ""),
+            _MARK[v.outcome] + (f": {v.reason}" if v.outcome is Outcome.INCONCLUSIVE else ""),
             str(len(v.sources)) if v.sources else "",
         )
         for v in verdicts
@@ -92,7 +92,7 @@ def junit_xml(verdicts: Sequence[Verdict]) -> str:
             name=f"{judged[0].scenario} run {run}",
             tests=str(len(judged)),
             failures=str(sum(v.outcome is Outcome.FAILED for v in judged)),
-            errors=str(sum(v.outcome is Outcome.UNJUDGED for v in judged)),
+            errors=str(sum(v.outcome is Outcome.INCONCLUSIVE for v in judged)),
         )
         for v in judged:
             case = ET.SubElement(
@@ -105,10 +105,10 @@ def junit_xml(verdicts: Sequence[Verdict]) -> str:
             )
             if v.outcome is Outcome.FAILED:
                 ET.SubElement(case, "failure", message=v.reason or "failed", type=v.relation).text = details
-            elif v.outcome is Outcome.UNJUDGED:
-                ET.SubElement(case, "error", message=v.reason, type="unjudged").text = details
+            elif v.outcome is Outcome.INCONCLUSIVE:
+                ET.SubElement(case, "error", message=v.reason, type="inconclusive").text = details
     suites.set("tests", str(len(verdicts)))
     suites.set("failures", str(sum(v.outcome is Outcome.FAILED for v in verdicts)))
-    suites.set("errors", str(sum(v.outcome is Outcome.UNJUDGED for v in verdicts)))
+    suites.set("errors", str(sum(v.outcome is Outcome.INCONCLUSIVE for v in verdicts)))
     ET.indent(suites)
     return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(suites, encoding="unicode") + "\n"

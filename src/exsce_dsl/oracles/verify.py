@@ -22,7 +22,7 @@ def judge_runs(store: Store, runs: Sequence[str], scenario: Scenario) -> list[Ve
     """The verdicts of every oracle of ``scenario`` on each of ``runs`` (uuids), run by run.
 
     A run whose mission did not complete (cancelled or stopped: its recording does not cover the
-    whole mission) is never passed: a clause it met is unjudged, saying so; one it broke fails,
+    whole mission) is never passed: a clause it met is inconclusive, saying so; one it broke fails,
     for what was recorded did break it.
 
     Raises :class:`ExsceError` for a run the store does not hold, a run of another
@@ -49,7 +49,7 @@ def judge_runs(store: Store, runs: Sequence[str], scenario: Scenario) -> list[Ve
             incomplete = known[run].mission_status
             if incomplete and verdict.outcome is Outcome.PASSED:
                 reason = f"the run is incomplete (its mission was {incomplete}): it was not seen to the end"
-                verdict = replace(verdict, outcome=Outcome.UNJUDGED, reason=reason, margin=None)
+                verdict = replace(verdict, outcome=Outcome.INCONCLUSIVE, reason=reason, margin=None)
             verdicts.append(verdict)
     return verdicts
 
@@ -81,7 +81,7 @@ def _verdict(run: str, scenario: str, oracle: Oracle, observed: float | None, wh
         "against": oracle.base_scenario if oracle.base_scenario not in (None, scenario) else None,
     }
     if observed is None:
-        return Verdict(**common, outcome=Outcome.UNJUDGED, reason=why)  # type: ignore[arg-type]
+        return Verdict(**common, outcome=Outcome.INCONCLUSIVE, reason=why)  # type: ignore[arg-type]
     try:
         given = {
             "value": oracle.value,
@@ -93,7 +93,7 @@ def _verdict(run: str, scenario: str, oracle: Oracle, observed: float | None, wh
             observed, **{k: v for k, v in given.items() if v is not None}
         )
     except RelationError as exc:
-        return Verdict(**common, outcome=Outcome.UNJUDGED, reason=str(exc))  # type: ignore[arg-type]
+        return Verdict(**common, outcome=Outcome.INCONCLUSIVE, reason=str(exc))  # type: ignore[arg-type]
     outcome = Outcome.PASSED if judged.passed else Outcome.FAILED
     margin = None if math.isnan(judged.margin) else judged.margin
     reason = "" if judged.passed else f"{observed:g} is not {judged.expected}"

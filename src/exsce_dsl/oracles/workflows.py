@@ -76,7 +76,7 @@ class Verification:
     @property
     def passed(self) -> bool:
         """No oracle failed and every one was judged."""
-        return not self.count(Outcome.FAILED) and not self.count(Outcome.UNJUDGED)
+        return not self.count(Outcome.FAILED) and not self.count(Outcome.INCONCLUSIVE)
 
 
 def verify_runs(

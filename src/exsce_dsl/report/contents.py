@@ -72,8 +72,8 @@ class RunContents:
         return sum(v.outcome is Outcome.FAILED for v in self.verdicts)
 
     @property
-    def unjudged(self) -> int:
-        return sum(v.outcome is Outcome.UNJUDGED for v in self.verdicts)
+    def inconclusive(self) -> int:
+        return sum(v.outcome is Outcome.INCONCLUSIVE for v in self.verdicts)
 
     @property
     def passed(self) -> int:
@@ -81,10 +81,10 @@ class RunContents:
 
     @property
     def status(self) -> str:
-        """failed, unjudged, passed, or 'not verified'."""
+        """failed, inconclusive, passed, or 'not verified'."""
         if not self.verdicts:
             return "not verified"
-        return "failed" if self.failed else "unjudged" if self.unjudged else "passed"
+        return "failed" if self.failed else "inconclusive" if self.inconclusive else "passed"
 
 
 NO_SPEC = (
