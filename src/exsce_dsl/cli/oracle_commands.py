@@ -135,7 +135,8 @@ def report_verification(verification: Verification, as_json: bool, junit: str | 
     failed = sum(v.outcome is Outcome.FAILED for v in verdicts)
     inconclusive = sum(v.outcome is Outcome.INCONCLUSIVE for v in verdicts)
     click.echo(
-        f"{len(verdicts) - failed - inconclusive} passed, {failed} failed, {inconclusive} inconclusive", err=True
+        f"{len(verdicts) - failed - inconclusive} passed, {failed} failed, {inconclusive} inconclusive",
+        err=True,
     )
     return ExitCode.FAILED if failed else ExitCode.INCONCLUSIVE if inconclusive else ExitCode.PASSED
 

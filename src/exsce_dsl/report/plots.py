@@ -35,7 +35,12 @@ _RINGS = (2.0, 6.0, 11.0, 17.0, 24.0, 32.0, 41.0, 51.0, 62.0, 74.0, 87.0, 101.0)
 _DIRECTIONS = 24
 _SEGMENT_SIZE = 70.0  # points² of the ring where a path segment starts
 _SEGMENT_COLOUR = "#6c3483"
-_STATUS_COLOURS = {"failed": "#c0392b", "inconclusive": "#d68910", "passed": "#1e8449", "not verified": "#5d6d7e"}
+_STATUS_COLOURS = {
+    "failed": "#c0392b",
+    "inconclusive": "#d68910",
+    "passed": "#1e8449",
+    "not verified": "#5d6d7e",
+}
 
 Box = tuple[float, float, float, float]
 """x_min, x_max, y_min, y_max."""
