@@ -41,6 +41,7 @@ STEPS: dict[str, list[set[str]]] = {
         {"signals"},
         {"segments"},
         {"metrics"},
+        {"coverage"},
         {"analyse", "ingest", "robots", "bag_identity", "bag_info", "bag_robots", "bag_runs", "missing"},
         {"spec_draft"},
     ],

@@ -33,10 +33,9 @@ from exsce_dsl.model.metrics import topic_name
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.runs.analyse import run_metrics, wanted_topics
 from exsce_dsl.runs.bags.names import topic_key
+from exsce_dsl.runs.coverage import PROV_TOPIC
 from exsce_dsl.runs.robots import StackRobots
 
-PROV_TOPIC = "/exsce/prov"
-"""Where the dispatcher publishes the run's PROV (latched), so that the bag holds it too."""
 ALWAYS = ("/tf", "/tf_static", "/clock", PROV_TOPIC)
 """Recorded in every run: the global TF tree, simulated time and the run-time PROV."""
 

@@ -61,10 +61,19 @@ class TopicSource:
 
     topic: str
     msgtype: str | None = None
+    rate: float | None = None
+    """The rate (Hz) the topic is published at, when the author declared it (``at 10 Hz``):
+    a run that recorded it far below is told (:class:`~exsce_dsl.model.coverage.Shortfall`)."""
 
     def clause(self) -> str:
-        """How a robot type writes it: ``on "/{ns}/odom" nav_msgs/msg/Odometry``."""
-        return f'on "{self.topic}"' + (f" {self.msgtype}" if self.msgtype else "")
+        """How a robot type writes it: ``on "/{ns}/odom" nav_msgs/msg/Odometry [at 50 Hz]``."""
+        rate = f" at {hertz(self.rate)}" if self.rate is not None else ""
+        return f'on "{self.topic}"' + (f" {self.msgtype}" if self.msgtype else "") + rate
+
+
+def hertz(rate: float) -> str:
+    """A rate as the language writes it: ``10 Hz``, ``12.5 Hz`` (read back as the same float)."""
+    return f"{int(rate)} Hz" if rate.is_integer() and abs(rate) < 1e15 else f"{rate!r} Hz"
 
 
 @dataclass(frozen=True)
@@ -129,17 +138,24 @@ class Signals:
     tolerance: Tolerance = field(default_factory=Tolerance)
     window: Window = Window.GOALS
     """What a robot's whole-run metrics cover (see :class:`Window`)."""
+    rates: tuple[tuple[str, float], ...] = ()
+    """(signal, Hz) the author declared for a signal wherever it is read from (``scan at 10
+    Hz``); a source's own rate (``scan on "/{ns}/scan" at 10 Hz``) wins for that source."""
     named: bool = True
     """Whether the author named the convention; if not, ingestion detects it from each bag, and
     only what ``said`` lists is the author's."""
     said: frozenset[str] = frozenset()
     """The fields the author's own lines set (``pose``, ``velocity``, ``scan``, ``navigation``,
-    ``tolerance``, ``window``): they win over a convention detected from the bag."""
+    ``tolerance``, ``window``, ``rates``): they win over a convention detected from the bag."""
     location: SourceLocation | None = field(default=None, compare=False, repr=False)
 
     def overridden(self, **sources: object) -> Signals:
         """These signals with some replaced (a robot type's own ``pose``, ``velocity``...)."""
         return replace(self, **sources)  # type: ignore[arg-type]
+
+    def rate_of(self, signal: str) -> float | None:
+        """The rate (Hz) declared for ``signal`` as a whole (``velocity at 20 Hz``), if any."""
+        return next((hz for name, hz in self.rates if name == signal), None)
 
     def over(self, detected: Signals) -> Signals:
         """``detected`` (a convention found in a bag) with what the author said of these signals."""

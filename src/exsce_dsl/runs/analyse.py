@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import datetime as dt
-import json
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -21,11 +20,12 @@ from exsce_dsl.model.expressions import Field, walk
 from exsce_dsl.model.messages import DISPATCHER, POSE, FieldPath, Fields
 from exsce_dsl.model.metrics import MetricDefinition
 from exsce_dsl.model.robots import Robot
-from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Bag, Run, RunClock, RunStatus, TaskExecution
+from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Bag, Run, RunClock, TaskExecution
 from exsce_dsl.monitor_kit.monitor_core import Compute, Topic, reducer, topic_name
 from exsce_dsl.runs.bag_identity import content_hash, run_uuid
 from exsce_dsl.runs.bags.reading import (
     ANY,
+    OBJECTS,
     BagError,
     Check,
     Reduce,
@@ -33,6 +33,13 @@ from exsce_dsl.runs.bags.reading import (
     Wanted,
     bag_topics,
     read_bag,
+)
+from exsce_dsl.runs.coverage import (
+    PROV_TOPIC,
+    Recording,
+    declared_rates,
+    find_coverage,
+    recorded_mission_status,
 )
 from exsce_dsl.runs.metrics.compute import HOTSPOT_PATHS, POSE_TOPIC, compute_metrics
 from exsce_dsl.runs.metrics.monitor_code import load_monitors
@@ -172,6 +179,8 @@ def analyse_bag(
     serving = [topic_name(p, r.namespace) for r in robots if r.id in stacks.serves for p in SERVED.values()]
     unread = unread_topics(scenario.metrics, robots, types, serving)
     wanted = with_stamps(stacks.adapt(wanted_topics(metrics, robots), robots), types, stamp_catalogue())
+    if PROV_TOPIC in types:
+        wanted[PROV_TOPIC] = Wanted(OBJECTS)
     recorded = read_bag(path, wanted, reductions(monitors, robots), field_checker(metrics, robots))
     timeline = decide_timeline(recorded)
     data = on_timeline(recorded, timeline)
@@ -222,6 +231,15 @@ def analyse_bag(
         lacking = missing_metrics(metrics, robots, acting, actions, values)
         if lacking:
             raise IncompleteRunError(_incomplete(path, lacking, problems))
+    status = recorded_mission_status(path, data.messages.get(PROV_TOPIC, ()))
+    spans = {r.id: span for r in robots if (span := stacks.recorded_span(r, topics)) is not None}
+    covered = find_coverage(
+        Recording(
+            scenario, robots, data, timeline, actions, values, status, spans,
+            declared_rates(robots, stacks.sources, data),
+        )
+    )  # fmt: skip
+    problems += covered.said()
     wall = timeline.to_wall
     run = Run(
         uuid=run_id or run_uuid(digest),
@@ -234,43 +252,11 @@ def analyse_bag(
         hotspots=tuple(hotspots),
         clocks=_run_clocks(timeline, data.spellings),
         conventions=tuple((d.robot, d.convention, d.evidence) for d in detected),
-        status=recorded_mission_status(path),
+        status=status,
+        coverage=covered.gaps,
+        topic_rates=covered.rates,
     )
     return AnalysedRun(run, digest, problems, timeline, detected)
-
-
-def recorded_mission_status(bag: Path) -> RunStatus:
-    """How the mission of the run in ``bag`` ended, as the run-time PROV beside it says
-    (``<bag's stem>.prov.json``, which ``exscec execute`` and ``simulate`` write): a run whose
-    mission was cancelled or stopped carries ``exsce:mission_status``; without the file, or with
-    one that does not say, the run counts as completed."""
-    beside = bag.with_name(bag.stem + ".prov.json") if bag.suffix else bag.with_name(bag.name + ".prov.json")
-    try:
-        document = json.loads(beside.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return RunStatus.COMPLETED
-    said = {str(v) for v in _values_of(document, "exsce:mission_status")}
-    for status in (RunStatus.CANCELLED, RunStatus.STOPPED):
-        if status.value in said:
-            return status
-    return RunStatus.COMPLETED
-
-
-def _values_of(document: object, key: str) -> list[object]:
-    """Every value of ``key`` in a PROV-JSON document, at any depth (bundles nest records)."""
-    found: list[object] = []
-    stack = [document]
-    while stack:
-        node = stack.pop()
-        if isinstance(node, dict):
-            for k, v in node.items():
-                if k == key:
-                    found.append(v.get("$") if isinstance(v, dict) else v)
-                else:
-                    stack.append(v)
-        elif isinstance(node, list):
-            stack.extend(node)
-    return found
 
 
 def _run_clocks(timeline: Timeline, spellings: Mapping[str, tuple[str, ...]]) -> tuple[RunClock, ...]:

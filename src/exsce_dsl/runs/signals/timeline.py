@@ -20,20 +20,21 @@ the other, so everything is put on one timeline before any window is cut:
   is not synchronised) on a wall-clock run is moved by that offset, and a note says so.
 
 What cannot be reconciled is said: a ``/clock`` that goes back (the simulation was reset during
-the recording) is an error; stamps of one series that go back by more than :data:`SAME_CLOCK`
-make that series timed by its log times, and stamped series whose offsets to log time differ by
-more than :data:`SAME_CLOCK` (two publishers on different clocks) are named in a note.
+the recording) is a :class:`ClockJump`: the timeline follows ``/clock`` up to the jump and goes
+on at its last rate after it (so every series stays in order), and the run's coverage says that
+nothing from the jump on is on one timeline.  Stamps of one series that go back by more than
+:data:`SAME_CLOCK` make that series timed by its log times, and a jump of its own; stamped series
+whose offsets to log time differ by more than :data:`SAME_CLOCK` (two publishers on different
+clocks) are named in a note.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 
 import numpy as np
 
-from exsce_dsl.errors import BagError
 from exsce_dsl.messages.catalogue import (
     MessageCatalogue,
     MessageTypeError,
@@ -84,6 +85,20 @@ class SourceClock:
 
 
 @dataclass(frozen=True)
+class ClockJump:
+    """A clock that went back: ``topic``'s (``/clock``, or a series' stamps) by ``back`` seconds,
+    at ``at`` on the run's timeline."""
+
+    topic: str
+    at: float
+    back: float
+
+    def describe(self) -> str:
+        what = "/clock" if self.topic == CLOCK_TOPIC else f"the stamps of {self.topic}"
+        return f"{what} went back {self.back:.3f} s (a simulation reset while recording)"
+
+
+@dataclass(frozen=True)
 class Timeline:
     """The run's timeline and how a log time goes onto it (piecewise linear between knots)."""
 
@@ -95,6 +110,8 @@ class Timeline:
     stamps' offsets."""
     log_knots: np.ndarray = field(default_factory=lambda: np.zeros(0))
     time_knots: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    jumps: tuple[ClockJump, ...] = ()
+    """Where a clock went back: from there on, the run is not on one timeline."""
 
     def from_log(self, times: np.ndarray) -> np.ndarray:
         """Log times (seconds) on the timeline."""
@@ -208,8 +225,12 @@ def decide_timeline(data: BagData) -> Timeline:
     clock = data.series.get(CLOCK_TOPIC)
     simulated = [s for s in stamped if s.simulated]
     notes: list[str] = []
+    jumps: list[ClockJump] = []
     if clock is not None and len(clock):
-        log_knots, time_knots = _clock_knots(clock, data.path)
+        log_knots, time_knots, jump = _clock_knots(clock)
+        if jump is not None:
+            jumps.append(jump)
+            notes.append(f"{jump.describe()} at log time {jump.at:.3f}: the timeline goes on at its pace")
         by = CLOCK_TOPIC
         simulated_run = bool(np.median(time_knots) < SIMULATED_BEFORE <= np.median(log_knots))
     elif simulated:
@@ -225,15 +246,18 @@ def decide_timeline(data: BagData) -> Timeline:
         log_knots = time_knots = np.zeros(0)
         by, simulated_run = LOG_TIME, False
     timeline = Timeline(simulated_run, (), (), by, log_knots, time_knots)
+    jumps = [replace(j, at=float(timeline.from_log(np.array([j.at]))[0])) for j in jumps]
     clocks = []
     for series in stamped:
-        clocks.append(_source_clock(series, timeline, notes))
+        clocks.append(_source_clock(series, timeline, notes, jumps))
     stamped_topics = {s.topic for s in stamped}
     for topic in sorted(set(data.series) - stamped_topics - {CLOCK_TOPIC}):
         clocks.append(SourceClock(topic, LOG_TIME, simulated_run))
     for topic in sorted({*data.feedback, *data.results, *data.messages}):
         clocks.append(SourceClock(topic, LOG_TIME, simulated_run))
-    return replace(timeline, clocks=tuple(sorted(clocks, key=lambda c: c.topic)), notes=tuple(notes))
+    return replace(
+        timeline, clocks=tuple(sorted(clocks, key=lambda c: c.topic)), notes=tuple(notes), jumps=tuple(jumps)
+    )
 
 
 def _stamped_series(data: BagData) -> list[_Stamped]:
@@ -252,19 +276,19 @@ def _stamped_series(data: BagData) -> list[_Stamped]:
     return found
 
 
-def _clock_knots(clock: Series, path: Path) -> tuple[np.ndarray, np.ndarray]:
-    """``/clock``'s messages as (log time, simulated time) knots; a clock going back is an error."""
+def _clock_knots(clock: Series) -> tuple[np.ndarray, np.ndarray, ClockJump | None]:
+    """``/clock``'s messages as (log time, simulated time) knots, up to where it first goes back
+    by more than :data:`SAME_CLOCK` (a reset: the jump, at its log time, is returned too)."""
     keys = [p.key for p in _CLOCK_PATHS]
     values = np.asarray(clock.fields[keys[0]] + clock.fields[keys[1]] * 1e-9, dtype=np.float64)
+    log = np.asarray(clock.t, dtype=np.float64)
     back = np.diff(values) < -SAME_CLOCK
+    jump = None
     if back.any():
         at = int(np.argmax(back))
-        raise BagError(
-            f"{path}: /clock goes back {values[at] - values[at + 1]:.3f} s at log time {clock.t[at + 1]:.3f} "
-            "(the simulation was reset while recording): its times cannot be put on one timeline; "
-            "split the bag where the simulation restarted"
-        )
-    return np.asarray(clock.t, dtype=np.float64), np.maximum.accumulate(values)
+        jump = ClockJump(CLOCK_TOPIC, float(log[at + 1]), float(values[at] - values[at + 1]))
+        log, values = log[: at + 1], values[: at + 1]
+    return log, np.maximum.accumulate(values), jump
 
 
 def _offset_knots(simulated: list[_Stamped]) -> tuple[np.ndarray, np.ndarray]:
@@ -284,12 +308,20 @@ def _offset_knots(simulated: list[_Stamped]) -> tuple[np.ndarray, np.ndarray]:
     return log_knots, log_knots - offsets
 
 
-def _source_clock(series: _Stamped, timeline: Timeline, notes: list[str]) -> SourceClock:
+def _source_clock(
+    series: _Stamped, timeline: Timeline, notes: list[str], jumps: list[ClockJump]
+) -> SourceClock:
     """How ``series`` goes on the timeline: by its stamps when they are of the timeline's clock
-    and never go back by more than :data:`SAME_CLOCK`, else by its log times."""
-    back = np.diff(series.stamps[np.isfinite(series.stamps)]) < -SAME_CLOCK
+    and never go back by more than :data:`SAME_CLOCK` (else a jump of ``jumps``), else by its
+    log times."""
+    known = np.isfinite(series.stamps)
+    stamps, log = series.stamps[known], series.log[known]
+    back = np.diff(stamps) < -SAME_CLOCK
     if back.any():
         notes.append(f"the stamps of {series.topic} go back by more than {SAME_CLOCK:g} s: timed by log time")
+        at = int(np.argmax(back))
+        where = float(timeline.from_log(np.array([log[at + 1]]))[0])
+        jumps.append(ClockJump(series.topic, where, float(stamps[at] - stamps[at + 1])))
         return SourceClock(series.topic, LOG_TIME, timeline.simulated)
     if series.simulated == timeline.simulated:
         if series.other_clock and not series.simulated:
