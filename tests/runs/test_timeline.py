@@ -21,12 +21,13 @@ from rosbags.highlevel import AnyReader
 from tests.bag_factory import Topic, typestore_for, write_bag
 from tests.clock_bags import CLOCK, CLOCK_TYPE, restamp
 
-from exsce_dsl.errors import BagError
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.prov.run import compile_run
 from exsce_dsl.rdf import to_quads, validate
 from exsce_dsl.runs.analyse import AnalysedRun, analyse_bag
+from exsce_dsl.runs.bags.reading import Wanted, bag_topics, read_bag
+from exsce_dsl.runs.signals.timeline import decide_timeline, stamp_catalogue, with_stamps
 from exsce_dsl.sim.run import simulate
 
 SPEC = Path(__file__).resolve().parents[2] / "examples" / "brsu_building_c" / "scenario_c.exsce"
@@ -174,8 +175,11 @@ def test_the_convention_is_detected_per_robot_and_said(
     )
 
 
-def test_a_clock_that_goes_back_is_refused_with_the_reason(scenario: Scenario, tmp_path: Path) -> None:
-    """A simulation reset while recording: /clock goes from 149 s back to 2 s."""
+def test_a_clock_that_goes_back_is_a_jump_of_the_timeline(tmp_path: Path) -> None:
+    """A simulation reset while recording: /clock goes from 149 s back to 2 s.  The timeline
+    follows /clock up to the jump (1 simulated second per 0.1 s logged) and goes on at that pace,
+    so the jump is at 149 + 1 = 150 s on it; the run's coverage says the rest is not on one
+    timeline (tests/runs/test_coverage)."""
     store = typestore_for("mcap")
     clock_type, time_type = store.types[CLOCK_TYPE], store.types["builtin_interfaces/msg/Time"]
     start = 1_767_312_000_000_000_000
@@ -185,8 +189,15 @@ def test_a_clock_that_goes_back_is_refused_with_the_reason(scenario: Scenario, t
     ]
     odometry = _odometry_messages(store, start)
     bag = write_bag(tmp_path / "reset", "mcap", [Topic(CLOCK, CLOCK_TYPE, ticks), odometry], store).path
-    with pytest.raises(BagError, match=r"reset: /clock goes back 147\.000 s .*simulation was reset"):
-        analyse_bag(bag, scenario)
+    types = bag_topics(bag)
+    wanted = with_stamps({"/tiago1/odom": Wanted(types["/tiago1/odom"], ())}, types, stamp_catalogue())
+    timeline = decide_timeline(read_bag(bag, wanted))
+    (jump,) = timeline.jumps
+    assert (jump.topic, jump.back, jump.at) == (CLOCK, pytest.approx(147.0), pytest.approx(150.0))
+    assert timeline.simulated
+    assert any("/clock went back 147.000 s" in note for note in timeline.notes)
+    later = timeline.from_log(np.array([start * 1e-9 + 3.0]))  # tick 30, after the reset
+    assert later[0] == pytest.approx(160.0)  # 150 + 10 × 1.0 s: in order, never back
 
 
 def _odometry_messages(store: object, start: int) -> Topic:
