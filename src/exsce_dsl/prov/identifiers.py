@@ -315,6 +315,22 @@ METRIC_ATTR = Term(EXSCE, "metric")
 """On a ``violation_duration`` value: the safety metric whose limit was violated."""
 VIOLATIONS = Term(EXSCE, "violations")
 DURATION = Term(EXSCE, "duration")
+COVERAGE_GAP_TYPE = Term(EXSCE, "coverage_gap")
+"""Something a run's recording does not cover (cut short, no data, a gap, a low rate, a clock jump)."""
+TOPIC_RATE_TYPE = Term(EXSCE, "topic_rate")
+"""How densely a topic a metric reads was recorded in a run."""
+SHORTFALL = Term(EXSCE, "shortfall")
+"""On a coverage gap: ``cut_short``, ``no_data``, ``gap``, ``low_rate`` or ``clock_jump``."""
+REASON = Term(EXSCE, "reason")
+TOPIC_NAME = Term(EXSCE, "topic_name")
+"""On a coverage gap or a topic rate: the topic, as the bag spells it."""
+READ_BY = Term(EXSCE, "read_by")
+"""On a coverage gap or a topic rate: the metrics whose values read the data, space-separated
+(absent on a gap: every metric of the run)."""
+GAP_START = Term(EXSCE, "gap_start")
+GAP_END = Term(EXSCE, "gap_end")
+MESSAGES = Term(EXSCE, "messages")
+RATE = Term(EXSCE, "rate")
 METRIC_TYPE = Term(RUN, "metricType")
 HOTSPOT_TYPE = Term(HOTSPOT, "type")
 ORACLE_METRIC = Term(ORACLE, "metric")
@@ -378,6 +394,7 @@ PARAMETER_SERVER = "parameter-server"
 GOAL_ROLE = "goal"
 TOPIC_ROLE = "topic"
 HOTSPOTS_BUNDLE = "hotspots_bundle"
+COVERAGE_BUNDLE = "coverage_bundle"
 GENERATION = "generation"
 GENERATION_BUNDLE = "scenario_generation"
 
@@ -485,6 +502,16 @@ def metric_value_name(metric: str, subject: str | None) -> str:
 def topics_collection_name(metric: str, robot_id: str | None) -> str:
     """``<robot>-<metric>-topics`` (``<metric>-topics`` for the mission): the topics a metric used."""
     return f"{metric_value_name(metric, robot_id)}-topics"
+
+
+def coverage_name(index: int) -> str:
+    """``coverage-NNN`` (1-based), in the run's namespace: one thing its recording does not cover."""
+    return f"coverage-{index:03d}"
+
+
+def rate_name(index: int) -> str:
+    """``rate-NNN`` (1-based), in the run's namespace: how densely one topic was recorded."""
+    return f"rate-{index:03d}"
 
 
 def hotspot_name(metric: str, robot_id: str | None, index: int) -> str:

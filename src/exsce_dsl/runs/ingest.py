@@ -270,12 +270,24 @@ def _result(bag: _Todo, analysed: AnalysedRun | None, done: Written) -> IngestRe
     return IngestResult(
         path,
         IngestStatus.REPLACED if bag.replacing else IngestStatus.INGESTED,
-        f"{path}: run {analysed.run.uuid} {_what_was_done(bag, len(analysed.run.metrics), done.report)}",
+        f"{path}: run {analysed.run.uuid} {_what_was_done(bag, len(analysed.run.metrics), done.report)}"
+        + _uncovered(analysed),
         analysed.run.uuid,
         tuple(analysed.problems),
         done.report.statements,
         tuple(analysed.picked()),
         tuple(analysed.clocks()),
+    )
+
+
+def _uncovered(analysed: AnalysedRun) -> str:
+    """``; its recording does not cover all of it: 2 gaps (cut short)``, or nothing."""
+    gaps = analysed.run.coverage
+    if not gaps:
+        return ""
+    kinds = ", ".join(dict.fromkeys(g.kind.value.replace("_", " ") for g in gaps))
+    return (
+        f"; its recording does not cover all of it: {len(gaps)} gap{'s' if len(gaps) != 1 else ''} ({kinds})"
     )
 
 

@@ -14,6 +14,7 @@ PROV entity (``classroom_c025-w001-R0.00_P0.00_Y0.00``).
 
 from __future__ import annotations
 
+from exsce_dsl.store.queries.coverage import run_coverage, run_topic_rates
 from exsce_dsl.store.queries.library import KINDS, Parameter, Query, query, query_names, standard_prefixes
 from exsce_dsl.store.queries.run_ids import (
     MIN_PREFIX,
@@ -122,10 +123,12 @@ __all__ = [
     "robot_metric_over_runs",
     "robots",
     "run_metric",
+    "run_coverage",
     "run_metric_values",
     "run_query",
     "run_scenarios",
     "run_segment_values",
+    "run_topic_rates",
     "runs",
     "safety_metrics",
     "scenario_ids",
