@@ -64,8 +64,8 @@ WORD = rf"(?!(?:{WORD_EXCLUDED})\b)[A-Za-z_][A-Za-z0-9_]*"
 METRIC_BEFORE = r"(?<![\w.-])"
 
 DIGITS = r"(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?"
-# Units, longest first, as in the textX rules Quantity, Length, Angle, MetricUnit.
-QUANTITY_UNITS = "m/s|cm/s|km/h|rad/s|deg/s|mm|cm|km|ms|min|std|rad|deg|m|s|h|%"
+# Units, longest first, as in the textX rules Quantity, Length, Angle, Frequency, MetricUnit.
+QUANTITY_UNITS = "m/s|cm/s|km/h|rad/s|deg/s|mm|cm|km|ms|min|std|rad|deg|Hz|m|s|h|%"
 METRIC_UNITS = "m/s|cm/s|km/h|rad/s|deg/s|mm|cm|km|ms|min|rad|deg|m|s|h"
 UNIT_AFTER = r"(?![\w/-])"
 
@@ -239,7 +239,9 @@ def repository() -> dict[str, Rule]:
             keywords("torso"),
             keywords("yes no", "constant.language.boolean" + S),
             # where its signals are: convention nav2, pose from tf map -> base_link, velocity on "..." TYPE
-            keywords("convention pose velocity scan navigation arrival from tf on within and motion window"),
+            keywords(
+                "convention pose velocity scan distance navigation arrival from tf on at within and motion window"
+            ),
             keywords("method nav2 move_base dispatcher none", "constant.language.convention" + S),
             keywords("planar 3d goals whole recording", "constant.language.motion" + S),
             match(MESSAGE_TYPE, "support.type.message" + S),

@@ -2,7 +2,10 @@
 
 ``convention nav2`` takes Nav2's sources; each ``pose``, ``velocity``, ``scan``,
 ``navigation`` or ``arrival`` line replaces the convention's for that signal
-(several ``pose`` lines are a list of preference, tried in order at ingest).
+(several ``pose`` lines are a list of preference, tried in order at ingest).  A rate
+(``scan on "/{ns}/scan" at 10 Hz``, or ``scan at 10 Hz`` for the signal wherever it is read
+from) says how often the topic is published: a run that recorded it at less than half of it
+is told (``runs.coverage``).
 A robot type that names no convention has it detected from each bag at ingest, and its own lines
 win over what is detected (``Signals.said``); one that says none of this at all likewise.
 """
@@ -38,6 +41,7 @@ _SIGNAL_FACTS = (
     "PoseFact",
     "VelocityFact",
     "ScanFact",
+    "RateFact",
     "NavigationFact",
     "ArrivalFact",
     "WindowFact",
@@ -71,6 +75,7 @@ def build_signals(
     velocities: list[TopicSource] = []
     scans: list[TopicSource] = []
     said: dict[str, Any] = {}
+    rates: dict[str, float] = {}
     for fact in mine:
         kind = fact.__class__.__name__
         if kind == "PoseFact":
@@ -84,6 +89,12 @@ def build_signals(
         elif kind == "ScanFact":
             if (source := _topic(fact.source, (LASER_SCAN,), "a laser scan", span, error)) is not None:
                 scans.append(source)
+        elif kind == "RateFact":
+            if fact.signal in rates:
+                error(f"{type_name} states the rate of its {fact.signal} twice", span(fact))
+            rate = _rate(fact.rate, span(fact), error)
+            if rate is not None:
+                rates[fact.signal] = rate
         elif kind in ("NavigationFact", "ArrivalFact", "WindowFact"):
             if kind in said:
                 word = _ONCE[kind]
@@ -96,6 +107,8 @@ def build_signals(
         changes["velocity"] = tuple(velocities)
     if scans:
         changes["scan"] = tuple(scans)
+    if rates:
+        changes["rates"] = tuple(rates.items())
     if "NavigationFact" in said:
         fact = said["NavigationFact"]
         navigation = Navigation(fact.navigation)
@@ -119,13 +132,23 @@ def _topic(source: Any, allowed: tuple[str, ...], what: str, span: Span, error: 
     where = span(source)
     if not _check_topic(source.topic, where, error):
         return None
+    rate = _rate(source.rate, where, error) if source.rate is not None else None
     if source.msgtype is None:
-        return TopicSource(source.topic)
+        return TopicSource(source.topic, rate=rate)
     msgtype = canonical_type(source.msgtype)
     if msgtype not in allowed:
         error(f"{what} is read from {', '.join(allowed)}, not from {msgtype}", where)
         return None
-    return TopicSource(source.topic, msgtype)
+    return TopicSource(source.topic, msgtype, rate)
+
+
+def _rate(text: str, where: SourceLocation, error: Report) -> float | None:
+    """A rate as written (``10 Hz``) in Hz; one not above zero is an error at ``where``."""
+    rate = float(text.strip().removesuffix("Hz"))
+    if not rate > 0:
+        error(f"a rate is a frequency above zero, not {text.strip()}", where)
+        return None
+    return rate
 
 
 def _check_topic(topic: str, where: SourceLocation, error: Report) -> bool:

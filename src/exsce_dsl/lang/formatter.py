@@ -38,7 +38,7 @@ from exsce_dsl.model import (
     Specification,
     Task,
 )
-from exsce_dsl.model.conventions import CONVENTIONS, METHOD, Signals, Tolerance
+from exsce_dsl.model.conventions import CONVENTIONS, METHOD, Signals, Tolerance, hertz
 from exsce_dsl.model.derived import DerivedScenario
 from exsce_dsl.model.metrics import MetricDefinition
 
@@ -152,6 +152,8 @@ def signal_lines(signals: Signals | None, over: Signals | None = None) -> list[s
         lines.append(_arrival(signals.tolerance))
     if signals.window != base.window:
         lines.append(f"window {signals.window.value}")
+    if signals.rates != base.rates:
+        lines += [f"{signal} at {hertz(rate)}" for signal, rate in signals.rates]
     return lines
 
 

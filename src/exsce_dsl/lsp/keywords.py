@@ -22,7 +22,11 @@ MEANINGS: dict[str, str] = {
     "velocity": '`velocity on "/{ns}/cmd_vel" [TYPE]`: where the robot\'s velocity is (Twist, TwistStamped '
     "or an Odometry's twist); several lines are tried in order. In a metric, `reads vel: robot "
     "velocity` reads it (`vel.linear.x` ... `vel.angular.z`).",
-    "scan": '`scan on "/{ns}/scan"`: the robot\'s laser scan (sensor_msgs/msg/LaserScan).',
+    "scan": '`scan on "/{ns}/scan" [at 10 Hz]`: the robot\'s laser scan (sensor_msgs/msg/LaserScan); '
+    "`scan at 10 Hz`: the rate it is published at, wherever it is read from (a run that recorded it "
+    "at less than half of it is told at ingest).",
+    "Hz": "`at 10 Hz`: the rate a robot's signal is published at (pose, velocity, scan or distance); a "
+    "run recorded at less than half of it is reported at ingest, and its clauses are inconclusive.",
     "distance": "`reads odometer: robot distance`: in a metric, the distance the robot has travelled "
     "so far (`odometer.data`, m), wherever its type says it is.",
     "navigation": '`navigation dispatcher|nav2|move_base|none [on "/{ns}/ACTION", ...]`: the '
@@ -48,7 +52,8 @@ MEANINGS: dict[str, str] = {
     "pose": "`pose NAME at (x, y[, z]) [facing YAW | rpy(R, P, Y)]`: a named pose of an area "
     "(lengths in m unless cm or mm follow; angles in rad unless deg follows); in a robot type, "
     '`pose from tf map -> base_link` or `pose on "/{ns}/odom" [TYPE]`: where the robot\'s pose is.',
-    "at": "`at (x, y[, z])`: a position; `starts at POSE`: a robot's start pose.",
+    "at": "`at (x, y[, z])`: a position; `starts at POSE`: a robot's start pose; in a robot type, "
+    "`scan at 10 Hz`: the rate a signal is published at.",
     "facing": "`facing YAW`: the heading (rad, or deg).",
     "rpy": "`rpy(roll, pitch, yaw)`: a full orientation (rad, or deg).",
     "obstacle": '`obstacle NAME [model "M"] at (x, y) [facing YAW] [size (sx, sy[, sz])]`: an obstacle '
