@@ -217,3 +217,16 @@ def test_a_cancelled_mission_in_the_bags_own_prov_is_cut_short(
     (gap,) = analysed.run.coverage
     assert (gap.kind, gap.robot, gap.metrics) == (Shortfall.CUT_SHORT, None, ())
     assert "cancelled" in gap.reason and _close(gap.end, span.end * 1e-9)
+
+
+def test_velocity_that_starts_after_the_robots_first_goal_is_no_data(
+    scenario: Scenario, clean: Path, tmp_path: Path
+) -> None:
+    """tiago1's velocity is lost for its first 20 s; its window starts with its first goal."""
+    bag = drop(clean, tmp_path / "late-velocity", "mcap", "/tiago1/nav_vel", -1.0, 20.0)
+    times = _log_times(clean, "/tiago1/nav_vel")
+    first = times[times >= bag_span(clean).start * 1e-9 + 20.0][0]
+    goal_start = _active_at(clean, "tiago1", _log_times(clean, "/tiago1/waypoint_dispatcher/feedback")[1])
+    (gap,) = analyse_bag(bag, scenario).run.coverage
+    assert (gap.kind, gap.robot, gap.topic) == (Shortfall.NO_DATA, "tiago1", "/tiago1/nav_vel")
+    assert _close(gap.start, goal_start) and _close(gap.end, first)
