@@ -23,7 +23,7 @@ from exsce_dsl.oracles.trials import (
     lowest_pass_rate_first,
     trial,
 )
-from exsce_dsl.oracles.workflows import verify_runs
+from exsce_dsl.oracles.workflows import Verification, verify_runs
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
 from exsce_dsl.store.base import Store
@@ -70,8 +70,17 @@ def verify_trial(
     elif faults:
         raise ExsceError("faults are planted in repeated runs only: give a number of runs to repeat")
     verification = verify_runs(store, scenario, [*runs, *played], record=record, now=now)
+    return trial_of(verification, required_pass_rate, confidence)
+
+
+def trial_of(
+    verification: Verification,
+    required_pass_rate: float = REQUIRED_PASS_RATE,
+    confidence: float = CONFIDENCE,
+) -> Trial:
+    """The runs that :func:`verify_runs` judged, as one trial (``execute --runs N --verify``)."""
     return trial(
-        scenario.id,
+        verification.scenario.id,
         verification.runs,
         verification.verdicts,
         required_pass_rate,

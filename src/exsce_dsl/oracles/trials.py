@@ -149,15 +149,11 @@ def _judge(
         return TrialOutcome.FLAKY, f"{counts} straddles the required {required:g}: flaky", None
     if passed:
         needed = runs_to_pass(required, confidence)
-        return TrialOutcome.INCONCLUSIVE, (
-            f"too few runs: {counts}; {needed} passing runs show a pass rate of {required:g} "
-            f"at {percent(confidence)}"
-        ), needed
+        said = f"{needed} passing runs show a pass rate of {required:g} at {percent(confidence)}"
+        return TrialOutcome.INCONCLUSIVE, f"too few runs: {counts}; {said}", needed
     needed = runs_to_fail(required, confidence)
-    return TrialOutcome.INCONCLUSIVE, (
-        f"too few runs: {counts}; {needed} failing runs show a pass rate below {required:g} "
-        f"at {percent(confidence)}"
-    )
+    said = f"{needed} failing runs show a pass rate below {required:g} at {percent(confidence)}"
+    return TrialOutcome.INCONCLUSIVE, f"too few runs: {counts}; {said}", needed
 
 
 def clause_trials(
@@ -184,7 +180,13 @@ def trial(
     """The trial of ``runs`` of ``scenario`` from their verdicts."""
     clauses = clause_trials(verdicts, required_pass_rate, confidence)
     return Trial(
-        scenario, tuple(runs), tuple(verdicts), tuple(clauses), required_pass_rate, confidence, tuple(warnings)
+        scenario,
+        tuple(runs),
+        tuple(verdicts),
+        tuple(clauses),
+        required_pass_rate,
+        confidence,
+        tuple(warnings),
     )
 
 
