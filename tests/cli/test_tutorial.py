@@ -45,11 +45,7 @@ def test_the_demo_runs_the_commands_of_the_tutorial() -> None:
 
 
 def test_every_command_of_the_tutorial_works_as_written(tmp_path: Path) -> None:
-    env = {
-        **os.environ,
-        "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}",
-        "COLUMNS": "120",
-    }
+    env = {**os.environ, "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}", "COLUMNS": "120"}
     env.pop("EXSCE_STORE", None)
     cwd = tmp_path
     for line in _shell_lines():
@@ -57,9 +53,8 @@ def test_every_command_of_the_tutorial_works_as_written(tmp_path: Path) -> None:
         if command.startswith("cd "):
             cwd = cwd / command[3:]
             continue
-        done = subprocess.run(
-            ["bash", "-c", command], cwd=cwd, env=env, capture_output=True, text=True, timeout=300
-        )
+        done = subprocess.run(["bash", "-c", command], cwd=cwd, env=env, capture_output=True, text=True,
+                              timeout=300)
         assert done.returncode == _expected_exit(line), f"{command}\n{done.stdout}\n{done.stderr}"
         assert "Traceback" not in done.stderr, command
     project = tmp_path / "my-project"
@@ -72,14 +67,12 @@ def test_every_command_of_the_tutorial_works_as_written(tmp_path: Path) -> None:
 def test_exscec_demo_shows_the_fault_run_failing_and_the_others_passing(tmp_path: Path) -> None:
     done = run_exscec("demo", "demo", cwd=tmp_path, timeout=600)  # the whole tutorial, a campaign too
     assert done.returncode == 0, done.stderr[-3000:]
-    summary = done.stderr[done.stderr.index("Summary") :]
+    summary = done.stderr[done.stderr.index("Summary"):]
     assert summary.startswith("Summary") and "every step ended as expected" in summary.splitlines()[0]
     assert re.search(r"passed, as expected\s+new run of scenario_c", summary)
     assert re.search(r"failed, as expected\s+run of scenario_c with the over-speed fault", summary)
     assert re.search(r"passed, as expected\s+run of derived c_one", summary)
-    assert (tmp_path / "demo" / "campaign.xml").is_file() and list(
-        (tmp_path / "demo" / "explore").rglob("minimal/*.exsce")
-    )
+    assert (tmp_path / "demo" / "campaign.xml").is_file() and list((tmp_path / "demo" / "explore").rglob("minimal/*.exsce"))
     assert "NOT" not in summary and "error" not in summary
     assert (tmp_path / "demo" / "report" / "index.html").is_file()
     assert f"[{len(STEPS)}/{len(STEPS)}]" in done.stderr and "$ exscec verify runs/faulty/" in done.stderr
@@ -93,13 +86,11 @@ def test_the_whole_method_runs_on_a_navigation_stacks_runs(tmp_path: Path, conve
     metric sources and report are the stack's."""
     done = run_exscec("demo", "demo", "--convention", convention, cwd=tmp_path)
     assert done.returncode == 0, done.stderr[-3000:]
-    summary = done.stderr[done.stderr.index("Summary") :]
+    summary = done.stderr[done.stderr.index("Summary"):]
     assert re.search(r"passed, as expected\s+new run of scenario_c", summary)
     assert re.search(r"failed, as expected\s+run of scenario_c with the over-speed fault", summary)
     assert re.search(r"passed, as expected\s+run of derived c_one", summary)
-    assert (tmp_path / "demo" / "campaign.xml").is_file() and list(
-        (tmp_path / "demo" / "explore").rglob("minimal/*.exsce")
-    )
+    assert (tmp_path / "demo" / "campaign.xml").is_file() and list((tmp_path / "demo" / "explore").rglob("minimal/*.exsce"))
     project = tmp_path / "demo"
     assert f"convention {convention}" in (project / "scenarios" / "robots.exsce").read_text(encoding="utf-8")
     (bag,) = (project / "runs" / "new").glob("*.bag")
@@ -123,7 +114,7 @@ def test_the_demo_runs_unchanged_against_a_remote_sparql_endpoint(tmp_path: Path
         done = run_exscec("demo", "remote-demo", "--store", f"{server.url}/query", cwd=tmp_path, timeout=600)
         assert done.returncode == 0, done.stderr[-3000:]
         listed = run_exscec("runs", "--store", f"{server.url}/query", "-f", "csv", cwd=tmp_path)
-    summary = done.stderr[done.stderr.index("Summary") :]
+    summary = done.stderr[done.stderr.index("Summary"):]
     assert re.search(r"failed, as expected\s+run of scenario_c with the over-speed fault", summary)
     assert f"store: {server.url}/query" in summary
     assert not (tmp_path / "remote-demo" / ".exsce").exists()  # nothing went to an embedded store
@@ -131,9 +122,7 @@ def test_the_demo_runs_unchanged_against_a_remote_sparql_endpoint(tmp_path: Path
     scenarios = [row["scenario_id"] for row in rows]
     # the demo's five runs of scenario_c and one of c_one; the campaign's, of its derived scenarios
     assert scenarios.count("scenario_c") == 5 and scenarios.count("c_one") == 1
-    assert len(rows) > 6 and all(
-        s.startswith("scenario_c_") for s in scenarios if s not in ("scenario_c", "c_one")
-    )
+    assert len(rows) > 6 and all(s.startswith("scenario_c_") for s in scenarios if s not in ("scenario_c", "c_one"))
 
 
 def test_a_verdict_other_than_expected_is_reported_and_the_demo_goes_on(tmp_path: Path) -> None:
@@ -203,12 +192,8 @@ def test_the_demo_says_how_to_type_its_commands_when_exscec_is_not_on_path(tmp_p
     elsewhere = [p for p in os.environ["PATH"].split(os.pathsep) if Path(p).absolute() != here]
     for folder, path in (("without", elsewhere), ("with", [str(exscec.parent), *elsewhere])):
         done = subprocess.run(
-            [str(exscec), "demo", folder, "--setup-only"],
-            cwd=tmp_path,
-            capture_output=True,
-            text=True,
-            env={**os.environ, "PATH": os.pathsep.join(path)},
-            timeout=120,
+            [str(exscec), "demo", folder, "--setup-only"], cwd=tmp_path, capture_output=True, text=True,
+            env={**os.environ, "PATH": os.pathsep.join(path)}, timeout=120,
         )
         assert done.returncode == 0, done.stderr
         hinted = f"first run '. {here}/activate'" in done.stderr
