@@ -191,9 +191,11 @@ def trial(
 
 
 def lowest_pass_rate_first(clauses: Iterable[ClauseTrial]) -> list[ClauseTrial]:
-    """``clauses`` by pass rate, lowest first (then the lower upper bound: the surer failure);
-    those no run judged last."""
+    """``clauses`` by pass rate, lowest first (then by the interval's upper bound, and its lower:
+    of equal rates, the surer failure and the less sure pass first); those no run judged last."""
     return sorted(
         clauses,
-        key=lambda c: (c.pass_rate is None, c.pass_rate or 0.0, c.high or 0.0, c.key.scenario, c.description),
-    )
+        key=lambda c: (
+            c.pass_rate is None, c.pass_rate or 0.0, c.high or 0.0, c.low or 0.0, c.key.scenario, c.description,
+        ),
+    )  # fmt: skip
