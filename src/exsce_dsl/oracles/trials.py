@@ -193,9 +193,9 @@ def trial(
 def lowest_pass_rate_first(clauses: Iterable[ClauseTrial]) -> list[ClauseTrial]:
     """``clauses`` by pass rate, lowest first (then by the interval's upper bound, and its lower:
     of equal rates, the surer failure and the less sure pass first); those no run judged last."""
-    return sorted(
-        clauses,
-        key=lambda c: (
-            c.pass_rate is None, c.pass_rate or 0.0, c.high or 0.0, c.low or 0.0, c.key.scenario, c.description,
-        ),
-    )  # fmt: skip
+    return sorted(clauses, key=_by_rate)
+
+
+def _by_rate(c: ClauseTrial) -> tuple[bool, float, float, float, str, str]:
+    rate, high, low = c.pass_rate or 0.0, c.high or 0.0, c.low or 0.0
+    return (c.pass_rate is None, rate, high, low, c.key.scenario, c.description)
