@@ -166,7 +166,11 @@ def verify(
     from exsce_dsl.store.open import open_store
 
     if not runs and repeat is None:
-        raise click.UsageError("give the runs to judge (stored runs or bags), or --repeat N")
+        context = click.get_current_context()
+        (argument,) = [p for p in context.command.params if p.name == "runs"]
+        raise click.MissingParameter(
+            "Give the runs to judge (stored runs or bags), or --repeat N.", context, argument
+        )
     if repeat is None and (seed is not None or faults or out_dir is not None):
         raise click.UsageError("--seed, --fault and --output are for the runs of --repeat N")
     scenario = load_spec(spec).scenario(scenario_id)
