@@ -56,7 +56,8 @@ WALK: tuple[tuple[str, ...], ...] = (
     ("ingest",),
     ("execute",),  # no robot answers: exit 2, no bag
     ("baseline",),
-    ("verify",),  # the baseline runs pass, the faulty run fails
+    ("verify",),  # the baseline runs pass, the faulty run fails; a trial of both is flaky
+    ("flaky",),  # the faulty run's clauses first
     ("derive",),  # c_one, with its oracles, into the store
     ("expect",),
     ("lineage",),

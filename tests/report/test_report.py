@@ -244,6 +244,7 @@ _COUNT_HEADERS = {
     "runs failed",
     "runs passed",
     "runs not verified",
+    "runs inconclusive",
     "oracles",
     "from runs",
     "#",
@@ -252,6 +253,8 @@ _COUNT_HEADERS = {
 }
 """Columns of counts, whose header says what they count."""
 _RANK = {"failed": 0, "inconclusive": 1, "passed": 2}
+_RATE = {"pass rate": r"[01]\.\d\d", "95 % interval": r"\[[01]\.\d\d, [01]\.\d\d\]"}
+"""Columns of pass rates (no unit: a fraction of runs), and the text each cell must be."""
 
 
 def _cells(tables: list[dict[str, Any]]) -> Iterator[tuple[str, bool, str]]:
@@ -291,10 +294,17 @@ def test_in_chromium_every_number_has_its_unit_failures_come_first_and_nothing_o
                     if header in _COUNT_HEADERS:
                         assert re.fullmatch(r"\d+", text), f"{where}: {header} {text!r} is not a count"
                         continue
+                    if header in _RATE:
+                        assert re.fullmatch(_RATE[header], text), f"{where}: {header} {text!r} is not a rate"
+                        continue
                     found = _MEASURE.fullmatch(text)
                     assert found, f"{where}: {header} {text!r} has no unit"
                     units_seen.add(found["unit"])
                 for table in tables:
+                    if "pass rate" in table["headers"]:  # lowest first
+                        at = table["headers"].index("pass rate")
+                        rates = [float(r["cells"][at][2] or 2) for r in table["rows"]]  # none judged: last
+                        assert rates == sorted(rates), f"{where}: pass rates not lowest first: {rates}"
                     if "outcome" in table["headers"]:
                         ranks = [_RANK[r["outcome"]] for r in table["rows"]]
                         assert ranks == sorted(ranks), f"{where}: verdicts not failures first: {ranks}"

@@ -17,6 +17,7 @@ from exsce_dsl.api.drafts import init_from_bag
 from exsce_dsl.api.execution import execute_ros1
 from exsce_dsl.api.stand_in import stand_in
 from exsce_dsl.api.tables import metrics, query, rows_frame, segments, sparql, verdicts
+from exsce_dsl.api.trials import flaky, verify_trial
 from exsce_dsl.api.workflows import (
     add_derived,
     baseline,
@@ -46,6 +47,7 @@ __all__ = [
     "derive",
     "execute_ros1",
     "expect",
+    "flaky",
     "ingest",
     "init_from_bag",
     "load",
@@ -60,4 +62,5 @@ __all__ = [
     "stand_in",
     "verdicts",
     "verify",
+    "verify_trial",
 ]

@@ -9,6 +9,7 @@ import click
 
 from exsce_dsl.cli.common import ExitCode, exit_status, reports_errors
 from exsce_dsl.cli.store_commands import store_option
+from exsce_dsl.cli.trial_commands import trial_options
 
 POLICIES = ("skip-waypoint", "retry-once", "skip-task", "stop-mission")
 """``Policy`` values (``exsce_dsl.execute.outcomes``), spelled here so that ``--help`` imports nothing."""
@@ -17,8 +18,8 @@ POLICIES = ("skip-waypoint", "retry-once", "skip-task", "stop-mission")
 @click.command(
     epilog=exit_status(
         passed="every run done (with --verify: every oracle passed)",
-        failed="--verify: an oracle failed",
-        inconclusive="--verify: an oracle could not be judged, and none failed",
+        failed="--verify: an oracle failed (several runs: a clause failed or is flaky)",
+        inconclusive="--verify: an oracle could not be judged (several runs: too few to tell), none failed",
         bad_input="bad input, no ROS master, or an action server that never answered (no bag is left)",
         interrupted="Ctrl-C or SIGTERM: the goals cancelled, the run cut short kept in -o DIR/incomplete/",
     )
@@ -89,6 +90,7 @@ POLICIES = ("skip-waypoint", "retry-once", "skip-task", "stop-mission")
 )
 @click.option("--verify", "judge", is_flag=True, help="Ingest each run's bag and judge it, as exscec verify.")
 @click.option("--junit", type=click.Path(dir_okay=False), help="With --verify: a JUnit XML report.")
+@trial_options
 @store_option
 @reports_errors
 def execute(
@@ -107,6 +109,8 @@ def execute(
     speed_up: float,
     judge: bool,
     junit: str | None,
+    required_pass_rate: float,
+    confidence: float,
     store_url: str | None,
 ) -> None:
     """Run a scenario's mission on a live ROS graph, record each run, judge it.
@@ -129,6 +133,8 @@ def execute(
     On your robot's graph (roscore and each robot's move_base up, and
     $ROS_MASTER_URI exported), three judged runs are
     exscec execute SPEC --ros1 --runs 3 --verify --junit verdicts.xml.
+    Several runs with --verify are one trial, as exscec verify --trial
+    judges it: a pass rate per clause, and a flaky clause fails (exit 1).
     Without a robot, --stand-in serves the goals with exsce's stand-in
     robots (exscec stand-in: move_base servers, odometry, TF, scans, on
     simulated time), started afresh for each run, with --fault planted.
@@ -180,6 +186,11 @@ def execute(
 
         with open_store(store_url) as store:
             verification = verify(store, scenario, [r.files.bag for r in done])
+        if runs > 1:
+            from exsce_dsl.cli.trial_commands import report_trial
+            from exsce_dsl.oracles.trial_runs import trial_of
+
+            sys.exit(report_trial(trial_of(verification, required_pass_rate, confidence), False, junit))
         sys.exit(report_verification(verification, False, junit))
 
 

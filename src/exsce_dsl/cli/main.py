@@ -34,6 +34,7 @@ COMMAND_MODULES: dict[str, str] = {
     "runs": "query_commands",
     "baseline": "oracle_commands",
     "verify": "oracle_commands",
+    "flaky": "trial_commands",
     "derive": "derive_commands",
     "lineage": "derive_commands",
     "expect": "derive_commands",

@@ -10,6 +10,7 @@ import click
 
 from exsce_dsl.cli.common import ExitCode, bag_arguments, exit_status, reports_errors, write_text
 from exsce_dsl.cli.store_commands import store_option
+from exsce_dsl.cli.trial_commands import trial_options
 
 if TYPE_CHECKING:
     from exsce_dsl.oracles.workflows import Verification
@@ -58,13 +59,14 @@ def baseline(spec: str, scenario_id: str | None, store_url: str | None) -> None:
 
 @click.command(
     epilog=exit_status(
-        passed="every oracle passed",
-        failed="an oracle failed",
+        passed="every oracle passed (a trial: every clause passed)",
+        failed="an oracle failed (a trial: a clause failed or is flaky)",
         bad_input="bad input: no oracles yet, an unknown or ambiguous run, a spec error, a bad bag",
-        inconclusive="an oracle could not be judged (its data missing or cut short), and none failed",
+        inconclusive="an oracle could not be judged (its data missing or cut short; a trial: too few "
+        "runs to tell), and none failed",
     )
 )
-@click.argument("runs", nargs=-1, required=True)
+@click.argument("runs", nargs=-1)
 @click.option(
     "--scenario",
     "spec",
@@ -73,7 +75,37 @@ def baseline(spec: str, scenario_id: str | None, store_url: str | None) -> None:
     help="The .exsce file of the scenario the runs are of.",
 )
 @click.option("--scenario-id", help="Which scenario, when the file declares several.")
-@click.option("--json", "as_json", is_flag=True, help="Print the verdicts as JSON.")
+@click.option("--trial", is_flag=True, help="Judge the runs as one trial: a pass rate per clause.")
+@click.option(
+    "--repeat",
+    type=click.IntRange(1),
+    metavar="N",
+    help="Play N new runs with the kinematic executor (as exscec simulate) and judge them, with "
+    "RUNS if given, as one trial.",
+)
+@click.option(
+    "--seed",
+    type=int,
+    metavar="S",
+    help="With --repeat: the runs' seed, as simulate's [default: 1, not simulate's 0, whose runs "
+    "usually made the baseline].",
+)
+@click.option(
+    "--fault",
+    "faults",
+    multiple=True,
+    metavar="NAME[:ARGS]",
+    help="With --repeat: a fault planted in every new run, as simulate's --fault (repeatable).",
+)
+@click.option(
+    "-o",
+    "--output",
+    "out_dir",
+    type=click.Path(file_okay=False),
+    help="With --repeat: the folder for the new runs' bags [default: runs/repeat].",
+)
+@trial_options
+@click.option("--json", "as_json", is_flag=True, help="Print the verdicts (a trial: the clauses) as JSON.")
 @click.option("--junit", type=click.Path(dir_okay=False), help="Also write a JUnit XML report to this file.")
 @click.option("--no-record", is_flag=True, help="Do not write the verdicts to the store.")
 @store_option
@@ -82,6 +114,13 @@ def verify(
     runs: tuple[str, ...],
     spec: str,
     scenario_id: str | None,
+    trial: bool,
+    repeat: int | None,
+    seed: int | None,
+    faults: tuple[str, ...],
+    out_dir: str | None,
+    required_pass_rate: float,
+    confidence: float,
     as_json: bool,
     junit: str | None,
     no_record: bool,
@@ -99,20 +138,60 @@ def verify(
     every oracle passed, 1 when one failed, 3 when one could not be judged
     (and none failed), 2 when nothing could be judged (bad input: below).
 
+    With --trial, or --repeat N (N new runs of the kinematic executor), the
+    runs are one trial: each run is judged and recorded as above, and each
+    clause gets the runs that passed, failed and were inconclusive, its pass
+    rate over the judged runs with a Wilson interval at --confidence, and an
+    outcome against --required-pass-rate.  A clause is passed when the
+    interval lies at or above the required rate, failed when below, flaky
+    when it straddles it and runs both passed and failed: a flaky clause is a
+    test that cannot be trusted to pass, and fails the trial (exit 1), as a
+    failed one does.  Inconclusive (exit 3, when none failed or is flaky):
+    the runs all agree but are too few (the table says how many would do),
+    or none could be judged.
+
     \b
     Example:
       exscec verify runs/*.bag --scenario examples/brsu_building_c/scenario_c.exsce --junit verdicts.xml
       exscec verify runs/faulty/*.bag --scenario examples/brsu_building_c/scenario_c.exsce  # exits 1
+      exscec verify runs/*.bag runs/faulty/*.bag --scenario examples/brsu_building_c/scenario_c.exsce \\
+          --trial --junit trial.xml  # exits 1: tiago1's max_velocity passed 3 runs of 4, flaky
+      exscec verify --scenario examples/brsu_building_c/scenario_c.exsce --repeat 2 --seed 7 \\
+          --required-pass-rate 0.5 --confidence 0.9  # exits 3: 2 runs are too few
     """
+    from exsce_dsl.cli.trial_commands import report_trial
     from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.oracles.trial_runs import REPEAT_FOLDER, REPEAT_SEED, verify_trial
     from exsce_dsl.oracles.workflows import IngestFailed, verify_runs
     from exsce_dsl.store.open import open_store
 
+    if not runs and repeat is None:
+        context = click.get_current_context()
+        (argument,) = [p for p in context.command.params if p.name == "runs"]
+        raise click.MissingParameter(
+            "Give the runs to judge (stored runs or bags), or --repeat N.", context, argument
+        )
+    if repeat is None and (seed is not None or faults or out_dir is not None):
+        raise click.UsageError("--seed, --fault and --output are for the runs of --repeat N")
     scenario = load_spec(spec).scenario(scenario_id)
     bags: list[str | Path] = [Path(r) for r in bag_arguments(runs) if Path(r).exists()]  # files, bag folders
     uuids: list[str | Path] = [r for r in runs if not Path(r).exists()]
     with open_store(store_url) as store:
         try:
+            if trial or repeat is not None:
+                judged = verify_trial(
+                    store,
+                    scenario,
+                    [*uuids, *bags],
+                    repeat=repeat or 0,
+                    out_dir=out_dir or REPEAT_FOLDER,
+                    seed=REPEAT_SEED if seed is None else seed,
+                    faults=faults,
+                    record=not no_record,
+                    required_pass_rate=required_pass_rate,
+                    confidence=confidence,
+                )
+                sys.exit(report_trial(judged, as_json, junit))
             verification = verify_runs(store, scenario, [*uuids, *bags], record=not no_record)
         except IngestFailed as exc:
             click.echo(f"error: {exc.message}", err=True)

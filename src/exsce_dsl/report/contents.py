@@ -21,7 +21,9 @@ from exsce_dsl.model.metrics import MetricDefinition
 from exsce_dsl.model.oracles import Oracle
 from exsce_dsl.model.runs import Hotspot
 from exsce_dsl.model.scenario import Scenario
+from exsce_dsl.model.trials import ClauseTrial
 from exsce_dsl.model.verdicts import Outcome, Verdict
+from exsce_dsl.oracles.trials import clause_trials, lowest_pass_rate_first
 from exsce_dsl.report.campaigns import CampaignContents, gather_campaigns
 from exsce_dsl.report.units import metric_units
 from exsce_dsl.similarity.clustering import Clustering, cluster
@@ -143,6 +145,12 @@ class ScenarioContents:
     def verdicts(self) -> tuple[Verdict, ...]:
         """The verdicts of all its runs, failures first (then run by run)."""
         return failures_first(v for r in self.runs for v in r.verdicts)
+
+    @property
+    def pass_rates(self) -> tuple[ClauseTrial, ...]:
+        """Each clause's pass rate over its runs' last verdicts, lowest first, with the default
+        required pass rate and confidence (as ``exscec flaky`` lists them)."""
+        return tuple(lowest_pass_rate_first(clause_trials(v for r in self.runs for v in r.verdicts)))
 
 
 @dataclass(frozen=True)

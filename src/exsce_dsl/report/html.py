@@ -23,6 +23,8 @@ from exsce_dsl.figures import save_figure
 from exsce_dsl.model.derivation import Derivation
 from exsce_dsl.model.verdicts import Verdict
 from exsce_dsl.oracles.report import expectation
+from exsce_dsl.oracles.trial_report import interval
+from exsce_dsl.oracles.trials import percent
 from exsce_dsl.report.contents import ReportContents, RunContents, ScenarioContents
 from exsce_dsl.report.plots import campaign_figure, metrics_figure, trajectory_figure
 from exsce_dsl.resources import resource_dir
@@ -62,6 +64,8 @@ def _environment() -> jinja2.Environment:
     env.filters["steps"] = _steps
     env.filters["counted"] = counted
     env.filters["noun"] = noun
+    env.filters["percent"] = percent
+    env.filters["interval"] = interval
     env.globals["scenario_page"] = lambda s: page_name("scenario", s) + ".html"
     env.globals["run_page"] = lambda r: page_name("run", r) + ".html"
     env.globals["campaign_page"] = lambda c: page_name("campaign", c) + ".html"
