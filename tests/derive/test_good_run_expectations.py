@@ -27,7 +27,17 @@ from conftest import EXAMPLES, run_exscec
 
 LEGS = (("classroom_c025-w001", "classroom_c022-w001"), ("classroom_c022-w001", "classroom_c018-w001"))
 """tiago1's path in scenario_c without navigate_home_1: its start pose, then delivery_a."""
-DERIVE = ("-t", "remove_task", "--task", "navigate_home_1", "--robot", "tiago1", "--id", "c_short", "--expect")
+DERIVE = (
+    "-t",
+    "remove_task",
+    "--task",
+    "navigate_home_1",
+    "--robot",
+    "tiago1",
+    "--id",
+    "c_short",
+    "--expect",
+)
 
 
 @pytest.fixture(scope="module")

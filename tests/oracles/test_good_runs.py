@@ -111,7 +111,9 @@ def test_a_baseline_leaves_out_failed_cancelled_and_unsafe_runs_and_says_why(
     failed = sorted({v["oracle"] for v in json.loads(verified.stdout) if v["verdict"] == "failed"})
     assert "r1-task_duration" in failed
     slow = next(v["run"] for v in json.loads(verified.stdout))
-    more = run_exscec("ingest", str(bags["cancelled"]), str(bags["fast"]), "--scenario", "spec.exsce", cwd=folder)
+    more = run_exscec(
+        "ingest", str(bags["cancelled"]), str(bags["fast"]), "--scenario", "spec.exsce", cwd=folder
+    )
     assert more.returncode == 0, more.stderr
     cancelled = _run_of(more.stderr + more.stdout, bags["cancelled"])
     fast = _run_of(more.stderr + more.stdout, bags["fast"])

@@ -4,8 +4,8 @@ drove a segment (the method's §4.2.1, with the proportion the right way round).
 A robot's expected ``distance_travelled`` or ``task_duration`` is the sum over the
 segments of its path (start pose, then its tasks' waypoints) of the segment's mean
 over the good stored runs of any scenario (:mod:`exsce_dsl.oracles.good_runs`: not failed nor
-inconclusive when verified, mission completed, no safety limit broken; every run when asked), in the task's direction or else the other
-way, between the same two positions whatever the headings (what a drive costs
+inconclusive when verified, mission completed, no safety limit broken; every run when asked), in
+the task's direction or else the other way, between the same two positions whatever the headings (what a drive costs
 hardly depends on the heading it ends with, and a task may name a pose with
 another heading).  A segment no run drove is estimated from the nearest poses p3, p4 of the same
 area to its ends p1, p2: from each of (p3, p2), (p1, p4), (p3, p4) that has data,
@@ -41,8 +41,8 @@ from exsce_dsl.model.acceptance import (
     When,
 )
 from exsce_dsl.model.expressions import Aggregate
-from exsce_dsl.store.base import Store
 from exsce_dsl.oracles.good_runs import good_runs
+from exsce_dsl.store.base import Store
 from exsce_dsl.store.queries import ValueStats, robot_metric_over_runs, segment_metric_between
 
 SUMMED = ("distance_travelled", "task_duration")

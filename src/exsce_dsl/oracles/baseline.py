@@ -85,9 +85,10 @@ def learn_baseline(
         own.require_some(f"scenario '{scenario.id}'")
     if len(own.used) < needed and learns:
         left = f" ({len(own.left_out)} left out: {own.reasons()})" if own.left_out else ""
+        runs = f"{len(own.used)} good stored run{'s' if len(own.used) != 1 else ''}"
         raise NotEnoughRuns(
-            f"scenario '{scenario.id}' has {len(own.used)} good stored run{'s' if len(own.used) != 1 else ''}"
-            f"{left}; its baseline needs {needed} (ingest more runs, or lower 'given at least N baseline runs')"
+            f"scenario '{scenario.id}' has {runs}{left}; its baseline needs {needed} "
+            "(ingest more runs, or lower 'given at least N baseline runs')"
         )
     chosen = {scenario.id: own}
     values = {scenario.id: run_values(store, list(own.used))}

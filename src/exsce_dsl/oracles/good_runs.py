@@ -109,7 +109,9 @@ def _reason(defects: Iterable[RunDefect], bounds: dict[str, str]) -> str:
             spots[(d.subject, d.robot or "")] = spots.get((d.subject, d.robot or ""), 0) + 1
     for (metric, robot), count in sorted(spots.items()):
         whose = f" of {robot}" if robot else ""
-        parts.append(f"{count} hotspot{'s' if count != 1 else ''} where {metric}{whose} broke its safety limit")
+        parts.append(
+            f"{count} hotspot{'s' if count != 1 else ''} where {metric}{whose} broke its safety limit"
+        )
     return "; ".join(parts)
 
 
