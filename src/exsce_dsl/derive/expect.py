@@ -5,9 +5,9 @@ A robot's expected ``distance_travelled`` or ``task_duration`` is the sum over t
 segments of its path (start pose, then its tasks' waypoints) of the segment's mean
 over the good stored runs of any scenario (:mod:`exsce_dsl.oracles.good_runs`: not failed nor
 inconclusive when verified, mission completed, no safety limit broken; every run when asked), in
-the task's direction or else the other way, between the same two positions whatever the headings (what a drive costs
-hardly depends on the heading it ends with, and a task may name a pose with
-another heading).  A segment no run drove is estimated from the nearest poses p3, p4 of the same
+the task's direction or else the other way, between the same two positions whatever the
+headings (what a drive costs hardly depends on the heading it ends with, and a task may name a
+pose with another heading).  A segment no run drove is estimated from the nearest poses p3, p4 of the same
 area to its ends p1, p2: from each of (p3, p2), (p1, p4), (p3, p4) that has data,
 ``m_ij * dist(p1, p2) / dist(p_i, p_j)``, averaged.  (The method's report writes
 the ratio upside down, which makes a longer neighbour segment give a *longer*
