@@ -188,4 +188,4 @@ def test_the_values_of_runs_whole_and_by_action() -> None:
         ("u-1", "r1-task_01-subtask_001-w_002", NAME[A], "distance_travelled", 6.0),
     ]
     assert {r.robot for r in q.run_segment_values(store, ["u-1", "u-2"])} == {"r1"}
-    assert q.run_segment_values(store, []) == [] and q.failed_runs(store, "corridor_runs") == set()
+    assert q.run_segment_values(store, []) == [] and q.run_defects(store, "corridor_runs") == []

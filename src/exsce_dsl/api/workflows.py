@@ -13,7 +13,7 @@ from pathlib import Path
 
 from prov.model import ProvDocument
 
-from exsce_dsl.derive.expect import SUMMED, Expected, expected_metric
+from exsce_dsl.derive.expect import SUMMED, Expected, expected_metric, learning_runs
 from exsce_dsl.derive.workflows import DerivedSpec, StoredDerivation, add_derivation, derive_spec
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.model import Scenario
@@ -99,9 +99,13 @@ def ingest(
     )
 
 
-def baseline(store: Store, spec: Specification, scenario: str | None = None) -> Baseline:
-    """``exscec baseline``: the oracles of a scenario from its acceptance criteria and stored runs."""
-    return build_baseline(store, spec, scenario)
+def baseline(
+    store: Store, spec: Specification, scenario: str | None = None, *, include_all: bool = False
+) -> Baseline:
+    """``exscec baseline``: the oracles of a scenario from its acceptance criteria and its good
+    stored runs (``include_all``: every run, ``--all-runs``); ``result.runs`` says which runs were
+    used and why the others were left out."""
+    return build_baseline(store, spec, scenario, include_all=include_all)
 
 
 def verify(
@@ -122,26 +126,43 @@ def derive(
     scenario: str | None = None,
     target: str | Path | None = None,
     expect_from: Store | None = None,
+    include_all: bool = False,
 ) -> DerivedSpec:
     """``exscec derive``: a scenario of ``spec`` transformed by ``steps`` in order, e.g.
     ``[("remove_robot", {"robot": "tiago2", "reassign": "tiago1"})]``; the result's ``text`` is
     the new file (write it to ``result.target``).  With ``expect_from``, the file holds the
-    acceptance criteria the stored runs imply (``exscec derive --expect``)."""
+    acceptance criteria the good stored runs imply (``exscec derive --expect``; ``include_all``:
+    every stored run, ``--all-runs``)."""
     return derive_spec(
-        spec, spec.root, steps, new_id=new_id, scenario_id=scenario, target=target, expect_from=expect_from
+        spec,
+        spec.root,
+        steps,
+        new_id=new_id,
+        scenario_id=scenario,
+        target=target,
+        expect_from=expect_from,
+        include_all=include_all,
     )
 
 
-def add_derived(store: Store, derived: DerivedSpec) -> StoredDerivation:
-    """``exscec derive --add-to-store``: the derived scenario, its generation and its oracles."""
-    return add_derivation(store, derived)
+def add_derived(store: Store, derived: DerivedSpec, *, include_all: bool = False) -> StoredDerivation:
+    """``exscec derive --add-to-store``: the derived scenario, its generation and its oracles
+    (from the base's good runs; ``include_all``: every run)."""
+    return add_derivation(store, derived, include_all=include_all)
 
 
-def expect(store: Store, spec: Specification | Scenario, scenario: str | None = None) -> list[Expected]:
+def expect(
+    store: Store, spec: Specification | Scenario, scenario: str | None = None, *, include_all: bool = False
+) -> list[Expected]:
     """``exscec expect``: each robot's expected distance travelled and task duration, and the path
-    segments each value comes from."""
+    segments each value comes from, from the good stored runs (``include_all``: every run)."""
     chosen = _scenario(spec, scenario)
-    return [expected_metric(store, chosen, robot.id, metric) for robot in chosen.robots for metric in SUMMED]
+    runs = learning_runs(store, include_all)
+    return [
+        expected_metric(store, chosen, robot.id, metric, runs=runs)
+        for robot in chosen.robots
+        for metric in SUMMED
+    ]
 
 
 def cluster(

@@ -209,3 +209,14 @@ class Progress:
         click.echo(f"\r\x1b[2K{line}", err=True)
         self._bar._last_line = None  # click draws only a changed bar: this one was just erased
         self._bar.render_progress()
+
+
+all_runs_option = click.option(
+    "--all-runs",
+    "include_all",
+    is_flag=True,
+    help="Learn from every stored run. By default only good runs count: a run is left out when its "
+    "last verification failed or was inconclusive, its mission was cancelled or stopped, or it broke "
+    "a safety limit (measured at ingest).",
+)
+"""The option of the commands that learn from stored runs (baselines, expected values)."""

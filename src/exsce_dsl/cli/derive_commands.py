@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from exsce_dsl.cli.common import reports_errors
+from exsce_dsl.cli.common import all_runs_option, reports_errors
 from exsce_dsl.cli.store_commands import store_option
 from exsce_dsl.wording import counted
 
@@ -61,6 +61,7 @@ def _requests(words: tuple[str, ...]) -> list[tuple[str, dict[str, str]]]:
     show_default=True,
     help="With --expect: how far from the expected change a run may be, in percent of that change.",
 )
+@all_runs_option
 @store_option
 @click.argument("steps", nargs=-1, type=click.UNPROCESSED)
 @reports_errors
@@ -73,6 +74,7 @@ def derive(
     add_to_store: bool,
     with_expectations: bool,
     tolerance: float,
+    include_all: bool,
     store_url: str | None,
     steps: tuple[str, ...],
 ) -> None:
@@ -86,7 +88,10 @@ def derive(
     per step) to the store.  --expect writes
     the new scenario's acceptance criteria from the stored runs (the base's
     safety clauses; distance and duration increasing, decreasing or invariant
-    against the base's runs, by the change its expected values imply).
+    against the base's runs, by the change its expected values imply), from
+    good runs only: a run that failed or was inconclusive when last verified,
+    whose mission was cancelled or stopped or that broke a safety limit is
+    left out, unless --all-runs.
 
     \b
     Example:
@@ -111,7 +116,7 @@ def derive(
         with open_store(store_url) as store:
             made = derive_spec(
                 loaded, spec, requests, new_id=new_id, scenario_id=scenario_id, target=output,
-                expect_from=store, tolerance=tolerance,
+                expect_from=store, tolerance=tolerance, include_all=include_all,
             )  # fmt: skip
         if made.criteria is None:
             click.echo(
@@ -127,7 +132,7 @@ def derive(
         click.echo(made.text, nl=False)
     if add_to_store:
         with open_store(store_url) as store:
-            stored = add_derivation(store, made)
+            stored = add_derivation(store, made, include_all=include_all)
         click.echo(stored.scenario.summary(), err=True)
         click.echo(stored.generation.summary(), err=True)
         if stored.oracles_written is not None:
@@ -184,27 +189,29 @@ def lineage(scenario: str, store_url: str | None) -> None:
 @click.command()
 @click.argument("spec", type=click.Path(dir_okay=False, exists=True))
 @click.option("--scenario-id", help="Which scenario, when the file declares several.")
+@all_runs_option
 @store_option
 @reports_errors
-def expect(spec: str, scenario_id: str | None, store_url: str | None) -> None:
+def expect(spec: str, scenario_id: str | None, include_all: bool, store_url: str | None) -> None:
     """Show a scenario's expected distance travelled and task duration per robot, and where each
-    value comes from: the path segments, observed in stored runs (of any scenario) or
-    estimated from segments near them, with the number of runs.
+    value comes from: the path segments, observed in good stored runs (of any scenario; every
+    run with --all-runs) or estimated from segments near them, with the number of runs.
 
     \b
     Example:
       exscec expect c_one.exsce
       exscec expect examples/brsu_building_c/scenario_c_alone.exsce
     """
-    from exsce_dsl.derive.expect import SUMMED, expected_metric
+    from exsce_dsl.derive.expect import SUMMED, expected_metric, learning_runs
     from exsce_dsl.lang.build import load_spec
     from exsce_dsl.store.open import open_store
 
     scenario = load_spec(spec).scenario(scenario_id)
     with open_store(store_url) as store:
+        learning = learning_runs(store, include_all)
         for robot in scenario.robots:
             for metric in SUMMED:
-                found = expected_metric(store, scenario, robot.id, metric)
+                found = expected_metric(store, scenario, robot.id, metric, runs=learning)
                 shown = f"{found.value:.4g}" if found.value is not None else "unknown"
                 click.echo(f"{robot.id} {metric}: {shown}")
                 for part in found.segments:

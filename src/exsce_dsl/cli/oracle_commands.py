@@ -8,7 +8,14 @@ from typing import TYPE_CHECKING
 
 import click
 
-from exsce_dsl.cli.common import ExitCode, bag_arguments, exit_status, reports_errors, write_text
+from exsce_dsl.cli.common import (
+    ExitCode,
+    all_runs_option,
+    bag_arguments,
+    exit_status,
+    reports_errors,
+    write_text,
+)
 from exsce_dsl.cli.store_commands import store_option
 from exsce_dsl.cli.trial_commands import trial_options
 
@@ -19,21 +26,27 @@ if TYPE_CHECKING:
 @click.command(epilog=exit_status(bad_input="bad input: a spec error, too few runs, no acceptance criteria"))
 @click.argument("spec", type=click.Path(dir_okay=False))
 @click.option("--scenario-id", help="Which scenario, when the file declares several.")
+@all_runs_option
 @store_option
 @reports_errors
-def baseline(spec: str, scenario_id: str | None, store_url: str | None) -> None:
-    """Build the oracles of a scenario from its acceptance criteria and its stored runs.
+def baseline(spec: str, scenario_id: str | None, include_all: bool, store_url: str | None) -> None:
+    """Build the oracles of a scenario from its acceptance criteria and its good stored runs.
 
     Each clause becomes an oracle per robot it is about; the value a
-    performance clause compares with is the mean of the metric over the stored
-    runs (tolerance: as written, else one standard deviation).  The oracles
-    are written to the store (the previous ones are kept as a revision) and
-    shown.  Refuses while the scenario has fewer runs than its criteria ask
-    ('given at least N baseline runs', 3 if not said).
+    performance clause compares with is the mean of the metric over the good
+    stored runs (tolerance: as written, else one standard deviation).  A run
+    is left out when its last verification failed or was inconclusive, its
+    mission was cancelled or stopped, or it broke a safety limit (--all-runs
+    keeps every run); the runs used and those left out, with why, are printed
+    and go to the oracles' provenance.  The oracles are written to the store
+    (the previous ones are kept as a revision) and shown.  Refuses while the
+    scenario has fewer good runs than its criteria ask ('given at least N
+    baseline runs', 3 if not said).
 
     \b
     Example:
       exscec baseline examples/brsu_building_c/scenario_c.exsce
+      exscec baseline examples/brsu_building_c/scenario_c.exsce --all-runs
     """
     from exsce_dsl.lang.build import load_spec
     from exsce_dsl.oracles.workflows import build_baseline
@@ -41,7 +54,7 @@ def baseline(spec: str, scenario_id: str | None, store_url: str | None) -> None:
     from exsce_dsl.tables import aligned
 
     with open_store(store_url) as store:
-        built = build_baseline(store, load_spec(spec), scenario_id)
+        built = build_baseline(store, load_spec(spec), scenario_id, include_all=include_all)
     scenario, oracles, report = built.scenario, built.oracles, built.written
     rows: list[tuple[str, ...]] = [("oracle", "relation", "value", "limit", "delta", "tolerance", "runs")]
     for o in oracles:
@@ -54,6 +67,10 @@ def baseline(spec: str, scenario_id: str | None, store_url: str | None) -> None:
             )
         )
     click.echo("\n".join(aligned(rows)))
+    for whose, chosen in built.runs.items():
+        of = "" if whose == scenario.id else f" (runs of {whose})"
+        every = " (every stored run: --all-runs)" if include_all else ""
+        click.echo(f"{chosen.summary()}{every}{of}", err=True)
     click.echo(report.summary(), err=True)
 
 

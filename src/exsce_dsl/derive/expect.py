@@ -3,10 +3,11 @@ drove a segment (the method's §4.2.1, with the proportion the right way round).
 
 A robot's expected ``distance_travelled`` or ``task_duration`` is the sum over the
 segments of its path (start pose, then its tasks' waypoints) of the segment's mean
-over every stored run of any scenario, in the task's direction or else the other
-way, between the same two positions whatever the headings (what a drive costs
-hardly depends on the heading it ends with, and a task may name a pose with
-another heading).  A segment no run drove is estimated from the nearest poses p3, p4 of the same
+over the good stored runs of any scenario (:mod:`exsce_dsl.oracles.good_runs`: not failed nor
+inconclusive when verified, mission completed, no safety limit broken; every run when asked), in
+the task's direction or else the other way, between the same two positions whatever the
+headings (what a drive costs hardly depends on the heading it ends with, and a task may name a
+pose with another heading).  A segment no run drove is estimated from the nearest poses p3, p4 of the same
 area to its ends p1, p2: from each of (p3, p2), (p1, p4), (p3, p4) that has data,
 ``m_ij * dist(p1, p2) / dist(p_i, p_j)``, averaged.  (The method's report writes
 the ratio upside down, which makes a longer neighbour segment give a *longer*
@@ -23,6 +24,7 @@ value.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 from exsce_dsl.derive.grid_lengths import grid_lengths
@@ -39,9 +41,9 @@ from exsce_dsl.model.acceptance import (
     When,
 )
 from exsce_dsl.model.expressions import Aggregate
+from exsce_dsl.oracles.good_runs import good_runs
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.queries import ValueStats, robot_metric_over_runs, segment_metric_between
-from exsce_dsl.store.queries import runs as stored_runs
 
 SUMMED = ("distance_travelled", "task_duration")
 """The metrics a robot's value of is the sum of its segments' values."""
@@ -85,15 +87,26 @@ def robot_path(scenario: Scenario, robot_id: str) -> list[tuple[Pose, Pose]]:
     return list(zip(poses, poses[1:], strict=False))
 
 
+def learning_runs(store: Store, include_all: bool = False) -> tuple[str, ...]:
+    """The runs whose drives expected values and estimates learn from: the good runs of every
+    scenario (:mod:`exsce_dsl.oracles.good_runs`), or every stored run with ``include_all``."""
+    return good_runs(store, include_all=include_all).used
+
+
 def _either_way(
-    store: Store, metric: str, start: Pose, goal: Pose, held_out: frozenset[frozenset[str]] = frozenset()
+    store: Store,
+    metric: str,
+    start: Pose,
+    goal: Pose,
+    held_out: frozenset[frozenset[str]],
+    runs: Sequence[str],
 ) -> tuple[ValueStats | None, bool]:
     if frozenset((start.id, goal.id)) in held_out:
         return None, False
-    found = segment_metric_between(store, metric, start, goal)
+    found = segment_metric_between(store, metric, start, goal, runs=runs)
     if found is not None:
         return found, False
-    return segment_metric_between(store, metric, goal, start), True
+    return segment_metric_between(store, metric, goal, start, runs=runs), True
 
 
 def segment_value(
@@ -105,15 +118,20 @@ def segment_value(
     held_out: frozenset[frozenset[str]] = frozenset(),
     on_grid: bool = True,
     detour: float = DETOUR,
+    *,
+    runs: Sequence[str] | None = None,
 ) -> ExpectedSegment:
     """One segment's value; ``held_out`` pairs of pose ids are treated as never driven (either way),
     to measure the estimate against what was driven (bench/estimate.py).  An estimate scales by
     path lengths on the environment's occupancy grid when it declares one (and ``on_grid``), else
     by straight-line lengths; its ``how`` says which.  On the grid, a neighbour driven more than
     ``detour`` (a fraction) longer than its grid path is scaled by the distance driven instead
-    (see :data:`DETOUR`; ``math.inf``: never)."""
+    (see :data:`DETOUR`; ``math.inf``: never).  Only the drives of ``runs`` count (default: the
+    good runs of every scenario, :func:`learning_runs`)."""
+    if runs is None:
+        runs = learning_runs(store)
     names = (start.id, goal.id)
-    found, reverse = _either_way(store, metric, start, goal, held_out)
+    found, reverse = _either_way(store, metric, start, goal, held_out, runs)
     if found is not None:
         return ExpectedSegment(
             *names, found.mean, "observed the other way" if reverse else "observed", found.count
@@ -125,33 +143,33 @@ def segment_value(
     p4 = min(near_goal, key=lambda p: math.dist(_xy(p), _xy(goal)))  # in p2's area
     neighbours = []
     for i, j in ((p3, goal), (start, p4), (p3, p4)):
-        near, _ = _either_way(store, metric, i, j, held_out)
+        near, _ = _either_way(store, metric, i, j, held_out, runs)
         if near is not None:
             neighbours.append((i, j, near))
     if not neighbours:
         return ExpectedSegment(*names, None, f"no data, nor for {p3.id} and {p4.id} near its ends")
     lengths = _lengths(scenario, on_grid, [(start, goal)] + [(i, j) for i, j, _ in neighbours])
-    estimates, used, notes, runs = [], [], [], 0
+    estimates, used, notes, drives = [], [], [], 0
     for i, j, near in neighbours:
         length = lengths.of(i, j)
         if length == 0:
             continue
         if lengths.on_grid:  # a detour the grid does not know: scale by the distance driven instead
-            driven = near if metric == DISTANCE else _either_way(store, DISTANCE, i, j, held_out)[0]
+            driven = near if metric == DISTANCE else _either_way(store, DISTANCE, i, j, held_out, runs)[0]
             if driven is not None and driven.mean > (1.0 + detour) * length:
                 longer = driven.mean / length - 1.0
                 notes.append(f"{i.id}–{j.id} per metre driven, {longer:.0%} longer than its grid path")
                 length = driven.mean
         estimates.append(near.mean * lengths.of(start, goal) / length)
         used.append(f"{i.id}–{j.id}")
-        runs += near.count
+        drives += near.count
     if not estimates:
         return ExpectedSegment(*names, None, f"no data, nor for {p3.id} and {p4.id} near its ends")
     return ExpectedSegment(
         *names,
         math.fsum(estimates) / len(estimates),
         f"estimated from {', '.join(used)} ({'; '.join([lengths.words, *notes])})",
-        runs,
+        drives,
     )
 
 
@@ -196,12 +214,24 @@ def _lengths(scenario: Scenario, on_grid: bool, pairs: list[tuple[Pose, Pose]]) 
     return _Lengths({k: v for k, v in on_map.items() if v is not None}, True)
 
 
-def expected_metric(store: Store, scenario: Scenario, robot: str, metric: str) -> Expected:
-    """The robot's expected value of a summed metric (see the module's description)."""
+def expected_metric(
+    store: Store,
+    scenario: Scenario,
+    robot: str,
+    metric: str,
+    *,
+    include_all: bool = False,
+    runs: Sequence[str] | None = None,
+) -> Expected:
+    """The robot's expected value of a summed metric (see the module's description), from the
+    good runs of every scenario (every stored run with ``include_all``; exactly ``runs`` when
+    given)."""
     if metric not in SUMMED:
         raise ValueError(f"'{metric}' is not a sum over path segments")
+    if runs is None:
+        runs = learning_runs(store, include_all)
     path = robot_path(scenario, robot)
-    parts = tuple(segment_value(store, scenario, metric, a, b) for a, b in path)
+    parts = tuple(segment_value(store, scenario, metric, a, b, runs=runs) for a, b in path)
     if any(p.value is None for p in parts):
         parts = _fall_back(parts, path, _lengths(scenario, True, path))
     values = [p.value for p in parts]
@@ -279,6 +309,8 @@ def metamorphic_acceptance(
     derived: Scenario,
     base_acceptance: Acceptance | None,
     tolerance_percent: float = RELATIVE_TOLERANCE,
+    *,
+    include_all: bool = False,
 ) -> Acceptance:
     """The acceptance criteria of a derived scenario, as the method's Listing 35 makes them: the
     base's safety clauses (limits on peaks or on metrics with a safety limit, see
@@ -296,7 +328,11 @@ def metamorphic_acceptance(
     runs observed: see :func:`_allowance`); waypoints are counted, so exactly.  A robot the base does not
     have (``add_robot``, ``replace_robot``) gets its own-baseline clauses only: a slow-down of the
     new robot is caught, and there is nothing of the base to relate it to.  Without an expected
-    value, or for a robot the base's runs do not show, there is no performance clause."""
+    value, or for a robot the base's runs do not show, there is no performance clause.
+
+    E and B come from good runs only (every stored run with ``include_all``): a run that failed,
+    was inconclusive, did not complete its mission or broke a safety limit would teach the
+    expectation its fault (:mod:`exsce_dsl.oracles.good_runs`)."""
     safety = []
     if base_acceptance is not None:
         robots = {r.id for r in derived.robots}
@@ -312,12 +348,14 @@ def metamorphic_acceptance(
             and holds_for_any_mission(e.metric, base)
         ]
     performance: list[Expectation] = []
-    base_runs = [run.uuid for run in stored_runs(store, base.id)]
+    chosen = good_runs(store, base.id, include_all=include_all, scenario=base)
+    base_runs = list(chosen.require_some(f"'{base.id}' to expect from").used)
+    learning = learning_runs(store, include_all)
     for robot in derived.robots:
         subject = Subject(Quantifier.ROBOT, robot.id)
         in_base = base.robot(robot.id) is not None
         for metric in SUMMED:
-            estimate = expected_metric(store, derived, robot.id, metric)
+            estimate = expected_metric(store, derived, robot.id, metric, runs=learning)
             expected = estimate.value
             if expected is None:
                 continue

@@ -13,10 +13,10 @@ from exsce_dsl.lang.formatter import declared_poses, format_document
 from exsce_dsl.model import Acceptance, Scenario
 from exsce_dsl.model.document import Specification
 from exsce_dsl.model.oracles import Oracle
-from exsce_dsl.oracles.baseline import baseline_oracles
+from exsce_dsl.oracles.baseline import learn_baseline
+from exsce_dsl.oracles.workflows import compile_learnt
 from exsce_dsl.prov import compile_scenario
 from exsce_dsl.prov.derivation import compile_derivation
-from exsce_dsl.prov.oracle import compile_oracles
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.writing import WriteReport, add_prov
 from exsce_dsl.transform.derivation import Derived, Request, derive, derived_document
@@ -50,12 +50,14 @@ def derive_spec(
     target: str | Path | None = None,
     expect_from: Store | None = None,
     tolerance: float = RELATIVE_TOLERANCE,
+    include_all: bool = False,
 ) -> DerivedSpec:
     """A scenario of ``spec`` (read from ``spec_path``) transformed by ``requests`` in order
     (``("remove_robot", {"robot": "tiago2", "reassign": "tiago1"})``), as the text of a new file
     for ``target`` (default: beside ``spec_path``, named after the new scenario).  With
     ``expect_from``, the file also holds the acceptance criteria the stored runs imply
-    (``tolerance``: percent of the expected change)."""
+    (``tolerance``: percent of the expected change), from the good runs (every run with
+    ``include_all``: see :mod:`exsce_dsl.oracles.good_runs`)."""
     base = spec.scenario(scenario_id)
     derived = derive(base, requests, new_id, {t.id: t for t in spec.tasks})
     path = Path(spec_path)
@@ -64,7 +66,12 @@ def derive_spec(
     criteria = None
     if expect_from is not None:
         found = metamorphic_acceptance(
-            expect_from, base, derived.scenario, spec.acceptance_of(base.id), tolerance
+            expect_from,
+            base,
+            derived.scenario,
+            spec.acceptance_of(base.id),
+            tolerance,
+            include_all=include_all,
         )
         if found.criteria:
             criteria = found
@@ -83,10 +90,13 @@ class StoredDerivation:
     oracles_written: WriteReport | None = None
 
 
-def add_derivation(store: Store, derived: DerivedSpec, generation: bool = True) -> StoredDerivation:
+def add_derivation(
+    store: Store, derived: DerivedSpec, generation: bool = True, *, include_all: bool = False
+) -> StoredDerivation:
     """Add the base and the derived scenario, the generation (one activity per step; not with
     ``generation=False``: the store has another way to the same scenario) and, when the derived
-    file has acceptance criteria, its oracles."""
+    file has acceptance criteria, its oracles (from the base's good runs; every run with
+    ``include_all``)."""
     add_prov(store, compile_scenario(derived.base))
     scenario = add_prov(store, compile_scenario(derived.scenario))
     made = compile_derivation(derived.derived.derivation)
@@ -94,6 +104,8 @@ def add_derivation(store: Store, derived: DerivedSpec, generation: bool = True) 
     if derived.criteria is None:
         return StoredDerivation(scenario, generated)
     base = derived.base
-    oracles = baseline_oracles(store, derived.criteria, derived.scenario, {base.id: base})
-    written = add_prov(store, compile_oracles(derived.scenario.id, oracles), replace=True)
-    return StoredDerivation(scenario, generated, tuple(oracles), written)
+    learnt = learn_baseline(
+        store, derived.criteria, derived.scenario, {base.id: base}, include_all=include_all
+    )
+    written = add_prov(store, compile_learnt(derived.scenario.id, learnt.oracles, learnt.runs), replace=True)
+    return StoredDerivation(scenario, generated, learnt.oracles, written)

@@ -2,8 +2,10 @@
 
 For each oracle the acceptance criteria plan, the value it compares with is a
 fixed one (``around``, ``from``), a limit (``stays below``), or the mean of the
-metric over the stored runs of the scenario (a baseline oracle) or of the
-scenario it was derived from (a metamorphic one); the tolerance follows the
+metric over the good stored runs of the scenario (a baseline oracle) or of the
+scenario it was derived from (a metamorphic one; good runs: those that did not fail,
+were not inconclusive, completed their mission and broke no safety limit, see
+:mod:`exsce_dsl.oracles.good_runs`); the tolerance follows the
 clause (``within 1 std``, ``within 10 %``, ``within 2 s``; one standard deviation
 for ``invariant`` if none is written).  The method's "update baseline" is
 writing these oracles to the store again.
@@ -20,11 +22,10 @@ from exsce_dsl.model import Scenario
 from exsce_dsl.model.acceptance import Acceptance, BasicRelation
 from exsce_dsl.model.metrics import default_topics
 from exsce_dsl.model.oracles import Oracle
+from exsce_dsl.oracles.good_runs import GoodRuns, good_runs
 from exsce_dsl.oracles.observe import RunValues, observe, run_values
 from exsce_dsl.oracles.plan import PlannedOracle, plan_oracles, tolerance_of
 from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries import failed_runs
-from exsce_dsl.store.queries import runs as stored_runs
 
 PACKAGE = "exsce.metamorphic.relationships"
 """The package the method's YAML names for the built-in relations (kept for its format)."""
@@ -46,43 +47,74 @@ def baseline_oracles(
     acceptance: Acceptance,
     scenario: Scenario,
     bases: dict[str, Scenario] | None = None,
+    *,
+    include_all: bool = False,
 ) -> list[Oracle]:
-    """The oracles of ``scenario`` with their numbers from the runs in ``store`` (less the runs
-    an oracle failed when they were verified).
+    """The oracles of ``scenario`` with their numbers from its good runs in ``store`` (see
+    :mod:`exsce_dsl.oracles.good_runs`; every run with ``include_all``).
 
     ``bases`` are the scenarios metamorphic clauses compare with (by id).  Raises
-    :class:`NotEnoughRuns` while the scenario has fewer runs than its criteria ask.
+    :class:`NotEnoughRuns` while the scenario has fewer good runs than its criteria ask.
     """
-    own = _usable_runs(store, scenario.id)
-    needed = acceptance.baseline_runs
+    return list(learn_baseline(store, acceptance, scenario, bases, include_all=include_all).oracles)
+
+
+@dataclass(frozen=True)
+class LearntBaseline:
+    """The oracles, and the runs of each scenario they learnt from (and those left out, with why)."""
+
+    oracles: tuple[Oracle, ...]
+    runs: dict[str, GoodRuns]
+    """By scenario id: the scenario's own, and each base a metamorphic clause compares with."""
+
+
+def learn_baseline(
+    store: Store,
+    acceptance: Acceptance,
+    scenario: Scenario,
+    bases: dict[str, Scenario] | None = None,
+    *,
+    include_all: bool = False,
+) -> LearntBaseline:
+    """:func:`baseline_oracles`, with the runs they were built from and the runs left out."""
     planned = plan_oracles(acceptance, scenario)
-    if len(own) < needed and any(p.needs_runs and p.expectation.against is None for p in planned):
+    own = _usable_runs(store, scenario, include_all)
+    needed = acceptance.baseline_runs
+    learns = any(p.needs_runs and p.expectation.against is None for p in planned)
+    if learns:
+        own.require_some(f"scenario '{scenario.id}'")
+    if len(own.used) < needed and learns:
+        left = f" ({len(own.left_out)} left out: {own.reasons()})" if own.left_out else ""
+        runs = f"{len(own.used)} good stored run{'s' if len(own.used) != 1 else ''}"
         raise NotEnoughRuns(
-            f"scenario '{scenario.id}' has {len(own)} stored run{'s' if len(own) != 1 else ''} "
-            "that no oracle failed; "
-            f"its baseline needs {needed} (ingest more runs, or lower 'given at least N baseline runs')"
+            f"scenario '{scenario.id}' has {runs}{left}; its baseline needs {needed} "
+            "(ingest more runs, or lower 'given at least N baseline runs')"
         )
-    values = {scenario.id: run_values(store, own)}
+    chosen = {scenario.id: own}
+    values = {scenario.id: run_values(store, list(own.used))}
     oracles = []
     for oracle in planned:
         base_id = oracle.expectation.against or scenario.id
+        base = (bases or {}).get(base_id, scenario) if base_id != scenario.id else scenario
         if base_id not in values:
-            base_runs = _usable_runs(store, base_id)
-            if not base_runs:
+            base_runs = _usable_runs(store, base if base.id == base_id else base_id, include_all)
+            if not base_runs.used and not base_runs.left_out:
                 raise ExsceError(
                     f"scenario '{scenario.id}' is compared with '{base_id}', which has no stored runs yet"
                 )
-            values[base_id] = run_values(store, base_runs)
-        base = (bases or {}).get(base_id, scenario) if base_id != scenario.id else scenario
+            base_runs.require_some(f"'{base_id}', which '{scenario.id}' is compared with")
+            chosen[base_id] = base_runs
+            values[base_id] = run_values(store, list(base_runs.used))
         stats = _statistics(oracle, list(values[base_id].values()), base)
         oracles.append(_numbers(oracle, stats, scenario))
-    return oracles
+    return LearntBaseline(tuple(oracles), chosen)
 
 
-def _usable_runs(store: Store, scenario_id: str) -> list[str]:
-    """The stored runs of a scenario, less those an oracle failed when they were verified."""
-    failed = failed_runs(store, scenario_id)
-    return [run.uuid for run in stored_runs(store, scenario_id) if run.uuid not in failed]
+def _usable_runs(store: Store, scenario: Scenario | str, include_all: bool = False) -> GoodRuns:
+    """The good runs of a scenario (every run with ``include_all``), and those left out with why."""
+    if isinstance(scenario, Scenario):
+        return good_runs(store, scenario.id, include_all=include_all, scenario=scenario)
+    return good_runs(store, scenario, include_all=include_all)
 
 
 def _statistics(oracle: PlannedOracle, runs: Sequence[RunValues], scenario: Scenario) -> Statistics | None:

@@ -9,15 +9,18 @@ from __future__ import annotations
 
 import datetime
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
+
+from prov.model import ProvDocument
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.document import Specification
 from exsce_dsl.model.oracles import Oracle
 from exsce_dsl.model.verdicts import Outcome, Verdict
-from exsce_dsl.oracles.baseline import baseline_oracles
+from exsce_dsl.oracles.baseline import learn_baseline
+from exsce_dsl.oracles.good_runs import GoodRuns
 from exsce_dsl.oracles.verify import judge_runs
 from exsce_dsl.prov.oracle import compile_oracles
 from exsce_dsl.prov.verdicts import compile_verdicts
@@ -42,11 +45,17 @@ class Baseline:
     scenario: Scenario
     oracles: tuple[Oracle, ...]
     written: WriteReport
+    runs: dict[str, GoodRuns] = field(default_factory=dict)
+    """The runs the oracles learnt from and those left out with why, by scenario (its own, and
+    each base a metamorphic clause compares with)."""
 
 
-def build_baseline(store: Store, spec: Specification, scenario_id: str | None = None) -> Baseline:
-    """Build the oracles of a scenario of ``spec`` from its acceptance criteria and the runs in
-    ``store``, and write them there (the previous ones are kept as a revision)."""
+def build_baseline(
+    store: Store, spec: Specification, scenario_id: str | None = None, *, include_all: bool = False
+) -> Baseline:
+    """Build the oracles of a scenario of ``spec`` from its acceptance criteria and its good runs
+    in ``store`` (every run with ``include_all``), and write them there, with the runs used and
+    those left out (the previous oracles are kept as a revision)."""
     scenario = spec.scenario(scenario_id)
     acceptance = spec.acceptance_of(scenario.id)
     if acceptance is None:
@@ -54,9 +63,20 @@ def build_baseline(store: Store, spec: Specification, scenario_id: str | None = 
             f"{spec.root} gives no acceptance criteria for '{scenario.id}' "
             f"(write 'acceptance for {scenario.id} {{...}}')"
         )
-    oracles = baseline_oracles(store, acceptance, scenario, {s.id: s for s in spec.scenarios})
-    written = add_prov(store, compile_oracles(scenario.id, oracles), replace=True)
-    return Baseline(scenario, tuple(oracles), written)
+    bases = {s.id: s for s in spec.scenarios}
+    learnt = learn_baseline(store, acceptance, scenario, bases, include_all=include_all)
+    written = add_prov(store, compile_learnt(scenario.id, learnt.oracles, learnt.runs), replace=True)
+    return Baseline(scenario, learnt.oracles, written, learnt.runs)
+
+
+def compile_learnt(scenario_id: str, oracles: Sequence[Oracle], runs: dict[str, GoodRuns]) -> ProvDocument:
+    """The PROV of a scenario's oracles with the runs they learnt from and those left out."""
+    return compile_oracles(
+        scenario_id,
+        oracles,
+        runs={base: chosen.used for base, chosen in runs.items()},
+        left_out={base: chosen.left_out for base, chosen in runs.items() if chosen.left_out},
+    )
 
 
 @dataclass(frozen=True)

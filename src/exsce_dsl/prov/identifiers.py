@@ -349,6 +349,10 @@ ORACLE_OUTCOME = Term(ORACLE, "outcome")
 ORACLE_MARGIN = Term(ORACLE, "margin")
 ORACLE_REASON = Term(ORACLE, "reason")
 ORACLE_AGAINST = Term(ORACLE, "against")
+BASELINE_RUNS_TYPE = Term(EXSCE, "baseline_runs")
+"""In an oracles bundle: the runs of one scenario its oracles learnt from (``oracle:runs``)."""
+LEFT_OUT_RUN_TYPE = Term(EXSCE, "left_out_run")
+"""In an oracles bundle: a stored run its oracles did not learn from, with ``oracle:reason``."""
 """On a verdict of a metamorphic oracle: the base scenario it compared with."""
 
 # Exploration campaigns (exsce_dsl.prov.campaign).

@@ -10,7 +10,14 @@ each metric (and robot) that has oracles:
 * one usage of the scenario whose runs it compares against, per oracle type:
   ``used(<scenario>:<oracle>-baseline; oracle, exsce:<base>, [oracle:relationship,
   oracle:type, oracle:value, oracle:limit, oracle:delta, oracle:tolerance,
-  oracle:package])`` (``-metamorphic`` for a metamorphic one).
+  oracle:package])`` (``-metamorphic`` for a metamorphic one);
+* for each scenario whose runs the oracles learnt from (its own, a metamorphic clause's base),
+  the entity ``<scenario>:baseline_runs-<that scenario>`` (``prov:type=exsce:baseline_runs``,
+  ``exsce:scenario``, ``oracle:runs`` the uuids of the runs used, separated by spaces), which
+  each oracle used (role ``baseline_runs``), and for each of its stored runs left out (it failed or
+  was inconclusive when verified, its mission did not complete, it broke a safety limit) the
+  entity ``<scenario>:left_out-<uuid>`` (``prov:type=exsce:left_out_run``, ``exsce:run``,
+  ``exsce:scenario``, ``oracle:reason``).
 
 Where exsce differs from the method, on purpose:
 
@@ -28,17 +35,17 @@ Where exsce differs from the method, on purpose:
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 from prov.constants import PROV_ROLE, PROV_TYPE
-from prov.identifier import QualifiedName
+from prov.identifier import Namespace, QualifiedName
 from prov.model import ProvDocument
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model.oracles import Oracle
 from exsce_dsl.prov import identifiers as ids
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, Namespaces
-from exsce_dsl.prov.records import Attributes, DocumentWriter
+from exsce_dsl.prov.records import Attributes, BundleWriter, DocumentWriter
 
 __all__ = ["compile_oracles"]
 
@@ -49,8 +56,12 @@ def compile_oracles(
     namespace: str = DEFAULT_NAMESPACE,
     *,
     checked: bool = False,
+    runs: Mapping[str, Sequence[str]] | None = None,
+    left_out: Mapping[str, Mapping[str, str]] | None = None,
 ) -> ProvDocument:
-    """The PROV document of the oracles that judge runs of scenario ``scenario_id``."""
+    """The PROV document of the oracles that judge runs of scenario ``scenario_id``; ``runs``:
+    the runs the oracles learnt from, by the scenario they are runs of, and ``left_out`` the
+    runs of those scenarios that they did not learn from, with why (uuid → reason)."""
     if not oracles:
         raise ExsceError(f"scenario '{scenario_id}' has no oracles to write")
     names = Namespaces(namespace)
@@ -68,6 +79,7 @@ def compile_oracles(
     for oracle in oracles:
         groups.setdefault((oracle.metric, oracle.robot, oracle.window), []).append(oracle)
 
+    learnt = _learnt_from(w, parts, scenario_id, runs or {}, left_out or {})
     topic_type = {PROV_TYPE: t(ids.ROS_TOPICS)}
     declared: set[QualifiedName] = set()
     topic_role = {PROV_ROLE: ids.TOPIC_ROLE}
@@ -88,6 +100,9 @@ def compile_oracles(
         if criteria:
             facts[t(ids.ORACLE_CRITERION)] = "; ".join(criteria)
         w.activity(activity, facts)
+        for compared in dict.fromkeys(oracle.base_scenario for oracle in group):
+            if compared in learnt:
+                w.used(activity, learnt[compared], {PROV_ROLE: "baseline_runs"})
         topics = dict.fromkeys(topic for oracle in group for topic in oracle.topics)
         for topic in topics:
             topic_id = topic_ns[ids.topic_name(topic)]
@@ -124,3 +139,37 @@ def compile_oracles(
             base = exsce[ids.check_name(oracle.base_scenario, "base scenario id")]
             w.used(activity, base, relation, identifier=usage)
     return writer.document
+
+
+def _learnt_from(
+    w: BundleWriter,
+    parts: Namespace,
+    scenario_id: str,
+    runs: Mapping[str, Sequence[str]],
+    left_out: Mapping[str, Mapping[str, str]],
+) -> dict[str, QualifiedName]:
+    """The entities of the runs the oracles learnt from (by scenario), and one per run left out."""
+    t = w.term
+    made = {}
+    for base, used in runs.items():
+        entity = parts[f"baseline_runs-{ids.check_name(base, 'scenario id')}"]
+        facts: Attributes = {
+            PROV_TYPE: t(ids.BASELINE_RUNS_TYPE),
+            t(ids.SCENARIO_ATTR): base,
+            t(ids.ORACLE_RUNS): " ".join(used),
+        }
+        w.entity(entity, facts)
+        made[base] = entity
+    for base, reasons in left_out.items():
+        for run, reason in reasons.items():
+            entity = parts[f"left_out-{ids.check_name(run, 'run uuid')}"]
+            w.entity(
+                entity,
+                {
+                    PROV_TYPE: t(ids.LEFT_OUT_RUN_TYPE),
+                    t(ids.RUN_ATTR): run,
+                    t(ids.SCENARIO_ATTR): base,
+                    t(ids.ORACLE_REASON): reason,
+                },
+            )
+    return made

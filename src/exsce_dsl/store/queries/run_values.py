@@ -223,7 +223,30 @@ def run_segment_values(
     return found
 
 
-def failed_runs(store: Store, scenario: str, namespace: str = DEFAULT_NAMESPACE) -> set[str]:
-    """The runs of ``scenario`` an oracle failed when they were last verified."""
-    rows = run_query(store, "failed_runs", {"scenario": scenario}, namespace)
-    return {text_of(row["run"]) or "" for row in rows}
+@dataclass(frozen=True)
+class RunDefect:
+    """One thing that makes a stored run unfit to learn from (see ``run_defects.rq``)."""
+
+    run: str
+    kind: str
+    """``failed``, ``inconclusive`` (a verdict of its last verification), ``mission`` (not
+    completed), ``violation`` (a safety limit violated), ``hotspot`` (where one was)."""
+    subject: str
+    """The oracle, the mission's end (``cancelled``...), or the safety metric."""
+    robot: str | None = None
+    seconds: float | None = None
+    """For a violation: how long the limit was violated."""
+
+
+def run_defects(
+    store: Store, scenario: str | None = None, namespace: str = DEFAULT_NAMESPACE
+) -> list[RunDefect]:
+    """The defects of the runs of ``scenario`` (of every run without one), by run."""
+    given = {} if scenario is None else {"scenario": scenario}
+    found = []
+    for row in run_query(store, "run_defects", given, namespace):
+        run, kind, subject = text_of(row["run"]), text_of(row["kind"]), text_of(row["subject"])
+        if run and kind and subject is not None:
+            kind = "inconclusive" if kind == "unjudged" else kind  # as older stores say
+            found.append(RunDefect(run, kind, subject, text_of(row["robot"]), float_of(row["seconds"])))
+    return found

@@ -78,11 +78,25 @@ def segment_metric_any(
 
 
 def segment_metric_between(
-    store: Store, metric: str, start: Pose, goal: Pose, namespace: str = DEFAULT_NAMESPACE
+    store: Store,
+    metric: str,
+    start: Pose,
+    goal: Pose,
+    namespace: str = DEFAULT_NAMESPACE,
+    *,
+    runs: Sequence[str] | None = None,
 ) -> ValueStats | None:
     """``metric`` over every stored drive from ``start``'s position to ``goal``'s, whatever the
-    headings, in runs of any scenario."""
-    given = {"metric": metric, "from": point_name(start), "to": point_name(goal)}
+    headings, in ``runs`` (of any scenario; every stored run if None)."""
+    given: dict[str, str | Sequence[str]] = {
+        "metric": metric,
+        "from": point_name(start),
+        "to": point_name(goal),
+    }
+    if runs is not None:
+        if not runs:
+            return None
+        given["run"] = list(runs)
     return stats_of(run_query(store, "segment_metric_between", given, namespace))
 
 
