@@ -6,7 +6,9 @@ A run of a scenario is **good** unless
   again replaces its verdicts, so a run fixed by a better baseline counts again);
 * its mission did not complete (``cancelled`` or ``stopped``: the recording does not cover it);
 * a safety limit was violated in it, as measured when it was ingested (a ``violation_duration``
-  above 0 s, or a hotspot), even if it was never verified.
+  above 0 s, or a hotspot), even if it was never verified;
+* its recording does not cover it (a coverage gap found at ingest: cut short, no data, a gap,
+  a thinned topic, a clock jump), even if it was never verified.
 
 A run that went wrong is not a sample of how the scenario performs: an over-speed run in a
 baseline widens its band and moves its mean, and in an estimate it teaches the fault to the
@@ -23,8 +25,9 @@ from dataclasses import dataclass, field
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.lang.standard_metrics import standard_metrics
 from exsce_dsl.model import Scenario
+from exsce_dsl.model.coverage import CoverageGap, Shortfall
 from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries import RunDefect, run_defects
+from exsce_dsl.store.queries import RunDefect, run_coverage, run_defects
 from exsce_dsl.store.queries import runs as stored_runs
 
 __all__ = ["GoodRuns", "NoGoodRuns", "good_runs"]
@@ -80,8 +83,24 @@ def good_runs(
     for defect in run_defects(store, scenario_id):
         defects.setdefault(defect.run, []).append(defect)
     bounds = _limit_bounds(scenario)
-    left_out = {run: _reason(defects[run], bounds) for run in every if run in defects}
-    return GoodRuns(tuple(run for run in every if run not in defects), left_out)
+    reasons = {run: _reason(found, bounds) for run, found in defects.items()}
+    for run, gaps in run_coverage(store, every).items():
+        said = _coverage_reason(gaps, mission_said=any(d.kind == "mission" for d in defects.get(run, ())))
+        if said:
+            reasons[run] = f"{reasons[run]}; {said}" if run in reasons else said
+    left_out = {run: reasons[run] for run in every if run in reasons}
+    return GoodRuns(tuple(run for run in every if run not in reasons), left_out)
+
+
+def _coverage_reason(gaps: Iterable[CoverageGap], mission_said: bool) -> str:
+    """What a run's recording does not cover, in words (its first gap, and how many more)."""
+    told = [
+        g for g in gaps if not (mission_said and g.kind is Shortfall.CUT_SHORT and g.robot is None)
+    ]  # the mission's status is said already
+    if not told:
+        return ""
+    more = f" and {len(told) - 1} more gap{'s' if len(told) > 2 else ''}" if len(told) > 1 else ""
+    return f"its recording does not cover it: {told[0].reason}{more}"
 
 
 def _reason(defects: Iterable[RunDefect], bounds: dict[str, str]) -> str:
