@@ -8,12 +8,13 @@ against every oracle of their scenario, the verdicts written to the store as pro
 from __future__ import annotations
 
 import datetime
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import Scenario
+from exsce_dsl.model.coverage import CoverageGap, TopicRate
 from exsce_dsl.model.document import Specification
 from exsce_dsl.model.oracles import Oracle
 from exsce_dsl.model.verdicts import Outcome, Verdict
@@ -86,10 +87,16 @@ def verify_runs(
     *,
     record: bool = True,
     now: datetime.datetime | None = None,
+    coverage: Mapping[str, Sequence[CoverageGap]] | None = None,
+    rates: Mapping[str, Sequence[TopicRate]] | None = None,
 ) -> Verification:
     """Judge ``runs`` (stored runs' uuids, unique prefixes of them or their IRIs, or paths of bags,
     which are ingested first) against every
-    oracle of ``scenario``; with ``record``, write the verdicts to the store (at ``now``, UTC)."""
+    oracle of ``scenario``; with ``record``, write the verdicts to the store (at ``now``, UTC).
+
+    ``coverage`` and ``rates`` (run uuid → what its recording does not cover, and how densely it
+    recorded each topic; see :func:`~exsce_dsl.oracles.verify.judge_runs`) make verdicts over
+    data the recording lacks inconclusive."""
     bags = [Path(r) for r in runs if isinstance(r, Path) or Path(r).exists()]
     given = [str(r) for r in runs if not (isinstance(r, Path) or Path(r).exists())]
     for text in given:
@@ -101,7 +108,7 @@ def verify_runs(
             raise IngestFailed(result.message)
         uuids.append(result.run_id)
     judged = tuple(dict.fromkeys(uuids))
-    verdicts = judge_runs(store, list(judged), scenario)
+    verdicts = judge_runs(store, list(judged), scenario, coverage, rates)
     if record:
         at = now or datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0)
         for run in dict.fromkeys(v.run for v in verdicts):

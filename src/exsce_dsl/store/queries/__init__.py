@@ -25,10 +25,12 @@ from exsce_dsl.store.queries.run_ids import (
 )
 from exsce_dsl.store.queries.run_values import *  # noqa: F403
 from exsce_dsl.store.queries.run_values import (
+    ActionTimes,
     MetricReading,
     MetricSource,
     StoredRun,
     ViolationDuration,
+    action_times,
     failed_runs,
     metric_sources,
     mission_metric,
@@ -84,6 +86,7 @@ from exsce_dsl.store.queries.terms import (
 
 __all__ = [
     "MIN_PREFIX",
+    "ActionTimes",
     "AmbiguousRunError",
     "Given",
     "KINDS",
@@ -98,6 +101,7 @@ __all__ = [
     "ValueStats",
     "UnknownRunError",
     "ViolationDuration",
+    "action_times",
     "bool_of",
     "datetime_of",
     "derivation_of",

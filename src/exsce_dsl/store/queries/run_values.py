@@ -227,3 +227,26 @@ def failed_runs(store: Store, scenario: str, namespace: str = DEFAULT_NAMESPACE)
     """The runs of ``scenario`` an oracle failed when they were last verified."""
     rows = run_query(store, "failed_runs", {"scenario": scenario}, namespace)
     return {text_of(row["run"]) or "" for row in rows}
+
+
+@dataclass(frozen=True)
+class ActionTimes:
+    """When one action of a run started and ended (None where its PROV does not say)."""
+
+    run: str
+    action: str
+    """The action's IRI, as :func:`run_segment_values` names it."""
+    start: datetime.datetime | None
+    end: datetime.datetime | None
+
+
+def action_times(store: Store, runs: Sequence[str], namespace: str = DEFAULT_NAMESPACE) -> list[ActionTimes]:
+    """When each action of ``runs`` (uuids) started and ended: the time a windowed clause covers."""
+    if not runs:
+        return []
+    found = []
+    for row in run_query(store, "action_times", {"run": list(runs)}, namespace):
+        run, action = text_of(row["run"]), text_of(row["action"])
+        if run is not None and action is not None:
+            found.append(ActionTimes(run, action, datetime_of(row["start"]), datetime_of(row["end"])))
+    return found
