@@ -16,7 +16,8 @@ verdict meets the gaps that concern it, and the rules below decide what it still
   was recorded may be broken in what was not, and a performance value computed over part of the
   data is not the run's.
 * A topic recorded below :data:`LOW_RATE_FRACTION` of the median rate of the same topic in the
-  runs the clause's expectation came from (its baseline's runs) is a gap too
+  runs the clause's expectation came from (a limit's: the runs of its scenario's baseline) is a
+  gap too
   (:func:`learned_rate_gaps`), when ingestion did not already find it thinned against a rate the
   specification declares.
 """
@@ -81,16 +82,18 @@ def learned_rate_gaps(
     verdict: Verdict,
     topics: Sequence[str],
     rates: Mapping[str, Sequence[TopicRate]],
+    baseline: Sequence[str],
     fraction: float = LOW_RATE_FRACTION,
 ) -> list[CoverageGap]:
     """A ``low_rate`` gap for each topic ``verdict``'s clause reads that its run recorded below
-    ``fraction`` of the median rate of the same topic in the runs its expectation came from
-    (``verdict.sources``, the run itself left out).
+    ``fraction`` of the median rate of the same topic in the ``baseline`` runs (uuids; the run
+    itself left out): those its expectation came from, or for a limit, which comes from no run,
+    those of its scenario's baseline.
 
     ``rates`` are run uuid → the rates of its topics; a topic's rate concerns the clause when it
     names the clause's metric (or, naming none, is one of ``topics``, the oracle's) and robot.
-    A topic no source run recorded is not compared."""
-    baseline = [run for run in dict.fromkeys(verdict.sources) if run != verdict.run and run in rates]
+    A topic no baseline run recorded is not compared."""
+    baseline = [run for run in dict.fromkeys(baseline) if run != verdict.run and run in rates]
     found = []
     for own in rates.get(verdict.run, ()):
         if not _reads(own, verdict, topics):

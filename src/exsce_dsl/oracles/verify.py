@@ -55,6 +55,7 @@ def judge_runs(
         )
     values = run_values(store, list(runs))
     times = _action_spans(store, runs)
+    baseline = [run for o in oracles if o.base_scenario == scenario.id for run in o.sources]
     verdicts = []
     for run in runs:
         gaps = [*(coverage or {}).get(run, ()), *_cut_short(known[run])]
@@ -66,7 +67,7 @@ def judge_runs(
             concerned = clause_gaps(verdict, gaps, span)
             if rates:
                 declared = {g.topic for g in concerned if g.kind is Shortfall.LOW_RATE}
-                learned = learned_rate_gaps(verdict, oracle.topics, rates)
+                learned = learned_rate_gaps(verdict, oracle.topics, rates, oracle.sources or baseline)
                 concerned += [g for g in learned if g.topic not in declared]
             verdicts.append(judge_coverage(verdict, concerned, _accumulates(oracle.metric, scenario)))
     return verdicts
