@@ -332,6 +332,8 @@ ORACLE_RUNS = Term(ORACLE, "runs")
 ORACLE_OUTCOME = Term(ORACLE, "outcome")
 ORACLE_MARGIN = Term(ORACLE, "margin")
 ORACLE_REASON = Term(ORACLE, "reason")
+ORACLE_SHORTFALL = Term(ORACLE, "shortfall")
+"""On a verdict: the kinds of what the recording did not cover (``cut_short gap``), space-separated."""
 ORACLE_AGAINST = Term(ORACLE, "against")
 """On a verdict of a metamorphic oracle: the base scenario it compared with."""
 
@@ -356,6 +358,8 @@ STEPS = Term(EXSCE, "steps")
 TRIAL_RUNS = Term(EXSCE, "trial_runs")
 CHECKED = Term(EXSCE, "checked")
 VIOLATED = Term(EXSCE, "violated")
+INCONCLUSIVE = Term(EXSCE, "inconclusive")
+"""On a trial: the relations it could not decide (runs not covered could have violated them)."""
 OUTCOME = Term(EXSCE, "outcome")
 RELATION = Term(EXSCE, "relation")
 TRIAL = Term(EXSCE, "trial_number")
