@@ -242,6 +242,7 @@ _MEASURE = re.compile(rf"(?:[<>]= )?{_NUMBER}(?: [+\-±] {_NUMBER})* (?P<unit>m|
 _COUNT_HEADERS = {
     "runs",
     "runs failed",
+    "runs inconclusive",
     "runs passed",
     "runs not verified",
     "oracles",

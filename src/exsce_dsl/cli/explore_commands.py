@@ -132,9 +132,9 @@ def explore(
     A relation is violated when it failed in more than half of a trial's
     runs, and inconclusive (neither passed nor a counterexample) when it
     would be had the runs that could not judge it (cut short, not covered
-    by their recordings) failed it.  Exit status: 0 when every relation
-    held, 1 when one was violated, 3 when none was but one was
-    inconclusive, 2 on bad input.
+    by their recordings) failed it.  It exits 0 when every relation held, 1
+    when one was violated, 3 when none was but one was inconclusive, 2 on
+    bad input.
 
     With --cluster, a Dask cluster's workers play the simulator's runs (one
     task a run, writing the bags into the campaign's folder) and analyse
