@@ -16,10 +16,12 @@ from exsce_dsl.model.metrics import Combine
 from exsce_dsl.model.verdicts import Outcome, Verdict
 from exsce_dsl.oracles.coverage_check import Span, clause_gaps, judge_coverage, learned_rate_gaps
 from exsce_dsl.oracles.verify import judge_runs
+from exsce_dsl.oracles.workflows import verify_runs
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import SimulatedRun, simulate
 from exsce_dsl.store.open import open_store
 from exsce_dsl.store.queries import runs
+from exsce_dsl.store.queries.results import verdicts as stored_verdicts
 
 from conftest import YARD_SPEC, run_exscec, write_map
 
@@ -262,3 +264,24 @@ def test_a_scan_recorded_at_a_tenth_of_the_baselines_rate_leaves_its_clause_inco
     assert judged["r2-distance_to_obstacles"].outcome is Outcome.PASSED
     rates[_stored(folder, clean)] = scan(9.0)
     assert _judge(folder, clean, [], rates=rates)["r1-distance_to_obstacles"].outcome is Outcome.PASSED
+
+
+def test_an_inconclusive_verdict_and_its_shortfall_are_provenance_in_the_store(yard) -> None:
+    folder, clean, _ = yard
+    uuid = _stored(folder, clean)
+    gap = CoverageGap(Shortfall.GAP, "/r2/scan has a 5 s gap", "r2", "/r2/scan", ("distance_to_obstacles",))
+    scenario = load_spec(folder / "spec.exsce").scenario()
+    with open_store(str(folder / ".exsce" / "store")) as store:
+        verification = verify_runs(store, scenario, [uuid], coverage={uuid: [gap]})
+        assert not verification.passed
+        [stored] = [v for v in stored_verdicts(store, "yard_run") if v.oracle == "r2-distance_to_obstacles"]
+        kinds = store.select(
+            "PREFIX oracle: <https://www.sesame-project.org/scenarios/oracles/> "
+            "SELECT ?kinds WHERE { GRAPH ?g { ?v oracle:outcome 'inconclusive' ; oracle:shortfall ?kinds } }"
+        )
+    assert stored.outcome is Outcome.INCONCLUSIVE and stored.shortfalls == (Shortfall.GAP,)
+    assert (
+        stored.reason
+        == "/r2/scan has a 5 s gap: the limit held in what was recorded, which does not show the rest"
+    )
+    assert [str(row["kinds"].value) for row in kinds] == ["gap"]  # type: ignore[union-attr]
