@@ -5,6 +5,8 @@ placed from the executor's own ground truth (the time of r1's first path segment
 from __future__ import annotations
 
 import datetime as dt
+import json
+import shutil
 from dataclasses import replace
 from pathlib import Path
 
@@ -285,3 +287,31 @@ def test_an_inconclusive_verdict_and_its_shortfall_are_provenance_in_the_store(y
         == "/r2/scan has a 5 s gap: the limit held in what was recorded, which does not show the rest"
     )
     assert [str(row["kinds"].value) for row in kinds] == ["gap"]  # type: ignore[union-attr]
+
+
+def test_a_cut_the_recording_shows_is_said_once_whether_or_not_the_mission_says_so_too(
+    yard, tmp_path
+) -> None:
+    """A cancelled run (its run-time PROV says so) whose coverage also says it was cut short gives
+    one reason, ingestion's; without coverage, the mission's status is the reason."""
+    folder, _, _ = yard
+    scenario = load_spec(folder / "spec.exsce").scenario()
+    store_copy = tmp_path / "store"
+    shutil.copytree(folder / ".exsce" / "store", store_copy)
+    bag = next(iter(simulate(scenario, tmp_path / "cut", 1, seed=5))).bag  # not stored yet
+    document = json.loads(bag.with_suffix(".prov.json").read_text())
+    for bundle in document["bundle"].values():
+        for activity in bundle.get("activity", {}).values():
+            if activity.get("prov:type", {}).get("$") == "exsce:run":
+                activity["exsce:mission_status"] = "cancelled"
+    bag.with_suffix(".prov.json").write_text(json.dumps(document))
+    with open_store(str(store_copy)) as store:
+        [uuid] = verify_runs(store, scenario, [bag], record=False).runs
+        alone = {v.oracle: v for v in judge_runs(store, [uuid], scenario)}
+        cut = CoverageGap(Shortfall.CUT_SHORT, "the recording ends with r1's goal to field-e active")
+        both = {v.oracle: v for v in judge_runs(store, [uuid], scenario, {uuid: [cut]})}
+    reason = "the run is incomplete (its mission was cancelled): it was not seen to the end"
+    assert alone["r1-max_velocity"].reason.startswith(reason + ": the limit held")
+    assert both["r1-max_velocity"].reason.startswith(cut.reason + ": the limit held")
+    assert all(reason not in v.reason for v in both.values())
+    assert {v.outcome for v in both.values()} == {v.outcome for v in alone.values()} == {Outcome.INCONCLUSIVE}

@@ -58,7 +58,8 @@ def judge_runs(
     baseline = [run for o in oracles if o.base_scenario == scenario.id for run in o.sources]
     verdicts = []
     for run in runs:
-        gaps = [*(coverage or {}).get(run, ()), *_cut_short(known[run])]
+        found = list((coverage or {}).get(run, ()))
+        gaps = found if any(g.kind is Shortfall.CUT_SHORT for g in found) else found + _cut_short(known[run])
         for oracle in oracles:
             window = _window(oracle)
             observed, why = observe(values[run], oracle.metric, oracle.robot, window, scenario)
@@ -75,7 +76,7 @@ def judge_runs(
 
 def _cut_short(run: StoredRun) -> list[CoverageGap]:
     """A run whose mission was cancelled or stopped, as the store says: its recording does not
-    cover the whole mission."""
+    cover the whole mission (unless ingestion already said the run was cut short)."""
     if run.mission_status is None:
         return []
     reason = f"the run is incomplete (its mission was {run.mission_status}): it was not seen to the end"
