@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import datetime
 import xml.etree.ElementTree as ET
+from dataclasses import replace
 
 import pytest
-from campaign_samples import REMOVE, REVERSE, SHRINKINGS, sample_trials
+from campaign_samples import DURATION, REMOVE, REVERSE, SHRINKINGS, sample_trials
 
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.model.campaign import CampaignPlan, CampaignRecord, Shrinking, Trial
@@ -164,3 +165,25 @@ def test_steps_read_as_the_transformation_declares_its_arguments() -> None:
         "unknown_step(a=1, b=2) → reverse_waypoint_order(task=delivery_a)"
     )
     assert steps_text([]) == "base scenario"
+
+
+def test_a_trial_that_decided_nothing_violated_but_not_everything_is_skipped_as_inconclusive() -> None:
+    """Trial 2 again, its duration relation undecided (runs cut short could have violated it):
+    written to the store, read back, and a ``<skipped message="inconclusive: ...">`` case."""
+    undecided = replace(_trials()[1], inconclusive=(DURATION,))
+    assert undecided.outcome == "inconclusive"
+    with open_store("memory:") as store:
+        add_prov(store, compile_campaign(PLAN, STARTED))
+        add_prov(store, compile_trial(undecided))
+        add_prov(store, compile_trial(_trials()[0]))  # decided: no exsce:inconclusive
+        record = campaign_record(store, "c_explore")
+    assert record is not None
+    first, second = sorted(record.trials, key=lambda t: t.number)
+    assert second.inconclusive == (DURATION,) and second.outcome == "inconclusive"
+    assert first.inconclusive == () and first.outcome == "violated"
+    suite = _suite(campaign_junit(record))
+    assert (suite.get("tests"), suite.get("failures"), suite.get("skipped")) == ("2", "1", "1")
+    skipped = suite.findall("testcase")[1].find("skipped")
+    assert skipped is not None and skipped.get("message") == (
+        f"inconclusive: {DURATION.text} (runs that could not judge it could have violated it)"
+    )

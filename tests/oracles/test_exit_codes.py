@@ -13,6 +13,7 @@ import datetime as dt
 import json
 import shutil
 import uuid
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import click
@@ -96,7 +97,7 @@ def test_verify_exits_0_passed_1_failed_2_bad_input_3_not_judged(yard: tuple[Pat
     assert code == ExitCode.FAILED == 1 and "FAIL" in table and "r1-max_velocity" in table, said
     code, table, said = verify(str(bags["blind"]))
     assert code == ExitCode.INCONCLUSIVE == 3, table + said  # r2's distance to obstacles has no scans
-    inconclusive = [line for line in table.splitlines() if "n/a" in line]
+    inconclusive = [line for line in table.splitlines() if "inconclusive" in line]
     assert inconclusive and all("r2-distance_to_obstacles" in line for line in inconclusive), table
     assert "FAIL" not in table and "0 failed, 1 inconclusive" in said
     code, _, said = verify(str(bags["blind"]), str(bags["fast"]))  # a failure outweighs the rest
@@ -172,12 +173,33 @@ def test_a_run_cut_short_is_never_passed(yard: tuple[Path, dict[str, Path]], tmp
     fast_cut = _cut_short(fast, tmp_path / "fast_cut", scenario)  # a bag of its own: not stored yet
     shutil.copytree(folder / ".exsce" / "store", tmp_path / "store")  # the yard's runs and baseline
     store = ["--store", str(tmp_path / "store"), "--no-record"]
-    judged = run_exscec("verify", str(cut), "--scenario", "spec.exsce", *store, cwd=folder)
+    junit = tmp_path / "cut.xml"
+    judged = run_exscec(
+        "verify", str(cut), "--scenario", "spec.exsce", *store, "--junit", str(junit), cwd=folder
+    )
     assert judged.returncode == ExitCode.INCONCLUSIVE, judged.stdout + judged.stderr
     assert "pass" not in judged.stdout.replace("passed", "")
     assert "the run is incomplete (its mission was cancelled)" in judged.stdout, judged.stdout
-    judged = run_exscec("verify", str(fast_cut), "--scenario", "spec.exsce", *store, cwd=folder)
-    assert judged.returncode == ExitCode.FAILED and "FAIL" in judged.stdout, judged.stdout + judged.stderr
+    rows = [line for line in judged.stdout.splitlines()[1:] if line.strip()]
+    assert len(rows) == 11 and all("inconclusive: " in line for line in rows), judged.stdout
+    report = ET.parse(junit).getroot()  # each clause a test skipped as inconclusive: none passed
+    suite = report.find("testsuite")
+    assert suite is not None and len(suite.findall("testcase")) == 11
+    counts = ("tests", "failures", "errors", "skipped")
+    assert (
+        tuple(report.get(k) for k in counts) == tuple(suite.get(k) for k in counts) == ("11", "0", "0", "11")
+    )
+    messages = [case.find("skipped").get("message", "") for case in suite.findall("testcase")]  # type: ignore[union-attr]
+    assert all(
+        m.startswith("inconclusive: the run is incomplete (its mission was cancelled)") for m in messages
+    )
+    assert not report.findall(".//error") and not report.findall(".//failure")
+    judged = run_exscec("verify", str(fast_cut), "--scenario", "spec.exsce", *store, "--json", cwd=folder)
+    assert judged.returncode == ExitCode.FAILED, judged.stdout + judged.stderr
+    outcomes = {v["oracle"]: (v["verdict"], v["shortfalls"]) for v in json.loads(judged.stdout)}
+    assert outcomes["r1-max_velocity"] == ("failed", ["cut_short"])  # broken in what was recorded
+    assert outcomes["r1-task_duration"] == ("inconclusive", ["cut_short"])  # not the whole run's
+    assert {verdict for verdict, _ in outcomes.values()} == {"failed", "inconclusive"}
     listed = json.loads(run_exscec("runs", "-f", "json", *store[:2], cwd=folder).stdout)
     statuses = {
         row["bag"]["value"]: row.get("mission_status", {}).get("value")
@@ -203,7 +225,8 @@ def test_a_bug_exits_70_with_a_word_and_no_traceback() -> None:
     [
         ((), ("0", "1", "2", "3", "70", "130", "141")),
         (("verify",), ("0", "1", "2", "3", "70")),
-        (("explore",), ("0", "1", "2", "70", "130")),
+        (("explore",), ("0", "1", "2", "3", "70", "130")),
+        (("execute",), ("0", "1", "2", "3", "70", "130")),
         (("baseline",), ("0", "2", "70")),
         (("ingest",), ("0", "2", "70")),
         (("check",), ("0", "2", "70")),

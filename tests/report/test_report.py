@@ -242,9 +242,9 @@ _MEASURE = re.compile(rf"(?:[<>]= )?{_NUMBER}(?: [+\-±] {_NUMBER})* (?P<unit>m|
 _COUNT_HEADERS = {
     "runs",
     "runs failed",
+    "runs inconclusive",
     "runs passed",
     "runs not verified",
-    "runs inconclusive",
     "oracles",
     "from runs",
     "#",

@@ -103,6 +103,7 @@ def _commands(stores: Stores) -> dict[str, tuple[str, ...]]:
     distance = ("-p", "metric=distance_travelled")
     speeding = ("-p", "scenario=yard_run", "-p", "metric=max_velocity")
     given: dict[str, tuple[str, ...]] = {
+        "action_times": every_run,
         "campaign_shrinkings": ("-p", f"campaign={campaign}"),
         "campaign_trials": ("-p", f"campaign={campaign}"),
         "campaigns": (),

@@ -141,7 +141,7 @@ LIVE_STEPS: tuple[Step, ...] = (
 """``exscec demo --ros1``: the method's loop on a live ROS 1 graph (a roscore of the demo's own),
 the robots played by the stand-in in move_base's convention; ``docs/live.md`` has the same steps."""
 
-_ENDINGS = {0: "passed", 1: "failed", 2: "refused (bad input)", 3: "not judged"}
+_ENDINGS = {0: "passed", 1: "failed", 2: "refused (bad input)", 3: "inconclusive"}
 """What a verify step's exit status says of the runs it judged (the codes of ``exscec --help``)."""
 
 

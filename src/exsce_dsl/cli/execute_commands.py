@@ -19,7 +19,8 @@ POLICIES = ("skip-waypoint", "retry-once", "skip-task", "stop-mission")
     epilog=exit_status(
         passed="every run done (with --verify: every oracle passed)",
         failed="--verify: an oracle failed (several runs: a clause failed or is flaky)",
-        inconclusive="--verify: an oracle could not be judged (several runs: too few to tell), none failed",
+        inconclusive="--verify: an oracle was inconclusive (a run cut short or not covered by its "
+        "recording; several runs: too few to tell), and none failed",
         bad_input="bad input, no ROS master, or an action server that never answered (no bag is left)",
         interrupted="Ctrl-C or SIGTERM: the goals cancelled, the run cut short kept in -o DIR/incomplete/",
     )
@@ -129,6 +130,11 @@ def execute(
     Ctrl-C or SIGTERM cancels the active goals, closes the bag and keeps the
     run in DIR/incomplete/ (its PROV says cancelled), where DIR/*.bag does not
     reach it; the exit status is 130.
+
+    With --verify each run is judged as exscec verify judges it, with its
+    exit status: 0 every oracle passed, 1 one failed, 3 one was inconclusive
+    (a run whose mission stopped is cut short: what it met is inconclusive,
+    never passed; a limit it broke fails), 2 bad input.
 
     On your robot's graph (roscore and each robot's move_base up, and
     $ROS_MASTER_URI exported), three judged runs are

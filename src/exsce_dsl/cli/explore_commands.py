@@ -15,8 +15,10 @@ from exsce_dsl.wording import counted
 
 @click.command(
     epilog=exit_status(
-        passed="no relation was violated",
+        passed="every relation checked held",
         failed="a metamorphic relation was violated",
+        inconclusive="none was violated, but one was inconclusive: runs that could not judge it "
+        "(cut short, not covered by their recordings) could have violated it",
         interrupted="Ctrl-C (and SIGTERM with --executor ros1): the same command goes on where it stopped",
     )
 )
@@ -127,7 +129,12 @@ def explore(
     The store is the campaign's state: the same command after a kill goes on
     where it stopped, and a larger --budget goes on with the same campaign.
     The base needs 3 stored runs (the campaign runs them if it has fewer).
-    Exit status: 0 when nothing was violated, 1 when a relation was.
+    A relation is violated when it failed in more than half of a trial's
+    runs, and inconclusive (neither passed nor a counterexample) when it
+    would be had the runs that could not judge it (cut short, not covered
+    by their recordings) failed it.  It exits 0 when every relation held, 1
+    when one was violated, 3 when none was but one was inconclusive, 2 on
+    bad input.
 
     With --cluster, a Dask cluster's workers play the simulator's runs (one
     task a run, writing the bags into the campaign's folder) and analyse
@@ -198,7 +205,8 @@ def explore(
     with chosen as executor, open_store(store_url) as store, Progress(budget, "Exploring") as progress:
 
         def trial_done(trial: Trial, resumed: bool) -> None:
-            found = f": {'; '.join(r.text for r in trial.violated)}" if trial.violated else ""
+            shown = trial.violated or trial.inconclusive
+            found = f": {'; '.join(r.text for r in shown)}" if shown else ""
             done = " (done before)" if resumed else ""
             progress.say(f"trial {trial.number}/{budget} {trial.scenario} {trial.outcome}{found}{done}")
             progress.update()
@@ -214,8 +222,11 @@ def explore(
         durations = run_seconds(store, result.record) if junit else {}
     record = result.record
     violated = {r.text for t in record.trials for r in t.violated}
+    undecided = {r.text for t in record.trials for r in t.inconclusive} - violated
     tried = len(record.trials)
     found = f"{counted(tried, 'derivation')} tried, {counted(len(violated), 'relation')} violated"
+    if undecided:
+        found += f", {len(undecided)} inconclusive"
     click.echo(f"campaign {record.plan.id}: {found}")
     click.echo(f"  files: {result.folder}")
     for shrinking in record.shrinkings:
@@ -229,7 +240,7 @@ def explore(
             click.echo(f"  reproduce: exscec verify {bags}/*.bag --scenario {file}")
     if junit:
         Path(junit).write_text(campaign_junit(record, durations), encoding="utf-8")
-    sys.exit(ExitCode.FAILED if violated else ExitCode.PASSED)
+    sys.exit(ExitCode.FAILED if violated else ExitCode.INCONCLUSIVE if undecided else ExitCode.PASSED)
 
 
 COMMANDS = [explore]

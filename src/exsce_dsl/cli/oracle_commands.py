@@ -79,8 +79,8 @@ def baseline(spec: str, scenario_id: str | None, include_all: bool, store_url: s
         passed="every oracle passed (a trial: every clause passed)",
         failed="an oracle failed (a trial: a clause failed or is flaky)",
         bad_input="bad input: no oracles yet, an unknown or ambiguous run, a spec error, a bad bag",
-        inconclusive="an oracle could not be judged (its data missing or cut short; a trial: too few "
-        "runs to tell), and none failed",
+        inconclusive="an oracle was inconclusive (the recording does not cover its data: missing, cut "
+        "short, with gaps, too sparse; a trial: too few runs to tell), and none failed",
     )
 )
 @click.argument("runs", nargs=-1)
@@ -151,9 +151,15 @@ def verify(
     value observed, the expectation, the margin and the verdict, and the runs
     the expectation came from.  The verdicts are written to the store as
     provenance.  A run the scenario's baseline was built from is judged with
-    a warning: it is part of the mean it is compared with.  Exits 0 when
-    every oracle passed, 1 when one failed, 3 when one could not be judged
-    (and none failed), 2 when nothing could be judged (bad input: below).
+    a warning: it is part of the mean it is compared with.
+
+    A verdict is passed, failed or inconclusive: a clause whose data the
+    recording does not cover (missing, the run cut short, a gap in a topic
+    it reads, a topic far below its rate) is inconclusive, never passed; a
+    limit broken in what was recorded still fails.  The table says why, the
+    JUnit report has it as <skipped message="inconclusive: ...">.  Exits 0
+    when every oracle passed, 1 when one failed, 3 when one was inconclusive
+    (and none failed), 2 on bad input (nothing judged).
 
     With --trial, or --repeat N (N new runs of the kinematic executor), the
     runs are one trial: each run is judged and recorded as above, and each
@@ -218,7 +224,7 @@ def verify(
 
 def report_verification(verification: Verification, as_json: bool, junit: str | None) -> ExitCode:
     """Print the verdicts (a table, or JSON), write the JUnit report, count them on stderr; the
-    exit status they give: 1 if one failed, 3 if one was not judged (and none failed), else 0."""
+    exit status they give: 1 if one failed, 3 if one was inconclusive (and none failed), else 0."""
     from exsce_dsl.model.verdicts import Outcome
     from exsce_dsl.oracles.report import junit_xml, verdict_table, verdicts_json
 

@@ -21,6 +21,7 @@ import shutil
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import NamedTuple
 
 from exsce_dsl.derive.workflows import DerivedSpec, add_derivation, derive_spec
 from exsce_dsl.errors import ExsceError
@@ -251,9 +252,17 @@ class _Campaign:
 
     def trial(self, number: int, candidate: Candidate) -> Trial:
         made, runs, verdicts = self.judge(candidate.requests, "scenarios")
-        checked, violated, failing = _violations(verdicts, len(runs))
+        found = _violations(verdicts, len(runs))
         trial = Trial(
-            self.plan.id, number, made.scenario.id, candidate.requests, runs, checked, violated, failing
+            self.plan.id,
+            number,
+            made.scenario.id,
+            candidate.requests,
+            runs,
+            found.checked,
+            found.violated,
+            found.failing,
+            found.inconclusive,
         )
         add_prov(self.store, compile_trial(trial))
         return trial
@@ -263,7 +272,7 @@ class _Campaign:
 
         def still_fails(requests: tuple[Request, ...]) -> bool:
             made, runs, verdicts = self.judge(requests, "shrinking")
-            violated = any(relation.same_check(found) for found in _violations(verdicts, len(runs))[1])
+            violated = any(relation.same_check(found) for found in _violations(verdicts, len(runs)).violated)
             tried = ShrinkTry(made.scenario.id, requests, violated)
             tries.append(tried)
             self.events.shrink_try_done(tried)
@@ -355,22 +364,44 @@ def _minimal_file(campaign: _Campaign, shrinking: Shrinking) -> Path:
     return target
 
 
-def _violations(
-    verdicts: Sequence[Verdict], runs: int
-) -> tuple[tuple[Relation, ...], tuple[Relation, ...], tuple[tuple[str, str], ...]]:
-    """The relations checked, those violated (failed in more than half of ``runs``), and the
-    failed verdicts of the violated ones as ``(run, verdict local name)``."""
+class RelationVerdicts(NamedTuple):
+    """What a trial's runs showed of each relation checked."""
+
+    checked: tuple[Relation, ...]
+    violated: tuple[Relation, ...]
+    """Failed in more than half of the runs."""
+    failing: tuple[tuple[str, str], ...]
+    """The failed verdicts of the violated relations as ``(run, verdict local name)``."""
+    inconclusive: tuple[Relation, ...]
+    """Not violated, but they would be had the runs that could not judge them (cut short, their
+    recordings not covering the clause) failed them: neither passed nor a counterexample."""
+
+
+def _violations(verdicts: Sequence[Verdict], runs: int) -> RelationVerdicts:
+    """The relations checked, violated and inconclusive in a trial of ``runs`` runs."""
     failures: dict[Relation, list[Verdict]] = {}
+    unjudged: dict[Relation, set[str]] = {}
     for verdict in verdicts:
         relation = Relation(verdict.metric, verdict.robot, verdict.relation, verdict.against)
         failures.setdefault(relation, [])
         if verdict.outcome is Outcome.FAILED:
             failures[relation].append(verdict)
-    violated = tuple(
-        sorted((r for r, failed in failures.items() if 2 * len({v.run for v in failed}) > runs), key=_order)
+        elif verdict.outcome is Outcome.INCONCLUSIVE:
+            unjudged.setdefault(relation, set()).add(verdict.run)
+    failed = {r: {v.run for v in found} for r, found in failures.items()}
+    violated = tuple(sorted((r for r, found in failed.items() if 2 * len(found) > runs), key=_order))
+    undecided = tuple(
+        sorted(
+            (
+                r
+                for r, found in failed.items()
+                if r not in violated and 2 * len(found | unjudged.get(r, set())) > runs
+            ),
+            key=_order,
+        )
     )
     failing = tuple((v.run, _verdict_name(v)) for relation in violated for v in failures[relation])
-    return tuple(sorted(failures, key=_order)), violated, failing
+    return RelationVerdicts(tuple(sorted(failures, key=_order)), violated, failing, undecided)
 
 
 def _order(relation: Relation) -> tuple[str, str, str, str]:

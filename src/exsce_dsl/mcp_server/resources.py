@@ -82,7 +82,7 @@ def resource_templates() -> list[types.ResourceTemplate]:
             title="A run in the store",
             uri_template=f"{RUNS}/{{run}}",
             description="A run by uuid (or a unique prefix of it): its scenario, times, bag, whole-run "
-            "metric values and the counts of its verdicts.",
+            "metric values and the counts of its verdicts (passed, failed, inconclusive).",
             mime_type=JSON,
         ),
     ]

@@ -50,7 +50,8 @@ T = TypeVar("T")
 INSTRUCTIONS = """\
 exsce's provenance store of robot test scenarios (W3C PROV as RDF), read-only.
 Scenarios are compiled from the exsce language; each run of a scenario has its metric values, per
-run and per path segment; verdicts say whether a run passed its oracles.
+run and per path segment; verdicts say whether a run passed its oracles, failed them, or was
+inconclusive (its recording does not cover what a clause needs: never a pass).
 Start with the `scenarios` and `runs` tools (or the resources exsce://scenarios and exsce://runs);
 the other query tools take scenario ids, run uuids, robot ids, metric names and pose names as those
 answers give them.  `lineage` shows how scenarios were derived, `run_verdicts` a run's verdicts,

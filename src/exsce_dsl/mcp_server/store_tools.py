@@ -151,8 +151,11 @@ def run_verdicts_tool() -> ToolEntry:
         description=(
             "The verdicts of a run's last validation (`exscec verify`) as the store holds them: one per "
             "oracle, failed ones first, each with the metric, robot, relation, observed and expected "
-            "values, limit, tolerance, margin, the runs the expectation came from and, when it could "
-            "not be judged, why; with the counts of passed, failed and inconclusive oracles."
+            "values, limit, tolerance, margin, the runs the expectation came from and, when it failed "
+            "or was inconclusive, why; `shortfalls` names what the recording did not cover there "
+            "(cut_short, no_data, gap, low_rate, clock_jump). An inconclusive verdict is never a pass: "
+            "the data the clause needs is missing, cut short or too sparse. With the counts of passed, "
+            "failed and inconclusive oracles."
         ),
         input_schema=object_schema(
             {"run": identifier(RUN_ID, "the run, by uuid or a unique prefix of it")}, ("run",)

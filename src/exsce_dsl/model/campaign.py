@@ -93,10 +93,19 @@ class Trial:
     """Failed in more than half of the runs."""
     failing_verdicts: tuple[tuple[str, str], ...] = ()
     """``(run uuid, verdict local name)`` of every failed verdict of a violated relation."""
+    inconclusive: tuple[Relation, ...] = ()
+    """Not violated, but they would be had the runs that could not judge them (cut short, not
+    covered by their recordings) failed them: neither passed nor counterexamples."""
 
     @property
     def outcome(self) -> str:
-        return "violated" if self.violated else "passed" if self.checked else "unchecked"
+        """``violated``, ``inconclusive`` (nothing violated, but something undecided), ``passed``
+        or ``unchecked`` (no relation to check)."""
+        if self.violated:
+            return "violated"
+        if self.inconclusive:
+            return "inconclusive"
+        return "passed" if self.checked else "unchecked"
 
 
 @dataclass(frozen=True)

@@ -5,6 +5,8 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass
 
+from exsce_dsl.model.coverage import Shortfall
+
 
 class Outcome(enum.Enum):
     PASSED = "passed"
@@ -52,6 +54,10 @@ class Verdict:
     against: str | None = None
     """For a metamorphic oracle, the base scenario whose runs it compares the run with (None:
     the run's own scenario).  A derived scenario can have both about one metric."""
+    shortfalls: tuple[Shortfall, ...] = ()
+    """What the recording did not cover of the part of the run the clause looks at (cut short, a
+    gap, a thinned topic...): why an inconclusive verdict is one, or what a failed limit was not
+    judged on (it failed on what was recorded)."""
 
     @property
     def description(self) -> str:

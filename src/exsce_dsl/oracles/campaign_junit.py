@@ -5,7 +5,9 @@ suites, built with :mod:`xml.etree.ElementTree` (which escapes every text and at
 The campaign is one ``<testsuite name="campaign ID">``; each trial a ``<testcase>``
 (``classname`` the campaign's id, ``name`` ``trial N: STEPS``) which fails when the trial
 violated a relation (the failure names the relations and the smallest derivation found that
-still violates each) and is skipped when it checked none.
+still violates each) and is skipped when it checked none, or when it decided none of them
+violated but runs it could not judge them on (cut short, not covered by their recordings)
+could have (``inconclusive: RELATIONS``).
 """
 
 from __future__ import annotations
@@ -111,10 +113,14 @@ def campaign_junit(record: CampaignRecord, durations: Mapping[str, float] | None
         if trial.violated:
             message, text = _failure(trial, record.shrinkings)
             ET.SubElement(case, "failure", message=message, type="relation violated").text = text
+        elif trial.inconclusive:
+            undecided = "; ".join(r.text for r in trial.inconclusive)
+            message = f"inconclusive: {undecided} (runs that could not judge it could have violated it)"
+            ET.SubElement(case, "skipped", message=message)
         elif not trial.checked:
             ET.SubElement(case, "skipped", message="no relation was checked")
     failures = sum(bool(t.violated) for t in record.trials)
-    skipped = sum(t.outcome == "unchecked" for t in record.trials)
+    skipped = sum(t.outcome in ("unchecked", "inconclusive") for t in record.trials)
     for element in (suites, suite):
         element.set("tests", str(len(record.trials)))
         element.set("failures", str(failures))

@@ -108,10 +108,7 @@ def observe(
         return None, f"'{metric}' has no value per path segment"
     owner = robot or window.robot
     mine = [s for s in values.segments if s.robot == owner]
-    # the window's path segments are those the run has any value of: one without a value of this
-    # metric makes the combination missing (the others' sum, min or max is not the window's)
-    segments = sorted({s.action: s for s in mine}.values(), key=lambda s: s.order)
-    picked = _in_window(segments, window, scenario.mission.tasks_of(owner))
+    picked = window_segments(values, robot, window, scenario)
     if not picked:
         return None, f"run {values.run} has no path segment of '{owner}' {window.text()}"
     found_values = {s.action: s.value for s in mine if s.metric == metric}
@@ -125,6 +122,19 @@ def observe(
     if info.combine is Combine.SUM:
         return float(sum(numbers)), ""
     return float(max(numbers) if info.combine is Combine.MAX else min(numbers)), ""
+
+
+def window_segments(
+    values: RunValues, robot: str | None, window: Window, scenario: Scenario
+) -> list[ObservedSegment]:
+    """The path segments of ``window`` in a run, in their order, one per action.
+
+    They are those the run has any value of: one without a value of a clause's metric makes the
+    combination missing (the others' sum, min or max is not the window's)."""
+    owner = robot or window.robot
+    mine = [s for s in values.segments if s.robot == owner]
+    segments = sorted({s.action: s for s in mine}.values(), key=lambda s: s.order)
+    return _in_window(segments, window, scenario.mission.tasks_of(owner))
 
 
 def _safety_metrics(scenario: Scenario, robot: str | None) -> set[str]:

@@ -9,7 +9,7 @@ from collections.abc import Sequence
 from exsce_dsl.model.verdicts import Outcome, Verdict
 from exsce_dsl.tables import aligned
 
-_MARK = {Outcome.PASSED: "pass", Outcome.FAILED: "FAIL", Outcome.INCONCLUSIVE: "n/a"}
+_MARK = {Outcome.PASSED: "pass", Outcome.FAILED: "FAIL", Outcome.INCONCLUSIVE: "inconclusive"}
 
 
 def _number(value: float | None) -> str:
@@ -71,6 +71,7 @@ def verdicts_json(verdicts: Sequence[Verdict]) -> str:
                 "margin": v.margin,
                 "runs": list(v.sources),
                 "reason": v.reason,
+                "shortfalls": [kind.value for kind in v.shortfalls],
             }
             for v in verdicts
         ],
@@ -79,21 +80,16 @@ def verdicts_json(verdicts: Sequence[Verdict]) -> str:
 
 
 def junit_xml(verdicts: Sequence[Verdict]) -> str:
-    """A JUnit report: a test suite per run, a test case per oracle (failed: ``<failure>``,
-    not judged: ``<error>``)."""
+    """A JUnit report: a test suite per run, a test case per oracle (failed: ``<failure>``;
+    inconclusive: ``<skipped message="inconclusive: REASON">``, a test that could not be judged,
+    which CI systems show apart from both passes and failures)."""
     suites = ET.Element("testsuites", name="exsce verify")
     by_run: dict[str, list[Verdict]] = {}
     for verdict in verdicts:
         by_run.setdefault(verdict.run, []).append(verdict)
     for run, judged in by_run.items():
-        suite = ET.SubElement(
-            suites,
-            "testsuite",
-            name=f"{judged[0].scenario} run {run}",
-            tests=str(len(judged)),
-            failures=str(sum(v.outcome is Outcome.FAILED for v in judged)),
-            errors=str(sum(v.outcome is Outcome.INCONCLUSIVE for v in judged)),
-        )
+        suite = ET.SubElement(suites, "testsuite", name=f"{judged[0].scenario} run {run}")
+        _counts(suite, judged)
         for v in judged:
             case = ET.SubElement(
                 suite, "testcase", classname=f"{v.scenario}.{v.criterion or 'oracles'}", name=v.description
@@ -106,9 +102,16 @@ def junit_xml(verdicts: Sequence[Verdict]) -> str:
             if v.outcome is Outcome.FAILED:
                 ET.SubElement(case, "failure", message=v.reason or "failed", type=v.relation).text = details
             elif v.outcome is Outcome.INCONCLUSIVE:
-                ET.SubElement(case, "error", message=v.reason, type="inconclusive").text = details
-    suites.set("tests", str(len(verdicts)))
-    suites.set("failures", str(sum(v.outcome is Outcome.FAILED for v in verdicts)))
-    suites.set("errors", str(sum(v.outcome is Outcome.INCONCLUSIVE for v in verdicts)))
+                ET.SubElement(case, "skipped", message=f"inconclusive: {v.reason}").text = details
+    _counts(suites, verdicts)
     ET.indent(suites)
     return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(suites, encoding="unicode") + "\n"
+
+
+def _counts(element: ET.Element, verdicts: Sequence[Verdict]) -> None:
+    """JUnit's counts on a suite (or all of them): tests, failures, skipped (inconclusive), and
+    errors, which a verdict never is (an error is the tool's, and stops it)."""
+    element.set("tests", str(len(verdicts)))
+    element.set("failures", str(sum(v.outcome is Outcome.FAILED for v in verdicts)))
+    element.set("errors", "0")
+    element.set("skipped", str(sum(v.outcome is Outcome.INCONCLUSIVE for v in verdicts)))

@@ -3,27 +3,40 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
-from dataclasses import replace
+from collections.abc import Mapping, Sequence
 
 from exsce_dsl.errors import ExsceError
+from exsce_dsl.lang.standard_metrics import standard_metrics
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.acceptance import Window
+from exsce_dsl.model.coverage import CoverageGap, Shortfall, TopicRate
+from exsce_dsl.model.metrics import Combine
 from exsce_dsl.model.oracles import Oracle
 from exsce_dsl.model.verdicts import Outcome, Verdict
-from exsce_dsl.oracles.observe import observe, parse_window, run_values
+from exsce_dsl.oracles.coverage_check import Span, clause_gaps, judge_coverage, learned_rate_gaps
+from exsce_dsl.oracles.observe import RunValues, observe, parse_window, run_values, window_segments
 from exsce_dsl.oracles.relations import RelationError, relation
 from exsce_dsl.store.base import Store
+from exsce_dsl.store.queries import StoredRun, action_times
 from exsce_dsl.store.queries import oracles as stored_oracles
 from exsce_dsl.store.queries import runs as stored_runs
 
 
-def judge_runs(store: Store, runs: Sequence[str], scenario: Scenario) -> list[Verdict]:
+def judge_runs(
+    store: Store,
+    runs: Sequence[str],
+    scenario: Scenario,
+    coverage: Mapping[str, Sequence[CoverageGap]] | None = None,
+    rates: Mapping[str, Sequence[TopicRate]] | None = None,
+) -> list[Verdict]:
     """The verdicts of every oracle of ``scenario`` on each of ``runs`` (uuids), run by run.
 
-    A run whose mission did not complete (cancelled or stopped: its recording does not cover the
-    whole mission) is never passed: a clause it met is inconclusive, saying so; one it broke fails,
-    for what was recorded did break it.
+    ``coverage`` (run uuid → what its recording does not cover) and ``rates`` (run uuid → how
+    densely its topics were recorded; the runs the oracles' expectations came from as well as
+    those judged) make a verdict over data the recording lacks inconclusive, never passed
+    (:mod:`exsce_dsl.oracles.coverage_check`).  A run whose mission did not complete (cancelled
+    or stopped, as the store says) is cut short whatever ``coverage`` says: a clause it met is
+    inconclusive; a limit it broke fails, for what was recorded did break it.
 
     Raises :class:`ExsceError` for a run the store does not hold, a run of another
     scenario, or a scenario without oracles (no baseline built yet).
@@ -41,17 +54,65 @@ def judge_runs(store: Store, runs: Sequence[str], scenario: Scenario) -> list[Ve
             f"(exscec baseline <spec> --scenario-id {scenario.id})"
         )
     values = run_values(store, list(runs))
+    times = _action_spans(store, runs)
+    baseline = [run for o in oracles if o.base_scenario == scenario.id for run in o.sources]
     verdicts = []
     for run in runs:
+        found = list((coverage or {}).get(run, ()))
+        gaps = found if any(g.kind is Shortfall.CUT_SHORT for g in found) else found + _cut_short(known[run])
         for oracle in oracles:
-            observed, why = observe(values[run], oracle.metric, oracle.robot, _window(oracle), scenario)
+            window = _window(oracle)
+            observed, why = observe(values[run], oracle.metric, oracle.robot, window, scenario)
             verdict = _verdict(run, scenario.id, oracle, observed, why)
-            incomplete = known[run].mission_status
-            if incomplete and verdict.outcome is Outcome.PASSED:
-                reason = f"the run is incomplete (its mission was {incomplete}): it was not seen to the end"
-                verdict = replace(verdict, outcome=Outcome.INCONCLUSIVE, reason=reason, margin=None)
-            verdicts.append(verdict)
+            span = _span(values[run], oracle, window, scenario, times)
+            concerned = clause_gaps(verdict, gaps, span)
+            if rates:
+                declared = {g.topic for g in concerned if g.kind is Shortfall.LOW_RATE}
+                learned = learned_rate_gaps(verdict, oracle.topics, rates, oracle.sources or baseline)
+                concerned += [g for g in learned if g.topic not in declared]
+            verdicts.append(judge_coverage(verdict, concerned, _accumulates(oracle.metric, scenario)))
     return verdicts
+
+
+def _cut_short(run: StoredRun) -> list[CoverageGap]:
+    """A run whose mission was cancelled or stopped, as the store says: its recording does not
+    cover the whole mission (unless ingestion already said the run was cut short)."""
+    if run.mission_status is None:
+        return []
+    reason = f"the run is incomplete (its mission was {run.mission_status}): it was not seen to the end"
+    return [CoverageGap(Shortfall.CUT_SHORT, reason)]
+
+
+_GROWS = {"mission_duration", "waypoints_visited", "violation_duration"}
+"""Built-in metrics without a per-segment combination whose value only grows with more data."""
+
+
+def _accumulates(metric: str, scenario: Scenario) -> Combine | None:
+    """How ``metric``'s value changes with more data (see :func:`judge_coverage`)."""
+    for definition in (*scenario.metrics, *standard_metrics()):
+        if definition.name == metric and definition.combine is not None:
+            return definition.combine
+    return Combine.SUM if metric in _GROWS else None
+
+
+def _action_spans(store: Store, runs: Sequence[str]) -> dict[str, Span]:
+    """Action IRI → when it started and ended (its bounds None where the store does not say)."""
+    return {t.action: Span(t.start, t.end) for t in action_times(store, list(runs))}
+
+
+def _span(
+    values: RunValues, oracle: Oracle, window: Window | None, scenario: Scenario, times: Mapping[str, Span]
+) -> Span:
+    """The part of the run a clause looks at: the time of its window's path segments (the whole
+    run without a window, or where a segment's times are not known)."""
+    if window is None:
+        return Span()
+    picked = [times.get(s.action, Span()) for s in window_segments(values, oracle.robot, window, scenario)]
+    starts = [p.start for p in picked if p.start is not None]
+    ends = [p.end for p in picked if p.end is not None]
+    if not picked or len(starts) < len(picked) or len(ends) < len(picked):
+        return Span()
+    return Span(min(starts), max(ends))
 
 
 def _window(oracle: Oracle) -> Window | None:

@@ -8,7 +8,7 @@ against every oracle of their scenario, the verdicts written to the store as pro
 from __future__ import annotations
 
 import datetime
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -16,6 +16,7 @@ from prov.model import ProvDocument
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import Scenario
+from exsce_dsl.model.coverage import CoverageGap, TopicRate
 from exsce_dsl.model.document import Specification
 from exsce_dsl.model.oracles import Oracle
 from exsce_dsl.model.verdicts import Outcome, Verdict
@@ -26,7 +27,9 @@ from exsce_dsl.prov.oracle import compile_oracles
 from exsce_dsl.prov.verdicts import compile_verdicts
 from exsce_dsl.runs.ingest import ingest_bags
 from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries import resolve_runs
+from exsce_dsl.store.queries import oracles as stored_oracles
+from exsce_dsl.store.queries import resolve_runs, run_coverage, run_topic_rates
+from exsce_dsl.store.queries import runs as stored_runs
 from exsce_dsl.store.queries.run_ids import names_a_prefix
 from exsce_dsl.store.writing import WriteReport, add_prov
 
@@ -106,10 +109,17 @@ def verify_runs(
     *,
     record: bool = True,
     now: datetime.datetime | None = None,
+    coverage: Mapping[str, Sequence[CoverageGap]] | None = None,
+    rates: Mapping[str, Sequence[TopicRate]] | None = None,
 ) -> Verification:
     """Judge ``runs`` (stored runs' uuids, unique prefixes of them or their IRIs, or paths of bags,
     which are ingested first) against every
-    oracle of ``scenario``; with ``record``, write the verdicts to the store (at ``now``, UTC)."""
+    oracle of ``scenario``; with ``record``, write the verdicts to the store (at ``now``, UTC).
+
+    ``coverage`` and ``rates`` (run uuid → what its recording does not cover, and how densely it
+    recorded each topic; see :func:`~exsce_dsl.oracles.verify.judge_runs`) make verdicts over
+    data the recording lacks inconclusive; without them, the store's are taken (what ingest
+    found, and the rates of the judged runs and of the runs their baselines learnt from)."""
     bags = [Path(r) for r in runs if isinstance(r, Path) or Path(r).exists()]
     given = [str(r) for r in runs if not (isinstance(r, Path) or Path(r).exists())]
     for text in given:
@@ -121,13 +131,25 @@ def verify_runs(
             raise IngestFailed(result.message)
         uuids.append(result.run_id)
     judged = tuple(dict.fromkeys(uuids))
-    verdicts = judge_runs(store, list(judged), scenario)
+    if coverage is None:
+        coverage = run_coverage(store, judged)
+    if rates is None:
+        rates = run_topic_rates(store, _rate_references(store, scenario.id, judged))
+    verdicts = judge_runs(store, list(judged), scenario, coverage, rates)
     if record:
         at = now or datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0)
         for run in dict.fromkeys(v.run for v in verdicts):
             mine = [v for v in verdicts if v.run == run]
             add_prov(store, compile_verdicts(run, mine, at), replace=True)
     return Verification(scenario, judged, tuple(verdicts), own_baseline_warnings(verdicts))
+
+
+def _rate_references(store: Store, scenario_id: str, judged: Sequence[str]) -> list[str]:
+    """The judged runs and every stored run of the scenario and of the scenarios its oracles
+    compare with: the runs whose topic rates a judged run's are compared with."""
+    scenarios = {scenario_id} | {o.base_scenario for o in stored_oracles(store, scenario_id)}
+    others = [run.uuid for sid in sorted(scenarios) for run in stored_runs(store, sid)]
+    return list(dict.fromkeys([*judged, *others]))
 
 
 def own_baseline_warnings(verdicts: Sequence[Verdict]) -> tuple[str, ...]:

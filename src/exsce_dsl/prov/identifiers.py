@@ -348,6 +348,8 @@ ORACLE_RUNS = Term(ORACLE, "runs")
 ORACLE_OUTCOME = Term(ORACLE, "outcome")
 ORACLE_MARGIN = Term(ORACLE, "margin")
 ORACLE_REASON = Term(ORACLE, "reason")
+ORACLE_SHORTFALL = Term(ORACLE, "shortfall")
+"""On a verdict: the kinds of what the recording did not cover (``cut_short gap``), space-separated."""
 ORACLE_AGAINST = Term(ORACLE, "against")
 BASELINE_RUNS_TYPE = Term(EXSCE, "baseline_runs")
 """In an oracles bundle: the runs of one scenario its oracles learnt from (``oracle:runs``)."""
@@ -376,6 +378,8 @@ STEPS = Term(EXSCE, "steps")
 TRIAL_RUNS = Term(EXSCE, "trial_runs")
 CHECKED = Term(EXSCE, "checked")
 VIOLATED = Term(EXSCE, "violated")
+INCONCLUSIVE = Term(EXSCE, "inconclusive")
+"""On a trial: the relations it could not decide (runs not covered could have violated them)."""
 OUTCOME = Term(EXSCE, "outcome")
 RELATION = Term(EXSCE, "relation")
 TRIAL = Term(EXSCE, "trial_number")

@@ -26,11 +26,13 @@ from exsce_dsl.store.queries.run_ids import (
 )
 from exsce_dsl.store.queries.run_values import *  # noqa: F403
 from exsce_dsl.store.queries.run_values import (
+    ActionTimes,
     MetricReading,
     MetricSource,
     RunDefect,
     StoredRun,
     ViolationDuration,
+    action_times,
     metric_sources,
     mission_metric,
     run_defects,
@@ -86,6 +88,7 @@ from exsce_dsl.store.queries.terms import (
 
 __all__ = [
     "MIN_PREFIX",
+    "ActionTimes",
     "AmbiguousRunError",
     "Given",
     "KINDS",
@@ -101,6 +104,7 @@ __all__ = [
     "ValueStats",
     "UnknownRunError",
     "ViolationDuration",
+    "action_times",
     "bool_of",
     "datetime_of",
     "derivation_of",

@@ -9,6 +9,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from exsce_dsl.model.coverage import Shortfall
 from exsce_dsl.model.geometry import Position
 from exsce_dsl.model.runs import Hotspot
 from exsce_dsl.model.verdicts import Outcome, Verdict
@@ -21,11 +22,11 @@ __all__ = ["RunHotspot", "hotspots", "pose_positions", "verdicts"]
 
 def verdicts(store: Store, scenario: str | None = None, namespace: str = DEFAULT_NAMESPACE) -> list[Verdict]:
     """The verdicts of each run's last validation (of ``scenario``'s runs, or all): failed ones
-    first, then those that could not be judged, then the passed ones."""
+    first, then the inconclusive ones, then the passed ones."""
     given = {} if scenario is None else {"scenario": scenario}
     found = []
     for row in run_query(store, "verdicts", given, namespace):
-        runs = text_of(row["runs"])
+        runs, shortfalls = text_of(row["runs"]), text_of(row["shortfalls"])
         found.append(
             Verdict(
                 run=text_of(row["run"]) or "",
@@ -46,6 +47,7 @@ def verdicts(store: Store, scenario: str | None = None, namespace: str = DEFAULT
                 sources=tuple(runs.split()) if runs else (),
                 reason=text_of(row["reason"]) or "",
                 against=text_of(row["against"]),
+                shortfalls=tuple(Shortfall(kind) for kind in shortfalls.split()) if shortfalls else (),
             )
         )
     return found

@@ -250,3 +250,26 @@ def run_defects(
             kind = "inconclusive" if kind == "unjudged" else kind  # as older stores say
             found.append(RunDefect(run, kind, subject, text_of(row["robot"]), float_of(row["seconds"])))
     return found
+
+
+@dataclass(frozen=True)
+class ActionTimes:
+    """When one action of a run started and ended (None where its PROV does not say)."""
+
+    run: str
+    action: str
+    """The action's IRI, as :func:`run_segment_values` names it."""
+    start: datetime.datetime | None
+    end: datetime.datetime | None
+
+
+def action_times(store: Store, runs: Sequence[str], namespace: str = DEFAULT_NAMESPACE) -> list[ActionTimes]:
+    """When each action of ``runs`` (uuids) started and ended: the time a windowed clause covers."""
+    if not runs:
+        return []
+    found = []
+    for row in run_query(store, "action_times", {"run": list(runs)}, namespace):
+        run, action = text_of(row["run"]), text_of(row["action"])
+        if run is not None and action is not None:
+            found.append(ActionTimes(run, action, datetime_of(row["start"]), datetime_of(row["end"])))
+    return found
