@@ -11,6 +11,16 @@ A relation is *violated* by a derivation when it failed in more than half of its
 odd run of three does not send shrinking after noise.  A smaller derivation still violates it
 when it violates the same check (:meth:`~exsce_dsl.model.campaign.Relation.same_check`): an
 expected value missed either way counts, whatever direction the smaller one's estimate took.
+A trial whose relations neither failed nor passed in more than half of its runs (their other
+verdicts inconclusive: a run cut short, data missing) is *inconclusive*: no counterexample,
+no pass.
+
+Every draw of the budget is tried unless ``stop_at_violation``, so that the campaign's figures
+(:class:`~exsce_dsl.model.campaign.CampaignFigures`: counterexamples per 100 executions,
+executions to the first failure) are measured over the whole budget; they are written on the
+campaign's activity when it ends.  Each distinct relation violated is shrunk once, from the
+first trial that violated it: later trials that violate it again are more counterexamples of
+one fault, and shrinking them again would spend runs to find the same smallest derivation.
 """
 
 from __future__ import annotations
@@ -21,6 +31,7 @@ import shutil
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import NamedTuple
 
 from exsce_dsl.derive.workflows import DerivedSpec, add_derivation, derive_spec
 from exsce_dsl.errors import ExsceError
@@ -32,6 +43,7 @@ from exsce_dsl.lang.formatter import declared_poses, format_document
 from exsce_dsl.model import Acceptance, Scenario
 from exsce_dsl.model.acceptance import BasicRelation
 from exsce_dsl.model.campaign import (
+    CampaignFigures,
     CampaignPlan,
     CampaignRecord,
     Relation,
@@ -77,7 +89,9 @@ class CampaignOptions:
     tolerance: float = TOLERANCE
     shrink: bool = True
     stop_at_violation: bool = False
-    """End the draws at the first trial that violates a relation (benchmarks: executions to detection)."""
+    """End the draws at the first trial that violates a relation (the figures then cover the
+    trials up to it).  By default every draw of the budget is tried, so that counterexamples per
+    100 executions is measured over the whole budget."""
     shrink_tries: int = SHRINK_TRIES
     jobs: int = 1
     """Bags of one scenario analysed in parallel."""
@@ -102,10 +116,10 @@ class CampaignResult:
     record: CampaignRecord
     folder: Path
     executions: int
-    """Runs executed by this call (not those read back)."""
-    executions_to_first_violation: int | None
-    """Runs executed, in draw order, up to and with the first trial that violated a relation
-    (counting the trials read back as executed); None when none did."""
+    """Runs executed by this call (not those read back), the base's and the shrinkings' included."""
+    figures: CampaignFigures
+    """What the trials of this budget found (those read back included): executions of drawn
+    derivations, counterexamples, executions to the first failure."""
     minimal_files: dict[str, Path] = field(default_factory=dict)
     """Relation text → the ``.exsce`` file of its minimal failing derivation."""
 
@@ -251,9 +265,17 @@ class _Campaign:
 
     def trial(self, number: int, candidate: Candidate) -> Trial:
         made, runs, verdicts = self.judge(candidate.requests, "scenarios")
-        checked, violated, failing = _violations(verdicts, len(runs))
+        judged = _violations(verdicts, len(runs))
         trial = Trial(
-            self.plan.id, number, made.scenario.id, candidate.requests, runs, checked, violated, failing
+            self.plan.id,
+            number,
+            made.scenario.id,
+            candidate.requests,
+            runs,
+            judged.checked,
+            judged.violated,
+            judged.failing,
+            judged.inconclusive,
         )
         add_prov(self.store, compile_trial(trial))
         return trial
@@ -263,7 +285,7 @@ class _Campaign:
 
         def still_fails(requests: tuple[Request, ...]) -> bool:
             made, runs, verdicts = self.judge(requests, "shrinking")
-            violated = any(relation.same_check(found) for found in _violations(verdicts, len(runs))[1])
+            violated = any(relation.same_check(found) for found in _violations(verdicts, len(runs)).violated)
             tried = ShrinkTry(made.scenario.id, requests, violated)
             tries.append(tried)
             self.events.shrink_try_done(tried)
@@ -313,8 +335,6 @@ def run_campaign(
         events.said(f"going on with {plan.id}: {len(done)} trial(s) done already")
     campaign.ensure_base_runs()
     trials: list[Trial] = []
-    executed_until: int | None = None
-    executed = 0
     for number, candidate in enumerate(draw(spec, base, options), start=1):
         if number in done:
             trial = done[number]
@@ -323,11 +343,8 @@ def run_campaign(
             trial = campaign.trial(number, candidate)
             events.trial_done(trial, False)
         trials.append(trial)
-        executed += len(trial.runs)
-        if trial.violated and executed_until is None:
-            executed_until = executed
-            if options.stop_at_violation:
-                break
+        if trial.violated and options.stop_at_violation:
+            break
     shrunk = {s.relation: s for s in (before.shrinkings if before else ())}
     if options.shrink:
         for trial in trials:
@@ -337,9 +354,11 @@ def run_campaign(
                 events.said(f"shrinking '{relation.text}' (found by trial {trial.number}: {trial.scenario})")
                 shrunk[relation] = campaign.shrinking(len(shrunk) + 1, relation, trial)
     files = {s.relation.text: _minimal_file(campaign, s) for s in shrunk.values()}
+    figures = CampaignFigures.of(trials)
+    add_prov(store, compile_campaign(plan, started, figures, _now()), replace=True)
     record = campaign_record(store, plan.id)
     assert record is not None  # written above
-    return CampaignResult(record, where, campaign.executions, executed_until, files)
+    return CampaignResult(record, where, campaign.executions, figures, files)
 
 
 def _minimal_file(campaign: _Campaign, shrinking: Shrinking) -> Path:
@@ -355,22 +374,41 @@ def _minimal_file(campaign: _Campaign, shrinking: Shrinking) -> Path:
     return target
 
 
-def _violations(
-    verdicts: Sequence[Verdict], runs: int
-) -> tuple[tuple[Relation, ...], tuple[Relation, ...], tuple[tuple[str, str], ...]]:
-    """The relations checked, those violated (failed in more than half of ``runs``), and the
-    failed verdicts of the violated ones as ``(run, verdict local name)``."""
+class Judged(NamedTuple):
+    """What a derivation's verdicts say of its relations."""
+
+    checked: tuple[Relation, ...]
+    violated: tuple[Relation, ...]
+    """Failed in more than half of the runs."""
+    failing: tuple[tuple[str, str], ...]
+    """The failed verdicts of the violated relations, as ``(run, verdict local name)``."""
+    inconclusive: tuple[Relation, ...]
+    """Not violated, and passed in no more than half of the runs (the rest inconclusive or missing)."""
+
+
+def _violations(verdicts: Sequence[Verdict], runs: int) -> Judged:
+    """The relations ``verdicts`` (of ``runs`` runs) checked, violated and left undecided."""
     failures: dict[Relation, list[Verdict]] = {}
+    unsure: dict[Relation, set[str]] = {}
+    """Runs where a relation had a verdict that did not pass: it passed in none of them."""
+    judged: dict[Relation, set[str]] = {}
     for verdict in verdicts:
         relation = Relation(verdict.metric, verdict.robot, verdict.relation, verdict.against)
         failures.setdefault(relation, [])
+        judged.setdefault(relation, set()).add(verdict.run)
+        if verdict.outcome is not Outcome.PASSED:
+            unsure.setdefault(relation, set()).add(verdict.run)
         if verdict.outcome is Outcome.FAILED:
             failures[relation].append(verdict)
     violated = tuple(
         sorted((r for r, failed in failures.items() if 2 * len({v.run for v in failed}) > runs), key=_order)
     )
+    passed = {r: len(judged[r] - unsure.get(r, set())) for r in failures}
+    inconclusive = tuple(
+        sorted((r for r in failures if r not in violated and 2 * passed[r] <= runs), key=_order)
+    )
     failing = tuple((v.run, _verdict_name(v)) for relation in violated for v in failures[relation])
-    return tuple(sorted(failures, key=_order)), violated, failing
+    return Judged(tuple(sorted(failures, key=_order)), violated, failing, inconclusive)
 
 
 def _order(relation: Relation) -> tuple[str, str, str, str]:

@@ -111,10 +111,13 @@ def campaign_junit(record: CampaignRecord, durations: Mapping[str, float] | None
         if trial.violated:
             message, text = _failure(trial, record.shrinkings)
             ET.SubElement(case, "failure", message=message, type="relation violated").text = text
+        elif trial.inconclusive:
+            undecided = "; ".join(r.text for r in trial.inconclusive)
+            ET.SubElement(case, "skipped", message=f"inconclusive: {undecided}")
         elif not trial.checked:
             ET.SubElement(case, "skipped", message="no relation was checked")
     failures = sum(bool(t.violated) for t in record.trials)
-    skipped = sum(t.outcome == "unchecked" for t in record.trials)
+    skipped = sum(t.outcome in ("unchecked", "inconclusive") for t in record.trials)
     for element in (suites, suite):
         element.set("tests", str(len(record.trials)))
         element.set("failures", str(failures))

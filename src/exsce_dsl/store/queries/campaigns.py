@@ -76,6 +76,7 @@ def campaign_trials(store: Store, campaign: str, namespace: str = DEFAULT_NAMESP
             tuple((text_of(row["runs"]) or "").split()),
             _relations(text_of(row["checked"])),
             _relations(text_of(row["violated"])),
+            inconclusive=_relations(text_of(row["inconclusive"])),
         )
         for row in run_query(store, "campaign_trials", {"campaign": campaign}, namespace)
     ]
