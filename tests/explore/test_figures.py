@@ -4,11 +4,14 @@ planted deadlock that keeps going after its first failure, beside its random bas
 
 from __future__ import annotations
 
+import datetime
 import json
 import re
 import shutil
 import subprocess
 import sys
+import xml.etree.ElementTree as ET
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -18,10 +21,14 @@ from exsce_dsl.explore.campaign import CampaignOptions, _violations, run_campaig
 from exsce_dsl.explore.executors import SimulatorExecutor
 from exsce_dsl.explore.figures import figures_table, random_baseline
 from exsce_dsl.lang.build import load_spec
-from exsce_dsl.model.campaign import CampaignFigures, Relation, Trial
+from exsce_dsl.model.campaign import CampaignFigures, CampaignPlan, Relation, Trial
 from exsce_dsl.model.verdicts import Outcome, Verdict
+from exsce_dsl.oracles.campaign_junit import campaign_junit
+from exsce_dsl.prov.campaign import compile_campaign, compile_trial
 from exsce_dsl.store.open import open_store
 from exsce_dsl.store.queries.campaigns import campaign_record, campaigns
+from exsce_dsl.store.queries.terms import run_query
+from exsce_dsl.store.writing import add_prov
 
 ROOT = Path(__file__).resolve().parents[2]
 EXSCEC = str(Path(sys.executable).parent / "exscec")
@@ -194,3 +201,34 @@ def test_a_campaign_that_keeps_going_finds_the_deadlock_again_beside_its_random_
     first = next(t.number for t in covering if t.violated)
     assert stopped.figures.trials == first and stopped.figures.counterexamples == 1
     assert str(stopped.figures.executions_to_first_failure) == _counted(covering)["to first failure"]
+
+
+def test_an_inconclusive_trial_and_the_figures_read_back_from_the_store() -> None:
+    plan = CampaignPlan("c_fig", "scenario_c", 3, 0, 2, 1, (), "simulator", "covering", True, 25.0)
+    trials = [
+        _trial(1, 2, inconclusive=(DURATION,)),
+        _trial(2, 2, violated=(SPEED,)),
+        _trial(3, 2),
+    ]
+    trials = [replace(t, campaign="c_fig") for t in trials]
+    figures = CampaignFigures.of(trials)
+    started = datetime.datetime(2025, 3, 1, 12, 0, tzinfo=datetime.timezone.utc)
+    with open_store("memory:") as store:
+        add_prov(store, compile_campaign(plan, started), replace=True)
+        for trial in trials:
+            add_prov(store, compile_trial(trial))
+        add_prov(store, compile_campaign(plan, started, figures, started), replace=True)  # as a campaign ends
+        record = campaign_record(store, "c_fig")
+        (row,) = run_query(store, "campaigns", {})
+    assert record is not None and list(record.trials) == trials
+    assert [t.outcome for t in record.trials] == ["inconclusive", "violated", "passed"]
+    assert record.figures == figures
+    # 6 executions, 1 counterexample after 4 of them, 1 trial inconclusive
+    stored = {name: None if term is None else term.value for name, term in row.items()}
+    assert (stored["executions"], stored["counterexamples"], stored["to_first_failure"]) == ("6", "1", "4")
+    assert (stored["inconclusive_trials"], stored["violated_relations"]) == ("1", "1")
+    assert float(stored["per_100_executions"] or "nan") == pytest.approx(100 / 6)
+    suite = ET.fromstring(campaign_junit(record))[0]
+    first = suite.findall("testcase")[0].find("skipped")
+    assert first is not None and first.get("message") == "inconclusive: tiago1 task_duration invariant"
+    assert (suite.get("failures"), suite.get("skipped")) == ("1", "1")
