@@ -16,26 +16,36 @@ and random draws find it as fast as covering ones; see MEASURED),
 
 three campaigns are run with the same budget (derivations) and runs per derived scenario:
 
-- the campaign: covering draws, metamorphic relations, stop at the first violating trial,
-  shrink its violated relations.  It *found* the fault when some shrinking's minimal
-  derivation, run again on the fault-free simulator (same per-scenario seeds, a fresh store
-  with only the base's runs to estimate from), does not violate that relation, and the fault
-  changed the relation's metric in those runs: the fault, not noise or a wrong expectation,
-  made it fail.  (The second condition is needed: expected values are estimated from every
-  run in the store, so a relation at the edge of its tolerance can fail in the campaign's
-  store and pass in the fresh one with runs the fault never touched.)  Executions to
-  detection: runs of derived scenarios up to and with the first violating trial
-  (CampaignResult.executions_to_first_violation), when that violation was the fault's;
-  shrunk size: steps of that minimal derivation (the smallest, if several relations were);
-  shrinking's executions: runs that relation's shrinking executed.  The fault-free check's
-  runs are the benchmark's, not the campaign's, and are not counted.
-- the baseline: uniform random draws, the base's safety limits only (no relations), stop at
-  the first violation, no shrinking.  It detected the fault when the violating trial's
-  derivation, run fault-free with the same safety limits, does not violate one of them (and
-  the fault changed its metric).
+- the campaign: covering draws, metamorphic relations, the whole budget (``--stop-at-violation``:
+  up to the first violating trial), each distinct violated relation shrunk once.  It *found*
+  the fault when some shrinking's minimal derivation, run again on the fault-free simulator
+  (same per-scenario seeds, a fresh store with only the base's runs to estimate from), does not
+  violate that relation, and the fault changed the relation's metric in those runs: the fault,
+  not noise or a wrong expectation, made it fail.  (The second condition is needed: expected
+  values are estimated from every run in the store, so a relation at the edge of its tolerance
+  can fail in the campaign's store and pass in the fresh one with runs the fault never
+  touched.)  Executions to detection: runs of derived scenarios up to and with the earliest
+  trial a relation the fault caused was found in; shrunk size: steps of that minimal
+  derivation (the smallest, if several relations were); shrinking's executions: runs that
+  relation's shrinking executed.  The fault-free check's runs are the benchmark's, not the
+  campaign's, and are not counted.
+- the baseline: uniform random draws (exsce_dsl.explore.draw, as ``exscec explore --strategy
+  random`` and ``--compare-random`` draw), the base's safety limits only (no relations), the
+  whole budget, no shrinking.  It detected the fault when a violating trial's derivation, run
+  fault-free with the same safety limits, does not violate one of them (and the fault changed
+  its metric); violating trials are checked in draw order up to the first the fault caused.
 - the false-alarm campaign (once per seed, no fault): covering draws, relations, the whole
   budget, no shrinking.  Every violating trial is a false alarm; the relations violated are
   listed, to see where they come from.
+
+Beside detection, each campaign and baseline reports the figures falsification tools report
+(exsce_dsl.model.campaign.CampaignFigures): *executions* (runs of drawn derivations: not the
+base's, not the shrinkings'), *counterexamples* (trials that violated a relation, whether the
+fault's or not), counterexamples per 100 executions, and executions to the first failure (the
+first violating trial, whatever it violated), per seed and over all seeds (the rate pooled:
+100 × Σ counterexamples / Σ executions; the median of the first failures, none counting as
+budget × runs + 1).  They need the whole budget: a campaign stopped at its first failure has
+one counterexample by construction.
 
 A campaign or baseline that did not detect the fault counts as budget × runs + 1 executions
 in the medians ("never" in the per-seed rows).  Targets (issue: exploration campaigns), per
