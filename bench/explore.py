@@ -63,8 +63,10 @@ whole budget; 2 cores shared with other work, 1 job, ~23 min for the five faults
     overspeed-reassigned               3 in 16           18.8          8       | 3 in 16  18.8        10
     no fault (false alarms)            0 in 16            0.0   none in 16
 
-Every counterexample above was the fault's; each fault was found and shrunk to 1 step, the
-baseline (safety limits only) found only the over-speed, two executions later.  A campaign
+The fault-free campaign violated nothing; every relation the campaigns violated was the
+fault's (each one's shrunk derivation checked fault-free), and each fault was found and shrunk
+to 1 step; the baseline (safety limits only) found only the over-speed, two executions later
+(its first counterexample checked, the fault's).  A campaign
 finds a latent fault with the one or two derivations that reveal it, so its rate is low
 (1 in 8 derivations) until a larger budget draws those derivations again.
 
