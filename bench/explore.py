@@ -16,32 +16,59 @@ and random draws find it as fast as covering ones; see MEASURED),
 
 three campaigns are run with the same budget (derivations) and runs per derived scenario:
 
-- the campaign: covering draws, metamorphic relations, stop at the first violating trial,
-  shrink its violated relations.  It *found* the fault when some shrinking's minimal
-  derivation, run again on the fault-free simulator (same per-scenario seeds, a fresh store
-  with only the base's runs to estimate from), does not violate that relation, and the fault
-  changed the relation's metric in those runs: the fault, not noise or a wrong expectation,
-  made it fail.  (The second condition is needed: expected values are estimated from every
-  run in the store, so a relation at the edge of its tolerance can fail in the campaign's
-  store and pass in the fresh one with runs the fault never touched.)  Executions to
-  detection: runs of derived scenarios up to and with the first violating trial
-  (CampaignResult.executions_to_first_violation), when that violation was the fault's;
-  shrunk size: steps of that minimal derivation (the smallest, if several relations were);
-  shrinking's executions: runs that relation's shrinking executed.  The fault-free check's
-  runs are the benchmark's, not the campaign's, and are not counted.
-- the baseline: uniform random draws, the base's safety limits only (no relations), stop at
-  the first violation, no shrinking.  It detected the fault when the violating trial's
-  derivation, run fault-free with the same safety limits, does not violate one of them (and
-  the fault changed its metric).
+- the campaign: covering draws, metamorphic relations, the whole budget (``--stop-at-violation``:
+  up to the first violating trial), each distinct violated relation shrunk once.  It *found*
+  the fault when some shrinking's minimal derivation, run again on the fault-free simulator
+  (same per-scenario seeds, a fresh store with only the base's runs to estimate from), does not
+  violate that relation, and the fault changed the relation's metric in those runs: the fault,
+  not noise or a wrong expectation, made it fail.  (The second condition is needed: expected
+  values are estimated from every run in the store, so a relation at the edge of its tolerance
+  can fail in the campaign's store and pass in the fresh one with runs the fault never
+  touched.)  Executions to detection: runs of derived scenarios up to and with the earliest
+  trial a relation the fault caused was found in; shrunk size: steps of that minimal
+  derivation (the smallest, if several relations were); shrinking's executions: runs that
+  relation's shrinking executed.  The fault-free check's runs are the benchmark's, not the
+  campaign's, and are not counted.
+- the baseline: uniform random draws (exsce_dsl.explore.draw, as ``exscec explore --strategy
+  random`` and ``--compare-random`` draw), the base's safety limits only (no relations), the
+  whole budget, no shrinking.  It detected the fault when a violating trial's derivation, run
+  fault-free with the same safety limits, does not violate one of them (and the fault changed
+  its metric); violating trials are checked in draw order up to the first the fault caused.
 - the false-alarm campaign (once per seed, no fault): covering draws, relations, the whole
   budget, no shrinking.  Every violating trial is a false alarm; the relations violated are
   listed, to see where they come from.
+
+Beside detection, each campaign and baseline reports the figures falsification tools report
+(exsce_dsl.model.campaign.CampaignFigures): *executions* (runs of drawn derivations: not the
+base's, not the shrinkings'), *counterexamples* (trials that violated a relation, whether the
+fault's or not), counterexamples per 100 executions, and executions to the first failure (the
+first violating trial, whatever it violated), per seed and over all seeds (the rate pooled:
+100 × Σ counterexamples / Σ executions; the median of the first failures, none counting as
+budget × runs + 1).  They need the whole budget: a campaign stopped at its first failure has
+one counterexample by construction.
 
 A campaign or baseline that did not detect the fault counts as budget × runs + 1 executions
 in the medians ("never" in the per-seed rows).  Targets (issue: exploration campaigns), per
 fault: found in at least 4 of 5 seeds (80 % of --seeds); every found fault shrunk to at most
 2 steps; median executions to detection below the baseline's; and a false-alarm rate of 0
 (violating trials / trials of the fault-free campaigns, over all seeds).
+
+Last measured (``--quick``: seed 0, budget 8 derivations × 2 runs = 16 executions each, the
+whole budget; 2 cores shared with other work, 1 job, ~23 min for the five faults' runs):
+
+    fault                    campaign: counterexamples  per 100  first failure | baseline: ...
+    slow-area                          1 in 16            6.2         10       | 0 in 16  0.0  none in 16
+    detour                             1 in 16            6.2          4       | 0 in 16  0.0  none in 16
+    deadlock-start                     1 in 16            6.2         16       | 0 in 16  0.0  none in 16
+    overspeed-reassigned               3 in 16           18.8          8       | 3 in 16  18.8        10
+    no fault (false alarms)            0 in 16            0.0   none in 16
+
+The fault-free campaign violated nothing; every relation the campaigns violated was the
+fault's (each one's shrunk derivation checked fault-free), and each fault was found and shrunk
+to 1 step; the baseline (safety limits only) found only the over-speed, two executions later
+(its first counterexample checked, the fault's).  A campaign
+finds a latent fault with the one or two derivations that reveal it, so its rate is low
+(1 in 8 derivations) until a larger budget draws those derivations again.
 
     python bench/explore.py                    # 5 seeds, budget 15, 2 runs per scenario
     python bench/explore.py --budget 20        # as first planned (over 30 min on 2 busy cores)
@@ -79,9 +106,10 @@ from exsce_dsl.explore.campaign import (
     run_campaign,
 )
 from exsce_dsl.explore.executors import SimulatorExecutor
+from exsce_dsl.explore.figures import first_failure, per_100
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.model import Scenario
-from exsce_dsl.model.campaign import Relation, Request
+from exsce_dsl.model.campaign import CampaignFigures, Relation, Request, Shrinking, Trial
 from exsce_dsl.model.document import Specification
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.open import open_store
@@ -122,6 +150,8 @@ class Unit:
     max_steps: int
     cache: str
     """The folder of bags kept for the other campaigns (see CountingExecutor)."""
+    stop: bool = False
+    """Campaign and baseline end their draws at the first violating trial (else: the whole budget)."""
 
 
 @dataclass
@@ -134,11 +164,15 @@ class Outcome:
     """Runs of the fault-free check (its base's included)."""
     simulated: int = 0
     """Runs simulated by this campaign and its check (not copied from the cache)."""
+    figures: CampaignFigures | None = None
+    """Executions of drawn derivations, counterexamples, executions to the first failure."""
     to_first_violation: int | None = None
     detected: bool = False
     to_detection: int | None = None
     violated: list[str] = field(default_factory=list)
     """Relations violated by the first violating trial (campaign, baseline)."""
+    detecting_trial: int | None = None
+    """The first trial whose violation the fault caused."""
     caused: list[str] = field(default_factory=list)
     """Of those, the ones the fault caused (not violated fault-free)."""
     not_caused: list[str] = field(default_factory=list)
@@ -218,7 +252,7 @@ class FaultFree:
             )
             self.campaign.ensure_base_runs()
         _, runs, verdicts = self.campaign.judge(tuple(requests), "fault-free")
-        return _violations(verdicts, len(runs))[1], runs
+        return _violations(verdicts, len(runs)).violated, runs
 
     def caused(
         self, relation: Relation, requests: Sequence[Request], store: Store, runs: Sequence[str]
@@ -256,15 +290,16 @@ def metric_values(store: Store, relation: Relation, runs: Sequence[str]) -> list
 
 
 def options_of(unit: Unit) -> CampaignOptions:
-    """The campaign's options (covering, relations, shrinking, stop at the first violation), the
-    baseline's (random, safety limits only, no shrinking) or the fault-free campaign's (covering,
-    relations, the whole budget, no shrinking)."""
+    """The campaign's options (covering, relations, shrinking), the baseline's (random, safety
+    limits only, no shrinking) or the fault-free campaign's (covering, relations, no shrinking);
+    each tries the whole budget unless the unit stops at the first violation."""
     kind = {
-        "campaign": ("covering", True, True, True),
-        "baseline": ("random", False, False, True),
-        "clean": ("covering", True, False, False),
+        "campaign": ("covering", True, True),
+        "baseline": ("random", False, False),
+        "clean": ("covering", True, False),
     }
-    strategy, relations, shrink, stop = kind[unit.kind]
+    strategy, relations, shrink = kind[unit.kind]
+    stop = unit.stop and unit.kind != "clean"
     return CampaignOptions(
         budget=unit.budget,
         seed=unit.seed,
@@ -298,7 +333,8 @@ def run_unit(unit: Unit) -> Outcome:
         )
         record = result.record
         outcome.executions = executor.runs
-        outcome.to_first_violation = result.executions_to_first_violation
+        outcome.figures = result.figures
+        outcome.to_first_violation = result.figures.executions_to_first_failure
         outcome.trials = len(record.trials)
         violating = [t for t in record.trials if t.violated]
         outcome.violating_trials = len(violating)
@@ -307,41 +343,70 @@ def run_unit(unit: Unit) -> Outcome:
                 outcome.false_alarms.update(r.text for r in trial.violated)
                 outcome.alarm_steps.append(trial.steps)
         elif violating:
-            first = violating[0]
-            outcome.violated = [r.text for r in first.violated]
+            outcome.violated = [r.text for r in violating[0].violated]
             fault_free = FaultFree(stack, spec, options, folder / "fault-free", Path(unit.cache))
             if unit.kind == "baseline":
-                for relation in first.violated:
-                    why = fault_free.caused(relation, first.steps, store, first.runs)
-                    if why == "yes":
-                        outcome.caused.append(relation.text)
-                    else:
-                        outcome.not_caused.append(f"{relation.text} ({why})")
+                judge_baseline(outcome, violating, fault_free, store)
             else:
                 ends = [runs for _, runs in marks[1:]] + [executor.runs]
                 spent = {text: end - runs for (text, runs), end in zip(marks, ends, strict=True)}
-                outcome.shrink_executions = sum(spent.values())
-                best = None
-                for shrinking in record.shrinkings:
-                    runs = [r.uuid for r in stored_runs(store, shrinking.minimal)]
-                    why = fault_free.caused(shrinking.relation, shrinking.minimal_steps, store, runs)
-                    if why != "yes":
-                        outcome.not_caused.append(f"{shrinking.relation.text} ({why})")
-                        continue
-                    outcome.caused.append(shrinking.relation.text)
-                    if best is None or len(shrinking.minimal_steps) < len(best.minimal_steps):
-                        best = shrinking
-                if best is not None:
-                    outcome.shrunk_steps = len(best.minimal_steps)
-                    outcome.minimal = best.minimal_steps
-                    outcome.shrink_executions_caused = spent.get(best.relation.text)
-            outcome.detected = bool(outcome.caused)
-            outcome.to_detection = outcome.to_first_violation if outcome.detected else None
+                judge_campaign(outcome, record.shrinkings, spent, fault_free, store)
+            outcome.detected = outcome.detecting_trial is not None
+            if outcome.detecting_trial is not None:
+                outcome.to_detection = executions_until(record.trials, outcome.detecting_trial)
             outcome.fault_free_runs = fault_free.executor.runs
             outcome.simulated += fault_free.executor.simulated
         outcome.simulated += executor.simulated
     outcome.seconds = time.perf_counter() - began
     return outcome
+
+
+def executions_until(trials: Sequence[Trial], number: int) -> int:
+    """Runs of the trials drawn up to and with trial ``number``."""
+    return sum(len(t.runs) for t in trials if t.number <= number)
+
+
+def judge_baseline(outcome: Outcome, violating: Sequence[Trial], fault_free: FaultFree, store: Store) -> None:
+    """The first violating trial whose violation the fault caused (trials checked in draw order,
+    up to that one: each check runs the derivation fault-free)."""
+    for trial in violating:
+        for relation in trial.violated:
+            why = fault_free.caused(relation, trial.steps, store, trial.runs)
+            if why == "yes":
+                outcome.caused.append(relation.text)
+            else:
+                outcome.not_caused.append(f"{relation.text} (trial {trial.number}: {why})")
+        if outcome.caused:
+            outcome.detecting_trial = trial.number
+            return
+
+
+def judge_campaign(
+    outcome: Outcome,
+    shrinkings: Sequence[Shrinking],
+    spent: dict[str, int],
+    fault_free: FaultFree,
+    store: Store,
+) -> None:
+    """The shrinkings whose minimal derivation the fault caused to violate its relation: the
+    smallest of them, and the earliest trial one of them was found in."""
+    outcome.shrink_executions = sum(spent.values())
+    best = None
+    for shrinking in shrinkings:
+        runs = [r.uuid for r in stored_runs(store, shrinking.minimal)]
+        why = fault_free.caused(shrinking.relation, shrinking.minimal_steps, store, runs)
+        if why != "yes":
+            outcome.not_caused.append(f"{shrinking.relation.text} ({why})")
+            continue
+        outcome.caused.append(shrinking.relation.text)
+        if outcome.detecting_trial is None or shrinking.trial < outcome.detecting_trial:
+            outcome.detecting_trial = shrinking.trial
+        if best is None or len(shrinking.minimal_steps) < len(best.minimal_steps):
+            best = shrinking
+    if best is not None:
+        outcome.shrunk_steps = len(best.minimal_steps)
+        outcome.minimal = best.minimal_steps
+        outcome.shrink_executions_caused = spent.get(best.relation.text)
 
 
 def steps_text(steps: Sequence[Request]) -> str:
@@ -366,7 +431,11 @@ def progress(outcome: Outcome) -> str:
         if unit.kind == "campaign" and outcome.minimal:
             said += f"; minimal: {steps_text(outcome.minimal)}"
     checked = f" + {outcome.fault_free_runs} fault-free" if outcome.fault_free_runs else ""
-    return f"  {where}: {said} ({outcome.executions}{checked} runs, {outcome.seconds:.0f} s)"
+    rate = ""
+    if outcome.figures is not None:
+        f = outcome.figures
+        rate = f"; {f.counterexamples} counterexamples in {f.executions} executions"
+    return f"  {where}: {said}{rate} ({outcome.executions}{checked} runs, {outcome.seconds:.0f} s)"
 
 
 def executions(outcome: Outcome, never: int) -> int:
@@ -422,6 +491,7 @@ def report_fault(
         ("fewer executions to detection than the baseline (medians)", median_campaign < median_baseline),
         ("false-alarm rate 0", alarm_rate == 0),
     ]
+    report_rates(campaigns, baselines, never)
     for text, met in targets:
         print(f"  {'PASS' if met else 'FAIL'}  {text}")
     runs_per_derivation = min((c.unit.runs for c in campaigns), default=0)
@@ -431,6 +501,38 @@ def report_fault(
             "no campaign can take fewer, only as few)"
         )
     return targets
+
+
+def rate_cells(outcome: Outcome | None) -> str:
+    """Executions, counterexamples, per 100 executions, executions to the first failure."""
+    if outcome is None or outcome.figures is None:
+        return f"{'-':>10}  {'-':>15}  {'-':>7}  {'-':>13}"
+    f = outcome.figures
+    return f"{f.executions:>10}  {f.counterexamples:>15}  {per_100(f):>7}  {first_failure(f):>13}"
+
+
+def pooled(outcomes: Sequence[Outcome], never: int) -> str:
+    """The cells of all seeds: counterexamples per 100 executions over all of them, and the
+    median executions to the first failure (a campaign with none counts as ``never``)."""
+    figures = [o.figures for o in outcomes if o.figures is not None]
+    executions = sum(f.executions for f in figures)
+    found = sum(f.counterexamples for f in figures)
+    rate = f"{100 * found / executions:.1f}" if executions else "-"
+    firsts = [f.executions_to_first_failure or never for f in figures]
+    median = f"{statistics.median(firsts):g}" if firsts else "-"
+    return f"{executions:>10}  {found:>15}  {rate:>7}  {median:>13}"
+
+
+def report_rates(campaigns: list[Outcome], baselines: list[Outcome], never: int) -> None:
+    """Counterexamples per 100 executions and executions to the first failure (whichever
+    relation failed, the fault's or not), campaign and baseline side by side."""
+    head = f"{'executions':>10}  {'counterexamples':>15}  {'per 100':>7}  {'first failure':>13}"
+    print(f"  seed  campaign: {head}  | baseline: {head}")
+    by_seed = {o.unit.seed: o for o in baselines}
+    for c in sorted(campaigns, key=lambda o: o.unit.seed):
+        baseline = rate_cells(by_seed.get(c.unit.seed))
+        print(f"  {c.unit.seed:>4}            {rate_cells(c)}  |           {baseline}")
+    print(f"  {'all':>4}            {pooled(campaigns, never)}  |           {pooled(baselines, never)}")
 
 
 def report_alarms(cleans: list[Outcome]) -> float:
@@ -443,6 +545,11 @@ def report_alarms(cleans: list[Outcome]) -> float:
     )
     for o in sorted(cleans, key=lambda o: o.unit.seed):
         print(f"  seed {o.unit.seed}: {o.violating_trials}/{o.trials} trials violated")
+    figures = [o.figures for o in cleans if o.figures is not None]
+    executions = sum(f.executions for f in figures)
+    if executions:
+        found = sum(f.counterexamples for f in figures)
+        print(f"  counterexamples per 100 executions without a fault: {100 * found / executions:.1f}")
     relations: Counter[str] = Counter()
     for o in cleans:
         relations.update(o.false_alarms)
@@ -466,10 +573,19 @@ def main() -> None:
     parser.add_argument("--runs", type=int, default=2, help="runs per derived scenario (default 2)")
     parser.add_argument("--max-steps", type=int, default=2, help="steps per drawn derivation (default 2)")
     parser.add_argument(
-        "--faults", nargs="+", default=MEASURED, metavar="FAULT",
+        "--faults",
+        nargs="+",
+        default=MEASURED,
+        metavar="FAULT",
         help="the faults to measure (default: all but overspeed-many-tasks)",
     )
     parser.add_argument("--quick", action="store_true", help="1 seed, budget 8")
+    parser.add_argument(
+        "--stop-at-violation",
+        action="store_true",
+        help="campaign and baseline end at their first violating trial (as measured before: "
+        "executions to detection only) [default: the whole budget]",
+    )
     parser.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1), help="campaigns run at once")
     options = parser.parse_args()
     if options.quick:
@@ -480,7 +596,7 @@ def main() -> None:
     if unknown:
         parser.error(f"unknown fault {unknown[0]}; the faults: {', '.join(FAULTS)}")
     cache = tempfile.TemporaryDirectory(prefix="exsce-explore-bags-")
-    sizes = (options.budget, options.runs, options.max_steps, cache.name)
+    sizes = (options.budget, options.runs, options.max_steps, cache.name, options.stop_at_violation)
     units = [Unit("clean", None, s, *sizes) for s in seeds]  # the longest first
     units += [Unit(k, f, s, *sizes) for s in seeds for f in options.faults for k in ("baseline", "campaign")]
     print(
@@ -512,11 +628,13 @@ def main() -> None:
         baselines = [o for o in of if o.unit.kind == "baseline"]
         passed += report_fault(fault, campaigns, baselines, alarm_rate, never, len(seeds))
     print(
-        "\n'to detection': runs of derived scenarios up to and with the first violating trial, when the "
-        "fault caused that violation;\n'never': no violation within the budget, 'never*': the first "
-        f"violation was not the fault's (the campaign stopped there); both count as {never} "
-        "(budget × runs + 1) in the medians.\n'shrink runs': the found relation's shrinking (all shrinkings "
-        "in brackets); 'all runs': every run executed, the base's 3 included."
+        "\n'to detection': runs of derived scenarios up to and with the first trial whose violation the "
+        "fault caused;\n'never': no violation within the budget, 'never*': violations, none the fault's "
+        f"(of those checked); both count as {never} (budget × runs + 1) in the medians.\n'shrink runs': "
+        "the found relation's shrinking (all shrinkings in brackets); 'all runs': every run executed, the "
+        "base's 3 included.\n'executions': runs of drawn derivations; 'counterexamples': trials that "
+        "violated a relation (the fault's or not); 'per 100': counterexamples per 100 executions; 'first "
+        f"failure': executions to the first violating trial ('all': median, none counting {never})."
     )
     met = sum(ok for _, ok in passed)
     print(f"\ntargets met: {met}/{len(passed)}; wall time {time.perf_counter() - began:.0f} s")

@@ -5,12 +5,16 @@ from __future__ import annotations
 import sys
 from contextlib import AbstractContextManager, nullcontext
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import click
 
 from exsce_dsl.cli.common import ExitCode, Progress, exit_status, reports_errors
 from exsce_dsl.cli.store_commands import store_option
 from exsce_dsl.wording import counted
+
+if TYPE_CHECKING:
+    from exsce_dsl.explore.campaign import CampaignResult
 
 
 @click.command(
@@ -46,6 +50,16 @@ from exsce_dsl.wording import counted
     help="Percent of an expected value a run may be off.",
 )  # fmt: skip
 @click.option("--no-shrink", is_flag=True, help="Do not shrink the violations found.")
+@click.option(
+    "--stop-at-violation", is_flag=True,
+    help="End the draws at the first trial that violates a relation [default: try the whole "
+    "budget, so that counterexamples per 100 executions covers all of it].",
+)  # fmt: skip
+@click.option(
+    "--compare-random", is_flag=True,
+    help="Also run the same budget with uniform random draws (same relations, no shrinking; its "
+    "files in OUTPUT-random) and print both campaigns' figures side by side.",
+)  # fmt: skip
 @click.option(
     "--fault", "faults", multiple=True,
     help="Plant a fault in the simulator, or in the stand-in robots of --executor ros1 --stand-in "
@@ -105,6 +119,8 @@ def explore(
     strategy: str,
     tolerance: float,
     no_shrink: bool,
+    stop_at_violation: bool,
+    compare_random: bool,
     faults: tuple[str, ...],
     executor_command: str | None,
     plugin: str | None,
@@ -125,6 +141,13 @@ def explore(
     and verifies the runs, and records every trial as provenance in the
     store.  Then each violated relation is shrunk to a smallest derivation
     that still violates it, written to OUTPUT/minimal/ with its criteria.
+
+    The summary gives the campaign's figures: executions (runs of the drawn
+    derivations), counterexamples (trials that violated a relation), their
+    rate per 100 executions and the executions to the first failure; trials
+    neither violated nor passed (verdicts inconclusive) are counted apart.
+    --compare-random runs the same budget with uniform random draws as well
+    and prints both campaigns' figures in one table.
 
     The store is the campaign's state: the same command after a kill goes on
     where it stopped, and a larger --budget goes on with the same campaign.
@@ -158,6 +181,9 @@ def explore(
       exscec explore examples/brsu_building_c/scenario_c.exsce -n 2 -k 1 -t reverse_waypoint_order
       exscec explore examples/brsu_building_c/scenario_c.exsce -n 1 -k 1 -t swap_start_poses \\
         --fault deadlock-start:tiago1:classroom_c025-w002 -o explore/deadlock --junit campaign.xml  # exits 1
+      exscec explore examples/brsu_building_c/scenario_c.exsce -n 2 -k 1 --max-steps 1 --no-shrink \
+        -t swap_start_poses -t reverse_task_order --fault deadlock-start:tiago1:classroom_c025-w002 \
+        --compare-random -o explore/compared  # exits 1
       exscec explore examples/brsu_building_c/scenario_c.exsce -n 1 -k 1 -t swap_start_poses \
         --executor ros1 --stand-in --start-master --speed-up 20 --no-shrink \
         --fault deadlock-start:tiago1:classroom_c025-w002 -o explore/live  # exits 1
@@ -171,9 +197,10 @@ def explore(
         SimulatorExecutor,
         named_executor,
     )
+    from exsce_dsl.explore.figures import random_baseline
     from exsce_dsl.lang.build import load_spec
     from exsce_dsl.model.campaign import Trial
-    from exsce_dsl.oracles.campaign_junit import campaign_junit, run_seconds, steps_text
+    from exsce_dsl.oracles.campaign_junit import campaign_junit, run_seconds
     from exsce_dsl.parallel.cluster import cluster_address
     from exsce_dsl.store.open import open_store
 
@@ -198,29 +225,62 @@ def explore(
         strategy=strategy,
         tolerance=tolerance,
         shrink=not no_shrink,
+        stop_at_violation=stop_at_violation,
         jobs=jobs,
         cluster=address,
     )
+    baseline = random_baseline(options) if compare_random else None
     parsed = load_spec(spec)
-    with chosen as executor, open_store(store_url) as store, Progress(budget, "Exploring") as progress:
+    total = budget * (2 if baseline else 1)
+    with chosen as executor, open_store(store_url) as store, Progress(total, "Exploring") as progress:
 
-        def trial_done(trial: Trial, resumed: bool) -> None:
-            shown = trial.violated or trial.inconclusive
-            found = f": {'; '.join(r.text for r in shown)}" if shown else ""
-            done = " (done before)" if resumed else ""
-            progress.say(f"trial {trial.number}/{budget} {trial.scenario} {trial.outcome}{found}{done}")
-            progress.update()
+        def events(who: str) -> CampaignEvents:
+            def trial_done(trial: Trial, resumed: bool) -> None:
+                shown = trial.violated or trial.inconclusive
+                found = f": {'; '.join(r.text for r in shown)}" if shown else ""
+                done = " (done before)" if resumed else ""
+                progress.say(
+                    f"{who}trial {trial.number}/{budget} {trial.scenario} {trial.outcome}{found}{done}"
+                )
+                progress.update()
 
-        events = CampaignEvents(said=progress.say, trial_done=trial_done)
+            return CampaignEvents(said=progress.say, trial_done=trial_done)
+
         try:
             result = run_campaign(
-                store, parsed, spec, options, executor, output, scenario_id=scenario_id, events=events
+                store, parsed, spec, options, executor, output, scenario_id=scenario_id, events=events("")
             )
+            random = None
+            if baseline is not None:
+                where = f"{output.rstrip('/')}-random" if output else None
+                random = run_campaign(
+                    store,
+                    parsed,
+                    spec,
+                    baseline,
+                    executor,
+                    where,
+                    scenario_id=scenario_id,
+                    events=events("random: "),
+                )
         except ExecutionInterrupted as stop:  # the campaign goes on where it stopped, run again
             click.echo(f"error: {stop.message}", err=True)
             sys.exit(ExitCode.INTERRUPTED)
         durations = run_seconds(store, result.record) if junit else {}
-    record = result.record
+    _summary(result, random)
+    if junit:
+        Path(junit).write_text(campaign_junit(result.record, durations), encoding="utf-8")
+    violated = any(t.violated for t in result.record.trials)
+    undecided = any(t.inconclusive for t in result.record.trials)
+    sys.exit(ExitCode.FAILED if violated else ExitCode.INCONCLUSIVE if undecided else ExitCode.PASSED)
+
+
+def _summary(result: CampaignResult, random: CampaignResult | None) -> None:
+    """What the campaign found, its figures (beside the random baseline's) and its shrinkings."""
+    from exsce_dsl.explore.figures import figures_table, first_failure, per_100
+    from exsce_dsl.oracles.campaign_junit import steps_text
+
+    record, figures = result.record, result.figures
     violated = {r.text for t in record.trials for r in t.violated}
     undecided = {r.text for t in record.trials for r in t.inconclusive} - violated
     tried = len(record.trials)
@@ -229,6 +289,18 @@ def explore(
         found += f", {len(undecided)} inconclusive"
     click.echo(f"campaign {record.plan.id}: {found}")
     click.echo(f"  files: {result.folder}")
+    if random is None:
+        inconclusive = f"; {figures.inconclusive} inconclusive" if figures.inconclusive else ""
+        found = counted(figures.counterexamples, "counterexample")
+        click.echo(
+            f"  {counted(figures.executions, 'execution')}, {found}"
+            f" ({per_100(figures)} per 100 executions), first failure after: {first_failure(figures)}"
+            f"{inconclusive}"
+        )
+    else:
+        click.echo(f"  random baseline {random.record.plan.id}: {random.folder}")
+        for line in figures_table([(record.plan.strategy, figures), ("random", random.figures)]):
+            click.echo(f"  {line}")
     for shrinking in record.shrinkings:
         file = result.minimal_files.get(shrinking.relation.text)
         steps = steps_text(shrinking.minimal_steps)
@@ -238,9 +310,6 @@ def explore(
         if file is not None:
             bags = result.folder / "runs" / shrinking.minimal
             click.echo(f"  reproduce: exscec verify {bags}/*.bag --scenario {file}")
-    if junit:
-        Path(junit).write_text(campaign_junit(record, durations), encoding="utf-8")
-    sys.exit(ExitCode.FAILED if violated else ExitCode.INCONCLUSIVE if undecided else ExitCode.PASSED)
 
 
 COMMANDS = [explore]

@@ -11,6 +11,16 @@ A relation is *violated* by a derivation when it failed in more than half of its
 odd run of three does not send shrinking after noise.  A smaller derivation still violates it
 when it violates the same check (:meth:`~exsce_dsl.model.campaign.Relation.same_check`): an
 expected value missed either way counts, whatever direction the smaller one's estimate took.
+A trial whose relations neither failed nor passed in more than half of its runs (their other
+verdicts inconclusive: a run cut short, data missing) is *inconclusive*: no counterexample,
+no pass.
+
+Every draw of the budget is tried unless ``stop_at_violation``, so that the campaign's figures
+(:class:`~exsce_dsl.model.campaign.CampaignFigures`: counterexamples per 100 executions,
+executions to the first failure) are measured over the whole budget; they are written on the
+campaign's activity when it ends.  Each distinct relation violated is shrunk once, from the
+first trial that violated it: later trials that violate it again are more counterexamples of
+one fault, and shrinking them again would spend runs to find the same smallest derivation.
 """
 
 from __future__ import annotations
@@ -33,6 +43,7 @@ from exsce_dsl.lang.formatter import declared_poses, format_document
 from exsce_dsl.model import Acceptance, Scenario
 from exsce_dsl.model.acceptance import BasicRelation
 from exsce_dsl.model.campaign import (
+    CampaignFigures,
     CampaignPlan,
     CampaignRecord,
     Relation,
@@ -78,7 +89,9 @@ class CampaignOptions:
     tolerance: float = TOLERANCE
     shrink: bool = True
     stop_at_violation: bool = False
-    """End the draws at the first trial that violates a relation (benchmarks: executions to detection)."""
+    """End the draws at the first trial that violates a relation (the figures then cover the
+    trials up to it).  By default every draw of the budget is tried, so that counterexamples per
+    100 executions is measured over the whole budget."""
     shrink_tries: int = SHRINK_TRIES
     jobs: int = 1
     """Bags of one scenario analysed in parallel."""
@@ -103,10 +116,10 @@ class CampaignResult:
     record: CampaignRecord
     folder: Path
     executions: int
-    """Runs executed by this call (not those read back)."""
-    executions_to_first_violation: int | None
-    """Runs executed, in draw order, up to and with the first trial that violated a relation
-    (counting the trials read back as executed); None when none did."""
+    """Runs executed by this call (not those read back), the base's and the shrinkings' included."""
+    figures: CampaignFigures
+    """What the trials of this budget found (those read back included): executions of drawn
+    derivations, counterexamples, executions to the first failure."""
     minimal_files: dict[str, Path] = field(default_factory=dict)
     """Relation text → the ``.exsce`` file of its minimal failing derivation."""
 
@@ -322,8 +335,6 @@ def run_campaign(
         events.said(f"going on with {plan.id}: {len(done)} trial(s) done already")
     campaign.ensure_base_runs()
     trials: list[Trial] = []
-    executed_until: int | None = None
-    executed = 0
     for number, candidate in enumerate(draw(spec, base, options), start=1):
         if number in done:
             trial = done[number]
@@ -332,11 +343,8 @@ def run_campaign(
             trial = campaign.trial(number, candidate)
             events.trial_done(trial, False)
         trials.append(trial)
-        executed += len(trial.runs)
-        if trial.violated and executed_until is None:
-            executed_until = executed
-            if options.stop_at_violation:
-                break
+        if trial.violated and options.stop_at_violation:
+            break
     shrunk = {s.relation: s for s in (before.shrinkings if before else ())}
     if options.shrink:
         for trial in trials:
@@ -346,9 +354,11 @@ def run_campaign(
                 events.said(f"shrinking '{relation.text}' (found by trial {trial.number}: {trial.scenario})")
                 shrunk[relation] = campaign.shrinking(len(shrunk) + 1, relation, trial)
     files = {s.relation.text: _minimal_file(campaign, s) for s in shrunk.values()}
+    figures = CampaignFigures.of(trials)
+    add_prov(store, compile_campaign(plan, started, figures, _now()), replace=True)
     record = campaign_record(store, plan.id)
     assert record is not None  # written above
-    return CampaignResult(record, where, campaign.executions, executed_until, files)
+    return CampaignResult(record, where, campaign.executions, figures, files)
 
 
 def _minimal_file(campaign: _Campaign, shrinking: Shrinking) -> Path:

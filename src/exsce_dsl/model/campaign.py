@@ -9,7 +9,7 @@ derivation, whose scenario has another id.
 from __future__ import annotations
 
 import datetime
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 Request = tuple[str, Mapping[str, str]]
@@ -109,6 +109,52 @@ class Trial:
 
 
 @dataclass(frozen=True)
+class CampaignFigures:
+    """What a campaign's trials found, in the figures falsification tools report: counterexamples
+    per 100 executions and executions to the first failure.  An *execution* is one run of a
+    drawn derivation (the base's runs and the shrinkings' are not draws and are not counted); a
+    *counterexample* is a trial that violated a relation."""
+
+    trials: int
+    executions: int
+    counterexamples: int
+    """Trials that violated at least one relation."""
+    violated_relations: int
+    """Distinct relations violated, one per check (:meth:`Relation.same_check`), as shrinking counts them."""
+    inconclusive: int
+    """Trials neither violated nor passed (:attr:`Trial.inconclusive`): counted in ``executions``
+    (their runs were executed) but neither as counterexamples nor as passes."""
+    executions_to_first_failure: int | None
+    """Executions in draw order up to and with the first violating trial's; None when none violated."""
+
+    @property
+    def per_100_executions(self) -> float | None:
+        """Counterexamples per 100 executions; None when nothing was executed."""
+        return 100 * self.counterexamples / self.executions if self.executions else None
+
+    @classmethod
+    def of(cls, trials: Sequence[Trial]) -> CampaignFigures:
+        """The figures of ``trials`` in the order they were drawn."""
+        executions, first = 0, None
+        distinct: list[Relation] = []
+        for trial in trials:
+            executions += len(trial.runs)
+            if trial.violated and first is None:
+                first = executions
+            for relation in trial.violated:
+                if not any(relation.same_check(known) for known in distinct):
+                    distinct.append(relation)
+        return cls(
+            trials=len(trials),
+            executions=executions,
+            counterexamples=sum(bool(t.violated) for t in trials),
+            violated_relations=len(distinct),
+            inconclusive=sum(t.outcome == "inconclusive" for t in trials),
+            executions_to_first_failure=first,
+        )
+
+
+@dataclass(frozen=True)
 class ShrinkTry:
     scenario: str
     steps: tuple[Request, ...]
@@ -138,3 +184,7 @@ class CampaignRecord:
     started: datetime.datetime | None
     trials: tuple[Trial, ...]
     shrinkings: tuple[Shrinking, ...]
+
+    @property
+    def figures(self) -> CampaignFigures:
+        return CampaignFigures.of(self.trials)

@@ -3,6 +3,10 @@ shrinking, so that each is written once, when it is done (the store is the campa
 
 * ``campaign_<id>:campaign_bundle``: the activity ``campaign_<id>:campaign``
   (``prov:type=exsce:campaign``, its plan as ``exsce:`` attributes), which used the base scenario;
+  when the campaign ends, the bundle is written again with ``prov:endedAtTime`` and its figures
+  (``exsce:executions``, ``exsce:counterexamples``, ``exsce:counterexamples_per_100_executions``,
+  ``exsce:violated_relations``, ``exsce:inconclusive_trials``, ``exsce:executions_to_first_failure``
+  when a trial failed);
 * ``campaign_<id>:trial_NNNN_bundle``: the entity ``campaign_<id>:trial_NNNN``
   (``prov:type=exsce:trial``, ``exsce:order``, ``exsce:scenario``, ``exsce:steps`` as JSON,
   ``exsce:trial_runs``, ``exsce:checked`` and ``exsce:violated``: relations, ``;``-separated,
@@ -26,7 +30,7 @@ from collections.abc import Sequence
 from prov.constants import PROV_TYPE
 from prov.model import ProvDocument
 
-from exsce_dsl.model.campaign import CampaignPlan, Relation, Request, Shrinking, Trial
+from exsce_dsl.model.campaign import CampaignFigures, CampaignPlan, Relation, Request, Shrinking, Trial
 from exsce_dsl.prov import identifiers as ids
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, Namespaces
 from exsce_dsl.prov.records import Attributes, DocumentWriter
@@ -58,15 +62,31 @@ def _writer(campaign: str, namespace: str) -> tuple[DocumentWriter, Namespaces, 
 
 
 def compile_campaign(
-    plan: CampaignPlan, started: datetime.datetime, namespace: str = DEFAULT_NAMESPACE
+    plan: CampaignPlan,
+    started: datetime.datetime,
+    figures: CampaignFigures | None = None,
+    ended: datetime.datetime | None = None,
+    namespace: str = DEFAULT_NAMESPACE,
 ) -> ProvDocument:
-    """The campaign's own bundle: the activity and its plan."""
+    """The campaign's own bundle: the activity and its plan, and once it ended its figures."""
     writer, names, iri = _writer(plan.id, namespace)
     parts = writer.element_namespace(plan.id, iri, "campaign")
     w = writer.bundle(parts["campaign_bundle"], f"campaign {plan.id}")
     t = w.term
     mine = w.of_element(plan.id, iri, "campaign")
     activity = mine["campaign"]
+    found: Attributes = {}
+    if figures is not None:
+        found = {
+            t(ids.CAMPAIGN_EXECUTIONS): figures.executions,
+            t(ids.COUNTEREXAMPLES): figures.counterexamples,
+            t(ids.VIOLATED_RELATIONS): figures.violated_relations,
+            t(ids.INCONCLUSIVE_TRIALS): figures.inconclusive,
+        }
+        if figures.per_100_executions is not None:
+            found[t(ids.COUNTEREXAMPLES_PER_100)] = float(figures.per_100_executions)
+        if figures.executions_to_first_failure is not None:
+            found[t(ids.TO_FIRST_FAILURE)] = figures.executions_to_first_failure
     w.activity(
         activity,
         {
@@ -82,8 +102,10 @@ def compile_campaign(
             t(ids.RELATIONS_CHECKED): plan.relations,
             t(ids.TOLERANCE): float(plan.tolerance),
             t(ids.SCENARIO_ATTR): plan.base,
+            **found,
         },
         start=started,
+        end=ended,
     )
     w.used(activity, w.fixed(ids.EXSCE)[ids.check_name(plan.base, "scenario id")])
     return writer.document
