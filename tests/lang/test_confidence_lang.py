@@ -97,14 +97,34 @@ def test_the_formatter_and_gherkin_print_the_confidence_back(spec_folder: Path) 
 # (id, replacement of "mission_duration is invariant at 99 %", column of its "at", words the message
 # must hold): counted by hand, the clause starts at column 10
 MISTAKES = [
-    ("hundred", "mission_duration is invariant at 100 %", 40, "between 50 % and 100 % (exclusive), not '100 %'"),
+    (
+        "hundred",
+        "mission_duration is invariant at 100 %",
+        40,
+        "between 50 % and 100 % (exclusive), not '100 %'",
+    ),
     ("fifty", "mission_duration is invariant at 50 %", 40, "between 50 % and 100 % (exclusive), not '50 %'"),
     ("tiny", "mission_duration is invariant at 0.99 %", 40, "between 50 % and 100 % (exclusive)"),
     ("fraction", "mission_duration is invariant at 0.99", 40, "a confidence is in per cent ('at 99 %')"),
     ("std", "mission_duration is invariant at 2 std", 40, "a confidence is in per cent"),
-    ("around", "mission_duration is invariant around 60 s at 99 %", 52, "around a fixed value write a tolerance"),
-    ("increasing", "mission_duration is increasing by 2 s at 99 % of s1", 48, "'at 99 %' is for 'is invariant'"),
-    ("decreasing", "mission_duration is decreasing from 1 min at 95 %", 52, "'at 95 %' is for 'is invariant'"),
+    (
+        "around",
+        "mission_duration is invariant around 60 s at 99 %",
+        52,
+        "around a fixed value write a tolerance",
+    ),
+    (
+        "increasing",
+        "mission_duration is increasing by 2 s at 99 % of s1",
+        48,
+        "'at 99 %' is for 'is invariant'",
+    ),
+    (
+        "decreasing",
+        "mission_duration is decreasing from 1 min at 95 %",
+        52,
+        "'at 95 %' is for 'is invariant'",
+    ),
 ]
 
 

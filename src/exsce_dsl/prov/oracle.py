@@ -10,7 +10,9 @@ each metric (and robot) that has oracles:
 * one usage of the scenario whose runs it compares against, per oracle type:
   ``used(<scenario>:<oracle>-baseline; oracle, exsce:<base>, [oracle:relationship,
   oracle:type, oracle:value, oracle:limit, oracle:delta, oracle:tolerance,
-  oracle:package])`` (``-metamorphic`` for a metamorphic one).
+  oracle:package, oracle:runs])`` (``-metamorphic`` for a metamorphic one); a clause
+  written ``at 99 %`` adds ``oracle:confidence`` (0.99) and ``oracle:sampleSize`` (n, the
+  runs its prediction interval comes from).
 
 Where exsce differs from the method, on purpose:
 
@@ -121,6 +123,9 @@ def compile_oracles(
                 relation[t(ids.ORACLE_PACKAGE)] = oracle.package
             if oracle.sources:
                 relation[t(ids.ORACLE_RUNS)] = " ".join(oracle.sources)
+            if oracle.confidence is not None:
+                relation[t(ids.ORACLE_CONFIDENCE)] = float(oracle.confidence)
+                relation[t(ids.ORACLE_SAMPLE_SIZE)] = len(oracle.sources)
             base = exsce[ids.check_name(oracle.base_scenario, "base scenario id")]
             w.used(activity, base, relation, identifier=usage)
     return writer.document
