@@ -33,7 +33,9 @@ classroom_c022 → classroom_c018)."""
 MANIFEST = "runs.json"
 
 
-def fill(store: EmbeddedStore, scenario: Scenario, folder: Path, runs: int, faulty: int, jobs: int) -> dict[str, list[str]]:
+def fill(
+    store: EmbeddedStore, scenario: Scenario, folder: Path, runs: int, faulty: int, jobs: int
+) -> dict[str, list[str]]:
     """Simulate and ingest the runs once: ``runs`` fault-free ones and ``faulty`` of each fault;
     the run uuids by group (``""`` for the fault-free runs) are kept next to the store."""
     manifest = folder / MANIFEST
@@ -62,7 +64,9 @@ def fill(store: EmbeddedStore, scenario: Scenario, folder: Path, runs: int, faul
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("--quick", action="store_true", help="40 fault-free runs and 10 of each fault")
     parser.add_argument("--runs", type=int, default=200, help="fault-free runs")
     parser.add_argument("--faulty-runs", type=int, default=30, help="runs of each fault")

@@ -7,9 +7,11 @@ from pathlib import Path
 
 import pytest
 
+from exsce_dsl.errors import ExportError
 from exsce_dsl.lang.build import analyse, load_spec
 from exsce_dsl.lang.formatter import format_spec_document
 from exsce_dsl.lang.gherkin import gherkin_features
+from exsce_dsl.lang.oracle_yaml import export_oracle_yaml
 from exsce_dsl.model.acceptance import BasicRelation, Quantity
 
 from conftest import write_map
@@ -145,3 +147,17 @@ def test_within_and_at_together_are_a_syntax_error(spec_folder: Path) -> None:
     analysis = analyse("spec.exsce")
     assert analysis.spec is None and analysis.errors
     assert analysis.errors[0].location is not None and analysis.errors[0].location.line == LINE
+
+
+def test_the_methods_oracle_file_cannot_hold_a_confidence(spec_folder: Path) -> None:
+    spec = load_spec("spec.exsce")
+    acceptance = spec.acceptance_of("s2")
+    assert acceptance is not None
+    baseline = {("mission_duration", None): (60.0, 2.0)}
+    with pytest.raises(ExportError) as raised:
+        export_oracle_yaml(acceptance, spec.scenario("s2"), baseline)
+    (diagnostic,) = raised.value.diagnostics
+    assert diagnostic.location is not None and diagnostic.location.line == LINE
+    assert diagnostic.message.startswith(
+        "'mission_duration is invariant at 99 %' takes its tolerance from the baseline's runs at a confidence"
+    )

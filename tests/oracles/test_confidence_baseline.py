@@ -4,10 +4,9 @@ read out of the store by a SPARQL query of this test; and the confidence and n a
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
+from pyoxigraph import Literal, NamedNode
 from scipy import stats
 
 from exsce_dsl.lang.build import load_spec
@@ -18,7 +17,6 @@ from exsce_dsl.prov.oracle import compile_oracles
 from exsce_dsl.runs.ingest import ingest_bags
 from exsce_dsl.sim.run import simulate
 from exsce_dsl.store.embedded import EmbeddedStore
-from pyoxigraph import Literal, NamedNode
 from exsce_dsl.store.queries import oracles as stored_oracles
 from exsce_dsl.store.queries.library import prologue, standard_prefixes
 from exsce_dsl.store.writing import add_prov

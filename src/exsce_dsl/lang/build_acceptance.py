@@ -312,12 +312,10 @@ class _AcceptanceBuilder:
         """Where ``at <confidence>`` is written in the relation (the parse tree keeps no position
         for a matched token)."""
         start, end = relation._tx_position, relation._tx_position_end
-        found = None
-        for found in re.finditer(r"\bat\s+" + re.escape(text), self.pf.text[start:end]):
-            pass
-        if found is None:
+        found = list(re.finditer(r"\bat\s+" + re.escape(text), self.pf.text[start:end]))
+        if not found:
             return self.pf.span(relation)
-        return self.pf.lines.span(start + found.start(), start + found.end())
+        return self.pf.lines.span(start + found[-1].start(), start + found[-1].end())
 
     def scope_fits(self, info: MetricInfo, subject: Subject, where: SourceLocation) -> bool:
         if subject.quantifier is Quantifier.MISSION and info.per_robot and not info.also_mission:

@@ -6,8 +6,8 @@ metric over the stored runs of the scenario (a baseline oracle) or of the
 scenario it was derived from (a metamorphic one); the tolerance follows the
 clause (``within 1 std``, ``within 10 %``, ``within 2 s``; one standard deviation
 for ``invariant`` if none is written), or its confidence (``at 99 %``: the half-width of the
-prediction interval for one new run, :func:`~exsce_dsl.oracles.intervals.prediction_half_width`).  The method's "update baseline" is
-writing these oracles to the store again.
+prediction interval for one new run, :func:`~exsce_dsl.oracles.intervals.prediction_half_width`).
+The method's "update baseline" is writing these oracles to the store again.
 """
 
 from __future__ import annotations

@@ -86,7 +86,9 @@ def t_quantile(p: float, df: float) -> float:
 def check_confidence(confidence: float) -> None:
     """A confidence is a fraction strictly between 0.5 and 1."""
     if not 0.5 < confidence < 1.0:
-        raise ExsceError(f"a confidence must be between 50 % and 100 % (exclusive), not {confidence * 100:g} %")
+        raise ExsceError(
+            f"a confidence must be between 50 % and 100 % (exclusive), not {confidence * 100:g} %"
+        )
 
 
 def prediction_half_width(values: Sequence[float], confidence: float) -> float:
