@@ -155,12 +155,14 @@ class Tally:
 
 def measure(
     store: EmbeddedStore, acceptance: Acceptance, scenario: Scenario, groups: dict[str, list[str]], n: int
-) -> tuple[dict[tuple[str, str, str], Tally], list[str]]:
-    """(setting, group, oracle) → its tally over the rotated baselines; and the performance oracles."""
+) -> tuple[dict[tuple[str, str, str], Tally], list[str], dict[str, dict[str, float]]]:
+    """(setting, group, oracle) → its tally over the rotated baselines; the performance oracles; and
+    each oracle's value in each fault-free run."""
     clean = groups[""]
     blocks = [clean[i : i + n] for i in range(0, len(clean) - n + 1, n)]
     tallies: dict[tuple[str, str, str], Tally] = defaultdict(Tally)
     performance: list[str] = []
+    observed: dict[str, dict[str, float]] = defaultdict(dict)
     for setting, confidence in SETTINGS.items():
         criteria = judged_as(acceptance, confidence)
         started = time.perf_counter()
@@ -180,6 +182,8 @@ def measure(
             )
             failing: dict[str, set[str]] = defaultdict(set)
             for v in verdicts:
+                if v.observed is not None and group_of[v.run] == "":
+                    observed[v.oracle][v.run] = v.observed
                 if v.outcome is Outcome.FAILED:
                     failing[v.run].add(v.oracle)
             for group, runs in judged.items():
@@ -197,7 +201,7 @@ def measure(
             f"in {time.perf_counter() - started:.0f} s",
             flush=True,
         )
-    return tallies, performance
+    return tallies, performance, observed
 
 
 def false_failures(tallies: dict[tuple[str, str, str], Tally], performance: list[str], n: int) -> None:
@@ -224,6 +228,31 @@ def false_failures(tallies: dict[tuple[str, str, str], Tally], performance: list
                 f"{'yes' if near[0] <= expected <= near[1] else 'NO':>3}"
                 + (f"  ({tally.inconclusive} inconclusive)" if tally.inconclusive else "")
             )
+
+
+def shapes(observed: dict[str, dict[str, float]], performance: list[str]) -> None:
+    """How far from normal each performance metric's fault-free values are: a prediction interval
+    promises 1 − c for normal values only (light tails fail less, heavy tails more)."""
+    print("\nThe fault-free values (all runs): how normal they are")
+    print(
+        f"{'oracle':<28} {'distinct':>8} {'mean':>10} {'std':>9} {'skew':>6} "
+        f"{'excess kurtosis':>16} {'Shapiro p':>10}"
+    )
+    for oracle in performance:
+        values = list(observed[oracle].values())
+        distinct = len(set(values))
+        spread = statistics.stdev(values) if len(values) > 1 else 0.0
+        if distinct < 3 or spread == 0:
+            print(
+                f"{oracle:<28} {distinct:>8} {statistics.fmean(values):>10.4g} {spread:>9.3g}  "
+                "(no spread to speak of)"
+            )
+            continue
+        print(
+            f"{oracle:<28} {distinct:>8} {statistics.fmean(values):>10.4g} {spread:>9.3g} "
+            f"{float(stats.skew(values)):>6.2f} {float(stats.kurtosis(values)):>16.2f} "
+            f"{float(stats.shapiro(values).pvalue):>10.2g}"
+        )
 
 
 def runs_failed(tallies: dict[tuple[str, str, str], Tally]) -> None:
@@ -278,9 +307,12 @@ def main() -> None:
         groups = {group: groups[group][: runs if not group else faulty] for group in ["", *FAULTS]}
         print(f"fault-free runs: {len(groups[''])}; faulty runs: {faulty} of each of {len(FAULTS)} faults")
         if not options.fill_only:
-            tallies, performance = measure(store, acceptance, scenario, groups, options.baseline_runs)
+            tallies, performance, observed = measure(
+                store, acceptance, scenario, groups, options.baseline_runs
+            )
             false_failures(tallies, performance, options.baseline_runs)
             runs_failed(tallies)
+            shapes(observed, performance)
             detections(tallies, performance, groups)
         store.close()
 
