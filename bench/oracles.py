@@ -23,6 +23,57 @@ at the same settings: the fraction of faulty runs each oracle failed, averaged o
     python bench/oracles.py --store DIR             # keep the runs in DIR (filled once, reused after)
 
 Prints figures; never a unit test.
+
+MEASURED (2-core machine shared with others, 2026-11-27; 200 fault-free runs, seeds 1..200, 15
+runs of each fault; 20 disjoint baselines of 10 runs, each judging the 190 other fault-free runs:
+3800 judgements per oracle and setting; ~1300 s to simulate, ~110 s to ingest, ~60-85 s per
+setting to build the 20 baselines and judge):
+
+    oracle                     setting  ±band    failed/judged  rate   1−c    binomial band   in
+    tiago1-task_duration       95 %     6.11 s     66/3800     0.017  0.050  [0.043, 0.057]  no
+    tiago1-task_duration       99 %     8.78 s     11/3800     0.003  0.010  [0.007, 0.013]  no
+    tiago1-task_duration       1 std    2.44 s   1723/3800     0.453  0.389  [0.374, 0.405]  no
+    tiago2-task_duration       95 %     6.62 s     47/3800     0.012  0.050                  no
+    tiago2-task_duration       99 %     9.51 s      0/3800     0.000  0.010                  no
+    tiago2-task_duration       1 std    2.65 s   1698/3800     0.447  0.389                  no
+    tiago1-distance_travelled  95 %     5.4 mm    149/3800     0.039  0.050  (se band [0.016, 0.062]: yes)
+    tiago1-distance_travelled  99 %     7.8 mm     20/3800     0.005  0.010  (se band [0.001, 0.010]: no)
+    tiago1-distance_travelled  1 std    2.2 mm   1393/3800     0.367  0.389  (se band [0.309, 0.425]: yes)
+    tiago2-distance_travelled  95 %     5.4 mm    149/3800     0.039  0.050  (se band [0.025, 0.054]: yes)
+    tiago2-distance_travelled  99 %     7.7 mm     24/3800     0.006  0.010  (se band [0.001, 0.011]: yes)
+    tiago2-distance_travelled  1 std    2.2 mm   1454/3800     0.383  0.389  [0.374, 0.405]  yes
+    tiago1/2-waypoints_visited any      0           0/3800     0.000         (always 3: no spread)
+    mission_duration           95 %     6.60 s     39/3800     0.010  0.050                  no
+    mission_duration           99 %     9.48 s      0/3800     0.000  0.010                  no
+    mission_duration           1 std    2.64 s   1697/3800     0.447  0.389                  no
+    fault-free runs failing any performance clause: 95 % 0.104, 99 % 0.014, 1 std 0.892
+
+Why the durations miss their bands (not tuned away): the executor draws each robot's speed
+uniformly in [0.9, 1.0] of its limit and its waits uniformly, so a duration is close to uniform:
+excess kurtosis −1.15, Shapiro–Wilk p ≈ 1e-5 over the 200 runs.  A uniform value never goes
+beyond √3 ≈ 1.73 standard deviations of its mean, while the 95 % band reaches 2.37 s_n (t_{.975,9}
+· √1.1): light tails fail less than promised (1.0-1.7 % at 95 %, 0-0.3 % at 99 %), and fail one
+standard deviation more often (0.45 against the 0.39 of normal values with n = 10; the asymptotic
+"about a third" is 0.32).  The distances (pose noise, kurtosis −0.33 and −0.04) are near normal and
+near their promise (0.039 at 95 %, 0.005 at 99 %; inside the baselines' standard-error band, just
+under the binomial one, which is too narrow: the 190 judgements of one baseline share its mean
+and spread).  waypoints_visited is 3 in every healthy run: its band is 0 and it never fails.
+
+Detection, fraction of 15 faulty runs failed (mean over the 20 baselines), at 95 % / 99 % / 1 std:
+
+    fault                       robot's duration  mission_duration  robot's distance  any performance clause
+    overspeed:tiago1            1.00/1.00/1.00    0.08/0.00/0.62    0.92/0.89/1.00    1.00/1.00/1.00
+    slow:tiago1                 1.00/1.00/1.00    1.00/1.00/1.00    0.49/0.16/1.00    1.00/1.00/1.00
+    skip-waypoint:tiago1        1.00/1.00/1.00    0.53/0.22/0.81    1.00/1.00/1.00    1.00/1.00/1.00
+    near-collision (tiago2)     1.00/0.93/1.00    1.00/0.93/1.00    1.00/1.00/1.00    1.00/1.00/1.00
+    detour:c022:c018            1.00/1.00/1.00    1.00/1.00/1.00    1.00/1.00/1.00    1.00/1.00/1.00
+    slow-area:classroom_c018    1.00/1.00/1.00    1.00/1.00/1.00    0.06/0.00/0.45    1.00/1.00/1.00
+
+Every fault is caught by some performance clause in every run at 99 % too (skip-waypoint also by
+waypoints_visited; overspeed and near-collision by their safety clauses), at 1.4 % of healthy runs
+failing some performance clause instead of 89 % with one standard deviation.  The distance band is
+a few millimetres (the executor drives the same grid path every run), so distance_travelled flags
+any change of path, even the other robot's (tiago2's distance fails under overspeed:tiago1).
 """
 
 from __future__ import annotations
