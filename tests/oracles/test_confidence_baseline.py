@@ -4,8 +4,11 @@ read out of the store by a SPARQL query of this test; and the confidence and n a
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
+from prov.model import ProvDocument
 from pyoxigraph import Literal, NamedNode
 from scipy import stats
 
@@ -14,6 +17,8 @@ from exsce_dsl.model import Scenario
 from exsce_dsl.model.acceptance import Acceptance
 from exsce_dsl.oracles.baseline import NotEnoughRuns, baseline_oracles
 from exsce_dsl.prov.oracle import compile_oracles
+from exsce_dsl.rdf import to_quads
+from exsce_dsl.rdf.shacl import validate
 from exsce_dsl.runs.ingest import ingest_bags
 from exsce_dsl.sim.run import simulate
 from exsce_dsl.store.embedded import EmbeddedStore
@@ -81,6 +86,16 @@ def stored_values(store: EmbeddedStore, metric: str, robot: str, runs: list[str]
     return np.array(found)
 
 
+def confidence_violations(document: ProvDocument) -> list[str]:
+    """The SHACL violations about a confidence (the oracle bundle alone lacks the scenario's
+    records, which other shapes want)."""
+    return [
+        v.message
+        for v in validate(to_quads(document), ["oracles"])
+        if "confidence" in v.message or "sample size" in v.message
+    ]
+
+
 def half_width(values: np.ndarray, confidence: float) -> float:
     n = len(values)
     return float(stats.t.ppf((1 + confidence) / 2, n - 1) * np.std(values, ddof=1) * np.sqrt(1 + 1 / n))
@@ -135,6 +150,11 @@ def test_the_confidence_and_n_are_in_the_oracles_prov_and_read_back(
     store, scenario, acceptance, runs = yard
     built = baseline_oracles(store, acceptance, scenario)
     document = compile_oracles(scenario.id, built, checked=True)
+    assert confidence_violations(document) == []
+    wrong = replace(built[0], confidence=1.0, sources=built[0].sources[:1])
+    found = confidence_violations(compile_oracles(scenario.id, [wrong, *built[1:]]))
+    assert any("strictly between 0.5 and 1" in m for m in found), found
+    assert any("sample size (oracle:sampleSize), an integer of at least 2" in m for m in found), found
     add_prov(store, document, replace=True)
     rows = list(
         store.select(
