@@ -62,7 +62,9 @@ def baseline(spec: str, scenario_id: str | None, include_all: bool, store_url: s
             (
                 o.name,
                 o.relation + ("" if o.base_scenario == scenario.id else f" of {o.base_scenario}"),
-                *(f"{n:.4g}" if n is not None else "" for n in (o.value, o.limit, o.delta, o.tolerance)),
+                *(f"{n:.4g}" if n is not None else "" for n in (o.value, o.limit, o.delta)),
+                (f"{o.tolerance:.4g}" if o.tolerance is not None else "")
+                + (f" (at {o.confidence * 100:g} %)" if o.confidence is not None else ""),
                 str(len(o.sources)) if o.sources else "",
             )
         )

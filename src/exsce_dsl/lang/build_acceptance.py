@@ -240,6 +240,11 @@ class _AcceptanceBuilder:
             tolerance = self.quantity(relation.tolerance, info, where, relative=True)
             if tolerance is None:
                 return None
+        confidence = None
+        if relation.confidence is not None:
+            confidence = self.confidence(relation, kind, value)
+            if confidence is None:
+                return None
         if kind == "Invariant":
             rel = BasicRelation.INVARIANT
         else:
@@ -266,7 +271,51 @@ class _AcceptanceBuilder:
             against=against,
             window=window,
             location=where,
+            confidence=confidence,
         )
+
+    def confidence(self, relation: Any, kind: str, value: Quantity | None) -> Quantity | None:
+        """``at 99 %``: a per cent strictly between 50 and 100, of an invariant around a mean."""
+        text = relation.confidence
+        where = self._confidence_span(relation, text)
+        if kind != "Invariant":
+            self.error(
+                f"'at {text}' is for 'is invariant': a change is judged against another scenario's "
+                "runs moved by a delta, which their spread cannot promise to hold with a confidence; "
+                "write a tolerance ('within ...')",
+                where,
+            )
+            return None
+        if value is not None:
+            self.error(
+                f"'at {text}' is a band around the baseline's mean, from its runs; around a fixed "
+                "value write a tolerance ('within ...')",
+                where,
+            )
+            return None
+        match = _QUANTITY.fullmatch(text)
+        assert match is not None, text  # the grammar lets only such tokens through
+        number, unit = match.group(1), match.group(2)
+        if unit != "%":
+            self.error(f"a confidence is in per cent ('at 99 %'), not '{text}'", where)
+            return None
+        if not 50.0 < float(number) < 100.0:
+            self.error(
+                f"a confidence must be between 50 % and 100 % (exclusive), not '{text}': "
+                "'at 95 %' fails one healthy run in 20, 'at 99 %' one in 100",
+                where,
+            )
+            return None
+        return Quantity(float(number), "%", number)
+
+    def _confidence_span(self, relation: Any, text: str) -> SourceLocation:
+        """Where ``at <confidence>`` is written in the relation (the parse tree keeps no position
+        for a matched token)."""
+        start, end = relation._tx_position, relation._tx_position_end
+        found = list(re.finditer(r"\bat\s+" + re.escape(text), self.pf.text[start:end]))
+        if not found:
+            return self.pf.span(relation)
+        return self.pf.lines.span(start + found[-1].start(), start + found[-1].end())
 
     def scope_fits(self, info: MetricInfo, subject: Subject, where: SourceLocation) -> bool:
         if subject.quantifier is Quantifier.MISSION and info.per_robot and not info.also_mission:

@@ -67,6 +67,8 @@ def expectation_text(e: Expectation) -> str:
             words += ["by", quantity_text(e.delta)]
         if e.tolerance is not None:
             words += ["within", quantity_text(e.tolerance)]
+        if e.confidence is not None:
+            words += ["at", quantity_text(e.confidence)]
         if e.against is not None:
             words += ["of", e.against]
     if e.window is not None:

@@ -436,6 +436,13 @@ def _numbers(e: Expectation, robot: str | None, stats: tuple[float, float] | Non
     if e.limit is not None:
         return {"limit": e.limit.value}
     whose = f"{e.metric} of {robot or 'the mission'}"
+    if e.confidence is not None:
+        # the band comes from every run's value, which the (mean, std) of a baseline does not keep
+        raise ExportError(
+            f"'{expectation_text(e)}' takes its tolerance from the baseline's runs at a confidence, "
+            "which the method's oracle files cannot say: write a tolerance ('within ...') to export it",
+            e.location,
+        )
     t = e.tolerance
     if stats is None and (e.value is None or (t is not None and t.unit == "std")):
         needs, fix = (

@@ -53,7 +53,8 @@ MEANINGS: dict[str, str] = {
     "(lengths in m unless cm or mm follow; angles in rad unless deg follows); in a robot type, "
     '`pose from tf map -> base_link` or `pose on "/{ns}/odom" [TYPE]`: where the robot\'s pose is.',
     "at": "`at (x, y[, z])`: a position; `starts at POSE`: a robot's start pose; in a robot type, "
-    "`scan at 10 Hz`: the rate a signal is published at.",
+    "`scan at 10 Hz`: the rate a signal is published at; `is invariant at 99 %`: a confidence instead "
+    "of a tolerance (the band one new healthy run falls in 99 times in 100).",
     "facing": "`facing YAW`: the heading (rad, or deg).",
     "rpy": "`rpy(roll, pitch, yaw)`: a full orientation (rad, or deg).",
     "obstacle": '`obstacle NAME [model "M"] at (x, y) [facing YAW] [size (sx, sy[, sz])]`: an obstacle '
@@ -91,8 +92,9 @@ MEANINGS: dict[str, str] = {
     "above": "`stays above LIMIT`: the relation above_min(result, limit).",
     "is": "`is invariant ...` or `is increasing|decreasing ...`: compares runs with a baseline or a base "
     "scenario.",
-    "invariant": "`is invariant [around V] [within T] [of baseline|SCENARIO]`: the relation "
-    "invariant(result, value, tolerance); tolerance one standard deviation unless told.",
+    "invariant": "`is invariant [around V] [within T | at C %] [of baseline|SCENARIO]`: the relation "
+    "invariant(result, value, tolerance); tolerance one standard deviation unless told; `at 99 %`: "
+    "mean ± t((1+c)/2, n−1)·s·√(1+1/n), Student's prediction interval for one new run from n runs.",
     "increasing": "`is increasing [from V] [by D] [within T]`: the relation increasing(result, value, delta, "
     "tolerance).",
     "decreasing": "`is decreasing [from V] [by D] [within T]`: the relation decreasing(result, value, delta, "

@@ -95,7 +95,9 @@ class Expectation:
     scenario whose runs a derived scenario's runs are compared with (metamorphic).
     ``tolerance`` of None means one standard deviation of the baseline for
     ``invariant`` around the baseline's mean, and none (exactly) around a fixed value
-    and for ``increasing`` and ``decreasing``.
+    and for ``increasing`` and ``decreasing``.  ``confidence`` (``at 99 %``, an ``invariant``
+    around the baseline's or base's mean only) replaces a written tolerance: the band is the
+    prediction interval for one new run given the runs the mean comes from.
     """
 
     subject: Subject
@@ -109,6 +111,16 @@ class Expectation:
     against: str | None = None
     window: Window | None = None
     location: SourceLocation | None = field(default=None, compare=False, repr=False)
+    confidence: Quantity | None = None
+    """``at 99 %``: in per cent as written, strictly between 50 and 100 (no ``tolerance`` then)."""
+
+    def __post_init__(self) -> None:
+        assert self.confidence is None or self.tolerance is None, "a band is a tolerance or a confidence"
+
+    @property
+    def confidence_level(self) -> float | None:
+        """The confidence as a fraction (0.99 for ``at 99 %``), None without one."""
+        return None if self.confidence is None else self.confidence.value / 100.0
 
 
 @dataclass(frozen=True)

@@ -44,6 +44,9 @@ class Oracle:
     """The title of the acceptance scenario it comes from."""
     sources: tuple[str, ...] = ()
     """The runs (uuids) its value and tolerance were computed from."""
+    confidence: float | None = None
+    """``at 99 %``: 0.99, the tolerance being the half-width of the prediction interval for one
+    new run, from the ``len(sources)`` runs (see :mod:`exsce_dsl.oracles.intervals`)."""
 
     @property
     def name(self) -> str:

@@ -7,8 +7,9 @@ scenario it was derived from (a metamorphic one; good runs: those that did not f
 were not inconclusive, completed their mission and broke no safety limit, see
 :mod:`exsce_dsl.oracles.good_runs`); the tolerance follows the
 clause (``within 1 std``, ``within 10 %``, ``within 2 s``; one standard deviation
-for ``invariant`` if none is written).  The method's "update baseline" is
-writing these oracles to the store again.
+for ``invariant`` if none is written), or its confidence (``at 99 %``: the half-width of the
+prediction interval for one new run, :func:`~exsce_dsl.oracles.intervals.prediction_half_width`).
+The method's "update baseline" is writing these oracles to the store again.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ from exsce_dsl.model.acceptance import Acceptance, BasicRelation
 from exsce_dsl.model.metrics import default_topics
 from exsce_dsl.model.oracles import Oracle
 from exsce_dsl.oracles.good_runs import GoodRuns, good_runs
+from exsce_dsl.oracles.intervals import prediction_half_width
 from exsce_dsl.oracles.observe import RunValues, observe, run_values
 from exsce_dsl.oracles.plan import PlannedOracle, plan_oracles, tolerance_of
 from exsce_dsl.store.base import Store
@@ -39,7 +41,10 @@ class NotEnoughRuns(ExsceError):
 class Statistics:
     mean: float
     std: float
+    """The population standard deviation (n in its denominator), the method's tolerance."""
     runs: tuple[str, ...]
+    values: tuple[float, ...] = ()
+    """The values, run by run, for a tolerance at a confidence."""
 
 
 def baseline_oracles(
@@ -49,14 +54,18 @@ def baseline_oracles(
     bases: dict[str, Scenario] | None = None,
     *,
     include_all: bool = False,
+    runs: Sequence[str] | None = None,
 ) -> list[Oracle]:
     """The oracles of ``scenario`` with their numbers from its good runs in ``store`` (see
     :mod:`exsce_dsl.oracles.good_runs`; every run with ``include_all``).
 
-    ``bases`` are the scenarios metamorphic clauses compare with (by id).  Raises
+    ``bases`` are the scenarios metamorphic clauses compare with (by id).  ``runs`` (uuids of
+    runs of ``scenario``), when given, are the baseline's own runs instead of its good stored ones
+    (bench/oracles.py builds baselines from chosen runs this way).  Raises
     :class:`NotEnoughRuns` while the scenario has fewer good runs than its criteria ask.
     """
-    return list(learn_baseline(store, acceptance, scenario, bases, include_all=include_all).oracles)
+    learnt = learn_baseline(store, acceptance, scenario, bases, include_all=include_all, runs=runs)
+    return list(learnt.oracles)
 
 
 @dataclass(frozen=True)
@@ -75,19 +84,20 @@ def learn_baseline(
     bases: dict[str, Scenario] | None = None,
     *,
     include_all: bool = False,
+    runs: Sequence[str] | None = None,
 ) -> LearntBaseline:
     """:func:`baseline_oracles`, with the runs they were built from and the runs left out."""
     planned = plan_oracles(acceptance, scenario)
-    own = _usable_runs(store, scenario, include_all)
+    own = GoodRuns(tuple(runs)) if runs is not None else _usable_runs(store, scenario, include_all)
     needed = acceptance.baseline_runs
     learns = any(p.needs_runs and p.expectation.against is None for p in planned)
     if learns:
         own.require_some(f"scenario '{scenario.id}'")
     if len(own.used) < needed and learns:
         left = f" ({len(own.left_out)} left out: {own.reasons()})" if own.left_out else ""
-        runs = f"{len(own.used)} good stored run{'s' if len(own.used) != 1 else ''}"
+        count = f"{len(own.used)} good stored run{'s' if len(own.used) != 1 else ''}"
         raise NotEnoughRuns(
-            f"scenario '{scenario.id}' has {runs}{left}; its baseline needs {needed} "
+            f"scenario '{scenario.id}' has {count}{left}; its baseline needs {needed} "
             "(ingest more runs, or lower 'given at least N baseline runs')"
         )
     chosen = {scenario.id: own}
@@ -129,7 +139,7 @@ def _statistics(oracle: PlannedOracle, runs: Sequence[RunValues], scenario: Scen
         return None
     mean = math.fsum(observed) / len(observed)
     std = math.sqrt(math.fsum((v - mean) ** 2 for v in observed) / len(observed))
-    return Statistics(mean, std, tuple(used))
+    return Statistics(mean, std, tuple(used), tuple(observed))
 
 
 def _numbers(oracle: PlannedOracle, stats: Statistics | None, scenario: Scenario) -> Oracle:
@@ -148,8 +158,10 @@ def _numbers(oracle: PlannedOracle, stats: Statistics | None, scenario: Scenario
     if e.limit is not None:
         return Oracle(**common, limit=e.limit.value)  # type: ignore[arg-type]
     # none written: one standard deviation around the runs' mean, but exactly a fixed value
-    needs_std = (e.tolerance is not None and e.tolerance.unit == "std") or (
-        e.tolerance is None and e.relation is BasicRelation.INVARIANT and e.value is None
+    needs_std = (
+        (e.tolerance is not None and e.tolerance.unit == "std")
+        or (e.tolerance is None and e.relation is BasicRelation.INVARIANT and e.value is None)
+        or e.confidence is not None
     )
     if stats is None and (e.value is None or needs_std):
         where = f"'{e.against}'" if e.against else f"scenario '{scenario.id}'"
@@ -164,8 +176,32 @@ def _numbers(oracle: PlannedOracle, stats: Statistics | None, scenario: Scenario
     tolerance: float | None = tolerance_of(e.tolerance, value, std, e.relation)
     if e.tolerance is None and e.value is not None:
         tolerance = None
+    confidence = e.confidence_level
+    if confidence is not None:
+        assert stats is not None  # needs_std
+        tolerance = _prediction_tolerance(oracle, stats, confidence, e.against or scenario.id)
     delta = (
         e.delta.value if e.delta is not None else (0.0 if e.relation is not BasicRelation.INVARIANT else None)
     )
     sources = stats.runs if stats is not None and (e.value is None or needs_std) else ()
-    return Oracle(**common, value=value, delta=delta, tolerance=tolerance, sources=sources)  # type: ignore[arg-type]
+    return Oracle(
+        **common,  # type: ignore[arg-type]
+        value=value,
+        delta=delta,
+        tolerance=tolerance,
+        sources=sources,
+        confidence=confidence,
+    )
+
+
+def _prediction_tolerance(oracle: PlannedOracle, stats: Statistics, confidence: float, base: str) -> float:
+    """The half-width of the prediction interval for one new run at ``confidence``; the spread
+    of at least 2 runs is needed."""
+    if len(stats.values) < 2:
+        whose = f" of robot '{oracle.robot}'" if oracle.robot else ""
+        raise NotEnoughRuns(
+            f"'{oracle.metric}'{whose} at {confidence * 100:g} % confidence needs the values of at "
+            f"least 2 runs of '{base}' to take its band from their spread, and only "
+            f"{len(stats.values)} has one (ingest more runs, or write a tolerance: 'within ...')"
+        )
+    return prediction_half_width(stats.values, confidence)

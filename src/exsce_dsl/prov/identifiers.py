@@ -345,6 +345,10 @@ ORACLE_TOLERANCE = Term(ORACLE, "tolerance")
 ORACLE_WINDOW = Term(ORACLE, "window")
 ORACLE_CRITERION = Term(ORACLE, "criterion")
 ORACLE_RUNS = Term(ORACLE, "runs")
+ORACLE_CONFIDENCE = Term(ORACLE, "confidence")
+"""On an output relation built ``at 99 %``: the confidence (0.99); its tolerance is the half-width
+of the prediction interval for one new run from oracle:sampleSize runs."""
+ORACLE_SAMPLE_SIZE = Term(ORACLE, "sampleSize")
 ORACLE_OUTCOME = Term(ORACLE, "outcome")
 ORACLE_MARGIN = Term(ORACLE, "margin")
 ORACLE_REASON = Term(ORACLE, "reason")

@@ -17,7 +17,9 @@ each metric (and robot) that has oracles:
   each oracle used (role ``baseline_runs``), and for each of its stored runs left out (it failed or
   was inconclusive when verified, its mission did not complete, it broke a safety limit) the
   entity ``<scenario>:left_out-<uuid>`` (``prov:type=exsce:left_out_run``, ``exsce:run``,
-  ``exsce:scenario``, ``oracle:reason``).
+  ``exsce:scenario``, ``oracle:reason``).  A clause
+  written ``at 99 %`` adds ``oracle:confidence`` (0.99) and ``oracle:sampleSize`` (n, the
+  runs its prediction interval comes from) to its usage.
 
 Where exsce differs from the method, on purpose:
 
@@ -136,6 +138,9 @@ def compile_oracles(
                 relation[t(ids.ORACLE_PACKAGE)] = oracle.package
             if oracle.sources:
                 relation[t(ids.ORACLE_RUNS)] = " ".join(oracle.sources)
+            if oracle.confidence is not None:
+                relation[t(ids.ORACLE_CONFIDENCE)] = float(oracle.confidence)
+                relation[t(ids.ORACLE_SAMPLE_SIZE)] = len(oracle.sources)
             base = exsce[ids.check_name(oracle.base_scenario, "base scenario id")]
             w.used(activity, base, relation, identifier=usage)
     return writer.document

@@ -58,6 +58,7 @@ def oracles(store: Store, scenario: str, namespace: str = DEFAULT_NAMESPACE) -> 
                 window=text_of(row["window"]),
                 criterion=text_of(row["criterion"]) or "",
                 sources=tuple((text_of(row["runs"]) or "").split()),
+                confidence=float_of(row["confidence"]),
             )
         )
     return found
