@@ -64,7 +64,7 @@ def test_the_worked_session_runs_as_written(session: dict[str, object]) -> None:
         "value",
         "unit",
     }
-    assert table.run.nunique() == 4 and (table.scenario == "scenario_c").all()
+    assert table.run.nunique() == 6 and (table.scenario == "scenario_c").all()
 
 
 def test_the_api_answers_as_the_command_line_does(session: dict[str, object]) -> None:
@@ -79,7 +79,7 @@ def test_the_api_answers_as_the_command_line_does(session: dict[str, object]) ->
     with exsce.open_store(store) as opened:
         api_runs = set(exsce.query(opened, "runs", scenario="scenario_c").run)
         table = exsce.metrics(opened, "scenario_c")
-    assert api_runs == cli_runs and len(api_runs) == 4
+    assert api_runs == cli_runs and len(api_runs) == 6
     # the API's values are the store's: one through the library query the CLI runs
     some = table[(table.metric == "distance_travelled") & (table.robot == "tiago1")].iloc[0]
     value = run_exscec(
