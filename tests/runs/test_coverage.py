@@ -230,3 +230,20 @@ def test_velocity_that_starts_after_the_robots_first_goal_is_no_data(
     (gap,) = analyse_bag(bag, scenario).run.coverage
     assert (gap.kind, gap.robot, gap.topic) == (Shortfall.NO_DATA, "tiago1", "/tiago1/nav_vel")
     assert _close(gap.start, goal_start) and _close(gap.end, first)
+
+
+def test_times_in_bursts_at_a_coarse_clocks_ticks_are_no_gaps_but_a_long_silence_is() -> None:
+    """A recorder on simulated time logs with the last /clock it heard: with a clock ticking every
+    0.5 s, a 20 Hz topic comes as 10 messages per tick (exsce's stand-in, Stage).  One tick of
+    silence is the clock's, not lost data; the threshold is 3 ticks (1.5 s), and 4 s is a gap."""
+    from exsce_dsl.runs.coverage import GAP_TICKS, gap_threshold
+
+    ticks = np.arange(0.0, 60.0, 0.5)
+    bursts = np.repeat(ticks, 10)
+    mean_period = 60.0 / len(bursts)  # about 0.05 s: ten of them are 0.5 s, the floor
+    assert gap_threshold(bursts) == pytest.approx(max(GAP_FLOOR, 10 * mean_period, GAP_TICKS * 0.5))
+    assert gap_threshold(bursts) == pytest.approx(1.5)
+    holed = bursts[(bursts < 20.0) | (bursts >= 24.0)]
+    assert np.diff(holed).max() == pytest.approx(4.5) and np.diff(holed).max() > gap_threshold(holed)
+    steady = np.arange(0.0, 60.0, 0.05)  # the same topic on a fine clock: ten periods, the floor
+    assert gap_threshold(steady) == pytest.approx(max(GAP_FLOOR, 10 * 0.05))

@@ -53,6 +53,11 @@ GAP_FLOOR = 0.5
 """Seconds: no gap threshold is shorter (see :func:`gap_threshold`)."""
 GAP_PERIODS = 10.0
 """A gap is longer than this many of the topic's median periods (see :func:`gap_threshold`)."""
+GAP_TICKS = 3.0
+"""For a topic whose times come in bursts at its clock's ticks: a gap is longer than this many
+ticks (the 95th percentile of the steps between its distinct times; see :func:`gap_threshold`)."""
+_SAME_TIME = 1e-6
+"""Seconds: two messages closer than this were logged at one clock tick."""
 LOW_RATE_FRACTION = 0.5
 """A topic recorded below this fraction of its declared rate is recorded at a low rate."""
 MIN_MESSAGES = 3
@@ -74,8 +79,22 @@ def gap_threshold(times: np.ndarray) -> float:
     from reporting a recorder's stall of tens of milliseconds, while staying shorter than what a
     safety metric must see (a robot at 1 m/s moves 0.5 m in it).  A thinned topic (every k-th
     message kept) has a k times longer median period, so it is not a series of gaps: that is
-    :data:`LOW_RATE_FRACTION`'s to find, against a declared rate."""
-    period = float(np.median(np.diff(times))) if len(times) > 1 else 0.0
+    :data:`LOW_RATE_FRACTION`'s to find, against a declared rate.
+
+    Times can be coarser than the topic's rate: a recorder on simulated time stamps what it logs
+    with the last ``/clock`` it heard, so a simulator that publishes its clock a few times a
+    second (Stage at 10 Hz, exsce's stand-in at 2 Hz of simulated time) gives bursts of messages
+    at one time and silences of one clock tick between them.  Such a topic's period is its mean
+    (span over messages), and no silence shorter than :data:`GAP_TICKS` of its clock's ticks is a
+    gap: the data is there, its times are not finer than the clock's."""
+    if len(times) < 2:
+        return GAP_FLOOR
+    steps = np.diff(times)
+    period = float(np.median(steps))
+    ticks = steps[steps > _SAME_TIME]
+    if period <= _SAME_TIME and len(ticks):  # bursts at the clock's ticks: most steps are none
+        mean = float(times[-1] - times[0]) / (len(times) - 1)
+        return max(GAP_FLOOR, GAP_PERIODS * mean, GAP_TICKS * float(np.percentile(ticks, 95)))
     return max(GAP_FLOOR, GAP_PERIODS * period)
 
 
