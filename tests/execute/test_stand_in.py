@@ -192,7 +192,10 @@ def test_a_goal_on_an_open_floor_is_reached_along_the_straight_line_on_simulated
     store = tmp_path / "store"
     done = run_exscec("ingest", str(recorded.bag), "--scenario", str(recorded.spec), "--store", str(store))
     assert done.returncode == 0, done.stderr
-    assert "warning" not in done.stderr  # every stamp on the recorder's clock (tf_static too)
+    # every stamp on the recorder's clock (tf_static too): the one warning is that the mission's
+    # second waypoint, which this drive never sent, was not reached in the recording
+    warned = [line for line in done.stderr.splitlines() if "warning" in line]
+    assert all("coverage: cut short" in line and "hall-c" in line for line in warned), done.stderr
     from exsce_dsl import api
 
     with api.open_store(str(store)) as opened:
