@@ -22,6 +22,7 @@ from scenario_builders import (
 )
 
 from exsce_dsl.errors import ExsceError
+from exsce_dsl.lang.method_yaml import import_scenario_yaml
 from exsce_dsl.model import (
     Area,
     Assignment,
@@ -146,19 +147,8 @@ def test_an_area_bundle_holds_each_variant_of_its_poses_and_shares_points() -> N
     assert sum(line.startswith("hadMember") for line in lines) == 8
 
 
-def method_yaml_contract_available() -> bool:
-    try:
-        from exsce_dsl.lang.method_yaml import import_scenario_yaml  # noqa: F401
-    except ImportError:
-        return False
-    return True
-
-
-@pytest.mark.skipif(not method_yaml_contract_available(), reason="no YAML importer")
 @pytest.mark.parametrize("name", ["scenario_c", "scenario_d", "scenario_e"])
 def test_imported_yaml_scenarios_have_the_records_of_the_published_models(name: str) -> None:
-    from exsce_dsl.lang.method_yaml import import_scenario_yaml
-
     documents = import_scenario_yaml(SCENARIOS / f"{name}.yaml", [MODELS])
     (scenario,) = documents[0].declarations
     assert isinstance(scenario, Scenario)
@@ -167,10 +157,7 @@ def test_imported_yaml_scenarios_have_the_records_of_the_published_models(name: 
     assert differences(ours, theirs) == []
 
 
-@pytest.mark.skipif(not method_yaml_contract_available(), reason="no YAML importer")
 def test_the_hand_written_ir_compiles_like_the_imported_one() -> None:
-    from exsce_dsl.lang.method_yaml import import_scenario_yaml
-
     documents = import_scenario_yaml(SCENARIOS / "scenario_c.yaml", [MODELS])
     (imported,) = documents[0].declarations
     assert isinstance(imported, Scenario)

@@ -35,6 +35,9 @@ ROBOT_SCHEMA = "https://robot-schema.org/"
 ROS_WIKI = "http://wiki.ros.org/"
 PROV_NAMESPACE = "http://www.w3.org/ns/prov#"
 XSD_NAMESPACE = "http://www.w3.org/2001/XMLSchema#"
+RDF_NAMESPACE = "http://www.w3.org/1999/02/22-rdf-syntax-ns#"
+RDF_TYPE = RDF_NAMESPACE + "type"
+"""``rdf:type``: the one spelling of the IRI every layer writes and reads."""
 
 # The fixed prefix names, as published.
 EXSCE = "exsce"

@@ -76,11 +76,16 @@ from prov.model import ProvBundle, ProvDocument, ProvRecord
 from pyoxigraph import Quad, RdfFormat, parse
 
 from exsce_dsl.errors import ExportError
-from exsce_dsl.prov.identifiers import PROV_NAMESPACE, XSD_NAMESPACE, is_valid_prefix
+from exsce_dsl.prov.identifiers import (
+    PROV_NAMESPACE,
+    RDF_NAMESPACE,
+    RDF_TYPE,
+    XSD_NAMESPACE,
+    is_valid_prefix,
+)
 
 __all__ = ["nquad_lines", "prefixes_of", "quads_of_lines", "to_quads"]
 
-RDF_NAMESPACE = "http://www.w3.org/1999/02/22-rdf-syntax-ns#"
 RDFS_NAMESPACE = "http://www.w3.org/2000/01/rdf-schema#"
 
 _IRI_SCHEMES = frozenset({"http", "https", "urn", "file", "mailto", "tag", "data"})
@@ -180,7 +185,7 @@ def _xsd(local: str) -> str:
 
 _XSD_BOOLEAN, _XSD_INT, _XSD_LONG, _XSD_INTEGER = _xsd("boolean"), _xsd("int"), _xsd("long"), _xsd("integer")
 _XSD_DOUBLE, _XSD_DATETIME, _XSD_ANY_URI = _xsd("double"), _xsd("dateTime"), _xsd("anyURI")
-_RDF_TYPE = iri_ref(RDF_NAMESPACE + "type")
+_RDF_TYPE = iri_ref(RDF_TYPE)
 _RDFS_LABEL = iri_ref(RDFS_NAMESPACE + "label")
 
 

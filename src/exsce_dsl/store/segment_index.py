@@ -44,7 +44,7 @@ from exsce_dsl.store.base import Store
 
 __all__ = ["is_index_graph", "segment_index", "segment_iri", "stale_index_graphs"]
 
-_RDF_TYPE = NamedNode("http://www.w3.org/1999/02/22-rdf-syntax-ns#type")
+_RDF_TYPE = NamedNode(ids.RDF_TYPE)
 _USED = f"{PROV_NAMESPACE}used"
 _STARTED_BY = f"{PROV_NAMESPACE}wasStartedBy"
 _ENDED_BY = f"{PROV_NAMESPACE}wasEndedBy"

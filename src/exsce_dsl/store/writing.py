@@ -52,7 +52,7 @@ from pyoxigraph import (
     Quad,
 )
 
-from exsce_dsl.prov.identifiers import PROV_NAMESPACE, ROBOT_SCHEMA, XSD_NAMESPACE
+from exsce_dsl.prov.identifiers import PROV_NAMESPACE, RDF_TYPE, ROBOT_SCHEMA, XSD_NAMESPACE
 from exsce_dsl.store.base import GraphSet, Store, StoreConflictError, StoreError
 from exsce_dsl.store.literals import INTEGER_TYPES
 from exsce_dsl.store.segment_index import segment_index, stale_index_graphs
@@ -67,7 +67,7 @@ __all__ = [
     "stored_graphs",
 ]
 
-_RDF_TYPE = "http://www.w3.org/1999/02/22-rdf-syntax-ns#type"
+_RDF_TYPE = RDF_TYPE
 _POSE_TYPES = frozenset(f"{ROBOT_SCHEMA}{local}" for local in ("Pose", "Point", "EulerAngles"))
 _WAS_REVISION_OF = NamedNode(f"{PROV_NAMESPACE}wasRevisionOf")
 _INVALIDATED_AT = NamedNode(f"{PROV_NAMESPACE}invalidatedAtTime")
