@@ -21,7 +21,7 @@ import time
 import tracemalloc
 from pathlib import Path
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.prov import compile_scenario
 from exsce_dsl.rdf import serialize
 

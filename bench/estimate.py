@@ -32,7 +32,7 @@ from pathlib import Path
 from typing import Any
 
 from exsce_dsl.derive.expect import SUMMED, robot_path, segment_value
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.runs.ingest import ingest_bags
 from exsce_dsl.sim.run import simulate

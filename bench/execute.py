@@ -66,7 +66,7 @@ from exsce_dsl.execute.ros1.recorder import Recorder
 from exsce_dsl.execute.ros1.session import ExecutedRun, Options, execute_runs
 from exsce_dsl.execute.stand_in import StandIn, Stats, start_stand_in
 from exsce_dsl.execute.stand_in.session import DEFAULT_SPEED_UP
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Pose, Scenario
 from exsce_dsl.sim.run import RunPlan, play_run
 

@@ -107,7 +107,7 @@ from exsce_dsl.explore.campaign import (
 )
 from exsce_dsl.explore.executors import SimulatorExecutor
 from exsce_dsl.explore.figures import first_failure, per_100
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.campaign import CampaignFigures, Relation, Request, Shrinking, Trial
 from exsce_dsl.model.document import Specification

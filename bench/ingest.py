@@ -210,7 +210,7 @@ def way_c(bag: Path, spec: Path, store: Path, stop_at_open: bool = False) -> dic
 
 
 def way_d(bag: Path, spec: Path) -> dict[str, float]:
-    from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.lang import load_spec
     from exsce_dsl.runs.analyse import analyse_bag
 
     analysed = analyse_bag(bag, load_spec(spec).scenario())
@@ -221,7 +221,7 @@ def way_e(bag: Path, spec: Path) -> dict[str, float]:
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
     import reference_metrics as reference  # type: ignore[import-not-found]
 
-    from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.lang import load_spec
 
     values, _ = reference.metrics_of_bag(bag, load_spec(spec).scenario())
     return {"values": len(values)}
@@ -244,7 +244,7 @@ def child(argv: list[str]) -> None:
         import compileall
 
         import exsce_dsl
-        from exsce_dsl.lang.spec_cache import load_spec_cached
+        from exsce_dsl.lang import load_spec_cached
 
         if argv[3] == "compile":  # under the run's PYTHONPYCACHEPREFIX
             compileall.compile_dir(Path(exsce_dsl.__file__).parent, quiet=1)
@@ -332,7 +332,7 @@ def fixed_costs(bag: Path, spec: Path, folder: Path) -> tuple[float, float]:
 
 
 def bench_convention(folder: Path, convention: str, minutes: float, keep: bool, compiled: bool) -> None:
-    from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.lang import load_spec
     from exsce_dsl.sim.run import simulate
 
     rounds = max(1, round(minutes * 60 / 115))  # one delivery + return ≈ 115 s, giving way included

@@ -90,7 +90,7 @@ from pathlib import Path
 
 from scipy import stats
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.acceptance import Acceptance, BasicRelation, Quantity
 from exsce_dsl.model.verdicts import Outcome

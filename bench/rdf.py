@@ -26,7 +26,7 @@ from pathlib import Path
 
 from pyoxigraph import Quad, RdfFormat, parse
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.prov import compile_scenario
 from exsce_dsl.rdf import check_scenario_shapes, serialize, to_quads
 from exsce_dsl.rdf.prov_o import nquad_lines, quads_of_lines

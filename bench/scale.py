@@ -33,7 +33,7 @@ SPEC = Path(__file__).resolve().parents[1] / "examples" / "brsu_building_c" / "s
 
 
 def _simulate(folder: Path, runs: int, seed: int) -> list[Path]:
-    from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.lang import load_spec
     from exsce_dsl.sim.run import simulate
 
     scenario = load_spec(SPEC).scenario("scenario_c")
@@ -53,7 +53,7 @@ def make_bags(folder: Path, count: int) -> list[Path]:
 
 
 def ingest(bags: list[Path], store_path: Path, jobs: int, cluster: str | None = None) -> float:
-    from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.lang import load_spec
     from exsce_dsl.runs.ingest import ingest_bags
     from exsce_dsl.store.embedded import EmbeddedStore
 

@@ -86,7 +86,7 @@ def test_ten_thousand_errors_give_bounded_output(tmp_path: Path) -> None:
     assert result.exit_code == 2 and "Traceback" not in said
     assert said.count("error:") >= 50  # several errors are shown ...
     assert len(said.splitlines()) <= 250 and len(said) < 60_000  # ... but not ten thousand of them
-    from exsce_dsl.lang.build import analyse
+    from exsce_dsl.lang import analyse
 
     total = len(analyse(spec).diagnostics)
     assert f"... and {total - 100} more errors (the first 100 are shown)" in said.splitlines()

@@ -16,7 +16,7 @@ import pytest
 from tests.draft_references import reference
 from yard_spec import yard_text
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.sim.run import simulate
 
 from conftest import run_exscec

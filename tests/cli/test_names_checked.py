@@ -23,7 +23,7 @@ from rosbags.rosbag1 import Reader, Writer
 
 from exsce_dsl import api as exsce
 from exsce_dsl.errors import UnknownNameWarning
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.sim.run import simulate
 
 from conftest import EXAMPLES, run_exscec

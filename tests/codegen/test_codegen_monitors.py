@@ -15,8 +15,7 @@ from pathlib import Path
 import pytest
 
 from exsce_dsl.codegen.monitors import monitor_files
-from exsce_dsl.lang.build import load_spec
-from exsce_dsl.lang.standard_metrics import standard_metrics
+from exsce_dsl.lang import load_spec, standard_metrics
 from exsce_dsl.resources import package_file
 from exsce_dsl.runs.analyse import analyse_bag, run_metrics, wanted_topics
 from exsce_dsl.runs.bags.reading import read_bag

@@ -33,8 +33,7 @@ from exsce_dsl.codegen.ros_monitor import (
     ros1_monitor_files,
     ros2_monitor_files,
 )
-from exsce_dsl.lang.build import load_spec
-from exsce_dsl.lang.standard_metrics import standard_metrics
+from exsce_dsl.lang import load_spec, standard_metrics
 from exsce_dsl.monitor_kit import monitor_runtime
 from exsce_dsl.oracles.relations import relation
 from exsce_dsl.resources import package_file

@@ -131,7 +131,7 @@ def test_a_segment_with_no_neighbour_data_falls_back_to_the_robot_s_rate_per_met
 
 def test_the_derived_scenario_s_criteria_follow_from_the_expected_change() -> None:
     from exsce_dsl.derive.expect import metamorphic_acceptance
-    from exsce_dsl.lang.format_acceptance import expectation_text
+    from exsce_dsl.lang import expectation_text
     from exsce_dsl.model.acceptance import (
         Acceptance,
         BasicRelation,

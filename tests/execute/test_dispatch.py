@@ -17,7 +17,7 @@ from exsce_dsl.execute.kinematic import ABORT_AFTER, KinematicNavigator
 from exsce_dsl.execute.mission import schedule
 from exsce_dsl.execute.navigator import SimulatedClock
 from exsce_dsl.execute.outcomes import DEFAULT_POLICY, MissionStatus, Outcome, Policy
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model import MissionType
 from exsce_dsl.sim.run import planning_grid
 

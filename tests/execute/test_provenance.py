@@ -23,7 +23,7 @@ from exsce_dsl.execute.mission import schedule
 from exsce_dsl.execute.navigator import SimulatedClock
 from exsce_dsl.execute.outcomes import DEFAULT_POLICY, MissionStatus, Policy
 from exsce_dsl.execute.provenance import mission_prov_json, mission_run_record
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model.runs import ActionStatus, RunStatus
 from exsce_dsl.prov.run import compile_run
 from exsce_dsl.rdf import to_quads, validate

@@ -10,7 +10,7 @@ import pytest
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.execute.recording import ALWAYS, PROV_TOPIC, recorded_topics
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
 
 from conftest import EXAMPLES

@@ -20,7 +20,7 @@ from exsce_dsl.execute.dispatcher import dispatch
 from exsce_dsl.execute.mission import schedule
 from exsce_dsl.execute.outcomes import MissionStatus, Outcome
 from exsce_dsl.execute.ros1.navigator import DispatcherNode, Ros1Navigator, RosClock, move_base_actions
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model import MissionType
 
 from conftest import EXAMPLES

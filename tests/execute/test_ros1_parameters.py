@@ -15,7 +15,7 @@ from tests.ros1_graph import Graph, ros1_graph
 from exsce_dsl.errors import RosGraphError
 from exsce_dsl.execute.ros1.graph import Master
 from exsce_dsl.execute.ros1.parameters import SCENARIO_NAMESPACE, dump_parameters, load_scenario
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
 
 from conftest import EXAMPLES, FIXTURES

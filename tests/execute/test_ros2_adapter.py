@@ -36,7 +36,7 @@ from exsce_dsl.execute.ros2 import (
     record_command,
     waypoint_outcomes,
 )
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model.conventions import METHOD, MOVE_BASE, NAV2, TopicSource
 from exsce_dsl.model.geometry import quaternion
 from exsce_dsl.model.scenario import Assignment

@@ -11,7 +11,7 @@ import pytest
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.execute.run_files import RunFiles
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model.runs import run_name
 from exsce_dsl.sim.run import simulate
 

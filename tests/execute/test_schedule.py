@@ -10,7 +10,7 @@ import pytest
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.execute.mission import TIMEOUT_FLOOR, goal_timeout, schedule
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model import MissionType
 
 from conftest import EXAMPLES

@@ -29,7 +29,7 @@ from rosbags.highlevel import AnyReader
 
 from exsce_dsl.execute.stand_in import GoalEnd, Stats, start_stand_in
 from exsce_dsl.execute.stand_in.session import NODE
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.sim.faults import Fault
 from exsce_dsl.sim.localisation import SCALE_ERROR
 

@@ -15,7 +15,7 @@ import pytest
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.execute.stand_in.legs import FIELDS, Fleet, Leg
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.sim.faults import DEADLOCK_WAIT, Fault
 from exsce_dsl.sim.localisation import SCALE_ERROR

@@ -17,7 +17,7 @@ import pytest
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.explore.campaign import CampaignOptions, run_campaign
 from exsce_dsl.explore.executors import CommandExecutor
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model.campaign import Relation
 from exsce_dsl.store.open import open_store
 from exsce_dsl.store.queries import derivation_of

@@ -20,7 +20,7 @@ from exsce_dsl.errors import ExsceError
 from exsce_dsl.explore.campaign import CampaignOptions, _violations, run_campaign
 from exsce_dsl.explore.executors import SimulatorExecutor
 from exsce_dsl.explore.figures import figures_table, random_baseline
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model.campaign import CampaignFigures, CampaignPlan, Relation, Trial
 from exsce_dsl.model.verdicts import Outcome, Verdict
 from exsce_dsl.oracles.campaign_junit import campaign_junit

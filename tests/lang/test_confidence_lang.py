@@ -8,10 +8,8 @@ from pathlib import Path
 import pytest
 
 from exsce_dsl.errors import ExportError
-from exsce_dsl.lang.build import analyse, load_spec
-from exsce_dsl.lang.formatter import format_spec_document
-from exsce_dsl.lang.gherkin import gherkin_features
-from exsce_dsl.lang.oracle_yaml import export_oracle_yaml
+from exsce_dsl.lang import analyse, export_oracle_yaml, format_spec_document, load_spec
+from exsce_dsl.lang.format.gherkin import gherkin_features
 from exsce_dsl.model.acceptance import BasicRelation, Quantity
 
 from conftest import write_map

@@ -13,10 +13,7 @@ from rosbags.highlevel import AnyReader
 from tests.bag_surgery import thin
 
 from exsce_dsl.errors import SpecError
-from exsce_dsl.lang.build import load_spec
-from exsce_dsl.lang.formatter import format_spec_document
-from exsce_dsl.lang.lexical import comments
-from exsce_dsl.lang.loader import display_path
+from exsce_dsl.lang import comments, display_path, format_spec_document, load_spec
 from exsce_dsl.model.conventions import TopicSource
 from exsce_dsl.model.coverage import Shortfall
 from exsce_dsl.runs.analyse import analyse_bag

@@ -8,8 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from exsce_dsl.lang.build import analyse, load_spec
-from exsce_dsl.lang.formatter import format_spec_document
+from exsce_dsl.lang import analyse, format_spec_document, load_spec
 
 from conftest import EXAMPLES, run_exscec
 

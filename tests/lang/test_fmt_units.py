@@ -11,8 +11,7 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from exsce_dsl.lang.build import load_spec
-from exsce_dsl.lang.formatter import format_document, format_spec_document
+from exsce_dsl.lang import format_document, format_spec_document, load_spec
 from exsce_dsl.model import Area, Document, Environment, Orientation, Pose, Position
 
 from conftest import run_exscec

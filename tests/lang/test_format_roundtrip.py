@@ -9,10 +9,15 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from exsce_dsl.lang.build import analyse, load_spec
-from exsce_dsl.lang.formatter import declared_poses, format_document, format_spec_document
-from exsce_dsl.lang.lexical import comments
-from exsce_dsl.lang.loader import display_path
+from exsce_dsl.lang import (
+    analyse,
+    comments,
+    declared_poses,
+    display_path,
+    format_document,
+    format_spec_document,
+    load_spec,
+)
 from exsce_dsl.model import (
     Area,
     Assignment,

@@ -9,8 +9,8 @@ import pytest
 from gherkin.parser import Parser
 
 from exsce_dsl.errors import ExportError
-from exsce_dsl.lang.build import load_spec
-from exsce_dsl.lang.gherkin import export_gherkin, gherkin_features
+from exsce_dsl.lang import load_spec
+from exsce_dsl.lang.format.gherkin import export_gherkin, gherkin_features
 from exsce_dsl.model.acceptance import (
     Acceptance,
     AtStartPose,

@@ -16,11 +16,11 @@ from lsprotocol import types
 
 import exsce_dsl.errors as errors_module
 from exsce_dsl.errors import Diagnostic, Severity, SourceLocation
-from exsce_dsl.lang.build import analyse
+from exsce_dsl.lang import analyse
+from exsce_dsl.lang.build.references import UnknownNames, declared_in
 from exsce_dsl.lang.chunks import declared_names
 from exsce_dsl.lang.loader import parse_whole
 from exsce_dsl.lang.parser import ParsedFile
-from exsce_dsl.lang.references import UnknownNames, declared_in
 from exsce_dsl.lsp.convert import TextLines, lsp_diagnostic
 
 from conftest import EXAMPLES, ROOT, run_exscec
@@ -425,7 +425,7 @@ def test_an_error_keeps_its_old_name_and_is_the_errors_modules_class(module: str
 def test_a_broken_file_whose_import_string_no_file_can_have_gives_diagnostics(tmp_path: Path) -> None:
     """Found by the parser fuzzer: the imports of a file that does not parse are read from its text,
     and a quoted run of 300 characters across lines is no file name (the OS says 'too long')."""
-    from exsce_dsl.lang.build import analyse
+    from exsce_dsl.lang import analyse
 
     spec = tmp_path / "broken.exsce"
     spec.write_text('import "a\n' + "x" * 300 + '.exsce"\nimport "b\x00.exsce"\nscenario {\n')

@@ -18,7 +18,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from exsce_dsl.errors import ExportError, ImportFormatError
-from exsce_dsl.lang.method_yaml import (
+from exsce_dsl.lang import (
     export_yaml,
     import_scenario_yaml,
     import_task_yaml,
@@ -573,8 +573,7 @@ def test_task_yaml_round_trip(task: Task, tmp_path_factory: pytest.TempPathFacto
 
 def test_imported_documents_format_and_load_back_to_the_same_scenario(tmp_path: Path) -> None:
     """The documents are meant to be written as ``.exsce`` files: doing so loses nothing."""
-    from exsce_dsl.lang.build import load_spec
-    from exsce_dsl.lang.formatter import declared_poses, format_document
+    from exsce_dsl.lang import declared_poses, format_document, load_spec
 
     documents = import_fixture("scenario_c")
     scenario = scenario_of(documents)
@@ -599,8 +598,7 @@ def test_area_is_the_pose_id_up_to_its_first_dash(tmp_path: Path) -> None:
 
 
 def test_imported_task_files_check_on_their_own(tmp_path: Path) -> None:
-    from exsce_dsl.lang.build import analyse
-    from exsce_dsl.lang.writer import write_documents
+    from exsce_dsl.lang import analyse, write_documents
 
     documents = import_fixture("scenario_c")
     written = write_documents(documents, tmp_path)

@@ -10,8 +10,7 @@ from pathlib import Path
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from exsce_dsl.lang.build import load_spec
-from exsce_dsl.lang.format_metrics import expression_text
+from exsce_dsl.lang import expression_text, load_spec
 from exsce_dsl.lang.lexical import number_text, string_literal
 from exsce_dsl.runs.metrics.monitor_code import monitor_source
 

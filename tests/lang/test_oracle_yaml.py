@@ -19,9 +19,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from exsce_dsl.errors import ExportError, ImportFormatError
-from exsce_dsl.lang.build import load_spec
-from exsce_dsl.lang.formatter import format_document
-from exsce_dsl.lang.oracle_yaml import (
+from exsce_dsl.lang import format_document, load_spec
+from exsce_dsl.lang.yaml.oracles import (
     default_topics,
     export_oracle_yaml,
     import_oracle_yaml,

@@ -13,7 +13,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.lang.build import analyse, load_spec
+from exsce_dsl.lang import analyse, load_spec
 from exsce_dsl.prov import compile_scenario
 
 from conftest import EXAMPLES

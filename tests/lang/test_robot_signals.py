@@ -13,10 +13,7 @@ import pytest
 
 from exsce_dsl.codegen.ros_monitor import ros1_monitor_files
 from exsce_dsl.errors import ExsceError, SpecError
-from exsce_dsl.lang.build import load_spec
-from exsce_dsl.lang.formatter import format_spec_document
-from exsce_dsl.lang.lexical import comments
-from exsce_dsl.lang.loader import display_path
+from exsce_dsl.lang import comments, display_path, format_spec_document, load_spec
 from exsce_dsl.model.conventions import (
     METHOD,
     MOVE_BASE,

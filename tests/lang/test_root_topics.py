@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from exsce_dsl.lang.build import analyse
+from exsce_dsl.lang import analyse
 
 from conftest import EXAMPLES
 

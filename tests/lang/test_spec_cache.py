@@ -12,10 +12,10 @@ from pathlib import Path
 import pytest
 
 from exsce_dsl.errors import SpecError
-from exsce_dsl.lang import build, spec_cache
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec, spec_cache
+from exsce_dsl.lang.build import specification as build
+from exsce_dsl.lang.build.standard_metrics import _parse_standard_metrics
 from exsce_dsl.lang.spec_cache import code_fingerprint, load_spec_cached
-from exsce_dsl.lang.standard_metrics import _parse_standard_metrics
 from exsce_dsl.model import Specification
 from exsce_dsl.model.metrics import MetricDefinition
 

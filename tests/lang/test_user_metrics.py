@@ -18,9 +18,8 @@ import pytest
 from rosbags.highlevel import AnyReader
 
 from exsce_dsl.errors import SpecError
-from exsce_dsl.lang.build import analyse, load_spec
-from exsce_dsl.lang.format_metrics import metric_lines
-from exsce_dsl.lang.standard_metrics import standard_metrics
+from exsce_dsl.lang import analyse, load_spec, standard_metrics
+from exsce_dsl.lang.format.metrics import metric_lines
 from exsce_dsl.model.metrics import METRICS, ComputedFor
 from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.sim.executor import Fault

@@ -11,12 +11,10 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from exsce_dsl.lang.build import analyse, analyse_files
-from exsce_dsl.lang.chunks import declaration_chunks
-from exsce_dsl.lang.expected import expected_at
-from exsce_dsl.lang.incremental import ParseCache
+from exsce_dsl.lang import ParseCache, continuations_at, declaration_chunks
+from exsce_dsl.lang.build.specification import analyse, analyse_files
+from exsce_dsl.lang.editor.symbols import index_file
 from exsce_dsl.lang.loader import load_files, parse_whole
-from exsce_dsl.lang.symbols import index_file
 
 from conftest import EXAMPLES
 
@@ -179,21 +177,21 @@ def test_the_index_holds_declarations_and_references_with_places() -> None:
     ],
 )
 def test_what_the_grammar_expects_at_the_end(text: str, keywords: set[str], name: bool) -> None:
-    expected = expected_at(text, len(text))
+    expected = continuations_at(text, len(text))
     assert expected is not None and expected.known
     assert keywords <= set(expected.keywords)
     assert expected.name is name
 
 
 def test_nothing_is_expected_inside_a_comment_or_a_string() -> None:
-    assert expected_at("task t { // visit ", 18) is None
-    assert expected_at('acceptance for s { scenario "moves sa', 37) is None
+    assert continuations_at("task t { // visit ", 18) is None
+    assert continuations_at('acceptance for s { scenario "moves sa', 37) is None
 
 
 def test_completion_in_a_long_environment_parses_only_the_area_it_is_in() -> None:
     text = environment_text(30, 12)
     at = text.index("    pose room_25-w04")
-    expected = expected_at(text, at)
+    expected = continuations_at(text, at)
     assert expected is not None
     assert expected.keywords == ("pose",) and expected.declaration == "environment"
     assert expected.before[:8] == ("environment", "big", "{", "map", "big", "area", "room_25", "{")

@@ -9,7 +9,7 @@ from dataclasses import replace
 import pytest
 from campaign_samples import DURATION, REMOVE, REVERSE, SHRINKINGS, sample_trials
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model.campaign import CampaignPlan, CampaignRecord, Shrinking, Trial
 from exsce_dsl.model.runs import Bag, Run
 from exsce_dsl.oracles.campaign_junit import campaign_junit, run_seconds, steps_text

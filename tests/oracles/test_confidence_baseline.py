@@ -12,7 +12,7 @@ from prov.model import ProvDocument
 from pyoxigraph import Literal, NamedNode
 from scipy import stats
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.acceptance import Acceptance
 from exsce_dsl.oracles.baseline import NotEnoughRuns, baseline_oracles

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model.coverage import CoverageGap, Shortfall, TopicRate
 from exsce_dsl.model.metrics import Combine
 from exsce_dsl.model.verdicts import Outcome, Verdict

@@ -22,7 +22,7 @@ from click.testing import CliRunner
 from rosbags.rosbag1 import Reader, Writer
 
 from exsce_dsl.cli.common import ExitCode, reports_errors
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.runs import Action, ActionId, ActionStatus, RunStatus
 from exsce_dsl.prov.recorder import recorded_prov_json, recorded_run

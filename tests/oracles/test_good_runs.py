@@ -21,7 +21,7 @@ from pathlib import Path
 
 import pytest
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.runs import Action, ActionId, ActionStatus, RunStatus
 from exsce_dsl.prov.recorder import recorded_prov_json, recorded_run

@@ -16,7 +16,7 @@ import pytest
 from prov.model import ProvDocument
 
 from exsce_dsl import api
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.mcp_server.store_tools import stored_run
 from exsce_dsl.prov.run import compile_run
 from exsce_dsl.runs.analyse import analyse_bag

@@ -18,7 +18,7 @@ import pytest
 from scipy.stats import binomtest
 
 from exsce_dsl import api
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
 

@@ -20,7 +20,7 @@ from tests.bag_surgery import bag_span, cut, drop, reset_clock, thin
 from tests.conftest import run_exscec
 
 from exsce_dsl.cli.common import ExitCode
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.sim.run import simulate
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "brsu_building_c"

@@ -140,7 +140,7 @@ def test_every_exscec_line_parses(block: Block, words: list[str]) -> None:
 
 def test_the_readmes_start_from_your_bag_runs_as_written(tmp_path: Path) -> None:
     """The four commands on a Nav2 run's bag the executor writes, named as the README names it."""
-    from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.lang import load_spec
     from exsce_dsl.sim.run import simulate
 
     readme = (ROOT / "README.md").read_text(encoding="utf-8")

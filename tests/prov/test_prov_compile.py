@@ -22,7 +22,7 @@ from scenario_builders import (
 )
 
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.lang.method_yaml import import_scenario_yaml
+from exsce_dsl.lang import import_scenario_yaml
 from exsce_dsl.model import (
     Area,
     Assignment,

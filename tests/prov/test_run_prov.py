@@ -12,7 +12,7 @@ from prov.model import ProvDocument
 from pyoxigraph import Literal, NamedNode, Quad
 
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Position, Scenario
 from exsce_dsl.model.derivation import Derivation, TransformationStep
 from exsce_dsl.model.oracles import Oracle, OracleType

@@ -26,7 +26,7 @@ from rdflib.compare import isomorphic
 from scenario_builders import large_scenario, merged, scenario_c
 
 from exsce_dsl.errors import ExportError
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.prov import compile_scenario, identifiers
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, Namespaces
 from exsce_dsl.rdf import FORMATS, as_dataset, serialize, text, to_dataset, to_quads

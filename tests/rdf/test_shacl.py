@@ -17,7 +17,7 @@ from prov.model import ProvDocument
 from pyoxigraph import DefaultGraph, Literal, NamedNode, Quad
 
 from exsce_dsl.errors import Diagnostic
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.prov import compile_scenario, source_locations
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE

@@ -16,7 +16,7 @@ import pytest
 from campaign_samples import DISTANCE, DURATION, REMOVE, SHRINKINGS, sample_trials
 from test_report import ARTIFACTS, _chromium
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model.campaign import CampaignPlan, CampaignRecord, Trial
 from exsce_dsl.prov import compile_scenario
 from exsce_dsl.prov.campaign import compile_campaign, compile_shrinking, compile_trial

@@ -20,7 +20,7 @@ from matplotlib.figure import Figure
 from matplotlib.text import Annotation, Text
 from matplotlib.transforms import Bbox
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model.geometry import Position
 from exsce_dsl.model.runs import Hotspot
 from exsce_dsl.model.verdicts import Outcome, Verdict

@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.report.contents import gather
 from exsce_dsl.report.plots import trajectory_figure
 from exsce_dsl.runs.signals.trajectories import trajectories

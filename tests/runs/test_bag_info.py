@@ -15,7 +15,7 @@ from tests.bag_factory import typestore_for, write_bag
 from tests.clock_bags import restamp
 from tests.real_shapes import SHAPES
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.runs.bag_info import bag_info
 from exsce_dsl.sim.run import simulate
 

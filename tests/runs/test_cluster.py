@@ -25,7 +25,7 @@ import pytest
 from distributed import Client, LocalCluster
 from pyoxigraph import CanonicalizationAlgorithm, Dataset
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.runs.ingest import IngestStatus, ingest_bags
 from exsce_dsl.sim.run import simulate
 from exsce_dsl.store.embedded import EmbeddedStore

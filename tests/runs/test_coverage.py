@@ -18,7 +18,7 @@ from rosbags.highlevel import AnyReader
 from tests.bag_factory import Topic, typestore_for
 from tests.bag_surgery import bag_span, cut, drop, reset_clock, rewrite, thin
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.coverage import CoverageGap, Shortfall
 from exsce_dsl.model.runs import RunStatus

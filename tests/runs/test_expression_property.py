@@ -20,7 +20,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.lang.build import analyse, load_spec
+from exsce_dsl.lang import analyse, load_spec
 from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.sim.run import simulate
 

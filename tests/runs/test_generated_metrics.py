@@ -13,7 +13,7 @@ import math
 import pytest
 import reference_metrics as reference
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model.metrics import METRICS
 from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.sim.executor import Fault

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from rosbags.highlevel import AnyReader
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.runs.ingest import ingest_bags
 from exsce_dsl.sim.run import simulate
 from exsce_dsl.store.open import open_store

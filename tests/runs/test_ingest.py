@@ -11,7 +11,7 @@ import pytest
 from rosbags.rosbag1 import Reader as Ros1Reader
 from rosbags.rosbag1 import Writer as Ros1Writer
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model.runs import MetricScope, MetricValue
 from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.runs.bags.reading import BagError

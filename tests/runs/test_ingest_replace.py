@@ -21,7 +21,7 @@ from rosbags.highlevel import AnyReader
 
 from exsce_dsl import api
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.oracles.verify import judge_runs
 from exsce_dsl.oracles.workflows import verify_runs
 from exsce_dsl.runs.analyse import analyse_bag

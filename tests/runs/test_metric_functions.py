@@ -17,7 +17,7 @@ from typing import Any
 import pytest
 from rosbags.highlevel import AnyReader
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model.expressions import CONDITION_AGGREGATES, FUNCTIONS, Aggregate, Call, walk
 from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.sim.run import simulate

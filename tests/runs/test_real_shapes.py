@@ -33,7 +33,7 @@ from rosbags.rosbag2 import Writer as Ros2Writer
 from tests.bag_factory import typestore_for, write_bag
 from tests.real_shapes import SHAPES
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.runs import MetricScope
 from exsce_dsl.runs.analyse import AnalysedRun, analyse_bag

@@ -25,7 +25,7 @@ from ros1_graph import require_ros1, ros1_graph
 from rosbags.highlevel import AnyReader
 from rosbags.rosbag1 import Reader as Ros1Reader
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.runs.ingest import ingest_bags
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.queries import MetricReading, run_metric_values, run_segment_values

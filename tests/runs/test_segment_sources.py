@@ -13,7 +13,7 @@ from operator import attrgetter
 import numpy as np
 import pytest
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Pose, Position, Scenario
 from exsce_dsl.model.conventions import Tolerance
 from exsce_dsl.runs.segments.arrival import arrival_segments

@@ -21,7 +21,7 @@ from tests.real_shapes import ROUTE, SHAPES, pose_topic
 from yard_spec import yard_text
 
 from exsce_dsl.errors import BagError, ExportError
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.lang.occupancy import FREE, OCCUPIED, UNKNOWN, load_occupancy_grid
 from exsce_dsl.model import Specification
 from exsce_dsl.runs.analyse import AnalysedRun, analyse_bag

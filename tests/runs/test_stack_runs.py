@@ -17,7 +17,7 @@ from rosbags.typesys import Stores, get_typestore
 from yard_spec import yard_text
 
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.prov.run import compile_run
 from exsce_dsl.prov.serialize import serialize_prov

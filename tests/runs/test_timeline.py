@@ -21,7 +21,7 @@ from rosbags.highlevel import AnyReader
 from tests.bag_factory import Topic, typestore_for, write_bag
 from tests.clock_bags import CLOCK, CLOCK_TYPE, restamp
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.prov.run import compile_run
 from exsce_dsl.rdf import to_quads, validate

@@ -33,7 +33,7 @@ from rosbags.rosbag2 import Reader as Ros2Reader
 from rosbags.rosbag2 import StoragePlugin
 from rosbags.rosbag2 import Writer as Ros2Writer
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.messages import path_of
 from exsce_dsl.model.runs import MetricScope, Run

@@ -13,7 +13,7 @@ from tests.bag_factory import typestore_for, write_bag
 from tests.real_shapes import kitti
 
 from exsce_dsl.errors import BagError
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.sim.run import simulate
 from exsce_dsl.suggest import closest_several

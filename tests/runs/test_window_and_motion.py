@@ -18,8 +18,7 @@ from rosbags.highlevel import AnyReader
 from tests.bag_factory import POSE_STAMPED, Topic, header, point, quaternion, typestore_for, write_bag
 
 from exsce_dsl.errors import BagError
-from exsce_dsl.lang.build import load_spec
-from exsce_dsl.lang.formatter import format_spec_document
+from exsce_dsl.lang import format_spec_document, load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.runs.analyse import AnalysedRun, analyse_bag
 from exsce_dsl.sim.run import simulate

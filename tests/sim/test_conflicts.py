@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario, Task
 from exsce_dsl.sim.conflicts import CLEARANCE, conflict_repairs
 from exsce_dsl.sim.executor import Execution, Fault, execute

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.sim.executor import Execution, Fault, GoalStatus, execute
 from exsce_dsl.sim.motion import DT

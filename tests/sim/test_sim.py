@@ -11,7 +11,7 @@ import pytest
 from rosbags.highlevel import AnyReader
 
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model import MissionType
 from exsce_dsl.sim.executor import Fault, GoalStatus, execute
 from exsce_dsl.sim.messages import FEEDBACK, RESULT, typestore
@@ -211,7 +211,7 @@ def test_the_recorders_provenance_is_written_beside_the_bag(scenario_d, tmp_path
 
 def test_any_seed_gives_a_bag_with_valid_stamps(tmp_path):
     """Seed 100001 once started in the year 2300, past what a nanosecond stamp (and ROS 1 time) holds."""
-    from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.lang import load_spec
     from exsce_dsl.model.messages import path_of
     from exsce_dsl.runs.bags.reading import Wanted, read_bag
     from exsce_dsl.sim.run import EPOCH, simulate

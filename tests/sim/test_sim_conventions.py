@@ -17,7 +17,7 @@ from rosbags.typesys import Stores, get_typestore
 
 from exsce_dsl.cli.run_commands import simulate as simulate_command
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.messages.navigation import navigation_catalogue, register_navigation_types
 from exsce_dsl.model.conventions import METHOD, NAV2
 from exsce_dsl.sim.executor import Fault, GoalStatus

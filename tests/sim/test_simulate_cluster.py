@@ -23,7 +23,7 @@ import pytest
 from distributed import Client, LocalCluster, get_task_stream
 
 from exsce_dsl.api import workflows
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.sim.run import simulate
 from exsce_dsl.store.open import open_store
 from exsce_dsl.store.queries.campaigns import campaign_record, campaigns

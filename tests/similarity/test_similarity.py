@@ -7,7 +7,7 @@ import json
 
 import pytest
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.prov import compile_scenario
 from exsce_dsl.similarity.clustering import cluster
 from exsce_dsl.similarity.distances import (

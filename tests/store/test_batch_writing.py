@@ -16,7 +16,7 @@ import pytest
 from prov.model import ProvDocument
 from pyoxigraph import BlankNode, CanonicalizationAlgorithm, Dataset
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.prov import compile_scenario
 from exsce_dsl.prov.run import compile_run

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 from tests.bag_surgery import cut, drop
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model.coverage import Shortfall
 from exsce_dsl.prov.run import compile_run
 from exsce_dsl.rdf import to_quads, validate

@@ -21,7 +21,7 @@ from prov.model import ProvDocument
 from pyoxigraph import QueryResultsFormat, RdfFormat, parse
 from SPARQLWrapper import CSV, JSON, POST, POSTDIRECTLY, TSV, XML, SPARQLWrapper
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.prov import compile_scenario
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.server import read_serve_info, serve_info_path

@@ -10,7 +10,7 @@ import pytest
 from prov.model import ProvDocument
 from pyoxigraph import Literal, NamedNode, Quad
 
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.prov import compile_scenario
 from exsce_dsl.rdf import to_quads
 from exsce_dsl.store.base import Store, StoreConflictError, StoreError

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.derivation import TaskOrigin, TransformationStep
 from exsce_dsl.prov.derivation import compile_derivation

@@ -12,8 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.lang.build import analyse, load_spec
-from exsce_dsl.lang.formatter import format_document, format_spec_document
+from exsce_dsl.lang import analyse, format_document, format_spec_document, load_spec
 from exsce_dsl.model import (
     Area,
     Assignment,

@@ -15,7 +15,7 @@ from prov.model import ProvDocument
 
 from exsce_dsl.derive.expect import SUMMED, Expected, expected_metric, learning_runs
 from exsce_dsl.derive.workflows import DerivedSpec, StoredDerivation, add_derivation, derive_spec
-from exsce_dsl.lang.build import load_spec
+from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.document import Specification
 from exsce_dsl.oracles.workflows import Baseline, Verification, build_baseline, verify_runs

@@ -102,7 +102,7 @@ def derive(
           -t remove_robot --robot tiago2 --reassign tiago1 -o c_one.exsce --expect --add-to-store
     """
     from exsce_dsl.derive.workflows import add_derivation, derive_spec
-    from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.lang import load_spec
     from exsce_dsl.store.open import open_store
     from exsce_dsl.transform.transformations import TRANSFORMATIONS
 
@@ -203,7 +203,7 @@ def expect(spec: str, scenario_id: str | None, include_all: bool, store_url: str
       exscec expect examples/brsu_building_c/scenario_c_alone.exsce
     """
     from exsce_dsl.derive.expect import SUMMED, expected_metric, learning_runs
-    from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.lang import load_spec
     from exsce_dsl.store.open import open_store
 
     scenario = load_spec(spec).scenario(scenario_id)

@@ -155,7 +155,7 @@ def execute(
     """
     from exsce_dsl.api.execution import execute_ros1
     from exsce_dsl.errors import ExecutionInterrupted
-    from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.lang import load_spec
 
     scenario = load_spec(spec).scenario(scenario_id)
     try:

@@ -198,7 +198,7 @@ def explore(
         named_executor,
     )
     from exsce_dsl.explore.figures import random_baseline
-    from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.lang import load_spec
     from exsce_dsl.model.campaign import Trial
     from exsce_dsl.oracles.campaign_junit import campaign_junit, run_seconds
     from exsce_dsl.parallel.cluster import cluster_address

@@ -65,7 +65,7 @@ def _target_command(target: Target) -> click.Command:
     @click.option("--force", is_flag=True, help="Replace files that exist.")
     @reports_errors
     def command(spec: str, out_dir: str, scenario_id: str | None, force: bool) -> None:
-        from exsce_dsl.lang.build import load_spec
+        from exsce_dsl.lang import load_spec
 
         for path in target.generate(load_spec(spec), scenario_id, Path(out_dir), force):
             click.echo(f"wrote {path}", err=True)

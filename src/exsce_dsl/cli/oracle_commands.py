@@ -48,7 +48,7 @@ def baseline(spec: str, scenario_id: str | None, include_all: bool, store_url: s
       exscec baseline examples/brsu_building_c/scenario_c.exsce
       exscec baseline examples/brsu_building_c/scenario_c.exsce --all-runs
     """
-    from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.lang import load_spec
     from exsce_dsl.oracles.workflows import build_baseline
     from exsce_dsl.store.open import open_store
     from exsce_dsl.tables import aligned
@@ -185,7 +185,7 @@ def verify(
           --required-pass-rate 0.5 --confidence 0.9  # exits 3: 2 runs are too few
     """
     from exsce_dsl.cli.trial_commands import report_trial
-    from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.lang import load_spec
     from exsce_dsl.oracles.trial_runs import REPEAT_FOLDER, REPEAT_SEED, verify_trial
     from exsce_dsl.oracles.workflows import IngestFailed, verify_runs
     from exsce_dsl.store.open import open_store

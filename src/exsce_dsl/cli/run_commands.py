@@ -113,7 +113,7 @@ def simulate(
       exscec simulate examples/brsu_building_c/scenario_c.exsce --fault overspeed:tiago1 -o runs/faulty/
       exscec simulate examples/brsu_building_c/scenario_c.exsce --convention nav2 --format mcap -o runs/
     """
-    from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.lang import load_spec
     from exsce_dsl.parallel.cluster import cluster_address
     from exsce_dsl.sim.executor import Fault
     from exsce_dsl.sim.run import simulate as play
@@ -200,7 +200,7 @@ def ingest(
       exscec ingest --replace runs/*.bag --scenario examples/brsu_building_c/scenario_c.exsce
       exscec ingest runs/*.bag --scenario examples/brsu_building_c/scenario_c.exsce --strict
     """
-    from exsce_dsl.lang.spec_cache import load_spec_cached
+    from exsce_dsl.lang import load_spec_cached
     from exsce_dsl.store.open import StoreOpening
 
     scenario = load_spec_cached(spec).scenario(scenario_id)

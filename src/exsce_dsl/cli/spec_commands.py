@@ -93,7 +93,7 @@ def compile_command(
       exscec compile examples/brsu_building_c/scenario_c.exsce -f json -o scenario_c.prov.json
       exscec compile examples/brsu_building_c/scenario_c.exsce --store
     """
-    from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.lang import load_spec
     from exsce_dsl.prov.spec import compile_spec_scenario
     from exsce_dsl.rdf import serialize
 
@@ -132,10 +132,7 @@ def fmt(specs: tuple[str, ...], check_only: bool, show_diff: bool) -> None:
       exscec fmt --check examples     # for CI: fails if a file below examples/ would change
       exscec fmt specs/
     """
-    from exsce_dsl.lang.build import load_spec
-    from exsce_dsl.lang.formatter import format_spec_document
-    from exsce_dsl.lang.lexical import comments
-    from exsce_dsl.lang.loader import display_path
+    from exsce_dsl.lang import comments, display_path, format_spec_document, load_spec
     from exsce_dsl.textfiles import read_text
 
     changed = []
@@ -213,9 +210,7 @@ def import_command(
     Example:
       exscec import out/scenarios/scenario_c.yaml -t out/config/tasks -o specs/
     """
-    from exsce_dsl.lang.method_yaml import import_scenario_yaml
-    from exsce_dsl.lang.oracle_yaml import is_oracle_yaml
-    from exsce_dsl.lang.writer import write_documents
+    from exsce_dsl.lang import import_scenario_yaml, is_oracle_yaml, write_documents
 
     if is_oracle_yaml(Path(yaml_file)):
         _import_oracles(Path(yaml_file), spec_path, out_dir, force)
@@ -228,10 +223,13 @@ def import_command(
 
 
 def _import_oracles(yaml_file: Path, spec_path: str | None, out_dir: str, force: bool) -> None:
-    from exsce_dsl.lang.build import load_spec
-    from exsce_dsl.lang.formatter import format_document
-    from exsce_dsl.lang.oracle_yaml import acceptance_document, import_oracles
-    from exsce_dsl.lang.writer import write_documents
+    from exsce_dsl.lang import (
+        acceptance_document,
+        format_document,
+        import_oracles,
+        load_spec,
+        write_documents,
+    )
     from exsce_dsl.model import Document
 
     if spec_path is None:
@@ -284,10 +282,7 @@ def export_command(spec: str, target: str, out_dir: str, scenario_id: str | None
       exscec export examples/brsu_building_c/scenario_c.exsce --to oracle-yaml -o out/  # exits 2
     """
     from exsce_dsl.errors import ExportError
-    from exsce_dsl.lang.build import load_spec
-    from exsce_dsl.lang.gherkin import export_gherkin
-    from exsce_dsl.lang.method_yaml import export_yaml
-    from exsce_dsl.lang.oracle_yaml import export_oracle_file
+    from exsce_dsl.lang import export_gherkin, export_oracle_file, export_yaml, load_spec
 
     loaded = load_spec(spec)
     if target == "gherkin":

@@ -77,7 +77,7 @@ def stand_in(
           --fault overspeed:tiago1 --speed-up 20
     """
     from exsce_dsl.api.stand_in import stand_in as play
-    from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.lang import load_spec
 
     if not ros1:
         raise click.UsageError("say --ros1: the stand-in plays on ROS 1 only (yet)")

@@ -12,7 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from exsce_dsl.codegen.output import write_files
-from exsce_dsl.lang.standard_metrics import standard_metrics
+from exsce_dsl.lang import standard_metrics
 from exsce_dsl.model import Specification
 from exsce_dsl.resources import package_file
 from exsce_dsl.runs.metrics.monitor_code import GENERATOR, monitor_source

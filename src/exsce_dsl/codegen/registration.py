@@ -26,7 +26,7 @@ def _target_generator(name: str) -> Any:
     def generate(
         metamodel: Any, model: Any, output_path: str | None, overwrite: bool, debug: bool, **custom_args: Any
     ) -> None:
-        from exsce_dsl.lang.build import load_spec
+        from exsce_dsl.lang import load_spec
 
         scenario_id = custom_args.pop("scenario", None)
         if custom_args:

@@ -24,8 +24,7 @@ from xml.sax.saxutils import escape
 
 from exsce_dsl.codegen.output import write_files
 from exsce_dsl.errors import SourceLocation
-from exsce_dsl.lang.format_acceptance import expectation_text
-from exsce_dsl.lang.standard_metrics import standard_metrics
+from exsce_dsl.lang import expectation_text, standard_metrics
 from exsce_dsl.messages.catalogue import MessageTypeError
 from exsce_dsl.messages.user import configured_catalogue
 from exsce_dsl.model import Scenario, Specification

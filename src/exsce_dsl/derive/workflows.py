@@ -9,7 +9,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from exsce_dsl.derive.expect import RELATIVE_TOLERANCE, metamorphic_acceptance
-from exsce_dsl.lang.formatter import declared_poses, format_document
+from exsce_dsl.lang import declared_poses, format_document
 from exsce_dsl.model import Acceptance, Scenario
 from exsce_dsl.model.document import Specification
 from exsce_dsl.model.oracles import Oracle

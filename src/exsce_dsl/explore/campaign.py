@@ -39,7 +39,7 @@ from exsce_dsl.explore.cover import covering_derivations
 from exsce_dsl.explore.draw import Candidate, draw_derivations
 from exsce_dsl.explore.executors import Executor, bags_in
 from exsce_dsl.explore.shrink import MAX_TRIES, shrink
-from exsce_dsl.lang.formatter import declared_poses, format_document
+from exsce_dsl.lang import declared_poses, format_document
 from exsce_dsl.model import Acceptance, Scenario
 from exsce_dsl.model.acceptance import BasicRelation
 from exsce_dsl.model.campaign import (

@@ -2,7 +2,7 @@
 
 The language server parses and caches each declaration on its own
 (:mod:`exsce_dsl.lang.incremental`), and completion parses only the declaration
-the cursor is in (:mod:`exsce_dsl.lang.expected`).  This is lexical only: strings,
+the cursor is in (:mod:`exsce_dsl.lang.editor.continuations`).  This is lexical only: strings,
 comments and braces.  A declaration starts with its keyword at brace depth 0,
 first in the text or right after the closing brace of the previous declaration
 or an import's string; nothing else can stand there in valid text, so valid text

@@ -61,14 +61,14 @@ def load_spec_cached(path: str | Path) -> Specification:
     depends on has changed (see the module's description); raises the same errors."""
     folder = cache_folder()
     if folder is None:
-        from exsce_dsl.lang.build import load_spec
+        from exsce_dsl.lang.build.specification import load_spec
 
         return load_spec(path)
     entry = folder / "specs" / f"{_entry_name(path)}.pickle"
     found = _valid_entry(read_cached(entry))
     if found is not None:
         return found
-    from exsce_dsl.lang.build import load_spec_reading
+    from exsce_dsl.lang.build.specification import load_spec_reading
 
     spec, read = load_spec_reading(path)
     dependencies = tuple((p, _digest(p)) for p in [*read, *_map_files(spec)])

@@ -3,7 +3,7 @@ what may be referred to there (poses where a waypoint goes, robots of the scenar
 mission, a scenario's metrics in its acceptance criteria, relations, transformations, and in
 a metric the topics it reads, their messages' fields and message types: :mod:`.fields`).
 
-The grammar says *whether* a name may come (:mod:`exsce_dsl.lang.expected`); the words
+The grammar says *whether* a name may come (:mod:`exsce_dsl.lang.editor.continuations`); the words
 before the point say *which kind* of name.  Names come from the files' indexes, which
 keep a file's last complete parse while its text does not parse.
 """
@@ -15,8 +15,7 @@ from dataclasses import dataclass
 
 from lsprotocol import types
 
-from exsce_dsl.lang.expected import Expected
-from exsce_dsl.lang.symbols import Symbol
+from exsce_dsl.lang import Continuations, Symbol
 from exsce_dsl.lsp.navigation import Names
 from exsce_dsl.model.metrics import METRICS
 from exsce_dsl.oracles.relations import relation, relation_names
@@ -90,12 +89,12 @@ class Wanted:
     environment: str | None = None
 
 
-def wanted_names(expected: Expected, names: Names) -> list[Wanted]:
+def wanted_names(allowed: Continuations, names: Names) -> list[Wanted]:
     """Which kinds of names fit at the point, from the words before it."""
-    before = expected.before
+    before = allowed.before
     if not before:
         return []
-    declaration = expected.declaration
+    declaration = allowed.declaration
     if declaration == "scenario":
         return _in_scenario(before, names)
     if declaration == "task":
@@ -250,7 +249,7 @@ def _detail(symbol: Symbol) -> str:
 
 
 def complete(
-    expected: Expected,
+    allowed: Continuations,
     names: Names,
     typed: str,
     replace: types.Range,
@@ -289,8 +288,8 @@ def complete(
 
     for label, what, detail in offered:
         add(label, _OFFERED_KINDS.get(what, types.CompletionItemKind.Text), detail, "0")
-    if expected.name or not expected.known:
-        for wanted in wanted_names(expected, names):
+    if allowed.name or not allowed.known:
+        for wanted in wanted_names(allowed, names):
             for symbol in candidates(wanted, names, all_symbols):
                 kind = _ITEM_KINDS.get(symbol.kind, types.CompletionItemKind.Text)
                 add(symbol.name, kind, _detail(symbol), "0")
@@ -298,15 +297,15 @@ def complete(
                 for name, info in METRICS.items():
                     if not names.symbols("metric", name):
                         add(name, types.CompletionItemKind.Field, f"built-in metric: {info.meaning}", "0")
-    for keyword in expected.keywords:
+    for keyword in allowed.keywords:
         add(keyword, types.CompletionItemKind.Keyword, "keyword", "1")
-    if expected.declaration == "acceptance" and {"stays", "is"} & set(expected.keywords):
+    if allowed.declaration == "acceptance" and {"stays", "is"} & set(allowed.keywords):
         for name in relation_names():
             if name in _RELATION_PHRASES:
                 phrase = _RELATION_PHRASES[name]
                 params = ", ".join(sorted(relation(name).parameters))
                 add(name, types.CompletionItemKind.Operator, f"relation {name}({params})", "2", insert=phrase)
-    if expected.declaration == "derive" and "remove" in expected.keywords:
+    if allowed.declaration == "derive" and "remove" in allowed.keywords:
         for name, (snippet, plain) in _STEPS.items():
             if name in TRANSFORMATIONS:
                 kind = types.CompletionItemKind.Snippet

@@ -7,10 +7,7 @@ import os
 
 from lsprotocol import types
 
-from exsce_dsl.lang.expected import expected_at
-from exsce_dsl.lang.formatter import format_spec_document
-from exsce_dsl.lang.lexical import comments
-from exsce_dsl.lang.loader import display_path, import_target
+from exsce_dsl.lang import comments, continuations_at, display_path, format_spec_document, import_target
 from exsce_dsl.lsp.actions import quick_fixes
 from exsce_dsl.lsp.completion import complete
 from exsce_dsl.lsp.convert import path_of, uri_of
@@ -86,24 +83,24 @@ def _editing(server: ExsceLanguageServer) -> None:
         text = ls.workspace.get_text_document(params.text_document.uri).source
         lines = ls.text_lines(text)
         offset = lines.offset(params.position)
-        expected = expected_at(text, offset)
-        if expected is None:
+        allowed = continuations_at(text, offset)
+        if allowed is None:
             return types.CompletionList(is_incomplete=False, items=[])
         path = path_of(params.text_document.uri)
         names = Names(ls.project.visible_indexes(path, last_complete=True), ls.project.reachable(path))
-        start = lines.position(*lines.location(expected.word_start))
+        start = lines.position(*lines.location(allowed.word_start))
         capabilities = ls.client_capabilities.text_document
         item = capabilities.completion.completion_item if capabilities and capabilities.completion else None
         snippets = bool(item and item.snippet_support)
-        typed = text[expected.word_start : offset]
+        typed = text[allowed.word_start : offset]
         offer = None
-        if expected.declaration == "metric":
-            offer = offers(text, offset, expected.word_start, "message type" in expected.others)
-        if offer is not None and offer.start != expected.word_start:  # a message type holds '/'
+        if allowed.declaration == "metric":
+            offer = offers(text, offset, allowed.word_start, "message type" in allowed.others)
+        if offer is not None and offer.start != allowed.word_start:  # a message type holds '/'
             start = lines.position(*lines.location(offer.start))
             typed = text[offer.start : offset]
         offered = offer.items if offer is not None else []
-        return complete(expected, names, typed, types.Range(start, params.position), snippets, offered)
+        return complete(allowed, names, typed, types.Range(start, params.position), snippets, offered)
 
     @server.feature(types.TEXT_DOCUMENT_HOVER)
     async def hover(ls: ExsceLanguageServer, params: types.HoverParams) -> types.Hover | None:

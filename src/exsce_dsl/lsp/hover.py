@@ -7,8 +7,7 @@ import re
 from collections.abc import Callable
 
 from exsce_dsl.errors import SourceLocation
-from exsce_dsl.lang.chunks import declaration_chunks, tokens
-from exsce_dsl.lang.symbols import Symbol
+from exsce_dsl.lang import Symbol, declaration_chunks, tokens
 from exsce_dsl.lsp.keywords import MEANINGS
 from exsce_dsl.lsp.navigation import Names, Target
 from exsce_dsl.model.metrics import METRICS, SI_UNIT

@@ -3,7 +3,7 @@
 Ids of poses, tasks, environments, robot types, scenarios and metrics are global;
 a robot's or a mission's belongs to a scenario, and a derived scenario has its
 base's (and those its steps add).  Everything here works on the files' indexes
-(:mod:`exsce_dsl.lang.symbols`), which exist even when a specification is not
+(:mod:`exsce_dsl.lang.editor.symbols`), which exist even when a specification is not
 valid.
 """
 
@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 from exsce_dsl.errors import RenameError as RenameError
 from exsce_dsl.errors import SourceLocation
-from exsce_dsl.lang.symbols import SCOPED_KINDS, FileIndex, Reference, Symbol
+from exsce_dsl.lang import SCOPED_KINDS, FileIndex, Reference, Symbol
 from exsce_dsl.model.names import is_valid_name
 
 NOT_NAMES = frozenset({"acceptance", "criterion"})

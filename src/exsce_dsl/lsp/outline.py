@@ -7,7 +7,7 @@ from collections.abc import Callable, Iterable
 from lsprotocol import types
 
 from exsce_dsl.errors import SourceLocation
-from exsce_dsl.lang.symbols import FileIndex, Symbol
+from exsce_dsl.lang import FileIndex, Symbol
 from exsce_dsl.lsp.convert import TextLines
 
 _SYMBOL_KINDS = {

@@ -20,10 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from exsce_dsl.errors import Diagnostic
-from exsce_dsl.lang.editor import analyse_for_editor, index_text
-from exsce_dsl.lang.incremental import ParseCache
-from exsce_dsl.lang.loader import display_path
-from exsce_dsl.lang.symbols import FileIndex
+from exsce_dsl.lang import FileIndex, ParseCache, analyse_for_editor, display_path, index_text
 from exsce_dsl.model.document import Specification
 from exsce_dsl.resources import package_file
 

@@ -20,7 +20,7 @@ from pygls.lsp.server import LanguageServer
 
 from exsce_dsl import __version__
 from exsce_dsl.errors import Diagnostic, SourceLocation
-from exsce_dsl.lang.symbols import FileIndex
+from exsce_dsl.lang import FileIndex
 from exsce_dsl.lsp.convert import TextLines, lsp_diagnostic, path_of, uri_of
 from exsce_dsl.lsp.navigation import Names, Target
 from exsce_dsl.lsp.project import Document, Project, RootAnalysis

@@ -56,7 +56,7 @@ def check_text(text: str, folder: str | None = None, name: str = DEFAULT_NAME) -
 
 
 def _check(text: str, base: Path, name: str) -> dict[str, Any]:
-    from exsce_dsl.lang.build import analyse
+    from exsce_dsl.lang import analyse
     from exsce_dsl.rdf.shacl import check_spec_shapes
 
     root = str(base / name)

@@ -23,7 +23,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field
 
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.lang.standard_metrics import standard_metrics
+from exsce_dsl.lang import standard_metrics
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.coverage import CoverageGap, Shortfall
 from exsce_dsl.store.base import Store

@@ -8,7 +8,7 @@ import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-from exsce_dsl.lang.standard_metrics import standard_metrics
+from exsce_dsl.lang import standard_metrics
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.acceptance import Moment, Window
 from exsce_dsl.model.metrics import Combine, ComputedFor, metric_info

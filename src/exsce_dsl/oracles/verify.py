@@ -6,7 +6,7 @@ import math
 from collections.abc import Mapping, Sequence
 
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.lang.standard_metrics import standard_metrics
+from exsce_dsl.lang import standard_metrics
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.acceptance import Window
 from exsce_dsl.model.coverage import CoverageGap, Shortfall, TopicRate

@@ -18,7 +18,7 @@ from exsce_dsl.model.derived import DerivedScenario
 
 
 def _generate(model: Any, output_path: str | None, overwrite: bool, fmt: str, suffix: str) -> None:
-    from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.lang import load_spec
     from exsce_dsl.prov.spec import compile_spec_scenario
     from exsce_dsl.rdf import serialize
 

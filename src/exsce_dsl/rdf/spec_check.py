@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from exsce_dsl.errors import Diagnostic
-from exsce_dsl.lang.build import analyse
+from exsce_dsl.lang import analyse
 from exsce_dsl.model.document import Specification
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE
 from exsce_dsl.rdf.shacl import check_spec_shapes

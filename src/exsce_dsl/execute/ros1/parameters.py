@@ -22,7 +22,7 @@ import yaml
 
 from exsce_dsl.errors import RosGraphError
 from exsce_dsl.execute.ros1.graph import Master
-from exsce_dsl.lang.yaml_export import scenario_to_yaml
+from exsce_dsl.lang import scenario_to_yaml
 from exsce_dsl.model import Scenario
 
 SCENARIO_NAMESPACE = "/scenario"

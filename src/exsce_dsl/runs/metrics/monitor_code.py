@@ -19,7 +19,7 @@ import types
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from exsce_dsl.lang.format_metrics import expression_text
+from exsce_dsl.lang import expression_text
 from exsce_dsl.model.expressions import Aggregate, Expression, Field, WindowValue, is_constant, walk
 from exsce_dsl.model.messages import FEEDBACK, RESULT
 from exsce_dsl.model.metrics import Combine, ComputedFor, MetricDefinition

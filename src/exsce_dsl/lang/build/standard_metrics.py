@@ -22,7 +22,7 @@ def standard_metrics() -> tuple[MetricDefinition, ...]:
 
 
 def _parse_standard_metrics() -> tuple[MetricDefinition, ...]:
-    from exsce_dsl.lang.build_metrics import build_metric
+    from exsce_dsl.lang.build.metrics import build_metric
     from exsce_dsl.lang.parser import parse_text
     from exsce_dsl.messages.catalogue import standard_catalogue
     from exsce_dsl.resources import package_file

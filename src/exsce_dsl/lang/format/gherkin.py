@@ -2,7 +2,7 @@
 
 One ``Feature`` per scenario, one Gherkin ``Scenario`` per criterion, its givens as
 ``Given``/``And`` steps, its *when* as ``When`` and its clauses as ``Then``/``And``,
-worded as in the DSL (:func:`exsce_dsl.lang.format_acceptance.expectation_text`).
+worded as in the DSL (:func:`exsce_dsl.lang.format.acceptance.expectation_text`).
 A step is one line of text, so titles and ids are written on one line.
 """
 
@@ -11,7 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from exsce_dsl.errors import ExportError
-from exsce_dsl.lang.format_acceptance import expectation_text
+from exsce_dsl.lang.format.acceptance import expectation_text
 from exsce_dsl.model import Scenario, Specification
 from exsce_dsl.model.acceptance import Acceptance, BaselineRuns, Criterion, Given, When
 from exsce_dsl.model.names import is_valid_name

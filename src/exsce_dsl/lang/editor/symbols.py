@@ -15,8 +15,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from exsce_dsl.errors import SourceLocation
-from exsce_dsl.lang.build import position_of
-from exsce_dsl.lang.build_derivation import step_of
+from exsce_dsl.lang.build.derivation import step_of
+from exsce_dsl.lang.build.poses import position_of
 from exsce_dsl.lang.lexical import quantity_text
 from exsce_dsl.lang.parser import ParsedFile
 

@@ -6,7 +6,7 @@ from collections.abc import Sequence
 from pathlib import Path, PurePosixPath
 
 from exsce_dsl.errors import ExportError
-from exsce_dsl.lang.formatter import declared_poses, format_document
+from exsce_dsl.lang.format.document import declared_poses, format_document
 from exsce_dsl.model import Document, Environment
 
 

@@ -17,10 +17,10 @@ import os
 from collections.abc import Iterable, Mapping, Sequence
 
 from exsce_dsl.errors import SourceLocation
-from exsce_dsl.lang.build_expressions import read_quantity
-from exsce_dsl.lang.format_acceptance import acceptance_lines
-from exsce_dsl.lang.format_derivation import derivation_lines
-from exsce_dsl.lang.format_metrics import metric_lines
+from exsce_dsl.lang.build.expressions import read_quantity
+from exsce_dsl.lang.format.acceptance import acceptance_lines
+from exsce_dsl.lang.format.derivation import derivation_lines
+from exsce_dsl.lang.format.metrics import metric_lines
 from exsce_dsl.lang.lexical import Comment, as_written, duration_text, read_angle, read_length
 from exsce_dsl.lang.lexical import number_text as _number
 from exsce_dsl.lang.lexical import string_literal as _string

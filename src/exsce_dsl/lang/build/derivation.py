@@ -8,10 +8,11 @@ from dataclasses import replace
 from typing import Any
 
 from exsce_dsl.errors import ExsceError, SourceLocation
-from exsce_dsl.lang.checks import check_environment_map
+from exsce_dsl.lang.build.checks import check_environment_map
+from exsce_dsl.lang.build.poses import position_of
 from exsce_dsl.lang.lexical import quantity_text
 from exsce_dsl.lang.parser import ParsedFile
-from exsce_dsl.lang.references import UnknownNames
+from exsce_dsl.lang.build.references import UnknownNames
 from exsce_dsl.model import Environment, Scenario, Task
 from exsce_dsl.model.derived import DerivedScenario, Step
 from exsce_dsl.transform.derivation import derive
@@ -63,8 +64,6 @@ def step_of(node: Any) -> tuple[str, dict[str, str | None]]:
     if kind == "RemoveStartPose":
         return "remove_start_pose", {"robot": _name(node.robot)}
     if kind == "MoveObstacle":
-        from exsce_dsl.lang.build import position_of  # not at the top: build imports this module
-
         p = position_of(node.position)
         metres = [p.x, p.y] + ([p.z] if p.z != 0.0 else [])  # as move_obstacle records it
         return "move_obstacle", {"obstacle": _name(node.obstacle), "to": ",".join(repr(v) for v in metres)}

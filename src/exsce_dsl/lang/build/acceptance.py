@@ -14,7 +14,7 @@ from typing import Any
 
 from exsce_dsl.errors import SourceLocation
 from exsce_dsl.lang.parser import ParsedFile
-from exsce_dsl.lang.references import UnknownNames, not_in_fleet
+from exsce_dsl.lang.build.references import UnknownNames, not_in_fleet
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.acceptance import (
     Acceptance,

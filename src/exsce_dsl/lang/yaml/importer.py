@@ -19,7 +19,7 @@ from pathlib import Path
 import yaml
 
 from exsce_dsl.errors import ExsceError, ImportFormatError, SourceLocation
-from exsce_dsl.lang.yaml_export import GOAL_TIMEOUT
+from exsce_dsl.lang.yaml.exporter import GOAL_TIMEOUT
 from exsce_dsl.model import (
     Area,
     Assignment,

@@ -43,7 +43,7 @@ _OTHER_RULES = {
 
 
 @dataclass(frozen=True)
-class Expected:
+class Continuations:
     """What may be written at a point."""
 
     word_start: int
@@ -64,7 +64,7 @@ class Expected:
         return "name" in self.others
 
 
-def expected_at(text: str, offset: int) -> Expected | None:
+def continuations_at(text: str, offset: int) -> Continuations | None:
     """What may come at ``offset`` of ``text``; None inside a comment or a string."""
     offset = max(0, min(offset, len(text)))
     window = max(0, offset - 200)
@@ -94,14 +94,14 @@ def expected_at(text: str, offset: int) -> Expected | None:
     except TextXSyntaxError as exc:
         at_end = (exc.line, exc.col) == _end_position(source + " ")
         if not at_end:
-            return Expected(word_start, declaration=declaration, before=before, known=False)
+            return Continuations(word_start, declaration=declaration, before=before, known=False)
         return _from_rules(exc.expected_rules or [], word_start, declaration, before)
-    return Expected(word_start, declaration=declaration, before=before)  # pragma: no cover
+    return Continuations(word_start, declaration=declaration, before=before)  # pragma: no cover
 
 
 def _from_rules(
     rules: list[Any], word_start: int, declaration: str | None, before: tuple[str, ...]
-) -> Expected:
+) -> Continuations:
     keywords: list[str] = []
     punctuation: list[str] = []
     others: set[str] = set()
@@ -118,7 +118,7 @@ def _from_rules(
                 punctuation.append(literal)
         elif name == "EOF":
             continue
-    return Expected(word_start, tuple(keywords), tuple(punctuation), frozenset(others), declaration, before)
+    return Continuations(word_start, tuple(keywords), tuple(punctuation), frozenset(others), declaration, before)
 
 
 def _without_areas(text: str, chunk: Chunk, end: int) -> str:

@@ -2,7 +2,7 @@
 
 References are resolved here rather than by textX so that *every* unknown
 name is reported (with a did-you-mean), not only the first one.  Checks that
-need the whole scenario live in :mod:`exsce_dsl.lang.checks`.
+need the whole scenario live in :mod:`exsce_dsl.lang.build.checks`.
 """
 
 from __future__ import annotations
@@ -13,16 +13,17 @@ from pathlib import Path
 from typing import Any
 
 from exsce_dsl.errors import Diagnostic, Severity, SourceLocation, SpecError, diagnostic_order
-from exsce_dsl.lang.build_acceptance import build_all_acceptance
-from exsce_dsl.lang.build_derivation import build_derivations
-from exsce_dsl.lang.build_metrics import build_metric
-from exsce_dsl.lang.build_signals import build_signals
-from exsce_dsl.lang.checks import check_environment_map, check_scenario
+from exsce_dsl.lang.build.acceptance import build_all_acceptance
+from exsce_dsl.lang.build.derivation import build_derivations
+from exsce_dsl.lang.build.metrics import build_metric
+from exsce_dsl.lang.build.poses import orientation_of, position_of
+from exsce_dsl.lang.build.signals import build_signals
+from exsce_dsl.lang.build.checks import check_environment_map, check_scenario
 from exsce_dsl.lang.lexical import quantity_parts, quantity_text, read_angle, read_duration, read_length
 from exsce_dsl.lang.loader import Parse, read_sources
 from exsce_dsl.lang.parser import ParsedFile
-from exsce_dsl.lang.references import UnknownNames, not_in_fleet
-from exsce_dsl.lang.standard_metrics import reserved_metric_names
+from exsce_dsl.lang.build.references import UnknownNames, not_in_fleet
+from exsce_dsl.lang.build.standard_metrics import reserved_metric_names
 from exsce_dsl.model import (
     Acceptance,
     Area,
@@ -104,7 +105,7 @@ def analyse_files(
 ) -> Analysis:
     """:func:`analyse` of files already parsed (the root first), with the problems found reading
     them; ``broken`` has the text of each file with a syntax error (the names they seem to
-    declare are not reported unknown: see :mod:`exsce_dsl.lang.references`), and ``parse``
+    declare are not reported unknown: see :mod:`exsce_dsl.lang.build.references`), and ``parse``
     reads the files not imported where an unknown name may be declared."""
     diagnostics = list(diagnostics)
     unknown = UnknownNames(files, broken, parse)
@@ -342,7 +343,7 @@ class _Builder:
                     pose = Pose(
                         decl.name,
                         position_of(decl.position),
-                        _orientation(decl.orientation),
+                        orientation_of(decl.orientation),
                         member.name,
                         pwhere,
                     )
@@ -368,7 +369,7 @@ class _Builder:
                 pose = Pose(
                     member.name,
                     position_of(member.position),
-                    _orientation(member.orientation),
+                    orientation_of(member.orientation),
                     None,
                     where,
                 )
@@ -391,7 +392,7 @@ class _Builder:
                             Pose(
                                 f"{task.name}-w{coordinate_count:03d}",
                                 position_of(wp.position),
-                                _orientation(wp.orientation),
+                                orientation_of(wp.orientation),
                                 None,
                                 pf.span(wp),
                             )
@@ -440,7 +441,7 @@ class _Builder:
             return None
         loc = pf.span(use)
         if use.orientation is not None:
-            return Pose(pose.id, pose.position, _orientation(use.orientation), pose.area, loc)
+            return Pose(pose.id, pose.position, orientation_of(use.orientation), pose.area, loc)
         return Pose(pose.id, pose.position, pose.orientation, pose.area, loc)
 
     # -------------------------------------------------------------- scenarios
@@ -553,22 +554,3 @@ def _ros(source: Any) -> RosResource | None:
     if source is None:
         return None
     return RosResource(source.package, source.path or None)
-
-
-def position_of(pos: Any) -> Position:
-    """A parsed `(x, y[, z])` with units, in metres (what the author wrote kept for the formatter)."""
-    unit = quantity_parts(pos.x)[1] or "m"
-    texts = [pos.x, pos.y] + ([pos.z] if pos.z is not None else [])
-    z = read_length(pos.z) if pos.z is not None else 0.0
-    return Position(read_length(pos.x), read_length(pos.y), z, unit, tuple(texts))
-
-
-def _orientation(orientation: Any) -> Orientation:
-    if orientation is None:
-        return Orientation()
-    unit = quantity_parts(orientation.yaw)[1] or "rad"
-    if orientation.__class__.__name__ == "Facing":
-        return Orientation(0.0, 0.0, read_angle(orientation.yaw), unit, (orientation.yaw,))
-    texts = (orientation.roll, orientation.pitch, orientation.yaw)
-    roll, pitch, yaw = (read_angle(t) for t in texts)
-    return Orientation(roll, pitch, yaw, unit, texts)

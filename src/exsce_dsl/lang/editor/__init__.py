@@ -1,0 +1,1 @@
+"""What only the language server uses: the analysis per keystroke, symbols, continuations."""

@@ -1,0 +1,1 @@
+"""The semantic model back to ``.exsce`` text (round-trip stable), and acceptance criteria as Gherkin."""
