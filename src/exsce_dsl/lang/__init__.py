@@ -19,8 +19,8 @@ Where the parts are, bottom to top (a part imports only from those before it):
 - ``format/``: the semantic model back to ``.exsce`` text, round-trip stable (``document``, and
   per kind ``acceptance``, ``derivation``, ``metrics``), writing files (``writer``), and acceptance
   criteria as Gherkin (``gherkin``).
-- ``yaml/``: the method's YAML files — scenario and task files in (``importer``, over YAML nodes
-  that keep their place: ``nodes``) and out (``exporter``), oracle files both ways (``oracles``).
+- ``yaml/``: the method's YAML files — scenario and task files in (``importer``, over YAML values
+  that keep their place: ``located``) and out (``exporter``), oracle files both ways (``oracles``).
 - ``registration``: textX's language and generator entry points.
 - ``editor/``: what only the language server uses — an analysis per keystroke (``analysis``),
   each file's symbols and references (``symbols``), what may be written at a point

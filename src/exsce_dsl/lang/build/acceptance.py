@@ -13,6 +13,7 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import Any
 
 from exsce_dsl.errors import SourceLocation
+from exsce_dsl.lang.build.context import Report
 from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.lang.build.references import UnknownNames, not_in_fleet
 from exsce_dsl.model import Scenario
@@ -35,8 +36,6 @@ from exsce_dsl.model.metrics import SI_UNIT, UNITS, Dimension, MetricInfo, known
 from exsce_dsl.suggest import did_you_mean
 
 _QUANTITY = re.compile(r"(\S+?)\s*(m/s|cm/s|km/h|rad/s|deg/s|mm|cm|km|ms|min|std|rad|deg|m|s|h|%)?")
-
-Report = Callable[[str, SourceLocation | None], None]
 
 
 def build_all_acceptance(
@@ -225,7 +224,7 @@ class _AcceptanceBuilder:
             if against is None:
                 return None
         if kind == "StaysBelow" or kind == "StaysAbove":
-            limit = self.quantity(relation.limit, info, where)
+            limit = clause_quantity(relation.limit, info, where, self.error)
             if limit is None:
                 return None
             rel = BasicRelation.BELOW_MAX if kind == "StaysBelow" else BasicRelation.ABOVE_MIN
@@ -233,23 +232,37 @@ class _AcceptanceBuilder:
             if node.window is not None and window is None:
                 return None
             return Expectation(subject, info.name, rel, limit=limit, window=window, location=where)
+        return self.comparison(node, subject, info, against, where)
+
+    def comparison(
+        self, node: Any, subject: Subject, info: MetricInfo, against: str | None, where: SourceLocation
+    ) -> Expectation | None:
+        """A clause that compares with a value or another scenario: ``is invariant``,
+        ``is increasing``, ``is decreasing``."""
+        relation, kind = node.relation, node.relation.__class__.__name__
         value = tolerance = delta = None
-        if relation.value is not None and (value := self.quantity(relation.value, info, where)) is None:
+        if (
+            relation.value is not None
+            and (value := clause_quantity(relation.value, info, where, self.error)) is None
+        ):
             return None
         if relation.tolerance is not None:
-            tolerance = self.quantity(relation.tolerance, info, where, relative=True)
+            tolerance = clause_quantity(relation.tolerance, info, where, self.error, relative=True)
             if tolerance is None:
                 return None
         confidence = None
         if relation.confidence is not None:
-            confidence = self.confidence(relation, kind, value)
+            confidence = confidence_of(self.pf, relation, kind, value, self.error)
             if confidence is None:
                 return None
         if kind == "Invariant":
             rel = BasicRelation.INVARIANT
         else:
             rel = BasicRelation.INCREASING if relation.direction == "increasing" else BasicRelation.DECREASING
-            if relation.delta is not None and (delta := self.quantity(relation.delta, info, where)) is None:
+            if (
+                relation.delta is not None
+                and (delta := clause_quantity(relation.delta, info, where, self.error)) is None
+            ):
                 return None
             if against is None and value is None:
                 self.error(
@@ -273,49 +286,6 @@ class _AcceptanceBuilder:
             location=where,
             confidence=confidence,
         )
-
-    def confidence(self, relation: Any, kind: str, value: Quantity | None) -> Quantity | None:
-        """``at 99 %``: a per cent strictly between 50 and 100, of an invariant around a mean."""
-        text = relation.confidence
-        where = self._confidence_span(relation, text)
-        if kind != "Invariant":
-            self.error(
-                f"'at {text}' is for 'is invariant': a change is judged against another scenario's "
-                "runs moved by a delta, which their spread cannot promise to hold with a confidence; "
-                "write a tolerance ('within ...')",
-                where,
-            )
-            return None
-        if value is not None:
-            self.error(
-                f"'at {text}' is a band around the baseline's mean, from its runs; around a fixed "
-                "value write a tolerance ('within ...')",
-                where,
-            )
-            return None
-        match = _QUANTITY.fullmatch(text)
-        assert match is not None, text  # the grammar lets only such tokens through
-        number, unit = match.group(1), match.group(2)
-        if unit != "%":
-            self.error(f"a confidence is in per cent ('at 99 %'), not '{text}'", where)
-            return None
-        if not 50.0 < float(number) < 100.0:
-            self.error(
-                f"a confidence must be between 50 % and 100 % (exclusive), not '{text}': "
-                "'at 95 %' fails one healthy run in 20, 'at 99 %' one in 100",
-                where,
-            )
-            return None
-        return Quantity(float(number), "%", number)
-
-    def _confidence_span(self, relation: Any, text: str) -> SourceLocation:
-        """Where ``at <confidence>`` is written in the relation (the parse tree keeps no position
-        for a matched token)."""
-        start, end = relation._tx_position, relation._tx_position_end
-        found = list(re.finditer(r"\bat\s+" + re.escape(text), self.pf.text[start:end]))
-        if not found:
-            return self.pf.span(relation)
-        return self.pf.lines.span(start + found[-1].start(), start + found[-1].end())
 
     def scope_fits(self, info: MetricInfo, subject: Subject, where: SourceLocation) -> bool:
         if subject.quantifier is Quantifier.MISSION and info.per_robot and not info.also_mission:
@@ -380,30 +350,79 @@ class _AcceptanceBuilder:
             return None
         return Window(moment, robot, pose=node.pose.name, location=where)
 
-    def quantity(
-        self, text: str, info: MetricInfo, where: SourceLocation, relative: bool = False
-    ) -> Quantity | None:
-        match = _QUANTITY.fullmatch(text)
-        assert match is not None, text  # the grammar lets only such tokens through
-        number, unit = match.group(1), match.group(2)
-        value = float(number)
-        if unit in ("std", "%"):
-            if not relative:
-                self.error(f"'{text}' is relative: 'std' and '%' are for tolerances ('within 1 std')", where)
-                return None
-            if value < 0:
-                self.error(f"a tolerance cannot be negative ('{text}')", where)
-                return None
-            return Quantity(value, unit, number)
-        if unit is None:
-            return Quantity(value, None, number)
-        dimension, factor = UNITS[unit]
-        if dimension is not info.dimension:
-            wanted = SI_UNIT[info.dimension] or "a plain number"
-            what = "a count" if info.dimension is Dimension.COUNT else f"a {info.dimension.value}"
-            self.error(f"'{info.name}' is {what}, in {wanted}; '{text}' is a {dimension.value}", where)
+
+def confidence_of(
+    pf: ParsedFile, relation: Any, kind: str, value: Quantity | None, error: Report
+) -> Quantity | None:
+    """``at 99 %``: a per cent strictly between 50 and 100, of an invariant around a mean."""
+    text = relation.confidence
+    where = _confidence_span(pf, relation, text)
+    if kind != "Invariant":
+        error(
+            f"'at {text}' is for 'is invariant': a change is judged against another scenario's "
+            "runs moved by a delta, which their spread cannot promise to hold with a confidence; "
+            "write a tolerance ('within ...')",
+            where,
+        )
+        return None
+    if value is not None:
+        error(
+            f"'at {text}' is a band around the baseline's mean, from its runs; around a fixed "
+            "value write a tolerance ('within ...')",
+            where,
+        )
+        return None
+    match = _QUANTITY.fullmatch(text)
+    assert match is not None, text  # the grammar lets only such tokens through
+    number, unit = match.group(1), match.group(2)
+    if unit != "%":
+        error(f"a confidence is in per cent ('at 99 %'), not '{text}'", where)
+        return None
+    if not 50.0 < float(number) < 100.0:
+        error(
+            f"a confidence must be between 50 % and 100 % (exclusive), not '{text}': "
+            "'at 95 %' fails one healthy run in 20, 'at 99 %' one in 100",
+            where,
+        )
+        return None
+    return Quantity(float(number), "%", number)
+
+
+def _confidence_span(pf: ParsedFile, relation: Any, text: str) -> SourceLocation:
+    """Where ``at <confidence>`` is written in the relation (the parse tree keeps no position
+    for a matched token)."""
+    start, end = relation._tx_position, relation._tx_position_end
+    found = list(re.finditer(r"\bat\s+" + re.escape(text), pf.text[start:end]))
+    if not found:
+        return pf.span(relation)
+    return pf.lines.span(start + found[-1].start(), start + found[-1].end())
+
+
+def clause_quantity(
+    text: str, info: MetricInfo, where: SourceLocation, error: Report, relative: bool = False
+) -> Quantity | None:
+    """A quantity of a clause on ``info``, in its unit (``std`` and ``%`` only where ``relative``)."""
+    match = _QUANTITY.fullmatch(text)
+    assert match is not None, text  # the grammar lets only such tokens through
+    number, unit = match.group(1), match.group(2)
+    value = float(number)
+    if unit in ("std", "%"):
+        if not relative:
+            error(f"'{text}' is relative: 'std' and '%' are for tolerances ('within 1 std')", where)
             return None
-        if relative and value < 0:
-            self.error(f"a tolerance cannot be negative ('{text}')", where)
+        if value < 0:
+            error(f"a tolerance cannot be negative ('{text}')", where)
             return None
-        return Quantity(value * factor, unit, number)
+        return Quantity(value, unit, number)
+    if unit is None:
+        return Quantity(value, None, number)
+    dimension, factor = UNITS[unit]
+    if dimension is not info.dimension:
+        wanted = SI_UNIT[info.dimension] or "a plain number"
+        what = "a count" if info.dimension is Dimension.COUNT else f"a {info.dimension.value}"
+        error(f"'{info.name}' is {what}, in {wanted}; '{text}' is a {dimension.value}", where)
+        return None
+    if relative and value < 0:
+        error(f"a tolerance cannot be negative ('{text}')", where)
+        return None
+    return Quantity(value * factor, unit, number)

@@ -9,6 +9,7 @@ from typing import Any
 
 from exsce_dsl.errors import ExsceError, SourceLocation
 from exsce_dsl.lang.build.checks import check_environment_map
+from exsce_dsl.lang.build.context import Report, report_duplicate
 from exsce_dsl.lang.build.poses import position_of
 from exsce_dsl.lang.lexical import quantity_text
 from exsce_dsl.lang.parser import ParsedFile
@@ -16,8 +17,6 @@ from exsce_dsl.lang.build.references import UnknownNames
 from exsce_dsl.model import Environment, Scenario, Task
 from exsce_dsl.model.derived import DerivedScenario, Step
 from exsce_dsl.transform.derivation import derive
-
-Report = Callable[[str, SourceLocation | None], None]
 
 
 def _name(ref: Any) -> str | None:
@@ -155,11 +154,9 @@ def build_derivations(
     for pf, decl in list(pending):
         made = declare(pf, decl)
         first = declared.get(decl.name)
-        if first is not None:
-            report(
-                f"duplicate scenario '{decl.name}' (first declared at {first.name_location})",
-                made.name_location,
-            )
+        if report_duplicate(
+            "scenario", decl.name, first.name_location if first else None, made.name_location, report
+        ):
             pending.remove((pf, decl))
             continue
         declared[decl.name] = made

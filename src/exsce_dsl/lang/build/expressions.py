@@ -16,6 +16,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+from exsce_dsl.errors import SourceLocation
 from exsce_dsl.lang.check_fields import FieldProblem, field_shape
 from exsce_dsl.lang.lexical import quantity_text
 from exsce_dsl.model.expressions import (
@@ -180,39 +181,16 @@ class ExpressionBuilder:
 
     def _arithmetic(self, op: str, left: Typed, right: Typed, node: Any) -> Typed:
         """``left op right`` for numbers (``op`` may be a comparison: same rules for the operands)."""
-        for side in (left, right):
-            if side.kind not in _NUMERIC:
-                raise self._fail(f"'{op}' needs numbers, but one side is {side.kind.value}", node)
-        where = self.pf.span(node)
-        expr = Binary(op, left.expr, right.expr, where)
-        kinds = {left.kind, right.kind}
-        if kinds <= {Kind.CONSTANT}:
-            return Typed(expr, Kind.CONSTANT)
-        if Kind.VALUE in kinds:
-            if kinds - {Kind.VALUE, Kind.CONSTANT}:
-                raise self._fail(
-                    "this mixes one number per window with values per message: aggregate the "
-                    "per-message values first (e.g. max(...))",
-                    node,
-                )
-            return Typed(expr, Kind.VALUE)
-        return self._elementwise(expr, [left, right], node)
+        typed = binary_type(op, left, right, self.pf.span(node))
+        if isinstance(typed, str):
+            raise self._fail(typed, node)
+        return typed
 
     def _elementwise(self, expr: Expression, operands: list[Typed], node: Any) -> Typed:
-        """Per-message operands: arrays broadcast over numbers; other topics are aligned in time."""
-        per_message = [o for o in operands if o.kind in _PER_MESSAGE]
-        clock = per_message[0].clock
-        arrays = any(o.kind is Kind.ARRAYS for o in per_message)
-        for other in per_message[1:]:
-            if other.clock == clock:
-                continue
-            if arrays:
-                raise self._fail(
-                    f"arrays cannot be aligned in time: {clock} and {other.clock} are different topics",
-                    node,
-                )
-            clock = f"{clock}&{other.clock}"
-        return Typed(expr, Kind.ARRAYS if arrays else Kind.NUMBERS, clock)
+        typed = elementwise_type(expr, operands)
+        if isinstance(typed, str):
+            raise self._fail(typed, node)
+        return typed
 
     def _signed(self, node: Any) -> Typed:
         inner = self._expr(node.operand)
@@ -417,3 +395,38 @@ def _text(parsed: str) -> str:
     """A string as written, from textX's (which turns ``\\"`` into ``"`` but keeps ``\\\\``):
     the inverse of :func:`exsce_dsl.lang.lexical.string_literal`, so that it prints back."""
     return parsed.replace("\\\\", "\\")
+
+
+def binary_type(op: str, left: Typed, right: Typed, where: SourceLocation) -> Typed | str:
+    """``left op right`` for numbers (``op`` may be a comparison: same rules for the operands),
+    or why the operands do not go together."""
+    for side in (left, right):
+        if side.kind not in _NUMERIC:
+            return f"'{op}' needs numbers, but one side is {side.kind.value}"
+    expr = Binary(op, left.expr, right.expr, where)
+    kinds = {left.kind, right.kind}
+    if kinds <= {Kind.CONSTANT}:
+        return Typed(expr, Kind.CONSTANT)
+    if Kind.VALUE in kinds:
+        if kinds - {Kind.VALUE, Kind.CONSTANT}:
+            return (
+                "this mixes one number per window with values per message: aggregate the "
+                "per-message values first (e.g. max(...))"
+            )
+        return Typed(expr, Kind.VALUE)
+    return elementwise_type(expr, [left, right])
+
+
+def elementwise_type(expr: Expression, operands: list[Typed]) -> Typed | str:
+    """Per-message operands: arrays broadcast over numbers; other topics are aligned in time
+    (or why they cannot be)."""
+    per_message = [o for o in operands if o.kind in _PER_MESSAGE]
+    clock = per_message[0].clock
+    arrays = any(o.kind is Kind.ARRAYS for o in per_message)
+    for other in per_message[1:]:
+        if other.clock == clock:
+            continue
+        if arrays:
+            return f"arrays cannot be aligned in time: {clock} and {other.clock} are different topics"
+        clock = f"{clock}&{other.clock}"
+    return Typed(expr, Kind.ARRAYS if arrays else Kind.NUMBERS, clock)

@@ -118,7 +118,9 @@ def _from_rules(
                 punctuation.append(literal)
         elif name == "EOF":
             continue
-    return Continuations(word_start, tuple(keywords), tuple(punctuation), frozenset(others), declaration, before)
+    return Continuations(
+        word_start, tuple(keywords), tuple(punctuation), frozenset(others), declaration, before
+    )
 
 
 def _without_areas(text: str, chunk: Chunk, end: int) -> str:

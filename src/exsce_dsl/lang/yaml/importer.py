@@ -12,14 +12,12 @@ before its last ``-`` (``classroom_c025-w001`` is in ``classroom_c025``).
 from __future__ import annotations
 
 import os
-from collections.abc import Iterator, Mapping, Sequence
-from dataclasses import dataclass
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
-import yaml
-
-from exsce_dsl.errors import ExsceError, ImportFormatError, SourceLocation
+from exsce_dsl.errors import ImportFormatError
 from exsce_dsl.lang.yaml.exporter import GOAL_TIMEOUT
+from exsce_dsl.lang.yaml.located import YamlFile, YamlNode, check_name, why_not_a_name
 from exsce_dsl.model import (
     Area,
     Assignment,
@@ -40,8 +38,7 @@ from exsce_dsl.model import (
     Task,
     WorldModel,
 )
-from exsce_dsl.model.names import KEYWORDS, is_valid_name
-from exsce_dsl.textfiles import read_text
+from exsce_dsl.model.names import is_valid_name
 
 #: Hardware facts of the robot types the method used (PAL Robotics): base, torso.
 KNOWN_ROBOT_TYPES: Mapping[str, tuple[str, bool]] = {
@@ -53,8 +50,6 @@ KNOWN_ROBOT_TYPES: Mapping[str, tuple[str, bool]] = {
 #: The area of a pose whose id has no ``-`` (so no area prefix).
 UNASSIGNED_AREA = "unassigned"
 
-_Key = str | int
-
 
 def import_scenario_yaml(path: Path, task_search_path: Sequence[Path] = ()) -> tuple[Document, ...]:
     """Read a scenario YAML file and the task files it names, as ``.exsce`` documents.
@@ -64,39 +59,13 @@ def import_scenario_yaml(path: Path, task_search_path: Sequence[Path] = ()) -> t
     with the same name (sorted, first wins). The documents come back with paths
     relative to the scenario document, which is first.
     """
-    scenario_file = YamlFile.read(path)
-    root = scenario_file.root_node()
-    finder = _TaskFinder([path.parent, *task_search_path])
-
+    root = YamlFile.read(path).root_node()
     scenario_id = root.get("id").ident("scenario")
-    robots_node = root.get("robots")
     environment_node = root.get("environment")
     mission_node = root.get("mission")
-
-    # Robots and their types, in the order of the YAML list.
-    robot_types: dict[str, RobotType] = {}
-    robot_rows: list[tuple[YamlNode, str, RobotType, str]] = []
-    for entry in robots_node.items_of_list():
-        robot_id = entry.get("robot_id").ident("robot")
-        if any(robot_id == row[1] for row in robot_rows):
-            raise entry.error(f"robot '{robot_id}' is listed twice")
-        type_id = entry.get("robot_type").ident("robot type")
-        if type_id not in robot_types:
-            base, torso = KNOWN_ROBOT_TYPES.get(type_id, (None, None))
-            robot_types[type_id] = RobotType(type_id, base, torso, entry.location)
-        namespace = entry.get("robot_namespace").text()
-        robot_rows.append((entry, robot_id, robot_types[type_id], namespace))
+    robot_types, robot_rows = _read_robots(root.get("robots"))
     robot_ids = [row[1] for row in robot_rows]
-
-    # Start poses, keyed by robot.
-    read_starts: dict[str, Pose] = {}
-    starts = environment_node.opt("robots")
-    for robot_id, entry in starts.items_of_mapping() if starts else ():
-        if robot_id not in robot_ids:
-            raise entry.error(
-                f"start pose for robot '{robot_id}', which is not in the robots list ({', '.join(robot_ids)})"
-            )
-        read_starts[robot_id] = _read_pose(entry.get("start_pose"))
+    read_starts = _read_starts(environment_node, robot_ids)
 
     # What else the scenario file says, checked before any task file is read.
     environment_id = environment_node.get("id").ident("environment")
@@ -105,30 +74,8 @@ def import_scenario_yaml(path: Path, task_search_path: Sequence[Path] = ()) -> t
     mission_id = mission_node.get("id").ident("mission")
     mission_type = _mission_type(mission_node.get("type"))
 
-    # The allocation, and each task once, in order of first use.
-    tasks: dict[str, Task] = {}
-    allocation: list[Assignment] = []
-    for entry in mission_node.get("allocation").items_of_list():
-        robot_node = entry.get("robot")
-        robot_id = robot_node.ident("robot")
-        if robot_id not in robot_ids:
-            raise robot_node.error(
-                f"allocation names robot '{robot_id}', which is not in the robots list "
-                f"({', '.join(robot_ids)})"
-            )
-        source = RosResource(entry.get("pkg").text(), entry.get("file_path").text())
-        task_id = _task_id_of(entry.get("file_path"))
-        known = tasks.get(task_id)
-        if known is None:
-            task_file = finder.find(entry)
-            tasks[task_id] = _read_task(YamlFile.read(task_file), task_id, source)
-        elif known.source != source:
-            raise entry.error(
-                f"task '{task_id}' comes from package {source.package} path {source.path} "
-                f"here, but from package {_describe(known.source)} at {known.location}; "
-                "tasks are named after their file, so two files cannot share a name"
-            )
-        allocation.append(Assignment(robot_id, task_id, entry.location))
+    finder = _TaskFinder([path.parent, *task_search_path])
+    tasks, allocation = _read_allocation(mission_node, robot_ids, finder)
 
     # Every pose used, declared once where it first occurs.
     poses = _PoseTable()
@@ -158,17 +105,87 @@ def import_scenario_yaml(path: Path, task_search_path: Sequence[Path] = ()) -> t
         timeout=_goal_timeout(mission_node),
     )
     scenario = Scenario(scenario_id, environment, robots, mission, tuple(tasks.values()), root.location)
+    return _documents(scenario, robot_types.values())
 
+
+_RobotRow = tuple[YamlNode, str, RobotType, str]
+"""A robot of the scenario file: its entry, id, type and namespace."""
+
+
+def _read_robots(robots_node: YamlNode) -> tuple[dict[str, RobotType], list[_RobotRow]]:
+    """Robots and their types, in the order of the YAML list."""
+    robot_types: dict[str, RobotType] = {}
+    robot_rows: list[_RobotRow] = []
+    for entry in robots_node.items_of_list():
+        robot_id = entry.get("robot_id").ident("robot")
+        if any(robot_id == row[1] for row in robot_rows):
+            raise entry.error(f"robot '{robot_id}' is listed twice")
+        type_id = entry.get("robot_type").ident("robot type")
+        if type_id not in robot_types:
+            base, torso = KNOWN_ROBOT_TYPES.get(type_id, (None, None))
+            robot_types[type_id] = RobotType(type_id, base, torso, entry.location)
+        namespace = entry.get("robot_namespace").text()
+        robot_rows.append((entry, robot_id, robot_types[type_id], namespace))
+    return robot_types, robot_rows
+
+
+def _read_starts(environment_node: YamlNode, robot_ids: list[str]) -> dict[str, Pose]:
+    """Start poses, keyed by robot."""
+    read_starts: dict[str, Pose] = {}
+    starts = environment_node.opt("robots")
+    for robot_id, entry in starts.items_of_mapping() if starts else ():
+        if robot_id not in robot_ids:
+            raise entry.error(
+                f"start pose for robot '{robot_id}', which is not in the robots list ({', '.join(robot_ids)})"
+            )
+        read_starts[robot_id] = _read_pose(entry.get("start_pose"))
+    return read_starts
+
+
+def _read_allocation(
+    mission_node: YamlNode, robot_ids: list[str], finder: _TaskFinder
+) -> tuple[dict[str, Task], list[Assignment]]:
+    """The allocation, and each task once, in order of first use."""
+    tasks: dict[str, Task] = {}
+    allocation: list[Assignment] = []
+    for entry in mission_node.get("allocation").items_of_list():
+        robot_node = entry.get("robot")
+        robot_id = robot_node.ident("robot")
+        if robot_id not in robot_ids:
+            raise robot_node.error(
+                f"allocation names robot '{robot_id}', which is not in the robots list "
+                f"({', '.join(robot_ids)})"
+            )
+        source = RosResource(entry.get("pkg").text(), entry.get("file_path").text())
+        task_id = _task_id_of(entry.get("file_path"))
+        known = tasks.get(task_id)
+        if known is None:
+            task_file = finder.find(entry)
+            tasks[task_id] = _read_task(YamlFile.read(task_file), task_id, source)
+        elif known.source != source:
+            raise entry.error(
+                f"task '{task_id}' comes from package {source.package} path {source.path} "
+                f"here, but from package {_describe(known.source)} at {known.location}; "
+                "tasks are named after their file, so two files cannot share a name"
+            )
+        allocation.append(Assignment(robot_id, task_id, entry.location))
+    return tasks, allocation
+
+
+def _documents(scenario: Scenario, robot_types: Iterable[RobotType]) -> tuple[Document, ...]:
+    """The scenario split as a person would write it: the scenario's document first, then one
+    per robot type, the environment's, and one per task."""
+    environment = scenario.environment
     parts: list[Document] = [
-        *(Document(f"robots/{t.id}.exsce", (), (t,)) for t in robot_types.values()),
+        *(Document(f"robots/{t.id}.exsce", (), (t,)) for t in robot_types),
         Document(f"environments/{environment.id}.exsce", (), (environment,)),
         # a task names poses, so its file imports the environment that declares them
         *(
             Document(f"tasks/{t.id}.exsce", (Import(f"../environments/{environment.id}.exsce"),), (t,))
-            for t in tasks.values()
+            for t in scenario.tasks
         ),
     ]
-    main = Document(f"{scenario_id}.exsce", tuple(Import(d.path) for d in parts), (scenario,))
+    main = Document(f"{scenario.id}.exsce", tuple(Import(d.path) for d in parts), (scenario,))
     return (main, *parts)
 
 
@@ -178,168 +195,10 @@ def import_task_yaml(path: Path, task_id: str | None = None, *, source: RosResou
     file = YamlFile.read(path)
     if task_id is None:
         task_id = _strip_yaml_suffix(path.name)
-        _check_name(task_id, "task", f"the name of file {path}", file.root_node())
+        check_name(task_id, "task", f"the name of file {path}", file.root_node())
     elif not is_valid_name(task_id):
-        raise ImportFormatError(f"task id '{task_id}' is not a valid exsce id: {_why_not_a_name(task_id)}")
+        raise ImportFormatError(f"task id '{task_id}' is not a valid exsce id: {why_not_a_name(task_id)}")
     return _read_task(file, task_id, source)
-
-
-# -- reading YAML with positions -------------------------------------------------------
-
-
-class YamlFile:
-    """A YAML file read twice: as data with ``yaml.safe_load``, and as a node tree
-    (composed by the same safe loader) that only serves line and column numbers."""
-
-    def __init__(self, name: str, data: object, tree: yaml.Node | None) -> None:
-        self.name = name
-        self.data = data
-        self.tree = tree
-
-    @classmethod
-    def read(cls, path: Path) -> YamlFile:
-        try:
-            text = read_text(path, "YAML file")
-        except ExsceError as e:
-            raise ImportFormatError(e.message, e.location) from None
-        try:
-            data = yaml.safe_load(text)
-            tree = yaml.compose(text, Loader=yaml.SafeLoader)
-        except yaml.YAMLError as e:
-            mark = getattr(e, "problem_mark", None)
-            location = node_location(str(path), mark) if mark is not None else None
-            problem = getattr(e, "problem", None) or str(e)
-            raise ImportFormatError(f"not valid YAML: {problem}", location) from e
-        return cls(str(path), data, tree)
-
-    def root_node(self) -> YamlNode:
-        return YamlNode(self, (), self.data)
-
-    def location(self, keys: tuple[_Key, ...]) -> SourceLocation:
-        """Where the value at ``keys`` starts, or the nearest enclosing value."""
-        node = self.tree
-        if node is None:
-            return SourceLocation(self.name, 1, 1)
-        for key in keys:
-            child = child_node(node, key)
-            if child is None:
-                break
-            node = child
-        return node_location(self.name, node.start_mark, node.end_mark)
-
-
-def child_node(node: yaml.Node, key: _Key) -> yaml.Node | None:
-    if isinstance(node, yaml.MappingNode) and isinstance(key, str):
-        return next((v for k, v in node.value if getattr(k, "value", None) == key), None)
-    if isinstance(node, yaml.SequenceNode) and isinstance(key, int) and key < len(node.value):
-        child: yaml.Node = node.value[key]
-        return child
-    return None
-
-
-def node_location(file: str, start: yaml.Mark, end: yaml.Mark | None = None) -> SourceLocation:
-    if end is None:
-        return SourceLocation(file, start.line + 1, start.column + 1)
-    return SourceLocation(file, start.line + 1, start.column + 1, end.line + 1, end.column + 1)
-
-
-@dataclass(frozen=True)
-class YamlNode:
-    """A value of a YAML file with the keys that lead to it, for error messages."""
-
-    file: YamlFile
-    keys: tuple[_Key, ...]
-    value: object
-
-    @property
-    def where(self) -> str:
-        text = ""
-        for key in self.keys:
-            text += f"[{key}]" if isinstance(key, int) else f".{key}" if text else key
-        return text or "the top level"
-
-    @property
-    def location(self) -> SourceLocation:
-        return self.file.location(self.keys)
-
-    def error(self, message: str) -> ImportFormatError:
-        return ImportFormatError(message, self.location)
-
-    def _mapping(self) -> Mapping[object, object]:
-        if not isinstance(self.value, Mapping):
-            raise self.error(f"{self.where} should be a mapping of keys to values, not {_kind(self.value)}")
-        return self.value
-
-    def get(self, key: str) -> YamlNode:
-        """The value of a required key."""
-        mapping = self._mapping()
-        if key not in mapping:
-            raise self.error(f"missing key '{key}' in {self.where}")
-        return YamlNode(self.file, (*self.keys, key), mapping[key])
-
-    def opt(self, key: str) -> YamlNode | None:
-        """The value of an optional key; ``None`` when absent or empty."""
-        mapping = self._mapping()
-        if mapping.get(key) is None:
-            return None
-        return YamlNode(self.file, (*self.keys, key), mapping[key])
-
-    def items_of_mapping(self) -> Iterator[tuple[str, YamlNode]]:
-        for key, value in self._mapping().items():
-            yield str(key), YamlNode(self.file, (*self.keys, str(key)), value)
-
-    def items_of_list(self) -> Iterator[YamlNode]:
-        if not isinstance(self.value, list):
-            raise self.error(f"{self.where} should be a list, not {_kind(self.value)}")
-        for i, value in enumerate(self.value):
-            yield YamlNode(self.file, (*self.keys, i), value)
-
-    def text(self) -> str:
-        if not isinstance(self.value, str):
-            raise self.error(f"{self.where} should be text, not {_kind(self.value)}")
-        return self.value
-
-    def number(self) -> float:
-        if isinstance(self.value, bool) or not isinstance(self.value, int | float):
-            raise self.error(f"{self.where} should be a number, not {_kind(self.value)}")
-        return float(self.value)
-
-    def ident(self, what: str) -> str:
-        """Text that must be a valid exsce id (it becomes a name in the DSL)."""
-        if isinstance(self.value, bool) or not isinstance(self.value, str | int | float):
-            raise self.error(f"{self.where} should be a {what} id, not {_kind(self.value)}")
-        text = str(self.value)
-        _check_name(text, what, self.where, self)
-        return text
-
-
-def _kind(value: object) -> str:
-    if value is None:
-        return "nothing"
-    if isinstance(value, Mapping):
-        return "a mapping"
-    if isinstance(value, list):
-        return "a list"
-    return f"{type(value).__name__} {value!r}"
-
-
-def _check_name(text: str, what: str, where: str, node: YamlNode) -> None:
-    if not is_valid_name(text):
-        raise node.error(f"{what} id '{text}' ({where}) is not a valid exsce id: {_why_not_a_name(text)}")
-
-
-def _why_not_a_name(text: str) -> str:
-    rule = "an id is letters, digits and '_', starting with a letter or '_', with single '-' between parts"
-    if not text:
-        return "it is empty"
-    if text in KEYWORDS:
-        return f"'{text}' is a word of the exsce language"
-    bad = next((c for c in text if not (c.isascii() and (c.isalnum() or c in "_-"))), None)
-    if bad is not None:
-        return f"it contains {bad!r}; {rule}"
-    if not (text[0].isalpha() or text[0] == "_"):
-        return f"it starts with {text[0]!r}; {rule}"
-    return rule
 
 
 # -- finding and reading task files -----------------------------------------------------
@@ -393,7 +252,7 @@ def _strip_yaml_suffix(name: str) -> str:
 
 def _task_id_of(file_path: YamlNode) -> str:
     task_id = _strip_yaml_suffix(Path(file_path.text()).name)
-    _check_name(task_id, "task", f"the name of file {file_path.text()}", file_path)
+    check_name(task_id, "task", f"the name of file {file_path.text()}", file_path)
     return task_id
 
 
@@ -439,7 +298,7 @@ def _area_of(pose_id: str, node: YamlNode) -> str:
     # The method names poses <area>-<point>: `classroom_c025-w001`, and also
     # `right_long_corridor-point-0`, so the area ends at the first '-'.
     area = pose_id.split("-", 1)[0]
-    _check_name(area, "area", f"the part of pose id '{pose_id}' before its first '-'", node)
+    check_name(area, "area", f"the part of pose id '{pose_id}' before its first '-'", node)
     return area
 
 

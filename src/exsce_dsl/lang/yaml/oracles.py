@@ -20,7 +20,7 @@ import yaml
 
 from exsce_dsl.errors import Diagnostic, ExportError, ImportFormatError, SourceLocation
 from exsce_dsl.lang.format.acceptance import expectation_text
-from exsce_dsl.lang.yaml.importer import YamlFile, YamlNode, child_node, node_location
+from exsce_dsl.lang.yaml.located import YamlFile, YamlNode, child_node, node_location
 from exsce_dsl.model import Document, Import, Scenario, Specification
 from exsce_dsl.model.acceptance import (
     Acceptance,
