@@ -9,7 +9,7 @@ from typing import Any
 
 from exsce_dsl.errors import ExsceError, SourceLocation
 from exsce_dsl.lang.build.checks import check_environment_map
-from exsce_dsl.lang.build.context import Report, report_duplicate
+from exsce_dsl.lang.build.context import Declared, Report, name_span, report_duplicate
 from exsce_dsl.lang.build.poses import position_of
 from exsce_dsl.lang.lexical import quantity_text
 from exsce_dsl.lang.parser import ParsedFile
@@ -139,20 +139,19 @@ def _obstacle_map_problems(env: Environment, obstacle_id: str, where: SourceLoca
 def build_derivations(
     files: Sequence[ParsedFile],
     scenarios: dict[str, Scenario],
-    declared: dict[str, Any],
+    declared: dict[str, Declared],
     tasks: Mapping[str, Task],
     report: Report,
-    declare: Callable[[ParsedFile, Any], Any],
     unknown: UnknownNames,
 ) -> dict[int, DerivedScenario]:
     """Every derive block of ``files``, bases first (one may start from a derived scenario).
 
-    The derived scenarios join ``scenarios`` and their names ``declared`` (made by ``declare``);
+    The derived scenarios join ``scenarios`` and their names ``declared``;
     returns them by the id of their parse tree node.
     """
     pending = [(pf, d) for pf in files for d in pf.tree.declarations if d.__class__.__name__ == "Derivation"]
     for pf, decl in list(pending):
-        made = declare(pf, decl)
+        made = Declared(decl, pf, name_span(pf, decl))
         first = declared.get(decl.name)
         if report_duplicate(
             "scenario", decl.name, first.name_location if first else None, made.name_location, report

@@ -18,7 +18,7 @@ from typing import Any
 from exsce_dsl.errors import Diagnostic, Severity, SpecError, diagnostic_order
 from exsce_dsl.lang.build.acceptance import build_all_acceptance
 from exsce_dsl.lang.build.checks import check_environment_map, check_scenario
-from exsce_dsl.lang.build.context import BuildContext, Declared, name_span
+from exsce_dsl.lang.build.context import BuildContext
 from exsce_dsl.lang.build.derivation import build_derivations
 from exsce_dsl.lang.build.environments import build_environment
 from exsce_dsl.lang.build.metrics import build_metric
@@ -124,7 +124,6 @@ def _build(ctx: BuildContext) -> Specification:
         ctx.declared["Scenario"],
         ctx.tasks,
         lambda message, at: ctx.error(message, at, code="derivation"),
-        lambda pf, decl: Declared(decl, pf, name_span(pf, decl)),
         ctx.unknown,
     )
     ctx.acceptance = build_all_acceptance(

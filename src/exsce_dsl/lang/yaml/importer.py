@@ -269,7 +269,7 @@ def _read_task(file: YamlFile, task_id: str, source: RosResource | None) -> Task
 
 
 def _goal_timeout(node: YamlNode) -> float | None:
-    """exsce's ``goal_timeout`` key (seconds; see :mod:`.yaml_export`), if there is one."""
+    """exsce's ``goal_timeout`` key (seconds; see :mod:`.exporter`), if there is one."""
     found = node.opt(GOAL_TIMEOUT)
     if found is None:
         return None

@@ -1,0 +1,38 @@
+"""``exsce_dsl.lang`` names the entry points other layers use, each from the module that defines it."""
+
+from __future__ import annotations
+
+import importlib
+import json
+import subprocess
+import sys
+
+import pytest
+
+import exsce_dsl.lang as lang
+
+
+@pytest.mark.parametrize("name", lang.__all__)
+def test_each_entry_point_is_the_name_its_module_defines(name: str) -> None:
+    module = importlib.import_module(f"exsce_dsl.lang.{lang._WHERE[name]}")
+    assert getattr(lang, name) is getattr(module, name)
+
+
+def test_every_entry_point_is_listed_once() -> None:
+    assert sorted(lang.__all__) == sorted(lang._WHERE) and len(set(lang.__all__)) == len(lang.__all__)
+
+
+def test_an_unknown_name_is_an_attribute_error() -> None:
+    with pytest.raises(AttributeError, match="no attribute 'load'"):
+        lang.load  # noqa: B018
+
+
+def test_importing_the_language_imports_no_part_of_it() -> None:
+    """One entry point (the cached specification) must not pull textX and every part in."""
+    code = "import json, sys\nimport exsce_dsl.lang\nprint(json.dumps(sorted(sys.modules)))"
+    found = set(
+        json.loads(
+            subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+        )
+    )
+    assert "textx" not in found and not any(m.startswith("exsce_dsl.lang.") for m in found)
