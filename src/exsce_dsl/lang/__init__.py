@@ -12,9 +12,12 @@ Where the parts are, bottom to top (a part imports only from those before it):
   parse cache that re-parses only the declarations an edit touched (``incremental``), and the
   bundled standard library (``stdlib/``).
 - ``build/``: parse trees to the semantic model, every reference resolved and every error
-  reported at its place — the specification (``specification``) and a builder per declaration
-  kind, expressions, metrics, signals, acceptance criteria, derivations, the checks that need a
-  whole scenario, unknown names with their did-you-mean (``references``) and the standard metrics.
+  reported at its place — the specification (``specification``), what its builders share (the
+  state, the duplicate-name check: ``context``; positions and orientations: ``poses``), a builder
+  per declaration kind (``robots``, ``environments``, ``tasks``, ``scenarios``, ``metrics`` with
+  ``expressions`` and ``signals``, ``acceptance``, ``derivation``), the checks that need a whole
+  scenario (``checks``), unknown names with their did-you-mean (``references``) and the
+  standard metrics.
   ``spec_cache`` keeps checked specifications in the user's cache folder.
 - ``format/``: the semantic model back to ``.exsce`` text, round-trip stable (``document``, and
   per kind ``acceptance``, ``derivation``, ``metrics``), writing files (``writer``), and acceptance
