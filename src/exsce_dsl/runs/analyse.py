@@ -11,9 +11,9 @@ from types import ModuleType
 import numpy as np
 
 from exsce_dsl.errors import ExsceError, IncompleteRunError
-from exsce_dsl.lang.check_fields import check_fields
 from exsce_dsl.lang.standard_metrics import standard_metrics
 from exsce_dsl.messages.catalogue import Source
+from exsce_dsl.messages.field_check import check_fields
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.conventions import Window
 from exsce_dsl.model.expressions import Field, walk
