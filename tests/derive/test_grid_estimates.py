@@ -24,7 +24,8 @@ import pytest
 
 from exsce_dsl.derive.expect import expected_metric, segment_value
 from exsce_dsl.derive.grid_lengths import GridLengths, grid_lengths
-from exsce_dsl.lang.occupancy import load_occupancy_grid
+from exsce_dsl.maps.grid import load_occupancy_grid
+from exsce_dsl.maps.planning import PlanningGrid
 from exsce_dsl.model import (
     Area,
     Assignment,
@@ -45,7 +46,6 @@ from exsce_dsl.model.runs import Action, ActionId, Bag, MetricScope, MetricValue
 from exsce_dsl.prov import compile_scenario
 from exsce_dsl.prov.run import compile_run
 from exsce_dsl.runs.ingest import ingest_bags
-from exsce_dsl.sim.planner import PlanningGrid
 from exsce_dsl.sim.run import simulate
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.writing import add_prov

@@ -18,8 +18,8 @@ from exsce_dsl.execute.mission import schedule
 from exsce_dsl.execute.navigator import SimulatedClock
 from exsce_dsl.execute.outcomes import DEFAULT_POLICY, MissionStatus, Outcome, Policy
 from exsce_dsl.lang import load_spec
+from exsce_dsl.maps.planning import planning_grid
 from exsce_dsl.model import MissionType
-from exsce_dsl.sim.run import planning_grid
 
 from conftest import EXAMPLES
 

@@ -24,10 +24,11 @@ from exsce_dsl.execute.navigator import SimulatedClock
 from exsce_dsl.execute.outcomes import DEFAULT_POLICY, MissionStatus, Policy
 from exsce_dsl.execute.provenance import mission_prov_json, mission_run_record
 from exsce_dsl.lang import load_spec
+from exsce_dsl.maps.planning import planning_grid
 from exsce_dsl.model.runs import ActionStatus, RunStatus
 from exsce_dsl.prov.run import compile_run
 from exsce_dsl.rdf import to_quads, validate
-from exsce_dsl.sim.run import planning_grid, simulate
+from exsce_dsl.sim.run import simulate
 
 from conftest import EXAMPLES
 

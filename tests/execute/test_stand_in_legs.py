@@ -16,11 +16,11 @@ import pytest
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.execute.stand_in.legs import FIELDS, Fleet, Leg
 from exsce_dsl.lang import load_spec
+from exsce_dsl.maps.planning import planning_grid
 from exsce_dsl.model import Scenario
 from exsce_dsl.sim.faults import DEADLOCK_WAIT, Fault
 from exsce_dsl.sim.localisation import SCALE_ERROR
 from exsce_dsl.sim.motion import DT
-from exsce_dsl.sim.run import planning_grid
 
 FLOOR = """
 environment floor {

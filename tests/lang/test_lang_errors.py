@@ -402,7 +402,7 @@ def test_every_error_class_is_in_the_errors_module() -> None:
         ("exsce_dsl.templating", "GenerationError"),
         ("exsce_dsl.lsp.navigation", "RenameError"),
         ("exsce_dsl.oracles.relations", "RelationError"),
-        ("exsce_dsl.sim.planner", "PlanningError"),
+        ("exsce_dsl.maps.planning", "PlanningError"),
         ("exsce_dsl.store.base", "StoreError"),
         ("exsce_dsl.store.base", "StoreLockedError"),
         ("exsce_dsl.store.base", "StoreConflictError"),

@@ -17,18 +17,19 @@ LAYERS: list[set[str]] = [
     # the base
     {"errors", "suggest", "resources", "textfiles", "tables", "templating", "figures", "user_cache", "wording"},
     {"model"},
-    {"messages", "monitor_kit", "parallel"},
+    {"messages", "maps", "monitor_kit", "parallel"},
     {"transform"},
     {"lang"},
     {"prov"},
     {"rdf"},
     {"store"},
-    {"sim", "runs"},
+    {"runs"},
+    {"sim"},
     {"oracles"},
     {"derive"},
     {"execute"},
     {"similarity", "explore", "codegen"},
-    {"report", "lsp", "mcp_server"},
+    {"report", "lsp", "mcp_server", "endpoint"},
     {"api"},
     {"cli"},
 ]
@@ -38,7 +39,7 @@ RANK = {name: rank for rank, names in enumerate(LAYERS) for name in names}
 STEPS: dict[str, list[set[str]]] = {
     "lang": [
         # the core the other parts share
-        {"locations", "lexical", "chunks", "parser", "loader", "incremental", "stdlib", "occupancy", "check_fields"},
+        {"locations", "lexical", "chunks", "parser", "loader", "incremental", "stdlib"},
         # parse trees to the model; the cache of checked specifications loads through it, and the
         # standard library's metrics are cached in it
         {"build", "spec_cache"},

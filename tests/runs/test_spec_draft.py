@@ -22,7 +22,7 @@ from yard_spec import yard_text
 
 from exsce_dsl.errors import BagError, ExportError
 from exsce_dsl.lang import load_spec
-from exsce_dsl.lang.occupancy import FREE, OCCUPIED, UNKNOWN, load_occupancy_grid
+from exsce_dsl.maps.grid import FREE, OCCUPIED, UNKNOWN, load_occupancy_grid
 from exsce_dsl.model import Specification
 from exsce_dsl.runs.analyse import AnalysedRun, analyse_bag
 from exsce_dsl.runs.spec_draft import default_spec_path, draft_spec

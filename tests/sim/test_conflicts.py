@@ -15,12 +15,11 @@ import numpy as np
 import pytest
 
 from exsce_dsl.lang import load_spec
+from exsce_dsl.maps.planning import PlanningGrid, planning_grid
 from exsce_dsl.model import Scenario, Task
 from exsce_dsl.sim.conflicts import CLEARANCE, conflict_repairs
 from exsce_dsl.sim.executor import Execution, Fault, execute
 from exsce_dsl.sim.motion import DT, Trajectory
-from exsce_dsl.sim.planner import PlanningGrid
-from exsce_dsl.sim.run import planning_grid
 from exsce_dsl.transform.derivation import derive
 
 from conftest import EXAMPLES

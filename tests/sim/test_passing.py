@@ -13,12 +13,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from exsce_dsl.maps.planning import PlanningGrid, planning_grid
 from exsce_dsl.model import Scenario, Task
 from exsce_dsl.sim.conflicts import CLEARANCE
 from exsce_dsl.sim.executor import Execution, execute
 from exsce_dsl.sim.motion import DT
-from exsce_dsl.sim.planner import PlanningGrid
-from exsce_dsl.sim.run import planning_grid
 from exsce_dsl.transform.derivation import derive
 
 SEEDS = (0, 1)

@@ -19,11 +19,11 @@ import pytest
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.lang import load_spec
+from exsce_dsl.maps.planning import PlanningGrid, planning_grid
 from exsce_dsl.model import Scenario
 from exsce_dsl.sim.executor import Execution, Fault, GoalStatus, execute
 from exsce_dsl.sim.motion import DT
-from exsce_dsl.sim.planner import PlanningGrid
-from exsce_dsl.sim.run import planning_grid, simulate
+from exsce_dsl.sim.run import simulate
 from exsce_dsl.transform.derivation import derive
 
 from conftest import EXAMPLES

@@ -12,10 +12,11 @@ from rosbags.highlevel import AnyReader
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.lang import load_spec
+from exsce_dsl.maps.planning import planning_grid
 from exsce_dsl.model import MissionType
 from exsce_dsl.sim.executor import Fault, GoalStatus, execute
 from exsce_dsl.sim.messages import FEEDBACK, RESULT, typestore
-from exsce_dsl.sim.run import planning_grid, simulate
+from exsce_dsl.sim.run import simulate
 
 from conftest import EXAMPLES
 

@@ -15,7 +15,7 @@ from exsce_dsl.store.base import GraphSet, StoreError, StoreLockedError
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.open import open_store
 from exsce_dsl.store.remote import RemoteStore
-from exsce_dsl.store.server import serve_info_path
+from exsce_dsl.store.serve_info import serve_info_path
 
 G = "http://example.org/g"
 

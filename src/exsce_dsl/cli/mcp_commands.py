@@ -6,7 +6,7 @@ import click
 
 from exsce_dsl.cli.common import reports_errors
 from exsce_dsl.cli.store_commands import store_option
-from exsce_dsl.store.base import QUERY_TIMEOUT  # not store.server: every command would import http.server
+from exsce_dsl.store.base import QUERY_TIMEOUT  # not the endpoint: every command would import http.server
 
 
 @click.command(name="mcp")

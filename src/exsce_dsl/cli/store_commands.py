@@ -232,10 +232,10 @@ def serve(
       exscec serve                        # at http://127.0.0.1:7878/
       exscec serve --bind 127.0.0.1:0     # on a free port, printed first
     """
+    from exsce_dsl.endpoint.server import SparqlServer, make_server, run_server
     from exsce_dsl.store.embedded import EmbeddedStore
     from exsce_dsl.store.open import open_store
     from exsce_dsl.store.remote import RemoteStore
-    from exsce_dsl.store.server import SparqlServer, make_server, run_server
 
     host, port = _parse_bind(bind)
     store = open_store(store_url)

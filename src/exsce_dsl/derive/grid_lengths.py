@@ -1,10 +1,10 @@
 """How far a robot drives between two points: the length of the shortest path on the environment's
 occupancy grid, round walls and through doorways, not the straight line across them.
 
-The grid is the executor's (``exsce_dsl.sim.run.planning_grid``: the map_server map the environment
-declares, read by the same loader, coarsened to the planner's 10 cm cells, occupied space inflated
-by the robot's radius).  A path is the shortest one on its free cells, 8-connected (a diagonal step
-costs √2 cells, and never cuts a corner), by scipy's Dijkstra on a graph built once per map.  Then
+The grid is the executor's (``exsce_dsl.maps.planning.planning_grid``: the map_server map the
+environment declares, coarsened to the planner's 10 cm cells, occupied space inflated by the robot's
+radius).  A path is the shortest one on its free cells, 8-connected (a diagonal step costs √2 cells,
+and never cuts a corner), by :mod:`exsce_dsl.maps.paths` on a graph built once per map.  Then
 it is pulled tight: from each corner, the farthest later corner that a straight line of free cells
 reaches comes next, so a path across an open room is its straight line, not a staircase of 45° and
 90° steps (8-connected lengths alone are up to 8 % too long, depending on the direction); and each
@@ -23,18 +23,13 @@ from __future__ import annotations
 import math
 from collections import OrderedDict
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy import ndimage
-from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import dijkstra
 
+from exsce_dsl.maps.paths import grid_graph, path_in_tree, shortest_path_tree
+from exsce_dsl.maps.planning import PlanningGrid, planning_grid
 from exsce_dsl.model import Scenario
-from exsce_dsl.sim.planner import grid_graph
-
-if TYPE_CHECKING:
-    from exsce_dsl.sim.planner import PlanningGrid
 
 Point = tuple[float, float]
 
@@ -73,7 +68,7 @@ class GridLengths:
         self._node = np.full(free.shape, -1, dtype=np.int64)
         self._node[free] = np.arange(int(free.sum()))
         self._cells = np.argwhere(free)  # node → (row, col)
-        self._graph = _free_space_graph(free, self._node, grid.resolution)
+        self._graph = grid_graph(free, grid.resolution, node=self._node)  # the planner's, no wall penalty
         distance, nearest = ndimage.distance_transform_edt(~free, return_indices=True)
         self._snap_distance: np.ndarray = distance * grid.resolution
         self._nearest: np.ndarray = nearest  # (2, rows, cols): the nearest free cell of every cell
@@ -93,13 +88,10 @@ class GridLengths:
         source, target = self._snap(a), self._snap(b)
         if source is None or target is None:
             return None
-        predecessors = self._tree(source)
-        if target != source and predecessors[target] < 0:
+        nodes = path_in_tree(self._tree(source), source, target)
+        if nodes is None:
             return None
-        nodes = [target]
-        while nodes[-1] != source:
-            nodes.append(int(predecessors[nodes[-1]]))
-        rows, cols = self._cells[nodes[::-1]].T
+        rows, cols = self._cells[nodes].T
         centres = np.column_stack(
             [self.origin[0] + (cols + 0.5) * self.resolution, self.origin[1] + (rows + 0.5) * self.resolution]
         )
@@ -129,8 +121,7 @@ class GridLengths:
         if source in self._trees:
             self._trees.move_to_end(source)
             return self._trees[source]
-        _, predecessors = dijkstra(self._graph, indices=source, return_predecessors=True)
-        tree: np.ndarray = np.asarray(predecessors, dtype=np.int32)
+        tree = shortest_path_tree(self._graph, source)
         self._trees[source] = tree
         if len(self._trees) > TREES:
             self._trees.popitem(last=False)
@@ -200,12 +191,6 @@ class GridLengths:
         return seen
 
 
-def _free_space_graph(free: np.ndarray, node: np.ndarray, cell: float) -> csr_matrix:
-    """The 8-connected graph of the free cells, edges weighted by their length in metres (the
-    planner's graph without its wall penalty)."""
-    return grid_graph(free, cell, node=node)
-
-
 _LOADED: OrderedDict[str, GridLengths] = OrderedDict()
 
 
@@ -219,10 +204,6 @@ def grid_lengths(scenario: Scenario) -> GridLengths | None:
         return None
     key = str(Path(declared.file).resolve())
     if key not in _LOADED:
-        # the executor's own loader and grid (imported here: the simulator's modules are slow to
-        # import, and only scenarios with a map need them)
-        from exsce_dsl.sim.run import planning_grid
-
         _LOADED[key] = GridLengths(planning_grid(scenario))
         if len(_LOADED) > MAPS:
             _LOADED.popitem(last=False)

@@ -1,7 +1,7 @@
 """A navigator for tests: robots drive the occupancy grid's shortest paths on a simulated clock.
 
 Each goal is planned from where its robot stands to the goal's position (the kinematic
-executor's planner, :mod:`exsce_dsl.sim.planner`) and driven at the robot's constant speed
+executor's planner, :mod:`exsce_dsl.maps.planning`) and driven at the robot's constant speed
 limit; it succeeds when the robot arrives.  Tests can make chosen goals fail, named by robot and
 pose id: one in ``aborts`` is aborted ``ABORT_AFTER`` seconds after it was sent, as many times as
 given; one in ``rejects`` is rejected at once; one in ``silent`` is accepted and never answered
@@ -19,8 +19,8 @@ from exsce_dsl.errors import ExsceError
 from exsce_dsl.execute.mission import DEFAULT_SPEED
 from exsce_dsl.execute.navigator import Finished, SimulatedClock
 from exsce_dsl.execute.outcomes import Outcome
+from exsce_dsl.maps.planning import PlanningGrid, Point
 from exsce_dsl.model import Pose, Scenario
-from exsce_dsl.sim.planner import PlanningGrid, Point
 
 ABORT_AFTER = 2.0
 """Seconds after which a goal the test wants aborted is aborted."""

@@ -166,7 +166,7 @@ def _digest(path: str) -> str | None:
 
 def _map_files(spec: Specification) -> list[str]:
     """The files the map checks read: each map_server YAML and the image it names."""
-    from exsce_dsl.lang.occupancy import map_image
+    from exsce_dsl.maps.grid import map_image
     from exsce_dsl.model import MapModel
 
     found: list[str] = []

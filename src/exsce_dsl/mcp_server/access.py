@@ -26,8 +26,7 @@ import anyio
 import anyio.to_thread
 
 from exsce_dsl.errors import TimeLimitError as TimeLimitError
-from exsce_dsl.store.base import Store
-from exsce_dsl.store.server import QUERY_TIMEOUT
+from exsce_dsl.store.base import QUERY_TIMEOUT, Store
 
 __all__ = ["DEFAULT_MAX_ROWS", "Access", "TimeLimitError"]
 

@@ -1,8 +1,8 @@
 """The ``sparql`` tool: any SELECT or ASK query, read-only, with the endpoint's limits.
 
 What ``exscec serve`` does for a query, this tool does too: a query is at most
-:data:`~exsce_dsl.store.server.MAX_QUERY` long and runs within the time limit
-(:data:`~exsce_dsl.store.server.QUERY_TIMEOUT` by default), and it never
+:data:`~exsce_dsl.store.base.MAX_QUERY` long and runs within the time limit
+(:data:`~exsce_dsl.store.base.QUERY_TIMEOUT` by default), and it never
 updates: the query's form is read from its tokens (comments, strings and IRIs
 skipped) and anything but SELECT and ASK is refused before the store is
 touched; what is sent then goes to the store's query operation, whose parser
@@ -26,8 +26,8 @@ from exsce_dsl.errors import ExsceError
 from exsce_dsl.mcp_server.access import Access
 from exsce_dsl.mcp_server.answers import READ_ONLY, ToolEntry, results_json
 from exsce_dsl.mcp_server.arguments import ArgumentError, object_schema
+from exsce_dsl.store.base import MAX_QUERY
 from exsce_dsl.store.queries import standard_prefixes
-from exsce_dsl.store.server import MAX_QUERY
 from exsce_dsl.store.sparql import declared_prefixes, query_form, query_keywords
 
 __all__ = ["read_only_query", "sparql_tool"]

@@ -4,7 +4,7 @@ The builder (``lang.build.metrics``) type-checks every node; a tree here is
 known to be well formed: fields exist in their message type, aggregates are
 over numbers, a metric's value is one number per window.  (A field of a type
 exsce does not know is checked later, against the bag's definition, by
-``lang.check_fields``.)
+``messages.field_check``.)
 """
 
 from __future__ import annotations

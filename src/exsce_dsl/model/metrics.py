@@ -163,7 +163,7 @@ class TopicRead:
     location: SourceLocation | None = field(default=None, compare=False, repr=False)
     fields: tuple[Field, ...] = ()
     """Every field the metric reads of the topic, where it is written: what the bag reader
-    decodes, and what ``lang.check_fields`` checks against the bag's definition."""
+    decodes, and what ``messages.field_check`` checks against the bag's definition."""
     signal: str | None = None
     """A robot's signal (``pose``, ``velocity``, ``distance``) rather than a topic: ``topic`` is
     then the name ingestion gives the signal (``/{ns}/~pose``), ``msgtype`` the signal's fields'."""

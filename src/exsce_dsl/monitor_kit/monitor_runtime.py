@@ -1,31 +1,27 @@
 """The live side of the metric monitors: messages in, metric values and oracle verdicts out.
 
-This module imports nothing of exsce (numpy only), like ``monitor_core``:
-``exscec generate ros1-monitor`` and ``ros2-monitor`` copy it as it is into
-the node packages, and the tests run it here on bags, without ROS.  The ROS
-nodes only subscribe, stamp each message with its receive time and hand it
-to :meth:`MonitorRuntime.on_message`; a timer calls :meth:`MonitorRuntime.tick`.
+This module imports only numpy and the standard library, like ``monitor_core`` (``tests/monitor_kit``
+holds them so): ``exscec generate ros1-monitor`` and ``ros2-monitor`` copy it as it is into the node
+packages, and the tests run it here on bags, without ROS.  The ROS nodes only subscribe, stamp each
+message with its receive time and hand it to :meth:`MonitorRuntime.on_message`; a timer calls
+:meth:`MonitorRuntime.tick`.
 
-The metrics come from the generated ``RobotMetrics`` and ``MissionMetrics``
-classes over ``core.Topic``s built from what has been received, in windows
-taken from the waypoint dispatcher's goal statuses as ingestion takes them:
-a robot's window runs from its first waypoint that became ACTIVE to the last
-one that reached a final status (to *now* while one is still active).
-Fields are read from message objects by attribute access along their paths,
-written as exsce writes them (``transforms[child_frame_id == "base_link"].
-transform.translation.x``, ``ranges[-1]``, ``len(status_list)``), and appended
-to growing numpy buffers (capacity doubles: amortised O(1) per message, no
-Python object kept per value).  A path that picks an element keeps a
-``#present`` mask, as ingestion does, so that a message without that element
-gives no sample.  Arrays (laser ranges, rows of any length) are reduced a block
-of messages at a time by the monitors' ``REDUCERS``, as ingestion reduces them,
-so their rows are not kept.  Each
-evaluation computes every metric over all data so far (vectorised: ~15 ms for
-an hour of scenario_c's two robots, ~700k messages).
+The metrics come from the generated ``RobotMetrics`` and ``MissionMetrics`` classes over ``core.Topic``s
+of what has been received, in windows taken from the waypoint dispatcher's goal statuses as ingestion
+takes them (a robot's runs from its first waypoint that became ACTIVE to the last one that reached a
+final status, or to *now* while one is active).  Fields are read from message objects along their paths
+as exsce writes them (``ranges[-1]``, ``len(status_list)``,
+``transforms[child_frame_id == "base_link"].transform.translation.x``) into growing numpy buffers
+(capacity doubles: amortised O(1) per message); a path that picks an element keeps a ``#present`` mask,
+as ingestion does, so that a message without the element gives no sample.  Arrays (laser ranges) are
+reduced a block of messages at a time by the monitors' ``REDUCERS``, as ingestion reduces them, so their
+rows are not kept.  An evaluation computes every metric over all data so far (vectorised: ~15 ms for an
+hour of scenario_c's two robots, ~700k messages).
 """
 
 from __future__ import annotations
 
+import functools
 import importlib
 import json
 import math
@@ -112,18 +108,12 @@ class Attributes:
                 except IndexError:
                     return None, False
             else:
-                node = next((x for x in node if _attribute(x, step.names) == step.value), None)
+                node = next((x for x in node if functools.reduce(getattr, step.names, x) == step.value), None)
                 if node is None:
                     return None, False
         if self.length:
             return len(node), True
         return node, True
-
-
-def _attribute(element: Any, names: tuple[str, ...]) -> Any:
-    for name in names:
-        element = getattr(element, name)
-    return element
 
 
 def attributes(text: str) -> Attributes:

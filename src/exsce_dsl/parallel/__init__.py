@@ -1,1 +1,2 @@
-"""Work spread over processes: the Dask client that ingest, simulate and explore share."""
+"""Work spread over processes: the process pool and the Dask client that ingest, simulate and explore
+share (:mod:`~exsce_dsl.parallel.workers`, :mod:`~exsce_dsl.parallel.cluster`)."""

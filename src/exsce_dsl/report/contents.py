@@ -15,7 +15,7 @@ from pathlib import Path
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.lang import load_spec
-from exsce_dsl.lang.occupancy import OccupancyGrid, load_occupancy_grid
+from exsce_dsl.maps.grid import OccupancyGrid, load_occupancy_grid
 from exsce_dsl.model.derivation import Derivation
 from exsce_dsl.model.metrics import MetricDefinition
 from exsce_dsl.model.oracles import Oracle

@@ -12,7 +12,7 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 from matplotlib.transforms import Bbox
 
-from exsce_dsl.lang.occupancy import OccupancyGrid
+from exsce_dsl.maps.grid import OccupancyGrid
 from exsce_dsl.model.oracles import Oracle
 from exsce_dsl.report.campaigns import CampaignContents
 from exsce_dsl.report.contents import RunContents, ScenarioContents

@@ -12,8 +12,8 @@ import numpy as np
 
 from exsce_dsl.errors import ExsceError, IncompleteRunError
 from exsce_dsl.lang import standard_metrics
-from exsce_dsl.lang.check_fields import check_fields
 from exsce_dsl.messages.catalogue import Source
+from exsce_dsl.messages.field_check import check_fields
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.conventions import Window
 from exsce_dsl.model.expressions import Field, walk

@@ -12,17 +12,16 @@ then it is analysed again and its run replaced in one write
 from __future__ import annotations
 
 import importlib
-import os
 import threading
-from collections.abc import Callable, Iterable, Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from enum import Enum
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, cast
+from typing import TYPE_CHECKING, cast
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import Scenario
+from exsce_dsl.parallel.workers import workers
 from exsce_dsl.prov import DEFAULT_NAMESPACE, compile_scenario
 from exsce_dsl.prov.run import compile_run
 from exsce_dsl.runs.bag_identity import content_hash
@@ -107,29 +106,6 @@ class _Todo:
         return self.run.run_id if self.run is not None else None
 
 
-Mapper = Callable[[Callable[[Any], Any], Iterable[Any]], Iterator[Any]]
-"""``map``, or a process pool's."""
-
-
-@contextmanager
-def _workers(jobs: int, tasks: int, cluster: str | None = None) -> Iterator[Mapper]:
-    """``map`` on the Dask cluster at ``cluster``, in this process (one job), or over a pool of
-    ``jobs`` processes kept for every phase."""
-    if cluster is not None:
-        from exsce_dsl.parallel.cluster import cluster_mapper
-
-        with cluster_mapper(cluster) as mapper:
-            yield mapper
-        return
-    if jobs <= 1 or tasks <= 1:
-        yield map
-        return
-    from concurrent.futures import ProcessPoolExecutor
-
-    with ProcessPoolExecutor(max_workers=min(jobs, tasks, os.cpu_count() or 1)) as pool:
-        yield pool.map
-
-
 def ingest_bags(
     paths: Sequence[Path],
     scenario: Scenario,
@@ -167,7 +143,7 @@ def ingest_bags(
     importing = _Importing(ANALYSIS) if in_process else None
     if importing is None:
         importlib.import_module(ANALYSIS)
-    with _workers(jobs, len(paths), cluster) as mapper:
+    with workers(jobs, len(paths), cluster) as mapper:
         # a digest the cluster could not compute is None: the bag's analysis then says what is wrong
         digests = [d if isinstance(d, str) else None for d in mapper(_digest, [opened[p] for p in paths])]
         if importing is not None:

@@ -28,7 +28,7 @@ from pathlib import Path
 
 from exsce_dsl.errors import ExportError, SourceLocation
 from exsce_dsl.lang import Comment, declared_poses, format_document
-from exsce_dsl.lang.occupancy import FREE, OccupancyGrid, grid_from_ros, save_occupancy_grid
+from exsce_dsl.maps.grid import FREE, OccupancyGrid, grid_from_ros, save_occupancy_grid
 from exsce_dsl.model import (
     Acceptance,
     Area,

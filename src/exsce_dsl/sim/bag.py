@@ -15,12 +15,12 @@ from rosbags.rosbag1 import Writer as Ros1Writer
 from rosbags.rosbag2 import StoragePlugin
 from rosbags.rosbag2 import Writer as Ros2Writer
 
+from exsce_dsl.maps.planning import PlanningGrid
 from exsce_dsl.messages.navigation import ros2_message_definition
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.conventions import Signals
 from exsce_dsl.sim.conventions import convention_writer
 from exsce_dsl.sim.executor import Execution
-from exsce_dsl.sim.planner import PlanningGrid
 from exsce_dsl.sim.scan import Laser
 from exsce_dsl.sim.writing import RobotRun
 

@@ -16,8 +16,8 @@ from typing import Protocol
 
 import numpy as np
 
+from exsce_dsl.maps.planning import Point
 from exsce_dsl.sim.motion import DT, Trajectory
-from exsce_dsl.sim.planner import Point
 
 CLEARANCE = 0.7
 """Metres between two robots' centres below which they touch (two 0.3 m robots, 0.1 m apart)."""

@@ -16,7 +16,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import ExsceError, PlanningError
+from exsce_dsl.maps.planning import PlanningGrid, Point
 from exsce_dsl.model import MissionType, Pose, Scenario
 from exsce_dsl.sim.actions import Action, GoalEvent, GoalStatus
 from exsce_dsl.sim.conflicts import MAX_REPAIRS, Leg, Repair, conflict_repairs, meetings
@@ -33,7 +34,6 @@ from exsce_dsl.sim.faults import (
 from exsce_dsl.sim.give_way import distance_to_polyline, give_way
 from exsce_dsl.sim.motion import DT, Limits, Trajectory, drive
 from exsce_dsl.sim.passing import Wait, head_on_wait
-from exsce_dsl.sim.planner import PlanningError, PlanningGrid, Point
 
 
 @dataclass

@@ -13,9 +13,9 @@ from typing import Any
 
 import numpy as np
 
+from exsce_dsl.maps.planning import PlanningGrid
 from exsce_dsl.sim.executor import Execution, GoalStatus
 from exsce_dsl.sim.messages import FEEDBACK, RESULT
-from exsce_dsl.sim.planner import PlanningGrid
 from exsce_dsl.sim.scan import Laser, laser_scans
 from exsce_dsl.sim.values import header, quaternion, ros_time, sample_stamps
 from exsce_dsl.sim.writing import Message, RobotRun

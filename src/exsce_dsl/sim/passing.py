@@ -20,9 +20,9 @@ from typing import Protocol
 
 import numpy as np
 
+from exsce_dsl.maps.planning import PlanningGrid, Point
 from exsce_dsl.sim.conflicts import CLEARANCE, STOOD, Leg, Timed, leg_at
 from exsce_dsl.sim.motion import DT, Trajectory
-from exsce_dsl.sim.planner import PlanningGrid, Point
 
 ASIDE = CLEARANCE + 0.3
 """Metres between a waiting robot's centre and the other's path: room to pass at clearance."""

@@ -19,13 +19,10 @@ import shutil
 import uuid
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, replace
-from functools import lru_cache
 from pathlib import Path
 
-import numpy as np
-
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.lang.occupancy import OccupancyGrid, load_occupancy_grid
+from exsce_dsl.maps.planning import PlanningGrid, planning_grid
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.conventions import Signals
 from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Run, run_name
@@ -34,7 +31,6 @@ from exsce_dsl.prov.recorder import recorded_prov_json, recorded_run
 from exsce_dsl.sim.bag import write_bag
 from exsce_dsl.sim.conventions import convention_writer
 from exsce_dsl.sim.executor import Execution, Fault, GoalStatus, execute
-from exsce_dsl.sim.planner import PlanningGrid
 
 FORMATS = ("ros1", "ros2", "mcap")
 #: Runs of seed S start at this instant plus S days (modulo SEED_DAYS), one hour apart (no wall clock:
@@ -244,29 +240,3 @@ def scenario_convention(scenario: Scenario) -> str:
             "executor writes one for the whole run: choose it with --convention"
         )
     return found[0] if found else "method"
-
-
-def planning_grid(scenario: Scenario) -> PlanningGrid:
-    env = scenario.environment
-    if env.map is not None and env.map.file is not None:
-        return _grid_from_file(env.map.file)
-    return _open_space(scenario)
-
-
-@lru_cache(maxsize=4)
-def _grid_from_file(path: str) -> PlanningGrid:
-    return PlanningGrid.from_map(load_occupancy_grid(Path(path)))
-
-
-def _open_space(scenario: Scenario) -> PlanningGrid:
-    """No map given: an empty grid around every pose of the scenario, 10 m of margin."""
-    poses = [p for p in scenario.environment.poses()] + [w for t in scenario.tasks for w in t.waypoints()]
-    xs = [p.position.x for p in poses]
-    ys = [p.position.y for p in poses]
-    resolution = 0.05
-    x0, y0 = min(xs) - 10.0, min(ys) - 10.0
-    width = int((max(xs) + 10.0 - x0) / resolution) + 1
-    height = int((max(ys) + 10.0 - y0) / resolution) + 1
-    cells = np.full((height, width), 254, dtype=np.uint8)
-    cells[0, :] = cells[-1, :] = cells[:, 0] = cells[:, -1] = 0  # a wall round the edge, for the laser
-    return PlanningGrid.from_map(OccupancyGrid(cells, resolution, (x0, y0, 0.0), 0.65, 0.196, False))

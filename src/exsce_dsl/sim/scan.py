@@ -13,9 +13,9 @@ from typing import Any
 
 import numpy as np
 
+from exsce_dsl.maps.planning import PlanningGrid
 from exsce_dsl.sim.executor import Execution
 from exsce_dsl.sim.motion import DT
-from exsce_dsl.sim.planner import PlanningGrid
 from exsce_dsl.sim.values import header
 
 SCAN_EVERY = 5  # samples of the 50 Hz clock: 10 Hz

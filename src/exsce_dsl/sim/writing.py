@@ -12,8 +12,8 @@ from typing import Any
 
 import numpy as np
 
+from exsce_dsl.maps.planning import PlanningGrid
 from exsce_dsl.sim.executor import Execution
-from exsce_dsl.sim.planner import PlanningGrid
 from exsce_dsl.sim.scan import Laser
 
 Message = tuple[str, str, int, Any]

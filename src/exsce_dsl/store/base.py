@@ -29,6 +29,8 @@ from exsce_dsl.errors import StoreLockedError as StoreLockedError
 
 QUERY_TIMEOUT = 60.0
 """Seconds a query may take, evaluation and serialization, by default (``exscec serve``, ``exscec mcp``)."""
+MAX_QUERY = 1024 * 1024
+"""The longest query text ``exscec serve`` and ``exscec mcp`` accept (bytes)."""
 
 Term = NamedNode | BlankNode | Literal
 Bindings = Mapping[str, Term | Sequence[Term]]

@@ -198,7 +198,7 @@ def _embedded_store(path: Path, token: str | None, timeout: float) -> Store:
     if not embedded.held_elsewhere:
         return embedded
     from exsce_dsl.store.remote import RemoteStore
-    from exsce_dsl.store.server import read_serve_info
+    from exsce_dsl.store.serve_info import read_serve_info
 
     info = read_serve_info(path)
     if info is None or not info.is_alive():

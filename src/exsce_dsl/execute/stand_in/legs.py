@@ -31,7 +31,8 @@ from typing import Any
 
 import numpy as np
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import ExsceError, PlanningError
+from exsce_dsl.maps.planning import PlanningGrid, Point
 from exsce_dsl.model import Orientation, Pose, Position, Scenario
 from exsce_dsl.sim.faults import (
     DEADLOCK_WAIT,
@@ -45,7 +46,6 @@ from exsce_dsl.sim.faults import (
 )
 from exsce_dsl.sim.localisation import Odometry, Poses, localise
 from exsce_dsl.sim.motion import DT, Limits, Trajectory, drive
-from exsce_dsl.sim.planner import PlanningError, PlanningGrid, Point
 from exsce_dsl.sim.scan import ROBOT_RADIUS, SCAN_EVERY, Laser, scan_ranges
 
 MATCH = 0.05

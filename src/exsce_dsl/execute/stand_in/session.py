@@ -23,10 +23,10 @@ from exsce_dsl.errors import ExsceError, RosGraphError
 from exsce_dsl.execute.ros1.channel import Message, NodeChannel
 from exsce_dsl.execute.ros1.graph import Master
 from exsce_dsl.execute.stand_in.legs import Fleet
+from exsce_dsl.maps.planning import planning_grid
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.metrics import topic_name
 from exsce_dsl.sim.faults import Fault
-from exsce_dsl.sim.run import planning_grid
 
 NODE = "/exsce_stand_in"
 """The node's name on the graph."""

@@ -9,13 +9,13 @@ its ``file:line:col`` and all of them at once.
 from __future__ import annotations
 
 import re
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
 from exsce_dsl.errors import SourceLocation
 from exsce_dsl.lang.build.context import Report
-from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.lang.build.references import UnknownNames, not_in_fleet
+from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.acceptance import (
     Acceptance,

@@ -10,7 +10,7 @@ from functools import lru_cache
 from pathlib import Path
 
 from exsce_dsl.errors import Diagnostic, ExsceError, Severity
-from exsce_dsl.lang.occupancy import FREE, OUTSIDE, OccupancyGrid, load_occupancy_grid, map_image
+from exsce_dsl.maps.grid import FREE, OUTSIDE, OccupancyGrid, load_occupancy_grid, map_image
 from exsce_dsl.model import Environment, Pose, Scenario
 from exsce_dsl.model.metrics import ComputedFor
 from exsce_dsl.model.names import is_ros_namespace

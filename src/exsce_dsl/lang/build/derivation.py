@@ -3,7 +3,7 @@ applied to the base scenario in order; a step that cannot apply is reported at i
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from typing import Any
 
@@ -11,9 +11,9 @@ from exsce_dsl.errors import ExsceError, SourceLocation
 from exsce_dsl.lang.build.checks import check_environment_map
 from exsce_dsl.lang.build.context import Declared, Report, name_span, report_duplicate
 from exsce_dsl.lang.build.poses import position_of
+from exsce_dsl.lang.build.references import UnknownNames
 from exsce_dsl.lang.lexical import quantity_text
 from exsce_dsl.lang.parser import ParsedFile
-from exsce_dsl.lang.build.references import UnknownNames
 from exsce_dsl.model import Environment, Scenario, Task
 from exsce_dsl.model.derived import DerivedScenario, Step
 from exsce_dsl.transform.derivation import derive

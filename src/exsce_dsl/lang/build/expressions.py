@@ -3,7 +3,7 @@
 Each node gets a :class:`~exsce_dsl.model.expressions.Kind` (a constant, a number
 or an array per message, a condition, one number per window), and the topic whose
 times its values follow.  A field is looked up in its topic's type
-(:mod:`exsce_dsl.lang.check_fields`); a field of a type exsce does not know is
+(:mod:`exsce_dsl.messages.field_check`); a field of a type exsce does not know is
 taken as a number per message, to be checked against the bag's definition.
 Every problem is reported at the node it concerns, and stops the checks of the
 nodes above it.
@@ -17,8 +17,8 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from exsce_dsl.errors import SourceLocation
-from exsce_dsl.lang.check_fields import FieldProblem, field_shape
 from exsce_dsl.lang.lexical import quantity_text
+from exsce_dsl.messages.field_check import FieldProblem, field_shape
 from exsce_dsl.model.expressions import (
     AGGREGATES,
     CONDITION_AGGREGATES,

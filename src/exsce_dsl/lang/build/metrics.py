@@ -12,7 +12,7 @@ Message types come from a catalogue (the user's definitions over rosbags'
 standard packages, :func:`exsce_dsl.messages.user.configured_catalogue`).  A
 type it lacks is a warning, not an error: the bag may define it, and its fields
 are checked against the bag's definition when the bag is read
-(:mod:`exsce_dsl.lang.check_fields`).
+(:mod:`exsce_dsl.messages.field_check`).
 """
 
 from __future__ import annotations

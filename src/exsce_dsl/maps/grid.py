@@ -1,6 +1,8 @@
-"""Occupancy grids in ROS map_server format (a YAML file beside a PGM image).
+"""Occupancy grids in ROS map_server format (a YAML file beside a PGM image): reading, writing, a
+nav_msgs/OccupancyGrid's data as one, and which cells and points are free.
 
-Used to check that poses lie in free space; the simulator reuses it later.
+The language checks that poses lie in free space (:meth:`OccupancyGrid.state_at`); the planner
+(:mod:`exsce_dsl.maps.planning`) plans on :meth:`OccupancyGrid.free_cells`.
 """
 
 from __future__ import annotations
@@ -40,6 +42,18 @@ class OccupancyGrid:
         """(x_min, x_max, y_min, y_max) of the grid in the map frame (origin yaw 0)."""
         ox, oy, _ = self.origin
         return ox, ox + self.width * self.resolution, oy, oy + self.height * self.resolution
+
+    def occupancy(self) -> np.ndarray:
+        """Each cell's occupancy, 0 (free) to 1 (occupied), by map_server's reading of the grey
+        levels (rows as in :attr:`cells`)."""
+        grey = self.cells.astype(np.float64)
+        occupancy: np.ndarray = grey / 255.0 if self.negate else (255.0 - grey) / 255.0
+        return occupancy
+
+    def free_cells(self) -> np.ndarray:
+        """Whether each cell is free space (below ``free_thresh``; rows as in :attr:`cells`)."""
+        free: np.ndarray = self.occupancy() < self.free_thresh
+        return free
 
     def state_at(self, x: float, y: float) -> str:
         """free, occupied, unknown or outside, by map_server's thresholds."""

@@ -2,23 +2,28 @@
 
 The map is coarsened to a planning grid, occupied space is inflated by the
 robot's radius (with a soft penalty near walls so paths keep clear of
-them), and shortest paths come from scipy's Dijkstra on the 8-connected graph
-of free cells: the graph is built once per map, vectorised.
+them), and shortest paths come from :mod:`exsce_dsl.maps.paths` (scipy's
+Dijkstra on the 8-connected graph of free cells, built once per map).
+:func:`planning_grid` is a scenario's grid: its map's, read once per process,
+or open floor round its poses when it declares no map file.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from functools import lru_cache
+from pathlib import Path
 
 import numpy as np
 from scipy import ndimage
-from scipy.sparse import coo_matrix, csr_matrix
-from scipy.sparse.csgraph import dijkstra
+from scipy.sparse import csr_matrix
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.errors import PlanningError as PlanningError
-from exsce_dsl.lang.occupancy import OccupancyGrid
+from exsce_dsl.maps.grid import OccupancyGrid, load_occupancy_grid
+from exsce_dsl.maps.paths import grid_graph, shortest_path
+from exsce_dsl.model import Scenario
 
 Point = tuple[float, float]
 
@@ -42,9 +47,7 @@ class PlanningGrid:
     def from_map(cls, grid: OccupancyGrid, robot_radius: float = 0.3, cell: float = 0.1) -> PlanningGrid:
         if grid.origin[2]:
             raise ExsceError("maps with a rotated origin are not supported by the executor")
-        grey = grid.cells[::-1].astype(np.float64)  # rows from the bottom
-        occupancy = grey / 255.0 if grid.negate else (255.0 - grey) / 255.0
-        free_full = occupancy < grid.free_thresh
+        free_full = grid.free_cells()[::-1]  # rows from the bottom
         clearance = ndimage.distance_transform_edt(free_full) * grid.resolution
         factor = max(1, round(cell / grid.resolution))
         rows, cols = (s // factor for s in free_full.shape)
@@ -113,15 +116,12 @@ class PlanningGrid:
             raise PlanningError(f"no free space near ({bad[0]:.2f}, {bad[1]:.2f}) on the map")
         width = self.free.shape[1]
         s, t = source[0] * width + source[1], target[0] * width + target[1]
-        dist, pred = dijkstra(self.graph, indices=s, return_predecessors=True, limit=np.inf)
-        if not np.isfinite(dist[t]):
+        nodes = shortest_path(self.graph, s, t)
+        if nodes is None:
             raise PlanningError(
                 f"no path from ({start[0]:.2f}, {start[1]:.2f}) to ({goal[0]:.2f}, {goal[1]:.2f})"
             )
-        nodes = [t]
-        while nodes[-1] != s:
-            nodes.append(int(pred[nodes[-1]]))
-        cells = [(n // width, n % width) for n in reversed(nodes)]
+        cells = [(n // width, n % width) for n in nodes]
         path = [start] + [self.centre(c) for c in cells[1:-1]] + [goal]
         return self._shortcut(path, robot_radius)
 
@@ -167,32 +167,29 @@ def _grid_graph(free: np.ndarray, clearance: np.ndarray, cell: float, robot_radi
     return grid_graph(free, cell, penalty)
 
 
-def grid_graph(
-    free: np.ndarray, cell: float, penalty: np.ndarray | None = None, node: np.ndarray | None = None
-) -> csr_matrix:
-    """The 8-connected graph of the ``free`` cells (no corner cutting), each edge weighted by its
-    length in metres, times the mean ``penalty`` of its two cells when given.  ``node`` numbers the
-    cells (default: row by row, every cell a node)."""
-    rows, cols = free.shape
-    index = np.arange(rows * cols).reshape(rows, cols) if node is None else node
-    sources, targets, weights = [], [], []
-    for dr, dc in ((0, 1), (1, 0), (1, 1), (1, -1)):
-        r0, r1 = max(0, -dr), rows - max(0, dr)
-        c0, c1 = max(0, -dc), cols - max(0, dc)
-        a = free[r0:r1, c0:c1] & free[r0 + dr : r1 + dr, c0 + dc : c1 + dc]
-        if dr and dc:  # no corner cutting: both cells beside the diagonal are free too
-            a &= free[r0 + dr : r1 + dr, c0:c1] & free[r0:r1, c0 + dc : c1 + dc]
-        step = cell * math.hypot(dr, dc)
-        if penalty is None:
-            weights.append(np.full(int(a.sum()), step))
-        else:
-            cost = step * 0.5 * (penalty[r0:r1, c0:c1] + penalty[r0 + dr : r1 + dr, c0 + dc : c1 + dc])
-            weights.append(cost[a])
-        sources.append(index[r0:r1, c0:c1][a])
-        targets.append(index[r0 + dr : r1 + dr, c0 + dc : c1 + dc][a])
-    src, dst, w = np.concatenate(sources), np.concatenate(targets), np.concatenate(weights)
-    n = int(index.max()) + 1
-    graph = coo_matrix(
-        (np.concatenate([w, w]), (np.concatenate([src, dst]), np.concatenate([dst, src]))), (n, n)
-    )
-    return graph.tocsr()
+def planning_grid(scenario: Scenario) -> PlanningGrid:
+    """The grid robots of ``scenario`` plan on: its environment's map file (read once per process
+    and file), else open floor round its poses."""
+    env = scenario.environment
+    if env.map is not None and env.map.file is not None:
+        return _grid_from_file(env.map.file)
+    return _open_space(scenario)
+
+
+@lru_cache(maxsize=4)
+def _grid_from_file(path: str) -> PlanningGrid:
+    return PlanningGrid.from_map(load_occupancy_grid(Path(path)))
+
+
+def _open_space(scenario: Scenario) -> PlanningGrid:
+    """No map given: an empty grid around every pose of the scenario, 10 m of margin."""
+    poses = [p for p in scenario.environment.poses()] + [w for t in scenario.tasks for w in t.waypoints()]
+    xs = [p.position.x for p in poses]
+    ys = [p.position.y for p in poses]
+    resolution = 0.05
+    x0, y0 = min(xs) - 10.0, min(ys) - 10.0
+    width = int((max(xs) + 10.0 - x0) / resolution) + 1
+    height = int((max(ys) + 10.0 - y0) / resolution) + 1
+    cells = np.full((height, width), 254, dtype=np.uint8)
+    cells[0, :] = cells[-1, :] = cells[:, 0] = cells[:, -1] = 0  # a wall round the edge, for the laser
+    return PlanningGrid.from_map(OccupancyGrid(cells, resolution, (x0, y0, 0.0), 0.65, 0.196, False))

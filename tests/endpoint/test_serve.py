@@ -24,7 +24,7 @@ from SPARQLWrapper import CSV, JSON, POST, POSTDIRECTLY, TSV, XML, SPARQLWrapper
 from exsce_dsl.lang import load_spec
 from exsce_dsl.prov import compile_scenario
 from exsce_dsl.store.embedded import EmbeddedStore
-from exsce_dsl.store.server import read_serve_info, serve_info_path
+from exsce_dsl.store.serve_info import read_serve_info, serve_info_path
 from exsce_dsl.store.writing import add_prov
 
 from conftest import EXAMPLES, run_exscec

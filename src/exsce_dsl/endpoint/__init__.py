@@ -1,0 +1,34 @@
+"""``exscec serve``: the embedded store as a SPARQL 1.1 Protocol endpoint, an HTTP face over
+:mod:`exsce_dsl.store` (beside :mod:`exsce_dsl.mcp_server`, the store's face for language models).
+
+Standard library HTTP (``ThreadingHTTPServer``) over a pyoxigraph store:
+
+* ``GET /query?query=...``, ``POST /query`` (``application/sparql-query`` or a
+  form with ``query=``); ``default-graph-uri`` and ``named-graph-uri`` are
+  honoured.  SELECT and ASK answer in SPARQL JSON, XML, CSV or TSV, CONSTRUCT
+  and DESCRIBE in Turtle, N-Triples or RDF/XML, by the ``Accept`` header (or
+  ``?format=json|xml|csv|tsv|ttl|nt``); JSON and Turtle when anything goes;
+* ``POST /update`` (``application/sparql-update`` or a form with
+  ``update=``): ``403`` unless the server was started with updates allowed,
+  then ``401`` without ``Authorization: Bearer <token>`` (compared in
+  constant time);
+* ``/sparql`` takes both, like Virtuoso's and Neptune's endpoints;
+* ``GET /store?graph=IRI`` (Graph Store Protocol, reading only): one graph,
+  or the whole dataset as N-Quads or TriG without ``graph``;
+* ``GET /``: a query page (no external resources).
+
+Only one process may open an embedded store folder, so while the endpoint
+runs it holds the store, and says so in ``<store>.serve.json``
+(:mod:`exsce_dsl.store.serve_info`: URL, pid, whether updates are allowed;
+never the token) next to the folder.  :func:`exsce_dsl.store.open.open_store`
+reads that file: other exscec commands on the same store go through the
+endpoint (queries always; writes when updates are allowed and
+``EXSCE_STORE_TOKEN`` holds the token) and otherwise fail with a message
+naming the server and what to do.  The file is removed when the server stops
+(Ctrl-C, SIGTERM).
+
+* :mod:`~exsce_dsl.endpoint.server` — the server, its start and its stop;
+* :mod:`~exsce_dsl.endpoint.handler` — one request: routing, queries, updates, the Graph Store;
+* :mod:`~exsce_dsl.endpoint.protocol` — reading a request: parameters, bodies, HTTP errors;
+* :mod:`~exsce_dsl.endpoint.formats` — answers: content negotiation and serialization.
+"""

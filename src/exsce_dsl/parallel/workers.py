@@ -1,0 +1,34 @@
+"""Where work runs: in this process, over a pool of processes on this machine (``--jobs``), or on a
+Dask cluster (``--cluster``, :mod:`exsce_dsl.parallel.cluster`), behind one ``map``."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
+from typing import Any
+
+Mapper = Callable[[Callable[[Any], Any], Iterable[Any]], Iterator[Any]]
+"""``map``, a process pool's or a Dask cluster's (results in order)."""
+
+
+@contextmanager
+def workers(jobs: int, tasks: int, cluster: str | None = None) -> Iterator[Mapper]:
+    """``map`` on the Dask cluster at ``cluster``, in this process (one job), or over a pool of
+    ``jobs`` processes (no more than ``tasks`` and this machine's cores) kept for every call."""
+    if cluster is not None:
+        from exsce_dsl.parallel.cluster import cluster_mapper
+
+        with cluster_mapper(cluster) as mapper:
+            yield mapper
+        return
+    if jobs <= 1 or tasks <= 1:
+        yield map
+        return
+    from concurrent.futures import ProcessPoolExecutor
+
+    with ProcessPoolExecutor(max_workers=min(jobs, tasks, os.cpu_count() or 1)) as pool:
+        yield pool.map
+
+
+__all__ = ["Mapper", "workers"]
