@@ -125,6 +125,8 @@ def _collector_paused() -> Iterator[None]:
 
 
 class _ScenarioCompiler:
+    """A scenario's PROV document: the scenario, environment, area, robot and task bundles."""
+
     def __init__(self, scenario: Scenario, names: Namespaces, checked: bool = False) -> None:
         self.scenario = scenario
         self.writer = DocumentWriter(names, checked)

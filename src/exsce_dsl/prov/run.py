@@ -98,6 +98,8 @@ def compile_run(
 
 
 class _RunCompiler:
+    """A run's PROV document: the run, bag, metric and hotspot bundles, and its coverage."""
+
     def __init__(
         self, run: Run, scenario: Scenario, names: Namespaces, checked: bool, own_bag_graph: bool = False
     ) -> None:
@@ -131,10 +133,12 @@ class _RunCompiler:
 
     # -- helpers -----------------------------------------------------------
 
-    def _parts(self, w: BundleWriter) -> Namespace:
+    def parts_in(self, w: BundleWriter) -> Namespace:
+        """The run's namespace, as bundle ``w`` declares it."""
         return w.of_element(self.run_prefix, self.run_ns_iri, "run")
 
-    def _run_id(self, w: BundleWriter) -> QualifiedName:
+    def run_id_in(self, w: BundleWriter) -> QualifiedName:
+        """The run's activity, as bundle ``w`` names it."""
         return w.fixed(ids.RUN)[ids.run_name(self.run.uuid)]
 
     def _pose_name(self, pose: Pose) -> str:
@@ -143,7 +147,8 @@ class _RunCompiler:
             name = self._pose_names[pose] = ids.pose_name(pose)
         return name
 
-    def _check_robot(self, robot_id: str, what: str) -> None:
+    def check_robot(self, robot_id: str, what: str) -> None:
+        """``what`` is for a robot of the scenario, else an error."""
         if robot_id not in self._robot_ids:
             raise ExsceError(
                 f"{what} of run {self.run.uuid} is for robot '{robot_id}', "
@@ -158,8 +163,8 @@ class _RunCompiler:
         run_ns = writer.document_namespace(ids.RUN)
         w = writer.bundle(run_ns[f"{ids.run_name(run.uuid)}_bundle"], f"the bundle of run {run.uuid}")
         t = w.term
-        parts = self._parts(w)
-        run_id = self._run_id(w)
+        parts = self.parts_in(w)
+        run_id = self.run_id_in(w)
         writer.claim(run_id, f"run {run.uuid}")
         uuid_attr = t(ids.RUN_ATTR)
         robot_ns, pose_ns = w.fixed(ids.ROBOT), w.fixed(ids.POSE)
@@ -188,7 +193,7 @@ class _RunCompiler:
         actions: dict[ActionId, QualifiedName] = {}
         for task in run.tasks:
             robot = task.robot
-            self._check_robot(robot, f"task {task.allocation}")
+            self.check_robot(robot, f"task {task.allocation}")
             if task.allocation > self._allocated.get(robot, 0):
                 raise ExsceError(
                     f"run {run.uuid} has task {task.allocation} of robot '{robot}', but mission "
@@ -236,7 +241,7 @@ class _RunCompiler:
         graphs = self.run_parts if self.own_bag_graph else writer.document_namespace(ids.EXSCE)
         w = writer.bundle(graphs[f"{name}_bundle"], f"the bundle of bag {bag.file_name}")
         t = w.term
-        bag_id = self._parts(w)[name]
+        bag_id = self.parts_in(w)[name]
         writer.claim(bag_id, f"bag {bag.file_name}")
         facts: Attributes = {PROV_TYPE: t(ids.ROS_BAGS)}
         if bag.path is not None:
@@ -257,7 +262,7 @@ class _RunCompiler:
 
     def _clocks(self, w: BundleWriter, held: set[str]) -> None:
         """Which clock each topic was timed by on the run's timeline (derived from the topic)."""
-        t, parts, topic_ns = w.term, self._parts(w), w.fixed(ids.TOPIC)
+        t, parts, topic_ns = w.term, self.parts_in(w), w.fixed(ids.TOPIC)
         for clock in self.run.clocks:
             if clock.topic not in held:
                 continue
@@ -275,9 +280,9 @@ class _RunCompiler:
     def _conventions(self, w: BundleWriter, held: set[str]) -> None:
         """The convention detected for each robot whose type names none, and the topics it was
         detected from."""
-        t, parts, topic_ns = w.term, self._parts(w), w.fixed(ids.TOPIC)
+        t, parts, topic_ns = w.term, self.parts_in(w), w.fixed(ids.TOPIC)
         for robot, convention, evidence in self.run.conventions:
-            self._check_robot(robot, "a detected convention")
+            self.check_robot(robot, "a detected convention")
             found = parts[ids.convention_name(robot)]
             self.writer.claim(found, f"the convention of '{robot}'")
             w.entity(
@@ -305,13 +310,13 @@ class _RunCompiler:
         run, writer = self.run, self.writer
         w = writer.bundle(self.run_parts[ids.HOTSPOTS_BUNDLE], "the bundle of the run's hotspots")
         t = w.term
-        parts = self._parts(w)
-        run_id = self._run_id(w)
+        parts = self.parts_in(w)
+        run_id = self.run_id_in(w)
         x, y, z = t(ids.COORD_X), t(ids.COORD_Y), t(ids.COORD_Z)
         counts: dict[tuple[str, str | None], int] = {}
         for hotspot in run.hotspots:
             if hotspot.robot is not None:
-                self._check_robot(hotspot.robot, f"a hotspot of '{hotspot.metric}'")
+                self.check_robot(hotspot.robot, f"a hotspot of '{hotspot.metric}'")
             key = (hotspot.metric, hotspot.robot)
             counts[key] = index = counts.get(key, 0) + 1
             hotspot_id = parts[ids.hotspot_name(hotspot.metric, hotspot.robot, index)]
@@ -345,8 +350,8 @@ class _MetricBundle:
             compiler.run_parts[f"{metric}_bundle"], f"the bundle of metric '{metric}'"
         )
         t = w.term
-        self.parts = compiler._parts(w)
-        self.run_id = compiler._run_id(w)
+        self.parts = compiler.parts_in(w)
+        self.run_id = compiler.run_id_in(w)
         self.topic_ns = w.fixed(ids.TOPIC)
         self.bag_topics = set(self.run.bag.topics)
         self.base: Attributes = {
@@ -363,7 +368,7 @@ class _MetricBundle:
         """The value's entity, its topics' collection and what generated it."""
         metric, robot, w = self.metric, value.robot, self.w
         if robot is not None:
-            self.compiler._check_robot(robot, f"the value of '{metric}'")
+            self.compiler.check_robot(robot, f"the value of '{metric}'")
         # a violation_duration is about one safety metric: its values and topics are that metric's
         named = metric if value.safety_metric is None else f"{metric}-{value.safety_metric}"
         collection = self._collection(value, named)

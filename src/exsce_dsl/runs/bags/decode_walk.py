@@ -45,6 +45,9 @@ def _probe_key(select: Select) -> str:
 
 
 class Walker:
+    """The fields of a message type walked over all messages at once: the bytes read at each
+    message's position, the requested values put under their keys."""
+
     def __init__(self, catalogue: MessageCatalogue, messages: RawMessages, cdr: bool) -> None:
         self.catalogue = catalogue
         self.buffer = messages.buffer
