@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import sys
 from collections import Counter
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import click
 
@@ -11,8 +14,36 @@ from exsce_dsl.cli.common import ExitCode, exit_status, reports_errors
 from exsce_dsl.cli.store_commands import store_option
 from exsce_dsl.cli.trial_commands import trial_options
 
+if TYPE_CHECKING:
+    from exsce_dsl.api.execution import ExecutedRun
+    from exsce_dsl.model import Scenario
+
 POLICIES = ("skip-waypoint", "retry-once", "skip-task", "stop-mission")
 """``Policy`` values (``exsce_dsl.execute.outcomes``), spelled here so that ``--help`` imports nothing."""
+
+
+@dataclass(frozen=True)
+class _ExecuteOptions:
+    """``exscec execute``'s arguments and options, as click gives them."""
+
+    spec: str
+    ros1: bool
+    scenario_id: str | None
+    runs: int
+    out_dir: str
+    start_master: bool
+    policy: str
+    server_timeout: float
+    goal_timeout: float | None
+    stand_in: bool
+    seed: int
+    faults: tuple[str, ...]
+    speed_up: float
+    judge: bool
+    junit: str | None
+    required_pass_rate: float
+    confidence: float
+    store_url: str | None
 
 
 @click.command(
@@ -94,26 +125,7 @@ POLICIES = ("skip-waypoint", "retry-once", "skip-task", "stop-mission")
 @trial_options
 @store_option
 @reports_errors
-def execute(
-    spec: str,
-    ros1: bool,
-    scenario_id: str | None,
-    runs: int,
-    out_dir: str,
-    start_master: bool,
-    policy: str,
-    server_timeout: float,
-    goal_timeout: float | None,
-    stand_in: bool,
-    seed: int,
-    faults: tuple[str, ...],
-    speed_up: float,
-    judge: bool,
-    junit: str | None,
-    required_pass_rate: float,
-    confidence: float,
-    store_url: str | None,
-) -> None:
+def execute(**given: Any) -> None:
     """Run a scenario's mission on a live ROS graph, record each run, judge it.
 
     The scenario goes on the parameter server (/scenario); one actionlib
@@ -153,24 +165,39 @@ def execute(
           --policy retry-once --verify --junit verdicts.xml --server-timeout 1 \\
           -o live/  # exits 2: no robot's move_base answers
     """
-    from exsce_dsl.api.execution import execute_ros1
-    from exsce_dsl.errors import ExecutionInterrupted
     from exsce_dsl.lang import load_spec
 
-    scenario = load_spec(spec).scenario(scenario_id)
+    options = _ExecuteOptions(**given)
+    scenario = load_spec(options.spec).scenario(options.scenario_id)
+    done = _execute_runs(scenario, options)
+    for run in done:
+        counts = Counter(r.outcome.value for r in run.mission.records)
+        said = ", ".join(f"{n} {outcome}" for outcome, n in sorted(counts.items()))
+        click.echo(
+            f"wrote {run.files.bag} (mission {run.mission.status.value}: {said or 'no goal'})", err=True
+        )
+    if options.judge:
+        sys.exit(_judge(scenario, [r.files.bag for r in done], options))
+
+
+def _execute_runs(scenario: Scenario, options: _ExecuteOptions) -> list[ExecutedRun]:
+    """The runs on the live graph; interrupted, what was kept is said and the exit status is 130."""
+    from exsce_dsl.api.execution import execute_ros1
+    from exsce_dsl.errors import ExecutionInterrupted
+
     try:
-        done = execute_ros1(
+        return execute_ros1(
             scenario,
-            out_dir,
-            runs,
-            start_master=start_master,
-            policy=policy,
-            server_timeout=server_timeout,
-            timeout=goal_timeout,
-            stand_in=stand_in,
-            seed=seed,
-            faults=faults,
-            speed_up=speed_up,
+            options.out_dir,
+            options.runs,
+            start_master=options.start_master,
+            policy=options.policy,
+            server_timeout=options.server_timeout,
+            timeout=options.goal_timeout,
+            stand_in=options.stand_in,
+            seed=options.seed,
+            faults=options.faults,
+            speed_up=options.speed_up,
         )
     except ExecutionInterrupted as stop:
         click.echo(f"error: {stop.message}", err=True)
@@ -179,25 +206,23 @@ def execute(
         for bag in stop.complete:
             click.echo(f"wrote {bag}", err=True)
         sys.exit(ExitCode.INTERRUPTED)
-    for run in done:
-        counts = Counter(r.outcome.value for r in run.mission.records)
-        said = ", ".join(f"{n} {outcome}" for outcome, n in sorted(counts.items()))
-        click.echo(
-            f"wrote {run.files.bag} (mission {run.mission.status.value}: {said or 'no goal'})", err=True
-        )
-    if judge:
-        from exsce_dsl.api.workflows import verify
-        from exsce_dsl.cli.oracle_commands import report_verification
-        from exsce_dsl.store.open import open_store
 
-        with open_store(store_url) as store:
-            verification = verify(store, scenario, [r.files.bag for r in done])
-        if runs > 1:
-            from exsce_dsl.cli.trial_commands import report_trial
-            from exsce_dsl.oracles.trial_runs import trial_of
 
-            sys.exit(report_trial(trial_of(verification, required_pass_rate, confidence), False, junit))
-        sys.exit(report_verification(verification, False, junit))
+def _judge(scenario: Scenario, bags: list[Path], options: _ExecuteOptions) -> ExitCode:
+    """--verify: the bags ingested and judged as exscec verify judges them (several: one trial)."""
+    from exsce_dsl.api.workflows import verify
+    from exsce_dsl.cli.oracle_commands import report_verification
+    from exsce_dsl.store.open import open_store
+
+    with open_store(options.store_url) as store:
+        verification = verify(store, scenario, bags)
+    if options.runs > 1:
+        from exsce_dsl.cli.trial_commands import report_trial
+        from exsce_dsl.oracles.trial_runs import trial_of
+
+        trial = trial_of(verification, options.required_pass_rate, options.confidence)
+        return report_trial(trial, False, options.junit)
+    return report_verification(verification, False, options.junit)
 
 
 COMMANDS = [execute]

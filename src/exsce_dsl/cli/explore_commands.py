@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import sys
 from contextlib import AbstractContextManager, nullcontext
+from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import click
 
@@ -14,7 +15,37 @@ from exsce_dsl.cli.store_commands import store_option
 from exsce_dsl.wording import counted
 
 if TYPE_CHECKING:
-    from exsce_dsl.explore.campaign import CampaignResult
+    from exsce_dsl.explore.campaign import CampaignOptions, CampaignResult
+    from exsce_dsl.explore.executors import Executor
+
+
+@dataclass(frozen=True)
+class _ExploreOptions:
+    """``exscec explore``'s arguments and options, as click gives them."""
+
+    spec: str
+    scenario_id: str | None
+    budget: int
+    seed: int
+    runs_per_scenario: int
+    transformations: tuple[str, ...]
+    max_steps: int
+    strategy: str
+    tolerance: float
+    no_shrink: bool
+    stop_at_violation: bool
+    compare_random: bool
+    faults: tuple[str, ...]
+    executor_command: str | None
+    plugin: str | None
+    stand_in: bool
+    start_master: bool
+    speed_up: float | None
+    jobs: int
+    cluster: str | None
+    output: str | None
+    junit: str | None
+    store_url: str | None
 
 
 @click.command(
@@ -108,31 +139,7 @@ if TYPE_CHECKING:
 @click.option("--junit", type=click.Path(dir_okay=False), help="Also write the campaign as JUnit XML.")
 @store_option
 @reports_errors
-def explore(
-    spec: str,
-    scenario_id: str | None,
-    budget: int,
-    seed: int,
-    runs_per_scenario: int,
-    transformations: tuple[str, ...],
-    max_steps: int,
-    strategy: str,
-    tolerance: float,
-    no_shrink: bool,
-    stop_at_violation: bool,
-    compare_random: bool,
-    faults: tuple[str, ...],
-    executor_command: str | None,
-    plugin: str | None,
-    stand_in: bool,
-    start_master: bool,
-    speed_up: float | None,
-    jobs: int,
-    cluster: str | None,
-    output: str | None,
-    junit: str | None,
-    store_url: str | None,
-) -> None:
+def explore(**given: Any) -> None:
     """Explore derivations of a scenario to find a fault, and shrink what fails.
 
     Draws BUDGET derivations (compositions of up to --max-steps applicable
@@ -188,57 +195,43 @@ def explore(
         --executor ros1 --stand-in --start-master --speed-up 20 --no-shrink \
         --fault deadlock-start:tiago1:classroom_c025-w002 -o explore/live  # exits 1
     """
-    from exsce_dsl.errors import ExecutionInterrupted, ExsceError
-    from exsce_dsl.explore.campaign import CampaignEvents, CampaignOptions, run_campaign
-    from exsce_dsl.explore.executors import (
-        CommandExecutor,
-        Executor,
-        ExecutorOptions,
-        SimulatorExecutor,
-        named_executor,
-    )
+    from exsce_dsl.oracles.campaign_junit import campaign_junit
+
+    options = _ExploreOptions(**given)
+    result, random, durations = _run_campaigns(options)
+    _summary(result, random)
+    if options.junit:
+        Path(options.junit).write_text(campaign_junit(result.record, durations), encoding="utf-8")
+    violated = any(t.violated for t in result.record.trials)
+    undecided = any(t.inconclusive for t in result.record.trials)
+    sys.exit(ExitCode.FAILED if violated else ExitCode.INCONCLUSIVE if undecided else ExitCode.PASSED)
+
+
+def _run_campaigns(
+    options: _ExploreOptions,
+) -> tuple[CampaignResult, CampaignResult | None, dict[str, float]]:
+    """The campaign (and its random baseline with --compare-random), each trial said as it ends;
+    with --junit, its runs' durations.  Ctrl-C exits 130: the same command goes on from there."""
+    from exsce_dsl.errors import ExecutionInterrupted
+    from exsce_dsl.explore.campaign import CampaignEvents, run_campaign
     from exsce_dsl.explore.figures import random_baseline
     from exsce_dsl.lang import load_spec
     from exsce_dsl.model.campaign import Trial
-    from exsce_dsl.oracles.campaign_junit import campaign_junit, run_seconds
-    from exsce_dsl.parallel.cluster import cluster_address
+    from exsce_dsl.oracles.campaign_junit import run_seconds
     from exsce_dsl.store.open import open_store
 
-    if executor_command and (faults or plugin):
-        raise ExsceError("give one of --fault (the simulator), --executor-command and --executor")
-    if (stand_in or start_master or speed_up is not None) and not plugin:
-        raise ExsceError("--stand-in, --start-master and --speed-up go with --executor ros1")
-    address = cluster_address(cluster)
-    chosen: AbstractContextManager[Executor]
-    if executor_command:
-        chosen = nullcontext(CommandExecutor(executor_command))
-    elif plugin:
-        chosen = named_executor(plugin, ExecutorOptions(faults, stand_in, start_master, None, speed_up))
-    else:
-        chosen = nullcontext(SimulatorExecutor.with_faults(faults, cluster=address))
-    options = CampaignOptions(
-        budget=budget,
-        seed=seed,
-        runs_per_scenario=runs_per_scenario,
-        max_steps=max_steps,
-        transformations=transformations,
-        strategy=strategy,
-        tolerance=tolerance,
-        shrink=not no_shrink,
-        stop_at_violation=stop_at_violation,
-        jobs=jobs,
-        cluster=address,
-    )
-    baseline = random_baseline(options) if compare_random else None
-    parsed = load_spec(spec)
-    total = budget * (2 if baseline else 1)
-    with chosen as executor, open_store(store_url) as store, Progress(total, "Exploring") as progress:
+    chosen, campaign = _executor(options)
+    baseline = random_baseline(campaign) if options.compare_random else None
+    parsed = load_spec(options.spec)
+    total = options.budget * (2 if baseline else 1)
+    with chosen as executor, open_store(options.store_url) as store, Progress(total, "Exploring") as progress:
 
         def events(who: str) -> CampaignEvents:
             def trial_done(trial: Trial, resumed: bool) -> None:
                 shown = trial.violated or trial.inconclusive
                 found = f": {'; '.join(r.text for r in shown)}" if shown else ""
                 done = " (done before)" if resumed else ""
+                budget = options.budget
                 progress.say(
                     f"{who}trial {trial.number}/{budget} {trial.scenario} {trial.outcome}{found}{done}"
                 )
@@ -246,33 +239,67 @@ def explore(
 
             return CampaignEvents(said=progress.say, trial_done=trial_done)
 
+        def run(plan: CampaignOptions, output: str | None, who: str) -> CampaignResult:
+            return run_campaign(
+                store, parsed, options.spec, plan, executor, output,
+                scenario_id=options.scenario_id, events=events(who),
+            )  # fmt: skip
+
         try:
-            result = run_campaign(
-                store, parsed, spec, options, executor, output, scenario_id=scenario_id, events=events("")
-            )
+            result = run(campaign, options.output, "")
             random = None
             if baseline is not None:
-                where = f"{output.rstrip('/')}-random" if output else None
-                random = run_campaign(
-                    store,
-                    parsed,
-                    spec,
-                    baseline,
-                    executor,
-                    where,
-                    scenario_id=scenario_id,
-                    events=events("random: "),
-                )
+                where = f"{options.output.rstrip('/')}-random" if options.output else None
+                random = run(baseline, where, "random: ")
         except ExecutionInterrupted as stop:  # the campaign goes on where it stopped, run again
             click.echo(f"error: {stop.message}", err=True)
             sys.exit(ExitCode.INTERRUPTED)
-        durations = run_seconds(store, result.record) if junit else {}
-    _summary(result, random)
-    if junit:
-        Path(junit).write_text(campaign_junit(result.record, durations), encoding="utf-8")
-    violated = any(t.violated for t in result.record.trials)
-    undecided = any(t.inconclusive for t in result.record.trials)
-    sys.exit(ExitCode.FAILED if violated else ExitCode.INCONCLUSIVE if undecided else ExitCode.PASSED)
+        durations = run_seconds(store, result.record) if options.junit else {}
+    return result, random, durations
+
+
+def _executor(options: _ExploreOptions) -> tuple[AbstractContextManager[Executor], CampaignOptions]:
+    """What runs the scenarios (the simulator, a command or a named executor) and the campaign's
+    plan, from the options, which are checked to go together."""
+    from exsce_dsl.errors import ExsceError
+    from exsce_dsl.explore.campaign import CampaignOptions
+    from exsce_dsl.explore.executors import (
+        CommandExecutor,
+        ExecutorOptions,
+        SimulatorExecutor,
+        named_executor,
+    )
+    from exsce_dsl.parallel.cluster import cluster_address
+
+    o = options
+    if o.executor_command and (o.faults or o.plugin):
+        raise ExsceError("give one of --fault (the simulator), --executor-command and --executor")
+    if (o.stand_in or o.start_master or o.speed_up is not None) and not o.plugin:
+        raise ExsceError("--stand-in, --start-master and --speed-up go with --executor ros1")
+    address = cluster_address(o.cluster)
+    chosen: AbstractContextManager[Executor]
+    if o.executor_command:
+        chosen = nullcontext(CommandExecutor(o.executor_command))
+    elif o.plugin:
+        chosen = named_executor(
+            o.plugin, ExecutorOptions(o.faults, o.stand_in, o.start_master, None, o.speed_up)
+        )
+    else:
+        chosen = nullcontext(SimulatorExecutor.with_faults(o.faults, cluster=address))
+    campaign = CampaignOptions(
+        budget=o.budget,
+        seed=o.seed,
+        runs_per_scenario=o.runs_per_scenario,
+        max_steps=o.max_steps,
+        transformations=o.transformations,
+        strategy=o.strategy,
+        tolerance=o.tolerance,
+        shrink=not o.no_shrink,
+        stop_at_violation=o.stop_at_violation,
+        jobs=o.jobs,
+        cluster=address,
+    )
+    return chosen, campaign
 
 
 def _summary(result: CampaignResult, random: CampaignResult | None) -> None:

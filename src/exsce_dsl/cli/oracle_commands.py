@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import sys
+from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import click
 
@@ -20,7 +21,10 @@ from exsce_dsl.cli.store_commands import store_option
 from exsce_dsl.cli.trial_commands import trial_options
 
 if TYPE_CHECKING:
+    from exsce_dsl.model import Scenario
+    from exsce_dsl.model.trials import Trial
     from exsce_dsl.oracles.workflows import Verification
+    from exsce_dsl.store.base import Store
 
 
 @click.command(epilog=exit_status(bad_input="bad input: a spec error, too few runs, no acceptance criteria"))
@@ -76,6 +80,26 @@ def baseline(spec: str, scenario_id: str | None, include_all: bool, store_url: s
     click.echo(report.summary(), err=True)
 
 
+@dataclass(frozen=True)
+class _VerifyOptions:
+    """``exscec verify``'s arguments and options, as click gives them."""
+
+    runs: tuple[str, ...]
+    spec: str
+    scenario_id: str | None
+    trial: bool
+    repeat: int | None
+    seed: int | None
+    faults: tuple[str, ...]
+    out_dir: str | None
+    required_pass_rate: float
+    confidence: float
+    as_json: bool
+    junit: str | None
+    no_record: bool
+    store_url: str | None
+
+
 @click.command(
     epilog=exit_status(
         passed="every oracle passed (a trial: every clause passed)",
@@ -129,22 +153,7 @@ def baseline(spec: str, scenario_id: str | None, include_all: bool, store_url: s
 @click.option("--no-record", is_flag=True, help="Do not write the verdicts to the store.")
 @store_option
 @reports_errors
-def verify(
-    runs: tuple[str, ...],
-    spec: str,
-    scenario_id: str | None,
-    trial: bool,
-    repeat: int | None,
-    seed: int | None,
-    faults: tuple[str, ...],
-    out_dir: str | None,
-    required_pass_rate: float,
-    confidence: float,
-    as_json: bool,
-    junit: str | None,
-    no_record: bool,
-    store_url: str | None,
-) -> None:
+def verify(**given: Any) -> None:
     """Judge runs against every oracle of their scenario.
 
     RUNS are stored runs (their uuids, or any unique prefix of one of 4
@@ -186,42 +195,55 @@ def verify(
     """
     from exsce_dsl.cli.trial_commands import report_trial
     from exsce_dsl.lang import load_spec
-    from exsce_dsl.oracles.trial_runs import REPEAT_FOLDER, REPEAT_SEED, verify_trial
     from exsce_dsl.oracles.workflows import IngestFailed, verify_runs
     from exsce_dsl.store.open import open_store
 
-    if not runs and repeat is None:
+    options = _VerifyOptions(**given)
+    _check_runs_given(options)
+    scenario = load_spec(options.spec).scenario(options.scenario_id)
+    runs = options.runs
+    bags: list[str | Path] = [Path(r) for r in bag_arguments(runs) if Path(r).exists()]  # files, bag folders
+    uuids: list[str | Path] = [r for r in runs if not Path(r).exists()]
+    with open_store(options.store_url) as store:
+        try:
+            if options.trial or options.repeat is not None:
+                judged = _verify_trial(store, scenario, [*uuids, *bags], options)
+                sys.exit(report_trial(judged, options.as_json, options.junit))
+            verification = verify_runs(store, scenario, [*uuids, *bags], record=not options.no_record)
+        except IngestFailed as exc:
+            click.echo(f"error: {exc.message}", err=True)
+            sys.exit(ExitCode.BAD_INPUT)
+    sys.exit(report_verification(verification, options.as_json, options.junit))
+
+
+def _check_runs_given(options: _VerifyOptions) -> None:
+    """Runs to judge, or --repeat N; and --seed, --fault and --output only with --repeat."""
+    if not options.runs and options.repeat is None:
         context = click.get_current_context()
         (argument,) = [p for p in context.command.params if p.name == "runs"]
         raise click.MissingParameter(
             "Give the runs to judge (stored runs or bags), or --repeat N.", context, argument
         )
-    if repeat is None and (seed is not None or faults or out_dir is not None):
+    if options.repeat is None and (options.seed is not None or options.faults or options.out_dir is not None):
         raise click.UsageError("--seed, --fault and --output are for the runs of --repeat N")
-    scenario = load_spec(spec).scenario(scenario_id)
-    bags: list[str | Path] = [Path(r) for r in bag_arguments(runs) if Path(r).exists()]  # files, bag folders
-    uuids: list[str | Path] = [r for r in runs if not Path(r).exists()]
-    with open_store(store_url) as store:
-        try:
-            if trial or repeat is not None:
-                judged = verify_trial(
-                    store,
-                    scenario,
-                    [*uuids, *bags],
-                    repeat=repeat or 0,
-                    out_dir=out_dir or REPEAT_FOLDER,
-                    seed=REPEAT_SEED if seed is None else seed,
-                    faults=faults,
-                    record=not no_record,
-                    required_pass_rate=required_pass_rate,
-                    confidence=confidence,
-                )
-                sys.exit(report_trial(judged, as_json, junit))
-            verification = verify_runs(store, scenario, [*uuids, *bags], record=not no_record)
-        except IngestFailed as exc:
-            click.echo(f"error: {exc.message}", err=True)
-            sys.exit(ExitCode.BAD_INPUT)
-    sys.exit(report_verification(verification, as_json, junit))
+
+
+def _verify_trial(store: Store, scenario: Scenario, runs: list[str | Path], options: _VerifyOptions) -> Trial:
+    """The runs (and --repeat N new ones) judged as one trial."""
+    from exsce_dsl.oracles.trial_runs import REPEAT_FOLDER, REPEAT_SEED, verify_trial
+
+    return verify_trial(
+        store,
+        scenario,
+        runs,
+        repeat=options.repeat or 0,
+        out_dir=options.out_dir or REPEAT_FOLDER,
+        seed=REPEAT_SEED if options.seed is None else options.seed,
+        faults=options.faults,
+        record=not options.no_record,
+        required_pass_rate=options.required_pass_rate,
+        confidence=options.confidence,
+    )
 
 
 def report_verification(verification: Verification, as_json: bool, junit: str | None) -> ExitCode:

@@ -59,7 +59,7 @@ size of the scenario.
 from __future__ import annotations
 
 import gc
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 
 from prov.constants import (
@@ -125,6 +125,8 @@ def _collector_paused() -> Iterator[None]:
 
 
 class _ScenarioCompiler:
+    """A scenario's PROV document: the scenario, environment, area, robot and task bundles."""
+
     def __init__(self, scenario: Scenario, names: Namespaces, checked: bool = False) -> None:
         self.scenario = scenario
         self.writer = DocumentWriter(names, checked)
@@ -143,7 +145,7 @@ class _ScenarioCompiler:
     def compile(self) -> ProvDocument:
         scenario = self.scenario
         environment = scenario.environment
-        area_poses, loose_start_poses, loose_obstacle_poses = self._place_poses()
+        area_poses, loose_start_poses, loose_obstacle_poses = _place_poses(scenario, self.pose_name)
         self._scenario_bundle(loose_start_poses)
         self._environment_bundle(environment, loose_obstacle_poses)
         for area_id, poses in area_poses.items():
@@ -167,39 +169,6 @@ class _ScenarioCompiler:
     ) -> BundleWriter:
         identifier = self.writer.document_namespace(prefix)[ids.bundle_name(element_id)]
         return self.writer.bundle(identifier, what, location)
-
-    def _place_poses(
-        self,
-    ) -> tuple[dict[str, dict[str, Pose]], list[Pose], list[Pose]]:
-        """Which bundle holds each pose: its area's, or (without area) its user's."""
-        scenario = self.scenario
-        by_area: dict[str, dict[str, Pose]] = {}
-
-        def place(area_id: str, pose: Pose) -> None:
-            by_area.setdefault(area_id, {}).setdefault(self.pose_name(pose), pose)
-
-        for area in scenario.environment.areas:
-            by_area.setdefault(area.id, {})
-            for pose in area.poses:
-                place(area.id, pose)
-        loose_start: list[Pose] = []
-        for robot in scenario.robots:
-            if robot.start_pose is not None:
-                if robot.start_pose.area is None:
-                    loose_start.append(robot.start_pose)
-                else:
-                    place(robot.start_pose.area, robot.start_pose)
-        for task in scenario.tasks:
-            for waypoint in task.waypoints():
-                if waypoint.area is not None:
-                    place(waypoint.area, waypoint)
-        loose_obstacle: list[Pose] = []
-        for obstacle in scenario.environment.obstacles:
-            if obstacle.pose.area is None:
-                loose_obstacle.append(obstacle.pose)
-            else:
-                place(obstacle.pose.area, obstacle.pose)
-        return by_area, loose_start, loose_obstacle
 
     # -- poses -------------------------------------------------------------
 
@@ -335,14 +304,14 @@ class _ScenarioCompiler:
             map_model: MapModel = environment.map
             map_id = parts[ids.map_entity_name(map_model.name)]
             grid_id, metadata_id = parts[ids.OCCUPANCY_GRID], parts[ids.MAP_METADATA]
-            w.entity(map_id, {PROV_TYPE: t(ids.MAP_TYPE), **self._ros(w, map_model.source)})
+            w.entity(map_id, {PROV_TYPE: t(ids.MAP_TYPE), **_ros(w, map_model.source)})
             w.entity(grid_id, {PROV_TYPE: t(ids.ROS_OCCUPANCY_GRID)})
             w.entity(metadata_id, {PROV_TYPE: t(ids.ROS_PARAMETER_SERVER)})
             members += [(map_id, grid_id), (map_id, metadata_id), (env_id, map_id)]
         if environment.world is not None:
             world: WorldModel = environment.world
             world_id = parts[ids.GAZEBO_WORLD]
-            w.entity(world_id, {PROV_TYPE: t(ids.ROS_GAZEBO_MODEL), **self._ros(w, world.source)})
+            w.entity(world_id, {PROV_TYPE: t(ids.ROS_GAZEBO_MODEL), **_ros(w, world.source)})
             members.append((env_id, world_id))
         obstacles = []
         for obstacle in environment.obstacles:
@@ -398,7 +367,7 @@ class _ScenarioCompiler:
         t = w.term
         task_ns = w.fixed(ids.TASK)
         task_id = task_ns[task.id]
-        w.entity(task_id, {PROV_TYPE: t(ids.PROV_PLAN), **self._ros(w, task.source)})
+        w.entity(task_id, {PROV_TYPE: t(ids.PROV_PLAN), **_ros(w, task.source)})
         plan_type = {PROV_TYPE: t(ids.PROV_PLAN)}
         subtask_ids = [task_ns[ids.subtask_name(task.id, i)] for i in range(1, len(task.subtasks) + 1)]
         for subtask_id in subtask_ids:
@@ -418,11 +387,46 @@ class _ScenarioCompiler:
                 )
         self._write_poses(w, (p for p in task.waypoints() if p.area is None))
 
-    @staticmethod
-    def _ros(w: BundleWriter, source: RosResource | None) -> Attributes:
-        if source is None:
-            return {}
-        found: Attributes = {w.term(ids.ROS_PKG): source.package}
-        if source.path is not None:
-            found[w.term(ids.ROS_RELATIVE_PATH)] = source.path
-        return found
+
+def _place_poses(
+    scenario: Scenario, pose_name: Callable[[Pose], str]
+) -> tuple[dict[str, dict[str, Pose]], list[Pose], list[Pose]]:
+    """Which bundle holds each pose: its area's (by ``pose_name``), or (without area) its user's:
+    the poses by area, then the start poses and the obstacles' poses that have none."""
+    by_area: dict[str, dict[str, Pose]] = {}
+
+    def place(area_id: str, pose: Pose) -> None:
+        by_area.setdefault(area_id, {}).setdefault(pose_name(pose), pose)
+
+    for area in scenario.environment.areas:
+        by_area.setdefault(area.id, {})
+        for pose in area.poses:
+            place(area.id, pose)
+    loose_start: list[Pose] = []
+    for robot in scenario.robots:
+        if robot.start_pose is not None:
+            if robot.start_pose.area is None:
+                loose_start.append(robot.start_pose)
+            else:
+                place(robot.start_pose.area, robot.start_pose)
+    for task in scenario.tasks:
+        for waypoint in task.waypoints():
+            if waypoint.area is not None:
+                place(waypoint.area, waypoint)
+    loose_obstacle: list[Pose] = []
+    for obstacle in scenario.environment.obstacles:
+        if obstacle.pose.area is None:
+            loose_obstacle.append(obstacle.pose)
+        else:
+            place(obstacle.pose.area, obstacle.pose)
+    return by_area, loose_start, loose_obstacle
+
+
+def _ros(w: BundleWriter, source: RosResource | None) -> Attributes:
+    """Where a resource lives in a ROS package, as attributes."""
+    if source is None:
+        return {}
+    found: Attributes = {w.term(ids.ROS_PKG): source.package}
+    if source.path is not None:
+        found[w.term(ids.ROS_RELATIVE_PATH)] = source.path
+    return found

@@ -38,6 +38,7 @@ Where exsce differs from the method, on purpose:
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 
 from prov.constants import PROV_ROLE, PROV_TYPE
 from prov.identifier import Namespace, QualifiedName
@@ -73,7 +74,6 @@ def compile_oracles(
     ids.check_name(scenario_id, "scenario id")
     bundle_ns = writer.document_namespace(ids.ORACLE)
     w = writer.bundle(bundle_ns[ids.bundle_name(scenario_id)], f"the oracles of '{scenario_id}'")
-    t = w.term
     parts = w.of_element(scenario_id, names.of_scenario(scenario_id), "scenario")
     exsce, topic_ns = w.fixed(ids.EXSCE), w.fixed(ids.TOPIC)
 
@@ -82,68 +82,110 @@ def compile_oracles(
         groups.setdefault((oracle.metric, oracle.robot, oracle.window), []).append(oracle)
 
     learnt = _learnt_from(w, parts, scenario_id, runs or {}, left_out or {})
-    topic_type = {PROV_TYPE: t(ids.ROS_TOPICS)}
-    declared: set[QualifiedName] = set()
-    topic_role = {PROV_ROLE: ids.TOPIC_ROLE}
+    topics = _Topics(topic_ns, {PROV_TYPE: w.term(ids.ROS_TOPICS)})
     for (metric, robot, window), group in groups.items():
         name = ids.check_name(group[0].name, "oracle name")
         activity = parts[name]
         writer.claim(activity, f"the oracle of '{metric}'" + (f" of robot '{robot}'" if robot else ""))
-        facts: Attributes = {
-            PROV_TYPE: t(ids.ORACLE_TYPE_VALUE),
-            t(ids.ORACLE_METRIC): metric,
-            t(ids.SCENARIO_ATTR): scenario_id,
-        }
-        if robot is not None:
-            facts[t(ids.ORACLE_ROBOT)] = robot
-        if window is not None:
-            facts[t(ids.ORACLE_WINDOW)] = window
-        criteria = sorted({oracle.criterion for oracle in group if oracle.criterion})
-        if criteria:
-            facts[t(ids.ORACLE_CRITERION)] = "; ".join(criteria)
-        w.activity(activity, facts)
+        w.activity(activity, _oracle_facts(w, scenario_id, metric, robot, window, group))
         for compared in dict.fromkeys(oracle.base_scenario for oracle in group):
             if compared in learnt:
                 w.used(activity, learnt[compared], {PROV_ROLE: "baseline_runs"})
-        topics = dict.fromkeys(topic for oracle in group for topic in oracle.topics)
-        for topic in topics:
-            topic_id = topic_ns[ids.topic_name(topic)]
-            if topic_id not in declared:
-                declared.add(topic_id)
-                w.entity(topic_id, topic_type)
-            w.used(activity, topic_id, topic_role)
-        kinds = [oracle.type for oracle in group]
-        for oracle in group:
-            # one usage per type, as the method has it; a type twice (a range: above and below)
-            # names its usages by relation too
-            suffix = oracle.type.value
-            if kinds.count(oracle.type) > 1:
-                suffix += f"-{oracle.relation}"
-            usage = parts[f"{name}-{suffix}"]
-            whose = f" of '{robot}'" if robot else ""
-            writer.claim(usage, f"the {oracle.type.value} oracle of '{metric}'{whose}")
-            relation: Attributes = {
-                t(ids.ORACLE_RELATIONSHIP): oracle.relation,
-                t(ids.ORACLE_KIND): oracle.type.value,
-            }
-            for term, value in (
-                (ids.ORACLE_VALUE, oracle.value),
-                (ids.ORACLE_LIMIT, oracle.limit),
-                (ids.ORACLE_DELTA, oracle.delta),
-                (ids.ORACLE_TOLERANCE, oracle.tolerance),
-            ):
-                if value is not None:
-                    relation[t(term)] = float(value)
-            if oracle.package is not None:
-                relation[t(ids.ORACLE_PACKAGE)] = oracle.package
-            if oracle.sources:
-                relation[t(ids.ORACLE_RUNS)] = " ".join(oracle.sources)
-            if oracle.confidence is not None:
-                relation[t(ids.ORACLE_CONFIDENCE)] = float(oracle.confidence)
-                relation[t(ids.ORACLE_SAMPLE_SIZE)] = len(oracle.sources)
-            base = exsce[ids.check_name(oracle.base_scenario, "base scenario id")]
-            w.used(activity, base, relation, identifier=usage)
+        _use_topics(w, activity, group, topics)
+        _use_bases(writer, w, parts, exsce, name, group)
     return writer.document
+
+
+def _oracle_facts(
+    w: BundleWriter,
+    scenario_id: str,
+    metric: str,
+    robot: str | None,
+    window: str | None,
+    group: Sequence[Oracle],
+) -> Attributes:
+    """The oracle activity's attributes: its metric, scenario, robot, window and criteria."""
+    t = w.term
+    facts: Attributes = {
+        PROV_TYPE: t(ids.ORACLE_TYPE_VALUE),
+        t(ids.ORACLE_METRIC): metric,
+        t(ids.SCENARIO_ATTR): scenario_id,
+    }
+    if robot is not None:
+        facts[t(ids.ORACLE_ROBOT)] = robot
+    if window is not None:
+        facts[t(ids.ORACLE_WINDOW)] = window
+    criteria = sorted({oracle.criterion for oracle in group if oracle.criterion})
+    if criteria:
+        facts[t(ids.ORACLE_CRITERION)] = "; ".join(criteria)
+    return facts
+
+
+@dataclass
+class _Topics:
+    """The bundle's topic entities: their namespace and type, and those declared so far."""
+
+    namespace: Namespace
+    type: Attributes
+    declared: set[QualifiedName] = field(default_factory=set)
+
+
+def _use_topics(w: BundleWriter, activity: QualifiedName, group: Sequence[Oracle], topics: _Topics) -> None:
+    """The oracle uses each topic its metric is computed from (each declared once per bundle)."""
+    for topic in dict.fromkeys(topic for oracle in group for topic in oracle.topics):
+        topic_id = topics.namespace[ids.topic_name(topic)]
+        if topic_id not in topics.declared:
+            topics.declared.add(topic_id)
+            w.entity(topic_id, topics.type)
+        w.used(activity, topic_id, {PROV_ROLE: ids.TOPIC_ROLE})
+
+
+def _use_bases(
+    writer: DocumentWriter,
+    w: BundleWriter,
+    parts: Namespace,
+    exsce: Namespace,
+    name: str,
+    group: Sequence[Oracle],
+) -> None:
+    """One usage of the scenario each clause compares against, per oracle type (a type twice,
+    a range: above and below, names its usages by relation too), carrying the clause."""
+    activity = parts[name]
+    kinds = [oracle.type for oracle in group]
+    for oracle in group:
+        suffix = oracle.type.value
+        if kinds.count(oracle.type) > 1:
+            suffix += f"-{oracle.relation}"
+        usage = parts[f"{name}-{suffix}"]
+        whose = f" of '{oracle.robot}'" if oracle.robot else ""
+        writer.claim(usage, f"the {oracle.type.value} oracle of '{oracle.metric}'{whose}")
+        base = exsce[ids.check_name(oracle.base_scenario, "base scenario id")]
+        w.used(activity, base, _clause(w, oracle), identifier=usage)
+
+
+def _clause(w: BundleWriter, oracle: Oracle) -> Attributes:
+    """A usage's attributes: the clause's relation, type, bounds, package and runs."""
+    t = w.term
+    relation: Attributes = {
+        t(ids.ORACLE_RELATIONSHIP): oracle.relation,
+        t(ids.ORACLE_KIND): oracle.type.value,
+    }
+    for term, value in (
+        (ids.ORACLE_VALUE, oracle.value),
+        (ids.ORACLE_LIMIT, oracle.limit),
+        (ids.ORACLE_DELTA, oracle.delta),
+        (ids.ORACLE_TOLERANCE, oracle.tolerance),
+    ):
+        if value is not None:
+            relation[t(term)] = float(value)
+    if oracle.package is not None:
+        relation[t(ids.ORACLE_PACKAGE)] = oracle.package
+    if oracle.sources:
+        relation[t(ids.ORACLE_RUNS)] = " ".join(oracle.sources)
+    if oracle.confidence is not None:
+        relation[t(ids.ORACLE_CONFIDENCE)] = float(oracle.confidence)
+        relation[t(ids.ORACLE_SAMPLE_SIZE)] = len(oracle.sources)
+    return relation
 
 
 def _learnt_from(

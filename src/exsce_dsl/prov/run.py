@@ -98,6 +98,8 @@ def compile_run(
 
 
 class _RunCompiler:
+    """A run's PROV document: the run, bag, metric and hotspot bundles, and its coverage."""
+
     def __init__(
         self, run: Run, scenario: Scenario, names: Namespaces, checked: bool, own_bag_graph: bool = False
     ) -> None:
@@ -131,10 +133,12 @@ class _RunCompiler:
 
     # -- helpers -----------------------------------------------------------
 
-    def _parts(self, w: BundleWriter) -> Namespace:
+    def parts_in(self, w: BundleWriter) -> Namespace:
+        """The run's namespace, as bundle ``w`` declares it."""
         return w.of_element(self.run_prefix, self.run_ns_iri, "run")
 
-    def _run_id(self, w: BundleWriter) -> QualifiedName:
+    def run_id_in(self, w: BundleWriter) -> QualifiedName:
+        """The run's activity, as bundle ``w`` names it."""
         return w.fixed(ids.RUN)[ids.run_name(self.run.uuid)]
 
     def _pose_name(self, pose: Pose) -> str:
@@ -143,7 +147,8 @@ class _RunCompiler:
             name = self._pose_names[pose] = ids.pose_name(pose)
         return name
 
-    def _check_robot(self, robot_id: str, what: str) -> None:
+    def check_robot(self, robot_id: str, what: str) -> None:
+        """``what`` is for a robot of the scenario, else an error."""
         if robot_id not in self._robot_ids:
             raise ExsceError(
                 f"{what} of run {self.run.uuid} is for robot '{robot_id}', "
@@ -158,8 +163,8 @@ class _RunCompiler:
         run_ns = writer.document_namespace(ids.RUN)
         w = writer.bundle(run_ns[f"{ids.run_name(run.uuid)}_bundle"], f"the bundle of run {run.uuid}")
         t = w.term
-        parts = self._parts(w)
-        run_id = self._run_id(w)
+        parts = self.parts_in(w)
+        run_id = self.run_id_in(w)
         writer.claim(run_id, f"run {run.uuid}")
         uuid_attr = t(ids.RUN_ATTR)
         robot_ns, pose_ns = w.fixed(ids.ROBOT), w.fixed(ids.POSE)
@@ -188,7 +193,7 @@ class _RunCompiler:
         actions: dict[ActionId, QualifiedName] = {}
         for task in run.tasks:
             robot = task.robot
-            self._check_robot(robot, f"task {task.allocation}")
+            self.check_robot(robot, f"task {task.allocation}")
             if task.allocation > self._allocated.get(robot, 0):
                 raise ExsceError(
                     f"run {run.uuid} has task {task.allocation} of robot '{robot}', but mission "
@@ -236,7 +241,7 @@ class _RunCompiler:
         graphs = self.run_parts if self.own_bag_graph else writer.document_namespace(ids.EXSCE)
         w = writer.bundle(graphs[f"{name}_bundle"], f"the bundle of bag {bag.file_name}")
         t = w.term
-        bag_id = self._parts(w)[name]
+        bag_id = self.parts_in(w)[name]
         writer.claim(bag_id, f"bag {bag.file_name}")
         facts: Attributes = {PROV_TYPE: t(ids.ROS_BAGS)}
         if bag.path is not None:
@@ -257,7 +262,7 @@ class _RunCompiler:
 
     def _clocks(self, w: BundleWriter, held: set[str]) -> None:
         """Which clock each topic was timed by on the run's timeline (derived from the topic)."""
-        t, parts, topic_ns = w.term, self._parts(w), w.fixed(ids.TOPIC)
+        t, parts, topic_ns = w.term, self.parts_in(w), w.fixed(ids.TOPIC)
         for clock in self.run.clocks:
             if clock.topic not in held:
                 continue
@@ -275,9 +280,9 @@ class _RunCompiler:
     def _conventions(self, w: BundleWriter, held: set[str]) -> None:
         """The convention detected for each robot whose type names none, and the topics it was
         detected from."""
-        t, parts, topic_ns = w.term, self._parts(w), w.fixed(ids.TOPIC)
+        t, parts, topic_ns = w.term, self.parts_in(w), w.fixed(ids.TOPIC)
         for robot, convention, evidence in self.run.conventions:
-            self._check_robot(robot, "a detected convention")
+            self.check_robot(robot, "a detected convention")
             found = parts[ids.convention_name(robot)]
             self.writer.claim(found, f"the convention of '{robot}'")
             w.entity(
@@ -297,99 +302,21 @@ class _RunCompiler:
         for value in self.run.metrics:
             by_metric.setdefault(value.metric, []).append(value)
         for metric, values in by_metric.items():
-            self._metric_bundle(metric, values, actions)
-
-    def _metric_bundle(
-        self, metric: str, values: list[MetricValue], actions: dict[ActionId, QualifiedName]
-    ) -> None:
-        run, writer = self.run, self.writer
-        ids.check_name(metric, "metric")
-        w = writer.bundle(self.run_parts[f"{metric}_bundle"], f"the bundle of metric '{metric}'")
-        t = w.term
-        parts = self._parts(w)
-        run_id = self._run_id(w)
-        topic_ns = w.fixed(ids.TOPIC)
-        bag_topics = set(run.bag.topics)
-        base: Attributes = {
-            PROV_TYPE: t(ids.OUTPUT_METRIC_TYPE),
-            t(ids.METRIC_TYPE): metric,
-            t(ids.RUN_ATTR): run.uuid,
-        }
-        robot_attr, unit_attr, safety_attr = t(ids.ROBOT_ATTR), t(ids.UNIT), t(ids.METRIC_ATTR)
-        primary_source = {PROV_TYPE: t(ids.PROV_PRIMARY_SOURCE)}
-        collections: dict[tuple[str | None, str | None], tuple[tuple[str, ...], QualifiedName]] = {}
-        collection_type = {PROV_TYPE: t(ids.TOPIC_COLLECTION_TYPE)}
-        for value in values:
-            robot = value.robot
-            if robot is not None:
-                self._check_robot(robot, f"the value of '{metric}'")
-            topics = tuple(dict.fromkeys(value.topics))
-            # a violation_duration is about one safety metric: its values and topics are that metric's
-            named = metric if value.safety_metric is None else f"{metric}-{value.safety_metric}"
-            key = (robot, value.safety_metric)
-            known = collections.get(key)
-            if known is None and topics:
-                for topic in topics:
-                    if topic not in bag_topics:
-                        raise ExsceError(
-                            f"metric '{metric}' of run {run.uuid} comes from topic '{topic}', "
-                            f"which bag {run.bag.file_name} does not hold"
-                        )
-                collection = parts[ids.topics_collection_name(named, robot)]
-                writer.claim(collection, f"the topics of '{metric}'" + (f" of '{robot}'" if robot else ""))
-                w.entity(collection, collection_type)
-                for topic in topics:
-                    w.member(collection, topic_ns[ids.topic_name(topic)])
-                known = collections[key] = (topics, collection)
-            elif known is not None and set(known[0]) != set(topics):
-                raise ExsceError(
-                    f"the values of '{metric}'"
-                    + (f" of robot '{robot}'" if robot else "")
-                    + f" in run {run.uuid} come from different topics: "
-                    f"{', '.join(known[0])} and {', '.join(topics) or 'none'}"
-                )
-            if value.scope is MetricScope.SEGMENT:
-                assert value.action is not None  # checked by MetricValue
-                generator = actions.get(value.action)
-                if generator is None:
-                    a = value.action
-                    raise ExsceError(
-                        f"a value of '{metric}' is for action "
-                        f"{ids.action_name(a.robot, a.allocation, a.subtask, a.waypoint)}, "
-                        f"which run {run.uuid} does not have"
-                    )
-                subject: str | None = generator.localpart
-            else:
-                generator = run_id
-                subject = robot
-            value_id = parts[ids.metric_value_name(named, subject)]
-            writer.claim(value_id, f"the value of '{metric}' of {subject or 'the mission'}")
-            facts = dict(base)
-            facts[PROV_VALUE] = float(value.value)
-            if robot is not None:
-                facts[robot_attr] = robot
-            if value.unit is not None:
-                facts[unit_attr] = value.unit
-            if value.safety_metric is not None:
-                facts[safety_attr] = value.safety_metric
-            if value.estimated_from is not None:
-                facts[t(ids.ESTIMATED_FROM)] = value.estimated_from
-            w.entity(value_id, facts)
-            if known is not None:
-                w.derivation(value_id, known[1], primary_source)
-            w.generated(value_id, generator)
+            bundle = _MetricBundle(self, metric, actions)
+            for value in values:
+                bundle.write(value)
 
     def _hotspot_bundle(self) -> None:
         run, writer = self.run, self.writer
         w = writer.bundle(self.run_parts[ids.HOTSPOTS_BUNDLE], "the bundle of the run's hotspots")
         t = w.term
-        parts = self._parts(w)
-        run_id = self._run_id(w)
+        parts = self.parts_in(w)
+        run_id = self.run_id_in(w)
         x, y, z = t(ids.COORD_X), t(ids.COORD_Y), t(ids.COORD_Z)
         counts: dict[tuple[str, str | None], int] = {}
         for hotspot in run.hotspots:
             if hotspot.robot is not None:
-                self._check_robot(hotspot.robot, f"a hotspot of '{hotspot.metric}'")
+                self.check_robot(hotspot.robot, f"a hotspot of '{hotspot.metric}'")
             key = (hotspot.metric, hotspot.robot)
             counts[key] = index = counts.get(key, 0) + 1
             hotspot_id = parts[ids.hotspot_name(hotspot.metric, hotspot.robot, index)]
@@ -408,3 +335,102 @@ class _RunCompiler:
                 facts[t(ids.ROBOT_ATTR)] = hotspot.robot
             w.entity(hotspot_id, facts)
             w.generated(hotspot_id, run_id)
+
+
+class _MetricBundle:
+    """The bundle of one metric of a run: each value an entity, derived from the collection of
+    topics it was computed from (one per robot and safety metric) and generated by its action or
+    by the run."""
+
+    def __init__(self, compiler: _RunCompiler, metric: str, actions: dict[ActionId, QualifiedName]) -> None:
+        self.compiler, self.metric, self.actions = compiler, metric, actions
+        self.run, self.writer = compiler.run, compiler.writer
+        ids.check_name(metric, "metric")
+        self.w = w = self.writer.bundle(
+            compiler.run_parts[f"{metric}_bundle"], f"the bundle of metric '{metric}'"
+        )
+        t = w.term
+        self.parts = compiler.parts_in(w)
+        self.run_id = compiler.run_id_in(w)
+        self.topic_ns = w.fixed(ids.TOPIC)
+        self.bag_topics = set(self.run.bag.topics)
+        self.base: Attributes = {
+            PROV_TYPE: t(ids.OUTPUT_METRIC_TYPE),
+            t(ids.METRIC_TYPE): metric,
+            t(ids.RUN_ATTR): self.run.uuid,
+        }
+        self.robot_attr, self.unit_attr, self.safety_attr = t(ids.ROBOT_ATTR), t(ids.UNIT), t(ids.METRIC_ATTR)
+        self.primary_source = {PROV_TYPE: t(ids.PROV_PRIMARY_SOURCE)}
+        self.collections: dict[tuple[str | None, str | None], tuple[tuple[str, ...], QualifiedName]] = {}
+        self.collection_type = {PROV_TYPE: t(ids.TOPIC_COLLECTION_TYPE)}
+
+    def write(self, value: MetricValue) -> None:
+        """The value's entity, its topics' collection and what generated it."""
+        metric, robot, w = self.metric, value.robot, self.w
+        if robot is not None:
+            self.compiler.check_robot(robot, f"the value of '{metric}'")
+        # a violation_duration is about one safety metric: its values and topics are that metric's
+        named = metric if value.safety_metric is None else f"{metric}-{value.safety_metric}"
+        collection = self._collection(value, named)
+        generator, subject = self._generator(value)
+        value_id = self.parts[ids.metric_value_name(named, subject)]
+        self.writer.claim(value_id, f"the value of '{metric}' of {subject or 'the mission'}")
+        facts = dict(self.base)
+        facts[PROV_VALUE] = float(value.value)
+        if robot is not None:
+            facts[self.robot_attr] = robot
+        if value.unit is not None:
+            facts[self.unit_attr] = value.unit
+        if value.safety_metric is not None:
+            facts[self.safety_attr] = value.safety_metric
+        if value.estimated_from is not None:
+            facts[w.term(ids.ESTIMATED_FROM)] = value.estimated_from
+        w.entity(value_id, facts)
+        if collection is not None:
+            w.derivation(value_id, collection, self.primary_source)
+        w.generated(value_id, generator)
+
+    def _collection(self, value: MetricValue, named: str) -> QualifiedName | None:
+        """The collection of the topics the value was computed from, written with the first value
+        of its robot and safety metric (the others must name the same topics); None without topics."""
+        metric, robot, run = self.metric, value.robot, self.run
+        topics = tuple(dict.fromkeys(value.topics))
+        key = (robot, value.safety_metric)
+        known = self.collections.get(key)
+        if known is None and topics:
+            for topic in topics:
+                if topic not in self.bag_topics:
+                    raise ExsceError(
+                        f"metric '{metric}' of run {run.uuid} comes from topic '{topic}', "
+                        f"which bag {run.bag.file_name} does not hold"
+                    )
+            collection = self.parts[ids.topics_collection_name(named, robot)]
+            self.writer.claim(collection, f"the topics of '{metric}'" + (f" of '{robot}'" if robot else ""))
+            self.w.entity(collection, self.collection_type)
+            for topic in topics:
+                self.w.member(collection, self.topic_ns[ids.topic_name(topic)])
+            known = self.collections[key] = (topics, collection)
+        elif known is not None and set(known[0]) != set(topics):
+            raise ExsceError(
+                f"the values of '{metric}'"
+                + (f" of robot '{robot}'" if robot else "")
+                + f" in run {run.uuid} come from different topics: "
+                f"{', '.join(known[0])} and {', '.join(topics) or 'none'}"
+            )
+        return known[1] if known is not None else None
+
+    def _generator(self, value: MetricValue) -> tuple[QualifiedName, str | None]:
+        """What generated the value (its action, for a segment's value; else the run) and whom
+        it is about, for its name."""
+        if value.scope is not MetricScope.SEGMENT:
+            return self.run_id, value.robot
+        assert value.action is not None  # checked by MetricValue
+        generator = self.actions.get(value.action)
+        if generator is None:
+            a = value.action
+            raise ExsceError(
+                f"a value of '{self.metric}' is for action "
+                f"{ids.action_name(a.robot, a.allocation, a.subtask, a.waypoint)}, "
+                f"which run {self.run.uuid} does not have"
+            )
+        return generator, generator.localpart

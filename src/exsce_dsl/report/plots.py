@@ -65,41 +65,9 @@ def trajectory_figure(scenario: ScenarioContents, run: RunContents, paths: Seque
     figure, axes, box, columns = _map_figure(box, entries)
     if scenario.grid is not None:
         _draw_grid(axes, scenario.grid, box)
-    colours = [f"C{i}" for i in range(10)]
-    for i, path in enumerate(paths):
-        colour = colours[i % len(colours)]
-        axes.plot(path.xy[:, 0], path.xy[:, 1], color=colour, linewidth=1.4, label=f"{path.topic} (driven)")
-        axes.plot(*path.xy[0], marker="o", color=colour, markersize=6)
-    planned_paths = [planned for _, planned in sorted(scenario.waypoints.items()) if planned]
-    for i, planned in enumerate(planned_paths):
-        xy = np.array([(x, y) for _, x, y in planned])
-        axes.scatter(
-            xy[1:, 0],
-            xy[1:, 1],
-            marker="s",
-            s=18,
-            color="#34495e",
-            zorder=3,
-            label="planned waypoints" if i == 0 else None,
-        )
+    _draw_paths(axes, paths, scenario)
     _mark_segment_starts(axes, run)
-    labelled: set[str] = set()
-    sizes = []
-    for spot in run.hotspots:
-        label = None if spot.metric in labelled else f"hotspot: {spot.metric}"
-        labelled.add(spot.metric)
-        sizes.append(60 + 30 * math.sqrt(spot.duration))
-        axes.scatter(
-            [spot.position.x],
-            [spot.position.y],
-            s=sizes[-1],
-            marker=markers.get(spot.metric, "X"),
-            color="#c0392b",
-            edgecolor="white",
-            linewidth=0.8,
-            zorder=4,
-            label=label,
-        )
+    sizes = _draw_hotspots(axes, run, markers)
     axes.set_xlim(box[0], box[1])
     axes.set_ylim(box[2], box[3])
     axes.set_aspect("equal")
@@ -117,7 +85,55 @@ def trajectory_figure(scenario: ScenarioContents, run: RunContents, paths: Seque
             fontsize=7,
             frameon=False,
         )
-    # hotspots' numbers first, nearest their markers; then the segments' labels, around both
+    _label_markers(axes, run, sizes)
+    return figure
+
+
+def _draw_paths(axes: Axes, paths: Sequence[Trajectory], scenario: ScenarioContents) -> None:
+    """Each robot's driven path (a dot where it starts) and the planned waypoints."""
+    colours = [f"C{i}" for i in range(10)]
+    for i, path in enumerate(paths):
+        colour = colours[i % len(colours)]
+        axes.plot(path.xy[:, 0], path.xy[:, 1], color=colour, linewidth=1.4, label=f"{path.topic} (driven)")
+        axes.plot(*path.xy[0], marker="o", color=colour, markersize=6)
+    planned_paths = [planned for _, planned in sorted(scenario.waypoints.items()) if planned]
+    for i, planned in enumerate(planned_paths):
+        xy = np.array([(x, y) for _, x, y in planned])
+        axes.scatter(
+            xy[1:, 0],
+            xy[1:, 1],
+            marker="s",
+            s=18,
+            color="#34495e",
+            zorder=3,
+            label="planned waypoints" if i == 0 else None,
+        )
+
+
+def _draw_hotspots(axes: Axes, run: RunContents, markers: Mapping[str, str]) -> list[float]:
+    """A marker per hotspot, one shape per metric, larger the longer it lasted: their sizes."""
+    labelled: set[str] = set()
+    sizes = []
+    for spot in run.hotspots:
+        label = None if spot.metric in labelled else f"hotspot: {spot.metric}"
+        labelled.add(spot.metric)
+        sizes.append(60 + 30 * math.sqrt(spot.duration))
+        axes.scatter(
+            [spot.position.x],
+            [spot.position.y],
+            s=sizes[-1],
+            marker=markers.get(spot.metric, "X"),
+            color="#c0392b",
+            edgecolor="white",
+            linewidth=0.8,
+            zorder=4,
+            label=label,
+        )
+    return sizes
+
+
+def _label_markers(axes: Axes, run: RunContents, sizes: Sequence[float]) -> None:
+    """The hotspots' numbers first, nearest their markers; then the segments' labels, around both."""
     starts = [(seg.x, seg.y) for seg in run.segments]
     taken = _marker_boxes(axes, starts, [_SEGMENT_SIZE] * len(starts))
     if run.hotspots:
@@ -127,7 +143,6 @@ def trajectory_figure(scenario: ScenarioContents, run: RunContents, paths: Seque
     if run.segments:
         labels = [f"S{i}" for i in range(1, len(starts) + 1)]
         _place_labels(axes, starts, [_SEGMENT_SIZE] * len(starts), labels, _SEGMENT_COLOUR, taken)
-    return figure
 
 
 def _mark_segment_starts(axes: Axes, run: RunContents) -> None:

@@ -23,6 +23,8 @@ from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Bag, Run, RunClock, TaskExecution
 from exsce_dsl.monitor_kit.monitor_core import Compute, Topic, reducer, topic_name
 from exsce_dsl.runs.bag_identity import content_hash, run_uuid
+from exsce_dsl.runs.bags.data import BagData
+from exsce_dsl.runs.bags.names import BagTopics
 from exsce_dsl.runs.bags.reading import (
     ANY,
     OBJECTS,
@@ -44,7 +46,7 @@ from exsce_dsl.runs.coverage import (
 from exsce_dsl.runs.metrics.compute import HOTSPOT_PATHS, POSE_TOPIC, compute_metrics
 from exsce_dsl.runs.metrics.monitor_code import load_monitors
 from exsce_dsl.runs.missing import missing_metrics, unread_topics
-from exsce_dsl.runs.robots import SERVED, stack_robots
+from exsce_dsl.runs.robots import SERVED, StackRobots, stack_robots
 from exsce_dsl.runs.segments.dispatcher import SUCCEEDED, segments
 from exsce_dsl.runs.segments.segment import Segment
 from exsce_dsl.runs.segments.sources import DISPATCHER_SOURCE, segment_robot
@@ -171,6 +173,76 @@ def analyse_bag(
     metrics = run_metrics(scenario)
     source = scenario.location.file if scenario.location else scenario.id
     monitors = load_monitors(metrics, source)
+    bag = _read_signals(path, scenario, metrics, monitors)
+    found = _segment_robots(path, scenario, bag)
+    robots, stacks = bag.robots, bag.stacks
+    values, hotspots = compute_metrics(
+        monitors,
+        metrics,
+        robots,
+        bag.topics,
+        found.actions,
+        found.results,
+        bag.problems,
+        found.whole_runs,
+        stacks.named(robots),
+    )
+    values = [bag.data.spelt(stacks.with_real_sources(v)) for v in values]
+    if strict:
+        acting = [r.id for r in robots if scenario.mission.tasks_of(r.id)]
+        lacking = missing_metrics(metrics, robots, acting, found.actions, values)
+        if lacking:
+            raise IncompleteRunError(_incomplete(path, lacking, bag.problems))
+    status = recorded_mission_status(path, bag.data.messages.get(PROV_TOPIC, ()))
+    spans = {r.id: span for r in robots if (span := stacks.recorded_span(r, bag.topics)) is not None}
+    covered = find_coverage(
+        Recording(
+            scenario, robots, bag.data, bag.timeline, found.actions, values, status, spans,
+            declared_rates(robots, stacks.sources, bag.data),
+        )
+    )  # fmt: skip
+    bag.problems += covered.said()
+    run = Run(
+        uuid=run_id or run_uuid(digest),
+        scenario=scenario.id,
+        start=_time(bag.recorded.start),
+        end=_time(bag.recorded.end),
+        bag=Bag(path.name, bag.data.topics, str(path.resolve())),
+        tasks=_task_executions(found.actions, found.segmented_by, bag.timeline.to_wall),
+        metrics=tuple(values),
+        hotspots=tuple(hotspots),
+        clocks=_run_clocks(bag.timeline, bag.data.spellings),
+        conventions=tuple((d.robot, d.convention, d.evidence) for d in bag.detected),
+        status=status,
+        coverage=covered.gaps,
+        topic_rates=covered.rates,
+    )
+    return AnalysedRun(run, digest, bag.problems, bag.timeline, bag.detected)
+
+
+@dataclass
+class _Signals:
+    """A bag read as a run of a scenario: its robots (conventions detected where their type names
+    none), the stacks serving their signals, every series on the run's one timeline, and the
+    problems found so far."""
+
+    types: BagTopics
+    robots: list[Robot]
+    detected: list[Detected]
+    stacks: StackRobots
+    unread: list[str]
+    recorded: BagData
+    timeline: Timeline
+    data: BagData
+    topics: dict[str, Topic]
+    problems: list[str]
+
+
+def _read_signals(
+    path: Path, scenario: Scenario, metrics: tuple[MetricDefinition, ...], monitors: ModuleType
+) -> _Signals:
+    """Read what the metrics need of the bag at ``path``, put it on one timeline, and serve each
+    robot's signals under the topics the monitors read."""
     types = bag_topics(path)
     robots, detected = with_detected_conventions(
         [r for r in scenario.robots if r.start_pose is not None], types
@@ -194,69 +266,49 @@ def analyse_bag(
         # (a user metric may read more of it than the method's fields: pose.pose.covariance)
         same = read is not None and len(read) == len(served) and np.array_equal(read.t, served.t)
         topics[name] = Topic(name, served.t, {**served.fields, **read.fields}) if same and read else served
-    actions: list[Segment] = []
-    results: dict[str, int | None] = {}
-    whole_runs: dict[str, tuple[float, float]] = {}
-    segmented_by: dict[str, str] = {}
-    for robot in robots:
+    return _Signals(types, robots, detected, stacks, unread, recorded, timeline, data, topics, problems)
+
+
+@dataclass
+class _Segmented:
+    """Each robot's path segments, whether its mission succeeded, the span that stands for its
+    whole run (where it has no segments, or its metrics are windowed on the recording), and
+    which source segmented it when not the method's dispatcher."""
+
+    actions: list[Segment] = field(default_factory=list)
+    results: dict[str, int | None] = field(default_factory=dict)
+    whole_runs: dict[str, tuple[float, float]] = field(default_factory=dict)
+    segmented_by: dict[str, str] = field(default_factory=dict)
+
+
+def _segment_robots(path: Path, scenario: Scenario, bag: _Signals) -> _Segmented:
+    """Each robot's path segments from the first segmentation source that finds them."""
+    stacks, data, out = bag.stacks, bag.data, _Segmented()
+    for robot in bag.robots:
         ns = robot.namespace.strip("/")
         feedback, result = topic_name(_FEEDBACK, ns), topic_name(_RESULT, ns)
         updates = data.feedback.get(feedback)
         dispatched = segments(scenario, robot.id, updates) if updates is not None else None
-        found = segment_robot(scenario, robot, data, stacks.track(robot, topics), dispatched)
-        problems += found.problems
-        actions.extend(found.segments)
+        found = segment_robot(scenario, robot, data, stacks.track(robot, bag.topics), dispatched)
+        bag.problems += found.problems
+        out.actions.extend(found.segments)
         if found.source and found.source != DISPATCHER_SOURCE:
-            segmented_by[robot.id] = found.source
+            out.segmented_by[robot.id] = found.source
         if found.succeeded is None and dispatched is not None:
-            results[robot.id] = _succeeded(data.results.get(result))
+            out.results[robot.id] = _succeeded(data.results.get(result))
         else:
-            results[robot.id] = found.succeeded
+            out.results[robot.id] = found.succeeded
             stacks.real_topics[feedback] = stacks.real_topics[result] = (
                 found.topics or stacks.real_topics.get(topic_name(SERVED["pose"], ns), ())
             )
         recording = robot.signals.window is Window.RECORDING
         if (not found.segments or recording) and scenario.mission.tasks_of(robot.id):
-            span = stacks.recorded_span(robot, topics)
+            span = stacks.recorded_span(robot, bag.topics)
             if span is None and not found.segments:
-                raise BagError("\n  ".join([_nothing_of(path, robot, types), *unread]))
+                raise BagError("\n  ".join([_nothing_of(path, robot, bag.types), *bag.unread]))
             if span is not None:
-                whole_runs[robot.id] = span
-    values, hotspots = compute_metrics(
-        monitors, metrics, robots, topics, actions, results, problems, whole_runs, stacks.named(robots)
-    )
-    values = [data.spelt(stacks.with_real_sources(v)) for v in values]
-    if strict:
-        acting = [r.id for r in robots if scenario.mission.tasks_of(r.id)]
-        lacking = missing_metrics(metrics, robots, acting, actions, values)
-        if lacking:
-            raise IncompleteRunError(_incomplete(path, lacking, problems))
-    status = recorded_mission_status(path, data.messages.get(PROV_TOPIC, ()))
-    spans = {r.id: span for r in robots if (span := stacks.recorded_span(r, topics)) is not None}
-    covered = find_coverage(
-        Recording(
-            scenario, robots, data, timeline, actions, values, status, spans,
-            declared_rates(robots, stacks.sources, data),
-        )
-    )  # fmt: skip
-    problems += covered.said()
-    wall = timeline.to_wall
-    run = Run(
-        uuid=run_id or run_uuid(digest),
-        scenario=scenario.id,
-        start=_time(recorded.start),
-        end=_time(recorded.end),
-        bag=Bag(path.name, data.topics, str(path.resolve())),
-        tasks=_task_executions(actions, segmented_by, wall),
-        metrics=tuple(values),
-        hotspots=tuple(hotspots),
-        clocks=_run_clocks(timeline, data.spellings),
-        conventions=tuple((d.robot, d.convention, d.evidence) for d in detected),
-        status=status,
-        coverage=covered.gaps,
-        topic_rates=covered.rates,
-    )
-    return AnalysedRun(run, digest, problems, timeline, detected)
+                out.whole_runs[robot.id] = span
+    return out
 
 
 def _run_clocks(timeline: Timeline, spellings: Mapping[str, tuple[str, ...]]) -> tuple[RunClock, ...]:

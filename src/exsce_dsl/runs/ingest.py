@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import importlib
 import threading
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from enum import Enum
 from pathlib import Path
@@ -132,8 +132,12 @@ def ingest_bags(
     """
     add_prov(store, compile_scenario(scenario, namespace))
     results: list[IngestResult] = []
-    todo: list[_Todo] = []
-    seen: dict[str, Path] = {}
+
+    def told(result: IngestResult) -> None:
+        results.append(result)
+        if progress:
+            progress(result)
+
     in_process = cluster is None and (jobs <= 1 or len(paths) <= 1)
     # what the workers open: on a cluster, from the root (a worker's working folder is its own);
     # messages name the paths as given
@@ -148,46 +152,71 @@ def ingest_bags(
         digests = [d if isinstance(d, str) else None for d in mapper(_digest, [opened[p] for p in paths])]
         if importing is not None:
             importing.wait()
-        stored = bag_runs(store, digests, scenario.id, namespace)
-        for path, digest, run in zip(paths, digests, stored, strict=True):
-            skipped = _skipped(path, digest, run, seen, scenario.id, replace)
-            if digest is not None:
-                seen.setdefault(digest, path)
-            if skipped is not None:
-                results.append(skipped)
-                if progress:
-                    progress(skipped)
-            else:
-                todo.append(_Todo(path, digest, run, replace and run is not None and run.stored))
+        todo = _to_analyse(store, paths, digests, scenario.id, namespace, replace, told)
         outcomes = mapper(_analyse, [(opened[t.path], scenario, t.digest, t.run_id, strict) for t in todo])
-
-        def written(done: Written) -> None:
-            bag, analysed = cast("tuple[_Todo, AnalysedRun | None]", done.key)
-            result = _result(bag, analysed, done)
-            results.append(result)
-            if progress:
-                progress(result)
-
-        with RunWriter(store, written) as writer:
-            for bag, outcome in zip(todo, outcomes, strict=True):
-                if isinstance(outcome, ExsceError):
-                    writer.flush()  # the bags before it are told first
-                    written(Written((bag, None), None, outcome))
-                    continue
-                try:
-                    own_bag_graph = bag.run is not None and not bag.run.own_id
-                    document = compile_run(outcome.run, scenario, namespace, own_bag_graph=own_bag_graph)
-                    if bag.replacing:
-                        writer.flush()
-                        report = replace_run(store, document, outcome.run.uuid, namespace)
-                        written(Written((bag, outcome), report))
-                        continue
-                except ExsceError as exc:
-                    writer.flush()
-                    written(Written((bag, outcome), None, exc))
-                    continue
-                writer.add(document, (bag, outcome))
+        _write_runs(store, scenario, namespace, todo, outcomes, told)
     return results
+
+
+def _to_analyse(
+    store: Store,
+    paths: Sequence[Path],
+    digests: Sequence[str | None],
+    scenario_id: str,
+    namespace: str,
+    replace: bool,
+    told: Callable[[IngestResult], None],
+) -> list[_Todo]:
+    """The bags to analyse; each other one (its run is stored, or an earlier bag has its content)
+    is told as skipped."""
+    todo: list[_Todo] = []
+    seen: dict[str, Path] = {}
+    stored = bag_runs(store, digests, scenario_id, namespace)
+    for path, digest, run in zip(paths, digests, stored, strict=True):
+        skipped = _skipped(path, digest, run, seen, scenario_id, replace)
+        if digest is not None:
+            seen.setdefault(digest, path)
+        if skipped is not None:
+            told(skipped)
+        else:
+            todo.append(_Todo(path, digest, run, replace and run is not None and run.stored))
+    return todo
+
+
+def _write_runs(
+    store: Store,
+    scenario: Scenario,
+    namespace: str,
+    todo: Sequence[_Todo],
+    outcomes: Iterable[AnalysedRun | ExsceError],
+    told: Callable[[IngestResult], None],
+) -> None:
+    """Each analysed run's PROV, written as the analyses come (in group commits; a replaced run
+    in a write of its own), and each bag's result told in order once its run is written."""
+
+    def written(done: Written) -> None:
+        bag, analysed = cast("tuple[_Todo, AnalysedRun | None]", done.key)
+        told(_result(bag, analysed, done))
+
+    with RunWriter(store, written) as writer:
+        for bag, outcome in zip(todo, outcomes, strict=True):
+            if isinstance(outcome, ExsceError):
+                writer.flush()  # the bags before it are told first
+                written(Written((bag, None), None, outcome))
+                continue
+            try:
+                own_bag_graph = bag.run is not None and not bag.run.own_id
+                document = compile_run(outcome.run, scenario, namespace, own_bag_graph=own_bag_graph)
+                if bag.replacing:
+                    writer.flush()
+                    report = replace_run(store, document, outcome.run.uuid, namespace)
+                    written(Written((bag, outcome), report))
+                    continue
+            except ExsceError as exc:
+                writer.flush()
+                written(Written((bag, outcome), None, exc))
+                continue
+            writer.add(document, (bag, outcome))
 
 
 def _shared_paths(paths: Sequence[Path]) -> list[Path]:

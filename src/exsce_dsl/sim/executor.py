@@ -134,7 +134,153 @@ def _play(
     plans: Plans,
     waits: dict[Leg, Wait],
 ) -> Execution:
-    rng = random.Random(seed)
+    """One playing of ``scenario``: each allocation entry's subtasks dispatched in turn, then the
+    robots giving way to each other and all trajectories held to one end."""
+    play = _Play(scenario, grid, random.Random(seed), faults, limits, avoid, plans, waits)
+    for number, entry in enumerate(scenario.mission.allocation):
+        play.run_entry(number, entry.robot, entry.task)
+    return play.finish()
+
+
+class _Play:
+    """The state of one playing: every robot's timeline, the dispatcher's events and the actions
+    so far, and what the faults and the repairs of earlier replays ask of each leg."""
+
+    def __init__(
+        self,
+        scenario: Scenario,
+        grid: PlanningGrid,
+        rng: random.Random,
+        faults: tuple[Fault, ...],
+        limits: Limits,
+        avoid: dict[Leg, tuple[Point, ...]],
+        plans: Plans,
+        waits: dict[Leg, Wait],
+    ) -> None:
+        self.scenario, self.grid, self.rng, self.faults, self.limits = scenario, grid, rng, faults, limits
+        self.avoid, self.plans, self.waits = avoid, plans, waits
+        self.timelines = _starting_timelines(scenario, rng)
+        self.speed = {
+            r: limits.max_speed * rng.uniform(0.9, 1.0) * speed_factor(scenario, r, faults)
+            for r in self.timelines
+        }
+        self.skip = {(f.robot, f.index) for f in faults if f.kind == "skip-waypoint"}
+        self.events: list[GoalEvent] = []
+        self.actions: list[Action] = []
+        self.last_pose = {r.id: r.start_pose for r in scenario.robots if r.start_pose is not None}
+        self.task_numbers: dict[str, int] = {}
+        self.waypoint_counts: dict[str, int] = {}
+        self.near_collision = any(f.kind == "near-collision" for f in faults)
+        self.approach: dict[str, list[Trajectory]] = {}
+        if self.near_collision:
+            self.approach = _near_collision(scenario, self.timelines, grid, limits)
+        self.slow_boxes = area_boxes(scenario, faults)
+        self.stuck = deadlocked(scenario, faults)
+        self.last_entry = {entry.robot: n for n, entry in enumerate(scenario.mission.allocation)}
+        self.parked: dict[str, tuple[float, float]] = {}
+        """Where robots that have done all their tasks stand: later paths go round them."""
+
+    def run_entry(self, number: int, robot: str, task_id: str) -> None:
+        """Allocation entry ``number``: the robot runs the task's subtasks in order (in a
+        sequential mission, once every robot before it has finished)."""
+        tl = self.timelines[robot]
+        if self.scenario.mission.type is MissionType.SEQUENTIAL:
+            tl.wait_until(max(t.samples for t in self.timelines.values()))
+        task = self.scenario.task(task_id)
+        assert task is not None
+        self.task_numbers[robot] = self.task_numbers.get(robot, 0) + 1
+        for s_number, subtask in enumerate(task.subtasks, start=1):
+            self.run_subtask(robot, task.id, s_number, subtask.waypoints)
+        if self.last_entry[robot] == number:
+            self.parked[robot] = (tl.x, tl.y)
+
+    def run_subtask(self, robot: str, task_id: str, s_number: int, waypoints: tuple[Pose, ...]) -> None:
+        """One dispatcher goal: accepted, then each waypoint active, advanced to and recorded."""
+        tl = self.timelines[robot]
+        ids = tuple(w.id for w in waypoints)
+        key = f"{robot}-task_{self.task_numbers[robot]:02d}-subtask_{s_number:03d}"
+        statuses = [GoalStatus.PENDING] * len(ids)
+        tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, 5))
+        self.events.append(GoalEvent(tl.now, robot, key, ids, tuple(statuses), False))  # goal accepted
+        tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, 5))  # the dispatcher activates its first waypoint
+        for w_number, goal in enumerate(waypoints, start=1):
+            statuses[w_number - 1] = GoalStatus.ACTIVE
+            start_t = tl.now
+            self.events.append(GoalEvent(start_t, robot, key, ids, tuple(statuses), False))
+            previous = self.last_pose[robot]
+            path, status = self.advance(robot, goal)
+            statuses[w_number - 1] = status
+            length = _length(path) if status is GoalStatus.SUCCEEDED else 0.0
+            number = self.task_numbers[robot]
+            self.actions.append(
+                Action(
+                    robot,
+                    number,
+                    task_id,
+                    s_number,
+                    w_number,
+                    previous,
+                    goal,
+                    start_t,
+                    tl.now,
+                    status,
+                    length,
+                    tuple(path),
+                )
+            )
+            last = w_number == len(ids)
+            self.events.append(GoalEvent(tl.now, robot, key, ids, tuple(statuses), last))
+            tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, int(self.rng.uniform(0.2, 0.6) * 50)))
+
+    def advance(self, robot: str, goal: Pose) -> tuple[list[Point], GoalStatus]:
+        """The robot's next leg, to ``goal``: driven (by way of a detour or a head-on wait when
+        asked), or given up at once when the skip-waypoint fault names it.  Its planned path and
+        the waypoint's status."""
+        tl = self.timelines[robot]
+        self.waypoint_counts[robot] = count = self.waypoint_counts.get(robot, 0) + 1
+        leg = (robot, count)
+        if self.stuck and count == 1:  # deadlock-start: every robot waits
+            tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, int(round(DEADLOCK_WAIT / DT))))
+        keep_clear = _standing(self.parked, self.avoid.get(leg, ()))
+        if leg in self.skip:
+            target = (goal.position.x, goal.position.y)
+            path = _plan_around(self.grid, (tl.x, tl.y), target, keep_clear, self.plans)
+            tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, 25))
+            return path, GoalStatus.ABORTED
+        for part in self.approach.pop(robot, []):  # the near-collision fault, inside the mission
+            tl.append(part)
+        via = detour_via(self.scenario, robot, self.last_pose[robot], goal, self.faults)
+        wait = self.waits.get(leg) if via is None else None
+        if wait is not None:
+            via = wait.place
+        hold = wait.until if wait is not None else None
+        until = int(round(hold / DT)) if hold is not None else None
+        limits = Limits(self.speed[robot], self.limits.max_accel, self.limits.max_turn_rate)
+        path, driven = _drive_to(self.grid, tl, goal, via, keep_clear, limits, self.plans, until)
+        tl.append(slow_in_areas(driven, self.slow_boxes) if self.slow_boxes else driven)
+        self.last_pose[robot] = goal
+        return path, GoalStatus.SUCCEEDED
+
+    def finish(self) -> Execution:
+        """The robots give way to each other (unless the near-collision fault forbids it) and
+        every trajectory is held to one end, a second after the last robot stops."""
+        trajectories = {r: Trajectory.concat(t.parts) for r, t in self.timelines.items()}
+        events, actions = self.events, self.actions
+        if not self.near_collision:
+            trajectories, events, actions = give_way(self.scenario, trajectories, events, actions)
+        end = max(len(t) for t in trajectories.values()) + 50
+        trajectories = {
+            r: Trajectory.concat(
+                [t, Trajectory.hold(float(t.x[-1]), float(t.y[-1]), float(t.yaw[-1]), end - len(t))]
+            )
+            for r, t in trajectories.items()
+        }
+        events.sort(key=lambda e: (e.t, e.robot))
+        return Execution(trajectories, events, actions, end * DT)
+
+
+def _starting_timelines(scenario: Scenario, rng: random.Random) -> dict[str, Timeline]:
+    """Each robot with a start pose, standing there for half a second to a second."""
     timelines: dict[str, Timeline] = {}
     for robot in scenario.robots:
         if robot.start_pose is None:
@@ -147,103 +293,7 @@ def _play(
         )
         tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, int(rng.uniform(0.5, 1.0) * 50)))
         timelines[robot.id] = tl
-    speed = {
-        r: limits.max_speed * rng.uniform(0.9, 1.0) * speed_factor(scenario, r, faults) for r in timelines
-    }
-    skip = {(f.robot, f.index) for f in faults if f.kind == "skip-waypoint"}
-    events: list[GoalEvent] = []
-    actions: list[Action] = []
-    last_pose = {r.id: r.start_pose for r in scenario.robots if r.start_pose is not None}
-    task_numbers: dict[str, int] = {}
-    waypoint_counts: dict[str, int] = {}
-    approach: dict[str, list[Trajectory]] = {}
-    if any(f.kind == "near-collision" for f in faults):
-        approach = _near_collision(scenario, timelines, grid, limits)
-    slow_boxes = area_boxes(scenario, faults)
-    stuck = deadlocked(scenario, faults)
-    last_entry = {entry.robot: n for n, entry in enumerate(scenario.mission.allocation)}
-    parked: dict[str, tuple[float, float]] = {}
-    """Where robots that have done all their tasks stand: later paths go round them."""
-
-    for number, entry in enumerate(scenario.mission.allocation):
-        tl = timelines[entry.robot]
-        if scenario.mission.type is MissionType.SEQUENTIAL:
-            start = max(t.samples for t in timelines.values())
-            tl.wait_until(start)
-        task = scenario.task(entry.task)
-        assert task is not None
-        task_numbers[entry.robot] = task_numbers.get(entry.robot, 0) + 1
-        robot_limits = Limits(speed[entry.robot], limits.max_accel, limits.max_turn_rate)
-        for s_number, subtask in enumerate(task.subtasks, start=1):
-            ids = tuple(w.id for w in subtask.waypoints)
-            key = f"{entry.robot}-task_{task_numbers[entry.robot]:02d}-subtask_{s_number:03d}"
-            statuses = [GoalStatus.PENDING] * len(ids)
-            tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, 5))
-            events.append(GoalEvent(tl.now, entry.robot, key, ids, tuple(statuses), False))  # goal accepted
-            tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, 5))  # the dispatcher activates its first waypoint
-            for w_number, goal in enumerate(subtask.waypoints, start=1):
-                waypoint_counts[entry.robot] = waypoint_counts.get(entry.robot, 0) + 1
-                statuses[w_number - 1] = GoalStatus.ACTIVE
-                start_t = tl.now
-                events.append(GoalEvent(start_t, entry.robot, key, ids, tuple(statuses), False))
-                if stuck and waypoint_counts[entry.robot] == 1:  # deadlock-start: every robot waits
-                    tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, int(round(DEADLOCK_WAIT / DT))))
-                previous = last_pose[entry.robot]
-                keep_clear = _standing(parked, avoid.get((entry.robot, waypoint_counts[entry.robot]), ()))
-                if (entry.robot, waypoint_counts[entry.robot]) in skip:
-                    path = _plan_around(
-                        grid, (tl.x, tl.y), (goal.position.x, goal.position.y), keep_clear, plans
-                    )
-                    tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, 25))
-                    status, length = GoalStatus.ABORTED, 0.0
-                else:
-                    for leg in approach.pop(entry.robot, []):  # the near-collision fault, inside the mission
-                        tl.append(leg)
-                    via = detour_via(scenario, entry.robot, previous, goal, faults)
-                    wait = waits.get((entry.robot, waypoint_counts[entry.robot])) if via is None else None
-                    if wait is not None:
-                        via = wait.place
-                    hold = wait.until if wait is not None else None
-                    until = int(round(hold / DT)) if hold is not None else None
-                    path, driven = _drive_to(grid, tl, goal, via, keep_clear, robot_limits, plans, until)
-                    length = _length(path)
-                    tl.append(slow_in_areas(driven, slow_boxes) if slow_boxes else driven)
-                    status = GoalStatus.SUCCEEDED
-                    last_pose[entry.robot] = goal
-                statuses[w_number - 1] = status
-                actions.append(
-                    Action(
-                        entry.robot,
-                        task_numbers[entry.robot],
-                        task.id,
-                        s_number,
-                        w_number,
-                        previous,
-                        goal,
-                        start_t,
-                        tl.now,
-                        status,
-                        length,
-                        tuple(path),
-                    )
-                )
-                last = w_number == len(ids)
-                events.append(GoalEvent(tl.now, entry.robot, key, ids, tuple(statuses), last))
-                tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, int(rng.uniform(0.2, 0.6) * 50)))
-        if last_entry[entry.robot] == number:
-            parked[entry.robot] = (tl.x, tl.y)
-    trajectories = {r: Trajectory.concat(t.parts) for r, t in timelines.items()}
-    if not any(f.kind == "near-collision" for f in faults):
-        trajectories, events, actions = give_way(scenario, trajectories, events, actions)
-    end = max(len(t) for t in trajectories.values()) + 50
-    trajectories = {
-        r: Trajectory.concat(
-            [t, Trajectory.hold(float(t.x[-1]), float(t.y[-1]), float(t.yaw[-1]), end - len(t))]
-        )
-        for r, t in trajectories.items()
-    }
-    events.sort(key=lambda e: (e.t, e.robot))
-    return Execution(trajectories, events, actions, end * DT)
+    return timelines
 
 
 def _drive_to(

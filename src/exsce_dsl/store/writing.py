@@ -183,78 +183,100 @@ def add_graphs(
     names = list(graphs)
     existing = store.existing_graphs(names)
     stored = store.graphs([name for name in names if name in existing]) if existing else {}
-    added: list[str] = []
-    merged: list[str] = []
-    unchanged: list[str] = []
-    conflicts: list[_Difference] = []
-    to_add: dict[str, list[Quad]] = {}
-    to_replace: dict[str, list[Quad]] = {}
-    derived_changes: dict[str, list[Quad]] = {}
+    plan = _WritePlan()
     for name in names:
-        new = list(graphs[name])
-        old = stored.get(name, [])
-        if name in derived:
-            if not old and new:
-                to_add[name] = new
-            elif old and _canonical(old) != _canonical(new):
-                derived_changes[name] = new
-            continue
-        if not old:
-            added.append(name)
-            to_add[name] = new
-        elif _is_pose_graph(old) and _is_pose_graph(new):
-            old_subjects, new_subjects = _descriptions(old), _descriptions(new)
-            changed = sorted(
-                s for s in new_subjects.keys() & old_subjects.keys() if new_subjects[s] != old_subjects[s]
-            )
-            if changed:
-                predicates = {p for s in changed for p, _ in old_subjects[s] ^ new_subjects[s]}
-                conflicts.append(
-                    _Difference(
-                        name, changed=tuple(changed), predicates=tuple(sorted(predicates)), pose_graph=True
-                    )
-                )
-                kept = [q for q in old if _key(q.subject) not in changed]
-                to_replace[name] = _union(kept, new)
-                continue
-            missing = _missing(old, new)
-            if missing:
-                merged.append(name)
-                to_add[name] = missing
-            else:
-                unchanged.append(name)
-        elif _canonical(old) == _canonical(new):
-            unchanged.append(name)
-        else:
-            conflicts.append(_subject_difference(name, old, new))
-            to_replace[name] = new
-    if conflicts and not replace:
+        plan.compare(name, stored.get(name, []), list(graphs[name]), derived=name in derived)
+    if plan.conflicts and not replace:
         raise StoreConflictError(
-            _conflict_message(store, graphs, conflicts, prefixes), [c.graph for c in conflicts]
+            _conflict_message(store, graphs, plan.conflicts, prefixes), [c.graph for c in plan.conflicts]
         )
-    revisions: dict[str, list[Quad]] = {}
-    if conflicts:
-        existing = store.graph_names()
-        now = datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0)
-        for difference in conflicts:
-            number = 1 + max((_revision_number(n, difference.graph) for n in existing), default=0)
-            revision = revision_name(difference.graph, number)
-            revisions[revision] = _revision_quads(
-                difference.graph, stored[difference.graph], revision, number, now
-            )
-    writes = {**to_add, **to_replace, **revisions, **derived_changes}
+    revisions = _revisions(store, plan.conflicts, stored) if plan.conflicts else {}
+    writes = {**plan.to_add, **plan.to_replace, **revisions, **plan.derived_changes}
     if writes:
-        store.write(GraphSet(writes), replace=set(to_replace) | set(revisions) | set(derived_changes))
+        store.write(
+            GraphSet(writes), replace=set(plan.to_replace) | set(revisions) | set(plan.derived_changes)
+        )
     return WriteReport(
         location=store.location,
-        added=tuple(added),
-        merged=tuple(merged),
-        replaced=tuple(to_replace),
-        unchanged=tuple(unchanged),
+        added=tuple(plan.added),
+        merged=tuple(plan.merged),
+        replaced=tuple(plan.to_replace),
+        unchanged=tuple(plan.unchanged),
         revisions=tuple(revisions),
         statements=sum(len(q) for q in writes.values()),
         prefixes=prefixes,
     )
+
+
+@dataclass
+class _WritePlan:
+    """What :func:`add_graphs` does with each graph, by what the store holds under its name."""
+
+    added: list[str] = field(default_factory=list)
+    merged: list[str] = field(default_factory=list)
+    unchanged: list[str] = field(default_factory=list)
+    conflicts: list[_Difference] = field(default_factory=list)
+    to_add: dict[str, list[Quad]] = field(default_factory=dict)
+    to_replace: dict[str, list[Quad]] = field(default_factory=dict)
+    derived_changes: dict[str, list[Quad]] = field(default_factory=dict)
+
+    def compare(self, name: str, old: list[Quad], new: list[Quad], *, derived: bool) -> None:
+        """Graph ``name``: new, unchanged, merged (a pose graph), a conflict, or a derived change."""
+        if derived:
+            if not old and new:
+                self.to_add[name] = new
+            elif old and _canonical(old) != _canonical(new):
+                self.derived_changes[name] = new
+        elif not old:
+            self.added.append(name)
+            self.to_add[name] = new
+        elif _is_pose_graph(old) and _is_pose_graph(new):
+            self.merge_poses(name, old, new)
+        elif _canonical(old) == _canonical(new):
+            self.unchanged.append(name)
+        else:
+            self.conflicts.append(_subject_difference(name, old, new))
+            self.to_replace[name] = new
+
+    def merge_poses(self, name: str, old: list[Quad], new: list[Quad]) -> None:
+        """A pose graph holds the union of the poses its scenarios use; a pose described
+        otherwise is a conflict, replaced (if allowed) by the union with the new description."""
+        old_subjects, new_subjects = _descriptions(old), _descriptions(new)
+        changed = sorted(
+            s for s in new_subjects.keys() & old_subjects.keys() if new_subjects[s] != old_subjects[s]
+        )
+        if changed:
+            predicates = {p for s in changed for p, _ in old_subjects[s] ^ new_subjects[s]}
+            self.conflicts.append(
+                _Difference(
+                    name, changed=tuple(changed), predicates=tuple(sorted(predicates)), pose_graph=True
+                )
+            )
+            kept = [q for q in old if _key(q.subject) not in changed]
+            self.to_replace[name] = _union(kept, new)
+            return
+        missing = _missing(old, new)
+        if missing:
+            self.merged.append(name)
+            self.to_add[name] = missing
+        else:
+            self.unchanged.append(name)
+
+
+def _revisions(
+    store: Store, conflicts: list[_Difference], stored: Mapping[str, list[Quad]]
+) -> dict[str, list[Quad]]:
+    """Each conflicting graph's old content, kept under its next revision name."""
+    revisions: dict[str, list[Quad]] = {}
+    existing = store.graph_names()
+    now = datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0)
+    for difference in conflicts:
+        number = 1 + max((_revision_number(n, difference.graph) for n in existing), default=0)
+        revision = revision_name(difference.graph, number)
+        revisions[revision] = _revision_quads(
+            difference.graph, stored[difference.graph], revision, number, now
+        )
+    return revisions
 
 
 # -- comparing graphs ------------------------------------------------------------

@@ -45,6 +45,9 @@ def _probe_key(select: Select) -> str:
 
 
 class Walker:
+    """The fields of a message type walked over all messages at once: the bytes read at each
+    message's position, the requested values put under their keys."""
+
     def __init__(self, catalogue: MessageCatalogue, messages: RawMessages, cdr: bool) -> None:
         self.catalogue = catalogue
         self.buffer = messages.buffer
@@ -163,7 +166,7 @@ class Walker:
                 if isinstance(request.equals, str):
                     out[request.key] = self._text_equals(pos, lengths, request.equals)
                 elif request.text:
-                    self._put(out, request, self._text_codes(pos, lengths))
+                    _put(out, request, self._text_codes(pos, lengths))
             after: np.ndarray = pos + lengths
             return after
         size = np.dtype(NUMERIC[basetype]).itemsize
@@ -173,7 +176,7 @@ class Walker:
             values = self.read(self._code(basetype), pos, rows).astype(np.float64)
             for request in requests:
                 if request.equals is None:
-                    self._put(out, request, values)
+                    _put(out, request, values)
                 elif not isinstance(request.equals, str):
                     out[request.key] = values == request.equals
         return pos + size
@@ -223,15 +226,15 @@ class Walker:
         code = self._code(basetype)
         for request in requests:
             if request.path.length and not request.steps:
-                self._put(out, request, counts.astype(np.float64))
+                _put(out, request, counts.astype(np.float64))
             elif request.steps and isinstance(request.steps[0], Index):
                 which = _element(counts, request.steps[0])
                 found = which >= 0
                 values = np.full(len(pos), np.nan)
                 values[found] = self.read(code, pos[found] + which[found] * size, rows[found])
-                self._put(out, request, values, found)
+                _put(out, request, values, found)
             else:
-                self._put(out, request, self._rows_of(code, pos, rows, counts, size), lengths=counts)
+                _put(out, request, self._rows_of(code, pos, rows, counts, size), lengths=counts)
         after: np.ndarray = pos + counts * size
         return after
 
@@ -267,7 +270,7 @@ class Walker:
         width = int(counts.max()) if len(counts) else 0
         for request in requests:
             if request.path.length and not request.steps:
-                self._put(out, request, counts.astype(np.float64))
+                _put(out, request, counts.astype(np.float64))
         inner = [r for r in requests if r.steps]
         selects = list(dict.fromkeys(r.steps[0] for r in inner if isinstance(r.steps[0], Select)))
         columns: list[dict[str, np.ndarray]] = []
@@ -299,76 +302,8 @@ class Walker:
             )
             columns.append({key: _spread(values, active, len(pos)) for key, values in local.items()})
         for request in inner:
-            self._collect(request, columns, counts, out)
+            _collect(request, columns, counts, out)
         return pos
-
-    def _collect(
-        self,
-        request: Request,
-        columns: list[dict[str, np.ndarray]],
-        counts: np.ndarray,
-        out: dict[str, np.ndarray],
-    ) -> None:
-        """A request's values from the element columns: all of them, or the picked one."""
-        first = request.steps[0]
-        n = len(counts)
-        stack = [c.get(request.key) for c in columns]
-        if isinstance(first, str):  # a field of every element: one row per message
-            values = np.full((n, len(stack)), np.nan)
-            for k, column in enumerate(stack):
-                if column is not None:
-                    values[:, k] = column
-            self._put(out, request, values, lengths=counts)
-            return
-        if isinstance(first, Index):
-            which = _element(counts, first)
-        else:
-            assert isinstance(first, Select)
-            hits = [c.get(_probe_key(first), np.zeros(n, dtype=bool)) for c in columns]
-            table = np.stack(hits, axis=1) if hits else np.zeros((n, 0), dtype=bool)
-            which = np.where(table.any(axis=1), table.argmax(axis=1), -1) if len(hits) else np.full(n, -1)
-        given = [c for c in stack if c is not None]
-        if request.row:  # an array in the picked element: one row a message, NaN-padded
-            width = max((c.shape[1] for c in given), default=0)
-            dtype = np.result_type(*given) if given else np.dtype(np.float64)
-            picked = np.full((n, width), np.nan, dtype=dtype)
-        else:
-            picked = np.full(n, np.nan)
-        present = which >= 0
-        lengths = np.zeros(n, dtype=np.int64)
-        for k, column in enumerate(stack):
-            take = which == k
-            if column is not None:
-                if picked.ndim == 2:
-                    picked[take, : column.shape[1]] = column[take]
-                    held = np.nan_to_num(columns[k].get(request.key + LENGTHS, np.zeros(n)))
-                    lengths[take] = held[take].astype(np.int64)
-                else:
-                    picked[take] = column[take]
-            inner = columns[k].get(request.key + PRESENT)
-            if inner is not None:
-                present[take] &= inner[take]
-        if picked.ndim == 2:
-            picked = picked[:, : int(lengths.max(initial=0))]
-            self._put(out, request, picked, present, lengths)
-        else:
-            self._put(out, request, picked, present)
-
-    def _put(
-        self,
-        out: dict[str, np.ndarray],
-        request: Request,
-        values: np.ndarray,
-        present: np.ndarray | None = None,
-        lengths: np.ndarray | None = None,
-    ) -> None:
-        out[request.key] = values
-        if lengths is not None:
-            out[request.key + LENGTHS] = lengths
-        if request.path.picks:
-            mask = np.ones(len(values), dtype=bool) if present is None else present
-            previous = out.get(request.key + PRESENT)
-            out[request.key + PRESENT] = mask if previous is None else mask & previous
 
 
 def _element(counts: np.ndarray, index: Index) -> np.ndarray:
@@ -388,3 +323,73 @@ def _spread(values: np.ndarray, active: np.ndarray, n: int) -> np.ndarray:
         full = np.full((n, *values.shape[1:]), np.nan, dtype=dtype)
     full[active] = values
     return full
+
+
+def _collect(
+    request: Request,
+    columns: list[dict[str, np.ndarray]],
+    counts: np.ndarray,
+    out: dict[str, np.ndarray],
+) -> None:
+    """A request's values from the element columns: all of them, or the picked one."""
+    first = request.steps[0]
+    n = len(counts)
+    stack = [c.get(request.key) for c in columns]
+    if isinstance(first, str):  # a field of every element: one row per message
+        values = np.full((n, len(stack)), np.nan)
+        for k, column in enumerate(stack):
+            if column is not None:
+                values[:, k] = column
+        _put(out, request, values, lengths=counts)
+        return
+    if isinstance(first, Index):
+        which = _element(counts, first)
+    else:
+        assert isinstance(first, Select)
+        hits = [c.get(_probe_key(first), np.zeros(n, dtype=bool)) for c in columns]
+        table = np.stack(hits, axis=1) if hits else np.zeros((n, 0), dtype=bool)
+        which = np.where(table.any(axis=1), table.argmax(axis=1), -1) if len(hits) else np.full(n, -1)
+    given = [c for c in stack if c is not None]
+    if request.row:  # an array in the picked element: one row a message, NaN-padded
+        width = max((c.shape[1] for c in given), default=0)
+        dtype = np.result_type(*given) if given else np.dtype(np.float64)
+        picked = np.full((n, width), np.nan, dtype=dtype)
+    else:
+        picked = np.full(n, np.nan)
+    present = which >= 0
+    lengths = np.zeros(n, dtype=np.int64)
+    for k, column in enumerate(stack):
+        take = which == k
+        if column is not None:
+            if picked.ndim == 2:
+                picked[take, : column.shape[1]] = column[take]
+                held = np.nan_to_num(columns[k].get(request.key + LENGTHS, np.zeros(n)))
+                lengths[take] = held[take].astype(np.int64)
+            else:
+                picked[take] = column[take]
+        inner = columns[k].get(request.key + PRESENT)
+        if inner is not None:
+            present[take] &= inner[take]
+    if picked.ndim == 2:
+        picked = picked[:, : int(lengths.max(initial=0))]
+        _put(out, request, picked, present, lengths)
+    else:
+        _put(out, request, picked, present)
+
+
+def _put(
+    out: dict[str, np.ndarray],
+    request: Request,
+    values: np.ndarray,
+    present: np.ndarray | None = None,
+    lengths: np.ndarray | None = None,
+) -> None:
+    """A request's values under its key, with their row lengths and, for a path that picks
+    (an element, a selection), whether each message had a value."""
+    out[request.key] = values
+    if lengths is not None:
+        out[request.key + LENGTHS] = lengths
+    if request.path.picks:
+        mask = np.ones(len(values), dtype=bool) if present is None else present
+        previous = out.get(request.key + PRESENT)
+        out[request.key + PRESENT] = mask if previous is None else mask & previous
