@@ -95,6 +95,7 @@ if TYPE_CHECKING:
 )
 @click.option(
     "--cluster",
+    "dask_address",
     metavar="ADDRESS",
     help="A Dask scheduler (tcp://host:8786): the simulator's runs are played and every bag is "
     "analysed on its workers, which must see the campaign's folder (--output) at the same path "
@@ -128,7 +129,7 @@ def explore(
     start_master: bool,
     speed_up: float | None,
     jobs: int,
-    cluster: str | None,
+    dask_address: str | None,
     output: str | None,
     junit: str | None,
     store_url: str | None,
@@ -201,21 +202,21 @@ def explore(
     from exsce_dsl.lang.build import load_spec
     from exsce_dsl.model.campaign import Trial
     from exsce_dsl.oracles.campaign_junit import campaign_junit, run_seconds
-    from exsce_dsl.parallel.cluster import cluster_address
+    from exsce_dsl.parallel.dask_client import dask_address as scheduler_address
     from exsce_dsl.store.open import open_store
 
     if executor_command and (faults or plugin):
         raise ExsceError("give one of --fault (the simulator), --executor-command and --executor")
     if (stand_in or start_master or speed_up is not None) and not plugin:
         raise ExsceError("--stand-in, --start-master and --speed-up go with --executor ros1")
-    address = cluster_address(cluster)
+    address = scheduler_address(dask_address)
     chosen: AbstractContextManager[Executor]
     if executor_command:
         chosen = nullcontext(CommandExecutor(executor_command))
     elif plugin:
         chosen = named_executor(plugin, ExecutorOptions(faults, stand_in, start_master, None, speed_up))
     else:
-        chosen = nullcontext(SimulatorExecutor.with_faults(faults, cluster=address))
+        chosen = nullcontext(SimulatorExecutor.with_faults(faults, dask_address=address))
     options = CampaignOptions(
         budget=budget,
         seed=seed,
@@ -227,7 +228,7 @@ def explore(
         shrink=not no_shrink,
         stop_at_violation=stop_at_violation,
         jobs=jobs,
-        cluster=address,
+        dask_address=address,
     )
     baseline = random_baseline(options) if compare_random else None
     parsed = load_spec(spec)

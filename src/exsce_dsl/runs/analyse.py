@@ -46,7 +46,7 @@ from exsce_dsl.runs.metrics.monitor_code import load_monitors
 from exsce_dsl.runs.missing import missing_metrics, unread_topics
 from exsce_dsl.runs.robots import SERVED, stack_robots
 from exsce_dsl.runs.segments.dispatcher import SUCCEEDED, segments
-from exsce_dsl.runs.segments.segment import Segment
+from exsce_dsl.runs.segments.recorded import RecordedAction
 from exsce_dsl.runs.segments.sources import DISPATCHER_SOURCE, segment_robot
 from exsce_dsl.runs.signals.detect import Detected, pose_like_topics, with_detected_conventions
 from exsce_dsl.runs.signals.timeline import (
@@ -194,7 +194,7 @@ def analyse_bag(
         # (a user metric may read more of it than the method's fields: pose.pose.covariance)
         same = read is not None and len(read) == len(served) and np.array_equal(read.t, served.t)
         topics[name] = Topic(name, served.t, {**served.fields, **read.fields}) if same and read else served
-    actions: list[Segment] = []
+    actions: list[RecordedAction] = []
     results: dict[str, int | None] = {}
     whole_runs: dict[str, tuple[float, float]] = {}
     segmented_by: dict[str, str] = {}
@@ -298,7 +298,7 @@ def _time(seconds: float) -> dt.datetime:
 
 
 def _task_executions(
-    actions: list[Segment], segmented_by: dict[str, str], wall: Callable[[np.ndarray], np.ndarray]
+    actions: list[RecordedAction], segmented_by: dict[str, str], wall: Callable[[np.ndarray], np.ndarray]
 ) -> tuple[TaskExecution, ...]:
     """The robots' tasks as executed, with their actions' times as the wall clock had them.  A
     segment that started and ended is an action (its metric values need one): ABORTED when its

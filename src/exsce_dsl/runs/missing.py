@@ -18,7 +18,7 @@ from exsce_dsl.model.messages import DISPATCHER, canonical_type
 from exsce_dsl.model.metrics import ComputedFor, MetricDefinition, topic_name
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import ActionId, MetricScope, MetricValue
-from exsce_dsl.runs.segments.segment import Segment
+from exsce_dsl.runs.segments.recorded import RecordedAction
 from exsce_dsl.suggest import closest_several
 
 SIGNAL_TYPES = {"pose": POSE_TYPES, "velocity": VELOCITY_TYPES, "scan": (LASER_SCAN,)}
@@ -137,7 +137,7 @@ def missing_metrics(
     metrics: Iterable[MetricDefinition],
     robots: Sequence[Robot],
     acting: Iterable[str],
-    segments: Sequence[Segment],
+    segments: Sequence[RecordedAction],
     values: Sequence[MetricValue],
 ) -> list[str]:
     """The values a run should have and has not: each robot metric of each robot that has tasks
@@ -165,5 +165,5 @@ def missing_metrics(
     return lacking
 
 
-def _action(segment: Segment) -> ActionId:
+def _action(segment: RecordedAction) -> ActionId:
     return ActionId(segment.robot, segment.allocation, segment.subtask, segment.waypoint)

@@ -18,7 +18,7 @@ import numpy as np
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import MissionType, Pose, Scenario
-from exsce_dsl.sim.actions import Action, GoalEvent, GoalStatus
+from exsce_dsl.sim.actions import GoalEvent, GoalStatus, SimulatedAction
 from exsce_dsl.sim.conflicts import MAX_REPAIRS, Leg, Repair, conflict_repairs, meetings
 from exsce_dsl.sim.faults import (
     DEADLOCK_WAIT,
@@ -68,7 +68,7 @@ class Execution:
 
     trajectories: dict[str, Trajectory]
     events: list[GoalEvent]
-    actions: list[Action]
+    actions: list[SimulatedAction]
     duration: float
 
 
@@ -113,7 +113,9 @@ def execute(
     return execution
 
 
-def _can_go_round(repair: Repair, actions: list[Action], avoid: dict[Leg, tuple[Point, ...]]) -> bool:
+def _can_go_round(
+    repair: Repair, actions: list[SimulatedAction], avoid: dict[Leg, tuple[Point, ...]]
+) -> bool:
     """The repair would change its leg: the place is not tried yet (nor one near it) and not
     so near the leg's ends that its path cannot go round it."""
     if any(math.dist(repair.place, p) < TRIED for p in avoid.get(repair.leg, ())):
@@ -152,7 +154,7 @@ def _play(
     }
     skip = {(f.robot, f.index) for f in faults if f.kind == "skip-waypoint"}
     events: list[GoalEvent] = []
-    actions: list[Action] = []
+    actions: list[SimulatedAction] = []
     last_pose = {r.id: r.start_pose for r in scenario.robots if r.start_pose is not None}
     task_numbers: dict[str, int] = {}
     waypoint_counts: dict[str, int] = {}
@@ -212,7 +214,7 @@ def _play(
                     last_pose[entry.robot] = goal
                 statuses[w_number - 1] = status
                 actions.append(
-                    Action(
+                    SimulatedAction(
                         entry.robot,
                         task_numbers[entry.robot],
                         task.id,
@@ -348,4 +350,4 @@ def _standing(parked: dict[str, Point], avoid: tuple[Point, ...]) -> tuple[Point
     return tuple(parked.values()) + avoid
 
 
-__all__ = ["Action", "Execution", "Fault", "GoalEvent", "GoalStatus", "execute", "np"]
+__all__ = ["SimulatedAction", "Execution", "Fault", "GoalEvent", "GoalStatus", "execute", "np"]

@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from exsce_dsl.model import Scenario
-from exsce_dsl.sim.actions import Action, GoalEvent
+from exsce_dsl.sim.actions import GoalEvent, SimulatedAction
 from exsce_dsl.sim.conflicts import CLEARANCE
 from exsce_dsl.sim.motion import DT, Trajectory
 
@@ -26,8 +26,11 @@ RAMP = 1.2  # seconds to go from full progress to standing still (keeps accelera
 
 
 def give_way(
-    scenario: Scenario, trajectories: dict[str, Trajectory], events: list[GoalEvent], actions: list[Action]
-) -> tuple[dict[str, Trajectory], list[GoalEvent], list[Action]]:
+    scenario: Scenario,
+    trajectories: dict[str, Trajectory],
+    events: list[GoalEvent],
+    actions: list[SimulatedAction],
+) -> tuple[dict[str, Trajectory], list[GoalEvent], list[SimulatedAction]]:
     """Right of way by fleet order, replayed on the trajectories (paths unchanged, clocks warped).
 
     Each robot advances along its own trajectory at a rate between -1 (backing up
@@ -143,7 +146,7 @@ def give_way(
         for e in events
     ]
     actions = [
-        Action(
+        SimulatedAction(
             a.robot,
             a.task_number,
             a.task,

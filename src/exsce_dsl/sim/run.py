@@ -29,7 +29,7 @@ from exsce_dsl.lang.occupancy import OccupancyGrid, load_occupancy_grid
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.conventions import Signals
 from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Run, run_name
-from exsce_dsl.parallel.cluster import cluster_mapper
+from exsce_dsl.parallel.dask_client import dask_map
 from exsce_dsl.prov.recorder import recorded_prov_json, recorded_run
 from exsce_dsl.sim.bag import write_bag
 from exsce_dsl.sim.conventions import convention_writer
@@ -101,7 +101,7 @@ def simulate(
     faults: Sequence[Fault] = (),
     convention: Signals | str | None = None,
     twist_stamped: bool = False,
-    cluster: str | None = None,
+    dask_address: str | None = None,
 ) -> Iterator[SimulatedRun]:
     """Play ``scenario`` ``runs`` times and write one bag per run into ``out_dir``, in run order.
 
@@ -111,17 +111,17 @@ def simulate(
     navigation stacks' ``cmd_vel`` a TwistStamped (Nav2 from Jazzy on).  Runs in another
     convention than the method's get other run ids, so their bags can share a folder.
 
-    With ``cluster`` (a Dask scheduler's address) each run is one task on the cluster's workers,
+    With ``dask_address`` (a Dask scheduler's address) each run is one task on the cluster's workers,
     with the same run ids and the same bytes.  The workers write the bags: ``out_dir`` (made
     absolute here) and the scenario's map file must be the same paths on every worker (a shared
     filesystem).  A task is tried twice, and a killed worker's task goes to another worker; a run
     that failed even so does not stop the others: when they are done, an :class:`ExsceError`
     names each failed run by its index."""
-    if cluster is not None:
+    if dask_address is not None:
         shared = _with_absolute_map(scenario)
         plan = RunPlan.of(shared, out_dir.absolute(), fmt, seed, faults, convention, twist_stamped)
         plan.out_dir.mkdir(parents=True, exist_ok=True)
-        return _on_cluster(cluster, plan, runs, out_dir)
+        return _on_dask(dask_address, plan, runs, out_dir)
     plan = RunPlan.of(scenario, out_dir, fmt, seed, faults, convention, twist_stamped)
     out_dir.mkdir(parents=True, exist_ok=True)
     return _here(plan, runs)
@@ -133,9 +133,9 @@ def _here(plan: RunPlan, runs: int) -> Iterator[SimulatedRun]:
         yield play_run(plan, index, grid)
 
 
-def _on_cluster(address: str, plan: RunPlan, runs: int, out_dir: Path) -> Iterator[SimulatedRun]:
+def _on_dask(address: str, plan: RunPlan, runs: int, out_dir: Path) -> Iterator[SimulatedRun]:
     failed: list[str] = []
-    with cluster_mapper(address) as mapper:
+    with dask_map(address) as mapper:
         for index, played in enumerate(mapper(_play_task, [(plan, index) for index in range(runs)])):
             if isinstance(played, SimulatedRun):
                 yield replace(played, bag=out_dir / played.bag.name)
