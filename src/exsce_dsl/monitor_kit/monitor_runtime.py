@@ -402,7 +402,8 @@ class MonitorRuntime:
         entries: dict[str, list[tuple[str, str, Any]]] = {}
         for _, namespace in self.robots:
             for pattern, key, func, compute in monitors.REDUCERS:
-                entries.setdefault(self.core.topic_name(pattern, namespace), []).append((key, func, compute))
+                topic = self.core.expand_topic(pattern, namespace)
+                entries.setdefault(topic, []).append((key, func, compute))
         self.buffers = {
             name: _Buffer(spec, self.core.reducer(entries[name]) if name in entries else None)
             for name, spec in self.specs.items()

@@ -480,7 +480,7 @@ def unescape_name(local: str) -> str:
     return unquote_to_bytes(local).decode("utf-8", "surrogatepass")
 
 
-def topic_name(topic: str) -> str:
+def topic_local_name(topic: str) -> str:
     """The local name in ``topic:`` of a topic, as a bag spells it, whatever its characters.
 
     An absolute name loses its first ``/`` (``/tiago1/nav_vel`` is ``topic:tiago1/nav_vel``,
@@ -493,7 +493,7 @@ def topic_name(topic: str) -> str:
 
 
 def topic_of_name(local: str) -> str:
-    """The topic whose local name in ``topic:`` is ``local`` (see :func:`topic_name`)."""
+    """The topic whose local name in ``topic:`` is ``local`` (see :func:`topic_local_name`)."""
     if local.startswith(_RELATIVE):
         return unescape_name(local[len(_RELATIVE) :])
     return "/" + unescape_name(local)
@@ -506,7 +506,7 @@ def bag_name(file_name: str) -> str:
 
 def clock_name(topic: str) -> str:
     """``clock-<topic>``, in the run's namespace: which clock the bag's ``topic`` was timed by."""
-    return f"clock-{topic_name(topic)}"
+    return f"clock-{topic_local_name(topic)}"
 
 
 def convention_name(robot_id: str) -> str:

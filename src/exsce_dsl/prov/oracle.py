@@ -107,7 +107,7 @@ def compile_oracles(
                 w.used(activity, learnt[compared], {PROV_ROLE: "baseline_runs"})
         topics = dict.fromkeys(topic for oracle in group for topic in oracle.topics)
         for topic in topics:
-            topic_id = topic_ns[ids.topic_name(topic)]
+            topic_id = topic_ns[ids.topic_local_name(topic)]
             if topic_id not in declared:
                 declared.add(topic_id)
                 w.entity(topic_id, topic_type)

@@ -43,7 +43,7 @@ Where exsce differs from the method's published run and its report, on purpose:
 * topics are ``topic:tiago1/nav_vel`` (the name without its first ``/``, so that
   the IRI is ``<base>topics/tiago1/nav_vel``), where the report wrote
   ``topic:/tiago1/nav_vel``; a name as a bag may hold it otherwise (relative, with
-  spaces...) is escaped (``topic:@groundtruth``, see :func:`ids.topic_name`), as is the
+  spaces...) is escaped (``topic:@groundtruth``, see :func:`ids.topic_local_name`), as is the
   bag file's name;
 * additions: each action's start and end time and ``exsce:status``
   (``SUCCEEDED``/``ABORTED``), with ``exsce:goal_outcome`` (``rejected``, ``timed out``,
@@ -249,7 +249,7 @@ class _RunCompiler:
         topic_ns = w.fixed(ids.TOPIC)
         topic_type = {PROV_TYPE: t(ids.ROS_TOPICS)}
         for topic in dict.fromkeys(bag.topics):
-            topic_id = topic_ns[ids.topic_name(topic)]
+            topic_id = topic_ns[ids.topic_local_name(topic)]
             w.entity(topic_id, topic_type)
             w.member(bag_id, topic_id)
         self._clocks(w, set(bag.topics))
@@ -270,7 +270,7 @@ class _RunCompiler:
                 t(ids.CLOCK_OFFSET): float(clock.offset),
             }
             w.entity(clock_id, facts)
-            w.derivation(clock_id, topic_ns[ids.topic_name(clock.topic)], {})
+            w.derivation(clock_id, topic_ns[ids.topic_local_name(clock.topic)], {})
 
     def _conventions(self, w: BundleWriter, held: set[str]) -> None:
         """The convention detected for each robot whose type names none, and the topics it was
@@ -290,7 +290,7 @@ class _RunCompiler:
             )
             for topic in evidence:
                 if topic in held:
-                    w.derivation(found, topic_ns[ids.topic_name(topic)], {})
+                    w.derivation(found, topic_ns[ids.topic_local_name(topic)], {})
 
     def _metric_bundles(self, actions: dict[ActionId, QualifiedName]) -> None:
         by_metric: dict[str, list[MetricValue]] = {}
@@ -339,7 +339,7 @@ class _RunCompiler:
                 writer.claim(collection, f"the topics of '{metric}'" + (f" of '{robot}'" if robot else ""))
                 w.entity(collection, collection_type)
                 for topic in topics:
-                    w.member(collection, topic_ns[ids.topic_name(topic)])
+                    w.member(collection, topic_ns[ids.topic_local_name(topic)])
                 known = collections[key] = (topics, collection)
             elif known is not None and set(known[0]) != set(topics):
                 raise ExsceError(

@@ -73,4 +73,4 @@ def _write(
     w.entity(entity, {k: v for k, v in facts.items() if v is not None})
     w.generated(entity, run)
     if topic is not None and topic in held:
-        w.derivation(entity, w.fixed(ids.TOPIC)[ids.topic_name(topic)], {})
+        w.derivation(entity, w.fixed(ids.TOPIC)[ids.topic_local_name(topic)], {})

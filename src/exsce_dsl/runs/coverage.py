@@ -39,7 +39,7 @@ from exsce_dsl.model.conventions import Window
 from exsce_dsl.model.coverage import CoverageGap, Shortfall, TopicRate
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import MetricValue, RunStatus
-from exsce_dsl.monitor_kit.monitor_core import topic_name
+from exsce_dsl.monitor_kit.monitor_core import expand_topic
 from exsce_dsl.runs.bags.reading import BagData
 from exsce_dsl.runs.segments.recorded import RecordedAction
 from exsce_dsl.runs.signals.sources import SIGNALS, RobotSources
@@ -223,7 +223,7 @@ def declared_rates(
                     s.rate
                     for s in listed
                     if getattr(s, "rate", None) is not None
-                    and topic_name(s.topic, robot.namespace) == chosen.topic
+                    and expand_topic(s.topic, robot.namespace) == chosen.topic
                 ),
                 None,
             )

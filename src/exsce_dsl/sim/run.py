@@ -16,7 +16,6 @@ from __future__ import annotations
 import datetime as dt
 import os
 import shutil
-import uuid
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, replace
 from functools import lru_cache
@@ -28,7 +27,7 @@ from exsce_dsl.errors import ExsceError
 from exsce_dsl.lang.occupancy import OccupancyGrid, load_occupancy_grid
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.conventions import Signals
-from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Run, run_name
+from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Run, run_name, run_uuid
 from exsce_dsl.parallel.dask_client import dask_map
 from exsce_dsl.prov.recorder import recorded_prov_json, recorded_run
 from exsce_dsl.sim.bag import write_bag
@@ -42,7 +41,6 @@ FORMATS = ("ros1", "ros2", "mcap")
 #: well before 2038-01-19.
 EPOCH = dt.datetime(2026, 1, 1, tzinfo=dt.timezone.utc)
 SEED_DAYS = 4_000
-_RUN_NAMESPACE = uuid.UUID("7f0f3f5e-5a3c-4c1e-9d8e-6b0e2a1c9d41")
 
 
 @dataclass(frozen=True)
@@ -173,12 +171,8 @@ def play_run(plan: RunPlan, index: int, grid: PlanningGrid | None = None) -> Sim
     run_seed = plan.seed * 1000 + index
     # days wrap so that every seed gives a time ROS 1 can stamp (see SEED_DAYS)
     start = EPOCH + dt.timedelta(days=plan.seed % SEED_DAYS, hours=index)
-    run_id = str(
-        uuid.uuid5(
-            _RUN_NAMESPACE,
-            f"{scenario.id}/{plan.seed}/{index}/{','.join(f.identity for f in plan.faults)}{plan.variant}",
-        )
-    )
+    faults = ",".join(f.identity for f in plan.faults)
+    run_id = run_uuid("simulated", f"{scenario.id}/{plan.seed}/{index}/{faults}{plan.variant}")
     grid = planning_grid(scenario) if grid is None else grid
     execution = execute(scenario, grid, run_seed, plan.faults)
     name = run_name(start, scenario.id, run_id)

@@ -90,7 +90,7 @@ def _topics(metric: MetricDefinition, alternative: int, namespaces: Sequence[str
     for n, ns in enumerate(namespaces):
         for whose, read in used:
             if whose is None or (metric.pair is not None and metric.pair.index(whose) == n):
-                topic = core.topic_name(patterns[read], ns)
+                topic = core.expand_topic(patterns[read], ns)
                 if topic not in found:
                     found.append(topic)
     return tuple(found)
@@ -311,7 +311,7 @@ def _pairs_missing(
 
 
 def _pose(topics: Mapping[str, core.Topic], namespace: str) -> core.Topic | None:
-    found = topics.get(core.topic_name(POSE_TOPIC, namespace))
+    found = topics.get(core.expand_topic(POSE_TOPIC, namespace))
     return found if found is not None and len(found) else None
 
 
