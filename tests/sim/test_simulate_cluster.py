@@ -22,7 +22,7 @@ from pathlib import Path
 import pytest
 from distributed import Client, LocalCluster, get_task_stream
 
-from exsce_dsl.api import workflows
+from exsce_dsl.api import commands
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.sim.run import simulate
 from exsce_dsl.store.open import open_store
@@ -79,8 +79,8 @@ def test_the_cluster_writes_the_bytes_a_local_simulate_writes(
             assert f"wrote {Path('there') / name}" in done.stderr  # as given, not the worker's path
     # the library does the same, in another format: ROS 2 bags are folders
     spec = load_spec(folder / "spec.exsce")
-    local = workflows.simulate(spec, tmp_path / "here", 2, format="ros2", seed=SEED)
-    remote = workflows.simulate(
+    local = commands.simulate(spec, tmp_path / "here", 2, format="ros2", seed=SEED)
+    remote = commands.simulate(
         spec, tmp_path / "there", 2, format="ros2", seed=SEED, dask_address=cluster.scheduler_address
     )
     assert [r.run_id for r in remote] == [r.run_id for r in local]

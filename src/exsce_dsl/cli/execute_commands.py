@@ -186,7 +186,7 @@ def execute(
             f"wrote {run.files.bag} (mission {run.mission.status.value}: {said or 'no goal'})", err=True
         )
     if judge:
-        from exsce_dsl.api.workflows import verify
+        from exsce_dsl.api.commands import verify
         from exsce_dsl.cli.oracle_commands import report_verification
         from exsce_dsl.store.open import open_store
 

@@ -20,7 +20,7 @@ from exsce_dsl.cli.store_commands import store_option
 from exsce_dsl.cli.trial_commands import trial_options
 
 if TYPE_CHECKING:
-    from exsce_dsl.oracles.workflows import Verification
+    from exsce_dsl.oracles.judging import Verification
 
 
 @click.command(epilog=exit_status(bad_input="bad input: a spec error, too few runs, no acceptance criteria"))
@@ -49,7 +49,7 @@ def baseline(spec: str, scenario_id: str | None, include_all: bool, store_url: s
       exscec baseline examples/brsu_building_c/scenario_c.exsce --all-runs
     """
     from exsce_dsl.lang.build import load_spec
-    from exsce_dsl.oracles.workflows import build_baseline
+    from exsce_dsl.oracles.judging import build_baseline
     from exsce_dsl.store.open import open_store
     from exsce_dsl.tables import aligned
 
@@ -186,8 +186,8 @@ def verify(
     """
     from exsce_dsl.cli.trial_commands import report_trial
     from exsce_dsl.lang.build import load_spec
+    from exsce_dsl.oracles.judging import IngestFailed, verify_runs
     from exsce_dsl.oracles.trial_runs import REPEAT_FOLDER, REPEAT_SEED, verify_trial
-    from exsce_dsl.oracles.workflows import IngestFailed, verify_runs
     from exsce_dsl.store.open import open_store
 
     if not runs and repeat is None:

@@ -1,4 +1,4 @@
-"""The ``exscec`` workflows as Python functions, with typed results.
+"""The ``exscec`` commands as Python functions, with typed results.
 
 Each function is what the command of the same name does, minus the printing: the CLI is a thin
 layer over the same library calls.  Functions that read or write runs take the store first (open
@@ -13,12 +13,12 @@ from pathlib import Path
 
 from prov.model import ProvDocument
 
+from exsce_dsl.derive.derive_scenario import DerivedSpec, StoredDerivation, add_derivation, derive_spec
 from exsce_dsl.derive.expect import SUMMED, ExpectedValue, expected_metric, learning_runs
-from exsce_dsl.derive.workflows import DerivedSpec, StoredDerivation, add_derivation, derive_spec
 from exsce_dsl.lang.build import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.document import Specification
-from exsce_dsl.oracles.workflows import Baseline, Verification, build_baseline, verify_runs
+from exsce_dsl.oracles.judging import Baseline, Verification, build_baseline, verify_runs
 from exsce_dsl.prov.spec import compile_spec_scenario
 from exsce_dsl.rdf import serialize
 from exsce_dsl.rdf.spec_check import SpecCheck, check_spec
