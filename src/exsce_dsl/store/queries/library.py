@@ -186,8 +186,8 @@ def standard_prefixes(namespace: str = DEFAULT_NAMESPACE) -> dict[str, str]:
     return {
         "prov": ids.PROV_NAMESPACE,
         "xsd": ids.XSD_NAMESPACE,
-        "rdf": "http://www.w3.org/1999/02/22-rdf-syntax-ns#",
-        "rdfs": "http://www.w3.org/2000/01/rdf-schema#",
+        "rdf": ids.RDF_NAMESPACE,
+        "rdfs": ids.RDFS_NAMESPACE,
         **Namespaces(namespace).fixed,
     }
 
