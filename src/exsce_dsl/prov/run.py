@@ -135,7 +135,7 @@ class _RunCompiler:
         return w.of_element(self.run_prefix, self.run_ns_iri, "run")
 
     def _run_id(self, w: BundleWriter) -> QualifiedName:
-        return w.fixed(ids.RUN)[ids.run_name(self.run.uuid)]
+        return w.fixed(ids.RUN)[ids.run_local_name(self.run.uuid)]
 
     def _pose_name(self, pose: Pose) -> str:
         name = self._pose_names.get(pose)
@@ -156,7 +156,7 @@ class _RunCompiler:
         run, scenario, names, writer = self.run, self.scenario, self.names, self.writer
         mission = scenario.mission
         run_ns = writer.document_namespace(ids.RUN)
-        w = writer.bundle(run_ns[f"{ids.run_name(run.uuid)}_bundle"], f"the bundle of run {run.uuid}")
+        w = writer.bundle(run_ns[f"{ids.run_local_name(run.uuid)}_bundle"], f"the bundle of run {run.uuid}")
         t = w.term
         parts = self._parts(w)
         run_id = self._run_id(w)

@@ -108,7 +108,7 @@ class Namespaces:
 
     def of_run(self, run_uuid: str) -> str:
         """The namespace of a run's parts: ``<base>runs/run_<uuid>/``."""
-        return f"{self.base}runs/{run_name(run_uuid)}/"
+        return f"{self.base}runs/{run_local_name(run_uuid)}/"
 
 
 # Local names.  Each function returns the part after the prefix.
@@ -201,7 +201,7 @@ def check_name(name: str, what: str) -> str:
     return name
 
 
-def run_name(run_uuid: str) -> str:
+def run_local_name(run_uuid: str) -> str:
     """``run_<uuid>``, in ``run:``: the run activity; ``run_<uuid>_bundle`` is its bundle."""
     return f"run_{check_name(run_uuid, 'run uuid')}"
 

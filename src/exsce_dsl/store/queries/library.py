@@ -66,7 +66,7 @@ KINDS: Mapping[str, Callable[[Namespaces, str], Term]] = {
     "point": lambda names, text: _iri(names, ids.POINT, text, "pose"),
     "id": lambda names, text: Literal(text),
     "run": lambda names, text: Literal(text),
-    "run_activity": lambda names, text: _iri(names, ids.RUN, ids.run_name(text), "run uuid"),
+    "run_activity": lambda names, text: _iri(names, ids.RUN, ids.run_local_name(text), "run uuid"),
     "robot": lambda names, text: Literal(text),
     "metric": lambda names, text: Literal(text),
     "metric_property": lambda names, text: _iri(names, ids.METRIC, text, "metric"),
