@@ -108,7 +108,7 @@ from exsce_dsl.explore.campaign import (
 from exsce_dsl.explore.executors import SimulatorExecutor
 from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
-from exsce_dsl.model.campaign import CampaignFigures, Relation, Request, Shrinking, Trial
+from exsce_dsl.model.campaign import CampaignFigures, CheckedRelation, Request, Shrinking, Trial
 from exsce_dsl.model.document import Specification
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.open import open_store
@@ -236,7 +236,7 @@ class FaultFree:
         self.executor = CountingExecutor(SimulatorExecutor(), cache)
         self.campaign: _Campaign | None = None
 
-    def judge(self, requests: Sequence[Request]) -> tuple[tuple[Relation, ...], tuple[str, ...]]:
+    def judge(self, requests: Sequence[Request]) -> tuple[tuple[CheckedRelation, ...], tuple[str, ...]]:
         """The relations the fault-free runs of ``requests`` violate, and those runs."""
         if self.campaign is None:
             store: Store = self.stack.enter_context(open_store("memory:"))
@@ -250,7 +250,7 @@ class FaultFree:
         return _violations(verdicts, len(runs)).violated, runs
 
     def caused(
-        self, relation: Relation, requests: Sequence[Request], store: Store, runs: Sequence[str]
+        self, relation: CheckedRelation, requests: Sequence[Request], store: Store, runs: Sequence[str]
     ) -> str:
         """Whether the fault caused ``relation``'s violation by the derivation ``requests``, whose
         faulty runs are ``runs`` of ``store``: "yes" when the fault-free runs (same seeds) do not
@@ -270,7 +270,7 @@ class FaultFree:
         return "yes"
 
 
-def metric_values(store: Store, relation: Relation, runs: Sequence[str]) -> list[float] | None:
+def metric_values(store: Store, relation: CheckedRelation, runs: Sequence[str]) -> list[float] | None:
     """The relation's metric in each run, rounded to 9 digits and sorted (None if not stored)."""
     values = []
     for run in runs:

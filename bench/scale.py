@@ -52,7 +52,7 @@ def make_bags(folder: Path, count: int) -> list[Path]:
         return sorted(p for part in parts for p in part)
 
 
-def ingest(bags: list[Path], store_path: Path, jobs: int, cluster: str | None = None) -> float:
+def ingest(bags: list[Path], store_path: Path, jobs: int, dask_address: str | None = None) -> float:
     from exsce_dsl.lang import load_spec
     from exsce_dsl.runs.ingest import ingest_bags
     from exsce_dsl.store.embedded import EmbeddedStore
@@ -61,7 +61,7 @@ def ingest(bags: list[Path], store_path: Path, jobs: int, cluster: str | None = 
     shutil.rmtree(store_path, ignore_errors=True)
     started = time.perf_counter()
     with EmbeddedStore(store_path) as store:
-        results = ingest_bags(bags, scenario, store, jobs, cluster=cluster)
+        results = ingest_bags(bags, scenario, store, jobs, dask_address=dask_address)
     seconds = time.perf_counter() - started
     failed = [r.message for r in results if r.failed]
     if failed:

@@ -6,10 +6,10 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from exsce_dsl.model.campaign import Relation, Shrinking, ShrinkTry, Trial
+from exsce_dsl.model.campaign import CheckedRelation, Shrinking, ShrinkTry, Trial
 
-DURATION = Relation("task_duration", "tiago1", "increasing", "scenario_c")
-DISTANCE = Relation("distance_travelled", "tiago1", "invariant")
+DURATION = CheckedRelation("task_duration", "tiago1", "increasing", "scenario_c")
+DISTANCE = CheckedRelation("distance_travelled", "tiago1", "invariant")
 REMOVE = ("remove_robot", {"robot": "tiago2", "reassign": "tiago1"})
 REVERSE = ("reverse_waypoint_order", {"task": "delivery_a"})
 

@@ -16,7 +16,7 @@ import numpy as np
 from exsce_dsl.model.geometry import Position
 from exsce_dsl.model.runs import ActionId, Hotspot, MetricScope, MetricValue
 from exsce_dsl.runs.bags.reading import BagData, Series
-from exsce_dsl.runs.segments.segment import Segment
+from exsce_dsl.runs.segments.recorded import RecordedAction
 
 HOTSPOT_RADIUS = 1.0  # metres: violations closer than this to a hotspot belong to it
 
@@ -120,7 +120,7 @@ class RobotSignals:
 
 def compute_metrics(
     signals: Sequence[RobotSignals],
-    actions: Sequence[Segment],
+    actions: Sequence[RecordedAction],
     results: dict[str, int | None],
     limits: SafetyLimits,
     problems: list[str],
@@ -163,7 +163,7 @@ def compute_metrics(
                     "waypoints_visited", MetricScope.ROBOT, float(visited), (sig.topics["result"],), sig.robot
                 )
             )
-        windows: list[tuple[Segment | None, float, float]] = [(None, start, end), *mine]
+        windows: list[tuple[RecordedAction | None, float, float]] = [(None, start, end), *mine]
         for action, a_start, a_end in windows:
             aid = (
                 None
@@ -349,7 +349,7 @@ def metrics_of_bag(path, scenario) -> tuple[list[MetricValue], list[Hotspot]]:  
 
     robots = [r for r in scenario.robots if r.start_pose is not None]
     data = read_bag(path, wanted_topics(run_metrics(scenario), robots))
-    actions: list[Segment] = []
+    actions: list[RecordedAction] = []
     results: dict[str, int | None] = {}
     for robot in robots:
         topics = robot_topics(robot.namespace)

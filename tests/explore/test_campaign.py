@@ -18,7 +18,7 @@ from exsce_dsl.errors import ExsceError
 from exsce_dsl.explore.campaign import CampaignOptions, run_campaign
 from exsce_dsl.explore.executors import CommandExecutor
 from exsce_dsl.lang import load_spec
-from exsce_dsl.model.campaign import Relation
+from exsce_dsl.model.campaign import CheckedRelation
 from exsce_dsl.store.open import open_store
 from exsce_dsl.store.queries import derivation_of
 from exsce_dsl.store.queries.campaigns import campaign_record, campaigns
@@ -158,8 +158,8 @@ def test_an_executor_command_with_an_unknown_placeholder_is_refused() -> None:
 
 def test_a_relation_reads_back_from_its_text() -> None:
     for relation in (
-        Relation("task_duration", "tiago1", "invariant"),
-        Relation("task_duration", "tiago1", "increasing", "scenario_c"),
-        Relation("distance_between_robots", None, "above_min"),
+        CheckedRelation("task_duration", "tiago1", "invariant"),
+        CheckedRelation("task_duration", "tiago1", "increasing", "scenario_c"),
+        CheckedRelation("distance_between_robots", None, "above_min"),
     ):
-        assert Relation.parse(relation.text) == relation
+        assert CheckedRelation.parse(relation.text) == relation

@@ -21,7 +21,7 @@ from exsce_dsl.explore.campaign import CampaignOptions, _violations, run_campaig
 from exsce_dsl.explore.executors import SimulatorExecutor
 from exsce_dsl.explore.figures import figures_table, random_baseline
 from exsce_dsl.lang import load_spec
-from exsce_dsl.model.campaign import CampaignFigures, CampaignPlan, Relation, Trial
+from exsce_dsl.model.campaign import CampaignFigures, CampaignPlan, CheckedRelation, Trial
 from exsce_dsl.model.verdicts import Outcome, Verdict
 from exsce_dsl.oracles.campaign_junit import campaign_junit
 from exsce_dsl.prov.campaign import compile_campaign, compile_trial
@@ -36,14 +36,14 @@ SPEC = "examples/brsu_building_c/scenario_c.exsce"
 DEADLOCK = "deadlock-start:tiago1:classroom_c025-w002"
 """Revealed by swapping the start poses of tiago1 and tiago2 (see exsce_dsl.sim.faults)."""
 
-SPEED = Relation("max_velocity", "tiago1", "below_max")
-DURATION = Relation("task_duration", "tiago1", "invariant")
-LONGER = Relation("task_duration", "tiago1", "increasing")
+SPEED = CheckedRelation("max_velocity", "tiago1", "below_max")
+DURATION = CheckedRelation("task_duration", "tiago1", "invariant")
+LONGER = CheckedRelation("task_duration", "tiago1", "increasing")
 """The same check as DURATION: an expected value missed, whichever way the estimate went."""
 
 
 def _trial(
-    number: int, runs: int, violated: tuple[Relation, ...] = (), inconclusive: tuple[Relation, ...] = ()
+    number: int, runs: int, violated: tuple[CheckedRelation, ...] = (), inconclusive: tuple[CheckedRelation, ...] = ()
 ) -> Trial:
     uuids = tuple(f"run{number}-{i}" for i in range(runs))
     return Trial("campaign_x", number, f"s{number}", (), uuids, (SPEED, DURATION), violated, (), inconclusive)
@@ -74,7 +74,7 @@ def test_the_figures_of_trials_counted_by_hand() -> None:
     assert CampaignFigures.of([]).per_100_executions is None
 
 
-def _verdict(run: str, relation: Relation, outcome: Outcome) -> Verdict:
+def _verdict(run: str, relation: CheckedRelation, outcome: Outcome) -> Verdict:
     return Verdict(run, "s", "", "o", relation.metric, relation.robot, relation.relationship, outcome)
 
 
@@ -83,16 +83,16 @@ def test_a_relation_neither_failed_nor_passed_in_most_runs_is_inconclusive() -> 
     runs = {
         SPEED: (P, P, U),  # passed in 2 of 3: passed
         DURATION: (F, U, P),  # failed in 1, passed in 1: neither
-        Relation("distance_travelled", "tiago1", "invariant"): (F, F, U),  # failed in 2 of 3: violated
-        Relation("distance_travelled", "tiago2", "invariant"): (U, U, P),  # passed in 1 of 3: neither
+        CheckedRelation("distance_travelled", "tiago1", "invariant"): (F, F, U),  # failed in 2 of 3: violated
+        CheckedRelation("distance_travelled", "tiago2", "invariant"): (U, U, P),  # passed in 1 of 3: neither
     }
     verdicts = [
         _verdict(f"r{i}", relation, o) for relation, outcomes in runs.items() for i, o in enumerate(outcomes)
     ]
     judged = _violations(verdicts, 3)
     assert set(judged.checked) == set(runs)
-    assert judged.violated == (Relation("distance_travelled", "tiago1", "invariant"),)
-    assert set(judged.inconclusive) == {DURATION, Relation("distance_travelled", "tiago2", "invariant")}
+    assert judged.violated == (CheckedRelation("distance_travelled", "tiago1", "invariant"),)
+    assert set(judged.inconclusive) == {DURATION, CheckedRelation("distance_travelled", "tiago2", "invariant")}
     trial = Trial("c", 1, "s", (), ("r0", "r1", "r2"), judged.checked, (), (), judged.inconclusive)
     assert trial.outcome == "inconclusive"  # neither a counterexample nor a pass
     assert CampaignFigures.of([trial]).counterexamples == 0

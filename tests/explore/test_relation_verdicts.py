@@ -13,7 +13,7 @@ from pathlib import Path
 
 from exsce_dsl.cli.common import ExitCode
 from exsce_dsl.explore.campaign import _violations
-from exsce_dsl.model.campaign import Relation
+from exsce_dsl.model.campaign import CheckedRelation
 from exsce_dsl.model.verdicts import Outcome, Verdict
 from exsce_dsl.store.open import open_store
 from exsce_dsl.store.queries.campaigns import campaign_record, campaigns
@@ -22,7 +22,7 @@ ROOT = Path(__file__).resolve().parents[2]
 EXSCEC = str(Path(sys.executable).parent / "exscec")
 SPEC = "examples/brsu_building_c/scenario_c.exsce"
 
-SPEED = Relation("max_velocity", "tiago1", "below_max")
+SPEED = CheckedRelation("max_velocity", "tiago1", "below_max")
 
 
 def _verdicts(*outcomes: Outcome) -> list[Verdict]:

@@ -1,5 +1,5 @@
 """What the language server parses with: declaration-by-declaration parsing (lang.incremental),
-the index of names (lang.symbols) and what the grammar expects at a point (lang.expected)."""
+the index of names (lang.editor.symbols) and what the grammar expects at a point (lang.editor.continuations)."""
 
 from __future__ import annotations
 

@@ -17,8 +17,8 @@ from exsce_dsl.model.coverage import CoverageGap, Shortfall, TopicRate
 from exsce_dsl.model.metrics import Combine
 from exsce_dsl.model.verdicts import Outcome, Verdict
 from exsce_dsl.oracles.coverage_check import Span, clause_gaps, judge_coverage, learned_rate_gaps
+from exsce_dsl.oracles.judging import verify_runs
 from exsce_dsl.oracles.verify import judge_runs
-from exsce_dsl.oracles.workflows import verify_runs
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import SimulatedRun, simulate
 from exsce_dsl.store.open import open_store

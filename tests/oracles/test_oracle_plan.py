@@ -35,7 +35,7 @@ from exsce_dsl.model.acceptance import (
     Window,
 )
 from exsce_dsl.model.metrics import default_topics
-from exsce_dsl.oracles.observe import ObservedSegment, RunValues, observe, parse_window
+from exsce_dsl.oracles.observe import ActionValue, RunValues, observe, parse_window
 from exsce_dsl.oracles.plan import plan_oracles, tolerance_of
 
 P = {name: Pose(f"room-{name}", Position(float(i), 0.0), Orientation(), "room") for i, name in enumerate("abcd")}
@@ -94,9 +94,9 @@ def test_default_topics_of_a_robot_at_the_root_have_no_empty_level() -> None:
     assert default_topics(at_root, "violation_duration", None) == ("/robot_pose",)
 
 
-def segment(allocation: int, waypoint: int, goal: str, value: float, metric: str = "distance_travelled") -> ObservedSegment:
+def segment(allocation: int, waypoint: int, goal: str, value: float, metric: str = "distance_travelled") -> ActionValue:
     action = f"run/r1-task_{allocation:02d}-subtask_001-w_{waypoint:03d}"
-    return ObservedSegment(action, "r1", allocation, (allocation, 1, waypoint), f"room-{goal}-R0.00_P0.00_Y0.00", metric, value)
+    return ActionValue(action, "r1", allocation, (allocation, 1, waypoint), f"room-{goal}-R0.00_P0.00_Y0.00", metric, value)
 
 
 # r1: t1 = a→b (2.0), b→c (3.0); t2 = c→a (5.0); max_velocity 0.5, 0.9, 0.7

@@ -67,7 +67,7 @@ def check_prov(local: str) -> None:
 @settings(max_examples=300, deadline=None)
 @given(topics)
 def test_any_topic_name_has_an_identifier_that_gives_it_back(topic: str) -> None:
-    local = ids.topic_name(topic)
+    local = ids.topic_local_name(topic)
     assert ids.topic_of_name(local) == topic
     check_identifier(local)
 
@@ -75,7 +75,7 @@ def test_any_topic_name_has_an_identifier_that_gives_it_back(topic: str) -> None
 @settings(max_examples=40, deadline=None)
 @given(topics)
 def test_prov_reads_back_every_topic_identifier(topic: str) -> None:
-    check_prov(ids.topic_name(topic))
+    check_prov(ids.topic_local_name(topic))
 
 
 @settings(max_examples=200, deadline=None)
@@ -104,11 +104,11 @@ def test_any_bag_file_name_has_an_identifier_that_gives_it_back(name: str) -> No
     ],
 )
 def test_topic_identifiers_as_written(topic: str, local: str) -> None:
-    assert ids.topic_name(topic) == local
+    assert ids.topic_local_name(topic) == local
     assert ids.topic_of_name(local) == topic
     check_identifier(local)
     check_prov(local)
 
 
 def test_a_topic_with_and_without_its_slash_are_two_identifiers() -> None:
-    assert ids.topic_name("groundtruth") != ids.topic_name("/groundtruth")
+    assert ids.topic_local_name("groundtruth") != ids.topic_local_name("/groundtruth")

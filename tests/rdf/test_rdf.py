@@ -317,7 +317,7 @@ def test_every_class_and_property_the_examples_use_is_in_the_vocabulary() -> Non
 
 
 def test_every_term_of_the_identifiers_module_is_in_the_vocabulary() -> None:
-    """Every class and property exsce writes is named in prov/identifiers.py (one module for all)."""
+    """Every class and property exsce writes is named in prov/identifiers (one place for all)."""
     vocabulary = vocabulary_graph()
     known = declared(vocabulary, RDFS.Class) | declared(vocabulary, RDF.Property)
     names = Namespaces()

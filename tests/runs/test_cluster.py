@@ -138,7 +138,7 @@ def test_a_worker_killed_in_the_middle_of_a_bag_loses_no_run(
     scenario = load_spec(folder / "spec.exsce").scenario()
     with a_worker_killed_while_running(cluster, "_analyse") as killed:
         with EmbeddedStore(tmp_path / "store") as store:
-            results = ingest_bags(bags, scenario, store, cluster=cluster.scheduler_address)
+            results = ingest_bags(bags, scenario, store, dask_address=cluster.scheduler_address)
     assert killed, "no worker was seen analysing a bag"
     assert [r.status for r in results] == [IngestStatus.INGESTED] * BAGS, [r.message for r in results]
     assert canonical(tmp_path / "store") == canonical(reference)

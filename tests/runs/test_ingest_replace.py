@@ -22,8 +22,8 @@ from rosbags.highlevel import AnyReader
 from exsce_dsl import api
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.lang import load_spec
+from exsce_dsl.oracles.judging import verify_runs
 from exsce_dsl.oracles.verify import judge_runs
-from exsce_dsl.oracles.workflows import verify_runs
 from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.runs.ingest import IngestStatus, ingest_bags
 from exsce_dsl.sim.run import simulate

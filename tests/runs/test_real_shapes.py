@@ -287,7 +287,7 @@ def chord_speed(t: np.ndarray, x: np.ndarray, y: np.ndarray) -> float:
     return float(np.max(moved / (after - before)))
 
 
-Expected = tuple[dict[str, float], set[str]]
+ReferenceValues = tuple[dict[str, float], set[str]]
 """Whole-run values of the robot by metric, and the metrics that must be missing (and said)."""
 
 
@@ -300,7 +300,7 @@ def pose_velocity(
     missing.discard("max_velocity")
 
 
-def jackal(bag: Path) -> Expected:
+def jackal(bag: Path) -> ReferenceValues:
     odom = read(bag, "/jackal_velocity_controller/odom")
     cmd = read(bag, "/cmd_vel")
     xy = positions(odom, lambda m: m.pose.pose)
@@ -315,7 +315,7 @@ def jackal(bag: Path) -> Expected:
     }, {"waypoints_visited", "distance_to_obstacles"}
 
 
-def kitti(bag: Path) -> Expected:
+def kitti(bag: Path) -> ReferenceValues:
     streams = {name: positions(read(bag, topic), lambda m: m.pose) for name, topic in STREAMS.items()}
     expected = {name: path_length(p["x"], p["y"]) for name, p in streams.items()}
     truth = streams["gt_path"]
@@ -358,7 +358,7 @@ def by_arrival(pose: dict[str, np.ndarray]) -> tuple[dict[str, float], slice]:
     }, window
 
 
-def tf_only(bag: Path) -> Expected:
+def tf_only(bag: Path) -> ReferenceValues:
     pose = composed_tf(bag)
     expected, window = by_arrival(pose)
     expected["planar_path"] = expected["distance_travelled"]
@@ -367,7 +367,7 @@ def tf_only(bag: Path) -> Expected:
     return expected, missing
 
 
-def namespaced(bag: Path) -> Expected:
+def namespaced(bag: Path) -> ReferenceValues:
     messages = read(bag, "/scout/pose")
     pose = positions(messages, lambda m: m.pose)
     expected, window = by_arrival(pose)
@@ -383,7 +383,7 @@ def namespaced(bag: Path) -> Expected:
     return expected, missing
 
 
-def drone(bag: Path) -> Expected:
+def drone(bag: Path) -> ReferenceValues:
     pose = positions(read(bag, "/mavros/local_position/pose"), lambda m: m.pose)
     length = path_length(pose["x"], pose["y"])  # in the plane until robot types say 'motion 3d'
     expected = {
@@ -421,11 +421,11 @@ def in_window(bag: Path, start: float, end: float) -> dict[str, float]:
     }
 
 
-def nav2(bag: Path) -> Expected:
+def nav2(bag: Path) -> ReferenceValues:
     return in_window(bag, *goals_window(bag)), set()
 
 
-REFERENCES: dict[str, Callable[[Path], Expected]] = {
+REFERENCES: dict[str, Callable[[Path], ReferenceValues]] = {
     "jackal": jackal,
     "kitti": kitti,
     "tf_only": tf_only,

@@ -221,9 +221,9 @@ def test_the_run_prov_and_the_store_name_topics_as_the_bag_does(bags: tuple[Path
     real = bags[1]
     run = analyse_bag(real, scenario).run
     provn = serialize_prov(compile_run(run, scenario), "provn")
-    assert {"@groundtruth", "groundtruth", "@cmd_vel"} <= {ids.topic_name(t) for t in run.bag.topics}
+    assert {"@groundtruth", "groundtruth", "@cmd_vel"} <= {ids.topic_local_name(t) for t in run.bag.topics}
     for topic in run.bag.topics:  # ORB-SLAM too, where the reader lists every topic of the bag
-        assert f"entity(topic:{ids.topic_name(topic)}," in provn, topic
+        assert f"entity(topic:{ids.topic_local_name(topic)}," in provn, topic
     with EmbeddedStore(None) as store:
         (result,) = ingest_bags([real], scenario, store)
         assert not result.failed, result.message

@@ -22,7 +22,7 @@ from pathlib import Path
 import pytest
 from distributed import Client, LocalCluster, get_task_stream
 
-from exsce_dsl.api import workflows
+from exsce_dsl.api import commands
 from exsce_dsl.lang import load_spec
 from exsce_dsl.sim.run import simulate
 from exsce_dsl.store.open import open_store
@@ -79,9 +79,9 @@ def test_the_cluster_writes_the_bytes_a_local_simulate_writes(
             assert f"wrote {Path('there') / name}" in done.stderr  # as given, not the worker's path
     # the library does the same, in another format: ROS 2 bags are folders
     spec = load_spec(folder / "spec.exsce")
-    local = workflows.simulate(spec, tmp_path / "here", 2, format="ros2", seed=SEED)
-    remote = workflows.simulate(
-        spec, tmp_path / "there", 2, format="ros2", seed=SEED, cluster=cluster.scheduler_address
+    local = commands.simulate(spec, tmp_path / "here", 2, format="ros2", seed=SEED)
+    remote = commands.simulate(
+        spec, tmp_path / "there", 2, format="ros2", seed=SEED, dask_address=cluster.scheduler_address
     )
     assert [r.run_id for r in remote] == [r.run_id for r in local]
     assert [r.bag.relative_to(tmp_path / "there") for r in remote] == [
@@ -118,7 +118,7 @@ def test_a_worker_killed_in_the_middle_of_a_run_loses_no_bag(
     folder, reference = yard
     scenario = load_spec(folder / "spec.exsce").scenario()
     with a_worker_killed_while_running(cluster, "_play_task") as killed:
-        played = list(simulate(scenario, tmp_path / "runs", RUNS, seed=SEED, cluster=cluster.scheduler_address))
+        played = list(simulate(scenario, tmp_path / "runs", RUNS, seed=SEED, dask_address=cluster.scheduler_address))
     assert killed, "no worker was seen playing a run"
     assert [r.bag.name for r in played] == sorted(n for n in reference if n.endswith(".bag"))
     assert hashes(tmp_path / "runs") == reference  # each bag once and whole, nothing half-written left

@@ -13,12 +13,7 @@ Each function says which command it is; errors are :class:`~exsce_dsl.errors.Exs
 the same messages the command prints.
 """
 
-from exsce_dsl.api.drafts import init_from_bag
-from exsce_dsl.api.execution import execute_ros1
-from exsce_dsl.api.stand_in import stand_in
-from exsce_dsl.api.tables import metrics, query, rows_frame, segments, sparql, verdicts
-from exsce_dsl.api.trials import flaky, verify_trial
-from exsce_dsl.api.workflows import (
+from exsce_dsl.api.commands import (
     add_derived,
     baseline,
     check,
@@ -32,6 +27,11 @@ from exsce_dsl.api.workflows import (
     simulate,
     verify,
 )
+from exsce_dsl.api.drafts import init_from_bag
+from exsce_dsl.api.execution import execute_ros1
+from exsce_dsl.api.stand_in import stand_in
+from exsce_dsl.api.tables import metrics, query, rows_frame, segments, sparql, verdicts
+from exsce_dsl.api.trials import flaky, verify_trial
 from exsce_dsl.errors import RosGraphError
 from exsce_dsl.store.queries.run_ids import AmbiguousRunError, UnknownRunError, resolve_run
 

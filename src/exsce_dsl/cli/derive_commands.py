@@ -101,7 +101,7 @@ def derive(
       exscec derive examples/brsu_building_c/scenario_c.exsce --id c_one \\
           -t remove_robot --robot tiago2 --reassign tiago1 -o c_one.exsce --expect --add-to-store
     """
-    from exsce_dsl.derive.workflows import add_derivation, derive_spec
+    from exsce_dsl.derive.derive_scenario import add_derivation, derive_spec
     from exsce_dsl.lang import load_spec
     from exsce_dsl.store.open import open_store
     from exsce_dsl.transform.transformations import TRANSFORMATIONS

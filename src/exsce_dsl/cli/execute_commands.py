@@ -210,7 +210,7 @@ def _execute_runs(scenario: Scenario, options: _ExecuteOptions) -> list[Executed
 
 def _judge(scenario: Scenario, bags: list[Path], options: _ExecuteOptions) -> ExitCode:
     """--verify: the bags ingested and judged as exscec verify judges them (several: one trial)."""
-    from exsce_dsl.api.workflows import verify
+    from exsce_dsl.api.commands import verify
     from exsce_dsl.cli.oracle_commands import report_verification
     from exsce_dsl.store.open import open_store
 

@@ -42,7 +42,7 @@ class _ExploreOptions:
     start_master: bool
     speed_up: float | None
     jobs: int
-    cluster: str | None
+    dask_address: str | None
     output: str | None
     junit: str | None
     store_url: str | None
@@ -126,6 +126,7 @@ class _ExploreOptions:
 )
 @click.option(
     "--cluster",
+    "dask_address",
     metavar="ADDRESS",
     help="A Dask scheduler (tcp://host:8786): the simulator's runs are played and every bag is "
     "analysed on its workers, which must see the campaign's folder (--output) at the same path "
@@ -269,14 +270,14 @@ def _executor(options: _ExploreOptions) -> tuple[AbstractContextManager[Executor
         SimulatorExecutor,
         named_executor,
     )
-    from exsce_dsl.parallel.cluster import cluster_address
+    from exsce_dsl.parallel.dask_client import dask_address as scheduler_address
 
     o = options
     if o.executor_command and (o.faults or o.plugin):
         raise ExsceError("give one of --fault (the simulator), --executor-command and --executor")
     if (o.stand_in or o.start_master or o.speed_up is not None) and not o.plugin:
         raise ExsceError("--stand-in, --start-master and --speed-up go with --executor ros1")
-    address = cluster_address(o.cluster)
+    address = scheduler_address(o.dask_address)
     chosen: AbstractContextManager[Executor]
     if o.executor_command:
         chosen = nullcontext(CommandExecutor(o.executor_command))
@@ -285,7 +286,7 @@ def _executor(options: _ExploreOptions) -> tuple[AbstractContextManager[Executor
             o.plugin, ExecutorOptions(o.faults, o.stand_in, o.start_master, None, o.speed_up)
         )
     else:
-        chosen = nullcontext(SimulatorExecutor.with_faults(o.faults, cluster=address))
+        chosen = nullcontext(SimulatorExecutor.with_faults(o.faults, dask_address=address))
     campaign = CampaignOptions(
         budget=o.budget,
         seed=o.seed,
@@ -297,7 +298,7 @@ def _executor(options: _ExploreOptions) -> tuple[AbstractContextManager[Executor
         shrink=not o.no_shrink,
         stop_at_violation=o.stop_at_violation,
         jobs=o.jobs,
-        cluster=address,
+        dask_address=address,
     )
     return chosen, campaign
 

@@ -23,7 +23,7 @@ from exsce_dsl.cli.trial_commands import trial_options
 if TYPE_CHECKING:
     from exsce_dsl.model import Scenario
     from exsce_dsl.model.trials import Trial
-    from exsce_dsl.oracles.workflows import Verification
+    from exsce_dsl.oracles.judging import Verification
     from exsce_dsl.store.base import Store
 
 
@@ -53,7 +53,7 @@ def baseline(spec: str, scenario_id: str | None, include_all: bool, store_url: s
       exscec baseline examples/brsu_building_c/scenario_c.exsce --all-runs
     """
     from exsce_dsl.lang import load_spec
-    from exsce_dsl.oracles.workflows import build_baseline
+    from exsce_dsl.oracles.judging import build_baseline
     from exsce_dsl.store.open import open_store
     from exsce_dsl.tables import aligned
 
@@ -195,7 +195,7 @@ def verify(**given: Any) -> None:
     """
     from exsce_dsl.cli.trial_commands import report_trial
     from exsce_dsl.lang import load_spec
-    from exsce_dsl.oracles.workflows import IngestFailed, verify_runs
+    from exsce_dsl.oracles.judging import IngestFailed, verify_runs
     from exsce_dsl.store.open import open_store
 
     options = _VerifyOptions(**given)

@@ -59,6 +59,7 @@ from exsce_dsl.model.conventions import CONVENTIONS
 )
 @click.option(
     "--cluster",
+    "dask_address",
     metavar="ADDRESS",
     help="A Dask scheduler (tcp://host:8786): each run is one task on its workers, which write the "
     "bags into --output themselves, so --output (and the map files) must be the same path on every "
@@ -75,7 +76,7 @@ def simulate(
     scenario_id: str | None,
     convention: str | None,
     cmd_vel_stamped: bool,
-    cluster: str | None,
+    dask_address: str | None,
 ) -> None:
     """Play a scenario with the kinematic executor and write one bag per run.
 
@@ -114,13 +115,13 @@ def simulate(
       exscec simulate examples/brsu_building_c/scenario_c.exsce --convention nav2 --format mcap -o runs/
     """
     from exsce_dsl.lang import load_spec
-    from exsce_dsl.parallel.cluster import cluster_address
+    from exsce_dsl.parallel.dask_client import dask_address as scheduler_address
     from exsce_dsl.sim.executor import Fault
     from exsce_dsl.sim.run import simulate as play
 
     scenario = load_spec(spec).scenario(scenario_id)
     parsed = tuple(Fault.parse(f) for f in faults)
-    address = cluster_address(cluster)
+    address = scheduler_address(dask_address)
     played = play(scenario, Path(out_dir), runs, fmt, seed, parsed, convention, cmd_vel_stamped, address)
     with Progress(runs, f"simulating {scenario.id}") as progress:
         for run in played:
@@ -143,6 +144,7 @@ def simulate(
 )
 @click.option(
     "--cluster",
+    "dask_address",
     metavar="ADDRESS",
     envvar="EXSCE_DASK_SCHEDULER",
     help="A Dask scheduler (tcp://host:8786): its workers read the bags and compute their metrics "
@@ -171,7 +173,7 @@ def ingest(
     spec: str,
     scenario_id: str | None,
     jobs: int,
-    cluster: str | None,
+    dask_address: str | None,
     verbose: bool,
     replace: bool,
     strict: bool,
@@ -224,7 +226,14 @@ def ingest(
                 progress.say(f"warning: {result.bag}: {problem}")
 
         results = ingest_bags(
-            paths, scenario, store, jobs, shown, cluster=cluster or None, replace=replace, strict=strict
+            paths,
+            scenario,
+            store,
+            jobs,
+            shown,
+            dask_address=dask_address or None,
+            replace=replace,
+            strict=strict,
         )
     done = sum(r.status is IngestStatus.INGESTED for r in results)
     skipped = sum(r.status is IngestStatus.SKIPPED for r in results)

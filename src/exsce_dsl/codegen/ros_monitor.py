@@ -41,7 +41,7 @@ from exsce_dsl.model.messages import (
     Step,
     canonical_type,
 )
-from exsce_dsl.model.metrics import ComputedFor, MetricDefinition, topic_name
+from exsce_dsl.model.metrics import ComputedFor, MetricDefinition, expand_topic
 from exsce_dsl.oracles.plan import PlannedOracle, plan_oracles
 from exsce_dsl.prov.identifiers import oracle_name
 from exsce_dsl.resources import package_file
@@ -140,7 +140,7 @@ def monitor_topics(
     for robot, ns in robots:
         dispatcher = ((FEEDBACK_TOPIC, FEEDBACK, "feedback"), (RESULT_TOPIC, RESULT, "result"))
         for pattern, msgtype, role in dispatcher:
-            add(topic_name(pattern, ns), TopicEntry(msgtype, role, robot), "the dispatcher")
+            add(expand_topic(pattern, ns), TopicEntry(msgtype, role, robot), "the dispatcher")
         for metric in metrics:
             reads = {r.name: r for r in metric.reads}
             expressions = [e for e in (metric.value, metric.fallback) if e is not None]

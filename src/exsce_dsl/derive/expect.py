@@ -57,7 +57,9 @@ by the distance driven on it, not by its grid path length (the grid knows walls,
 
 
 @dataclass(frozen=True)
-class ExpectedSegment:
+class PathSegmentValue:
+    """A path segment's expected value of a metric: observed on stored runs, or estimated."""
+
     start: str
     goal: str
     value: float | None
@@ -67,11 +69,13 @@ class ExpectedSegment:
 
 
 @dataclass(frozen=True)
-class Expected:
+class ExpectedValue:
+    """A robot's expected value of a metric, with the values of its path's segments it came from."""
+
     robot: str
     metric: str
     value: float | None
-    segments: tuple[ExpectedSegment, ...]
+    segments: tuple[PathSegmentValue, ...]
 
 
 def robot_path(scenario: Scenario, robot_id: str) -> list[tuple[Pose, Pose]]:
@@ -120,7 +124,7 @@ def segment_value(
     detour: float = DETOUR,
     *,
     runs: Sequence[str] | None = None,
-) -> ExpectedSegment:
+) -> PathSegmentValue:
     """One segment's value; ``held_out`` pairs of pose ids are treated as never driven (either way),
     to measure the estimate against what was driven (bench/estimate.py).  An estimate scales by
     path lengths on the environment's occupancy grid when it declares one (and ``on_grid``), else
@@ -133,12 +137,12 @@ def segment_value(
     names = (start.id, goal.id)
     found, reverse = _either_way(store, metric, start, goal, held_out, runs)
     if found is not None:
-        return ExpectedSegment(
+        return PathSegmentValue(
             *names, found.mean, "observed the other way" if reverse else "observed", found.count
         )
     near_start, near_goal = _area_poses(scenario, start, names), _area_poses(scenario, goal, names)
     if not near_start or not near_goal or math.dist(_xy(start), _xy(goal)) == 0:
-        return ExpectedSegment(*names, None, "no data, and no pose near it to estimate from")
+        return PathSegmentValue(*names, None, "no data, and no pose near it to estimate from")
     p3 = min(near_start, key=lambda p: math.dist(_xy(p), _xy(start)))  # in p1's area
     p4 = min(near_goal, key=lambda p: math.dist(_xy(p), _xy(goal)))  # in p2's area
     neighbours = []
@@ -147,7 +151,7 @@ def segment_value(
         if near is not None:
             neighbours.append((i, j, near))
     if not neighbours:
-        return ExpectedSegment(*names, None, f"no data, nor for {p3.id} and {p4.id} near its ends")
+        return PathSegmentValue(*names, None, f"no data, nor for {p3.id} and {p4.id} near its ends")
     lengths = _lengths(scenario, on_grid, [(start, goal)] + [(i, j) for i, j, _ in neighbours])
     estimates, used, notes, drives = [], [], [], 0
     for i, j, near in neighbours:
@@ -164,8 +168,8 @@ def segment_value(
         used.append(f"{i.id}–{j.id}")
         drives += near.count
     if not estimates:
-        return ExpectedSegment(*names, None, f"no data, nor for {p3.id} and {p4.id} near its ends")
-    return ExpectedSegment(
+        return PathSegmentValue(*names, None, f"no data, nor for {p3.id} and {p4.id} near its ends")
+    return PathSegmentValue(
         *names,
         math.fsum(estimates) / len(estimates),
         f"estimated from {', '.join(used)} ({'; '.join([lengths.words, *notes])})",
@@ -222,7 +226,7 @@ def expected_metric(
     *,
     include_all: bool = False,
     runs: Sequence[str] | None = None,
-) -> Expected:
+) -> ExpectedValue:
     """The robot's expected value of a summed metric (see the module's description), from the
     good runs of every scenario (every stored run with ``include_all``; exactly ``runs`` when
     given)."""
@@ -236,7 +240,7 @@ def expected_metric(
         parts = _fall_back(parts, path, _lengths(scenario, True, path))
     values = [p.value for p in parts]
     total = math.fsum(v for v in values if v is not None) if parts and None not in values else None
-    return Expected(robot, metric, total, parts)
+    return ExpectedValue(robot, metric, total, parts)
 
 
 def _area_poses(scenario: Scenario, pose: Pose, leave_out: tuple[str, ...]) -> list[Pose]:
@@ -246,8 +250,8 @@ def _area_poses(scenario: Scenario, pose: Pose, leave_out: tuple[str, ...]) -> l
 
 
 def _fall_back(
-    parts: tuple[ExpectedSegment, ...], path: list[tuple[Pose, Pose]], lengths: _Lengths
-) -> tuple[ExpectedSegment, ...]:
+    parts: tuple[PathSegmentValue, ...], path: list[tuple[Pose, Pose]], lengths: _Lengths
+) -> tuple[PathSegmentValue, ...]:
     """Segments with no value and no neighbour data: their length (on the grid, or straight) times
     the robot's value per metre of such length over the segments that have a value."""
     known = [
@@ -379,7 +383,7 @@ def metamorphic_acceptance(
     return Acceptance(derived.id, tuple(criteria))
 
 
-def _allowance(expected: Expected, tolerance_percent: float) -> float:
+def _allowance(expected: ExpectedValue, tolerance_percent: float) -> float:
     """What a run may differ from ``expected`` by: ``tolerance_percent`` of it, but for distance
     at most OBSERVED_DISTANCE percent of the segments observed in stored runs (the estimate's
     error is in the estimated segments; a path between two poses hardly varies)."""

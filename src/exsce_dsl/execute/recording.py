@@ -29,7 +29,7 @@ from dataclasses import replace
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.conventions import CONVENTIONS, Signals, TfSource
-from exsce_dsl.model.metrics import topic_name
+from exsce_dsl.model.metrics import expand_topic
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.runs.analyse import run_metrics, wanted_topics
 from exsce_dsl.runs.bags.names import topic_key
@@ -73,7 +73,7 @@ def _signal_topics(signals: Signals, namespace: str) -> Iterable[str]:
     """Every source of the robot's pose, velocity, scan and distance (TF: ``tf`` and ``tf_static``)."""
     for source in (*signals.pose, *signals.velocity, *signals.scan, *signals.distance):
         if isinstance(source, TfSource):
-            yield topic_name(source.tf, namespace)
-            yield topic_name(source.tf_static, namespace)
+            yield expand_topic(source.tf, namespace)
+            yield expand_topic(source.tf_static, namespace)
         else:
-            yield topic_name(source.topic, namespace)
+            yield expand_topic(source.topic, namespace)

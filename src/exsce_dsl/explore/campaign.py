@@ -9,7 +9,7 @@ read back, and a scenario whose bags are all in its folder and in the store is n
 
 A relation is *violated* by a derivation when it failed in more than half of its runs: one
 odd run of three does not send shrinking after noise.  A smaller derivation still violates it
-when it violates the same check (:meth:`~exsce_dsl.model.campaign.Relation.same_check`): an
+when it violates the same check (:meth:`~exsce_dsl.model.campaign.CheckedRelation.same_check`): an
 expected value missed either way counts, whatever direction the smaller one's estimate took.
 A trial whose relations neither failed nor passed in more than half of its runs (their other
 verdicts inconclusive: a run cut short, data missing) is *inconclusive*: no counterexample,
@@ -33,7 +33,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import NamedTuple
 
-from exsce_dsl.derive.workflows import DerivedSpec, add_derivation, derive_spec
+from exsce_dsl.derive.derive_scenario import DerivedSpec, add_derivation, derive_spec
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.explore.cover import covering_derivations
 from exsce_dsl.explore.draw import Candidate, draw_derivations
@@ -46,7 +46,7 @@ from exsce_dsl.model.campaign import (
     CampaignFigures,
     CampaignPlan,
     CampaignRecord,
-    Relation,
+    CheckedRelation,
     Request,
     Shrinking,
     ShrinkTry,
@@ -54,9 +54,9 @@ from exsce_dsl.model.campaign import (
 )
 from exsce_dsl.model.document import Specification
 from exsce_dsl.model.verdicts import Outcome, Verdict
-from exsce_dsl.oracles.workflows import IngestFailed, verify_runs
+from exsce_dsl.oracles.judging import IngestFailed, verify_runs
 from exsce_dsl.prov.campaign import compile_campaign, compile_shrinking, compile_trial
-from exsce_dsl.runs.ingest import ingest_bags, stored_run
+from exsce_dsl.runs.ingest import ingest_bags, stored_bag_run_id
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.queries import derivation_of
 from exsce_dsl.store.queries import runs as stored_runs
@@ -95,10 +95,10 @@ class CampaignOptions:
     shrink_tries: int = SHRINK_TRIES
     jobs: int = 1
     """Bags of one scenario analysed in parallel."""
-    cluster: str | None = None
+    dask_address: str | None = None
     """A Dask scheduler's address: the bags are analysed on its workers (``jobs`` is then not used),
     which open them by their absolute paths (a shared filesystem).  Where the runs are played is
-    the executor's business (:class:`~exsce_dsl.explore.executors.SimulatorExecutor`'s ``cluster``)."""
+    the executor's business (:class:`~exsce_dsl.explore.executors.SimulatorExecutor`'s ``dask_address``)."""
 
 
 @dataclass
@@ -121,7 +121,7 @@ class CampaignResult:
     """What the trials of this budget found (those read back included): executions of drawn
     derivations, counterexamples, executions to the first failure."""
     minimal_files: dict[str, Path] = field(default_factory=dict)
-    """Relation text → the ``.exsce`` file of its minimal failing derivation."""
+    """A checked relation's text → the ``.exsce`` file of its minimal failing derivation."""
 
 
 def plan_campaign(base: Scenario, options: CampaignOptions, executor: Executor) -> CampaignPlan:
@@ -210,17 +210,18 @@ class _Campaign:
         store, else executed now and ingested (one transaction per run)."""
         if out.is_dir():
             bags = bags_in(out)  # not the .prov.json, .rosparams and logs beside them
-            known = [stored_run(bag, self.store, scenario.id) for bag in bags]
+            known = [stored_bag_run_id(bag, self.store, scenario.id) for bag in bags]
             if len(bags) == runs and all(known):
                 return [k for k in known if k is not None]
             shutil.rmtree(out)  # a run cut short: start the scenario again
         bags = self.executor.execute(scenario, scenario_file, out, runs, self.seed_of(scenario.id))
         self.executions += len(bags)
         uuids = []
-        if self.options.cluster is not None:  # a worker's working folder is not ours
+        if self.options.dask_address is not None:  # a worker's working folder is not ours
             bags = [bag.absolute() for bag in bags]
-        cluster = self.options.cluster
-        for result in ingest_bags(bags, scenario, self.store, self.options.jobs, cluster=cluster):
+        for result in ingest_bags(
+            bags, scenario, self.store, self.options.jobs, dask_address=self.options.dask_address
+        ):
             if result.failed or result.run_id is None:
                 raise IngestFailed(result.message)
             uuids.append(result.run_id)
@@ -280,7 +281,7 @@ class _Campaign:
         add_prov(self.store, compile_trial(trial))
         return trial
 
-    def shrinking(self, number: int, relation: Relation, trial: Trial) -> Shrinking:
+    def shrinking(self, number: int, relation: CheckedRelation, trial: Trial) -> Shrinking:
         tries: list[ShrinkTry] = []
 
         def still_fails(requests: tuple[Request, ...]) -> bool:
@@ -377,22 +378,22 @@ def _minimal_file(campaign: _Campaign, shrinking: Shrinking) -> Path:
 class RelationVerdicts(NamedTuple):
     """What a trial's runs showed of each relation checked."""
 
-    checked: tuple[Relation, ...]
-    violated: tuple[Relation, ...]
+    checked: tuple[CheckedRelation, ...]
+    violated: tuple[CheckedRelation, ...]
     """Failed in more than half of the runs."""
     failing: tuple[tuple[str, str], ...]
     """The failed verdicts of the violated relations as ``(run, verdict local name)``."""
-    inconclusive: tuple[Relation, ...]
+    inconclusive: tuple[CheckedRelation, ...]
     """Not violated, but they would be had the runs that could not judge them (cut short, their
     recordings not covering the clause) failed them: neither passed nor a counterexample."""
 
 
 def _violations(verdicts: Sequence[Verdict], runs: int) -> RelationVerdicts:
     """The relations checked, violated and inconclusive in a trial of ``runs`` runs."""
-    failures: dict[Relation, list[Verdict]] = {}
-    unjudged: dict[Relation, set[str]] = {}
+    failures: dict[CheckedRelation, list[Verdict]] = {}
+    unjudged: dict[CheckedRelation, set[str]] = {}
     for verdict in verdicts:
-        relation = Relation(verdict.metric, verdict.robot, verdict.relation, verdict.against)
+        relation = CheckedRelation(verdict.metric, verdict.robot, verdict.relation, verdict.against)
         failures.setdefault(relation, [])
         if verdict.outcome is Outcome.FAILED:
             failures[relation].append(verdict)
@@ -414,7 +415,7 @@ def _violations(verdicts: Sequence[Verdict], runs: int) -> RelationVerdicts:
     return RelationVerdicts(tuple(sorted(failures, key=_order)), violated, failing, undecided)
 
 
-def _order(relation: Relation) -> tuple[str, str, str, str]:
+def _order(relation: CheckedRelation) -> tuple[str, str, str, str]:
     return (relation.robot or "", relation.metric, relation.relationship, relation.against or "")
 
 

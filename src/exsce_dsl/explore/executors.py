@@ -67,18 +67,18 @@ class Executor(Protocol):
 @dataclass(frozen=True)
 class SimulatorExecutor:
     """exsce's kinematic executor, in the method's convention unless the robots name another;
-    with ``cluster`` (a Dask scheduler's address), each run is played by one of its workers, which
+    with ``dask_address`` (a Dask scheduler's address), each run is played by one of its workers, which
     write the bags under ``out_dir``: the same path on every worker (a shared filesystem)."""
 
     faults: tuple[Fault, ...] = ()
     format: str = "ros1"
-    cluster: str | None = None
+    dask_address: str | None = None
 
     @classmethod
     def with_faults(
-        cls, faults: Sequence[str], format: str = "ros1", cluster: str | None = None
+        cls, faults: Sequence[str], format: str = "ros1", dask_address: str | None = None
     ) -> SimulatorExecutor:
-        return cls(tuple(Fault.parse(f) for f in faults), format, cluster)
+        return cls(tuple(Fault.parse(f) for f in faults), format, dask_address)
 
     @property
     def name(self) -> str:
@@ -89,7 +89,9 @@ class SimulatorExecutor:
     def execute(
         self, scenario: Scenario, scenario_file: Path, out_dir: Path, runs: int, seed: int
     ) -> list[Path]:
-        played = simulate(scenario, out_dir, runs, self.format, seed, self.faults, cluster=self.cluster)
+        played = simulate(
+            scenario, out_dir, runs, self.format, seed, self.faults, dask_address=self.dask_address
+        )
         return [run.bag for run in played]
 
 

@@ -1,7 +1,7 @@
 """What an exploration campaign did, as it is written to the store and read back: the campaign
 itself, each derivation it tried (a *trial*) and each violation it shrank.
 
-A *relation* here is one oracle of a derived scenario, named by what it checks (robot, metric,
+A *checked relation* here is one oracle of a derived scenario, named by what it checks (robot, metric,
 relationship), not by the scenario: the same relation can then be looked for in a smaller
 derivation, whose scenario has another id.
 """
@@ -17,7 +17,7 @@ Request = tuple[str, Mapping[str, str]]
 
 
 @dataclass(frozen=True)
-class Relation:
+class CheckedRelation:
     """What an oracle checks: ``tiago1 task_duration invariant``, ``tiago1 task_duration
     increasing vs scenario_c`` (a metamorphic relation to the base's runs)."""
 
@@ -31,7 +31,7 @@ class Relation:
         against = f"vs {self.against}" if self.against else None
         return " ".join(p for p in (self.robot, self.metric, self.relationship, against) if p)
 
-    def same_check(self, other: Relation) -> bool:
+    def same_check(self, other: CheckedRelation) -> bool:
         """Whether ``other`` checks the same thing: the same metric of the same robot, against
         the same scenario, by the same limit, or by an expected value whichever way it moved
         (the direction, ``increasing`` or ``invariant``, comes from the estimate, which a
@@ -42,7 +42,7 @@ class Relation:
         )
 
     @classmethod
-    def parse(cls, text: str) -> Relation:
+    def parse(cls, text: str) -> CheckedRelation:
         """The inverse of :attr:`text`."""
         words = text.split()
         against = None
@@ -88,12 +88,12 @@ class Trial:
     scenario: str
     steps: tuple[Request, ...]
     runs: tuple[str, ...]
-    checked: tuple[Relation, ...]
-    violated: tuple[Relation, ...]
+    checked: tuple[CheckedRelation, ...]
+    violated: tuple[CheckedRelation, ...]
     """Failed in more than half of the runs."""
     failing_verdicts: tuple[tuple[str, str], ...] = ()
     """``(run uuid, verdict local name)`` of every failed verdict of a violated relation."""
-    inconclusive: tuple[Relation, ...] = ()
+    inconclusive: tuple[CheckedRelation, ...] = ()
     """Not violated, but they would be had the runs that could not judge them (cut short, not
     covered by their recordings) failed them: neither passed nor counterexamples."""
 
@@ -120,7 +120,8 @@ class CampaignFigures:
     counterexamples: int
     """Trials that violated at least one relation."""
     violated_relations: int
-    """Distinct relations violated, one per check (:meth:`Relation.same_check`), as shrinking counts them."""
+    """Distinct relations violated, one per check (:meth:`CheckedRelation.same_check`), as shrinking
+    counts them."""
     inconclusive: int
     """Trials neither violated nor passed (:attr:`Trial.inconclusive`): counted in ``executions``
     (their runs were executed) but neither as counterexamples nor as passes."""
@@ -136,7 +137,7 @@ class CampaignFigures:
     def of(cls, trials: Sequence[Trial]) -> CampaignFigures:
         """The figures of ``trials`` in the order they were drawn."""
         executions, first = 0, None
-        distinct: list[Relation] = []
+        distinct: list[CheckedRelation] = []
         for trial in trials:
             executions += len(trial.runs)
             if trial.violated and first is None:
@@ -167,7 +168,7 @@ class Shrinking:
 
     campaign: str
     number: int
-    relation: Relation
+    relation: CheckedRelation
     trial: int
     original: str
     """The scenario of the trial it was found in."""

@@ -51,7 +51,7 @@ def signal_pattern(signal: str) -> str:
     return f"/{{ns}}/~{signal}"
 
 
-def topic_name(pattern: str, namespace: str) -> str:
+def expand_topic(pattern: str, namespace: str) -> str:
     """``pattern`` with ``{ns}`` replaced by a robot's namespace; a robot at the root (no
     namespace) leaves no empty level: ``/{ns}/odom`` is then ``/odom``.  (``runs.monitor_core``
     has its own copy: it runs standalone in generated ROS nodes.)"""
@@ -169,7 +169,7 @@ class TopicRead:
     then the name ingestion gives the signal (``/{ns}/~pose``), ``msgtype`` the signal's fields'."""
 
     def topic_of(self, namespace: str) -> str:
-        return topic_name(self.topic, namespace)
+        return expand_topic(self.topic, namespace)
 
 
 @dataclass(frozen=True)
@@ -249,4 +249,4 @@ def default_topics(scenario: Scenario, metric: str, robot: str | None) -> tuple[
     leaves = TOPICS.get(metric, ())
     if robot is None and metric == "violation_duration":
         leaves = (_POSE,)  # the mission's violations are of the distance between robots
-    return tuple(topic_name(f"/{{ns}}/{leaf}", r.namespace) for r in robots for leaf in leaves)
+    return tuple(expand_topic(f"/{{ns}}/{leaf}", r.namespace) for r in robots for leaf in leaves)

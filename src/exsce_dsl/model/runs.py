@@ -27,6 +27,10 @@ from exsce_dsl.model.coverage import CoverageGap, TopicRate
 from exsce_dsl.model.geometry import Pose, Position
 from exsce_dsl.model.names import NAME_PATTERN
 
+RUN_NAMESPACE = uuid.UUID("5b8f9a52-3f0c-4a8e-8f0e-2d6c1b7e4a90")
+"""The namespace of every run id minted from a key (:func:`run_uuid`); since the first release a
+bag's run has uuid5 of its bag's sha256 under it, which stored runs depend on."""
+
 RUN_NAME_TIME = "%Y-%m-%dT%H-%M-%S"
 """How a run's files write its start: ISO 8601 in UTC, with ``-`` for ``:`` (file-safe)."""
 
@@ -223,6 +227,14 @@ class Run:
     def actions(self) -> Iterator[Action]:
         for task in self.tasks:
             yield from task.actions
+
+
+def run_uuid(*key: str) -> str:
+    """A run's id, minted under :data:`RUN_NAMESPACE` from what identifies the run (the parts
+    joined by a space): a bag's sha256, so that ingesting a bag twice is recognised; the sha256
+    and a scenario's IRI, for the bag's run under a scenario other than the one the store first
+    held it as; ``"simulated"`` and the scenario, seed, index and faults of a simulated run."""
+    return str(uuid.uuid5(RUN_NAMESPACE, " ".join(key)))
 
 
 def run_name(start: datetime.datetime, scenario: str, run_id: str) -> str:

@@ -29,7 +29,7 @@ PRESENT = "#present"
 """Suffix of the key of a field path's mask: which messages have the array element it picks."""
 
 
-def topic_name(pattern: str, namespace: str) -> str:
+def expand_topic(pattern: str, namespace: str) -> str:
     """``pattern`` with ``{ns}`` replaced by a robot's namespace; a robot at the root (no
     namespace) leaves no empty level: ``/{ns}/odom`` is then ``/odom``."""
     name = pattern.replace("{ns}", namespace.strip("/"))

@@ -327,7 +327,9 @@ class _Dispatch:
 
 
 @dataclass(frozen=True)
-class Verdict:
+class CheckResult:
+    """One oracle's check so far: the value seen and ``verdict``, passed, failed or not yet."""
+
     oracle: Mapping[str, Any]
     value: float | None
     verdict: str
@@ -342,7 +344,7 @@ class Evaluation:
     windows: Mapping[str, tuple[float, float] | None]
     robots: Mapping[str, Mapping[str, float | None]]
     mission: Mapping[str, float | None]
-    verdicts: tuple[Verdict, ...]
+    verdicts: tuple[CheckResult, ...]
     problems: tuple[str, ...] = ()
 
     def outcome(self) -> tuple[str, ...]:
@@ -390,7 +392,8 @@ class MonitorRuntime:
         entries: dict[str, list[tuple[str, str, Any]]] = {}
         for _, namespace in self.robots:
             for pattern, key, func, compute in monitors.REDUCERS:
-                entries.setdefault(self.core.topic_name(pattern, namespace), []).append((key, func, compute))
+                topic = self.core.expand_topic(pattern, namespace)
+                entries.setdefault(topic, []).append((key, func, compute))
         self.buffers = {
             name: _Buffer(spec, self.core.reducer(entries[name]) if name in entries else None)
             for name, spec in self.specs.items()
@@ -447,12 +450,12 @@ class MonitorRuntime:
             whose = oracle.get("robot")
             value = (mission if whose is None else robots.get(whose, {})).get(oracle["metric"])
             if value is None:
-                verdicts.append(Verdict(oracle, None, NOT_YET, None))
+                verdicts.append(CheckResult(oracle, None, NOT_YET, None))
                 continue
             passed, margin = judge(
                 oracle["relation"], value, oracle.get("limit"), oracle.get("value"), oracle.get("tolerance")
             )
-            verdicts.append(Verdict(oracle, value, PASSED if passed else FAILED, margin))
+            verdicts.append(CheckResult(oracle, value, PASSED if passed else FAILED, margin))
         with self._lock:
             problems = {**dict.fromkeys(self.problems), **problems}
         return Evaluation(now, windows, robots, mission, tuple(verdicts), tuple(problems))

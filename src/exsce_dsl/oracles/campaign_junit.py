@@ -15,7 +15,7 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from collections.abc import Mapping, Sequence
 
-from exsce_dsl.model.campaign import CampaignRecord, Relation, Request, Shrinking, Trial
+from exsce_dsl.model.campaign import CampaignRecord, CheckedRelation, Request, Shrinking, Trial
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.queries import runs as stored_runs
 from exsce_dsl.transform.transformations import TRANSFORMATIONS
@@ -47,7 +47,7 @@ def _seconds(value: float) -> str:
     return f"{value:.3f}"
 
 
-def _shrunk(relation: Relation, trial: int, shrinkings: Sequence[Shrinking]) -> list[str]:
+def _shrunk(relation: CheckedRelation, trial: int, shrinkings: Sequence[Shrinking]) -> list[str]:
     """Where ``relation``, violated in ``trial``, was shrunk to: ``minimal derivation STEPS
     (scenario ID, N tries)`` per shrinking of it found in this trial; else which trial it was
     shrunk from, or that it was not."""

@@ -22,7 +22,9 @@ _WINDOW = re.compile(
 
 
 @dataclass(frozen=True)
-class ObservedSegment:
+class ActionValue:
+    """One action's value of a metric, as the store holds it for a run."""
+
     action: str
     robot: str
     allocation: int
@@ -40,7 +42,7 @@ class RunValues:
 
     run: str
     whole: dict[tuple[str, str | None], list[float]] = field(default_factory=dict)
-    segments: list[ObservedSegment] = field(default_factory=list)
+    segments: list[ActionValue] = field(default_factory=list)
     violations: dict[str | None, set[str]] = field(default_factory=dict)
     """Robot (None: the mission) → the safety metrics whose violation durations the run has."""
 
@@ -61,7 +63,7 @@ def run_values(store: Store, runs: Sequence[str]) -> dict[str, RunValues]:
             continue
         numbers = (int(parts["task"]), int(parts["subtask"]), int(parts["waypoint"]))
         found[reading.run].segments.append(
-            ObservedSegment(
+            ActionValue(
                 reading.action or "",
                 parts["robot"],
                 numbers[0],
@@ -126,7 +128,7 @@ def observe(
 
 def window_segments(
     values: RunValues, robot: str | None, window: Window, scenario: Scenario
-) -> list[ObservedSegment]:
+) -> list[ActionValue]:
     """The path segments of ``window`` in a run, in their order, one per action.
 
     They are those the run has any value of: one without a value of a clause's metric makes the
@@ -143,9 +145,7 @@ def _safety_metrics(scenario: Scenario, robot: str | None) -> set[str]:
     return {m.name for m in (*standard_metrics(), *scenario.metrics) if m.safety and m.subject in wanted}
 
 
-def _in_window(
-    segments: list[ObservedSegment], window: Window, tasks: Sequence[str]
-) -> list[ObservedSegment]:
+def _in_window(segments: list[ActionValue], window: Window, tasks: Sequence[str]) -> list[ActionValue]:
     if window.task is not None:
         indices = [k for k, task in enumerate(tasks, start=1) if task == window.task]
         if not indices:

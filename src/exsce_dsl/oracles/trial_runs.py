@@ -1,7 +1,7 @@
 """Trials as the CLI and the Python API run them.
 
 :func:`verify_trial`: runs of a scenario (stored runs, bags, and ``repeat`` new runs played by the
-kinematic executor) judged against its oracles as :func:`~exsce_dsl.oracles.workflows.verify_runs`
+kinematic executor) judged against its oracles as :func:`~exsce_dsl.oracles.judging.verify_runs`
 does (the verdicts recorded), and counted per clause (:mod:`exsce_dsl.oracles.trials`).
 :func:`stored_pass_rates`: the same statistics over the verdicts the store holds, each run's last.
 """
@@ -15,6 +15,7 @@ from pathlib import Path
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.trials import ClauseTrial, Trial
+from exsce_dsl.oracles.judging import Verification, verify_runs
 from exsce_dsl.oracles.trials import (
     CONFIDENCE,
     REQUIRED_PASS_RATE,
@@ -23,7 +24,6 @@ from exsce_dsl.oracles.trials import (
     lowest_pass_rate_first,
     trial,
 )
-from exsce_dsl.oracles.workflows import Verification, verify_runs
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
 from exsce_dsl.store.base import Store

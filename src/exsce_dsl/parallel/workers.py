@@ -1,5 +1,5 @@
 """Where work runs: in this process, over a pool of processes on this machine (``--jobs``), or on a
-Dask cluster (``--cluster``, :mod:`exsce_dsl.parallel.cluster`), behind one ``map``."""
+Dask cluster (``--cluster``, :mod:`exsce_dsl.parallel.dask_client`), behind one ``map``."""
 
 from __future__ import annotations
 
@@ -13,13 +13,13 @@ Mapper = Callable[[Callable[[Any], Any], Iterable[Any]], Iterator[Any]]
 
 
 @contextmanager
-def workers(jobs: int, tasks: int, cluster: str | None = None) -> Iterator[Mapper]:
-    """``map`` on the Dask cluster at ``cluster``, in this process (one job), or over a pool of
+def workers(jobs: int, tasks: int, dask_address: str | None = None) -> Iterator[Mapper]:
+    """``map`` on the Dask cluster at ``dask_address``, in this process (one job), or over a pool of
     ``jobs`` processes (no more than ``tasks`` and this machine's cores) kept for every call."""
-    if cluster is not None:
-        from exsce_dsl.parallel.cluster import cluster_mapper
+    if dask_address is not None:
+        from exsce_dsl.parallel.dask_client import dask_map
 
-        with cluster_mapper(cluster) as mapper:
+        with dask_map(dask_address) as mapper:
             yield mapper
         return
     if jobs <= 1 or tasks <= 1:

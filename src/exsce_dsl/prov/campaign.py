@@ -30,7 +30,7 @@ from collections.abc import Sequence
 from prov.constants import PROV_TYPE
 from prov.model import ProvDocument
 
-from exsce_dsl.model.campaign import CampaignFigures, CampaignPlan, Relation, Request, Shrinking, Trial
+from exsce_dsl.model.campaign import CampaignFigures, CampaignPlan, CheckedRelation, Request, Shrinking, Trial
 from exsce_dsl.prov import identifiers as ids
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, Namespaces
 from exsce_dsl.prov.records import Attributes, DocumentWriter
@@ -48,7 +48,7 @@ def steps_json(steps: Sequence[Request]) -> str:
     return json.dumps([[name, dict(sorted(arguments.items()))] for name, arguments in steps])
 
 
-def relations_text(relations: Sequence[Relation]) -> str:
+def relations_text(relations: Sequence[CheckedRelation]) -> str:
     return "; ".join(r.text for r in relations)
 
 

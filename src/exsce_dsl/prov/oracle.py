@@ -133,7 +133,7 @@ class _Topics:
 def _use_topics(w: BundleWriter, activity: QualifiedName, group: Sequence[Oracle], topics: _Topics) -> None:
     """The oracle uses each topic its metric is computed from (each declared once per bundle)."""
     for topic in dict.fromkeys(topic for oracle in group for topic in oracle.topics):
-        topic_id = topics.namespace[ids.topic_name(topic)]
+        topic_id = topics.namespace[ids.topic_local_name(topic)]
         if topic_id not in topics.declared:
             topics.declared.add(topic_id)
             w.entity(topic_id, topics.type)

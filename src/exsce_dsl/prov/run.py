@@ -43,7 +43,7 @@ Where exsce differs from the method's published run and its report, on purpose:
 * topics are ``topic:tiago1/nav_vel`` (the name without its first ``/``, so that
   the IRI is ``<base>topics/tiago1/nav_vel``), where the report wrote
   ``topic:/tiago1/nav_vel``; a name as a bag may hold it otherwise (relative, with
-  spaces...) is escaped (``topic:@groundtruth``, see :func:`ids.topic_name`), as is the
+  spaces...) is escaped (``topic:@groundtruth``, see :func:`ids.topic_local_name`), as is the
   bag file's name;
 * additions: each action's start and end time and ``exsce:status``
   (``SUCCEEDED``/``ABORTED``), with ``exsce:goal_outcome`` (``rejected``, ``timed out``,
@@ -139,7 +139,7 @@ class _RunCompiler:
 
     def run_id_in(self, w: BundleWriter) -> QualifiedName:
         """The run's activity, as bundle ``w`` names it."""
-        return w.fixed(ids.RUN)[ids.run_name(self.run.uuid)]
+        return w.fixed(ids.RUN)[ids.run_local_name(self.run.uuid)]
 
     def _pose_name(self, pose: Pose) -> str:
         name = self._pose_names.get(pose)
@@ -161,7 +161,7 @@ class _RunCompiler:
         run, scenario, names, writer = self.run, self.scenario, self.names, self.writer
         mission = scenario.mission
         run_ns = writer.document_namespace(ids.RUN)
-        w = writer.bundle(run_ns[f"{ids.run_name(run.uuid)}_bundle"], f"the bundle of run {run.uuid}")
+        w = writer.bundle(run_ns[f"{ids.run_local_name(run.uuid)}_bundle"], f"the bundle of run {run.uuid}")
         t = w.term
         parts = self.parts_in(w)
         run_id = self.run_id_in(w)
@@ -254,7 +254,7 @@ class _RunCompiler:
         topic_ns = w.fixed(ids.TOPIC)
         topic_type = {PROV_TYPE: t(ids.ROS_TOPICS)}
         for topic in dict.fromkeys(bag.topics):
-            topic_id = topic_ns[ids.topic_name(topic)]
+            topic_id = topic_ns[ids.topic_local_name(topic)]
             w.entity(topic_id, topic_type)
             w.member(bag_id, topic_id)
         self._clocks(w, set(bag.topics))
@@ -275,7 +275,7 @@ class _RunCompiler:
                 t(ids.CLOCK_OFFSET): float(clock.offset),
             }
             w.entity(clock_id, facts)
-            w.derivation(clock_id, topic_ns[ids.topic_name(clock.topic)], {})
+            w.derivation(clock_id, topic_ns[ids.topic_local_name(clock.topic)], {})
 
     def _conventions(self, w: BundleWriter, held: set[str]) -> None:
         """The convention detected for each robot whose type names none, and the topics it was
@@ -295,7 +295,7 @@ class _RunCompiler:
             )
             for topic in evidence:
                 if topic in held:
-                    w.derivation(found, topic_ns[ids.topic_name(topic)], {})
+                    w.derivation(found, topic_ns[ids.topic_local_name(topic)], {})
 
     def _metric_bundles(self, actions: dict[ActionId, QualifiedName]) -> None:
         by_metric: dict[str, list[MetricValue]] = {}
@@ -408,7 +408,7 @@ class _MetricBundle:
             self.writer.claim(collection, f"the topics of '{metric}'" + (f" of '{robot}'" if robot else ""))
             self.w.entity(collection, self.collection_type)
             for topic in topics:
-                self.w.member(collection, self.topic_ns[ids.topic_name(topic)])
+                self.w.member(collection, self.topic_ns[ids.topic_local_name(topic)])
             known = self.collections[key] = (topics, collection)
         elif known is not None and set(known[0]) != set(topics):
             raise ExsceError(

@@ -30,7 +30,7 @@ def write_coverage(writer: DocumentWriter, run_parts: Namespace, parts: tuple[st
     w = writer.bundle(run_parts[ids.COVERAGE_BUNDLE], "the bundle of the run's coverage")
     mine = w.of_element(parts[0], parts[1], "run")
     held = set(run.bag.topics)
-    run_id = w.fixed(ids.RUN)[ids.run_name(run.uuid)]
+    run_id = w.fixed(ids.RUN)[ids.run_local_name(run.uuid)]
     t = w.term
     for index, gap in enumerate(run.coverage, start=1):
         gap_id = mine[ids.coverage_name(index)]
@@ -73,4 +73,4 @@ def _write(
     w.entity(entity, {k: v for k, v in facts.items() if v is not None})
     w.generated(entity, run)
     if topic is not None and topic in held:
-        w.derivation(entity, w.fixed(ids.TOPIC)[ids.topic_name(topic)], {})
+        w.derivation(entity, w.fixed(ids.TOPIC)[ids.topic_local_name(topic)], {})

@@ -80,13 +80,12 @@ from exsce_dsl.prov.identifiers import (
     PROV_NAMESPACE,
     RDF_NAMESPACE,
     RDF_TYPE,
+    RDFS_NAMESPACE,
     XSD_NAMESPACE,
     is_valid_prefix,
 )
 
 __all__ = ["nquad_lines", "prefixes_of", "quads_of_lines", "to_quads"]
-
-RDFS_NAMESPACE = "http://www.w3.org/2000/01/rdf-schema#"
 
 _IRI_SCHEMES = frozenset({"http", "https", "urn", "file", "mailto", "tag", "data"})
 """Prefix names that would read as the scheme of a full IRI in JSON-LD."""

@@ -15,6 +15,7 @@ from prov.model import ProvDocument
 from pyoxigraph import BlankNode, DefaultGraph, Literal, NamedNode, Quad, Triple
 
 from exsce_dsl.errors import ExportError
+from exsce_dsl.prov.identifiers import RDF_LANG_STRING, XSD_STRING
 from exsce_dsl.prov.serialize import PROV_FORMATS, serialize_prov
 from exsce_dsl.rdf import text
 from exsce_dsl.rdf.prov_o import nquad_lines, prefixes_of, quads_of_lines
@@ -110,10 +111,8 @@ class _RdflibTerms:
     """pyoxigraph term → rdflib term, each converted once."""
 
     def __init__(self) -> None:
-        from rdflib import XSD
-
         self._cache: dict[NamedNode | BlankNode | Literal, Node] = {}
-        self._plain = {str(XSD.string), "http://www.w3.org/1999/02/22-rdf-syntax-ns#langString"}
+        self._plain = {XSD_STRING, RDF_LANG_STRING}
 
     def __call__(self, term: NamedNode | BlankNode | Literal | Triple) -> Node:
         from rdflib import BNode, URIRef

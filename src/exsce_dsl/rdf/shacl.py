@@ -23,7 +23,7 @@ from exsce_dsl.errors import Diagnostic, ExsceError, Severity, SourceLocation
 from exsce_dsl.model.document import Specification
 from exsce_dsl.model.scenario import Scenario
 from exsce_dsl.prov import compile_scenario, source_locations
-from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE
+from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, SHACL_NAMESPACE, SHAPES_NAMESPACE
 from exsce_dsl.rdf.prov_o import prefixes_of, to_quads
 from exsce_dsl.rdf.serialize import as_graph
 from exsce_dsl.resources import package_file
@@ -33,7 +33,6 @@ if TYPE_CHECKING:
     from rdflib.term import Node
 
 __all__ = [
-    "SHAPES_NAMESPACE",
     "Violation",
     "check_scenario_shapes",
     "check_spec_shapes",
@@ -44,10 +43,7 @@ __all__ = [
     "vocabulary_graph",
 ]
 
-SHAPES_NAMESPACE = "https://www.sesame-project.org/scenarios/shapes/"
-"""Where the shapes live (prefix ``exsce-sh:``)."""
-
-_SH = "http://www.w3.org/ns/shacl#"
+_SH = SHACL_NAMESPACE
 
 
 @dataclass(frozen=True)

@@ -19,7 +19,7 @@ from typing import Any
 from pyoxigraph import BlankNode, DefaultGraph, Literal, NamedNode, Quad, Triple
 
 from exsce_dsl.errors import ExportError
-from exsce_dsl.prov.identifiers import RDF_NAMESPACE, RDF_TYPE
+from exsce_dsl.prov.identifiers import RDF_LANG_STRING, RDF_TYPE, XSD_STRING
 from exsce_dsl.rdf.prov_o import iri_ref, quoted
 
 __all__ = ["jsonld", "nquads", "trig", "turtle"]
@@ -29,8 +29,8 @@ _Triple = tuple[_Term, NamedNode, _Term]
 
 _LOCAL_NAME = re.compile(r"[A-Za-z0-9_](?:[A-Za-z0-9_.\-]*[A-Za-z0-9_\-])?")
 _RDF_TYPE = NamedNode(RDF_TYPE)
-_XSD_STRING = NamedNode("http://www.w3.org/2001/XMLSchema#string")
-_RDF_LANG_STRING = NamedNode(RDF_NAMESPACE + "langString")
+_XSD_STRING = NamedNode(XSD_STRING)
+_RDF_LANG_STRING = NamedNode(RDF_LANG_STRING)
 
 
 class _Spelling:

@@ -11,7 +11,7 @@ from __future__ import annotations
 import datetime
 from dataclasses import dataclass
 
-from exsce_dsl.model.campaign import CampaignPlan, CampaignRecord, Relation
+from exsce_dsl.model.campaign import CampaignPlan, CampaignRecord, CheckedRelation
 from exsce_dsl.oracles.campaign_junit import steps_text
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.queries.campaigns import campaign_record, campaigns
@@ -97,7 +97,7 @@ class CampaignContents:
 
 def campaign_contents(record: CampaignRecord) -> CampaignContents:
     """What the page of ``record``'s campaign shows."""
-    seen: set[Relation] = set()
+    seen: set[CheckedRelation] = set()
     trials: list[TrialContents] = []
     found: list[int] = []
     for trial in sorted(record.trials, key=lambda t: t.number):

@@ -20,9 +20,9 @@ from exsce_dsl.model.expressions import Field, walk
 from exsce_dsl.model.messages import DISPATCHER, POSE, FieldPath, Fields
 from exsce_dsl.model.metrics import MetricDefinition
 from exsce_dsl.model.robots import Robot
-from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Bag, Run, RunClock, TaskExecution
-from exsce_dsl.monitor_kit.monitor_core import Compute, Topic, reducer, topic_name
-from exsce_dsl.runs.bag_identity import content_hash, run_uuid
+from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Bag, Run, RunClock, TaskExecution, run_uuid
+from exsce_dsl.monitor_kit.monitor_core import Compute, Topic, expand_topic, reducer
+from exsce_dsl.runs.bag_identity import content_hash
 from exsce_dsl.runs.bags.data import BagData
 from exsce_dsl.runs.bags.names import BagTopics
 from exsce_dsl.runs.bags.reading import (
@@ -48,7 +48,7 @@ from exsce_dsl.runs.metrics.monitor_code import load_monitors
 from exsce_dsl.runs.missing import missing_metrics, unread_topics
 from exsce_dsl.runs.robots import SERVED, StackRobots, stack_robots
 from exsce_dsl.runs.segments.dispatcher import SUCCEEDED, segments
-from exsce_dsl.runs.segments.segment import Segment
+from exsce_dsl.runs.segments.recorded import RecordedAction
 from exsce_dsl.runs.segments.sources import DISPATCHER_SOURCE, segment_robot
 from exsce_dsl.runs.signals.detect import Detected, pose_like_topics, with_detected_conventions
 from exsce_dsl.runs.signals.timeline import (
@@ -102,14 +102,14 @@ def wanted_topics(metrics: tuple[MetricDefinition, ...], robots: list[Robot]) ->
     for robot in robots:
         ns = robot.namespace.strip("/")
         for pattern, msgtype in [(_FEEDBACK, ANY), (_RESULT, ANY), (POSE_TOPIC, POSE)]:
-            types[topic_name(pattern, ns)] = msgtype
-        paths.setdefault(topic_name(POSE_TOPIC, ns), {}).update(dict.fromkeys(HOTSPOT_PATHS))
+            types[expand_topic(pattern, ns)] = msgtype
+        paths.setdefault(expand_topic(POSE_TOPIC, ns), {}).update(dict.fromkeys(HOTSPOT_PATHS))
         for metric in metrics:
             read_paths = fields_read(metric)
             for read in metric.reads:
                 if read.signal:  # a signal: read from the sources runs/signals chooses
                     continue
-                topic = topic_name(read.topic, ns)
+                topic = expand_topic(read.topic, ns)
                 types.setdefault(topic, ANY if read.msgtype in DISPATCHER else read.msgtype)
                 paths.setdefault(topic, {}).update(dict.fromkeys(read_paths.get(read.name, ())))
     return {topic: Wanted(msgtype, tuple(paths.get(topic, {}))) for topic, msgtype in types.items()}
@@ -148,7 +148,7 @@ def reductions(monitors: ModuleType, robots: list[Robot]) -> dict[str, Reduce]:
     entries: dict[str, list[tuple[str, str, Compute]]] = {}
     for robot in robots:
         for pattern, key, func, compute in monitors.REDUCERS:
-            entries.setdefault(topic_name(pattern, robot.namespace), []).append((key, func, compute))
+            entries.setdefault(expand_topic(pattern, robot.namespace), []).append((key, func, compute))
     return {topic: reducer(found) for topic, found in entries.items()}
 
 
@@ -161,7 +161,7 @@ def analyse_bag(
 ) -> AnalysedRun:
     """The metrics of the bag at ``path`` as a run of ``scenario``; ``digest`` is the bag's
     :func:`content_hash` when the caller has it already, ``run_id`` the run's id when it is not
-    the bag's own (:func:`~exsce_dsl.runs.bag_identity.run_uuid`); ``strict``: a metric value
+    the bag's own (:func:`~exsce_dsl.model.runs.run_uuid` of its sha256); ``strict``: a metric value
     that would be missing is an :class:`IncompleteRunError` (saying why, as the run's problems
     would).
 
@@ -248,7 +248,7 @@ def _read_signals(
         [r for r in scenario.robots if r.start_pose is not None], types
     )
     stacks = stack_robots(robots, types, {r.id for r in robots})
-    serving = [topic_name(p, r.namespace) for r in robots if r.id in stacks.serves for p in SERVED.values()]
+    serving = [expand_topic(p, r.namespace) for r in robots if r.id in stacks.serves for p in SERVED.values()]
     unread = unread_topics(scenario.metrics, robots, types, serving)
     wanted = with_stamps(stacks.adapt(wanted_topics(metrics, robots), robots), types, stamp_catalogue())
     if PROV_TOPIC in types:
@@ -275,7 +275,7 @@ class _Segmented:
     whole run (where it has no segments, or its metrics are windowed on the recording), and
     which source segmented it when not the method's dispatcher."""
 
-    actions: list[Segment] = field(default_factory=list)
+    actions: list[RecordedAction] = field(default_factory=list)
     results: dict[str, int | None] = field(default_factory=dict)
     whole_runs: dict[str, tuple[float, float]] = field(default_factory=dict)
     segmented_by: dict[str, str] = field(default_factory=dict)
@@ -286,7 +286,7 @@ def _segment_robots(path: Path, scenario: Scenario, bag: _Signals) -> _Segmented
     stacks, data, out = bag.stacks, bag.data, _Segmented()
     for robot in bag.robots:
         ns = robot.namespace.strip("/")
-        feedback, result = topic_name(_FEEDBACK, ns), topic_name(_RESULT, ns)
+        feedback, result = expand_topic(_FEEDBACK, ns), expand_topic(_RESULT, ns)
         updates = data.feedback.get(feedback)
         dispatched = segments(scenario, robot.id, updates) if updates is not None else None
         found = segment_robot(scenario, robot, data, stacks.track(robot, bag.topics), dispatched)
@@ -299,7 +299,7 @@ def _segment_robots(path: Path, scenario: Scenario, bag: _Signals) -> _Segmented
         else:
             out.results[robot.id] = found.succeeded
             stacks.real_topics[feedback] = stacks.real_topics[result] = (
-                found.topics or stacks.real_topics.get(topic_name(SERVED["pose"], ns), ())
+                found.topics or stacks.real_topics.get(expand_topic(SERVED["pose"], ns), ())
             )
         recording = robot.signals.window is Window.RECORDING
         if (not found.segments or recording) and scenario.mission.tasks_of(robot.id):
@@ -350,7 +350,7 @@ def _time(seconds: float) -> dt.datetime:
 
 
 def _task_executions(
-    actions: list[Segment], segmented_by: dict[str, str], wall: Callable[[np.ndarray], np.ndarray]
+    actions: list[RecordedAction], segmented_by: dict[str, str], wall: Callable[[np.ndarray], np.ndarray]
 ) -> tuple[TaskExecution, ...]:
     """The robots' tasks as executed, with their actions' times as the wall clock had them.  A
     segment that started and ended is an action (its metric values need one): ABORTED when its

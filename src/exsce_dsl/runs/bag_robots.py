@@ -26,7 +26,7 @@ import numpy as np
 from exsce_dsl.errors import BagError
 from exsce_dsl.model.conventions import Navigation, Signals
 from exsce_dsl.model.goals import GoalStatus
-from exsce_dsl.model.metrics import topic_name
+from exsce_dsl.model.metrics import expand_topic
 from exsce_dsl.model.names import is_ros_namespace
 from exsce_dsl.model.robots import Robot, RobotType
 from exsce_dsl.runs.bags.reading import ANY, OBJECTS, BagData, Wanted, bag_topics, read_bag
@@ -125,7 +125,7 @@ def bag_contents(path: Path) -> BagContents:
     for model in models:
         wanted.update(goal_wanted(model.signals, model.namespace))
         if model.signals.navigation is Navigation.DISPATCHER:
-            wanted[topic_name(FEEDBACK, model.namespace)] = Wanted(ANY)
+            wanted[expand_topic(FEEDBACK, model.namespace)] = Wanted(ANY)
     grids = sorted(t for t, m in types.items() if m == OCCUPANCY_GRID)
     maps = [t for t in grids if t.lstrip("/") == "map"] or [t for t in grids if "costmap" not in t][:1]
     wanted.update({t: Wanted(OBJECTS) for t in maps})
@@ -177,7 +177,7 @@ def _places(robot: BagRobot, model: Robot, data: BagData, track: Track) -> None:
 
 
 def _dispatched(robot: BagRobot, data: BagData, track: Track) -> None:
-    topic = topic_name(FEEDBACK, robot.namespace)
+    topic = expand_topic(FEEDBACK, robot.namespace)
     updates = data.feedback.get(topic) or []
     for goal in dispatcher_goals(updates):
         places = []

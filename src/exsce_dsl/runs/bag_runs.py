@@ -1,8 +1,8 @@
 """Which run a bag is in the store, as a run of one scenario: its id, and whether it is stored.
 
-A bag's run has the bag's own id (:func:`~exsce_dsl.runs.bag_identity.run_uuid`, from its
+A bag's run has the bag's own id (:func:`~exsce_dsl.model.runs.run_uuid`, from its
 content) under the first scenario the store holds it as, and an id from its content and the
-scenario's IRI (:func:`~exsce_dsl.runs.bag_identity.scenario_run_uuid`) under any other.  So a
+scenario's IRI (:func:`~exsce_dsl.model.runs.run_uuid` of both) under any other.  So a
 store holds one run per bag and scenario, the ids of runs of one scenario are what they always
 were, and a run keeps its id when it is analysed again.
 """
@@ -12,9 +12,9 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from exsce_dsl.model.runs import run_uuid
 from exsce_dsl.prov import identifiers as ids
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, Namespaces
-from exsce_dsl.runs.bag_identity import run_uuid, scenario_run_uuid
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.queries import run_scenarios
 
@@ -44,7 +44,7 @@ def bag_runs(
     """For each bag (by its content hash; None for a bag that could not be hashed) its run as a
     run of scenario ``scenario_id``, in one query."""
     scenario_iri = Namespaces(namespace).fixed[ids.EXSCE] + scenario_id
-    pairs = {d: (run_uuid(d), scenario_run_uuid(d, scenario_iri)) for d in digests if d is not None}
+    pairs = {d: (run_uuid(d), run_uuid(d, scenario_iri)) for d in digests if d is not None}
     held = run_scenarios(store, [run for pair in pairs.values() for run in pair], namespace)
     found: list[BagRun | None] = []
     for digest in digests:

@@ -39,9 +39,9 @@ from exsce_dsl.model.conventions import Window
 from exsce_dsl.model.coverage import CoverageGap, Shortfall, TopicRate
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import MetricValue, RunStatus
-from exsce_dsl.monitor_kit.monitor_core import topic_name
+from exsce_dsl.monitor_kit.monitor_core import expand_topic
 from exsce_dsl.runs.bags.reading import BagData
-from exsce_dsl.runs.segments.segment import Segment
+from exsce_dsl.runs.segments.recorded import RecordedAction
 from exsce_dsl.runs.signals.sources import SIGNALS, RobotSources
 from exsce_dsl.runs.signals.timeline import CLOCK_TOPIC, Timeline
 
@@ -118,7 +118,7 @@ class Recording:
     robots: list[Robot]
     data: BagData
     timeline: Timeline
-    segments: list[Segment]
+    segments: list[RecordedAction]
     values: list[MetricValue]
     status: RunStatus
     signal_spans: Mapping[str, tuple[float, float]]
@@ -223,7 +223,7 @@ def declared_rates(
                     s.rate
                     for s in listed
                     if getattr(s, "rate", None) is not None
-                    and topic_name(s.topic, robot.namespace) == chosen.topic
+                    and expand_topic(s.topic, robot.namespace) == chosen.topic
                 ),
                 None,
             )
@@ -324,7 +324,7 @@ def _cut_short(recording: Recording, wall: Wall) -> list[CoverageGap]:
     return gaps
 
 
-def _never_finished(segments: list[Segment]) -> list[Segment]:
+def _never_finished(segments: list[RecordedAction]) -> list[RecordedAction]:
     """A robot's planned waypoints after its last finished one, when it started some and none
     failed (a failed goal, not the recording, explains the rest)."""
     if not any(s.start is not None for s in segments):

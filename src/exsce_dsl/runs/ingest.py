@@ -85,7 +85,9 @@ def _digest(path: Path) -> str | None:
     return content_hash(path) if path.exists() else None
 
 
-def stored_run(path: Path, store: Store, scenario_id: str, namespace: str = DEFAULT_NAMESPACE) -> str | None:
+def stored_bag_run_id(
+    path: Path, store: Store, scenario_id: str, namespace: str = DEFAULT_NAMESPACE
+) -> str | None:
     """The uuid of the run of ``scenario_id`` that ``path`` holds when the store has it already
     (same content), else None."""
     (found,) = bag_runs(store, [_digest(path)], scenario_id, namespace)
@@ -113,15 +115,15 @@ def ingest_bags(
     jobs: int = 1,
     progress: Callable[[IngestResult], None] | None = None,
     namespace: str = DEFAULT_NAMESPACE,
-    cluster: str | None = None,
+    dask_address: str | None = None,
     replace: bool = False,
     strict: bool = False,
 ) -> list[IngestResult]:
     """Ingest each bag as a run of ``scenario``; the scenario itself is added to the store first.
 
     With ``jobs`` > 1, worker processes hash the bags, then read them and compute their metrics;
-    with ``cluster`` (a Dask scheduler's address) the cluster's workers do, and ``jobs`` is not
-    used (see :mod:`exsce_dsl.parallel.cluster`).  This process alone compiles each run's PROV and
+    with ``dask_address`` (a Dask scheduler's address) the cluster's workers do, and ``jobs`` is not
+    used (see :mod:`exsce_dsl.parallel.dask_client`).  This process alone compiles each run's PROV and
     writes it, each run wholly or not at all, in group commits when the runs come faster than the
     store takes them one by one (:mod:`exsce_dsl.store.batch_writing`).  With ``replace``, a bag
     the store holds as a run of ``scenario`` is analysed again and its run's graphs replaced in
@@ -138,16 +140,16 @@ def ingest_bags(
         if progress:
             progress(result)
 
-    in_process = cluster is None and (jobs <= 1 or len(paths) <= 1)
+    in_process = dask_address is None and (jobs <= 1 or len(paths) <= 1)
     # what the workers open: on a cluster, from the root (a worker's working folder is its own);
     # messages name the paths as given
-    opened = dict(zip(paths, _shared_paths(paths) if cluster is not None else paths, strict=True))
+    opened = dict(zip(paths, _shared_paths(paths) if dask_address is not None else paths, strict=True))
     # in this process, what reads the bags is imported while they are hashed (hashing lets go of
     # Python's lock); for worker processes, before they start (forked, they have it)
     importing = _Importing(ANALYSIS) if in_process else None
     if importing is None:
         importlib.import_module(ANALYSIS)
-    with workers(jobs, len(paths), cluster) as mapper:
+    with workers(jobs, len(paths), dask_address) as mapper:
         # a digest the cluster could not compute is None: the bag's analysis then says what is wrong
         digests = [d if isinstance(d, str) else None for d in mapper(_digest, [opened[p] for p in paths])]
         if importing is not None:
@@ -220,7 +222,7 @@ def _write_runs(
 
 
 def _shared_paths(paths: Sequence[Path]) -> list[Path]:
-    from exsce_dsl.parallel.cluster import shared_paths
+    from exsce_dsl.parallel.dask_client import shared_paths
 
     return shared_paths(paths)
 

@@ -15,10 +15,10 @@ from dataclasses import dataclass
 
 from exsce_dsl.model.conventions import LASER_SCAN, POSE_TYPES, VELOCITY_TYPES, TopicSource
 from exsce_dsl.model.messages import DISPATCHER, canonical_type
-from exsce_dsl.model.metrics import ComputedFor, MetricDefinition, topic_name
+from exsce_dsl.model.metrics import ComputedFor, MetricDefinition, expand_topic
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import ActionId, MetricScope, MetricValue
-from exsce_dsl.runs.segments.segment import Segment
+from exsce_dsl.runs.segments.recorded import RecordedAction
 from exsce_dsl.suggest import closest_several
 
 SIGNAL_TYPES = {"pose": POSE_TYPES, "velocity": VELOCITY_TYPES, "scan": (LASER_SCAN,)}
@@ -72,7 +72,7 @@ def unread_topics(
                 continue
             for robot in robots:
                 msgtype = canonical_type(read.msgtype)
-                lacks(topic_name(read.topic, robot.namespace), (msgtype,), msgtype, f"metric {metric.name}")
+                lacks(expand_topic(read.topic, robot.namespace), (msgtype,), msgtype, f"metric {metric.name}")
     return [_said(unread, bag) for unread in found.values()]
 
 
@@ -84,16 +84,16 @@ def _robot_sources(robot: Robot, bag: Mapping[str, str], lacks: Lacks) -> None:
         topics = [s for s in sources if isinstance(s, TopicSource)]
         if signal not in signals.said or len(topics) < len(sources):
             continue  # the convention's own (a fallback is expected to be absent), or a TF chain
-        if any(topic_name(s.topic, ns) in bag for s in topics):
+        if any(expand_topic(s.topic, ns) in bag for s in topics):
             continue
         for source in topics:
             msgtype = canonical_type(source.msgtype) if source.msgtype else ""
             expected, kind = ((msgtype,), msgtype) if msgtype else (types, f"{signal}")
-            lacks(topic_name(source.topic, ns), expected, kind, f"the {signal} of '{robot.id}'")
+            lacks(expand_topic(source.topic, ns), expected, kind, f"the {signal} of '{robot.id}'")
     if "navigation" in signals.said:
-        actions = [topic_name(a, ns) for a in signals.actions]
+        actions = [expand_topic(a, ns) for a in signals.actions]
         prefixes = {t.rstrip("/") + "/" for t in actions}
-        if not any(topic_name(t, "").startswith(p) for t in bag for p in prefixes):
+        if not any(expand_topic(t, "").startswith(p) for t in bag for p in prefixes):
             for action in actions:
                 lacks(action, (), "navigation action", f"the navigation of '{robot.id}'")
 
@@ -137,7 +137,7 @@ def missing_metrics(
     metrics: Iterable[MetricDefinition],
     robots: Sequence[Robot],
     acting: Iterable[str],
-    segments: Sequence[Segment],
+    segments: Sequence[RecordedAction],
     values: Sequence[MetricValue],
 ) -> list[str]:
     """The values a run should have and has not: each robot metric of each robot that has tasks
@@ -165,5 +165,5 @@ def missing_metrics(
     return lacking
 
 
-def _action(segment: Segment) -> ActionId:
+def _action(segment: RecordedAction) -> ActionId:
     return ActionId(segment.robot, segment.allocation, segment.subtask, segment.waypoint)

@@ -22,7 +22,7 @@ import numpy as np
 
 from exsce_dsl.model.conventions import METHOD, Navigation, TfSource, TopicSource
 from exsce_dsl.model.messages import FieldPath
-from exsce_dsl.model.metrics import topic_name
+from exsce_dsl.model.metrics import expand_topic
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import MetricValue
 from exsce_dsl.monitor_kit.monitor_core import Topic
@@ -71,7 +71,7 @@ class StackRobots:
             if robot.id not in self.serves:
                 continue
             for signal, pattern in SERVED.items():
-                name = topic_name(pattern, robot.namespace)
+                name = expand_topic(pattern, robot.namespace)
                 served = adapted.pop(name, None)
                 if served is not None:
                     popped[name] = served
@@ -80,7 +80,7 @@ class StackRobots:
             signals = robot.signals
             if signals.navigation is not Navigation.DISPATCHER:
                 for pattern in (FEEDBACK, RESULT):
-                    adapted.pop(topic_name(pattern, robot.namespace), None)
+                    adapted.pop(expand_topic(pattern, robot.namespace), None)
             adapted.update(goal_wanted(signals, robot.namespace))
         for topic, more in signals_wanted(self.sources.values(), scan_paths).items():
             # a source that is a served topic itself (the method's robot_pose) keeps what the
@@ -114,7 +114,7 @@ class StackRobots:
                 topic = signals.get(signal_topic(signal, robot.namespace))
                 if topic is None:
                     continue
-                name = topic_name(pattern, robot.namespace)
+                name = expand_topic(pattern, robot.namespace)
                 found[name] = _as_method_fields(name, signal, topic, robot.three_d)
                 self.real_topics[name] = robot.used[signal].topics
                 if robot.used[signal].from_pose:
@@ -146,7 +146,7 @@ class StackRobots:
                 ("scan", signals.scan),
                 ("distance", signals.distance),
             ):
-                served = topic_name(SERVED[signal], ns)
+                served = expand_topic(SERVED[signal], ns)
                 chosen = mine.used.get(signal) or mine.chosen.get(signal)
                 looked = [_looked_for(s, ns) for s in sources]
                 if chosen is not None:
@@ -160,13 +160,13 @@ class StackRobots:
                 names = [signal_topic(signal, ns)] + ([served] if robot.id in self.serves else [])
                 found.update(dict.fromkeys(names, said))
             if signals.navigation is not Navigation.DISPATCHER:
-                actions = ", ".join(topic_name(a, ns) for a in signals.actions)
+                actions = ", ".join(expand_topic(a, ns) for a in signals.actions)
                 said = (
                     f"no navigation goals (looked for {actions})"
                     if actions
                     else "no path segments (no navigation goals, and no arrival at its planned waypoints)"
                 )
-                found.update(dict.fromkeys((topic_name(FEEDBACK, ns), topic_name(RESULT, ns)), said))
+                found.update(dict.fromkeys((expand_topic(FEEDBACK, ns), expand_topic(RESULT, ns)), said))
         return found
 
     def recorded_span(self, robot: Robot, topics: Mapping[str, Topic]) -> tuple[float, float] | None:
@@ -196,8 +196,8 @@ def stack_robots(robots: list[Robot], available: Mapping[str, str], serves: set[
 
 def _looked_for(source: TopicSource | TfSource, ns: str) -> str:
     if isinstance(source, TfSource):
-        return f"TF {source.fixed} -> {source.body} on {topic_name(source.tf, ns)}"
-    return topic_name(source.topic, ns)
+        return f"TF {source.fixed} -> {source.body} on {expand_topic(source.tf, ns)}"
+    return expand_topic(source.topic, ns)
 
 
 def _as_method_fields(name: str, signal: str, topic: Topic, three_d: bool) -> Topic:

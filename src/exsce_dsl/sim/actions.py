@@ -10,7 +10,7 @@ from exsce_dsl.model.goals import GoalStatus as GoalStatus
 
 
 @dataclass(frozen=True)
-class Action:
+class SimulatedAction:
     """One waypoint goal: the ground truth of a path segment."""
 
     robot: str

@@ -19,7 +19,7 @@ import numpy as np
 from exsce_dsl.errors import ExsceError, PlanningError
 from exsce_dsl.maps.planning import PlanningGrid, Point
 from exsce_dsl.model import MissionType, Pose, Scenario
-from exsce_dsl.sim.actions import Action, GoalEvent, GoalStatus
+from exsce_dsl.sim.actions import GoalEvent, GoalStatus, SimulatedAction
 from exsce_dsl.sim.conflicts import MAX_REPAIRS, Leg, Repair, conflict_repairs, meetings
 from exsce_dsl.sim.faults import (
     DEADLOCK_WAIT,
@@ -68,7 +68,7 @@ class Execution:
 
     trajectories: dict[str, Trajectory]
     events: list[GoalEvent]
-    actions: list[Action]
+    actions: list[SimulatedAction]
     duration: float
 
 
@@ -113,7 +113,9 @@ def execute(
     return execution
 
 
-def _can_go_round(repair: Repair, actions: list[Action], avoid: dict[Leg, tuple[Point, ...]]) -> bool:
+def _can_go_round(
+    repair: Repair, actions: list[SimulatedAction], avoid: dict[Leg, tuple[Point, ...]]
+) -> bool:
     """The repair would change its leg: the place is not tried yet (nor one near it) and not
     so near the leg's ends that its path cannot go round it."""
     if any(math.dist(repair.place, p) < TRIED for p in avoid.get(repair.leg, ())):
@@ -166,7 +168,7 @@ class _Play:
         }
         self.skip = {(f.robot, f.index) for f in faults if f.kind == "skip-waypoint"}
         self.events: list[GoalEvent] = []
-        self.actions: list[Action] = []
+        self.actions: list[SimulatedAction] = []
         self.last_pose = {r.id: r.start_pose for r in scenario.robots if r.start_pose is not None}
         self.task_numbers: dict[str, int] = {}
         self.waypoint_counts: dict[str, int] = {}
@@ -213,7 +215,7 @@ class _Play:
             length = _length(path) if status is GoalStatus.SUCCEEDED else 0.0
             number = self.task_numbers[robot]
             self.actions.append(
-                Action(
+                SimulatedAction(
                     robot,
                     number,
                     task_id,
@@ -398,4 +400,4 @@ def _standing(parked: dict[str, Point], avoid: tuple[Point, ...]) -> tuple[Point
     return tuple(parked.values()) + avoid
 
 
-__all__ = ["Action", "Execution", "Fault", "GoalEvent", "GoalStatus", "execute", "np"]
+__all__ = ["SimulatedAction", "Execution", "Fault", "GoalEvent", "GoalStatus", "execute", "np"]

@@ -14,7 +14,7 @@ from dataclasses import replace
 import numpy as np
 
 from exsce_dsl.model import Scenario
-from exsce_dsl.sim.actions import Action, GoalEvent
+from exsce_dsl.sim.actions import GoalEvent, SimulatedAction
 from exsce_dsl.sim.conflicts import CLEARANCE
 from exsce_dsl.sim.motion import DT, Trajectory
 
@@ -28,8 +28,11 @@ STEP = DT / RAMP  # the most a robot's rate changes in one sample
 
 
 def give_way(
-    scenario: Scenario, trajectories: dict[str, Trajectory], events: list[GoalEvent], actions: list[Action]
-) -> tuple[dict[str, Trajectory], list[GoalEvent], list[Action]]:
+    scenario: Scenario,
+    trajectories: dict[str, Trajectory],
+    events: list[GoalEvent],
+    actions: list[SimulatedAction],
+) -> tuple[dict[str, Trajectory], list[GoalEvent], list[SimulatedAction]]:
     """Right of way by fleet order, replayed on the trajectories (paths unchanged, clocks warped).
 
     Each robot advances along its own trajectory at a rate between -1 (backing up
@@ -61,7 +64,9 @@ class _Replay:
     """All robots replayed together, one sample at a time: where each stands along its own
     trajectory (a fractional sample index), at what rate it advances, and how long it has waited."""
 
-    def __init__(self, trajectories: dict[str, Trajectory], order: list[str], actions: list[Action]) -> None:
+    def __init__(
+        self, trajectories: dict[str, Trajectory], order: list[str], actions: list[SimulatedAction]
+    ) -> None:
         self.trajectories, self.order = trajectories, order
         self.position = {r: 0.0 for r in order}  # fractional sample index along the robot's own trajectory
         self.rate = {r: 1.0 for r in order}

@@ -16,7 +16,6 @@ from __future__ import annotations
 import datetime as dt
 import os
 import shutil
-import uuid
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -25,8 +24,8 @@ from exsce_dsl.errors import ExsceError
 from exsce_dsl.maps.planning import PlanningGrid, planning_grid
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.conventions import Signals
-from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Run, run_name
-from exsce_dsl.parallel.cluster import cluster_mapper
+from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Run, run_name, run_uuid
+from exsce_dsl.parallel.dask_client import dask_map
 from exsce_dsl.prov.recorder import recorded_prov_json, recorded_run
 from exsce_dsl.sim.bag import write_bag
 from exsce_dsl.sim.conventions import convention_writer
@@ -38,7 +37,6 @@ FORMATS = ("ros1", "ros2", "mcap")
 #: well before 2038-01-19.
 EPOCH = dt.datetime(2026, 1, 1, tzinfo=dt.timezone.utc)
 SEED_DAYS = 4_000
-_RUN_NAMESPACE = uuid.UUID("7f0f3f5e-5a3c-4c1e-9d8e-6b0e2a1c9d41")
 
 
 @dataclass(frozen=True)
@@ -97,7 +95,7 @@ def simulate(
     faults: Sequence[Fault] = (),
     convention: Signals | str | None = None,
     twist_stamped: bool = False,
-    cluster: str | None = None,
+    dask_address: str | None = None,
 ) -> Iterator[SimulatedRun]:
     """Play ``scenario`` ``runs`` times and write one bag per run into ``out_dir``, in run order.
 
@@ -107,17 +105,17 @@ def simulate(
     navigation stacks' ``cmd_vel`` a TwistStamped (Nav2 from Jazzy on).  Runs in another
     convention than the method's get other run ids, so their bags can share a folder.
 
-    With ``cluster`` (a Dask scheduler's address) each run is one task on the cluster's workers,
+    With ``dask_address`` (a Dask scheduler's address) each run is one task on the cluster's workers,
     with the same run ids and the same bytes.  The workers write the bags: ``out_dir`` (made
     absolute here) and the scenario's map file must be the same paths on every worker (a shared
     filesystem).  A task is tried twice, and a killed worker's task goes to another worker; a run
     that failed even so does not stop the others: when they are done, an :class:`ExsceError`
     names each failed run by its index."""
-    if cluster is not None:
+    if dask_address is not None:
         shared = _with_absolute_map(scenario)
         plan = RunPlan.of(shared, out_dir.absolute(), fmt, seed, faults, convention, twist_stamped)
         plan.out_dir.mkdir(parents=True, exist_ok=True)
-        return _on_cluster(cluster, plan, runs, out_dir)
+        return _on_dask(dask_address, plan, runs, out_dir)
     plan = RunPlan.of(scenario, out_dir, fmt, seed, faults, convention, twist_stamped)
     out_dir.mkdir(parents=True, exist_ok=True)
     return _here(plan, runs)
@@ -129,9 +127,9 @@ def _here(plan: RunPlan, runs: int) -> Iterator[SimulatedRun]:
         yield play_run(plan, index, grid)
 
 
-def _on_cluster(address: str, plan: RunPlan, runs: int, out_dir: Path) -> Iterator[SimulatedRun]:
+def _on_dask(address: str, plan: RunPlan, runs: int, out_dir: Path) -> Iterator[SimulatedRun]:
     failed: list[str] = []
-    with cluster_mapper(address) as mapper:
+    with dask_map(address) as mapper:
         for index, played in enumerate(mapper(_play_task, [(plan, index) for index in range(runs)])):
             if isinstance(played, SimulatedRun):
                 yield replace(played, bag=out_dir / played.bag.name)
@@ -169,12 +167,8 @@ def play_run(plan: RunPlan, index: int, grid: PlanningGrid | None = None) -> Sim
     run_seed = plan.seed * 1000 + index
     # days wrap so that every seed gives a time ROS 1 can stamp (see SEED_DAYS)
     start = EPOCH + dt.timedelta(days=plan.seed % SEED_DAYS, hours=index)
-    run_id = str(
-        uuid.uuid5(
-            _RUN_NAMESPACE,
-            f"{scenario.id}/{plan.seed}/{index}/{','.join(f.identity for f in plan.faults)}{plan.variant}",
-        )
-    )
+    faults = ",".join(f.identity for f in plan.faults)
+    run_id = run_uuid("simulated", f"{scenario.id}/{plan.seed}/{index}/{faults}{plan.variant}")
     grid = planning_grid(scenario) if grid is None else grid
     execution = execute(scenario, grid, run_seed, plan.faults)
     name = run_name(start, scenario.id, run_id)

@@ -9,10 +9,11 @@ from typing import Any
 
 from pyoxigraph import BlankNode, NamedNode
 
+from exsce_dsl.prov.identifiers import XSD_STRING
 from exsce_dsl.store.base import Rows, Term
 from exsce_dsl.store.literals import canonical_literal, literal_text
 
-_XSD_STRING = "http://www.w3.org/2001/XMLSchema#string"
+_XSD_STRING = XSD_STRING
 
 
 def term_json(term: Term) -> dict[str, str]:

@@ -47,6 +47,7 @@ from pyoxigraph import (
 )
 
 from exsce_dsl import __version__
+from exsce_dsl.prov.identifiers import SKOLEM_BASE
 from exsce_dsl.store import virtuoso
 from exsce_dsl.store.base import Bindings, GraphSet, Replace, Rows, Store, StoreError
 from exsce_dsl.store.sparql import bind, graph_node, query_form, term_text, write_update
@@ -59,7 +60,7 @@ go as a body, since web servers cap forms (Jetty, under Fuseki, at 200 kB)."""
 ASK_VIRTUOSO = "__ASK_RETVAL"
 """Virtuoso answers ASK as a table with this one column: one row of 1 when true, none when false."""
 N_TRIPLES = "application/n-triples"
-SKOLEM = "https://www.sesame-project.org/.well-known/genid/exsce/"
+SKOLEM = SKOLEM_BASE
 """Where the IRIs that stand for blank nodes on Virtuoso begin (RDF 1.1 Concepts, 3.5): written
 in their place, read back as blank nodes."""
 

@@ -19,11 +19,12 @@ from __future__ import annotations
 
 from pyoxigraph import BlankNode, Literal, NamedNode, RdfFormat, Triple, parse
 
+from exsce_dsl.prov.identifiers import LDP_NAMESPACE, SPARQL_RESULTS_NAMESPACE, XSD_NAMESPACE
 from exsce_dsl.store.base import Rows, StoreError, Term
 
 OWN_GRAPHS = (
     "http://www.openlinksw.com/schemas/virtrdf#",
-    "http://www.w3.org/ns/ldp#",
+    LDP_NAMESPACE,
     "http://localuriqaserver/",
     "http://www.openlinksw.com/",
 )
@@ -32,8 +33,8 @@ listed, exported or cleared (dropping ``virtrdf#`` breaks the server)."""
 
 TURTLE = "text/turtle"
 
-_RES = "http://www.w3.org/2005/sparql-results#"
-_XSD = "http://www.w3.org/2001/XMLSchema#"
+_RES = SPARQL_RESULTS_NAMESPACE
+_XSD = XSD_NAMESPACE
 _DECIMAL, _DOUBLE = NamedNode(_XSD + "decimal"), NamedNode(_XSD + "double")
 _INT, _INTEGER = NamedNode(_XSD + "int"), NamedNode(_XSD + "integer")
 

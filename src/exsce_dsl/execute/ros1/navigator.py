@@ -26,7 +26,7 @@ from exsce_dsl.execute.ros1.channel import Message, NodeChannel
 from exsce_dsl.model import Pose, Scenario
 from exsce_dsl.model.conventions import Navigation
 from exsce_dsl.model.geometry import quaternion
-from exsce_dsl.model.metrics import topic_name
+from exsce_dsl.model.metrics import expand_topic
 
 MOVE_BASE_ACTION = "/{ns}/move_base"
 STARTUP = 30.0
@@ -56,7 +56,7 @@ def move_base_actions(scenario: Scenario) -> dict[str, str]:
                 f"robot '{robot.id}' navigates with Nav2 (ROS 2); ROS 1 sends move_base goals"
             )
         pattern = signals.actions[0] if signals.navigation is Navigation.MOVE_BASE else MOVE_BASE_ACTION
-        name = topic_name(pattern, robot.namespace)
+        name = expand_topic(pattern, robot.namespace)
         if not _NAME.match(name):
             raise RosGraphError(f"robot '{robot.id}': '{name}' is not a ROS action name")
         actions[robot.id] = name

@@ -32,7 +32,7 @@ from exsce_dsl.execute.outcomes import Outcome
 from exsce_dsl.model import Pose, Scenario
 from exsce_dsl.model.conventions import NAV2, Navigation
 from exsce_dsl.model.geometry import quaternion
-from exsce_dsl.model.metrics import topic_name
+from exsce_dsl.model.metrics import expand_topic
 from exsce_dsl.model.robots import Robot
 
 NAVIGATE_TO_POSE = "nav2_msgs/action/NavigateToPose"
@@ -112,8 +112,8 @@ def nav2_actions(robot: Robot) -> Nav2Actions:
     waypoints = [a for a in named if _leaf(a) == "follow_waypoints"]
     defaults = {_leaf(a): a for a in NAV2.actions}
     return Nav2Actions(
-        topic_name((to_pose or [defaults["navigate_to_pose"]])[0], robot.namespace),
-        topic_name((waypoints or [defaults["follow_waypoints"]])[0], robot.namespace),
+        expand_topic((to_pose or [defaults["navigate_to_pose"]])[0], robot.namespace),
+        expand_topic((waypoints or [defaults["follow_waypoints"]])[0], robot.namespace),
     )
 
 

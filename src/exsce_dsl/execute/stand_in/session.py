@@ -25,7 +25,7 @@ from exsce_dsl.execute.ros1.graph import Master
 from exsce_dsl.execute.stand_in.legs import Fleet
 from exsce_dsl.maps.planning import planning_grid
 from exsce_dsl.model import Scenario
-from exsce_dsl.model.metrics import topic_name
+from exsce_dsl.model.metrics import expand_topic
 from exsce_dsl.sim.faults import Fault
 
 NODE = "/exsce_stand_in"
@@ -75,7 +75,7 @@ class StandIn:
     @property
     def actions(self) -> dict[str, str]:
         """Each robot's ``move_base`` action name."""
-        return {name: topic_name("/{ns}/move_base", r.namespace) for name, r in self.fleet.robots.items()}
+        return {name: expand_topic("/{ns}/move_base", r.namespace) for name, r in self.fleet.robots.items()}
 
     def goals_ended(self) -> list[GoalEnd]:
         with self._lock:

@@ -24,7 +24,7 @@ from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import ActionId, Hotspot, MetricScope, MetricValue
 from exsce_dsl.monitor_kit import monitor_core as core
 from exsce_dsl.runs.metrics.monitor_code import reads_used
-from exsce_dsl.runs.segments.segment import Segment
+from exsce_dsl.runs.segments.recorded import RecordedAction
 
 HOTSPOT_RADIUS = 1.0  # metres: violations closer than this to a hotspot belong to it
 POSE_TOPIC = "/{ns}/robot_pose"
@@ -32,7 +32,7 @@ POSE_TOPIC = "/{ns}/robot_pose"
 HOTSPOT_PATHS = (path_of("pose", "pose", "position", "x"), path_of("pose", "pose", "position", "y"))
 """What hotspots read of the pose."""
 
-Window = tuple[Segment | None, float, float]
+Window = tuple[RecordedAction | None, float, float]
 
 
 def compute_metrics(
@@ -40,7 +40,7 @@ def compute_metrics(
     metrics: Sequence[MetricDefinition],
     robots: Sequence[Robot],
     topics: Mapping[str, core.Topic],
-    actions: Sequence[Segment],
+    actions: Sequence[RecordedAction],
     results: Mapping[str, int | None],
     problems: list[str],
     whole_runs: Mapping[str, tuple[float, float]] | None = None,
@@ -90,7 +90,7 @@ def _topics(metric: MetricDefinition, alternative: int, namespaces: Sequence[str
     for n, ns in enumerate(namespaces):
         for whose, read in used:
             if whose is None or (metric.pair is not None and metric.pair.index(whose) == n):
-                topic = core.topic_name(patterns[read], ns)
+                topic = core.expand_topic(patterns[read], ns)
                 if topic not in found:
                     found.append(topic)
     return tuple(found)
@@ -221,7 +221,7 @@ def _robot_violations(
         where = _position_at(pose, t[over])
         hotspots.extend(
             Hotspot(metric.name, Position(float(c[0]), float(c[1])), n, d, robot.id)
-            for c, n, d in cluster(where, held[over])
+            for c, n, d in group_hotspots(where, held[over])
         )
     return [
         MetricValue(
@@ -275,7 +275,7 @@ def _mission_values(
             middle = (_position_at(poses[0], t[over]) + _position_at(poses[1], t[over])) / 2
             hotspots.extend(
                 Hotspot(metric.name, Position(float(c[0]), float(c[1])), n, d)
-                for c, n, d in cluster(middle, held[over])
+                for c, n, d in group_hotspots(middle, held[over])
             )
     found = [MetricValue(metric.name, MetricScope.MISSION, value, tuple(source), unit=metric.unit or None)]
     if metric.safety is not None:
@@ -311,7 +311,7 @@ def _pairs_missing(
 
 
 def _pose(topics: Mapping[str, core.Topic], namespace: str) -> core.Topic | None:
-    found = topics.get(core.topic_name(POSE_TOPIC, namespace))
+    found = topics.get(core.expand_topic(POSE_TOPIC, namespace))
     return found if found is not None and len(found) else None
 
 
@@ -324,7 +324,7 @@ def _position_at(pose: core.Topic, times: np.ndarray) -> np.ndarray:
     )
 
 
-def cluster(points: np.ndarray, durations: np.ndarray) -> list[tuple[np.ndarray, int, float]]:
+def group_hotspots(points: np.ndarray, durations: np.ndarray) -> list[tuple[np.ndarray, int, float]]:
     """Greedy spatial clustering: a point joins the first centre within HOTSPOT_RADIUS."""
     centres: list[list[float]] = []
     members: list[list[int]] = []

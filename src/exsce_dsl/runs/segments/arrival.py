@@ -9,7 +9,7 @@ For a robot whose bag holds no goals at all, only its pose track.  The rules:
    moment it set off, not the start of the recording (a bag often begins well before the
    mission).  If it set off at once, that is the track's first sample.  A robot that never
    moved: every segment NOT_STARTED, with a warning.
-2. **Arrival.**  Segment k ends at the first sample, at or after segment k-1's end (the first
+2. **Arrival.**  The k-th segment ends at the first sample, at or after segment k-1's end (the first
    one: its start), where the robot is within the `Tolerance` of waypoint k (in 3-D when the
    waypoint gives a height or the robot's type says ``motion 3d``: see `track.near`); it starts when
    segment k-1 ended, so the time spent at a waypoint counts to the next segment, as the

@@ -14,13 +14,13 @@ from exsce_dsl.errors import SegmentError as SegmentError
 from exsce_dsl.model import Pose, Scenario
 from exsce_dsl.model.goals import ACTIONLIB_FINAL, GoalStatus, actionlib_names
 from exsce_dsl.runs.bags.reading import StatusUpdate
-from exsce_dsl.runs.segments.segment import Segment
+from exsce_dsl.runs.segments.recorded import RecordedAction
 
 ACTIVE, SUCCEEDED = GoalStatus.ACTIVE, GoalStatus.SUCCEEDED
 FINAL = {code: name for code, name in actionlib_names().items() if code in ACTIONLIB_FINAL}
 
 
-def segments(scenario: Scenario, robot: str, updates: list[StatusUpdate]) -> list[Segment]:
+def segments(scenario: Scenario, robot: str, updates: list[StatusUpdate]) -> list[RecordedAction]:
     """The actions of ``robot`` in a run, from its dispatcher feedback ``updates`` (time order)."""
     plan = planned_goals(scenario, robot)
     goals = dispatcher_goals(updates)
@@ -29,7 +29,7 @@ def segments(scenario: Scenario, robot: str, updates: list[StatusUpdate]) -> lis
             f"robot '{robot}' ran {len(goals)} dispatcher goals but scenario '{scenario.id}' "
             f"gives it {len(plan)} subtasks: the bag is from another scenario"
         )
-    out: list[Segment] = []
+    out: list[RecordedAction] = []
     robot_decl = scenario.robot(robot)
     previous = robot_decl.start_pose if robot_decl is not None else None
     for index, (allocation, task, subtask, poses) in enumerate(plan):
@@ -47,7 +47,7 @@ def segments(scenario: Scenario, robot: str, updates: list[StatusUpdate]) -> lis
             status = FINAL[final[1]] if final else ("ACTIVE" if start is not None else "NOT_STARTED")
             assert previous is not None  # the checks ensure robots with tasks have a start pose
             out.append(
-                Segment(
+                RecordedAction(
                     robot,
                     allocation,
                     task,

@@ -19,7 +19,7 @@ from exsce_dsl.model.robots import Robot
 from exsce_dsl.runs.bags.reading import BagData
 from exsce_dsl.runs.segments.arrival import arrival_segments
 from exsce_dsl.runs.segments.goals import goal_segments
-from exsce_dsl.runs.segments.segment import Segment
+from exsce_dsl.runs.segments.recorded import RecordedAction
 from exsce_dsl.runs.segments.track import SUCCEEDED, Track
 from exsce_dsl.runs.signals.navigation_goals import read_goals
 
@@ -30,7 +30,7 @@ DISPATCHER_SOURCE = "the waypoint dispatcher"
 class RobotSegments:
     """One robot's segments, what segmented them, and what it could not make sense of."""
 
-    segments: list[Segment]
+    segments: list[RecordedAction]
     source: str
     succeeded: int | None
     topics: tuple[str, ...] = ()
@@ -47,7 +47,7 @@ class SegmentInput:
     robot: Robot
     data: BagData
     track: Track
-    dispatcher: list[Segment] | None
+    dispatcher: list[RecordedAction] | None
     problems: list[str] = field(default_factory=list)
 
 
@@ -101,7 +101,7 @@ SEGMENT_SOURCES: tuple[SegmentSource, ...] = (
 
 
 def segment_robot(
-    scenario: Scenario, robot: Robot, data: BagData, track: Track, dispatcher: list[Segment] | None
+    scenario: Scenario, robot: Robot, data: BagData, track: Track, dispatcher: list[RecordedAction] | None
 ) -> RobotSegments:
     """The robot's segments from the first of :data:`SEGMENT_SOURCES` that gives any;
     ``dispatcher``: its segments from the method's dispatcher, if its bag has that."""
@@ -119,9 +119,9 @@ def segment_robot(
     return RobotSegments([], "", None, (), tuple(given.problems))
 
 
-def _started(segments: list[Segment] | tuple[Segment, ...]) -> bool:
+def _started(segments: list[RecordedAction] | tuple[RecordedAction, ...]) -> bool:
     return any(s.start is not None for s in segments)
 
 
-def _succeeded(segments: tuple[Segment, ...]) -> int:
+def _succeeded(segments: tuple[RecordedAction, ...]) -> int:
     return sum(s.status == SUCCEEDED for s in segments)

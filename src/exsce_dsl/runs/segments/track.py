@@ -5,7 +5,7 @@ waypoint's pose.  The dispatcher's statuses (`segments`) say which waypoint each
 real stacks do not run the dispatcher, so `goal_segments` matches their navigation goals to the
 planned waypoints by pose and `arrival_segments` watches the robot's pose arrive at them.  Both
 find, for each planned waypoint, an `Outcome` (start, end, status), and `build_segmentation` turns the
-outcomes into `Segment`s with the same start-pose rule:
+outcomes into `RecordedAction`s with the same start-pose rule:
 
 - a segment the robot attempted (one with a start time) starts where it is expected to be: at
   the goal pose of the previous attempted segment if that one SUCCEEDED (SKIPPED and NOT_STARTED
@@ -34,7 +34,7 @@ import numpy.typing as npt
 from exsce_dsl.model import Orientation, Pose, Position, Scenario
 from exsce_dsl.model.conventions import Tolerance
 from exsce_dsl.runs.segments.dispatcher import SegmentError, planned_goals
-from exsce_dsl.runs.segments.segment import Segment
+from exsce_dsl.runs.segments.recorded import RecordedAction
 
 Floats = npt.NDArray[np.float64]
 Flags = npt.NDArray[np.bool_]
@@ -128,7 +128,7 @@ class Track:
 
 @dataclass(frozen=True)
 class PlannedWaypoint:
-    """One waypoint of a robot's plan, numbered as `Segment` numbers it."""
+    """One waypoint of a robot's plan, numbered as `RecordedAction` numbers it."""
 
     allocation: int  # the robot's n-th task, from 1
     task: str
@@ -165,7 +165,7 @@ class Outcome:
 class Segmentation:
     """A robot's path segments from one source, and what the source could not make sense of."""
 
-    segments: tuple[Segment, ...]
+    segments: tuple[RecordedAction, ...]
     warnings: tuple[str, ...]
 
 
@@ -186,9 +186,9 @@ def build_segmentation(
     declared = scenario.robot(robot)
     assert declared is not None  # planned_waypoints checked it
     reached: Pose | None = None  # the last SUCCEEDED goal pose
-    attempted: Segment | None = None  # the last segment with a start time
+    attempted: RecordedAction | None = None  # the last segment with a start time
     untracked = False
-    out: list[Segment] = []
+    out: list[RecordedAction] = []
     for planned, outcome in zip(plan, outcomes, strict=True):
         home = reached or declared.start_pose
         start_pose: Pose | None = home
@@ -207,7 +207,7 @@ def build_segmentation(
                 untracked = True
         if start_pose is None:
             raise SegmentError(f"robot '{robot}' has no start pose and no pose track to take one from")
-        segment = Segment(
+        segment = RecordedAction(
             robot,
             planned.allocation,
             planned.task,

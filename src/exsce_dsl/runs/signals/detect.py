@@ -42,7 +42,7 @@ from exsce_dsl.model.conventions import (
     TfSource,
     TopicSource,
 )
-from exsce_dsl.model.metrics import topic_name
+from exsce_dsl.model.metrics import expand_topic
 from exsce_dsl.model.robots import Robot, RobotType
 
 TF_CHAINS = tuple(
@@ -90,14 +90,14 @@ def with_detected_conventions(
 def detect_convention(robot: Robot, types: Mapping[str, str]) -> tuple[Signals, Detected]:
     """The signals of ``robot`` as its bag has them (the rules of this module's docstring)."""
     ns = robot.namespace
-    dispatcher = topic_name("/{ns}/waypoint_dispatcher/feedback", ns)
+    dispatcher = expand_topic("/{ns}/waypoint_dispatcher/feedback", ns)
     if dispatcher in types:
         return METHOD, Detected(robot.id, "method", (dispatcher,))
     for action in NAV2.actions:
-        status = topic_name(f"{action}/_action/status", ns)
+        status = expand_topic(f"{action}/_action/status", ns)
         if status in types:
             return NAV2, Detected(robot.id, "nav2", (status,))
-    move_base = topic_name(f"{MOVE_BASE.actions[0]}/status", ns)
+    move_base = expand_topic(f"{MOVE_BASE.actions[0]}/status", ns)
     if move_base in types:
         return MOVE_BASE, Detected(robot.id, "move_base", (move_base,))
     return _without_goals(robot, types)
@@ -109,11 +109,11 @@ def _without_goals(robot: Robot, types: Mapping[str, str]) -> tuple[Signals, Det
     odometry = _odometries(mine, ns)
     poses: list[PoseSource] = []
     evidence: list[str] = []
-    tf = topic_name("/{ns}/tf", ns)
+    tf = expand_topic("/{ns}/tf", ns)
     if types.get(tf) == "tf2_msgs/msg/TFMessage":
         poses += TF_CHAINS
         evidence.append(tf)
-    amcl = topic_name("/{ns}/amcl_pose", ns)
+    amcl = expand_topic("/{ns}/amcl_pose", ns)
     if mine.get(amcl) == POSE_WITH_COVARIANCE:
         poses.append(TopicSource(amcl, POSE_WITH_COVARIANCE))
         evidence.append(amcl)
@@ -123,11 +123,11 @@ def _without_goals(robot: Robot, types: Mapping[str, str]) -> tuple[Signals, Det
     if len(streams) == 1:
         poses.append(TopicSource(streams[0], mine[streams[0]]))
         evidence.append(streams[0])
-    cmd_vel = topic_name("/{ns}/cmd_vel", ns)
+    cmd_vel = expand_topic("/{ns}/cmd_vel", ns)
     velocity = [TopicSource(cmd_vel)] if mine.get(cmd_vel) in (TWIST, TWIST_STAMPED) else []
     velocity += [TopicSource(t, ODOMETRY) for t in odometry]
     scans = sorted(t for t, m in mine.items() if m == LASER_SCAN)
-    scan_topic = topic_name("/{ns}/scan", ns)
+    scan_topic = expand_topic("/{ns}/scan", ns)
     scan = [scan_topic] if scan_topic in scans else scans[:1] if len(scans) == 1 else []
     signals = Signals(
         convention="detected",
@@ -142,7 +142,7 @@ def _without_goals(robot: Robot, types: Mapping[str, str]) -> tuple[Signals, Det
 
 def _odometries(mine: Mapping[str, str], ns: str) -> list[str]:
     """The namespace's odometry topics, ``/{ns}/odom`` first, then the others by name."""
-    own = topic_name("/{ns}/odom", ns)
+    own = expand_topic("/{ns}/odom", ns)
     found = sorted(t for t, m in mine.items() if m == ODOMETRY)
     return sorted(found, key=lambda t: t != own)
 
@@ -195,7 +195,7 @@ def robot_namespaces(types: Mapping[str, str]) -> list[tuple[str, Signals, Detec
     interfaces = [f"{action}/_action/status" for action in NAV2.actions]
     interfaces += [f"{MOVE_BASE.actions[0]}/status", "/{ns}/waypoint_dispatcher/feedback"]
     at_root = any("/" not in t.lstrip("/") and m in _ROBOT_TYPES for t, m in types.items()) or any(
-        topic_name(i, "") in types for i in interfaces
+        expand_topic(i, "") in types for i in interfaces
     )
     found: list[tuple[str, Signals, Detected]] = []
     for namespace in ([""] if at_root else []) + namespaces:

@@ -27,7 +27,7 @@ import numpy as np
 
 from exsce_dsl.model.conventions import Navigation, Signals
 from exsce_dsl.model.goals import ACTION_FINAL, ACTIONLIB_FINAL, action_names, actionlib_names
-from exsce_dsl.model.metrics import topic_name
+from exsce_dsl.model.metrics import expand_topic
 from exsce_dsl.runs.bags.reading import OBJECTS, BagData, Wanted
 from exsce_dsl.runs.signals.tf_poses import yaw_from_quaternion
 
@@ -72,11 +72,11 @@ Messages = Sequence[tuple[float, Any]]
 def goal_wanted(signals: Signals, namespace: str) -> dict[str, Wanted]:
     """What the robot's navigation goals are read from, all as message objects (few: a status
     array a second and at each change, a plan per goal or replanning)."""
-    actions = [topic_name(a, namespace) for a in signals.actions]
+    actions = [expand_topic(a, namespace) for a in signals.actions]
     if signals.navigation is Navigation.NAV2:
         found = [f"{a}/_action/status" for a in actions]
         found += [f"{a}/_action/feedback" for a in actions if _follows_waypoints(a)]
-        return {t: Wanted(OBJECTS) for t in [*found, topic_name(PLAN, namespace)]}
+        return {t: Wanted(OBJECTS) for t in [*found, expand_topic(PLAN, namespace)]}
     if signals.navigation is Navigation.MOVE_BASE:
         return {f"{a}/{part}": Wanted(OBJECTS) for a in actions for part in ("goal", "status", "result")}
     return {}
@@ -85,7 +85,7 @@ def goal_wanted(signals: Signals, namespace: str) -> dict[str, Wanted]:
 def read_goals(signals: Signals, namespace: str, data: BagData) -> tuple[list[Goal], list[str]]:
     """The robot's goals from the bag's messages, and the topics they came from."""
     messages = data.messages
-    actions = [topic_name(a, namespace) for a in signals.actions]
+    actions = [expand_topic(a, namespace) for a in signals.actions]
     goals: list[Goal] = []
     used: list[str] = []
     for action in actions:
@@ -94,10 +94,10 @@ def read_goals(signals: Signals, namespace: str, data: BagData) -> tuple[list[Go
             if not status:
                 continue
             feedback = messages.get(f"{action}/_action/feedback", []) if _follows_waypoints(action) else []
-            plans = messages.get(topic_name(PLAN, namespace), [])
+            plans = messages.get(expand_topic(PLAN, namespace), [])
             goals += _nav2_goals(status, feedback, plans)
             used += [f"{action}/_action/status"] + (
-                [topic_name(PLAN, namespace)] if plans is not None else []
+                [expand_topic(PLAN, namespace)] if plans is not None else []
             )
         elif signals.navigation is Navigation.MOVE_BASE:
             status = messages.get(f"{action}/status")

@@ -43,7 +43,7 @@ from exsce_dsl.model.conventions import (
     TopicSource,
 )
 from exsce_dsl.model.messages import FieldPath, canonical_type, path_of
-from exsce_dsl.model.metrics import signal_pattern, topic_name
+from exsce_dsl.model.metrics import expand_topic, signal_pattern
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.monitor_kit.monitor_core import Signal, Topic, speed
 from exsce_dsl.runs.bags.decode import TEXTS
@@ -79,7 +79,7 @@ _TF_TEXTS = (path_of("transforms", "header", "frame_id"), path_of("transforms", 
 
 def signal_topic(signal: str, namespace: str) -> str:
     """The name a robot's signal goes under among a run's topics (``~`` is in no bag's topics)."""
-    return topic_name(signal_pattern(signal), namespace)
+    return expand_topic(signal_pattern(signal), namespace)
 
 
 @dataclass(frozen=True)
@@ -177,12 +177,12 @@ def _present(
     signal: str, source: TopicSource | TfSource, types: tuple[str, ...], ns: str, available: Mapping[str, str]
 ) -> Chosen | None:
     if isinstance(source, TfSource):
-        tf, static = topic_name(source.tf, ns), topic_name(source.tf_static, ns)
+        tf, static = expand_topic(source.tf, ns), expand_topic(source.tf_static, ns)
         if available.get(tf) != TF_MESSAGE:
             return None
         topics = (tf, static) if available.get(static) == TF_MESSAGE else (tf,)
         return Chosen(signal, tf=source, tf_topics=topics)
-    topic = topic_name(source.topic, ns)
+    topic = expand_topic(source.topic, ns)
     msgtype = available.get(topic)
     if msgtype is None or msgtype not in types:
         return None
@@ -196,8 +196,8 @@ def _described(
 ) -> str:
     """A source looked for, and what the bag has there instead when it has the topic."""
     if isinstance(source, TfSource):
-        return f"TF {source.fixed} -> {source.body} on {topic_name(source.tf, ns)}"
-    topic = topic_name(source.topic, ns)
+        return f"TF {source.fixed} -> {source.body} on {expand_topic(source.tf, ns)}"
+    topic = expand_topic(source.topic, ns)
     there = available.get(topic)
     expected = (canonical_type(source.msgtype),) if source.msgtype else types
     if there is None or there in expected:

@@ -8,7 +8,7 @@ import json
 from exsce_dsl.model.campaign import (
     CampaignPlan,
     CampaignRecord,
-    Relation,
+    CheckedRelation,
     Request,
     Shrinking,
     ShrinkTry,
@@ -28,8 +28,8 @@ def _steps(text: str | None) -> tuple[Request, ...]:
     )
 
 
-def _relations(text: str | None) -> tuple[Relation, ...]:
-    return tuple(Relation.parse(part) for part in (text or "").split(";") if part.strip())
+def _relations(text: str | None) -> tuple[CheckedRelation, ...]:
+    return tuple(CheckedRelation.parse(part) for part in (text or "").split(";") if part.strip())
 
 
 def _plans(
@@ -92,7 +92,7 @@ def shrinkings(store: Store, campaign: str, namespace: str = DEFAULT_NAMESPACE) 
             found[number] = Shrinking(
                 campaign,
                 number,
-                Relation.parse(text_of(row["relation"]) or ""),
+                CheckedRelation.parse(text_of(row["relation"]) or ""),
                 int_of(row["trial"]),
                 text_of(row["original"]) or "",
                 text_of(row["minimal"]) or "",

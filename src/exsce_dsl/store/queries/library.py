@@ -66,7 +66,7 @@ KINDS: Mapping[str, Callable[[Namespaces, str], Term]] = {
     "point": lambda names, text: _iri(names, ids.POINT, text, "pose"),
     "id": lambda names, text: Literal(text),
     "run": lambda names, text: Literal(text),
-    "run_activity": lambda names, text: _iri(names, ids.RUN, ids.run_name(text), "run uuid"),
+    "run_activity": lambda names, text: _iri(names, ids.RUN, ids.run_local_name(text), "run uuid"),
     "robot": lambda names, text: Literal(text),
     "metric": lambda names, text: Literal(text),
     "metric_property": lambda names, text: _iri(names, ids.METRIC, text, "metric"),
@@ -186,8 +186,8 @@ def standard_prefixes(namespace: str = DEFAULT_NAMESPACE) -> dict[str, str]:
     return {
         "prov": ids.PROV_NAMESPACE,
         "xsd": ids.XSD_NAMESPACE,
-        "rdf": "http://www.w3.org/1999/02/22-rdf-syntax-ns#",
-        "rdfs": "http://www.w3.org/2000/01/rdf-schema#",
+        "rdf": ids.RDF_NAMESPACE,
+        "rdfs": ids.RDFS_NAMESPACE,
         **Namespaces(namespace).fixed,
     }
 

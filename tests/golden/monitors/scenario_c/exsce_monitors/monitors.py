@@ -54,7 +54,7 @@ class RobotMetrics:
 
     def topic(self, pattern: str) -> core.Topic | None:
         """The robot's topic ``pattern`` (``{ns}``: its namespace), None if the run lacks it."""
-        found = self.topics.get(core.topic_name(pattern, self.namespace))
+        found = self.topics.get(core.expand_topic(pattern, self.namespace))
         return found if found is not None and len(found) else None
 
     def prepared(self, metric: str) -> tuple[int, list[core.Prepared]] | None:
@@ -269,7 +269,7 @@ class MissionMetrics:
         self.distance_between_robots: float | None = None
 
     def topic(self, namespace: str, pattern: str) -> core.Topic | None:
-        found = self.topics.get(core.topic_name(pattern, namespace))
+        found = self.topics.get(core.expand_topic(pattern, namespace))
         return found if found is not None and len(found) else None
 
     def pairs(self) -> list[tuple[tuple[str, str], tuple[str, str]]]:

@@ -28,15 +28,15 @@ from typing import Any
 
 from exsce_dsl.errors import ExsceError
 
-CLUSTER_ENV = "EXSCE_DASK_SCHEDULER"
+DASK_SCHEDULER_ENV = "EXSCE_DASK_SCHEDULER"
 """The environment variable ``--cluster`` defaults to: the scheduler's address."""
 
 CONNECT_SECONDS = 20.0
 
 
-def cluster_address(given: str | None) -> str | None:
+def dask_address(given: str | None) -> str | None:
     """The scheduler's address: ``given``, else $EXSCE_DASK_SCHEDULER, else None."""
-    return given or os.environ.get(CLUSTER_ENV) or None
+    return given or os.environ.get(DASK_SCHEDULER_ENV) or None
 
 
 def shared_paths(paths: Iterable[Path]) -> list[Path]:
@@ -47,7 +47,7 @@ def shared_paths(paths: Iterable[Path]) -> list[Path]:
 
 
 @contextmanager
-def cluster_mapper(address: str) -> Iterator[Callable[[Callable[[Any], Any], Iterable[Any]], Iterator[Any]]]:
+def dask_map(address: str) -> Iterator[Callable[[Callable[[Any], Any], Iterable[Any]], Iterator[Any]]]:
     """A ``map`` whose calls run on the Dask cluster at ``address``, results in order; a task
     that failed on the cluster (twice, or killed its workers) gives an ExsceError in its place."""
     try:
@@ -73,4 +73,4 @@ def cluster_mapper(address: str) -> Iterator[Callable[[Callable[[Any], Any], Ite
         client.close()  # type: ignore[no-untyped-call]
 
 
-__all__ = ["CLUSTER_ENV", "cluster_address", "cluster_mapper", "shared_paths"]
+__all__ = ["DASK_SCHEDULER_ENV", "dask_address", "dask_map", "shared_paths"]

@@ -1,4 +1,5 @@
-"""A path segment: one planned waypoint of a robot's mission, as a run executed it.
+"""A recorded action: one planned waypoint of a robot's mission (the path segment that ends at
+it), as a run's bag shows it executed.
 
 Every source of segments (the method's dispatcher, a navigation stack's goals, arrival at the
 planned waypoints: :data:`~exsce_dsl.runs.segments.sources.SEGMENT_SOURCES`) gives this one type;
@@ -13,7 +14,11 @@ from exsce_dsl.model import Pose
 
 
 @dataclass(frozen=True)
-class Segment:
+class RecordedAction:
+    """One waypoint goal as ingest finds it in a bag (times in seconds since the epoch, the status
+    as text); analysis makes one that started and ended the run's
+    :class:`~exsce_dsl.model.runs.Action`."""
+
     robot: str
     allocation: int  # the robot's n-th task, from 1
     task: str

@@ -14,7 +14,7 @@ from exsce_dsl.model import Acceptance, Scenario
 from exsce_dsl.model.document import Specification
 from exsce_dsl.model.oracles import Oracle
 from exsce_dsl.oracles.baseline import learn_baseline
-from exsce_dsl.oracles.workflows import compile_learnt
+from exsce_dsl.oracles.judging import compile_learnt
 from exsce_dsl.prov import compile_scenario
 from exsce_dsl.prov.derivation import compile_derivation
 from exsce_dsl.store.base import Store

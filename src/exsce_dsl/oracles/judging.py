@@ -1,4 +1,4 @@
-"""The oracle workflows as the CLI, the Python API and the demo run them.
+"""Judging runs by their scenario's oracles, as the CLI, the Python API and the demo do it.
 
 :func:`build_baseline`: a scenario's oracles from its acceptance criteria and its stored runs,
 written to the store.  :func:`verify_runs`: runs (stored uuids, or bags ingested first) judged

@@ -1,4 +1,4 @@
-"""The ``exscec`` workflows as Python functions, with typed results.
+"""The ``exscec`` commands as Python functions, with typed results.
 
 Each function is what the command of the same name does, minus the printing: the CLI is a thin
 layer over the same library calls.  Functions that read or write runs take the store first (open
@@ -13,12 +13,12 @@ from pathlib import Path
 
 from prov.model import ProvDocument
 
-from exsce_dsl.derive.expect import SUMMED, Expected, expected_metric, learning_runs
-from exsce_dsl.derive.workflows import DerivedSpec, StoredDerivation, add_derivation, derive_spec
+from exsce_dsl.derive.derive_scenario import DerivedSpec, StoredDerivation, add_derivation, derive_spec
+from exsce_dsl.derive.expect import SUMMED, ExpectedValue, expected_metric, learning_runs
 from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.document import Specification
-from exsce_dsl.oracles.workflows import Baseline, Verification, build_baseline, verify_runs
+from exsce_dsl.oracles.judging import Baseline, Verification, build_baseline, verify_runs
 from exsce_dsl.prov.spec import compile_spec_scenario
 from exsce_dsl.rdf import serialize
 from exsce_dsl.rdf.spec_check import SpecCheck, check_spec
@@ -72,30 +72,38 @@ def simulate(
     seed: int = 0,
     faults: Sequence[str] = (),
     convention: str | None = None,
-    cluster: str | None = None,
+    dask_address: str | None = None,
 ) -> list[SimulatedRun]:
     """``exscec simulate``: play a scenario ``runs`` times with the kinematic executor, one bag per
-    run in ``out_dir`` (``faults`` as on the command line: ``overspeed:tiago1``).  With ``cluster``
+    run in ``out_dir`` (``faults`` as on the command line: ``overspeed:tiago1``).  With ``dask_address``
     (a Dask scheduler's address) each run is a task on the cluster's workers, which write the bags
     into ``out_dir``: the same path on every worker (a shared filesystem); the same bytes as here."""
     chosen = _scenario(spec, scenario)
     parsed = tuple(Fault.parse(f) for f in faults)
-    return list(play(chosen, Path(out_dir), runs, format, seed, parsed, convention, cluster=cluster))
+    return list(
+        play(chosen, Path(out_dir), runs, format, seed, parsed, convention, dask_address=dask_address)
+    )
 
 
 def ingest(
     store: Store, spec: Specification | Scenario, bags: Sequence[str | Path], *, scenario: str | None = None,
-    jobs: int = 1, cluster: str | None = None, replace: bool = False, strict: bool = False,
+    jobs: int = 1, dask_address: str | None = None, replace: bool = False, strict: bool = False,
 ) -> list[IngestResult]:  # fmt: skip
     """``exscec ingest``: each bag's metrics and run PROV into ``store``, one transaction per run
     (a bag that fails is reported in its result, and nothing of it is written); the bags are
-    analysed by ``jobs`` processes, or on the Dask cluster whose scheduler is at ``cluster``.
+    analysed by ``jobs`` processes, or on the Dask cluster whose scheduler is at ``dask_address``.
     With ``replace``, a bag already stored as a run of the scenario is analysed again and its run
     replaced in one transaction (its verdicts dropped), as ``exscec ingest --replace``;
     ``strict``: a bag whose run would lack a metric value fails (``exscec ingest --strict``)."""
     chosen = _scenario(spec, scenario)
     return ingest_bags(
-        [Path(b) for b in bags], chosen, store, jobs, cluster=cluster, replace=replace, strict=strict
+        [Path(b) for b in bags],
+        chosen,
+        store,
+        jobs,
+        dask_address=dask_address,
+        replace=replace,
+        strict=strict,
     )
 
 
@@ -153,7 +161,7 @@ def add_derived(store: Store, derived: DerivedSpec, *, include_all: bool = False
 
 def expect(
     store: Store, spec: Specification | Scenario, scenario: str | None = None, *, include_all: bool = False
-) -> list[Expected]:
+) -> list[ExpectedValue]:
     """``exscec expect``: each robot's expected distance travelled and task duration, and the path
     segments each value comes from, from the good stored runs (``include_all``: every run)."""
     chosen = _scenario(spec, scenario)
