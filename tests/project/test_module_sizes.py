@@ -23,24 +23,9 @@ MOST_CLASS_LINES = 300
 REASON = "Long because:"
 """How a module's or class's docstring says why it is longer (in its first paragraph)."""
 
-_BEING_SPLIT_IN_ISSUE_36 = {
-    "prov/identifiers.py",
-}
-"""Temporary: the other parts of issue 36 split these (lang/ by concern, store/server.py into
-endpoint/, the IRI constants, monitor_kit); this set goes when their branches are merged."""
-
-
-def _being_split(relative: str) -> bool:
-    return any(
-        relative == p or (p.endswith("/") and relative.startswith(p)) for p in _BEING_SPLIT_IN_ISSUE_36
-    )
-
-
 def _package_modules() -> Iterator[tuple[str, Path]]:
     for path in sorted(PACKAGE.rglob("*.py")):
-        relative = path.relative_to(PACKAGE).as_posix()
-        if not _being_split(relative):
-            yield relative, path
+        yield path.relative_to(PACKAGE).as_posix(), path
 
 
 @functools.cache

@@ -391,9 +391,8 @@ class MonitorRuntime:
         self.oracles = [dict(o) for o in oracles]
         entries: dict[str, list[tuple[str, str, Any]]] = {}
         for _, namespace in self.robots:
-            for pattern, key, func, compute in monitors.REDUCERS:
-                topic = self.core.expand_topic(pattern, namespace)
-                entries.setdefault(topic, []).append((key, func, compute))
+            for pattern, *reduction in monitors.REDUCERS:
+                entries.setdefault(self.core.expand_topic(pattern, namespace), []).append(tuple(reduction))
         self.buffers = {
             name: _Buffer(spec, self.core.reducer(entries[name]) if name in entries else None)
             for name, spec in self.specs.items()
