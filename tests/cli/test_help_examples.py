@@ -33,7 +33,7 @@ import click
 
 from exsce_dsl.cli.main import main
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
 
 BIN = Path(sys.executable).parent
 

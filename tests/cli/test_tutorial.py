@@ -18,7 +18,8 @@ from exsce_dsl.api.demo import STEPS, Step, command_hint, run_steps, set_up, sum
 from exsce_dsl.cli.demo_commands import run_in_process
 from exsce_dsl.runs.bags.reading import bag_topics
 
-from conftest import ROOT, run_exscec
+from tests.support.cli import run_exscec
+from tests.support.paths import ROOT
 
 TUTORIAL = ROOT / "docs" / "tutorial.md"
 
@@ -108,7 +109,7 @@ def test_the_whole_method_runs_on_a_navigation_stacks_runs(tmp_path: Path, conve
 
 
 def test_the_demo_runs_unchanged_against_a_remote_sparql_endpoint(tmp_path: Path) -> None:
-    from store_servers import oxigraph_server
+    from tests.support.store_servers import oxigraph_server
 
     with oxigraph_server(tmp_path / "oxigraph") as server:
         done = run_exscec("demo", "remote-demo", "--store", f"{server.url}/query", cwd=tmp_path, timeout=600)

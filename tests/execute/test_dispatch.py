@@ -21,7 +21,7 @@ from exsce_dsl.lang.build import load_spec
 from exsce_dsl.model import MissionType
 from exsce_dsl.sim.run import planning_grid
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
 
 # environment.exsce, by hand
 P = {

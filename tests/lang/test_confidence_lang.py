@@ -14,7 +14,7 @@ from exsce_dsl.lang.gherkin import gherkin_features
 from exsce_dsl.lang.oracle_yaml import export_oracle_yaml
 from exsce_dsl.model.acceptance import BasicRelation, Quantity
 
-from conftest import write_map
+from tests.support.map_files import write_map
 
 SPEC = """\
 robot type tiago {

@@ -11,7 +11,8 @@ import pytest
 from exsce_dsl.lang.build import analyse, load_spec
 from exsce_dsl.lang.formatter import format_spec_document
 
-from conftest import EXAMPLES, run_exscec
+from tests.support.cli import run_exscec
+from tests.support.paths import EXAMPLES
 
 DERIVED = """\
 import "scenario_c.exsce"

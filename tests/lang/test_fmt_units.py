@@ -15,7 +15,7 @@ from exsce_dsl.lang.build import load_spec
 from exsce_dsl.lang.formatter import format_document, format_spec_document
 from exsce_dsl.model import Area, Document, Environment, Orientation, Pose, Position
 
-from conftest import run_exscec
+from tests.support.cli import run_exscec
 
 # Canonical text: `exscec fmt` must leave it as it is.
 SPEC = """\

@@ -19,7 +19,7 @@ from exsce_dsl.lang.standard_metrics import _parse_standard_metrics
 from exsce_dsl.model import Specification
 from exsce_dsl.model.metrics import MetricDefinition
 
-from conftest import write_map  # type: ignore[import-not-found]
+from tests.support.map_files import write_map
 
 ENVIRONMENT = """\
 environment yard {

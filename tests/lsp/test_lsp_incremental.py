@@ -18,7 +18,7 @@ from exsce_dsl.lang.incremental import ParseCache
 from exsce_dsl.lang.loader import load_files, parse_whole
 from exsce_dsl.lang.symbols import index_file
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
 
 SPECS = sorted(EXAMPLES.rglob("*.exsce"))
 

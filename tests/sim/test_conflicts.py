@@ -23,7 +23,7 @@ from exsce_dsl.sim.planner import PlanningGrid
 from exsce_dsl.sim.run import planning_grid
 from exsce_dsl.transform.derivation import derive
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
 
 MET_BEFORE = {
     "a new robot for tiago1, tiago2 on another delivery": (
