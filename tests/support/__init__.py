@@ -20,5 +20,6 @@ them).  Every test imports these the same way: ``from tests.support.bag_factory 
 - ``store_servers``: real SPARQL servers (``oxigraph serve``, ``exscec serve``) as child processes.
 - ``dask_cluster``: a real Dask cluster on 127.0.0.1, and a worker killed mid-task.
 - ``ros1_graph``: a real ROS 1 graph (roscore, rosbag, nodes on Debian's Python).
+- ``help_examples``: every ``exscec ... --help`` example, and the walk that runs a chapter of them.
 - ``lsp_helpers``: the language server's end-to-end sessions, workspaces and waiting.
 """
