@@ -16,7 +16,7 @@ the same file, each way in a fresh process (so that peaks do not mix):
   (d) the metrics alone, as ingestion computes them: monitors generated from the
       metric declarations (the standard library's);
   (e) the metrics alone by the hand-written path (d) replaced, kept as the tests'
-      reference (tests/reference_metrics.py), on the same decoded topics.
+      reference (tests/support/reference_metrics.py), on the same decoded topics.
 
 It prints MB/s and messages/s for each, peak memory, the ratios, and (c)'s fixed
 cost on a line of its own: the time from the start of ``exscec ingest`` to the
@@ -218,10 +218,10 @@ def way_d(bag: Path, spec: Path) -> dict[str, float]:
 
 
 def way_e(bag: Path, spec: Path) -> dict[str, float]:
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-    import reference_metrics as reference  # type: ignore[import-not-found]
-
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
     from exsce_dsl.lang import load_spec
+
+    from tests.support import reference_metrics as reference  # type: ignore[import-not-found]
 
     values, _ = reference.metrics_of_bag(bag, load_spec(spec).scenario())
     return {"values": len(values)}

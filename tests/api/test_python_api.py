@@ -14,7 +14,8 @@ from pathlib import Path
 
 import pytest
 
-from conftest import EXAMPLES, run_exscec
+from tests.support.cli import run_exscec
+from tests.support.paths import EXAMPLES
 
 DOC = Path(__file__).resolve().parents[2] / "docs" / "python.md"
 

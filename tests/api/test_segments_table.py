@@ -14,7 +14,7 @@ from exsce_dsl import api as exsce
 from exsce_dsl.model.scenario import Scenario
 from exsce_dsl.store.base import Store
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
 
 UNITS = {
     "distance_travelled": "m",

@@ -15,7 +15,7 @@ from click.testing import CliRunner
 
 from exsce_dsl.cli.main import main
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
 
 SPEC = str(EXAMPLES / "brsu_building_c" / "scenario_c.exsce")
 

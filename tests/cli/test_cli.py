@@ -8,7 +8,8 @@ from pathlib import Path
 
 import yaml
 
-from conftest import EXAMPLES, FIXTURES, run_exscec
+from tests.support.cli import run_exscec
+from tests.support.paths import EXAMPLES, FIXTURES
 
 SCENARIO_C = EXAMPLES / "brsu_building_c" / "scenario_c.exsce"
 

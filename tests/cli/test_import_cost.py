@@ -18,7 +18,7 @@ from pathlib import Path
 
 import pytest
 
-from conftest import EXAMPLES  # type: ignore[import-not-found]
+from tests.support.paths import EXAMPLES
 
 NEVER_FOR_INGEST = (
     "rdflib",

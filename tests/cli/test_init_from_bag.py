@@ -1,7 +1,7 @@
 """Issue 33, "Done when" line 1: from a bag to a report in four commands, as a new user would,
 in an empty folder: ``exscec bag info BAG``, ``exscec init --from-bag BAG``, ``exscec ingest BAG
 --scenario <bag stem>.exsce``, ``exscec report``; every one exits 0, the report is written, and
-the stored run's values are the bag's, as rosbags reads it (tests/draft_references.py).
+the stored run's values are the bag's, as rosbags reads it (tests/support/draft_references.py).
 
 One test per convention, on a bag the test writes (the executor's run of the yard), each in
 another format.
@@ -13,13 +13,13 @@ import json
 from pathlib import Path
 
 import pytest
-from tests.draft_references import reference
-from yard_spec import yard_text
 
 from exsce_dsl.lang import load_spec
 from exsce_dsl.sim.run import simulate
 
-from conftest import run_exscec
+from tests.support.cli import run_exscec
+from tests.support.draft_references import reference
+from tests.support.yard_spec import yard_text
 
 ROBOTS = {"root_robot": "", "r2": "r2"}
 """The yard's robots as a drafted specification names them (r1 is at the root), and namespaces."""

@@ -26,7 +26,8 @@ from exsce_dsl.errors import UnknownNameWarning
 from exsce_dsl.lang import load_spec
 from exsce_dsl.sim.run import simulate
 
-from conftest import EXAMPLES, run_exscec
+from tests.support.cli import run_exscec
+from tests.support.paths import EXAMPLES
 
 BUILDING = EXAMPLES / "brsu_building_c"
 ODOMETRY = "nav_msgs/msg/Odometry"
@@ -230,7 +231,7 @@ def test_a_misspelt_parameter_warns_through_the_api(stored: tuple[str, str]) -> 
 
 def test_a_misspelt_metric_parameter_warns_on_virtuoso_too(bag: Path, tmp_path: Path) -> None:
     """The store's names come from SPARQL the store evaluates: Virtuoso 7 answers the same."""
-    from store_servers import virtuoso_server
+    from tests.support.store_servers import virtuoso_server
 
     (tmp_path / "gt.exsce").write_text(spec("/groundtruth"))
     with virtuoso_server(tmp_path / "virtuoso") as server:

@@ -15,7 +15,8 @@ import numpy as np
 import pytest
 from rosbags.highlevel import AnyReader
 
-from conftest import EXAMPLES, run_exscec
+from tests.support.cli import run_exscec
+from tests.support.paths import EXAMPLES
 
 BUILDING = EXAMPLES / "brsu_building_c"
 SPEC = f"""\

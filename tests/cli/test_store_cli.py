@@ -9,8 +9,9 @@ from pathlib import Path
 import pytest
 from pyoxigraph import RdfFormat, parse
 
-from conftest import EXAMPLES, run_exscec
-from store_servers import Server, oxigraph_server
+from tests.support.cli import run_exscec
+from tests.support.paths import EXAMPLES
+from tests.support.store_servers import Server, oxigraph_server
 
 SCENARIO_C = EXAMPLES / "brsu_building_c" / "scenario_c.exsce"
 
@@ -77,7 +78,7 @@ def test_compile_to_a_sparql_endpoint_refuses_a_changed_scenario_then_replaces_i
 
 
 def test_an_unreachable_endpoint_is_named(in_tmp: Path) -> None:
-    from store_servers import free_port
+    from tests.support.store_servers import free_port
 
     url = f"http://127.0.0.1:{free_port()}/sparql"
     result = run_exscec("store", "graphs", "--store", url)

@@ -1,10 +1,8 @@
-"""docs/tutorial.md, run as written, and exscec demo, which runs the same commands."""
+"""docs/tutorial.md, run as written, and exscec demo, which runs the same commands (the demo on a
+navigation stack's topics: test_demo_conventions.py; against a remote endpoint: test_demo_remote.py)."""
 
 from __future__ import annotations
 
-import csv
-import io
-import json
 import os
 import re
 import subprocess
@@ -16,9 +14,9 @@ import pytest
 
 from exsce_dsl.api.demo import STEPS, Step, command_hint, run_steps, set_up, summary_lines
 from exsce_dsl.cli.demo_commands import run_in_process
-from exsce_dsl.runs.bags.reading import bag_topics
 
-from conftest import ROOT, run_exscec
+from tests.support.cli import run_exscec
+from tests.support.paths import ROOT
 
 TUTORIAL = ROOT / "docs" / "tutorial.md"
 
@@ -78,51 +76,6 @@ def test_exscec_demo_shows_the_fault_run_failing_and_the_others_passing(tmp_path
     assert f"[{len(STEPS)}/{len(STEPS)}]" in done.stderr and "$ exscec verify runs/faulty/" in done.stderr
     again = run_exscec("demo", "demo", cwd=tmp_path)
     assert again.returncode == 2 and "is not empty" in again.stderr and "Traceback" not in again.stderr
-
-
-@pytest.mark.parametrize("convention", ["nav2", "move_base"])
-def test_the_whole_method_runs_on_a_navigation_stacks_runs(tmp_path: Path, convention: str) -> None:
-    """The demo with the robots on Nav2's (move_base's) topics: the same verdicts, and its bags,
-    metric sources and report are the stack's."""
-    done = run_exscec("demo", "demo", "--convention", convention, cwd=tmp_path)
-    assert done.returncode == 0, done.stderr[-3000:]
-    summary = done.stderr[done.stderr.index("Summary"):]
-    assert re.search(r"passed, as expected\s+new run of scenario_c", summary)
-    assert re.search(r"failed, as expected\s+run of scenario_c with the over-speed fault", summary)
-    assert re.search(r"passed, as expected\s+run of derived c_one", summary)
-    assert (tmp_path / "demo" / "campaign.xml").is_file() and list((tmp_path / "demo" / "explore").rglob("minimal/*.exsce"))
-    project = tmp_path / "demo"
-    assert f"convention {convention}" in (project / "scenarios" / "robots.exsce").read_text(encoding="utf-8")
-    (bag,) = (project / "runs" / "new").glob("*.bag")
-    goals = "/tiago1/navigate_to_pose/_action/status" if convention == "nav2" else "/tiago1/move_base/status"
-    assert goals in bag_topics(bag) and "/tiago1/robot_pose" not in bag_topics(bag)
-    listed = run_exscec("runs", "--format", "json", cwd=project)
-    run = json.loads(listed.stdout)["results"]["bindings"][0]["run"]["value"]
-    sources = run_exscec(
-        "query", "metric_sources", "-p", f"run={run}", "-p", "metric=max_velocity", "-f", "csv", cwd=project
-    )
-    assert sources.returncode == 0, sources.stderr
-    assert "/tiago1/cmd_vel" in sources.stdout and "/tiago1/nav_vel" not in sources.stdout
-    page = next((project / "report").glob("run-*.html")).read_text(encoding="utf-8")
-    assert "<img" in page
-
-
-def test_the_demo_runs_unchanged_against_a_remote_sparql_endpoint(tmp_path: Path) -> None:
-    from store_servers import oxigraph_server
-
-    with oxigraph_server(tmp_path / "oxigraph") as server:
-        done = run_exscec("demo", "remote-demo", "--store", f"{server.url}/query", cwd=tmp_path, timeout=600)
-        assert done.returncode == 0, done.stderr[-3000:]
-        listed = run_exscec("runs", "--store", f"{server.url}/query", "-f", "csv", cwd=tmp_path)
-    summary = done.stderr[done.stderr.index("Summary"):]
-    assert re.search(r"failed, as expected\s+run of scenario_c with the over-speed fault", summary)
-    assert f"store: {server.url}/query" in summary
-    assert not (tmp_path / "remote-demo" / ".exsce").exists()  # nothing went to an embedded store
-    rows = list(csv.DictReader(io.StringIO(listed.stdout)))
-    scenarios = [row["scenario_id"] for row in rows]
-    # the demo's five runs of scenario_c and one of c_one; the campaign's, of its derived scenarios
-    assert scenarios.count("scenario_c") == 5 and scenarios.count("c_one") == 1
-    assert len(rows) > 6 and all(s.startswith("scenario_c_") for s in scenarios if s not in ("scenario_c", "c_one"))
 
 
 def test_a_verdict_other_than_expected_is_reported_and_the_demo_goes_on(tmp_path: Path) -> None:

@@ -21,7 +21,7 @@ from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Document, Orientation, Pose, Position, Scenario, Specification, Subtask, Task
 from exsce_dsl.templating import GenerationError
 
-from conftest import EXAMPLES, FIXTURES
+from tests.support.paths import EXAMPLES, FIXTURES
 
 SCENARIO_C = EXAMPLES / "brsu_building_c" / "scenario_c.exsce"
 SCENARIO_D = EXAMPLES / "brsu_building_c" / "scenario_d.exsce"

@@ -21,7 +21,8 @@ from exsce_dsl.runs.analyse import analyse_bag, run_metrics, wanted_topics
 from exsce_dsl.runs.bags.reading import read_bag
 from exsce_dsl.sim.run import simulate
 
-from conftest import EXAMPLES, run_exscec
+from tests.support.cli import run_exscec
+from tests.support.paths import EXAMPLES
 
 GOLDEN = Path(__file__).parents[1] / "golden" / "monitors" / "scenario_c"
 SPEC = EXAMPLES / "brsu_building_c" / "scenario_c.exsce"

@@ -43,7 +43,8 @@ from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
 from exsce_dsl.templating import GenerationError
 
-from conftest import EXAMPLES, run_exscec
+from tests.support.cli import run_exscec
+from tests.support.paths import EXAMPLES
 
 BUILDING = EXAMPLES / "brsu_building_c"
 SPEC = BUILDING / "scenario_c.exsce"

@@ -12,7 +12,8 @@ import yaml
 from exsce_dsl.codegen import registration
 from exsce_dsl.codegen.targets import TARGETS
 
-from conftest import EXAMPLES, ROOT, run_exscec
+from tests.support.cli import run_exscec
+from tests.support.paths import EXAMPLES, ROOT
 
 SCENARIO_C = EXAMPLES / "brsu_building_c" / "scenario_c.exsce"
 WRITTEN = [

@@ -23,7 +23,8 @@ from exsce_dsl.lang import load_spec
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
 
-from conftest import EXAMPLES, run_exscec
+from tests.support.cli import run_exscec
+from tests.support.paths import EXAMPLES
 
 LEGS = (("classroom_c025-w001", "classroom_c022-w001"), ("classroom_c022-w001", "classroom_c018-w001"))
 """tiago1's path in scenario_c without navigate_home_1: its start pose, then delivery_a."""

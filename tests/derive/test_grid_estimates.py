@@ -61,7 +61,7 @@ TIAGO = RobotType("tiago", base="pmb2", torso=True)
 
 
 def write_walled_map(folder: Path, door: tuple[float, float] | None = (7.0, 8.5)) -> Path:
-    """The module's map in map_server format (as conftest's ``write_map``); ``door`` (y from, to)
+    """The module's map in map_server format (as tests/support/map_files.py's ``write_map``); ``door`` (y from, to)
     None: the wall is closed."""
     grid = np.full((HEIGHT, WIDTH), 254, dtype=np.uint8)
     wall = np.ones(HEIGHT, dtype=bool)  # by row from the bottom

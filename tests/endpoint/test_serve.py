@@ -27,8 +27,9 @@ from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.serve_info import read_serve_info, serve_info_path
 from exsce_dsl.store.writing import add_prov
 
-from conftest import EXAMPLES, run_exscec
-from store_servers import Server, exscec_serve, start_exscec_serve, stop
+from tests.support.cli import run_exscec
+from tests.support.paths import EXAMPLES
+from tests.support.store_servers import Server, exscec_serve, start_exscec_serve, stop
 
 TOKEN = "s3cret-token"
 SCENARIO_C = EXAMPLES / "brsu_building_c" / "scenario_c.exsce"

@@ -21,7 +21,7 @@ from exsce_dsl.lang import load_spec
 from exsce_dsl.maps.planning import planning_grid
 from exsce_dsl.model import MissionType
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
 
 # environment.exsce, by hand
 P = {

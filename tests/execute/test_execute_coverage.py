@@ -13,9 +13,9 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import pytest
-from ros1_graph import require_ros1
 
-from conftest import run_exscec
+from tests.support.cli import run_exscec
+from tests.support.ros1_graph import require_ros1
 
 SPEC = str(Path(__file__).resolve().parents[2] / "examples" / "brsu_building_c" / "scenario_c.exsce")
 

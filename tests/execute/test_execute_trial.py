@@ -12,11 +12,13 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import pytest
-from execute.test_ros1_execute import SPEC, on_graph, start_server
-from ros1_graph import ros1_graph
 from scipy.stats import binomtest
 
-from conftest import run_exscec
+from tests.support.cli import run_exscec
+from tests.support.paths import EXAMPLES
+from tests.support.ros1_graph import on_graph, ros1_graph, start_server
+
+SPEC = str(EXAMPLES / "brsu_building_c" / "scenario_c.exsce")
 
 
 def test_several_live_runs_with_verify_are_one_trial(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:

@@ -28,7 +28,6 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
-from tests.ros1_graph import require_ros1
 
 from exsce_dsl import api as exsce
 from exsce_dsl.api.demo import LIVE_STEPS
@@ -36,7 +35,8 @@ from exsce_dsl.execute.outcomes import Outcome
 from exsce_dsl.execute.ros1.graph import start_master
 from exsce_dsl.sim.run import simulate
 
-from conftest import run_exscec
+from tests.support.cli import run_exscec
+from tests.support.ros1_graph import require_ros1
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 RELATIVE = {"max_velocity": 0.01, "distance_travelled": 0.06, "mission_duration": 0.05, "task_duration": 0.05}

@@ -30,7 +30,7 @@ from exsce_dsl.prov.run import compile_run
 from exsce_dsl.rdf import to_quads, validate
 from exsce_dsl.sim.run import simulate
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
 
 # environment.exsce, by hand
 P = {

@@ -13,7 +13,7 @@ from exsce_dsl.execute.recording import ALWAYS, PROV_TOPIC, recorded_topics
 from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
 
 BUILDING = EXAMPLES / "brsu_building_c"
 IMPORTS = f'import "{BUILDING}/environment.exsce"\nimport "{BUILDING}/tasks/deliveries.exsce"\n'

@@ -14,31 +14,20 @@ from pathlib import Path
 
 import pytest
 import yaml
-from ros1_graph import Graph, ros1_graph
 from rosbags.rosbag1 import Reader
 from rosbags.typesys import Stores, get_typestore
 
-from conftest import EXAMPLES, run_exscec
+from tests.support.cli import run_exscec
+from tests.support.paths import EXAMPLES
+from tests.support.ros1_graph import on_graph, ros1_graph, start_server
 
-SERVER = Path(__file__).resolve().parents[1] / "fixtures" / "ros1" / "move_base_server.py"
 SPEC = str(EXAMPLES / "brsu_building_c" / "scenario_c.exsce")
 RUN_NAME = re.compile(r"^\d{4}-\d\d-\d\dT\d\d-\d\d-\d\d_scenario_c_run-[0-9a-f]{8}$")
 """The method's names: ``2023-06-13T15-48-07_scenario_c_run-e30df0b6``."""
 
 
-def start_server(graph: Graph, log: Path, robots: str, *args: str) -> None:
-    server = graph.run_python("move_base_server", SERVER, "--log", str(log), "--robots", robots, *args)
-    goals = {f"/{r}/move_base/goal" for r in robots.split(",")}
-    graph.wait_until(lambda: goals <= graph.system_state().subscribers.keys(), "the servers", 30.0, [server])
-
-
 def seen(log: Path) -> list[dict]:
     return [json.loads(line) for line in log.read_text().splitlines()] if log.exists() else []
-
-
-def on_graph(graph: Graph, monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setenv("ROS_MASTER_URI", graph.uri)
-    monkeypatch.setenv("ROS_IP", "127.0.0.1")
 
 
 def everything_under(folder: Path) -> list[str]:

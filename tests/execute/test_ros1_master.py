@@ -7,7 +7,6 @@ import sys
 from pathlib import Path
 
 import pytest
-from tests.ros1_graph import require_ros1
 
 from exsce_dsl.errors import RosGraphError
 from exsce_dsl.execute.ros1.channel import NodeChannel
@@ -22,6 +21,8 @@ from exsce_dsl.execute.ros1.graph import (
     ros_python,
     start_master,
 )
+
+from tests.support.ros1_graph import require_ros1
 
 
 def test_a_started_master_answers_keeps_parameters_and_is_gone_after(tmp_path: Path) -> None:

@@ -13,7 +13,6 @@ from dataclasses import replace
 from pathlib import Path
 
 import pytest
-from ros1_graph import Graph, ros1_graph
 
 from exsce_dsl.errors import RosGraphError
 from exsce_dsl.execute.dispatcher import dispatch
@@ -23,9 +22,9 @@ from exsce_dsl.execute.ros1.navigator import DispatcherNode, Ros1Navigator, RosC
 from exsce_dsl.lang import load_spec
 from exsce_dsl.model import MissionType
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
+from tests.support.ros1_graph import Graph, ros1_graph, start_server
 
-SERVER = Path(__file__).resolve().parents[1] / "fixtures" / "ros1" / "move_base_server.py"
 # environment.exsce, by hand: x, y, yaw in degrees
 P = {
     "c022-w001": (52.82560729980469, 32.562904357910156, 130.0),
@@ -42,13 +41,6 @@ TIAGO2 = ["c022-w002", "c018-w002", "c025-w002"]
 @pytest.fixture(scope="module")
 def scenario_c():
     return load_spec(EXAMPLES / "brsu_building_c" / "scenario_c.exsce").scenario("scenario_c")
-
-
-def start_server(graph: Graph, log: Path, robots: str, *args: str) -> None:
-    """The test server for ``robots`` (``tiago1,tiago2``), once its action topics are up."""
-    server = graph.run_python("move_base_server", SERVER, "--log", str(log), "--robots", robots, *args)
-    goals = {f"/{r}/move_base/goal" for r in robots.split(",")}
-    graph.wait_until(lambda: goals <= graph.system_state().subscribers.keys(), "the servers", 30.0, [server])
 
 
 def seen(log: Path) -> list[dict]:

@@ -10,7 +10,6 @@ from pathlib import Path
 
 import pytest
 import yaml
-from tests.ros1_graph import Graph, ros1_graph
 
 from exsce_dsl.errors import RosGraphError
 from exsce_dsl.execute.ros1.graph import Master
@@ -18,7 +17,8 @@ from exsce_dsl.execute.ros1.parameters import SCENARIO_NAMESPACE, dump_parameter
 from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
 
-from conftest import EXAMPLES, FIXTURES
+from tests.support.paths import EXAMPLES, FIXTURES
+from tests.support.ros1_graph import Graph, ros1_graph
 
 BUILDING = EXAMPLES / "brsu_building_c"
 ROSLAUNCH = ("/run_id", "/rosdistro", "/rosversion", "/roslaunch/uris")

@@ -13,12 +13,13 @@ from pathlib import Path
 
 import pytest
 from rosbags.highlevel import AnyReader
-from tests.ros1_graph import Graph, Process, ros1_graph
 
 from exsce_dsl.errors import RosGraphError
 from exsce_dsl.execute.ros1 import recorder as recorder_module
 from exsce_dsl.execute.ros1.graph import free_port
 from exsce_dsl.execute.ros1.recorder import Recorder
+
+from tests.support.ros1_graph import Graph, Process, ros1_graph
 
 FIXTURES = Path(__file__).resolve().parents[1] / "fixtures" / "ros1"
 PUBLISHER = FIXTURES / "counting_publisher.py"

@@ -41,7 +41,7 @@ from exsce_dsl.model.conventions import METHOD, MOVE_BASE, NAV2, TopicSource
 from exsce_dsl.model.geometry import quaternion
 from exsce_dsl.model.scenario import Assignment
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
 
 # environment.exsce and tasks/*.exsce, by hand: (x, y, yaw as the task visits it)
 C022_W001 = (52.82560729980469, 32.562904357910156, 2.269)

@@ -15,7 +15,7 @@ from exsce_dsl.lang import load_spec
 from exsce_dsl.model.runs import run_name
 from exsce_dsl.sim.run import simulate
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
 
 RUN = "e30df0b6-0a1b-11ee-9c4d-0242ac120002"
 START = dt.datetime(2023, 6, 13, 15, 48, 7, tzinfo=dt.timezone.utc)

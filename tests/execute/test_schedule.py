@@ -13,7 +13,7 @@ from exsce_dsl.execute.mission import TIMEOUT_FLOOR, goal_timeout, schedule
 from exsce_dsl.lang import load_spec
 from exsce_dsl.model import MissionType
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
 
 # environment.exsce, by hand: (x, y, yaw as the task uses it)
 POSES = {

@@ -1,6 +1,6 @@
 """The stand-in robot on a real roscore: an actionlib client drives it, ``rosbag record`` records it.
 
-Each test starts a fresh roscore (``tests/ros1_graph.py``), the stand-in of a one-robot
+Each test starts a fresh roscore (``tests/support/ros1_graph.py``), the stand-in of a one-robot
 scenario on an open floor (``start_stand_in``), the real ``rosbag record`` and an actionlib
 ``move_base`` client run by Debian's Python (``tests/fixtures/ros1/move_base_client.py``).  The
 bag is read with rosbags, an independent path; reference values are hand calculations (the goal,
@@ -24,7 +24,6 @@ from typing import Any
 
 import numpy as np
 import pytest
-from ros1_graph import require_ros1, ros1_graph
 from rosbags.highlevel import AnyReader
 
 from exsce_dsl.execute.stand_in import GoalEnd, Stats, start_stand_in
@@ -33,7 +32,8 @@ from exsce_dsl.lang import load_spec
 from exsce_dsl.sim.faults import Fault
 from exsce_dsl.sim.localisation import SCALE_ERROR
 
-from conftest import run_exscec
+from tests.support.cli import run_exscec
+from tests.support.ros1_graph import require_ros1, ros1_graph
 
 pytestmark = pytest.mark.ros1
 

@@ -15,13 +15,14 @@ import time
 from pathlib import Path
 
 import pytest
-from ros1_graph import require_ros1
 from rosbags.highlevel import AnyReader
 from rosbags.typesys import Stores, get_typestore
 
 from exsce_dsl.store.open import open_store
 from exsce_dsl.store.queries import derivation_of
 from exsce_dsl.store.queries.campaigns import campaign_record, campaigns
+
+from tests.support.ros1_graph import require_ros1
 
 ROOT = Path(__file__).resolve().parents[2]
 EXSCEC = str(Path(sys.executable).parent / "exscec")

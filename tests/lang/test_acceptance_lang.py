@@ -20,7 +20,8 @@ from exsce_dsl.model.acceptance import (
     Window,
 )
 
-from conftest import run_exscec, write_map
+from tests.support.cli import run_exscec
+from tests.support.map_files import write_map
 
 SPEC = """\
 robot type tiago {

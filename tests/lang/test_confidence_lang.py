@@ -12,7 +12,7 @@ from exsce_dsl.lang import analyse, export_oracle_yaml, format_spec_document, lo
 from exsce_dsl.lang.format.gherkin import gherkin_features
 from exsce_dsl.model.acceptance import BasicRelation, Quantity
 
-from conftest import write_map
+from tests.support.map_files import write_map
 
 SPEC = """\
 robot type tiago {

@@ -10,7 +10,6 @@ from pathlib import Path
 
 import pytest
 from rosbags.highlevel import AnyReader
-from tests.bag_surgery import thin
 
 from exsce_dsl.errors import SpecError
 from exsce_dsl.lang import comments, display_path, format_spec_document, load_spec
@@ -18,6 +17,8 @@ from exsce_dsl.model.conventions import TopicSource
 from exsce_dsl.model.coverage import Shortfall
 from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.sim.run import simulate
+
+from tests.support.bag_surgery import thin
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "brsu_building_c"
 RATED = """\

@@ -10,7 +10,8 @@ import pytest
 
 from exsce_dsl.lang import analyse, format_spec_document, load_spec
 
-from conftest import EXAMPLES, run_exscec
+from tests.support.cli import run_exscec
+from tests.support.paths import EXAMPLES
 
 DERIVED = """\
 import "scenario_c.exsce"

@@ -10,7 +10,7 @@ import pytest
 from exsce_dsl.errors import SourceLocation
 from exsce_dsl.lang import analyse
 
-from conftest import write_map
+from tests.support.map_files import write_map
 
 SCENARIO = """\
 import "env.exsce"

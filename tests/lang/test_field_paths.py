@@ -26,7 +26,7 @@ from exsce_dsl.model.expressions import Aggregate, Field
 from exsce_dsl.model.messages import FieldPath, Index, Select
 from exsce_dsl.monitor_kit import monitor_runtime
 
-from conftest import run_exscec
+from tests.support.cli import run_exscec
 
 READS = """\
 metric m for each robot {

@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 from exsce_dsl.lang import format_document, format_spec_document, load_spec
 from exsce_dsl.model import Area, Document, Environment, Orientation, Pose, Position
 
-from conftest import run_exscec
+from tests.support.cli import run_exscec
 
 # Canonical text: `exscec fmt` must leave it as it is.
 SPEC = """\

@@ -37,7 +37,7 @@ from exsce_dsl.model import (
 )
 from exsce_dsl.model.names import KEYWORDS
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
 
 EXAMPLE_FILES = sorted(EXAMPLES.rglob("*.exsce"))
 

@@ -23,7 +23,8 @@ from exsce_dsl.model.acceptance import (
     When,
 )
 
-from conftest import EXAMPLES, run_exscec
+from tests.support.cli import run_exscec
+from tests.support.paths import EXAMPLES
 
 SCENARIO_C = EXAMPLES / "brsu_building_c" / "scenario_c.exsce"
 

@@ -23,7 +23,8 @@ from exsce_dsl.lang.loader import parse_whole
 from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.lsp.convert import TextLines, lsp_diagnostic
 
-from conftest import EXAMPLES, ROOT, run_exscec
+from tests.support.cli import run_exscec
+from tests.support.paths import EXAMPLES, ROOT
 
 ENV = """\
 environment yard {

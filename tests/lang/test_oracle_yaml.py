@@ -42,7 +42,8 @@ from exsce_dsl.model.acceptance import (
     Window,
 )
 
-from conftest import EXAMPLES, FIXTURES, run_exscec
+from tests.support.cli import run_exscec
+from tests.support.paths import EXAMPLES, FIXTURES
 
 ORACLES = FIXTURES / "oracles" / "scenario_c.yaml"
 EXAMPLE = EXAMPLES / "brsu_building_c"

@@ -16,7 +16,7 @@ from exsce_dsl.errors import ExsceError
 from exsce_dsl.lang import analyse, load_spec
 from exsce_dsl.prov import compile_scenario
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
 
 FOLDER = EXAMPLES / "brsu_building_c"
 FILES = sorted(FOLDER.rglob("*.exsce"))

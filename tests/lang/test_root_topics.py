@@ -10,7 +10,7 @@ import pytest
 
 from exsce_dsl.lang import analyse
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
 
 BUILDING = EXAMPLES / "brsu_building_c"
 METRIC = """\

@@ -19,7 +19,7 @@ from exsce_dsl.lang.spec_cache import code_fingerprint, load_spec_cached
 from exsce_dsl.model import Specification
 from exsce_dsl.model.metrics import MetricDefinition
 
-from conftest import write_map  # type: ignore[import-not-found]
+from tests.support.map_files import write_map
 
 ENVIRONMENT = """\
 environment yard {

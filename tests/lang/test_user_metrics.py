@@ -25,7 +25,8 @@ from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
 
-from conftest import EXAMPLES, run_exscec
+from tests.support.cli import run_exscec
+from tests.support.paths import EXAMPLES
 
 BUILDING = EXAMPLES / "brsu_building_c"
 

@@ -14,7 +14,7 @@ import pytest_lsp
 from lsprotocol import types
 from pytest_lsp import ClientServerConfig, LanguageClient
 
-from lsp_helpers import (
+from tests.support.lsp_helpers import (
     EXSCEC,
     change_document,
     close_document,

@@ -16,7 +16,7 @@ from exsce_dsl.lang.build.specification import analyse, analyse_files
 from exsce_dsl.lang.editor.symbols import index_file
 from exsce_dsl.lang.loader import load_files, parse_whole
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
 
 SPECS = sorted(EXAMPLES.rglob("*.exsce"))
 

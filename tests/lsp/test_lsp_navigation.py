@@ -13,8 +13,8 @@ from lsprotocol import types
 from pygls.exceptions import JsonRpcException
 from pytest_lsp import ClientServerConfig, LanguageClient
 
-from conftest import run_exscec
-from lsp_helpers import (
+from tests.support.cli import run_exscec
+from tests.support.lsp_helpers import (
     EXSCEC,
     close_document,
     copy_workspace,

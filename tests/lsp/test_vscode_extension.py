@@ -29,7 +29,8 @@ import pytest
 
 from exsce_dsl.model.expressions import FUNCTIONS
 
-from conftest import ROOT, run_exscec
+from tests.support.cli import run_exscec
+from tests.support.paths import ROOT
 
 VSCODE = ROOT / "editors" / "vscode"
 GRAMMAR_JSON = VSCODE / "syntaxes" / "exsce.tmLanguage.json"

@@ -23,7 +23,8 @@ from mcp.client.stdio import StdioServerParameters, get_default_environment, std
 from mcp.shared.exceptions import MCPError
 from mcp_types import CallToolResult, TextContent, TextResourceContents
 
-from conftest import EXAMPLES, run_exscec
+from tests.support.cli import run_exscec
+from tests.support.paths import EXAMPLES
 
 EXSCEC = Path(sys.executable).with_name("exscec")
 T = TypeVar("T")

@@ -7,7 +7,6 @@ import xml.etree.ElementTree as ET
 from dataclasses import replace
 
 import pytest
-from campaign_samples import DURATION, REMOVE, REVERSE, SHRINKINGS, sample_trials
 
 from exsce_dsl.lang import load_spec
 from exsce_dsl.model.campaign import CampaignPlan, CampaignRecord, Shrinking, Trial
@@ -21,7 +20,8 @@ from exsce_dsl.store.queries.campaigns import campaign_record
 from exsce_dsl.store.writing import add_prov
 from exsce_dsl.transform.derivation import derive
 
-from conftest import EXAMPLES
+from tests.support.campaign_samples import DURATION, REMOVE, REVERSE, SHRINKINGS, sample_trials
+from tests.support.paths import EXAMPLES
 
 STARTED = datetime.datetime(2025, 3, 1, 12, 0, tzinfo=datetime.timezone.utc)
 PLAN = CampaignPlan(

@@ -26,7 +26,8 @@ from exsce_dsl.store.queries import oracles as stored_oracles
 from exsce_dsl.store.queries.library import prologue, standard_prefixes
 from exsce_dsl.store.writing import add_prov
 
-from conftest import YARD_SPEC, write_map
+from tests.support.map_files import write_map
+from tests.support.yard_spec import YARD_SPEC
 
 CRITERIA = """\
   scenario "performs as before" {

@@ -25,7 +25,9 @@ from exsce_dsl.store.open import open_store
 from exsce_dsl.store.queries import runs
 from exsce_dsl.store.queries.results import verdicts as stored_verdicts
 
-from conftest import YARD_SPEC, run_exscec, write_map
+from tests.support.cli import run_exscec
+from tests.support.map_files import write_map
+from tests.support.yard_spec import YARD_SPEC
 
 T0 = dt.datetime(2026, 1, 1, 12, 0, 0, tzinfo=dt.timezone.utc)
 

@@ -29,7 +29,9 @@ from exsce_dsl.prov.recorder import recorded_prov_json, recorded_run
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
 
-from conftest import YARD_SPEC, run_exscec, write_map
+from tests.support.cli import run_exscec
+from tests.support.map_files import write_map
+from tests.support.yard_spec import YARD_SPEC
 
 
 def _without_topic(bag: Path, topic: str, out: Path) -> Path:

@@ -1,6 +1,6 @@
 """Baselines learn from good runs only, and their provenance says which runs were left out and why.
 
-Real runs of the yard (tests/conftest.py's YARD_SPEC; its baseline needs 4 runs): four clean runs;
+Real runs of the yard (tests/support/yard_spec.py's YARD_SPEC; its baseline needs 4 runs): four clean runs;
 a slow run of r1, verified (it fails r1's task duration, and the failed verdict is stored); a
 clean run whose run-time PROV says its mission was cancelled (as ``exscec execute`` leaves an
 interrupted run); an over-speed run of r1, ingested and never verified.  The baseline is built
@@ -28,7 +28,9 @@ from exsce_dsl.prov.recorder import recorded_prov_json, recorded_run
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
 
-from conftest import YARD_SPEC, run_exscec, write_map
+from tests.support.cli import run_exscec
+from tests.support.map_files import write_map
+from tests.support.yard_spec import YARD_SPEC
 
 LEFT_OUT = """
 SELECT ?run ?scenario ?reason WHERE {

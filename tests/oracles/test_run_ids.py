@@ -27,8 +27,10 @@ from exsce_dsl.store.queries import AmbiguousRunError, UnknownRunError, resolve_
 from exsce_dsl.store.remote import RemoteStore
 from exsce_dsl.store.writing import add_prov
 
-from conftest import YARD_SPEC, run_exscec, write_map
-from store_servers import virtuoso_server
+from tests.support.cli import run_exscec
+from tests.support.map_files import write_map
+from tests.support.store_servers import virtuoso_server
+from tests.support.yard_spec import YARD_SPEC
 
 RUN_IRI = "https://www.sesame-project.org/scenarios/runs/run_{}"
 

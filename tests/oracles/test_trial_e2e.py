@@ -22,7 +22,9 @@ from exsce_dsl.lang import load_spec
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
 
-from conftest import YARD_SPEC, run_exscec, write_map
+from tests.support.cli import run_exscec
+from tests.support.map_files import write_map
+from tests.support.yard_spec import YARD_SPEC
 
 REQUIRED = 0.8
 CONFIDENCE = 0.95

@@ -1,6 +1,6 @@
 """What the recording does not cover, through ``exscec verify`` as a user runs it: executor bags
 of scenario_c cut short, with a topic silent, thinned or with ``/clock`` reset
-(:mod:`tests.bag_surgery`), judged against a baseline of clean runs.
+(:mod:`tests.support.bag_surgery`), judged against a baseline of clean runs.
 
 The issue's case: a run cut at 60 % of its mission had its safety clauses passed
 (``tiago1-max_velocity below_max 1.0: pass``) over a run of which 40 % was never seen.  Here no
@@ -16,12 +16,13 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import pytest
-from tests.bag_surgery import bag_span, cut, drop, reset_clock, thin
-from tests.conftest import run_exscec
 
 from exsce_dsl.cli.common import ExitCode
 from exsce_dsl.lang import load_spec
 from exsce_dsl.sim.run import simulate
+
+from tests.support.bag_surgery import bag_span, cut, drop, reset_clock, thin
+from tests.support.cli import run_exscec
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "brsu_building_c"
 SAFETY = ("max_velocity", "distance_to_obstacles", "distance_between_robots")

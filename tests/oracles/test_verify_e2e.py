@@ -27,8 +27,9 @@ from exsce_dsl.runs.bags.reading import bag_topics
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
 
-from conftest import YARD_SPEC as SPEC
-from conftest import run_exscec, write_map
+from tests.support.cli import run_exscec
+from tests.support.map_files import write_map
+from tests.support.yard_spec import YARD_SPEC as SPEC
 
 FAULTS = ("overspeed:r1", "slow:r1", "skip-waypoint:r1:2", "near-collision")
 SHOULD_FAIL = {

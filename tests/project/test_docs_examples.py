@@ -8,7 +8,7 @@
 - The README's "Start from your bag" block runs as written on a bag the test writes.
 
 docs/tutorial.md (tests/cli/test_tutorial.py), docs/python.md and the README's Python block
-(tests/api/test_python_api.py) and every ``--help`` example (tests/cli/test_help_examples.py)
+(tests/api/test_python_api.py) and every ``--help`` example (tests/cli/test_help_examples_*.py)
 run as written in their own tests.
 """
 

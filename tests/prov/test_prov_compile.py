@@ -13,13 +13,6 @@ from hypothesis import given
 from hypothesis import strategies as st
 from prov.model import ProvDocument
 from rdflib import Namespace, URIRef
-from scenario_builders import (
-    C022_W001,
-    C025_W001,
-    large_scenario,
-    merged,
-    scenario_c,
-)
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.lang import import_scenario_yaml
@@ -52,7 +45,14 @@ from exsce_dsl.prov.identifiers import (
 )
 from exsce_dsl.rdf import FORMATS, serialize
 
-from prov_contract import differences, normalised_published, records
+from tests.support.prov_contract import differences, normalised_published, records
+from tests.support.scenario_builders import (
+    C022_W001,
+    C025_W001,
+    large_scenario,
+    merged,
+    scenario_c,
+)
 
 MODELS = Path(__file__).parents[1] / "fixtures" / "hbrs-sesame-models"
 SCENARIOS = MODELS / "scenarios"

@@ -34,8 +34,8 @@ from exsce_dsl.prov.oracle import compile_oracles
 from exsce_dsl.prov.run import compile_run
 from exsce_dsl.rdf import to_quads, validate
 
-from conftest import EXAMPLES, FIXTURES
-from prov_contract import PROV, Record, Records, differences, normalised_published, records
+from tests.support.paths import EXAMPLES, FIXTURES
+from tests.support.prov_contract import PROV, Record, Records, differences, normalised_published, records
 
 RUN_FIXTURE = FIXTURES / "runs" / "2023-06-26T21-47-04_scenario_c_run-30af607a.prov.json"
 UUID = "30af607a-145a-11ee-aa3d-0d574918902f"

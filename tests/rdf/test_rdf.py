@@ -23,7 +23,6 @@ from pyoxigraph import NamedNode as OxNamedNode
 from pyoxigraph import Store as OxStore
 from rdflib import RDF, RDFS, Dataset, Graph, Literal, Namespace, URIRef
 from rdflib.compare import isomorphic
-from scenario_builders import large_scenario, merged, scenario_c
 
 from exsce_dsl.errors import ExportError
 from exsce_dsl.lang import load_spec
@@ -32,7 +31,8 @@ from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, Namespaces
 from exsce_dsl.rdf import FORMATS, as_dataset, serialize, text, to_dataset, to_quads
 from exsce_dsl.rdf.shacl import shape_names, shapes_graph, vocabulary_graph
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
+from tests.support.scenario_builders import large_scenario, merged, scenario_c
 
 HAS_LXML = importlib.util.find_spec("lxml") is not None
 
@@ -67,7 +67,7 @@ def test_the_text_does_not_depend_on_the_process() -> None:
         import hashlib, sys
         sys.path[:0] = [{str(Path(__file__).parent)!r}, {str(Path(__file__).parents[1])!r}]
         from test_rdf import every_format
-        from scenario_builders import scenario_c
+        from tests.support.scenario_builders import scenario_c
         from exsce_dsl.prov import compile_scenario
         texts = every_format(compile_scenario(scenario_c()))
         print(hashlib.sha256(repr(sorted(texts.items())).encode()).hexdigest())

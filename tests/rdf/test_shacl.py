@@ -32,7 +32,8 @@ from exsce_dsl.rdf import (
 )
 from exsce_dsl.rdf.shacl import shape_names, violation_diagnostics
 
-from conftest import EXAMPLES, run_exscec
+from tests.support.cli import run_exscec
+from tests.support.paths import EXAMPLES
 
 E = DEFAULT_NAMESPACE
 PROV = "http://www.w3.org/ns/prov#"

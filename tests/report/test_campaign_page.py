@@ -13,7 +13,6 @@ from html.parser import HTMLParser
 from pathlib import Path
 
 import pytest
-from campaign_samples import DISTANCE, DURATION, REMOVE, SHRINKINGS, sample_trials
 from test_report import ARTIFACTS, _chromium
 
 from exsce_dsl.lang import load_spec
@@ -29,7 +28,8 @@ from exsce_dsl.store.open import open_store
 from exsce_dsl.store.writing import add_prov
 from exsce_dsl.transform.derivation import derive
 
-from conftest import EXAMPLES
+from tests.support.campaign_samples import DISTANCE, DURATION, REMOVE, SHRINKINGS, sample_trials
+from tests.support.paths import EXAMPLES
 
 SPEC = EXAMPLES / "brsu_building_c" / "scenario_c.exsce"
 PLAN = CampaignPlan(

@@ -41,7 +41,8 @@ from exsce_dsl.sim.run import simulate
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.queries import MetricReading, StoredRun
 
-from conftest import EXAMPLES, ROOT, run_exscec
+from tests.support.cli import run_exscec
+from tests.support.paths import EXAMPLES, ROOT
 
 if TYPE_CHECKING:
     from playwright.sync_api import Browser

@@ -21,7 +21,8 @@ from exsce_dsl.sim.run import simulate
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.wording import counted, noun
 
-from conftest import EXAMPLES, run_exscec
+from tests.support.cli import run_exscec
+from tests.support.paths import EXAMPLES
 
 _HEADING = re.compile(r"-R[-0-9.]+_P[-0-9.]+_Y[-0-9.]+$")
 _PLURALS = r"scenarios|runs|robots|oracles|segments|hotspots|verdicts|steps|derivations|clusters|relations"

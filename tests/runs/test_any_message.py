@@ -26,7 +26,8 @@ from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from exsce_dsl.lang import load_spec
 from exsce_dsl.runs.analyse import analyse_bag
 
-from conftest import EXAMPLES, run_exscec
+from tests.support.cli import run_exscec
+from tests.support.paths import EXAMPLES
 
 TURTLE = "turtlesim/msg/Pose"
 TURTLE_MSG = "float32 x\nfloat32 y\nfloat32 theta\nfloat32 linear_velocity\nfloat32 angular_velocity\n"

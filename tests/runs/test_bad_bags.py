@@ -1,7 +1,7 @@
 """Bags that cannot be read (issue 17): a clear error naming the bag and the reason, exit status 1,
 no traceback, nothing written to the store; the same under ``python -O``, where asserts are gone.
 
-Each bad bag is made here, at test time, from a small valid bag (:mod:`bad_bags`), and ingested by
+Each bad bag is made here, at test time, from a small valid bag (:mod:`tests.support.bad_bags`), and ingested by
 the real ``exscec`` into a copy of a store that holds the scenario only; the store's graphs and
 quads are counted before and after.
 """
@@ -28,7 +28,7 @@ from exsce_dsl.runs.bags.ros1 import read_topics
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.writing import add_prov
 
-import bad_bags
+from tests.support import bad_bags
 
 EXSCEC = str(Path(sys.executable).with_name("exscec"))
 SPEC = bad_bags.SPEC

@@ -1,4 +1,4 @@
-"""The bag factory (:mod:`bag_factory`) writes what it says: read back with rosbags' AnyReader,
+"""The bag factory (:mod:`tests.support.bag_factory`) writes what it says: read back with rosbags' AnyReader,
 which takes every type from the bag itself, each bag holds its connections, types and messages
 byte for byte, in time order however they were written, compressed as asked."""
 
@@ -8,13 +8,14 @@ import struct
 from collections import Counter
 from pathlib import Path
 
-import bag_factory as factory
 import numpy as np
 import pytest
 from rosbags.highlevel import AnyReader
 from rosbags.rosbag1 import Reader as Ros1Reader
 from rosbags.rosbag2 import Reader as Ros2Reader
 from rosbags.typesys import Stores, get_typestore
+
+from tests.support import bag_factory as factory
 
 FORMAT_NAMES = list(factory.FORMATS)
 

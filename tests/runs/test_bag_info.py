@@ -11,15 +11,15 @@ from pathlib import Path
 
 import pytest
 from rosbags.highlevel import AnyReader
-from tests.bag_factory import typestore_for, write_bag
-from tests.clock_bags import restamp
-from tests.real_shapes import SHAPES
 
 from exsce_dsl.lang import load_spec
 from exsce_dsl.runs.bag_info import bag_info
 from exsce_dsl.sim.run import simulate
 
-from conftest import run_exscec
+from tests.support.bag_factory import typestore_for, write_bag
+from tests.support.cli import run_exscec
+from tests.support.clock_bags import restamp
+from tests.support.real_shapes import SHAPES
 
 SPEC = Path(__file__).resolve().parents[2] / "examples" / "brsu_building_c" / "scenario_c.exsce"
 

@@ -11,7 +11,6 @@ import gc
 from pathlib import Path
 from typing import Any
 
-import bag_factory as factory
 import numpy as np
 import pytest
 from rosbags.highlevel import AnyReader
@@ -22,6 +21,8 @@ from exsce_dsl.runs.bags import chunk_batches, mcap_index, ros1
 from exsce_dsl.runs.bags.buffers import mapped
 from exsce_dsl.runs.bags.decode import decode
 from exsce_dsl.runs.bags.raw_messages import RawMessages
+
+from tests.support import bag_factory as factory
 
 
 def _bag(tmp_path: Path, fmt: str) -> factory.WrittenBag:

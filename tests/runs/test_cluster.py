@@ -30,8 +30,10 @@ from exsce_dsl.runs.ingest import IngestStatus, ingest_bags
 from exsce_dsl.sim.run import simulate
 from exsce_dsl.store.embedded import EmbeddedStore
 
-from conftest import YARD_SPEC, run_exscec, write_map
-from dask_cluster import a_worker_killed_while_running, local_cluster
+from tests.support.cli import run_exscec
+from tests.support.dask_cluster import a_worker_killed_while_running, local_cluster
+from tests.support.map_files import write_map
+from tests.support.yard_spec import YARD_SPEC
 
 BAGS = 6
 

@@ -1,5 +1,5 @@
 """What a run's recording does not cover, found at ingest: executor bags of scenario_c, cut short,
-with a topic silent, thinned or with ``/clock`` reset (:mod:`tests.bag_surgery`), each giving the
+with a topic silent, thinned or with ``/clock`` reset (:mod:`tests.support.bag_surgery`), each giving the
 shortfall it should, and a clean bag giving none.
 
 Every expected bound is computed here from the surgery's parameters and the bag as rosbags reads
@@ -15,8 +15,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 from rosbags.highlevel import AnyReader
-from tests.bag_factory import Topic, typestore_for
-from tests.bag_surgery import bag_span, cut, drop, reset_clock, rewrite, thin
 
 from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
@@ -25,6 +23,9 @@ from exsce_dsl.model.runs import RunStatus
 from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.runs.coverage import GAP_FLOOR
 from exsce_dsl.sim.run import simulate
+
+from tests.support.bag_factory import Topic, typestore_for
+from tests.support.bag_surgery import bag_span, cut, drop, reset_clock, rewrite, thin
 
 SPEC = Path(__file__).resolve().parents[2] / "examples" / "brsu_building_c" / "scenario_c.exsce"
 SCAN_METRICS = ("distance_to_obstacles", "violation_duration")

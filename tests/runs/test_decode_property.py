@@ -32,7 +32,6 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-import bag_factory as factory
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, note, settings
@@ -50,6 +49,8 @@ from exsce_dsl.messages.catalogue import (
 from exsce_dsl.model.messages import FieldPath, Index, Select
 from exsce_dsl.runs.bags.decode import PRESENT, DecodeError, decode
 from exsce_dsl.runs.bags.raw_messages import RawMessages
+
+from tests.support import bag_factory as factory
 
 FORMATS = ("ros1", "cdr", "cdr_be")
 """ROS 1 serialization, CDR little-endian, CDR big-endian."""

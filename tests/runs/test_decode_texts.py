@@ -9,7 +9,6 @@ import math
 from pathlib import Path
 from typing import Any
 
-import bag_factory as factory
 import numpy as np
 import pytest
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
@@ -19,6 +18,8 @@ from exsce_dsl.model.messages import FieldPath, Index, path_of
 from exsce_dsl.runs.bags.decode import TEXTS, DecodeError, decode, decode_slowly
 from exsce_dsl.runs.bags.raw_messages import RawMessages
 from exsce_dsl.runs.bags.reading import Wanted, read_bag
+
+from tests.support import bag_factory as factory
 
 TF = "tf2_msgs/msg/TFMessage"
 FRAMES = [("map", "odom"), ("odom", "base_link"), ("base_link", "laser"), ("odom", "base_füßprint")]

@@ -1,7 +1,7 @@
 """The built-in metrics through generated monitors equal the hand-written path they replaced.
 
 The standard library declares the method's metrics in the language; ingestion
-computes them with monitors generated from it.  tests/reference_metrics.py is
+computes them with monitors generated from it.  tests/support/reference_metrics.py is
 the hand-written computation exsce used before; on the same decoded bags both
 must give the same values, topics, violations and hotspots.
 """
@@ -11,7 +11,6 @@ from __future__ import annotations
 import math
 
 import pytest
-import reference_metrics as reference
 
 from exsce_dsl.lang import load_spec
 from exsce_dsl.model.metrics import METRICS
@@ -19,7 +18,8 @@ from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
 
-from conftest import EXAMPLES
+from tests.support import reference_metrics as reference
+from tests.support.paths import EXAMPLES
 
 BUILDING = EXAMPLES / "brsu_building_c"
 

@@ -23,7 +23,7 @@ from exsce_dsl.sim.messages import typestore
 from exsce_dsl.sim.run import simulate
 from exsce_dsl.store.embedded import EmbeddedStore
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
 
 BUILDING = EXAMPLES / "brsu_building_c"
 

@@ -31,7 +31,8 @@ from exsce_dsl.store.base import Store
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.queries import run_metric_values, run_query, runs
 
-from conftest import EXAMPLES, run_exscec
+from tests.support.cli import run_exscec
+from tests.support.paths import EXAMPLES
 
 RUN_NAMESPACE = uuid.UUID("5b8f9a52-3f0c-4a8e-8f0e-2d6c1b7e4a90")
 """The namespace of run ids since the first release: a run's id is uuid5 of its bag's sha256."""
@@ -273,7 +274,7 @@ def test_a_run_is_replaced_on_a_sparql_server_as_in_the_embedded_store(
 ) -> None:
     from exsce_dsl.store.open import open_store
 
-    from store_servers import oxigraph_server, virtuoso_server
+    from tests.support.store_servers import oxigraph_server, virtuoso_server
 
     bag = bags[0]
     embedded = EmbeddedStore()

@@ -22,7 +22,7 @@ from exsce_dsl.lang import load_spec
 from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.sim.run import simulate
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
 
 BUILDING = EXAMPLES / "brsu_building_c"
 Change = Callable[[str, int], int | None]

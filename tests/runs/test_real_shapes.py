@@ -4,7 +4,7 @@ ingested through the library and once through the real ``exscec``; the values eq
 computed here from rosbags' deserialisation of the same bags (relative error < 1e-4), and a
 metric whose data does not overlap its window is missing, never 0.
 
-The shapes (:mod:`tests.real_shapes` writes them): a Jackal outdoors (odometry on
+The shapes (:mod:`tests.support.real_shapes` writes them): a Jackal outdoors (odometry on
 ``/jackal_velocity_controller/odom``, ``/cmd_vel``, no goals, no TF), a KITTI-like sequence (ground
 truth and two visual odometries, PoseStamped on relative names, ``ORB-SLAM`` among them), a robot
 with TF only, one PoseStamped stream under a namespace stamped in simulated time beside wall-clock
@@ -30,8 +30,6 @@ from rosbags.rosbag1 import Writer as Ros1Writer
 from rosbags.rosbag2 import Reader as Ros2Reader
 from rosbags.rosbag2 import StoragePlugin
 from rosbags.rosbag2 import Writer as Ros2Writer
-from tests.bag_factory import typestore_for, write_bag
-from tests.real_shapes import SHAPES
 
 from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
@@ -39,7 +37,9 @@ from exsce_dsl.model.runs import MetricScope
 from exsce_dsl.runs.analyse import AnalysedRun, analyse_bag
 from exsce_dsl.sim.run import simulate
 
-from conftest import run_exscec
+from tests.support.bag_factory import typestore_for, write_bag
+from tests.support.cli import run_exscec
+from tests.support.real_shapes import SHAPES
 
 FORMATS = ("ros1", "sqlite3", "mcap")
 EXECUTOR_FORMATS = {"ros1": "ros1", "sqlite3": "ros2", "mcap": "mcap"}

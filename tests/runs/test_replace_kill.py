@@ -35,7 +35,7 @@ from exsce_dsl.sim.run import simulate
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.queries import run_metric_values, runs
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
 
 CHILD = """
 import sys, time

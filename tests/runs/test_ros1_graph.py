@@ -21,7 +21,6 @@ from typing import Any
 
 import numpy as np
 import pytest
-from ros1_graph import require_ros1, ros1_graph
 from rosbags.highlevel import AnyReader
 from rosbags.rosbag1 import Reader as Ros1Reader
 
@@ -30,7 +29,9 @@ from exsce_dsl.runs.ingest import ingest_bags
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.queries import MetricReading, run_metric_values, run_segment_values
 
-from conftest import EXAMPLES, run_exscec
+from tests.support.cli import run_exscec
+from tests.support.paths import EXAMPLES
+from tests.support.ros1_graph import require_ros1, ros1_graph
 
 pytestmark = pytest.mark.ros1
 

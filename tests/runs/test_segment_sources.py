@@ -22,7 +22,7 @@ from exsce_dsl.runs.segments.goals import goal_segments
 from exsce_dsl.runs.segments.track import Segmentation, Track, near, planned_waypoints
 from exsce_dsl.runs.signals.navigation_goals import Goal
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
 
 R = "tiago1"
 S_ID = W3_ID = "classroom_c025-w001"

@@ -17,7 +17,6 @@ import numpy as np
 import pytest
 from rosbags.highlevel import AnyReader
 from rosbags.typesys import Stores, get_typestore
-from yard_spec import yard_text
 
 from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
@@ -31,6 +30,8 @@ from exsce_dsl.runs.signals.sources import (
 )
 from exsce_dsl.runs.signals.trajectories import trajectories
 from exsce_dsl.sim.run import simulate
+
+from tests.support.yard_spec import yard_text
 
 
 def _scenario(tmp_path: Path, robot_type: str) -> Scenario:

@@ -1,5 +1,5 @@
 """A specification drafted from a bag (``exscec init --from-bag``, issue 33 item 2) checks and
-ingests as written, and says what the bag says, as rosbags reads it (tests/draft_references.py).
+ingests as written, and says what the bag says, as rosbags reads it (tests/support/draft_references.py).
 
 On the executor's runs of the yard in every convention and format, one restamped onto simulated
 time, and on bags of real shapes written here: a robot at the root without goals, one in a
@@ -14,11 +14,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 from rosbags.highlevel import AnyReader
-from tests.bag_factory import ODOMETRY, START_NS, Topic, header, quaternion, typestore_for, write_bag
-from tests.clock_bags import restamp
-from tests.draft_references import reference, whole_path
-from tests.real_shapes import ROUTE, SHAPES, pose_topic
-from yard_spec import yard_text
 
 from exsce_dsl.errors import BagError, ExportError
 from exsce_dsl.lang import load_spec
@@ -27,6 +22,12 @@ from exsce_dsl.model import Specification
 from exsce_dsl.runs.analyse import AnalysedRun, analyse_bag
 from exsce_dsl.runs.spec_draft import default_spec_path, draft_spec
 from exsce_dsl.sim.run import simulate
+
+from tests.support.bag_factory import ODOMETRY, START_NS, Topic, header, quaternion, typestore_for, write_bag
+from tests.support.clock_bags import restamp
+from tests.support.draft_references import reference, whole_path
+from tests.support.real_shapes import ROUTE, SHAPES, pose_topic
+from tests.support.yard_spec import yard_text
 
 YARD_GOALS = {"root_robot": [(5.0, 0.0), (5.0, 4.0)], "r2": [(5.0, 8.0)]}
 """Where the yard's tasks send its robots (r1 at the root, r2 in /r2): yard-b, yard-c; yard-e."""

@@ -14,7 +14,6 @@ from pathlib import Path
 import pytest
 from rosbags.highlevel import AnyReader
 from rosbags.typesys import Stores, get_typestore
-from yard_spec import yard_text
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.lang import load_spec
@@ -24,6 +23,8 @@ from exsce_dsl.prov.serialize import serialize_prov
 from exsce_dsl.runs.analyse import AnalysedRun, analyse_bag
 from exsce_dsl.runs.bags.reading import bag_topics
 from exsce_dsl.sim.run import simulate
+
+from tests.support.yard_spec import yard_text
 
 
 def _scenario(tmp_path: Path, robot_type: str, name: str) -> Scenario:

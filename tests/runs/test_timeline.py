@@ -3,7 +3,7 @@ time give the values of the same run recorded on one clock, with a specification
 neither a convention nor a clock (scenario_c as shipped: its robot type says nothing of topics).
 
 The reference bags are the executor's (stamps equal log times, their values checked elsewhere
-against rosbags' deserialisation); :func:`tests.clock_bags.restamp` moves every stamp of them
+against rosbags' deserialisation); :func:`tests.support.clock_bags.restamp` moves every stamp of them
 onto a simulated clock through rosbags.  Distances and speeds stay as they were; durations scale
 by the simulation's rate.  One value is also recomputed here from rosbags alone: each robot's
 distance travelled along its odometry between its first goal's start and its last goal's end.
@@ -18,8 +18,6 @@ import numpy as np
 import pytest
 from pyoxigraph import Store
 from rosbags.highlevel import AnyReader
-from tests.bag_factory import Topic, typestore_for, write_bag
-from tests.clock_bags import CLOCK, CLOCK_TYPE, restamp
 
 from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
@@ -29,6 +27,9 @@ from exsce_dsl.runs.analyse import AnalysedRun, analyse_bag
 from exsce_dsl.runs.bags.reading import Wanted, bag_topics, read_bag
 from exsce_dsl.runs.signals.timeline import decide_timeline, stamp_catalogue, with_stamps
 from exsce_dsl.sim.run import simulate
+
+from tests.support.bag_factory import Topic, typestore_for, write_bag
+from tests.support.clock_bags import CLOCK, CLOCK_TYPE, restamp
 
 SPEC = Path(__file__).resolve().parents[2] / "examples" / "brsu_building_c" / "scenario_c.exsce"
 DURATIONS = {"task_duration", "mission_duration", "violation_duration"}
@@ -201,7 +202,7 @@ def test_a_clock_that_goes_back_is_a_jump_of_the_timeline(tmp_path: Path) -> Non
 
 
 def _odometry_messages(store: object, start: int) -> Topic:
-    from tests.bag_factory import ODOMETRY, odometry
+    from tests.support.bag_factory import ODOMETRY, odometry
 
     return Topic(
         "/tiago1/odom",

@@ -16,16 +16,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from bag_factory import (
-    ODOMETRY,
-    POSE_STAMPED,
-    Topic,
-    odometry,
-    pose_stamped,
-    series,
-    typestore_for,
-    write_bag,
-)
 from rosbags.highlevel import AnyReader
 from rosbags.rosbag1 import Reader as Ros1Reader
 from rosbags.rosbag1 import Writer as Ros1Writer
@@ -48,7 +38,17 @@ from exsce_dsl.sim.run import simulate
 from exsce_dsl.store import queries as q
 from exsce_dsl.store.embedded import EmbeddedStore
 
-from conftest import EXAMPLES
+from tests.support.bag_factory import (
+    ODOMETRY,
+    POSE_STAMPED,
+    Topic,
+    odometry,
+    pose_stamped,
+    series,
+    typestore_for,
+    write_bag,
+)
+from tests.support.paths import EXAMPLES
 
 BUILDING = EXAMPLES / "brsu_building_c"
 SPEC = f"""

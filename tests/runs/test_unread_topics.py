@@ -9,8 +9,6 @@ from pathlib import Path
 
 import pytest
 from rosbags.highlevel import AnyReader
-from tests.bag_factory import typestore_for, write_bag
-from tests.real_shapes import kitti
 
 from exsce_dsl.errors import BagError
 from exsce_dsl.lang import load_spec
@@ -18,7 +16,9 @@ from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.sim.run import simulate
 from exsce_dsl.suggest import closest_several
 
-from conftest import EXAMPLES
+from tests.support.bag_factory import typestore_for, write_bag
+from tests.support.paths import EXAMPLES
+from tests.support.real_shapes import kitti
 
 BUILDING = EXAMPLES / "brsu_building_c"
 FARM = """\

@@ -15,13 +15,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 from rosbags.highlevel import AnyReader
-from tests.bag_factory import POSE_STAMPED, Topic, header, point, quaternion, typestore_for, write_bag
 
 from exsce_dsl.errors import BagError
 from exsce_dsl.lang import format_spec_document, load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.runs.analyse import AnalysedRun, analyse_bag
 from exsce_dsl.sim.run import simulate
+
+from tests.support.bag_factory import POSE_STAMPED, Topic, header, point, quaternion, typestore_for, write_bag
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "brsu_building_c"
 START_NS = 1_767_312_000_000_000_000

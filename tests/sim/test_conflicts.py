@@ -22,7 +22,7 @@ from exsce_dsl.sim.executor import Execution, Fault, execute
 from exsce_dsl.sim.motion import DT, Trajectory
 from exsce_dsl.transform.derivation import derive
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
 
 MET_BEFORE = {
     "a new robot for tiago1, tiago2 on another delivery": (

@@ -26,7 +26,7 @@ from exsce_dsl.sim.motion import DT
 from exsce_dsl.sim.run import simulate
 from exsce_dsl.transform.derivation import derive
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
 
 SEEDS = (1, 2)
 C069 = (11.721145629882812, 53.50111770629883, 12.687057495117188, 55.12968444824219)

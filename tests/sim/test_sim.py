@@ -18,7 +18,7 @@ from exsce_dsl.sim.executor import Fault, GoalStatus, execute
 from exsce_dsl.sim.messages import FEEDBACK, RESULT, typestore
 from exsce_dsl.sim.run import simulate
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
 
 BUILDING = EXAMPLES / "brsu_building_c"
 

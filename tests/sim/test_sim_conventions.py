@@ -23,7 +23,7 @@ from exsce_dsl.model.conventions import METHOD, NAV2
 from exsce_dsl.sim.executor import Fault, GoalStatus
 from exsce_dsl.sim.run import SimulatedRun, simulate
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
 
 FORMATS = ("ros1", "ros2", "mcap")
 CONVENTIONS = ("nav2", "move_base")

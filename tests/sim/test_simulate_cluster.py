@@ -28,8 +28,10 @@ from exsce_dsl.sim.run import simulate
 from exsce_dsl.store.open import open_store
 from exsce_dsl.store.queries.campaigns import campaign_record, campaigns
 
-from conftest import YARD_SPEC, run_exscec, write_map
-from dask_cluster import a_worker_killed_while_running, local_cluster
+from tests.support.cli import run_exscec
+from tests.support.dask_cluster import a_worker_killed_while_running, local_cluster
+from tests.support.map_files import write_map
+from tests.support.yard_spec import YARD_SPEC
 
 RUNS = 4
 SEED = 3

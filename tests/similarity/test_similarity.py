@@ -23,7 +23,8 @@ from exsce_dsl.similarity.facts import scenario_facts
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.writing import add_prov
 
-from conftest import EXAMPLES, run_exscec
+from tests.support.cli import run_exscec
+from tests.support.paths import EXAMPLES
 
 
 def facts(id_, bases=("pmb2",), torsos=(True,), segments=(), metrics=None, violation=None, hotspots=None):

@@ -29,8 +29,8 @@ from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.remote import RemoteStore
 from exsce_dsl.store.writing import add_prov, stored_graphs
 
-from conftest import EXAMPLES
-from store_servers import oxigraph_server
+from tests.support.paths import EXAMPLES
+from tests.support.store_servers import oxigraph_server
 
 SPEC = EXAMPLES / "brsu_building_c" / "scenario_c.exsce"
 RUNS = 5

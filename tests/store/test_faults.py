@@ -26,8 +26,8 @@ from exsce_dsl.sim.run import simulate
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.writing import add_prov
 
-from conftest import EXAMPLES
-from store_servers import oxigraph_server
+from tests.support.paths import EXAMPLES
+from tests.support.store_servers import oxigraph_server
 
 EXSCEC = str(Path(sys.executable).with_name("exscec"))
 SPEC = EXAMPLES / "brsu_building_c" / "scenario_c.exsce"

@@ -6,8 +6,6 @@ from __future__ import annotations
 
 import datetime
 
-from scenario_builders import C022_W001, C025_W001, scenario_c
-
 from exsce_dsl.model.oracles import Oracle, OracleType
 from exsce_dsl.model.runs import Action, ActionId, Bag, MetricScope, MetricValue, Run, TaskExecution
 from exsce_dsl.prov import compile_scenario
@@ -17,6 +15,8 @@ from exsce_dsl.rdf import to_quads, validate
 from exsce_dsl.store import queries as q
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.writing import add_prov
+
+from tests.support.scenario_builders import C022_W001, C025_W001, scenario_c
 
 ODD_TOPICS = ("groundtruth", "ORB-SLAM", "/tiago1/my scan", "/50%@x", "/r\u00e9seau/\u20ac", "/tiago1/nav_vel")
 BAG_NAME = "run #1 (copy) 50%.bag"

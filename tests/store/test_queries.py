@@ -57,8 +57,8 @@ from exsce_dsl.store.queries import MetricSource, PathSegment, RobotFacts, Value
 from exsce_dsl.store.remote import RemoteStore
 from exsce_dsl.store.writing import add_prov
 
-from conftest import run_exscec
-from store_servers import oxigraph_server, virtuoso_server
+from tests.support.cli import run_exscec
+from tests.support.store_servers import oxigraph_server, virtuoso_server
 
 # -- the scenarios ---------------------------------------------------------------------------
 

@@ -8,7 +8,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from tests.bag_surgery import cut, drop
 
 from exsce_dsl.lang import load_spec
 from exsce_dsl.model.coverage import Shortfall
@@ -19,6 +18,8 @@ from exsce_dsl.runs.ingest import ingest_bags
 from exsce_dsl.sim.run import simulate
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.queries import run_coverage, run_topic_rates
+
+from tests.support.bag_surgery import cut, drop
 
 SPEC = Path(__file__).resolve().parents[2] / "examples" / "brsu_building_c" / "scenario_c.exsce"
 

@@ -29,8 +29,10 @@ from exsce_dsl.store.base import GraphSet
 from exsce_dsl.store.open import open_store
 from exsce_dsl.store.queries import query, query_names
 
-from conftest import YARD_SPEC, run_exscec, write_map
-from store_servers import virtuoso_server
+from tests.support.cli import run_exscec
+from tests.support.map_files import write_map
+from tests.support.store_servers import virtuoso_server
+from tests.support.yard_spec import YARD_SPEC
 
 FORMATS = ("table", "json", "csv")
 EMPTY_HERE = {"campaign_shrinkings", "run_coverage"}

@@ -36,7 +36,7 @@ from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.segment_index import segment_index, segment_iri
 from exsce_dsl.store.writing import add_prov
 
-from conftest import run_exscec
+from tests.support.cli import run_exscec
 
 
 def pose(name: str, x: float) -> Pose:

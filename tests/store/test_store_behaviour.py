@@ -16,7 +16,7 @@ from exsce_dsl.store.base import GraphSet, Store, StoreError
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.remote import RemoteStore
 
-from store_servers import Server, exscec_serve, oxigraph_server, virtuoso_server
+from tests.support.store_servers import Server, exscec_serve, oxigraph_server, virtuoso_server
 
 EX = "http://example.org/"
 G1, G2, G3 = f"{EX}g1", f"{EX}g2", f"{EX}g3"

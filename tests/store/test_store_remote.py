@@ -14,7 +14,7 @@ from pyoxigraph import Literal, NamedNode, Quad
 from exsce_dsl.store.base import GraphSet, StoreError
 from exsce_dsl.store.remote import RemoteStore
 
-from store_servers import Server, free_port, oxigraph_server
+from tests.support.store_servers import Server, free_port, oxigraph_server
 
 G = "http://example.org/g"
 

@@ -18,8 +18,8 @@ from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.remote import RemoteStore
 from exsce_dsl.store.writing import add_graphs, add_prov, is_revision, revision_name
 
-from conftest import EXAMPLES
-from store_servers import Server, oxigraph_server
+from tests.support.paths import EXAMPLES
+from tests.support.store_servers import Server, oxigraph_server
 
 BASE = "https://www.sesame-project.org/scenarios/"
 SCENARIO_GRAPH = f"{BASE}scenario_c_bundle"

@@ -26,8 +26,11 @@ from exsce_dsl.store.base import GraphSet, Store, StoreError
 from exsce_dsl.store.open import open_store
 from exsce_dsl.store.remote import RemoteStore
 
-from conftest import EXAMPLES, YARD_SPEC, run_exscec, write_map
-from store_servers import Server, virtuoso_server
+from tests.support.cli import run_exscec
+from tests.support.map_files import write_map
+from tests.support.paths import EXAMPLES
+from tests.support.store_servers import Server, virtuoso_server
+from tests.support.yard_spec import YARD_SPEC
 
 EX = "http://example.org/virtuoso/"
 G1, G2 = f"{EX}g1", f"{EX}g2"

@@ -15,7 +15,8 @@ from exsce_dsl.model.derivation import TaskOrigin, TransformationStep
 from exsce_dsl.prov.derivation import compile_derivation
 from exsce_dsl.transform.derivation import derive
 
-from conftest import EXAMPLES, run_exscec
+from tests.support.cli import run_exscec
+from tests.support.paths import EXAMPLES
 
 SPEC = EXAMPLES / "brsu_building_c" / "scenario_c.exsce"
 

@@ -10,7 +10,7 @@ from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.transform.derivation import derive
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
 
 BASE = load_spec(EXAMPLES / "brsu_building_c" / "scenario_c.exsce").scenario("scenario_c")
 

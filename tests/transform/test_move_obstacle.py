@@ -34,7 +34,8 @@ from exsce_dsl.model.derived import DerivedScenario, Step
 from exsce_dsl.prov.derivation import compile_derivation
 from exsce_dsl.transform.derivation import derive, derived_document
 
-from conftest import run_exscec, write_map
+from tests.support.cli import run_exscec
+from tests.support.map_files import write_map
 
 YARD = """\
 environment yard {

@@ -29,7 +29,7 @@ from exsce_dsl.lang import load_spec
 from exsce_dsl.sim.messages import typestore
 from exsce_dsl.sim.run import simulate
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
 
 SPEC = EXAMPLES / "brsu_building_c" / "scenario_c.exsce"
 MCAP_MAGIC = b"\x89MCAP0\r\n"

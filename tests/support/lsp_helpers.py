@@ -15,7 +15,7 @@ from lsprotocol import types
 from pygls.uris import from_fs_path
 from pytest_lsp import LanguageClient
 
-from conftest import EXAMPLES
+from tests.support.paths import EXAMPLES
 
 EXSCEC = str(Path(sys.executable).with_name("exscec"))
 

@@ -16,7 +16,8 @@ from pathlib import Path
 from typing import Any
 
 from rosbags.highlevel import AnyReader
-from tests.bag_factory import FORMATS, Topic, typestore_for, write_bag
+
+from tests.support.bag_factory import FORMATS, Topic, typestore_for, write_bag
 
 SIM_START = 931.25
 """Simulated seconds at the first message: a Gazebo world started a quarter of an hour ago."""

@@ -3,7 +3,7 @@ a topic thinned, ``/clock`` reset backwards.
 
 Each function reads a bag through rosbags' own reader and deserialisation, edits the messages as
 (log time in ns, message object) per topic, and writes a new bag with rosbags' writers
-(:func:`tests.bag_factory.write_bag`), so nothing of exsce's reading is used to make it.  Times
+(:func:`tests.support.bag_factory.write_bag`), so nothing of exsce's reading is used to make it.  Times
 are given in seconds from the bag's first message (:func:`bag_span` says where it starts and
 ends), so a test computes its expected values from the parameters it passed.
 """
@@ -16,8 +16,9 @@ from pathlib import Path
 from typing import Any
 
 from rosbags.highlevel import AnyReader
-from tests.bag_factory import FORMATS, Topic, typestore_for, write_bag
-from tests.clock_bags import CLOCK, CLOCK_TYPE, _time
+
+from tests.support.bag_factory import FORMATS, Topic, typestore_for, write_bag
+from tests.support.clock_bags import CLOCK, CLOCK_TYPE, _time
 
 Messages = list[tuple[int, Any]]
 Edit = Callable[[str, Messages, int, int], Messages]

@@ -27,7 +27,8 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from tests.bag_factory import (
+
+from tests.support.bag_factory import (
     IMU,
     ODOMETRY,
     POSE_STAMPED,

@@ -324,3 +324,22 @@ def ros1_graph(home: Path, sim_time: bool = True) -> Iterator[Graph]:
     finally:
         for process in reversed(graph.processes):
             graph.stop(process)
+
+
+MOVE_BASE_SERVER = Path(__file__).resolve().parents[1] / "fixtures" / "ros1" / "move_base_server.py"
+"""The tests' move_base action servers (rospy, actionlib), one per robot, logging the goals they get."""
+
+
+def start_server(graph: Graph, log: Path, robots: str, *args: str) -> None:
+    """The test server for ``robots`` (``tiago1,tiago2``), once its action topics are up."""
+    server = graph.run_python(
+        "move_base_server", MOVE_BASE_SERVER, "--log", str(log), "--robots", robots, *args
+    )
+    goals = {f"/{r}/move_base/goal" for r in robots.split(",")}
+    graph.wait_until(lambda: goals <= graph.system_state().subscribers.keys(), "the servers", 30.0, [server])
+
+
+def on_graph(graph: Graph, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Point this process's ROS clients (``exscec execute --ros1`` run from it) at ``graph``."""
+    monkeypatch.setenv("ROS_MASTER_URI", graph.uri)
+    monkeypatch.setenv("ROS_IP", "127.0.0.1")
