@@ -8,6 +8,7 @@ path gives the same values (tests/runs/test_generated_metrics.py).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -270,19 +271,27 @@ def _safety_signals(sig: RobotSignals, limits: SafetyLimits, start: float, end: 
 
 
 def _cluster(points: np.ndarray, durations: np.ndarray) -> list[tuple[np.ndarray, int, float]]:
-    """Greedy spatial clustering: a point joins the first centre within HOTSPOT_RADIUS."""
-    centres: list[list[float]] = []
-    members: list[list[int]] = []
-    for i, p in enumerate(points):
-        for k, c in enumerate(centres):
-            if np.hypot(p[0] - c[0], p[1] - c[1]) <= HOTSPOT_RADIUS:
-                members[k].append(i)
-                c[:] = points[members[k]].mean(axis=0)
+    """The hotspots' rule, written out again with plain Python numbers: in order, a point joins the
+    first group whose centre (the mean of its points so far) is within HOTSPOT_RADIUS, else it
+    starts a group."""
+    groups: list[list[tuple[float, float, float]]] = []  # (x, y, duration) of each member
+    for (x, y), duration in zip(points.tolist(), durations.tolist(), strict=True):
+        for group in groups:
+            cx = sum(m[0] for m in group) / len(group)
+            cy = sum(m[1] for m in group) / len(group)
+            if math.hypot(x - cx, y - cy) <= HOTSPOT_RADIUS:
+                group.append((x, y, duration))
                 break
         else:
-            centres.append([float(p[0]), float(p[1])])
-            members.append([i])
-    return [(np.asarray(c), len(m), float(durations[m].sum())) for c, m in zip(centres, members, strict=True)]
+            groups.append([(x, y, duration)])
+    return [
+        (
+            np.array([sum(m[0] for m in g) / len(g), sum(m[1] for m in g) / len(g)]),
+            len(g),
+            sum(m[2] for m in g),
+        )
+        for g in groups
+    ]
 
 
 def _between_robots(
