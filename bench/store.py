@@ -214,6 +214,9 @@ def library_parameters(name: str, scenario: Scenario, some_runs: list[str]) -> t
         elif parameter.kind == "pose":
             poses = [pose_name(start_pose), pose_name(goal_pose)]
             given[parameter.name] = poses if parameter.many else poses[parameter.name == "goal"]
+        elif parameter.name == "prefix":  # run_ids: the first 8 characters, as users type them
+            given[parameter.name] = some_runs[0][:8]
+            scope = "1 run"
         elif parameter.kind == "point":
             given[parameter.name] = point_name(start_pose if parameter.name == "from" else goal_pose)
         else:
