@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import sys
-from contextlib import AbstractContextManager, nullcontext
+from contextlib import AbstractContextManager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -260,33 +260,15 @@ def _run_campaigns(
 
 
 def _executor(options: _ExploreOptions) -> tuple[AbstractContextManager[Executor], CampaignOptions]:
-    """What runs the scenarios (the simulator, a command or a named executor) and the campaign's
-    plan, from the options, which are checked to go together."""
-    from exsce_dsl.errors import ExsceError
+    """What runs the scenarios and the campaign's plan, from the options."""
     from exsce_dsl.explore.campaign import CampaignOptions
-    from exsce_dsl.explore.executors import (
-        CommandExecutor,
-        ExecutorOptions,
-        SimulatorExecutor,
-        named_executor,
-    )
+    from exsce_dsl.explore.executors import ExecutorOptions, chosen_executor
     from exsce_dsl.parallel.dask_client import dask_address as scheduler_address
 
     o = options
-    if o.executor_command and (o.faults or o.plugin):
-        raise ExsceError("give one of --fault (the simulator), --executor-command and --executor")
-    if (o.stand_in or o.start_master or o.speed_up is not None) and not o.plugin:
-        raise ExsceError("--stand-in, --start-master and --speed-up go with --executor ros1")
     address = scheduler_address(o.dask_address)
-    chosen: AbstractContextManager[Executor]
-    if o.executor_command:
-        chosen = nullcontext(CommandExecutor(o.executor_command))
-    elif o.plugin:
-        chosen = named_executor(
-            o.plugin, ExecutorOptions(o.faults, o.stand_in, o.start_master, None, o.speed_up)
-        )
-    else:
-        chosen = nullcontext(SimulatorExecutor.with_faults(o.faults, dask_address=address))
+    given = ExecutorOptions(o.faults, o.stand_in, o.start_master, None, o.speed_up)
+    chosen = chosen_executor(o.executor_command, o.plugin, given, address)
     campaign = CampaignOptions(
         budget=o.budget,
         seed=o.seed,

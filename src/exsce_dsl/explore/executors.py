@@ -226,6 +226,26 @@ def named_executor(name: str, options: ExecutorOptions | None = None) -> Abstrac
     return nullcontext(plugin_executor(name))
 
 
+def chosen_executor(
+    command: str | None,
+    name: str | None,
+    options: ExecutorOptions,
+    dask_address: str | None = None,
+) -> AbstractContextManager[Executor]:
+    """What plays a campaign's scenarios: another program (``command``), the executor called
+    ``name``, else exsce's simulator with ``options.faults`` (on the Dask cluster at
+    ``dask_address`` when given).  The options must go together."""
+    if command and (options.faults or name):
+        raise ExsceError("give one of --fault (the simulator), --executor-command and --executor")
+    if (options.stand_in or options.start_master or options.speed_up is not None) and not name:
+        raise ExsceError("--stand-in, --start-master and --speed-up go with --executor ros1")
+    if command:
+        return nullcontext(CommandExecutor(command))
+    if name:
+        return named_executor(name, options)
+    return nullcontext(SimulatorExecutor.with_faults(options.faults, dask_address=dask_address))
+
+
 def plugin_executor(name: str) -> Executor:
     """The executor a package registered under ``exsce.executors`` as ``name``."""
     found = {point.name: point for point in entry_points(group=ENTRY_POINT_GROUP)}
