@@ -53,21 +53,24 @@ def scan_ranges(
     theta = yaw[:, None] + laser.angles()[None, :]
     dx, dy = np.cos(theta), np.sin(theta)
     ox, oy = np.broadcast_to(x[:, None], theta.shape), np.broadcast_to(y[:, None], theta.shape)
-    travelled = np.zeros(theta.shape)
-    active = np.ones(theta.shape, dtype=bool)
+    # the beams still marching, as flat indices: each step costs what is left, not every beam
+    flat_ox, flat_oy, flat_dx, flat_dy = (a.reshape(-1) for a in (ox, oy, dx, dy))
+    travelled = np.zeros(theta.size)
+    marching = np.arange(theta.size)
     hit_eps = grid.map_resolution
     for _ in range(64):
-        if not active.any():
+        if marching.size == 0:
             break
-        px = ox[active] + dx[active] * travelled[active]
-        py = oy[active] + dy[active] * travelled[active]
+        so_far = travelled[marching]
+        px = flat_ox[marching] + flat_dx[marching] * so_far
+        py = flat_oy[marching] + flat_dy[marching] * so_far
         clearance = grid.clearance_at(np.column_stack([px, py]))
         step = np.maximum(clearance - hit_eps * 0.5, hit_eps * 0.5)
         done = clearance < hit_eps
-        moved = travelled[active] + np.where(done, 0.0, step)
-        travelled[active] = moved
-        still = ~done & (moved < laser.range_max)
-        active[active] = still
+        moved = so_far + np.where(done, 0.0, step)
+        travelled[marching] = moved
+        marching = marching[~done & (moved < laser.range_max)]
+    travelled = travelled.reshape(theta.shape)
     ranges = np.where(travelled < laser.range_max, travelled, np.inf)
     for qx, qy in others:  # other robots are discs
         cx, cy = qx[:, None] - ox, qy[:, None] - oy
