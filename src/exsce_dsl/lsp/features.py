@@ -3,6 +3,7 @@ server that has them (``exscec lsp``)."""
 
 from __future__ import annotations
 
+import contextlib
 import os
 
 from lsprotocol import types
@@ -16,6 +17,9 @@ from exsce_dsl.lsp.hover import keyword_hover, symbol_hover, word_at
 from exsce_dsl.lsp.navigation import RENAMEABLE, Names, RenameError, import_at
 from exsce_dsl.lsp.outline import document_symbol, workspace_symbols
 from exsce_dsl.lsp.server import ExsceLanguageServer, failed, options_of
+
+FIRST_ANALYSIS_WAIT = 5.0
+"""Seconds a document's first completion waits for its first analysis (its imports' names)."""
 
 
 def create_server() -> ExsceLanguageServer:
@@ -79,14 +83,19 @@ def _editing(server: ExsceLanguageServer) -> None:
         types.TEXT_DOCUMENT_COMPLETION,
         types.CompletionOptions(trigger_characters=[" ", ",", ":", ".", "["]),
     )
-    def completion(ls: ExsceLanguageServer, params: types.CompletionParams) -> types.CompletionList:
+    async def completion(ls: ExsceLanguageServer, params: types.CompletionParams) -> types.CompletionList:
+        path = path_of(params.text_document.uri)
+        if path not in ls.project.roots:
+            # just opened: what it imports is indexed by its first analysis, so wait for that one
+            # (later completions answer at once from the last analysis, whatever is typed)
+            with contextlib.suppress(TimeoutError):
+                await ls.scheduler.settled(FIRST_ANALYSIS_WAIT)
         text = ls.workspace.get_text_document(params.text_document.uri).source
         lines = ls.text_lines(text)
         offset = lines.offset(params.position)
         allowed = continuations_at(text, offset)
         if allowed is None:
             return types.CompletionList(is_incomplete=False, items=[])
-        path = path_of(params.text_document.uri)
         names = Names(ls.project.visible_indexes(path, last_complete=True), ls.project.reachable(path))
         start = lines.position(*lines.location(allowed.word_start))
         capabilities = ls.client_capabilities.text_document

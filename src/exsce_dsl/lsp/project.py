@@ -121,7 +121,7 @@ class Project:
     def scan(self, folders: Iterable[str]) -> int:
         """Index every ``.exsce`` file below ``folders`` that is not indexed yet (for references,
         renaming and workspace symbols); returns how many were read."""
-        indexes, texts = dict(self.indexes), dict(self.texts)
+        indexes, texts, complete = dict(self.indexes), dict(self.texts), dict(self.complete)
         count = 0
         for path in _exsce_files(folders):
             if path in indexes:
@@ -135,7 +135,9 @@ class Project:
                 indexes[path] = index
                 texts[path] = text
                 count += 1
-        self.indexes, self.texts = indexes, texts
+                if not self.cache.parse(text, display_path(path))[1]:  # parsed once, kept by the cache
+                    complete[path] = index  # an edit with a syntax error still completes its names
+        self.indexes, self.texts, self.complete = indexes, texts, complete
         return count
 
     # -------------------------------------------------------------- event loop
