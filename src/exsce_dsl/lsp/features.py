@@ -22,6 +22,14 @@ FIRST_ANALYSIS_WAIT = 5.0
 """Seconds a document's first completion waits for its first analysis (its imports' names)."""
 
 
+async def _first_analysis(ls: ExsceLanguageServer, path: str) -> None:
+    """Wait for a just-opened document's first analysis, which indexes what it imports (later
+    completions answer at once from the last analysis, whatever is typed)."""
+    if path not in ls.project.roots:
+        with contextlib.suppress(TimeoutError):
+            await ls.scheduler.settled(FIRST_ANALYSIS_WAIT)
+
+
 def create_server() -> ExsceLanguageServer:
     """A server with every feature registered."""
     server = ExsceLanguageServer()
@@ -85,11 +93,7 @@ def _editing(server: ExsceLanguageServer) -> None:
     )
     async def completion(ls: ExsceLanguageServer, params: types.CompletionParams) -> types.CompletionList:
         path = path_of(params.text_document.uri)
-        if path not in ls.project.roots:
-            # just opened: what it imports is indexed by its first analysis, so wait for that one
-            # (later completions answer at once from the last analysis, whatever is typed)
-            with contextlib.suppress(TimeoutError):
-                await ls.scheduler.settled(FIRST_ANALYSIS_WAIT)
+        await _first_analysis(ls, path)
         text = ls.workspace.get_text_document(params.text_document.uri).source
         lines = ls.text_lines(text)
         offset = lines.offset(params.position)
