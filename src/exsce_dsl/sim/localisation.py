@@ -21,7 +21,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import lfilter
 
 from exsce_dsl.sim.motion import DT, Trajectory
 
@@ -136,8 +135,15 @@ def _wandering(rng: np.random.Generator, sigma: float, samples: int) -> np.ndarr
     a = math.exp(-DT / NOISE_TIME)
     white = rng.normal(0.0, sigma, samples + 1)
     # the first value already has the stationary spread: a·e₀ + √(1−a²)·n₁ with e₀ ~ N(0, σ²)
-    wandering: np.ndarray = lfilter([math.sqrt(1.0 - a * a)], [1.0, -a], white[1:], zi=[a * white[0]])[0]
-    return wandering
+    # y[n] = √(1−a²)·e[n] + a·y[n−1], as a plain loop: the very bits of scipy.signal.lfilter
+    # (tests/sim/test_localisation_noise.py), without the second it takes to import scipy.signal
+    gain = math.sqrt(1.0 - a * a)
+    wandering = [0.0] * samples
+    carried = a * float(white[0])
+    for i, e in enumerate(white[1:].tolist()):
+        wandering[i] = gain * e + carried
+        carried = a * wandering[i]
+    return np.array(wandering)
 
 
 def _wrap(angle: np.ndarray) -> np.ndarray:
