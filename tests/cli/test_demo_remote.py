@@ -1,4 +1,5 @@
-"""exscec demo against a remote SPARQL endpoint (a real ``oxigraph serve``) instead of its embedded store."""
+"""exscec demo against a remote SPARQL endpoint (a real ``oxigraph serve``) instead of its embedded
+store, with the robots on move_base's topics: one demo run checks both (each costs a minute)."""
 
 from __future__ import annotations
 
@@ -8,14 +9,18 @@ import re
 from pathlib import Path
 
 from tests.support.cli import run_exscec
+from tests.support.stack_demo import check_stack_demo
 from tests.support.store_servers import oxigraph_server
 
 
-def test_the_demo_runs_unchanged_against_a_remote_sparql_endpoint(tmp_path: Path) -> None:
+def test_the_demo_on_move_base_runs_unchanged_against_a_remote_sparql_endpoint(tmp_path: Path) -> None:
     with oxigraph_server(tmp_path / "oxigraph") as server:
-        done = run_exscec("demo", "remote-demo", "--store", f"{server.url}/query", cwd=tmp_path, timeout=600)
-        assert done.returncode == 0, done.stderr[-3000:]
-        listed = run_exscec("runs", "--store", f"{server.url}/query", "-f", "csv", cwd=tmp_path)
+        store = ("--store", f"{server.url}/query")
+        done = run_exscec(
+            "demo", "remote-demo", *store, "--convention", "move_base", cwd=tmp_path, timeout=600
+        )
+        check_stack_demo(done, tmp_path / "remote-demo", "move_base", *store)
+        listed = run_exscec("runs", *store, "-f", "csv", cwd=tmp_path)
     summary = done.stderr[done.stderr.index("Summary") :]
     assert re.search(r"failed, as expected\s+run of scenario_c with the over-speed fault", summary)
     assert f"store: {server.url}/query" in summary

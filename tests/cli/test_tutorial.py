@@ -1,5 +1,6 @@
-"""docs/tutorial.md, run as written, and exscec demo, which runs the same commands (the demo on a
-navigation stack's topics: test_demo_conventions.py; against a remote endpoint: test_demo_remote.py)."""
+"""docs/tutorial.md, run as written, and how exscec demo, which runs the same commands, reports them
+(the demo itself: the live chapter of the help examples, test_help_examples_live.py; on a navigation
+stack's topics: test_demo_conventions.py; against a remote endpoint: test_demo_remote.py)."""
 
 from __future__ import annotations
 
@@ -15,7 +16,6 @@ import pytest
 from exsce_dsl.api.demo import STEPS, Step, command_hint, run_steps, set_up, summary_lines
 from exsce_dsl.cli.demo_commands import run_in_process
 
-from tests.support.cli import run_exscec
 from tests.support.paths import ROOT
 
 TUTORIAL = ROOT / "docs" / "tutorial.md"
@@ -60,22 +60,6 @@ def test_every_command_of_the_tutorial_works_as_written(tmp_path: Path) -> None:
     assert int(junit.get("failures", junit.find("testsuite").get("failures"))) == 0  # type: ignore[union-attr]
     assert (project / "report" / "index.html").is_file() and (project / "clusters.svg").is_file()
     assert (project / "scenario_c.provn").read_text(encoding="utf-8").startswith("document")
-
-
-def test_exscec_demo_shows_the_fault_run_failing_and_the_others_passing(tmp_path: Path) -> None:
-    done = run_exscec("demo", "demo", cwd=tmp_path, timeout=600)  # the whole tutorial, a campaign too
-    assert done.returncode == 0, done.stderr[-3000:]
-    summary = done.stderr[done.stderr.index("Summary"):]
-    assert summary.startswith("Summary") and "every step ended as expected" in summary.splitlines()[0]
-    assert re.search(r"passed, as expected\s+new run of scenario_c", summary)
-    assert re.search(r"failed, as expected\s+run of scenario_c with the over-speed fault", summary)
-    assert re.search(r"passed, as expected\s+run of derived c_one", summary)
-    assert (tmp_path / "demo" / "campaign.xml").is_file() and list((tmp_path / "demo" / "explore").rglob("minimal/*.exsce"))
-    assert "NOT" not in summary and "error" not in summary
-    assert (tmp_path / "demo" / "report" / "index.html").is_file()
-    assert f"[{len(STEPS)}/{len(STEPS)}]" in done.stderr and "$ exscec verify runs/faulty/" in done.stderr
-    again = run_exscec("demo", "demo", cwd=tmp_path)
-    assert again.returncode == 2 and "is not empty" in again.stderr and "Traceback" not in again.stderr
 
 
 def test_a_verdict_other_than_expected_is_reported_and_the_demo_goes_on(tmp_path: Path) -> None:

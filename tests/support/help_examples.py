@@ -150,7 +150,16 @@ def collected() -> list[Example]:
     ]
 
 
-def walk(chapter: str, tmp_path: Path) -> None:
+@dataclass(frozen=True)
+class Walked:
+    """What a chapter's walk left: its scratch folder, and how each example that is not a server
+    ended (by its line), for a test to look closer at one of them."""
+
+    scratch: Path
+    ended: dict[str, subprocess.CompletedProcess[str]]
+
+
+def walk(chapter: str, tmp_path: Path) -> Walked:
     """Run every example of ``chapter``'s commands as written, in order, in one scratch folder."""
     scratch = tmp_path / "walk"
     scratch.mkdir()
@@ -168,6 +177,7 @@ def walk(chapter: str, tmp_path: Path) -> None:
     commands = CHAPTERS[chapter]
     everything = [e for e in collected() if e.command in commands]
     ran: list[Example] = []
+    ended: dict[str, subprocess.CompletedProcess[str]] = {}
     for path in commands:
         for example in (e for e in everything if e.command == path):
             if path == ("serve",):
@@ -191,9 +201,11 @@ def walk(chapter: str, tmp_path: Path) -> None:
                     f"{example}\nexit {done.returncode}\n{done.stdout[-3000:]}\n{done.stderr[-3000:]}"
                 )
                 assert "Traceback" not in done.stderr and "internal error" not in done.stderr, str(example)
+                ended[example.line] = done
             ran.append(example)
     assert ran == sorted(everything, key=lambda e: commands.index(e.command))  # each ran, in order
     assert {e.command for e in ran} == set(commands)
+    return Walked(scratch, ended)
 
 
 # -- the servers ------------------------------------------------------------------------------

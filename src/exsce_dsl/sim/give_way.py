@@ -68,6 +68,9 @@ class _Replay:
         self, trajectories: dict[str, Trajectory], order: list[str], actions: list[SimulatedAction]
     ) -> None:
         self.trajectories, self.order = trajectories, order
+        # plain floats: at() runs a million times a replay, and numpy scalars cost thrice as much
+        self.xs = {r: trajectories[r].x.tolist() for r in order}
+        self.ys = {r: trajectories[r].y.tolist() for r in order}
         self.position = {r: 0.0 for r in order}  # fractional sample index along the robot's own trajectory
         self.rate = {r: 1.0 for r in order}
         self.waited = {r: 0 for r in order}
@@ -165,10 +168,10 @@ class _Replay:
 
     def at(self, r: str, p: float) -> tuple[float, float]:
         """Where ``r`` is at fractional sample ``p`` of its own trajectory."""
-        tr, last = self.trajectories[r], self.last[r]
+        xs, ys, last = self.xs[r], self.ys[r], self.last[r]
         k = min(int(p), last)
         k1, f = min(k + 1, last), p - k
-        return (float(tr.x[k] + f * (tr.x[k1] - tr.x[k])), float(tr.y[k] + f * (tr.y[k1] - tr.y[k])))
+        return (xs[k] + f * (xs[k1] - xs[k]), ys[k] + f * (ys[k1] - ys[k]))
 
 
 def _warped(tr: Trajectory, p: np.ndarray) -> tuple[Trajectory, np.ndarray]:
