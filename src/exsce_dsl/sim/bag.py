@@ -19,6 +19,7 @@ from exsce_dsl.maps.planning import PlanningGrid
 from exsce_dsl.messages.navigation import ros2_message_definition
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.conventions import Signals
+from exsce_dsl.sim.batches import Batch
 from exsce_dsl.sim.conventions import convention_writer
 from exsce_dsl.sim.executor import Execution
 from exsce_dsl.sim.scan import Laser
@@ -56,7 +57,7 @@ def write_bag(
     laser = laser or Laser()
     store = writer.typestore(fmt)
     rng = np.random.default_rng(seed)
-    messages: list[tuple[int, int, str, Any]] = []  # (time, order, topic, message)
+    messages: list[tuple[int, int, str, Any]] = []  # (time, order, topic, message or its bytes)
     types: dict[str, str] = {}
     latched: set[str] = set()
     robots = [r for r in scenario.robots if r.id in execution.trajectories]
@@ -65,9 +66,18 @@ def write_bag(
             store, robot.id, robot.namespace.strip("/"), execution, grid, laser, rng, start_ns, twist_stamped
         )
         latched.update(run.topic(name) for name in writer.latched)
-        for topic, msgtype, stamp, msg in writer.messages(run):
-            types[topic] = msgtype
-            messages.append((stamp, order, topic, msg))
+        for written in writer.messages(run):
+            if isinstance(written, Batch):
+                types[written.topic] = written.msgtype
+                serialized = written.serialized(_serializer(store, fmt))
+                messages.extend(
+                    (stamp, order, written.topic, raw)
+                    for stamp, raw in zip(written.stamps.tolist(), serialized, strict=True)
+                )
+            else:
+                topic, msgtype, stamp, msg = written
+                types[topic] = msgtype
+                messages.append((stamp, order, topic, msg))
     messages.sort(key=lambda m: (m[0], m[1], m[2]))
     _write(path, fmt, store, messages, types, latched)
     return len(messages)
@@ -81,7 +91,9 @@ def _write(
     types: dict[str, str],
     latched: set[str],
 ) -> None:
-    serialize = store.serialize_ros1 if fmt == "ros1" else store.serialize_cdr
+    def serialize(msg: Any, msgtype: str) -> Any:  # a batch's messages come serialized
+        return msg if isinstance(msg, bytes) else _serializer(store, fmt)(msg, msgtype)
+
     if fmt == "ros1":
         with Ros1Writer(path) as writer:
             connections = {
@@ -96,6 +108,10 @@ def _write(
             conns = {t: _ros2_connection(writer2, store, t, types[t], t in latched) for t in sorted(types)}
             for stamp, _, topic, msg in messages:
                 writer2.write(conns[topic], stamp, serialize(msg, types[topic]))
+
+
+def _serializer(store: Any, fmt: str) -> Any:
+    return store.serialize_ros1 if fmt == "ros1" else store.serialize_cdr
 
 
 def _ros2_connection(writer: Ros2Writer, store: Any, topic: str, msgtype: str, latched: bool) -> Any:

@@ -14,10 +14,18 @@ from typing import Any
 import numpy as np
 
 from exsce_dsl.maps.planning import PlanningGrid
+from exsce_dsl.sim.batches import Batch, stamp_columns
 from exsce_dsl.sim.executor import Execution, GoalStatus
 from exsce_dsl.sim.messages import FEEDBACK, RESULT
 from exsce_dsl.sim.scan import Laser, laser_scans
-from exsce_dsl.sim.values import header, quaternion, ros_time, sample_stamps
+from exsce_dsl.sim.values import (
+    header,
+    header_at,
+    heading_columns,
+    planar_rotation,
+    ros_time,
+    sample_stamps,
+)
 from exsce_dsl.sim.writing import Message, RobotRun
 
 POSE_EVERY, VEL_EVERY, DIST_EVERY = 1, 2, 5  # samples of the 50 Hz clock
@@ -62,7 +70,7 @@ class Topics:
         return self._name("waypoint_dispatcher/result")
 
 
-def method_messages(run: RobotRun) -> Iterator[Message]:
+def method_messages(run: RobotRun) -> Iterator[Message | Batch]:
     """Every message of one robot in the method's convention."""
     topics = Topics(run.namespace)
     yield from robot_messages(
@@ -80,7 +88,7 @@ def robot_messages(
     laser: Laser,
     rng: np.random.Generator,
     start_ns: int,
-) -> Iterator[Message]:
+) -> Iterator[Message | Batch]:
     tr = execution.trajectories[robot]
     n = len(tr)
     stamps = sample_stamps(start_ns, n)
@@ -92,35 +100,53 @@ def robot_messages(
     covariance = np.zeros(36)
     covariance[[0, 7, 35]] = [POSE_NOISE**2, POSE_NOISE**2, YAW_NOISE**2]
     pose_type = "geometry_msgs/msg/PoseWithCovarianceStamped"
-    for i in range(0, n, POSE_EVERY):
+
+    def robot_pose(sec: int, nanosec: int, seq: int, x: float, y: float, qz: float, qw: float) -> Any:
         pose = T["geometry_msgs/msg/Pose"](
-            position=T["geometry_msgs/msg/Point"](x=float(px[i]), y=float(py[i]), z=0.0),
-            orientation=quaternion(store, float(pyaw[i])),
+            position=T["geometry_msgs/msg/Point"](x=x, y=y, z=0.0), orientation=planar_rotation(store, qz, qw)
         )
-        msg = T[pose_type](
-            header=header(store, int(stamps[i]), "map", i),
+        return T[pose_type](
+            header=header_at(store, sec, nanosec, "map", seq),
             pose=T["geometry_msgs/msg/PoseWithCovariance"](pose=pose, covariance=covariance),
         )
-        yield topics.pose, pose_type, int(stamps[i]), msg
+
+    at = np.arange(0, n, POSE_EVERY)
+    yield Batch(
+        topics.pose,
+        pose_type,
+        stamps[at],
+        robot_pose,
+        {
+            **stamp_columns(stamps[at]),
+            "seq": at.astype("<u4"),
+            "x": px[at],
+            "y": py[at],
+            **heading_columns(pyaw[at]),
+        },
+    )
     # nav_vel: Twist (the command the robot follows)
-    for i in range(0, n, VEL_EVERY):
-        msg = T["geometry_msgs/msg/Twist"](
-            linear=T["geometry_msgs/msg/Vector3"](x=float(tr.v[i]), y=0.0, z=0.0),
-            angular=T["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=float(tr.w[i])),
+
+    def velocity(v: float, w: float) -> Any:
+        return T["geometry_msgs/msg/Twist"](
+            linear=T["geometry_msgs/msg/Vector3"](x=v, y=0.0, z=0.0),
+            angular=T["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=w),
         )
-        yield topics.vel, "geometry_msgs/msg/Twist", int(stamps[i]), msg
+
+    at = np.arange(0, n, VEL_EVERY)
+    yield Batch(topics.vel, "geometry_msgs/msg/Twist", stamps[at], velocity, {"v": tr.v[at], "w": tr.w[at]})
     # distance_travelled: Float64, cumulative
     step = np.concatenate([[0.0], np.hypot(np.diff(tr.x), np.diff(tr.y))])
     travelled = np.cumsum(step)
-    for i in range(0, n, DIST_EVERY):
-        yield (
-            topics.distance,
-            "std_msgs/msg/Float64",
-            int(stamps[i]),
-            T["std_msgs/msg/Float64"](data=float(travelled[i])),
-        )
+    at = np.arange(0, n, DIST_EVERY)
+    yield Batch(
+        topics.distance,
+        "std_msgs/msg/Float64",
+        stamps[at],
+        lambda data: T["std_msgs/msg/Float64"](data=data),
+        {"data": travelled[at]},
+    )
     # scan: LaserScan against the map and the other robots
-    yield from laser_scans(
+    yield laser_scans(
         store, topics.scan, f"{topics.ns}/base_laser_link", robot, execution, grid, laser, rng, stamps
     )
 

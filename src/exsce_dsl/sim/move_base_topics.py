@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from exsce_dsl.sim.batches import Batch
 from exsce_dsl.sim.executor import GoalStatus
 from exsce_dsl.sim.goals import NavigationGoal, Phase, listed, navigation_goals, status_samples
 from exsce_dsl.sim.localisation import Localisation, localise
@@ -48,7 +49,7 @@ STATUS_LIST_TIMEOUT = 5.0
 LATCHED = ("tf_static",)
 
 
-def move_base_messages(run: RobotRun) -> Iterator[Message]:
+def move_base_messages(run: RobotRun) -> Iterator[Message | Batch]:
     """Every message of one robot driven by move_base."""
     tr = run.execution.trajectories[run.robot]
     stamps = sample_stamps(run.start_ns, len(tr))

@@ -21,6 +21,7 @@ import numpy as np
 
 from exsce_dsl.messages.navigation import stored_name
 from exsce_dsl.model.goals import ActionGoalStatus
+from exsce_dsl.sim.batches import Batch
 from exsce_dsl.sim.goals import NavigationGoal, Phase, listed, navigation_goals, status_samples
 from exsce_dsl.sim.localisation import Localisation, localise
 from exsce_dsl.sim.motion import DT
@@ -46,7 +47,7 @@ PLAN_SPACING = 0.05  # metres between the poses of a published plan (a grid plan
 LATCHED = ("tf_static", f"{ACTION}/_action/status")
 
 
-def nav2_messages(run: RobotRun) -> Iterator[Message]:
+def nav2_messages(run: RobotRun) -> Iterator[Message | Batch]:
     """Every message of one robot driven by Nav2."""
     tr = run.execution.trajectories[run.robot]
     stamps = sample_stamps(run.start_ns, len(tr))

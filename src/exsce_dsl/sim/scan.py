@@ -7,16 +7,16 @@ scans of a robot are marched together as one numpy array.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from exsce_dsl.maps.planning import PlanningGrid
+from exsce_dsl.sim.batches import Batch, stamp_columns
 from exsce_dsl.sim.executor import Execution
 from exsce_dsl.sim.motion import DT
-from exsce_dsl.sim.values import header
+from exsce_dsl.sim.values import header_at
 
 SCAN_EVERY = 5  # samples of the 50 Hz clock: 10 Hz
 ROBOT_RADIUS = 0.3  # other robots are discs of this radius
@@ -94,18 +94,19 @@ def laser_scans(
     laser: Laser,
     rng: np.random.Generator,
     stamps: np.ndarray,
-) -> Iterator[tuple[str, str, int, Any]]:
+) -> Batch:
     """``sensor_msgs/LaserScan`` messages of ``robot`` every SCAN_EVERY samples (stamps: one per
-    sample), against the map and the other robots: (topic, type, stamp, message)."""
+    sample), against the map and the other robots."""
     T = store.types
     tr = execution.trajectories[robot]
     idx = np.arange(0, len(tr), SCAN_EVERY)
     others = [(o.x[idx], o.y[idx]) for r, o in execution.trajectories.items() if r != robot]
     ranges = scan_ranges(grid, laser, tr.x[idx], tr.y[idx], tr.yaw[idx], others, ROBOT_RADIUS, rng)
     empty = np.zeros(0, dtype=np.float32)
-    for k, i in enumerate(idx.tolist()):
-        msg = T["sensor_msgs/msg/LaserScan"](
-            header=header(store, int(stamps[i]), frame, k),
+
+    def scan(sec: int, nanosec: int, seq: int, ranges: np.ndarray) -> Any:
+        return T["sensor_msgs/msg/LaserScan"](
+            header=header_at(store, sec, nanosec, frame, seq),
             angle_min=laser.angle_min,
             angle_max=laser.angle_max,
             angle_increment=laser.angle_increment,
@@ -113,7 +114,10 @@ def laser_scans(
             scan_time=SCAN_EVERY * DT,
             range_min=laser.range_min,
             range_max=laser.range_max,
-            ranges=ranges[k],
+            ranges=ranges,
             intensities=empty,
         )
-        yield topic, "sensor_msgs/msg/LaserScan", int(stamps[i]), msg
+
+    seq = np.arange(len(idx)).astype("<u4")
+    columns = {**stamp_columns(stamps[idx]), "seq": seq, "ranges": ranges.astype("<f4")}
+    return Batch(topic, "sensor_msgs/msg/LaserScan", stamps[idx], scan, columns)

@@ -28,10 +28,11 @@ from typing import Any
 
 import numpy as np
 
+from exsce_dsl.sim.batches import Batch, stamp_columns
 from exsce_dsl.sim.localisation import LOCALISATION_NOISE, LOCALISATION_YAW_NOISE, Localisation
 from exsce_dsl.sim.motion import DT
 from exsce_dsl.sim.scan import laser_scans
-from exsce_dsl.sim.values import header, pose, transform, twist
+from exsce_dsl.sim.values import header, header_at, heading_columns, planar_rotation, pose, transform, twist
 from exsce_dsl.sim.writing import Message, RobotRun
 
 MAP, ODOM, BASE, FOOTPRINT, LASER = "map", "odom", "base_link", "base_footprint", "base_laser_link"
@@ -56,18 +57,18 @@ AMCL_COVARIANCE = np.diag(
 ).ravel()
 
 
-def stack_messages(run: RobotRun, frames: Localisation, stamps: np.ndarray) -> Iterator[Message]:
+def stack_messages(run: RobotRun, frames: Localisation, stamps: np.ndarray) -> Iterator[Message | Batch]:
     """TF, odometry, AMCL's pose, velocity commands and scans of one robot."""
     yield from _tf(run, frames, stamps)
-    yield from _odometry(run, frames, stamps)
+    yield _odometry(run, frames, stamps)
     yield from _amcl_pose(run, frames, stamps)
     yield from _cmd_vel(run, stamps)
-    yield from laser_scans(
+    yield laser_scans(
         run.store, run.topic("scan"), LASER, run.robot, run.execution, run.grid, run.laser, run.rng, stamps
     )
 
 
-def _tf(run: RobotRun, frames: Localisation, stamps: np.ndarray) -> Iterator[Message]:
+def _tf(run: RobotRun, frames: Localisation, stamps: np.ndarray) -> Iterator[Message | Batch]:
     T, store = run.store.types, run.store
     tf, kind = run.topic("tf"), "tf2_msgs/msg/TFMessage"
     static = [
@@ -75,69 +76,114 @@ def _tf(run: RobotRun, frames: Localisation, stamps: np.ndarray) -> Iterator[Mes
         transform(store, int(stamps[0]), BASE, LASER, 0.0, 0.0, 0.0, LASER_HEIGHT),
     ]
     yield run.topic(TF_STATIC), kind, int(stamps[0]), T[kind](transforms=static)
-    odom, correction = frames.odom, frames.correction
-    for i in range(0, len(stamps), ODOM_EVERY):
-        moved = transform(store, int(stamps[i]), ODOM, BASE, odom.x[i], odom.y[i], odom.yaw[i])
-        yield tf, kind, int(stamps[i]), T[kind](transforms=[moved])
-    for i in range(0, len(stamps), CORRECTION_EVERY):
-        corrected = transform(
-            store, int(stamps[i]), MAP, ODOM, correction.x[i], correction.y[i], correction.yaw[i]
-        )
-        yield tf, kind, int(stamps[i]), T[kind](transforms=[corrected])
-    yield from _joints(run, frames, stamps)
+    for parent, child, poses, every in (
+        (ODOM, BASE, frames.odom, ODOM_EVERY),
+        (MAP, ODOM, frames.correction, CORRECTION_EVERY),
+    ):
+
+        def moved(
+            sec: int,
+            nanosec: int,
+            x: float,
+            y: float,
+            qz: float,
+            qw: float,
+            parent: str = parent,
+            child: str = child,
+        ) -> Any:
+            rotation = planar_rotation(store, qz, qw)
+            return T[kind](transforms=[_transform_at(store, sec, nanosec, parent, child, x, y, rotation)])
+
+        at = np.arange(0, len(stamps), every)
+        columns = {
+            **stamp_columns(stamps[at]),
+            "x": poses.x[at],
+            "y": poses.y[at],
+            **heading_columns(poses.yaw[at]),
+        }
+        yield Batch(tf, kind, stamps[at], moved, columns)
+    yield _joints(run, frames, stamps)
 
 
-def _joints(run: RobotRun, frames: Localisation, stamps: np.ndarray) -> Iterator[Message]:
+def _transform_at(
+    store: Any, sec: int, nanosec: int, parent: str, child: str, x: float, y: float, rotation: Any
+) -> Any:
+    """:func:`~exsce_dsl.sim.values.transform` of a stamp given as seconds and nanoseconds."""
+    T = store.types
+    return T["geometry_msgs/msg/TransformStamped"](
+        header=header_at(store, sec, nanosec, parent),
+        child_frame_id=child,
+        transform=T["geometry_msgs/msg/Transform"](
+            translation=T["geometry_msgs/msg/Vector3"](x=x, y=y, z=0.0), rotation=rotation
+        ),
+    )
+
+
+def _joints(run: RobotRun, frames: Localisation, stamps: np.ndarray) -> Batch:
     """robot_state_publisher's moving joints: each wheel turned about its axle (y) by the distance its
     contact point rolled, at twice the clock's rate (angles interpolated between samples)."""
     T, store = run.store.types, run.store
     kind = "tf2_msgs/msg/TFMessage"
     times = np.arange(len(stamps) * JOINTS_PER_SAMPLE) / JOINTS_PER_SAMPLE
     joint_stamps = np.interp(times, np.arange(len(stamps)), stamps.astype(float)).astype(np.int64)
-    angles = []
-    for _, _, y, radius in WHEELS:
+    columns = stamp_columns(joint_stamps)
+    for number, (_, _, y, radius) in enumerate(WHEELS):
         speed = frames.v - frames.w * y  # the wheel's forward speed: the body's, less the turn's share
         rolled = np.concatenate([[0.0], np.cumsum(speed[:-1] * DT)])
-        angles.append(np.interp(times, np.arange(len(stamps)), rolled / radius))
-    for k, stamp in enumerate(joint_stamps.tolist()):
+        half = (np.interp(times, np.arange(len(stamps)), rolled / radius) / 2).tolist()
+        columns[f"sin{number}"] = np.array([math.sin(a) for a in half], dtype="<f8")
+        columns[f"cos{number}"] = np.array([math.cos(a) for a in half], dtype="<f8")
+
+    def turned(sec: int, nanosec: int, **halves: float) -> Any:
         transforms = [
-            _wheel(store, stamp, child, x, y, float(angle[k]))
-            for (child, x, y, _), angle in zip(WHEELS, angles, strict=True)
+            _transform_at(
+                store,
+                sec,
+                nanosec,
+                BASE,
+                child,
+                x,
+                y,
+                T["geometry_msgs/msg/Quaternion"](x=0.0, y=halves[f"sin{n}"], z=0.0, w=halves[f"cos{n}"]),
+            )
+            for n, (child, x, y, _) in enumerate(WHEELS)
         ]
-        yield run.topic("tf"), kind, stamp, T[kind](transforms=transforms)
+        return T[kind](transforms=transforms)
+
+    return Batch(run.topic("tf"), kind, joint_stamps, turned, columns)
 
 
-def _wheel(store: Any, ns: int, child: str, x: float, y: float, angle: float) -> Any:
-    """The transform base_link → a wheel turned by ``angle`` radians about its axle."""
-    T = store.types
-    return T["geometry_msgs/msg/TransformStamped"](
-        header=header(store, ns, BASE),
-        child_frame_id=child,
-        transform=T["geometry_msgs/msg/Transform"](
-            translation=T["geometry_msgs/msg/Vector3"](x=x, y=y, z=0.0),
-            rotation=T["geometry_msgs/msg/Quaternion"](
-                x=0.0, y=math.sin(angle / 2), z=0.0, w=math.cos(angle / 2)
-            ),
-        ),
-    )
-
-
-def _odometry(run: RobotRun, frames: Localisation, stamps: np.ndarray) -> Iterator[Message]:
+def _odometry(run: RobotRun, frames: Localisation, stamps: np.ndarray) -> Batch:
     T, store = run.store.types, run.store
     kind = "nav_msgs/msg/Odometry"
     odom = frames.odom
-    for seq, i in enumerate(range(0, len(stamps), ODOM_EVERY)):
-        msg = T[kind](
-            header=header(store, int(stamps[i]), ODOM, seq),
+
+    def odometry(
+        sec: int, nanosec: int, seq: int, x: float, y: float, qz: float, qw: float, v: float, w: float
+    ) -> Any:
+        pose = T["geometry_msgs/msg/Pose"](
+            position=T["geometry_msgs/msg/Point"](x=x, y=y, z=0.0), orientation=planar_rotation(store, qz, qw)
+        )
+        return T[kind](
+            header=header_at(store, sec, nanosec, ODOM, seq),
             child_frame_id=BASE,
-            pose=T["geometry_msgs/msg/PoseWithCovariance"](
-                pose=pose(store, odom.x[i], odom.y[i], odom.yaw[i]), covariance=ODOM_COVARIANCE
-            ),
+            pose=T["geometry_msgs/msg/PoseWithCovariance"](pose=pose, covariance=ODOM_COVARIANCE),
             twist=T["geometry_msgs/msg/TwistWithCovariance"](
-                twist=twist(store, frames.v[i], frames.w[i]), covariance=TWIST_COVARIANCE
+                twist=twist(store, v, w), covariance=TWIST_COVARIANCE
             ),
         )
-        yield run.topic("odom"), kind, int(stamps[i]), msg
+
+    at = np.arange(0, len(stamps), ODOM_EVERY)
+    columns = {
+        **stamp_columns(stamps[at]),
+        "seq": np.arange(len(at)).astype("<u4"),
+        "x": odom.x[at],
+        "y": odom.y[at],
+        **heading_columns(odom.yaw[at]),
+        "v": frames.v[at],
+        "w": frames.w[at],
+    }
+    return Batch(run.topic("odom"), kind, stamps[at], odometry, columns)
 
 
 def _amcl_pose(run: RobotRun, frames: Localisation, stamps: np.ndarray) -> Iterator[Message]:

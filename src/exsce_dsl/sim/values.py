@@ -30,10 +30,35 @@ def duration(store: Any, seconds: float) -> Any:
 
 
 def header(store: Any, ns: int, frame: str, seq: int = 0) -> Any:
+    return header_at(store, ns // 1_000_000_000, ns % 1_000_000_000, frame, seq)
+
+
+def header_at(store: Any, sec: int, nanosec: int, frame: str, seq: int = 0) -> Any:
+    """A header stamped ``sec`` s + ``nanosec`` ns (the ``seq`` only where the header has one)."""
     kind = store.types["std_msgs/msg/Header"]
-    if "seq" in kind.__dataclass_fields__:
-        return kind(seq=seq, stamp=ros_time(store, ns), frame_id=frame)
-    return kind(stamp=ros_time(store, ns), frame_id=frame)
+    stamp = store.types["builtin_interfaces/msg/Time"](sec=sec, nanosec=nanosec)
+    if has_seq(store):
+        return kind(seq=seq, stamp=stamp, frame_id=frame)
+    return kind(stamp=stamp, frame_id=frame)
+
+
+def has_seq(store: Any) -> bool:
+    """Whether the typestore's ``std_msgs/Header`` has a ``seq`` (ROS 1's does)."""
+    return "seq" in store.types["std_msgs/msg/Header"].__dataclass_fields__
+
+
+def planar_rotation(store: Any, qz: float, qw: float) -> Any:
+    """The quaternion of a heading, given as its ``z`` and ``w`` (see :func:`heading_columns`)."""
+    return store.types["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=qz, w=qw)
+
+
+def heading_columns(yaw: np.ndarray) -> dict[str, np.ndarray]:
+    """``qz`` and ``qw`` of each heading, by ``math`` as :func:`quaternion` computes them (numpy's
+    sine may differ in the last bit)."""
+    return {
+        "qz": np.array([math.sin(a / 2) for a in yaw.tolist()], dtype="<f8"),
+        "qw": np.array([math.cos(a / 2) for a in yaw.tolist()], dtype="<f8"),
+    }
 
 
 def quaternion(store: Any, yaw: float) -> Any:

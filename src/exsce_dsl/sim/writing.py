@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from exsce_dsl.maps.planning import PlanningGrid
+from exsce_dsl.sim.batches import Batch
 from exsce_dsl.sim.executor import Execution
 from exsce_dsl.sim.scan import Laser
 
@@ -42,5 +43,5 @@ class RobotRun:
         return f"/{self.namespace}/{name}" if self.namespace else f"/{name}"
 
 
-RobotWriter = Callable[[RobotRun], Iterator[Message]]
-"""A convention's writer: every message of one robot."""
+RobotWriter = Callable[[RobotRun], Iterator[Message | Batch]]
+"""A convention's writer: every message of one robot, one at a time or in batches of one topic."""
