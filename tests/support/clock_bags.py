@@ -86,8 +86,30 @@ def _moved(value: Any, move: Any, store: Any) -> Any:
         return type(value)(_moved(v, move, store) for v in value)
     if not dataclasses.is_dataclass(value) or isinstance(value, type):
         return value
-    if type(value).__name__.endswith("builtin_interfaces__msg__Time"):
+    if _is_time(value):
         stamp = value.sec + value.nanosec * 1e-9
         return _time(store, move(stamp)) if stamp > 0 else value
-    changes = {f.name: _moved(getattr(value, f.name), move, store) for f in dataclasses.fields(value)}
-    return dataclasses.replace(value, **changes)
+    names = _fields_with_time(value)
+    if not names:
+        return value
+    return dataclasses.replace(value, **{name: _moved(getattr(value, name), move, store) for name in names})
+
+
+_WITH_TIME: dict[type, tuple[str, ...]] = {}
+"""Per message class, the fields that hold, or may hold, a Time (a list may, another time)."""
+
+
+def _is_time(value: Any) -> bool:
+    return type(value).__name__.endswith("builtin_interfaces__msg__Time")
+
+
+def _fields_with_time(value: Any) -> tuple[str, ...]:
+    kind = type(value)
+    if kind not in _WITH_TIME:
+        _WITH_TIME[kind] = tuple(
+            f.name
+            for f in dataclasses.fields(value)
+            if isinstance(field := getattr(value, f.name), list | tuple)
+            or (dataclasses.is_dataclass(field) and (_is_time(field) or _fields_with_time(field)))
+        )
+    return _WITH_TIME[kind]
