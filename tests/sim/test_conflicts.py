@@ -129,3 +129,12 @@ def test_a_later_meeting_is_offered_after_the_first() -> None:
     ]
     repairs = conflict_repairs(trajectories, actions, ["first", "second"])
     assert [r.leg for r in repairs] == [("second", 1), ("first", 1), ("second", 2), ("first", 1)]
+
+
+def test_a_robot_farther_than_the_safe_distance_never_makes_another_give_way() -> None:
+    """give_way skips its checks when no robot is within SAFE_DISTANCE: that holds only while the
+    nearest a robot keeps from one standing (GOAL_WAIT, CLEARANCE + 0.1) is below it."""
+    from exsce_dsl.sim import give_way
+
+    assert give_way.GOAL_WAIT < give_way.SAFE_DISTANCE
+    assert give_way.CLEARANCE + 0.1 < give_way.SAFE_DISTANCE

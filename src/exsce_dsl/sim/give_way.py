@@ -121,6 +121,9 @@ class _Replay:
         look = self.at(
             r, min(position + 1.0 + self.rate[r] * RAMP / DT / 2, self.last[r])
         )  # where braking would end
+        if self._nobody_near(r, here, look, placed):
+            self.waited[r] = 0
+            return 1.0
         # robots before r that drive, and every robot that stands (waiting, parked or not started)
         active = {h: p for h, p in placed.items() if self.position[h] < self.moving[h] and not self.still[h]}
         threats = [  # robots with right of way coming at r: where they would stop is too close
@@ -157,6 +160,22 @@ class _Replay:
             math.dist(behind, braking[h]) > math.dist(here, braking[h]) for h in active if h in braking
         )
         return -1.0 if threatened and position > 0 and away else 0.0
+
+    def _nobody_near(
+        self,
+        r: str,
+        here: tuple[float, float],
+        look: tuple[float, float],
+        placed: dict[str, tuple[float, float]],
+    ) -> bool:
+        """No other robot, where it was or is now, within SAFE_DISTANCE of ``here`` or ``look``: then
+        none threatens, blocks or is bumped into, as each of those needs one nearer (a robot keeps
+        at most GOAL_WAIT or CLEARANCE + 0.1 from one standing, both below SAFE_DISTANCE)."""
+        for where in (placed, self.previous):
+            for h, p in where.items():
+                if h != r and (math.dist(here, p) < SAFE_DISTANCE or math.dist(look, p) < SAFE_DISTANCE):
+                    return False
+        return True
 
     def keep_from(self, r: str, p: tuple[float, float]) -> float:
         """How near r comes to a robot standing at p: farther when p is r's goal, so that the
