@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -94,15 +94,19 @@ class PlanningGrid:
             self.origin[1] + (rc[0] + 0.5) * self.resolution,
         )
 
+    @cached_property
+    def _bordered_clearance(self) -> np.ndarray:
+        """:attr:`clearance` with a border of zeros: where every point outside the map is looked up."""
+        return np.pad(self.clearance, 1)
+
     def clearance_at(self, points: np.ndarray) -> np.ndarray:
         """Metres from each point (n×2) to the nearest non-free cell; 0 outside the map."""
-        cols = np.floor((points[:, 0] - self.origin[0]) / self.map_resolution).astype(np.int64)
-        rows = np.floor((points[:, 1] - self.origin[1]) / self.map_resolution).astype(np.int64)
-        inside = (
-            (rows >= 0) & (rows < self.clearance.shape[0]) & (cols >= 0) & (cols < self.clearance.shape[1])
-        )
-        out = np.zeros(len(points))
-        out[inside] = self.clearance[rows[inside], cols[inside]]
+        height, width = self.clearance.shape
+        cols = np.floor((points[:, 0] - self.origin[0]) / self.map_resolution)
+        rows = np.floor((points[:, 1] - self.origin[1]) / self.map_resolution)
+        cols = np.clip(cols, -1, width).astype(np.int64) + 1
+        rows = np.clip(rows, -1, height).astype(np.int64) + 1
+        out: np.ndarray = self._bordered_clearance[rows, cols]
         for x, y, radius in self.discs:
             away = np.hypot(points[:, 0] - x, points[:, 1] - y) - radius
             np.minimum(out, np.maximum(away, 0.0), out=out)
