@@ -16,8 +16,8 @@ from __future__ import annotations
 
 import difflib
 import json
+import os
 from collections.abc import Iterator
-from contextlib import chdir
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -58,8 +58,12 @@ class Stores:
     def answer(self, store: str, *args: str) -> str:
         """What ``exscec ARGS --store STORE`` prints, run in this process (the comparison below
         runs 234 of them: a process each would cost a minute of starting Python)."""
-        with chdir(self.folder):
+        before = Path.cwd()
+        os.chdir(self.folder)  # contextlib.chdir is Python 3.11's; exsce runs on 3.10 too
+        try:
             done = CliRunner(env={"COLUMNS": "120"}).invoke(main, [*args, "--store", store])
+        finally:
+            os.chdir(before)
         assert done.exit_code == 0, f"{args} on {store}: {done.stderr}{done.exception!r}"
         return done.stdout
 
