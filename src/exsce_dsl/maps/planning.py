@@ -101,14 +101,16 @@ class PlanningGrid:
 
     def clearance_at(self, points: np.ndarray) -> np.ndarray:
         """Metres from each point (n×2) to the nearest non-free cell; 0 outside the map."""
+        return self.clearance_of(points[:, 0], points[:, 1])
+
+    def clearance_of(self, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
+        """:meth:`clearance_at` of the points ``(xs[i], ys[i])``."""
         height, width = self.clearance.shape
-        cols = np.floor((points[:, 0] - self.origin[0]) / self.map_resolution)
-        rows = np.floor((points[:, 1] - self.origin[1]) / self.map_resolution)
-        cols = np.clip(cols, -1, width).astype(np.int64) + 1
-        rows = np.clip(rows, -1, height).astype(np.int64) + 1
-        out: np.ndarray = self._bordered_clearance[rows, cols]
+        cols = np.clip(np.floor((xs - self.origin[0]) / self.map_resolution), -1, width).astype(np.int64)
+        rows = np.clip(np.floor((ys - self.origin[1]) / self.map_resolution), -1, height).astype(np.int64)
+        out: np.ndarray = self._bordered_clearance.take((rows + 1) * (width + 2) + (cols + 1))
         for x, y, radius in self.discs:
-            away = np.hypot(points[:, 0] - x, points[:, 1] - y) - radius
+            away = np.hypot(xs - x, ys - y) - radius
             np.minimum(out, np.maximum(away, 0.0), out=out)
         return out
 

@@ -53,23 +53,30 @@ def scan_ranges(
     theta = yaw[:, None] + laser.angles()[None, :]
     dx, dy = np.cos(theta), np.sin(theta)
     ox, oy = np.broadcast_to(x[:, None], theta.shape), np.broadcast_to(y[:, None], theta.shape)
-    # the beams still marching, as flat indices: each step costs what is left, not every beam
-    flat_ox, flat_oy, flat_dx, flat_dy = (a.reshape(-1) for a in (ox, oy, dx, dy))
+    # the beams still marching, compacted after each step: each step costs what is left
+    beam = np.arange(theta.size)
+    bx, by, bdx, bdy = (a.reshape(-1) for a in (ox, oy, dx, dy))
+    so_far = np.zeros(theta.size)
     travelled = np.zeros(theta.size)
-    marching = np.arange(theta.size)
     hit_eps = grid.map_resolution
     for _ in range(64):
-        if marching.size == 0:
+        if beam.size == 0:
             break
-        so_far = travelled[marching]
-        px = flat_ox[marching] + flat_dx[marching] * so_far
-        py = flat_oy[marching] + flat_dy[marching] * so_far
-        clearance = grid.clearance_at(np.column_stack([px, py]))
-        step = np.maximum(clearance - hit_eps * 0.5, hit_eps * 0.5)
+        clearance = grid.clearance_of(bx + bdx * so_far, by + bdy * so_far)
         done = clearance < hit_eps
-        moved = so_far + np.where(done, 0.0, step)
-        travelled[marching] = moved
-        marching = marching[~done & (moved < laser.range_max)]
+        moved = so_far + np.where(done, 0.0, np.maximum(clearance - hit_eps * 0.5, hit_eps * 0.5))
+        going = ~done & (moved < laser.range_max)
+        stopped = ~going
+        travelled[beam[stopped]] = moved[stopped]
+        beam, bx, by, bdx, bdy, so_far = (
+            beam[going],
+            bx[going],
+            by[going],
+            bdx[going],
+            bdy[going],
+            moved[going],
+        )
+    travelled[beam] = so_far  # beams still marching after the last step
     travelled = travelled.reshape(theta.shape)
     ranges = np.where(travelled < laser.range_max, travelled, np.inf)
     for qx, qy in others:  # other robots are discs
