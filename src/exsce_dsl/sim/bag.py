@@ -91,8 +91,10 @@ def _write(
     types: dict[str, str],
     latched: set[str],
 ) -> None:
+    serializer = _serializer(store, fmt)
+
     def serialize(msg: Any, msgtype: str) -> Any:  # a batch's messages come serialized
-        return msg if isinstance(msg, bytes) else _serializer(store, fmt)(msg, msgtype)
+        return msg if isinstance(msg, bytes) else serializer(msg, msgtype)
 
     if fmt == "ros1":
         with Ros1Writer(path) as writer:

@@ -5,7 +5,8 @@ messages whose strings never change: only stamps, sequence numbers, coordinates 
 A :class:`Batch` builds one message with a sentinel in each such *slot*, serializes it with
 rosbags, finds where each sentinel landed, and writes every message's numbers into copies of
 those bytes with numpy: the bytes rosbags would have written for each message, without a Python
-object per message (the first and last are serialized by rosbags too, and must agree).
+object per message.  The first, middle and last messages are serialized by rosbags too; where
+they disagree with the copies, the batch is serialized one message at a time instead.
 """
 
 from __future__ import annotations
@@ -53,7 +54,7 @@ class Batch:
         if not len(self):
             return []
         rows = self._from_template(serialize)
-        if rows is None:  # a sentinel's bytes were also somewhere else: one message at a time
+        if rows is None:  # the template's copies are not what rosbags writes: one message at a time
             return [bytes(serialize(self.build(**self.values(i)), self.msgtype)) for i in range(len(self))]
         return [row.tobytes() for row in rows]
 

@@ -32,7 +32,16 @@ from exsce_dsl.sim.batches import Batch, stamp_columns
 from exsce_dsl.sim.localisation import LOCALISATION_NOISE, LOCALISATION_YAW_NOISE, Localisation
 from exsce_dsl.sim.motion import DT
 from exsce_dsl.sim.scan import laser_scans
-from exsce_dsl.sim.values import header, header_at, heading_columns, planar_rotation, pose, transform, twist
+from exsce_dsl.sim.values import (
+    header,
+    header_at,
+    heading_columns,
+    planar_rotation,
+    pose,
+    transform,
+    transform_at,
+    twist,
+)
 from exsce_dsl.sim.writing import Message, RobotRun
 
 MAP, ODOM, BASE, FOOTPRINT, LASER = "map", "odom", "base_link", "base_footprint", "base_laser_link"
@@ -92,7 +101,7 @@ def _tf(run: RobotRun, frames: Localisation, stamps: np.ndarray) -> Iterator[Mes
             child: str = child,
         ) -> Any:
             rotation = planar_rotation(store, qz, qw)
-            return T[kind](transforms=[_transform_at(store, sec, nanosec, parent, child, x, y, rotation)])
+            return T[kind](transforms=[transform_at(store, sec, nanosec, parent, child, x, y, rotation)])
 
         at = np.arange(0, len(stamps), every)
         columns = {
@@ -103,20 +112,6 @@ def _tf(run: RobotRun, frames: Localisation, stamps: np.ndarray) -> Iterator[Mes
         }
         yield Batch(tf, kind, stamps[at], moved, columns)
     yield _joints(run, frames, stamps)
-
-
-def _transform_at(
-    store: Any, sec: int, nanosec: int, parent: str, child: str, x: float, y: float, rotation: Any
-) -> Any:
-    """:func:`~exsce_dsl.sim.values.transform` of a stamp given as seconds and nanoseconds."""
-    T = store.types
-    return T["geometry_msgs/msg/TransformStamped"](
-        header=header_at(store, sec, nanosec, parent),
-        child_frame_id=child,
-        transform=T["geometry_msgs/msg/Transform"](
-            translation=T["geometry_msgs/msg/Vector3"](x=x, y=y, z=0.0), rotation=rotation
-        ),
-    )
 
 
 def _joints(run: RobotRun, frames: Localisation, stamps: np.ndarray) -> Batch:
@@ -136,7 +131,7 @@ def _joints(run: RobotRun, frames: Localisation, stamps: np.ndarray) -> Batch:
 
     def turned(sec: int, nanosec: int, **halves: float) -> Any:
         transforms = [
-            _transform_at(
+            transform_at(
                 store,
                 sec,
                 nanosec,

@@ -37,14 +37,9 @@ def header_at(store: Any, sec: int, nanosec: int, frame: str, seq: int = 0) -> A
     """A header stamped ``sec`` s + ``nanosec`` ns (the ``seq`` only where the header has one)."""
     kind = store.types["std_msgs/msg/Header"]
     stamp = store.types["builtin_interfaces/msg/Time"](sec=sec, nanosec=nanosec)
-    if has_seq(store):
+    if "seq" in kind.__dataclass_fields__:
         return kind(seq=seq, stamp=stamp, frame_id=frame)
     return kind(stamp=stamp, frame_id=frame)
-
-
-def has_seq(store: Any) -> bool:
-    """Whether the typestore's ``std_msgs/Header`` has a ``seq`` (ROS 1's does)."""
-    return "seq" in store.types["std_msgs/msg/Header"].__dataclass_fields__
 
 
 def planar_rotation(store: Any, qz: float, qw: float) -> Any:
@@ -62,7 +57,7 @@ def heading_columns(yaw: np.ndarray) -> dict[str, np.ndarray]:
 
 
 def quaternion(store: Any, yaw: float) -> Any:
-    return store.types["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=math.sin(yaw / 2), w=math.cos(yaw / 2))
+    return planar_rotation(store, math.sin(yaw / 2), math.cos(yaw / 2))
 
 
 def pose(store: Any, x: float, y: float, yaw: float, z: float = 0.0) -> Any:
@@ -91,10 +86,29 @@ def transform(
     store: Any, ns: int, parent: str, child: str, x: float, y: float, yaw: float, z: float = 0.0, seq: int = 0
 ) -> Any:
     """``geometry_msgs/TransformStamped``: the pose of ``child`` in ``parent``."""
-    return store.types["geometry_msgs/msg/TransformStamped"](
-        header=header(store, ns, parent, seq),
+    rotation = quaternion(store, float(yaw))
+    sec, nanosec = ns // 1_000_000_000, ns % 1_000_000_000
+    return transform_at(store, sec, nanosec, parent, child, float(x), float(y), rotation, float(z), seq)
+
+
+def transform_at(
+    store: Any,
+    sec: int,
+    nanosec: int,
+    parent: str,
+    child: str,
+    x: float,
+    y: float,
+    rotation: Any,
+    z: float = 0.0,
+    seq: int = 0,
+) -> Any:
+    """:func:`transform` stamped ``sec`` s + ``nanosec`` ns, its rotation given as a quaternion."""
+    T = store.types
+    return T["geometry_msgs/msg/TransformStamped"](
+        header=header_at(store, sec, nanosec, parent, seq),
         child_frame_id=child,
-        transform=store.types["geometry_msgs/msg/Transform"](
-            translation=vector(store, x, y, z), rotation=quaternion(store, float(yaw))
+        transform=T["geometry_msgs/msg/Transform"](
+            translation=T["geometry_msgs/msg/Vector3"](x=x, y=y, z=z), rotation=rotation
         ),
     )
