@@ -21,6 +21,7 @@ import xmlrpc.client
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
+from functools import cache
 from pathlib import Path
 
 import pytest
@@ -41,6 +42,14 @@ CALLER = "/exsce_tests"
 
 def require_ros1() -> None:
     """Fail (not skip: CI installs ROS 1) when the graph's programs or rospy are missing."""
+    missing = _missing()
+    if missing:
+        pytest.fail(f"ROS 1 is not installed ({', '.join(missing)} missing): run {INSTALL}", pytrace=False)
+
+
+@cache
+def _missing() -> tuple[str, ...]:
+    """What of ROS 1 is not installed, found once per process (the rospy probe takes a second)."""
     missing = [name for name in ("roscore", "rosbag") if shutil.which(name) is None]
     if not ROS_PYTHON.exists():
         missing.append(str(ROS_PYTHON))
@@ -56,8 +65,7 @@ def require_ros1() -> None:
             missing.append(f"rospy or its messages for {ROS_PYTHON} ({why})")
     if _rosbag_program("record") is None:
         missing.append("rosbag's record program")
-    if missing:
-        pytest.fail(f"ROS 1 is not installed ({', '.join(missing)} missing): run {INSTALL}", pytrace=False)
+    return tuple(missing)
 
 
 def _rosbag_program(name: str) -> Path | None:
