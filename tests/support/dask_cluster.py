@@ -15,8 +15,13 @@ from distributed import Client, LocalCluster
 
 @contextmanager
 def local_cluster(workers: int = 2) -> Iterator[LocalCluster]:
+    # the dashboard on a free port too: None still tries 8787, which another worker's cluster may hold
     with LocalCluster(
-        n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None
+        n_workers=workers,
+        threads_per_worker=1,
+        processes=True,
+        host="127.0.0.1",
+        dashboard_address="127.0.0.1:0",
     ) as started:
         yield started
 
