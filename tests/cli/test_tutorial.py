@@ -3,8 +3,8 @@
 The tutorial's commands are the demo's, line for line, exit statuses included (the first test
 here), so they run where the demo runs, as a process of its own and checked step by step: the live
 chapter of the help examples (test_help_examples_live.py), which also runs the tutorial's
-``exscec demo my-project --setup-only``; on a navigation stack's topics: test_demo_conventions.py;
-against a remote endpoint: test_demo_remote.py."""
+``exscec demo my-project --setup-only``; on Nav2's topics against a remote endpoint:
+test_demo_remote.py; on move_base's, live: tests/execute/test_live_loop.py."""
 
 from __future__ import annotations
 

@@ -33,6 +33,7 @@ from exsce_dsl import api as exsce
 from exsce_dsl.api.demo import LIVE_STEPS
 from exsce_dsl.execute.outcomes import Outcome
 from exsce_dsl.execute.ros1.graph import start_master
+from exsce_dsl.runs.bags.reading import bag_topics
 from exsce_dsl.sim.run import simulate
 
 from tests.support.cli import run_exscec
@@ -67,6 +68,15 @@ def test_the_new_run_passes_and_the_over_speed_run_fails(demo: tuple[Path, str])
     faulty_run = stored[stored.bag == faulty_bag.name].run.item()
     outcomes = verdicts[verdicts.run == faulty_run].set_index("oracle").outcome
     assert outcomes["tiago1-max_velocity"] == "failed" and outcomes["tiago2-max_velocity"] == "passed"
+    # the runs are move_base's: its goal topics in the bags, max_velocity read from cmd_vel
+    (new_bag,) = (folder / "runs" / "new").glob("*.bag")
+    assert "/tiago1/move_base/status" in bag_topics(new_bag) and "/tiago1/robot_pose" not in bag_topics(new_bag)
+    sources = run_exscec(
+        "query", "metric_sources", "-p", f"run={faulty_run}", "-p", "metric=max_velocity", "-f", "csv",
+        cwd=folder,
+    )  # fmt: skip
+    assert sources.returncode == 0, sources.stderr
+    assert "/tiago1/cmd_vel" in sources.stdout and "/tiago1/nav_vel" not in sources.stdout
     # every file of every run, under the method's names, and nothing cut short
     for runs in ("baseline", "new", "faulty"):
         bags = sorted((folder / "runs" / runs).glob("*.bag"))
