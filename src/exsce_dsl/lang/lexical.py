@@ -56,6 +56,16 @@ def string_literal(text: str) -> str:
     return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
 
 
+_ESCAPED = re.compile(r"""\\([\\"'])""")
+
+
+def string_value(literal: str) -> str:
+    """The text a quoted string of the language (the grammar's ``Quoted``, quotes included)
+    stands for: the inverse of :func:`string_literal`.  A backslash before any other character
+    stays, as it is written (``"\\d"`` is two characters)."""
+    return _ESCAPED.sub(r"\1", literal[1:-1])
+
+
 # A quantity token of the grammar (``Length``, ``Angle``, ``Quantity``, ``MetricQuantity``): a
 # number and, after optional spaces, a unit.
 _QUANTITY = re.compile(r"([-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?)\s*(\S+)?")

@@ -15,6 +15,7 @@ from textx import TextXSyntaxError, metamodel_from_file
 
 from exsce_dsl.errors import Diagnostic, ExsceSyntaxError, SourceLocation
 from exsce_dsl.lang.chunks import area_spans, declaration_chunks
+from exsce_dsl.lang.lexical import string_value
 from exsce_dsl.lang.locations import LineIndex
 from exsce_dsl.model.metrics import UNITS
 from exsce_dsl.model.names import KEYWORDS
@@ -30,6 +31,7 @@ _RULE_WORDS = {
     "STRICTFLOAT": "a number",
     "INT": "a number",
     "STRING": "a quoted string",
+    "Quoted": "a quoted string",
     "EOF": "the end of the file",
     "Length": "a length (a number, in m unless followed by cm or mm)",
     "Angle": "an angle (a number, in rad unless followed by deg)",
@@ -41,7 +43,9 @@ _LONG_PIECE = 4000
 
 def new_metamodel() -> Any:
     """A fresh metamodel of the exsce grammar (textX caches nothing across them)."""
-    return metamodel_from_file(str(grammar_file()), autokwd=True)
+    made = metamodel_from_file(str(grammar_file()), autokwd=True)
+    made.register_obj_processors({"Quoted": string_value})  # textX's STRING does not unescape
+    return made
 
 
 @functools.lru_cache(maxsize=1)

@@ -386,15 +386,9 @@ def _steps(part: Any) -> list[Step]:
             steps.append(Index(int(pick.index)))
             continue
         number = pick.select.number
-        value = float(number) if number is not None else _text(pick.select.text)
+        value = float(number) if number is not None else str(pick.select.text)
         steps.append(Select(tuple(pick.select.field), value))
     return steps
-
-
-def _text(parsed: str) -> str:
-    """A string as written, from textX's (which turns ``\\"`` into ``"`` but keeps ``\\\\``):
-    the inverse of :func:`exsce_dsl.lang.lexical.string_literal`, so that it prints back."""
-    return parsed.replace("\\\\", "\\")
 
 
 def binary_type(op: str, left: Typed, right: Typed, where: SourceLocation) -> Typed | str:

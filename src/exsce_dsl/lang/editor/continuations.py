@@ -27,6 +27,7 @@ _OTHER_RULES = {
     "Name": "name",
     "Ref": "name",
     "STRING": "string",
+    "Quoted": "string",
     "INT": "number",
     "NUMBER": "number",
     "FLOAT": "number",
