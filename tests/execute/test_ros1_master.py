@@ -3,7 +3,10 @@ over XML-RPC and stopped, a master that is not there named (a real roscore; no r
 
 from __future__ import annotations
 
+import os
+import signal
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -38,6 +41,34 @@ def test_a_started_master_answers_keeps_parameters_and_is_gone_after(tmp_path: P
         process = started.process
     assert process.poll() is not None
     assert not Master(started.uri).reachable()
+
+
+def test_a_master_whose_roscore_died_is_stopped_whole(tmp_path: Path) -> None:
+    """roslaunch starts rosmaster and rosout in sessions of their own: with roscore gone (killed,
+    as stop() kills one that takes over 15 s to shut down), a signal to its group no longer
+    reaches them; stop() ends them by the pids it noted when the master came up."""
+    require_ros1()
+    with start_master(tmp_path / "ros") as started:
+        below = dict(started.below)
+        words = {w.decode() for pid in below for w in Path(f"/proc/{pid}/cmdline").read_bytes().split(b"\0")}
+        assert {"/usr/bin/rosmaster", "/usr/lib/rosout/rosout"} <= words
+        os.kill(started.process.pid, signal.SIGKILL)
+        started.process.wait(10)
+        assert Master(started.uri).reachable()  # the orphans still answer
+    assert not Master(started.uri).reachable()
+    deadline = time.monotonic() + 10
+    while any(_alive(pid) for pid in below) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not [pid for pid in below if _alive(pid)]
+
+
+def _alive(pid: int) -> bool:
+    """A process that runs (not one that has exited and waits for its parent to reap it)."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return False
+    return stat[stat.rindex(")") + 2] != "Z"
 
 
 def test_no_master_is_named_with_its_uri() -> None:

@@ -16,7 +16,7 @@ import socket
 import subprocess
 import time
 import xmlrpc.client
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from types import TracebackType
 from typing import Any
@@ -152,6 +152,9 @@ class StartedMaster:
     uri: str
     process: subprocess.Popen[bytes]
     log: Path
+    below: dict[int, str] = field(default_factory=dict)
+    """What roscore started (rosmaster, rosout: roslaunch gives each a session of its own, out of
+    reach of a signal to roscore's group), by pid, with their start times."""
 
     def __enter__(self) -> StartedMaster:
         return self
@@ -162,13 +165,22 @@ class StartedMaster:
         self.stop()
 
     def stop(self) -> None:
+        """Ctrl-C to roscore, as in a terminal; then SIGKILL what is left: its group, and rosmaster
+        and rosout (roscore killed after 15 s of shutting down, on a loaded machine, left them running)."""
         if self.process.poll() is None:
+            self.below.update(_descendants(self.process.pid))
             _signal_group(self.process, signal.SIGINT)
             try:
                 self.process.wait(15.0)
             except subprocess.TimeoutExpired:
                 pass
-        _signal_group(self.process, signal.SIGKILL)  # what roslaunch left (rosmaster, rosout)
+        _signal_group(self.process, signal.SIGKILL)
+        for pid, started in self.below.items():
+            if _process_stat(pid)[1] == started:  # the same process, not a later one given its pid
+                try:
+                    os.kill(pid, signal.SIGKILL)
+                except (ProcessLookupError, PermissionError):
+                    pass
         if self.process.poll() is None:
             self.process.wait(5.0)
 
@@ -200,6 +212,7 @@ def start_master(ros_home: Path, port: int | None = None, timeout: float = 30.0)
                 tail = "\n".join(log.read_text(errors="replace").splitlines()[-10:])
                 raise RosGraphError(f"roscore did not start on port {port}:\n{tail}")
             time.sleep(0.1)
+        started.below.update(_descendants(process.pid))
     except BaseException:
         started.stop()
         raise
@@ -219,3 +232,34 @@ def _signal_group(process: subprocess.Popen[bytes], sig: int) -> None:
         os.killpg(process.pid, sig)
     except (ProcessLookupError, PermissionError):
         pass
+
+
+def _descendants(pid: int) -> dict[int, str]:
+    """The processes below ``pid`` now, by pid, with their start times, as /proc shows them
+    (nothing where there is no /proc)."""
+    children: dict[int, list[int]] = {}
+    started: dict[int, str] = {}
+    try:
+        entries = [int(e.name) for e in Path("/proc").iterdir() if e.name.isdigit()]
+    except OSError:
+        return {}
+    for entry in entries:
+        parent, started[entry] = _process_stat(entry)
+        children.setdefault(parent, []).append(entry)
+    found: dict[int, str] = {}
+    todo = [pid]
+    while todo:
+        for child in children.get(todo.pop(), []):
+            found[child] = started[child]
+            todo.append(child)
+    return found
+
+
+def _process_stat(pid: int) -> tuple[int, str]:
+    """(parent pid, start time) of process ``pid``; (-1, "") if there is none."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return -1, ""
+    fields = stat[stat.rindex(")") + 2 :].split()  # after "pid (command) ": state, ppid, ...
+    return int(fields[1]), fields[19]
