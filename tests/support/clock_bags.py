@@ -81,26 +81,37 @@ def _time(store: Any, seconds: float) -> Any:
 
 
 def _moved(value: Any, move: Any, store: Any) -> Any:
-    """``value`` with every builtin_interfaces/msg/Time in it moved by ``move`` (seconds → seconds)."""
-    if isinstance(value, list | tuple):
-        return type(value)(_moved(v, move, store) for v in value)
-    if not dataclasses.is_dataclass(value) or isinstance(value, type):
-        return value
+    """``value`` with every builtin_interfaces/msg/Time in it moved by ``move`` (seconds → seconds):
+    a Time is replaced, what holds one is changed in place (a message just deserialised, owned
+    here; rosbags' message classes are not frozen)."""
     if _is_time(value):
         stamp = value.sec + value.nanosec * 1e-9
         return _time(store, move(stamp)) if stamp > 0 else value
-    names = _fields_with_time(value)
-    if not names:
+    if isinstance(value, list):
+        if value and (dataclasses.is_dataclass(value[0]) or isinstance(value[0], list | tuple)):
+            value[:] = [_moved(v, move, store) for v in value]  # a ROS array holds one type
         return value
-    return dataclasses.replace(value, **{name: _moved(getattr(value, name), move, store) for name in names})
+    if isinstance(value, tuple):
+        return tuple(_moved(v, move, store) for v in value)
+    if not dataclasses.is_dataclass(value) or isinstance(value, type):
+        return value
+    for name in _fields_with_time(value):
+        setattr(value, name, _moved(getattr(value, name), move, store))
+    return value
 
 
 _WITH_TIME: dict[type, tuple[str, ...]] = {}
 """Per message class, the fields that hold, or may hold, a Time (a list may, another time)."""
 
 
+_IS_TIME: dict[type, bool] = {}
+
+
 def _is_time(value: Any) -> bool:
-    return type(value).__name__.endswith("builtin_interfaces__msg__Time")
+    kind = type(value)
+    if kind not in _IS_TIME:
+        _IS_TIME[kind] = kind.__name__.endswith("builtin_interfaces__msg__Time")
+    return _IS_TIME[kind]
 
 
 def _fields_with_time(value: Any) -> tuple[str, ...]:
