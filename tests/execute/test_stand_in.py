@@ -271,22 +271,18 @@ def test_a_cancelled_goal_stops_the_robot_where_it_is(tmp_path: Path) -> None:
 
 
 def test_the_command_serves_until_sigterm_then_stops_the_node_and_its_master(tmp_path: Path) -> None:
+    """... and removes its temporary folder of logs (none given) when it stopped cleanly."""
     require_ros1()
     spec = tmp_path / "floor.exsce"
     spec.write_text(FLOOR)
     exscec = Path(sys.executable).with_name("exscec")
-    argv = [
-        str(exscec),
-        "stand-in",
-        str(spec),
-        "--ros1",
-        "--start-master",
-        "--log-dir",
-        str(tmp_path / "logs"),
-    ]
+    argv = [str(exscec), "stand-in", str(spec), "--ros1", "--start-master"]
+    temporary = tmp_path / "tmp"
+    temporary.mkdir()
     process = subprocess.Popen(
-        argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True
-    )
+        argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+        env={**os.environ, "TMPDIR": str(temporary)},
+    )  # fmt: skip
     try:
         assert process.stdout is not None
         ready, _, _ = select.select([process.stdout], [], [], 60.0)
@@ -308,6 +304,7 @@ def test_the_command_serves_until_sigterm_then_stops_the_node_and_its_master(tmp
         while not (gone(node_pid) and gone(master_pid)) and time.monotonic() < deadline:
             time.sleep(0.1)
         assert gone(node_pid) and gone(master_pid)
+        assert not list(temporary.iterdir())
     finally:
         if process.poll() is None:
             os.killpg(process.pid, signal.SIGKILL)

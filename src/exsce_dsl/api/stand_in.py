@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import shutil
 import tempfile
 from collections.abc import Iterator, Sequence
 from contextlib import ExitStack, contextmanager
@@ -31,7 +32,8 @@ def stand_in(
     """``exscec stand-in --ros1``: the scenario's robots as move_base servers on the ROS 1 master at
     ``master_uri`` (else ``$ROS_MASTER_URI``; ``start_master``: a roscore of its own, stopped at the
     end), with ``faults`` as on the command line (``overspeed:tiago1``), simulated time
-    ``speed_up`` times faster than wall time; logs in ``log_dir`` (else a new temporary folder)."""
+    ``speed_up`` times faster than wall time; logs in ``log_dir`` (else a new temporary folder,
+    removed when the stand-in stops cleanly and kept, for its logs, when it fails)."""
     chosen = spec if isinstance(spec, Scenario) else spec.scenario(scenario)
     parsed = tuple(Fault.parse(f) for f in faults)
     logs = Path(log_dir) if log_dir is not None else Path(tempfile.mkdtemp(prefix="exsce-stand-in-"))
@@ -43,3 +45,5 @@ def stand_in(
         yield stack.enter_context(
             start_stand_in(chosen, uri, seed=seed, faults=parsed, speed_up=speed_up, log_dir=logs)
         )
+    if log_dir is None:  # stopped cleanly: nothing there to read
+        shutil.rmtree(logs, ignore_errors=True)

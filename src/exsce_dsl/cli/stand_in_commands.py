@@ -41,7 +41,8 @@ from exsce_dsl.cli.common import exit_status, reports_errors
 @click.option(
     "--log-dir",
     type=click.Path(file_okay=False),
-    help="Folder for the node's log (and the roscore's) [default: a new temporary folder].",
+    help="Folder for the node's log (and the roscore's) [default: a new temporary folder, removed "
+    "when the stand-in stops cleanly].",
 )
 @reports_errors
 def stand_in(

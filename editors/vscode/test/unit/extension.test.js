@@ -10,14 +10,22 @@ const { execFileSync } = require("node:child_process");
 const fs = require("node:fs");
 const os = require("node:os");
 const path = require("node:path");
-const { test } = require("node:test");
+const { after, test } = require("node:test");
 
 const ACTIVATE = path.join(__dirname, "activate.js");
 const FAKE_SERVER = path.join(__dirname, "fake-server.js");
 
+const made = [];
+
+after(() => {
+  for (const each of made) fs.rmSync(each, { recursive: true, force: true });
+});
+
 /** Activate and deactivate in a process of its own; what it saw, and the methods the fake server got. */
 function activate(settings, env = {}) {
-  const log = path.join(fs.mkdtempSync(path.join(os.tmpdir(), "exsce-lsp-")), "methods.log");
+  const scratch = fs.mkdtempSync(path.join(os.tmpdir(), "exsce-lsp-"));
+  made.push(scratch);
+  const log = path.join(scratch, "methods.log");
   const stdout = execFileSync(process.execPath, [ACTIVATE, JSON.stringify(settings)], {
     env: { ...process.env, FAKE_SERVER_LOG: log, ...env },
     encoding: "utf8",

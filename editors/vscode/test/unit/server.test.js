@@ -5,12 +5,20 @@ const assert = require("node:assert/strict");
 const fs = require("node:fs");
 const os = require("node:os");
 const path = require("node:path");
-const { test } = require("node:test");
+const { after, test } = require("node:test");
 const { resolveServer, expandVariables, ServerNotFound } = require("../../server");
 
+const made = [];
+
 function folder() {
-  return fs.mkdtempSync(path.join(os.tmpdir(), "exsce-server-"));
+  const created = fs.mkdtempSync(path.join(os.tmpdir(), "exsce-server-"));
+  made.push(created);
+  return created;
 }
+
+after(() => {
+  for (const each of made) fs.rmSync(each, { recursive: true, force: true });
+});
 
 function program(file, mode = 0o755) {
   fs.mkdirSync(path.dirname(file), { recursive: true });
