@@ -26,6 +26,8 @@ from pathlib import Path
 
 import pytest
 
+from exsce_dsl.execute.ros1.graph import descendants, process_stat
+
 ROS_PYTHON = Path("/usr/bin/python3")
 """Debian's Python, the one rospy, rosbag and the message packages are installed for."""
 ROSBAG_FOLDERS = (Path("/usr/lib/rosbag"), Path("/opt/ros/noetic/lib/rosbag"))
@@ -176,7 +178,7 @@ class Graph:
         """Kill what the process left, in its group or below it, as soon as it has exited, once."""
         _signal_group(process, signal.SIGKILL)
         for pid, started in process.below.items():
-            if _stat(pid)[1] == started:  # the same process, not a later one given its pid
+            if process_stat(pid)[1] == started:  # the same process, not a later one given its pid
                 try:
                     os.kill(pid, signal.SIGKILL)
                 except ProcessLookupError:
@@ -269,34 +271,6 @@ class Graph:
         self._ended(process)
         assert code == 0, f"rosbag play exited with {code}:\n{process.output()}"
         return process
-
-
-def descendants(pid: int) -> dict[int, str]:
-    """The processes below ``pid`` now, by pid, with their start times (which tell a process
-    from a later one given the same pid), as /proc shows them."""
-    children: dict[int, list[int]] = {}
-    started: dict[int, str] = {}
-    for entry in Path("/proc").iterdir():
-        if entry.name.isdigit():
-            parent, started[int(entry.name)] = _stat(int(entry.name))
-            children.setdefault(parent, []).append(int(entry.name))
-    found: dict[int, str] = {}
-    todo = [pid]
-    while todo:
-        for child in children.get(todo.pop(), []):
-            found[child] = started[child]
-            todo.append(child)
-    return found
-
-
-def _stat(pid: int) -> tuple[int, str]:
-    """(parent pid, start time) of process ``pid``; (-1, "") if there is none."""
-    try:
-        stat = Path(f"/proc/{pid}/stat").read_text()
-    except OSError:
-        return -1, ""
-    fields = stat[stat.rindex(")") + 2 :].split()  # after "pid (command) ": state, ppid, ...
-    return int(fields[1]), fields[19]
 
 
 def _signal_group(process: Process, sig: int) -> None:

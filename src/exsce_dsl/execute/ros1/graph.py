@@ -168,7 +168,7 @@ class StartedMaster:
         """Ctrl-C to roscore, as in a terminal; then SIGKILL what is left: its group, and rosmaster
         and rosout (roscore killed after 15 s of shutting down, on a loaded machine, left them running)."""
         if self.process.poll() is None:
-            self.below.update(_descendants(self.process.pid))
+            self.below.update(descendants(self.process.pid))
             _signal_group(self.process, signal.SIGINT)
             try:
                 self.process.wait(15.0)
@@ -176,7 +176,7 @@ class StartedMaster:
                 pass
         _signal_group(self.process, signal.SIGKILL)
         for pid, started in self.below.items():
-            if _process_stat(pid)[1] == started:  # the same process, not a later one given its pid
+            if process_stat(pid)[1] == started:  # the same process, not a later one given its pid
                 try:
                     os.kill(pid, signal.SIGKILL)
                 except (ProcessLookupError, PermissionError):
@@ -212,7 +212,7 @@ def start_master(ros_home: Path, port: int | None = None, timeout: float = 30.0)
                 tail = "\n".join(log.read_text(errors="replace").splitlines()[-10:])
                 raise RosGraphError(f"roscore did not start on port {port}:\n{tail}")
             time.sleep(0.1)
-        started.below.update(_descendants(process.pid))
+        started.below.update(descendants(process.pid))
     except BaseException:
         started.stop()
         raise
@@ -234,7 +234,7 @@ def _signal_group(process: subprocess.Popen[bytes], sig: int) -> None:
         pass
 
 
-def _descendants(pid: int) -> dict[int, str]:
+def descendants(pid: int) -> dict[int, str]:
     """The processes below ``pid`` now, by pid, with their start times, as /proc shows them
     (nothing where there is no /proc)."""
     children: dict[int, list[int]] = {}
@@ -244,7 +244,7 @@ def _descendants(pid: int) -> dict[int, str]:
     except OSError:
         return {}
     for entry in entries:
-        parent, started[entry] = _process_stat(entry)
+        parent, started[entry] = process_stat(entry)
         children.setdefault(parent, []).append(entry)
     found: dict[int, str] = {}
     todo = [pid]
@@ -255,7 +255,7 @@ def _descendants(pid: int) -> dict[int, str]:
     return found
 
 
-def _process_stat(pid: int) -> tuple[int, str]:
+def process_stat(pid: int) -> tuple[int, str]:
     """(parent pid, start time) of process ``pid``; (-1, "") if there is none."""
     try:
         stat = Path(f"/proc/{pid}/stat").read_text()
