@@ -207,7 +207,9 @@ def start_master(ros_home: Path, port: int | None = None, timeout: float = 30.0)
     try:
         deadline = time.monotonic() + timeout
         master = Master(uri)
-        while not (master.reachable() and master.has_param("/run_id")):
+        # up: the master answers with its run id, and rosout, which roslaunch starts after it, is
+        # registered (so both are among the processes noted below)
+        while not (master.reachable() and master.has_param("/run_id") and master.lookup_node("/rosout")):
             if process.poll() is not None or time.monotonic() > deadline:
                 tail = "\n".join(log.read_text(errors="replace").splitlines()[-10:])
                 raise RosGraphError(f"roscore did not start on port {port}:\n{tail}")
