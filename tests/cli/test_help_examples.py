@@ -4,6 +4,7 @@ examples has its place in a chapter; the chapters run in tests/cli/test_help_exa
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 from exsce_dsl.cli.main import main
@@ -46,3 +47,10 @@ def test_every_chapter_runs_in_a_test_file_of_its_own() -> None:
     assert {p.name for p in Path(__file__).parent.glob("test_help_examples_*.py")} == {
         f"test_help_examples_{chapter}.py" for chapter in CHAPTERS
     }
+
+
+def test_every_example_line_reads_as_typed() -> None:
+    """A ``\\`` at a line's end in a (not raw) docstring joins the lines in Python itself: the
+    help then showed one long line with the next line's indentation inside it."""
+    for example in collected():
+        assert not re.search(r"\S {3,}[^\s#]", example.line), str(example)  # not before a #: comments align
