@@ -25,7 +25,7 @@ from exsce_dsl.execute.ros1.graph import (
     start_master,
 )
 
-from tests.support.ros1_graph import require_ros1
+from tests.support.ros1_graph import gone, require_ros1
 
 
 def test_a_started_master_answers_keeps_parameters_and_is_gone_after(tmp_path: Path) -> None:
@@ -57,18 +57,9 @@ def test_a_master_whose_roscore_died_is_stopped_whole(tmp_path: Path) -> None:
         assert Master(started.uri).reachable()  # the orphans still answer
     assert not Master(started.uri).reachable()
     deadline = time.monotonic() + 10
-    while any(_alive(pid) for pid in below) and time.monotonic() < deadline:
+    while not all(gone(pid) for pid in below) and time.monotonic() < deadline:
         time.sleep(0.05)
-    assert not [pid for pid in below if _alive(pid)]
-
-
-def _alive(pid: int) -> bool:
-    """A process that runs (not one that has exited and waits for its parent to reap it)."""
-    try:
-        stat = Path(f"/proc/{pid}/stat").read_text()
-    except OSError:
-        return False
-    return stat[stat.rindex(")") + 2] != "Z"
+    assert all(gone(pid) for pid in below)
 
 
 def test_no_master_is_named_with_its_uri() -> None:

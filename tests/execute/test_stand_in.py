@@ -33,7 +33,7 @@ from exsce_dsl.sim.faults import Fault
 from exsce_dsl.sim.localisation import SCALE_ERROR
 
 from tests.support.cli import run_exscec
-from tests.support.ros1_graph import require_ros1, ros1_graph
+from tests.support.ros1_graph import gone, require_ros1, ros1_graph
 
 pytestmark = pytest.mark.ros1
 
@@ -309,15 +309,6 @@ def test_the_command_serves_until_sigterm_then_stops_the_node_and_its_master(tmp
         if process.poll() is None:
             os.killpg(process.pid, signal.SIGKILL)
             process.wait()
-
-
-def gone(pid: int) -> bool:
-    """Whether process ``pid`` has ended (or is a zombie its parent has yet to reap)."""
-    try:
-        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
-    except OSError:
-        return True
-    return state in ("Z", "X")
 
 
 def test_the_command_wants_ros1_and_a_master(tmp_path: Path) -> None:

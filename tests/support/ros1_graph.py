@@ -273,6 +273,15 @@ class Graph:
         return process
 
 
+def gone(pid: int) -> bool:
+    """Whether process ``pid`` has ended (or is a zombie its parent has yet to reap)."""
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return True
+    return state in ("Z", "X")
+
+
 def _signal_group(process: Process, sig: int) -> None:
     try:
         os.killpg(process.popen.pid, sig)

@@ -108,7 +108,5 @@ def transform_at(
     return T["geometry_msgs/msg/TransformStamped"](
         header=header_at(store, sec, nanosec, parent, seq),
         child_frame_id=child,
-        transform=T["geometry_msgs/msg/Transform"](
-            translation=T["geometry_msgs/msg/Vector3"](x=x, y=y, z=z), rotation=rotation
-        ),
+        transform=T["geometry_msgs/msg/Transform"](translation=vector(store, x, y, z), rotation=rotation),
     )
