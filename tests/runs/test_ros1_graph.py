@@ -13,6 +13,7 @@ existing code path, within tolerances that the transport explains (see ``TOLERAN
 from __future__ import annotations
 
 import json
+import re
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -148,15 +149,39 @@ def executor_bag(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return bag
 
 
+GAP = re.compile(r"coverage: gap: (?P<topic>\S+) has no message for (?P<seconds>[0-9.]+) s ")
+"""How ingest reports a topic's silence in the recording (a coverage problem, not an error)."""
+STALL = 4 * LAG
+"""The longest silence the transport explains on a topic that is not the dispatcher's: a
+stall of d wall seconds (rosbag play or record waiting for a core) is a silence of RATE × d in
+bag time, and a message may be received up to 4 LAG off its bag time (asserted below)."""
+
+
+def transport_gaps(problems: Sequence[str]) -> dict[str, float]:
+    """The silences among ``problems``, by topic (the longest); fails on any other problem."""
+    gaps: dict[str, float] = {}
+    for problem in problems:
+        gap = GAP.match(problem)
+        assert gap is not None, f"a problem the transport does not explain: {problem}"
+        topic, seconds = gap["topic"], float(gap["seconds"])
+        gaps[topic] = max(seconds, gaps.get(topic, 0.0))
+    return gaps
+
+
 def ingested(
-    bag: Path, store_folder: Path
+    bag: Path, store_folder: Path, stall: float = 0.0
 ) -> tuple[dict[tuple[str, ...], float], dict[tuple[str, ...], float]]:
     """Ingest ``bag`` into a fresh embedded store; its whole-run values by (metric, robot, safety
-    metric) and its path segments' by (metric, robot, goal pose), read back from the store."""
+    metric) and its path segments' by (metric, robot, goal pose), read back from the store.
+
+    The only problems allowed are silences of at most ``stall`` seconds, on topics other than
+    the dispatcher's."""
     scenario = load_spec(SPEC).scenario()
     store = EmbeddedStore(store_folder)
     (result,) = ingest_bags([bag], scenario, store)
-    assert result.status == "ingested" and not result.problems, (result.message, result.problems)
+    assert result.status == "ingested", (result.message, result.problems)
+    gaps = transport_gaps(result.problems)
+    assert all(s <= stall and not t.endswith(DISPATCHER) for t, s in gaps.items()), result.problems
     assert result.run_id is not None
 
     def keyed(readings: list[MetricReading], *names: str) -> dict[tuple[str, ...], float]:
@@ -210,7 +235,9 @@ def test_a_run_recorded_from_a_live_graph_has_the_executors_metrics(
             assert off.max() <= (LAG if dispatcher else 4 * LAG), f"{topic}: off by {off.max():.3f} s"
 
     executor_whole, executor_segments = ingested(executor_bag, tmp_path / "executor_store")
-    through_whole, through_segments = ingested(recorded, tmp_path / "recorded_store")
+    # Under load a stall of the transport may leave a silence in the recording, which ingest
+    # reports; the values must agree all the same.
+    through_whole, through_segments = ingested(recorded, tmp_path / "recorded_store", STALL)
     assert {key[0] for key in executor_whole} == set(TOLERANCE)
     assert_agree(executor_whole, through_whole)
     assert_agree(executor_segments, through_segments)
