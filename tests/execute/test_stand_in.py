@@ -316,9 +316,13 @@ def test_the_command_wants_ros1_and_a_master(tmp_path: Path) -> None:
     spec.write_text(FLOOR)
     without = run_exscec("stand-in", str(spec))
     assert without.returncode == 2 and "--ros1" in without.stderr
-    env = {k: v for k, v in os.environ.items() if k != "ROS_MASTER_URI"}
+    temporary = tmp_path / "tmp"
+    temporary.mkdir()
+    env = {k: v for k, v in os.environ.items() if k != "ROS_MASTER_URI"} | {"TMPDIR": str(temporary)}
     exscec = Path(sys.executable).with_name("exscec")
     unset = subprocess.run(
         [str(exscec), "stand-in", str(spec), "--ros1"], env=env, capture_output=True, text=True, timeout=60
     )
     assert unset.returncode == 2 and "ROS_MASTER_URI is not set" in unset.stderr
+    # it failed before it logged anything: no empty log folder is left behind
+    assert not list(temporary.iterdir())

@@ -37,13 +37,18 @@ def stand_in(
     chosen = spec if isinstance(spec, Scenario) else spec.scenario(scenario)
     parsed = tuple(Fault.parse(f) for f in faults)
     logs = Path(log_dir) if log_dir is not None else Path(tempfile.mkdtemp(prefix="exsce-stand-in-"))
-    with ExitStack() as stack:
-        if start_master:
-            uri = stack.enter_context(start_roscore(logs / "ros")).uri
-        else:
-            uri = master_uri or environment_master_uri()
-        yield stack.enter_context(
-            start_stand_in(chosen, uri, seed=seed, faults=parsed, speed_up=speed_up, log_dir=logs)
-        )
+    try:
+        with ExitStack() as stack:
+            if start_master:
+                uri = stack.enter_context(start_roscore(logs / "ros")).uri
+            else:
+                uri = master_uri or environment_master_uri()
+            yield stack.enter_context(
+                start_stand_in(chosen, uri, seed=seed, faults=parsed, speed_up=speed_up, log_dir=logs)
+            )
+    except BaseException:
+        if log_dir is None and not any(logs.iterdir()):  # failed before it logged: nothing to read
+            logs.rmdir()
+        raise
     if log_dir is None:  # stopped cleanly: nothing there to read
         shutil.rmtree(logs, ignore_errors=True)
