@@ -13,7 +13,8 @@ rosbags cannot write MCAP chunks compressed with lz4 (its MCAP reader reads them
 its writer only knows zstd), so no format here has them.
 
 Messages are rosbags objects of the format's typestore (:func:`typestore_for`:
-ROS 1's ``std_msgs/Header`` has a ``seq``, ROS 2's has not); the builders
+ROS 1's ``std_msgs/Header`` has a ``seq``, ROS 2's has not), or bytes already serialised in
+the format's encoding (a message copied from another bag); the builders
 (:func:`odometry`, :func:`pose_stamped`, :func:`twist_stamped`, :func:`imu`,
 :func:`tf_message`, :func:`laser_scan`, :func:`turtle_pose`) make the ``index``-th
 message of a series from a seed, the same values every time.
@@ -193,7 +194,12 @@ def _write_ros1(
                 )
             )
         for i, time_ns, message in _in_order(topics, order):
-            writer.write(connections[i], time_ns, store.serialize_ros1(message, topics[i].msgtype))
+            writer.write(connections[i], time_ns, _serialised(message, store.serialize_ros1, topics[i].msgtype))
+
+
+def _serialised(message: Any, serialise: Callable[[Any, str], Any], msgtype: str) -> Any:
+    """``message``'s bytes: already serialised (in the bag's encoding), or by ``serialise``."""
+    return message if isinstance(message, bytes | bytearray | memoryview) else serialise(message, msgtype)
 
 
 def _qos(depth: int) -> Qos:
@@ -230,7 +236,7 @@ def _write_ros2(
             for topic in topics
         ]
         for i, time_ns, message in _in_order(topics, order):
-            writer.write(connections[i], time_ns, store.serialize_cdr(message, topics[i].msgtype))
+            writer.write(connections[i], time_ns, _serialised(message, store.serialize_cdr, topics[i].msgtype))
             storage = writer.storage
             if (
                 chunk_bytes is not None

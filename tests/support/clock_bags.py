@@ -6,16 +6,22 @@ moved onto a simulated clock, ``sim = SIM_START + (stamp - first log time) * rat
 left as they were; with ``clock_hz`` it also records ``/clock`` (rosgraph_msgs/msg/Clock) as
 Gazebo publishes it.  The robots drove the same paths, so every distance, speed limit and count
 of the restamped bag equals the original's; durations scale by ``rate``.  Messages are rewritten
-through rosbags' own deserialisation, so nothing of exsce's reading is used to make them.
+through rosbags' own deserialisation, so nothing of exsce's reading is used to make them; a
+message whose only stamp is its leading header's (odometry, scans) has that stamp rewritten in
+its bytes, where rosbags' serialisation puts it, and one with no stamp is copied as it is.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import math
+import struct
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 from rosbags.highlevel import AnyReader
+from rosbags.interfaces import Nodetype
 
 from tests.support.bag_factory import FORMATS, Topic, typestore_for, write_bag
 
@@ -42,13 +48,22 @@ def restamp(
         messages: dict[tuple[str, str], list[tuple[int, Any]]] = {}
         store = typestore_for(fmt)
         store.register({k: v for k, v in reader.typestore.fielddefs.items() if k not in store.fielddefs})
+        same_encoding = reader.is2 == (FORMATS[fmt].ros == 2)
         for connection, time_ns, raw in reader.messages():
-            message = reader.deserialize(raw, connection.msgtype)
             behind = (lag or {}).get(connection.topic, 0.0)
+            move: Callable[[float], float] | None
             if shift_to_simulated:
-                moved = _moved(message, lambda s, b=behind: SIM_START + (s - first * 1e-9) * rate - b, store)
+                move = lambda s, b=behind: SIM_START + (s - first * 1e-9) * rate - b  # noqa: E731
             else:
-                moved = _moved(message, lambda s, b=behind: s - b, store) if behind else message
+                move = (lambda s, b=behind: s - b) if behind else None  # noqa: E731
+            stamps = _stamps(reader.typestore, connection.msgtype) if same_encoding else "other"
+            if move is None and same_encoding or stamps == "none":
+                moved: Any = raw  # no stamp to move: its bytes as they are
+            elif move is not None and stamps == "header":
+                moved = _header_moved(raw, reader.is2, move)
+            else:
+                message = reader.deserialize(raw, connection.msgtype)
+                moved = _moved(message, move, store) if move is not None else message
             messages.setdefault((connection.topic, connection.msgtype), []).append((time_ns, moved))
     topics = [Topic(topic, msgtype, found) for (topic, msgtype), found in messages.items()]
     if clock_hz is not None:
@@ -74,10 +89,59 @@ def _clock(store: Any, first: int, last: int, rate: float, hz: float) -> Topic:
 
 
 def _time(store: Any, seconds: float) -> Any:
-    sec = int(seconds // 1)
-    return store.types["builtin_interfaces/msg/Time"](
-        sec=sec, nanosec=int(round((seconds - sec) * 1e9)) % 10**9
-    )
+    sec, nanosec = _sec_nanosec(seconds)
+    return store.types["builtin_interfaces/msg/Time"](sec=sec, nanosec=nanosec)
+
+
+def _sec_nanosec(seconds: float) -> tuple[int, int]:
+    """``seconds`` as a Time's (sec, nanosec), rounded to the nanosecond (the fraction alone: a
+    float of epoch seconds times 1e9 is too coarse for nanoseconds)."""
+    sec = math.floor(seconds)
+    nanosec = round((seconds - sec) * 1e9)
+    return (sec + 1, 0) if nanosec == 10**9 else (sec, nanosec)
+
+
+_HEADER_STAMP = struct.Struct("<iI")
+"""A leading header's stamp (sec, nanosec), little-endian: 4 bytes into the message in both
+encodings (ROS 1: after the header's ``seq``; CDR: after the encapsulation header)."""
+_TIME = "builtin_interfaces/msg/Time"
+_HEADER = "std_msgs/msg/Header"
+
+
+def _header_moved(raw: bytes | memoryview, cdr: bool, move: Callable[[float], float]) -> bytes:
+    """A serialised message whose one stamp leads it (its header's), with that stamp moved."""
+    data = bytearray(raw)
+    assert not cdr or data[1] == 1, "CDR not little-endian"
+    sec, nanosec = _HEADER_STAMP.unpack_from(data, 4)
+    stamp = sec + nanosec * 1e-9
+    if stamp > 0:
+        _HEADER_STAMP.pack_into(data, 4, *_sec_nanosec(move(stamp)))
+    return bytes(data)
+
+
+_STAMPS: dict[tuple[int, str], str] = {}
+
+
+def _stamps(store: Any, msgtype: str) -> str:
+    """Where ``msgtype`` holds Times: ``none``, ``header`` (only its leading header's stamp) or
+    ``other`` (anywhere else too: TF transforms, goal stamps)."""
+    key = (id(store), msgtype)
+    if key not in _STAMPS:
+        fields = store.fielddefs[msgtype][1]
+        leading = bool(fields) and fields[0][1] == (Nodetype.NAME, _HEADER)
+        later = any(_holds_time(store, spec) for _, spec in fields[1 if leading else 0 :])
+        _STAMPS[key] = "other" if later else "header" if leading else "none"
+    return _STAMPS[key]
+
+
+def _holds_time(store: Any, spec: tuple[Any, Any]) -> bool:
+    """Whether a field of type ``spec`` (rosbags' field definition) holds a Time."""
+    kind, detail = spec
+    if kind == Nodetype.NAME:  # a message
+        return detail == _TIME or any(_holds_time(store, s) for _, s in store.fielddefs[detail][1])
+    if kind in (Nodetype.ARRAY, Nodetype.SEQUENCE):  # (element spec, length)
+        return _holds_time(store, detail[0])
+    return False  # a base type
 
 
 def _moved(value: Any, move: Any, store: Any) -> Any:
