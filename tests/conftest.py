@@ -4,6 +4,8 @@ tests import live in tests/support/."""
 from __future__ import annotations
 
 import os
+import shutil
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -20,6 +22,57 @@ def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
     simulated time) and leave a core idle meanwhile: with two workers on two cores 12 % of the
     workers' time went to waiting; a third worker takes it (CI: 18 min -> 15 min)."""
     return (os.cpu_count() or 1) + 1
+
+
+LONGEST_FIRST = (
+    "execute/test_live_loop.py",
+    "cli/test_help_examples_runs.py",
+    "explore/test_explore_ros1.py",
+    "cli/test_help_examples_explore.py",
+    "execute/test_ros1_execute.py",
+    "cli/test_help_examples_live.py",
+    "runs/test_ros1_graph.py",
+    "runs/test_timeline.py",
+    "cli/test_demo_remote.py",
+    "explore/test_campaign.py",
+    "cli/test_init_from_bag.py",
+    "report/test_report.py",
+    "execute/test_stand_in.py",
+    "api/test_python_api.py",
+    "mcp_server/test_mcp_server.py",
+    "store/test_same_answers.py",
+)
+"""Test files that take longest (35-110 s each on two cores), longest first: xdist hands out
+files in collection order (``--no-loadscope-reorder``; its default puts the files with most
+tests first, and so these, of one or two tests each, last, where one worker went on alone for
+a minute after the others had finished)."""
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """The files of :data:`LONGEST_FIRST` first, in its order; the others after, as collected."""
+    root = Path(__file__).parent
+    rank = {root / name: i for i, name in enumerate(LONGEST_FIRST)}
+    items.sort(key=lambda item: rank.get(item.path, len(LONGEST_FIRST)))
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """The run's own cache folder (``$EXSCE_CACHE``) for the tests and every ``exscec`` they start,
+    shared by the xdist workers, which inherit it: the suite leaves the user's ``~/.cache/exsce``
+    alone (it wrote an entry there for every scenario in every temporary folder, 130 MB)."""
+    if hasattr(config, "workerinput"):  # an xdist worker: its controller chose the folder
+        return
+    folder = tempfile.mkdtemp(prefix="exsce-test-cache-")
+    config.stash[_CACHE] = folder
+    os.environ["EXSCE_CACHE"] = folder
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    folder = config.stash.get(_CACHE, None)
+    if folder is not None:
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+_CACHE = pytest.StashKey[str]()
 
 
 @pytest.fixture

@@ -87,7 +87,8 @@ def test_a_campaign_whose_runs_were_cut_short_finds_its_relations_inconclusive_a
     shutil.copytree(ROOT / "examples", tmp_path / "examples")
     (tmp_path / "cutting.py").write_text(CUTTING_EXECUTOR)
     command = f"{sys.executable} cutting.py {EXSCEC} {{scenario_file}} {{scenario}} {{runs}} {{seed}} {{out}}"
-    env = {k: v for k, v in os.environ.items() if not k.startswith("EXSCE_")} | {"EXSCE_STORE": "store"}
+    env = {k: v for k, v in os.environ.items() if not k.startswith("EXSCE_") or k == "EXSCE_CACHE"}
+    env |= {"EXSCE_STORE": "store"}
     explored = subprocess.run(
         [EXSCEC, "explore", SPEC, "-n", "1", "-k", "1", "-t", "swap_start_poses", "--no-shrink",
          "--executor-command", command, "-o", "campaign", "--junit", "campaign.xml"],

@@ -14,7 +14,7 @@ from exsce_dsl.messages import typestore_cache
 @pytest.fixture
 def cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     folder = tmp_path / "cache"
-    monkeypatch.setenv("EXSCE_CACHE_DIR", str(folder))
+    monkeypatch.setenv("EXSCE_CACHE", str(folder))
     return folder
 
 
@@ -50,12 +50,20 @@ def test_a_broken_cache_falls_back_to_rosbags_and_is_rewritten(cache: Path, text
 def test_a_cache_that_cannot_be_written_is_not_kept(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     blocker = tmp_path / "a_file"
     blocker.write_text("")
-    monkeypatch.setenv("EXSCE_CACHE_DIR", str(blocker / "cache"))  # a folder inside a file
+    monkeypatch.setenv("EXSCE_CACHE", str(blocker / "cache"))  # a folder inside a file
     assert typestore_cache.standard_fielddefs("ros2_humble") == get_typestore(Stores.ROS2_HUMBLE).fielddefs
     assert not (blocker / "cache").exists()
 
 
-def test_the_cache_folder_follows_xdg(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.delenv("EXSCE_CACHE_DIR", raising=False)
+def test_the_definitions_go_where_every_cache_entry_goes(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delenv("EXSCE_CACHE", raising=False)
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
-    assert typestore_cache.cache_folder() == tmp_path / "exsce"
+    typestore_cache.standard_fielddefs("ros2_humble")
+    assert list((tmp_path / "exsce").glob("typestore-ros2_humble-*.json"))
+
+
+def test_nothing_is_kept_when_the_cache_is_off(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("EXSCE_CACHE", "")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    assert typestore_cache.standard_fielddefs("ros2_humble") == get_typestore(Stores.ROS2_HUMBLE).fielddefs
+    assert not list(tmp_path.iterdir())

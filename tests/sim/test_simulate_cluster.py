@@ -140,7 +140,7 @@ def test_a_campaign_explored_on_the_cluster_is_the_campaign_explored_here(
         project.mkdir()
         for name in ("spec.exsce", "map.yaml", "map.pgm"):
             shutil.copy(folder / name, project / name)
-        env = {k: v for k, v in os.environ.items() if not k.startswith("EXSCE_")}
+        env = {k: v for k, v in os.environ.items() if not k.startswith("EXSCE_") or k == "EXSCE_CACHE"}
         on_cluster = ["--cluster", cluster.scheduler_address] if where == "there" else []
         with Client(cluster.scheduler_address, set_as_default=False) as watcher, get_task_stream(watcher) as ran:
             outcomes[where] = subprocess.run(

@@ -11,52 +11,37 @@ shape) falls back to rosbags itself; a cache that cannot be written is simply no
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 from importlib.metadata import PackageNotFoundError, version
-from pathlib import Path
 from typing import Any
+
+from exsce_dsl.user_cache import cache_folder, read_cached, write_cached
 
 FORMAT = 1
 """Bumped when the file's layout changes, so older files are not read."""
 
 
-def cache_folder() -> Path:
-    """``$EXSCE_CACHE_DIR``, else ``$XDG_CACHE_HOME/exsce``, else ``~/.cache/exsce``."""
-    if os.environ.get("EXSCE_CACHE_DIR"):
-        return Path(os.environ["EXSCE_CACHE_DIR"])
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "exsce"
-
-
 def standard_fielddefs(store: str) -> dict[str, Any]:
     """The ``fielddefs`` of rosbags' typestore ``store`` (``ros2_jazzy``, ``ros1_noetic``, ...),
-    equal to ``get_typestore(Stores(store)).fielddefs``."""
+    equal to ``get_typestore(Stores(store)).fielddefs``; kept in the user's cache folder
+    (:func:`exsce_dsl.user_cache.cache_folder`) unless ``$EXSCE_CACHE`` is set empty."""
     try:
         rosbags = version("rosbags")
     except PackageNotFoundError:  # pragma: no cover - rosbags is a dependency
         rosbags = "unknown"
-    path = cache_folder() / f"typestore-{store}-rosbags-{rosbags}-v{FORMAT}.json"
-    try:
-        return _restored(json.loads(path.read_text(encoding="utf-8")))
-    except (OSError, ValueError, TypeError, KeyError, IndexError):
-        pass
+    folder = cache_folder()
+    path = None if folder is None else folder / f"typestore-{store}-rosbags-{rosbags}-v{FORMAT}.json"
+    data = None if path is None else read_cached(path)
+    if data is not None:
+        try:
+            return _restored(json.loads(data))
+        except (ValueError, TypeError, KeyError, IndexError):
+            pass
     from rosbags.typesys import Stores, get_typestore
 
     fielddefs: dict[str, Any] = get_typestore(Stores(store)).fielddefs
-    _write(path, json.dumps(fielddefs))
+    if path is not None:
+        write_cached(path, json.dumps(fielddefs).encode())
     return fielddefs
-
-
-def _write(path: Path, text: str) -> None:
-    """Write atomically (a reader never sees half a file), or not at all."""
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with tempfile.NamedTemporaryFile("w", encoding="utf-8", dir=path.parent, delete=False) as f:
-            f.write(text)
-        os.replace(f.name, path)
-    except OSError:
-        pass
 
 
 def _restored(data: Any) -> dict[str, Any]:
