@@ -7,7 +7,7 @@ per run, run ``i`` driving as run ``i`` of ``exscec simulate --seed S``), and it
 1. **Real-time factor** of the stand-in per run: simulated seconds / wall seconds over the
    mission (first goal sent to last result received, the simulated span from the mission's own
    record), and over the recording as the node counts it (its ``stats`` right after ``rosbag
-   record`` is receiving and when the mission has ended).  At the default speed-up (20) and at
+   record`` is receiving and when the mission has ended).  At the default speed-up (10) and at
    each ``--speed-up``.  Target: >= 10x on this 2-core machine.  Beside it, the wall time of a
    whole run (the stand-in's start to the run's files in place) versus the kinematic executor's
    (``play_run`` of the same run, as ``exscec simulate`` plays it, bag written), measured in
@@ -35,7 +35,7 @@ per run, run ``i`` driving as run ``i`` of ``exscec simulate --seed S``), and it
    default rates.
 
     python bench/execute.py                       # 3 runs at speed-up 10 and 20 (about 2 min)
-    python bench/execute.py --quick               # 1 run at the default speed-up (20)
+    python bench/execute.py --quick               # 1 run at the default speed-up (10)
     python bench/execute.py --runs 3 --speed-up 10 20 40
 
 Needs ROS 1 for ``/usr/bin/python3`` (``sh scripts/install-ros1``).  Prints figures; never a
@@ -381,7 +381,7 @@ def main() -> None:
     parser.add_argument("--runs", type=int, default=3, help="runs per speed-up (default 3)")
     parser.add_argument(
         "--speed-up", type=float, nargs="+", default=[10.0, 20.0], metavar="X",
-        help="the stand-in's speed-ups measured besides the default 20 (default: 10 20)",
+        help="the stand-in's speed-ups measured besides the default 10 (default: 10 20)",
     )  # fmt: skip
     parser.add_argument("--seed", type=int, default=0, help="the stand-in's seed (default 0)")
     parser.add_argument("--quick", action="store_true", help="1 run at the default speed-up")

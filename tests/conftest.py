@@ -27,25 +27,26 @@ def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
 LONGEST_FIRST = (
     "execute/test_live_loop.py",
     "cli/test_help_examples_runs.py",
-    "explore/test_explore_ros1.py",
-    "cli/test_help_examples_explore.py",
-    "execute/test_ros1_execute.py",
-    "cli/test_help_examples_live.py",
-    "runs/test_ros1_graph.py",
     "runs/test_timeline.py",
+    "runs/test_ros1_graph.py",
     "cli/test_demo_remote.py",
     "explore/test_campaign.py",
+    "explore/test_explore_ros1.py",
+    "cli/test_help_examples_explore.py",
     "cli/test_init_from_bag.py",
+    "execute/test_ros1_execute.py",
     "report/test_report.py",
-    "execute/test_stand_in.py",
     "api/test_python_api.py",
+    "cli/test_help_examples_live.py",
     "mcp_server/test_mcp_server.py",
     "store/test_same_answers.py",
+    "execute/test_stand_in.py",
 )
-"""Test files that take longest (35-110 s each on two cores), longest first: xdist hands out
-files in collection order (``--no-loadscope-reorder``; its default puts the files with most
-tests first, and so these, of one or two tests each, last, where one worker went on alone for
-a minute after the others had finished)."""
+"""Test files that take longest (35-120 s each on two cores), roughly longest first, a file on
+a live ROS graph after one or two that are not, so that live ones seldom share the cores: xdist
+hands out files in collection order (``--no-loadscope-reorder``; its default puts the files with
+most tests first, and so these, of one or two tests each, last, where one worker went on alone
+for a minute after the others had finished)."""
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:

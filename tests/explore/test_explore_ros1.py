@@ -67,7 +67,7 @@ def test_a_deadlock_planted_in_the_stand_in_is_found_on_the_live_graph_and_shrun
     require_ros1()
     explored = _exscec(
         project, "explore", SPEC, "--executor", "ros1", "--stand-in", "--fault", DEADLOCK,
-        "--speed-up", "20", "-n", "1", "-k", "1", "-t", "swap_start_poses",
+        "-n", "1", "-k", "1", "-t", "swap_start_poses",
         "-o", "explore/deadlock", "--junit", "campaign.xml",
     )  # fmt: skip
     assert explored.returncode == 1, explored.stdout + explored.stderr

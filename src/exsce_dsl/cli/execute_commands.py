@@ -116,7 +116,7 @@ class _ExecuteOptions:
 @click.option(
     "--speed-up",
     type=click.FloatRange(min=0, min_open=True),
-    default=20.0,  # execute.stand_in.session.DEFAULT_SPEED_UP
+    default=10.0,  # execute.stand_in.session.DEFAULT_SPEED_UP (a test holds them equal)
     show_default=True,
     help="With --stand-in: simulated time runs this many times faster than wall time.",
 )
@@ -160,7 +160,7 @@ def execute(**given: Any) -> None:
     \b
     Examples:
       exscec execute examples/brsu_building_c/scenario_c.exsce --ros1 --start-master --stand-in \\
-          --fault overspeed:tiago1 --speed-up 20 -o live-fault/
+          --fault overspeed:tiago1 -o live-fault/
       exscec execute examples/brsu_building_c/scenario_c.exsce --ros1 --start-master --runs 3 \\
           --policy retry-once --verify --junit verdicts.xml --server-timeout 1 \\
           -o live/  # exits 2: no robot's move_base answers

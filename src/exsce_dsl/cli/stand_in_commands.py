@@ -27,7 +27,7 @@ from exsce_dsl.cli.common import exit_status, reports_errors
 )
 @click.option(
     "--speed-up",
-    default=20.0,  # execute.stand_in.session.DEFAULT_SPEED_UP
+    default=10.0,  # execute.stand_in.session.DEFAULT_SPEED_UP (a test holds them equal)
     show_default=True,
     type=click.FloatRange(min=0.0, min_open=True),
     help="Simulated time (/clock) runs this many times faster than wall time.",
@@ -66,7 +66,8 @@ def stand_in(
     --convention move_base` writes them.  Between goals the robots stand
     still and every topic keeps publishing.  Time is simulated: the
     stand-in sets /use_sim_time and publishes /clock, --speed-up times
-    faster than wall time (slower if it cannot keep up).
+    faster than wall time (slower if it cannot keep up; on a busy machine
+    a slower clock keeps rosbag record from losing messages).
 
     The first line on stdout is ROS_MASTER_URI=URI; it runs until Ctrl-C
     or SIGTERM.  Drive it with any actionlib client, or exscec execute.
@@ -75,7 +76,7 @@ def stand_in(
     Example:
       exscec stand-in examples/brsu_building_c/scenario_c.exsce --ros1 --start-master
       exscec stand-in examples/brsu_building_c/scenario_c.exsce --ros1 --start-master \\
-          --fault overspeed:tiago1 --speed-up 20
+          --fault overspeed:tiago1 --speed-up 5   # slower: a busy machine's recorder keeps up
     """
     from exsce_dsl.api.stand_in import stand_in as play
     from exsce_dsl.lang import load_spec

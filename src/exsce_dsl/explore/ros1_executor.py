@@ -32,11 +32,10 @@ from exsce_dsl.errors import ExsceError
 from exsce_dsl.execute.ros1.graph import start_master as start_roscore
 from exsce_dsl.execute.ros1.session import LOGS, Interruption, execute_runs
 from exsce_dsl.execute.stand_in import start_stand_in
+from exsce_dsl.execute.stand_in.session import DEFAULT_SPEED_UP
 from exsce_dsl.model import Scenario
 from exsce_dsl.sim.faults import Fault
 
-DEFAULT_SPEED_UP = 10.0
-"""Simulated seconds per wall second of the stand-in, as ``exscec execute --stand-in``'s."""
 NEEDS_STAND_IN = (
     "the ros1 executor drives exsce's stand-in robots only, for now: give --stand-in (a campaign "
     "starts each derived scenario from its own start poses, and exsce cannot yet move a real "

@@ -158,10 +158,13 @@ class StandIn:
             self._reader.join(5.0)
 
 
-DEFAULT_SPEED_UP = 20.0
-"""How many times faster than wall time simulated time runs by default: 13x reached on a loaded
-2-core machine (bench/execute.py; planning stops the clock, so the factor stays below it); at
-10 it reached 8.9x."""
+DEFAULT_SPEED_UP = 10.0
+"""How many times faster than wall time simulated time runs by default (``execute``,
+``stand-in`` and ``explore --executor ros1`` alike): 8.9x reached on a loaded 2-core machine
+(bench/execute.py; planning stops the clock, so the factor stays below it).  At 20 (13x
+reached) ``rosbag record`` lost messages there: it queues 100 per topic, a tenth of a second of
+odometry at 20x, and a recorder kept off a core longer than that leaves a gap that makes the
+run inconclusive."""
 
 
 @contextmanager
