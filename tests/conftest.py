@@ -7,13 +7,14 @@ import os
 import shutil
 import tempfile
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 
-from exsce_dsl.lang import load_spec
-from exsce_dsl.model import Scenario, Task
-
 from tests.support.paths import EXAMPLES
+
+if TYPE_CHECKING:  # exsce is imported once the run's cache folder is set (pytest_configure)
+    from exsce_dsl.model import Scenario, Task
 
 
 def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
@@ -85,5 +86,7 @@ def in_tmp(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
 @pytest.fixture(scope="session")
 def spec_c() -> tuple[Scenario, dict[str, Task]]:
     """The shipped scenario_c and the tasks its specification declares (loaded once)."""
+    from exsce_dsl.lang import load_spec
+
     spec = load_spec(EXAMPLES / "brsu_building_c" / "scenario_c.exsce")
     return spec.scenario("scenario_c"), {t.id: t for t in spec.tasks}
