@@ -87,7 +87,8 @@ def in_session(folder: Path, work: Callable[[ClientSession], Awaitable[T]], *opt
 
     async def main() -> T:
         # the server runs the package the tests run (the client passes few variables on)
-        env = get_default_environment() | {k: v for k, v in os.environ.items() if k == "PYTHONPATH"}
+        passed_on = ("PYTHONPATH", "EXSCE_CACHE")  # and the test run's own cache folder
+        env = get_default_environment() | {k: v for k, v in os.environ.items() if k in passed_on}
         server = StdioServerParameters(command=str(EXSCEC), args=["mcp", *options], cwd=str(folder), env=env)
         with open(folder / "mcp-server.log", "a", encoding="utf-8") as errlog:
             async with stdio_client(server, errlog=errlog) as (read, write):
