@@ -16,19 +16,16 @@ import pytest
 
 from tests.support.cli import run_exscec
 from tests.support.ros1_graph import require_ros1
+from tests.support.shared_baseline import copy_of_baseline_project
 
 SPEC = str(Path(__file__).resolve().parents[2] / "examples" / "brsu_building_c" / "scenario_c.exsce")
 
 
 def test_a_stopped_mission_is_inconclusive_through_execute_verify(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, tmp_path_factory: pytest.TempPathFactory
 ) -> None:
     require_ros1()
-    monkeypatch.chdir(tmp_path)
-    assert run_exscec("simulate", SPEC, "--runs", "3", "-o", "sim").returncode == 0
-    bags = map(str, sorted((tmp_path / "sim").glob("*.bag")))
-    assert run_exscec("ingest", *bags, "--scenario", SPEC).returncode == 0
-    assert run_exscec("baseline", SPEC).returncode == 0
+    monkeypatch.chdir(copy_of_baseline_project(tmp_path_factory, tmp_path))
     done = run_exscec(
         "execute", SPEC, "--ros1", "--start-master", "--stand-in", "--fault", "skip-waypoint:tiago1:2",
         "--policy", "stop-mission", "-o", "live", "--verify", "--junit", "verdicts.xml",

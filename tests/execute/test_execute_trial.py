@@ -17,16 +17,15 @@ from scipy.stats import binomtest
 from tests.support.cli import run_exscec
 from tests.support.paths import EXAMPLES
 from tests.support.ros1_graph import on_graph, ros1_graph, start_server
+from tests.support.shared_baseline import copy_of_baseline_project
 
 SPEC = str(EXAMPLES / "brsu_building_c" / "scenario_c.exsce")
 
 
-def test_several_live_runs_with_verify_are_one_trial(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.chdir(tmp_path)
-    assert run_exscec("simulate", SPEC, "--runs", "3", "-o", "sim").returncode == 0
-    bags = map(str, sorted((tmp_path / "sim").glob("*.bag")))
-    assert run_exscec("ingest", *bags, "--scenario", SPEC).returncode == 0
-    assert run_exscec("baseline", SPEC).returncode == 0
+def test_several_live_runs_with_verify_are_one_trial(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, tmp_path_factory: pytest.TempPathFactory
+) -> None:
+    monkeypatch.chdir(copy_of_baseline_project(tmp_path_factory, tmp_path))
     with ros1_graph(tmp_path / "ros", sim_time=False) as graph:
         on_graph(graph, monkeypatch)
         start_server(graph, tmp_path / "goals.jsonl", "tiago1,tiago2", "--duration", "0.2")

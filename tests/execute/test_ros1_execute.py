@@ -20,6 +20,7 @@ from rosbags.typesys import Stores, get_typestore
 from tests.support.cli import run_exscec
 from tests.support.paths import EXAMPLES
 from tests.support.ros1_graph import on_graph, ros1_graph, start_server
+from tests.support.shared_baseline import copy_of_baseline_project
 
 SPEC = str(EXAMPLES / "brsu_building_c" / "scenario_c.exsce")
 RUN_NAME = re.compile(r"^\d{4}-\d\d-\d\dT\d\d-\d\d-\d\d_scenario_c_run-[0-9a-f]{8}$")
@@ -135,20 +136,12 @@ def test_an_interruption_mid_mission_cancels_the_goals_and_keeps_the_run_apart(
 
 
 def test_verify_ingests_the_recorded_bag_and_judges_it_as_verify_does(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, tmp_path_factory: pytest.TempPathFactory
 ) -> None:
     """A baseline from three simulated runs (about 120 s of mission); the test server ends each
     goal after 0.2 s, so the live run's durations fail their oracles, while each robot's three
     goals SUCCEEDED (read from move_base's recorded result topic) pass waypoints_visited."""
-    monkeypatch.chdir(tmp_path)
-    assert run_exscec("simulate", SPEC, "--runs", "3", "-o", "sim").returncode == 0
-    assert (
-        run_exscec(
-            "ingest", *map(str, sorted((tmp_path / "sim").glob("*.bag"))), "--scenario", SPEC
-        ).returncode
-        == 0
-    )
-    assert run_exscec("baseline", SPEC).returncode == 0
+    monkeypatch.chdir(copy_of_baseline_project(tmp_path_factory, tmp_path))
     with ros1_graph(tmp_path / "ros", sim_time=False) as graph:
         on_graph(graph, monkeypatch)
         start_server(graph, tmp_path / "goals.jsonl", "tiago1,tiago2", "--duration", "0.2")
