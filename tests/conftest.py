@@ -42,8 +42,11 @@ LONGEST_FIRST = (
     "mcp_server/test_mcp_server.py",
     "store/test_same_answers.py",
     "execute/test_stand_in.py",
+    "project/test_static_checks.py",
+    "cli/test_root_namespace_nav2.py",
+    "explore/test_figures.py",
 )
-"""Test files that take longest (35-120 s each on two cores), roughly longest first, a file on
+"""Test files that take longest (30-120 s each on two cores), roughly longest first, a file on
 a live ROS graph after one or two that are not, so that live ones seldom share the cores: xdist
 hands out files in collection order (``--no-loadscope-reorder``; its default puts the files with
 most tests first, and so these, of one or two tests each, last, where one worker went on alone
