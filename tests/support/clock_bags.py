@@ -57,7 +57,7 @@ def restamp(
             else:
                 move = (lambda s, b=behind: s - b) if behind else None  # noqa: E731
             stamps = _stamps(reader.typestore, connection.msgtype) if same_encoding else "other"
-            if move is None and same_encoding or stamps == "none":
+            if (move is None and same_encoding) or stamps == "none":
                 moved: Any = raw  # no stamp to move: its bytes as they are
             elif move is not None and stamps == "header":
                 moved = _header_moved(raw, reader.is2, move)
