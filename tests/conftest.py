@@ -32,7 +32,6 @@ LONGEST_FIRST = (
     "runs/test_ros1_graph.py",
     "cli/test_demo_remote.py",
     "explore/test_campaign.py",
-    "explore/test_explore_ros1.py",
     "cli/test_help_examples_explore.py",
     "cli/test_init_from_bag.py",
     "execute/test_ros1_execute.py",

@@ -193,7 +193,7 @@ def explore(**given: Any) -> None:
         -t swap_start_poses -t reverse_task_order --fault deadlock-start:tiago1:classroom_c025-w002 \\
         --compare-random -o explore/compared  # exits 1
       exscec explore examples/brsu_building_c/scenario_c.exsce -n 1 -k 1 -t swap_start_poses \\
-        --executor ros1 --stand-in --start-master --no-shrink \\
+        --executor ros1 --stand-in --start-master \\
         --fault deadlock-start:tiago1:classroom_c025-w002 -o explore/live  # exits 1
     """
     from exsce_dsl.oracles.campaign_junit import campaign_junit
