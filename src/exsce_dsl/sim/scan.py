@@ -52,22 +52,70 @@ def scan_ranges(
     """Ranges (scans × beams, float32) for a robot at ``x, y, yaw`` (one row per scan)."""
     theta = yaw[:, None] + laser.angles()[None, :]
     dx, dy = np.cos(theta), np.sin(theta)
-    ox, oy = np.broadcast_to(x[:, None], theta.shape), np.broadcast_to(y[:, None], theta.shape)
-    # the beams still marching, compacted after each step: each step costs what is left
-    beam = np.arange(theta.size)
-    bx, by, bdx, bdy = (a.reshape(-1) for a in (ox, oy, dx, dy))
-    so_far = np.zeros(theta.size)
-    travelled = np.zeros(theta.size)
-    hit_eps = grid.map_resolution
-    for _ in range(64):
+    travelled = _marched(grid, laser, x, y, dx, dy).reshape(theta.shape)
+    ranges = np.where(travelled < laser.range_max, travelled, np.inf)
+    for qx, qy in others:  # other robots are discs
+        cx, cy = qx[:, None] - x[:, None], qy[:, None] - y[:, None]
+        along = cx * dx + cy * dy
+        across2 = cx * cx + cy * cy - along * along
+        inside = (across2 < robot_radius**2) & (along > 0)
+        hit = along - np.sqrt(np.maximum(robot_radius**2 - across2, 0.0))
+        ranges = np.where(inside & (hit > 0) & (hit < ranges), hit, ranges)
+    noisy = ranges + rng.normal(0.0, laser.noise, ranges.shape)
+    noisy = np.where(np.isfinite(ranges), np.maximum(noisy, laser.range_min), np.inf)
+    return noisy.astype(np.float32)
+
+
+MARCHED_AT_ONCE = 65536
+"""Beams marched together: their arrays stay in the processor's cache (all of a run's beams at
+once, near a million, marched a third slower)."""
+
+
+def _marched(
+    grid: PlanningGrid, laser: Laser, x: np.ndarray, y: np.ndarray, dx: np.ndarray, dy: np.ndarray
+) -> np.ndarray:
+    """How far each beam (scan-major, flat) goes until it hits (range_max or more: nothing hit)."""
+    beams = dx.shape[1]
+    hit_eps, least = grid.map_resolution, grid.map_resolution * 0.5
+    # a scan's beams all start where the robot stands: their first step is the scan's own
+    start = grid.clearance_of(x, y)
+    first = np.repeat(np.maximum(start - least, least), beams)
+    inside = np.repeat(start < hit_eps, beams)  # in a wall: every beam hits at once
+    travelled = np.where(inside, 0.0, first)
+    marching = np.flatnonzero(~inside & (first < laser.range_max))
+    ox, oy, ux, uy = np.repeat(x, beams), np.repeat(y, beams), dx.reshape(-1), dy.reshape(-1)
+    for chunk in np.array_split(marching, max(1, -(-marching.size // MARCHED_AT_ONCE))):
+        _march(grid, laser.range_max, chunk, ox[chunk], oy[chunk], ux[chunk], uy[chunk], travelled)
+    return travelled
+
+
+def _march(
+    grid: PlanningGrid,
+    range_max: float,
+    beam: np.ndarray,
+    bx: np.ndarray,
+    by: np.ndarray,
+    bdx: np.ndarray,
+    bdy: np.ndarray,
+    travelled: np.ndarray,
+) -> None:
+    """March the beams ``beam`` from ``travelled[beam]`` on (sphere tracing), each step as far as
+    the clearance where it stands, and write where each stops into ``travelled``; the beams still
+    marching are compacted after each step, so that each step costs what is left."""
+    hit_eps, least = grid.map_resolution, grid.map_resolution * 0.5
+    so_far = travelled[beam]
+    for _ in range(63):  # the first step was the scan's
         if beam.size == 0:
             break
         clearance = grid.clearance_of(bx + bdx * so_far, by + bdy * so_far)
-        done = clearance < hit_eps
-        moved = so_far + np.where(done, 0.0, np.maximum(clearance - hit_eps * 0.5, hit_eps * 0.5))
-        going = ~done & (moved < laser.range_max)
+        hit = clearance < hit_eps
+        moved = so_far + np.maximum(clearance - least, least)
+        going = ~hit & (moved < range_max)
+        if going.all():
+            so_far = moved
+            continue
         stopped = ~going
-        travelled[beam[stopped]] = moved[stopped]
+        travelled[beam[stopped]] = np.where(hit[stopped], so_far[stopped], moved[stopped])
         beam, bx, by, bdx, bdy, so_far = (
             beam[going],
             bx[going],
@@ -77,18 +125,6 @@ def scan_ranges(
             moved[going],
         )
     travelled[beam] = so_far  # beams still marching after the last step
-    travelled = travelled.reshape(theta.shape)
-    ranges = np.where(travelled < laser.range_max, travelled, np.inf)
-    for qx, qy in others:  # other robots are discs
-        cx, cy = qx[:, None] - ox, qy[:, None] - oy
-        along = cx * dx + cy * dy
-        across2 = cx * cx + cy * cy - along * along
-        inside = (across2 < robot_radius**2) & (along > 0)
-        hit = along - np.sqrt(np.maximum(robot_radius**2 - across2, 0.0))
-        ranges = np.where(inside & (hit > 0) & (hit < ranges), hit, ranges)
-    noisy = ranges + rng.normal(0.0, laser.noise, ranges.shape)
-    noisy = np.where(np.isfinite(ranges), np.maximum(noisy, laser.range_min), np.inf)
-    return noisy.astype(np.float32)
 
 
 def laser_scans(
