@@ -8,7 +8,8 @@ Gazebo publishes it.  The robots drove the same paths, so every distance, speed 
 of the restamped bag equals the original's; durations scale by ``rate``.  Messages are rewritten
 through rosbags' own deserialisation, so nothing of exsce's reading is used to make them; a
 message whose only stamp is its leading header's (odometry, scans) has that stamp rewritten in
-its bytes, where rosbags' serialisation puts it, and one with no stamp is copied as it is.
+its bytes, where rosbags' serialisation puts it (a TFMessage's transforms too: test_clock_bags
+holds both to rosbags' own round trip), and one with no stamp is copied as it is.
 """
 
 from __future__ import annotations
@@ -61,6 +62,8 @@ def restamp(
                 moved: Any = raw  # no stamp to move: its bytes as they are
             elif move is not None and stamps == "header":
                 moved = _header_moved(raw, reader.is2, move)
+            elif move is not None and stamps == "tf":
+                moved = _transforms_moved(raw, reader.is2, move)
             else:
                 message = reader.deserialize(raw, connection.msgtype)
                 moved = _moved(message, move, store) if move is not None else message
@@ -119,12 +122,48 @@ def _header_moved(raw: bytes | memoryview, cdr: bool, move: Callable[[float], fl
     return bytes(data)
 
 
+def _transforms_moved(raw: bytes | memoryview, cdr: bool, move: Callable[[float], float]) -> bytes:
+    """A serialised ``tf2_msgs/msg/TFMessage`` with each transform's header stamp moved.  A
+    transform is a header (ROS 1: seq, stamp, frame_id; CDR: stamp, frame_id), a child_frame_id
+    and seven float64; in CDR each field is aligned to its size, counted after the 4-byte
+    encapsulation header (ROS 1 packs them)."""
+    data = bytearray(raw)
+    assert not cdr or data[1] == 1, "CDR not little-endian"
+    base = 4 if cdr else 0
+
+    def aligned(at: int, size: int) -> int:
+        return base + -(-(at - base) // size) * size if cdr else at
+
+    at = aligned(base, 4)
+    (count,) = _UINT32.unpack_from(data, at)
+    at += 4
+    for _ in range(count):
+        at = aligned(at, 4) + (0 if cdr else 4)  # ROS 1: past the header's seq
+        sec, nanosec = _HEADER_STAMP.unpack_from(data, at)
+        stamp = sec + nanosec * 1e-9
+        if stamp > 0:
+            _HEADER_STAMP.pack_into(data, at, *_sec_nanosec(move(stamp)))
+        at += 8
+        for _ in ("frame_id", "child_frame_id"):
+            at = aligned(at, 4)
+            (length,) = _UINT32.unpack_from(data, at)
+            at += 4 + length
+        at = aligned(at, 8) + 7 * 8  # translation, rotation
+    assert at == len(data) or (cdr and 0 < len(data) - at < 8), "a TFMessage of another layout"
+    return bytes(data)
+
+
+_UINT32 = struct.Struct("<I")
+_TF = "tf2_msgs/msg/TFMessage"
 _STAMPS: dict[tuple[int, str], str] = {}
 
 
 def _stamps(store: Any, msgtype: str) -> str:
-    """Where ``msgtype`` holds Times: ``none``, ``header`` (only its leading header's stamp) or
-    ``other`` (anywhere else too: TF transforms, goal stamps)."""
+    """Where ``msgtype`` holds Times: ``none``, ``header`` (only its leading header's stamp),
+    ``tf`` (a TFMessage: its transforms' header stamps) or ``other`` (anywhere else too: goal
+    stamps)."""
+    if msgtype == _TF:
+        return "tf"
     key = (id(store), msgtype)
     if key not in _STAMPS:
         fields = store.fielddefs[msgtype][1]
