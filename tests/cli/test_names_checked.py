@@ -26,7 +26,7 @@ from exsce_dsl.errors import UnknownNameWarning
 from exsce_dsl.lang import load_spec
 from exsce_dsl.sim.run import simulate
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.paths import EXAMPLES
 
 BUILDING = EXAMPLES / "brsu_building_c"
@@ -114,7 +114,7 @@ def ground_truth_path(bag: Path) -> float:
 
 
 def runs_in(store: str) -> list[dict[str, dict[str, str]]]:
-    listed = run_exscec("runs", "-f", "json", "--store", store)
+    listed = exscec_here("runs", "-f", "json", "--store", store)
     assert listed.returncode == 0, listed.stderr
     rows: list[dict[str, dict[str, str]]] = json.loads(listed.stdout)["results"]["bindings"]
     return rows
@@ -125,7 +125,7 @@ def test_a_misspelt_topic_warns_with_did_you_mean_and_the_bags_topics_of_its_typ
 ) -> None:
     (tmp_path / "gt.exsce").write_text(spec("/ground_truth"))
     store = str(tmp_path / "store")
-    done = run_exscec("ingest", str(bag), "--scenario", str(tmp_path / "gt.exsce"), "--store", store, timeout=300)
+    done = exscec_here("ingest", str(bag), "--scenario", str(tmp_path / "gt.exsce"), "--store", store)
     assert done.returncode == 0, done.stderr
     said = [line for line in done.stderr.splitlines() if "did you mean" in line]
     assert len(said) == 1, done.stderr  # once for the bag and the topic, not once per reader
@@ -138,16 +138,16 @@ def test_a_misspelt_topic_warns_with_did_you_mean_and_the_bags_topics_of_its_typ
     # what needs no pose and no ground truth is still stored: task_duration
     (row,) = runs_in(store)
     run = row["run"]["value"]
-    table = run_exscec("query", "run_metric", "-p", f"run={run}", "-p", "metric=task_duration", "-p", "robot=bot",
-                       "-f", "csv", "--store", store)  # fmt: skip
+    table = exscec_here("query", "run_metric", "-p", f"run={run}", "-p", "metric=task_duration", "-p", "robot=bot",
+                        "-f", "csv", "--store", store)  # fmt: skip
     assert table.returncode == 0 and float(table.stdout.splitlines()[1].split(",")[0]) > 0, table.stdout
 
 
 def test_strict_ingest_refuses_a_missing_metric_and_stores_nothing(bag: Path, tmp_path: Path) -> None:
     (tmp_path / "gt.exsce").write_text(spec("/ground_truth"))
     store = str(tmp_path / "store")
-    done = run_exscec("ingest", str(bag), "--scenario", str(tmp_path / "gt.exsce"), "--store", store, "--strict",
-                      timeout=300)  # fmt: skip
+    done = exscec_here("ingest", str(bag), "--scenario", str(tmp_path / "gt.exsce"), "--store", store,
+                       "--strict")  # fmt: skip
     assert done.returncode == 2, done.stderr
     assert f"error: {bag}: 1 metric value would be missing (gt_path of 'bot')" in done.stderr, done.stderr
     assert "did you mean /groundtruth?" in done.stderr
@@ -155,12 +155,12 @@ def test_strict_ingest_refuses_a_missing_metric_and_stores_nothing(bag: Path, tm
     assert runs_in(store) == []
     # spelt as the bag spells it, the same bag ingests with --strict, with rosbags' path length
     (tmp_path / "fixed.exsce").write_text(spec("/groundtruth"))
-    done = run_exscec("ingest", str(bag), "--scenario", str(tmp_path / "fixed.exsce"), "--store", store, "--strict",
-                      timeout=300)  # fmt: skip
+    done = exscec_here("ingest", str(bag), "--scenario", str(tmp_path / "fixed.exsce"), "--store",
+                       store, "--strict")  # fmt: skip
     assert done.returncode == 0 and "did you mean" not in done.stderr, done.stderr
     (row,) = runs_in(store)
-    table = run_exscec("query", "run_metric", "-p", f"run={row['run']['value']}", "-p", "metric=gt_path", "-p",
-                       "robot=bot", "-f", "csv", "--store", store)  # fmt: skip
+    table = exscec_here("query", "run_metric", "-p", f"run={row['run']['value']}", "-p", "metric=gt_path", "-p",
+                        "robot=bot", "-f", "csv", "--store", store)  # fmt: skip
     assert float(table.stdout.splitlines()[1].split(",")[0]) == pytest.approx(ground_truth_path(bag), rel=1e-9)
 
 
@@ -181,7 +181,7 @@ def stored(bag: Path, tmp_path_factory: pytest.TempPathFactory) -> tuple[str, st
     folder = tmp_path_factory.mktemp("store")
     (folder / "gt.exsce").write_text(spec("/groundtruth"))
     store = str(folder / "store")
-    done = run_exscec("ingest", str(bag), "--scenario", str(folder / "gt.exsce"), "--store", store, timeout=300)
+    done = exscec_here("ingest", str(bag), "--scenario", str(folder / "gt.exsce"), "--store", store)
     assert done.returncode == 0, done.stderr
     (row,) = runs_in(store)
     return store, row["run"]["value"]
@@ -209,11 +209,11 @@ def test_a_misspelt_metric_parameter_warns_with_did_you_mean(
     def asked(params: dict[str, str]) -> list[str]:
         return [a for k, v in params.items() for a in ("-p", f"{k}={v}")]
 
-    done = run_exscec("query", query, *asked({**right, **wrong}), "-f", "csv", "--store", store)
+    done = exscec_here("query", query, *asked({**right, **wrong}), "-f", "csv", "--store", store)
     assert done.returncode == 0, done.stderr
     assert done.stdout.count("\n") == 1, done.stdout  # the header: no row
     assert done.stderr.strip() == said, done.stderr
-    done = run_exscec("query", query, *asked(right), "-f", "csv", "--store", store)
+    done = exscec_here("query", query, *asked(right), "-f", "csv", "--store", store)
     assert done.returncode == 0 and done.stderr == "", done.stderr
     assert done.stdout.count("\n") == 2, done.stdout  # the header and one row
 
@@ -236,12 +236,12 @@ def test_a_misspelt_metric_parameter_warns_on_virtuoso_too(bag: Path, tmp_path: 
     (tmp_path / "gt.exsce").write_text(spec("/groundtruth"))
     with virtuoso_server(tmp_path / "virtuoso") as server:
         store = f"virtuoso+{server.url}"
-        done = run_exscec("ingest", str(bag), "--scenario", str(tmp_path / "gt.exsce"), "--store", store,
-                          timeout=300)  # fmt: skip
+        done = exscec_here("ingest", str(bag), "--scenario", str(tmp_path / "gt.exsce"), "--store",
+                           store)  # fmt: skip
         assert done.returncode == 0, done.stderr
         (row,) = runs_in(store)
-        done = run_exscec("query", "run_metric", "-p", f"run={row['run']['value']}", "-p", "metric=distance_travelld",
-                          "-p", "robot=bott", "-f", "csv", "--store", store)  # fmt: skip
+        done = exscec_here("query", "run_metric", "-p", f"run={row['run']['value']}", "-p", "metric=distance_travelld",
+                           "-p", "robot=bott", "-f", "csv", "--store", store)  # fmt: skip
     assert done.returncode == 0, done.stderr
     assert done.stderr.splitlines() == [
         "warning: the store holds no metric 'distance_travelld'; did you mean 'distance_travelled'?",

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 from pyoxigraph import RdfFormat, parse
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.paths import EXAMPLES
 from tests.support.store_servers import Server, oxigraph_server
 
@@ -23,36 +23,36 @@ def oxigraph(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
 
 
 def test_compile_adds_to_the_project_store_and_store_commands_show_it(in_tmp: Path) -> None:
-    added = run_exscec("compile", str(SCENARIO_C), "--store")
+    added = exscec_here("compile", str(SCENARIO_C), "--store")
     assert added.returncode == 0, added.stderr
     assert added.stdout == ""  # no PROV printed unless -f or -o
     assert added.stderr.strip() == ".exsce/store: added 14 graphs (377 statements written)"
-    again = run_exscec("compile", str(SCENARIO_C), "--store", "-f", "nq")
+    again = exscec_here("compile", str(SCENARIO_C), "--store", "-f", "nq")
     assert again.returncode == 0 and "no change" in again.stderr and again.stdout.count(" .\n") == 377
 
-    info = run_exscec("store", "info")
+    info = exscec_here("store", "info")
     assert info.returncode == 0, info.stderr
     assert info.stdout.splitlines() == [
         "store:      .exsce/store (embedded Oxigraph)",
         "graphs:     14 (+ 0 revisions, + 0 of the segment index)",
         "statements: 377",
     ]
-    graphs = run_exscec("store", "graphs")
+    graphs = exscec_here("store", "graphs")
     assert "https://www.sesame-project.org/scenarios/scenario_c_bundle" in graphs.stdout
     assert len(graphs.stdout.splitlines()) == 14 and "14 graphs, 377 statements" in graphs.stderr
 
-    exported = run_exscec("store", "export", "-f", "nq", "-o", "all.nq")
+    exported = exscec_here("store", "export", "-f", "nq", "-o", "all.nq")
     assert exported.returncode == 0, exported.stderr
     quads = list(parse((in_tmp / "all.nq").read_bytes(), format=RdfFormat.N_QUADS))
     assert len(quads) == 377 and len({q.graph_name for q in quads}) == 14
-    trig = run_exscec("store", "export")
+    trig = exscec_here("store", "export")
     assert len(list(parse(trig.stdout, format=RdfFormat.TRIG))) == 377
 
-    refused = run_exscec("store", "clear")  # asks; no answer on stdin
+    refused = exscec_here("store", "clear")  # asks; no answer on stdin
     assert refused.returncode != 0
-    cleared = run_exscec("store", "clear", "--yes")
+    cleared = exscec_here("store", "clear", "--yes")
     assert cleared.returncode == 0 and "removed 14 graphs" in cleared.stderr
-    assert run_exscec("store", "graphs").stdout == ""
+    assert exscec_here("store", "graphs").stdout == ""
 
 
 def test_compile_to_a_sparql_endpoint_refuses_a_changed_scenario_then_replaces_it(
@@ -60,20 +60,20 @@ def test_compile_to_a_sparql_endpoint_refuses_a_changed_scenario_then_replaces_i
 ) -> None:
     shutil.copytree(EXAMPLES / "brsu_building_c", in_tmp / "bc")
     url = f"oxigraph+{oxigraph.url}"
-    assert run_exscec("compile", "bc/scenario_c.exsce", "--store", url).returncode == 0
+    assert exscec_here("compile", "bc/scenario_c.exsce", "--store", url).returncode == 0
     spec = in_tmp / "bc" / "scenario_c.exsce"
     spec.write_text(spec.read_text().replace("tiago2 does navigate_home_2", "tiago1 does navigate_home_2"))
-    refused = run_exscec("compile", "bc/scenario_c.exsce", "--store", url)
+    refused = exscec_here("compile", "bc/scenario_c.exsce", "--store", url)
     assert refused.returncode == 2
     lines = refused.stderr.splitlines()
     assert lines[0] == (
         f"error: {oxigraph.url}/query already holds another version of scenario exsce:scenario_c: 1 graph differs"
     )
     assert lines[1].startswith("  exsce:scenario_c_bundle: mission:mission_c differs")
-    replaced = run_exscec("compile", "bc/scenario_c.exsce", "--store", url, "--replace")
+    replaced = exscec_here("compile", "bc/scenario_c.exsce", "--store", url, "--replace")
     assert replaced.returncode == 0, replaced.stderr
     assert "replaced 1 graph" in replaced.stderr and "exsce:scenario_c_bundle?revision=1" in replaced.stderr
-    info = run_exscec("store", "info", "--store", url)
+    info = exscec_here("store", "info", "--store", url)
     assert "graphs:     14 (+ 1 revisions, + 0 of the segment index)" in info.stdout and "SPARQL 1.1 endpoint" in info.stdout
 
 
@@ -81,7 +81,7 @@ def test_an_unreachable_endpoint_is_named(in_tmp: Path) -> None:
     from tests.support.store_servers import free_port
 
     url = f"http://127.0.0.1:{free_port()}/sparql"
-    result = run_exscec("store", "graphs", "--store", url)
+    result = exscec_here("store", "graphs", "--store", url)
     assert result.returncode == 2
     assert (
         f"cannot reach the SPARQL endpoint {url}" in result.stderr and "connection refused" in result.stderr

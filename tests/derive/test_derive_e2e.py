@@ -21,7 +21,7 @@ from exsce_dsl.lang import load_spec
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.paths import EXAMPLES
 
 DERIVED_ORACLES = {
@@ -41,9 +41,9 @@ def project(tmp_path_factory: pytest.TempPathFactory) -> Path:
     shutil.copytree(EXAMPLES / "brsu_building_c", folder / "c")
     base = load_spec(folder / "c" / "scenario_c.exsce").scenario("scenario_c")
     bags = [str(run.bag) for run in simulate(base, folder / "base_runs", 3, seed=1)]
-    ingested = run_exscec("ingest", *bags, "--scenario", "c/scenario_c.exsce", cwd=folder)
+    ingested = exscec_here("ingest", *bags, "--scenario", "c/scenario_c.exsce", cwd=folder)
     assert ingested.returncode == 0, ingested.stderr
-    derived = run_exscec(
+    derived = exscec_here(
         "derive", "c/scenario_c.exsce", "-t", "remove_robot", "--robot", "tiago2", "--reassign", "tiago1",
         "--id", "c_one", "-o", "c/c_one.exsce", "--expect", "--tolerance", "15", "--add-to-store", cwd=folder,
     )
@@ -53,7 +53,7 @@ def project(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 def _verdicts(folder: Path, bags: list[Path]) -> tuple[int, list[dict[str, object]]]:
-    judged = run_exscec("verify", *map(str, bags), "--scenario", "c/c_one.exsce", "--json", cwd=folder)
+    judged = exscec_here("verify", *map(str, bags), "--scenario", "c/c_one.exsce", "--json", cwd=folder)
     assert "Traceback" not in judged.stderr
     return judged.returncode, json.loads(judged.stdout)
 
@@ -64,7 +64,7 @@ def test_the_derived_scenario_says_what_its_runs_should_show(project: Path) -> N
     assert "distance_between_robots" not in text  # one robot left: nothing between robots to judge
     assert "tiago1 waypoints_visited is invariant around 6 within 0 %" in text
     assert "tiago1 waypoints_visited is increasing by 3 within 0 of scenario_c" in text
-    expected = run_exscec("expect", "c/c_one.exsce", cwd=project)
+    expected = exscec_here("expect", "c/c_one.exsce", cwd=project)
     assert expected.returncode == 0, expected.stderr
     lines = expected.stdout.splitlines()
     distance = float(lines[0].removeprefix("tiago1 distance_travelled: "))
@@ -75,12 +75,12 @@ def test_the_derived_scenario_says_what_its_runs_should_show(project: Path) -> N
     # (nobody's, and its room has no other pose: per metre)
     assert [how.split(" ", 1)[0] for how in hows] == ["observed", "observed", "estimated", "observed", "estimated", "no"]
     assert "per metre" in hows[5]
-    stored = run_exscec("query", "oracles", "-p", "scenario=c_one", "--format", "json", cwd=project)
+    stored = exscec_here("query", "oracles", "-p", "scenario=c_one", "--format", "json", cwd=project)
     rows = json.loads(stored.stdout)["results"]["bindings"]
     kinds = {(r["metric"]["value"], r["type"]["value"], r["base"]["value"]) for r in rows}
     assert ("distance_travelled", "metamorphic", "scenario_c") in kinds
     assert ("distance_travelled", "baseline", "c_one") in kinds
-    lineage = run_exscec("lineage", "c_one", cwd=project)
+    lineage = exscec_here("lineage", "c_one", cwd=project)
     assert lineage.stdout.splitlines()[:2] == [
         "scenario_c", "  └─ remove_robot(reassign=tiago1 robot=tiago2)"
     ]

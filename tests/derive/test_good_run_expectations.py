@@ -23,7 +23,7 @@ from exsce_dsl.lang import load_spec
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.paths import EXAMPLES
 
 LEGS = (("classroom_c025-w001", "classroom_c022-w001"), ("classroom_c022-w001", "classroom_c018-w001"))
@@ -50,7 +50,7 @@ def project(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[str], 
     clean = [run.bag for run in simulate(base, folder / "clean", 3, seed=1)]
     overspeed = (Fault.parse("overspeed:tiago1"),)
     [fast] = [run.bag for run in simulate(base, folder / "fast", 1, seed=7, faults=overspeed)]
-    ingested = run_exscec("ingest", *map(str, [*clean, fast]), "--scenario", "c/scenario_c.exsce", cwd=folder)
+    ingested = exscec_here("ingest", *map(str, [*clean, fast]), "--scenario", "c/scenario_c.exsce", cwd=folder)
     assert ingested.returncode == 0, ingested.stderr
     said = ingested.stdout + ingested.stderr
 
@@ -65,7 +65,7 @@ def project(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[str], 
 def _leg_durations(folder: Path, runs: list[str]) -> dict[tuple[str, str], list[float]]:
     """tiago1's task_duration on each leg of LEGS, one value per run, as the store holds them."""
     given = [a for run in runs for a in ("-p", f"run={run}")]
-    done = run_exscec("query", "run_segment_values", *given, "--format", "json", cwd=folder)
+    done = exscec_here("query", "run_segment_values", *given, "--format", "json", cwd=folder)
     assert done.returncode == 0, done.stderr
     found: dict[tuple[str, str], list[float]] = {leg: [] for leg in LEGS}
     for row in json.loads(done.stdout)["results"]["bindings"]:
@@ -95,13 +95,13 @@ def test_an_over_speed_run_does_not_move_the_expected_duration(project: tuple[Pa
     every = _sum_of_means(_leg_durations(folder, [*clean, fast]))
     assert abs(fault_free - every) > 2.0  # the over-speed run drives these legs much faster
 
-    derived = run_exscec("derive", "c/scenario_c.exsce", *DERIVE, "-o", "c/good.exsce", cwd=folder)
+    derived = exscec_here("derive", "c/scenario_c.exsce", *DERIVE, "-o", "c/good.exsce", cwd=folder)
     assert derived.returncode == 0, derived.stderr
     assert _expected((folder / "c" / "good.exsce").read_text(), "task_duration") == pytest.approx(
         fault_free, abs=0.0015
     )
 
-    everything = run_exscec(
+    everything = exscec_here(
         "derive", "c/scenario_c.exsce", *DERIVE, "--all-runs", "-o", "c/every.exsce", cwd=folder
     )
     assert everything.returncode == 0, everything.stderr
@@ -110,7 +110,7 @@ def test_an_over_speed_run_does_not_move_the_expected_duration(project: tuple[Pa
     )
 
     for flags, count in (((), 3), (("--all-runs",), 4)):  # each observed segment: drives of how many runs
-        shown = run_exscec("expect", "c/good.exsce", *flags, cwd=folder)
+        shown = exscec_here("expect", "c/good.exsce", *flags, cwd=folder)
         assert shown.returncode == 0, shown.stderr
         observed = [line for line in shown.stdout.splitlines() if "  observed" in line]
         assert observed and all(line.endswith(f"({count} runs)") for line in observed), shown.stdout

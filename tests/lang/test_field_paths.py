@@ -26,7 +26,7 @@ from exsce_dsl.model.expressions import Aggregate, Field
 from exsce_dsl.model.messages import FieldPath, Index, Select
 from exsce_dsl.monitor_kit import monitor_runtime
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 
 READS = """\
 metric m for each robot {
@@ -248,7 +248,7 @@ def test_a_misspelt_standard_type_is_a_warning_with_a_did_you_mean(tmp_path):
 
 def test_check_prints_the_warning_and_succeeds(tmp_path):
     (tmp_path / "m.exsce").write_text(TURTLE)
-    done = run_exscec("check", "m.exsce", cwd=tmp_path)
+    done = exscec_here("check", "m.exsce", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     assert "m.exsce:2:3: warning: exsce does not know the message type turtlesim/msg/Pose" in done.stderr
     assert "m.exsce: ok (0 scenarios)" in done.stderr
@@ -372,11 +372,11 @@ def test_msg_path_goes_in_front_of_the_environment_s_folders(tmp_path, monkeypat
     _write(tmp_path, "b/turtlesim/msg/Pose.msg", TURTLE_MSG)
     (tmp_path / "m.exsce").write_text(TURTLE)
     monkeypatch.setenv("EXSCE_MSG_PATH", str(tmp_path / "b"))
-    from_b = run_exscec("check", "m.exsce", cwd=tmp_path)
+    from_b = exscec_here("check", "m.exsce", cwd=tmp_path)
     assert from_b.returncode == 2 and "m.exsce:3:29: error: turtle (turtlesim/msg/Pose) has no field" in from_b.stderr
-    from_a = run_exscec("--msg-path", "a", "check", "m.exsce", cwd=tmp_path)
+    from_a = exscec_here("--msg-path", "a", "check", "m.exsce", cwd=tmp_path)
     assert from_a.returncode == 0 and "warning" not in from_a.stderr, from_a.stderr
-    helped = run_exscec("--help")
+    helped = exscec_here("--help")
     assert "--msg-path DIR" in helped.stdout and "EXSCE_MSG_PATH" in helped.stdout
 
 

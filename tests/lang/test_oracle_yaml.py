@@ -42,7 +42,7 @@ from exsce_dsl.model.acceptance import (
     Window,
 )
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.paths import EXAMPLES, FIXTURES
 
 ORACLES = FIXTURES / "oracles" / "scenario_c.yaml"
@@ -409,28 +409,28 @@ def test_export_then_import_gives_the_same_criteria(value: float, tolerance: flo
 
 def test_cli_imports_and_exports_an_oracle_file(tmp_path: Path) -> None:
     spec = example_without_acceptance(tmp_path / "example")
-    printed = run_exscec("import", str(ORACLES), "--spec", str(spec))
+    printed = exscec_here("import", str(ORACLES), "--spec", str(spec))
     assert printed.returncode == 0, printed.stderr
     assert printed.stdout.startswith('acceptance for scenario_c {\n  scenario "baseline" {\n    when mission_c runs\n')
 
-    written = run_exscec("import", str(ORACLES), "--spec", str(spec), "-o", str(tmp_path / "specs"))
+    written = exscec_here("import", str(ORACLES), "--spec", str(spec), "-o", str(tmp_path / "specs"))
     assert written.returncode == 0, written.stderr
     criteria_file = tmp_path / "specs" / "scenario_c_acceptance.exsce"
     assert criteria_file.read_text().startswith('import "../example/scenario_c.exsce"\n\nacceptance for')
 
-    exported = run_exscec("export", str(criteria_file), "--to", "oracle-yaml", "--scenario", "scenario_c",
-                          "-o", str(tmp_path / "out"))
+    exported = exscec_here("export", str(criteria_file), "--to", "oracle-yaml", "--scenario", "scenario_c",
+                           "-o", str(tmp_path / "out"))
     assert exported.returncode == 0, exported.stderr
     data = yaml.safe_load((tmp_path / "out" / "oracles" / "scenario_c.yaml").read_text())
     assert as_floats(data) == as_floats(yaml.safe_load(ORACLES.read_text()))
 
 
 def test_cli_oracle_import_needs_the_spec_and_export_says_which_clause(tmp_path: Path) -> None:
-    no_spec = run_exscec("import", str(ORACLES))
+    no_spec = exscec_here("import", str(ORACLES))
     assert no_spec.returncode == 2
     assert "name the spec of its scenario with --spec" in no_spec.stderr
 
-    no_baseline = run_exscec("export", str(EXAMPLE / "scenario_c.exsce"), "--to", "oracle-yaml", "-o", str(tmp_path))
+    no_baseline = exscec_here("export", str(EXAMPLE / "scenario_c.exsce"), "--to", "oracle-yaml", "-o", str(tmp_path))
     assert no_baseline.returncode == 2
     assert "scenario_c.exsce:35:10: error: 'each robot task_duration is invariant within 3 std' needs the mean" in (
         no_baseline.stderr

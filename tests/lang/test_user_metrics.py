@@ -25,7 +25,7 @@ from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.paths import EXAMPLES
 
 BUILDING = EXAMPLES / "brsu_building_c"
@@ -122,17 +122,17 @@ acceptance for calm {{
 def test_oracles_on_user_metrics_pass_a_calm_run_and_fail_an_overspeed_one(tmp_path):
     (tmp_path / "spec.exsce").write_text(SPEC.format(building=BUILDING))
     for name, faults in (("clean", []), ("fast", ["--fault", "overspeed:tiago1"])):
-        done = run_exscec("simulate", "spec.exsce", "-o", name, "--seed", "2", *faults, cwd=tmp_path)
+        done = exscec_here("simulate", "spec.exsce", "-o", name, "--seed", "2", *faults, cwd=tmp_path)
         assert done.returncode == 0, done.stderr
     bags = {name: next((tmp_path / name).glob("*.bag")) for name in ("clean", "fast")}
-    ingested = run_exscec("ingest", *map(str, bags.values()), "--scenario", "spec.exsce", cwd=tmp_path)
+    ingested = exscec_here("ingest", *map(str, bags.values()), "--scenario", "spec.exsce", cwd=tmp_path)
     assert ingested.returncode == 0, ingested.stderr
-    built = run_exscec("baseline", "spec.exsce", cwd=tmp_path)
+    built = exscec_here("baseline", "spec.exsce", cwd=tmp_path)
     assert built.returncode == 0, built.stderr
-    judged = run_exscec("verify", *map(str, bags.values()), "--scenario", "spec.exsce", "--json", cwd=tmp_path)
+    judged = exscec_here("verify", *map(str, bags.values()), "--scenario", "spec.exsce", "--json", cwd=tmp_path)
     assert judged.returncode == 1, judged.stderr
     verdicts = json.loads(judged.stdout)
-    listed = json.loads(run_exscec("runs", "--format", "json", cwd=tmp_path).stdout)["results"]["bindings"]
+    listed = json.loads(exscec_here("runs", "--format", "json", cwd=tmp_path).stdout)["results"]["bindings"]
     case = {row["run"]["value"]: Path(row["bag"]["value"]).parent.name for row in listed}
     case |= {row["run"]["value"]: name for row in listed for name, bag in bags.items()
              if Path(row["bag"]["value"]).name == bag.name}
@@ -225,14 +225,14 @@ def test_declaration_errors_are_reported_at_their_line_and_column(tmp_path, text
 
 def test_check_prints_a_metric_error_as_file_line_col(tmp_path):
     (tmp_path / "m.exsce").write_text(_HEADER + "  value mean(vel.linar.x)\n}\n")
-    done = run_exscec("check", "m.exsce", cwd=tmp_path)
+    done = exscec_here("check", "m.exsce", cwd=tmp_path)
     assert done.returncode == 2 and "Traceback" not in done.stderr
     assert "m.exsce:3:14: error: vel (geometry_msgs/msg/Twist) has no field 'linar'" in done.stderr
 
 
 def test_check_names_an_unknown_function_at_its_place_with_the_functions_there_are(tmp_path):
     (tmp_path / "m.exsce").write_text(_HEADER + "  value max(vel.linear.x) - min(absl(vel.linear.x))\n}\n")
-    done = run_exscec("check", "m.exsce", cwd=tmp_path)
+    done = exscec_here("check", "m.exsce", cwd=tmp_path)
     assert done.returncode == 2 and "Traceback" not in done.stderr
     assert "m.exsce:3:33: error: unknown function 'absl'; did you mean 'abs'? (the functions: min," in (
         done.stderr

@@ -25,7 +25,7 @@ from exsce_dsl.store.open import open_store
 from exsce_dsl.store.queries import runs
 from exsce_dsl.store.queries.results import verdicts as stored_verdicts
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.map_files import write_map
 from tests.support.yard_spec import YARD_SPEC
 
@@ -175,11 +175,11 @@ def yard(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, SimulatedRun, 
     clean = list(simulate(scenario, folder / "runs", 5, seed=1))
     fast = next(iter(simulate(scenario, folder / "fast", 1, seed=2, faults=(Fault.parse("overspeed:r1"),))))
     spec = ("--scenario", "spec.exsce")
-    done = run_exscec("ingest", *(str(r.bag) for r in clean[:4]), *spec, cwd=folder)
+    done = exscec_here("ingest", *(str(r.bag) for r in clean[:4]), *spec, cwd=folder)
     assert done.returncode == 0, done.stderr
-    done = run_exscec("baseline", "spec.exsce", cwd=folder)
+    done = exscec_here("baseline", "spec.exsce", cwd=folder)
     assert done.returncode == 0, done.stderr
-    done = run_exscec("ingest", str(clean[4].bag), str(fast.bag), *spec, cwd=folder)
+    done = exscec_here("ingest", str(clean[4].bag), str(fast.bag), *spec, cwd=folder)
     assert done.returncode == 0, done.stderr
     return folder, clean[4], fast
 

@@ -28,7 +28,7 @@ from exsce_dsl.prov.recorder import recorded_prov_json, recorded_run
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.map_files import write_map
 from tests.support.yard_spec import YARD_SPEC
 
@@ -76,7 +76,7 @@ def _run_of(ingested: str, bag: Path) -> str:
 
 
 def _rows(folder: Path, query: str, *store: str) -> list[dict[str, str]]:
-    done = run_exscec("sparql", query, "-f", "json", *store, cwd=folder)
+    done = exscec_here("sparql", query, "-f", "json", *store, cwd=folder)
     assert done.returncode == 0, done.stderr
     return [{k: v["value"] for k, v in row.items()} for row in json.loads(done.stdout)["results"]["bindings"]]
 
@@ -102,25 +102,25 @@ def test_a_baseline_leaves_out_failed_cancelled_and_unsafe_runs_and_says_why(
 ) -> None:
     folder, bags = yard
     clean = [bags[f"clean_{i}"] for i in range(4)]
-    ingested = run_exscec("ingest", *map(str, clean), "--scenario", "spec.exsce", cwd=folder)
+    ingested = exscec_here("ingest", *map(str, clean), "--scenario", "spec.exsce", cwd=folder)
     assert ingested.returncode == 0, ingested.stderr
     good = [_run_of(ingested.stderr + ingested.stdout, bag) for bag in clean]
-    first = run_exscec("baseline", "spec.exsce", cwd=folder)
+    first = exscec_here("baseline", "spec.exsce", cwd=folder)
     assert first.returncode == 0 and "built from 4 runs\n" in first.stderr, first.stderr
 
-    verified = run_exscec("verify", str(bags["slow"]), "--scenario", "spec.exsce", "--json", cwd=folder)
+    verified = exscec_here("verify", str(bags["slow"]), "--scenario", "spec.exsce", "--json", cwd=folder)
     assert verified.returncode == 1, verified.stdout + verified.stderr
     failed = sorted({v["oracle"] for v in json.loads(verified.stdout) if v["verdict"] == "failed"})
     assert "r1-task_duration" in failed
     slow = next(v["run"] for v in json.loads(verified.stdout))
-    more = run_exscec(
+    more = exscec_here(
         "ingest", str(bags["cancelled"]), str(bags["fast"]), "--scenario", "spec.exsce", cwd=folder
     )
     assert more.returncode == 0, more.stderr
     cancelled = _run_of(more.stderr + more.stdout, bags["cancelled"])
     fast = _run_of(more.stderr + more.stdout, bags["fast"])
 
-    built = run_exscec("baseline", "spec.exsce", cwd=folder)
+    built = exscec_here("baseline", "spec.exsce", cwd=folder)
     assert built.returncode == 0, built.stderr
     [summary] = [line for line in built.stderr.splitlines() if line.startswith("built from")]
     assert summary.startswith("built from 4 runs; left out 3: "), summary
@@ -147,7 +147,7 @@ def test_a_baseline_leaves_out_failed_cancelled_and_unsafe_runs_and_says_why(
     [row] = [line.split() for line in built.stdout.splitlines() if line.startswith("r1-task_duration ")]
     assert float(row[2]) == pytest.approx(clean_mean, rel=1e-3)
 
-    everything = run_exscec("baseline", "spec.exsce", "--all-runs", cwd=folder)
+    everything = exscec_here("baseline", "spec.exsce", "--all-runs", cwd=folder)
     assert everything.returncode == 0, everything.stderr
     assert "built from 7 runs (every stored run: --all-runs)" in everything.stderr
     [row] = [line.split() for line in everything.stdout.splitlines() if line.startswith("r1-task_duration ")]
@@ -161,11 +161,11 @@ def test_no_good_run_left_is_an_error_that_names_the_reasons(
     folder, bags = yard
     store = ("--store", str(tmp_path / "store"))
     two = [str(bags["cancelled"]), str(bags["fast"])]
-    ingested = run_exscec("ingest", *two, "--scenario", "spec.exsce", *store, cwd=folder)
+    ingested = exscec_here("ingest", *two, "--scenario", "spec.exsce", *store, cwd=folder)
     assert ingested.returncode == 0, ingested.stderr
     cancelled = _run_of(ingested.stderr + ingested.stdout, bags["cancelled"])
     fast = _run_of(ingested.stderr + ingested.stdout, bags["fast"])
-    refused = run_exscec("baseline", "spec.exsce", *store, cwd=folder)
+    refused = exscec_here("baseline", "spec.exsce", *store, cwd=folder)
     assert refused.returncode == 2, refused.stdout + refused.stderr
     assert "Traceback" not in refused.stderr
     message = " ".join(refused.stderr.split())

@@ -27,7 +27,7 @@ from exsce_dsl.store.queries import AmbiguousRunError, UnknownRunError, resolve_
 from exsce_dsl.store.remote import RemoteStore
 from exsce_dsl.store.writing import add_prov
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.map_files import write_map
 from tests.support.store_servers import virtuoso_server
 from tests.support.yard_spec import YARD_SPEC
@@ -37,7 +37,7 @@ RUN_IRI = "https://www.sesame-project.org/scenarios/runs/run_{}"
 
 def _stored_runs(folder: Path) -> dict[str, str]:
     """Bag file name → run uuid, as `exscec runs -f json` lists them."""
-    listed = run_exscec("runs", "-f", "json", cwd=folder)
+    listed = exscec_here("runs", "-f", "json", cwd=folder)
     assert listed.returncode == 0, listed.stderr
     rows = json.loads(listed.stdout)["results"]["bindings"]
     return {row["bag"]["value"]: row["run"]["value"] for row in rows}
@@ -52,16 +52,16 @@ def yard(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
     (folder / "spec.exsce").write_text(YARD_SPEC)
     scenario = load_spec(folder / "spec.exsce").scenario()
     bags = [run.bag for run in simulate(scenario, folder / "runs", 5, seed=1)]
-    ingested = run_exscec("ingest", *map(str, bags[:4]), "--scenario", "spec.exsce", cwd=folder)
+    ingested = exscec_here("ingest", *map(str, bags[:4]), "--scenario", "spec.exsce", cwd=folder)
     assert ingested.returncode == 0, ingested.stderr
-    built = run_exscec("baseline", "spec.exsce", cwd=folder)
+    built = exscec_here("baseline", "spec.exsce", cwd=folder)
     assert built.returncode == 0, built.stderr
     return folder, bags[4]
 
 
 def test_verify_takes_the_eight_characters_tables_print(yard: tuple[Path, Path]) -> None:
     folder, new_bag = yard
-    first = run_exscec("verify", str(new_bag), "--scenario", "spec.exsce", "--no-record", cwd=folder)
+    first = exscec_here("verify", str(new_bag), "--scenario", "spec.exsce", "--no-record", cwd=folder)
     assert first.returncode == 0, first.stdout + first.stderr
     printed = {line.split()[0] for line in first.stdout.splitlines()[1:]}  # the table's run column
     assert len(printed) == 1
@@ -69,21 +69,21 @@ def test_verify_takes_the_eight_characters_tables_print(yard: tuple[Path, Path])
     uuid = _stored_runs(folder)[new_bag.name]
     assert len(eight) == 8 and uuid.startswith(eight)
 
-    again = run_exscec("verify", eight, "--scenario", "spec.exsce", "--json", "--no-record", cwd=folder)
+    again = exscec_here("verify", eight, "--scenario", "spec.exsce", "--json", "--no-record", cwd=folder)
     assert again.returncode == 0, again.stderr
     assert "no run" not in again.stderr
     judged = json.loads(again.stdout)
     assert len(judged) == 11 and {v["run"] for v in judged} == {uuid}
 
-    by_iri = run_exscec("verify", RUN_IRI.format(uuid), "--scenario", "spec.exsce", "--json", cwd=folder)
+    by_iri = exscec_here("verify", RUN_IRI.format(uuid), "--scenario", "spec.exsce", "--json", cwd=folder)
     assert by_iri.returncode == 0, by_iri.stderr
     assert {v["run"] for v in json.loads(by_iri.stdout)} == {uuid}
 
-    values = run_exscec("query", "run_metric_values", "-p", f"run={eight}", "-f", "json", cwd=folder)
+    values = exscec_here("query", "run_metric_values", "-p", f"run={eight}", "-f", "json", cwd=folder)
     assert values.returncode == 0, values.stderr
     rows = json.loads(values.stdout)["results"]["bindings"]
     assert rows and {row["run"]["value"] for row in rows} == {uuid}
-    one = run_exscec(
+    one = exscec_here(
         "query", "run_metric", "-p", f"run={eight.upper()}", "-p", "metric=distance_travelled", "-p", "robot=r1",
         cwd=folder,
     )  # fmt: skip
@@ -131,29 +131,29 @@ def test_an_ambiguous_run_prefix_lists_the_candidates(twins: tuple[Path, dict[st
     folder, uuids = twins
     assert _stored_runs(folder) == uuids  # stored as chosen
 
-    ambiguous = run_exscec("query", "run_metric_values", "-p", "run=abcd", cwd=folder)
+    ambiguous = exscec_here("query", "run_metric_values", "-p", "run=abcd", cwd=folder)
     assert ambiguous.returncode == 2, ambiguous.stderr
     said = ambiguous.stderr
     assert "run id 'abcd' is ambiguous: 3 runs start with it" in said and "Traceback" not in said
     for bag, uuid in uuids.items():  # each candidate on its line, with its scenario and bag
         assert any(uuid in line and "yard_run" in line and bag in line for line in said.splitlines()), said
-    two = run_exscec("verify", "abcd12", "--scenario", "spec.exsce", cwd=folder)
+    two = exscec_here("verify", "abcd12", "--scenario", "spec.exsce", cwd=folder)
     assert two.returncode == 2 and "2 runs start with it" in two.stderr and "abcd5678" not in two.stderr
 
-    one = run_exscec("query", "run_metric_values", "-p", "run=abcd5", "-f", "json", cwd=folder)
+    one = exscec_here("query", "run_metric_values", "-p", "run=abcd5", "-f", "json", cwd=folder)
     assert one.returncode == 0, one.stderr
     assert {r["run"]["value"] for r in json.loads(one.stdout)["results"]["bindings"]} == {
         "abcd5678-0000-4000-8000-000000000003"
     }
 
-    unknown = run_exscec("query", "run_metric_values", "-p", "run=abce12", cwd=folder)
+    unknown = exscec_here("query", "run_metric_values", "-p", "run=abce12", cwd=folder)
     assert unknown.returncode == 2, unknown.stderr
     assert "the store holds no run abce12; the closest ids" in unknown.stderr
     assert "abcd1234-0000-4000-8000-000000000001" in unknown.stderr  # shares 'abc', as all three do
 
-    short = run_exscec("verify", "abc", "--scenario", "spec.exsce", cwd=folder)
+    short = exscec_here("verify", "abc", "--scenario", "spec.exsce", cwd=folder)
     assert short.returncode == 2 and "run id 'abc' is too short: give at least 4 characters" in short.stderr
-    pasted = run_exscec("query", "run_metric_values", "-p", 'run=abcd" } UNION { ?s ?p ?o', cwd=folder)
+    pasted = exscec_here("query", "run_metric_values", "-p", 'run=abcd" } UNION { ?s ?p ?o', cwd=folder)
     assert pasted.returncode == 2 and "is not a run id" in pasted.stderr, pasted.stderr
 
     with api.open_store(str(folder / ".exsce" / "store")) as store:
@@ -170,14 +170,14 @@ def test_verifying_a_run_of_the_baseline_warns(yard: tuple[Path, Path]) -> None:
     stored = _stored_runs(folder)
     a = next(uuid for bag, uuid in sorted(stored.items()) if bag != new_bag.name)
     b = stored[new_bag.name]
-    own = run_exscec("verify", a[:8], "--scenario", "spec.exsce", "--no-record", cwd=folder)
+    own = exscec_here("verify", a[:8], "--scenario", "spec.exsce", "--no-record", cwd=folder)
     assert own.returncode == 0, own.stderr  # it passes, as a run of its own mean does
     warned = [line for line in own.stderr.splitlines() if line.startswith("warning:")]
     assert warned == [
         f"warning: run {a[:8]} is one of the 4 runs the baseline of 'yard_run' was built from: "
         "its verdicts against that baseline say little (judge runs the baseline did not use)"
     ]
-    new = run_exscec("verify", b, "--scenario", "spec.exsce", "--no-record", cwd=folder)
+    new = exscec_here("verify", b, "--scenario", "spec.exsce", "--no-record", cwd=folder)
     assert new.returncode == 0 and "warning" not in new.stderr, new.stderr
 
     with api.open_store(str(folder / ".exsce" / "store")) as store:

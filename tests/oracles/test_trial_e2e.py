@@ -22,7 +22,7 @@ from exsce_dsl.lang import load_spec
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.map_files import write_map
 from tests.support.yard_spec import YARD_SPEC
 
@@ -54,8 +54,8 @@ def baseline_yard(tmp_path_factory: pytest.TempPathFactory) -> Path:
     (folder / "spec.exsce").write_text(YARD_SPEC)
     scenario = load_spec(folder / "spec.exsce").scenario()
     clean = [str(run.bag) for run in simulate(scenario, folder / "baseline", 4, seed=1)]
-    assert run_exscec("ingest", *clean, "--scenario", "spec.exsce", cwd=folder).returncode == 0
-    built = run_exscec("baseline", "spec.exsce", cwd=folder)
+    assert exscec_here("ingest", *clean, "--scenario", "spec.exsce", cwd=folder).returncode == 0
+    built = exscec_here("baseline", "spec.exsce", cwd=folder)
     assert built.returncode == 0, built.stderr
     return folder
 
@@ -83,9 +83,9 @@ def _stored_counts(folder: Path) -> dict[tuple[str, str, str | None], tuple[int,
 
 
 def test_repeated_fault_free_runs_give_each_clause_the_outcome_of_its_counts(yard: Path) -> None:
-    done = run_exscec(
+    done = exscec_here(
         "verify", "--scenario", "spec.exsce", "--repeat", "6", "--seed", "11", "-o", "repeat",
-        "--json", "--junit", "trial.xml", cwd=yard, timeout=300,
+        "--json", "--junit", "trial.xml", cwd=yard,
     )  # fmt: skip
     clauses = json.loads(done.stdout)
     assert len(list((yard / "repeat").glob("*.bag"))) == 6
@@ -112,7 +112,7 @@ def test_a_trial_of_clean_and_over_speed_bags_finds_the_clause_flaky(yard: Path)
         str(r.bag)
         for r in simulate(scenario, yard / "fast", 2, seed=22, faults=(Fault.parse("overspeed:r1"),))
     ]
-    done = run_exscec(
+    done = exscec_here(
         "verify",
         *clean,
         *fast,
@@ -141,14 +141,14 @@ def test_a_trial_of_clean_and_over_speed_bags_finds_the_clause_flaky(yard: Path)
     props = {p.get("name"): p.get("value") for p in case.iter("property")}
     assert (props["runs"], props["passed"], props["failed"], props["pass_rate"]) == ("5", "3", "2", "0.6000")
 
-    listed = run_exscec("flaky", "yard_run", "--format", "json", cwd=yard)
+    listed = exscec_here("flaky", "yard_run", "--format", "json", cwd=yard)
     assert listed.returncode == 0, listed.stderr
     ranked = json.loads(listed.stdout)
     rates = [c["pass_rate"] for c in ranked]
     assert rates == sorted(rates) and rates[0] == pytest.approx(0.6)  # 3 of 5 is the lowest stored
     top = [c["oracle"] for c in ranked if c["pass_rate"] == rates[0]]
     assert "r1-max_velocity" in top
-    table = run_exscec("flaky", cwd=yard).stdout.splitlines()
+    table = exscec_here("flaky", cwd=yard).stdout.splitlines()
     assert table[0].split()[:2] == ["scenario", "clause"]
     assert table[1].split()[0] == "yard_run" and table[1].split()[-1] == "flaky"
 
@@ -158,7 +158,7 @@ def test_a_trial_of_clean_and_over_speed_bags_finds_the_clause_flaky(yard: Path)
         (c["oracle"], c["passed"], c["failed"]) for c in ranked
     ]
 
-    assert run_exscec("report", "-o", "report", cwd=yard).returncode == 0
+    assert exscec_here("report", "-o", "report", cwd=yard).returncode == 0
     page = (yard / "report" / "scenario-yard_run.html").read_text()
     rates = page[
         page.index("<h2>Pass rates, lowest first</h2>") : page.index("<h2>Verdicts, failures first</h2>")
@@ -170,13 +170,13 @@ def test_a_trial_of_clean_and_over_speed_bags_finds_the_clause_flaky(yard: Path)
 
 
 def test_trials_refuse_what_they_cannot_judge(yard: Path) -> None:
-    nothing = run_exscec("verify", "--scenario", "spec.exsce", cwd=yard)
+    nothing = exscec_here("verify", "--scenario", "spec.exsce", cwd=yard)
     assert nothing.returncode == 2 and "--repeat N" in nothing.stderr
-    seedless = run_exscec("verify", "abcd1234", "--scenario", "spec.exsce", "--seed", "3", cwd=yard)
+    seedless = exscec_here("verify", "abcd1234", "--scenario", "spec.exsce", "--seed", "3", cwd=yard)
     assert seedless.returncode == 2 and "--repeat" in seedless.stderr
-    rate = run_exscec(
+    rate = exscec_here(
         "verify", "--scenario", "spec.exsce", "--repeat", "2", "--required-pass-rate", "1", cwd=yard
     )
     assert rate.returncode == 2 and "0<x<1" in rate.stderr
-    unknown = run_exscec("flaky", "yard_rn", cwd=yard)
+    unknown = exscec_here("flaky", "yard_rn", cwd=yard)
     assert unknown.returncode == 2 and "did you mean 'yard_run'?" in unknown.stderr

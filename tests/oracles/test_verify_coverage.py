@@ -22,7 +22,7 @@ from exsce_dsl.lang import load_spec
 from exsce_dsl.sim.run import simulate
 
 from tests.support.bag_surgery import bag_span, cut, drop, reset_clock, thin
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "brsu_building_c"
 SAFETY = ("max_velocity", "distance_to_obstacles", "distance_between_robots")
@@ -37,11 +37,11 @@ def project(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
     scenario = load_spec(folder / "scenario_c.exsce").scenario("scenario_c")
     baseline = simulate(scenario, folder / "baseline", runs=3, fmt="mcap", seed=1)
     store = ("--store", str(folder / "store"))
-    done = run_exscec(
+    done = exscec_here(
         "ingest", *(str(r.bag) for r in baseline), "--scenario", "scenario_c.exsce", *store, cwd=folder
     )
     assert done.returncode == 0, done.stderr
-    built = run_exscec("baseline", "scenario_c.exsce", *store, cwd=folder)
+    built = exscec_here("baseline", "scenario_c.exsce", *store, cwd=folder)
     assert built.returncode == 0, built.stderr
     (fresh,) = simulate(scenario, folder / "fresh", fmt="mcap", seed=11)
     return folder, fresh.bag
@@ -49,9 +49,9 @@ def project(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
 
 def _verify(folder: Path, bag: Path, junit: Path | None = None) -> tuple[int, dict[str, dict[str, object]]]:
     extra = ("--junit", str(junit)) if junit else ()
-    done = run_exscec(
+    done = exscec_here(
         "verify", str(bag), "--scenario", "scenario_c.exsce", "--store", str(folder / "store"), "--json",
-        *extra, cwd=folder, timeout=300,
+        *extra, cwd=folder,
     )  # fmt: skip
     assert "Traceback" not in done.stderr, done.stderr
     return done.returncode, {v["oracle"]: v for v in json.loads(done.stdout)}
@@ -132,7 +132,7 @@ def test_a_baseline_leaves_out_the_runs_its_recording_does_not_cover(project: tu
     for name in ("cut", "gap", "thin", "clock"):
         if not (folder / name).exists():
             pytest.skip("needs the runs of the tests above (run this module whole)")
-    built = run_exscec("baseline", "scenario_c.exsce", "--store", str(folder / "store"), cwd=folder)
+    built = exscec_here("baseline", "scenario_c.exsce", "--store", str(folder / "store"), cwd=folder)
     assert built.returncode == 0, built.stderr
     said = built.stdout + built.stderr
     assert "built from 4 runs" in said, said  # the 3 baseline runs and the clean fresh one

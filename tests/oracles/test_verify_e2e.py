@@ -27,7 +27,7 @@ from exsce_dsl.runs.bags.reading import bag_topics
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.map_files import write_map
 from tests.support.yard_spec import YARD_SPEC as SPEC
 
@@ -78,14 +78,14 @@ def test_baseline_refuses_too_few_runs_then_builds_from_enough(
     yard: tuple[Path, list[Path], dict[str, Path]],
 ) -> None:
     folder, clean, _ = yard
-    three = run_exscec("ingest", *map(str, clean[:3]), "--scenario", "spec.exsce", cwd=folder)
+    three = exscec_here("ingest", *map(str, clean[:3]), "--scenario", "spec.exsce", cwd=folder)
     assert three.returncode == 0, three.stderr
-    refused = run_exscec("baseline", "spec.exsce", cwd=folder)
+    refused = exscec_here("baseline", "spec.exsce", cwd=folder)
     assert refused.returncode == 2 and "Traceback" not in refused.stderr
     assert "scenario 'yard_run' has 3 good stored runs; its baseline needs 4" in refused.stderr
-    fourth = run_exscec("ingest", str(clean[3]), "--scenario", "spec.exsce", cwd=folder)
+    fourth = exscec_here("ingest", str(clean[3]), "--scenario", "spec.exsce", cwd=folder)
     assert fourth.returncode == 0, fourth.stderr
-    built = run_exscec("baseline", "spec.exsce", cwd=folder)
+    built = exscec_here("baseline", "spec.exsce", cwd=folder)
     assert built.returncode == 0, built.stderr
     lines = {line.split()[0]: line.split()[1:] for line in built.stdout.splitlines()[1:]}
     assert set(lines) == ORACLES
@@ -115,9 +115,9 @@ def nav2_yard(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[Path
         fault: next(iter(simulate(scenario, folder / "faults", 1, seed=2, faults=(Fault.parse(fault),)))).bag
         for fault in FAULTS
     }
-    baseline = run_exscec("ingest", *map(str, clean[:4]), "--scenario", "spec.exsce", cwd=folder)
+    baseline = exscec_here("ingest", *map(str, clean[:4]), "--scenario", "spec.exsce", cwd=folder)
     assert baseline.returncode == 0, baseline.stderr
-    built = run_exscec("baseline", "spec.exsce", cwd=folder)
+    built = exscec_here("baseline", "spec.exsce", cwd=folder)
     assert built.returncode == 0, built.stderr
     return folder, clean, faulty
 
@@ -133,12 +133,12 @@ def test_the_fault_table_holds_for_nav2_runs(nav2_yard: tuple[Path, list[Path], 
 def _fault_table_holds(folder: Path, clean: list[Path], faulty: dict[str, Path]) -> None:
     bags = {"clean": clean[4:], **{fault: [bag] for fault, bag in faulty.items()}}
     given = [str(bag) for group in bags.values() for bag in group]
-    judged = run_exscec(
+    judged = exscec_here(
         "verify", *given, "--scenario", "spec.exsce", "--json", "--junit", "verdicts.xml", cwd=folder
     )
     assert judged.returncode == 1, judged.stderr  # some oracle failed
     verdicts = json.loads(judged.stdout)
-    listed = run_exscec("runs", "--format", "json", cwd=folder)
+    listed = exscec_here("runs", "--format", "json", cwd=folder)
     bag_of_run = {
         row["run"]["value"]: row["bag"]["value"] for row in json.loads(listed.stdout)["results"]["bindings"]
     }
@@ -169,7 +169,7 @@ def test_the_verdicts_are_provenance_in_the_store(yard: tuple[Path, list[Path], 
         "SELECT ?outcome (COUNT(?v) AS ?n) WHERE { GRAPH ?g { ?v a exsce:verdict ; oracle:outcome ?outcome } } "
         "GROUP BY ?outcome ORDER BY ?outcome"
     )
-    found = run_exscec("sparql", query, "--format", "csv", cwd=folder)
+    found = exscec_here("sparql", query, "--format", "csv", cwd=folder)
     assert found.returncode == 0, found.stderr
     assert found.stdout.split() == ["outcome,n", "failed,10", f"passed,{len(ORACLES) * 6 - 10}"]
 
@@ -206,14 +206,14 @@ def test_a_derived_scenario_is_judged_against_the_runs_of_its_base(
     (folder / "long.exsce").write_text(LONG)
     scenario = load_spec(folder / "long.exsce").scenario()
     bag = next(iter(simulate(scenario, folder / "long", 1, seed=5))).bag
-    built = run_exscec("baseline", "long.exsce", cwd=folder)
+    built = exscec_here("baseline", "long.exsce", cwd=folder)
     assert built.returncode == 0, built.stderr
     rows = {line.split()[0]: line.split()[1:] for line in built.stdout.splitlines()[1:]}
     # the base's runs that passed (4 baseline + 2 clean), not the 4 a fault made fail
     relation, of, base, value, delta, tolerance, runs = rows["r1-distance_travelled"]
     assert (relation, of, base, delta, tolerance, runs) == ("increasing", "of", "yard_run", "4", "0", "6")
     assert float(value) == pytest.approx(11.95, abs=0.01)
-    judged = run_exscec("verify", str(bag), "--scenario", "long.exsce", "--json", cwd=folder)
+    judged = exscec_here("verify", str(bag), "--scenario", "long.exsce", "--json", cwd=folder)
     assert judged.returncode == 0, judged.stdout + judged.stderr
     verdicts = {v["oracle"]: v for v in json.loads(judged.stdout)}
     assert set(verdicts) == {"r1-distance_travelled", "r1-max_velocity", "r1-waypoints_visited"}

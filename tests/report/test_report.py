@@ -41,7 +41,7 @@ from exsce_dsl.sim.run import simulate
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.queries import MetricReading, StoredRun
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.paths import EXAMPLES, ROOT
 
 if TYPE_CHECKING:
@@ -86,16 +86,16 @@ def project(tmp_path_factory: pytest.TempPathFactory) -> Path:
         ),
     ]
     for step in steps:
-        done = run_exscec(*step, cwd=folder)
+        done = exscec_here(*step, cwd=folder)
         assert done.returncode == 0, (step, done.stdout, done.stderr)
-    verified = run_exscec("verify", *fast, "--scenario", "c/scenario_c.exsce", cwd=folder)
+    verified = exscec_here("verify", *fast, "--scenario", "c/scenario_c.exsce", cwd=folder)
     assert verified.returncode == 1, verified.stderr  # the over-speed run fails its limits
     one = load_spec(folder / "c" / "c_one.exsce").scenario("c_one")
     one_bags = [str(run.bag) for run in simulate(one, folder / "one", 1, seed=3)]
-    judged = run_exscec("verify", *one_bags, "--scenario", "c/c_one.exsce", cwd=folder)
+    judged = exscec_here("verify", *one_bags, "--scenario", "c/c_one.exsce", cwd=folder)
     assert judged.returncode in (0, 1) and "increasing" in judged.stdout, judged.stderr
     (folder / "verify-c_one.txt").write_text(judged.stdout, encoding="utf-8")
-    made = run_exscec("report", "-o", "out", "--spec", "c/scenario_c.exsce", cwd=folder)
+    made = exscec_here("report", "-o", "out", "--spec", "c/scenario_c.exsce", cwd=folder)
     assert made.returncode == 0, made.stderr
     assert "wrote out/index.html (2 scenarios, 5 runs)" in made.stderr
     return folder
@@ -341,7 +341,7 @@ def test_in_chromium_a_metamorphic_verdict_expects_what_the_cli_prints(project: 
 
 
 def test_run_pages_show_the_hotspots_and_say_what_is_missing_without_a_map(project: Path) -> None:
-    done = run_exscec("report", "-o", "plain", cwd=project)
+    done = exscec_here("report", "-o", "plain", cwd=project)
     assert done.returncode == 0, done.stderr
     assert "note: no occupancy grid" in done.stderr
     index = (project / "plain" / "index.html").read_text(encoding="utf-8")
@@ -388,21 +388,21 @@ def test_page_names_keep_safe_ids_and_digest_the_others() -> None:
 
 
 def test_cluster_draws_the_dendrogram_as_png_and_svg(project: Path) -> None:
-    done = run_exscec(
+    done = exscec_here(
         "cluster", "--k", "2", "--dendrogram", "tree.png", "--dendrogram", "tree.svg", cwd=project
     )
     assert done.returncode == 0, done.stderr
     assert (project / "tree.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     svg = (project / "tree.svg").read_text(encoding="utf-8")
     assert svg.lstrip().startswith("<?xml") and "<!-- scenario_c -->" in svg and "<!-- c_one -->" in svg
-    again = run_exscec("cluster", "--k", "2", "--dendrogram", "tree.svg", cwd=project)
+    again = exscec_here("cluster", "--k", "2", "--dendrogram", "tree.svg", cwd=project)
     assert again.returncode == 0 and (project / "tree.svg").read_text(encoding="utf-8") == svg  # reproducible
-    bad = run_exscec("cluster", "--dendrogram", "tree.pdf", cwd=project)
+    bad = exscec_here("cluster", "--dendrogram", "tree.pdf", cwd=project)
     assert bad.returncode == 2 and ".png or .svg" in bad.stderr
 
 
 def test_every_metric_value_on_a_run_page_has_its_unit(project: Path) -> None:
-    done = run_exscec("report", "-o", "units", cwd=project)  # no --spec: units from the store alone
+    done = exscec_here("report", "-o", "units", cwd=project)  # no --spec: units from the store alone
     assert done.returncode == 0, done.stderr
     page = _failed_run_page(project).name
     text = (project / "units" / page).read_text(encoding="utf-8")

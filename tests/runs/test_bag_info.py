@@ -17,7 +17,7 @@ from exsce_dsl.runs.bag_info import bag_info
 from exsce_dsl.sim.run import simulate
 
 from tests.support.bag_factory import typestore_for, write_bag
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.clock_bags import restamp
 from tests.support.real_shapes import SHAPES
 
@@ -60,11 +60,11 @@ def test_a_simulated_nav2_bag_says_its_topics_clocks_tf_goals_and_conventions(ba
 
 
 def test_the_command_prints_a_table_and_json(bags: dict[str, Path], tmp_path: Path) -> None:
-    table = run_exscec("bag", "info", str(bags["method"]), cwd=tmp_path)
+    table = exscec_here("bag", "info", str(bags["method"]), cwd=tmp_path)
     assert table.returncode == 0, table.stderr
     assert "timeline  wall clock" in table.stdout
     assert "namespace 'tiago1': convention method (from /tiago1/waypoint_dispatcher/feedback)" in table.stdout
-    listed = run_exscec(
+    listed = exscec_here(
         "bag", "info", "-f", "json", str(bags["method"]), str(bags["simulated"]), cwd=tmp_path
     )
     assert listed.returncode == 0, listed.stderr
@@ -76,7 +76,7 @@ def test_the_command_prints_a_table_and_json(bags: dict[str, Path], tmp_path: Pa
 def test_a_file_that_is_no_bag_is_named_with_the_reason(tmp_path: Path) -> None:
     junk = tmp_path / "junk.bag"
     junk.write_bytes(b"not a bag at all")
-    found = run_exscec("bag", "info", str(junk), cwd=tmp_path)
+    found = exscec_here("bag", "info", str(junk), cwd=tmp_path)
     assert found.returncode == 2 and "junk.bag" in found.stderr and "Traceback" not in found.stderr
 
 
@@ -89,5 +89,5 @@ def test_each_tf_edge_has_its_rate_and_static_ones_none(tmp_path: Path) -> None:
     assert dict(info.tf_rates) == pytest.approx({("map", "odom"): 10.0, ("odom", "base_link"): 30.0})
     assert ("base_link", "base_laser_link", True) in info.tf_edges
     assert {t.definition for t in info.topics} == {"the bag"}  # rosbags' writers always keep them
-    table = run_exscec("bag", "info", str(bag), cwd=tmp_path).stdout
+    table = exscec_here("bag", "info", str(bag), cwd=tmp_path).stdout
     assert "map -> odom (10.0 Hz)" in table and "base_link -> base_laser_link (static)" in table

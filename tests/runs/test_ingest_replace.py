@@ -31,7 +31,7 @@ from exsce_dsl.store.base import Store
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.queries import run_metric_values, run_query, runs
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.paths import EXAMPLES
 
 RUN_NAMESPACE = uuid.UUID("5b8f9a52-3f0c-4a8e-8f0e-2d6c1b7e4a90")
@@ -248,9 +248,9 @@ def test_the_skip_message_names_the_scenario_and_replace(bags, project) -> None:
     shutil.copyfile(bags[0], bag)
     store = str(project.parent / "store")
     spec = "bc/scenario_c.exsce"
-    first = run_exscec("ingest", "a.bag", "--scenario", spec, "--store", store, cwd=project.parent)
+    first = exscec_here("ingest", "a.bag", "--scenario", spec, "--store", store, cwd=project.parent)
     assert first.returncode == 0, first.stderr
-    second = run_exscec("ingest", "a.bag", "--scenario", spec, "--store", store, cwd=project.parent)
+    second = exscec_here("ingest", "a.bag", "--scenario", spec, "--store", store, cwd=project.parent)
     assert second.returncode == 0, second.stderr
     run = _bag_id(bag)
     assert second.stderr.splitlines() == [
@@ -258,13 +258,13 @@ def test_the_skip_message_names_the_scenario_and_replace(bags, project) -> None:
         "pass --replace to analyse it again under this spec",
         "0 ingested, 1 skipped, 0 failed",
     ]
-    replaced = run_exscec(
+    replaced = exscec_here(
         "ingest", "--replace", "a.bag", "--scenario", spec, "--store", store, cwd=project.parent
     )
     assert replaced.returncode == 0, replaced.stderr
     assert f"a.bag: run {run} analysed again" in replaced.stderr
     assert replaced.stderr.splitlines()[-1] == "0 ingested, 1 replaced, 0 skipped, 0 failed"
-    listed = run_exscec("runs", "--store", store, cwd=project.parent)
+    listed = exscec_here("runs", "--store", store, cwd=project.parent)
     assert listed.stdout.count(run) == 1 and "scenario_c" in listed.stdout
 
 

@@ -38,7 +38,7 @@ from exsce_dsl.runs.analyse import AnalysedRun, analyse_bag
 from exsce_dsl.sim.run import simulate
 
 from tests.support.bag_factory import typestore_for, write_bag
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.real_shapes import SHAPES
 
 FORMATS = ("ros1", "sqlite3", "mcap")
@@ -538,18 +538,18 @@ def test_the_shapes_through_exscec(
     for shape in REFERENCES:
         store = str(folder / f"store_{shape}")
         paths = [str(bags[(shape, fmt)]) for fmt in FORMATS]
-        done = run_exscec(
-            "ingest", *paths, "--scenario", str(scenarios[shape][0]), "--store", store, timeout=300
+        done = exscec_here(
+            "ingest", *paths, "--scenario", str(scenarios[shape][0]), "--store", store
         )
         assert done.returncode == 0, f"{shape}:\n{done.stdout}\n{done.stderr}"
         assert "Traceback" not in done.stderr and "convention" in done.stderr, done.stderr
-        listed = run_exscec("runs", "-f", "json", "--store", store)
+        listed = exscec_here("runs", "-f", "json", "--store", store)
         assert listed.returncode == 0, listed.stderr
         rows = json.loads(listed.stdout)["results"]["bindings"]
         runs = {row["run"]["value"]: Path(row["path"]["value"]) for row in rows}
         assert len(runs) == len(FORMATS)
         runs_given = [a for r in runs for a in ("-p", f"run={r}")]
-        queried = run_exscec("query", "run_metric_values", *runs_given, "-f", "json", "--store", store)
+        queried = exscec_here("query", "run_metric_values", *runs_given, "-f", "json", "--store", store)
         assert queried.returncode == 0, queried.stderr
         stored: dict[str, dict[str, float]] = {}
         for row in json.loads(queried.stdout)["results"]["bindings"]:

@@ -23,7 +23,7 @@ from exsce_dsl.similarity.facts import scenario_facts
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.writing import add_prov
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.paths import EXAMPLES
 
 
@@ -122,16 +122,16 @@ def test_clustering_groups_the_scenarios_that_differ_only_by_waypoint_order(proj
 
 
 def test_cli_cluster_prints_the_table_and_the_json(project):
-    table = run_exscec("cluster", "--k", "2", cwd=project)
+    table = exscec_here("cluster", "--k", "2", cwd=project)
     assert table.returncode == 0, table.stderr
     rows = dict(line.split() for line in table.stdout.splitlines()[1:])
     assert rows["scenario_c"] == rows["c_reversed"] != rows["c_one"] == rows["c_one_reversed"]
-    out = run_exscec("cluster", "-s", "scenario_c", "-s", "c_one", "--json", cwd=project)
+    out = exscec_here("cluster", "-s", "scenario_c", "-s", "c_one", "--json", cwd=project)
     data = json.loads(out.stdout)
     assert data["scenarios"] == ["scenario_c", "c_one"] and data["pairs"][0]["d1"] == 0.5
-    unknown = run_exscec("cluster", "-s", "nope", "-s", "c_one", cwd=project)
+    unknown = exscec_here("cluster", "-s", "nope", "-s", "c_one", cwd=project)
     assert unknown.returncode == 2 and "not in the store: nope" in unknown.stderr and "Traceback" not in unknown.stderr
-    bad = run_exscec("cluster", "-w", "d9=1", cwd=project)
+    bad = exscec_here("cluster", "-w", "d9=1", cwd=project)
     assert bad.returncode == 2 and "write NAME=W" in bad.stderr
 
 

@@ -57,7 +57,7 @@ from exsce_dsl.store.queries import MetricSource, PathSegment, RobotFacts, Value
 from exsce_dsl.store.remote import RemoteStore
 from exsce_dsl.store.writing import add_prov
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.store_servers import oxigraph_server, virtuoso_server
 
 # -- the scenarios ---------------------------------------------------------------------------
@@ -509,9 +509,9 @@ def test_the_library_checks_parameters(store: Store) -> None:
 
 def test_exscec_query_prints_tables_json_and_csv(store_folder: Path) -> None:
     folder = str(store_folder)
-    listed = run_exscec("query", "--list")
+    listed = exscec_here("query", "--list")
     assert listed.returncode == 0 and "segment_metric_of_scenario: Mean and variance" in listed.stdout
-    as_json = run_exscec(
+    as_json = exscec_here(
         "query",
         "segment_metric",
         "-p",
@@ -539,13 +539,13 @@ def test_exscec_query_prints_tables_json_and_csv(store_folder: Path) -> None:
         "datatype": "http://www.w3.org/2001/XMLSchema#integer",
     }
     assert float(row["mean"]["value"]) == 11.0 and float(row["variance"]["value"]) == 1.0
-    as_csv = run_exscec("runs", "s", "-f", "csv", "--store", folder)
+    as_csv = exscec_here("runs", "s", "-f", "csv", "--store", folder)
     assert as_csv.returncode == 0, as_csv.stderr
     lines = as_csv.stdout.splitlines()  # (CRLF, read back as text)
     assert lines[0] == "run,scenario_id,start,end,bag,path,mission_status" and lines[1].startswith(
         f"{RUN_3},s,2024-05-01T09:00:00.000,"  # one precision (no zone: none made up)
     )
-    table = run_exscec("query", "robots", "-p", "scenario=s", "--store", folder)
+    table = exscec_here("query", "robots", "-p", "scenario=s", "--store", folder)
     assert table.stdout.splitlines() == [
         "robot  type   base  torso",
         "-----  -----  ----  -----",
@@ -557,7 +557,7 @@ def test_exscec_query_prints_tables_json_and_csv(store_folder: Path) -> None:
 def test_exscec_sparql_reads_a_query_from_a_file(store_folder: Path, tmp_path: Path) -> None:
     query_file = tmp_path / "count.rq"
     query_file.write_text("SELECT (COUNT(*) AS ?n) WHERE { GRAPH ?g { ?run a exsce:run } }\n")
-    answer = run_exscec("sparql", f"@{query_file}", "-f", "csv", "--store", str(store_folder))
+    answer = exscec_here("sparql", f"@{query_file}", "-f", "csv", "--store", str(store_folder))
     assert answer.returncode == 0, answer.stderr
     assert answer.stdout.splitlines() == ["n", "5"]  # four runs and the hand-written one
 
@@ -573,11 +573,11 @@ def test_csv_answers_end_lines_with_crlf_and_quote_as_rfc_4180() -> None:
 
 
 def test_exscec_query_reports_mistakes(store_folder: Path) -> None:
-    missing = run_exscec("query", "run_metric", "-p", f"run={RUN_1}", "--store", str(store_folder))
+    missing = exscec_here("query", "run_metric", "-p", f"run={RUN_1}", "--store", str(store_folder))
     assert missing.returncode == 2 and "error: query 'run_metric' needs metric, robot" in missing.stderr
-    unknown = run_exscec("query", "rnus", "--store", str(store_folder))
+    unknown = exscec_here("query", "rnus", "--store", str(store_folder))
     assert unknown.returncode == 2 and "no query called 'rnus'; did you mean 'runs'?" in unknown.stderr
-    malformed = run_exscec("query", "runs", "-p", "scenario", "--store", str(store_folder))
+    malformed = exscec_here("query", "runs", "-p", "scenario", "--store", str(store_folder))
     assert malformed.returncode == 2 and "a parameter is NAME=VALUE" in malformed.stderr
 
 

@@ -36,7 +36,7 @@ from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.segment_index import segment_index, segment_iri
 from exsce_dsl.store.writing import add_prov
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 
 
 def pose(name: str, x: float) -> Pose:
@@ -159,7 +159,7 @@ def test_store_graphs_and_info_set_the_index_apart(tmp_path: Path) -> None:
     with EmbeddedStore(tmp_path / ".exsce" / "store") as store:
         add_prov(store, compile_scenario(SCENARIO))
         add_prov(store, compile_run(run("u-1", (5.0, 6.0, 5.0)), SCENARIO))
-    listed = run_exscec("store", "graphs", cwd=tmp_path)
+    listed = exscec_here("store", "graphs", cwd=tmp_path)
     assert listed.returncode == 0, listed.stderr
     assert (
         "/segments/" not in listed.stdout
@@ -167,9 +167,9 @@ def test_store_graphs_and_info_set_the_index_apart(tmp_path: Path) -> None:
         and "run_u-1_bundle" in listed.stdout
     )
     assert "and 5 graphs of the segment index: --index lists them" in listed.stderr  # 2 segments, 3 actions
-    everything = run_exscec("store", "graphs", "--index", cwd=tmp_path)
+    everything = exscec_here("store", "graphs", "--index", cwd=tmp_path)
     assert everything.stdout.count("/segments/corridor_runs/") == 2 and everything.stdout.count("-w_00") == 3
-    info = run_exscec("store", "info", cwd=tmp_path)
+    info = exscec_here("store", "info", cwd=tmp_path)
     assert "+ 5 of the segment index)" in info.stdout
 
 

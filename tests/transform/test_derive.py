@@ -15,7 +15,7 @@ from exsce_dsl.model.derivation import TaskOrigin, TransformationStep
 from exsce_dsl.prov.derivation import compile_derivation
 from exsce_dsl.transform.derivation import derive
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.paths import EXAMPLES
 
 SPEC = EXAMPLES / "brsu_building_c" / "scenario_c.exsce"
@@ -205,7 +205,7 @@ def test_preconditions_fail_with_clear_errors(base: Scenario, requests: list, wo
 
 def test_exscec_derive_writes_a_file_that_checks_clean_and_stores_the_generation(in_tmp: Path) -> None:
     shutil.copytree(EXAMPLES / "brsu_building_c", in_tmp / "c")
-    made = run_exscec(
+    made = exscec_here(
         "derive", "c/scenario_c.exsce", "-t", "remove_robot", "--robot", "tiago2", "--reassign", "tiago1",
         "-t", "reverse_waypoint_order", "--task", "delivery_a", "--id", "c_alone", "-o", "c/c_alone.exsce",
         "--add-to-store",
@@ -214,15 +214,15 @@ def test_exscec_derive_writes_a_file_that_checks_clean_and_stores_the_generation
     text = (in_tmp / "c" / "c_alone.exsce").read_text()
     assert text.startswith('import "scenario_c.exsce"\n') and "task delivery_a_reversed {" in text
     assert "tiago1 does delivery_a_reversed then delivery_b then navigate_home_1 then navigate_home_2" in text
-    checked = run_exscec("check", "c/c_alone.exsce")
+    checked = exscec_here("check", "c/c_alone.exsce")
     assert checked.returncode == 0, checked.stdout + checked.stderr
-    lineage = run_exscec("query", "derivation", "-p", "scenario=c_alone", "--format", "csv")
+    lineage = exscec_here("query", "derivation", "-p", "scenario=c_alone", "--format", "csv")
     assert lineage.returncode == 0, lineage.stderr
     assert "remove_robot" in lineage.stdout and "reverse_waypoint_order" in lineage.stdout
-    again = run_exscec("derive", "c/c_alone.exsce", "-t", "reverse_task_order", "--id", "c_alone_rev",
-                       "-o", "c/c_alone_rev.exsce", "--add-to-store")
+    again = exscec_here("derive", "c/c_alone.exsce", "-t", "reverse_task_order", "--id", "c_alone_rev",
+                        "-o", "c/c_alone_rev.exsce", "--add-to-store")
     assert again.returncode == 0, again.stderr
-    tree = run_exscec("lineage", "c_alone")
+    tree = exscec_here("lineage", "c_alone")
     assert tree.returncode == 0, tree.stderr
     assert tree.stdout.splitlines() == [
         "scenario_c",
@@ -230,17 +230,17 @@ def test_exscec_derive_writes_a_file_that_checks_clean_and_stores_the_generation
         "c_alone  (this one)",
         "  └─ reverse_task_order: c_alone_rev",
     ]
-    expected = run_exscec("expect", "c/c_alone.exsce")  # nothing ingested: every segment says so
+    expected = exscec_here("expect", "c/c_alone.exsce")  # nothing ingested: every segment says so
     assert expected.returncode == 0, expected.stderr
     lines = expected.stdout.splitlines()
     assert lines[0] == "tiago1 distance_travelled: unknown"
     assert lines[1] == "  classroom_c025-w001 → classroom_c018-w001: -  no data, nor for classroom_c025-w002 and classroom_c018-w002 near its ends"
-    criteria = run_exscec("derive", "c/scenario_c.exsce", "-t", "reverse_task_order", "--id", "c_expect", "--expect")
+    criteria = exscec_here("derive", "c/scenario_c.exsce", "-t", "reverse_task_order", "--id", "c_expect", "--expect")
     assert criteria.returncode == 0, criteria.stderr  # no runs stored: only the safety clauses are copied
     assert "acceptance for c_expect {" in criteria.stdout and 'scenario "as safe as scenario_c" {' in criteria.stdout
     assert "then each robot max_velocity stays below 1.0 m/s" in criteria.stdout
     assert "0.8 m/s" not in criteria.stdout  # that limit was for a part of a run only
-    bad = run_exscec("derive", "c/scenario_c.exsce", "-t", "remove_robot", "--robot", "tiago5")
+    bad = exscec_here("derive", "c/scenario_c.exsce", "-t", "remove_robot", "--robot", "tiago5")
     assert bad.returncode == 2 and "has no robot 'tiago5'; did you mean" in bad.stderr and "Traceback" not in bad.stderr
 
 

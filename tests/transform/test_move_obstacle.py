@@ -34,7 +34,7 @@ from exsce_dsl.model.derived import DerivedScenario, Step
 from exsce_dsl.prov.derivation import compile_derivation
 from exsce_dsl.transform.derivation import derive, derived_document
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.map_files import write_map
 
 YARD = """\
@@ -281,19 +281,19 @@ def test_the_derived_document_is_a_derive_block_when_the_environment_changed(fol
 def test_exscec_derive_writes_a_derive_block_that_checks_and_compiles(in_tmp: Path) -> None:
     write_map(in_tmp, "yard")
     (in_tmp / "yard.exsce").write_text(YARD)
-    made = run_exscec(
+    made = exscec_here(
         "derive", "yard.exsce", "-t", "move_obstacle", "--obstacle", "mast", "--to", "4,2.5",
         "--id", "yard_moved", "-o", "new.exsce", "--add-to-store",
     )
     assert made.returncode == 0, made.stderr
     assert (in_tmp / "new.exsce").read_text() == MOVED
-    checked = run_exscec("check", "new.exsce")
+    checked = exscec_here("check", "new.exsce")
     assert checked.returncode == 0, checked.stdout + checked.stderr
-    compiled = run_exscec("compile", "new.exsce", "-f", "provn")
+    compiled = exscec_here("compile", "new.exsce", "-f", "provn")
     assert compiled.returncode == 0, compiled.stderr
     assert "hadMember(exsce:yard_moved, env:yard_moved_environment)" in compiled.stdout
     assert 'exsce:to="4.0,2.5"' in compiled.stdout and "bundle yard_moved:scenario_generation" in compiled.stdout
-    bad = run_exscec("derive", "yard.exsce", "-t", "move_obstacle", "--obstacle", "mats", "--to", "4,2.5")
+    bad = exscec_here("derive", "yard.exsce", "-t", "move_obstacle", "--obstacle", "mats", "--to", "4,2.5")
     assert bad.returncode == 2 and "has no obstacle 'mats'; did you mean 'mast'?" in bad.stderr
     assert "Traceback" not in bad.stderr
 
