@@ -17,7 +17,7 @@ import pytest
 from exsce_dsl.lang import load_spec
 from exsce_dsl.sim.run import simulate
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here, run_exscec
 from tests.support.draft_references import reference
 from tests.support.yard_spec import yard_text
 
@@ -26,7 +26,7 @@ ROBOTS = {"root_robot": "", "r2": "r2"}
 
 
 def _ok(*args: str) -> str:
-    done = run_exscec(*args, timeout=300)
+    done = exscec_here(*args)
     assert done.returncode == 0, f"exscec {' '.join(args)}:\n{done.stdout}\n{done.stderr}"
     assert "Traceback" not in done.stderr, done.stderr
     return done.stdout

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from rosbags.highlevel import AnyReader
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.paths import EXAMPLES
 
 BUILDING = EXAMPLES / "brsu_building_c"
@@ -67,7 +67,7 @@ EXECUTING, SUCCEEDED = 2, 4  # action_msgs/msg/GoalStatus
 
 def ok(*args: str) -> str:
     """exscec's stderr, after checking that it exited 0 and warned of nothing."""
-    done = run_exscec(*args, timeout=300)
+    done = exscec_here(*args)
     assert done.returncode == 0, f"exscec {' '.join(args)}:\n{done.stdout}\n{done.stderr}"
     assert "warning" not in done.stderr and "Traceback" not in done.stderr, done.stderr
     return done.stdout

@@ -29,7 +29,7 @@ from exsce_dsl.prov.recorder import recorded_prov_json, recorded_run
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here, run_exscec
 from tests.support.map_files import write_map
 from tests.support.yard_spec import YARD_SPEC
 
@@ -64,9 +64,9 @@ def yard(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Path
     scenario = load_spec(folder / "spec.exsce").scenario()
     clean = [run.bag for run in simulate(scenario, folder / "runs", 5, seed=1)]
     fast = next(iter(simulate(scenario, folder / "faults", 1, seed=2, faults=(Fault.parse("overspeed:r1"),))))
-    ingested = run_exscec("ingest", *map(str, clean[:4]), "--scenario", "spec.exsce", cwd=folder)
+    ingested = exscec_here("ingest", *map(str, clean[:4]), "--scenario", "spec.exsce", cwd=folder)
     assert ingested.returncode == 0, ingested.stderr
-    built = run_exscec("baseline", "spec.exsce", cwd=folder)
+    built = exscec_here("baseline", "spec.exsce", cwd=folder)
     assert built.returncode == 0, built.stderr
     (folder / "blind").mkdir()
     blind = _without_topic(clean[4], "/r2/scan", folder / "blind" / "no_r2_scan.bag")
@@ -76,7 +76,7 @@ def yard(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Path
 def test_no_oracles_exits_2_not_1(yard: tuple[Path, dict[str, Path]]) -> None:
     folder, bags = yard
     store = str(folder / "no-baseline")  # runs, but no baseline built
-    ingested = run_exscec(
+    ingested = exscec_here(
         "ingest", str(bags["first"]), "--scenario", "spec.exsce", "--store", store, cwd=folder
     )
     assert ingested.returncode == 0, ingested.stderr
@@ -202,7 +202,7 @@ def test_a_run_cut_short_is_never_passed(yard: tuple[Path, dict[str, Path]], tmp
     assert outcomes["r1-max_velocity"] == ("failed", ["cut_short"])  # broken in what was recorded
     assert outcomes["r1-task_duration"] == ("inconclusive", ["cut_short"])  # not the whole run's
     assert {verdict for verdict, _ in outcomes.values()} == {"failed", "inconclusive"}
-    listed = json.loads(run_exscec("runs", "-f", "json", *store[:2], cwd=folder).stdout)
+    listed = json.loads(exscec_here("runs", "-f", "json", *store[:2], cwd=folder).stdout)
     statuses = {
         row["bag"]["value"]: row.get("mission_status", {}).get("value")
         for row in listed["results"]["bindings"]
