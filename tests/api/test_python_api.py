@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.paths import EXAMPLES
 
 DOC = Path(__file__).resolve().parents[2] / "docs" / "python.md"
@@ -72,7 +72,7 @@ def test_the_api_answers_as_the_command_line_does(session: dict[str, object]) ->
     folder = session["folder"]
     assert isinstance(folder, Path)
     store = str(folder / "store")
-    listed = run_exscec("query", "runs", "-p", "scenario=scenario_c", "-f", "json", "--store", store)
+    listed = exscec_here("query", "runs", "-p", "scenario=scenario_c", "-f", "json", "--store", store)
     assert listed.returncode == 0, listed.stderr
     cli_runs = {b["run"]["value"] for b in json.loads(listed.stdout)["results"]["bindings"]}
     from exsce_dsl import api as exsce
@@ -83,7 +83,7 @@ def test_the_api_answers_as_the_command_line_does(session: dict[str, object]) ->
     assert api_runs == cli_runs and len(api_runs) == 6
     # the API's values are the store's: one through the library query the CLI runs
     some = table[(table.metric == "distance_travelled") & (table.robot == "tiago1")].iloc[0]
-    value = run_exscec(
+    value = exscec_here(
         "query", "run_metric", "-p", f"run={some.run}", "-p", "robot=tiago1", "-p",
         "metric=distance_travelled", "-f", "json", "--store", store,
     )  # fmt: skip

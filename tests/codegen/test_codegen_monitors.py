@@ -21,7 +21,7 @@ from exsce_dsl.runs.analyse import analyse_bag, run_metrics, wanted_topics
 from exsce_dsl.runs.bags.reading import read_bag
 from exsce_dsl.sim.run import simulate
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.paths import EXAMPLES
 
 GOLDEN = Path(__file__).parents[1] / "golden" / "monitors" / "scenario_c"
@@ -41,7 +41,7 @@ def test_the_core_imports_nothing_of_exsce():
 
 
 def test_generate_writes_a_package_that_passes_ruff_and_computes_what_ingest_computes(tmp_path):
-    done = run_exscec("generate", "monitors", str(SPEC), "-o", str(tmp_path / "out"))
+    done = exscec_here("generate", "monitors", str(SPEC), "-o", str(tmp_path / "out"))
     assert done.returncode == 0, done.stderr
     package = tmp_path / "out" / "exsce_monitors"
     assert sorted(p.name for p in package.iterdir()) == ["__init__.py", "monitor_core.py", "monitors.py"]

@@ -43,7 +43,7 @@ from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
 from exsce_dsl.templating import GenerationError
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.paths import EXAMPLES
 
 BUILDING = EXAMPLES / "brsu_building_c"
@@ -88,7 +88,7 @@ def test_the_dispatcher_topics_are_those_ingestion_reads() -> None:
 
 @pytest.mark.parametrize("ros", [1, 2])
 def test_generate_writes_python_that_compiles_and_passes_ruff_and_xml_that_parses(in_tmp: Path, ros: int) -> None:
-    done = run_exscec("generate", f"ros{ros}-monitor", str(SPEC), "-o", "out")
+    done = exscec_here("generate", f"ros{ros}-monitor", str(SPEC), "-o", "out")
     assert done.returncode == 0, done.stderr
     package = in_tmp / "out" / PACKAGE
     assert done.stderr.count("wrote ") == len(FILES[ros](load_spec(SPEC), None))

@@ -20,7 +20,7 @@ from exsce_dsl.model.acceptance import (
     Window,
 )
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.map_files import write_map
 
 SPEC = """\
@@ -134,7 +134,7 @@ def test_the_formatter_prints_the_criteria_back(spec_folder: Path) -> None:
 def test_fmt_diff_shows_and_writes_nothing(spec_folder: Path) -> None:
     messy = SPEC.replace("    then r1 task_duration", "  then   r1 task_duration")
     (spec_folder / "spec.exsce").write_text(messy)
-    shown = run_exscec("fmt", "--diff", "spec.exsce", cwd=spec_folder)
+    shown = exscec_here("fmt", "--diff", "spec.exsce", cwd=spec_folder)
     assert shown.returncode == 0 and "+    then r1 task_duration" in shown.stdout
     assert (spec_folder / "spec.exsce").read_text() == messy
 
@@ -177,6 +177,6 @@ def test_each_mistake_is_reported_at_its_line_and_column(spec_folder: Path, case
 
 def test_check_prints_acceptance_errors_as_file_line_col(spec_folder: Path) -> None:
     (spec_folder / "spec.exsce").write_text(SPEC.replace("r1 distance_travelled", "r1 distance_travel"))
-    result = run_exscec("check", "spec.exsce", cwd=spec_folder)
+    result = exscec_here("check", "spec.exsce", cwd=spec_folder)
     assert result.returncode == 2 and "Traceback" not in result.stderr
     assert "spec.exsce:49:13: error: unknown metric 'distance_travel'" in result.stdout + result.stderr

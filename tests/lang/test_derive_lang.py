@@ -10,7 +10,7 @@ import pytest
 
 from exsce_dsl.lang import analyse, format_spec_document, load_spec
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.paths import EXAMPLES
 
 DERIVED = """\
@@ -92,10 +92,10 @@ def test_a_step_that_cannot_apply_is_reported_at_its_line(folder: Path, old: str
 
 
 def test_compile_writes_the_generation_with_the_derived_scenario(folder: Path) -> None:
-    compiled = run_exscec("compile", str(folder / "scenario_c_alone.exsce"), "-f", "provn")
+    compiled = exscec_here("compile", str(folder / "scenario_c_alone.exsce"), "-f", "provn")
     assert compiled.returncode == 0, compiled.stderr
     assert "bundle scenario_c_alone:scenario_generation" in compiled.stdout
     assert "used(scenario_c_alone:generation, exsce:scenario_c, -)" in compiled.stdout
     assert 'exsce:transform="reverse_waypoint_order", exsce:step=2' in compiled.stdout
-    checked = run_exscec("check", str(folder / "derived.exsce"))
+    checked = exscec_here("check", str(folder / "derived.exsce"))
     assert checked.returncode == 0, checked.stdout + checked.stderr

@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 from exsce_dsl.lang import format_document, format_spec_document, load_spec
 from exsce_dsl.model import Area, Document, Environment, Orientation, Pose, Position
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 
 # Canonical text: `exscec fmt` must leave it as it is.
 SPEC = """\
@@ -122,9 +122,9 @@ def test_fmt_prints_the_quantity_as_written(spec_file: Path, place: str, line: s
 
 
 def test_exscec_fmt_leaves_a_file_with_units_unchanged(spec_file: Path) -> None:
-    checked = run_exscec("fmt", "--check", "units.exsce", cwd=spec_file.parent)
+    checked = exscec_here("fmt", "--check", "units.exsce", cwd=spec_file.parent)
     assert checked.returncode == 0, checked.stderr
-    result = run_exscec("fmt", "units.exsce", cwd=spec_file.parent)
+    result = exscec_here("fmt", "units.exsce", cwd=spec_file.parent)
     assert result.returncode == 0, result.stderr
     assert spec_file.read_text() == SPEC
 
@@ -141,7 +141,7 @@ def test_exscec_fmt_puts_one_space_between_number_and_unit(spec_file: Path) -> N
     )
     assert messy != SPEC
     spec_file.write_text(messy)
-    result = run_exscec("fmt", "units.exsce", cwd=spec_file.parent)
+    result = exscec_here("fmt", "units.exsce", cwd=spec_file.parent)
     assert result.returncode == 0, result.stderr
     assert spec_file.read_text() == SPEC
 

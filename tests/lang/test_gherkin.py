@@ -23,7 +23,7 @@ from exsce_dsl.model.acceptance import (
     When,
 )
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.paths import EXAMPLES
 
 SCENARIO_C = EXAMPLES / "brsu_building_c" / "scenario_c.exsce"
@@ -109,7 +109,7 @@ def test_a_spec_without_criteria_has_no_features(tmp_path: Path) -> None:
 
 
 def test_cli_writes_one_feature_per_scenario_with_criteria(tmp_path: Path) -> None:
-    result = run_exscec("export", str(SCENARIO_C), "--to", "gherkin", "-o", str(tmp_path / "features"))
+    result = exscec_here("export", str(SCENARIO_C), "--to", "gherkin", "-o", str(tmp_path / "features"))
     assert result.returncode == 0, result.stderr
     assert [p.name for p in (tmp_path / "features").iterdir()] == ["scenario_c.feature"]
     feature = parsed((tmp_path / "features" / "scenario_c.feature").read_text())

@@ -23,7 +23,7 @@ from mcp.client.stdio import StdioServerParameters, get_default_environment, std
 from mcp.shared.exceptions import MCPError
 from mcp_types import CallToolResult, TextContent, TextResourceContents
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here, run_exscec
 from tests.support.paths import EXAMPLES
 
 EXSCEC = Path(sys.executable).with_name("exscec")
@@ -45,7 +45,7 @@ class Project:
         self.verified_json: list[dict[str, Any]] = []
 
     def exscec(self, *args: str) -> str:
-        done = run_exscec(*args, cwd=self.folder)
+        done = exscec_here(*args, cwd=self.folder)
         assert done.returncode == 0, f"exscec {' '.join(args)}: {done.stderr}"
         return done.stdout
 

@@ -21,7 +21,7 @@ from exsce_dsl.sim.run import simulate
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.wording import counted, noun
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.paths import EXAMPLES
 
 _HEADING = re.compile(r"-R[-0-9.]+_P[-0-9.]+_Y[-0-9.]+$")
@@ -42,10 +42,10 @@ def project(tmp_path_factory: pytest.TempPathFactory) -> Path:
     environment.write_text(without, encoding="utf-8")
     scenario = load_spec(folder / "c" / "scenario_c.exsce").scenario("scenario_c")
     [run] = simulate(scenario, folder / "runs", 1, seed=4)
-    done = run_exscec("ingest", str(run.bag), "--scenario", "c/scenario_c.exsce", cwd=folder)
+    done = exscec_here("ingest", str(run.bag), "--scenario", "c/scenario_c.exsce", cwd=folder)
     assert done.returncode == 0, done.stderr
     for output, specs in (("out", ["c/scenario_c.exsce"]), ("plain", []), ("nomap", ["nomap/scenario_c.exsce"])):
-        made = run_exscec("report", "-o", output, *[a for s in specs for a in ("--spec", s)], cwd=folder)
+        made = exscec_here("report", "-o", output, *[a for s in specs for a in ("--spec", s)], cwd=folder)
         assert made.returncode == 0, made.stderr
         (folder / f"{output}.stderr").write_text(made.stderr, encoding="utf-8")
     return folder

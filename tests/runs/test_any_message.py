@@ -26,7 +26,7 @@ from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from exsce_dsl.lang import load_spec
 from exsce_dsl.runs.analyse import analyse_bag
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.paths import EXAMPLES
 
 TURTLE = "turtlesim/msg/Pose"
@@ -174,7 +174,7 @@ def test_metrics_over_odometry_and_a_type_known_only_from_the_bag(
     tmp_path: Path, fmt: str, namespace: str
 ) -> None:
     spec = _spec(tmp_path, namespace)
-    result = run_exscec("simulate", str(spec), "--runs", "1", "-o", str(tmp_path / "runs"), "--format", fmt, cwd=tmp_path)
+    result = exscec_here("simulate", str(spec), "--runs", "1", "-o", str(tmp_path / "runs"), "--format", fmt, cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     (source,) = [p for p in (tmp_path / "runs").iterdir() if not p.name.endswith(".prov.json")]
     target = tmp_path / ("rewritten.bag" if fmt == "ros1" else "rewritten")

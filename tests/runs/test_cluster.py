@@ -30,7 +30,7 @@ from exsce_dsl.runs.ingest import IngestStatus, ingest_bags
 from exsce_dsl.sim.run import simulate
 from exsce_dsl.store.embedded import EmbeddedStore
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here, run_exscec
 from tests.support.dask_cluster import a_worker_killed_while_running, local_cluster
 from tests.support.map_files import write_map
 from tests.support.yard_spec import YARD_SPEC
@@ -116,7 +116,7 @@ def test_ingest_on_a_cluster_takes_paths_relative_to_the_callers_folder(
     # open yard, r2 field-d (8,1) -> field-c (8,8); each reaches all its waypoints
     runs = [a for run in _run_ids(done.stderr) for a in ("-p", f"run={run}")]
     assert len(runs) == 2 * BAGS
-    values = run_exscec("query", "run_metric_values", *runs, "-f", "json", "--store", "store", cwd=caller)
+    values = exscec_here("query", "run_metric_values", *runs, "-f", "json", "--store", "store", cwd=caller)
     assert values.returncode == 0, values.stderr
     found: dict[tuple[str, str], list[float]] = {}
     for row in json.loads(values.stdout)["results"]["bindings"]:

@@ -30,7 +30,7 @@ from exsce_dsl.runs.ingest import ingest_bags
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.queries import MetricReading, run_metric_values, run_segment_values
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.paths import EXAMPLES
 from tests.support.ros1_graph import require_ros1, ros1_graph
 
@@ -138,7 +138,7 @@ def bag_topics(path: Path) -> BagTopics:
 
 def simulate(folder: Path, *options: str) -> list[Path]:
     """``exscec simulate SPEC options -o folder``: the executor's bags."""
-    done = run_exscec("simulate", str(SPEC), "-o", str(folder), *options)
+    done = exscec_here("simulate", str(SPEC), "-o", str(folder), *options)
     assert done.returncode == 0, done.stderr
     return sorted(folder.glob("*.bag"))
 
@@ -259,13 +259,13 @@ def verdict_messages(bag: Path) -> list[dict[str, Any]]:
 def verify(bag: Path, baseline: Sequence[Path], store: Path) -> dict[str, dict[str, Any]]:
     """`exscec verify --json` of ``bag`` against a baseline of ``baseline``'s runs: the verdicts
     of whole runs (those of part of a run have a window), by oracle."""
-    done = run_exscec(
+    done = exscec_here(
         "ingest", *map(str, baseline), "--scenario", str(SPEC), "--store", str(store), "-j", "2"
     )
     assert done.returncode == 0, done.stderr
-    done = run_exscec("baseline", str(SPEC), "--store", str(store))
+    done = exscec_here("baseline", str(SPEC), "--store", str(store))
     assert done.returncode == 0, done.stderr
-    done = run_exscec(
+    done = exscec_here(
         "verify", str(bag), "--scenario", str(SPEC), "--store", str(store), "--json", "--no-record"
     )
     assert done.returncode in (0, 1), done.stderr
@@ -281,7 +281,7 @@ def test_the_generated_monitor_node_on_a_live_graph_gives_verifys_verdicts(tmp_p
     reference = verify(bag, baseline, tmp_path / "store")
     assert {reference[o]["verdict"] for o in DECIDED_LIVE} == {"passed", "failed"}
 
-    done = run_exscec("generate", "ros1-monitor", str(SPEC), "-o", str(tmp_path / "generated"))
+    done = exscec_here("generate", "ros1-monitor", str(SPEC), "-o", str(tmp_path / "generated"))
     assert done.returncode == 0, done.stderr
     package = tmp_path / "generated" / "exsce_monitor_scenario_c"
     run = bag_topics(bag)

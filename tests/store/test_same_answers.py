@@ -34,7 +34,7 @@ from exsce_dsl.store.base import GraphSet
 from exsce_dsl.store.open import open_store
 from exsce_dsl.store.queries import query, query_names
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here
 from tests.support.map_files import write_map
 from tests.support.store_servers import virtuoso_server
 from tests.support.yard_spec import YARD_SPEC
@@ -52,7 +52,7 @@ class Stores:
     virtuoso: str
 
     def output(self, store: str, *args: str) -> str:
-        done = run_exscec(*args, "--store", store, cwd=self.folder, timeout=300)
+        done = exscec_here(*args, "--store", store, cwd=self.folder)
         assert done.returncode == 0, f"{args} on {store}: {done.stderr}"
         assert "Traceback" not in done.stderr
         return done.stdout
@@ -89,7 +89,7 @@ def stores(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Stores]:
             both.output(store, "baseline", "spec.exsce")
             both.output(store, "derive", "spec.exsce", "--id", "yard_reversed", "-t", "reverse_waypoint_order",
                         "--task", "patrol_1", "-o", "reversed.exsce", "--expect", "--add-to-store")  # fmt: skip
-        judged = run_exscec("verify", bags[-1], "--scenario", "spec.exsce", "--store", both.embedded, cwd=folder)
+        judged = exscec_here("verify", bags[-1], "--scenario", "spec.exsce", "--store", both.embedded, cwd=folder)
         assert judged.returncode == 1 and "2 failed" in judged.stderr  # the run over speed
         both.output(both.embedded, "explore", "spec.exsce", "-n", "1", "-k", "1", "-t", "reverse_waypoint_order")
         with open_store(both.embedded) as here, open_store(both.virtuoso, timeout=60) as there:

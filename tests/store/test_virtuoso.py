@@ -26,7 +26,7 @@ from exsce_dsl.store.base import GraphSet, Store, StoreError
 from exsce_dsl.store.open import open_store
 from exsce_dsl.store.remote import RemoteStore
 
-from tests.support.cli import run_exscec
+from tests.support.cli import exscec_here, run_exscec
 from tests.support.map_files import write_map
 from tests.support.paths import EXAMPLES
 from tests.support.store_servers import Server, virtuoso_server
@@ -152,7 +152,7 @@ def _method_on(store_url: str, folder: Path, bags: list[Path]) -> tuple[list[dic
     overview page."""
 
     def exscec(*args: str) -> str:
-        done = run_exscec(*args, "--store", store_url, cwd=folder, timeout=300)
+        done = exscec_here(*args, "--store", store_url, cwd=folder)
         assert done.returncode in (0, 1), done.stderr
         assert "Traceback" not in done.stderr
         return done.stdout
