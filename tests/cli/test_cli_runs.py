@@ -1,4 +1,5 @@
-"""simulate → ingest → query through the real exscec, in a temporary project folder."""
+"""simulate → ingest → query through the exscec commands (in-process: tests/support/cli.py), in a
+temporary project folder."""
 
 from __future__ import annotations
 

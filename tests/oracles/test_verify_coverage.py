@@ -1,5 +1,5 @@
-"""What the recording does not cover, through ``exscec verify`` as a user runs it: executor bags
-of scenario_c cut short, with a topic silent, thinned or with ``/clock`` reset
+"""What the recording does not cover, through the ``exscec verify`` command (in-process): executor
+bags of scenario_c cut short, with a topic silent, thinned or with ``/clock`` reset
 (:mod:`tests.support.bag_surgery`), judged against a baseline of clean runs.
 
 The issue's case: a run cut at 60 % of its mission had its safety clauses passed
