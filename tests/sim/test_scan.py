@@ -81,3 +81,10 @@ def test_scans_marched_in_batches_are_each_scan_alone(grid: PlanningGrid) -> Non
     for i in (0, count // 2, count - 1):
         assert np.array_equal(together[i], _ranges(grid, x[i], y[i], yaw[i]))
     assert np.isfinite(together).mean() > 0.5  # most beams meet the wall or the map's edge
+
+
+def test_a_beam_that_leaves_the_map_stops_at_its_edge(grid: PlanningGrid) -> None:
+    """Outside the map is nothing free: a beam stops where it leaves (5 m below the robot here),
+    not where a step from inside happened to land (it stepped 5 m past the edge)."""
+    down = _ranges(grid, 2.5, 5.0, 0.0)[_beam(-math.pi / 2)]
+    assert down == pytest.approx(5.0, abs=grid.map_resolution)

@@ -48,7 +48,11 @@ class PlanningGrid:
         if grid.origin[2]:
             raise ExsceError("maps with a rotated origin are not supported by the executor")
         free_full = grid.free_cells()[::-1]  # rows from the bottom
-        clearance = ndimage.distance_transform_edt(free_full) * grid.resolution
+        # outside the map is no free space either (clearance_of finds 0 there): a free cell's
+        # clearance is also bounded by its distance to the map's edge, so that a laser beam
+        # marched on it stops at the edge instead of stepping past it
+        bordered = np.pad(free_full, 1, constant_values=False)
+        clearance = ndimage.distance_transform_edt(bordered)[1:-1, 1:-1] * grid.resolution
         factor = max(1, round(cell / grid.resolution))
         rows, cols = (s // factor for s in free_full.shape)
         coarse = (
