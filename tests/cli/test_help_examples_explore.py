@@ -74,7 +74,7 @@ def _check_the_live_campaign(explored: subprocess.CompletedProcess[str], project
     assert f"exscec verify explore/live/runs/{minimal}/*.bag --scenario {file.relative_to(project)}" in (
         explored.stdout
     )
-    env = {k: v for k, v in os.environ.items() if not k.startswith(("EXSCE_", "ROS_"))}
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("EXSCE_", "ROS_")) or k == "EXSCE_CACHE"}
     again = subprocess.run(
         [EXSCEC, "verify", str(derived_bag), "--scenario", str(file)],
         cwd=project, env=env, capture_output=True, text=True, timeout=300,

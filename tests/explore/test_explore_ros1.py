@@ -31,8 +31,9 @@ def project(tmp_path: Path) -> Path:
 
 
 def _exscec(project: Path, *args: str) -> subprocess.CompletedProcess[str]:
-    # no ROS_MASTER_URI: the campaign starts a roscore of its own and stops it at its end
-    env = {k: v for k, v in os.environ.items() if not k.startswith(("EXSCE_", "ROS_"))}
+    # no ROS_MASTER_URI: the campaign starts a roscore of its own and stops it at its end; the
+    # run's cache folder stays (the suite leaves ~/.cache/exsce alone)
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("EXSCE_", "ROS_")) or k == "EXSCE_CACHE"}
     env["EXSCE_STORE"] = str(project / "store")
     return subprocess.run([EXSCEC, *args], cwd=project, env=env, capture_output=True, text=True, timeout=400)
 
@@ -63,7 +64,7 @@ def test_the_ros1_executor_without_its_stand_in_is_refused_before_anything_runs(
 
 def test_a_campaign_stopped_by_sigterm_mid_run_exits_130_and_leaves_no_ros_process(project: Path) -> None:
     require_ros1()
-    env = {k: v for k, v in os.environ.items() if not k.startswith(("EXSCE_", "ROS_"))}
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("EXSCE_", "ROS_")) or k == "EXSCE_CACHE"}
     env |= {"EXSCE_STORE": str(project / "store"), "TMPDIR": str(project / "tmp")}  # roscore's home
     (project / "tmp").mkdir()
     command = [EXSCEC, "explore", SPEC, "--executor", "ros1", "--stand-in", "-n", "1", "-k", "1", "-o", "c"]
