@@ -28,6 +28,7 @@ __all__ = [
     "ExportError",
     "ExsceError",
     "ExsceSyntaxError",
+    "FederationRefused",
     "GenerationError",
     "ImportFormatError",
     "IncompleteRunError",
@@ -218,6 +219,10 @@ class SegmentError(ExsceError):
 
 class StoreError(ExsceError):
     """The store cannot do what was asked (unreachable, locked, refused, conflicting)."""
+
+
+class FederationRefused(StoreError):
+    """A query or update would reach another server (SERVICE, LOAD) that no flag allows."""
 
 
 class StoreLockedError(StoreError):
