@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+
 import click
 
 from exsce_dsl.cli.common import reports_errors
@@ -24,17 +26,25 @@ from exsce_dsl.store.base import QUERY_TIMEOUT  # not the endpoint: every comman
     default=1000,
     show_default=True,
     metavar="N",
-    help="The most rows a query answer shows; a longer answer says how many rows it cut.",
+    help="The most rows a query answer shows; a longer answer says it was cut.",
+)
+@click.option(
+    "--root",
+    type=click.Path(exists=True, file_okay=False),
+    default=None,
+    metavar="DIR",
+    help="The folder whose specification files the check tool may read (default: where it starts).",
 )
 @store_option
 @reports_errors
-def mcp(timeout: float, max_rows: int, store_url: str | None) -> None:
+def mcp(timeout: float, max_rows: int, root: str | None, store_url: str | None) -> None:
     """Serve the store and the checker to an MCP client (Model Context Protocol), on stdio.
 
     Read-only.  Tools: one per query of the query library (exscec query
     --list), lineage, run_verdicts, check (exscec check of a specification's
     text, diagnostics as file:line:col) and sparql (SELECT and ASK only; no
-    updates, no SERVICE).  Resources: exsce://scenarios, exsce://runs, and
+    updates, no SERVICE).  The check tool reads no file outside the folder the
+    server started in (or --root).  Resources: exsce://scenarios, exsce://runs, and
     exsce://scenarios/{id}, exsce://runs/{uuid}.  The store is opened for each
     request, so ingests and other commands may use it in between.
 
@@ -68,7 +78,8 @@ def mcp(timeout: float, max_rows: int, store_url: str | None) -> None:
     with store_open.open_store(store_url):  # a store URL that cannot work fails now, not at a request
         pass
     click.echo(f"exscec mcp: serving {store_open.store_url(store_url)} read-only on stdio", err=True)
-    serve(Access(store_url, timeout=timeout, max_rows=max_rows))
+    folder = os.path.abspath(root or os.getcwd())
+    serve(Access(store_url, timeout=timeout, max_rows=max_rows, root=folder))
 
 
 COMMANDS = [mcp]
