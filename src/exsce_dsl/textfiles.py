@@ -98,4 +98,5 @@ def without_bom(text: str) -> str:
 
 
 def _megabytes(size: int) -> str:
-    return f"{size / (1024 * 1024):g} MiB"
+    megabytes = size / (1024 * 1024)
+    return f"{megabytes:g} MiB" if megabytes >= 1 else f"{size} bytes"

@@ -49,8 +49,8 @@ def mcp(timeout: float, max_rows: int, root: str | None, store_url: str | None) 
     request, so ingests and other commands may use it in between.
 
     MCP clients start the server themselves and talk to it on stdin and
-    stdout; give the store as an absolute --store (a client may start the
-    server in any folder).
+    stdout; give the store as an absolute --store, and the project's folder
+    as --root (a client may start the server in any folder).
 
     \b
     Example (a client's session, by hand):
@@ -61,7 +61,8 @@ def mcp(timeout: float, max_rows: int, root: str | None, store_url: str | None) 
         "mcpServers": {
           "exsce": {
             "command": "/path/to/venv/bin/exscec",
-            "args": ["mcp", "--store", "/path/to/project/.exsce/store"]
+            "args": ["mcp", "--store", "/path/to/project/.exsce/store",
+                     "--root", "/path/to/project"]
           }
         }
       }

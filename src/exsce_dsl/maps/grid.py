@@ -91,7 +91,13 @@ def _map_yaml(yaml_path: Path) -> object:
     """The data of a map's YAML file, read with bounds (:func:`~exsce_dsl.textfiles.read_text`);
     an error names the place of a YAML mistake but quotes nothing of the file (a map may name
     any file, and its content is not ours to show)."""
-    text = read_text(yaml_path, "map file")
+    try:
+        text = read_text(yaml_path, "map file")
+    except ExsceError as exc:
+        told = f"cannot read {yaml_path}"
+        if not exc.message.startswith(told):
+            raise
+        raise ExsceError(f"cannot read map file {yaml_path}{exc.message.removeprefix(told)}") from None
     try:
         return yaml.safe_load(text)
     except yaml.MarkedYAMLError as exc:
