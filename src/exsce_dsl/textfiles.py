@@ -6,12 +6,19 @@ none of them can make a command, the language server or the MCP server read fore
 is opened without blocking (a FIFO would wait for a writer), the opened descriptor, not the
 path, is checked to be a regular file (``/dev/zero`` is a device), and no more than the limit
 plus one byte is read.
+
+The language server and the MCP server read only inside their folder: within
+:func:`reading_inside`, a file outside the folders given is refused with the
+same words whether it exists or not.
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
 import stat
+from collections.abc import Iterator
+from contextvars import ContextVar
 from pathlib import Path
 
 from exsce_dsl.errors import ExsceError, SourceLocation
@@ -22,6 +29,28 @@ MAX_FILE_VARIABLE = "EXSCE_MAX_FILE_MB"
 UTF8_BOM = b"\xef\xbb\xbf"
 
 _CHUNK = 1024 * 1024
+_READABLE: ContextVar[tuple[str, ...] | None] = ContextVar("exsce_readable_folders", default=None)
+"""The folders files may be read from (None: anywhere), set by :func:`reading_inside`."""
+
+
+@contextlib.contextmanager
+def reading_inside(*folders: str | Path) -> Iterator[None]:
+    """Within the block (in this thread), :func:`read_bytes` and :func:`read_text` read only
+    files inside ``folders`` (symbolic links followed before looking)."""
+    token = _READABLE.set(tuple(os.path.realpath(f) for f in folders))
+    try:
+        yield
+    finally:
+        _READABLE.reset(token)
+
+
+def is_inside(path: str | Path, folders: tuple[str, ...]) -> bool:
+    """Whether ``path``, symbolic links followed, lies inside one of ``folders`` (real paths)."""
+    try:
+        real = os.path.realpath(path)
+    except (OSError, ValueError):
+        return False
+    return any(real == f or real.startswith(f.rstrip(os.sep) + os.sep) for f in folders)
 
 
 def max_file_bytes() -> int:
@@ -41,6 +70,10 @@ def read_bytes(path: str | Path, what: str = "file", limit: int | None = None) -
     """The bytes of ``path``; an :class:`ExsceError` if it is missing, a folder, not a regular
     file (a FIFO, a device), unreadable, or longer than ``limit`` (:func:`max_file_bytes`)."""
     most = max_file_bytes() if limit is None else limit
+    readable = _READABLE.get()
+    if readable is not None and not is_inside(path, readable):
+        shown = " or ".join(readable) or "no folder"
+        raise ExsceError(f"{path} is outside the workspace ({shown}): only files inside it are read")
     flags = os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOCTTY", 0) | getattr(os, "O_CLOEXEC", 0)
     try:
         descriptor = os.open(path, flags)

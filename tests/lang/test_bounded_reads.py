@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from exsce_dsl.lang import analyse
+
 from tests.support.cli import run_exscec
 
 ENVIRONMENT = """environment e {{

@@ -9,6 +9,7 @@ import os
 from pathlib import Path
 
 from exsce_dsl.lang import ImportScope, analyse
+
 from tests.support.cli import run_exscec
 
 SECRET = "hunter2-secret-token"

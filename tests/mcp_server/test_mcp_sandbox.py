@@ -140,3 +140,30 @@ def test_check_tool_text_imports_nothing(tmp_path: Path) -> None:
     assert within["ok"] is True  # a file inside the server's folder is imported
     for message in (beyond, escaping):
         assert "is outside the server's folder" in message and SECRET not in message
+
+
+def test_check_tool_reads_no_map_outside_its_folder(tmp_path: Path) -> None:
+    folder, outside = tmp_path / "server", tmp_path / "other"
+    folder.mkdir()
+    outside.mkdir()
+    (outside / "m.yaml").write_text(f"{SECRET}: [\n", encoding="utf-8")  # a YAML error, were it read
+    spec = (
+        "environment e {{\n"
+        '  map m from package "p" path "maps/" file "{}"\n'
+        "  area a {{\n    pose p1 at (0.0, 0.0) facing 0\n  }}\n}}\n"
+    )
+
+    async def work(session: ClientSession) -> list[Any]:
+        return [
+            answer(await session.call_tool("check", {"text": spec.format(outside / name), "folder": "."}))
+            for name in ("m.yaml", "missing.yaml")
+        ]
+
+    found = in_session(folder, work)
+    messages = []
+    for checked, name in zip(found, ("m.yaml", "missing.yaml"), strict=True):
+        (d,) = checked["diagnostics"]
+        assert (d["line"], d["column"]) == (2, 3)
+        messages.append(d["message"].replace(name, "NAME"))
+    assert messages[0] == messages[1] and "is outside the workspace" in messages[0]
+    assert SECRET not in str(found)

@@ -24,7 +24,7 @@ from exsce_dsl.errors import Diagnostic, ExsceError, ExsceSyntaxError, SourceLoc
 from exsce_dsl.lang.chunks import imported_paths
 from exsce_dsl.lang.parser import ParsedFile, parse_text
 from exsce_dsl.suggest import closest
-from exsce_dsl.textfiles import read_text, without_bom
+from exsce_dsl.textfiles import is_inside, read_text, without_bom
 
 Parse = Callable[[str, str], tuple[ParsedFile | None, Sequence[Diagnostic]]]
 """Parses (text, path): the tree (None if nothing could be parsed) and the syntax errors found."""
@@ -87,13 +87,7 @@ class ImportScope:
 
     def holds(self, path: str) -> bool:
         """Whether ``path`` lies inside the scope (anywhere: always)."""
-        if self.folders is None:
-            return True
-        try:
-            real = os.path.realpath(path)
-        except (OSError, ValueError):
-            return False
-        return any(real == f or real.startswith(f.rstrip(os.sep) + os.sep) for f in self.folders)
+        return self.folders is None or is_inside(path, self.folders)
 
 
 ANYWHERE = ImportScope()
@@ -173,7 +167,8 @@ def read_sources(
             target = import_target(path, imp.path)
             problem = scope.refusal(imp.path, target)
             if problem is None and target not in overlay and not _is_file(target):
-                problem = f"imported file '{imp.path}' not found (looked for {target}){_closest_file(imp.path, target)}"
+                closest = _closest_file(imp.path, target)
+                problem = f"imported file '{imp.path}' not found (looked for {target}){closest}"
             if problem is not None:
                 diagnostics.append(Diagnostic(problem, pf.span(imp), code="import"))
                 continue

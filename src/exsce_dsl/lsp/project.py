@@ -7,11 +7,11 @@ re-parses one declaration, and each file's index (its declarations and
 references) is kept by its text.  A file's diagnostics are those every analysis
 that reads it finds there.
 
-An analysis imports only ``.exsce`` files inside the workspace: the client's
-workspace folders when the document is inside one of them, else the document's
-own folder (a file opened alone).  An analysis that fails on a bug of ours
-still publishes: one diagnostic at the document's start says so
-(:meth:`Project.failed`).
+An analysis imports only ``.exsce`` files inside the workspace, and reads no
+other file outside it (a map): the client's workspace folders when the document
+is inside one of them, else the document's own folder (a file opened alone).
+An analysis that fails on a bug of ours still publishes: one diagnostic at the
+document's start says so (:meth:`Project.failed`).
 
 :meth:`Project.analyse` and :meth:`Project.scan` run on the analysis thread
 only; the rest reads what they publish (whole dictionaries replaced at once)
@@ -23,13 +23,12 @@ from __future__ import annotations
 import os
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 
 from exsce_dsl.errors import Diagnostic, ExsceError, SourceLocation
 from exsce_dsl.lang import FileIndex, ImportScope, ParseCache, analyse_for_editor, display_path, index_text
 from exsce_dsl.model.document import Specification
 from exsce_dsl.resources import package_file
-from exsce_dsl.textfiles import read_text
+from exsce_dsl.textfiles import read_text, reading_inside
 
 _SKIP_FOLDERS = frozenset({"node_modules", "__pycache__", "build", "dist"})
 _SCAN_LIMIT = 5000
@@ -91,7 +90,9 @@ class Project:
     def analyse(self, root: str, documents: Mapping[str, Document]) -> RootAnalysis:
         """Analyse the open document ``root`` with what it imports (open ones as the editor has them)."""
         overlay = {path: doc.text for path, doc in documents.items()}
-        result = analyse_for_editor(root, overlay, self.cache, self.texts, self.import_scope(root))
+        scope = self.import_scope(root)
+        with reading_inside(*(scope.folders or ())):  # maps too: nothing outside the workspace
+            result = analyse_for_editor(root, overlay, self.cache, self.texts, scope)
         indexes, texts, complete = dict(self.indexes), dict(self.texts), dict(self.complete)
         for file in result.files:
             texts[file.path] = file.text
@@ -139,7 +140,12 @@ class Project:
         self._generation += 1
         versions = {root: documents[root].version} if root in documents else {}
         done = RootAnalysis(
-            root, versions, (root,), {root: [Diagnostic(message, where, code="internal")]}, None, self._generation
+            root,
+            versions,
+            (root,),
+            {root: [Diagnostic(message, where, code="internal")]},
+            None,
+            self._generation,
         )
         self.roots = {**self.roots, root: done}
         return done

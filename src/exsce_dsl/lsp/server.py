@@ -11,7 +11,6 @@ so the event loop stays free.
 from __future__ import annotations
 
 import os
-from pathlib import Path
 from typing import Any
 
 from lsprotocol import types

@@ -45,7 +45,9 @@ class ToolEntry:
         return self.tool.name
 
 
-def first_rows_json(store: Store, query: str, max_rows: int, bindings: Bindings | None = None) -> dict[str, Any]:
+def first_rows_json(
+    store: Store, query: str, max_rows: int, bindings: Bindings | None = None
+) -> dict[str, Any]:
     """The first ``max_rows`` rows of a SELECT as SPARQL 1.1 Query Results JSON, the store asked
     for one more only (:meth:`~exsce_dsl.store.base.Store.select_first`)."""
     rows, more = store.select_first(query, max_rows, bindings)

@@ -5,7 +5,8 @@ error, with did-you-mean), then SHACL on each scenario's PROV-O.  The text is
 checked as the file ``name`` in ``folder``, without writing there: imports are
 resolved relative to the folder, from the files on disk, as they would be for
 the file itself, but only ``.exsce`` files inside the server's folder (where it
-started, or its ``--root``) are read, and ``folder`` must be inside it too.
+started, or its ``--root``) are read, and ``folder`` must be inside it too;
+no other file outside it is read either (a map the text names).
 Without a folder, the text is checked in a scratch folder of its own, and every
 import is refused where it is written: a text given alone imports nothing.
 
@@ -29,6 +30,7 @@ from exsce_dsl.errors import Diagnostic, Severity
 from exsce_dsl.mcp_server.access import Access
 from exsce_dsl.mcp_server.answers import READ_ONLY, ToolEntry
 from exsce_dsl.mcp_server.arguments import ArgumentError, object_schema
+from exsce_dsl.textfiles import reading_inside
 
 if TYPE_CHECKING:
     from exsce_dsl.lang import ImportScope
@@ -54,11 +56,11 @@ def check_text(
     ``folder`` only inside ``root`` (the working directory by default)."""
     from exsce_dsl.lang import ImportScope
 
+    workspace = Path(os.path.realpath(root if root is not None else os.getcwd()))
     if folder is None:
         with tempfile.TemporaryDirectory(prefix="exsce-check-") as scratch:
             base = Path(os.path.realpath(scratch))
-            return _check(text, base, name, ImportScope.nowhere(NO_IMPORTS))
-    workspace = Path(os.path.realpath(root if root is not None else os.getcwd()))
+            return _check(text, base, name, ImportScope.nowhere(NO_IMPORTS), workspace)
     base = Path(folder).expanduser()
     scope = ImportScope.inside(workspace)
     if not scope.holds(str(base.absolute())):
@@ -68,15 +70,16 @@ def check_text(
             f"folder '{folder}' is not a folder (imports are resolved relative to it; "
             f"a relative folder is taken from {os.getcwd()})"
         )
-    return _check(text, Path(os.path.realpath(base)), name, scope)
+    return _check(text, Path(os.path.realpath(base)), name, scope, workspace)
 
 
-def _check(text: str, base: Path, name: str, scope: ImportScope) -> dict[str, Any]:
+def _check(text: str, base: Path, name: str, scope: ImportScope, workspace: Path) -> dict[str, Any]:
+    """The check of ``text`` as ``base/name``, reading no file outside ``workspace`` (a map)."""
     from exsce_dsl.lang import analyse
     from exsce_dsl.rdf.shacl import check_spec_shapes
 
     root = str(base / name)
-    with _ONE_AT_A_TIME:
+    with _ONE_AT_A_TIME, reading_inside(workspace):
         analysis = analyse(root, {root: text}, scope)
         diagnostics = list(analysis.diagnostics)
         if not analysis.errors and analysis.spec is not None:

@@ -35,8 +35,8 @@ from exsce_dsl.mcp_server.access import Access
 from exsce_dsl.mcp_server.answers import READ_ONLY, ToolEntry, first_rows_json
 from exsce_dsl.mcp_server.arguments import ArgumentError, object_schema
 from exsce_dsl.store.base import MAX_QUERY
-from exsce_dsl.store.queries import standard_prefixes
 from exsce_dsl.store.federation import refuse_federation
+from exsce_dsl.store.queries import standard_prefixes
 from exsce_dsl.store.sparql import declared_prefixes, query_form
 
 __all__ = ["read_only_query", "sparql_tool"]
@@ -60,11 +60,18 @@ def read_only_query(text: str) -> tuple[str, str]:
     try:
         refuse_federation(prologue + text)
     except FederationRefused as exc:
-        raise ExsceError(f"{exc.message} (the sparql tool reads this store only, never another server)") from None
+        raise ExsceError(
+            f"{exc.message} (the sparql tool reads this store only, never another server)"
+        ) from None
     return form, prologue + text
 
 
-_FORMS = {"SelectQuery": "SELECT", "AskQuery": "ASK", "ConstructQuery": "CONSTRUCT", "DescribeQuery": "DESCRIBE"}
+_FORMS = {
+    "SelectQuery": "SELECT",
+    "AskQuery": "ASK",
+    "ConstructQuery": "CONSTRUCT",
+    "DescribeQuery": "DESCRIBE",
+}
 
 
 def _form(text: str) -> str:
