@@ -61,7 +61,7 @@ def max_file_bytes() -> int:
         megabytes = float(given) if given else MAX_FILE_MB
     except ValueError:
         megabytes = MAX_FILE_MB
-    if not megabytes > 0:
+    if not 0 < megabytes < 1024 * 1024:  # not NaN, not infinite: a size
         megabytes = MAX_FILE_MB
     return int(megabytes * 1024 * 1024)
 
