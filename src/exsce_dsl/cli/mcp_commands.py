@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+
 import click
 
 from exsce_dsl.cli.common import reports_errors
@@ -24,23 +26,31 @@ from exsce_dsl.store.base import QUERY_TIMEOUT  # not the endpoint: every comman
     default=1000,
     show_default=True,
     metavar="N",
-    help="The most rows a query answer shows; a longer answer says how many rows it cut.",
+    help="The most rows a query answer shows; a longer answer says it was cut.",
+)
+@click.option(
+    "--root",
+    type=click.Path(exists=True, file_okay=False),
+    default=None,
+    metavar="DIR",
+    help="The folder whose specification files the check tool may read (default: where it starts).",
 )
 @store_option
 @reports_errors
-def mcp(timeout: float, max_rows: int, store_url: str | None) -> None:
+def mcp(timeout: float, max_rows: int, root: str | None, store_url: str | None) -> None:
     """Serve the store and the checker to an MCP client (Model Context Protocol), on stdio.
 
     Read-only.  Tools: one per query of the query library (exscec query
     --list), lineage, run_verdicts, check (exscec check of a specification's
     text, diagnostics as file:line:col) and sparql (SELECT and ASK only; no
-    updates, no SERVICE).  Resources: exsce://scenarios, exsce://runs, and
+    updates, no SERVICE).  The check tool reads no file outside the folder the
+    server started in (or --root).  Resources: exsce://scenarios, exsce://runs, and
     exsce://scenarios/{id}, exsce://runs/{uuid}.  The store is opened for each
     request, so ingests and other commands may use it in between.
 
     MCP clients start the server themselves and talk to it on stdin and
-    stdout; give the store as an absolute --store (a client may start the
-    server in any folder).
+    stdout; give the store as an absolute --store, and the project's folder
+    as --root (a client may start the server in any folder).
 
     \b
     Example (a client's session, by hand):
@@ -51,7 +61,8 @@ def mcp(timeout: float, max_rows: int, store_url: str | None) -> None:
         "mcpServers": {
           "exsce": {
             "command": "/path/to/venv/bin/exscec",
-            "args": ["mcp", "--store", "/path/to/project/.exsce/store"]
+            "args": ["mcp", "--store", "/path/to/project/.exsce/store",
+                     "--root", "/path/to/project"]
           }
         }
       }
@@ -68,7 +79,8 @@ def mcp(timeout: float, max_rows: int, store_url: str | None) -> None:
     with store_open.open_store(store_url):  # a store URL that cannot work fails now, not at a request
         pass
     click.echo(f"exscec mcp: serving {store_open.store_url(store_url)} read-only on stdio", err=True)
-    serve(Access(store_url, timeout=timeout, max_rows=max_rows))
+    folder = os.path.abspath(root or os.getcwd())
+    serve(Access(store_url, timeout=timeout, max_rows=max_rows, root=folder))
 
 
 COMMANDS = [mcp]

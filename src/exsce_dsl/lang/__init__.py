@@ -49,7 +49,7 @@ if TYPE_CHECKING:
     from exsce_dsl.lang.format.writer import write_documents
     from exsce_dsl.lang.incremental import ParseCache
     from exsce_dsl.lang.lexical import Comment, comments
-    from exsce_dsl.lang.loader import display_path, import_target
+    from exsce_dsl.lang.loader import ImportScope, display_path, import_target
     from exsce_dsl.lang.spec_cache import load_spec_cached
     from exsce_dsl.lang.yaml.exporter import export_yaml, scenario_to_yaml, task_to_yaml
     from exsce_dsl.lang.yaml.importer import import_scenario_yaml, import_task_yaml
@@ -70,6 +70,7 @@ _WHERE = {
     "standard_metrics": "build.standard_metrics",
     "display_path": "loader",
     "import_target": "loader",
+    "ImportScope": "loader",
     "comments": "lexical",
     "Comment": "lexical",
     # writing it back
@@ -112,6 +113,7 @@ __all__ = [
     "Comment",
     "Continuations",
     "FileIndex",
+    "ImportScope",
     "ParseCache",
     "Reference",
     "Symbol",

@@ -83,6 +83,7 @@ def _documents(server: ExsceLanguageServer) -> None:
         folders = [path_of(f.uri) for f in ls.workspace.folders.values()]
         if not folders and ls.workspace.root_path:
             folders = [ls.workspace.root_path]
+        ls.project.workspace = tuple(os.path.abspath(f) for f in folders)
         await ls.scheduler.run(ls.project.scan, folders)
 
 

@@ -7,6 +7,12 @@ re-parses one declaration, and each file's index (its declarations and
 references) is kept by its text.  A file's diagnostics are those every analysis
 that reads it finds there.
 
+An analysis imports only ``.exsce`` files inside the workspace, and reads no
+other file outside it (a map): the client's workspace folders when the document
+is inside one of them, else the document's own folder (a file opened alone).
+An analysis that fails on a bug of ours still publishes: one diagnostic at the
+document's start says so (:meth:`Project.failed`).
+
 :meth:`Project.analyse` and :meth:`Project.scan` run on the analysis thread
 only; the rest reads what they publish (whole dictionaries replaced at once)
 from the event loop.
@@ -17,12 +23,12 @@ from __future__ import annotations
 import os
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 
-from exsce_dsl.errors import Diagnostic
-from exsce_dsl.lang import FileIndex, ParseCache, analyse_for_editor, display_path, index_text
+from exsce_dsl.errors import Diagnostic, ExsceError, SourceLocation
+from exsce_dsl.lang import FileIndex, ImportScope, ParseCache, analyse_for_editor, display_path, index_text
 from exsce_dsl.model.document import Specification
 from exsce_dsl.resources import package_file
+from exsce_dsl.textfiles import read_text, reading_inside
 
 _SKIP_FOLDERS = frozenset({"node_modules", "__pycache__", "build", "dist"})
 _SCAN_LIMIT = 5000
@@ -67,6 +73,8 @@ class Project:
         """Of each file, the index of its last text without syntax errors (completion falls back on it)."""
         self.library = _library_index()
         """The standard library of metrics."""
+        self.workspace: tuple[str, ...] = ()
+        """The client's workspace folders (absolute paths)."""
         self._generation = 0
 
     # ---------------------------------------------------------- analysis thread
@@ -82,7 +90,9 @@ class Project:
     def analyse(self, root: str, documents: Mapping[str, Document]) -> RootAnalysis:
         """Analyse the open document ``root`` with what it imports (open ones as the editor has them)."""
         overlay = {path: doc.text for path, doc in documents.items()}
-        result = analyse_for_editor(root, overlay, self.cache, self.texts)
+        scope = self.import_scope(root)
+        with reading_inside(*(scope.folders or ())):  # maps too: nothing outside the workspace
+            result = analyse_for_editor(root, overlay, self.cache, self.texts, scope)
         indexes, texts, complete = dict(self.indexes), dict(self.texts), dict(self.complete)
         for file in result.files:
             texts[file.path] = file.text
@@ -110,6 +120,36 @@ class Project:
         self.roots = {**self.roots, root: done}
         return done
 
+    def import_scope(self, root: str) -> ImportScope:
+        """What ``root`` may import: files inside the workspace folders when it is inside one of
+        them, else inside its own folder."""
+        workspace = ImportScope.inside(*self.workspace)
+        if self.workspace and workspace.holds(root):
+            return workspace
+        return ImportScope.inside(os.path.dirname(os.path.abspath(root)))
+
+    def failed(self, root: str, documents: Mapping[str, Document], error: BaseException) -> RootAnalysis:
+        """The analysis of ``root`` that raised ``error`` (a bug): one diagnostic at its start
+        saying so, in place of what an analysis would have found."""
+        kind = type(error).__name__
+        message = f"internal error: exsce could not check this file ({kind}), so no other problem is shown"
+        if isinstance(error, RecursionError):
+            message += "; something in it is nested too deeply for the checker"
+        message += "; please report it, with the file"
+        where = SourceLocation(root, 1, 1, 1, 1)
+        self._generation += 1
+        versions = {root: documents[root].version} if root in documents else {}
+        done = RootAnalysis(
+            root,
+            versions,
+            (root,),
+            {root: [Diagnostic(message, where, code="internal")]},
+            None,
+            self._generation,
+        )
+        self.roots = {**self.roots, root: done}
+        return done
+
     def close(self, path: str, documents: Mapping[str, Document]) -> None:
         """``path`` is no longer open: it is no longer a root (its analysis is dropped)."""
         roots = dict(self.roots)
@@ -127,8 +167,8 @@ class Project:
             if path in indexes:
                 continue
             try:
-                text = Path(path).read_text(encoding="utf-8")
-            except (OSError, UnicodeDecodeError):
+                text = read_text(path, "specification")
+            except ExsceError:  # not a regular file (a FIFO would block), too large, not UTF-8
                 continue
             index = index_text(text, display_path(path), self.cache)
             if index is not None:

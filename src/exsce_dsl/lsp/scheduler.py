@@ -80,11 +80,12 @@ class Scheduler:
                 documents = self._documents()
                 for root in self.project.roots_to_analyse(changed, documents):
                     # the edited documents first: their diagnostics are published before the others'
+                    read = dict(self._documents())
                     try:
-                        result = await self.run(self.project.analyse, root, dict(self._documents()))
-                    except Exception:  # a bug must not stop the analyses of the other documents
+                        result = await self.run(self.project.analyse, root, read)
+                    except Exception as exc:  # a bug must not stop the analyses of the other documents
                         logger.exception("the analysis of %s failed", root)
-                        continue
+                        result = self.project.failed(root, read, exc)  # and the editor is told
                     self._done([result])
         finally:
             if self._timer is None and not self._changed:

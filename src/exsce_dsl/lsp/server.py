@@ -11,7 +11,6 @@ so the event loop stays free.
 from __future__ import annotations
 
 import os
-from pathlib import Path
 from typing import Any
 
 from lsprotocol import types
@@ -19,13 +18,14 @@ from pygls.exceptions import JsonRpcException
 from pygls.lsp.server import LanguageServer
 
 from exsce_dsl import __version__
-from exsce_dsl.errors import Diagnostic, SourceLocation
+from exsce_dsl.errors import Diagnostic, ExsceError, SourceLocation
 from exsce_dsl.lang import FileIndex
 from exsce_dsl.lsp.convert import TextLines, lsp_diagnostic, path_of, uri_of
 from exsce_dsl.lsp.navigation import Names, Target
 from exsce_dsl.lsp.project import Document, Project, RootAnalysis
 from exsce_dsl.lsp.scheduler import Scheduler
 from exsce_dsl.lsp.shapes import ShapeChecks
+from exsce_dsl.textfiles import read_text
 
 REQUEST_FAILED = -32803
 """LSP's error code for a request that is valid but cannot be done."""
@@ -59,8 +59,8 @@ class ExsceLanguageServer(LanguageServer):
         if known is not None:
             return known
         try:
-            return Path(path).read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError):
+            return read_text(path)
+        except ExsceError:
             return ""
 
     def lines_of(self, path: str) -> TextLines:

@@ -15,6 +15,7 @@ import numpy as np
 import yaml
 
 from exsce_dsl.errors import ExsceError
+from exsce_dsl.textfiles import read_bytes, read_text
 
 FREE, OCCUPIED, UNKNOWN, OUTSIDE = "free", "occupied", "unknown", "outside"
 
@@ -78,42 +79,90 @@ class OccupancyGrid:
 def map_image(yaml_path: Path) -> Path | None:
     """The image a map_server YAML names, or None when the YAML cannot be read or names none."""
     try:
-        meta = yaml.safe_load(yaml_path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, yaml.YAMLError):
+        meta = _map_yaml(yaml_path)
+    except ExsceError:
         return None
     if not isinstance(meta, dict) or "image" not in meta:
         return None
     return yaml_path.parent / str(meta["image"])
 
 
-def load_occupancy_grid(yaml_path: Path) -> OccupancyGrid:
-    """Read a map_server YAML and its PGM image (binary P5 or ASCII P2)."""
+def _map_yaml(yaml_path: Path) -> object:
+    """The data of a map's YAML file, read with bounds (:func:`~exsce_dsl.textfiles.read_text`);
+    an error names the place of a YAML mistake but quotes nothing of the file (a map may name
+    any file, and its content is not ours to show)."""
     try:
-        meta = yaml.safe_load(yaml_path.read_text(encoding="utf-8"))
-    except (OSError, yaml.YAMLError) as exc:
-        raise ExsceError(f"cannot read map file {yaml_path}: {exc}") from None
+        text = read_text(yaml_path, "map file")
+    except ExsceError as exc:
+        told = f"cannot read {yaml_path}"
+        if not exc.message.startswith(told):
+            raise
+        raise ExsceError(f"cannot read map file {yaml_path}{exc.message.removeprefix(told)}") from None
+    try:
+        return yaml.safe_load(text)
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
+        raise ExsceError(f"map file {yaml_path} is not valid YAML{where}") from None
+    except (yaml.YAMLError, RecursionError):
+        raise ExsceError(f"map file {yaml_path} is not valid YAML (or is nested too deeply)") from None
+
+
+def load_occupancy_grid(yaml_path: Path) -> OccupancyGrid:
+    """Read a map_server YAML and its PGM image (binary P5 or ASCII P2), each a regular file of
+    at most :func:`~exsce_dsl.textfiles.max_file_bytes`."""
+    meta = _map_yaml(yaml_path)
     if not isinstance(meta, dict) or "image" not in meta or "resolution" not in meta:
         raise ExsceError(f"map file {yaml_path} is not a map_server YAML (needs image, resolution)")
     image = yaml_path.parent / str(meta["image"])
-    origin = [float(v) for v in (meta.get("origin") or [0.0, 0.0, 0.0])] + [0.0, 0.0, 0.0]
+    try:
+        origin = [float(v) for v in (meta.get("origin") or [0.0, 0.0, 0.0])] + [0.0, 0.0, 0.0]
+        resolution = float(meta["resolution"])
+        thresholds = float(meta.get("occupied_thresh", 0.65)), float(meta.get("free_thresh", 0.196))
+    except (TypeError, ValueError):  # the value is not quoted: the file may be anything
+        raise ExsceError(
+            f"map file {yaml_path}: resolution, origin and thresholds must be numbers"
+        ) from None
     return OccupancyGrid(
         cells=_read_pgm(image),
-        resolution=float(meta["resolution"]),
+        resolution=resolution,
         origin=(origin[0], origin[1], origin[2]),
-        occupied_thresh=float(meta.get("occupied_thresh", 0.65)),
-        free_thresh=float(meta.get("free_thresh", 0.196)),
+        occupied_thresh=thresholds[0],
+        free_thresh=thresholds[1],
         negate=bool(meta.get("negate", 0)),
     )
 
 
 def _read_pgm(path: Path) -> np.ndarray:
-    try:
-        data = path.read_bytes()
-    except OSError as exc:
-        raise ExsceError(f"cannot read map image {path}: {exc.strerror}") from None
+    data = read_bytes(path, "map image")
     magic = data[:2]
     if magic not in (b"P5", b"P2"):
         raise ExsceError(f"map image {path} is not a PGM file (only PGM maps are supported)")
+    try:
+        width, height, maxval, pos = _pgm_header(data)
+    except (ValueError, IndexError):  # the header's words are not numbers: quoted nowhere
+        raise ExsceError(f"map image {path} has no valid PGM header (width, height, maxval)") from None
+    if width <= 0 or height <= 0 or not 0 < maxval < 65536:
+        raise ExsceError(f"map image {path} has no valid PGM header (width, height, maxval)")
+    if magic == b"P2":
+        try:
+            values = np.array(data[pos:].split(), dtype=np.int64)
+        except ValueError:
+            raise ExsceError(f"map image {path} holds something other than numbers") from None
+    else:
+        pos += 1  # the single whitespace after maxval
+        dtype = np.uint8 if maxval < 256 else np.dtype(">u2")
+        if len(data) - pos < width * height * np.dtype(dtype).itemsize:
+            raise ExsceError(f"map image {path} is truncated")
+        values = np.frombuffer(data, dtype=dtype, count=width * height, offset=pos).astype(np.int64)
+    if values.size != width * height:
+        raise ExsceError(f"map image {path} is truncated")
+    scaled = values * 255 // maxval if maxval != 255 else values
+    return scaled.astype(np.uint8).reshape(height, width)
+
+
+def _pgm_header(data: bytes) -> tuple[int, int, int, int]:
+    """Width, height and maxval of a PGM image, and the offset just after them."""
     fields: list[bytes] = []
     pos = 2
     while len(fields) < 3:
@@ -125,18 +174,11 @@ def _read_pgm(path: Path) -> np.ndarray:
         start = pos
         while pos < len(data) and not data[pos : pos + 1].isspace():
             pos += 1
+        if start == pos:
+            raise ValueError("the header ends early")
         fields.append(data[start:pos])
     width, height, maxval = (int(f) for f in fields)
-    if magic == b"P2":
-        values = np.array(data[pos:].split(), dtype=np.int64)
-    else:
-        pos += 1  # the single whitespace after maxval
-        dtype = np.uint8 if maxval < 256 else np.dtype(">u2")
-        values = np.frombuffer(data, dtype=dtype, count=width * height, offset=pos).astype(np.int64)
-    if values.size != width * height:
-        raise ExsceError(f"map image {path} is truncated")
-    scaled = values * 255 // maxval if maxval != 255 else values
-    return scaled.astype(np.uint8).reshape(height, width)
+    return width, height, maxval, pos
 
 
 FREE_GREY, OCCUPIED_GREY, UNKNOWN_GREY = 254, 0, 205

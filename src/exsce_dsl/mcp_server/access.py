@@ -42,12 +42,14 @@ MAX_WORKING = 4
 
 @dataclass
 class Access:
-    """The store URL (None: the default store), the time limit of a request in seconds, and the
-    most rows an answer shows."""
+    """The store URL (None: the default store), the time limit of a request in seconds, the
+    most rows an answer shows, and the server's folder (None: where it started), outside which
+    no specification file is read."""
 
     store_url: str | None = None
     timeout: float = QUERY_TIMEOUT
     max_rows: int = DEFAULT_MAX_ROWS
+    root: str | None = None
     _limiter: anyio.CapacityLimiter | None = field(default=None, init=False, repr=False)
     _working: int = field(default=0, init=False, repr=False)
     _count_lock: threading.Lock = field(default_factory=threading.Lock, init=False, repr=False)

@@ -2,8 +2,9 @@
 
 A query answer is the same JSON as ``exscec query NAME --format json`` and
 ``exscec sparql --format json`` print, so a client reads one format from the
-command line and from the server.  At most ``max_rows`` rows are sent; an
-answer cut short says so in a ``truncated`` member (rows shown, rows found).
+command line and from the server.  At most ``max_rows`` rows are sent, and
+no more than one further row is taken from the store; an answer cut short says
+so in a ``truncated`` member (``{"shown": rows shown, "more": true}``).
 
 A tool's result carries its answer twice, as the protocol asks: as structured
 content (a JSON object) and as that object's JSON text, for clients that read
@@ -21,8 +22,9 @@ import mcp_types as types
 
 from exsce_dsl.mcp_server.access import Access
 from exsce_dsl.store.answers import results_json
+from exsce_dsl.store.base import Bindings, Store
 
-__all__ = ["READ_ONLY", "ToolEntry", "results_json", "tool_error", "tool_result"]
+__all__ = ["READ_ONLY", "ToolEntry", "first_rows_json", "results_json", "tool_error", "tool_result"]
 
 READ_ONLY = types.ToolAnnotations(
     read_only_hint=True, destructive_hint=False, idempotent_hint=True, open_world_hint=False
@@ -41,6 +43,18 @@ class ToolEntry:
     @property
     def name(self) -> str:
         return self.tool.name
+
+
+def first_rows_json(
+    store: Store, query: str, max_rows: int, bindings: Bindings | None = None
+) -> dict[str, Any]:
+    """The first ``max_rows`` rows of a SELECT as SPARQL 1.1 Query Results JSON, the store asked
+    for one more only (:meth:`~exsce_dsl.store.base.Store.select_first`)."""
+    rows, more = store.select_first(query, max_rows, bindings)
+    answer = results_json(rows)
+    if more:
+        answer["truncated"] = {"shown": len(rows), "more": True}
+    return answer
 
 
 def tool_result(answer: dict[str, Any]) -> types.CallToolResult:

@@ -13,6 +13,7 @@ import functools
 from collections.abc import Iterable
 from pathlib import Path
 
+from exsce_dsl.errors import ExsceError
 from exsce_dsl.messages.catalogue import (
     MessageCatalogue,
     MessageTypeError,
@@ -24,6 +25,7 @@ from exsce_dsl.messages.msg_path import MSG_PATH as MSG_PATH
 from exsce_dsl.messages.msg_path import definition_files as _definition_files
 from exsce_dsl.messages.msg_path import msg_path_files as msg_path_files
 from exsce_dsl.messages.msg_path import msg_path_folders as msg_path_folders
+from exsce_dsl.textfiles import read_text
 
 
 def user_catalogue(folders: Iterable[str | Path]) -> MessageCatalogue:
@@ -34,9 +36,9 @@ def user_catalogue(folders: Iterable[str | Path]) -> MessageCatalogue:
         for path in _definition_files(Path(folder)):
             source = Source(str(path))
             try:
-                text = path.read_text(encoding="utf-8")
-            except (OSError, UnicodeDecodeError) as exc:
-                raise MessageTypeError(f"{path}: cannot read the message definition: {exc}") from None
+                text = read_text(path, "message definition")  # a regular file, bounded
+            except ExsceError as exc:
+                raise MessageTypeError(f"{path}: cannot read the message definition: {exc.message}") from None
             kind = path.suffix[1:]
             name = _msg_type(path) if kind == "msg" else path.stem
             catalogue.add(parse_definition(text, name, kind, source).definitions, source)

@@ -95,6 +95,13 @@ class Store(abc.ABC):
     def select(self, query: str, bindings: Bindings | None = None) -> Rows:
         """Run a SELECT; ``bindings`` are bound as RDF terms, never pasted into the text."""
 
+    def select_first(self, query: str, most: int, bindings: Bindings | None = None) -> tuple[Rows, bool]:
+        """The first ``most`` rows of a SELECT, and whether it has more.  A store that can stop
+        reading solutions after ``most + 1`` does (the embedded one): a query with a billion
+        solutions answers its first thousand without computing the rest."""
+        rows = self.select(query, bindings)
+        return Rows(rows.variables, rows.rows[:most]), len(rows) > most
+
     @abc.abstractmethod
     def ask(self, query: str, bindings: Bindings | None = None) -> bool: ...
 

@@ -19,6 +19,7 @@ not exist yet finds it empty.
 
 from __future__ import annotations
 
+import itertools
 import os
 import time
 from collections.abc import Sequence
@@ -204,15 +205,25 @@ class EmbeddedStore(Store):
             raise StoreError(f"the query failed on the store at {self.location}: {exc}") from None
 
     def select(self, query: str, bindings: Bindings | None = None) -> Rows:
+        return self._solutions(query, bindings, None)[0]
+
+    def select_first(self, query: str, most: int, bindings: Bindings | None = None) -> tuple[Rows, bool]:
+        return self._solutions(query, bindings, most)
+
+    def _solutions(self, query: str, bindings: Bindings | None, most: int | None) -> tuple[Rows, bool]:
+        """The rows of a SELECT (the first ``most``, pulled lazily) and whether there were more."""
         result = self.query(query, bindings)
         if not isinstance(result, QuerySolutions):
             raise StoreError("not a SELECT query")
         variables = tuple(v.value for v in result.variables)
+        taken = result if most is None else itertools.islice(result, most + 1)
         try:
-            rows = tuple(tuple(solution[v] for v in variables) for solution in result)
+            rows = tuple(tuple(solution[v] for v in variables) for solution in taken)
         except (OSError, RuntimeError, ValueError) as exc:
             raise StoreError(f"the query failed on the store at {self.location}: {exc}") from None
-        return Rows(variables, rows)
+        if most is not None and len(rows) > most:
+            return Rows(variables, rows[:most]), True
+        return Rows(variables, rows), False
 
     def ask(self, query: str, bindings: Bindings | None = None) -> bool:
         result = self.query(query, bindings)

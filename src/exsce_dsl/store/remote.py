@@ -27,6 +27,7 @@ every request, or HTTP Digest).
 from __future__ import annotations
 
 import base64
+import itertools
 import socket
 import urllib.error
 import urllib.parse
@@ -206,15 +207,27 @@ class RemoteStore(Store):
             body, _ = self._post_sparql(self.url, "query", bind(query, bindings), virtuoso.TURTLE)
             rows = virtuoso.result_set_rows(body, self.label)
             return Rows(rows.variables, tuple(tuple(_unskolemised(t) for t in row) for row in rows.rows))
+        return self._solutions(query, bindings, None)[0]
+
+    def select_first(self, query: str, most: int, bindings: Bindings | None = None) -> tuple[Rows, bool]:
+        """As the base's, but the solutions of the answer are turned into rows lazily."""
+        if self.is_virtuoso():
+            return super().select_first(query, most, bindings)
+        return self._solutions(query, bindings, most)
+
+    def _solutions(self, query: str, bindings: Bindings | None, most: int | None) -> tuple[Rows, bool]:
+        """The rows of a SELECT's answer (the first ``most``) and whether it has more."""
         result = self._query(query, bindings)
         variables = tuple(v.value for v in result.variables) if isinstance(result, QuerySolutions) else ()
         if not isinstance(result, QuerySolutions) or (
             variables == (ASK_VIRTUOSO,) and query_form(query) == "ASK"
         ):
             raise StoreError("not a SELECT query")
-        return Rows(
-            variables, tuple(tuple(_unskolemised(solution[v]) for v in variables) for solution in result)
-        )
+        taken = result if most is None else itertools.islice(result, most + 1)
+        rows = tuple(tuple(_unskolemised(solution[v]) for v in variables) for solution in taken)
+        if most is not None and len(rows) > most:
+            return Rows(variables, rows[:most]), True
+        return Rows(variables, rows), False
 
     def ask(self, query: str, bindings: Bindings | None = None) -> bool:
         result = self._query(query, bindings)

@@ -27,7 +27,7 @@ from exsce_dsl.lang.build.robots import build_robot_type
 from exsce_dsl.lang.build.scenarios import build_scenario
 from exsce_dsl.lang.build.standard_metrics import reserved_metric_names
 from exsce_dsl.lang.build.tasks import build_task, task_pose_candidates
-from exsce_dsl.lang.loader import Parse, read_sources
+from exsce_dsl.lang.loader import ANYWHERE, ImportScope, Parse, read_sources
 from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.model import Document, Import, Specification
 
@@ -63,9 +63,12 @@ def load_spec_reading(
     return analysis.spec, tuple(f.path for f in sources.files)
 
 
-def analyse(path: str | Path, overlay: Mapping[str, str] | None = None) -> Analysis:
-    """Like :func:`load_spec`, but return diagnostics instead of raising (for editors and ``check``)."""
-    sources = read_sources(path, overlay)
+def analyse(
+    path: str | Path, overlay: Mapping[str, str] | None = None, scope: ImportScope = ANYWHERE
+) -> Analysis:
+    """Like :func:`load_spec`, but return diagnostics instead of raising (for editors and ``check``);
+    ``scope`` says which files may be imported."""
+    sources = read_sources(path, overlay, scope=scope)
     return analyse_files(sources.files, sources.diagnostics, sources.broken)
 
 

@@ -18,7 +18,7 @@ from exsce_dsl.errors import Diagnostic
 from exsce_dsl.lang.build.specification import Analysis, analyse_files
 from exsce_dsl.lang.editor.symbols import FileIndex, index_file
 from exsce_dsl.lang.incremental import ParseCache
-from exsce_dsl.lang.loader import parse_whole, read_sources
+from exsce_dsl.lang.loader import ANYWHERE, ImportScope, parse_whole, read_sources
 from exsce_dsl.lang.parser import ParsedFile
 
 
@@ -47,8 +47,10 @@ def analyse_for_editor(
     overlay: Mapping[str, str],
     cache: ParseCache,
     indexed: Mapping[str, str] | None = None,
+    scope: ImportScope = ANYWHERE,
 ) -> EditorAnalysis:
-    """Analyse ``root``; ``indexed`` maps absolute paths to the texts whose index the caller has."""
+    """Analyse ``root``; ``indexed`` maps absolute paths to the texts whose index the caller has,
+    ``scope`` says which files may be imported (the editor's workspace)."""
     known = indexed or {}
     read: list[FileRead] = []
 
@@ -59,7 +61,7 @@ def analyse_for_editor(
         read.append(FileRead(full, text, index, pf is not None and not errors))
         return pf, errors
 
-    sources = read_sources(root, overlay, parse=parse)
+    sources = read_sources(root, overlay, parse=parse, scope=scope)
     analysis = analyse_files(sources.files, sources.diagnostics, sources.broken, parse=cache.parse)
     return EditorAnalysis(analysis, tuple(read))
 
