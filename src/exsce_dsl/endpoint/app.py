@@ -161,7 +161,8 @@ async def _answer(endpoint: Endpoint, job: Job) -> Response:
 
 async def _not_found(request: Request) -> Response:
     raise RefusedRequest(
-        HTTPStatus.NOT_FOUND, f"{request.method} {request.url.path}: no such resource (try /, /query, /update)"
+        HTTPStatus.NOT_FOUND,
+        f"{request.method} {request.url.path}: no such resource (try /, /query, /update)",
     )
 
 

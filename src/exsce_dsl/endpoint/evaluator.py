@@ -146,7 +146,9 @@ class Evaluator:
             try:
                 await anyio.to_thread.run_sync(conn.send, job)
             except OSError:
-                raise RefusedRequest(HTTPStatus.SERVICE_UNAVAILABLE, "the query worker stopped; try again") from None
+                raise RefusedRequest(
+                    HTTPStatus.SERVICE_UNAVAILABLE, "the query worker stopped; try again"
+                ) from None
             tag, payload = await self._receive(conn, session, job)
             if tag == END:
                 finished = True

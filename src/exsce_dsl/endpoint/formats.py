@@ -47,6 +47,8 @@ _FORMAT_NAMES = {
     "nq": "application/n-quads",
     "trig": "application/trig",
 }
+
+
 def format_parameter(params: Parameters) -> str:
     """``format=`` / ``output=`` (short names or media types, as clients send them) as an Accept value."""
     wanted = [*params.get("format", []), *params.get("output", [])]

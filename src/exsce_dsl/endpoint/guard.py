@@ -8,6 +8,8 @@
 * A request from a browser page of another origin is refused (403): its ``Origin`` header, when
   present, must be this server's own origin, and its ``Sec-Fetch-Site``, when present, must be
   ``same-origin`` or ``none``.  No CORS header is ever sent.
+* A request framed both by ``Content-Length`` and ``Transfer-Encoding`` is refused and its
+  connection closed (h11 refuses every other bad framing itself).
 * Every answer says ``Cache-Control: no-store`` and ``X-Content-Type-Options: nosniff``.
 """
 
@@ -118,6 +120,14 @@ class Guard:
                 self.log(f"{client[0]} {scope['method']} {scope['path']}{query[:200]} {shown}")
 
     def _refusal(self, headers: dict[str, str]) -> Any:
+        if "transfer-encoding" in headers and "content-length" in headers:
+            # h11 reads such a body as chunked and would read what follows as the next request
+            # (RFC 9112, 6.1: reject, or close the connection after the answer): both, here
+            return PlainTextResponse(
+                "a request framed both by Content-Length and by Transfer-Encoding is refused\n",
+                status_code=400,
+                headers={"Connection": "close"},
+            )
         host = headers.get("host", "")
         if not self.rule.admits(host):
             return PlainTextResponse(

@@ -123,7 +123,9 @@ def serve(
         if info_path is not None and store_path is not None:
             info = ServeInfo(url, os.getpid(), str(store_path.resolve()), options.token is not None)
             write_serve_info(info_path, info)
-        app = make_app(evaluator, HostRule(options.host, port, options.allowed_hosts), options.token, options.log)
+        app = make_app(
+            evaluator, HostRule(options.host, port, options.allowed_hosts), options.token, options.log
+        )
         config = uvicorn.Config(
             app,
             lifespan="off",
