@@ -254,26 +254,11 @@ def serve(
       exscec serve --bind 127.0.0.1:0     # on a free port, printed first
       exscec serve --allow-federation query.wikidata.org
     """
-    from exsce_dsl.endpoint.server import (
-        ServeOptions,
-        allowed_names,
-        check_token,
-        is_loopback,
-        new_token,
-        servable_store,
-    )
+    from exsce_dsl.endpoint.server import ServeOptions, allowed_names, is_loopback, servable_store
     from exsce_dsl.endpoint.server import serve as serve_store
 
     host, port = _parse_bind(bind)
-    if not allow_updates:
-        token = None
-    elif token:
-        token = check_token(token)
-    else:
-        token = new_token()
-        click.echo(
-            f"updates need this bearer token: {token}  (exscec commands: EXSCE_STORE_TOKEN={token})", err=True
-        )
+    token = _update_token(token) if allow_updates else None
     if not is_loopback(host):
         click.echo(
             f"warning: listening on {host}: other machines can reach this endpoint"
@@ -304,6 +289,18 @@ def serve(
         click.echo(f"serving {where} at {url}/ ({mode}); Ctrl-C to stop", err=True)
 
     serve_store(store_path, options, on_ready=ready)
+
+
+def _update_token(given: str | None) -> str:
+    """The token updates need: ``given`` (if long enough), else a new one, printed once."""
+    from exsce_dsl.endpoint.server import check_token, new_token
+
+    if given:
+        return check_token(given)
+    token = new_token()
+    shown = f"updates need this bearer token: {token}  (exscec commands: EXSCE_STORE_TOKEN={token})"
+    click.echo(shown, err=True)
+    return token
 
 
 def _parse_bind(bind: str) -> tuple[str, int]:
