@@ -22,6 +22,7 @@ from __future__ import annotations
 import contextlib
 import json
 import re
+import signal
 import sys
 import threading
 from dataclasses import dataclass
@@ -249,13 +250,14 @@ def _import_parser() -> None:
 
 
 def _die_with_parent() -> None:
-    """Ask Linux to kill this process when its parent (the fork server, which stops with the
-    HTTP process) dies, so that a runaway query never outlives the server."""
+    """Leave Ctrl-C to the HTTP process (which stops this one: a terminal sends SIGINT to the
+    whole process group), and ask Linux to kill this process when its parent (the fork server,
+    which stops with the HTTP process) dies, so that a runaway query never outlives the server."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     if not sys.platform.startswith("linux"):
         return
     with contextlib.suppress(Exception):
         import ctypes
-        import signal
 
         libc = ctypes.CDLL(None, use_errno=True)
         libc.prctl(1, int(signal.SIGKILL), 0, 0, 0)  # PR_SET_PDEATHSIG
