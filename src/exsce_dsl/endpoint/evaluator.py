@@ -174,8 +174,6 @@ class Evaluator:
                 try:
                     tag, payload = await self._receive(conn, session, job)
                 except RefusedRequest as exc:
-                    if self.log is not None:
-                        self.log(f"an answer was cut after its headers: {exc.message}")
                     raise AnswerCut(exc.message) from None
                 if tag == END:
                     finished = True

@@ -16,6 +16,7 @@
 from __future__ import annotations
 
 import ipaddress
+import logging
 from collections.abc import Callable, Collection
 from typing import Any
 
@@ -23,7 +24,9 @@ from starlette.responses import PlainTextResponse
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from exsce_dsl import __version__
+from exsce_dsl.endpoint.evaluator import AnswerCut
 
+LOGGER = logging.getLogger("exsce_dsl.endpoint")
 WILDCARDS = ("0.0.0.0", "::", "")
 LOOPBACK_NAMES = ("127.0.0.1", "localhost", "::1")
 
@@ -112,6 +115,8 @@ class Guard:
                 await refusal(scope, receive, sending)
             else:
                 await self.app(scope, receive, sending)
+        except AnswerCut as cut:  # headers sent: uvicorn closes the connection before the body's end
+            LOGGER.warning("an answer to %s was cut: %s", scope.get("client", ("-",))[0], cut)
         finally:
             if self.log is not None:
                 client = scope.get("client") or ("-", 0)

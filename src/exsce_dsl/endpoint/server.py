@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import logging
 import os
 import secrets
 import signal
@@ -133,12 +134,14 @@ def serve(
             ws="none",
             log_config=None,
             access_log=False,
+            proxy_headers=False,
             server_header=False,
             date_header=True,
             limit_concurrency=MAX_CONNECTIONS,
             timeout_graceful_shutdown=1,
             timeout_keep_alive=5,
         )
+        _log_to_stderr()
         if on_ready is not None:
             on_ready(url)
         server = _Server(config, evaluator)
@@ -150,6 +153,19 @@ def serve(
         if info_path is not None:
             with contextlib.suppress(FileNotFoundError):
                 info_path.unlink()
+
+
+def _log_to_stderr() -> None:
+    """uvicorn's warnings and errors (a malformed request, a bug of ours) and the endpoint's own,
+    one line each on stderr; an answer cut after its headers is said once, by the guard."""
+    handler = logging.StreamHandler()
+    handler.setFormatter(logging.Formatter("exscec serve: %(message)s"))
+    handler.addFilter(lambda record: "without completing response" not in record.getMessage())
+    for name in ("uvicorn.error", "exsce_dsl.endpoint"):
+        logger = logging.getLogger(name)
+        logger.handlers[:] = [handler]
+        logger.setLevel(logging.WARNING)
+        logger.propagate = False
 
 
 def _listen(host: str, port: int) -> socket.socket:
