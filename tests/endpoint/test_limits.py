@@ -5,6 +5,7 @@ server at once, and answers (``/store``'s too) are counted while they stream."""
 from __future__ import annotations
 
 import concurrent.futures
+import contextlib
 import http.client
 import signal
 import threading
@@ -56,6 +57,12 @@ def query(server: Server, text: str) -> tuple[int, bytes]:
     return get(f"{server.url}/query?{urllib.parse.urlencode({'query': text})}")
 
 
+def ask_and_forget(server: Server, text: str) -> None:
+    """Send a query whose answer will never come (the server is stopped meanwhile)."""
+    with contextlib.suppress(OSError, http.client.HTTPException):
+        query(server, text)
+
+
 def test_ask_answered_within_a_second_after_two_runaway_queries(store: Path) -> None:
     with exscec_serve("--store", str(store), "--query-timeout", "1") as server:
         for _ in range(2):
@@ -79,7 +86,7 @@ def test_ask_answered_within_a_second_after_two_runaway_queries(store: Path) -> 
 def test_sigterm_stops_within_two_seconds_with_a_runaway_query(store: Path) -> None:
     server = start_exscec_serve("--store", str(store), "--query-timeout", "600")
     try:
-        running = threading.Thread(target=lambda: query(server, RUNAWAY), daemon=True)
+        running = threading.Thread(target=ask_and_forget, args=(server, RUNAWAY), daemon=True)
         running.start()
         time.sleep(0.5)  # the query is running in the worker
         children = psutil.Process(server.process.pid).children(recursive=True)
@@ -142,3 +149,23 @@ def test_store_obeys_max_answer(store: Path) -> None:
         assert status == 503 and b"over the endpoint's limit" in body
         status, body = query(server, "SELECT * WHERE { GRAPH ?g { ?s ?p ?o } } LIMIT 3")
         assert status == 200 and body.count(b'"s":') == 3
+
+
+def test_runaway_query_does_not_outlive_a_killed_server(store: Path) -> None:
+    """SIGKILL leaves the server no time to stop its worker: the worker goes with its fork server."""
+    server = start_exscec_serve("--store", str(store), "--query-timeout", "600")
+    try:
+        running = threading.Thread(target=ask_and_forget, args=(server, RUNAWAY), daemon=True)
+        running.start()
+        time.sleep(0.5)
+        children = psutil.Process(server.process.pid).children(recursive=True)
+        assert len(children) >= 2  # the fork server and the worker
+        server.process.kill()
+        server.process.wait(timeout=10)
+        gone, alive = psutil.wait_procs(children, timeout=3)
+        assert not alive
+    finally:
+        stop(server.process)
+    serve_info_path(store).unlink()  # a killed server leaves it (ignored: its pid is dead)
+    with EmbeddedStore(store) as reopened:
+        assert len(reopened.graph(GRAPH.value)) == 3000

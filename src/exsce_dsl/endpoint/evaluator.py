@@ -62,6 +62,8 @@ class Evaluator:
         self._context.set_forkserver_preload(["exsce_dsl.endpoint.worker"])
         self._process: Any = None
         self._conn: Connection | None = None
+        self._lifeline: Connection | None = None
+        """Held, never written: the worker ends when it reads EOF (this process has gone)."""
         self._lock: asyncio.Lock | None = None
         self._session = 0
         """The running job's number; 0 when none runs."""
@@ -78,9 +80,13 @@ class Evaluator:
     def start(self) -> None:
         """Start a worker and wait until it has opened the store (a StoreError if it cannot)."""
         ours, theirs = self._context.Pipe()
-        process = self._context.Process(target=run_worker, args=(theirs, self.settings), daemon=True)
+        lifeline, held = self._context.Pipe(duplex=False)
+        process = self._context.Process(
+            target=run_worker, args=(theirs, lifeline, self.settings), daemon=True
+        )
         process.start()
         theirs.close()
+        lifeline.close()
         try:
             if not ours.poll(STARTUP_SECONDS):
                 raise StoreError(f"the query worker did not start within {STARTUP_SECONDS:g} s")
@@ -93,7 +99,7 @@ class Evaluator:
         if message[:1] != READY:
             process.join(5)
             raise StoreError(json.loads(message[1:])["message"])
-        self._process, self._conn = process, ours
+        self._process, self._conn, self._lifeline = process, ours, held
 
     def kill(self) -> None:
         """Stop the worker now (SIGKILL), whatever it is doing; the next job starts another."""
@@ -101,6 +107,9 @@ class Evaluator:
         if process is not None:
             process.kill()
             process.join(5)
+        if self._lifeline is not None:
+            self._lifeline.close()
+            self._lifeline = None
 
     def interrupt(self) -> None:
         """Kill the worker if a job runs: the server is stopping (no other worker is started)."""

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import os
 import re
 import signal
 import sys
@@ -116,10 +117,10 @@ class _Chunks:
             self.buffer.clear()
 
 
-def run_worker(conn: Connection, settings: Settings) -> None:
+def run_worker(conn: Connection, lifeline: Connection, settings: Settings) -> None:
     """The worker's life: open the store, say READY, answer jobs until the pipe closes (or a
     ``None`` job), then flush and release the store."""
-    _die_with_parent()
+    _leave_stopping_to_the_server(lifeline)
     try:
         store = EmbeddedStore(settings.store_path)
         oxigraph = store.oxigraph
@@ -249,18 +250,20 @@ def _import_parser() -> None:
         import rdflib.plugins.sparql.parser  # noqa: F401
 
 
-def _die_with_parent() -> None:
-    """Leave Ctrl-C to the HTTP process (which stops this one: a terminal sends SIGINT to the
-    whole process group), and ask Linux to kill this process when its parent (the fork server,
-    which stops with the HTTP process) dies, so that a runaway query never outlives the server."""
+def _leave_stopping_to_the_server(lifeline: Connection) -> None:
+    """Leave Ctrl-C to the HTTP process (a terminal sends SIGINT to the whole process group; the
+    server then stops this process), and end this process as soon as the HTTP process is gone:
+    ``lifeline``'s other end is held by the HTTP process only, so it reads EOF when that process
+    dies, even by SIGKILL, and a runaway query never outlives the server.  (The fork server
+    cannot do it: it lives as long as any of its children.)"""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    if not sys.platform.startswith("linux"):
-        return
-    with contextlib.suppress(Exception):
-        import ctypes
 
-        libc = ctypes.CDLL(None, use_errno=True)
-        libc.prctl(1, int(signal.SIGKILL), 0, 0, 0)  # PR_SET_PDEATHSIG
+    def watch() -> None:
+        with contextlib.suppress(EOFError, OSError):
+            lifeline.recv_bytes()
+        os._exit(1)
+
+    threading.Thread(target=watch, name="lifeline", daemon=True).start()
 
 
 __all__ = ["CHUNK", "Job", "Settings", "run_worker", "too_large"]
