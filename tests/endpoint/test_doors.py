@@ -127,6 +127,9 @@ def test_load_refused_with_updates(writable: Server, listener: socket.socket) ->
     for text in (f"LOAD <{target}>", f"LOAD SILENT <{target}> INTO GRAPH <http://example.org/g>"):
         status, body = http(f"{writable.url}/update", text.encode(), headers)
         assert status == 403 and b"LOAD <" in body and b"is refused" in body
+    service = f"INSERT {{ ?s ?p ?o }} WHERE {{ SERVICE <{target}> {{ ?s ?p ?o }} }}"
+    status, body = http(f"{writable.url}/update", service.encode(), headers)
+    assert status == 403 and b"SERVICE <" in body
     assert not connected(listener)
     ok = b"INSERT DATA { <http://example.org/s> <http://example.org/p> 'download service' }"
     assert http(f"{writable.url}/update", ok, headers)[0] == 204  # the words in data are no clause

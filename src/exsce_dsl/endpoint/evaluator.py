@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import asyncio
 import json
+import logging
 import multiprocessing
 from collections.abc import AsyncIterator, Callable
 from dataclasses import dataclass
@@ -33,6 +34,7 @@ from exsce_dsl.endpoint.protocol import RefusedRequest
 from exsce_dsl.endpoint.worker import DATA, END, HEAD, READY, REFUSED, Job, Settings, run_worker
 from exsce_dsl.errors import StoreError
 
+LOGGER = logging.getLogger("exsce_dsl.endpoint")
 FIRST_BUFFER = 4 * 1024 * 1024
 """Bytes of an answer read before its headers are sent."""
 STARTUP_SECONDS = 30.0
@@ -148,8 +150,12 @@ class Evaluator:
                 self.kill()
                 try:
                     await anyio.to_thread.run_sync(self.start)
-                except StoreError as exc:
-                    raise RefusedRequest(HTTPStatus.SERVICE_UNAVAILABLE, exc.message) from None
+                except StoreError as exc:  # the detail (paths, processes) is the operator's
+                    LOGGER.warning("the query worker could not start: %s", exc.message)
+                    raise RefusedRequest(
+                        HTTPStatus.SERVICE_UNAVAILABLE,
+                        "the store cannot be opened now (the server's log says why)",
+                    ) from None
             conn = self._conn
             assert conn is not None
             try:
@@ -244,8 +250,7 @@ class Evaluator:
                 try:
                     await anyio.to_thread.run_sync(self.start)
                 except StoreError as exc:
-                    if self.log is not None:
-                        self.log(f"the query worker could not start again: {exc.message}")
+                    LOGGER.warning("the query worker could not start again: %s", exc.message)
 
 
 def _next_message(conn: Connection) -> bytes | None:
