@@ -31,7 +31,7 @@ from tests.support.cli import run_exscec
 from tests.support.paths import EXAMPLES
 from tests.support.store_servers import Server, exscec_serve, start_exscec_serve, stop
 
-TOKEN = "s3cret-token"
+TOKEN = "s3cret-token-of-the-tests"
 SCENARIO_C = EXAMPLES / "brsu_building_c" / "scenario_c.exsce"
 SCENARIO_A = EXAMPLES / "brsu_building_c" / "scenario_a.exsce"
 PREFIXES = """PREFIX geom: <https://robot-schema.org/>

@@ -21,7 +21,7 @@ from tests.support.store_servers import Server, exscec_serve, oxigraph_server, v
 EX = "http://example.org/"
 G1, G2, G3 = f"{EX}g1", f"{EX}g2", f"{EX}g3"
 P = NamedNode(f"{EX}p")
-TOKEN = "behaviour-token"
+TOKEN = "behaviour-token-of-the-tests"
 
 
 def q(s: str, o: str | Literal | NamedNode, g: str, p: NamedNode = P) -> Quad:

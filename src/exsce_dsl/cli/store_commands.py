@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import ipaddress
-import secrets
 from collections.abc import Callable
 from typing import Any, TypeVar
 
@@ -185,7 +183,23 @@ def clear(store_url: str | None) -> None:
     "--token",
     envvar="EXSCE_STORE_TOKEN",
     metavar="TOKEN",
-    help="The bearer token updates need (default: $EXSCE_STORE_TOKEN, else a new one, printed once).",
+    help="The bearer token updates need, 16 characters or more "
+    "(default: $EXSCE_STORE_TOKEN, else a new one, printed once).",
+)
+@click.option(
+    "--allow-federation",
+    "federation_hosts",
+    multiple=True,
+    metavar="HOST",
+    help="Let SERVICE (and, with --allow-updates, LOAD) reach HOST; repeatable. Default: no host.",
+)
+@click.option(
+    "--allowed-host",
+    "allowed_hosts",
+    multiple=True,
+    metavar="NAME",
+    help="Answer requests whose Host header is NAME (a reverse proxy's name), besides the bound "
+    "address; repeatable.",
 )
 @click.option("--union-default-graph", is_flag=True, help="Queries without GRAPH see every named graph.")
 @click.option("--log", "log_requests", is_flag=True, help="Print each request on stderr.")
@@ -195,7 +209,7 @@ def clear(store_url: str | None) -> None:
     default=60.0,
     show_default=True,
     metavar="SECONDS",
-    help="Answer 503 to a query that runs longer.",
+    help="Stop a query or update that runs longer (with its answer) and answer 503.",
 )
 @click.option(
     "--max-answer-mb",
@@ -203,7 +217,7 @@ def clear(store_url: str | None) -> None:
     default=256.0,
     show_default=True,
     metavar="MIB",
-    help="Answer 503 instead of a larger answer.",
+    help="Answer 503 instead of a larger answer (also /store).",
 )
 @reports_errors
 def serve(
@@ -211,6 +225,8 @@ def serve(
     bind: str,
     allow_updates: bool,
     token: str | None,
+    federation_hosts: tuple[str, ...],
+    allowed_hosts: tuple[str, ...],
     union_default_graph: bool,
     log_requests: bool,
     query_timeout: float,
@@ -227,35 +243,23 @@ def serve(
     on stdout: ask it with `curl 'URL/query?query=ASK%7B%7D'`, or from
     another machine's exscec with --store URL/query.
 
+    Closed unless opened: SERVICE and LOAD reach no other server without
+    --allow-federation HOST; requests must name the server as bound in their
+    Host header (--allowed-host adds a name) and come from its own page, not
+    another origin's; a query is stopped at --query-timeout.
+
     \b
     Example:
       exscec serve                        # at http://127.0.0.1:7878/
       exscec serve --bind 127.0.0.1:0     # on a free port, printed first
+      exscec serve --allow-federation query.wikidata.org
     """
-    from exsce_dsl.endpoint.server import SparqlServer, make_server, run_server
-    from exsce_dsl.store.embedded import EmbeddedStore
-    from exsce_dsl.store.open import open_store
-    from exsce_dsl.store.remote import RemoteStore
+    from exsce_dsl.endpoint.server import ServeOptions, allowed_names, is_loopback, servable_store
+    from exsce_dsl.endpoint.server import serve as serve_store
 
     host, port = _parse_bind(bind)
-    store = open_store(store_url)
-    if isinstance(store, RemoteStore):
-        if store.served_by is not None:
-            raise click.ClickException(
-                f"{store.location}: the store is served already (pid {store.served_by})"
-            )
-        raise click.UsageError(
-            f"{store.location} is a SPARQL endpoint already; exscec serve serves an embedded store"
-        )
-    assert isinstance(store, EmbeddedStore)
-    if not allow_updates:
-        token = None
-    elif not token:
-        token = secrets.token_urlsafe(24)
-        click.echo(
-            f"updates need this bearer token: {token}  (exscec commands: EXSCE_STORE_TOKEN={token})", err=True
-        )
-    if not _is_loopback(host):
+    token = _update_token(token) if allow_updates else None
+    if not is_loopback(host):
         click.echo(
             f"warning: listening on {host}: other machines can reach this endpoint"
             + (" and, with the token, change the store" if token else ""),
@@ -265,23 +269,38 @@ def serve(
     def log(line: str) -> None:
         click.echo(line, err=True)
 
-    server = make_server(
-        store,
+    options = ServeOptions(
         host,
         port,
         token=token,
         union_default_graph=union_default_graph,
-        log=log if log_requests else None,
         query_timeout=query_timeout,
         max_answer=int(max_answer_mb * 2**20),
+        allowed_hosts=allowed_names(allowed_hosts),
+        federation_hosts=allowed_names(federation_hosts),
+        log=log if log_requests else None,
     )
+    store_path = servable_store(store_url)
 
-    def ready(server: SparqlServer) -> None:
-        click.echo(f"{server.url}/")
+    def ready(url: str) -> None:
+        click.echo(f"{url}/")
         mode = "updates with a bearer token" if token else "read-only"
-        click.echo(f"serving {store.location} at {server.url}/ ({mode}); Ctrl-C to stop", err=True)
+        where = store_path if store_path is not None else "memory:"
+        click.echo(f"serving {where} at {url}/ ({mode}); Ctrl-C to stop", err=True)
 
-    run_server(server, on_ready=ready)
+    serve_store(store_path, options, on_ready=ready)
+
+
+def _update_token(given: str | None) -> str:
+    """The token updates need: ``given`` (if long enough), else a new one, printed once."""
+    from exsce_dsl.endpoint.server import check_token, new_token
+
+    if given:
+        return check_token(given)
+    token = new_token()
+    shown = f"updates need this bearer token: {token}  (exscec commands: EXSCE_STORE_TOKEN={token})"
+    click.echo(shown, err=True)
+    return token
 
 
 def _parse_bind(bind: str) -> tuple[str, int]:
@@ -296,15 +315,6 @@ def _parse_bind(bind: str) -> tuple[str, int]:
     if not 0 <= port <= 65535:
         raise click.BadParameter(f"port {port} is out of range", param_hint="--bind")
     return host, port
-
-
-def _is_loopback(host: str) -> bool:
-    if host == "localhost":
-        return True
-    try:
-        return ipaddress.ip_address(host).is_loopback
-    except ValueError:
-        return False
 
 
 COMMANDS = [store_group, serve]

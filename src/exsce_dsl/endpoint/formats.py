@@ -1,13 +1,13 @@
-"""Answers: which format a client asks for (its ``Accept`` header, or ``format=``), and a query's
-answer serialized in it (SELECT and ASK as SPARQL results, CONSTRUCT and DESCRIBE as RDF)."""
+"""Answers' formats: which one a client asks for (its ``Accept`` header, or ``format=``), among
+SPARQL results (SELECT, ASK), graphs (CONSTRUCT, DESCRIBE, one graph of the Graph Store) and
+datasets (the whole store)."""
 
 from __future__ import annotations
 
-import re
 from http import HTTPStatus
 from typing import Any
 
-from pyoxigraph import QueryBoolean, QueryResultsFormat, QuerySolutions, QueryTriples, RdfFormat
+from pyoxigraph import QueryResultsFormat, RdfFormat
 
 from exsce_dsl.endpoint.protocol import Parameters, RefusedRequest
 
@@ -47,35 +47,6 @@ _FORMAT_NAMES = {
     "nq": "application/n-quads",
     "trig": "application/trig",
 }
-_UPDATE_START = re.compile(
-    r"^\s*(?:(?:PREFIX\s+\S*\s*<[^>]*>|BASE\s*<[^>]*>|#[^\n]*)\s*)*"
-    r"(INSERT|DELETE|LOAD|CLEAR|DROP|CREATE|ADD|MOVE|COPY|WITH)\b",
-    re.IGNORECASE,
-)
-
-
-def evaluate(store: Any, text: str, options: dict[str, Any], accept: str) -> tuple[bytes, str]:
-    """Run a query and serialize its answer in the format ``accept`` asks for: (bytes, media type)."""
-    try:
-        result = store.query(text, **options)
-    except SyntaxError as exc:
-        hint = " (this is an update: POST it to /update)" if _UPDATE_START.match(text) else ""
-        raise RefusedRequest(HTTPStatus.BAD_REQUEST, f"SPARQL syntax error: {exc}{hint}") from None
-    except (OSError, RuntimeError, ValueError) as exc:
-        raise RefusedRequest(HTTPStatus.INTERNAL_SERVER_ERROR, f"the query failed: {exc}") from None
-    if isinstance(result, (QuerySolutions, QueryBoolean)):
-        media = negotiate(accept, RESULT_FORMATS, "application/sparql-results+json")
-        formats: dict[str, Any] = RESULT_FORMATS
-    else:
-        assert isinstance(result, QueryTriples)
-        media = negotiate(accept, GRAPH_FORMATS, "text/turtle")
-        formats = GRAPH_FORMATS
-    try:
-        data = result.serialize(format=formats[media])
-    except (ValueError, OSError, RuntimeError) as exc:
-        raise RefusedRequest(HTTPStatus.INTERNAL_SERVER_ERROR, f"the query failed: {exc}") from None
-    assert data is not None
-    return data, media
 
 
 def format_parameter(params: Parameters) -> str:

@@ -1,15 +1,22 @@
-"""Reading a SPARQL 1.1 Protocol request: its parameters, its body's text, whether a POST is a query
-or an update, and the HTTP errors a bad request is answered with."""
+"""Reading a SPARQL 1.1 Protocol request: its parameters, its body (read with a cap), whether a POST
+is a query or an update, and the HTTP errors a bad request is answered with.
+
+The HTTP framing itself (Content-Length, chunked bodies, one request after another on a
+connection) is uvicorn's and h11's: a request framed two ways, or with a negative or bad
+Content-Length, is refused there with 400 and its connection closed."""
 
 from __future__ import annotations
 
 import urllib.parse
+from collections.abc import AsyncIterator
 from http import HTTPStatus
 
 from pyoxigraph import NamedNode
 
 MAX_BODY = 256 * 1024 * 1024
-"""The largest request body accepted (bytes)."""
+"""The largest request body accepted with the update token (bytes): a write through the endpoint."""
+MAX_QUERY_BODY = 4 * 1024 * 1024
+"""The largest body accepted without it: a query (at most MAX_QUERY), URL-encoded."""
 
 Parameters = dict[str, list[str]]
 """A query string's or a form's parameters, each with every value given."""
@@ -23,6 +30,30 @@ class RefusedRequest(Exception):
         self.status = status
         self.message = message
         self.headers = headers or {}
+
+
+async def read_body(length: str | None, stream: AsyncIterator[bytes], cap: int) -> bytes:
+    """A request's body (``length``: its Content-Length header), refused with 413 past ``cap``
+    bytes, before it is read when the header says so, else as soon as it passes."""
+    if length is not None and length.isdigit() and int(length) > cap:
+        raise _too_large(cap)
+    parts: list[bytes] = []
+    size = 0
+    async for part in stream:
+        size += len(part)
+        if size > cap:
+            raise _too_large(cap)
+        parts.append(part)
+    return b"".join(parts)
+
+
+def _too_large(cap: int) -> RefusedRequest:
+    return RefusedRequest(
+        HTTPStatus.REQUEST_ENTITY_TOO_LARGE,
+        f"the body is larger than {cap // 2**20} MiB"
+        + ("" if cap >= MAX_BODY else " (larger bodies need the update token)"),
+        {"Connection": "close"},
+    )
 
 
 def one(params: Parameters, name: str, default: str | None = None) -> str:
