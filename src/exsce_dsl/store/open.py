@@ -90,8 +90,13 @@ def store_url(url: str | None = None) -> str:
     return url or os.environ.get(STORE_ENV) or str(DEFAULT_STORE)
 
 
-def open_store(url: str | None = None, *, token: str | None = None, timeout: float = 60.0) -> Store:
-    """The store ``url`` names (see the module's table); ``token`` defaults to ``$EXSCE_STORE_TOKEN``."""
+def open_store(
+    url: str | None = None, *, token: str | None = None, timeout: float = 60.0, read_only: bool = False
+) -> Store:
+    """The store ``url`` names (see the module's table); ``token`` defaults to ``$EXSCE_STORE_TOKEN``.
+
+    ``read_only``: an embedded store folder is only ever read (a read-only view: nothing is
+    written to its folder, which may be on a read-only mount), and a write fails saying so."""
     spec = store_url(url).strip()
     token = token or os.environ.get(TOKEN_ENV) or None
     if spec == "memory:":
@@ -110,6 +115,8 @@ def open_store(url: str | None = None, *, token: str | None = None, timeout: flo
         raise StoreError(f"cannot open a store at {spec!r}: expected a folder, memory:, or an http(s):// URL")
     if spec.startswith("file:"):
         spec = urllib.parse.unquote(urllib.parse.urlsplit(spec).path)
+    if read_only:
+        return EmbeddedStore(Path(spec), read_only=True)
     return _embedded_store(Path(spec), token, timeout)
 
 
