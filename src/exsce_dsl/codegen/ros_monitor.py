@@ -120,7 +120,8 @@ def monitor_topics(
 
     def add(topic: str, entry: TopicEntry, by: str, where: SourceLocation | None = None) -> TopicEntry:
         if not is_ros_topic(topic):
-            raise GenerationError(f"'{topic}' (read by {by}) is not a ROS topic name ({ROS_TOPIC_RULE})", where)
+            said = f"'{topic}' (read by {by}) is not a ROS topic name ({ROS_TOPIC_RULE})"
+            raise GenerationError(said, where)
         found = topics.setdefault(topic, entry)
         if (found.role, found.robot) != (entry.role, entry.robot):
             raise GenerationError(
