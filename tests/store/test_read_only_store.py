@@ -114,3 +114,14 @@ def test_a_store_opened_read_only_writes_nothing(tmp_path: Path) -> None:
         with pytest.raises(StoreError, match="opened read-only"):
             reading.clear()
     assert {p.name: p.stat().st_mtime_ns for p in store.iterdir()} == before
+
+
+def test_a_reader_does_not_stop_a_writer(tmp_path: Path) -> None:
+    """A read command holds no lock: an ingest may open the store for writing meanwhile."""
+    store = _store_with_data(tmp_path)
+    with open_store(str(store), read_only=True) as reading:
+        assert reading.ask(f"ASK {{ GRAPH <{G}> {{ ?s ?p ?o }} }}")
+        writer = EmbeddedStore(store)
+        assert not writer.held_elsewhere
+        writer.clear()
+        writer.close()

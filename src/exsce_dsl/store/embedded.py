@@ -80,15 +80,15 @@ class EmbeddedStore(Store):
     def _open(self) -> OxStore:
         assert self.path is not None
         path = self.path
-        if self._unwritable is not None:
-            said = f"cannot write to the store at {path}: {self._unwritable} (reading it works)"
-            raise _UnwritableError(said)
         if path.exists() and not path.is_dir():
             raise StoreError(f"cannot open the store at {path}: it is a file, not a store folder")
         if path.is_dir() and any(path.iterdir()) and not (path / "CURRENT").exists():
             raise StoreError(
                 f"cannot open the store at {path}: the folder is not empty and holds no Oxigraph store"
             )
+        if self._unwritable is not None:
+            said = f"cannot write to the store at {path}: {self._unwritable} (reading it works)"
+            raise _UnwritableError(said)
         try:
             path.mkdir(parents=True, exist_ok=True)
             self._store = OxStore(str(path))

@@ -115,9 +115,7 @@ def open_store(
         raise StoreError(f"cannot open a store at {spec!r}: expected a folder, memory:, or an http(s):// URL")
     if spec.startswith("file:"):
         spec = urllib.parse.unquote(urllib.parse.urlsplit(spec).path)
-    if read_only:
-        return EmbeddedStore(Path(spec), read_only=True)
-    return _embedded_store(Path(spec), token, timeout)
+    return _embedded_store(Path(spec), token, timeout, read_only)
 
 
 class StoreOpening:
@@ -200,16 +198,17 @@ def _preset_store(preset: Preset, url: str, token: str | None, timeout: float) -
     )
 
 
-def _embedded_store(path: Path, token: str | None, timeout: float) -> Store:
-    embedded = EmbeddedStore(path)
-    if not embedded.held_elsewhere:
+def _embedded_store(path: Path, token: str | None, timeout: float, read_only: bool = False) -> Store:
+    embedded = EmbeddedStore(path, read_only=read_only)
+    if not read_only and not embedded.held_elsewhere:
         return embedded
-    from exsce_dsl.store.remote import RemoteStore
     from exsce_dsl.store.serve_info import read_serve_info
 
-    info = read_serve_info(path)
+    info = read_serve_info(path) if path.exists() else None
     if info is None or not info.is_alive():
-        return embedded  # reads see a read-only view; a write says who holds the store
+        return embedded  # reads see a read-only view; a write says who holds the store, or why not
+    from exsce_dsl.store.remote import RemoteStore
+
     embedded.close()
     mode = "updates allowed" if info.updates else "read-only"
     label = f"the store {path} (held by exscec serve, pid {info.pid}, {mode}, at {info.url})"
