@@ -22,7 +22,9 @@ from exsce_dsl.messages import typestore_cache
 from exsce_dsl.runs.metrics import monitor_code
 from exsce_dsl.user_cache import KEY_NAME, MAGIC, cache_folder, read_cached, write_cached
 
+from tests.support.cli import run_exscec
 from tests.support.map_files import write_map
+from tests.support.paths import EXAMPLES
 from tests.support.yard_spec import YARD_SPEC
 
 NOBODY = 65534
@@ -112,6 +114,13 @@ def test_world_writable_cache_refused_with_warning(cache: Path) -> None:
     assert [w.category for w in caught] == [CacheWarning]  # one warning, however often asked
     assert "may be written by other users" in str(caught[0].message)
     assert list(cache.iterdir()) == []  # nothing written into it
+    # the command works without it, saying so once
+    spec = EXAMPLES / "brsu_building_c" / "scenario_c.exsce"
+    done = run_exscec("check", str(spec))
+    assert done.returncode == 0, done.stderr
+    assert done.stderr.count("warning: the cache folder") == 1, done.stderr
+    assert "Traceback" not in done.stderr
+    assert list(cache.iterdir()) == []
 
 
 @pytest.mark.parametrize("mode", [0o770, 0o707])
