@@ -81,3 +81,16 @@ def test_deep_yaml_import_located(tmp_path: Path, depth: int) -> None:
         rf"scenario\.yaml:2:{column}: error: not valid YAML: nested more than {MAX_YAML_DEPTH} levels deep",
     )
     assert not list((tmp_path).glob("out/*.exsce"))
+
+
+def test_the_editor_s_parse_reports_deep_parentheses_too(tmp_path: Path) -> None:
+    """The language server parses a piece at a time (ParseCache): the same located error, not a
+    RecursionError that leaves the editor without diagnostics."""
+    from exsce_dsl.lang.incremental import ParseCache
+
+    text = _metric(tmp_path, "max(" + "(" * 1000 + FIELD + ")" * 1000 + ")").read_text()
+    tree, diagnostics = ParseCache().parse(text, "metric.exsce")
+    assert tree is None
+    (error,) = diagnostics
+    assert error.location is not None and (error.location.line, error.location.column) == (3, 32)
+    assert f"parentheses nested more than {MAX_NESTING} deep" in error.message
