@@ -29,11 +29,8 @@ DERIVED_ORACLES = {
     ("tiago1-distance_to_obstacles", "above_min"),
     # not the example's own fast_driving_time (a total) and mean_turn_rate (a mean): limits on
     # them are about the base's mission, not safety limits for any mission
-    *(
-        (f"tiago1-{m}", r)
-        for m in ("distance_travelled", "task_duration", "waypoints_visited")
-        for r in ("invariant", "increasing")
-    ),
+    *((f"tiago1-{m}", r) for m in ("distance_travelled", "task_duration", "waypoints_visited")
+      for r in ("invariant", "increasing")),
 }
 
 
@@ -47,23 +44,8 @@ def project(tmp_path_factory: pytest.TempPathFactory) -> Path:
     ingested = exscec_here("ingest", *bags, "--scenario", "c/scenario_c.exsce", cwd=folder)
     assert ingested.returncode == 0, ingested.stderr
     derived = exscec_here(
-        "derive",
-        "c/scenario_c.exsce",
-        "-t",
-        "remove_robot",
-        "--robot",
-        "tiago2",
-        "--reassign",
-        "tiago1",
-        "--id",
-        "c_one",
-        "-o",
-        "c/c_one.exsce",
-        "--expect",
-        "--tolerance",
-        "15",
-        "--add-to-store",
-        cwd=folder,
+        "derive", "c/scenario_c.exsce", "-t", "remove_robot", "--robot", "tiago2", "--reassign", "tiago1",
+        "--id", "c_one", "-o", "c/c_one.exsce", "--expect", "--tolerance", "15", "--add-to-store", cwd=folder,
     )
     assert derived.returncode == 0, derived.stderr
     assert "8 oracles" in derived.stderr
@@ -91,14 +73,7 @@ def test_the_derived_scenario_says_what_its_runs_should_show(project: Path) -> N
     # c025-w001 → c022-w001 → c018-w001 (tiago1's), c018-w001 → c022-w002 (nobody's),
     # c022-w002 → c018-w002 (tiago2's), c018-w002 → c025-w001 (nobody's), c025-w001 → c025-w002
     # (nobody's, and its room has no other pose: per metre)
-    assert [how.split(" ", 1)[0] for how in hows] == [
-        "observed",
-        "observed",
-        "estimated",
-        "observed",
-        "estimated",
-        "no",
-    ]
+    assert [how.split(" ", 1)[0] for how in hows] == ["observed", "observed", "estimated", "observed", "estimated", "no"]
     assert "per metre" in hows[5]
     stored = exscec_here("query", "oracles", "-p", "scenario=c_one", "--format", "json", cwd=project)
     rows = json.loads(stored.stdout)["results"]["bindings"]
@@ -107,8 +82,7 @@ def test_the_derived_scenario_says_what_its_runs_should_show(project: Path) -> N
     assert ("distance_travelled", "baseline", "c_one") in kinds
     lineage = exscec_here("lineage", "c_one", cwd=project)
     assert lineage.stdout.splitlines()[:2] == [
-        "scenario_c",
-        "  └─ remove_robot(reassign=tiago1 robot=tiago2)",
+        "scenario_c", "  └─ remove_robot(reassign=tiago1 robot=tiago2)"
     ]
 
 
