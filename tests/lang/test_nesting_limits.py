@@ -94,3 +94,22 @@ def test_the_editor_s_parse_reports_deep_parentheses_too(tmp_path: Path) -> None
     (error,) = diagnostics
     assert error.location is not None and (error.location.line, error.location.column) == (3, 32)
     assert f"parentheses nested more than {MAX_NESTING} deep" in error.message
+
+
+def test_a_parser_recursion_past_the_count_is_located_too(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Should the parser recurse past Python's limit on text the count lets through (a deeper
+    caller, a construct it does not foresee), the parse still ends in a located syntax error."""
+    from exsce_dsl.errors import ExsceSyntaxError
+    from exsce_dsl.lang import parser
+
+    monkeypatch.setattr(parser, "MAX_NESTING", 10_000)  # the count lets everything through
+    text = _metric(tmp_path, "max(" + "(" * 200 + FIELD + ")" * 200 + ")").read_text()
+    with pytest.raises(ExsceSyntaxError) as raised:
+        parser.parse_text(text, "metric.exsce")
+    (error,) = raised.value.diagnostics
+    assert "nests too deeply to be read" in error.message
+    assert error.location is not None
+    assert (error.location.line, error.location.column) == (3, len("  value max(") + 200)
+    assert parser.parse_text(text.replace("(" * 200, "").replace(")" * 200, ""), "metric.exsce")  # parses on

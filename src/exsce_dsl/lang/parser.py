@@ -86,8 +86,9 @@ def parse_text(text: str, path: str) -> ParsedFile:
     except TextXSyntaxError as exc:
         raise ExsceSyntaxError([_syntax_diagnostic(exc, text, path)]) from None
     except RecursionError:  # deeper than the count above foresees (a deep caller, another construct)
-        where = SourceLocation(path, 1, 1, 1, 1)
-        message = "the file nests too deeply to be read: split its expressions or blocks"
+        _shared_metamodel.cache_clear()  # a parser stopped midway is not reused
+        where = _deepest_parenthesis(text, path) or SourceLocation(path, 1, 1, 1, 1)
+        message = "the file nests too deeply to be read: write its expressions flatter"
         raise ExsceSyntaxError([Diagnostic(message, where, code="syntax")]) from None
     if isinstance(tree, str):  # textX's model of a text with nothing but whitespace and comments
         where = SourceLocation(path, 1, 1, 1, 1)
@@ -113,6 +114,19 @@ def nesting_diagnostic(text: str, path: str) -> Diagnostic | None:
         elif token.group() == ")":
             depth = max(0, depth - 1)
     return None
+
+
+def _deepest_parenthesis(text: str, path: str) -> SourceLocation | None:
+    """Where the parentheses of ``text`` are nested deepest (the first such), if it has any."""
+    depth, deepest, at = 0, 0, None
+    for token in _NESTING_TOKEN.finditer(text):
+        if token.group() == "(":
+            depth += 1
+            if depth > deepest:
+                deepest, at = depth, token
+        elif token.group() == ")":
+            depth = max(0, depth - 1)
+    return LineIndex(path, text).span(at.start(), at.end()) if at is not None else None
 
 
 def metamodel() -> Any:
