@@ -178,7 +178,7 @@ def _make_private(root: Path, folder: Path) -> None:
         root.mkdir(mode=0o700, parents=True)
         os.chmod(root, 0o700)  # whatever the umask
     current = root
-    for part in folder.relative_to(root).parts:
+    for part in Path(os.path.abspath(folder)).relative_to(os.path.abspath(root)).parts:
         current = current / part
         try:
             current.mkdir(mode=0o700)
