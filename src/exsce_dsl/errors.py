@@ -22,6 +22,7 @@ __all__ = [
     "AmbiguousRunError",
     "ArgumentError",
     "BagError",
+    "CacheWarning",
     "DecodeError",
     "Diagnostic",
     "ExecutionInterrupted",
@@ -303,3 +304,8 @@ class RenameError(ValueError):
 class UnknownNameWarning(UserWarning):
     """A query's parameter names a metric, robot or scenario the store does not hold (``store``;
     ``api.query`` warns with it, ``exscec query`` prints it)."""
+
+
+class CacheWarning(UserWarning):
+    """The user's cache folder cannot be trusted (another user's, or writable by others), so it is
+    not used (``user_cache``)."""

@@ -11,12 +11,15 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 import pytest
+from rosbags.highlevel import AnyReader
 
 from exsce_dsl.lang import load_spec
 from exsce_dsl.sim.run import simulate
 
+from tests.support.bag_factory import FORMATS, Topic, typestore_for, write_bag
 from tests.support.cli import exscec_here, run_exscec
 from tests.support.draft_references import reference
 from tests.support.yard_spec import yard_text
@@ -89,3 +92,41 @@ def test_init_says_what_is_wrong_with_its_input(
     assert again.returncode == 2 and "would overwrite mine.exsce; use --force to replace" in again.stderr
     _ok("init", "--from-bag", str(bag), "-o", "mine.exsce", "--force")
     _ok("check", "mine.exsce")
+
+
+def _renamed_bag(source: Path, target: Path, namespace: str, keep_root: bool = True) -> Path:
+    """``source`` (an executor's bag, robot r2 in namespace r2) written again by rosbags with r2's
+    topics under ``namespace`` instead (and, unless ``keep_root``, without the root robot's)."""
+    with AnyReader([source]) as reader:
+        store = typestore_for("ros1")
+        store.register({k: v for k, v in reader.typestore.fielddefs.items() if k not in store.fielddefs})
+        found: dict[tuple[str, str], list[tuple[int, Any]]] = {}
+        for connection, time_ns, raw in reader.messages():
+            message = reader.deserialize(raw, connection.msgtype)
+            found.setdefault((connection.topic, connection.msgtype), []).append((time_ns, message))
+    topics = [
+        Topic(topic.replace("/r2/", f"/{namespace}/", 1), msgtype, messages)
+        for (topic, msgtype), messages in found.items()
+        if keep_root or topic.startswith("/r2/")
+    ]
+    write_bag(target, FORMATS["ros1"], topics, store)
+    return target
+
+
+@pytest.mark.parametrize("namespace", ['r"2', "..", "r'2", "r2\n  robot evil"])
+def test_init_drafts_that_check_for_namespaces_with_quotes_or_dots(
+    in_tmp: Path, tmp_path_factory: pytest.TempPathFactory, namespace: str
+) -> None:
+    recorded = tmp_path_factory.mktemp("recorded")
+    source = _yard_bag(recorded, "method", "ros1")
+    bag = _renamed_bag(source, recorded / "odd.bag", namespace)
+    _ok("init", "--from-bag", str(bag), "-o", "odd.exsce")
+    _ok("check", "odd.exsce")  # the draft checks: the namespace is left out, saying why
+    text = Path("odd.exsce").read_text()
+    assert "// Left out: namespace " in text and "is not a valid ROS name" in text
+    assert all(line.lstrip().startswith("//") or "evil" not in line for line in text.splitlines())
+    # a bag whose every robot is in such a namespace: no draft, and why (not one that fails check)
+    only = _renamed_bag(source, recorded / "only.bag", namespace, keep_root=False)
+    done = exscec_here("init", "--from-bag", str(only), "-o", "only.exsce")
+    assert done.returncode == 2 and "no robot to draft a specification for" in done.stderr
+    assert not Path("only.exsce").exists()

@@ -20,6 +20,7 @@ from exsce_dsl.resources import package_file
 from exsce_dsl.runs.analyse import analyse_bag, run_metrics, wanted_topics
 from exsce_dsl.runs.bags.reading import read_bag
 from exsce_dsl.sim.run import simulate
+from exsce_dsl.user_cache import read_cached
 
 from tests.support.cli import exscec_here
 from tests.support.paths import EXAMPLES
@@ -94,7 +95,7 @@ def test_ingest_keeps_the_rendered_monitors_in_the_cache_folder(tmp_path, monkey
     monkeypatch.setenv("EXSCE_CACHE", str(tmp_path / "cache"))
     monitor_code.load_monitors(metrics, "scenario_c.exsce")
     (cached,) = (tmp_path / "cache").glob("monitors-*.py")
-    assert cached.read_text() == monitor_code.monitor_source(metrics, "scenario_c.exsce")
+    assert read_cached(cached) == monitor_code.monitor_source(metrics, "scenario_c.exsce").encode()
     other = tuple(m for m in metrics if m.name != "mean_turn_rate")
     monitor_code.load_monitors(other, "scenario_c.exsce")  # other metrics: another file
     assert len(list((tmp_path / "cache").glob("monitors-*.py"))) == 2

@@ -18,6 +18,7 @@ from exsce_dsl.lang.build.standard_metrics import _parse_standard_metrics
 from exsce_dsl.lang.spec_cache import code_fingerprint, load_spec_cached
 from exsce_dsl.model import Specification
 from exsce_dsl.model.metrics import MetricDefinition
+from exsce_dsl.user_cache import read_cached
 
 from tests.support.map_files import write_map
 
@@ -257,4 +258,5 @@ def test_the_standard_library_is_parsed_once_per_installation(
     assert made == [1]
     assert first == second and [m.name for m in first] == [m.name for m in _parse_standard_metrics()]
     (entry,) = (cache / "specs").glob("stdlib-metrics-*.pickle")
-    assert pickle.loads(entry.read_bytes()[len(spec_cache.FORMAT) :]) == first
+    content = read_cached(entry)
+    assert content is not None and pickle.loads(content[len(spec_cache.FORMAT) :]) == first

@@ -9,6 +9,7 @@ import pytest
 from rosbags.typesys import Stores, get_typestore
 
 from exsce_dsl.messages import typestore_cache
+from exsce_dsl.user_cache import read_cached, write_cached
 
 
 @pytest.fixture
@@ -24,15 +25,18 @@ def test_the_cached_definitions_are_rosbags_own(cache: Path, store: str) -> None
     assert typestore_cache.standard_fielddefs(store) == rosbags  # written
     [written] = cache.glob(f"typestore-{store}-*.json")
     assert typestore_cache.standard_fielddefs(store) == rosbags  # read back: tuples, lists, Nodetypes
-    assert json.loads(written.read_text())["std_msgs/msg/Header"]  # a real file, JSON
+    content = read_cached(written)
+    assert content is not None and json.loads(content)["std_msgs/msg/Header"]  # a real file, JSON
 
 
 def test_the_file_is_what_is_read(cache: Path) -> None:
     typestore_cache.standard_fielddefs("ros2_humble")
     [written] = cache.glob("typestore-ros2_humble-*.json")
-    data = json.loads(written.read_text())
+    content = read_cached(written)
+    assert content is not None
+    data = json.loads(content)
     del data["nav_msgs/msg/Odometry"]
-    written.write_text(json.dumps(data))
+    write_cached(written, json.dumps(data).encode())
     assert "nav_msgs/msg/Odometry" not in typestore_cache.standard_fielddefs("ros2_humble")
 
 
@@ -40,11 +44,12 @@ def test_the_file_is_what_is_read(cache: Path) -> None:
 def test_a_broken_cache_falls_back_to_rosbags_and_is_rewritten(cache: Path, text: str) -> None:
     typestore_cache.standard_fielddefs("ros1_noetic")
     [written] = cache.glob("typestore-ros1_noetic-*.json")
-    written.write_text(text)
+    write_cached(written, text.encode())
     rosbags = get_typestore(Stores.ROS1_NOETIC).fielddefs
     assert typestore_cache.standard_fielddefs("ros1_noetic") == rosbags
     assert typestore_cache.standard_fielddefs("ros1_noetic") == rosbags  # from the rewritten file
-    assert json.loads(written.read_text())["std_msgs/msg/Header"]
+    content = read_cached(written)
+    assert content is not None and json.loads(content)["std_msgs/msg/Header"]
 
 
 def test_a_cache_that_cannot_be_written_is_not_kept(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import importlib
 import os
+import warnings
+from typing import TextIO
 
 import click
 
@@ -101,8 +103,31 @@ def main(debug: bool, msg_paths: tuple[str, ...]) -> None:
       exscec compile examples/brsu_building_c/scenario_c.exsce -f provn
     """
     State.debug = debug
+    if warnings.showwarning is not _show_warning:
+        warnings.showwarning = _show_warning
     if msg_paths:  # in the environment, so that worker processes see them too
         from exsce_dsl.messages.msg_path import MSG_PATH
 
         folders = [os.path.abspath(p) for p in msg_paths]
         os.environ[MSG_PATH] = os.pathsep.join([*folders, *filter(None, [os.environ.get(MSG_PATH)])])
+
+
+_python_show_warning = warnings.showwarning
+
+
+def _show_warning(
+    message: Warning | str,
+    category: type[Warning],
+    filename: str,
+    lineno: int,
+    file: TextIO | None = None,
+    line: str | None = None,
+) -> None:
+    """exsce's own warnings (an untrusted cache folder) as ``warning: ...`` lines; others as Python
+    shows them."""
+    from exsce_dsl.errors import CacheWarning
+
+    if issubclass(category, CacheWarning):
+        click.echo(f"warning: {message}", err=True)
+    else:
+        _python_show_warning(message, category, filename, lineno, file, line)

@@ -180,7 +180,7 @@ def query_command(
     library_query = query(name)
     given = _parameters(params)
     library_query.bindings(given)  # check the parameters before opening the store
-    with open_store(store_url) as store:
+    with open_store(store_url, read_only=not library_query.is_update) as store:
         rows = run_query(store, name, given, check_runs=True)
         unknown = [] if library_query.is_update else unknown_names(store, name, given)
     for warning in unknown:
@@ -224,7 +224,7 @@ def sparql_command(text: str, fmt: str, output: str | None, store_url: str | Non
     verb = kind.group(1).upper() if kind else ""
     if verb not in ("SELECT", "ASK"):
         raise ExsceError("exscec sparql runs SELECT and ASK queries")
-    with open_store(store_url) as store:
+    with open_store(store_url, read_only=True) as store:
         if verb == "ASK":
             answer = store.ask(prologue + text)
             if fmt == "json":
@@ -254,7 +254,7 @@ def runs_command(scenario: str | None, fmt: str, output: str | None, store_url: 
     from exsce_dsl.store.queries.stored_names import unknown_names
 
     given = {} if scenario is None else {"scenario": scenario}
-    with open_store(store_url) as store:
+    with open_store(store_url, read_only=True) as store:
         rows = run_query(store, "runs", given)
         unknown = unknown_names(store, "runs", given) if not rows else []
     for warning in unknown:

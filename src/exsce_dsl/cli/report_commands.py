@@ -47,7 +47,7 @@ def report(output: str, specs: tuple[str, ...], store_url: str | None) -> None:
     from exsce_dsl.report.html import write_report
     from exsce_dsl.store.open import open_store
 
-    with open_store(store_url) as store:
+    with open_store(store_url, read_only=True) as store:
         contents = gather(store, [Path(s) for s in specs])
     runs = sum(len(s.runs) for s in contents.scenarios)
     with Progress(runs, "drawing runs") as progress:

@@ -66,7 +66,7 @@ def info(store_url: str | None) -> None:
     from exsce_dsl.store.segment_index import is_index_graph
     from exsce_dsl.store.writing import is_revision
 
-    with open_store(store_url) as store:
+    with open_store(store_url, read_only=True) as store:
         sizes = store.graph_sizes()
         if isinstance(store, EmbeddedStore):
             if store.path is None:
@@ -107,7 +107,7 @@ def graphs(store_url: str | None, with_index: bool) -> None:
     from exsce_dsl.store.open import open_store
     from exsce_dsl.store.segment_index import is_index_graph
 
-    with open_store(store_url) as store:
+    with open_store(store_url, read_only=True) as store:
         sizes = store.graph_sizes()
     hidden = 0 if with_index else sum(1 for name in sizes if is_index_graph(name))
     if not with_index:
@@ -145,7 +145,7 @@ def export(store_url: str | None, fmt: str, output: str | None) -> None:
     """
     from exsce_dsl.store.open import open_store
 
-    with open_store(store_url) as store:
+    with open_store(store_url, read_only=True) as store:
         data = store.export(fmt)
     write_text(data.decode("utf-8"), output)
 

@@ -42,6 +42,7 @@ from exsce_dsl.model.messages import (
     canonical_type,
 )
 from exsce_dsl.model.metrics import ComputedFor, MetricDefinition, expand_topic
+from exsce_dsl.model.names import ROS_TOPIC_RULE, is_ros_topic
 from exsce_dsl.oracles.plan import PlannedOracle, plan_oracles
 from exsce_dsl.prov.identifiers import oracle_name
 from exsce_dsl.resources import package_file
@@ -54,7 +55,6 @@ RESULT_TOPIC = "/{ns}/waypoint_dispatcher/result"
 VERDICT_TOPIC = "/exsce/verdicts"
 _ROS_PACKAGE = re.compile(r"[a-z][a-z0-9]*(?:_[a-z0-9]+)*")
 """REP 144: lowercase letters, digits and single underscores, starting with a letter."""
-_ROS_TOPIC = re.compile(r"/?[A-Za-z_][A-Za-z0-9_]*(?:/[A-Za-z_][A-Za-z0-9_]*)*")
 _ROSPY_TIME = {"sec": "secs", "nanosec": "nsecs"}
 """rospy's names of the fields of a time or a duration, which ROS 2 (and exsce's paths) name
 otherwise."""
@@ -118,12 +118,10 @@ def monitor_topics(
     topics: dict[str, TopicEntry] = {}
     trees: dict[str, Fields | None] = {}
 
-    def add(topic: str, entry: TopicEntry, by: str) -> TopicEntry:
-        if not _ROS_TOPIC.fullmatch(topic) or "__" in topic:
-            raise GenerationError(
-                f"'{topic}' (read by {by}) is not a ROS topic name: names of letters, digits and '_', "
-                "not starting with a digit, separated by '/'"
-            )
+    def add(topic: str, entry: TopicEntry, by: str, where: SourceLocation | None = None) -> TopicEntry:
+        if not is_ros_topic(topic):
+            said = f"'{topic}' (read by {by}) is not a ROS topic name ({ROS_TOPIC_RULE})"
+            raise GenerationError(said, where)
         found = topics.setdefault(topic, entry)
         if (found.role, found.robot) != (entry.role, entry.robot):
             raise GenerationError(
@@ -156,7 +154,7 @@ def monitor_topics(
                         read.location,
                     )
                 wanted = TopicEntry(canonical_type(read.msgtype))
-                entry = add(read.topic_of(ns), wanted, f"metric {metric.name}")
+                entry = add(read.topic_of(ns), wanted, f"metric {metric.name}", read.location)
                 if entry.msgtype not in trees:
                     trees[entry.msgtype] = _tree(entry.msgtype)
                 key = node.path.key

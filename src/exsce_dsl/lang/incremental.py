@@ -25,7 +25,7 @@ from textx import TextXSyntaxError
 from exsce_dsl.errors import Diagnostic, SourceLocation
 from exsce_dsl.lang.chunks import Chunk, area_spans, declaration_chunks, line_head_chunks
 from exsce_dsl.lang.locations import LineIndex
-from exsce_dsl.lang.parser import ParsedFile, metamodel, syntax_diagnostic_at
+from exsce_dsl.lang.parser import ParsedFile, metamodel, nesting_diagnostic, syntax_diagnostic_at
 
 # An area is parsed inside an environment of its own, then moved to where it is written.
 _AREA_HEAD = "environment _ {\n"
@@ -68,6 +68,10 @@ class ParseCache:
         known = self._files.get(path)
         if known is not None and known[0] == text:
             return known[1], known[2]
+        too_deep = nesting_diagnostic(text, path)
+        if too_deep is not None:  # the parser would recurse past Python's limit
+            self._files[path] = (text, None, (too_deep,))
+            return None, (too_deep,)
         used: set[tuple[str, str, str, int]] = set()
         lines = LineIndex(path, text)
         errors: list[Diagnostic] = []

@@ -40,6 +40,14 @@ _RULE_WORDS = {
 # Environments this long (characters) are parsed an area at a time to try a correction.
 _LONG_PIECE = 4000
 
+MAX_NESTING = 20
+"""Parentheses nested deeper than this are refused before parsing: the parser recurses some
+forty Python frames a level, and Python stops at a thousand (issue 46: 28 levels were an
+internal error)."""
+
+# What the nesting count skips (strings and comments), and what it counts.
+_NESTING_TOKEN = re.compile(r""""(?:\\.|[^"\\])*"|'(?:\\.|[^'\\])*'|//[^\n]*|/\*.*?\*/|[()]""", re.DOTALL)
+
 
 def new_metamodel() -> Any:
     """A fresh metamodel of the exsce grammar (textX caches nothing across them)."""
@@ -69,15 +77,56 @@ class ParsedFile:
 def parse_text(text: str, path: str) -> ParsedFile:
     """Parse one file's text; raise :class:`ExsceSyntaxError` on bad syntax."""
     lines = LineIndex(path, text)
+    too_deep = nesting_diagnostic(text, path)
+    if too_deep is not None:
+        raise ExsceSyntaxError([too_deep])
     try:
         # textX reads the file itself when given no text: an empty editor buffer is not the file
         tree = _shared_metamodel().model_from_str(text or " ", file_name=path)
     except TextXSyntaxError as exc:
         raise ExsceSyntaxError([_syntax_diagnostic(exc, text, path)]) from None
+    except RecursionError:  # deeper than the count above foresees (a deep caller, another construct)
+        _shared_metamodel.cache_clear()  # a parser stopped midway is not reused
+        where = _deepest_parenthesis(text, path) or SourceLocation(path, 1, 1, 1, 1)
+        message = "the file nests too deeply to be read: write its expressions flatter"
+        raise ExsceSyntaxError([Diagnostic(message, where, code="syntax")]) from None
     if isinstance(tree, str):  # textX's model of a text with nothing but whitespace and comments
         where = SourceLocation(path, 1, 1, 1, 1)
         raise ExsceSyntaxError([Diagnostic("the file declares nothing (it is empty or all comments)", where)])
     return ParsedFile(path, text, tree, lines)
+
+
+def nesting_diagnostic(text: str, path: str) -> Diagnostic | None:
+    """The error at the first parenthesis nested deeper than :data:`MAX_NESTING`, if any
+    (parentheses in strings and comments are not counted)."""
+    depth = 0
+    for token in _NESTING_TOKEN.finditer(text):
+        if token.group() == "(":
+            depth += 1
+            if depth > MAX_NESTING:
+                message = (
+                    f"parentheses nested more than {MAX_NESTING} deep: exsce reads at most "
+                    f"{MAX_NESTING} levels (write the expression flatter)"
+                )
+                return Diagnostic(
+                    message, LineIndex(path, text).span(token.start(), token.end()), code="syntax"
+                )
+        elif token.group() == ")":
+            depth = max(0, depth - 1)
+    return None
+
+
+def _deepest_parenthesis(text: str, path: str) -> SourceLocation | None:
+    """Where the parentheses of ``text`` are nested deepest (the first such), if it has any."""
+    depth, deepest, at = 0, 0, None
+    for token in _NESTING_TOKEN.finditer(text):
+        if token.group() == "(":
+            depth += 1
+            if depth > deepest:
+                deepest, at = depth, token
+        elif token.group() == ")":
+            depth = max(0, depth - 1)
+    return LineIndex(path, text).span(at.start(), at.end()) if at is not None else None
 
 
 def metamodel() -> Any:

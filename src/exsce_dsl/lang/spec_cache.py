@@ -22,8 +22,14 @@ The first three name the entry; the last two are recorded in it and
 compared, file by file, each time it is found.  Only a specification that
 loads without errors is kept (an error is always reported afresh); with an
 overlay (an editor's unsaved text) nothing is cached.  ``$EXSCE_CACHE`` set
-empty turns the cache off.  The entries are pickles, read only from the
-user's own cache folder, as Python reads ``__pycache__``.
+empty turns the cache off.
+
+The entries are pickles, and unpickling runs code, so an entry is unpickled only
+after :func:`~exsce_dsl.user_cache.read_cached` has checked it: a file of the
+user's own, in a private folder, whose HMAC under the user's ``0600`` key matches
+(issue 46).  Anyone who could forge that code could already read the user's key,
+hence run code as the user.  A data format instead would mean a serialiser for
+every class of the semantic model, kept in step with it.
 """
 
 from __future__ import annotations
@@ -91,7 +97,7 @@ def _cached_by_code(name: str, make: Callable[[], T]) -> T:
     data = read_cached(entry)
     if data is not None and data.startswith(FORMAT):
         try:
-            value: T = pickle.loads(data[len(FORMAT) :])  # noqa: S301 - the user's own cache folder
+            value: T = pickle.loads(data[len(FORMAT) :])  # noqa: S301 - read_cached checked its HMAC
             return value
         except Exception:  # noqa: BLE001 - a damaged entry is made again
             pass
@@ -138,7 +144,7 @@ def _valid_entry(data: bytes | None) -> Specification | None:
     if data is None or not data.startswith(FORMAT):
         return None
     try:
-        dependencies, definitions, spec = pickle.loads(data[len(FORMAT) :])  # noqa: S301 - own cache
+        dependencies, definitions, spec = pickle.loads(data[len(FORMAT) :])  # noqa: S301 - HMAC checked
     except Exception:  # noqa: BLE001 - a damaged entry is made again
         return None
     if definitions != _msg_path_dependencies():

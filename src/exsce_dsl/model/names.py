@@ -54,3 +54,19 @@ def is_topic_pattern(text: str) -> bool:
     and the generated monitors could not hold as they are)."""
     rest = text.replace("{ns}", "")
     return bool(text.replace("/", "")) and text.isprintable() and not _NOT_IN_TOPICS.search(rest)
+
+
+_ROS_TOPIC = re.compile(r"/?[A-Za-z_][A-Za-z0-9_]*(?:/[A-Za-z_][A-Za-z0-9_]*)*")
+ROS_TOPIC_RULE = "names of letters, digits and '_', not starting with a digit, separated by '/', no '__'"
+"""What :func:`is_ros_topic` takes, for error messages."""
+
+
+def is_ros_topic(topic: str) -> bool:
+    """True if a ROS 1 or ROS 2 node may subscribe to ``topic``: the rule of the ROS monitor
+    generators, which ``check`` applies too.  ``{ns}`` stands for a robot's namespace (itself
+    checked by :func:`is_ros_namespace`); an empty level left by a robot at the root is no level.
+    Stricter than :func:`is_topic_pattern`: a bag may hold names ROS refuses (``ORB-SLAM``)."""
+    name = topic.replace("{ns}", "ns")
+    while "//" in name:
+        name = name.replace("//", "/")
+    return bool(_ROS_TOPIC.fullmatch(name)) and "__" not in name

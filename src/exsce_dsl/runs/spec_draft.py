@@ -26,7 +26,7 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from exsce_dsl.errors import ExportError, SourceLocation
+from exsce_dsl.errors import BagError, ExportError, SourceLocation
 from exsce_dsl.lang import Comment, declared_poses, format_document
 from exsce_dsl.maps.grid import FREE, OccupancyGrid, grid_from_ros, save_occupancy_grid
 from exsce_dsl.model import (
@@ -95,6 +95,8 @@ def draft_spec(bag: Path, out: Path, force: bool = False) -> SpecDraft:
     if out.suffix != ".exsce":
         raise ExportError(f"{out}: a specification's file name ends in .exsce")
     contents = bag_contents(bag)
+    if not contents.robots:  # every robot's namespace is a name the language cannot hold
+        raise BagError(f"{bag}: no robot to draft a specification for: {'; '.join(contents.skipped)}")
     map_yaml = out.with_name(f"{out.stem}_map.yaml") if contents.map is not None else None
     targets = [out] + ([map_yaml, map_yaml.with_suffix(".pgm")] if map_yaml else [])
     existing = [str(t) for t in targets if t.exists()]
@@ -177,6 +179,7 @@ class _Drafter:
             f"Drafted by `exscec init --from-bag` from {c.path.name}: {c.topics} topics, "
             f"{c.end - c.start:.1f} s, {counted(len(c.robots), 'robot')} found.",
             f"Next: exscec check {self.file}; exscec ingest {c.path.name} --scenario {self.file}",
+            *(f"Left out: {why}" for why in c.skipped),  # a name the language could not hold
             "",
         ]
         types = self._robot_types(header)

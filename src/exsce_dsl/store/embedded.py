@@ -15,6 +15,11 @@ read-only view instead (``Store.read_only``): what was committed when it
 opened the store, so while an ingest runs a reader sees each run wholly or not
 at all.  The folder is created on the first write: reading a store that does
 not exist yet finds it empty.
+
+A store that cannot be opened for writing — its folder on a read-only mount,
+not writable, or on a full disk — is read through a read-only view as well, and
+a write to it fails saying why (issue 46: such a store could not even be read).
+``read_only=True`` never opens the folder for writing at all.
 """
 
 from __future__ import annotations
@@ -43,23 +48,33 @@ from exsce_dsl.store.sparql import bind, checked_quads, graph_node, write_update
 VIEW_ATTEMPTS = 5
 """Times a read-only view is opened before a writer's compaction racing it is an error."""
 
+UNWRITABLE = (
+    "Read-only file system",
+    "Permission denied",
+    "No space left on device",
+    "Operation not permitted",
+)
+"""What RocksDB says when a store folder can be read but not written (its messages carry no errno)."""
+
 
 class EmbeddedStore(Store):
     """``path=None`` keeps the data in memory (tests, benchmarks)."""
 
-    def __init__(self, path: Path | str | None = None) -> None:
+    def __init__(self, path: Path | str | None = None, *, read_only: bool = False) -> None:
         self.path = Path(path) if path is not None else None
         self.location = str(path) if path is not None else "memory:"
         self._store: OxStore | None = None
         self._empty: OxStore | None = None
         self._view: OxStore | None = None
+        self._unwritable: str | None = "it was opened read-only" if read_only else None
+        """Why the folder cannot be opened for writing, once known: reads use a read-only view."""
         if self.path is None:
             self._store = OxStore()
-        elif self.path.exists():
+        elif self.path.exists() and not read_only:
             try:
                 self._open()
-            except StoreLockedError:
-                pass  # another process writes: reads use a read-only view, writes say who holds it
+            except (StoreLockedError, _UnwritableError):
+                pass  # reads use a read-only view; writes say who holds the store, or why not
 
     # -- opening -------------------------------------------------------------
 
@@ -72,12 +87,19 @@ class EmbeddedStore(Store):
             raise StoreError(
                 f"cannot open the store at {path}: the folder is not empty and holds no Oxigraph store"
             )
+        if self._unwritable is not None:
+            said = f"cannot write to the store at {path}: {self._unwritable} (reading it works)"
+            raise _UnwritableError(said)
         try:
             path.mkdir(parents=True, exist_ok=True)
             self._store = OxStore(str(path))
         except OSError as exc:
             if "lock" in str(exc).lower():
                 raise StoreLockedError(_locked_message(path, exc), str(path)) from None
+            reason = next((r for r in UNWRITABLE if r in str(exc)), None)
+            if reason is not None and (path / "CURRENT").exists():
+                self._unwritable = reason.lower()
+                return self._open()  # raises, saying why
             raise StoreError(f"cannot open the store at {path}: {exc}") from None
         self._empty = None
         return self._store
@@ -92,7 +114,7 @@ class EmbeddedStore(Store):
         if self.path is not None and self.path.exists():  # made since, or reopened after close()
             try:
                 return self._open()
-            except StoreLockedError:
+            except (StoreLockedError, _UnwritableError):
                 return self._read_only_view()
         if self._empty is None:
             self._empty = OxStore()
@@ -137,6 +159,8 @@ class EmbeddedStore(Store):
             self._open()
         except StoreLockedError:
             return True
+        except _UnwritableError:
+            return False  # read through a view; a write says why it cannot be
         return False
 
     def _exists(self) -> bool:
@@ -278,6 +302,11 @@ class EmbeddedStore(Store):
         self._store = None
         self._empty = None
         self._view = None
+
+
+class _UnwritableError(StoreError):
+    """The store folder can be read but not opened for writing (read-only mount, no permission,
+    full disk): reads use a read-only view, and a write raises this."""
 
 
 def _with_fresh_blank_nodes(graphs: GraphSet) -> list[Quad]:

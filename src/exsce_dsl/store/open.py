@@ -90,8 +90,13 @@ def store_url(url: str | None = None) -> str:
     return url or os.environ.get(STORE_ENV) or str(DEFAULT_STORE)
 
 
-def open_store(url: str | None = None, *, token: str | None = None, timeout: float = 60.0) -> Store:
-    """The store ``url`` names (see the module's table); ``token`` defaults to ``$EXSCE_STORE_TOKEN``."""
+def open_store(
+    url: str | None = None, *, token: str | None = None, timeout: float = 60.0, read_only: bool = False
+) -> Store:
+    """The store ``url`` names (see the module's table); ``token`` defaults to ``$EXSCE_STORE_TOKEN``.
+
+    ``read_only``: an embedded store folder is only ever read (a read-only view: nothing is
+    written to its folder, which may be on a read-only mount), and a write fails saying so."""
     spec = store_url(url).strip()
     token = token or os.environ.get(TOKEN_ENV) or None
     if spec == "memory:":
@@ -110,7 +115,7 @@ def open_store(url: str | None = None, *, token: str | None = None, timeout: flo
         raise StoreError(f"cannot open a store at {spec!r}: expected a folder, memory:, or an http(s):// URL")
     if spec.startswith("file:"):
         spec = urllib.parse.unquote(urllib.parse.urlsplit(spec).path)
-    return _embedded_store(Path(spec), token, timeout)
+    return _embedded_store(Path(spec), token, timeout, read_only)
 
 
 class StoreOpening:
@@ -193,16 +198,17 @@ def _preset_store(preset: Preset, url: str, token: str | None, timeout: float) -
     )
 
 
-def _embedded_store(path: Path, token: str | None, timeout: float) -> Store:
-    embedded = EmbeddedStore(path)
-    if not embedded.held_elsewhere:
+def _embedded_store(path: Path, token: str | None, timeout: float, read_only: bool = False) -> Store:
+    embedded = EmbeddedStore(path, read_only=read_only)
+    if not read_only and not embedded.held_elsewhere:
         return embedded
-    from exsce_dsl.store.remote import RemoteStore
     from exsce_dsl.store.serve_info import read_serve_info
 
-    info = read_serve_info(path)
+    info = read_serve_info(path) if path.exists() else None
     if info is None or not info.is_alive():
-        return embedded  # reads see a read-only view; a write says who holds the store
+        return embedded  # reads see a read-only view; a write says who holds the store, or why not
+    from exsce_dsl.store.remote import RemoteStore
+
     embedded.close()
     mode = "updates allowed" if info.updates else "read-only"
     label = f"the store {path} (held by exscec serve, pid {info.pid}, {mode}, at {info.url})"

@@ -46,6 +46,12 @@ _NUMERIC = (Kind.CONSTANT, Kind.NUMBERS, Kind.ARRAYS, Kind.VALUE)
 _PER_MESSAGE = (Kind.NUMBERS, Kind.ARRAYS, Kind.CONDITIONS, Kind.ARRAY_CONDITIONS)
 _CONDITIONS = (Kind.CONDITIONS, Kind.ARRAY_CONDITIONS)
 
+MAX_DEPTH = 100
+"""The deepest expression a metric may hold, in operations within operations (a sum of n terms
+is n - 1 deep): every later stage (the generated monitors, Python's parser, which allows 200
+nested parentheses, pickling) walks an expression by recursion (issue 46: a sum of 500 terms
+passed ``check`` and broke ``generate``)."""
+
 
 @dataclass(frozen=True)
 class Typed:
@@ -75,6 +81,26 @@ class _Failed(Exception):
     """An expression with an error (already reported): its parents are not checked further."""
 
 
+def expression_depth(expr: Expression) -> int:
+    """How many operations deep ``expr`` is (a leaf: 0), counted without recursion."""
+    deepest = 0
+    pending: list[tuple[Expression, int]] = [(expr, 0)]
+    while pending:
+        node, depth = pending.pop()
+        deepest = max(deepest, depth)
+        children: list[Expression] = []
+        if isinstance(node, Unary):
+            children = [node.operand]
+        elif isinstance(node, Binary):
+            children = [node.left, node.right]
+        elif isinstance(node, (Call, Aggregate)):
+            children = list(node.args)
+            if isinstance(node, Aggregate) and node.where is not None:
+                children.append(node.where)
+        pending.extend((child, depth + 1) for child in children)
+    return deepest
+
+
 def read_quantity(text: str) -> tuple[float, Dimension | None]:
     """A quantity token (``0.8 m/s``) in SI, with its unit's dimension (None without a unit)."""
     match = _QUANTITY.fullmatch(text.strip())
@@ -98,6 +124,14 @@ class ExpressionBuilder:
         try:
             typed = self._expr(tree)
         except _Failed:
+            return None
+        depth = expression_depth(typed.expr)
+        if depth > MAX_DEPTH:
+            self.error(
+                f"this expression nests {depth} operations deep (each + or * of a sum or product is one): "
+                f"exsce reads at most {MAX_DEPTH}",
+                tree,
+            )
             return None
         if typed.kind is not Kind.VALUE:
             self.error(

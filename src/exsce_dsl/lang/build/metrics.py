@@ -41,7 +41,7 @@ from exsce_dsl.model.metrics import (
     TopicRead,
     signal_pattern,
 )
-from exsce_dsl.model.names import TOPIC_RULE, is_topic_pattern
+from exsce_dsl.model.names import ROS_TOPIC_RULE, TOPIC_RULE, is_ros_topic, is_topic_pattern
 from exsce_dsl.suggest import did_you_mean
 
 
@@ -197,6 +197,12 @@ class _MetricBuilder:
                 read,
             )
             return
+        if not is_ros_topic(read.topic):  # the ROS monitor generators' own rule
+            self.warning(
+                f"'{read.topic}' is no topic a ROS node can subscribe to ({ROS_TOPIC_RULE}): "
+                "bags may hold it, but ros1-monitor and ros2-monitor refuse it",
+                read,
+            )
         # a topic of each robot without '{ns}': only robots at the root may read it (checks.py)
         self.reads[read.name] = TopicRead(read.name, msgtype, read.topic, self.pf.span(read))
         if tree is not None:

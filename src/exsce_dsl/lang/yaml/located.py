@@ -14,6 +14,44 @@ from exsce_dsl.textfiles import read_text
 
 _Key = str | int
 
+MAX_DEPTH = 64
+"""The deepest nesting of a YAML file read here (the method's files nest a handful of levels):
+composing a node tree recurses once a level, and Python stops at a thousand (issue 46: a list
+nested 50,000 deep was an internal error)."""
+
+
+class _BoundedLoader(yaml.SafeLoader):
+    """The safe loader, refusing nesting deeper than :data:`MAX_DEPTH` where it starts."""
+
+    def __init__(self, stream: str) -> None:
+        super().__init__(stream)
+        self._depth = 0
+
+    def compose_node(self, parent: yaml.Node | None, index: int) -> yaml.Node | None:
+        self._depth += 1
+        try:
+            if self._depth > MAX_DEPTH:
+                mark = self.peek_event().start_mark  # type: ignore[no-untyped-call]
+                raise yaml.composer.ComposerError(
+                    None, None, f"nested more than {MAX_DEPTH} levels deep", mark
+                )
+            node: yaml.Node | None = super().compose_node(parent, index)
+            return node
+        finally:
+            self._depth -= 1
+
+
+def load_located(text: str) -> tuple[object, yaml.Node | None]:
+    """The data of a YAML text and its node tree (for line and column numbers), read once by the
+    safe loader, nesting at most :data:`MAX_DEPTH` deep; raises ``yaml.YAMLError``."""
+    loader = _BoundedLoader(text)
+    try:
+        tree = loader.get_single_node()
+        data = loader.construct_document(tree) if tree is not None else None
+    finally:
+        loader.dispose()
+    return data, tree
+
 
 class YamlFile:
     """A YAML file read twice: as data with ``yaml.safe_load``, and as a node tree
@@ -31,8 +69,7 @@ class YamlFile:
         except ExsceError as e:
             raise ImportFormatError(e.message, e.location) from None
         try:
-            data = yaml.safe_load(text)
-            tree = yaml.compose(text, Loader=yaml.SafeLoader)
+            data, tree = load_located(text)
         except yaml.YAMLError as e:
             mark = getattr(e, "problem_mark", None)
             location = node_location(str(path), mark) if mark is not None else None
