@@ -51,6 +51,8 @@ REASONS: dict[str, tuple[str, ...]] = {
     "ROS 1 truncated in its header": ("truncated", "runs past the end of the file"),
     "ROS 1 bag named .mcap": ("a ROS 1 bag, but named", "rename it to end in .bag"),
     "ROS 2 folder without metadata.yaml": ("without its metadata.yaml", "ros2 bag reindex"),
+    "ROS 2 metadata.yaml nested deep": ("metadata.yaml does not parse",),
+    "ROS 2 metadata.yaml a FIFO": ("metadata.yaml", "not a regular file"),
     "garbage named .bag": ("not a bag",),
     "MCAP truncated in the middle": ("MCAP file is truncated", "mcap recover"),
     "MCAP truncated before its footer": ("MCAP file is truncated",),

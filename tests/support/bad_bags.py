@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import bz2
 import gzip
+import os
 import shutil
 import struct
 import zlib
@@ -315,6 +316,23 @@ def ros2_without_metadata(bags: dict[str, Path], folder: Path) -> Path:
     return folder / "killed"
 
 
+def ros2_metadata_nested_deep(bags: dict[str, Path], folder: Path) -> Path:
+    """A ROS 2 bag folder whose metadata.yaml nests 50,000 lists deep (issue 46: Python's YAML
+    loader recursed until it failed, an internal error)."""
+    shutil.copytree(bags["mcap"].parent, folder / "deep")
+    (folder / "deep" / "metadata.yaml").write_text("[" * 50_000 + "]" * 50_000)
+    return folder / "deep"
+
+
+def ros2_metadata_fifo(bags: dict[str, Path], folder: Path) -> Path:
+    """A ROS 2 bag folder whose metadata.yaml is a FIFO that nobody writes (issue 46: reading it
+    waited forever)."""
+    shutil.copytree(bags["mcap"].parent, folder / "fifo")
+    (folder / "fifo" / "metadata.yaml").unlink()
+    os.mkfifo(folder / "fifo" / "metadata.yaml")
+    return folder / "fifo"
+
+
 def garbage_named_bag(bags: dict[str, Path], folder: Path) -> Path:
     (folder / "noise.bag").write_bytes(bytes(range(256)) * 64)
     return folder / "noise.bag"
@@ -444,6 +462,8 @@ MAKERS: dict[str, Maker] = {
     "ROS 1 truncated in its header": ros1_truncated_in_header,
     "ROS 1 bag named .mcap": ros1_named_mcap,
     "ROS 2 folder without metadata.yaml": ros2_without_metadata,
+    "ROS 2 metadata.yaml nested deep": ros2_metadata_nested_deep,
+    "ROS 2 metadata.yaml a FIFO": ros2_metadata_fifo,
     "garbage named .bag": garbage_named_bag,
     "MCAP truncated in the middle": mcap_truncated_middle,
     "MCAP truncated before its footer": mcap_truncated_before_footer,

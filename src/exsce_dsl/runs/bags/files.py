@@ -20,12 +20,13 @@ from dataclasses import dataclass
 from pathlib import Path, PurePath
 from typing import Any
 
-from exsce_dsl.errors import BagError
+from exsce_dsl.errors import BagError, ExsceError
 from exsce_dsl.runs.bags.file_problems import FileProblem
 from exsce_dsl.runs.bags.mcap_file import check_mcap
 from exsce_dsl.runs.bags.mcap_index import MAGIC as MCAP_MAGIC
 from exsce_dsl.runs.bags.ros1 import MAGIC as ROS1_MAGIC
 from exsce_dsl.runs.bags.ros1_file import check_ros1
+from exsce_dsl.textfiles import read_text
 
 SQLITE_MAGIC = b"SQLite format 3\x00"
 
@@ -142,7 +143,7 @@ def _check_mapped(path: Path, check: Callable[[mmap.mmap, Path], None]) -> None:
 
 def _check_ros2_folder(folder: Path) -> None:
     meta = folder / "metadata.yaml"
-    if not meta.is_file():
+    if not meta.is_file() and not meta.exists():
         inside = sorted(p.name for p in folder.iterdir())
         if not inside:
             raise BagError(
@@ -159,10 +160,13 @@ def _check_ros2_folder(folder: Path) -> None:
         )
     import yaml  # here: only a ROS 2 bag folder needs it
 
+    loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml's bounds its nesting (issue 46)
     try:
-        info = _bag_information(yaml.safe_load(meta.read_text(encoding="utf-8")))
-    except (yaml.YAMLError, UnicodeDecodeError) as exc:
-        reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        info = _bag_information(yaml.load(read_text(meta, "metadata.yaml"), Loader=loader))
+    except ExsceError as exc:
+        raise BagError(f"{folder}: {exc.message}") from None
+    except (yaml.YAMLError, RecursionError) as exc:
+        reason = str(exc).splitlines()[0] if str(exc) else "nested too deeply"
         raise BagError(f"{folder}: its metadata.yaml does not parse: {reason}") from None
     except FileProblem as problem:
         raise BagError(f"{folder}: its metadata.yaml {problem}") from None

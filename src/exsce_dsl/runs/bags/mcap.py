@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from exsce_dsl.errors import ExsceError
 from exsce_dsl.messages.catalogue import MessageCatalogue, Source, parse_definition, standard_catalogue
 from exsce_dsl.runs.bags.chunk_batches import Messages
 from exsce_dsl.runs.bags.data import OBJECTS, BagData, Check, Reduce, Wanted
@@ -23,6 +24,7 @@ from exsce_dsl.runs.bags.mcap_index import IDL_SEPARATOR, Schema, read_topics, s
 from exsce_dsl.runs.bags.objects import deserialized, deserializer_for
 from exsce_dsl.runs.bags.reader import BagReader, UnsupportedBag
 from exsce_dsl.runs.bags.reading_base import IndexReading
+from exsce_dsl.textfiles import read_text
 
 
 def mcap_files(path: Path) -> list[Path] | None:
@@ -35,11 +37,11 @@ def mcap_files(path: Path) -> list[Path] | None:
 
     loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml's: ten times faster
     try:
-        text = (path / "metadata.yaml").read_text()
+        text = read_text(path / "metadata.yaml", "metadata.yaml")  # bounded: never a FIFO's wait
         info = yaml.load(text, Loader=loader)["rosbag2_bagfile_information"]
         storage, mode = info.get("storage_identifier"), info.get("compression_mode") or ""
         files = [path / str(name) for name in info.get("relative_file_paths") or ()]
-    except (OSError, UnicodeDecodeError, yaml.YAMLError, KeyError, TypeError, AttributeError):
+    except (ExsceError, yaml.YAMLError, KeyError, TypeError, AttributeError):
         return None
     if storage != "mcap" or str(mode).lower() not in ("", "none") or not files:
         return None
