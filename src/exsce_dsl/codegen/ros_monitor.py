@@ -20,7 +20,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
-from xml.sax.saxutils import escape
 
 from exsce_dsl.codegen.output import write_files
 from exsce_dsl.errors import SourceLocation
@@ -270,17 +269,6 @@ def _not_live(
     return ""
 
 
-def _xml_comment(text: str) -> str:
-    """``text`` inside an XML (or Markdown) comment, which may not hold ``--``; it only comes
-    from inside Python string literals, where ``\\u002d`` keeps its meaning ('-')."""
-    return text.replace("--", "-\\u002d")
-
-
-def _xml_text(text: str) -> str:
-    """``text`` as XML character data."""
-    return escape(text)
-
-
 def _context(spec: Specification, scenario_id: str | None, ros: int) -> tuple[dict[str, Any], str]:
     scenario = spec.scenario(scenario_id)
     package = package_name(scenario.id, scenario.location)
@@ -300,8 +288,6 @@ def _context(spec: Specification, scenario_id: str | None, ros: int) -> tuple[di
         "source": source,
         "generator": generator,
         "header": header,
-        "header_xml": _xml_comment(header),
-        "scenario_xml": _xml_text(python_string(scenario.id)),
         "robots": robots,
         "topics": topics,
         "oracles": judged,
