@@ -21,8 +21,8 @@ import types
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from exsce_dsl.lang import expression_text
 from exsce_dsl.errors import GenerationError
+from exsce_dsl.lang import expression_text
 from exsce_dsl.model.expressions import (
     AGGREGATES,
     CONDITION_AGGREGATES,
