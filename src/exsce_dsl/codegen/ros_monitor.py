@@ -14,11 +14,10 @@ dozen lines of rospy or rclpy, differs between the two.
 from __future__ import annotations
 
 import dataclasses
-import os
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 from typing import Any
 
 from exsce_dsl.codegen.output import write_files
@@ -345,11 +344,9 @@ def generate_ros1_monitor(
     spec: Specification, scenario_id: str | None, out_dir: Path, overwrite: bool = False
 ) -> list[Path]:
     """Write the ROS 1 (catkin, rospy) monitor package of the scenario below ``out_dir``."""
-    written = write_files(out_dir, ros1_monitor_files(spec, scenario_id), overwrite)
-    for path in written:
-        if path.parent.name == "scripts":
-            os.chmod(path, 0o755)  # rosrun runs the node script itself
-    return written
+    files = ros1_monitor_files(spec, scenario_id)
+    scripts = [name for name in files if PurePosixPath(name).parent.name == "scripts"]
+    return write_files(out_dir, files, overwrite, executable=scripts)  # rosrun runs the node script itself
 
 
 def generate_ros2_monitor(
