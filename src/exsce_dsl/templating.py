@@ -41,14 +41,27 @@ def python_name(name: str) -> str:
     return name
 
 
+def _escaped(char: str) -> str:
+    code = ord(char)
+    return f"\\x{code:02x}" if code < 0x100 else f"\\u{code:04x}" if code < 0x10000 else f"\\U{code:08x}"
+
+
+def _double_quoted(text: str) -> str:
+    """``text`` between double quotes, in ASCII: ``"`` and ``\\`` escaped, control characters as
+    JSON escapes them, and every other character past ``~`` as ``\\xXX``, ``\\uXXXX`` or
+    ``\\UXXXXXXXX``: one escape per code point, which Python and YAML read back alike (JSON's
+    surrogate pairs for characters past U+FFFF would read back as two lone surrogates)."""
+    return "".join(c if c < "\x7f" else _escaped(c) for c in json.dumps(text, ensure_ascii=False))
+
+
 def python_string(text: str) -> str:
-    """A Python string literal of ``text`` (JSON's quoting is valid Python for any str)."""
-    return json.dumps(text, ensure_ascii=True)
+    """A Python string literal of ``text``, on one line and in ASCII."""
+    return _double_quoted(text)
 
 
 def yaml_string(text: str) -> str:
-    """A double-quoted YAML scalar of ``text`` (YAML 1.2 is a superset of JSON)."""
-    return json.dumps(text, ensure_ascii=True)
+    """A double-quoted YAML scalar of ``text``, on one line and in ASCII."""
+    return _double_quoted(text)
 
 
 _BREAKING = frozenset(("Cc", "Cf", "Cs", "Co", "Cn", "Zl", "Zp"))

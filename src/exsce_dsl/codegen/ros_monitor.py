@@ -116,11 +116,12 @@ def monitor_topics(
     topics: dict[str, TopicEntry] = {}
     trees: dict[str, Fields | None] = {}
 
-    def add(topic: str, entry: TopicEntry, by: str) -> TopicEntry:
+    def add(topic: str, entry: TopicEntry, by: str, location: SourceLocation | None = None) -> TopicEntry:
         if not _ROS_TOPIC.fullmatch(topic) or "__" in topic:
             raise GenerationError(
                 f"'{topic}' (read by {by}) is not a ROS topic name: names of letters, digits and '_', "
-                "not starting with a digit, separated by '/'"
+                "not starting with a digit, separated by '/'",
+                location,
             )
         found = topics.setdefault(topic, entry)
         if (found.role, found.robot) != (entry.role, entry.robot):
@@ -154,7 +155,7 @@ def monitor_topics(
                         read.location,
                     )
                 wanted = TopicEntry(canonical_type(read.msgtype))
-                entry = add(read.topic_of(ns), wanted, f"metric {metric.name}")
+                entry = add(read.topic_of(ns), wanted, f"metric {metric.name}", read.location)
                 if entry.msgtype not in trees:
                     trees[entry.msgtype] = _tree(entry.msgtype)
                 key = node.path.key
