@@ -15,14 +15,16 @@ import matplotlib
 from matplotlib.figure import Figure
 
 from exsce_dsl.errors import ExsceError
+from exsce_dsl.templating import comment_text
 
 FORMATS = ("png", "svg")
 
 
 def plain(text: str) -> str:
     """``text`` as matplotlib draws it literally: each ``$`` escaped, so that no part of it is
-    read as mathtext (a topic named ``$x^^$`` would stop the drawing with a parse error)."""
-    return text.replace("$", "\\$")
+    read as mathtext (a topic named ``$x^^$`` would stop the drawing with a parse error), and on
+    one line, without the control characters an SVG file may not hold."""
+    return comment_text(text).replace("$", "\\$")
 
 
 def save_figure(figure: Figure, path: Path, dpi: int = 110) -> None:

@@ -19,7 +19,6 @@ from pathlib import Path
 import pytest
 import yaml
 from hypothesis import given, settings
-from hypothesis import strategies as st
 
 from exsce_dsl.codegen.dispatcher import MISSION_FILE, dispatcher_files
 from exsce_dsl.codegen.monitors import monitor_files
@@ -30,6 +29,7 @@ from exsce_dsl.lang.format.gherkin import gherkin_features
 from exsce_dsl.model import Specification
 
 from tests.support.hostile_specs import (
+    HOSTILE,
     SLOTS,
     called_names,
     check_files_read_back,
@@ -37,15 +37,6 @@ from tests.support.hostile_specs import (
     python_files,
     spec_text,
     write_spec,
-)
-
-PIECES = (
-    "\n", "\r", "\r\n", "\t", "\v", "\f", "\0", "\x85", "\u2028", "\u2029", "\u202e", "\ufeff", "\uffff",
-    "'", '"', "\\", "#", '"""', "'''", "{{", "}}", "{%", "%}", "{#", "</", "<!--", "-->", "]]>", "&", "<", ">",
-    "--", "`", "$x^^$", "(", ")", ":", "\U0001f916", "__import__('os').system('true')", "x = 1",
-)  # fmt: skip
-HOSTILE = st.lists(st.one_of(st.sampled_from(PIECES), st.text(max_size=3)), min_size=1, max_size=8).map(
-    "".join
 )
 
 Generator = Callable[[Specification], dict[str, str]]

@@ -6,10 +6,15 @@ the hostile ones."""
 
 from __future__ import annotations
 
+import functools
+import tempfile
+import xml.etree.ElementTree as ET
+from html.parser import HTMLParser
 from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
 from matplotlib.figure import Figure
 
 from exsce_dsl.figures import save_figure
@@ -24,6 +29,7 @@ from exsce_dsl.runs.signals.trajectories import Trajectory
 from exsce_dsl.store.queries import MetricReading, StoredRun
 
 from tests.support.cli import exscec_here
+from tests.support.hostile_specs import HOSTILE
 
 MATH = "$x^^$"
 UUID = "0fcc1782-0c63-5500-b8af-3de8573bc05f"
@@ -116,3 +122,43 @@ def test_report_output_refuses_planted_symlink(tmp_path: Path) -> None:
     assert not (folder / "index.html").is_symlink() and "<html" in (folder / "index.html").read_text()
     assert (folder / "images").is_dir() and not (folder / "images").is_symlink()
     assert (folder / "notes.txt").read_text() == "kept\n"
+
+
+class _Tags(HTMLParser):
+    """The start tags of a page, with their attributes' names."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.tags: list[tuple[str, tuple[str, ...]]] = []
+
+    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+        self.tags.append((tag, tuple(name for name, _ in attrs)))
+
+
+def _page_tags(folder: Path) -> dict[str, list[tuple[str, tuple[str, ...]]]]:
+    """Each page's tags, pages named by kind (run, scenario, index): their names hold ids."""
+    found = {}
+    for page in folder.glob("*.html"):
+        parser = _Tags()
+        parser.feed(page.read_text(encoding="utf-8"))
+        found[page.name.split("-", 1)[0]] = parser.tags
+    return found
+
+
+@functools.cache
+def _plain_tags() -> dict[str, list[tuple[str, tuple[str, ...]]]]:
+    with tempfile.TemporaryDirectory() as folder:
+        return _page_tags(write_report(_contents("plain"), Path(folder) / "plain").parent)
+
+
+@pytest.mark.filterwarnings("ignore:Glyph .* missing from font")
+@settings(max_examples=10, deadline=None)
+@given(name=HOSTILE)
+def test_hostile_text_in_the_report_stays_text(name: str) -> None:
+    """Every page has the tags and attributes of a report of harmless names, and every image
+    is drawn (each SVG parses): the text never becomes markup nor mathtext."""
+    with tempfile.TemporaryDirectory() as folder:
+        write_report(_contents(name), Path(folder) / "hostile")
+        assert _page_tags(Path(folder) / "hostile") == _plain_tags()
+        for image in (Path(folder) / "hostile" / "images").glob("*.svg"):
+            ET.parse(image)

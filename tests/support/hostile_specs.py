@@ -15,8 +15,19 @@ from collections.abc import Mapping
 from pathlib import Path
 
 import yaml
+from hypothesis import strategies as st
 
 from exsce_dsl.lang.lexical import string_literal
+
+PIECES = (
+    "\n", "\r", "\r\n", "\t", "\v", "\f", "\0", "\x85", "\u2028", "\u2029", "\u202e", "\ufeff", "\uffff",
+    "'", '"', "\\", "#", '"""', "'''", "{{", "}}", "{%", "%}", "{#", "</", "<!--", "-->", "]]>", "&", "<", ">",
+    "--", "`", "$x^^$", "(", ")", ":", "\U0001f916", "__import__('os').system('true')", "x = 1",
+)  # fmt: skip
+HOSTILE = st.lists(st.one_of(st.sampled_from(PIECES), st.text(max_size=3)), min_size=1, max_size=8).map(
+    "".join
+)
+"""Texts made of what breaks out of literals, comments and markup, in any order, and anything else."""
 
 TEMPLATE = """\
 robot type rover {
