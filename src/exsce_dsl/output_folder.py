@@ -9,7 +9,7 @@ a link met on the way is refused, and each file is written to a fresh name
 beside its target and renamed over it: a rename replaces whatever is at the
 target (even a link put there meanwhile) and never writes through it, and a
 reader never sees a half-written file.  A set of files written as one piece
-(the report) is written into a private folder first and renamed into its
+(the report) is written into a new hidden folder first and renamed into its
 place when complete (:func:`written_whole`).
 """
 
@@ -21,7 +21,6 @@ import os
 import secrets
 import shutil
 import stat
-import tempfile
 from collections.abc import Iterator
 from pathlib import Path, PurePosixPath
 
@@ -100,8 +99,6 @@ def write_below(folder: Path, relative: str, data: bytes, mode: int = 0o666) -> 
     ``mode`` is masked by the umask as ``open`` masks it.  A link below ``folder`` is refused."""
     *inside, name = relative_parts(relative)
     target = folder.joinpath(*inside, name)
-    umask = os.umask(0)
-    os.umask(umask)
     try:
         with _opened_folder(folder, tuple(inside)) as fd:
             try:
@@ -114,11 +111,10 @@ def write_below(folder: Path, relative: str, data: bytes, mode: int = 0o666) -> 
                 raise ExsceError(f"cannot write {target}: it is a folder")
             temporary = f".{name}.{secrets.token_hex(6)}.tmp"
             flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | _NOFOLLOW
-            out = os.open(temporary, flags, 0o600, dir_fd=fd)
+            out = os.open(temporary, flags, mode, dir_fd=fd)  # the umask applies, as to open()
             try:
                 with os.fdopen(out, "wb") as stream:
                     stream.write(data)
-                    os.fchmod(stream.fileno(), mode & ~umask)
                 os.replace(temporary, name, src_dir_fd=fd, dst_dir_fd=fd)
             except BaseException:
                 with contextlib.suppress(OSError):
@@ -131,7 +127,7 @@ def write_below(folder: Path, relative: str, data: bytes, mode: int = 0o666) -> 
 
 @contextlib.contextmanager
 def written_whole(folder: Path) -> Iterator[Path]:
-    """A new private folder to write a set of files into; when the block ends, what it holds
+    """A new hidden folder to write a set of files into; when the block ends, what it holds
     takes its place in ``folder`` (made if missing), and on an error it is removed and
     ``folder`` is left as it was.
 
@@ -152,10 +148,8 @@ def written_whole(folder: Path) -> Iterator[Path]:
         if mode is None:
             target.parent.mkdir(parents=True, exist_ok=True)
         where = target if mode is not None else target.parent
-        staging = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".partial", dir=where))
-        umask = os.umask(0)
-        os.umask(umask)
-        staging.chmod(0o777 & ~umask)
+        staging = where / f".{target.name}.{secrets.token_hex(8)}.partial"
+        staging.mkdir(0o777)  # new (an existing name is an error), with the umask's permissions
     except OSError as exc:
         raise ExsceError(f"cannot write into {folder}: {exc.strerror or exc}") from None
     try:
@@ -191,7 +185,10 @@ def _install(staging: Path, target: Path) -> None:
                 aside.append(target / f".{entry.name}.{secrets.token_hex(6)}.old")
                 _rename(place, aside[-1])
             else:
-                place.unlink()  # a file or a link where the folder goes: the link, not its target
+                try:
+                    place.unlink()  # a file or a link where the folder goes: the link, not its target
+                except OSError as exc:
+                    raise ExsceError(f"cannot write {place}: {exc.strerror or exc}") from None
         _rename(entry, place)  # over a file or a link: replaces it, never writes through it
     for old in aside:
         shutil.rmtree(old, ignore_errors=True)

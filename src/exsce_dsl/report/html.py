@@ -102,7 +102,7 @@ def write_report(
 ) -> Path:
     """Write the report into ``folder`` and return its index page.
 
-    The report is written into a private folder first and renamed into ``folder`` when
+    The report is written into a new hidden folder first and renamed into ``folder`` when
     complete: a report that fails half-way leaves an earlier one as it was, and a link
     planted in ``folder`` is replaced, not written through.
     ``progress`` is told of every run drawn (bags are read for the paths driven).
