@@ -159,3 +159,19 @@ def test_a_link_swapped_in_after_the_check_is_replaced_not_followed(tmp_path: Pa
     assert written.read_text() == "y = 2\n" and outside.read_text() == "mine\n"
     assert os.access(written, os.X_OK) and not written.is_symlink()
     assert sorted(p.name for p in out.iterdir()) == ["x.py"]  # no temporary file left
+
+
+def test_ingest_of_the_hostile_spec_runs_nothing(tmp_path: Path) -> None:
+    """The finding as it was met: ``exscec ingest`` of a run with the hostile spec."""
+    from exsce_dsl.sim.run import simulate
+
+    marker = tmp_path / "ran"
+    spec = write_spec(tmp_path, "SELECTION", _payload(marker))
+    try:
+        scenario = load_spec(spec).scenario()
+    except ExsceError:
+        return  # refused: nothing to ingest
+    (run,) = simulate(scenario, tmp_path / "runs", 1, seed=3)
+    done = exscec_here("ingest", str(run.bag), "--scenario", str(spec), cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert not marker.exists()
