@@ -7,6 +7,8 @@ writes through a symbolic link planted in its output folder."""
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 import os
 from pathlib import Path
 
@@ -16,6 +18,7 @@ from exsce_dsl.codegen.output import write_files
 from exsce_dsl.codegen.readback import check_generated, check_written
 from exsce_dsl.errors import ExsceError, GenerationError
 from exsce_dsl.lang import load_spec, standard_metrics
+from exsce_dsl.model.expressions import Number, Unary
 from exsce_dsl.runs.metrics.monitor_code import load_monitors, monitor_source
 
 from tests.support.cli import exscec_here
@@ -175,3 +178,21 @@ def test_ingest_of_the_hostile_spec_runs_nothing(tmp_path: Path) -> None:
     done = exscec_here("ingest", str(run.bag), "--scenario", str(spec), cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     assert not marker.exists()
+
+
+def test_generate_of_a_500_term_sum_is_an_error_at_the_metric(tmp_path: Path) -> None:
+    """Issue 46, item 9: it passed check, and generate exited 70 (a RecursionError)."""
+    spec = tmp_path / "sum.exsce"
+    terms = " + ".join(["max(v.data)"] * 500)
+    spec.write_text(f'metric m for each robot {{\n  reads v: std_msgs/msg/Float64 on "/{{ns}}/v"\n  value {terms}\n}}\n')
+    done = exscec_here("generate", "monitors", str(spec), "-o", str(tmp_path / "out"))
+    assert done.returncode == 2 and done.stderr.startswith(f"{spec}:"), done.stderr  # refused where it is
+    assert not (tmp_path / "out").exists()
+    try:
+        (metric,) = load_spec(spec).metrics
+    except ExsceError:
+        return  # the checks refuse it already
+    with pytest.raises(GenerationError, match="nests 501 deep, more than the 100"):
+        monitor_source([metric], "sum.exsce")
+    deep = dataclasses.replace(metric, value=functools.reduce(lambda e, _: Unary("-", e), range(99), Number(1.0)))
+    assert "core.finite" in monitor_source([deep], "deep.exsce")  # 100 deep: code is written for it
