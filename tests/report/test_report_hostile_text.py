@@ -18,13 +18,15 @@ from hypothesis import given, settings
 from matplotlib.figure import Figure
 
 from exsce_dsl.figures import save_figure
+from exsce_dsl.model.campaign import CampaignPlan, CampaignRecord, CheckedRelation, Trial
 from exsce_dsl.model.geometry import Position
 from exsce_dsl.model.runs import Hotspot
 from exsce_dsl.model.verdicts import Outcome, Verdict
 from exsce_dsl.report import html
+from exsce_dsl.report.campaigns import campaign_contents
 from exsce_dsl.report.contents import ReportContents, RunContents, ScenarioContents
 from exsce_dsl.report.html import page_name, write_report
-from exsce_dsl.report.plots import trajectory_figure
+from exsce_dsl.report.plots import campaign_figure, trajectory_figure
 from exsce_dsl.runs.signals.trajectories import Trajectory
 from exsce_dsl.store.queries import MetricReading, StoredRun
 
@@ -162,3 +164,16 @@ def test_hostile_text_in_the_report_stays_text(name: str) -> None:
         assert _page_tags(Path(folder) / "hostile") == _plain_tags()
         for image in (Path(folder) / "hostile" / "images").glob("*.svg"):
             ET.parse(image)
+
+
+def test_a_campaigns_relations_with_mathtext_chars_are_drawn_one_per_line(tmp_path: Path) -> None:
+    plan = CampaignPlan("c", "s", 2, 1, 1, 1, (), "walk", "kinematic", False, 5.0)
+    violated = (
+        CheckedRelation("task_duration", f"r{MATH}", "increasing"),
+        CheckedRelation("distance_travelled", "r1", "invariant"),
+    )
+    trial = Trial("c", 1, "s_1", (), ("run",), violated, violated)
+    figure = campaign_figure(campaign_contents(CampaignRecord(plan, None, (trial,), ())))
+    save_figure(figure, tmp_path / "campaign.svg")
+    (label,) = [t for t in _texts(figure) if "task_duration" in t]
+    assert len(label.split("\n")) == 2 and "\\$" in label

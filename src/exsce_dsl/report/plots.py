@@ -448,7 +448,7 @@ def campaign_figure(campaign: CampaignContents) -> Figure:
         count += len(trial.new)
         axes.plot([tried_so_far], [count], marker="o", color="#c0392b", markersize=5, gid=f"found-{count}")
         axes.annotate(
-            plain("\n".join(trial.new)),
+            "\n".join(plain(relation) for relation in trial.new),
             (tried_so_far, count),
             # below and right of the dot the line never goes (it only rises, to the right); too
             # near the right end, below and left
