@@ -3,11 +3,14 @@
 It sits beside :mod:`exsce_dsl.resources` because two layers render templates:
 ``runs`` (the monitors that ingestion runs) and ``codegen`` (files for users).
 
-Generated code is Python and YAML.  Nothing from a user's file is pasted into
-it raw: identifiers go through :func:`python_name` (checked, never rewritten),
-strings through :func:`python_string` or :func:`yaml_string` (quoted by the
-target's own rules), and numbers through :func:`python_number` or
-:func:`yaml_number`.
+Generated code is Python and YAML (and, in the ROS packages, XML, CMake and
+Markdown).  Nothing from a user's file is pasted into it raw: identifiers go
+through :func:`python_name` (checked, never rewritten), strings through
+:func:`python_string` or :func:`yaml_string` (quoted by the target's own
+rules), and numbers through :func:`python_number` or :func:`yaml_number`.
+Text that only informs a reader (comments) goes through :func:`comment_text`,
+which leaves it on one line, and then through :func:`xml_comment_text`,
+:func:`xml_text` or :func:`markdown_text` in those languages.
 Undefined template variables are errors (``StrictUndefined``).
 """
 
@@ -18,8 +21,10 @@ import json
 import keyword
 import math
 import re
+import unicodedata
 from collections.abc import Callable, Mapping
 from typing import Any
+from xml.sax.saxutils import escape
 
 import jinja2
 
@@ -36,14 +41,65 @@ def python_name(name: str) -> str:
     return name
 
 
+def _escaped(char: str) -> str:
+    code = ord(char)
+    return f"\\x{code:02x}" if code < 0x100 else f"\\u{code:04x}" if code < 0x10000 else f"\\U{code:08x}"
+
+
+def _double_quoted(text: str) -> str:
+    """``text`` between double quotes, in ASCII: ``"`` and ``\\`` escaped, control characters as
+    JSON escapes them, and every other character past ``~`` as ``\\xXX``, ``\\uXXXX`` or
+    ``\\UXXXXXXXX``: one escape per code point, which Python and YAML read back alike (JSON's
+    surrogate pairs for characters past U+FFFF would read back as two lone surrogates)."""
+    return "".join(c if c < "\x7f" else _escaped(c) for c in json.dumps(text, ensure_ascii=False))
+
+
 def python_string(text: str) -> str:
-    """A Python string literal of ``text`` (JSON's quoting is valid Python for any str)."""
-    return json.dumps(text, ensure_ascii=True)
+    """A Python string literal of ``text``, on one line and in ASCII."""
+    return _double_quoted(text)
 
 
 def yaml_string(text: str) -> str:
-    """A double-quoted YAML scalar of ``text`` (YAML 1.2 is a superset of JSON)."""
-    return json.dumps(text, ensure_ascii=True)
+    """A double-quoted YAML scalar of ``text``, on one line and in ASCII."""
+    return _double_quoted(text)
+
+
+_BREAKING = frozenset(("Cc", "Cf", "Cs", "Co", "Cn", "Zl", "Zp"))
+"""Unicode categories a comment may not hold: control characters (NUL, \\r, \\v, \\f, U+0085...),
+format characters (bidirectional overrides that make code read otherwise than it runs),
+surrogates, private use, noncharacters (U+FFFF, which XML may not hold) and the line and
+paragraph separators U+2028 and U+2029."""
+
+
+def comment_text(text: str) -> str:
+    """``text`` on one line, for a ``#`` comment of generated code (Python, YAML, CMake, INI):
+    every line break and control or format character becomes a space, so that nothing after
+    it is read as code."""
+    return "".join(" " if unicodedata.category(c) in _BREAKING else c for c in text)
+
+
+def docstring_text(text: str) -> str:
+    """:func:`comment_text` inside a Python docstring: backslashes and quotes escaped besides,
+    so that the text neither ends the docstring nor starts an escape sequence."""
+    return comment_text(text).replace("\\", "\\\\").replace('"', '\\"').replace("'", "\\'")
+
+
+def xml_comment_text(text: str) -> str:
+    """:func:`comment_text` inside an XML (or Markdown) comment, which may not hold ``--``
+    (``-\\u002d`` reads as ``--`` where the text is a Python literal) nor end with ``-``."""
+    return comment_text(text).replace("--", "-\\u002d").removesuffix("-")
+
+
+def xml_text(text: str) -> str:
+    """:func:`comment_text` as XML character data (between tags, not in an attribute): ``& < >``
+    escaped."""
+    return escape(comment_text(text))
+
+
+def markdown_text(text: str) -> str:
+    """:func:`comment_text` for a Markdown page: ``& < >`` as HTML entities (no tag of the
+    text reaches a renderer that shows HTML)."""
+    return escape(comment_text(text))
 
 
 def python_number(value: float | int) -> str:
@@ -98,6 +154,11 @@ def environment() -> jinja2.Environment:
         pynum=python_number,
         yamlnum=yaml_number,
         unwrap=unwrap,
+        comment=comment_text,
+        docstring=docstring_text,
+        xmlcomment=xml_comment_text,
+        xmltext=xml_text,
+        mdtext=markdown_text,
     )
     env.tests["node"] = _is_node
     return env

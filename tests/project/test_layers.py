@@ -15,7 +15,8 @@ PACKAGE = Path(__file__).resolve().parents[2] / "src" / "exsce_dsl"
 
 LAYERS: list[set[str]] = [
     # the base
-    {"errors", "suggest", "resources", "textfiles", "tables", "templating", "figures", "user_cache", "wording"},
+    {"errors", "suggest", "resources", "textfiles", "tables", "templating", "figures", "user_cache", "wording",
+     "output_folder"},
     {"model"},
     {"messages", "maps", "monitor_kit", "parallel"},
     {"transform"},

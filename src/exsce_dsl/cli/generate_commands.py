@@ -35,7 +35,10 @@ def generate() -> None:
     """Generate files from a scenario: monitors, runtime monitor nodes, dispatcher configuration.
 
     Each target writes its files below the folder given with -o and refuses
-    to replace files that exist unless told with --force.
+    to replace files that exist unless told with --force.  It never writes
+    through a symbolic link inside that folder, and writes nothing when a
+    file it made would not read back in its language (Python, YAML, XML,
+    CMake): both are errors (exit 2).
 
     \b
     Example:

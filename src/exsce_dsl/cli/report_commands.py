@@ -18,7 +18,7 @@ from exsce_dsl.wording import counted
     default="report",
     show_default=True,
     type=click.Path(file_okay=False),
-    help="The folder to write the report into.",
+    help="The folder to write the report into (its pages are replaced when the new report is complete).",
 )
 @click.option(
     "--spec",

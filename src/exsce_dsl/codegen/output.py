@@ -1,32 +1,34 @@
-"""Write generated files: every path stays below the output folder, nothing is half-written."""
+"""Write generated files: every path stays below the output folder, nothing is half-written,
+no link below it is followed, and every file reads back in its language before any is written."""
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from pathlib import Path, PurePosixPath
+from collections.abc import Collection, Mapping
+from pathlib import Path
 
+from exsce_dsl.codegen.readback import check_generated
+from exsce_dsl.output_folder import existing, relative_parts, write_below
 from exsce_dsl.templating import GenerationError
 
 
-def write_files(out_dir: Path, files: Mapping[str, str], overwrite: bool = False) -> list[Path]:
+def write_files(
+    out_dir: Path, files: Mapping[str, str], overwrite: bool = False, executable: Collection[str] = ()
+) -> list[Path]:
     """Write ``files`` (relative POSIX path → text) below ``out_dir``; return the paths written.
 
     Relative paths may be built from ids in a user's file, so each is checked to
-    stay below ``out_dir``.  If any target exists and ``overwrite`` is false,
-    nothing is written.
+    stay below ``out_dir``; a symbolic link on the way to one is refused.  If any
+    target exists and ``overwrite`` is false, or a file does not read back in its
+    language (:func:`~exsce_dsl.codegen.readback.check_generated`), nothing is
+    written.  The files of ``executable`` are written executable (mode 0755).
     """
-    targets = {_target(out_dir, rel): text for rel, text in files.items()}
-    existing = sorted(str(t) for t in targets if t.exists())
-    if existing and not overwrite:
-        raise GenerationError(f"would overwrite {', '.join(existing)}; use --force to replace")
-    for target, text in targets.items():
-        target.parent.mkdir(parents=True, exist_ok=True)
-        target.write_text(text, encoding="utf-8")
-    return list(targets)
-
-
-def _target(out_dir: Path, relative: str) -> Path:
-    rel = PurePosixPath(relative)
-    if rel.is_absolute() or not rel.parts or any(p in ("..", "") or "\\" in p for p in rel.parts):
-        raise GenerationError(f"refusing to write outside the output folder: {relative}")
-    return out_dir.joinpath(*rel.parts)
+    for relative, text in files.items():
+        relative_parts(relative)
+        check_generated(str(out_dir.joinpath(relative)), text)
+    found = sorted(str(out_dir.joinpath(rel)) for rel in files if existing(out_dir, rel))
+    if found and not overwrite:
+        raise GenerationError(f"would overwrite {', '.join(found)}; use --force to replace")
+    return [
+        write_below(out_dir, rel, text.encode("utf-8"), 0o777 if rel in executable else 0o666)
+        for rel, text in files.items()
+    ]

@@ -14,13 +14,11 @@ dozen lines of rospy or rclpy, differs between the two.
 from __future__ import annotations
 
 import dataclasses
-import os
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 from typing import Any
-from xml.sax.saxutils import escape
 
 from exsce_dsl.codegen.output import write_files
 from exsce_dsl.errors import SourceLocation
@@ -268,17 +266,6 @@ def _not_live(
     return ""
 
 
-def _xml_comment(text: str) -> str:
-    """``text`` inside an XML (or Markdown) comment, which may not hold ``--``; it only comes
-    from inside Python string literals, where ``\\u002d`` keeps its meaning ('-')."""
-    return text.replace("--", "-\\u002d")
-
-
-def _xml_text(text: str) -> str:
-    """``text`` as XML character data."""
-    return escape(text)
-
-
 def _context(spec: Specification, scenario_id: str | None, ros: int) -> tuple[dict[str, Any], str]:
     scenario = spec.scenario(scenario_id)
     package = package_name(scenario.id, scenario.location)
@@ -298,8 +285,6 @@ def _context(spec: Specification, scenario_id: str | None, ros: int) -> tuple[di
         "source": source,
         "generator": generator,
         "header": header,
-        "header_xml": _xml_comment(header),
-        "scenario_xml": _xml_text(python_string(scenario.id)),
         "robots": robots,
         "topics": topics,
         "oracles": judged,
@@ -357,11 +342,9 @@ def generate_ros1_monitor(
     spec: Specification, scenario_id: str | None, out_dir: Path, overwrite: bool = False
 ) -> list[Path]:
     """Write the ROS 1 (catkin, rospy) monitor package of the scenario below ``out_dir``."""
-    written = write_files(out_dir, ros1_monitor_files(spec, scenario_id), overwrite)
-    for path in written:
-        if path.parent.name == "scripts":
-            os.chmod(path, 0o755)  # rosrun runs the node script itself
-    return written
+    files = ros1_monitor_files(spec, scenario_id)
+    scripts = [name for name in files if PurePosixPath(name).parent.name == "scripts"]
+    return write_files(out_dir, files, overwrite, executable=scripts)  # rosrun runs the node script itself
 
 
 def generate_ros2_monitor(

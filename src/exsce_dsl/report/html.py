@@ -25,6 +25,7 @@ from exsce_dsl.model.verdicts import Verdict
 from exsce_dsl.oracles.report import expectation
 from exsce_dsl.oracles.trial_report import interval
 from exsce_dsl.oracles.trials import percent
+from exsce_dsl.output_folder import written_whole
 from exsce_dsl.report.contents import ReportContents, RunContents, ScenarioContents
 from exsce_dsl.report.plots import campaign_figure, metrics_figure, trajectory_figure
 from exsce_dsl.resources import resource_dir
@@ -99,15 +100,22 @@ def _steps(derivation: Derivation) -> str:
 def write_report(
     contents: ReportContents, folder: Path, progress: Callable[[int], None] | None = None
 ) -> Path:
-    """Write the report into ``folder`` (created; earlier pages of it replaced) and return its index page.
+    """Write the report into ``folder`` and return its index page.
 
+    The report is written into a new hidden folder first and renamed into ``folder`` when
+    complete: a report that fails half-way leaves an earlier one as it was, and a link
+    planted in ``folder`` is replaced, not written through.
     ``progress`` is told of every run drawn (bags are read for the paths driven).
     """
+    with written_whole(folder) as staging:
+        _write_pages(contents, staging, progress)
+    return folder / "index.html"
+
+
+def _write_pages(contents: ReportContents, folder: Path, progress: Callable[[int], None] | None) -> None:
+    """Every page and image of the report, into ``folder`` (new and empty)."""
     images = folder / "images"
-    try:
-        images.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise ExsceError(f"cannot write the report into {folder}: {exc.strerror}") from None
+    images.mkdir()
     env = _environment()
     generated = datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0)
     common = {"contents": contents, "version": __version__, "generated": generated.isoformat()}
@@ -145,7 +153,6 @@ def write_report(
             )
             if progress is not None:
                 progress(1)
-    return folder / "index.html"
 
 
 def _run_image(scenario: ScenarioContents, run: RunContents, folder: Path) -> RunImage:

@@ -12,6 +12,7 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 from matplotlib.transforms import Bbox
 
+from exsce_dsl.figures import plain
 from exsce_dsl.maps.grid import OccupancyGrid
 from exsce_dsl.model.oracles import Oracle
 from exsce_dsl.report.campaigns import CampaignContents
@@ -73,7 +74,7 @@ def trajectory_figure(scenario: ScenarioContents, run: RunContents, paths: Seque
     axes.set_aspect("equal")
     axes.set_xlabel("x (m)")
     axes.set_ylabel("y (m)")
-    axes.set_title(f"run {run.run.uuid[:8]} of {scenario.id}")
+    axes.set_title(plain(f"run {run.run.uuid[:8]} of {scenario.id}"))
     handles, labels = axes.get_legend_handles_labels()
     if handles:  # below the map, not over it
         figure.legend(
@@ -94,7 +95,9 @@ def _draw_paths(axes: Axes, paths: Sequence[Trajectory], scenario: ScenarioConte
     colours = [f"C{i}" for i in range(10)]
     for i, path in enumerate(paths):
         colour = colours[i % len(colours)]
-        axes.plot(path.xy[:, 0], path.xy[:, 1], color=colour, linewidth=1.4, label=f"{path.topic} (driven)")
+        axes.plot(
+            path.xy[:, 0], path.xy[:, 1], color=colour, linewidth=1.4, label=plain(f"{path.topic} (driven)")
+        )
         axes.plot(*path.xy[0], marker="o", color=colour, markersize=6)
     planned_paths = [planned for _, planned in sorted(scenario.waypoints.items()) if planned]
     for i, planned in enumerate(planned_paths):
@@ -115,7 +118,7 @@ def _draw_hotspots(axes: Axes, run: RunContents, markers: Mapping[str, str]) -> 
     labelled: set[str] = set()
     sizes = []
     for spot in run.hotspots:
-        label = None if spot.metric in labelled else f"hotspot: {spot.metric}"
+        label = None if spot.metric in labelled else plain(f"hotspot: {spot.metric}")
         labelled.add(spot.metric)
         sizes.append(60 + 30 * math.sqrt(spot.duration))
         axes.scatter(
@@ -409,13 +412,15 @@ def metrics_figure(scenario: ScenarioContents, units: Mapping[str, str]) -> Figu
             colour = _STATUS_COLOURS[status.get(value.run, "not verified")]
             axes.scatter([value.value], [row_of[_row(value)]], s=26, color=colour, zorder=3)
         axes.set_xlim(low, high)
-        axes.set_yticks(range(len(rows)), rows, fontsize=8)
+        axes.set_yticks(range(len(rows)), [plain(row) for row in rows], fontsize=8)
         axes.set_ylim(-0.6, len(rows) - 0.4)
         unit = units.get(metric)
-        axes.set_xlabel(f"{metric} ({unit})" if unit else metric, fontsize=8)
+        axes.set_xlabel(plain(f"{metric} ({unit})" if unit else metric), fontsize=8)
         axes.tick_params(axis="x", labelsize=8)
         axes.spines[["top", "right"]].set_visible(False)
-    figure.suptitle(f"{scenario.id}: run values (dots) and what the oracles accept (green)", fontsize=10)
+    figure.suptitle(
+        plain(f"{scenario.id}: run values (dots) and what the oracles accept (green)"), fontsize=10
+    )
     return figure
 
 
@@ -443,7 +448,7 @@ def campaign_figure(campaign: CampaignContents) -> Figure:
         count += len(trial.new)
         axes.plot([tried_so_far], [count], marker="o", color="#c0392b", markersize=5, gid=f"found-{count}")
         axes.annotate(
-            "\n".join(trial.new),
+            "\n".join(plain(relation) for relation in trial.new),
             (tried_so_far, count),
             # below and right of the dot the line never goes (it only rises, to the right); too
             # near the right end, below and left
@@ -475,5 +480,5 @@ def campaign_figure(campaign: CampaignContents) -> Figure:
     axes.set_ylabel("relations violated\n(distinct, count)", fontsize=9)
     axes.tick_params(labelsize=8)
     axes.spines[["top", "right"]].set_visible(False)
-    axes.set_title(f"campaign {campaign.id}: violations found over budget", fontsize=10)
+    axes.set_title(plain(f"campaign {campaign.id}: violations found over budget"), fontsize=10)
     return figure

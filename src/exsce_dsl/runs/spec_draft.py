@@ -23,6 +23,7 @@ The text is the formatter's (IR → ``.exsce``), comments placed through source 
 from __future__ import annotations
 
 import re
+import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -59,6 +60,7 @@ from exsce_dsl.model.acceptance import (
 )
 from exsce_dsl.model.conventions import CONVENTIONS, METHOD, Window
 from exsce_dsl.model.names import KEYWORDS, is_valid_name
+from exsce_dsl.output_folder import existing, write_below
 from exsce_dsl.runs.bag_robots import BagContents, BagRobot, Place, bag_contents
 from exsce_dsl.wording import counted
 
@@ -99,19 +101,26 @@ def draft_spec(bag: Path, out: Path, force: bool = False) -> SpecDraft:
         raise BagError(f"{bag}: no robot to draft a specification for: {'; '.join(contents.skipped)}")
     map_yaml = out.with_name(f"{out.stem}_map.yaml") if contents.map is not None else None
     targets = [out] + ([map_yaml, map_yaml.with_suffix(".pgm")] if map_yaml else [])
-    existing = [str(t) for t in targets if t.exists()]
-    if existing and not force:
-        raise ExportError(f"would overwrite {', '.join(existing)}; use --force to replace")
+    found = [str(t) for t in targets if existing(t.parent, t.name)]  # a link there is refused
+    if found and not force:
+        raise ExportError(f"would overwrite {', '.join(found)}; use --force to replace")
     m = contents.map
     grid = grid_from_ros(m.values, m.width, m.height, m.resolution, m.origin) if m is not None else None
     drafter = _Drafter(contents, out.name, _name(_file_stem(bag), set(), "bag"), grid=grid)
     document, poses = drafter.document(map_yaml.name if map_yaml else None)
     text = format_document(document, poses, drafter.comments)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    written = save_occupancy_grid(grid, map_yaml) if grid is not None and map_yaml is not None else ()
-    out.write_text(text, encoding="utf-8")
+    written = _write_map(grid, map_yaml) if grid is not None and map_yaml is not None else ()
+    write_below(out.parent, out.name, text.encode("utf-8"))
     robots = tuple((rid, r.namespace, r.convention or "detected") for rid, r in drafter.ids.items())
     return SpecDraft(out, text, written, robots, tuple(drafter.notes))
+
+
+def _write_map(grid: OccupancyGrid, map_yaml: Path) -> tuple[Path, ...]:
+    """The map's YAML and PGM, made in a private folder and written beside the specification
+    as :func:`~exsce_dsl.output_folder.write_below` writes (never through a link)."""
+    with tempfile.TemporaryDirectory() as private:
+        made = save_occupancy_grid(grid, Path(private) / map_yaml.name)
+        return tuple(write_below(map_yaml.parent, path.name, path.read_bytes()) for path in made)
 
 
 def dsl_name(text: str, taken: set[str], fallback: str) -> str:

@@ -7,7 +7,7 @@ from pathlib import Path
 from matplotlib.figure import Figure
 from scipy.cluster.hierarchy import dendrogram
 
-from exsce_dsl.figures import save_figure
+from exsce_dsl.figures import plain, save_figure
 from exsce_dsl.similarity.clustering import Clustering
 from exsce_dsl.wording import counted
 
@@ -21,7 +21,7 @@ def dendrogram_figure(result: Clustering) -> Figure:
     cut = _cut_height(result)
     dendrogram(
         result.linkage,
-        labels=list(result.scenarios),
+        labels=[plain(s) for s in result.scenarios],
         orientation="right",
         color_threshold=cut,
         above_threshold_color="#888888",

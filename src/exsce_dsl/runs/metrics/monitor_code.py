@@ -7,7 +7,9 @@ library's metrics and the specification's own and executes that text (kept in
 the user's cache folder like ``__pycache__``, never loaded by a name from a
 data file); ``exscec generate monitors`` writes the same text to a file.
 Metric names are checked Python identifiers, topic names and strings go
-through the template's quoting filters, and local variable names are exsce's
+through the template's quoting filters, operators and function names are
+checked against the language's (:func:`check_written_code`), the expression's
+text reaches only a one-line comment, and local variable names are exsce's
 own, so nothing from a user's file becomes code unchecked.
 """
 
@@ -19,8 +21,24 @@ import types
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from exsce_dsl.errors import GenerationError
 from exsce_dsl.lang import expression_text
-from exsce_dsl.model.expressions import Aggregate, Expression, Field, WindowValue, is_constant, walk
+from exsce_dsl.model.expressions import (
+    AGGREGATES,
+    CONDITION_AGGREGATES,
+    ELEMENTWISE,
+    SERIES,
+    WINDOW_VALUES,
+    Aggregate,
+    Binary,
+    Call,
+    Expression,
+    Field,
+    Unary,
+    WindowValue,
+    is_constant,
+    walk,
+)
 from exsce_dsl.model.messages import FEEDBACK, RESULT
 from exsce_dsl.model.metrics import Combine, ComputedFor, MetricDefinition
 from exsce_dsl.user_cache import cache_folder, read_cached, write_cached
@@ -45,6 +63,57 @@ _UFUNCS = {
     "sqrt": "np.sqrt",
 }
 _PAIR_COMBINE = {Combine.MIN: "min", Combine.MAX: "max", Combine.SUM: "sum"}
+_WRITTEN: list[tuple[type, str, frozenset[str]]] = [
+    (Binary, "op", frozenset(("+", "-", "*", "/", "<", "<=", ">", ">=", "==", "!=", "and", "or"))),
+    (Unary, "op", frozenset(("-", "not"))),
+    (Call, "func", frozenset((*ELEMENTWISE, *SERIES))),
+    (Aggregate, "func", frozenset((*AGGREGATES, *CONDITION_AGGREGATES))),
+    (WindowValue, "name", frozenset(WINDOW_VALUES)),
+]
+"""The attributes of expression nodes the template writes as code, and the words they may be."""
+
+
+MAX_DEPTH = 100
+"""How deep an expression may nest to be written as code (the template's macros recurse once
+per level, and Python's parser takes 200 nested parentheses at most)."""
+
+
+def _depth(expr: Expression) -> int:
+    """How deep ``expr`` nests (1: a leaf), counted without recursion."""
+    deepest, stack = 0, [(expr, 1)]
+    while stack:
+        node, depth = stack.pop()
+        deepest = max(deepest, depth)
+        children: list[Expression] = []
+        if isinstance(node, Unary):
+            children = [node.operand]
+        elif isinstance(node, Binary):
+            children = [node.left, node.right]
+        elif isinstance(node, (Call, Aggregate)):
+            children = [*node.args, *([node.where] if isinstance(node, Aggregate) and node.where else [])]
+        stack += [(child, depth + 1) for child in children]
+    return deepest
+
+
+def check_written_code(metric: MetricDefinition, expr: Expression) -> None:
+    """Raise a :class:`GenerationError` unless every operator and function name of ``expr``
+    (which the template writes as code, not as a literal) is one of the language's, and it nests
+    at most :data:`MAX_DEPTH` deep."""
+    depth = _depth(expr)
+    if depth > MAX_DEPTH:
+        raise GenerationError(
+            f"metric '{metric.name}': its expression nests {depth} deep, more than the {MAX_DEPTH} "
+            "that code is generated for; split it into metrics of their own",
+            metric.location,
+        )
+    for node in walk(expr):
+        for kind, attribute, allowed in _WRITTEN:
+            word = getattr(node, attribute, None) if isinstance(node, kind) else None
+            if word is not None and word not in allowed:
+                raise GenerationError(
+                    f"metric '{metric.name}': {word!r} is no {attribute} of the language",
+                    getattr(node, "location", None),
+                )
 
 
 @dataclass(frozen=True)
@@ -78,6 +147,7 @@ def alternatives(metric: MetricDefinition) -> list[Alternative]:
     for number, expr in enumerate((metric.value, metric.fallback)):
         if expr is None:
             continue
+        check_written_code(metric, expr)
         nodes = walk(expr)
         aggregates: list[Aggregate] = []
         for node in nodes:
