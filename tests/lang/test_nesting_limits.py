@@ -10,9 +10,9 @@ from pathlib import Path
 
 import pytest
 
-from exsce_dsl.lang.build.expressions import MAX_DEPTH
 from exsce_dsl.lang.parser import MAX_NESTING
 from exsce_dsl.lang.yaml.located import MAX_DEPTH as MAX_YAML_DEPTH
+from exsce_dsl.model.expressions import MAX_DEPTH
 
 from tests.support.cli import exscec_here
 

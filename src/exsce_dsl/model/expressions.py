@@ -134,3 +134,30 @@ def walk(expr: Expression) -> list[Expression]:
         if isinstance(expr, Aggregate) and expr.where is not None:
             found += walk(expr.where)
     return found
+
+
+MAX_DEPTH = 100
+"""The deepest expression a metric may hold, in operations within operations (a sum of n terms
+is n - 1 deep): every later stage (the generated monitors, Python's parser, which allows 200
+nested parentheses, pickling) walks an expression by recursion (issue 46: a sum of 500 terms
+passed ``check`` and broke ``generate``)."""
+
+
+def expression_depth(expr: Expression) -> int:
+    """How many operations deep ``expr`` is (a leaf: 0), counted without recursion."""
+    deepest = 0
+    pending: list[tuple[Expression, int]] = [(expr, 0)]
+    while pending:
+        node, depth = pending.pop()
+        deepest = max(deepest, depth)
+        children: list[Expression] = []
+        if isinstance(node, Unary):
+            children = [node.operand]
+        elif isinstance(node, Binary):
+            children = [node.left, node.right]
+        elif isinstance(node, (Call, Aggregate)):
+            children = list(node.args)
+            if isinstance(node, Aggregate) and node.where is not None:
+                children.append(node.where)
+        pending.extend((child, depth + 1) for child in children)
+    return deepest

@@ -23,6 +23,7 @@ from exsce_dsl.model.expressions import (
     AGGREGATES,
     CONDITION_AGGREGATES,
     FUNCTIONS,
+    MAX_DEPTH,
     SERIES,
     Aggregate,
     Binary,
@@ -33,6 +34,7 @@ from exsce_dsl.model.expressions import (
     Number,
     Unary,
     WindowValue,
+    expression_depth,
 )
 from exsce_dsl.model.messages import DISPATCHER, FEEDBACK, RESULT, FieldPath, Fields, Index, Select, Step
 from exsce_dsl.model.metrics import UNITS, ComputedFor, Dimension, TopicRead
@@ -45,13 +47,6 @@ _QUANTITY = re.compile(r"(\S+?)\s*([a-z/]+)?")
 _NUMERIC = (Kind.CONSTANT, Kind.NUMBERS, Kind.ARRAYS, Kind.VALUE)
 _PER_MESSAGE = (Kind.NUMBERS, Kind.ARRAYS, Kind.CONDITIONS, Kind.ARRAY_CONDITIONS)
 _CONDITIONS = (Kind.CONDITIONS, Kind.ARRAY_CONDITIONS)
-
-MAX_DEPTH = 100
-"""The deepest expression a metric may hold, in operations within operations (a sum of n terms
-is n - 1 deep): every later stage (the generated monitors, Python's parser, which allows 200
-nested parentheses, pickling) walks an expression by recursion (issue 46: a sum of 500 terms
-passed ``check`` and broke ``generate``)."""
-
 
 @dataclass(frozen=True)
 class Typed:
@@ -79,26 +74,6 @@ class Scope:
 
 class _Failed(Exception):
     """An expression with an error (already reported): its parents are not checked further."""
-
-
-def expression_depth(expr: Expression) -> int:
-    """How many operations deep ``expr`` is (a leaf: 0), counted without recursion."""
-    deepest = 0
-    pending: list[tuple[Expression, int]] = [(expr, 0)]
-    while pending:
-        node, depth = pending.pop()
-        deepest = max(deepest, depth)
-        children: list[Expression] = []
-        if isinstance(node, Unary):
-            children = [node.operand]
-        elif isinstance(node, Binary):
-            children = [node.left, node.right]
-        elif isinstance(node, (Call, Aggregate)):
-            children = list(node.args)
-            if isinstance(node, Aggregate) and node.where is not None:
-                children.append(node.where)
-        pending.extend((child, depth + 1) for child in children)
-    return deepest
 
 
 def read_quantity(text: str) -> tuple[float, Dimension | None]:

@@ -27,6 +27,7 @@ from exsce_dsl.model.expressions import (
     AGGREGATES,
     CONDITION_AGGREGATES,
     ELEMENTWISE,
+    MAX_DEPTH,
     SERIES,
     WINDOW_VALUES,
     Aggregate,
@@ -36,6 +37,7 @@ from exsce_dsl.model.expressions import (
     Field,
     Unary,
     WindowValue,
+    expression_depth,
     is_constant,
     walk,
 )
@@ -73,37 +75,15 @@ _WRITTEN: list[tuple[type, str, frozenset[str]]] = [
 """The attributes of expression nodes the template writes as code, and the words they may be."""
 
 
-MAX_DEPTH = 100
-"""How deep an expression may nest to be written as code (the template's macros recurse once
-per level, and Python's parser takes 200 nested parentheses at most)."""
-
-
-def _depth(expr: Expression) -> int:
-    """How deep ``expr`` nests (1: a leaf), counted without recursion."""
-    deepest, stack = 0, [(expr, 1)]
-    while stack:
-        node, depth = stack.pop()
-        deepest = max(deepest, depth)
-        children: list[Expression] = []
-        if isinstance(node, Unary):
-            children = [node.operand]
-        elif isinstance(node, Binary):
-            children = [node.left, node.right]
-        elif isinstance(node, (Call, Aggregate)):
-            children = [*node.args, *([node.where] if isinstance(node, Aggregate) and node.where else [])]
-        stack += [(child, depth + 1) for child in children]
-    return deepest
-
-
 def check_written_code(metric: MetricDefinition, expr: Expression) -> None:
     """Raise a :class:`GenerationError` unless every operator and function name of ``expr``
     (which the template writes as code, not as a literal) is one of the language's, and it nests
     at most :data:`MAX_DEPTH` deep."""
-    depth = _depth(expr)
-    if depth > MAX_DEPTH:
+    depth = expression_depth(expr)
+    if depth > MAX_DEPTH:  # the builder refuses these; a model made in Python may not have been built
         raise GenerationError(
-            f"metric '{metric.name}': its expression nests {depth} deep, more than the {MAX_DEPTH} "
-            "that code is generated for; split it into metrics of their own",
+            f"metric '{metric.name}': its expression nests {depth} operations deep, more than the "
+            f"{MAX_DEPTH} that code is generated for; split it into metrics of their own",
             metric.location,
         )
     for node in walk(expr):
