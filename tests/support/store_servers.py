@@ -160,7 +160,38 @@ VIRTUOSO_STARTUP_SECONDS = 90.0
 def virtuoso_server(location: Path) -> Iterator[Server]:
     """Virtuoso 7 (``virtuoso-t +foreground``) with a new database in LOCATION, its HTTP
     server at a free port (``/sparql``), the SPARQL user allowed to update (as an
-    administrator would, with ``isql-vt``)."""
+    administrator would, with ``isql-vt``).
+
+    A port found free may be taken by another test's server before Virtuoso listens on it
+    ("Failed HTTP listen" in its log, and it exits): it is started again on other ports, in a
+    folder of its own, up to three times."""
+    for attempt in range(3):
+        folder = location if attempt == 0 else location.with_name(f"{location.name}-{attempt}")
+        process, url, sql_port = _start_virtuoso(folder)
+        try:
+            wait_until_answering(f"{url}/sparql?query=ASK%7B%7D", process, VIRTUOSO_STARTUP_SECONDS)
+            break
+        except RuntimeError:
+            stop(process)
+            log = folder / "virtuoso.log"
+            said = log.read_text(errors="replace") if log.exists() else ""
+            if "listen" not in said.lower() or attempt == 2:
+                raise
+    try:
+        granted = subprocess.run(
+            ["isql-vt", str(sql_port), "dba", "dba", 'exec=GRANT SPARQL_UPDATE TO "SPARQL";'],
+            capture_output=True, text=True, timeout=60,
+        )  # fmt: skip
+        if granted.returncode != 0:
+            raise RuntimeError(f"isql-vt could not grant SPARQL_UPDATE: {granted.stdout} {granted.stderr}")
+        yield Server(url, process)
+    finally:
+        stop(process)
+
+
+def _start_virtuoso(location: Path) -> tuple[subprocess.Popen[str], str, int]:
+    """Virtuoso started on a new database in LOCATION at two free ports: the process, its HTTP
+    URL and its SQL port."""
     sql_port, http_port = free_port(), free_port()
     location.mkdir(parents=True, exist_ok=True)
     ini = location / "virtuoso.ini"
@@ -172,15 +203,4 @@ def virtuoso_server(location: Path) -> Iterator[Server]:
         stderr=subprocess.DEVNULL,
         text=True,
     )
-    url = f"http://127.0.0.1:{http_port}"
-    try:
-        wait_until_answering(f"{url}/sparql?query=ASK%7B%7D", process, VIRTUOSO_STARTUP_SECONDS)
-        granted = subprocess.run(
-            ["isql-vt", str(sql_port), "dba", "dba", 'exec=GRANT SPARQL_UPDATE TO "SPARQL";'],
-            capture_output=True, text=True, timeout=60,
-        )  # fmt: skip
-        if granted.returncode != 0:
-            raise RuntimeError(f"isql-vt could not grant SPARQL_UPDATE: {granted.stdout} {granted.stderr}")
-        yield Server(url, process)
-    finally:
-        stop(process)
+    return process, f"http://127.0.0.1:{http_port}", sql_port
