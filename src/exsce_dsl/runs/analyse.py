@@ -307,8 +307,16 @@ def _segment_robots(path: Path, scenario: Scenario, bag: _Signals) -> _Segmented
             if span is None and not found.segments:
                 raise BagError("\n  ".join([_nothing_of(path, robot, bag.types), *bag.unread]))
             if span is not None:
-                out.whole_runs[robot.id] = span
+                out.whole_runs[robot.id] = _recording(span, data)
     return out
+
+
+def _recording(span: tuple[float, float], data: BagData) -> tuple[float, float]:
+    """The whole-run window of a robot without goals (or whose window is its whole recording):
+    the recording, from its first message to its last, on the run's timeline — never the span of
+    the robot's signals alone (an event-driven velocity topic, teleop's ``cmd_vel``, starts after
+    the pose and ends before it, and a metric over the pose would lose its samples outside)."""
+    return min(span[0], data.start), max(span[1], data.end)
 
 
 def _run_clocks(timeline: Timeline, spellings: Mapping[str, tuple[str, ...]]) -> tuple[RunClock, ...]:
