@@ -13,7 +13,8 @@ source, an ``arrival`` tolerance, a ``window``) win over what is detected:
    ``/{ns}/tf``), else ``/{ns}/amcl_pose``, else an odometry under the namespace (``/{ns}/odom``
    first, then any other such as ``/jackal_velocity_controller/odom``), else the namespace's only
    PoseStamped or PoseWithCovarianceStamped topic; the velocity from ``/{ns}/cmd_vel``, else the
-   odometry's twist (else, later, from the poses); the distance along the odometry; the scan on
+   odometry's twist, else another Twist or TwistStamped topic under the namespace or at the root
+   (``/velocity``; else, later, from the poses); the distance along the odometry; the scan on
    ``/{ns}/scan``, else the namespace's only LaserScan.
 
 "Under the namespace" is every topic below ``/{ns}/`` (every topic, for a robot at the root).
@@ -124,8 +125,9 @@ def _without_goals(robot: Robot, types: Mapping[str, str]) -> tuple[Signals, Det
         poses.append(TopicSource(streams[0], mine[streams[0]]))
         evidence.append(streams[0])
     cmd_vel = expand_topic("/{ns}/cmd_vel", ns)
-    velocity = [TopicSource(cmd_vel)] if mine.get(cmd_vel) in (TWIST, TWIST_STAMPED) else []
-    velocity += [TopicSource(t, ODOMETRY) for t in odometry]
+    # /{ns}/cmd_vel is always looked for, so that a robot without a velocity is told where
+    velocity = [TopicSource(cmd_vel)] + [TopicSource(t, ODOMETRY) for t in odometry]
+    velocity += [TopicSource(t, types[t]) for t in _twists(types, ns) if t != cmd_vel]
     scans = sorted(t for t, m in mine.items() if m == LASER_SCAN)
     scan_topic = expand_topic("/{ns}/scan", ns)
     scan = [scan_topic] if scan_topic in scans else scans[:1] if len(scans) == 1 else []
@@ -138,6 +140,27 @@ def _without_goals(robot: Robot, types: Mapping[str, str]) -> tuple[Signals, Det
         navigation=Navigation.NONE,
     )
     return signals, Detected(robot.id, "none (no navigation goals)", tuple(evidence))
+
+
+def _twists(types: Mapping[str, str], ns: str) -> list[str]:
+    """The Twist and TwistStamped topics a robot's velocity may be read from besides its
+    ``cmd_vel`` and odometry: under its namespace (a robot at the root: the root's own topics,
+    one level deep, not another robot's), then at the root; ``velocity`` and ``vel`` first."""
+    level = ns.strip("/")
+
+    def at_root(topic: str) -> bool:
+        return "/" not in topic.lstrip("/")
+
+    def preferred(topic: str) -> tuple[bool, bool, str]:
+        name = topic.rstrip("/").rsplit("/", 1)[-1]
+        return (at_root(topic) and bool(level), name not in ("velocity", "vel"), topic)
+
+    found = [
+        t
+        for t, m in types.items()
+        if m in (TWIST, TWIST_STAMPED) and (at_root(t) or (level and under_namespace(t, level)))
+    ]
+    return sorted(found, key=preferred)
 
 
 def _odometries(mine: Mapping[str, str], ns: str) -> list[str]:
