@@ -212,7 +212,8 @@ def robot_namespaces(types: Mapping[str, str]) -> list[tuple[str, Signals, Detec
     names of navigation interfaces, :data:`NOT_ROBOTS`).  A root with a robot's topics of its own (a
     velocity, a scan, a pose) takes in the namespaces that show nothing it does not (a Jackal's
     ``/cmd_vel`` with its ``/jackal_velocity_controller/odom``); a root without, whose every piece of
-    evidence is another robot's topic (a fleet's global ``/tf``), is not a robot of its own."""
+    evidence is the global ``/tf`` or another robot's topic (a fleet's, or a Gazebo robot's whose
+    topics are all under ``/elektron/`` but whose TF is at the root), is not a robot of its own."""
     levels = {t.lstrip("/").split("/")[0] for t in types if "/" in t.lstrip("/")}
     namespaces = sorted(levels - NOT_ROBOTS)
     interfaces = [f"{action}/_action/status" for action in NAV2.actions]
@@ -232,6 +233,7 @@ def robot_namespaces(types: Mapping[str, str]) -> list[tuple[str, Signals, Detec
     if any("/" not in t.lstrip("/") and m in _BODY_TYPES for t, m in types.items()):
         return found[:1] + [f for f in found[1:] if not set(f[2].evidence) <= root]
     others = [ns for ns, _, _ in found[1:]]
-    if root and others and all(any(under_namespace(t, ns) for ns in others) for t in root):
+    tf = expand_topic("/{ns}/tf", "")  # a global /tf is the namespaced robots' (Gazebo's elektron)
+    if root and others and all(t == tf or any(under_namespace(t, ns) for ns in others) for t in root):
         found.pop(0)
     return found
