@@ -1,6 +1,6 @@
 """A robot whose topics are all under one namespace is drafted in it, even with TF at the root
 (issue 47, item 8): a Gazebo robot under ``/elektron/...`` whose ``/tf`` is global was drafted as a
-robot at the root, beside itself in ``elektron``."""
+robot at the root, beside itself in ``elektron``; and its counts agree with their nouns."""
 
 from __future__ import annotations
 
@@ -47,3 +47,15 @@ def test_robot_under_elektron_is_drafted_in_its_namespace(tmp_path: Path) -> Non
     (robot,) = load_spec(draft.spec).scenario().robots
     assert robot.namespace == "elektron"
     assert 'namespace ""' not in draft.spec.read_text()
+
+
+def test_counts_agree_with_their_numbers(tmp_path: Path) -> None:
+    """ "1 waypoints", "1 topics": a count's noun agrees with its number (wording.counted)."""
+    store = typestore_for("ros1")
+    times = [START_NS + i * PERIOD_NS for i in range(20)]
+    bag = tmp_path / "one_topic.bag"
+    write_bag(
+        bag, "ros1", [Topic("/odom", ODOMETRY, [(t, odometry(store, i, t)) for i, t in enumerate(times)])]
+    )
+    text = init_from_bag(bag, tmp_path / "one_topic.exsce").text
+    assert "from one_topic.bag: 1 topic, " in text and "1 robot found" in text, text.splitlines()[0]

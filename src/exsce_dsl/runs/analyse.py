@@ -58,6 +58,7 @@ from exsce_dsl.runs.signals.timeline import (
     stamp_catalogue,
     with_stamps,
 )
+from exsce_dsl.wording import counted
 
 _FEEDBACK = "/{ns}/waypoint_dispatcher/feedback"
 _RESULT = "/{ns}/waypoint_dispatcher/result"
@@ -331,7 +332,7 @@ def _run_clocks(timeline: Timeline, spellings: Mapping[str, tuple[str, ...]]) ->
 def _incomplete(path: Path, lacking: list[str], problems: list[str]) -> str:
     """Why ``--strict`` refuses a run: the values it would lack, then the run's problems."""
     why = "".join(f"\n  {p}" for p in dict.fromkeys(problems))
-    values = f"{len(lacking)} metric value{'s' if len(lacking) != 1 else ''}"
+    values = counted(len(lacking), "metric value")
     return (
         f"{path}: {values} would be missing ({'; '.join(lacking)}), and --strict stores no run "
         "with a missing metric" + (f":{why}" if why else "")

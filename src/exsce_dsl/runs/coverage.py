@@ -44,6 +44,7 @@ from exsce_dsl.runs.bags.reading import BagData
 from exsce_dsl.runs.segments.recorded import RecordedAction
 from exsce_dsl.runs.signals.sources import SIGNALS, RobotSources
 from exsce_dsl.runs.signals.timeline import CLOCK_TOPIC, Timeline
+from exsce_dsl.wording import counted
 
 PROV_TOPIC = "/exsce/prov"
 """Where the mission dispatcher publishes the run-time PROV (std_msgs/String, latched), so that
@@ -312,7 +313,7 @@ def _cut_short(recording: Recording, wall: Wall) -> list[CoverageGap]:
             since = max(done) if done else end
             interrupted.append(since)
             reason = (
-                f"robot '{robot.id}': {len(left)} planned waypoint{'s' if len(left) != 1 else ''} never "
+                f"robot '{robot.id}': {counted(len(left), 'planned waypoint')} never "
                 f"finished (the next: {left[0].goal.id or 'a waypoint'} of task {left[0].task}) when the "
                 "recording ended, and none of its goals failed"
             )

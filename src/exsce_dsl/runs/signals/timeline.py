@@ -47,6 +47,7 @@ from exsce_dsl.messages.user import configured_user_catalogue
 from exsce_dsl.model.messages import path_of
 from exsce_dsl.runs.bags.decode import TEXTS
 from exsce_dsl.runs.bags.reading import WHOLE, BagData, Series, StatusUpdate, Wanted
+from exsce_dsl.wording import counted
 
 CLOCK_TOPIC = "/clock"
 CLOCK_TYPE = "rosgraph_msgs/msg/Clock"
@@ -239,10 +240,10 @@ class _Stamped:
         if same <= COARSE_SHARE * int(going.sum()):
             return ""
         rate = 1.0 / float(np.median(np.diff(log)[going]))
-        distinct = len(np.unique(stamps))
+        distinct = counted(len(np.unique(stamps)), "distinct stamp")
         return (
-            f"the stamps of {self.topic} are coarser than its rate ({distinct} distinct stamps for "
-            f"{len(stamps)} messages at {rate:.1f} Hz): timed by log time"
+            f"the stamps of {self.topic} are coarser than its rate ({distinct} for "
+            f"{counted(len(stamps), 'message')} at {rate:.1f} Hz): timed by log time"
         )
 
 
