@@ -38,6 +38,7 @@ __all__ = [
     "RelationError",
     "RenameError",
     "RosGraphError",
+    "ScenarioChoiceError",
     "SegmentError",
     "Severity",
     "SourceLocation",
@@ -167,6 +168,21 @@ class SpecError(ExsceError):
 
 class ExsceSyntaxError(SpecError):
     """The text does not follow the grammar."""
+
+
+class ScenarioChoiceError(ExsceError):
+    """A file declares no scenario or several, and none was named: the message names the option
+    that chooses one, which each command spells its own way (``--scenario`` where the file is an
+    argument, ``--scenario-id`` where ``--scenario`` is the file)."""
+
+    def __init__(self, root: str, found: Sequence[str], option: str = "--scenario") -> None:
+        listed = ", ".join(found) or "none"
+        super().__init__(f"{root} declares {len(found)} scenarios ({listed}); name one with {option}")
+        self.root, self.found, self.option = root, tuple(found), option
+
+    def naming(self, option: str) -> ScenarioChoiceError:
+        """The same error, naming ``option``."""
+        return ScenarioChoiceError(self.root, self.found, option)
 
 
 class ImportFormatError(ExsceError):

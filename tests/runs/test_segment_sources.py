@@ -383,7 +383,7 @@ def test_arrival_a_waypoint_never_reached(scenario, poses) -> None:
     ]
     assert result.warnings == (
         "robot tiago1 never reached classroom_c018-w001 (delivery_a subtask 1 waypoint 2) after 2.000; "
-        "it and the 1 waypoints after it are NOT_REACHED",
+        "it and the 1 waypoint after it are NOT_REACHED",
     )
 
 

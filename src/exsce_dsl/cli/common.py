@@ -15,7 +15,7 @@ from typing import Any, TypeVar
 
 import click
 
-from exsce_dsl.errors import Diagnostic, ExsceError
+from exsce_dsl.errors import Diagnostic, ExsceError, ScenarioChoiceError
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -101,6 +101,15 @@ def print_diagnostics(diagnostics: Iterable[Diagnostic]) -> None:
         click.echo(f"... and {said} (the first {SHOWN_DIAGNOSTICS} are shown)", err=True)
 
 
+def _scenario_option() -> str:
+    """How the running command spells its option that names a scenario (``--scenario`` or
+    ``--scenario-id``: ``ingest`` and ``verify`` take the file as ``--scenario``)."""
+    context = click.get_current_context(silent=True)
+    params = context.command.params if context is not None else []
+    spelt = [p.opts[0] for p in params if p.name == "scenario_id" and p.opts]
+    return spelt[0] if spelt else "--scenario"
+
+
 def reports_errors(func: F) -> F:
     """Turn library errors into ``file:line:col: error: message`` and exit status 2 (bad input);
     an unexpected exception is a bug of ours: exit status 70 (see :class:`ExitCode`)."""
@@ -112,6 +121,8 @@ def reports_errors(func: F) -> F:
         except ExsceError as exc:
             if State.debug:  # the traceback, and the exit status it has without --debug
                 traceback.print_exc()
+            if isinstance(exc, ScenarioChoiceError):
+                exc = exc.naming(_scenario_option())
             print_diagnostics(exc.diagnostics)
             sys.exit(ExitCode.BAD_INPUT)
         except click.UsageError:  # exit 2, with the usage line

@@ -49,10 +49,10 @@ class Window(Enum):
     """What a robot's whole-run metrics cover."""
 
     GOALS = "goals"
-    """Its first goal's start to its last goal's end (without goals: the whole recording of its
-    signals), as the method's dispatcher measures a mission."""
+    """Its first goal's start to its last goal's end (without goals: the whole recording), as
+    the method's dispatcher measures a mission."""
     RECORDING = "whole recording"
-    """The whole recording of its signals, goals or not."""
+    """The whole recording, goals or not."""
 
 
 @dataclass(frozen=True)

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 
-from exsce_dsl.errors import ExsceError, SourceLocation
+from exsce_dsl.errors import ExsceError, ScenarioChoiceError, SourceLocation
 from exsce_dsl.model.acceptance import Acceptance
 from exsce_dsl.model.derived import DerivedScenario
 from exsce_dsl.model.environment import Environment
@@ -101,6 +101,5 @@ class Specification:
             if isinstance(d, (Scenario, DerivedScenario))
         ]
         if len(own) != 1:
-            found = ", ".join(s.id for s in own) or "none"
-            raise ExsceError(f"{self.root} declares {len(own)} scenarios ({found}); name one with --scenario")
+            raise ScenarioChoiceError(str(self.root), [s.id for s in own])
         return own[0]

@@ -58,6 +58,7 @@ from exsce_dsl.runs.signals.timeline import (
     stamp_catalogue,
     with_stamps,
 )
+from exsce_dsl.wording import counted
 
 _FEEDBACK = "/{ns}/waypoint_dispatcher/feedback"
 _RESULT = "/{ns}/waypoint_dispatcher/result"
@@ -307,8 +308,16 @@ def _segment_robots(path: Path, scenario: Scenario, bag: _Signals) -> _Segmented
             if span is None and not found.segments:
                 raise BagError("\n  ".join([_nothing_of(path, robot, bag.types), *bag.unread]))
             if span is not None:
-                out.whole_runs[robot.id] = span
+                out.whole_runs[robot.id] = _recording(span, data)
     return out
+
+
+def _recording(span: tuple[float, float], data: BagData) -> tuple[float, float]:
+    """The whole-run window of a robot without goals (or whose window is its whole recording):
+    the recording, from its first message to its last, on the run's timeline — never the span of
+    the robot's signals alone (an event-driven velocity topic, teleop's ``cmd_vel``, starts after
+    the pose and ends before it, and a metric over the pose would lose its samples outside)."""
+    return min(span[0], data.start), max(span[1], data.end)
 
 
 def _run_clocks(timeline: Timeline, spellings: Mapping[str, tuple[str, ...]]) -> tuple[RunClock, ...]:
@@ -323,7 +332,7 @@ def _run_clocks(timeline: Timeline, spellings: Mapping[str, tuple[str, ...]]) ->
 def _incomplete(path: Path, lacking: list[str], problems: list[str]) -> str:
     """Why ``--strict`` refuses a run: the values it would lack, then the run's problems."""
     why = "".join(f"\n  {p}" for p in dict.fromkeys(problems))
-    values = f"{len(lacking)} metric value{'s' if len(lacking) != 1 else ''}"
+    values = counted(len(lacking), "metric value")
     return (
         f"{path}: {values} would be missing ({'; '.join(lacking)}), and --strict stores no run "
         "with a missing metric" + (f":{why}" if why else "")

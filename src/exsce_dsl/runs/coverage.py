@@ -12,7 +12,8 @@ each topic a metric reads was recorded (:class:`~exsce_dsl.model.coverage.TopicR
   (its first goal's start to its last goal's end; its recorded signals' span when it has no
   goals or its type says ``window whole recording``) by more than the topic's gap threshold.
 - **gap**: two consecutive messages of such a topic further apart than its gap threshold
-  (:func:`gap_threshold`).
+  (:func:`gap_threshold`), unless the topic is event-driven (:func:`event_driven`: bursts with
+  pauses, which are said once and are no gaps).
 - **low rate**: a topic recorded at less than :data:`LOW_RATE_FRACTION` of the rate its robot
   type declares (``scan at 10 Hz``) over its span.
 - **clock jump**: ``/clock`` or a source's stamps going back (a simulation reset): from there to
@@ -27,6 +28,7 @@ from __future__ import annotations
 
 import datetime as dt
 import json
+from collections import Counter
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -44,6 +46,7 @@ from exsce_dsl.runs.bags.reading import BagData
 from exsce_dsl.runs.segments.recorded import RecordedAction
 from exsce_dsl.runs.signals.sources import SIGNALS, RobotSources
 from exsce_dsl.runs.signals.timeline import CLOCK_TOPIC, Timeline
+from exsce_dsl.wording import counted
 
 PROV_TOPIC = "/exsce/prov"
 """Where the mission dispatcher publishes the run-time PROV (std_msgs/String, latched), so that
@@ -60,6 +63,11 @@ _SAME_TIME = 1e-6
 """Seconds: two messages closer than this were logged at one clock tick."""
 LOW_RATE_FRACTION = 0.5
 """A topic recorded below this fraction of its declared rate is recorded at a low rate."""
+EVENT_PAUSES = 3
+"""A topic with at least this many silences longer than its gap threshold, holding together at
+least :data:`EVENT_SHARE` of its span, comes in bursts: it is event-driven (teleop's ``cmd_vel``,
+sent while a key is held), and its pauses are not gaps (see :func:`event_driven`)."""
+EVENT_SHARE = 0.2
 MIN_MESSAGES = 3
 """Fewer messages than this give no period to measure gaps and rates by: such a topic (a latched
 ``tf_static``, a map) is not checked."""
@@ -98,6 +106,27 @@ def gap_threshold(times: np.ndarray) -> float:
     return max(GAP_FLOOR, GAP_PERIODS * period)
 
 
+def event_driven(topic: str, times: np.ndarray, threshold: float) -> str:
+    """Why ``topic`` is event-driven (empty: it is periodic, and a silence is a gap).
+
+    A periodic publisher's steps are its period, and a silence longer than the gap threshold is
+    data lost: one or two such, short beside the recording.  A topic published only when
+    something happens (a velocity command while a key is held, a goal, a button) is many bursts
+    at a period with pauses of any length between them: :data:`EVENT_PAUSES` or more pauses
+    holding :data:`EVENT_SHARE` of its span or more.  Said once, so that a periodic topic with
+    repeated long drop-outs, taken for one, is still seen."""
+    steps = np.diff(times)
+    pauses = steps[steps > threshold]
+    span = float(times[-1] - times[0]) if len(times) > 1 else 0.0
+    if len(pauses) < EVENT_PAUSES or span <= 0 or float(pauses.sum()) < EVENT_SHARE * span:
+        return ""
+    return (
+        f"{topic} is event-driven ({counted(len(pauses) + 1, 'burst')} with pauses of "
+        f"{float(pauses.min()):.3f} to {float(pauses.max()):.3f} s, {float(pauses.sum()) / span:.0%} "
+        "of its span): its pauses are not gaps"
+    )
+
+
 @dataclass(frozen=True)
 class ReadTopic:
     """One topic of the bag that metric values were computed from, on the run's timeline."""
@@ -131,10 +160,32 @@ class Recording:
 class Coverage:
     gaps: tuple[CoverageGap, ...]
     rates: tuple[TopicRate, ...]
+    notes: tuple[str, ...] = ()
+    """What was found and is no gap (an event-driven topic), said once."""
 
     def said(self) -> list[str]:
-        """Each gap as a warning of the run: ``coverage: cut short: ...``."""
-        return [f"coverage: {g.kind.value.replace('_', ' ')}: {g.reason}" for g in self.gaps]
+        """The gaps as warnings of the run, one per kind: the worst (the longest) with how many
+        there are and where (``coverage: gap: /scan has no message for 2.100 s (...); the
+        longest of 12 of this kind in this run: /scan 9, /odom 3``); then the notes."""
+        kinds: dict[Shortfall, list[CoverageGap]] = {}
+        for gap in self.gaps:
+            kinds.setdefault(gap.kind, []).append(gap)
+        said = []
+        for kind, found in kinds.items():
+            line = f"coverage: {kind.value.replace('_', ' ')}: {max(found, key=_length).reason}"
+            if len(found) > 1:
+                where = Counter(g.topic or (f"robot '{g.robot}'" if g.robot else "the run") for g in found)
+                listed = ", ".join(f"{w} {n}" for w, n in where.items())
+                line += f"; the longest of {len(found)} of this kind in this run: {listed}"
+            said.append(line)
+        return said + [f"coverage: {note}" for note in self.notes]
+
+
+def _length(gap: CoverageGap) -> float:
+    """Seconds a gap lasts (unbounded: longer than any)."""
+    if gap.start is None or gap.end is None:
+        return float("inf")
+    return (gap.end - gap.start).total_seconds()
 
 
 def find_coverage(recording: Recording) -> Coverage:
@@ -143,20 +194,23 @@ def find_coverage(recording: Recording) -> Coverage:
     topics = read_topics(recording.data, recording.values, recording.robots)
     gaps = _cut_short(recording, wall)
     windows = robot_windows(recording)
+    notes: list[str] = []
     for read in topics:
         if len(read.times) < MIN_MESSAGES:
             continue  # a latched topic (tf_static, a map) or too few to tell
         threshold = gap_threshold(read.times)
-        gaps += _silences(read, threshold, wall)
+        bursts = event_driven(read.topic, read.times, threshold)
+        notes += [bursts] if bursts else []
+        gaps += [] if bursts else _silences(read, threshold, wall)
         window = windows.get(read.robot) if read.robot is not None else None
-        if window is not None:
+        if window is not None and not bursts:  # a command starts when the robot is told to move
             gaps += _no_data(read, window, threshold, wall)
         declared = recording.declared.get(read.topic)
         if declared is not None:
             gaps += _low_rate(read, declared, wall)
     gaps += _clock_jumps(recording, wall)
     rates = tuple(_rate(read) for read in topics)
-    return Coverage(tuple(gaps), rates)
+    return Coverage(tuple(gaps), rates, tuple(notes))
 
 
 def read_topics(
@@ -312,7 +366,7 @@ def _cut_short(recording: Recording, wall: Wall) -> list[CoverageGap]:
             since = max(done) if done else end
             interrupted.append(since)
             reason = (
-                f"robot '{robot.id}': {len(left)} planned waypoint{'s' if len(left) != 1 else ''} never "
+                f"robot '{robot.id}': {counted(len(left), 'planned waypoint')} never "
                 f"finished (the next: {left[0].goal.id or 'a waypoint'} of task {left[0].task}) when the "
                 "recording ended, and none of its goals failed"
             )

@@ -30,6 +30,7 @@ from exsce_dsl.store.base import Store
 from exsce_dsl.store.batch_writing import RunWriter, Written
 from exsce_dsl.store.run_replacing import replace_run, verdict_graphs
 from exsce_dsl.store.writing import WriteReport, add_prov
+from exsce_dsl.wording import counted
 
 if TYPE_CHECKING:
     from exsce_dsl.runs.analyse import AnalysedRun
@@ -293,9 +294,7 @@ def _uncovered(analysed: AnalysedRun) -> str:
     if not gaps:
         return ""
     kinds = ", ".join(dict.fromkeys(g.kind.value.replace("_", " ") for g in gaps))
-    return (
-        f"; its recording does not cover all of it: {len(gaps)} gap{'s' if len(gaps) != 1 else ''} ({kinds})"
-    )
+    return f"; its recording does not cover all of it: {counted(len(gaps), 'gap')} ({kinds})"
 
 
 def _what_was_done(bag: _Todo, values: int, report: WriteReport) -> str:

@@ -185,7 +185,7 @@ class _Drafter:
         for robot in c.robots:
             self.ids[_name(robot.namespace or "root_robot", self.taken, "robot")] = robot
         header = [
-            f"Drafted by `exscec init --from-bag` from {c.path.name}: {c.topics} topics, "
+            f"Drafted by `exscec init --from-bag` from {c.path.name}: {counted(c.topics, 'topic')}, "
             f"{c.end - c.start:.1f} s, {counted(len(c.robots), 'robot')} found.",
             f"Next: exscec check {self.file}; exscec ingest {c.path.name} --scenario {self.file}",
             *(f"Left out: {why}" for why in c.skipped),  # a name the language could not hold

@@ -49,6 +49,7 @@ from exsce_dsl.errors import ExsceError
 from exsce_dsl.runs.bags.buffers import mapped, release
 from exsce_dsl.runs.bags.chunk_batches import ChunkBatch, Decoder, Gathered, Messages
 from exsce_dsl.runs.bags.reader import UnsupportedBag
+from exsce_dsl.wording import counted
 
 MAGIC = b"\x89MCAP0\r\n"
 OP_HEADER = 0x01
@@ -300,7 +301,7 @@ def _summary(data: mmap.mmap) -> _Summary:
     if unknown:
         raise UnsupportedBag(f"chunks hold messages of channels {sorted(unknown)}, which the summary lacks")
     if chunk_count is not None and chunk_count != len(chunks):
-        raise UnsupportedBag(f"the summary indexes {len(chunks)} of the {chunk_count} chunks")
+        raise UnsupportedBag(f"the summary indexes {len(chunks)} of the {counted(chunk_count, 'chunk')}")
     return _Summary(found, sorted(chunks, key=lambda c: c.start), counts)
 
 
@@ -365,7 +366,7 @@ def _read_topics(data: mmap.mmap, topics: Container[str], decoder: Decoder) -> d
             expected = summary.message_counts.get(cid, 0)
             if found != expected:
                 raise UnsupportedBag(
-                    f"the message indexes of topic {channel.topic} list {found} messages, "
+                    f"the message indexes of topic {channel.topic} list {counted(found, 'message')}, "
                     f"its statistics {expected}"
                 )
     return gathered.by_topic()

@@ -45,6 +45,7 @@ from exsce_dsl.runs.segments.track import (
     near,
     planned_waypoints,
 )
+from exsce_dsl.wording import counted
 
 STILL_POSITION = 0.01
 """Metres: a robot whose position changes less than this has not moved (localisation noise)."""
@@ -93,7 +94,7 @@ def arrival_segments(
             later = len(plan) - k - 1
             warnings.append(
                 f"robot {robot} never reached {planned.label} after {track.times[index]:.3f}"
-                + (f"; it and the {later} waypoints after it are NOT_REACHED" if later else "")
+                + (f"; it and the {counted(later, 'waypoint')} after it are NOT_REACHED" if later else "")
             )
             outcomes += [Outcome(None, None, "NOT_REACHED")] * (len(plan) - k)
             break

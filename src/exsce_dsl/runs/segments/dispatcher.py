@@ -15,6 +15,7 @@ from exsce_dsl.model import Pose, Scenario
 from exsce_dsl.model.goals import ACTIONLIB_FINAL, GoalStatus, actionlib_names
 from exsce_dsl.runs.bags.reading import StatusUpdate
 from exsce_dsl.runs.segments.recorded import RecordedAction
+from exsce_dsl.wording import counted
 
 ACTIVE, SUCCEEDED = GoalStatus.ACTIVE, GoalStatus.SUCCEEDED
 FINAL = {code: name for code, name in actionlib_names().items() if code in ACTIONLIB_FINAL}
@@ -26,8 +27,8 @@ def segments(scenario: Scenario, robot: str, updates: list[StatusUpdate]) -> lis
     goals = dispatcher_goals(updates)
     if len(goals) > len(plan):
         raise SegmentError(
-            f"robot '{robot}' ran {len(goals)} dispatcher goals but scenario '{scenario.id}' "
-            f"gives it {len(plan)} subtasks: the bag is from another scenario"
+            f"robot '{robot}' ran {counted(len(goals), 'dispatcher goal')} but scenario '{scenario.id}' "
+            f"gives it {counted(len(plan), 'subtask')}: the bag is from another scenario"
         )
     out: list[RecordedAction] = []
     robot_decl = scenario.robot(robot)

@@ -13,7 +13,8 @@ source, an ``arrival`` tolerance, a ``window``) win over what is detected:
    ``/{ns}/tf``), else ``/{ns}/amcl_pose``, else an odometry under the namespace (``/{ns}/odom``
    first, then any other such as ``/jackal_velocity_controller/odom``), else the namespace's only
    PoseStamped or PoseWithCovarianceStamped topic; the velocity from ``/{ns}/cmd_vel``, else the
-   odometry's twist (else, later, from the poses); the distance along the odometry; the scan on
+   odometry's twist, else another Twist or TwistStamped topic under the namespace or at the root
+   (``/velocity``; else, later, from the poses); the distance along the odometry; the scan on
    ``/{ns}/scan``, else the namespace's only LaserScan.
 
 "Under the namespace" is every topic below ``/{ns}/`` (every topic, for a robot at the root).
@@ -124,8 +125,9 @@ def _without_goals(robot: Robot, types: Mapping[str, str]) -> tuple[Signals, Det
         poses.append(TopicSource(streams[0], mine[streams[0]]))
         evidence.append(streams[0])
     cmd_vel = expand_topic("/{ns}/cmd_vel", ns)
-    velocity = [TopicSource(cmd_vel)] if mine.get(cmd_vel) in (TWIST, TWIST_STAMPED) else []
-    velocity += [TopicSource(t, ODOMETRY) for t in odometry]
+    # /{ns}/cmd_vel is always looked for, so that a robot without a velocity is told where
+    velocity = [TopicSource(cmd_vel)] + [TopicSource(t, ODOMETRY) for t in odometry]
+    velocity += [TopicSource(t, types[t]) for t in _twists(types, ns) if t != cmd_vel]
     scans = sorted(t for t, m in mine.items() if m == LASER_SCAN)
     scan_topic = expand_topic("/{ns}/scan", ns)
     scan = [scan_topic] if scan_topic in scans else scans[:1] if len(scans) == 1 else []
@@ -138,6 +140,27 @@ def _without_goals(robot: Robot, types: Mapping[str, str]) -> tuple[Signals, Det
         navigation=Navigation.NONE,
     )
     return signals, Detected(robot.id, "none (no navigation goals)", tuple(evidence))
+
+
+def _twists(types: Mapping[str, str], ns: str) -> list[str]:
+    """The Twist and TwistStamped topics a robot's velocity may be read from besides its
+    ``cmd_vel`` and odometry: under its namespace (a robot at the root: the root's own topics,
+    one level deep, not another robot's), then at the root; ``velocity`` and ``vel`` first."""
+    level = ns.strip("/")
+
+    def at_root(topic: str) -> bool:
+        return "/" not in topic.lstrip("/")
+
+    def preferred(topic: str) -> tuple[bool, bool, str]:
+        name = topic.rstrip("/").rsplit("/", 1)[-1]
+        return (at_root(topic) and bool(level), name not in ("velocity", "vel"), topic)
+
+    found = [
+        t
+        for t, m in types.items()
+        if m in (TWIST, TWIST_STAMPED) and (at_root(t) or (level and under_namespace(t, level)))
+    ]
+    return sorted(found, key=preferred)
 
 
 def _odometries(mine: Mapping[str, str], ns: str) -> list[str]:
@@ -189,7 +212,8 @@ def robot_namespaces(types: Mapping[str, str]) -> list[tuple[str, Signals, Detec
     names of navigation interfaces, :data:`NOT_ROBOTS`).  A root with a robot's topics of its own (a
     velocity, a scan, a pose) takes in the namespaces that show nothing it does not (a Jackal's
     ``/cmd_vel`` with its ``/jackal_velocity_controller/odom``); a root without, whose every piece of
-    evidence is another robot's topic (a fleet's global ``/tf``), is not a robot of its own."""
+    evidence is the global ``/tf`` or another robot's topic (a fleet's, or a Gazebo robot's whose
+    topics are all under ``/elektron/`` but whose TF is at the root), is not a robot of its own."""
     levels = {t.lstrip("/").split("/")[0] for t in types if "/" in t.lstrip("/")}
     namespaces = sorted(levels - NOT_ROBOTS)
     interfaces = [f"{action}/_action/status" for action in NAV2.actions]
@@ -209,6 +233,7 @@ def robot_namespaces(types: Mapping[str, str]) -> list[tuple[str, Signals, Detec
     if any("/" not in t.lstrip("/") and m in _BODY_TYPES for t, m in types.items()):
         return found[:1] + [f for f in found[1:] if not set(f[2].evidence) <= root]
     others = [ns for ns, _, _ in found[1:]]
-    if root and others and all(any(under_namespace(t, ns) for ns in others) for t in root):
+    tf = expand_topic("/{ns}/tf", "")  # a global /tf is the namespaced robots' (Gazebo's elektron)
+    if root and others and all(t == tf or any(under_namespace(t, ns) for ns in others) for t in root):
         found.pop(0)
     return found

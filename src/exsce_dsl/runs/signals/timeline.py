@@ -10,7 +10,9 @@ the other, so everything is put on one timeline before any window is cut:
 - The run's timeline is the robots' own clock: simulated time when ``/clock`` was recorded or the
   stamps are far (:data:`OTHER_CLOCK`) from their log times, else the wall clock.  Durations are
   then the robots' (a simulation running at half speed does not make a task twice as long).
-- A series whose messages carry usable stamps of the timeline's clock is timed by them.
+- A series whose messages carry usable stamps of the timeline's clock is timed by them, if they
+  are finer than its rate (else, a driver stamping whole seconds at 27 Hz, by its log times, said
+  in a note).
 - Every other series (no header, such as a Twist or a goal status array; or stamps of another
   clock) is timed by its log times, mapped onto the timeline: through ``/clock`` where it was
   recorded (each ``/clock`` message pairs a log time with a simulated time), else through the
@@ -45,6 +47,7 @@ from exsce_dsl.messages.user import configured_user_catalogue
 from exsce_dsl.model.messages import path_of
 from exsce_dsl.runs.bags.decode import TEXTS
 from exsce_dsl.runs.bags.reading import WHOLE, BagData, Series, StatusUpdate, Wanted
+from exsce_dsl.wording import counted
 
 CLOCK_TOPIC = "/clock"
 CLOCK_TYPE = "rosgraph_msgs/msg/Clock"
@@ -54,6 +57,9 @@ SAME_CLOCK = 1.0
 """Seconds: publishers of one clock differ by latency, far less than this."""
 STRETCH = 10.0
 """Seconds of log time over which one offset from log time to stamps is taken (without /clock)."""
+COARSE_SHARE = 0.25
+"""Share of a series' steps whose header stamp repeats (log time going on) above which its stamps
+are coarser than its rate, and it is timed by log time (DESIGN.md, Time)."""
 
 STAMP_PATHS = (path_of("header", "stamp", "sec"), path_of("header", "stamp", "nanosec"))
 TF_STAMP_KEYS = ("transforms.header.stamp.sec", "transforms.header.stamp.nanosec")
@@ -218,6 +224,28 @@ class _Stamped:
     def other_clock(self) -> bool:
         return abs(self.offset) > SAME_CLOCK
 
+    def coarse(self) -> str:
+        """Why the stamps are coarser than the series' rate (empty: they are not): header stamps
+        that stay the same while log time goes on, for more than :data:`COARSE_SHARE` of the
+        steps (a driver stamping whole seconds at 27 Hz would make every duration a whole
+        number of seconds, and hold each message for 0 s)."""
+        if self.kind != HEADER_STAMPS:
+            return ""
+        known = np.isfinite(self.stamps) & (self.stamps > 0)
+        stamps, log = self.stamps[known], self.log[known]
+        going = np.diff(log) > 0
+        if going.sum() < 2:
+            return ""
+        same = int(np.count_nonzero((np.diff(stamps) == 0) & going))
+        if same <= COARSE_SHARE * int(going.sum()):
+            return ""
+        rate = 1.0 / float(np.median(np.diff(log)[going]))
+        distinct = counted(len(np.unique(stamps)), "distinct stamp")
+        return (
+            f"the stamps of {self.topic} are coarser than its rate ({distinct} for "
+            f"{counted(len(stamps), 'message')} at {rate:.1f} Hz): timed by log time"
+        )
+
 
 def decide_timeline(data: BagData) -> Timeline:
     """The run's timeline for the series ``data`` read (with their stamps, :func:`with_stamps`)."""
@@ -314,6 +342,10 @@ def _source_clock(
     """How ``series`` goes on the timeline: by its stamps when they are of the timeline's clock
     and never go back by more than :data:`SAME_CLOCK` (else a jump of ``jumps``), else by its
     log times."""
+    coarse = series.coarse()
+    if coarse:
+        notes.append(coarse)
+        return SourceClock(series.topic, LOG_TIME, timeline.simulated)
     known = np.isfinite(series.stamps)
     stamps, log = series.stamps[known], series.log[known]
     back = np.diff(stamps) < -SAME_CLOCK
