@@ -272,7 +272,8 @@ def _read_signals(
 @dataclass
 class _Segmented:
     """Each robot's path segments, whether its mission succeeded, the span that stands for its
-    whole run (where it has no segments, or its metrics are windowed on the recording), and
+    whole run (where it has no segments, its segments are arrivals, not recorded goals, or its
+    metrics are windowed on the recording), and
     which source segmented it when not the method's dispatcher."""
 
     actions: list[RecordedAction] = field(default_factory=list)
@@ -301,7 +302,8 @@ def _segment_robots(path: Path, scenario: Scenario, bag: _Signals) -> _Segmented
             stacks.real_topics[feedback] = stacks.real_topics[result] = (
                 found.topics or stacks.real_topics.get(expand_topic(SERVED["pose"], ns), ())
             )
-        recording = robot.signals.window is Window.RECORDING
+        # the whole run is the recording unless recorded goals span it: never an arrival
+        recording = robot.signals.window is Window.RECORDING or not found.goals
         if (not found.segments or recording) and scenario.mission.tasks_of(robot.id):
             span = stacks.recorded_span(robot, bag.topics)
             if span is None and not found.segments:
