@@ -167,7 +167,9 @@ def tf_bag(folder: Path, fmt: str, reset_at: float | None = None, with_clock: bo
 
 
 def _read(bag: Path) -> dict[str, list[Any]]:
-    with AnyReader([bag], default_typestore=typestore_for("ros1" if bag.suffix == ".bag" else "sqlite3")) as r:
+    with AnyReader(
+        [bag], default_typestore=typestore_for("ros1" if bag.suffix == ".bag" else "sqlite3")
+    ) as r:
         found: dict[str, list[Any]] = {}
         for c, _, raw in r.messages():
             found.setdefault(c.topic, []).append(r.deserialize(raw, c.msgtype))

@@ -75,9 +75,9 @@ class AnalysedRun:
 
     def picked(self) -> list[str]:
         """What ingestion decided for this bag: each detected convention, and the timeline when
-        it is not simply the wall clock."""
+        it is not simply the wall clock (in ``exscec bag info``'s words)."""
         said = [d.describe() for d in self.detected]
-        if self.timeline is not None and self.timeline.simulated:
+        if self.timeline is not None and _told(self.timeline):
             said.append(f"timeline: {self.timeline.describe()}")
         return said
 
@@ -85,8 +85,15 @@ class AnalysedRun:
         """Which clock each source was timed by, on the run's timeline."""
         if self.timeline is None:
             return []
-        said = [] if self.timeline.simulated else [f"timeline: {self.timeline.describe()}"]
+        said = [] if _told(self.timeline) else [f"timeline: {self.timeline.describe()}"]
+        mapping = self.timeline.mapping()
+        said += [mapping] if mapping else []
         return said + [f"clock of {c.describe()}" for c in self.timeline.clocks]
+
+
+def _told(timeline: Timeline) -> bool:
+    """Whether ingestion tells the timeline without ``-v``: simulated, or log time no date."""
+    return timeline.simulated or not timeline.dated
 
 
 def run_metrics(scenario: Scenario) -> tuple[MetricDefinition, ...]:
@@ -212,6 +219,7 @@ def analyse_bag(
         metrics=tuple(values),
         hotspots=tuple(hotspots),
         clocks=_run_clocks(bag.timeline, bag.data.spellings),
+        dated=bag.timeline.dated,
         conventions=tuple((d.robot, d.convention, d.evidence) for d in bag.detected),
         status=status,
         coverage=covered.gaps,

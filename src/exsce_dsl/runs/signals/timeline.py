@@ -48,6 +48,7 @@ from exsce_dsl.messages.user import configured_user_catalogue
 from exsce_dsl.model.messages import path_of
 from exsce_dsl.runs.bags.decode import TEXTS
 from exsce_dsl.runs.bags.reading import WHOLE, BagData, Series, StatusUpdate, Wanted
+from exsce_dsl.runs.signals.clock_words import describe_clocks, log_time_is_dated
 from exsce_dsl.runs.signals.stamp_tracks import StampTrack, first_back, header_track, resets, tf_tracks
 
 CLOCK_TOPIC = "/clock"
@@ -120,6 +121,16 @@ class Timeline:
     time_knots: np.ndarray = field(default_factory=lambda: np.zeros(0))
     jumps: tuple[ClockJump, ...] = ()
     """Where a clock went back: from there on, the run is not on one timeline."""
+    log_start: float = float("inf")
+    """The bag's first log time (s): before a year after 1970 it is simulated time, no date
+    (inf: not known, a date)."""
+    clock_recorded: bool = False
+    """Whether the bag recorded ``/clock``."""
+
+    @property
+    def dated(self) -> bool:
+        """Whether the recorder's log times are dates (not simulated time: no run of 1970)."""
+        return log_time_is_dated(self.log_start)
 
     def from_log(self, times: np.ndarray) -> np.ndarray:
         """Log times (seconds) on the timeline."""
@@ -130,9 +141,12 @@ class Timeline:
         return _through(np.asarray(times, dtype=np.float64), self.time_knots, self.log_knots)
 
     def describe(self) -> str:
-        if not self.simulated:
-            return "wall clock (log time and stamps agree)"
-        return f"simulated time (log times mapped through {self.by})"
+        """The bag's clocks in the words ``exscec bag info`` uses (:func:`describe_clocks`)."""
+        return describe_clocks(self.log_start, self.clock_recorded, self.simulated)
+
+    def mapping(self) -> str | None:
+        """How log times go onto the timeline, when they are moved at all."""
+        return None if self.by == LOG_TIME else f"log times mapped onto the timeline through {self.by}"
 
 
 def _through(times: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
@@ -258,7 +272,8 @@ def decide_timeline(data: BagData) -> Timeline:
     tracks = [t for s in stamped for t in s.tracks]
     for back, together in resets(tracks, SAME_CLOCK):
         jumps.append(ClockJump(back.track, back.at, back.back, together))
-    timeline = Timeline(simulated_run, (), (), by, log_knots, time_knots)
+    recorded = clock is not None and bool(len(clock))
+    timeline = Timeline(simulated_run, (), (), by, log_knots, time_knots, (), data.start, recorded)
     jumps = [replace(j, at=float(timeline.from_log(np.array([j.at]))[0])) for j in jumps]
     clocks = []
     for series in stamped:
@@ -268,6 +283,8 @@ def decide_timeline(data: BagData) -> Timeline:
         clocks.append(SourceClock(topic, LOG_TIME, simulated_run))
     for topic in sorted({*data.feedback, *data.results, *data.messages}):
         clocks.append(SourceClock(topic, LOG_TIME, simulated_run))
+    if not timeline.dated and recorded:  # the recorder logged simulated time: so is every source
+        clocks = [replace(c, simulated=True) for c in clocks]
     return replace(
         timeline, clocks=tuple(sorted(clocks, key=lambda c: c.topic)), notes=tuple(notes), jumps=tuple(jumps)
     )
