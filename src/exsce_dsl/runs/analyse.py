@@ -205,7 +205,7 @@ def analyse_bag(
     covered = find_coverage(
         Recording(
             scenario, robots, bag.data, bag.timeline, found.actions, values, status, spans,
-            declared_rates(robots, stacks.sources, bag.data),
+            declared_rates(robots, stacks.sources, bag.data), frozenset(found.whole_runs),
         )
     )  # fmt: skip
     bag.problems += covered.said()
