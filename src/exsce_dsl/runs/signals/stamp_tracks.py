@@ -107,17 +107,24 @@ def resets(tracks: Sequence[StampTrack], tolerance: float) -> list[tuple[Back, t
     when it has messages before and after it; it went back with the others when one of its own
     steps back is within :data:`TOGETHER` (or two of its periods) of that moment."""
     stepped = {t.name: backs(t, tolerance) for t in tracks}
+    times = {name: np.array([b.at for b in found]) for name, found in stepped.items()}
     candidates = sorted((b for found in stepped.values() for b in found), key=lambda b: b.at)
     found: list[tuple[Back, tuple[str, ...]]] = []
     for candidate in candidates:
         if found and candidate.at - found[-1][0].at <= TOGETHER:
             continue  # the same reset, seen from another track
         alive = [t for t in tracks if len(t.log) and t.log[0] < candidate.at <= t.log[-1]]
-        within = [
-            [b for b in stepped[t.name] if abs(b.at - candidate.at) <= max(TOGETHER, 2 * t.period())]
-            for t in alive
+        near = [
+            _near(stepped[t.name], times[t.name], candidate.at, max(TOGETHER, 2 * t.period())) for t in alive
         ]
-        if alive and all(within):
-            first = min((b for bs in within for b in bs), key=lambda b: b.at)
+        if alive and all(near):
+            first = min((b for steps in near for b in steps), key=lambda b: b.at)
             found.append((first, tuple(sorted(t.name for t in alive))))
     return found
+
+
+def _near(steps: list[Back], at: np.ndarray, moment: float, within: float) -> list[Back]:
+    """The steps (their log times ``at``, sorted) within ``within`` seconds of ``moment``."""
+    low = int(np.searchsorted(at, moment - within, side="left"))
+    high = int(np.searchsorted(at, moment + within, side="right"))
+    return steps[low:high]
