@@ -116,10 +116,10 @@ def test_a_drone_in_3d_arrives_when_it_has_climbed_and_its_path_is_3d(fmt: str, 
     # at the top once within 0.35 m of it: 9.65 m up, 2 s + 9.65 s after the start (20 Hz: 11.65 s)
     assert top.end.timestamp() - start == pytest.approx(11.65, abs=1 / HZ)
     assert far.end.timestamp() - start == pytest.approx(12.0 + 9.65 / 2.0, abs=1 / HZ)
-    # the whole run is its goals': from leaving the pad to reaching far, along the track in x-y-z
-    window = (top.start.timestamp() - start, far.end.timestamp() - start)
+    # the whole run is its recording (arrivals cut segments, never the run), along the track in x-y-z
+    window = (0.0, _drone_track()[-1][0])
     assert _whole(flying, "distance_travelled", "drone1") == pytest.approx(_path(window, 3), rel=1e-9)
-    assert _path(window, 3) > 19.0
+    assert _path(window, 3) == pytest.approx(20.0, rel=1e-9)
     speed = [
         v for v in flying.run.metrics if (v.metric, v.robot, v.action) == ("max_velocity", "drone1", None)
     ]
@@ -137,9 +137,11 @@ def test_planar_motion_measures_in_the_plane_but_a_height_given_is_still_compare
     assert top.end.timestamp() - START_NS * 1e-9 == pytest.approx(11.65, abs=1 / HZ)
     far = max(planar.run.actions(), key=lambda a: a.id.waypoint)
     assert top.start is not None and far.end is not None
-    window = (top.start.timestamp() - START_NS * 1e-9, far.end.timestamp() - START_NS * 1e-9)
+    # the whole run is its recording, not its arrivals: the 10 m flown in the plane
+    window = (0.0, _drone_track()[-1][0])
     assert _whole(planar, "distance_travelled", "drone1") == pytest.approx(_path(window, 2), rel=1e-9)
-    assert _path(window, 2) == pytest.approx(9.65, abs=0.06)
+    assert _path(window, 2) == pytest.approx(10.0, rel=1e-9)
+    assert far.end.timestamp() - START_NS * 1e-9 < window[1] - 1.0
 
 
 def test_window_whole_recording_covers_all_of_the_robots_signals(tmp_path: Path) -> None:

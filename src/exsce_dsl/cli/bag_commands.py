@@ -65,7 +65,10 @@ def _table(info: object) -> str:
     from exsce_dsl.runs.bag_info import BagInfo
 
     assert isinstance(info, BagInfo)
-    start = dt.datetime.fromtimestamp(info.start, tz=dt.timezone.utc).isoformat(timespec="seconds")
+    if info.dated:
+        start = dt.datetime.fromtimestamp(info.start, tz=dt.timezone.utc).isoformat(timespec="seconds")
+    else:  # log time that is no date (simulated time): never a date of 1970
+        start = f"{info.start:.3f} s (no date)"
     lines = [
         f"bag       {info.path}",
         f"format    {info.format}, {info.size / 1e6:.1f} MB",

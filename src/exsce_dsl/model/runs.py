@@ -223,6 +223,9 @@ class Run:
     """What the recording does not cover (cut short, gaps, thinned topics, clock jumps)."""
     topic_rates: tuple[TopicRate, ...] = ()
     """How densely each topic a metric reads was recorded."""
+    dated: bool = True
+    """Whether ``start``, ``end`` and the actions' times are dates; not when the recorder logged
+    simulated time (they are then seconds after 1970 of simulated time, and no date is written)."""
 
     def actions(self) -> Iterator[Action]:
         for task in self.tasks:

@@ -173,7 +173,8 @@ class _RunCompiler:
         run_facts: Attributes = {PROV_TYPE: t(ids.RUN_TYPE), uuid_attr: run.uuid}
         if run.status is not RunStatus.COMPLETED:
             run_facts[t(ids.MISSION_STATUS)] = run.status.value
-        w.activity(run_id, run_facts, run.start, run.end)
+        dated = run.dated  # a run on simulated log time has no date (not one of 1970)
+        w.activity(run_id, run_facts, run.start if dated else None, run.end if dated else None)
         parameters = parts[ids.PARAMETER_SERVER]
         writer.claim(parameters, "the run's parameter server")
         parameter_facts: Attributes = {PROV_TYPE: t(ids.ROS_PARAMETER_SERVER)}
@@ -223,7 +224,7 @@ class _RunCompiler:
                     facts[t(ids.GOAL_OUTCOME)] = action.outcome
                 if action.attempts > 1:
                     facts[t(ids.ATTEMPTS)] = action.attempts
-                w.activity(action_id, facts, action.start, action.end)
+                w.activity(action_id, facts, *((action.start, action.end) if run.dated else (None, None)))
                 w.ended(action_id, pose_ns[self._pose_name(action.goal_pose)], attributes=goal)
                 w.started(action_id, pose_ns[self._pose_name(action.start_pose)])
                 w.associated(action_id, agent)

@@ -76,9 +76,9 @@ class AnalysedRun:
 
     def picked(self) -> list[str]:
         """What ingestion decided for this bag: each detected convention, and the timeline when
-        it is not simply the wall clock."""
+        it is not simply the wall clock (in ``exscec bag info``'s words)."""
         said = [d.describe() for d in self.detected]
-        if self.timeline is not None and self.timeline.simulated:
+        if self.timeline is not None and _told(self.timeline):
             said.append(f"timeline: {self.timeline.describe()}")
         return said
 
@@ -86,8 +86,15 @@ class AnalysedRun:
         """Which clock each source was timed by, on the run's timeline."""
         if self.timeline is None:
             return []
-        said = [] if self.timeline.simulated else [f"timeline: {self.timeline.describe()}"]
+        said = [] if _told(self.timeline) else [f"timeline: {self.timeline.describe()}"]
+        mapping = self.timeline.mapping()
+        said += [mapping] if mapping else []
         return said + [f"clock of {c.describe()}" for c in self.timeline.clocks]
+
+
+def _told(timeline: Timeline) -> bool:
+    """Whether ingestion tells the timeline without ``-v``: simulated, or log time no date."""
+    return timeline.simulated or not timeline.dated
 
 
 def run_metrics(scenario: Scenario) -> tuple[MetricDefinition, ...]:
@@ -199,7 +206,7 @@ def analyse_bag(
     covered = find_coverage(
         Recording(
             scenario, robots, bag.data, bag.timeline, found.actions, values, status, spans,
-            declared_rates(robots, stacks.sources, bag.data),
+            declared_rates(robots, stacks.sources, bag.data), frozenset(found.whole_runs),
         )
     )  # fmt: skip
     bag.problems += covered.said()
@@ -213,6 +220,7 @@ def analyse_bag(
         metrics=tuple(values),
         hotspots=tuple(hotspots),
         clocks=_run_clocks(bag.timeline, bag.data.spellings),
+        dated=bag.timeline.dated,
         conventions=tuple((d.robot, d.convention, d.evidence) for d in bag.detected),
         status=status,
         coverage=covered.gaps,
@@ -273,7 +281,8 @@ def _read_signals(
 @dataclass
 class _Segmented:
     """Each robot's path segments, whether its mission succeeded, the span that stands for its
-    whole run (where it has no segments, or its metrics are windowed on the recording), and
+    whole run (where it has no segments, its segments are arrivals, not recorded goals, or its
+    metrics are windowed on the recording), and
     which source segmented it when not the method's dispatcher."""
 
     actions: list[RecordedAction] = field(default_factory=list)
@@ -302,7 +311,8 @@ def _segment_robots(path: Path, scenario: Scenario, bag: _Signals) -> _Segmented
             stacks.real_topics[feedback] = stacks.real_topics[result] = (
                 found.topics or stacks.real_topics.get(expand_topic(SERVED["pose"], ns), ())
             )
-        recording = robot.signals.window is Window.RECORDING
+        # the whole run is the recording unless recorded goals span it: never an arrival
+        recording = robot.signals.window is Window.RECORDING or not found.goals
         if (not found.segments or recording) and scenario.mission.tasks_of(robot.id):
             span = stacks.recorded_span(robot, bag.topics)
             if span is None and not found.segments:

@@ -23,6 +23,7 @@ from exsce_dsl.messages.user import configured_user_catalogue
 from exsce_dsl.model.goals import action_names, actionlib_names
 from exsce_dsl.runs.bags.reading import bag_topics
 from exsce_dsl.runs.bags.rosbags_fallback import typestore_for
+from exsce_dsl.runs.signals.clock_words import describe_clocks, log_time_is_dated
 from exsce_dsl.runs.signals.detect import robot_namespaces
 from exsce_dsl.runs.signals.timeline import SAME_CLOCK, SIMULATED_BEFORE
 
@@ -72,11 +73,19 @@ class BagInfo:
     """Per namespace, the convention ingestion would detect and from what."""
 
     @property
+    def clock_recorded(self) -> bool:
+        return any(t.name.lstrip("/") == "clock" for t in self.topics)
+
+    @property
+    def dated(self) -> bool:
+        """Whether its log times are dates (not simulated time logged by the recorder)."""
+        return log_time_is_dated(self.start)
+
+    @property
     def timeline(self) -> str:
-        simulated = any(t.clock == "simulated" for t in self.topics) or any(
-            t.name.lstrip("/") == "clock" for t in self.topics
-        )
-        return "simulated time (stamps of a simulation)" if simulated else "wall clock"
+        """Its clocks, in the words ``exscec ingest`` uses (:func:`describe_clocks`)."""
+        simulated = any(t.clock == "simulated" for t in self.topics) or self.clock_recorded
+        return describe_clocks(self.start, self.clock_recorded, simulated)
 
     def as_dict(self) -> dict[str, Any]:
         return {
@@ -87,6 +96,7 @@ class BagInfo:
             "end": self.end,
             "duration_s": self.end - self.start,
             "timeline": self.timeline,
+            "dated": self.dated,
             "topics": [t.__dict__ for t in self.topics],
             "tf": [
                 {"parent": p, "child": c, "static": s, "rate": self.tf_rates.get((p, c))}
@@ -111,6 +121,9 @@ def bag_info(path: Path) -> BagInfo:
     except Exception as exc:  # rosbags' readers raise their own errors for corrupt files
         raise BagError(f"{path}: cannot read the bag: {type(exc).__name__}: {exc}") from None
     size = sum(p.stat().st_size for p in ([path] if path.is_file() else path.rglob("*")) if p.is_file())
+    if not log_time_is_dated(start) and any(t.name.lstrip("/") == "clock" for t in topics):
+        # the recorder logged simulated time: stamps that agree with it are simulated too
+        topics = tuple(replace(t, clock="simulated") if t.clock == "wall clock" else t for t in topics)
     return BagInfo(
         str(path), _format(path), size, start, end, topics, edges, rates, goals, _conventions(types)
     )

@@ -154,6 +154,9 @@ class Recording:
     """Robot → the span of its recorded signals (its window when it has no goals)."""
     declared: Mapping[str, float]
     """Bag topic (as spelt) → the rate its robot type declares (Hz)."""
+    whole_recording: frozenset[str] = frozenset()
+    """Robots whose window is their recording though they have segments (arrivals, which cut
+    segments, never the run)."""
 
 
 @dataclass(frozen=True)
@@ -242,11 +245,12 @@ def read_topics(
 def robot_windows(recording: Recording) -> dict[str, tuple[float, float]]:
     """Each robot's window on the timeline: its first goal's start to its last goal's end (the
     recording's end while a goal is still active), or its recorded signals' span when it has no
-    goals or its type says ``window whole recording``."""
+    goals (arrivals are no goals) or its type says ``window whole recording``."""
     found: dict[str, tuple[float, float]] = {}
     for robot in recording.robots:
         started = [s for s in recording.segments if s.robot == robot.id and s.start is not None]
-        if started and robot.signals.window is not Window.RECORDING:
+        recorded = robot.signals.window is Window.RECORDING or robot.id in recording.whole_recording
+        if started and not recorded:
             first = min(s.start for s in started if s.start is not None)
             last = max(s.end if s.end is not None else recording.data.end for s in started)
             found[robot.id] = (first, last)

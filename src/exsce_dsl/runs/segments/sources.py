@@ -4,8 +4,9 @@
 method's waypoint dispatcher (its goal statuses), the navigation stack's goals (Nav2's actions,
 move_base's) matched to the planned waypoints by pose, and arrival of the robot's pose at the
 planned waypoints.  The first that gives a segment the robot started wins; when none does, the
-robot's metrics are of its whole run only, and a problem says why.  Adding a source is one entry
-here (and its module beside this one).
+robot's metrics are of its whole run only, and a problem says why.  Only recorded goals may
+window the whole run (their span); arrivals cut segments, and the run stays its recording.
+Adding a source is one entry here (and its module beside this one).
 """
 
 from __future__ import annotations
@@ -36,6 +37,9 @@ class RobotSegments:
     topics: tuple[str, ...] = ()
     """The bag's topics the segments came from."""
     problems: tuple[str, ...] = ()
+    goals: bool = True
+    """Whether the segments are recorded goals, whose span may stand for the robot's whole run;
+    arrival's are not: an arrival cuts segments, never the run (the run is then its recording)."""
 
 
 @dataclass
@@ -89,7 +93,8 @@ def _arrival(given: SegmentInput) -> RobotSegments | None:
     given.problems.extend(f"robot '{robot.id}': {w}" for w in found.warnings)
     if not _started(found.segments):
         return None
-    return RobotSegments(list(found.segments), "arrival at the planned waypoints", _succeeded(found.segments))
+    name = "arrival at the planned waypoints"
+    return RobotSegments(list(found.segments), name, _succeeded(found.segments), goals=False)
 
 
 SEGMENT_SOURCES: tuple[SegmentSource, ...] = (
@@ -109,8 +114,9 @@ def segment_robot(
     for source in SEGMENT_SOURCES:
         found = source.find(given)
         if found is not None:
+            problems = tuple(given.problems)
             return RobotSegments(
-                found.segments, found.source, found.succeeded, found.topics, tuple(given.problems)
+                found.segments, found.source, found.succeeded, found.topics, problems, found.goals
             )
     given.problems.append(
         f"robot '{robot.id}': no path segments (no navigation goals, and no pose that reaches its planned "

@@ -24,10 +24,13 @@ the other, so everything is put on one timeline before any window is cut:
 What cannot be reconciled is said: a ``/clock`` that goes back (the simulation was reset during
 the recording) is a :class:`ClockJump`: the timeline follows ``/clock`` up to the jump and goes
 on at its last rate after it (so every series stays in order), and the run's coverage says that
-nothing from the jump on is on one timeline.  Stamps of one series that go back by more than
-:data:`SAME_CLOCK` make that series timed by its log times, and a jump of its own; stamped series
-whose offsets to log time differ by more than :data:`SAME_CLOCK` (two publishers on different
-clocks) are named in a note.
+nothing from the jump on is on one timeline.  Stamps are judged per publisher
+(:mod:`~exsce_dsl.runs.signals.stamp_tracks`: per edge for TF, whose edges come from several
+nodes): a publisher whose stamps go back by more than :data:`SAME_CLOCK` makes its series timed
+by its log times, with a note, and is a jump only when every stamped publisher recorded then goes
+back together (a reset without ``/clock``); stamped series whose offsets to log time differ by
+more than :data:`SAME_CLOCK` (two publishers on different clocks) are named in a note.  No sample
+is ever left out.
 """
 
 from __future__ import annotations
@@ -47,6 +50,8 @@ from exsce_dsl.messages.user import configured_user_catalogue
 from exsce_dsl.model.messages import path_of
 from exsce_dsl.runs.bags.decode import TEXTS
 from exsce_dsl.runs.bags.reading import WHOLE, BagData, Series, StatusUpdate, Wanted
+from exsce_dsl.runs.signals.clock_words import describe_clocks, log_time_is_dated
+from exsce_dsl.runs.signals.stamp_tracks import StampTrack, first_back, header_track, resets, tf_tracks
 from exsce_dsl.wording import counted
 
 CLOCK_TOPIC = "/clock"
@@ -98,9 +103,13 @@ class ClockJump:
     topic: str
     at: float
     back: float
+    together: tuple[str, ...] = ()
+    """Without ``/clock``: every stamped publisher that went back with ``topic``'s."""
 
     def describe(self) -> str:
         what = "/clock" if self.topic == CLOCK_TOPIC else f"the stamps of {self.topic}"
+        if len(self.together) > 1:
+            what = f"the stamps of every stamped source ({', '.join(self.together)})"
         return f"{what} went back {self.back:.3f} s (a simulation reset while recording)"
 
 
@@ -118,6 +127,16 @@ class Timeline:
     time_knots: np.ndarray = field(default_factory=lambda: np.zeros(0))
     jumps: tuple[ClockJump, ...] = ()
     """Where a clock went back: from there on, the run is not on one timeline."""
+    log_start: float = float("inf")
+    """The bag's first log time (s): before a year after 1970 it is simulated time, no date
+    (inf: not known, a date)."""
+    clock_recorded: bool = False
+    """Whether the bag recorded ``/clock``."""
+
+    @property
+    def dated(self) -> bool:
+        """Whether the recorder's log times are dates (not simulated time: no run of 1970)."""
+        return log_time_is_dated(self.log_start)
 
     def from_log(self, times: np.ndarray) -> np.ndarray:
         """Log times (seconds) on the timeline."""
@@ -128,9 +147,12 @@ class Timeline:
         return _through(np.asarray(times, dtype=np.float64), self.time_knots, self.log_knots)
 
     def describe(self) -> str:
-        if not self.simulated:
-            return "wall clock (log time and stamps agree)"
-        return f"simulated time (log times mapped through {self.by})"
+        """The bag's clocks in the words ``exscec bag info`` uses (:func:`describe_clocks`)."""
+        return describe_clocks(self.log_start, self.clock_recorded, self.simulated)
+
+    def mapping(self) -> str | None:
+        """How log times go onto the timeline, when they are moved at all."""
+        return None if self.by == LOG_TIME else f"log times mapped onto the timeline through {self.by}"
 
 
 def _through(times: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
@@ -215,6 +237,8 @@ class _Stamped:
     log: np.ndarray
     stamps: np.ndarray
     offset: float
+    tracks: tuple[StampTrack, ...] = ()
+    """Its stamps per publisher (per edge for TF), as they are judged for going back."""
 
     @property
     def simulated(self) -> bool:
@@ -273,16 +297,22 @@ def decide_timeline(data: BagData) -> Timeline:
     else:
         log_knots = time_knots = np.zeros(0)
         by, simulated_run = LOG_TIME, False
-    timeline = Timeline(simulated_run, (), (), by, log_knots, time_knots)
+    tracks = [t for s in stamped for t in s.tracks]
+    for back, together in resets(tracks, SAME_CLOCK):
+        jumps.append(ClockJump(back.track, back.at, back.back, together))
+    recorded = clock is not None and bool(len(clock))
+    timeline = Timeline(simulated_run, (), (), by, log_knots, time_knots, (), data.start, recorded)
     jumps = [replace(j, at=float(timeline.from_log(np.array([j.at]))[0])) for j in jumps]
     clocks = []
     for series in stamped:
-        clocks.append(_source_clock(series, timeline, notes, jumps))
+        clocks.append(_source_clock(series, timeline, notes))
     stamped_topics = {s.topic for s in stamped}
     for topic in sorted(set(data.series) - stamped_topics - {CLOCK_TOPIC}):
         clocks.append(SourceClock(topic, LOG_TIME, simulated_run))
     for topic in sorted({*data.feedback, *data.results, *data.messages}):
         clocks.append(SourceClock(topic, LOG_TIME, simulated_run))
+    if not timeline.dated and recorded:  # the recorder logged simulated time: so is every source
+        clocks = [replace(c, simulated=True) for c in clocks]
     return replace(
         timeline, clocks=tuple(sorted(clocks, key=lambda c: c.topic)), notes=tuple(notes), jumps=tuple(jumps)
     )
@@ -300,7 +330,8 @@ def _stamped_series(data: BagData) -> list[_Stamped]:
             continue
         known = np.isfinite(stamps) & (stamps > 0)
         offset = float(np.median(series.t[known] - stamps[known]))
-        found.append(_Stamped(topic, kind, series.t, stamps, offset))
+        tracks = tf_tracks(series) if kind == TRANSFORM_STAMPS else [header_track(topic, series.t, stamps)]
+        found.append(_Stamped(topic, kind, series.t, stamps, offset, tuple(tracks)))
     return found
 
 
@@ -321,7 +352,7 @@ def _clock_knots(clock: Series) -> tuple[np.ndarray, np.ndarray, ClockJump | Non
 
 def _offset_knots(simulated: list[_Stamped]) -> tuple[np.ndarray, np.ndarray]:
     """Knots from the stamps' offsets to log time: one per :data:`STRETCH` of log time, the median
-    offset of every simulated stamp logged in it."""
+    offset of every simulated stamp logged in it, up to where they would go back (a reset)."""
     log = np.concatenate([s.log for s in simulated])
     stamps = np.concatenate([s.stamps for s in simulated])
     keep = np.isfinite(stamps) & (stamps > 0)
@@ -333,27 +364,28 @@ def _offset_knots(simulated: list[_Stamped]) -> tuple[np.ndarray, np.ndarray]:
     starts, ends = np.concatenate([[0], edges]), np.concatenate([edges, [len(log)]])
     log_knots = np.array([np.median(log[a:b]) for a, b in zip(starts, ends, strict=True)])
     offsets = np.array([np.median(offset[a:b]) for a, b in zip(starts, ends, strict=True)])
-    return log_knots, log_knots - offsets
+    time_knots = log_knots - offsets
+    back = np.flatnonzero(np.diff(time_knots) < 0)
+    if back.size:  # the stamps went back (a reset): the timeline goes on at its pace, in order
+        log_knots, time_knots = log_knots[: back[0] + 1], time_knots[: back[0] + 1]
+    return log_knots, time_knots
 
 
-def _source_clock(
-    series: _Stamped, timeline: Timeline, notes: list[str], jumps: list[ClockJump]
-) -> SourceClock:
+def _source_clock(series: _Stamped, timeline: Timeline, notes: list[str]) -> SourceClock:
     """How ``series`` goes on the timeline: by its stamps when they are of the timeline's clock
-    and never go back by more than :data:`SAME_CLOCK` (else a jump of ``jumps``), else by its
-    log times."""
+    and none of its publishers' go back by more than :data:`SAME_CLOCK`, else by its log times
+    (a note says which publisher went back: a reset is decided over every publisher); stamps
+    coarser than the series' rate are never used (a note says so)."""
     coarse = series.coarse()
     if coarse:
         notes.append(coarse)
         return SourceClock(series.topic, LOG_TIME, timeline.simulated)
-    known = np.isfinite(series.stamps)
-    stamps, log = series.stamps[known], series.log[known]
-    back = np.diff(stamps) < -SAME_CLOCK
-    if back.any():
-        notes.append(f"the stamps of {series.topic} go back by more than {SAME_CLOCK:g} s: timed by log time")
-        at = int(np.argmax(back))
-        where = float(timeline.from_log(np.array([log[at + 1]]))[0])
-        jumps.append(ClockJump(series.topic, where, float(stamps[at] - stamps[at + 1])))
+    back = first_back(series.tracks, SAME_CLOCK)
+    if back is not None:
+        notes.append(
+            f"the stamps of {back.track} go back {back.back:.3f} s at log time {back.at:.3f} "
+            f"(by more than {SAME_CLOCK:g} s): {series.topic} timed by log time"
+        )
         return SourceClock(series.topic, LOG_TIME, timeline.simulated)
     if series.simulated == timeline.simulated:
         if series.other_clock and not series.simulated:
