@@ -11,8 +11,8 @@ Each shape is what a kind of robot or data set records, with nothing of the meth
   base_link`` (30 Hz) on ``/tf``, ``base_link → base_laser_link`` on ``/tf_static``;
 - ``namespaced``: one PoseStamped stream under ``/scout``, its header stamps in simulated time
   (a Gazebo world's 120 s) and log times on the wall clock, without ``/clock``; header-less
-  Float32 topics beside it (a reported speed during the drive, a battery voltage only in the
-  three seconds before its pose was first recorded);
+  Float32 topics beside it (a reported speed during the drive, a battery voltage only before
+  the robot set off);
 - ``drone``: a drone's PoseStamped (``/mavros/local_position/pose``) climbing 12 m as it flies.
 
 The robots follow one :class:`Route` (rest, two straight legs at two speeds, rest), sampled at
@@ -260,7 +260,7 @@ def namespaced(store: Any) -> list[Topic]:
             [(wall_log(s), float32(data=float(v))) for s, v in zip(speed_times, speeds, strict=True)],
         ),
         Topic(
-            "/scout/battery", FLOAT32, [(wall_log(s), float32(data=24.0 - s)) for s in times(5.0, -3.0, -1.5)]
+            "/scout/battery", FLOAT32, [(wall_log(s), float32(data=24.0 - s)) for s in times(5.0, 0.0, 1.5)]
         ),
     ]
 

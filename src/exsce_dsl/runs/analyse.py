@@ -202,11 +202,10 @@ def analyse_bag(
         if lacking:
             raise IncompleteRunError(_incomplete(path, lacking, bag.problems))
     status = recorded_mission_status(path, bag.data.messages.get(PROV_TOPIC, ()))
-    spans = {r.id: span for r in robots if (span := stacks.recorded_span(r, bag.topics)) is not None}
     covered = find_coverage(
         Recording(
-            scenario, robots, bag.data, bag.timeline, found.actions, values, status, spans,
-            declared_rates(robots, stacks.sources, bag.data), frozenset(found.whole_runs),
+            scenario, robots, bag.data, bag.timeline, found.actions, values, status, found.whole_runs,
+            declared_rates(robots, stacks.sources, bag.data),
         )
     )  # fmt: skip
     bag.problems += covered.said()

@@ -37,7 +37,6 @@ from typing import Any
 import numpy as np
 
 from exsce_dsl.model import Scenario
-from exsce_dsl.model.conventions import Window
 from exsce_dsl.model.coverage import CoverageGap, Shortfall, TopicRate
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import MetricValue, RunStatus
@@ -150,13 +149,11 @@ class Recording:
     segments: list[RecordedAction]
     values: list[MetricValue]
     status: RunStatus
-    signal_spans: Mapping[str, tuple[float, float]]
-    """Robot → the span of its recorded signals (its window when it has no goals)."""
+    whole_runs: Mapping[str, tuple[float, float]]
+    """Robot → its whole-run window where that is not its goals' span: the recording (no goals,
+    segments from arrivals, which cut segments, never the run, or ``window whole recording``)."""
     declared: Mapping[str, float]
     """Bag topic (as spelt) → the rate its robot type declares (Hz)."""
-    whole_recording: frozenset[str] = frozenset()
-    """Robots whose window is their recording though they have segments (arrivals, which cut
-    segments, never the run)."""
 
 
 @dataclass(frozen=True)
@@ -243,19 +240,18 @@ def read_topics(
 
 
 def robot_windows(recording: Recording) -> dict[str, tuple[float, float]]:
-    """Each robot's window on the timeline: its first goal's start to its last goal's end (the
-    recording's end while a goal is still active), or its recorded signals' span when it has no
-    goals (arrivals are no goals) or its type says ``window whole recording``."""
+    """Each robot's window on the timeline, as its whole-run values have it: the recording where
+    analysis said so (:attr:`Recording.whole_runs`), else its first goal's start to its last goal's
+    end (the recording's end while a goal is still active)."""
     found: dict[str, tuple[float, float]] = {}
     for robot in recording.robots:
         started = [s for s in recording.segments if s.robot == robot.id and s.start is not None]
-        recorded = robot.signals.window is Window.RECORDING or robot.id in recording.whole_recording
-        if started and not recorded:
+        if robot.id in recording.whole_runs:
+            found[robot.id] = recording.whole_runs[robot.id]
+        elif started:
             first = min(s.start for s in started if s.start is not None)
             last = max(s.end if s.end is not None else recording.data.end for s in started)
             found[robot.id] = (first, last)
-        elif robot.id in recording.signal_spans:
-            found[robot.id] = recording.signal_spans[robot.id]
     return found
 
 
