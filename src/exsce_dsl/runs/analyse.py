@@ -150,13 +150,18 @@ def field_checker(metrics: tuple[MetricDefinition, ...], robots: list[Robot]) ->
     return check
 
 
-def reductions(monitors: ModuleType, robots: list[Robot]) -> dict[str, Reduce]:
+def reductions(monitors: ModuleType, robots: list[Robot], stacks: StackRobots) -> dict[str, Reduce]:
     """Topic → what to reduce of each block of its messages as the bag is read (the monitors'
-    aggregates over arrays), so that no topic's arrays are ever all in memory."""
+    aggregates over arrays), so that no topic's arrays are ever all in memory.  A signal served
+    under another name than its bag topic's (a scan on ``/base_scan`` served as ``/scan``) is
+    reduced as its bag topic is read: the reader keeps no arrays of a topic it reduces, so a
+    reduction keyed by the served name alone left the monitors without the scan's ranges."""
     entries: dict[str, list[tuple[str, str, Compute]]] = {}
     for robot in robots:
         for pattern, key, func, compute in monitors.REDUCERS:
-            entries.setdefault(expand_topic(pattern, robot.namespace), []).append((key, func, compute))
+            name = expand_topic(pattern, robot.namespace)
+            for topic in dict.fromkeys([name, stacks.read_from(name) or name]):
+                entries.setdefault(topic, []).append((key, func, compute))
     return {topic: reducer(found) for topic, found in entries.items()}
 
 
@@ -261,7 +266,7 @@ def _read_signals(
     wanted = with_stamps(stacks.adapt(wanted_topics(metrics, robots), robots), types, stamp_catalogue())
     if PROV_TOPIC in types:
         wanted[PROV_TOPIC] = Wanted(OBJECTS)
-    recorded = read_bag(path, wanted, reductions(monitors, robots), field_checker(metrics, robots))
+    recorded = read_bag(path, wanted, reductions(monitors, robots, stacks), field_checker(metrics, robots))
     timeline = decide_timeline(recorded)
     data = on_timeline(recorded, timeline)
     problems = unread + list(data.problems) + list(timeline.notes)

@@ -96,6 +96,18 @@ class StackRobots:
             adapted[topic] = more
         return adapted
 
+    def read_from(self, name: str) -> str | None:
+        """The bag topic a served or signal topic (``/{ns}/scan``, ``/{ns}/~scan``) is read from,
+        when it is one topic (not a TF chain) of another name; None otherwise."""
+        for robot in self.sources.values():
+            for signal, chosen in robot.chosen.items():
+                names = {signal_topic(signal, robot.namespace)}
+                if robot.robot in self.serves and signal in SERVED:
+                    names.add(expand_topic(SERVED[signal], robot.namespace))
+                if name in names and chosen.tf is None and chosen.topic and chosen.topic != name:
+                    return chosen.topic
+        return None
+
     def served_topics(self, data: BagData, problems: list[str]) -> dict[str, Topic]:
         """The robots' signals under their own names (``/{ns}/~pose``), and under the method's
         topic names with the method's fields for the robots that declare where they are."""
