@@ -21,20 +21,9 @@ from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.runs.signals.timeline import LOG_TIME
 
 from tests.support.bag_factory import POSE_STAMPED, START_NS, Topic, typestore_for, write_bag
+from tests.support.yard_spec import FAR_YARD
 
-SPEC = """
-environment yard {
-  area ground {
-    pose start at (0.0, 0.0)
-    pose far at (50.0, 50.0)
-  }
-}
-task go {
-  visit far
-}
-robot type bot {
-  base diff_drive
-}
+SPEC = FAR_YARD + """
 metric far_out_time for each robot {
   unit s
   reads loc: geometry_msgs/msg/PoseStamped on "/location"

@@ -19,20 +19,9 @@ from exsce_dsl.runs.analyse import analyse_bag
 from tests.runs.test_turtlesim_path import SPEC as TURTLE_SPEC
 from tests.runs.test_turtlesim_path import TURTLESIM
 from tests.support.bag_factory import ODOMETRY, START_NS, Topic, odometry, typestore_for, write_bag
+from tests.support.yard_spec import FAR_YARD
 
-SPEC = """
-environment yard {
-  area ground {
-    pose start at (0.0, 0.0)
-    pose far at (50.0, 50.0)
-  }
-}
-task go {
-  visit far
-}
-robot type bot {
-  base diff_drive
-}
+SPEC = FAR_YARD + """
 scenario holes in yard {
   robots {
     tb: bot namespace "" starts at start

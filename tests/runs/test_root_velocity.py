@@ -28,20 +28,9 @@ from tests.support.bag_factory import (
     typestore_for,
     write_bag,
 )
+from tests.support.yard_spec import FAR_YARD
 
-SPEC = """
-environment yard {
-  area ground {
-    pose start at (0.0, 0.0)
-    pose far at (50.0, 50.0)
-  }
-}
-task go {
-  visit far
-}
-robot type bot {
-  base diff_drive
-}
+SPEC = FAR_YARD + """
 scenario rooted in yard {
   robots {
     tb: bot namespace "" starts at start

@@ -2,7 +2,9 @@
 
 - :data:`YARD` with two robots of one robot type (r1 at the root namespace, r2 in /r2), whose
   type's lines the tests fill in: the scene of the signal and stack-run tests;
-- :data:`YARD_SPEC`, two robots patrolling a 10 m square: the scene of the verify tests."""
+- :data:`YARD_SPEC`, two robots patrolling a 10 m square: the scene of the verify tests;
+- :data:`FAR_YARD`, a yard whose one task goes to a pose no recorded robot reaches (50 m away),
+  and a robot type of nothing but its base: the scene of the tests of one bag's shape."""
 
 from __future__ import annotations
 
@@ -100,5 +102,20 @@ acceptance for yard_run {
      and each robot task_duration is invariant within 20 %
      and each robot distance_travelled is invariant within 10 %
   }
+}
+"""
+
+FAR_YARD = """
+environment yard {
+  area ground {
+    pose start at (0.0, 0.0)
+    pose far at (50.0, 50.0)
+  }
+}
+task go {
+  visit far
+}
+robot type bot {
+  base diff_drive
 }
 """
