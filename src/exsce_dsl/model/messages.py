@@ -120,5 +120,17 @@ def canonical_type(name: str) -> str:
     return name if "/" in rest else f"{package}/msg/{rest}"
 
 
+OLD_NAMES = {"tf/msg/tfMessage": "tf2_msgs/msg/TFMessage"}
+"""Types that ROS renamed without changing a field: the old name (ROS 1's ``tf``, recorded by
+``tf::TransformBroadcaster`` before tf2) → the type exsce reads it as.  Each is decoded by its own
+definition from the bag; only what it is taken for changes."""
+
+
+def standard_type(name: str) -> str:
+    """:func:`canonical_type`, with an old name of a type (:data:`OLD_NAMES`) as its new one."""
+    canonical = canonical_type(name)
+    return OLD_NAMES.get(canonical, canonical)
+
+
 def _number(value: float) -> str:
     return str(int(value)) if float(value).is_integer() else repr(float(value))

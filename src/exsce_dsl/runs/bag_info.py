@@ -21,6 +21,7 @@ from exsce_dsl.errors import BagError
 from exsce_dsl.messages.catalogue import standard_catalogue
 from exsce_dsl.messages.user import configured_user_catalogue
 from exsce_dsl.model.goals import action_names, actionlib_names
+from exsce_dsl.model.messages import standard_type
 from exsce_dsl.runs.bags.reading import bag_topics
 from exsce_dsl.runs.bags.rosbags_fallback import typestore_for
 from exsce_dsl.runs.signals.clock_words import describe_clocks, log_time_is_dated
@@ -156,7 +157,7 @@ def _read(
         logs, stamps = [], []
         for index, (connection, time_ns, raw) in enumerate(reader.messages(connections=connections)):
             whole = msgtype in _STATUS
-            if index >= (TF_SAMPLE if msgtype == _TF else SAMPLE) and not whole:
+            if index >= (TF_SAMPLE if standard_type(msgtype) == _TF else SAMPLE) and not whole:
                 break
             try:
                 message = reader.deserialize(raw, connection.msgtype)
@@ -166,7 +167,7 @@ def _read(
             stamp = _stamp(message)
             if stamp is not None:
                 stamps.append(time_ns * 1e-9 - stamp)
-            if msgtype == _TF:
+            if standard_type(msgtype) == _TF:
                 for transform in message.transforms:
                     edge = (transform.header.frame_id, transform.child_frame_id)
                     edges[edge] = name.endswith("tf_static")

@@ -19,7 +19,7 @@ import numpy as np
 from exsce_dsl.errors import BagError
 from exsce_dsl.messages.catalogue import MessageCatalogue
 from exsce_dsl.messages.user import configured_user_catalogue
-from exsce_dsl.model.messages import canonical_type
+from exsce_dsl.model.messages import canonical_type, standard_type
 from exsce_dsl.runs.bags.data import OBJECTS, WHOLE, BagData, Check, Reduce, Series, StatusUpdate, Wanted
 from exsce_dsl.runs.bags.decode import TEXTS, decode, decode_slowly, vectorisable
 from exsce_dsl.runs.bags.names import TopicMatch
@@ -140,7 +140,7 @@ class Reading:
         """Whether the connection of ``topic`` with ``msgtype`` is read (a problem says why not)."""
         expected = self.wanted_for(topic).msgtype
         msgtype = canonical_type(msgtype)
-        if expected not in WHOLE and msgtype != canonical_type(expected):
+        if expected not in WHOLE and standard_type(msgtype) != standard_type(expected):
             problem = f"topic {topic} carries {msgtype}, not {expected}: its metrics are missing"
             if problem not in self.problems:
                 self.problems.append(problem)

@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from exsce_dsl.messages.catalogue import MessageCatalogue, Source, parse_definition, standard_ros1_catalogue
-from exsce_dsl.model.messages import canonical_type
+from exsce_dsl.model.messages import standard_type
 from exsce_dsl.runs.bags.buffers import Buffer, mapped, release
 from exsce_dsl.runs.bags.chunk_batches import ChunkBatch, Decoder, Gathered, Messages
 from exsce_dsl.runs.bags.data import OBJECTS, BagData, Check, Reduce, Wanted
@@ -243,7 +243,7 @@ def _read(
 
 def _topics(path: Path) -> BagTopics:
     """The bag's own index: rosbags would read every chunk's index first."""
-    return BagTopics({topic: canonical_type(msgtype) for topic, msgtype in connections(path).items()})
+    return BagTopics({topic: standard_type(msgtype) for topic, msgtype in connections(path).items()})
 
 
 ROS1 = BagReader(
