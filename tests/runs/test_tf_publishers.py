@@ -35,6 +35,7 @@ from tests.support.bag_factory import (
     vector3,
     write_bag,
 )
+from tests.support.real_shapes import transform_stamped
 
 CLOCK_TYPE = "rosgraph_msgs/msg/Clock"
 DURATION = 30.0
@@ -92,17 +93,6 @@ def _drive(t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return x, y, np.where(t < 11.0, 0.0, np.pi / 2)
 
 
-def _transform(store: Any, stamp_ns: int, parent: str, child: str, x: float, y: float, yaw: float) -> Any:
-    t = store.types
-    return t["geometry_msgs/msg/TransformStamped"](
-        header=header(store, stamp_ns, parent),
-        child_frame_id=child,
-        transform=t["geometry_msgs/msg/Transform"](
-            translation=vector3(store, (x, y, 0.0)), rotation=quaternion(store, yaw)
-        ),
-    )
-
-
 def _odometry(store: Any, index: int, stamp_ns: int, x: float, y: float, yaw: float) -> Any:
     t = store.types
     body = t["geometry_msgs/msg/Pose"](position=point(store, (x, y, 0.0)), orientation=quaternion(store, yaw))
@@ -148,11 +138,11 @@ def tf_bag(folder: Path, fmt: str, reset_at: float | None = None, with_clock: bo
     fast = np.arange(int(DURATION * 50) + 1) / 50
     x, y, yaw = _drive(fast)
     for i, s in enumerate(fast):
-        moved = _transform(store, stamp(s), "odom", "base_link", x[i], y[i], yaw[i])
+        moved = transform_stamped(store, stamp(s), "odom", "base_link", x[i], y[i], yaw[i])
         tf.append((_log_ns(s), store.types[TF_MESSAGE](transforms=[moved])))
         odom.append((_log_ns(s), _odometry(store, i, stamp(s), x[i], y[i], yaw[i])))
     for s in np.arange(int(DURATION * 10) + 1) / 10:
-        moved = _transform(store, stamp(s) + int(POST_DATED * 1e9), "map", "odom", *MAP_TO_ODOM)
+        moved = transform_stamped(store, stamp(s) + int(POST_DATED * 1e9), "map", "odom", *MAP_TO_ODOM)
         tf.append((_log_ns(s), store.types[TF_MESSAGE](transforms=[moved])))
         if reset_at is not None and with_clock:
             clock.append((_log_ns(s), _clock(store, stamp(s) * 1e-9)))
