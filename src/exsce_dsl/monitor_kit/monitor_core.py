@@ -85,11 +85,14 @@ def window(t: np.ndarray, start: float, end: float) -> slice:
 
 def hold(t: np.ndarray) -> np.ndarray:
     """How long each sample holds: until the next one (the last one, one median period; at most
-    two periods, so that a gap in the recording does not count as time spent)."""
+    two periods, so that a gap in the recording does not count as time spent).  The period is
+    the median of the steps that move: samples sharing a time (a burst logged at once, coarse
+    stamps) would make the median 0, and every sample hold for no time at all."""
     if len(t) < 2:
         return np.zeros(len(t))
     gaps = np.diff(t)
-    period = float(np.median(gaps))
+    moving = gaps[gaps > 0]
+    period = float(np.median(moving)) if len(moving) else 0.0
     held: np.ndarray = np.minimum(np.append(gaps, period), 2 * period)
     return held
 
