@@ -233,3 +233,15 @@ def test_a_bag_without_a_robot_says_so_and_writes_nothing(tmp_path: Path) -> Non
     with pytest.raises(BagError, match=r"battery.bag: no robot found: .*its pose-like topics: none"):
         draft_spec(bag, tmp_path / "draft.exsce")
     assert not (tmp_path / "draft.exsce").exists()
+
+
+def test_a_bag_whose_robots_have_no_readable_pose_is_refused_not_drafted_empty(tmp_path: Path) -> None:
+    """Stumble: init --from-bag on rosbag.js's turtlesim bag (poses as turtlesim/Pose, TF world ->
+    turtle1) exited 0 with a specification of no robots, which check then refused ("mission
+    allocates no task")."""
+    from tests.support.paths import ROOT
+
+    bag = ROOT / "tests" / "fixtures" / "realbags" / "rosbag.js" / "example.bag"
+    with pytest.raises(BagError, match=r"example.bag: no robot to draft .*pose-like topics: /tf \("):
+        draft_spec(bag, tmp_path / "draft.exsce")
+    assert not (tmp_path / "draft.exsce").exists()

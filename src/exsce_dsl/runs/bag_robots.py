@@ -98,6 +98,8 @@ class BagContents:
     other_maps: tuple[str, ...] = ()
     skipped: tuple[str, ...] = ()
     """Why robots found in the bag are left out."""
+    pose_like: tuple[str, ...] = ()
+    """The bag's pose-like topics (said when no robot can be placed)."""
 
 
 def bag_contents(path: Path) -> BagContents:
@@ -150,6 +152,7 @@ def bag_contents(path: Path) -> BagContents:
         grid,
         tuple(t for t in grids if t not in maps),
         skipped,
+        tuple(pose_like_topics(types)),
     )
 
 

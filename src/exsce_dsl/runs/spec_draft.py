@@ -99,6 +99,8 @@ def draft_spec(bag: Path, out: Path, force: bool = False) -> SpecDraft:
     contents = bag_contents(bag)
     if not contents.robots:  # every robot's namespace is a name the language cannot hold
         raise BagError(f"{bag}: no robot to draft a specification for: {'; '.join(contents.skipped)}")
+    if all(r.start is None for r in contents.robots):
+        raise BagError(_nowhere(bag, contents))
     map_yaml = out.with_name(f"{out.stem}_map.yaml") if contents.map is not None else None
     targets = [out] + ([map_yaml, map_yaml.with_suffix(".pgm")] if map_yaml else [])
     found = [str(t) for t in targets if existing(t.parent, t.name)]  # a link there is refused
@@ -113,6 +115,20 @@ def draft_spec(bag: Path, out: Path, force: bool = False) -> SpecDraft:
     write_below(out.parent, out.name, text.encode("utf-8"))
     robots = tuple((rid, r.namespace, r.convention or "detected") for rid, r in drafter.ids.items())
     return SpecDraft(out, text, written, robots, tuple(drafter.notes))
+
+
+def _nowhere(bag: Path, contents: BagContents) -> str:
+    """Why no robot of ``bag`` can be drafted: none has a pose exsce reads, nor goals (a
+    specification without robots would not check: its mission would allocate no task)."""
+    robots = ", ".join(f"{r.namespace or '/'}" for r in contents.robots)
+    listed = "; ".join(contents.pose_like) or "none"
+    return (
+        f"{bag}: no robot to draft a specification for: the namespaces that look like robots "
+        f"({robots}) have no navigation goals and no pose exsce reads (TF map or odom -> base_link "
+        f"or base_footprint on /{{ns}}/tf, an Odometry, a PoseStamped or a PoseWithCovarianceStamped); "
+        f"the bag's pose-like topics: {listed}. Write the robots' types by hand, saying where each "
+        'pose is (pose from tf FIXED -> BODY, or pose on "TOPIC"): docs/bags.md'
+    )
 
 
 def _write_map(grid: OccupancyGrid, map_yaml: Path) -> tuple[Path, ...]:
