@@ -51,7 +51,14 @@ from exsce_dsl.model.messages import path_of
 from exsce_dsl.runs.bags.decode import TEXTS
 from exsce_dsl.runs.bags.reading import WHOLE, BagData, Series, StatusUpdate, Wanted
 from exsce_dsl.runs.signals.clock_words import describe_clocks, log_time_is_dated
-from exsce_dsl.runs.signals.stamp_tracks import StampTrack, first_back, header_track, resets, tf_tracks
+from exsce_dsl.runs.signals.stamp_tracks import (
+    StampTrack,
+    first_back,
+    header_tracks,
+    publishers_apart,
+    resets,
+    tf_tracks,
+)
 from exsce_dsl.wording import counted
 
 CLOCK_TOPIC = "/clock"
@@ -86,13 +93,17 @@ class SourceClock:
     """Whether the times are simulated time (stamps of a simulation, or log times mapped onto it)."""
     offset: float = 0.0
     """Median of log time minus stamp, in seconds (0 for a series timed by log time)."""
+    by_log: tuple[str, ...] = ()
+    """Of a topic timed by its stamps, the publishers (connections) whose messages are timed by
+    their log times instead (their stamps go back, or stand apart from the others')."""
 
     def describe(self) -> str:
         kind = "simulated" if self.simulated else "wall clock"
         if self.clock == LOG_TIME:
             mapped = ", mapped onto simulated time" if self.simulated else ""
             return f"{self.topic}: log time{mapped}"
-        return f"{self.topic}: {self.clock} ({kind}, {self.offset:+.3f} s from log time)"
+        but = f"; log time for {', '.join(self.by_log)}" if self.by_log else ""
+        return f"{self.topic}: {self.clock} ({kind}, {self.offset:+.3f} s from log time{but})"
 
 
 @dataclass(frozen=True)
@@ -330,7 +341,7 @@ def _stamped_series(data: BagData) -> list[_Stamped]:
             continue
         known = np.isfinite(stamps) & (stamps > 0)
         offset = float(np.median(series.t[known] - stamps[known]))
-        tracks = tf_tracks(series) if kind == TRANSFORM_STAMPS else [header_track(topic, series.t, stamps)]
+        tracks = tf_tracks(series) if kind == TRANSFORM_STAMPS else header_tracks(series, stamps)
         found.append(_Stamped(topic, kind, series.t, stamps, offset, tuple(tracks)))
     return found
 
@@ -375,26 +386,38 @@ def _source_clock(series: _Stamped, timeline: Timeline, notes: list[str]) -> Sou
     """How ``series`` goes on the timeline: by its stamps when they are of the timeline's clock
     and none of its publishers' go back by more than :data:`SAME_CLOCK`, else by its log times
     (a note says which publisher went back: a reset is decided over every publisher); stamps
-    coarser than the series' rate are never used (a note says so)."""
+    coarser than the series' rate are never used (a note says so).  Of a topic with several
+    publishers, one whose stamps go back or stand apart from the others' is timed by its log
+    times alone, with a note (:func:`publishers_apart`)."""
     coarse = series.coarse()
     if coarse:
         notes.append(coarse)
         return SourceClock(series.topic, LOG_TIME, timeline.simulated)
-    back = first_back(series.tracks, SAME_CLOCK)
-    if back is not None:
+    apart = (
+        publishers_apart(series.tracks, timeline.from_log, SAME_CLOCK) if series.kind == HEADER_STAMPS else {}
+    )
+    kept = [t for t in series.tracks if t.publisher not in apart]
+    back = first_back(kept, SAME_CLOCK)
+    if back is not None or not kept:
+        back = back or first_back(series.tracks, SAME_CLOCK)
+        went = f"go back {back.back:.3f} s at log time {back.at:.3f}" if back else "stand apart"
         notes.append(
-            f"the stamps of {back.track} go back {back.back:.3f} s at log time {back.at:.3f} "
+            f"the stamps of {back.track if back else series.topic} {went} "
             f"(by more than {SAME_CLOCK:g} s): {series.topic} timed by log time"
         )
         return SourceClock(series.topic, LOG_TIME, timeline.simulated)
+    offset = series.offset
+    if apart:
+        notes.extend(f"{why}: its messages timed by log time" for why in apart.values())
+        offset = float(np.median(np.concatenate([t.log - t.stamps for t in kept])))
     if series.simulated == timeline.simulated:
-        if series.other_clock and not series.simulated:
+        if abs(offset) > SAME_CLOCK and not series.simulated:
             notes.append(
-                f"the stamps of {series.topic} are {series.offset:+.3f} s from log time "
+                f"the stamps of {series.topic} are {offset:+.3f} s from log time "
                 "(a clock not synchronised with the recorder's): moved onto log time"
             )
-        return SourceClock(series.topic, series.kind, series.simulated, series.offset)
-    return SourceClock(series.topic, LOG_TIME, timeline.simulated, series.offset)
+        return SourceClock(series.topic, series.kind, series.simulated, offset, tuple(apart))
+    return SourceClock(series.topic, LOG_TIME, timeline.simulated, offset)
 
 
 def on_timeline(data: BagData, timeline: Timeline) -> BagData:
@@ -437,6 +460,11 @@ def _series_on(series: Series, clock: SourceClock | None, timeline: Timeline) ->
     stamps = _stamps(series)
     assert stamps is not None  # a series is timed by header stamps only where it has them
     times = stamps if clock.simulated or abs(clock.offset) <= SAME_CLOCK else stamps + clock.offset
+    if clock.by_log and series.publishers is not None:  # those publishers' messages by their log times
+        by_log = [series.publisher_names.index(p) for p in clock.by_log]
+        mine = np.isin(series.publishers, by_log)
+        times = times.copy()
+        times[mine] = timeline.from_log(series.t[mine])
     return _retimed(series, times)
 
 
@@ -447,8 +475,9 @@ def _retimed(series: Series, times: np.ndarray) -> Series:
         fields = {
             k: (v[order] if k != TEXTS and len(v) == len(times) else v) for k, v in series.fields.items()
         }
-        return Series(series.topic, series.msgtype, times[order], fields)
-    return Series(series.topic, series.msgtype, times, series.fields)
+        publishers = series.publishers[order] if series.publishers is not None else None
+        return replace(series, t=times[order], fields=fields, publishers=publishers)
+    return replace(series, t=times)
 
 
 def _tf_moved(series: Series, offset: float) -> Series:
@@ -457,4 +486,4 @@ def _tf_moved(series: Series, offset: float) -> Series:
     fields = dict(series.fields)
     fields[sec] = series.fields[sec] + series.fields[nanosec] * 1e-9 + offset
     fields[nanosec] = np.zeros_like(series.fields[nanosec])
-    return Series(series.topic, series.msgtype, series.t, fields)
+    return replace(series, fields=fields)
