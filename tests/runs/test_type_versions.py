@@ -23,6 +23,7 @@ from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 from exsce_dsl.errors import BagError
 from exsce_dsl.model.messages import path_of
+from exsce_dsl.runs.bag_info import bag_info
 from exsce_dsl.runs.bags.data import Wanted
 from exsce_dsl.runs.bags.reading import read_bag
 from exsce_dsl.runs.bags.rosbags_fallback import read_with_rosbags
@@ -170,3 +171,12 @@ def test_two_versions_read_whole_each_by_its_own_definition(tmp_path: Path) -> N
     data = read_bag(bag, {"/pose": Wanted("**")})
     found = [(t, m.x, m.y) for t, m in data.messages["/pose"]]
     assert [row[1:] for row in found] == [row[1:] for row in _reference(bag)["/pose"]]
+
+
+def test_bag_info_lists_both_versions_of_a_type(tmp_path: Path) -> None:
+    bag = _ros1_bag(tmp_path / "versions.bag", ("/old", "/new"))
+    with Ros1Reader(bag) as reader:
+        md5s = sorted(c.digest[:8] for c in reader.connections)
+    assert len(set(md5s)) == 2
+    for topic in bag_info(bag).topics:
+        assert topic.definition == f"the bag (2 versions: {', '.join(md5s)})"
