@@ -26,11 +26,13 @@ the recording) is a :class:`ClockJump`: the timeline follows ``/clock`` up to th
 on at its last rate after it (so every series stays in order), and the run's coverage says that
 nothing from the jump on is on one timeline.  Stamps are judged per publisher
 (:mod:`~exsce_dsl.runs.signals.stamp_tracks`: per edge for TF, whose edges come from several
-nodes): a publisher whose stamps go back by more than :data:`SAME_CLOCK` makes its series timed
-by its log times, with a note, and is a jump only when every stamped publisher recorded then goes
-back together (a reset without ``/clock``); stamped series whose offsets to log time differ by
-more than :data:`SAME_CLOCK` (two publishers on different clocks) are named in a note.  No sample
-is ever left out.
+nodes; per connection for every other topic): of a topic's several publishers, one whose stamps
+go back by more than :data:`SAME_CLOCK`, or stand that far apart from the others' (post-dated),
+has its messages timed by their log times, with a note; a TF edge or a topic's only publisher
+whose stamps go back makes its series timed by log time.  A jump is only every stamped publisher
+recorded then going back together (a reset without ``/clock``); stamped series whose offsets to
+log time differ by more than :data:`SAME_CLOCK` (publishers on different clocks) are named in a
+note.  No sample is ever left out.
 """
 
 from __future__ import annotations
