@@ -45,6 +45,8 @@ COUNT = 200
 """Messages per publisher: 20 s at 10 Hz each, interleaved."""
 POST_DATED = 1.7
 BACK = 5.0
+SIMULATED_NS = START_NS - 100 * 10**9
+"""Subtracted from every stamp of a simulated run (use_sim_time: stamps of about 100 s, no /clock)."""
 X = path_of("pose", "position", "x")
 
 
@@ -61,7 +63,7 @@ def _stamp_of(shape: str, publisher: int, index: int, log_ns: int) -> int:
     return log_ns - late - (int(BACK * 1e9) if index >= COUNT // 2 else 0)
 
 
-def _bag(tmp_path: Path, fmt: str, shape: str) -> Path:
+def _bag(tmp_path: Path, fmt: str, shape: str, simulated: bool = False) -> Path:
     store = typestore_for(fmt)
     topics = []
     for publisher in (0, 1):
@@ -71,6 +73,7 @@ def _bag(tmp_path: Path, fmt: str, shape: str) -> Path:
             stamp_ns = _stamp_of(shape, publisher, i, log_ns)
             if shape == "reset" and publisher == 0 and i >= COUNT // 2:
                 stamp_ns -= int(BACK * 1e9)
+            stamp_ns -= SIMULATED_NS if simulated else 0
             messages.append((log_ns, pose_stamped(store, 2 * i + publisher, stamp_ns, seed=publisher)))
         topics.append(Topic("/pose", POSE_STAMPED, messages, publisher))
     path = tmp_path / ("two.bag" if fmt == "ros1" else "two")
@@ -80,8 +83,9 @@ def _bag(tmp_path: Path, fmt: str, shape: str) -> Path:
 
 def _reference(path: Path, by_log: set[int]) -> tuple[np.ndarray, np.ndarray]:
     """(time, x) of every /pose message, sorted by time: a publisher in ``by_log`` (the rank of
-    its connection) timed by its log times, the others by their header stamps."""
-    rows: list[tuple[float, float]] = []
+    its connection) timed by its log times, the others by their header stamps; log times of a
+    simulated run moved onto its clock by the others' median offset (log time minus stamp)."""
+    rows: list[tuple[float, float, float, bool]] = []
     with AnyReader(
         [path], default_typestore=typestore_for("ros1" if path.suffix == ".bag" else "mcap")
     ) as reader:
@@ -89,9 +93,12 @@ def _reference(path: Path, by_log: set[int]) -> tuple[np.ndarray, np.ndarray]:
         for conn, log_ns, raw in reader.messages():
             message = reader.deserialize(raw, conn.msgtype)
             stamp = message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
-            rows.append((log_ns / 1e9 if ranks[conn.id] in by_log else stamp, message.pose.position.x))
-    ordered = sorted(rows, key=lambda r: r[0])
-    return np.array([r[0] for r in ordered]), np.array([r[1] for r in ordered])
+            rows.append((log_ns / 1e9, stamp, message.pose.position.x, ranks[conn.id] in by_log))
+    offset = float(np.median([log - stamp for log, stamp, _, mine in rows if not mine]))
+    if abs(offset) < 300:  # a wall-clock run: log times are its clock
+        offset = 0.0
+    timed = sorted(((log - offset if mine else stamp), x) for log, stamp, x, mine in rows)
+    return np.array([t for t, _ in timed]), np.array([x for _, x in timed])
 
 
 def _placed(path: Path) -> tuple[Any, Any]:
@@ -102,21 +109,23 @@ def _placed(path: Path) -> tuple[Any, Any]:
     return timeline, on_timeline(data, timeline).series["/pose"]
 
 
+@pytest.mark.parametrize("simulated", [False, True], ids=["wall-clock", "simulated"])
 @pytest.mark.parametrize("fmt", ["ros1", "mcap"])
 @pytest.mark.parametrize("shape", ["post-dated", "back"])
 def test_one_publisher_off_is_no_reset_and_only_its_messages_use_log_time(
-    tmp_path: Path, fmt: str, shape: str
+    tmp_path: Path, fmt: str, shape: str, simulated: bool
 ) -> None:
-    path = _bag(tmp_path, fmt, shape)
+    path = _bag(tmp_path, fmt, shape, simulated)
     timeline, series = _placed(path)
     assert timeline.jumps == ()  # one publisher's clock is no reset
     clock = next(c for c in timeline.clocks if c.topic == "/pose")
     assert clock.clock == HEADER_STAMPS
     assert len(clock.by_log) == 1
     assert any(clock.by_log[0] in note and "timed by log time" in note for note in timeline.notes)
+    assert timeline.simulated == simulated
     times, xs = _reference(path, by_log={1})
     assert len(series) == 2 * COUNT  # no sample left out
-    np.testing.assert_allclose(series.t, times, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(series.t, times, rtol=0, atol=1e-5)
     assert series.fields[X.key].tolist() == xs.tolist()
 
 

@@ -155,28 +155,41 @@ def publishers_apart(
     """Of one series' publishers (tracks with a ``publisher``), those whose stamps cannot time
     their messages, and why: stamps that go back by more than ``tolerance``, none usable, or
     further than ``tolerance`` from the other publishers' (a node post-dating its messages).  The
-    others' are those of the publisher nearest the timeline (``on_timeline``: log times onto it),
-    so that a publisher sure of its clock is never judged by a late one."""
+    others' are those of the steady publisher nearest the timeline (``on_timeline``: log times
+    onto it), so that a publisher sure of its clock is never judged by a late one."""
     named = [t for t in tracks if t.publisher]
     if len(named) < 2:
         return {}
     found = {t.publisher: f"{t.name} carries no usable stamps" for t in named if not len(t.log)}
-    ahead = {t.publisher: float(np.median(t.stamps - on_timeline(t.log))) for t in named if len(t.log)}
-    reference = min(ahead.values(), key=abs, default=0.0)
     for track in named:
-        if track.publisher in found:
-            continue
-        step = backs(track, tolerance)[:1]
+        step = backs(track, tolerance)[:1] if track.publisher not in found else []
         if step:
             back, at = step[0].back, step[0].at
             found[track.publisher] = (
                 f"the stamps of {track.name} go back {back:.3f} s at log time {at:.3f} (by more than "
                 f"{tolerance:g} s)"
             )
-        elif abs(ahead[track.publisher] - reference) > tolerance:
-            apart = ahead[track.publisher] - reference
+    steady = [t for t in named if t.publisher not in found]
+    ahead = {t.publisher: float(np.median(t.stamps - on_timeline(t.log))) for t in steady}
+    reference = min(ahead.values(), key=abs, default=0.0)
+    for track in steady:
+        apart = ahead[track.publisher] - reference
+        if abs(apart) > tolerance:
             found[track.publisher] = (
                 f"the stamps of {track.name} are {apart:+.3f} s from those of the topic's other "
                 f"publishers (post-dated, or of another clock; by more than {tolerance:g} s)"
             )
     return found
+
+
+def steady_stamps(
+    tracks: Sequence[StampTrack], offset: float, tolerance: float
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """The log times and stamps of a series' publishers that can time their messages, judged
+    before there is a timeline (against the series' own median ``offset``, log time minus stamp):
+    what a timeline made of stamps is made of.  None: every publisher can (or none)."""
+    apart = publishers_apart(tracks, lambda log: log - offset, tolerance)
+    kept = [t for t in tracks if t.publisher not in apart]
+    if not apart or not kept:
+        return None
+    return np.concatenate([t.log for t in kept]), np.concatenate([t.stamps for t in kept])

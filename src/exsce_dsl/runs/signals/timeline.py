@@ -59,6 +59,7 @@ from exsce_dsl.runs.signals.stamp_tracks import (
     header_tracks,
     publishers_apart,
     resets,
+    steady_stamps,
     tf_tracks,
 )
 from exsce_dsl.wording import counted
@@ -299,7 +300,7 @@ def decide_timeline(data: BagData) -> Timeline:
         by = CLOCK_TOPIC
         simulated_run = bool(np.median(time_knots) < SIMULATED_BEFORE <= np.median(log_knots))
     elif simulated:
-        log_knots, time_knots = _offset_knots(simulated)
+        log_knots, time_knots = _offset_knots([_steady(s) for s in simulated])
         named = ", ".join(s.topic for s in simulated[:3]) + (" ..." if len(simulated) > 3 else "")
         by = f"the offsets of {named}"
         simulated_run = True
@@ -346,6 +347,13 @@ def _stamped_series(data: BagData) -> list[_Stamped]:
         tracks = tf_tracks(series) if kind == TRANSFORM_STAMPS else header_tracks(series, stamps)
         found.append(_Stamped(topic, kind, series.t, stamps, offset, tuple(tracks)))
     return found
+
+
+def _steady(series: _Stamped) -> _Stamped:
+    """``series`` without the stamps of its publishers that cannot time it (a post-dated one
+    would pull a timeline made of stamps its way)."""
+    found = steady_stamps(series.tracks, series.offset, SAME_CLOCK)
+    return series if found is None else replace(series, log=found[0], stamps=found[1])
 
 
 def _clock_knots(clock: Series) -> tuple[np.ndarray, np.ndarray, ClockJump | None]:
