@@ -10,7 +10,7 @@ namespace, the convention ingestion would detect and the topics that show it.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -175,7 +175,7 @@ def _read(
             if whole:
                 _goals(goals.setdefault(name, {}), message, _STATUS[msgtype]())
         info = _topic(name, msgtype, count, logs, stamps)
-        topics.append(replace(info, definition=_definition(msgtype, connections)))
+        topics.append(replace(info, definition=_definition(msgtype, connections, reader.connections)))
     ended = {topic: _ends(found) for topic, found in goals.items()}
     rates = {edge: r for edge, times in seen.items() if not edges[edge] and (r := _rate(times)) is not None}
     return tuple(topics), tuple((p, c, s) for (p, c), s in sorted(edges.items())), rates, ended
@@ -184,11 +184,18 @@ def _read(
 BAG_OWN, USER_OWN, TYPESTORE, UNKNOWN = "the bag", "EXSCE_MSG_PATH", "rosbags' typestore", "unknown"
 
 
-def _definition(msgtype: str, connections: list[Any]) -> str:
+def _definition(msgtype: str, connections: list[Any], every: Sequence[Any] = ()) -> str:
     """Where ingestion finds the definition of ``msgtype``: the bag's own (a ROS 1 connection's,
     an MCAP schema, a ROS 2 bag's type description), else the user's files, else rosbags'
-    standard typestores."""
+    standard typestores.  Where the bag (``every`` connection) holds several versions of the
+    type, each connection is decoded by its own: their hashes are listed."""
     if any(getattr(getattr(c, "msgdef", None), "data", "").strip() for c in connections):
+        versions = {
+            c.msgdef.data.strip(): c.digest for c in every if c.msgtype == msgtype and c.msgdef.data.strip()
+        }
+        if len(versions) > 1:
+            hashes = ", ".join(sorted(str(d).removeprefix("RIHS01_")[:8] for d in versions.values()))
+            return f"{BAG_OWN} ({len(versions)} versions: {hashes})"
         return BAG_OWN
     if msgtype in configured_user_catalogue().definitions:
         return USER_OWN
