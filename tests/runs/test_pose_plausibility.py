@@ -235,3 +235,14 @@ def test_a_clean_drive_whose_speed_matches_its_velocity_is_untouched(tmp_path: P
     assert values["location_path"] == pytest.approx(path, rel=1e-6)
     assert not [p for p in analysed.problems if "plausible" in p or "distance or speed" in p]
     assert bag_info(bag).plausibility == ()
+
+
+def test_interleaved_tracks_refused_by_ingest_strict_command(tmp_path: Path) -> None:
+    bag = _bag(tmp_path, "tracks", "mcap")
+    _spec(tmp_path)
+    done = exscec_here(
+        "ingest", str(bag), "--scenario", "rooted.exsce", "--store", str(tmp_path / "store"), "--strict",
+        cwd=tmp_path,
+    )  # fmt: skip
+    assert done.returncode != 0
+    assert "no plausible pose (/location alternates between two tracks up to 3.8 m apart" in done.stderr
