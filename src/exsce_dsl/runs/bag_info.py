@@ -133,8 +133,17 @@ def bag_info(path: Path) -> BagInfo:
         topics = tuple(replace(t, clock="simulated") if t.clock == "wall clock" else t for t in topics)
     return BagInfo(
         str(path), _format(path), size, start, end, topics, edges, rates, goals, _conventions(types),
-        bag_findings(path, types),
+        _plausibility(path, types),
     )  # fmt: skip
+
+
+def _plausibility(path: Path, types: Mapping[str, str]) -> tuple[str, ...]:
+    """The pose topics no robot could make; a bag whose poses cannot be read says so, and the
+    rest of what it holds is still shown."""
+    try:
+        return bag_findings(path, types)
+    except BagError as exc:
+        return (f"not checked: {exc.message}",)
 
 
 def _format(path: Path) -> str:
