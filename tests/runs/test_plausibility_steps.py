@@ -3,10 +3,12 @@ allowance for noise and clock jitter, and what tells two tracks from a teleport.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
-from exsce_dsl.lang import standard_metrics
+from exsce_dsl.lang import load_spec, standard_metrics
 from exsce_dsl.runs.plausible_poses import spec_speed_limit
 from exsce_dsl.runs.signals.plausibility import (
     DEFAULT_BOUND,
@@ -14,6 +16,31 @@ from exsce_dsl.runs.signals.plausibility import (
     check_poses,
     speed_bound,
 )
+
+from tests.support.yard_spec import FAR_YARD
+
+LIMITS = """
+metric ramp_speed for each robot {
+  unit m/s
+  safe below 1.5 m/s
+  reads vel: geometry_msgs/msg/Twist on "/{ns}/ramp_vel"
+  value max(vel.linear.x)
+}
+metric slow_turn for each robot {
+  unit m/s
+  safe below 0.4 m/s
+  reads vel: geometry_msgs/msg/Twist on "/{ns}/turn_vel"
+  value max(vel.linear.y)
+}
+scenario rooted in yard {
+  robots {
+    tb: bot namespace "" starts at start
+  }
+  mission go_far sequential {
+    tb does go
+  }
+}
+"""
 
 
 def _line(speed: float, hz: float = 10.0, seconds: float = 20.0) -> tuple[np.ndarray, np.ndarray]:
@@ -26,9 +53,14 @@ def test_the_bound_is_the_specs_limit_times_three_else_ten_metres_a_second() -> 
     assert speed_bound(0.5) == pytest.approx(1.5)
 
 
-def test_the_standard_librarys_limit_is_no_spec_limit() -> None:
-    """Every spec has the method's ``max_velocity`` (safe below 1 m/s): only the spec's own counts."""
-    assert spec_speed_limit(()) is None
+def test_the_specs_speed_limit_is_its_own_metrics_largest_in_metres_a_second(tmp_path: Path) -> None:
+    """The standard library's ``max_velocity`` (safe below 1 m/s) is the method's, for indoor
+    robots: only the spec's own metrics give its limit."""
+    spec = tmp_path / "limits.exsce"
+    spec.write_text(FAR_YARD + LIMITS)
+    metrics = load_spec(spec).scenario().metrics
+    assert spec_speed_limit(metrics) == pytest.approx(1.5)
+    assert spec_speed_limit([*metrics, *standard_metrics()]) == pytest.approx(1.5)
     assert spec_speed_limit(standard_metrics()) == pytest.approx(1.0)
 
 

@@ -67,11 +67,11 @@ class Refused:
 
 
 def spec_speed_limit(metrics: Iterable[MetricDefinition]) -> float | None:
-    """The spec's own speed limit: a ``safe below`` limit on its ``max_velocity`` (None: none)."""
-    for metric in metrics:
-        if metric.name == "max_velocity" and metric.safety is not None and metric.safety.bound == "below":
-            return metric.safety.limit
-    return None
+    """The spec's own speed limit: the largest ``safe below`` limit of its metrics in m/s (None:
+    none).  The standard library's ``max_velocity`` (safe below 1 m/s) is the method's limit for
+    indoor robots, not the spec's: a drone or a car is not refused for going faster."""
+    below = [m.safety for m in metrics if m.unit == "m/s" and m.safety is not None]
+    return max((s.limit for s in below if s.bound == "below"), default=None)
 
 
 def refuse_implausible(

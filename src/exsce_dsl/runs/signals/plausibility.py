@@ -6,8 +6,8 @@ apart reads as kilometres of path and metres per second of speed), or a pose tha
 :func:`check_poses` measures every step between consecutive poses against physics:
 
 - a step is **implausible** when it is longer than ``bound × its time + NOISE``: the speed
-  ``bound`` is the spec's own speed limit (a ``safe below`` limit on ``max_velocity``) ×
-  :data:`SPEC_FACTOR`, else :data:`DEFAULT_BOUND`; when the robot's own velocity is recorded,
+  ``bound`` is the spec's own speed limit (the largest ``safe below`` limit in m/s of its own
+  metrics) × :data:`SPEC_FACTOR`, else :data:`DEFAULT_BOUND`; when the robot's own velocity is recorded,
   the bound is at most :data:`VELOCITY_FACTOR` × the largest speed it reports (never below
   :data:`VELOCITY_FLOOR`); :data:`NOISE` allows for a localiser's corrections and the jitter of
   the recorder's clock (two messages logged a fraction of a millisecond apart);
