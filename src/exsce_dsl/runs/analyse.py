@@ -46,6 +46,7 @@ from exsce_dsl.runs.coverage import (
 from exsce_dsl.runs.metrics.compute import HOTSPOT_PATHS, POSE_TOPIC, compute_metrics
 from exsce_dsl.runs.metrics.monitor_code import load_monitors
 from exsce_dsl.runs.missing import missing_metrics, unread_topics
+from exsce_dsl.runs.plausible_poses import Refused, refuse_implausible, spec_speed_limit
 from exsce_dsl.runs.robots import SERVED, StackRobots, stack_robots
 from exsce_dsl.runs.segments.dispatcher import SUCCEEDED, segments
 from exsce_dsl.runs.segments.recorded import RecordedAction
@@ -193,12 +194,12 @@ def analyse_bag(
         monitors,
         metrics,
         robots,
-        bag.topics,
+        bag.refused.usable(bag.topics),
         found.actions,
         found.results,
         bag.problems,
         found.whole_runs,
-        stacks.named(robots),
+        {**stacks.named(robots), **bag.refused.reasons},
     )
     values = [bag.data.spelt(stacks.with_real_sources(v)) for v in values]
     if strict:
@@ -249,6 +250,8 @@ class _Signals:
     data: BagData
     topics: dict[str, Topic]
     problems: list[str]
+    refused: Refused = field(default_factory=Refused)
+    """The topics whose poses no robot could make: the monitors do not read them."""
 
 
 def _read_signals(
@@ -279,7 +282,11 @@ def _read_signals(
         # (a user metric may read more of it than the method's fields: pose.pose.covariance)
         same = read is not None and len(read) == len(served) and np.array_equal(read.t, served.t)
         topics[name] = Topic(name, served.t, {**served.fields, **read.fields}) if same and read else served
-    return _Signals(types, robots, detected, stacks, unread, recorded, timeline, data, topics, problems)
+    refused = refuse_implausible(robots, stacks, topics, data, spec_speed_limit(scenario.metrics))
+    problems += refused.problems
+    return _Signals(
+        types, robots, detected, stacks, unread, recorded, timeline, data, topics, problems, refused
+    )
 
 
 @dataclass
@@ -303,7 +310,9 @@ def _segment_robots(path: Path, scenario: Scenario, bag: _Signals) -> _Segmented
         feedback, result = expand_topic(_FEEDBACK, ns), expand_topic(_RESULT, ns)
         updates = data.feedback.get(feedback)
         dispatched = segments(scenario, robot.id, updates) if updates is not None else None
-        found = segment_robot(scenario, robot, data, stacks.track(robot, bag.topics), dispatched)
+        # an implausible pose places no arrival; the whole run still spans the recording
+        track = stacks.track(robot, bag.refused.usable(bag.topics))
+        found = segment_robot(scenario, robot, data, track, dispatched)
         bag.problems += found.problems
         out.actions.extend(found.segments)
         if found.source and found.source != DISPATCHER_SOURCE:

@@ -4,8 +4,9 @@ From the bag's own index and metadata: its format, size, time span, and per topi
 message count and rate.  From a sample of each topic's first messages (at most :data:`SAMPLE`,
 deserialised by rosbags): which clock its stamps are (the recorder's wall clock or a
 simulation's, and their offset to log time), the TF tree's edges (static or not), and, read
-whole because they are few, the navigation actions' goals and how they ended.  Last, per
-namespace, the convention ingestion would detect and the topics that show it.
+whole because they are few, the navigation actions' goals and how they ended.  Per namespace,
+the convention ingestion would detect and the topics that show it.  Last, read whole, the pose
+topics whose steps no robot could make (two tracks, teleports: :mod:`~exsce_dsl.runs.plausible_poses`).
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from exsce_dsl.model.goals import action_names, actionlib_names
 from exsce_dsl.model.messages import standard_type
 from exsce_dsl.runs.bags.reading import bag_topics
 from exsce_dsl.runs.bags.rosbags_fallback import typestore_for
+from exsce_dsl.runs.plausible_poses import bag_findings
 from exsce_dsl.runs.signals.clock_words import describe_clocks, log_time_is_dated
 from exsce_dsl.runs.signals.detect import robot_namespaces
 from exsce_dsl.runs.signals.timeline import SAME_CLOCK, SIMULATED_BEFORE
@@ -72,6 +74,9 @@ class BagInfo:
     """A navigation status topic → final status → goals."""
     conventions: tuple[str, ...] = ()
     """Per namespace, the convention ingestion would detect and from what."""
+    plausibility: tuple[str, ...] = ()
+    """Pose topics no robot could have made (two tracks, teleports): ingestion makes no distance
+    or speed of them (:mod:`~exsce_dsl.runs.plausible_poses`)."""
 
     @property
     def clock_recorded(self) -> bool:
@@ -105,6 +110,7 @@ class BagInfo:
             ],
             "goals": {topic: dict(ends) for topic, ends in self.goals.items()},
             "conventions": list(self.conventions),
+            "plausibility": list(self.plausibility),
         }
 
 
@@ -126,8 +132,18 @@ def bag_info(path: Path) -> BagInfo:
         # the recorder logged simulated time: stamps that agree with it are simulated too
         topics = tuple(replace(t, clock="simulated") if t.clock == "wall clock" else t for t in topics)
     return BagInfo(
-        str(path), _format(path), size, start, end, topics, edges, rates, goals, _conventions(types)
-    )
+        str(path), _format(path), size, start, end, topics, edges, rates, goals, _conventions(types),
+        _plausibility(path, types),
+    )  # fmt: skip
+
+
+def _plausibility(path: Path, types: Mapping[str, str]) -> tuple[str, ...]:
+    """The pose topics no robot could make; a bag whose poses cannot be read says so, and the
+    rest of what it holds is still shown."""
+    try:
+        return bag_findings(path, types)
+    except BagError as exc:
+        return (f"not checked: {exc.message}",)
 
 
 def _format(path: Path) -> str:
