@@ -51,7 +51,8 @@ Where exsce differs from the method's published run and its report, on purpose:
   goal sent more than once; ``exsce:mission_status`` (``cancelled``, ``stopped``) on a run whose
   mission did not complete; ``exsce:unit`` on a value when known;
   ``exsce:metric`` on a ``violation_duration`` value (the safety metric, as the
-  report's Listing 46 queries it); hotspots.
+  report's Listing 46 queries it); hotspots; what each value used (its window and why, the
+  samples of each source, the findings that touch it: :mod:`exsce_dsl.prov.run_accounting`).
 
 Compiling is deterministic: the same run gives the same document.
 """
@@ -69,6 +70,7 @@ from exsce_dsl.model.scenario import Scenario
 from exsce_dsl.prov import identifiers as ids
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, Namespaces
 from exsce_dsl.prov.records import Attributes, BundleWriter, DocumentWriter
+from exsce_dsl.prov.run_accounting import accounting_facts, write_sample_counts
 from exsce_dsl.prov.run_coverage import write_coverage
 
 __all__ = ["compile_run"]
@@ -386,7 +388,12 @@ class _MetricBundle:
             facts[self.safety_attr] = value.safety_metric
         if value.estimated_from is not None:
             facts[w.term(ids.ESTIMATED_FROM)] = value.estimated_from
+        if value.accounting is not None:
+            facts.update(accounting_facts(w, self.run, value.accounting))
         w.entity(value_id, facts)
+        if value.accounting is not None:
+            where = (value_id, ids.metric_value_name(named, subject))
+            write_sample_counts(self.writer, w, self.parts, where, value.accounting, self.bag_topics)
         if collection is not None:
             w.derivation(value_id, collection, self.primary_source)
         w.generated(value_id, generator)
