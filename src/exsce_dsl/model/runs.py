@@ -252,6 +252,9 @@ class Run:
     """What the recording does not cover (cut short, gaps, thinned topics, clock jumps)."""
     topic_rates: tuple[TopicRate, ...] = ()
     """How densely each topic a metric reads was recorded."""
+    problems: tuple[str, ...] = ()
+    """What ingestion said of the run: the values it could not compute and why, topics it could
+    not read (the run's warnings)."""
     dated: bool = True
     """Whether ``start``, ``end`` and the actions' times are dates; not when the recorder logged
     simulated time (they are then seconds after 1970 of simulated time, and no date is written)."""

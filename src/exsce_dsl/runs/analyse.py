@@ -233,6 +233,7 @@ def analyse_bag(
         status=status,
         coverage=covered.gaps,
         topic_rates=covered.rates,
+        problems=tuple(dict.fromkeys(bag.problems)),
     )
     return AnalysedRun(run, digest, bag.problems, bag.timeline, bag.detected)
 

@@ -207,6 +207,9 @@ COUNTED_FOR = Term(EXSCE, "counted_for")
 SAMPLES_USED = Term(EXSCE, "samples_used")
 SAMPLES_IN_WINDOW = Term(EXSCE, "samples_in_window")
 FEWER_BECAUSE = Term(EXSCE, "fewer_because")
+RUN_PROBLEM_TYPE = Term(EXSCE, "run_problem")
+"""Something ingestion said of a run (a value it could not compute, and why)."""
+PROBLEM = Term(EXSCE, "problem")
 METRIC_TYPE = Term(RUN, "metricType")
 HOTSPOT_TYPE = Term(HOTSPOT, "type")
 ORACLE_METRIC = Term(ORACLE, "metric")
@@ -289,5 +292,6 @@ GOAL_ROLE = "goal"
 TOPIC_ROLE = "topic"
 HOTSPOTS_BUNDLE = "hotspots_bundle"
 COVERAGE_BUNDLE = "coverage_bundle"
+PROBLEMS_BUNDLE = "problems_bundle"
 GENERATION = "generation"
 GENERATION_BUNDLE = "scenario_generation"
