@@ -21,7 +21,6 @@ from exsce_dsl.store.queries import (
     value_accounts,
 )
 from exsce_dsl.suggest import did_you_mean
-from exsce_dsl.wording import counted
 
 __all__ = ["Explanation", "explain"]
 
@@ -103,13 +102,11 @@ def _value_lines(value: ValueAccount, topics: tuple[str, ...]) -> list[str]:
             "    window: not recorded (stored before values said what they used; ingest the bag again)"
         )
         return lines
-    lines.append(f"    window: {_window(value)}")
+    lines.append(f"    window: {value.window_text()}")
     lines.append(f"      why: {value.reason}")
-    if value.sources:
-        lines.append("    samples:")
-        for c in value.sources:
-            used = f"{c.used} of {counted(c.in_window, 'sample')} in the window"
-            lines.append(f"      {' + '.join(c.topics)}: {used}" + (f" ({c.why})" if c.why else ""))
+    samples = value.samples_text()
+    if samples:
+        lines += ["    samples:", *(f"      {line}" for line in samples)]
     else:
         lines.append(
             "    samples: none read (the value comes from the window or the goals, not from samples)"
@@ -117,19 +114,3 @@ def _value_lines(value: ValueAccount, topics: tuple[str, ...]) -> list[str]:
     lines.append("    annotations:" + ("" if value.annotations else " none"))
     lines += [f"      {a}" for a in value.annotations]
     return lines
-
-
-def _window(value: ValueAccount) -> str:
-    assert value.window is not None
-    start, end = value.window
-    said = f"{_seconds(start)} to {_seconds(end)} after the run's start ({_seconds(end - start)})"
-    if value.dates is not None:
-        first, last = (d.isoformat().replace("+00:00", "Z") for d in value.dates)
-        said += f", {first} to {last}"
-    return said
-
-
-def _seconds(value: float) -> str:
-    """``12.345 s``; never ``-0.000 s`` (a window may open a fraction of a millisecond before the
-    run's first log time, where a header stamp is earlier)."""
-    return f"{value:.3f} s".replace("-0.000", "0.000")

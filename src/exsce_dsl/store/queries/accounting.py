@@ -11,6 +11,7 @@ from exsce_dsl.model.runs import SourceCount
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE
 from exsce_dsl.store.base import Store, Term
 from exsce_dsl.store.queries.terms import datetime_of, float_of, int_of, run_query, text_of
+from exsce_dsl.wording import counted
 
 TOPIC_SEPARATOR = ", "
 """Between the topics of one source in ``exsce:topic_name`` (as the run's PROV writes them)."""
@@ -34,6 +35,41 @@ class ValueAccount:
     reason: str | None
     annotations: tuple[str, ...]
     sources: tuple[SourceCount, ...]
+
+    def window_text(self) -> str:
+        """``0.000 s to 395.304 s after the run's start (395.304 s), <date> to <date>``; '' for
+        a value stored before values said what they used."""
+        if self.window is None:
+            return ""
+        start, end = self.window
+        said = f"{_seconds(start)} to {_seconds(end)} after the run's start ({_seconds(end - start)})"
+        if self.dates is not None:
+            first, last = (d.isoformat().replace("+00:00", "Z") for d in self.dates)
+            said += f", {first} to {last}"
+        return said
+
+    def samples_text(self) -> list[str]:
+        """One line per source: ``/odom: 3952 of 3952 samples in the window`` (and why fewer)."""
+        return [
+            f"{' + '.join(c.topics)}: {c.used} of {counted(c.in_window, 'sample')} in the window"
+            + (f" ({c.why})" if c.why else "")
+            for c in self.sources
+        ]
+
+    def summary(self) -> str:
+        """What the value used, in a few lines (the report shows it on hover)."""
+        if self.window is None or self.reason is None:
+            return "what it used was not recorded (ingest the bag again)"
+        lines = [f"window: {self.window_text()}", f"why: {self.reason}"]
+        lines += self.samples_text() or ["no samples read (the value comes from the window or the goals)"]
+        lines += [f"annotation: {a}" for a in self.annotations]
+        return "\n".join(lines)
+
+
+def _seconds(value: float) -> str:
+    """``12.345 s``; never ``-0.000 s`` (a window may open a fraction of a millisecond before the
+    run's first log time, where a header stamp is earlier)."""
+    return f"{value:.3f} s".replace("-0.000", "0.000")
 
 
 def value_accounts(
