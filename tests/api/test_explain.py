@@ -363,3 +363,18 @@ def test_the_findings_that_touch_a_value_are_its_annotations() -> None:
         "a gap on the pose's own topic",
     )
     assert (shifted.accounting.start, shifted.accounting.end) == (100.0, 200.0)
+
+
+def test_the_report_shows_what_each_value_used(husky_store: tuple[str, str, Path], tmp_path: Path) -> None:
+    store, run, _ = husky_store
+    done = exscec_here("report", "--store", store, "-o", str(tmp_path / "report"))
+    assert done.returncode == 0, done.stderr
+    page = (tmp_path / "report" / f"run-{run}.html").read_text(encoding="utf-8")
+    values = page[page.index("<h2>Metric values</h2>") :]
+    n = len(_stamps(HUSKY, ODOM))
+    row = values[values.index("<td>distance_travelled</td>") :]
+    row = row[: row.index("</details>")]
+    assert "what it used (window: the recording (the spec&#39;s window whole recording))" in row
+    assert f"{ODOM}: {n} of {n} samples in the window" in row
+    segments = page[page.index("<h3>Path segments</h3>") : page.index("<h2>Verdicts")]
+    assert segments.count("why: path segment to waypoint") == 4  # distance and duration of S1, S2
