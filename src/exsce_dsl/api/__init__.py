@@ -29,7 +29,7 @@ from exsce_dsl.api.commands import (
 )
 from exsce_dsl.api.drafts import init_from_bag
 from exsce_dsl.api.execution import execute_ros1
-from exsce_dsl.api.explain import Explanation, explain
+from exsce_dsl.api.explain import explain
 from exsce_dsl.api.stand_in import stand_in
 from exsce_dsl.api.tables import metrics, query, rows_frame, segments, sparql, verdicts
 from exsce_dsl.api.trials import flaky, verify_trial
@@ -38,7 +38,6 @@ from exsce_dsl.store.queries.run_ids import AmbiguousRunError, UnknownRunError, 
 
 __all__ = [
     "AmbiguousRunError",
-    "Explanation",
     "RosGraphError",
     "UnknownRunError",
     "add_derived",
