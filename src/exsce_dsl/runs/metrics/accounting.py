@@ -41,16 +41,24 @@ class SampleCounter:
         self._based: dict[tuple[int, str], tuple[core.Prepared, bool]] = {}
 
     def accounting(
-        self, prepared: Sequence[core.Prepared], sources: Sequence[str], start: float, end: float, reason: str
+        self,
+        prepared: Sequence[core.Prepared],
+        sources: Sequence[str],
+        window: tuple[float, float],
+        reason: str,
+        held: bool = False,
     ) -> Accounting:
-        """The accounting of a value over ``[start, end]`` (the run's timeline) from ``prepared``."""
-        counts = [c for name in sources if (c := self.count(prepared, name, start, end)) is not None]
+        """The accounting of a value over ``window`` (the run's timeline) from ``prepared``;
+        ``held``: the value sums how long samples hold (a duration, a violation duration)."""
+        start, end = window
+        counts = [c for name in sources if (c := self.count(prepared, name, window, held)) is not None]
         return Accounting(start, end, reason, tuple(counts))
 
     def count(
-        self, prepared: Sequence[core.Prepared], name: str, start: float, end: float
+        self, prepared: Sequence[core.Prepared], name: str, window: tuple[float, float], held: bool = False
     ) -> SourceCount | None:
         """Samples of source ``name`` in the window and those used (None: not a series read)."""
+        start, end = window
         topic = self.topics.get(name)
         if topic is None or not len(topic):
             return None
@@ -64,7 +72,7 @@ class SampleCounter:
             used, why = _used(p, topic.t[w], start, end)
             if best is None or used > best[0]:
                 best = (used, why)
-            notes += _held(p, start, end)
+            notes += _held(p, start, end) if held or p.func == "duration" else []
         used, why = best if best is not None else (n, [])
         said = "; ".join(dict.fromkeys(why + notes)) or None
         return SourceCount((name,), used, n, said)
@@ -133,8 +141,6 @@ def _valid(p: core.Prepared, pw: slice) -> int:
 
 def _held(p: core.Prepared, start: float, end: float) -> list[str]:
     """A duration's note: samples before a gap hold two median periods, not the whole gap."""
-    if p.func != "duration":
-        return []
     t = p.t[core.window(p.t, start, end)]
     if len(t) < 3:
         return []

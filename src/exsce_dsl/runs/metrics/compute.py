@@ -184,7 +184,7 @@ def _robot_values(
             if action is None
             else segment_reason(action.allocation, action.subtask, action.waypoint)
         )
-        used = counter.accounting(prepared[1], topics, start, end, why)
+        used = counter.accounting(prepared[1], topics, (start, end), why)
         if action is None:
             found.append(
                 MetricValue(
@@ -254,7 +254,7 @@ def _robot_violations(
             robot.id,
             unit="s",
             safety_metric=metric.name,
-            accounting=counting[0].accounting(aggregates[:1], source, start, end, counting[1]),
+            accounting=counting[0].accounting(aggregates[:1], source, window, counting[1], held=True),
         )
     ]
 
@@ -277,7 +277,7 @@ def _mission_values(
             return []
         read = _topics(metric, 0, [r.namespace for r in robots])
         found = monitor.prepared(metric.name, ("", ""), ("", ""))
-        used = SampleCounter(topics).accounting(found[1] if found else [], read, start, end, MISSION_SPAN)
+        used = SampleCounter(topics).accounting(found[1] if found else [], read, (start, end), MISSION_SPAN)
         return [
             MetricValue(
                 metric.name, MetricScope.MISSION, value, read, unit=metric.unit or None, accounting=used
@@ -297,7 +297,7 @@ def _mission_values(
         choice, aggregates = prepared
         read = _topics(metric, choice, [first[1], second[1]])
         source += [t for t in read if t not in source]
-        for c in counter.accounting(aggregates, read, start, end, MISSION_SPAN).sources:
+        for c in counter.accounting(aggregates, read, (start, end), MISSION_SPAN).sources:
             if c.topics[0] not in counts or counts[c.topics[0]].used < c.used:
                 counts[c.topics[0]] = c
         if metric.safety is None:
