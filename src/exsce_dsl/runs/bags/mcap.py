@@ -20,7 +20,7 @@ from exsce_dsl.errors import ExsceError
 from exsce_dsl.messages.catalogue import MessageCatalogue, Source, parse_definition, standard_catalogue
 from exsce_dsl.runs.bags.chunk_batches import Messages
 from exsce_dsl.runs.bags.data import OBJECTS, BagData, Check, Reduce, Wanted
-from exsce_dsl.runs.bags.mcap_index import IDL_SEPARATOR, Schema, read_topics, schemas
+from exsce_dsl.runs.bags.mcap_index import IDL_SEPARATOR, Schema, read_topics, recorded_span, schemas
 from exsce_dsl.runs.bags.objects import deserialized, deserializer_for
 from exsce_dsl.runs.bags.reader import BagReader, UnsupportedBag
 from exsce_dsl.runs.bags.reading_base import IndexReading
@@ -74,14 +74,17 @@ class _Mcap(IndexReading):
 
     def read(self, files: list[Path]) -> BagData:
         found: dict[str, list[Messages]] = {}
+        spans = []  # the recording's: its topics not read too
         for file in files:
             self.schemas = schemas(file)
+            spans.append(recorded_span(file))
             for topic, messages in read_topics(file, self.match, self.decoder).items():
                 found.setdefault(topic, []).append(messages)
         if not found:
             raise UnsupportedBag("none of the topics")  # rosbags then says whether the bag is empty
         start = min(int(m.times.min()) for parts in found.values() for m in parts)
         end = max(int(m.times.max()) for parts in found.values() for m in parts)
+        start, end = min(start, *(s for s, _ in spans)), max(end, *(e for _, e in spans))
         for topic, parts in sorted(found.items()):
             raws = [raw for m in parts for raw in m.raws]
             if not raws:
