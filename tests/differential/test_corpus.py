@@ -15,7 +15,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 from exsce_dsl.lang import load_spec
@@ -23,117 +22,29 @@ from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.runs.spec_draft import draft_spec
 
 from tests.runs.test_turtlesim_path import SPEC as TURTLE_SPEC
-from tests.support.differential import STORAGES, converted, mismatches, planned_waypoints
+from tests.support.differential import (
+    ODOMETRY_METRICS,
+    STORAGES,
+    TURTLE_METRICS,
+    converted,
+    mismatches,
+    odometry_references,
+    planned_waypoints,
+    turtle_references,
+)
 from tests.support.paths import ROOT
 from tests.support.reference_path import (
     Expected,
     Key,
     Recording,
     RobotSources,
-    Samples,
-    duration_where,
     path_length,
     planar_speed,
-    position,
     run_values,
-    speeds,
     xy,
 )
 
 REALBAGS = ROOT / "tests" / "fixtures" / "realbags"
-
-TURTLE_METRICS = """
-metric pose_speed for each robot {
-  unit m/s
-  reads pose: turtlesim/msg/Pose on "/{ns}/pose"
-  value max(speed(pose.x, pose.y))
-}
-metric least_x for each robot {
-  unit m
-  reads pose: turtlesim/msg/Pose on "/{ns}/pose"
-  value min(pose.x)
-}
-metric most_y for each robot {
-  unit m
-  reads pose: turtlesim/msg/Pose on "/{ns}/pose"
-  value max(pose.y)
-}
-metric mean_x for each robot {
-  unit m
-  reads pose: turtlesim/msg/Pose on "/{ns}/pose"
-  value mean(pose.x)
-}
-metric east_time for each robot {
-  unit s
-  reads pose: turtlesim/msg/Pose on "/{ns}/pose"
-  value duration where pose.x > 5.5
-}
-"""
-
-ODOMETRY_METRICS = """
-metric odom_path for each robot {
-  unit m
-  reads odom: nav_msgs/msg/Odometry on "/{ns}/TOPIC"
-  value path_length(odom.pose.pose.position.x, odom.pose.pose.position.y)
-}
-metric odom_speed for each robot {
-  unit m/s
-  reads odom: nav_msgs/msg/Odometry on "/{ns}/TOPIC"
-  value max(speed(odom.pose.pose.position.x, odom.pose.pose.position.y))
-}
-metric least_forward for each robot {
-  unit m/s
-  reads odom: nav_msgs/msg/Odometry on "/{ns}/TOPIC"
-  value min(odom.twist.twist.linear.x)
-}
-metric most_x for each robot {
-  unit m
-  reads odom: nav_msgs/msg/Odometry on "/{ns}/TOPIC"
-  value max(odom.pose.pose.position.x)
-}
-metric mean_forward for each robot {
-  unit m/s
-  reads odom: nav_msgs/msg/Odometry on "/{ns}/TOPIC"
-  value mean(odom.twist.twist.linear.x)
-}
-metric brisk_time for each robot {
-  unit s
-  reads odom: nav_msgs/msg/Odometry on "/{ns}/TOPIC"
-  value duration where odom.twist.twist.linear.x > 0.5
-}
-"""
-
-
-def _forward(message: object) -> float:
-    return float(message.twist.twist.linear.x)  # type: ignore[attr-defined]
-
-
-def odometry_functions(samples: Samples) -> dict[str, float]:
-    """The reference of :data:`ODOMETRY_METRICS` over every message of one odometry."""
-    x, y = xy(samples)
-    forward = samples.column(_forward)
-    return {
-        "odom_path": path_length(x, y),
-        "odom_speed": float(np.nanmax(speeds(samples.t, x, y))),
-        "least_forward": float(forward.min()),
-        "most_x": float(x.max()),
-        "mean_forward": float(forward.mean()),
-        "brisk_time": duration_where(samples.t, forward > 0.5),
-    }
-
-
-def turtle_functions(samples: Samples) -> dict[str, float]:
-    """The reference of the turtles' user metrics over every message of one pose topic (float32
-    fields, widened to float64)."""
-    x, y = (np.array([position(m)[k] for m in samples.messages], dtype=np.float64) for k in (0, 1))
-    return {
-        "pose_path": path_length(x, y),
-        "pose_speed": float(np.nanmax(speeds(samples.t, x, y))),
-        "least_x": float(x.min()),
-        "most_y": float(y.max()),
-        "mean_x": float(x.mean()),
-        "east_time": duration_where(samples.t, x > 5.5),
-    }
 
 
 @dataclass(frozen=True)
@@ -154,28 +65,12 @@ def _turtles(spec: str) -> list[RobotSources]:
     return [RobotSources(r, velocity=f"/{r}/cmd_vel") for r in ("turtle1", "turtle2")]
 
 
-def _turtle_functions(bag: Recording) -> dict[Key, Expected]:
-    found: dict[Key, Expected] = {}
-    for robot in ("turtle1", "turtle2"):
-        topic = f"/{robot}/pose"
-        for name, value in turtle_functions(bag.samples(topic)).items():
-            found[(name, robot)] = Expected(value, (topic,))
-    return found
-
-
 def _odometry_robot(robot: str, topic: str) -> Callable[[str], list[RobotSources]]:
     def robots(spec: str) -> list[RobotSources]:
         waypoints = planned_waypoints(spec)
         return [RobotSources(robot, pose=topic, velocity=topic, distance=topic, waypoints=waypoints)]
 
     return robots
-
-
-def _odometry_functions(robot: str, topic: str) -> Callable[[Recording], dict[Key, Expected]]:
-    def functions(bag: Recording) -> dict[Key, Expected]:
-        return {(n, robot): Expected(v, (topic,)) for n, v in odometry_functions(bag.samples(topic)).items()}
-
-    return functions
 
 
 def _stage(spec: str) -> list[RobotSources]:
@@ -195,25 +90,25 @@ CORPUS = {
     c.file: c
     for c in [
         *(
-            Corpus(f"rosbag.js/{name}", _turtles, _turtle_functions, spec=TURTLES)
+            Corpus(f"rosbag.js/{name}", _turtles, turtle_references(("turtle1", "turtle2")), spec=TURTLES)
             for name in ("example.bag", "example-bz2.bag", "example-lz4.bag")
         ),
         Corpus(
             "robot_localization/test1.bag",
             _odometry_robot("husky_velocity_controller", HUSKY_ODOM),
-            _odometry_functions("husky_velocity_controller", HUSKY_ODOM),
+            odometry_references("husky_velocity_controller", HUSKY_ODOM),
             extra=ODOMETRY_METRICS.replace("TOPIC", "odom"),
         ),
         Corpus(
             "robot_localization/test2.bag",
             _odometry_robot("jackal_velocity_controller", JACKAL_ODOM),
-            _odometry_functions("jackal_velocity_controller", JACKAL_ODOM),
+            odometry_references("jackal_velocity_controller", JACKAL_ODOM),
             extra=ODOMETRY_METRICS.replace("TOPIC", "odom"),
         ),
         Corpus(
             "embag/test.bag",
             _stage,
-            _odometry_functions("root_robot", "/base_pose_ground_truth"),
+            odometry_references("root_robot", "/base_pose_ground_truth"),
             extra=ODOMETRY_METRICS.replace("/{ns}/TOPIC", "/{ns}/base_pose_ground_truth"),
             # Finding (issue 47, differential suite): on this Stage bag (stamps on a simulated
             # clock, log times on the wall clock) exsce's whole-run durations are 7.588689 s in

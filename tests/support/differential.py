@@ -11,15 +11,26 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Collection, Mapping
+from collections.abc import Callable, Collection, Mapping
 from pathlib import Path
 
+import numpy as np
 from rosbags.convert import convert
 
 from exsce_dsl.model.runs import MetricScope
 from exsce_dsl.runs.analyse import AnalysedRun
 
-from tests.support.reference_path import Expected, Key
+from tests.support.reference_path import (
+    Expected,
+    Key,
+    Recording,
+    Samples,
+    duration_where,
+    path_length,
+    position,
+    speeds,
+    xy,
+)
 
 RELATIVE = 1e-6
 STORAGES = ("sqlite3", "mcap")
@@ -86,3 +97,123 @@ def planned_waypoints(spec: str) -> tuple[tuple[float, float], ...]:
     poses = {m[1]: (float(m[2]), float(m[3])) for m in POSE_LINE.finditer(spec)}
     names = [n.strip() for line in VISIT_LINE.findall(spec) for n in line.split(",")]
     return tuple(poses[n] for n in names)
+
+
+# ------------------------------------------------------------------ user metrics and their references
+
+TURTLE_METRICS = """
+metric pose_speed for each robot {
+  unit m/s
+  reads pose: turtlesim/msg/Pose on "/{ns}/pose"
+  value max(speed(pose.x, pose.y))
+}
+metric least_x for each robot {
+  unit m
+  reads pose: turtlesim/msg/Pose on "/{ns}/pose"
+  value min(pose.x)
+}
+metric most_y for each robot {
+  unit m
+  reads pose: turtlesim/msg/Pose on "/{ns}/pose"
+  value max(pose.y)
+}
+metric mean_x for each robot {
+  unit m
+  reads pose: turtlesim/msg/Pose on "/{ns}/pose"
+  value mean(pose.x)
+}
+metric east_time for each robot {
+  unit s
+  reads pose: turtlesim/msg/Pose on "/{ns}/pose"
+  value duration where pose.x > 5.5
+}
+"""
+
+ODOMETRY_METRICS = """
+metric odom_path for each robot {
+  unit m
+  reads odom: nav_msgs/msg/Odometry on "/{ns}/TOPIC"
+  value path_length(odom.pose.pose.position.x, odom.pose.pose.position.y)
+}
+metric odom_speed for each robot {
+  unit m/s
+  reads odom: nav_msgs/msg/Odometry on "/{ns}/TOPIC"
+  value max(speed(odom.pose.pose.position.x, odom.pose.pose.position.y))
+}
+metric least_forward for each robot {
+  unit m/s
+  reads odom: nav_msgs/msg/Odometry on "/{ns}/TOPIC"
+  value min(odom.twist.twist.linear.x)
+}
+metric most_x for each robot {
+  unit m
+  reads odom: nav_msgs/msg/Odometry on "/{ns}/TOPIC"
+  value max(odom.pose.pose.position.x)
+}
+metric mean_forward for each robot {
+  unit m/s
+  reads odom: nav_msgs/msg/Odometry on "/{ns}/TOPIC"
+  value mean(odom.twist.twist.linear.x)
+}
+metric brisk_time for each robot {
+  unit s
+  reads odom: nav_msgs/msg/Odometry on "/{ns}/TOPIC"
+  value duration where odom.twist.twist.linear.x > 0.5
+}
+"""
+
+
+def _forward(message: object) -> float:
+    return float(message.twist.twist.linear.x)  # type: ignore[attr-defined]
+
+
+def odometry_functions(samples: Samples) -> dict[str, float]:
+    """The reference of :data:`ODOMETRY_METRICS` over every message of one odometry."""
+    x, y = xy(samples)
+    forward = samples.column(_forward)
+    return {
+        "odom_path": path_length(x, y),
+        "odom_speed": float(np.nanmax(speeds(samples.t, x, y))),
+        "least_forward": float(forward.min()),
+        "most_x": float(x.max()),
+        "mean_forward": float(forward.mean()),
+        "brisk_time": duration_where(samples.t, forward > 0.5),
+    }
+
+
+def turtle_functions(samples: Samples) -> dict[str, float]:
+    """The reference of the turtles' user metrics over every message of one pose topic (float32
+    fields, widened to float64)."""
+    x, y = (np.array([position(m)[k] for m in samples.messages], dtype=np.float64) for k in (0, 1))
+    return {
+        "pose_path": path_length(x, y),
+        "pose_speed": float(np.nanmax(speeds(samples.t, x, y))),
+        "least_x": float(x.min()),
+        "most_y": float(y.max()),
+        "mean_x": float(x.mean()),
+        "east_time": duration_where(samples.t, x > 5.5),
+    }
+
+
+def turtle_references(robots: tuple[str, ...]) -> Callable[[Recording], dict[Key, Expected]]:
+    """The reference of the turtles' user metrics (``pose_path`` and :data:`TURTLE_METRICS`)
+    of ``robots``, each over ``/{robot}/pose``."""
+
+    def functions(bag: Recording) -> dict[Key, Expected]:
+        found: dict[Key, Expected] = {}
+        for robot in robots:
+            topic = f"/{robot}/pose"
+            for name, value in turtle_functions(bag.samples(topic)).items():
+                found[(name, robot)] = Expected(value, (topic,))
+        return found
+
+    return functions
+
+
+def odometry_references(robot: str, topic: str) -> Callable[[Recording], dict[Key, Expected]]:
+    """The reference of :data:`ODOMETRY_METRICS` of ``robot`` over ``topic``."""
+
+    def functions(bag: Recording) -> dict[Key, Expected]:
+        return {(n, robot): Expected(v, (topic,)) for n, v in odometry_functions(bag.samples(topic)).items()}
+
+    return functions
