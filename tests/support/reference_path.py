@@ -163,7 +163,8 @@ def hold(t: np.ndarray) -> np.ndarray:
         return np.zeros(len(t))
     gaps = np.diff(t)
     period = float(np.median(gaps))
-    return np.minimum(np.append(gaps, period), 2 * period)
+    held: np.ndarray = np.minimum(np.append(gaps, period), 2 * period)
+    return held
 
 
 def duration_where(t: np.ndarray, condition: np.ndarray) -> float:
@@ -246,7 +247,7 @@ def robot_values(bag: Recording, robot: RobotSources) -> dict[Key, Expected]:
     distance_travelled, max_velocity, distance_to_obstacles and their violation durations."""
     r = robot.robot
     pose = _pose(bag, robot)
-    pose_topic = (robot.pose,) if robot.pose else ()
+    pose_topic: tuple[str, ...] = (robot.pose,) if robot.pose else ()
     found: dict[Key, Expected] = {("task_duration", r): Expected(bag.span)}
     reached = arrivals(*xy(pose), robot.waypoints) if pose is not None and robot.waypoints else None
     found[("waypoints_visited", r)] = Expected(None if reached is None else float(reached))
@@ -258,6 +259,7 @@ def robot_values(bag: Recording, robot: RobotSources) -> dict[Key, Expected]:
         found[("distance_travelled", r)] = Expected(path_length(*xy(pose)), pose_topic)
     else:
         found[("distance_travelled", r)] = Expected(None)
+    read: tuple[str, ...]
     if robot.velocity:
         vel = bag.samples(robot.velocity)
         t, v, read = vel.t, vel.column(planar_speed), (robot.velocity,)
