@@ -47,14 +47,15 @@ def converted(bag: Path, folder: Path, storage: str) -> Path:
 
 
 def run_values(run: AnalysedRun) -> dict[Key, tuple[float, tuple[str, ...]]]:
-    """The run's whole-run values (robot and mission scopes): (metric, robot) → value and topics;
-    a violation duration as ``violation_duration/<its safety metric>``."""
+    """The run's values: (metric, robot) → value and topics; a violation duration as
+    ``violation_duration/<its safety metric>``, a path segment's value as ``metric@<waypoint>``."""
     found: dict[Key, tuple[float, tuple[str, ...]]] = {}
     for v in run.run.metrics:
-        if v.scope not in (MetricScope.ROBOT, MetricScope.MISSION):
-            continue
         name = v.metric if v.safety_metric is None else f"{v.metric}/{v.safety_metric}"
-        found[(name, v.robot if v.scope is MetricScope.ROBOT else None)] = (v.value, tuple(v.topics))
+        if v.scope is MetricScope.SEGMENT and v.action is not None:
+            found[(f"{name}@{v.action.waypoint}", v.action.robot)] = (v.value, tuple(v.topics))
+        elif v.scope in (MetricScope.ROBOT, MetricScope.MISSION):
+            found[(name, v.robot if v.scope is MetricScope.ROBOT else None)] = (v.value, tuple(v.topics))
     return found
 
 
@@ -72,7 +73,7 @@ def mismatches(
         if want.value is None:
             if got is not None:
                 wrong.append(f"{key}: exsce {got[0]!r}, the reference has no value")
-            elif not _told(run.problems, metric.partition("/")[0], robot):
+            elif not _told(run.problems, metric.partition("/")[0].partition("@")[0], robot):
                 wrong.append(f"{key}: missing without a reason naming it")
         elif got is None:
             wrong.append(f"{key}: exsce has no value, the reference {want.value!r}")

@@ -191,18 +191,42 @@ def separation(first: tuple[np.ndarray, ...], second: tuple[np.ndarray, ...]) ->
     return np.asarray(np.hypot(x[inside] - ox, y[inside] - oy))
 
 
-def arrivals(x: np.ndarray, y: np.ndarray, waypoints: Sequence[tuple[float, float]]) -> int | None:
-    """How many planned waypoints the pose reaches in order; None when it never leaves its start
-    (no segments: nothing arrives)."""
-    if not len(x) or not (np.hypot(x - x[0], y - y[0]) > TOLERANCE).any():
+def heading(message: Any) -> float:
+    """The yaw of a pose message (turtlesim's ``theta``; 0 for a position alone)."""
+    pose = getattr(message, "pose", None)
+    if pose is None:
+        return float(getattr(message, "theta", 0.0))
+    while hasattr(pose, "pose"):
+        pose = pose.pose
+    q = pose.orientation
+    return float(np.arctan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z)))
+
+
+def cuts(samples: Samples, waypoints: Sequence[tuple[float, float]]) -> list[int] | None:
+    """The pose samples that start and end the path segments of arrival: the moment the robot
+    set off (the last sample still at its first pose, within 1 cm and 0.01 rad, before it first
+    went farther than the tolerance), then its arrival at each planned waypoint reached, in order;
+    None when it never moved."""
+    x, y = xy(samples)
+    yaw = samples.column(heading)
+    away = np.hypot(x - x[0], y - y[0]) if len(x) else np.zeros(0)
+    if not (away > TOLERANCE).any():
         return None
-    at, reached = 0, 0
+    moved = int(np.flatnonzero(away > TOLERANCE)[0])
+    turned = np.abs(np.angle(np.exp(1j * (yaw[:moved] - yaw[0]))))
+    still = np.flatnonzero((away[:moved] <= 0.01) & (turned <= 0.01))
+    found = [int(still[-1]) if len(still) else 0]
     for wx, wy in waypoints:
-        near = np.flatnonzero(np.hypot(x[at:] - wx, y[at:] - wy) <= TOLERANCE)
+        near = np.flatnonzero(np.hypot(x[found[-1] :] - wx, y[found[-1] :] - wy) <= TOLERANCE)
         if not len(near):
             break
-        at, reached = at + int(near[0]), reached + 1
-    return reached or None
+        found.append(found[-1] + int(near[0]))
+    return found
+
+
+def inside(t: np.ndarray, start: float, end: float) -> slice:
+    """The samples of ``t`` in ``[start, end]``."""
+    return slice(int(np.searchsorted(t, start, "left")), int(np.searchsorted(t, end, "right")))
 
 
 # ------------------------------------------------------------------ a robot's built-in metrics
@@ -242,46 +266,85 @@ def _pose(bag: Recording, robot: RobotSources) -> Samples | None:
     return bag.samples(robot.pose) if robot.pose else None
 
 
-def robot_values(bag: Recording, robot: RobotSources) -> dict[Key, Expected]:
-    """The robot's whole-run built-in values: task_duration, waypoints_visited,
-    distance_travelled, max_velocity, distance_to_obstacles and their violation durations."""
-    r = robot.robot
-    pose = _pose(bag, robot)
+@dataclass(frozen=True)
+class _Signal:
+    """A robot's signal for one built-in metric: times, per-sample values (x and y for a path),
+    and the topics it came from."""
+
+    t: np.ndarray
+    v: tuple[np.ndarray, ...]
+    topics: tuple[str, ...]
+
+
+def _signals(bag: Recording, robot: RobotSources, pose: Samples | None) -> dict[str, _Signal | None]:
+    """The samples each of the robot's per-segment metrics reads."""
     pose_topic: tuple[str, ...] = (robot.pose,) if robot.pose else ()
-    found: dict[Key, Expected] = {("task_duration", r): Expected(bag.span)}
-    reached = arrivals(*xy(pose), robot.waypoints) if pose is not None and robot.waypoints else None
-    found[("waypoints_visited", r)] = Expected(None if reached is None else float(reached))
+    found: dict[str, _Signal | None] = {"distance_travelled": None, "max_velocity": None}
     if robot.distance:
-        found[("distance_travelled", r)] = Expected(
-            path_length(*xy(bag.samples(robot.distance))), (robot.distance,)
-        )
+        odometry = bag.samples(robot.distance)
+        found["distance_travelled"] = _Signal(odometry.t, xy(odometry), (robot.distance,))
     elif pose is not None:
-        found[("distance_travelled", r)] = Expected(path_length(*xy(pose)), pose_topic)
-    else:
-        found[("distance_travelled", r)] = Expected(None)
-    read: tuple[str, ...]
+        found["distance_travelled"] = _Signal(pose.t, xy(pose), pose_topic)
     if robot.velocity:
         vel = bag.samples(robot.velocity)
-        t, v, read = vel.t, vel.column(planar_speed), (robot.velocity,)
+        found["max_velocity"] = _Signal(vel.t, (vel.column(planar_speed),), (robot.velocity,))
     elif pose is not None and len(pose.t) > 1:
-        t, v, read = pose.t, speeds(pose.t, *xy(pose)), pose_topic
-    else:
-        t, v, read = np.zeros(0), np.zeros(0), ()
-    found[("max_velocity", r)] = Expected(float(np.nanmax(v)) if len(v) else None, read)
-    if len(v):
-        with np.errstate(invalid="ignore"):
-            found[("violation_duration/max_velocity", r)] = Expected(duration_where(t, v > SPEED_LIMIT), read)
-    if robot.scan:
-        scans = bag.samples(robot.scan)
-        nearest = nearest_ranges(scans)
-        found[("distance_to_obstacles", r)] = Expected(float(np.nanmin(nearest)), (robot.scan,))
-        with np.errstate(invalid="ignore"):
-            below = nearest < CLEARANCE_LIMIT
-        found[("violation_duration/distance_to_obstacles", r)] = Expected(
-            duration_where(scans.t, below), (robot.scan,)
-        )
-    else:
-        found[("distance_to_obstacles", r)] = Expected(None)
+        found["max_velocity"] = _Signal(pose.t, (speeds(pose.t, *xy(pose)),), pose_topic)
+    scans = bag.samples(robot.scan) if robot.scan else None
+    found["distance_to_obstacles"] = (
+        _Signal(scans.t, (nearest_ranges(scans),), (robot.scan,)) if scans and robot.scan else None
+    )
+    return found
+
+
+def _aggregate(metric: str, signal: _Signal, window: slice) -> float | None:
+    values = [v[window] for v in signal.v]
+    if not len(values[0]):
+        return None
+    if metric == "distance_travelled":
+        return path_length(*values)
+    found = float(np.nanmax(values[0]) if metric == "max_velocity" else np.nanmin(values[0]))
+    return None if np.isnan(found) else found
+
+
+LIMITS = {"max_velocity": (SPEED_LIMIT, 1.0), "distance_to_obstacles": (CLEARANCE_LIMIT, -1.0)}
+"""Each safety metric's limit, and the sign of its excess (above a 'below' limit, below an
+'above' one)."""
+
+
+def robot_values(bag: Recording, robot: RobotSources) -> dict[Key, Expected]:
+    """The robot's built-in values: over the whole run (task_duration, waypoints_visited,
+    distance_travelled, max_velocity, distance_to_obstacles, the violation durations), and per
+    path segment of arrival (``metric@k``, k from 1: the same but the count and violations)."""
+    r = robot.robot
+    pose = _pose(bag, robot)
+    found: dict[Key, Expected] = {("task_duration", r): Expected(bag.span)}
+    segments = cuts(pose, robot.waypoints) if pose is not None and robot.waypoints else None
+    found[("waypoints_visited", r)] = Expected(
+        float(len(segments) - 1) if segments and len(segments) > 1 else None
+    )
+    windows = []
+    if pose is not None and segments:
+        for k, (a, b) in enumerate(zip(segments, segments[1:], strict=False), start=1):
+            start, end = float(pose.t[a]), float(pose.t[b])
+            windows.append((f"@{k}", start, end))
+            found[(f"task_duration@{k}", r)] = Expected(end - start)
+    for metric, signal in _signals(bag, robot, pose).items():
+        if signal is None:
+            found[(metric, r)] = Expected(None)
+            continue
+        found[(metric, r)] = Expected(_aggregate(metric, signal, slice(None)), signal.topics)
+        for suffix, start, end in windows:
+            found[(metric + suffix, r)] = Expected(
+                _aggregate(metric, signal, inside(signal.t, start, end)), signal.topics
+            )
+        limit, sign = LIMITS.get(metric, (None, 0.0))
+        if limit is not None:
+            with np.errstate(invalid="ignore"):
+                over = sign * (signal.v[0] - limit) > 0
+            found[(f"violation_duration/{metric}", r)] = Expected(
+                duration_where(signal.t, over), signal.topics
+            )
     return found
 
 
