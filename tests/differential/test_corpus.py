@@ -4,9 +4,12 @@ tests/support/reference_path.py: equal to 1e-6 where both compute, missing with 
 where the reference has no value.
 
 Each bag is ingested as a user would: its ``exscec init --from-bag`` draft, with metrics of the
-user functions (path, speed, min, max, mean, duration) added; turtlesim's, whose draft places no
-robot (its poses are ``turtlesim/Pose``, no pose type exsce knows), by a specification written
-here, as tests/runs/test_turtlesim_path.py has it.
+user functions (path, speed, min, max, mean, duration) added.  Turtlesim's by a specification
+written here, as tests/runs/test_turtlesim_path.py has it.  Finding (left to init's owner):
+``exscec init --from-bag example.bag`` says "robots root_robot (/, detected)" and exits 0, but
+writes a scenario with no robot and an empty mission, which ``exscec check`` refuses (exit 2:
+"mission 'example_mission' allocates no task"; its poses are ``turtlesim/Pose``, no pose type,
+and its TF is ``world -> turtle1``, no ``map``/``odom`` frame).
 """
 
 from __future__ import annotations
@@ -62,6 +65,10 @@ class Corpus:
 
 
 def _turtles(spec: str) -> list[RobotSources]:
+    """The turtles: a velocity (``cmd_vel``) and no pose a robot's pose may come from (docs/bags.md:
+    Odometry, PoseStamped, PoseWithCovarianceStamped or TF ``map``/``odom`` → body; theirs is
+    ``turtlesim/Pose``, read by the user metrics only): no distance, no arrival, no distance
+    between them."""
     return [RobotSources(r, velocity=f"/{r}/cmd_vel") for r in ("turtle1", "turtle2")]
 
 

@@ -5,8 +5,9 @@ equal to 1e-6 where both compute, missing with a reason exactly where the refere
 value.
 
 The bags come from the builders of the tests that found each shape (tests/runs/test_tf_publishers,
-test_coarse_stamps, test_clock_words, test_whole_run_window, and tests/support/real_shapes), each
-with the specification of its test, and the user functions' metrics added where they apply.
+test_root_velocity, test_coarse_stamps, test_clock_words, test_whole_run_window, and
+tests/support/real_shapes), each with the specification of its test, and the user functions'
+metrics added where they apply.
 """
 
 from __future__ import annotations
@@ -25,6 +26,8 @@ from tests.runs.test_clock_words import SPEC as CLOCK_SPEC
 from tests.runs.test_clock_words import clock_bag
 from tests.runs.test_coarse_stamps import SPEC as COARSE_SPEC
 from tests.runs.test_coarse_stamps import _poses as coarse_poses
+from tests.runs.test_root_velocity import SPEC as ROOTED_SPEC
+from tests.runs.test_root_velocity import _messages as rooted_topics
 from tests.runs.test_tf_publishers import SPEC as TF_SPEC
 from tests.runs.test_tf_publishers import tf_bag
 from tests.runs.test_turtlesim_path import SPEC as TURTLE_SPEC
@@ -149,6 +152,13 @@ def _turtles_bag(folder: Path, fmt: str) -> Path:
     return bag
 
 
+def _rooted_bag(folder: Path, fmt: str) -> Path:
+    store = typestore_for(fmt)
+    bag = folder / ("rooted.bag" if fmt == "ros1" else "rooted")
+    write_bag(bag, fmt, rooted_topics(store, velocity=True), store)
+    return bag
+
+
 def _two_robots_bag(folder: Path, fmt: str) -> Path:
     """Two odometries crossing (r1 along real_shapes' route at 20 Hz; r2 the other way, at
     15 Hz from 0.3 s), and r1's scan at 10 Hz (8 to 12 beams a message)."""
@@ -231,6 +241,10 @@ SHAPES = {
         _scenario("jackal") + ODOMETRY_METRICS.replace("{ns}/TOPIC", JACKAL_ODOM.lstrip("/")),
         [RobotSources("jackal", pose=JACKAL_ODOM, velocity="/cmd_vel", distance=JACKAL_ODOM, waypoints=FAR)],
         odometry_references("jackal", JACKAL_ODOM),
+    ),
+    # item 5: a root /location (PoseStamped) and a root /velocity (TwistStamped)
+    "root_velocity": Shape(
+        _rooted_bag, ROOTED_SPEC, [RobotSources("tb", pose="/location", velocity="/velocity", waypoints=FAR)]
     ),
     # item 3: turtlesim's Pose: no header, float32
     "headerless_float32": Shape(
