@@ -235,6 +235,13 @@ SHAPES = {
         [RobotSources("bot", pose="/odom", velocity="/odom", distance="/odom", waypoints=((40.0, 40.0),))],
         odometry_references("bot", "/odom"),
     ),
+    # item 7 too: Gazebo's stamps on simulated time from 931.25 s, log time on the wall clock, /clock
+    "simulated_stamps": Shape(
+        lambda folder, fmt: clock_bag(folder, "gazebo", fmt),
+        CLOCK_SPEC + ODOMETRY_METRICS.replace("TOPIC", "odom"),
+        [RobotSources("bot", pose="/odom", velocity="/odom", distance="/odom", waypoints=((40.0, 40.0),))],
+        odometry_references("bot", "/odom"),
+    ),
     # item 8: teleop's cmd_vel, sent only while a key is held
     "event_driven": Shape(
         _teleop_bag,
