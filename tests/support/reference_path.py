@@ -18,8 +18,10 @@ The rules it follows, the simplest that say what the documentation says:
   a violation lasts as long as the samples over the limit hold;
 - two robots' distance is the second's position interpolated at the first's pose times, where
   both have data;
-- arrival: a robot that left its start (more than the tolerance) arrives at each planned
-  waypoint, in order, at its first pose sample within the tolerance after the previous arrival.
+- arrival: a robot that left its start (more than the tolerance) set off at the last sample at
+  which it was still at its first pose (1 cm, 0.01 rad), and arrives at each planned waypoint, in
+  order, at its first pose sample within the tolerance from the previous arrival; each path
+  segment runs from one to the next, its values over the samples of each source in that time.
 
 A value the data cannot support is ``None``: the test then expects it missing with a reason.
 """
