@@ -20,7 +20,7 @@ from exsce_dsl.errors import ExsceError
 from exsce_dsl.messages.catalogue import MessageCatalogue, Source, parse_definition, standard_catalogue
 from exsce_dsl.runs.bags.chunk_batches import Messages
 from exsce_dsl.runs.bags.data import OBJECTS, BagData, Check, Reduce, Wanted
-from exsce_dsl.runs.bags.mcap_index import IDL_SEPARATOR, Schema, definitions, read_channels
+from exsce_dsl.runs.bags.mcap_index import IDL_SEPARATOR, Schema, definitions, read_channels, recorded_span
 from exsce_dsl.runs.bags.objects import deserialized, deserializer_for
 from exsce_dsl.runs.bags.reader import BagReader, UnsupportedBag
 from exsce_dsl.runs.bags.reading_base import IndexReading
@@ -74,13 +74,16 @@ class _Mcap(IndexReading):
 
     def read(self, files: list[Path]) -> BagData:
         found: list[tuple[str, Messages]] = []
+        spans = []  # the recording's: its topics not read too
         for file in files:
             self.schemas = definitions(file)
+            spans.append(recorded_span(file))
             found.extend(read_channels(file, self.match, self.decoder).by_key())
         if not found:
             raise UnsupportedBag("none of the topics")  # rosbags then says whether the bag is empty
         start = min(int(m.times.min()) for _, m in found)
         end = max(int(m.times.max()) for _, m in found)
+        start, end = min(start, *(s for s, _ in spans)), max(end, *(e for _, e in spans))
         for topic, messages in found:  # each channel's by its own schema
             if not messages.raws:
                 continue

@@ -170,6 +170,14 @@ def read_channels(path: Path, topics: Container[str], decoder: Decoder) -> Gathe
         return _read_topics(data, topics, decoder)
 
 
+def recorded_span(path: Path) -> tuple[int, int]:
+    """The log times (ns) of the file's first and last message, of every channel, from its chunk
+    indexes: the recording's span, whichever topics are read."""
+    with mapped(path) as data:
+        chunks = _summary(data).chunks
+        return min(c.message_start_time for c in chunks), max(c.message_end_time for c in chunks)
+
+
 def schemas(path: Path) -> dict[str, Schema]:
     """Topic → the schema of its channels (of its first channel if they differ), from the
     summary section."""

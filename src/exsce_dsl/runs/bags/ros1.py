@@ -81,6 +81,20 @@ def connections(path: Path) -> dict[str, str]:
         return {topic: _ros2_name(msgtype) for topic, msgtype, _, _ in found.values()}
 
 
+def recorded_span(path: Path) -> tuple[int, int] | None:
+    """The log times (ns) of the bag's first and last message, of every topic, from its chunk
+    infos: the recording's span, whichever topics are read."""
+    with mapped(path) as data:
+        _, pos, chunk_count = _connections(data, ())
+        times = []
+        for _ in range(chunk_count):
+            fields, _, pos = _record(data, pos)
+            for name in ("start_time", "end_time"):
+                sec, nsec = struct.unpack("<II", fields[name])
+                times.append(sec * 10**9 + nsec)
+        return (min(times), max(times)) if times else None
+
+
 def _connections(
     data: mmap.mmap, topics: Container[str] | None
 ) -> tuple[dict[int, tuple[str, str, str, str]], int, int]:
@@ -219,6 +233,9 @@ class _Ros1(IndexReading):
             raise UnsupportedBag("none of the topics")  # rosbags then says whether the bag is empty
         start = min(int(m.times.min()) for _, m in found)
         end = max(int(m.times.max()) for _, m in found)
+        span = recorded_span(self.path)  # the recording: its topics not read too
+        if span is not None:
+            start, end = min(start, span[0]), max(end, span[1])
         for topic, messages in found:  # each connection's by its own definition
             if not messages.raws:
                 continue
