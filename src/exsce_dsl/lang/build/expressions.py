@@ -48,7 +48,6 @@ _NUMERIC = (Kind.CONSTANT, Kind.NUMBERS, Kind.ARRAYS, Kind.VALUE)
 _PER_MESSAGE = (Kind.NUMBERS, Kind.ARRAYS, Kind.CONDITIONS, Kind.ARRAY_CONDITIONS)
 _CONDITIONS = (Kind.CONDITIONS, Kind.ARRAY_CONDITIONS)
 
-
 @dataclass(frozen=True)
 class Typed:
     """An expression with its kind and, for per-message values, the topic whose times they follow."""
