@@ -281,6 +281,10 @@ class ArgumentError(ExsceError):
     """A tool was called with arguments its input schema does not allow (``mcp_server``)."""
 
 
+class UnknownValueError(ExsceError):
+    """A stored run has no value, nor a problem, of the metric, robot or segment asked for."""
+
+
 class TimeLimitError(ExsceError):
     """A request ran over the server's time limit (``mcp_server``)."""
 

@@ -55,7 +55,7 @@ STEPS: dict[str, list[set[str]]] = {
         {"segments"},
         {"metrics"},
         {"coverage"},
-        {"analyse", "ingest", "robots", "bag_identity", "bag_info", "bag_robots", "bag_runs", "missing"},
+        {"analyse", "ingest", "robots", "bag_identity", "bag_info", "bag_robots", "bag_runs", "missing", "plausible_poses"},
         {"spec_draft"},
     ],
 }

@@ -63,7 +63,9 @@ def test_batches_of_chunks_give_the_messages_rosbags_reads(
     calls: list[tuple[str, int]] = []
     decoded: list[np.ndarray] = []
 
-    def decoder(topic: str, msgtype: str, definition: str, times: np.ndarray, messages: RawMessages) -> bool:
+    def decoder(
+        topic: str, msgtype: str, definition: str, times: np.ndarray, messages: RawMessages, publisher: str
+    ) -> bool:
         calls.append((topic, len(messages)))
         if topic == "/tf":
             return False  # keep the raw bytes

@@ -20,7 +20,7 @@ from exsce_dsl.lang import load_spec
 from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.runs.signals.timeline import LOG_TIME
 
-from tests.support.bag_factory import POSE_STAMPED, START_NS, Topic, typestore_for, write_bag
+from tests.support.bag_factory import POSE_STAMPED, START_NS, Topic, header, typestore_for, write_bag
 from tests.support.yard_spec import FAR_YARD
 
 SPEC = FAR_YARD + """
@@ -44,21 +44,21 @@ SPEED = 0.25  # m/s along x
 
 
 def _poses(store: Any) -> Topic:
-    """``/location`` at 27 Hz from 0.4 s past a whole second, stamped with whole seconds."""
+    """``/location`` at 27 Hz from 0.4 s past a whole second, stamped with whole seconds (in
+    the typestore's ROS version: the differential suite writes it in ROS 2 too)."""
     types = store.types
     messages = []
     for i in range(COUNT):
         log_ns = START_NS + 400_000_000 + i * PERIOD_NS
-        stamp_sec = log_ns // 10**9
-        header = types["std_msgs/msg/Header"](
-            seq=i, stamp=types["builtin_interfaces/msg/Time"](sec=stamp_sec, nanosec=0), frame_id="map"
-        )
+        whole_second = log_ns // 10**9 * 10**9
         x = SPEED * i * PERIOD_NS / 1e9
         pose = types["geometry_msgs/msg/Pose"](
             position=types["geometry_msgs/msg/Point"](x=x, y=0.0, z=0.0),
             orientation=types["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0, w=1.0),
         )
-        messages.append((log_ns, types[POSE_STAMPED](header=header, pose=pose)))
+        messages.append(
+            (log_ns, types[POSE_STAMPED](header=header(store, whole_second, "map", i), pose=pose))
+        )
     return Topic("/location", POSE_STAMPED, messages)
 
 

@@ -184,7 +184,9 @@ def by_index(file: Path, topics: set[str], keep: bool = True) -> dict[str, list[
     out; when ``keep``, the raw bytes it keeps must be the same."""
     handed: dict[str, list[tuple[int, bytes]]] = {}
 
-    def decoder(topic: str, msgtype: str, definition: str, times: np.ndarray, messages: RawMessages) -> bool:
+    def decoder(
+        topic: str, msgtype: str, definition: str, times: np.ndarray, messages: RawMessages, publisher: str
+    ) -> bool:
         assert msgtype == TYPES[topic] and definition
         assert times.dtype == np.int64 and len(times) == len(messages)
         raws = [messages.buffer[s:e].tobytes() for s, e in zip(messages.starts, messages.ends, strict=True)]
@@ -312,7 +314,9 @@ def test_definitions_and_schemas_are_the_bags(bags: dict[str, Path]) -> None:
     bag = bags["zstd"]
     seen: dict[str, str] = {}
 
-    def decoder(topic: str, msgtype: str, definition: str, times: np.ndarray, messages: RawMessages) -> bool:
+    def decoder(
+        topic: str, msgtype: str, definition: str, times: np.ndarray, messages: RawMessages, publisher: str
+    ) -> bool:
         seen[topic] = definition
         return True
 
@@ -500,7 +504,9 @@ def test_summaries_read_the_same(
     copy.write_bytes(with_summary(mcap_of(bags["zstd-small-chunks"]).read_bytes(), change))
     handed: dict[str, list[tuple[int, bytes]]] = {}
 
-    def decoder(topic: str, msgtype: str, definition: str, times: np.ndarray, messages: RawMessages) -> bool:
+    def decoder(
+        topic: str, msgtype: str, definition: str, times: np.ndarray, messages: RawMessages, publisher: str
+    ) -> bool:
         raws = [messages.buffer[s:e].tobytes() for s, e in zip(messages.starts, messages.ends, strict=True)]
         handed.setdefault(topic, []).extend(zip(times.tolist(), raws, strict=True))
         return True
@@ -606,7 +612,7 @@ def test_topic_with_channels_of_two_types_raises(tmp_path: Path) -> None:
             b, START + 1, bytes(STORE.serialize_cdr(T["std_msgs/msg/Int32"](data=1), "std_msgs/msg/Int32"))
         )
         writer.write(c, START + 2, _string("c"))
-    with pytest.raises(UnsupportedBag, match="different schemas"):
+    with pytest.raises(UnsupportedBag, match="different types"):
         read_topics(mcap_of(tmp_path / "two"), {"/mixed"}, lambda *_: True)
     assert len(read_topics(mcap_of(tmp_path / "two"), {"/fine"}, lambda *_: True)["/fine"].times) == 1
 
@@ -629,7 +635,9 @@ def test_decoder_error_is_not_hidden_by_buffer_error(bags: dict[str, Path], layo
     exported pointers exist``.  Here the decoder's own error comes out, whatever the chunks."""
     calls = []
 
-    def failing(topic: str, msgtype: str, definition: str, times: np.ndarray, messages: RawMessages) -> bool:
+    def failing(
+        topic: str, msgtype: str, definition: str, times: np.ndarray, messages: RawMessages, publisher: str
+    ) -> bool:
         calls.append(topic)
         if len(calls) == 3:
             raise RuntimeError("the decoder's own error")
@@ -646,7 +654,9 @@ def test_decoder_may_keep_what_it_is_handed(
     """Buffers kept past reading are the decoder's own (no view of the closed map)."""
     kept: list[tuple[np.ndarray, RawMessages]] = []
 
-    def keeping(topic: str, msgtype: str, definition: str, times: np.ndarray, messages: RawMessages) -> bool:
+    def keeping(
+        topic: str, msgtype: str, definition: str, times: np.ndarray, messages: RawMessages, publisher: str
+    ) -> bool:
         kept.append((times, messages))
         return True
 

@@ -40,9 +40,9 @@ from tests.support.store_servers import virtuoso_server
 from tests.support.yard_spec import YARD_SPEC
 
 FORMATS = ("table", "json", "csv")
-EMPTY_HERE = {"campaign_shrinkings", "run_coverage"}
+EMPTY_HERE = {"campaign_shrinkings", "run_coverage", "run_problems"}
 """Queries with no rows on these runs (the campaign violated nothing, so shrank nothing; the
-executor's recordings cover every run)."""
+executor's recordings cover every run, and ingestion had nothing to say of them)."""
 
 
 @dataclass(frozen=True)
@@ -144,6 +144,7 @@ def _commands(stores: Stores) -> dict[str, tuple[str, ...]]:
         "run_metric": ("-p", f"run={runs[0]}", *distance, "-p", "robot=r1"),
         "run_coverage": every_run,
         "run_metric_values": every_run,
+        "run_problems": ("-p", f"run={runs[0]}"),
         "run_defects": ("-p", "scenario=yard_run"),
         "run_mission_metric": ("-p", f"run={runs[0]}", "-p", "metric=mission_duration"),
         "run_scenarios": every_run,
@@ -152,6 +153,7 @@ def _commands(stores: Stores) -> dict[str, tuple[str, ...]]:
         "runs": ("-p", "scenario=yard_run"),
         "safety_metrics": ("-p", "scenario=yard_run"),
         "scenarios": (),
+        "value_accounting": ("-p", f"run={runs[0]}", *distance),
         "segment_metric": (*distance, *poses, *every_run),
         "segment_metric_any": (*distance, *poses),
         "segment_metric_between": (*distance, "-p", f"from={start.split('-R')[0]}", "-p", f"to={goal.split('-R')[0]}"),

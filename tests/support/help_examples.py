@@ -67,6 +67,7 @@ CHAPTERS: dict[str, tuple[tuple[str, ...], ...]] = {
         ("query",),
         ("sparql",),
         ("runs",),
+        ("explain",),  # what a stored run's distance used
         ("cluster",),
         ("report",),
         ("store",),

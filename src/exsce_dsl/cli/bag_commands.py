@@ -91,6 +91,8 @@ def _table(info: object) -> str:
         lines.append(f"goals     {topic}: {sum(ends.values())} ({counted})")
     for said in info.conventions:
         lines.append(f"robots    {said}")
+    for said in info.plausibility:
+        lines.append(f"poses     {said}: no distance or speed is made of it")
     return "\n".join(lines)
 
 

@@ -34,6 +34,7 @@ COMMAND_MODULES: dict[str, str] = {
     "query": "query_commands",
     "sparql": "query_commands",
     "runs": "query_commands",
+    "explain": "query_commands",
     "baseline": "oracle_commands",
     "verify": "oracle_commands",
     "flaky": "trial_commands",

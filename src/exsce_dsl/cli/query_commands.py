@@ -264,4 +264,35 @@ def runs_command(scenario: str | None, fmt: str, output: str | None, store_url: 
         click.echo(f"{len(rows)} run{'s' if len(rows) != 1 else ''}", err=True)
 
 
-COMMANDS = [query_command, sparql_command, runs_command]
+@click.command(name="explain")
+@click.argument("run")
+@click.argument("metric")
+@click.option("--robot", help="Only this robot's values (the mission's left out).")
+@click.option(
+    "--segment", metavar="ACTION", help="Only this path segment: its action's name, or its end (w_002)."
+)
+@store_option
+@reports_errors
+def explain_command(
+    run: str, metric: str, robot: str | None, segment: str | None, store_url: str | None
+) -> None:
+    """Show what each value of METRIC in RUN used: its sources, its window and why, the samples
+    of each source it used of those in the window (and why fewer), and the coverage findings
+    that touch it; a missing value, why it is missing.
+
+    RUN is a run's uuid, a unique prefix of it, or its IRI (`exscec runs` lists them).
+
+    \b
+    Example:
+      exscec explain $(exscec runs scenario_c -f csv | sed -n 2p | cut -d, -f1) \\
+          distance_travelled --robot tiago1
+    """
+    from exsce_dsl.api.explain import explain
+    from exsce_dsl.store.open import open_store
+
+    with open_store(store_url, read_only=True) as store:
+        found = explain(store, run, metric, robot, segment)
+    click.echo(found.text())
+
+
+COMMANDS = [query_command, sparql_command, runs_command, explain_command]

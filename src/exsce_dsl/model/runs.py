@@ -135,6 +135,33 @@ class Bag:
 
 
 @dataclass(frozen=True)
+class SourceCount:
+    """How many samples of one source a value used, of the samples its window holds.
+
+    ``topics``: the bag topics the series was read from (a pose from TF: ``/tf``; one series may
+    come from several topics together); ``why``: why fewer than all were used, or what else a
+    reader should know of how they were used (None: every sample, plainly)."""
+
+    topics: tuple[str, ...]
+    used: int
+    in_window: int
+    why: str | None = None
+
+
+@dataclass(frozen=True)
+class Accounting:
+    """What a value used: its window (``start``, ``end``: seconds since the epoch on the run's
+    wall clock, where its actions' times are) and ``reason`` (why the window is that one), the
+    samples of each source, and the ``annotations`` (coverage findings) that touch it."""
+
+    start: float
+    end: float
+    reason: str
+    sources: tuple[SourceCount, ...] = ()
+    annotations: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
 class MetricValue:
     """One value of a metric, computed from ``topics`` of the run's bag.
 
@@ -154,6 +181,8 @@ class MetricValue:
     estimated_from: str | None = None
     """What the value was estimated from where the bag lacked its signal (``pose``: a speed
     computed from the robot's positions, its bag having no velocity)."""
+    accounting: Accounting | None = None
+    """What the value used (None: not known, as for values made before accounting existed)."""
 
     def __post_init__(self) -> None:
         scope = self.scope
@@ -223,6 +252,9 @@ class Run:
     """What the recording does not cover (cut short, gaps, thinned topics, clock jumps)."""
     topic_rates: tuple[TopicRate, ...] = ()
     """How densely each topic a metric reads was recorded."""
+    problems: tuple[str, ...] = ()
+    """What ingestion said of the run: the values it could not compute and why, topics it could
+    not read (the run's warnings)."""
     dated: bool = True
     """Whether ``start``, ``end`` and the actions' times are dates; not when the recorder logged
     simulated time (they are then seconds after 1970 of simulated time, and no date is written)."""

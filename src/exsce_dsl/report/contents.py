@@ -30,7 +30,7 @@ from exsce_dsl.similarity.clustering import Clustering, cluster
 from exsce_dsl.similarity.facts import scenario_facts
 from exsce_dsl.store import queries
 from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries import MetricReading, StoredRun
+from exsce_dsl.store.queries import MetricReading, StoredRun, ValueAccount
 from exsce_dsl.store.queries.results import hotspots, pose_positions, verdicts
 
 _RANK = {Outcome.FAILED: 0, Outcome.PASSED: 2}
@@ -68,6 +68,18 @@ class RunContents:
     hotspots: tuple[Hotspot, ...]
     segments: tuple[RunSegment, ...] = ()
     """Its path segments, by robot then in the order it drove them (the report numbers them S1, S2...)."""
+    accounts: tuple[ValueAccount, ...] = ()
+    """What each of its values used (window, why, samples per source, findings)."""
+
+    def used(
+        self, metric: str, robot: str | None, safety: str | None = None, action: str | None = None
+    ) -> str:
+        """What the value of ``metric`` (of ``robot``, about ``safety``, over segment ``action``)
+        used, in a few lines; '' when the store does not say."""
+        for a in self.accounts:
+            if (a.metric, a.robot, a.safety_metric, a.action) == (metric, robot, safety, action):
+                return a.summary()
+        return ""
 
     @property
     def failed(self) -> int:
@@ -219,6 +231,7 @@ def gather(store: Store, specs: Sequence[Path] = ()) -> ReportContents:
                         failures_first(judged.get(r.uuid, ())),
                         tuple(spots.get(r.uuid, ())),
                         tuple(driven.get(r.uuid, ())),
+                        tuple(queries.value_accounts(store, r.uuid)),
                     )
                     for r in runs
                 ),

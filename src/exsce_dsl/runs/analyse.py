@@ -43,9 +43,11 @@ from exsce_dsl.runs.coverage import (
     find_coverage,
     recorded_mission_status,
 )
+from exsce_dsl.runs.metrics.accounting import finish_accounting
 from exsce_dsl.runs.metrics.compute import HOTSPOT_PATHS, POSE_TOPIC, compute_metrics
 from exsce_dsl.runs.metrics.monitor_code import load_monitors
 from exsce_dsl.runs.missing import missing_metrics, unread_topics
+from exsce_dsl.runs.plausible_poses import Refused, refuse_implausible, spec_speed_limit
 from exsce_dsl.runs.robots import SERVED, StackRobots, stack_robots
 from exsce_dsl.runs.segments.dispatcher import SUCCEEDED, segments
 from exsce_dsl.runs.segments.recorded import RecordedAction
@@ -193,12 +195,13 @@ def analyse_bag(
         monitors,
         metrics,
         robots,
-        bag.topics,
+        bag.refused.usable(bag.topics),
         found.actions,
         found.results,
         bag.problems,
         found.whole_runs,
-        stacks.named(robots),
+        {**stacks.named(robots), **bag.refused.reasons},
+        found.reasons,
     )
     values = [bag.data.spelt(stacks.with_real_sources(v)) for v in values]
     if strict:
@@ -214,6 +217,8 @@ def analyse_bag(
         )
     )  # fmt: skip
     bag.problems += covered.said()
+    real = {n: _spelt(stacks.real_topics.get(n, (n,)), bag.data.spellings) for n in bag.topics}
+    values = [finish_accounting(v, bag.timeline.to_wall, real, covered.gaps) for v in values]
     run = Run(
         uuid=run_id or run_uuid(digest),
         scenario=scenario.id,
@@ -229,6 +234,7 @@ def analyse_bag(
         status=status,
         coverage=covered.gaps,
         topic_rates=covered.rates,
+        problems=tuple(dict.fromkeys(bag.problems)),
     )
     return AnalysedRun(run, digest, bag.problems, bag.timeline, bag.detected)
 
@@ -249,6 +255,8 @@ class _Signals:
     data: BagData
     topics: dict[str, Topic]
     problems: list[str]
+    refused: Refused = field(default_factory=Refused)
+    """The topics whose poses no robot could make: the monitors do not read them."""
 
 
 def _read_signals(
@@ -279,7 +287,11 @@ def _read_signals(
         # (a user metric may read more of it than the method's fields: pose.pose.covariance)
         same = read is not None and len(read) == len(served) and np.array_equal(read.t, served.t)
         topics[name] = Topic(name, served.t, {**served.fields, **read.fields}) if same and read else served
-    return _Signals(types, robots, detected, stacks, unread, recorded, timeline, data, topics, problems)
+    refused = refuse_implausible(robots, stacks, topics, data, spec_speed_limit(scenario.metrics))
+    problems += refused.problems
+    return _Signals(
+        types, robots, detected, stacks, unread, recorded, timeline, data, topics, problems, refused
+    )
 
 
 @dataclass
@@ -293,6 +305,8 @@ class _Segmented:
     results: dict[str, int | None] = field(default_factory=dict)
     whole_runs: dict[str, tuple[float, float]] = field(default_factory=dict)
     segmented_by: dict[str, str] = field(default_factory=dict)
+    reasons: dict[str, str] = field(default_factory=dict)
+    """Robot → why its whole-run window is the recording."""
 
 
 def _segment_robots(path: Path, scenario: Scenario, bag: _Signals) -> _Segmented:
@@ -303,7 +317,9 @@ def _segment_robots(path: Path, scenario: Scenario, bag: _Signals) -> _Segmented
         feedback, result = expand_topic(_FEEDBACK, ns), expand_topic(_RESULT, ns)
         updates = data.feedback.get(feedback)
         dispatched = segments(scenario, robot.id, updates) if updates is not None else None
-        found = segment_robot(scenario, robot, data, stacks.track(robot, bag.topics), dispatched)
+        # an implausible pose places no arrival; the whole run still spans the recording
+        track = stacks.track(robot, bag.refused.usable(bag.topics))
+        found = segment_robot(scenario, robot, data, track, dispatched)
         bag.problems += found.problems
         out.actions.extend(found.segments)
         if found.source and found.source != DISPATCHER_SOURCE:
@@ -323,7 +339,24 @@ def _segment_robots(path: Path, scenario: Scenario, bag: _Signals) -> _Segmented
                 raise BagError("\n  ".join([_nothing_of(path, robot, bag.types), *bag.unread]))
             if span is not None:
                 out.whole_runs[robot.id] = _recording(span, data)
+                out.reasons[robot.id] = _why_recording(robot, found.goals, bool(found.segments))
     return out
+
+
+def _why_recording(robot: Robot, goals: bool, segmented: bool) -> str:
+    """Why a robot's whole-run window is the recording."""
+    if robot.signals.window is Window.RECORDING:
+        return "the recording (the spec's window whole recording)"
+    if not goals:
+        return "the recording (no recorded goals" + (
+            "; arrivals cut path segments only)" if segmented else ")"
+        )
+    return "the recording (no path segments)"
+
+
+def _spelt(topics: tuple[str, ...], spellings: Mapping[str, tuple[str, ...]]) -> tuple[str, ...]:
+    """``topics`` as the bag spells them."""
+    return tuple(dict.fromkeys(s for t in topics for s in spellings.get(t, (t,))))
 
 
 def _recording(span: tuple[float, float], data: BagData) -> tuple[float, float]:

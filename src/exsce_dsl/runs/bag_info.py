@@ -4,13 +4,14 @@ From the bag's own index and metadata: its format, size, time span, and per topi
 message count and rate.  From a sample of each topic's first messages (at most :data:`SAMPLE`,
 deserialised by rosbags): which clock its stamps are (the recorder's wall clock or a
 simulation's, and their offset to log time), the TF tree's edges (static or not), and, read
-whole because they are few, the navigation actions' goals and how they ended.  Last, per
-namespace, the convention ingestion would detect and the topics that show it.
+whole because they are few, the navigation actions' goals and how they ended.  Per namespace,
+the convention ingestion would detect and the topics that show it.  Last, read whole, the pose
+topics whose steps no robot could make (two tracks, teleports: :mod:`~exsce_dsl.runs.plausible_poses`).
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -24,6 +25,7 @@ from exsce_dsl.model.goals import action_names, actionlib_names
 from exsce_dsl.model.messages import standard_type
 from exsce_dsl.runs.bags.reading import bag_topics
 from exsce_dsl.runs.bags.rosbags_fallback import typestore_for
+from exsce_dsl.runs.plausible_poses import bag_findings
 from exsce_dsl.runs.signals.clock_words import describe_clocks, log_time_is_dated
 from exsce_dsl.runs.signals.detect import robot_namespaces
 from exsce_dsl.runs.signals.timeline import SAME_CLOCK, SIMULATED_BEFORE
@@ -72,6 +74,9 @@ class BagInfo:
     """A navigation status topic → final status → goals."""
     conventions: tuple[str, ...] = ()
     """Per namespace, the convention ingestion would detect and from what."""
+    plausibility: tuple[str, ...] = ()
+    """Pose topics no robot could have made (two tracks, teleports): ingestion makes no distance
+    or speed of them (:mod:`~exsce_dsl.runs.plausible_poses`)."""
 
     @property
     def clock_recorded(self) -> bool:
@@ -105,6 +110,7 @@ class BagInfo:
             ],
             "goals": {topic: dict(ends) for topic, ends in self.goals.items()},
             "conventions": list(self.conventions),
+            "plausibility": list(self.plausibility),
         }
 
 
@@ -126,8 +132,18 @@ def bag_info(path: Path) -> BagInfo:
         # the recorder logged simulated time: stamps that agree with it are simulated too
         topics = tuple(replace(t, clock="simulated") if t.clock == "wall clock" else t for t in topics)
     return BagInfo(
-        str(path), _format(path), size, start, end, topics, edges, rates, goals, _conventions(types)
-    )
+        str(path), _format(path), size, start, end, topics, edges, rates, goals, _conventions(types),
+        _plausibility(path, types),
+    )  # fmt: skip
+
+
+def _plausibility(path: Path, types: Mapping[str, str]) -> tuple[str, ...]:
+    """The pose topics no robot could make; a bag whose poses cannot be read says so, and the
+    rest of what it holds is still shown."""
+    try:
+        return bag_findings(path, types)
+    except BagError as exc:
+        return (f"not checked: {exc.message}",)
 
 
 def _format(path: Path) -> str:
@@ -175,7 +191,7 @@ def _read(
             if whole:
                 _goals(goals.setdefault(name, {}), message, _STATUS[msgtype]())
         info = _topic(name, msgtype, count, logs, stamps)
-        topics.append(replace(info, definition=_definition(msgtype, connections)))
+        topics.append(replace(info, definition=_definition(msgtype, connections, reader.connections)))
     ended = {topic: _ends(found) for topic, found in goals.items()}
     rates = {edge: r for edge, times in seen.items() if not edges[edge] and (r := _rate(times)) is not None}
     return tuple(topics), tuple((p, c, s) for (p, c), s in sorted(edges.items())), rates, ended
@@ -184,11 +200,18 @@ def _read(
 BAG_OWN, USER_OWN, TYPESTORE, UNKNOWN = "the bag", "EXSCE_MSG_PATH", "rosbags' typestore", "unknown"
 
 
-def _definition(msgtype: str, connections: list[Any]) -> str:
+def _definition(msgtype: str, connections: list[Any], every: Sequence[Any] = ()) -> str:
     """Where ingestion finds the definition of ``msgtype``: the bag's own (a ROS 1 connection's,
     an MCAP schema, a ROS 2 bag's type description), else the user's files, else rosbags'
-    standard typestores."""
+    standard typestores.  Where the bag (``every`` connection) holds several versions of the
+    type, each connection is decoded by its own: their hashes are listed."""
     if any(getattr(getattr(c, "msgdef", None), "data", "").strip() for c in connections):
+        versions = {
+            c.msgdef.data.strip(): c.digest for c in every if c.msgtype == msgtype and c.msgdef.data.strip()
+        }
+        if len(versions) > 1:
+            hashes = ", ".join(sorted(str(d).removeprefix("RIHS01_")[:8] for d in versions.values()))
+            return f"{BAG_OWN} ({len(versions)} versions: {hashes})"
         return BAG_OWN
     if msgtype in configured_user_catalogue().definitions:
         return USER_OWN

@@ -300,6 +300,16 @@ def coverage_name(index: int) -> str:
     return f"coverage-{index:03d}"
 
 
+def problem_name(index: int) -> str:
+    """``problem-NNN`` (1-based), in the run's namespace: one thing ingestion said of the run."""
+    return f"problem-{index:03d}"
+
+
+def sample_count_name(value_name: str, index: int) -> str:
+    """``<value>-samples_N`` (1-based), in the run's namespace: the samples one source gave a value."""
+    return f"{value_name}-samples_{index}"
+
+
 def rate_name(index: int) -> str:
     """``rate-NNN`` (1-based), in the run's namespace: how densely one topic was recorded."""
     return f"rate-{index:03d}"

@@ -190,6 +190,26 @@ GAP_START = Term(EXSCE, "gap_start")
 GAP_END = Term(EXSCE, "gap_end")
 MESSAGES = Term(EXSCE, "messages")
 RATE = Term(EXSCE, "rate")
+WINDOW_START = Term(EXSCE, "window_start")
+"""On a metric value: where its window begins (``xsd:dateTime``, the recorder's wall clock; only
+on a run with dates)."""
+WINDOW_END = Term(EXSCE, "window_end")
+WINDOW_FROM = Term(EXSCE, "window_from")
+"""On a metric value: where its window begins, in seconds after the run's start."""
+WINDOW_TO = Term(EXSCE, "window_to")
+WINDOW_REASON = Term(EXSCE, "window_reason")
+"""On a metric value: why its window is what it is (the recording, the goals' span, a segment)."""
+ANNOTATIONS = Term(EXSCE, "annotations")
+"""On a metric value: the coverage findings that touch it, one per line."""
+SAMPLE_COUNT_TYPE = Term(EXSCE, "sample_count")
+"""How many samples of one source a metric value used, of those its window holds."""
+COUNTED_FOR = Term(EXSCE, "counted_for")
+SAMPLES_USED = Term(EXSCE, "samples_used")
+SAMPLES_IN_WINDOW = Term(EXSCE, "samples_in_window")
+FEWER_BECAUSE = Term(EXSCE, "fewer_because")
+RUN_PROBLEM_TYPE = Term(EXSCE, "run_problem")
+"""Something ingestion said of a run (a value it could not compute, and why)."""
+PROBLEM = Term(EXSCE, "problem")
 METRIC_TYPE = Term(RUN, "metricType")
 HOTSPOT_TYPE = Term(HOTSPOT, "type")
 ORACLE_METRIC = Term(ORACLE, "metric")
@@ -272,5 +292,6 @@ GOAL_ROLE = "goal"
 TOPIC_ROLE = "topic"
 HOTSPOTS_BUNDLE = "hotspots_bundle"
 COVERAGE_BUNDLE = "coverage_bundle"
+PROBLEMS_BUNDLE = "problems_bundle"
 GENERATION = "generation"
 GENERATION_BUNDLE = "scenario_generation"

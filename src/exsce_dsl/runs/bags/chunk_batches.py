@@ -21,9 +21,12 @@ per-call work is amortised, small enough that memory stays a small part of the b
 bench/ingest.py's bags 8 MB is as fast as 16 MB (Nav2: 1.66 s both) and peaks 45 MB lower on the
 method's (113 against 159 MB for a 78 MB bag)."""
 
-Decoder = Callable[[str, str, str, np.ndarray, RawMessages], bool]
-"""(topic, message type, its definition, receive times in ns, its messages in a batch of chunks) → whether
-it took them; False keeps their raw bytes (for messages deserialized whole)."""
+Decoder = Callable[[str, str, str, np.ndarray, RawMessages, str], bool]
+"""(topic, message type, its definition, receive times in ns, its messages in a batch of chunks, their
+publisher) → whether it took them; False keeps their raw bytes (for messages deserialized whole).
+Each connection (channel) is handed with its own definition: two versions of one type on a topic
+are two definitions.  The publisher names the connection within its topic (a ROS 1 connection's
+caller id, else its number), so that each publisher's stamps can be judged on their own."""
 
 
 @dataclass(frozen=True)
@@ -75,9 +78,9 @@ class Gathered:
     """What an index reader gathers of each key's messages (a connection's, a channel's), batch by
     batch: their receive times, and the bytes of those the decoder did not take."""
 
-    def __init__(self, names: Mapping[int, tuple[str, str, str]], decoder: Decoder) -> None:
+    def __init__(self, names: Mapping[int, tuple[str, str, str, str]], decoder: Decoder) -> None:
         self.names = names
-        """Key → (topic, message type, its definition), in the order the topics are merged."""
+        """Key → (topic, message type, its definition, its publisher), in the order the topics are merged."""
         self.decoder = decoder
         self.times: dict[int, list[np.ndarray]] = {key: [] for key in names}
         self.raws: dict[int, list[bytes]] = {key: [] for key in names}
@@ -85,8 +88,8 @@ class Gathered:
     def decode(self, batch: ChunkBatch) -> None:
         """Hand each key's messages of ``batch`` to the decoder; keep the bytes it does not take."""
         for key, times, messages in batch.messages():
-            topic, msgtype, definition = self.names[key]
-            if not self.decoder(topic, msgtype, definition, times, messages):
+            topic, msgtype, definition, publisher = self.names[key]
+            if not self.decoder(topic, msgtype, definition, times, messages, publisher):
                 self.raws[key].extend(messages.raws())
             self.times[key].append(times)
 
@@ -94,17 +97,22 @@ class Gathered:
         """How many of ``key``'s messages were read."""
         return sum(len(t) for t in self.times[key])
 
+    def by_key(self) -> Iterator[tuple[str, Messages]]:
+        """Each key's topic and messages (keys none of whose messages were read left out): each
+        with its own definition, for the messages deserialized whole."""
+        for key, (topic, msgtype, definition, _) in self.names.items():
+            if self.times[key]:
+                yield topic, Messages(msgtype, definition, np.concatenate(self.times[key]), self.raws[key])
+
     def by_topic(self) -> dict[str, Messages]:
-        """Each topic's messages, those of several keys on one topic merged."""
+        """Each topic's messages, those of several keys on one topic merged (the definition
+        said is the first key's: :meth:`by_key` keeps each key's)."""
         out: dict[str, Messages] = {}
-        for key, (topic, msgtype, definition) in self.names.items():
-            if not self.times[key]:
-                continue
-            times = np.concatenate(self.times[key])
+        for topic, messages in self.by_key():
             known = out.get(topic)
             if known is not None:  # several connections (channels) on one topic: its messages merged
-                times = np.concatenate([known.times, times])
-                out[topic] = Messages(known.msgtype, known.definition, times, known.raws + self.raws[key])
+                times = np.concatenate([known.times, messages.times])
+                out[topic] = Messages(known.msgtype, known.definition, times, known.raws + messages.raws)
             else:
-                out[topic] = Messages(msgtype, definition, times, self.raws[key])
+                out[topic] = messages
         return out

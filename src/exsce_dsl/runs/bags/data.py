@@ -43,6 +43,10 @@ class Series:
     msgtype: str
     t: np.ndarray
     fields: Mapping[str, np.ndarray]
+    publishers: np.ndarray | None = None
+    """Where the topic has several publishers (connections, channels): each message's, an index
+    into :attr:`publisher_names` (its clock is judged per publisher); None: one publisher."""
+    publisher_names: tuple[str, ...] = ()
 
     def __len__(self) -> int:
         return len(self.t)

@@ -20,7 +20,7 @@ from exsce_dsl.errors import ExsceError
 from exsce_dsl.messages.catalogue import MessageCatalogue, Source, parse_definition, standard_catalogue
 from exsce_dsl.runs.bags.chunk_batches import Messages
 from exsce_dsl.runs.bags.data import OBJECTS, BagData, Check, Reduce, Wanted
-from exsce_dsl.runs.bags.mcap_index import IDL_SEPARATOR, Schema, read_topics, schemas
+from exsce_dsl.runs.bags.mcap_index import IDL_SEPARATOR, Schema, definitions, read_channels, recorded_span
 from exsce_dsl.runs.bags.objects import deserialized, deserializer_for
 from exsce_dsl.runs.bags.reader import BagReader, UnsupportedBag
 from exsce_dsl.runs.bags.reading_base import IndexReading
@@ -73,32 +73,32 @@ class _Mcap(IndexReading):
     cdr = True
 
     def read(self, files: list[Path]) -> BagData:
-        found: dict[str, list[Messages]] = {}
+        found: list[tuple[str, Messages]] = []
+        spans = []  # the recording's: its topics not read too
         for file in files:
-            self.schemas = schemas(file)
-            for topic, messages in read_topics(file, self.match, self.decoder).items():
-                found.setdefault(topic, []).append(messages)
+            self.schemas = definitions(file)
+            spans.append(recorded_span(file))
+            found.extend(read_channels(file, self.match, self.decoder).by_key())
         if not found:
             raise UnsupportedBag("none of the topics")  # rosbags then says whether the bag is empty
-        start = min(int(m.times.min()) for parts in found.values() for m in parts)
-        end = max(int(m.times.max()) for parts in found.values() for m in parts)
-        for topic, parts in sorted(found.items()):
-            raws = [raw for m in parts for raw in m.raws]
-            if not raws:
+        start = min(int(m.times.min()) for _, m in found)
+        end = max(int(m.times.max()) for _, m in found)
+        start, end = min(start, *(s for s, _ in spans)), max(end, *(e for _, e in spans))
+        for topic, messages in found:  # each channel's by its own schema
+            if not messages.raws:
                 continue
-            msgtype = parts[0].msgtype
-            catalogue = self.catalogues[self.catalogue_key(msgtype, parts[0].definition)]
+            msgtype = messages.msgtype
+            catalogue = self.catalogues[self.catalogue_key(msgtype, messages.definition)]
             store = deserializer_for(catalogue, msgtype)
-            all_times = np.concatenate([m.times for m in parts])
-            order = np.argsort(all_times, kind="stable")
+            order = np.argsort(messages.times, kind="stable")
             read = functools.partial(store.deserialize_cdr, typename=msgtype)
             lazy = topic if self.wanted_for(topic).msgtype == OBJECTS else None
-            objects = deserialized(read, [raws[i] for i in order.tolist()], lazy)
-            self.add_whole(topic, all_times[order] / 1e9, objects)
-        return self.data(start / 1e9, end / 1e9, tuple(sorted(found)))
+            objects = deserialized(read, [messages.raws[i] for i in order.tolist()], lazy)
+            self.add_whole(topic, messages.times[order] / 1e9, objects)
+        return self.data(start / 1e9, end / 1e9, tuple(sorted({topic for topic, _ in found})))
 
     def own_types(self, topic: str, msgtype: str, definition: str) -> MessageCatalogue:
-        schema = self.schemas[topic]  # read_topics hands out the one schema of this topic
+        schema = self.schemas[(msgtype, definition)]  # the schema of the file being read
         return schema_catalogue(schema, Source(f"the bag {self.path.name}"))
 
     def standard_types(self) -> MessageCatalogue:

@@ -157,11 +157,25 @@ def read_topics(path: Path, topics: Container[str], decoder: Decoder) -> dict[st
     """The messages of ``topics``, handed to ``decoder`` a batch of chunks and a channel at a time,
     so only what it keeps stays in memory, never the whole bag's chunks.
 
-    ``definition`` is the schema's text; its encoding (``ros2msg`` or ``ros2idl``) is
-    :func:`schemas`' ``encoding``, the same for every channel of a topic read here (a topic
-    whose channels carry different schemas is an :class:`UnsupportedBag`)."""
+    ``definition`` is the schema's text; its encoding (``ros2msg`` or ``ros2idl``) is that of
+    the schema :func:`definitions` gives for it.  The channels of a topic may carry different
+    schemas of one type (two versions of it); of different types, they are an
+    :class:`UnsupportedBag`."""
+    return read_channels(path, topics, decoder).by_topic()
+
+
+def read_channels(path: Path, topics: Container[str], decoder: Decoder) -> Gathered:
+    """:func:`read_topics`, the messages kept per channel (each with its own schema)."""
     with mapped(path) as data:
         return _read_topics(data, topics, decoder)
+
+
+def recorded_span(path: Path) -> tuple[int, int]:
+    """The log times (ns) of the file's first and last message, of every channel, from its chunk
+    indexes: the recording's span, whichever topics are read."""
+    with mapped(path) as data:
+        chunks = _summary(data).chunks
+        return min(c.message_start_time for c in chunks), max(c.message_end_time for c in chunks)
 
 
 def schemas(path: Path) -> dict[str, Schema]:
@@ -173,6 +187,18 @@ def schemas(path: Path) -> dict[str, Schema]:
     for _, channel in sorted(summary.channels.items()):
         if channel.schema is not None:
             found.setdefault(channel.topic, channel.schema)
+    return found
+
+
+def definitions(path: Path) -> dict[tuple[str, str], Schema]:
+    """(type name, definition text) → the schema of the file that says it: what a channel's
+    messages are decoded by (each channel its own, :func:`read_channels`)."""
+    with mapped(path) as data:
+        summary = _summary(data)
+    found: dict[tuple[str, str], Schema] = {}
+    for _, channel in sorted(summary.channels.items()):
+        if channel.schema is not None:
+            found.setdefault((channel.schema.name, channel.schema.text), channel.schema)
     return found
 
 
@@ -315,7 +341,7 @@ _RECORD_NAMES = {
 
 def _wanted(summary: _Summary, topics: Container[str]) -> dict[int, _Channel]:
     wanted = {cid: c for cid, c in sorted(summary.channels.items()) if c.topic in topics}
-    first: dict[str, Schema | None] = {}
+    first: dict[str, str] = {}
     for channel in wanted.values():
         if channel.schema is None:
             raise UnsupportedBag(f"topic {channel.topic} has a channel without schema")
@@ -323,18 +349,18 @@ def _wanted(summary: _Summary, topics: Container[str]) -> dict[int, _Channel]:
             raise UnsupportedBag(f"topic {channel.topic} is encoded as {channel.message_encoding!r}, not CDR")
         if channel.schema.encoding not in SCHEMA_ENCODINGS and channel.schema.text.strip():
             raise UnsupportedBag(f"the schema of topic {channel.topic} is {channel.schema.encoding!r}")
-        if first.setdefault(channel.topic, channel.schema) != channel.schema:
-            raise UnsupportedBag(f"topic {channel.topic} has channels of different schemas")
+        if first.setdefault(channel.topic, channel.schema.name) != channel.schema.name:
+            raise UnsupportedBag(f"topic {channel.topic} has channels of different types")
     return wanted
 
 
-def _read_topics(data: mmap.mmap, topics: Container[str], decoder: Decoder) -> dict[str, Messages]:
+def _read_topics(data: mmap.mmap, topics: Container[str], decoder: Decoder) -> Gathered:
     summary = _summary(data)
     wanted = _wanted(summary, topics)
     names = {}
     for cid, channel in wanted.items():
         assert channel.schema is not None  # _wanted checked it
-        names[cid] = (channel.topic, channel.schema.name, channel.schema.text)
+        names[cid] = (channel.topic, channel.schema.name, channel.schema.text, f"channel {cid}")
     gathered = Gathered(names, decoder)
     batch, batch_from, batch_to = ChunkBatch(), 0, 0
     for index in summary.chunks:
@@ -369,7 +395,7 @@ def _read_topics(data: mmap.mmap, topics: Container[str], decoder: Decoder) -> d
                     f"the message indexes of topic {channel.topic} list {counted(found, 'message')}, "
                     f"its statistics {expected}"
                 )
-    return gathered.by_topic()
+    return gathered
 
 
 def _chunk_records(data: mmap.mmap, index: _ChunkIndex) -> bytes:

@@ -5,8 +5,10 @@ the metrics read (:mod:`exsce_dsl.runs.bags.decode`, a decoder driven by the
 message definition).  A type's definition comes from the bag itself (a ROS 1
 connection's definition, an MCAP schema, a ROS 2 bag's type descriptions),
 else from the user's ``.msg``/``.idl`` files, else from rosbags' standard
-typestores.  Several connections on one topic are merged, and every topic's
-messages are put in time order.  The dispatcher's few feedback and result
+typestores, per connection: two versions of one type in a bag are decoded each by
+its own.  Several connections on one topic are merged, each message's connection
+kept where there are several (:attr:`Series.publishers`, whose stamps are judged
+apart), and every topic's messages are put in time order.  The dispatcher's few feedback and result
 messages are deserialized by rosbags.
 
 Each format has its reader (:mod:`~exsce_dsl.runs.bags.reader`), and :data:`READERS` lists

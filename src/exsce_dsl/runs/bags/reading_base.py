@@ -39,8 +39,18 @@ class _Topic:
         self.blocks: list[dict[str, np.ndarray]] = []
         self.texts: dict[str, int] = {}
         """The texts of the topic's text paths, in the order of their codes (every block's)."""
+        self.publishers: dict[str, int] = {}
+        """The topic's publishers (connections), in the order they were first met."""
+        self.block_publishers: list[int] = []
+        """Each block's publisher."""
 
-    def add(self, times: np.ndarray, fields: dict[str, np.ndarray], text_keys: Sequence[str] = ()) -> None:
+    def add(
+        self,
+        times: np.ndarray,
+        fields: dict[str, np.ndarray],
+        text_keys: Sequence[str] = (),
+        publisher: str = "",
+    ) -> None:
         if TEXTS in fields:  # each block codes its own texts: recode them into the topic's table
             table = fields.pop(TEXTS)
             recode = np.array(
@@ -52,6 +62,7 @@ class _Topic:
                 fields[key] = np.where(at < 0, np.nan, recode[at])
         self.times.append(times)
         self.blocks.append(fields)
+        self.block_publishers.append(self.publishers.setdefault(publisher, len(self.publishers)))
 
     def series(self) -> Series:
         times = np.concatenate(self.times) if self.times else np.zeros(0, dtype=np.int64)
@@ -63,7 +74,13 @@ class _Topic:
             fields[key] = values if in_order else values[order]
         if self.texts:
             fields[TEXTS] = np.array(list(self.texts), dtype=object)
-        return Series(self.topic, self.msgtype, times[order] / 1e9, fields)
+        if len(self.publishers) < 2:
+            return Series(self.topic, self.msgtype, times[order] / 1e9, fields)
+        sizes = [len(t) for t in self.times]  # per block, not per message: a block is one publisher's
+        publishers = np.repeat(np.array(self.block_publishers, dtype=np.int32), sizes)
+        return Series(
+            self.topic, self.msgtype, times[order] / 1e9, fields, publishers[order], tuple(self.publishers)
+        )
 
 
 def _concatenate(parts: Sequence[np.ndarray]) -> np.ndarray:
@@ -113,7 +130,7 @@ class Reading:
         self.updates: dict[str, list[StatusUpdate]] = {}
         self.objects: dict[str, list[tuple[float, Any]]] = {}
         self.problems: list[str] = []
-        self.checked: set[tuple[str, str]] = set()
+        self.checked: set[tuple[str, str, int]] = set()
         self.spellings: dict[str, list[str]] = {}
         self._wanted_for: dict[str, Wanted] = {}
         self.catalogues: dict[Hashable, MessageCatalogue] = {}
@@ -155,8 +172,10 @@ class Reading:
         return True
 
     def prepare(self, topic: str, msgtype: str, catalogue: MessageCatalogue) -> None:
-        """Check the fields the metrics read of ``topic`` against the type's definition, once."""
-        if (topic, msgtype) in self.checked or self.wanted_for(topic).msgtype in WHOLE:
+        """Check the fields the metrics read of ``topic`` against the type's definition, once per
+        definition (``catalogue``: each version of a type the bag carries is checked)."""
+        key = (topic, msgtype, id(catalogue))  # catalogues live as long as the reading
+        if key in self.checked or self.wanted_for(topic).msgtype in WHOLE:
             return
         lacking = catalogue.missing(msgtype)
         if lacking:
@@ -169,7 +188,7 @@ class Reading:
             tree, source = catalogue.tree(msgtype), catalogue.source_of(msgtype)
             for name in self.match.read_for(topic):
                 self.check(name, canonical_type(msgtype), tree, source)
-        self.checked.add((topic, msgtype))
+        self.checked.add(key)
 
     def add(
         self,
@@ -177,14 +196,17 @@ class Reading:
         msgtype: str,
         times: np.ndarray,
         fields: dict[str, np.ndarray],
+        publisher: str = "",
     ) -> None:
+        """One block of ``publisher``'s messages on ``topic`` (a connection's: per connection,
+        never per message)."""
         msgtype = canonical_type(msgtype)
         wanted = self.wanted_for(topic)
         text_keys = [p.key for p in wanted.texts]
         for name in self.match.read_for(topic):
             found = self.topics.setdefault(name, _Topic(name, msgtype))
             kept = dict(fields) if wanted.rows else _kept(dict(fields), name, self.reduce, text_keys)
-            found.add(times, kept, text_keys)
+            found.add(times, kept, text_keys, publisher)
 
     def decode(
         self, topic: str, msgtype: str, catalogue: MessageCatalogue, messages: RawMessages, cdr: bool
@@ -257,9 +279,16 @@ class IndexReading(Reading):
         its deserializer needs of the batch's file is taken now (nothing, by default)."""
 
     def decoder(
-        self, topic: str, msgtype: str, definition: str, times: np.ndarray, messages: RawMessages
+        self,
+        topic: str,
+        msgtype: str,
+        definition: str,
+        times: np.ndarray,
+        messages: RawMessages,
+        publisher: str = "",
     ) -> bool:
-        """Decode one batch's messages of a topic; False: keep their bytes (messages read whole)."""
+        """Decode one batch's messages of a connection, by its own definition; False: keep their
+        bytes (messages read whole)."""
         if not self.accepts(topic, msgtype):
             return True  # nothing kept
         if self.wanted_for(topic).msgtype in WHOLE:
@@ -267,7 +296,7 @@ class IndexReading(Reading):
             return False
         catalogue = self.catalogue(topic, msgtype, definition)
         self.prepare(topic, msgtype, catalogue)
-        self.add(topic, msgtype, times, self.decode(topic, msgtype, catalogue, messages, self.cdr))
+        self.add(topic, msgtype, times, self.decode(topic, msgtype, catalogue, messages, self.cdr), publisher)
         return True
 
 

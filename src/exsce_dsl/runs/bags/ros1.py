@@ -65,6 +65,11 @@ def _record(buf: Buffer, pos: int) -> tuple[dict[str, bytes], int, int]:
 def read_topics(path: Path, topics: Container[str], decoder: Decoder) -> dict[str, Messages]:
     """The messages of ``topics``, handed to ``decoder`` a batch of chunks at a time, so only what
     it keeps stays in memory, never the whole bag's chunks."""
+    return read_connections(path, topics, decoder).by_topic()
+
+
+def read_connections(path: Path, topics: Container[str], decoder: Decoder) -> Gathered:
+    """:func:`read_topics`, the messages kept per connection (each with its own definition)."""
     with mapped(path) as data:
         return _read_topics(data, topics, decoder)
 
@@ -73,14 +78,29 @@ def connections(path: Path) -> dict[str, str]:
     """Topic → message type (``pkg/msg/Name``) of every connection of a ROS 1 bag, from its index."""
     with mapped(path) as data:
         found, _, _ = _connections(data, None)
-        return {topic: _ros2_name(msgtype) for topic, msgtype, _ in found.values()}
+        return {topic: _ros2_name(msgtype) for topic, msgtype, _, _ in found.values()}
+
+
+def recorded_span(path: Path) -> tuple[int, int] | None:
+    """The log times (ns) of the bag's first and last message, of every topic, from its chunk
+    infos: the recording's span, whichever topics are read."""
+    with mapped(path) as data:
+        _, pos, chunk_count = _connections(data, ())
+        times = []
+        for _ in range(chunk_count):
+            fields, _, pos = _record(data, pos)
+            for name in ("start_time", "end_time"):
+                sec, nsec = struct.unpack("<II", fields[name])
+                times.append(sec * 10**9 + nsec)
+        return (min(times), max(times)) if times else None
 
 
 def _connections(
     data: mmap.mmap, topics: Container[str] | None
-) -> tuple[dict[int, tuple[str, str, str]], int, int]:
-    """Connection id → (topic, type, message definition) of ``topics`` (all if None); and where
-    the chunk infos start, and how many there are."""
+) -> tuple[dict[int, tuple[str, str, str, str]], int, int]:
+    """Connection id → (topic, type, message definition, publisher) of ``topics`` (all if None);
+    and where the chunk infos start, and how many there are.  The publisher is the connection's
+    caller id (the node that published: rosbag records it), else its number."""
     if data[: len(MAGIC)] != MAGIC:
         raise UnsupportedBag("not a ROS 1 bag 2.0")
     fields, _, _ = _record(data, len(MAGIC))
@@ -91,7 +111,7 @@ def _connections(
     chunk_count = struct.unpack("<I", fields["chunk_count"])[0]
     if index_pos == 0 or index_pos >= len(data):
         raise UnsupportedBag("the bag has no index (not closed properly)")
-    found: dict[int, tuple[str, str, str]] = {}
+    found: dict[int, tuple[str, str, str, str]] = {}
     pos = index_pos
     for _ in range(conn_count):
         fields, data_at, pos = _record(data, pos)
@@ -101,15 +121,17 @@ def _connections(
         topic = fields["topic"].decode(errors="backslashreplace")
         conn_fields, _ = _header_at(data, data_at)  # the data of a connection record is a header too
         if topics is None or topic in topics:
-            found[struct.unpack("<I", fields["conn"])[0]] = (
+            conn = struct.unpack("<I", fields["conn"])[0]
+            found[conn] = (
                 topic,
                 conn_fields.get("type", b"").decode(errors="backslashreplace"),
                 conn_fields.get("message_definition", b"").decode(errors="backslashreplace"),
+                conn_fields.get("callerid", b"").decode(errors="backslashreplace") or f"connection {conn}",
             )
     return found, pos, chunk_count
 
 
-def _read_topics(data: mmap.mmap, topics: Container[str], decoder: Decoder) -> dict[str, Messages]:
+def _read_topics(data: mmap.mmap, topics: Container[str], decoder: Decoder) -> Gathered:
     wanted, pos, chunk_count = _connections(data, topics)
     chunks = []
     for _ in range(chunk_count):
@@ -118,8 +140,8 @@ def _read_topics(data: mmap.mmap, topics: Container[str], decoder: Decoder) -> d
             raise UnsupportedBag("chunk info record expected")
         chunks.append(struct.unpack("<Q", fields["chunk_pos"])[0])
     names = {
-        conn: (topic, _ros2_name(msgtype), definition)
-        for conn, (topic, msgtype, definition) in wanted.items()
+        conn: (topic, _ros2_name(msgtype), definition, publisher)
+        for conn, (topic, msgtype, definition, publisher) in wanted.items()
     }
     gathered = Gathered(names, decoder)
     view = np.frombuffer(data, dtype=np.uint8)
@@ -134,14 +156,14 @@ def _read_topics(data: mmap.mmap, topics: Container[str], decoder: Decoder) -> d
             release(data, batch_from, pos)
     gathered.decode(batch)
     del batch
-    return gathered.by_topic()
+    return gathered
 
 
 def _read_chunk(
     data: mmap.mmap,
     view: np.ndarray,
     chunk_pos: int,
-    wanted: dict[int, tuple[str, str, str]],
+    wanted: dict[int, tuple[str, str, str, str]],
     batch: ChunkBatch,
 ) -> int:
     """Add the chunk at ``chunk_pos`` and its wanted messages to ``batch``; where the records after
@@ -206,12 +228,15 @@ class _Ros1(IndexReading):
     """The fast path for ROS 1 bags: the bag's own index, numpy gathers, no per-message Python."""
 
     def read(self) -> BagData:
-        found = read_topics(self.path, self.match, self.decoder)
+        found = list(read_connections(self.path, self.match, self.decoder).by_key())
         if not found:
             raise UnsupportedBag("none of the topics")  # rosbags then says whether the bag is empty
-        start = min(int(m.times.min()) for m in found.values())
-        end = max(int(m.times.max()) for m in found.values())
-        for topic, messages in sorted(found.items()):
+        start = min(int(m.times.min()) for _, m in found)
+        end = max(int(m.times.max()) for _, m in found)
+        span = recorded_span(self.path)  # the recording: its topics not read too
+        if span is not None:
+            start, end = min(start, span[0]), max(end, span[1])
+        for topic, messages in found:  # each connection's by its own definition
             if not messages.raws:
                 continue
             catalogue = self.catalogue(topic, messages.msgtype, messages.definition)
@@ -221,10 +246,7 @@ class _Ros1(IndexReading):
             lazy = topic if self.wanted_for(topic).msgtype == OBJECTS else None
             objects = deserialized(read, [messages.raws[i] for i in order.tolist()], lazy)
             self.add_whole(topic, messages.times[order] / 1e9, objects)
-        return self.data(start / 1e9, end / 1e9, tuple(sorted(found)))
-
-    def catalogue_key(self, msgtype: str, definition: str) -> str:
-        return msgtype  # the first definition of a type serves every connection of it
+        return self.data(start / 1e9, end / 1e9, tuple(sorted({topic for topic, _ in found})))
 
     def own_types(self, topic: str, msgtype: str, definition: str) -> MessageCatalogue:
         if not definition.strip():

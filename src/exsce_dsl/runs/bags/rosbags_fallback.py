@@ -4,8 +4,9 @@ on (an MCAP file without a summary, a ROS 1 bag without an index, whole-file com
 rosbags hands out one message at a time: they are joined into blocks of :data:`BLOCK` and each
 block decoded at once.  Its readers raise their own errors for corrupt and truncated files:
 they are said as :class:`~exsce_dsl.errors.BagError`\\ s.  A type's definition comes from the
-bag (the types rosbags read of it), else from the user's files, else from rosbags' standard
-typestores.
+bag (each connection's own: rosbags' typestore keeps one definition of a type, the last
+connection's, where a bag holds two versions of it), else from the user's files, else from
+rosbags' standard typestores.
 """
 
 from __future__ import annotations
@@ -22,6 +23,8 @@ from exsce_dsl.messages.catalogue import MessageCatalogue, MessageTypeError, Sou
 from exsce_dsl.messages.user import configured_user_catalogue
 from exsce_dsl.model.messages import canonical_type
 from exsce_dsl.runs.bags.data import OBJECTS, WHOLE, BagData, Check, Reduce, Wanted
+from exsce_dsl.runs.bags.mcap import schema_catalogue
+from exsce_dsl.runs.bags.mcap_index import Schema
 from exsce_dsl.runs.bags.names import BagTopics
 from exsce_dsl.runs.bags.objects import deserialized, deserializer_for
 from exsce_dsl.runs.bags.raw_messages import RawMessages
@@ -54,9 +57,11 @@ def read_with_rosbags(
         if reader.message_count == 0:
             raise BagError(f"{path}: the bag holds no messages")
         reading = Reading(path, wanted, reduce, check)
+        source = Source(f"the bag {path.name}")
         bag_types = MessageCatalogue()
-        bag_types.add(reader.typestore.fielddefs, Source(f"the bag {path.name}"))
+        bag_types.add(reader.typestore.fielddefs, source)
         catalogue = bag_types.layered(configured_user_catalogue(), standard_catalogue())
+        own: dict[tuple[str, str], MessageCatalogue] = {}
         cdr = not _is_ros1(path)
         by_topic: dict[str, list[Any]] = {}
         for conn in reader.connections:
@@ -64,7 +69,8 @@ def read_with_rosbags(
                 by_topic.setdefault(conn.topic, []).append(conn)
         for _, conns in sorted(by_topic.items()):
             for conn in conns:
-                _read_connection(reader, reading, conn, catalogue, cdr)
+                types = _connection_types(conn, source, catalogue, own)
+                _read_connection(reader, reading, conn, types, cdr)
         data = reading.data(
             reader.start_time / 1e9,
             reader.end_time / 1e9,
@@ -77,6 +83,29 @@ def read_with_rosbags(
     finally:
         reader.close()
     return data
+
+
+def _connection_types(
+    conn: Any, source: Source, catalogue: MessageCatalogue, own: dict[tuple[str, str], MessageCatalogue]
+) -> MessageCatalogue:
+    """The types of ``conn``'s messages: its own definition first (once per definition, in
+    ``own``), then the bag's, the user's and the standard ones (``catalogue``)."""
+    from rosbags.interfaces import MessageDefinitionFormat
+
+    msgdef = conn.msgdef
+    if msgdef.format == MessageDefinitionFormat.NONE or not msgdef.data.strip():
+        return catalogue
+    key = (conn.msgtype, msgdef.data)
+    if key not in own:
+        encoding = "ros2idl" if msgdef.format == MessageDefinitionFormat.IDL else "ros2msg"
+        mine = schema_catalogue(Schema(conn.msgtype, encoding, msgdef.data), source)
+        own[key] = mine.layered(catalogue)
+    return own[key]
+
+
+def _publisher(conn: Any) -> str:
+    """The node that published on ``conn`` (a ROS 1 connection's caller id), else its number."""
+    return getattr(conn.ext, "callerid", None) or f"connection {conn.id}"
 
 
 def _read_connection(
@@ -97,9 +126,8 @@ def _read_connection(
                 topic, times / 1e9, deserialized(functools.partial(read, typename=msgtype), raws, lazy)
             )
         else:
-            reading.add(
-                topic, msgtype, times, reading.decode(topic, msgtype, catalogue, RawMessages.join(raws), cdr)
-            )
+            fields = reading.decode(topic, msgtype, catalogue, RawMessages.join(raws), cdr)
+            reading.add(topic, msgtype, times, fields, _publisher(conn))
 
 
 def _blocks(messages: Iterator[tuple[Any, int, bytes]]) -> Iterator[tuple[list[int], list[bytes]]]:

@@ -21,8 +21,9 @@ from exsce_dsl.model.geometry import Position
 from exsce_dsl.model.messages import path_of
 from exsce_dsl.model.metrics import ComputedFor, MetricDefinition
 from exsce_dsl.model.robots import Robot
-from exsce_dsl.model.runs import ActionId, Hotspot, MetricScope, MetricValue
+from exsce_dsl.model.runs import Accounting, ActionId, Hotspot, MetricScope, MetricValue, SourceCount
 from exsce_dsl.monitor_kit import monitor_core as core
+from exsce_dsl.runs.metrics.accounting import GOALS_SPAN, MISSION_SPAN, SampleCounter, segment_reason
 from exsce_dsl.runs.metrics.monitor_code import reads_used
 from exsce_dsl.runs.segments.recorded import RecordedAction
 
@@ -45,13 +46,16 @@ def compute_metrics(
     problems: list[str],
     whole_runs: Mapping[str, tuple[float, float]] | None = None,
     named: Mapping[str, str] | None = None,
+    reasons: Mapping[str, str] | None = None,
 ) -> tuple[list[MetricValue], list[Hotspot]]:
     """Every metric of ``metrics`` for a run. ``results``: robot → waypoints SUCCEEDED (None: no topic);
     ``whole_runs``: robot → the span its whole-run values cover, where it is not its path
     segments' (a robot without segments, or whose window is its whole recording);
     ``named``: a topic the monitors read → how the run's problems name it: the bag's topics it was
     read from, or the sources looked for (a robot's signals are read where its convention puts
-    them, not from the method's topics the metrics are declared over)."""
+    them, not from the method's topics the metrics are declared over); ``reasons``: robot → why
+    its ``whole_runs`` span is its whole-run window (the recording, and why).  Each value carries
+    its accounting: window, reason, and the samples of each source it used."""
     named = named or {}
     values: list[MetricValue] = []
     hotspots: list[Hotspot] = []
@@ -66,11 +70,14 @@ def compute_metrics(
             continue
         # the robot's whole-run window: its goals' (first start to last end), unless told otherwise
         start, end = whole if whole is not None else (min(s for _, s, _ in mine), max(e for _, _, e in mine))
+        why = (reasons or {}).get(robot.id, "the recording") if whole is not None else GOALS_SPAN
         monitor = monitors.RobotMetrics(robot.id, robot.namespace, topics, results.get(robot.id))
+        counter = SampleCounter(topics)
         for metric in by_subject[ComputedFor.ROBOT]:
-            values += _robot_values(monitor, metric, robot, [(None, start, end), *mine], problems, named)
+            windows = [(None, start, end), *mine]
+            values += _robot_values(monitor, metric, robot, windows, problems, named, (counter, why))
             if metric.safety is not None:
-                values += _robot_violations(monitor, metric, robot, start, end, topics, hotspots)
+                values += _robot_violations(monitor, metric, robot, (start, end), hotspots, (counter, why))
     if spans:
         start, end = min(s for s, _ in spans), max(e for _, e in spans)
         fleet = [(r.id, r.namespace) for r in robots]
@@ -152,11 +159,13 @@ def _robot_values(
     windows: list[Window],
     problems: list[str],
     named: Mapping[str, str],
+    counting: tuple[SampleCounter, str],
 ) -> list[MetricValue]:
     prepared = monitor.prepared(metric.name)
     if prepared is None:
         problems.append(_missing(metric, robot, monitor.topics, windows[0][1], windows[0][2], named))
         return []
+    counter, whole_reason = counting
     getter = getattr(monitor, f"get_{metric.name}")
     unit = metric.unit or None  # a count has no unit
     topics = _topics(metric, prepared[0], [robot.namespace])  # one alternative for the whole run
@@ -170,11 +179,23 @@ def _robot_values(
             else:
                 lacking.append((start, end))
             continue
+        why = (
+            whole_reason
+            if action is None
+            else segment_reason(action.allocation, action.subtask, action.waypoint)
+        )
+        used = counter.accounting(prepared[1], topics, (start, end), why)
         if action is None:
-            found.append(MetricValue(metric.name, MetricScope.ROBOT, value, topics, robot.id, unit=unit))
+            found.append(
+                MetricValue(
+                    metric.name, MetricScope.ROBOT, value, topics, robot.id, unit=unit, accounting=used
+                )
+            )
         else:
             aid = ActionId(robot.id, action.allocation, action.subtask, action.waypoint)
-            found.append(MetricValue(metric.name, MetricScope.SEGMENT, value, topics, None, aid, unit))
+            found.append(
+                MetricValue(metric.name, MetricScope.SEGMENT, value, topics, None, aid, unit, accounting=used)
+            )
     if lacking:
         outside = _outside(topics, monitor.topics, *lacking[0], named)
         problems.append(
@@ -205,11 +226,12 @@ def _robot_violations(
     monitor: Any,
     metric: MetricDefinition,
     robot: Robot,
-    start: float,
-    end: float,
-    topics: Mapping[str, core.Topic],
+    window: tuple[float, float],
     hotspots: list[Hotspot],
+    counting: tuple[SampleCounter, str],
 ) -> list[MetricValue]:
+    start, end = window
+    topics = monitor.topics
     prepared = monitor.prepared(metric.name)
     if prepared is None or getattr(monitor, f"get_{metric.name}")(start, end) is None:
         return []  # the metric is missing, so are its violations and hotspots
@@ -232,6 +254,7 @@ def _robot_violations(
             robot.id,
             unit="s",
             safety_metric=metric.name,
+            accounting=counting[0].accounting(aggregates[:1], source, window, counting[1], held=True),
         )
     ]
 
@@ -253,19 +276,30 @@ def _mission_values(
             problems.append(f"{metric.name} of the mission is missing")
             return []
         read = _topics(metric, 0, [r.namespace for r in robots])
-        return [MetricValue(metric.name, MetricScope.MISSION, value, read, unit=metric.unit or None)]
+        found = monitor.prepared(metric.name, ("", ""), ("", ""))
+        used = SampleCounter(topics).accounting(found[1] if found else [], read, (start, end), MISSION_SPAN)
+        return [
+            MetricValue(
+                metric.name, MetricScope.MISSION, value, read, unit=metric.unit or None, accounting=used
+            )
+        ]
     if value is None:
         if len(robots) >= 2:
             problems.append(_pairs_missing(monitor, metric, start, end, named))
         return []
     source: list[str] = []
     violation = 0.0
+    counter, counts = SampleCounter(topics), dict[str, SourceCount]()
     for first, second in monitor.pairs():
         prepared = monitor.prepared(metric.name, first, second)
         if prepared is None:
             continue
         choice, aggregates = prepared
-        source += [t for t in _topics(metric, choice, [first[1], second[1]]) if t not in source]
+        read = _topics(metric, choice, [first[1], second[1]])
+        source += [t for t in read if t not in source]
+        for c in counter.accounting(aggregates, read, (start, end), MISSION_SPAN).sources:
+            if c.topics[0] not in counts or counts[c.topics[0]].used < c.used:
+                counts[c.topics[0]] = c
         if metric.safety is None:
             continue
         t, held, over = _violations(aggregates[0], metric, start, end)
@@ -277,7 +311,12 @@ def _mission_values(
                 Hotspot(metric.name, Position(float(c[0]), float(c[1])), n, d)
                 for c, n, d in group_hotspots(middle, held[over])
             )
-    found = [MetricValue(metric.name, MetricScope.MISSION, value, tuple(source), unit=metric.unit or None)]
+    used = Accounting(start, end, MISSION_SPAN, tuple(counts.values()))
+    found = [
+        MetricValue(
+            metric.name, MetricScope.MISSION, value, tuple(source), unit=metric.unit or None, accounting=used
+        )
+    ]
     if metric.safety is not None:
         found.append(
             MetricValue(
@@ -287,6 +326,7 @@ def _mission_values(
                 tuple(source),
                 unit="s",
                 safety_metric=metric.name,
+                accounting=used,
             )
         )
     return found

@@ -4,8 +4,9 @@ A topic's stamps come from its publishers' clocks, and TF's from several nodes a
 robot the controller's ``odom → base_footprint`` stamped at about log time and AMCL's ``map →
 odom`` post-dated by its transform tolerance (up to seconds ahead), interleaved on ``/tf``.  Read
 as one series, those stamps "go back" dozens of times a second, and no clock did.  So stamps are
-judged per publisher (a :class:`StampTrack`): per edge (parent → child) for TF, per topic for
-every other stamped series (the readers merge a topic's connections).
+judged per publisher (a :class:`StampTrack`): per edge (parent → child) for TF, per connection
+for every other stamped series (the readers keep each message's connection where a topic has
+several: :attr:`~exsce_dsl.runs.bags.data.Series.publishers`).
 
 A track whose stamps go back by more than the caller's tolerance is a finding about that
 publisher (:func:`first_back`), never a reason to leave samples out.  A reset of the clock is
@@ -16,7 +17,7 @@ recorder that did not record ``/clock``.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -37,9 +38,13 @@ class StampTrack:
     """One publisher's stamps: its log times and stamps (seconds), in log-time order."""
 
     name: str
-    """The topic, with the TF edge it carries (``/tf (map → odom)``)."""
+    """The topic, with the TF edge or the publisher it carries (``/tf (map → odom)``,
+    ``/pose (/amcl)``)."""
     log: np.ndarray
     stamps: np.ndarray
+    publisher: str = ""
+    """The topic's publisher (connection) whose stamps these are; empty: the topic's only one, or
+    a TF edge."""
 
     def period(self) -> float:
         """The median interval between its messages (inf with fewer than two)."""
@@ -59,6 +64,20 @@ def header_track(topic: str, log: np.ndarray, stamps: np.ndarray) -> StampTrack:
     """The track of a series with one stamp per message (its header's); unusable stamps left out."""
     known = np.isfinite(stamps) & (stamps > 0)
     return StampTrack(topic, log[known], stamps[known])
+
+
+def header_tracks(series: Series, stamps: np.ndarray) -> list[StampTrack]:
+    """One track per publisher (connection) of a series with one stamp per message: the series'
+    own where it has a single publisher."""
+    log = np.asarray(series.t, dtype=np.float64)
+    if series.publishers is None:
+        return [header_track(series.topic, log, stamps)]
+    found = []
+    for index, publisher in enumerate(series.publisher_names):
+        mine = series.publishers == index
+        track = header_track(f"{series.topic} ({publisher})", log[mine], stamps[mine])
+        found.append(StampTrack(track.name, track.log, track.stamps, publisher))
+    return found
 
 
 def tf_tracks(series: Series) -> list[StampTrack]:
@@ -128,3 +147,49 @@ def _near(steps: list[Back], at: np.ndarray, moment: float, within: float) -> li
     low = int(np.searchsorted(at, moment - within, side="left"))
     high = int(np.searchsorted(at, moment + within, side="right"))
     return steps[low:high]
+
+
+def publishers_apart(
+    tracks: Sequence[StampTrack], on_timeline: Callable[[np.ndarray], np.ndarray], tolerance: float
+) -> dict[str, str]:
+    """Of one series' publishers (tracks with a ``publisher``), those whose stamps cannot time
+    their messages, and why: stamps that go back by more than ``tolerance``, none usable, or
+    further than ``tolerance`` from the other publishers' (a node post-dating its messages).  The
+    others' are those of the steady publisher nearest the timeline (``on_timeline``: log times
+    onto it), so that a publisher sure of its clock is never judged by a late one."""
+    named = [t for t in tracks if t.publisher]
+    if len(named) < 2:
+        return {}
+    found = {t.publisher: f"{t.name} carries no usable stamps" for t in named if not len(t.log)}
+    for track in named:
+        step = backs(track, tolerance)[:1] if track.publisher not in found else []
+        if step:
+            back, at = step[0].back, step[0].at
+            found[track.publisher] = (
+                f"the stamps of {track.name} go back {back:.3f} s at log time {at:.3f} (by more than "
+                f"{tolerance:g} s)"
+            )
+    steady = [t for t in named if t.publisher not in found]
+    ahead = {t.publisher: float(np.median(t.stamps - on_timeline(t.log))) for t in steady}
+    reference = min(ahead.values(), key=abs, default=0.0)
+    for track in steady:
+        apart = ahead[track.publisher] - reference
+        if abs(apart) > tolerance:
+            found[track.publisher] = (
+                f"the stamps of {track.name} are {apart:+.3f} s from those of the topic's other "
+                f"publishers (post-dated, or of another clock; by more than {tolerance:g} s)"
+            )
+    return found
+
+
+def steady_stamps(
+    tracks: Sequence[StampTrack], offset: float, tolerance: float
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """The log times and stamps of a series' publishers that can time their messages, judged
+    before there is a timeline (against the series' own median ``offset``, log time minus stamp):
+    what a timeline made of stamps is made of.  None: every publisher can (or none)."""
+    apart = publishers_apart(tracks, lambda log: log - offset, tolerance)
+    kept = [t for t in tracks if t.publisher not in apart]
+    if not apart or not kept:
+        return None
+    return np.concatenate([t.log for t in kept]), np.concatenate([t.stamps for t in kept])

@@ -26,11 +26,13 @@ the recording) is a :class:`ClockJump`: the timeline follows ``/clock`` up to th
 on at its last rate after it (so every series stays in order), and the run's coverage says that
 nothing from the jump on is on one timeline.  Stamps are judged per publisher
 (:mod:`~exsce_dsl.runs.signals.stamp_tracks`: per edge for TF, whose edges come from several
-nodes): a publisher whose stamps go back by more than :data:`SAME_CLOCK` makes its series timed
-by its log times, with a note, and is a jump only when every stamped publisher recorded then goes
-back together (a reset without ``/clock``); stamped series whose offsets to log time differ by
-more than :data:`SAME_CLOCK` (two publishers on different clocks) are named in a note.  No sample
-is ever left out.
+nodes; per connection for every other topic): of a topic's several publishers, one whose stamps
+go back by more than :data:`SAME_CLOCK`, or stand that far apart from the others' (post-dated),
+has its messages timed by their log times, with a note; a TF edge or a topic's only publisher
+whose stamps go back makes its series timed by log time.  A jump is only every stamped publisher
+recorded then going back together (a reset without ``/clock``); stamped series whose offsets to
+log time differ by more than :data:`SAME_CLOCK` (publishers on different clocks) are named in a
+note.  No sample is ever left out.
 """
 
 from __future__ import annotations
@@ -51,7 +53,15 @@ from exsce_dsl.model.messages import path_of
 from exsce_dsl.runs.bags.decode import TEXTS
 from exsce_dsl.runs.bags.reading import WHOLE, BagData, Series, StatusUpdate, Wanted
 from exsce_dsl.runs.signals.clock_words import describe_clocks, log_time_is_dated
-from exsce_dsl.runs.signals.stamp_tracks import StampTrack, first_back, header_track, resets, tf_tracks
+from exsce_dsl.runs.signals.stamp_tracks import (
+    StampTrack,
+    first_back,
+    header_tracks,
+    publishers_apart,
+    resets,
+    steady_stamps,
+    tf_tracks,
+)
 from exsce_dsl.wording import counted
 
 CLOCK_TOPIC = "/clock"
@@ -86,13 +96,17 @@ class SourceClock:
     """Whether the times are simulated time (stamps of a simulation, or log times mapped onto it)."""
     offset: float = 0.0
     """Median of log time minus stamp, in seconds (0 for a series timed by log time)."""
+    by_log: tuple[str, ...] = ()
+    """Of a topic timed by its stamps, the publishers (connections) whose messages are timed by
+    their log times instead (their stamps go back, or stand apart from the others')."""
 
     def describe(self) -> str:
         kind = "simulated" if self.simulated else "wall clock"
         if self.clock == LOG_TIME:
             mapped = ", mapped onto simulated time" if self.simulated else ""
             return f"{self.topic}: log time{mapped}"
-        return f"{self.topic}: {self.clock} ({kind}, {self.offset:+.3f} s from log time)"
+        but = f"; log time for {', '.join(self.by_log)}" if self.by_log else ""
+        return f"{self.topic}: {self.clock} ({kind}, {self.offset:+.3f} s from log time{but})"
 
 
 @dataclass(frozen=True)
@@ -286,7 +300,7 @@ def decide_timeline(data: BagData) -> Timeline:
         by = CLOCK_TOPIC
         simulated_run = bool(np.median(time_knots) < SIMULATED_BEFORE <= np.median(log_knots))
     elif simulated:
-        log_knots, time_knots = _offset_knots(simulated)
+        log_knots, time_knots = _offset_knots([_steady(s) for s in simulated])
         named = ", ".join(s.topic for s in simulated[:3]) + (" ..." if len(simulated) > 3 else "")
         by = f"the offsets of {named}"
         simulated_run = True
@@ -330,9 +344,16 @@ def _stamped_series(data: BagData) -> list[_Stamped]:
             continue
         known = np.isfinite(stamps) & (stamps > 0)
         offset = float(np.median(series.t[known] - stamps[known]))
-        tracks = tf_tracks(series) if kind == TRANSFORM_STAMPS else [header_track(topic, series.t, stamps)]
+        tracks = tf_tracks(series) if kind == TRANSFORM_STAMPS else header_tracks(series, stamps)
         found.append(_Stamped(topic, kind, series.t, stamps, offset, tuple(tracks)))
     return found
+
+
+def _steady(series: _Stamped) -> _Stamped:
+    """``series`` without the stamps of its publishers that cannot time it (a post-dated one
+    would pull a timeline made of stamps its way)."""
+    found = steady_stamps(series.tracks, series.offset, SAME_CLOCK)
+    return series if found is None else replace(series, log=found[0], stamps=found[1])
 
 
 def _clock_knots(clock: Series) -> tuple[np.ndarray, np.ndarray, ClockJump | None]:
@@ -375,26 +396,38 @@ def _source_clock(series: _Stamped, timeline: Timeline, notes: list[str]) -> Sou
     """How ``series`` goes on the timeline: by its stamps when they are of the timeline's clock
     and none of its publishers' go back by more than :data:`SAME_CLOCK`, else by its log times
     (a note says which publisher went back: a reset is decided over every publisher); stamps
-    coarser than the series' rate are never used (a note says so)."""
+    coarser than the series' rate are never used (a note says so).  Of a topic with several
+    publishers, one whose stamps go back or stand apart from the others' is timed by its log
+    times alone, with a note (:func:`publishers_apart`)."""
     coarse = series.coarse()
     if coarse:
         notes.append(coarse)
         return SourceClock(series.topic, LOG_TIME, timeline.simulated)
-    back = first_back(series.tracks, SAME_CLOCK)
-    if back is not None:
+    apart = (
+        publishers_apart(series.tracks, timeline.from_log, SAME_CLOCK) if series.kind == HEADER_STAMPS else {}
+    )
+    kept = [t for t in series.tracks if t.publisher not in apart]
+    back = first_back(kept, SAME_CLOCK)
+    if back is not None or not kept:
+        back = back or first_back(series.tracks, SAME_CLOCK)
+        went = f"go back {back.back:.3f} s at log time {back.at:.3f}" if back else "stand apart"
         notes.append(
-            f"the stamps of {back.track} go back {back.back:.3f} s at log time {back.at:.3f} "
+            f"the stamps of {back.track if back else series.topic} {went} "
             f"(by more than {SAME_CLOCK:g} s): {series.topic} timed by log time"
         )
         return SourceClock(series.topic, LOG_TIME, timeline.simulated)
+    offset = series.offset
+    if apart:
+        notes.extend(f"{why}: its messages timed by log time" for why in apart.values())
+        offset = float(np.median(np.concatenate([t.log - t.stamps for t in kept])))
     if series.simulated == timeline.simulated:
-        if series.other_clock and not series.simulated:
+        if abs(offset) > SAME_CLOCK and not series.simulated:
             notes.append(
-                f"the stamps of {series.topic} are {series.offset:+.3f} s from log time "
+                f"the stamps of {series.topic} are {offset:+.3f} s from log time "
                 "(a clock not synchronised with the recorder's): moved onto log time"
             )
-        return SourceClock(series.topic, series.kind, series.simulated, series.offset)
-    return SourceClock(series.topic, LOG_TIME, timeline.simulated, series.offset)
+        return SourceClock(series.topic, series.kind, series.simulated, offset, tuple(apart))
+    return SourceClock(series.topic, LOG_TIME, timeline.simulated, offset)
 
 
 def on_timeline(data: BagData, timeline: Timeline) -> BagData:
@@ -437,6 +470,11 @@ def _series_on(series: Series, clock: SourceClock | None, timeline: Timeline) ->
     stamps = _stamps(series)
     assert stamps is not None  # a series is timed by header stamps only where it has them
     times = stamps if clock.simulated or abs(clock.offset) <= SAME_CLOCK else stamps + clock.offset
+    if clock.by_log and series.publishers is not None:  # those publishers' messages by their log times
+        by_log = [series.publisher_names.index(p) for p in clock.by_log]
+        mine = np.isin(series.publishers, by_log)
+        times = times.copy()
+        times[mine] = timeline.from_log(series.t[mine])
     return _retimed(series, times)
 
 
@@ -447,8 +485,9 @@ def _retimed(series: Series, times: np.ndarray) -> Series:
         fields = {
             k: (v[order] if k != TEXTS and len(v) == len(times) else v) for k, v in series.fields.items()
         }
-        return Series(series.topic, series.msgtype, times[order], fields)
-    return Series(series.topic, series.msgtype, times, series.fields)
+        publishers = series.publishers[order] if series.publishers is not None else None
+        return replace(series, t=times[order], fields=fields, publishers=publishers)
+    return replace(series, t=times)
 
 
 def _tf_moved(series: Series, offset: float) -> Series:
@@ -457,4 +496,4 @@ def _tf_moved(series: Series, offset: float) -> Series:
     fields = dict(series.fields)
     fields[sec] = series.fields[sec] + series.fields[nanosec] * 1e-9 + offset
     fields[nanosec] = np.zeros_like(series.fields[nanosec])
-    return Series(series.topic, series.msgtype, series.t, fields)
+    return replace(series, fields=fields)

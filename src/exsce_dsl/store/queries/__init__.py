@@ -14,6 +14,7 @@ PROV entity (``classroom_c025-w001-R0.00_P0.00_Y0.00``).
 
 from __future__ import annotations
 
+from exsce_dsl.store.queries.accounting import ValueAccount, run_problems, value_accounts
 from exsce_dsl.store.queries.coverage import run_coverage, run_topic_rates
 from exsce_dsl.store.queries.library import KINDS, Parameter, Query, query, query_names, standard_prefixes
 from exsce_dsl.store.queries.run_ids import (
@@ -101,6 +102,7 @@ __all__ = [
     "RunCandidate",
     "RunDefect",
     "StoredRun",
+    "ValueAccount",
     "ValueStats",
     "UnknownRunError",
     "ViolationDuration",
@@ -130,6 +132,7 @@ __all__ = [
     "run_metric",
     "run_coverage",
     "run_defects",
+    "run_problems",
     "run_metric_values",
     "run_query",
     "run_scenarios",
@@ -138,6 +141,7 @@ __all__ = [
     "runs",
     "safety_metrics",
     "scenario_ids",
+    "value_accounts",
     "segment_metric",
     "segment_metric_any",
     "segment_metric_between",
