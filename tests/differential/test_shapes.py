@@ -1,5 +1,5 @@
 """Issue 47, item 5: every metric on synthetic bags of the shapes real recordings showed (items 1-8
-of the issue; interleaved tracks and teleports are the plausibility checks' own tests), in ROS 1,
+of the issue, interleaved tracks and teleports included), in ROS 1,
 ROS 2 sqlite3 and MCAP, against the independent reference of tests/support/reference_path.py:
 equal to 1e-6 where both compute, missing with a reason exactly where the reference has no
 value.
@@ -26,6 +26,8 @@ from tests.runs.test_clock_words import SPEC as CLOCK_SPEC
 from tests.runs.test_clock_words import clock_bag
 from tests.runs.test_coarse_stamps import SPEC as COARSE_SPEC
 from tests.runs.test_coarse_stamps import _poses as coarse_poses
+from tests.runs.test_pose_plausibility import SPEC as PLAUSIBILITY_SPEC
+from tests.runs.test_pose_plausibility import _messages as plausibility_topics
 from tests.runs.test_root_velocity import SPEC as ROOTED_SPEC
 from tests.runs.test_root_velocity import _messages as rooted_topics
 from tests.runs.test_tf_publishers import SPEC as TF_SPEC
@@ -159,6 +161,24 @@ def _rooted_bag(folder: Path, fmt: str) -> Path:
     return bag
 
 
+def _implausible_bag(shape: str) -> Callable[[Path, str], Path]:
+    """test_pose_plausibility's root ``/location`` in one of its shapes (``tracks``: two
+    estimates alternating 1.8 to 3.8 m apart; ``teleport``: a 5 m jump), beside the robot's own
+    ``/velocity``."""
+
+    def write(folder: Path, fmt: str) -> Path:
+        store = typestore_for(fmt)
+        bag = folder / (f"{shape}.bag" if fmt == "ros1" else shape)
+        write_bag(bag, fmt, plausibility_topics(store, shape, True), store)
+        return bag
+
+    return write
+
+
+def _no_location_path(bag: Recording) -> dict[Key, Expected]:
+    return {("location_path", "tb"): Expected(None)}
+
+
 def _two_robots_bag(folder: Path, fmt: str) -> Path:
     """Two odometries crossing (r1 along real_shapes' route at 20 Hz; r2 the other way, at
     15 Hz from 0.3 s), and r1's scan at 10 Hz (8 to 12 beams a message)."""
@@ -253,6 +273,18 @@ SHAPES = {
     "root_velocity": Shape(
         _rooted_bag, ROOTED_SPEC, [RobotSources("tb", pose="/location", velocity="/velocity", waypoints=FAR)]
     ),
+    # item 4: a root /location alternating between two tracks, and one that teleports: no
+    # distance and no path from it (the reference computes nothing from such a pose), the
+    # speed from the robot's own /velocity
+    **{
+        f"implausible_{shape}": Shape(
+            _implausible_bag(shape),
+            PLAUSIBILITY_SPEC,
+            [RobotSources("tb", pose="/location", velocity="/velocity", waypoints=FAR, implausible=True)],
+            _no_location_path,
+        )
+        for shape in ("tracks", "teleport")
+    },
     # item 3: turtlesim's Pose: no header, float32
     "headerless_float32": Shape(
         _turtles_bag,

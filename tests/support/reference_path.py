@@ -239,7 +239,8 @@ class RobotSources:
     """Where a robot's signals are in a bag, as the test states them: its pose (a topic, or TF
     ``fixed → body`` as ``(tf_reader, frames)``), its velocity topic (None: estimated from the
     pose), its distance topic (an odometry whose path is the distance; None: the pose's path),
-    its scan, and its planned waypoints."""
+    its scan, and its planned waypoints; ``implausible``: the test wrote its pose so that no robot
+    could have made it (two tracks alternating, a teleport), and nothing is computed from it."""
 
     robot: str
     pose: str | None = None
@@ -248,6 +249,7 @@ class RobotSources:
     scan: str | None = None
     waypoints: tuple[tuple[float, float], ...] = ()
     tf_pose: Callable[[Recording], Samples] | None = None
+    implausible: bool = False
 
 
 Key = tuple[str, str | None]
@@ -263,6 +265,8 @@ class Expected:
 
 
 def _pose(bag: Recording, robot: RobotSources) -> Samples | None:
+    if robot.implausible:
+        return None
     if robot.tf_pose is not None:
         return robot.tf_pose(bag)
     return bag.samples(robot.pose) if robot.pose else None
