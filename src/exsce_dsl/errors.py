@@ -50,6 +50,7 @@ __all__ = [
     "TimeLimitError",
     "UnknownNameWarning",
     "UnknownRunError",
+    "UnknownValueError",
 ]
 
 
