@@ -67,6 +67,9 @@ SHAPES = {
     "simulated_log": (int(SIM_LOG_START * 1e9), None, True),
     "wall_clock": (START_NS, None, False),
     "gazebo": (START_NS, 931.25, True),
+    # a stand-in's simulation whose /clock runs as the wall clock: bag info called it simulated
+    # time and ingest -v the wall clock (found on the live demo's bags)
+    "clock_at_wall_time": (START_NS, None, True),
 }
 
 
@@ -133,7 +136,12 @@ def test_clocks_described_alike_by_bag_info_and_ingest(shape: str, tmp_path: Pat
     table = exscec_here("bag", "info", str(bag))
     assert table.returncode == 0, table.stderr
     assert f"timeline  {told}" in table.stdout
-    expected = {"simulated_log": "simulated time", "wall_clock": "wall clock", "gazebo": "simulated time"}
+    expected = {
+        "simulated_log": "simulated time",
+        "wall_clock": "wall clock",
+        "gazebo": "simulated time",
+        "clock_at_wall_time": "wall clock",
+    }
     assert told.startswith(expected[shape]), told
 
 

@@ -89,8 +89,12 @@ class BagInfo:
 
     @property
     def timeline(self) -> str:
-        """Its clocks, in the words ``exscec ingest`` uses (:func:`describe_clocks`)."""
-        simulated = any(t.clock == "simulated" for t in self.topics) or self.clock_recorded
+        """Its clocks, in the words ``exscec ingest`` uses (:func:`describe_clocks`), decided as
+        ingestion decides (:func:`~exsce_dsl.runs.signals.timeline.decide_timeline`): by
+        ``/clock`` where it was recorded (a simulation whose clock runs as the wall clock, a
+        stand-in's, is the wall clock), else by the stamps."""
+        clocks = [t for t in self.topics if t.name.lstrip("/") == "clock"]
+        simulated = any(t.clock == "simulated" for t in clocks or self.topics)
         return describe_clocks(self.start, self.clock_recorded, simulated)
 
     def as_dict(self) -> dict[str, Any]:
@@ -223,10 +227,11 @@ def _rate(times: list[float]) -> float | None:
 
 
 def _stamp(message: Any) -> float | None:
+    """A message's stamp: its header's, its first transform's, or a ``/clock`` message's time."""
     header = getattr(message, "header", None)
     if header is None and getattr(message, "transforms", None):
         header = message.transforms[0].header
-    stamp = getattr(header, "stamp", None)
+    stamp = getattr(header, "stamp", None) if header is not None else getattr(message, "clock", None)
     if stamp is None:
         return None
     seconds = float(stamp.sec) + float(stamp.nanosec) * 1e-9
