@@ -41,6 +41,7 @@ ORPHAN = "orphan graph"
 OLD_BAG_BUNDLE = "old bag bundle"
 DANGLING = "dangling reference"
 NO_SCENARIO = "run without scenario"
+_REBUILD = "build it again: exscec baseline SPEC"
 
 
 @dataclass(frozen=True)
@@ -212,7 +213,7 @@ def _dangling(store: Store, names: Namespaces, runs: set[str]) -> list[StoreFind
         missing = sorted({r for r in listed.value.split() if r not in runs})
         if missing:
             shown = ", ".join(missing[:3]) + (f" and {len(missing) - 3} more" if len(missing) > 3 else "")
-            message = f"learnt from run {shown}, which the store does not hold (build it again: exscec baseline SPEC)"
+            message = f"learnt from run {shown}, which the store does not hold ({_REBUILD})"
             found.append(StoreFinding(DANGLING, graph.value, message))
     return sorted(set(found), key=lambda f: (f.graph, f.message))
 
