@@ -8,8 +8,10 @@ from __future__ import annotations
 import re
 from collections.abc import Sequence
 
-__all__ = ["graph_run", "replace_advice"]
+__all__ = ["graph_run", "replace_advice", "shared_element"]
 
+_SHARED_GRAPH = re.compile(r"/(robots|environments|tasks)/([^/?]+)_bundle$")
+_SHARED_KINDS = {"robots": "robot", "environments": "environment or area", "tasks": "task"}
 _RUN_GRAPH = re.compile(r"/runs/run_([^/?]+?)(?:_bundle)?(?:/[^?]*)?(?:[?&]revision=\d+)?$")
 
 
@@ -19,9 +21,18 @@ def graph_run(graph: str) -> str | None:
     return found.group(1) if found is not None else None
 
 
+def shared_element(graph: str) -> tuple[str, str] | None:
+    """(kind, id) when ``graph`` is the bundle of a robot, environment, area or task: named by the
+    element's id alone, so every scenario of the store with an element of that id shares it."""
+    found = _SHARED_GRAPH.search(graph)
+    return (_SHARED_KINDS[found.group(1)], found.group(2)) if found is not None else None
+
+
 def replace_advice(graphs: Sequence[str]) -> str:
     """What to run to replace conflicting ``graphs``: ``ingest --replace`` for a run's (a run is
-    analysed again from its bag), ``compile --store --replace`` for a spec's."""
+    analysed again from its bag), ``compile --store --replace`` for a spec's, with a warning for
+    graphs every scenario with an element of that id shares (another scenario's robot is
+    replaced too)."""
     runs = sorted({run for g in graphs if (run := graph_run(g)) is not None})
     if runs:
         which = ", ".join(runs[:3]) + (f" and {len(runs) - 3} more" if len(runs) > 3 else "")
@@ -29,7 +40,16 @@ def replace_advice(graphs: Sequence[str]) -> str:
             f"the store holds run {which} with other content: to analyse the run again and replace "
             "it, ingest its bag with replace (`exscec ingest BAG --scenario SPEC --replace`)"
         )
-    return (
+    advice = (
         "to replace it, add it again with replace (`exscec compile SPEC --store --replace`): "
         "the old version is kept as a revision (prov:wasRevisionOf)"
     )
+    shared = sorted({found for g in graphs if (found := shared_element(g)) is not None})
+    if shared:
+        which = ", ".join(f"{kind} '{element}'" for kind, element in shared[:3])
+        advice += (
+            f"; but {which} {'is' if len(shared) == 1 else 'are'} named by id alone, shared by every "
+            "scenario of the store that names one so: if another scenario declares it otherwise, "
+            "give this scenario's another id (--replace would change the other scenario's too)"
+        )
+    return advice
