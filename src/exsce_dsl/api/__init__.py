@@ -34,16 +34,13 @@ from exsce_dsl.api.stand_in import stand_in
 from exsce_dsl.api.tables import metrics, query, rows_frame, segments, sparql, verdicts
 from exsce_dsl.api.trials import flaky, verify_trial
 from exsce_dsl.errors import RosGraphError
-from exsce_dsl.store.checking import StoreCheck, StoreFinding, check_store
-from exsce_dsl.store.migrating import MigrationReport, migrate_store
+from exsce_dsl.store.checking import check_store
+from exsce_dsl.store.migrating import migrate_store
 from exsce_dsl.store.queries.run_ids import AmbiguousRunError, UnknownRunError, resolve_run
 
 __all__ = [
     "AmbiguousRunError",
-    "MigrationReport",
     "RosGraphError",
-    "StoreCheck",
-    "StoreFinding",
     "UnknownRunError",
     "add_derived",
     "baseline",
