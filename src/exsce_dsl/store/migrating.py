@@ -45,9 +45,8 @@ class MigrationReport:
         lines = [f"{m.old} -> {m.new}" for m in self.moved]
         count = len(self.moved)
         if count:
-            lines.append(
-                f"{self.location}: {count} bag bundle{'s' if count != 1 else ''} named by their run now"
-            )
+            named = "bag bundles named by their run" if count != 1 else "bag bundle named by its run"
+            lines.append(f"{self.location}: {count} {named} now")
         else:
             lines.append(f"{self.location}: nothing to migrate (every bag bundle is named by its run)")
         return "\n".join(lines)
