@@ -173,3 +173,28 @@ def test_store_check_fix_renames_an_old_bag_bundle(project: Path, tmp_path: Path
     result = api.check_store(store, fix=True)
     assert result.clean and len(result.fixed) == 2
     assert store.graph_sizes() == current
+
+
+def test_store_check_finds_the_same_on_an_oxigraph_server(project: Path, tmp_path: Path) -> None:
+    """The checks are SPARQL 1.1: a server finds what the embedded store finds, and --fix mends
+    it there in the same one write."""
+    from exsce_dsl.store.open import open_store
+
+    from tests.support.store_servers import oxigraph_server
+
+    embedded, (_, gone) = _written(project, tmp_path / "store")
+    embedded.remove_graphs([f"{RUNS}{gone}_bundle"])
+    _make_old(embedded)
+    expected = api.check_store(embedded)
+    assert {f.kind for f in expected.findings} == {"orphan graph", "old bag bundle", "dangling reference"}
+    contents = embedded.graphs(sorted(embedded.graph_names()))
+    with (
+        oxigraph_server(tmp_path / "served") as server,
+        open_store(f"oxigraph+{server.url}", timeout=20) as remote,
+    ):
+        remote.write(GraphSet(contents))
+        assert api.check_store(remote).findings == expected.findings
+        api.check_store(remote, fix=True)
+        api.check_store(embedded, fix=True)
+        assert remote.graph_sizes() == embedded.graph_sizes()
+        assert {f.kind for f in api.check_store(remote).findings} == {"dangling reference"}
