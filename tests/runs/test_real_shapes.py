@@ -206,7 +206,7 @@ def bags(folder: Path, scenarios: dict[str, tuple[Path, Scenario]]) -> dict[tupl
     for fmt in FORMATS:
         for shape, topics in SHAPES.items():
             store = typestore_for(fmt)
-            # named apart from the scenario: a bag's PROV bundle is exsce:NAME_bundle, as a scenario's is
+            # named apart from the scenario (which it need not be since bag bundles are named by their run)
             path = folder / fmt / (f"{shape}_{fmt}.bag" if fmt == "ros1" else f"{shape}_{fmt}")
             path.parent.mkdir(exist_ok=True)
             write_bag(path, fmt, topics(store), store)

@@ -74,6 +74,8 @@ CHAPTERS: dict[str, tuple[tuple[str, ...], ...]] = {
         ("store", "info"),
         ("store", "graphs"),
         ("store", "export"),
+        ("store", "check"),  # finds nothing on the store the walk wrote
+        ("store", "migrate"),  # nothing to move: the walk wrote the current identities
         ("serve",),
         ("lsp",),
         ("mcp",),

@@ -34,6 +34,8 @@ from exsce_dsl.api.stand_in import stand_in
 from exsce_dsl.api.tables import metrics, query, rows_frame, segments, sparql, verdicts
 from exsce_dsl.api.trials import flaky, verify_trial
 from exsce_dsl.errors import RosGraphError
+from exsce_dsl.store.checking import check_store
+from exsce_dsl.store.migrating import migrate_store
 from exsce_dsl.store.queries.run_ids import AmbiguousRunError, UnknownRunError, resolve_run
 
 __all__ = [
@@ -43,6 +45,7 @@ __all__ = [
     "add_derived",
     "baseline",
     "check",
+    "check_store",
     "cluster",
     "compile_prov",
     "derive",
@@ -54,6 +57,7 @@ __all__ = [
     "init_from_bag",
     "load",
     "metrics",
+    "migrate_store",
     "open_store",
     "query",
     "resolve_run",

@@ -24,7 +24,8 @@ class ExitCode(IntEnum):
     """The exit status of every exscec command: one meaning each, whatever the command.
 
     A command that judges nothing exits 0 or 2 (or 70); ``exscec fmt --check`` exits 1 when a
-    file would change, as black does (a check of the files that failed).
+    file would change, as black does (a check of the files that failed), and ``exscec store
+    check`` when the store has something left to mend.
     """
 
     PASSED = 0

@@ -1,13 +1,14 @@
-"""Commands on the store: ``store info|graphs|export|clear`` and ``serve``."""
+"""Commands on the store: ``store info|graphs|export|clear|check|migrate`` and ``serve``."""
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Callable
 from typing import Any, TypeVar
 
 import click
 
-from exsce_dsl.cli.common import reports_errors, write_text
+from exsce_dsl.cli.common import ExitCode, reports_errors, write_text
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -167,6 +168,59 @@ def clear(store_url: str | None) -> None:
         count = len(store.graph_names())
         store.clear()
     click.echo(f"{store.location}: removed {count} graph{'s' if count != 1 else ''}", err=True)
+
+
+@store_group.command(name="check")
+@store_option
+@click.option("--fix", is_flag=True, help="Mend what is safe: remove orphan graphs, rename old bag bundles.")
+@reports_errors
+def check(store_url: str | None, fix: bool) -> None:
+    """Find what no longer hangs together in the store, and with --fix mend what is safe.
+
+    Orphan graphs (a run's graphs without its run, a bag's bundle without
+    its run, a path segment no stored run observes), bag bundles named by the
+    old scheme (by the bag's file), dangling references (a record naming
+    something no graph describes, a baseline of runs the store no longer
+    holds) and runs without their scenario.  --fix removes the orphans and
+    renames the old bag bundles, in one write; the rest says what to run.
+    Exits 1 when something is left to mend.
+
+    \b
+    Example:
+      exscec store check
+      exscec store check --fix
+    """
+    from exsce_dsl.api import check_store
+    from exsce_dsl.store.open import open_store
+
+    with open_store(store_url, read_only=not fix) as store:
+        result = check_store(store, fix=fix)
+    click.echo(result.summary())
+    if not result.clean:
+        sys.exit(ExitCode.FAILED)
+
+
+@store_group.command(name="migrate")
+@store_option
+@reports_errors
+def migrate(store_url: str | None) -> None:
+    """Move a store written by an older exscec to the current identities.
+
+    A run's bag bundle was named by the bag's file (exsce:<bag file>_bundle),
+    so two recordings with one file name could not share a store; it is
+    named by the run now (<run>:bag_bundle).  This renames the old graphs,
+    in one write; their statements do not change.
+
+    \b
+    Example:
+      exscec store migrate
+    """
+    from exsce_dsl.api import migrate_store
+    from exsce_dsl.store.open import open_store
+
+    with open_store(store_url) as store:
+        report = migrate_store(store)
+    click.echo(report.summary())
 
 
 @click.command()

@@ -14,7 +14,7 @@ run's own namespace, ``<base>runs/run_<uuid>/``, prefix ``run_<first 8 of uuid>`
   the robot's previous pose and ended by its goal pose (``prov:role="goal"``),
   associated with the robot's agent, informing its task execution, and informed by
   the robot's previous action (across its tasks).
-* ``exsce:<bag file>_bundle``: the bag (``ros:Bags``, ``exsce:file_path``) and its
+* ``R:bag_bundle``: the bag ``R:<bag file>`` (``ros:Bags``, ``exsce:file_path``) and its
   topics ``topic:<name>`` (``ros:Topics``), members of the bag.
 * ``R:<metric>_bundle``, one per metric: a collection ``R:[<robot>-]<metric>-topics``
   (``exsce:topic``) of the topics it was computed from, and each value
@@ -34,6 +34,10 @@ run's own namespace, ``<base>runs/run_<uuid>/``, prefix ``run_<first 8 of uuid>`
 
 Where exsce differs from the method's published run and its report, on purpose:
 
+* the bag's bundle is named by the run (``R:bag_bundle``), where the method named it by the
+  bag's file (``exsce:<bag file>_bundle``): two recordings with one file name (``test.bag`` in two
+  folders) or a bag named like a scenario would have shared one graph in a store.  The bag entity
+  keeps its published name, ``R:<bag file>``, which is in the run's namespace;
 * the run activity also *used* the scenario entity ``exsce:<scenario>`` (the
   method's queries, Listings 37–47, follow that edge; its recorder did not write it);
 * the end of an action carries ``exsce:run``, not ``exsce:runs`` (a misspelling);
@@ -86,7 +90,6 @@ def compile_run(
     namespace: str = DEFAULT_NAMESPACE,
     *,
     checked: bool = False,
-    own_bag_graph: bool = False,
 ) -> ProvDocument:
     """The PROV document of ``run``, a run of ``scenario``: run, bag and metric bundles.
 
@@ -94,25 +97,20 @@ def compile_run(
     scenario (another scenario, an unknown robot, a task the mission does not
     allocate, a metric of an unknown action or from a topic the bag lacks) or two
     of its parts would share an identifier.  ``checked`` builds every record
-    through prov's API (slower; for tests).  ``own_bag_graph`` names the bag's bundle in the
-    run's namespace (``R:<bag file>_bundle``): for a bag that is a run of another scenario too,
-    whose run holds ``exsce:<bag file>_bundle``.
+    through prov's API (slower; for tests).
     """
-    return _RunCompiler(run, scenario, Namespaces(namespace), checked, own_bag_graph).compile()
+    return _RunCompiler(run, scenario, Namespaces(namespace), checked).compile()
 
 
 class _RunCompiler:
     """A run's PROV document: the run, bag, metric and hotspot bundles, and its coverage."""
 
-    def __init__(
-        self, run: Run, scenario: Scenario, names: Namespaces, checked: bool, own_bag_graph: bool = False
-    ) -> None:
+    def __init__(self, run: Run, scenario: Scenario, names: Namespaces, checked: bool) -> None:
         if run.scenario != scenario.id:
             raise ExsceError(f"run {run.uuid} is a run of '{run.scenario}', not of '{scenario.id}'")
         self.run = run
         self.scenario = scenario
         self.names = names
-        self.own_bag_graph = own_bag_graph
         self.writer = DocumentWriter(names, checked)
         for prefix in _DOCUMENT_PREFIXES:
             self.writer.document_namespace(prefix)
@@ -244,8 +242,7 @@ class _RunCompiler:
         run, writer = self.run, self.writer
         bag = run.bag
         name = ids.bag_name(bag.file_name)
-        graphs = self.run_parts if self.own_bag_graph else writer.document_namespace(ids.EXSCE)
-        w = writer.bundle(graphs[f"{name}_bundle"], f"the bundle of bag {bag.file_name}")
+        w = writer.bundle(self.run_parts[ids.BAG_BUNDLE], f"the bundle of bag {bag.file_name}")
         t = w.term
         bag_id = self.parts_in(w)[name]
         writer.claim(bag_id, f"bag {bag.file_name}")

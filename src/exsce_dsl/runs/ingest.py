@@ -208,8 +208,7 @@ def _write_runs(
                 written(Written((bag, None), None, outcome))
                 continue
             try:
-                own_bag_graph = bag.run is not None and not bag.run.own_id
-                document = compile_run(outcome.run, scenario, namespace, own_bag_graph=own_bag_graph)
+                document = compile_run(outcome.run, scenario, namespace)
                 if bag.replacing:
                     writer.flush()
                     report = replace_run(store, document, outcome.run.uuid, namespace)

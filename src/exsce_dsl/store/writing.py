@@ -54,6 +54,7 @@ from pyoxigraph import (
 
 from exsce_dsl.prov.identifiers import PROV_NAMESPACE, RDF_TYPE, ROBOT_SCHEMA, XSD_NAMESPACE
 from exsce_dsl.store.base import GraphSet, Store, StoreConflictError, StoreError
+from exsce_dsl.store.graph_owners import replace_advice
 from exsce_dsl.store.literals import INTEGER_TYPES
 from exsce_dsl.store.segment_index import segment_index, stale_index_graphs
 
@@ -441,10 +442,7 @@ def _conflict_message(
         if not details:
             details.append("blank-node statements differ")
         lines.append(f"  {compact(c.graph, prefixes)}: {'; '.join(details)}")
-    lines.append(
-        "to replace it, add it again with replace (`exscec compile SPEC --store --replace`): "
-        "the old version is kept as a revision (prov:wasRevisionOf)"
-    )
+    lines.append(replace_advice([c.graph for c in conflicts]))
     return "\n".join(lines)
 
 
