@@ -48,7 +48,8 @@ _ACTION_TYPE = "exsce:action"
 
 def read_execution(document: object, source: str, scenario: str) -> Execution | None:
     """The execution in a run-time PROV ``document`` (PROV-JSON, parsed), read from ``source``;
-    None when it holds no run of ``scenario`` (another scenario's, or not ours)."""
+    None when it holds no run, or a run of another scenario than ``scenario`` (a run that names
+    no scenario, as the method's own recorder writes it, is taken as one of ``scenario``)."""
     if not isinstance(document, Mapping):
         return None
     for bundle in _bundles(document):
@@ -61,7 +62,13 @@ def read_execution(document: object, source: str, scenario: str) -> Execution | 
         if len(runs) != 1:
             continue
         run_name, run = runs[0]
-        if f"exsce:{scenario}" not in {u.get("prov:entity") for u in _records(bundle, "used").values()}:
+        used = {
+            str(u.get("prov:entity"))
+            for u in _records(bundle, "used").values()
+            if u.get("prov:activity") == run_name
+        }
+        scenarios = {u for u in used if u.startswith("exsce:")}  # the method's recorder names none
+        if scenarios and f"exsce:{scenario}" not in scenarios:
             continue
         bags = [g.get("prov:entity") for g in _records(bundle, "wasGeneratedBy").values()
                 if g.get("prov:activity") == run_name]  # fmt: skip
