@@ -119,6 +119,7 @@ def _commands(stores: Stores) -> dict[str, tuple[str, ...]]:
     start, goal = segment["start"], segment["goal"]
     campaign = _first(stores, "query", "campaigns")["campaign"]
     judged = _first(stores, "query", "verdicts")["run"]  # the run over speed, with its verdicts
+    dispatched = _first(stores, "query", "run_lineage", "-p", f"run={judged}")["item"]  # its execution
     poses = ("-p", f"start={start}", "-p", f"goal={goal}")
     distance = ("-p", "metric=distance_travelled")
     speeding = ("-p", "scenario=yard_run", "-p", "metric=max_velocity")
@@ -129,6 +130,7 @@ def _commands(stores: Stores) -> dict[str, tuple[str, ...]]:
         "campaigns": (),
         "derivation": ("-p", "scenario=yard_reversed"),
         "derived_scenarios": ("-p", "base=yard_run"),
+        "dispatched_runs": ("-p", f"prefix={dispatched[:8]}"),
         "hotspot_counts": speeding,
         "hotspots": every_run,
         "metric_names": (),

@@ -59,14 +59,15 @@ class RunLineage:
         return "\n".join(lines)
 
     def _value_lines(self) -> list[str]:
-        accounts = {(a.metric, a.robot, a.action, a.value): a for a in self.accounts}
+        accounts = {(a.metric, a.robot, a.action, a.safety_metric): a for a in self.accounts}
         lines = [f"values ({len(self.chain.values)})"]
         for value in self.chain.values:
             whom = value.action or value.robot  # a segment's action names its robot
             unit = f" {value.unit}" if value.unit else ""
             of = f" of {whom}" if whom else ""
-            lines.append(f"  {value.metric}{of} = {value.value:.6g}{unit}")
-            account = accounts.get((value.metric, value.robot, value.action, value.value))
+            safety = f" ({value.safety_metric})" if value.safety_metric else ""
+            lines.append(f"  {value.metric}{safety}{of} = {value.value:.6g}{unit}")
+            account = accounts.get((value.metric, value.robot, value.action, value.safety_metric))
             if account is not None and account.window is not None:
                 lines.append(f"    window: {account.window_text()}")
                 lines += [f"    {line}" for line in account.samples_text()]

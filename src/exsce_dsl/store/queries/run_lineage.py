@@ -60,6 +60,8 @@ class ChainValue:
     value: float
     unit: str | None
     window_reason: str | None
+    safety_metric: str | None = None
+    """The safety metric of a ``violation_duration`` value."""
 
 
 @dataclass(frozen=True)
@@ -154,6 +156,7 @@ def _value(row: dict[str, Term | None]) -> ChainValue:
         float_of(row["value"]) or 0.0,
         text_of(row["unit"]),
         text_of(row["detail"]),
+        text_of(row["safety"]),
     )
 
 
