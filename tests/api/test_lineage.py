@@ -144,14 +144,20 @@ def test_reingesting_the_bag_is_still_skipped_under_the_same_run(
     assert f"already a run of scenario 'scenario_c' (run {run})" in said
 
 
-def test_a_bag_without_run_time_prov_has_no_execution_in_its_chain(tmp_path: Path) -> None:
-    """The .prov.json removed, the simulated bag carries none (simulate does not record /exsce/prov)."""
+def test_a_replaced_run_keeps_its_execution_and_loses_it_with_its_run_time_prov(tmp_path: Path) -> None:
+    """``ingest --replace`` writes the execution again (no conflict with the stored one); the
+    .prov.json removed (simulate records no /exsce/prov in the bag), the run has none."""
     ok("simulate", SPEC, "--runs", "1", "--seed", "9", "-o", "sim", cwd=tmp_path)
-    for prov in (tmp_path / "sim").glob("*.prov.json"):
-        prov.unlink()
-    said = ok("ingest", *map(str, (tmp_path / "sim").glob("*.bag")), "--scenario", SPEC, cwd=tmp_path)
-    found = INGESTED.search(said)
-    assert found is not None, said
+    (bag,) = (tmp_path / "sim").glob("*.bag")
+    found = INGESTED.search(ok("ingest", str(bag), "--scenario", SPEC, cwd=tmp_path))
+    assert found is not None
+    again = ok("ingest", str(bag), "--scenario", SPEC, "--replace", cwd=tmp_path)
+    assert f"run {found[1]} analysed again" in again
+    lines = ok("lineage", found[1], cwd=tmp_path).splitlines()
+    assert lines[2].startswith("execution ") and sum(line.startswith("  goal ") for line in lines) == 6
+    bag.with_suffix(".prov.json").unlink()
+    ok("ingest", str(bag), "--scenario", SPEC, "--replace", cwd=tmp_path)
     lines = ok("lineage", found[1], cwd=tmp_path).splitlines()
     assert "execution: no run-time PROV came with the bag" in lines
+    assert not any(line.startswith("  goal ") for line in lines)
     assert "verdicts: none (exscec verify RUN)" in lines
