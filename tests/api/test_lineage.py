@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import re
+import shutil
 from pathlib import Path
 from typing import Any
 
@@ -161,3 +162,21 @@ def test_a_replaced_run_keeps_its_execution_and_loses_it_with_its_run_time_prov(
     assert "execution: no run-time PROV came with the bag" in lines
     assert not any(line.startswith("  goal ") for line in lines)
     assert "verdicts: none (exscec verify RUN)" in lines
+
+
+def test_the_chain_of_a_derived_scenario_s_run_starts_at_its_base(tmp_path: Path) -> None:
+    shutil.copytree(EXAMPLES / "brsu_building_c", tmp_path / "c")
+    ok("derive", "c/scenario_c.exsce", "-t", "remove_robot", "--robot", "tiago2", "--reassign", "tiago1",
+       "--id", "c_one", "-o", "c/c_one.exsce", "--add-to-store", cwd=tmp_path)  # fmt: skip
+    ok("simulate", "c/c_one.exsce", "--runs", "1", "-o", "sim", cwd=tmp_path)
+    said = ok(
+        "ingest", *map(str, (tmp_path / "sim").glob("*.bag")), "--scenario", "c/c_one.exsce", cwd=tmp_path
+    )
+    found = INGESTED.search(said)
+    assert found is not None, said
+    chain = rows("query", "run_lineage", "-p", f"run={found[1]}", cwd=tmp_path)
+    assert [(r["part"], r.get("item")) for r in chain][:1] == [("derived_from", "scenario_c")]
+    assert {r["scenario"] for r in chain} == {"c_one"}
+    assert {r["robot"] for r in chain if r["part"] == "goal"} == {"tiago1"}  # tiago2's tasks reassigned
+    lines = ok("lineage", found[1], cwd=tmp_path).splitlines()
+    assert lines[1:3] == ["scenario c_one", "  derived from scenario_c by remove_robot"]
