@@ -55,6 +55,7 @@ STEPS: dict[str, list[set[str]]] = {
         {"segments"},
         {"metrics"},
         {"coverage"},
+        {"recorded_execution"},
         {"analyse", "ingest", "robots", "bag_identity", "bag_info", "bag_robots", "bag_runs", "missing", "plausible_poses"},
         {"spec_draft"},
     ],

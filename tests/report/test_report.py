@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import itertools
+import json
 import os
 import re
 import shutil
@@ -143,6 +144,27 @@ def test_the_store_gives_lineage_runs_verdicts_hotspots_and_maps(project: Path) 
     assert set(base.waypoints) == {"tiago1", "tiago2"} and len(base.waypoints["tiago1"]) == 4  # start + 3
     assert contents.clustering is not None and set(contents.clustering.scenarios) == {"scenario_c", "c_one"}
     assert any(o.type.value == "baseline" and o.value is not None for o in base.oracles)
+
+
+def test_each_run_page_names_the_run_its_dispatcher_recorded(project: Path) -> None:
+    """simulate wrote each run's .prov.json beside its bag: its run id is on the run's page."""
+    recorded = sorted(project.glob("*/*.prov.json"))
+    assert len(recorded) == 5
+    pages = "\n".join(p.read_text(encoding="utf-8") for p in _pages(project) if p.name.startswith("run-"))
+    shown = set(re.findall(r'<span class="id dispatched">([0-9a-f-]{36})</span>', pages))
+    assert shown == {_run_of(p) for p in recorded}
+
+
+def _run_of(prov: Path) -> str:
+    """The dispatcher's run id, from the run activity of its .prov.json."""
+    bundles = json.loads(prov.read_text(encoding="utf-8"))["bundle"].values()
+    (run,) = [
+        a["exsce:run"]
+        for b in bundles
+        for a in b.get("activity", {}).values()
+        if a.get("prov:type", {}).get("$") == "exsce:run"
+    ]
+    return str(run)
 
 
 def test_every_page_is_written_and_every_link_and_image_is_there(project: Path) -> None:

@@ -118,6 +118,8 @@ def _commands(stores: Stores) -> dict[str, tuple[str, ...]]:
     segment = _first(stores, "query", "path_segments", "-p", "scenario=yard_run")
     start, goal = segment["start"], segment["goal"]
     campaign = _first(stores, "query", "campaigns")["campaign"]
+    judged = _first(stores, "query", "verdicts")["run"]  # the run over speed, with its verdicts
+    dispatched = _first(stores, "query", "run_lineage", "-p", f"run={judged}")["item"]  # its execution
     poses = ("-p", f"start={start}", "-p", f"goal={goal}")
     distance = ("-p", "metric=distance_travelled")
     speeding = ("-p", "scenario=yard_run", "-p", "metric=max_velocity")
@@ -128,6 +130,7 @@ def _commands(stores: Stores) -> dict[str, tuple[str, ...]]:
         "campaigns": (),
         "derivation": ("-p", "scenario=yard_reversed"),
         "derived_scenarios": ("-p", "base=yard_run"),
+        "dispatched_runs": ("-p", f"prefix={dispatched[:8]}"),
         "hotspot_counts": speeding,
         "hotspots": every_run,
         "metric_names": (),
@@ -141,6 +144,7 @@ def _commands(stores: Stores) -> dict[str, tuple[str, ...]]:
         "robots": ("-p", "scenario=yard_run"),
         "run_ids": ("-p", f"prefix={runs[0][:8]}"),
         "run_known": ("-p", f"run={runs[0]}"),
+        "run_lineage": ("-p", f"run={judged}"),
         "run_metric": ("-p", f"run={runs[0]}", *distance, "-p", "robot=r1"),
         "run_coverage": every_run,
         "run_metric_values": every_run,

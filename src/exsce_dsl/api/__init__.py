@@ -30,6 +30,7 @@ from exsce_dsl.api.commands import (
 from exsce_dsl.api.drafts import init_from_bag
 from exsce_dsl.api.execution import execute_ros1
 from exsce_dsl.api.explain import explain
+from exsce_dsl.api.lineage import run_lineage
 from exsce_dsl.api.stand_in import stand_in
 from exsce_dsl.api.tables import metrics, query, rows_frame, segments, sparql, verdicts
 from exsce_dsl.api.trials import flaky, verify_trial
@@ -62,6 +63,7 @@ __all__ = [
     "query",
     "resolve_run",
     "rows_frame",
+    "run_lineage",
     "segments",
     "simulate",
     "sparql",

@@ -153,21 +153,38 @@ def _step_text(step: object) -> str:
 @store_option
 @reports_errors
 def lineage(scenario: str, store_url: str | None) -> None:
-    """Print where a scenario comes from and what was derived from it.
+    """Print where a scenario or a run comes from.
 
-    Ancestors first (each with the transformations that made the next), then
-    the scenario, then its descendants as a tree, from the derivation
-    provenance in the store.
+    For a scenario: its ancestors first (each with the transformations that
+    made the next), then the scenario, then its descendants as a tree, from the
+    derivation provenance in the store.
+
+    For a run (its uuid or a prefix of it, or the id its dispatcher gave it, as
+    `exscec simulate` and `execute` print it): the chain from dispatch to
+    verdict: scenario and derivations, the dispatcher's execution (the goals it
+    sent and their outcomes), the bag, each value with its window and samples,
+    the verdicts and the baseline runs they used.
 
     \b
     Example:
       exscec lineage c_one
     """
     from exsce_dsl.store.open import open_store
-    from exsce_dsl.store.queries import derivation_of, derived_scenarios
+    from exsce_dsl.store.queries import derivation_of, derived_scenarios, scenario_ids
     from exsce_dsl.store.queries import lineage as ancestry
 
     with open_store(store_url) as store:
+        if scenario not in scenario_ids(store):
+            from exsce_dsl.api.lineage import run_lineage
+            from exsce_dsl.errors import UnknownRunError
+            from exsce_dsl.store.queries.run_ids import is_full_uuid, names_a_prefix
+
+            try:
+                click.echo(run_lineage(store, scenario).text())
+                return
+            except UnknownRunError:
+                if names_a_prefix(scenario) or is_full_uuid(scenario):
+                    raise  # an id of a run: say the store lacks it
         chain = list(reversed(ancestry(store, scenario)))
         for derivation in chain:
             click.echo(derivation.base)

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model.coverage import CoverageGap, TopicRate
+from exsce_dsl.model.executions import Execution
 from exsce_dsl.model.geometry import Pose, Position
 from exsce_dsl.model.names import NAME_PATTERN
 
@@ -258,6 +259,8 @@ class Run:
     dated: bool = True
     """Whether ``start``, ``end`` and the actions' times are dates; not when the recorder logged
     simulated time (they are then seconds after 1970 of simulated time, and no date is written)."""
+    execution: Execution | None = None
+    """What the dispatcher did, as the run-time PROV recorded with the bag says (None without it)."""
 
     def actions(self) -> Iterator[Action]:
         for task in self.tasks:

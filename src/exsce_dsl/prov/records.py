@@ -18,6 +18,8 @@ from prov.constants import (
     PROV,
     PROV_ATTR_ACTIVITY,
     PROV_ATTR_AGENT,
+    PROV_ATTR_ALTERNATE1,
+    PROV_ATTR_ALTERNATE2,
     PROV_ATTR_COLLECTION,
     PROV_ATTR_ENDTIME,
     PROV_ATTR_ENTITY,
@@ -34,6 +36,7 @@ from prov.identifier import Namespace, QualifiedName
 from prov.model import (
     ProvActivity,
     ProvAgent,
+    ProvAlternate,
     ProvAssociation,
     ProvBundle,
     ProvCommunication,
@@ -209,6 +212,13 @@ class BundleWriter:
             self._add(ProvAgent, identifier, attributes.items())
 
     # -- relations ---------------------------------------------------------
+
+    def alternate(self, one: QualifiedName, other: QualifiedName) -> None:
+        """``alternateOf(one, other)``: two entities that present aspects of the same thing."""
+        if self._checked:
+            self.bundle.alternate(one, other)
+        else:
+            self._add(ProvAlternate, None, ((PROV_ATTR_ALTERNATE1, one), (PROV_ATTR_ALTERNATE2, other)))
 
     def member(self, collection: QualifiedName, entity: QualifiedName) -> None:
         if self._checked:

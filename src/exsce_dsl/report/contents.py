@@ -70,6 +70,8 @@ class RunContents:
     """Its path segments, by robot then in the order it drove them (the report numbers them S1, S2...)."""
     accounts: tuple[ValueAccount, ...] = ()
     """What each of its values used (window, why, samples per source, findings)."""
+    dispatched: str | None = None
+    """The id its dispatcher gave the run (its run-time PROV's), when the bag came with one."""
 
     def used(
         self, metric: str, robot: str | None, safety: str | None = None, action: str | None = None
@@ -203,6 +205,7 @@ def gather(store: Store, specs: Sequence[Path] = ()) -> ReportContents:
     grids, missing, notes = _grids(declared)
     ids = queries.scenario_ids(store)
     all_verdicts = verdicts(store)
+    dispatched = dict(queries.dispatched_runs(store, ""))  # every run's dispatcher's id, in one query
     derivations = {s: queries.derivation_of(store, s) for s in ids}
     children: dict[str, list[str]] = {}
     for scenario_id, derivation in derivations.items():
@@ -232,6 +235,7 @@ def gather(store: Store, specs: Sequence[Path] = ()) -> ReportContents:
                         tuple(spots.get(r.uuid, ())),
                         tuple(driven.get(r.uuid, ())),
                         tuple(queries.value_accounts(store, r.uuid)),
+                        dispatched.get(r.uuid),
                     )
                     for r in runs
                 ),

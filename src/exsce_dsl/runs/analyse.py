@@ -48,6 +48,7 @@ from exsce_dsl.runs.metrics.compute import HOTSPOT_PATHS, POSE_TOPIC, compute_me
 from exsce_dsl.runs.metrics.monitor_code import load_monitors
 from exsce_dsl.runs.missing import missing_metrics, unread_topics
 from exsce_dsl.runs.plausible_poses import Refused, refuse_implausible, spec_speed_limit
+from exsce_dsl.runs.recorded_execution import recorded_execution
 from exsce_dsl.runs.robots import SERVED, StackRobots, stack_robots
 from exsce_dsl.runs.segments.dispatcher import SUCCEEDED, segments
 from exsce_dsl.runs.segments.recorded import RecordedAction
@@ -235,6 +236,7 @@ def analyse_bag(
         coverage=covered.gaps,
         topic_rates=covered.rates,
         problems=tuple(dict.fromkeys(bag.problems)),
+        execution=recorded_execution(path, scenario.id, bag.data.messages.get(PROV_TOPIC, ())),
     )
     return AnalysedRun(run, digest, bag.problems, bag.timeline, bag.detected)
 

@@ -280,6 +280,16 @@ VERDICTS_BUNDLE = "verdicts_bundle"
 TRANSFORM_ATTR = Term(EXSCE, "transform")
 STEP = Term(EXSCE, "step")
 
+# The execution of a run as its dispatcher recorded it (see exsce_dsl.prov.run_execution).
+EXECUTION_TYPE = Term(EXSCE, "execution")
+"""The dispatcher's run activity, ``run:run_<dispatcher's uuid>``, stored with the ingested run."""
+DISPATCHED_GOAL_TYPE = Term(EXSCE, "dispatched_goal")
+"""One goal the dispatcher sent, as its run-time PROV names it."""
+DISPATCHED_RUN = Term(EXSCE, "dispatched_run")
+"""On an execution: the dispatcher's uuid of the run."""
+RUN_TIME_PROV = Term(EXSCE, "run_time_prov")
+"""On an execution: where its run-time PROV was read (``/exsce/prov`` or the ``.prov.json``)."""
+
 # The segment index (written by the store beside a run's bundles, see exsce_dsl.store.segment_index).
 PATH_SEGMENT = Term(EXSCE, "PathSegment")
 START_POSE = Term(EXSCE, "startPose")
@@ -296,5 +306,6 @@ BAG_BUNDLE = "bag_bundle"
 file, which two recordings may share)."""
 COVERAGE_BUNDLE = "coverage_bundle"
 PROBLEMS_BUNDLE = "problems_bundle"
+EXECUTION_BUNDLE = "execution_bundle"
 GENERATION = "generation"
 GENERATION_BUNDLE = "scenario_generation"

@@ -25,6 +25,15 @@ from exsce_dsl.store.queries.run_ids import (
     resolve_run,
     resolve_runs,
 )
+from exsce_dsl.store.queries.run_lineage import (
+    ChainExecution,
+    ChainGoal,
+    ChainValue,
+    ChainVerdict,
+    RunChain,
+    dispatched_runs,
+    run_chain,
+)
 from exsce_dsl.store.queries.run_values import *  # noqa: F403
 from exsce_dsl.store.queries.run_values import (
     ActionTimes,
@@ -90,6 +99,10 @@ from exsce_dsl.store.queries.terms import (
 __all__ = [
     "MIN_PREFIX",
     "ActionTimes",
+    "ChainExecution",
+    "ChainGoal",
+    "ChainValue",
+    "ChainVerdict",
     "AmbiguousRunError",
     "Given",
     "KINDS",
@@ -100,6 +113,7 @@ __all__ = [
     "Query",
     "RobotFacts",
     "RunCandidate",
+    "RunChain",
     "RunDefect",
     "StoredRun",
     "ValueAccount",
@@ -111,6 +125,7 @@ __all__ = [
     "datetime_of",
     "derivation_of",
     "derived_scenarios",
+    "dispatched_runs",
     "float_of",
     "hotspot_counts",
     "int_of",
@@ -130,6 +145,7 @@ __all__ = [
     "robot_metric_over_runs",
     "robots",
     "run_metric",
+    "run_chain",
     "run_coverage",
     "run_defects",
     "run_problems",
