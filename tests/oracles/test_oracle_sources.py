@@ -53,14 +53,14 @@ def judged(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFact
     scenario = spec.scenario()
     bags = [run.bag for run in simulate(scenario, folder / "runs", 2, seed=1)]
     store = EmbeddedStore()
-    ingest_bags(bags[:1], scenario, store)
+    [ingested] = ingest_bags(bags[:1], scenario, store)
     build_baseline(store, spec)
     verification = verify_runs(store, scenario, [bags[1]])
-    return store, scenario, bags, verification
+    return store, scenario, bags, verification, ingested.run_id
 
 
 def test_a_stack_robot_s_oracles_name_its_topics_not_nav_vel(judged) -> None:
-    store, scenario, bags, _ = judged
+    store, scenario, bags, _, _ = judged
     types = _by_type(bags[0])
     held = {t for topics in types.values() for t in topics}
     assert not any(t.endswith(("/nav_vel", "/robot_pose")) for t in held)
@@ -75,7 +75,7 @@ def test_a_stack_robot_s_oracles_name_its_topics_not_nav_vel(judged) -> None:
 
 
 def test_a_stack_robot_s_verdicts_name_the_judged_value_s_topics(judged) -> None:
-    store, _, bags, verification = judged
+    store, _, bags, verification, _ = judged
     types = _by_type(bags[1])
     held = {t for topics in types.values() for t in topics}
     assert len(verification.verdicts) == 11 and all(v.topics for v in verification.verdicts)
@@ -92,3 +92,34 @@ def test_a_stack_robot_s_verdicts_name_the_judged_value_s_topics(judged) -> None
     named = {"/" + topic.value.removeprefix(TOPICS) for (topic,) in rows.rows}
     assert named == _mine(types["geometry_msgs/msg/Twist"], "r1")
     assert not any("nav_vel" in t for t in named)
+
+
+def _parents(bag: Path, topics: set[str]) -> dict[str, str]:
+    """Each frame's parent in the bag's transforms on ``topics``, as rosbags reads them."""
+    found: dict[str, str] = {}
+    with AnyReader([bag]) as reader:
+        connections = [c for c in reader.connections if c.topic in topics]
+        for connection, _, raw in reader.messages(connections=connections):
+            for transform in reader.deserialize(raw, connection.msgtype).transforms:
+                found[transform.child_frame_id] = transform.header.frame_id
+    return found
+
+
+def test_a_pose_from_tf_names_the_transforms_it_composed(judged) -> None:
+    """A value computed from TF poses names the chain of frames it composed (``map → odom →
+    base_link``) on its sample counts (``exsce:tf_chain``), not only ``/tf``."""
+    from exsce_dsl.store.queries.accounting import value_accounts
+
+    store, _, bags, _, baseline_run = judged
+    [value] = value_accounts(store, baseline_run, "distance_between_robots")
+    types = _by_type(bags[0])
+    for robot in ("r1", "r2"):
+        tf = _mine(types["tf2_msgs/msg/TFMessage"], robot)
+        parents, frame, chain = _parents(bags[0], tf), "base_link", ["base_link"]
+        while frame in parents:
+            frame = parents[frame]
+            chain.insert(0, frame)
+        assert chain[0] == "map" and len(chain) >= 3
+        [count] = [c for c in value.sources if set(c.topics) == tf]
+        assert count.tf_chain == " → ".join(chain)
+        assert any(line.startswith(f"TF {' → '.join(chain)} on /{robot}/tf") for line in value.samples_text())

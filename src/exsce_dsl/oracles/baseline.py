@@ -9,7 +9,9 @@ were not inconclusive, completed their mission and broke no safety limit, see
 clause (``within 1 std``, ``within 10 %``, ``within 2 s``; one standard deviation
 for ``invariant`` if none is written), or its confidence (``at 99 %``: the half-width of the
 prediction interval for one new run, :func:`~exsce_dsl.oracles.intervals.prediction_half_width`).
-The method's "update baseline" is writing these oracles to the store again.
+The method's "update baseline" is writing these oracles to the store again.  Each oracle names
+the topics the values it learnt from were computed from, as the store holds them
+(:mod:`exsce_dsl.oracles.sources`), not the method's topics for its metric.
 """
 
 from __future__ import annotations
