@@ -28,7 +28,7 @@ from exsce_dsl.oracles.good_runs import GoodRuns, good_runs
 from exsce_dsl.oracles.intervals import prediction_half_width
 from exsce_dsl.oracles.observe import RunValues, observe, run_values
 from exsce_dsl.oracles.plan import PlannedOracle, plan_oracles, tolerance_of
-from exsce_dsl.oracles.sources import ValueSources
+from exsce_dsl.oracles.sources import ValueSources, unread_topics
 from exsce_dsl.store.base import Store
 
 PACKAGE = "exsce.metamorphic.relationships"
@@ -121,6 +121,7 @@ def learn_baseline(
         stats = _statistics(oracle, list(values[base_id].values()), base)
         whole_run = oracle.window_text is None
         topics = sources.topics(stats.runs if stats else (), oracle.metric, oracle.robot, whole_run=whole_run)
+        topics = topics or unread_topics(scenario, oracle.metric, oracle.robot)
         oracles.append(_numbers(oracle, stats, scenario, topics))
     return LearntBaseline(tuple(oracles), chosen)
 

@@ -4,18 +4,31 @@ A metric's value in the store names the topics it really came from (its ``R:<met
 collection): for a robot that runs Nav2 or move_base, its odometry, ``/cmd_vel`` or TF, not
 the method's ``/nav_vel``.  An oracle learnt from runs names the sources of the values it learnt
 from; a verdict names those of the judged run's value.  The method's default topics
-(:func:`~exsce_dsl.model.metrics.default_topics`) are no evidence of what was read: an oracle
-whose runs hold no value of its metric names no topic.
+(:func:`~exsce_dsl.model.metrics.default_topics`) are no evidence of what a stack's robot
+published: an oracle no stored value was learnt from (fixed numbers, the method's oracle files)
+names them only when its robots declare no signals of their own (:func:`unread_topics`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable
 
+from exsce_dsl.model import Scenario
+from exsce_dsl.model.metrics import default_topics
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.queries import MetricSource, metric_sources
 
-__all__ = ["ValueSources"]
+__all__ = ["ValueSources", "unread_topics"]
+
+
+def unread_topics(scenario: Scenario, metric: str, robot: str | None) -> tuple[str, ...]:
+    """The topics of an oracle no stored value was learnt from: the method's topics of ``metric``
+    (those its oracle files name) when the robots it is about (``robot``, or all for the mission)
+    declare no signals of their own; none when one does (a Nav2 robot's are known from its runs)."""
+    robots = [r for r in scenario.robots if robot is None or r.id == robot]
+    if any(r.declares_signals for r in robots):
+        return ()
+    return default_topics(scenario, metric, robot)
 
 
 class ValueSources:

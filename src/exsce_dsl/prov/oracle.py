@@ -32,7 +32,8 @@ Where exsce differs from the method, on purpose:
 * a mission oracle has no ``oracle:robot`` (the method wrote the string ``"None"``);
 * the topics an oracle used are those its values were read from (a Nav2 robot's ``/cmd_vel``,
   odometry, TF), not the method's topics for its metric (``/nav_vel`` for every robot); an
-  oracle no stored run gave a value to names none;
+  oracle no stored run gave a value to names the method's topics only for robots that declare
+  no signals of their own;
 * the usages of the base scenario have identifiers (one baseline and one
   metamorphic usage per oracle), so that a baseline can be updated in place;
 * every number is an ``xsd:double`` (the method wrote ``xsd:float`` and, for
