@@ -267,7 +267,7 @@ def signal_topics(robot: RobotSources, data: BagData, problems: list[str] | None
         for chosen in first.with_all():
             topic: Topic | None
             try:
-                if chosen.tf is not None:
+                if chosen.tf is not None and not chosen.from_pose:
                     topic, frames = _tf_pose(name, chosen, data)
                     chosen = replace(chosen, frames=frames)
                 else:
