@@ -214,3 +214,40 @@ def test_a_clause_between_robots_is_not_copied_to_a_scenario_of_one_robot() -> N
     apart = Expectation(Subject(Quantifier.MISSION), "distance_between_robots", BasicRelation.ABOVE_MIN, limit=Quantity(0.1, "m", "0.1"))
     made = metamorphic_acceptance(EmbeddedStore(None), BASE, LONGER, Acceptance("base", (Criterion("apart", (), None, (apart,)),)))
     assert made.criteria == ()  # one robot: nothing between robots to judge, and no runs to expect from
+
+
+def test_derive_expect_keeps_a_user_safety_clause_on_mean_speed() -> None:
+    """Issue 48, item 6: ``derive --expect`` dropped ``mean_speed stays below`` (a limit on a mean,
+    which it took for a clause about the base's own mission) from the derived "as safe as"
+    criteria; every limit the user wrote is carried, on any metric, below or above."""
+    from exsce_dsl.derive.expect import metamorphic_acceptance
+    from exsce_dsl.lang import expectation_text
+    from exsce_dsl.model.acceptance import (
+        Acceptance,
+        BasicRelation,
+        Criterion,
+        Expectation,
+        Quantifier,
+        Quantity,
+        Subject,
+    )
+
+    def limit(metric: str, relation: BasicRelation, value: float, unit: str) -> Expectation:
+        quantity = Quantity(value, unit, f"{value}")
+        return Expectation(Subject(Quantifier.EACH_ROBOT), metric, relation, limit=quantity)
+
+    clauses = (
+        limit("max_velocity", BasicRelation.BELOW_MAX, 1.0, "m/s"),
+        limit("mean_speed", BasicRelation.BELOW_MAX, 2.0, "m/s"),
+        limit("fast_driving_time", BasicRelation.BELOW_MAX, 2.0, "s"),
+        limit("mean_clearance", BasicRelation.ABOVE_MIN, 0.3, "m"),
+    )
+    base_criteria = Acceptance("base", (Criterion("moves safely", (), None, clauses),))
+    made = metamorphic_acceptance(EmbeddedStore(None), BASE, LONGER, base_criteria)
+    [safe] = [c for c in made.criteria if c.title == "as safe as base"]
+    assert [expectation_text(e) for e in safe.expectations] == [
+        "each robot max_velocity stays below 1.0 m/s",
+        "each robot mean_speed stays below 2.0 m/s",
+        "each robot fast_driving_time stays below 2.0 s",
+        "each robot mean_clearance stays above 0.3 m",
+    ]

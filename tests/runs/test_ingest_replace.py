@@ -293,3 +293,53 @@ def test_a_run_is_replaced_on_a_sparql_server_as_in_the_embedded_store(
         assert after == pytest.approx(_values(embedded, _bag_id(bag)), rel=1e-12)
         assert remote.graph_sizes() == embedded.graph_sizes()
         assert [r.uuid for r in runs(remote)] == [_bag_id(bag)]
+
+
+def _segment_graphs(store: Store) -> set[str]:
+    return {g for g in store.graph_names() if "/segments/" in g}
+
+
+def _driven_segments(store: Store) -> set[str]:
+    """The segments some run's action graph says it drove (``?segment exsce:run ?run``)."""
+    rows = store.select(
+        "SELECT DISTINCT ?segment WHERE { GRAPH ?g { ?segment ?p ?run } "
+        'FILTER(STRENDS(STR(?p), "/run") && CONTAINS(STR(?segment), "/segments/") '
+        '&& CONTAINS(STR(?g), "/runs/run_")) }'
+    )
+    return {segment.value for (segment,) in rows.rows}
+
+
+@pytest.mark.parametrize("how", ["replace_run", "add_prov"])
+def test_a_segment_graph_left_without_its_run_after_replace_is_pruned(bags, project, how) -> None:
+    """Issue 48: a run replaced by a version that drives fewer path segments left the segment
+    graphs only its old version drove in the store, naming no run (``ingest --replace`` writes
+    through ``replace_run``, ``add_prov(..., replace=True)`` is what ``compile --replace`` does)."""
+    from dataclasses import replace
+
+    from exsce_dsl.model.runs import MetricScope
+    from exsce_dsl.prov.run import compile_run
+    from exsce_dsl.store.run_replacing import replace_run
+    from exsce_dsl.store.writing import add_prov
+
+    store = EmbeddedStore()
+    scenario = _scenario(project)
+    [first] = ingest_bags([bags[0]], scenario, store)
+    assert first.run_id is not None
+    before = _segment_graphs(store)
+    assert before and before == _driven_segments(store)
+    old = analyse_bag(bags[0], scenario).run
+    # the new version: tiago1's second task (its drive home) is not in it, nor its segments' values
+    kept = tuple(t for t in old.tasks if not (t.robot == "tiago1" and t.allocation == 2))
+    gone = {a.id for t in old.tasks if t not in kept for a in t.actions}
+    assert gone
+    values = tuple(v for v in old.metrics if not (v.scope is MetricScope.SEGMENT and v.action in gone))
+    fewer = replace(old, uuid=first.run_id, tasks=kept, metrics=values)
+    document = compile_run(fewer, scenario)
+    if how == "replace_run":
+        replace_run(store, document, first.run_id)
+    else:
+        add_prov(store, document, replace=True)
+    after = _segment_graphs(store)
+    driven = {(a.start_pose, a.goal_pose) for t in kept for a in t.actions}
+    assert len(after) == len(driven) < len(before)  # the drive home's segments are gone ...
+    assert after == _driven_segments(store)  # ... and no segment graph is left without its run

@@ -40,7 +40,6 @@ from exsce_dsl.model.acceptance import (
     Subject,
     When,
 )
-from exsce_dsl.model.expressions import Aggregate
 from exsce_dsl.oracles.good_runs import good_runs
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.queries import ValueStats, robot_metric_over_runs, segment_metric_between
@@ -289,23 +288,6 @@ metres to a leg, a real planner as much)."""
 PAIRWISE = frozenset({"distance_between_robots"})
 """Mission metrics that need two robots at least."""
 
-PEAKS = frozenset({"max_velocity", "distance_to_obstacles", "distance_between_robots", "violation_duration"})
-"""Built-in metrics whose limits hold for any mission: a peak over the run, or seconds a safety
-limit was broken."""
-
-
-def holds_for_any_mission(metric: str, scenario: Scenario) -> bool:
-    """A limit on ``metric`` is a safety clause, kept for a derived scenario: the metric is a
-    peak (a max or a min over the run) or declares a safety limit.  A limit on a mean or a total
-    (a mean turn rate, seconds spent over a speed) is about the base's own mission: removing a
-    task's long drive raises a mean turn rate in a scenario that drives as well as before."""
-    definition = next((m for m in scenario.metrics if m.name == metric), None)
-    if definition is None:
-        return metric in PEAKS
-    return definition.safety is not None or (
-        isinstance(definition.value, Aggregate) and definition.value.func in ("max", "min")
-    )
-
 
 def metamorphic_acceptance(
     store: Store,
@@ -317,9 +299,10 @@ def metamorphic_acceptance(
     include_all: bool = False,
 ) -> Acceptance:
     """The acceptance criteria of a derived scenario, as the method's Listing 35 makes them: the
-    base's safety clauses (limits on peaks or on metrics with a safety limit, see
-    :func:`holds_for_any_mission`; about robots it still has; a clause between robots is dropped
-    when one robot is left), and per robot, for distance travelled, task duration and waypoints visited,
+    base's safety clauses (every limit the user wrote, ``stays below`` or ``stays above``, on any
+    metric: a peak, a mean, a total; over the whole run, about robots it still has; a clause
+    between robots is dropped when one robot is left), and per robot, for distance travelled,
+    task duration and waypoints visited,
 
     * the expected value itself, as the new scenario's own baseline (``is invariant around E
       within P %``): a run far from it either way fails, so a slow-down or a detour is caught;
@@ -349,7 +332,6 @@ def metamorphic_acceptance(
             and e.window is None
             and (e.subject.robot is None or e.subject.robot in robots)
             and (e.metric not in PAIRWISE or len(robots) > 1)
-            and holds_for_any_mission(e.metric, base)
         ]
     performance: list[Expectation] = []
     chosen = good_runs(store, base.id, include_all=include_all, scenario=base)

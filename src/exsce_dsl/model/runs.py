@@ -147,6 +147,9 @@ class SourceCount:
     used: int
     in_window: int
     why: str | None = None
+    tf_chain: str | None = None
+    """For a series composed from TF on ``topics``: the frames composed, the fixed frame first
+    (``map → odom → base_link``)."""
 
 
 @dataclass(frozen=True)

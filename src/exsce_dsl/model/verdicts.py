@@ -58,6 +58,10 @@ class Verdict:
     """What the recording did not cover of the part of the run the clause looks at (cut short, a
     gap, a thinned topic...): why an inconclusive verdict is one, or what a failed limit was not
     judged on (it failed on what was recorded)."""
+    topics: tuple[str, ...] = ()
+    """The bag topics the judged run's value was computed from, as the store's value names them
+    (its odometry, ``/cmd_vel`` or TF for a Nav2 robot, not the method's ``/nav_vel``); written
+    to the verdict's PROV, not read back from it."""
 
     @property
     def description(self) -> str:

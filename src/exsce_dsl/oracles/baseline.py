@@ -9,7 +9,9 @@ were not inconclusive, completed their mission and broke no safety limit, see
 clause (``within 1 std``, ``within 10 %``, ``within 2 s``; one standard deviation
 for ``invariant`` if none is written), or its confidence (``at 99 %``: the half-width of the
 prediction interval for one new run, :func:`~exsce_dsl.oracles.intervals.prediction_half_width`).
-The method's "update baseline" is writing these oracles to the store again.
+The method's "update baseline" is writing these oracles to the store again.  Each oracle names
+the topics the values it learnt from were computed from, as the store holds them
+(:mod:`exsce_dsl.oracles.sources`), not the method's topics for its metric.
 """
 
 from __future__ import annotations
@@ -21,12 +23,12 @@ from dataclasses import dataclass
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.acceptance import Acceptance, BasicRelation
-from exsce_dsl.model.metrics import default_topics
 from exsce_dsl.model.oracles import Oracle
 from exsce_dsl.oracles.good_runs import GoodRuns, good_runs
 from exsce_dsl.oracles.intervals import prediction_half_width
 from exsce_dsl.oracles.observe import RunValues, observe, run_values
 from exsce_dsl.oracles.plan import PlannedOracle, plan_oracles, tolerance_of
+from exsce_dsl.oracles.sources import ValueSources, unread_topics
 from exsce_dsl.store.base import Store
 
 PACKAGE = "exsce.metamorphic.relationships"
@@ -103,6 +105,7 @@ def learn_baseline(
     chosen = {scenario.id: own}
     values = {scenario.id: run_values(store, list(own.used))}
     oracles = []
+    sources = ValueSources(store)  # what the values learnt from were read from, not the method's topics
     for oracle in planned:
         base_id = oracle.expectation.against or scenario.id
         base = (bases or {}).get(base_id, scenario) if base_id != scenario.id else scenario
@@ -116,7 +119,10 @@ def learn_baseline(
             chosen[base_id] = base_runs
             values[base_id] = run_values(store, list(base_runs.used))
         stats = _statistics(oracle, list(values[base_id].values()), base)
-        oracles.append(_numbers(oracle, stats, scenario))
+        whole_run = oracle.window_text is None
+        topics = sources.topics(stats.runs if stats else (), oracle.metric, oracle.robot, whole_run=whole_run)
+        topics = topics or unread_topics(scenario, oracle.metric, oracle.robot)
+        oracles.append(_numbers(oracle, stats, scenario, topics))
     return LearntBaseline(tuple(oracles), chosen)
 
 
@@ -142,7 +148,9 @@ def _statistics(oracle: PlannedOracle, runs: Sequence[RunValues], scenario: Scen
     return Statistics(mean, std, tuple(used), tuple(observed))
 
 
-def _numbers(oracle: PlannedOracle, stats: Statistics | None, scenario: Scenario) -> Oracle:
+def _numbers(
+    oracle: PlannedOracle, stats: Statistics | None, scenario: Scenario, topics: tuple[str, ...]
+) -> Oracle:
     e = oracle.expectation
     common = {
         "metric": oracle.metric,
@@ -150,7 +158,7 @@ def _numbers(oracle: PlannedOracle, stats: Statistics | None, scenario: Scenario
         "relation": e.relation.value,
         "type": oracle.type,
         "base_scenario": e.against or scenario.id,
-        "topics": default_topics(scenario, oracle.metric, oracle.robot),
+        "topics": topics,
         "package": PACKAGE,
         "window": oracle.window_text,
         "criterion": oracle.criterion,

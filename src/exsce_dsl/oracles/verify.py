@@ -16,6 +16,7 @@ from exsce_dsl.model.verdicts import Outcome, Verdict
 from exsce_dsl.oracles.coverage_check import Span, clause_gaps, judge_coverage, learned_rate_gaps
 from exsce_dsl.oracles.observe import RunValues, observe, parse_window, run_values, window_segments
 from exsce_dsl.oracles.relations import RelationError, relation
+from exsce_dsl.oracles.sources import ValueSources
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.queries import StoredRun, action_times
 from exsce_dsl.store.queries import oracles as stored_oracles
@@ -57,13 +58,15 @@ def judge_runs(
     times = _action_spans(store, runs)
     baseline = [run for o in oracles if o.base_scenario == scenario.id for run in o.sources]
     verdicts = []
+    sources = ValueSources(store)
     for run in runs:
         found = list((coverage or {}).get(run, ()))
         gaps = found if any(g.kind is Shortfall.CUT_SHORT for g in found) else found + _cut_short(known[run])
         for oracle in oracles:
             window = _window(oracle)
             observed, why = observe(values[run], oracle.metric, oracle.robot, window, scenario)
-            verdict = _verdict(run, scenario.id, oracle, observed, why)
+            topics = sources.topics((run,), oracle.metric, oracle.robot, whole_run=window is None)
+            verdict = _verdict(run, scenario.id, oracle, observed, why, topics)
             span = _span(values[run], oracle, window, scenario, times)
             concerned = clause_gaps(verdict, gaps, span)
             if rates:
@@ -123,7 +126,9 @@ def _window(oracle: Oracle) -> Window | None:
     return window
 
 
-def _verdict(run: str, scenario: str, oracle: Oracle, observed: float | None, why: str) -> Verdict:
+def _verdict(
+    run: str, scenario: str, oracle: Oracle, observed: float | None, why: str, topics: tuple[str, ...] = ()
+) -> Verdict:
     common = {
         "run": run,
         "scenario": scenario,
@@ -140,6 +145,7 @@ def _verdict(run: str, scenario: str, oracle: Oracle, observed: float | None, wh
         "window": oracle.window,
         "sources": oracle.sources,
         "against": oracle.base_scenario if oracle.base_scenario not in (None, scenario) else None,
+        "topics": topics,
     }
     if observed is None:
         return Verdict(**common, outcome=Outcome.INCONCLUSIVE, reason=why)  # type: ignore[arg-type]

@@ -5,8 +5,9 @@ each metric (and robot) that has oracles:
 
 * the oracle activity ``<scenario>:[<robot>-]<metric>`` (``prov:type=exsce:oracle``,
   ``oracle:metric``, ``oracle:robot`` for a robot's metric, ``exsce:scenario``);
-* ``used(oracle, topic:<topic>, [prov:role="topic"])`` for each topic the metric is
-  computed from (the topics declared as ``ros:Topics`` entities);
+* ``used(oracle, topic:<topic>, [prov:role="topic"])`` for each topic the values it learnt
+  from were computed from (the topics declared as ``ros:Topics`` entities), as the stored
+  values name them (:mod:`exsce_dsl.oracles.sources`);
 * one usage of the scenario whose runs it compares against, per oracle type:
   ``used(<scenario>:<oracle>-baseline; oracle, exsce:<base>, [oracle:relationship,
   oracle:type, oracle:value, oracle:limit, oracle:delta, oracle:tolerance,
@@ -29,6 +30,10 @@ Where exsce differs from the method, on purpose:
 * the activity says which scenario it judges (``exsce:scenario``), where the
   method's queries matched the oracle's identifier against the scenario id as text;
 * a mission oracle has no ``oracle:robot`` (the method wrote the string ``"None"``);
+* the topics an oracle used are those its values were read from (a Nav2 robot's ``/cmd_vel``,
+  odometry, TF), not the method's topics for its metric (``/nav_vel`` for every robot); an
+  oracle no stored run gave a value to names the method's topics only for robots that declare
+  no signals of their own;
 * the usages of the base scenario have identifiers (one baseline and one
   metamorphic usage per oracle), so that a baseline can be updated in place;
 * every number is an ``xsd:double`` (the method wrote ``xsd:float`` and, for

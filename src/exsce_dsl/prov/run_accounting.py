@@ -10,7 +10,9 @@ On the value ``R:<value>`` (``exsce:output_metric``):
 And one entity ``R:<value>-samples_N`` (``exsce:sample_count``) per source it read samples of,
 derived from the source's topics: ``exsce:counted_for`` (the value), ``exsce:topic_name`` (the
 topics, ``, ``-separated), ``exsce:samples_used``, ``exsce:samples_in_window`` (``xsd:int``) and
-``exsce:fewer_because`` where it used fewer (or something else is worth saying).
+``exsce:fewer_because`` where it used fewer (or something else is worth saying), and
+``exsce:tf_chain`` the transforms composed where the source is a pose from TF
+(``map → odom → base_link``).
 """
 
 from __future__ import annotations
@@ -67,6 +69,8 @@ def write_sample_counts(
         }
         if count.why:
             facts[t(ids.FEWER_BECAUSE)] = count.why
+        if count.tf_chain:
+            facts[t(ids.TF_CHAIN)] = count.tf_chain
         w.entity(count_id, facts)
         for topic in count.topics:
             if topic in held:

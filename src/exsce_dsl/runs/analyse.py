@@ -219,7 +219,8 @@ def analyse_bag(
     )  # fmt: skip
     bag.problems += covered.said()
     real = {n: _spelt(stacks.real_topics.get(n, (n,)), bag.data.spellings) for n in bag.topics}
-    values = [finish_accounting(v, bag.timeline.to_wall, real, covered.gaps) for v in values]
+    chains = stacks.real_chains
+    values = [finish_accounting(v, bag.timeline.to_wall, real, covered.gaps, chains) for v in values]
     run = Run(
         uuid=run_id or run_uuid(digest),
         scenario=scenario.id,

@@ -58,6 +58,8 @@ class StackRobots:
     serves: set[str] = field(default_factory=set)
     real_topics: dict[str, tuple[str, ...]] = field(default_factory=dict)
     """A served topic name → the bag's topics its values came from."""
+    real_chains: dict[str, str] = field(default_factory=dict)
+    """A served topic name composed from TF → the transforms composed (``map → odom → base_link``)."""
     estimated: dict[str, str] = field(default_factory=dict)
     """A served topic name → what it was estimated from (``pose``), where the bag lacked it."""
 
@@ -118,6 +120,8 @@ class StackRobots:
                 found[name] = series
                 used = robot.used[name.rsplit("~", 1)[1]]
                 self.real_topics[name] = used.topics
+                if used.tf_chain is not None:
+                    self.real_chains[name] = used.tf_chain
                 if used.from_pose:
                     self.estimated[name] = "pose"
             if robot.robot not in self.serves:
@@ -129,6 +133,9 @@ class StackRobots:
                 name = expand_topic(pattern, robot.namespace)
                 found[name] = _as_method_fields(name, signal, topic, robot.three_d)
                 self.real_topics[name] = robot.used[signal].topics
+                chain = robot.used[signal].tf_chain
+                if chain is not None:
+                    self.real_chains[name] = chain
                 if robot.used[signal].from_pose:
                     self.estimated[name] = "pose"
         return found

@@ -27,7 +27,7 @@ from pyoxigraph import Literal, NamedNode, Quad
 from exsce_dsl.prov import identifiers as ids
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, PROV_NAMESPACE, Namespaces
 from exsce_dsl.store.base import GraphSet, Store, StoreConflictError
-from exsce_dsl.store.segment_index import segment_index
+from exsce_dsl.store.segment_index import orphan_segment_graphs, segment_index
 from exsce_dsl.store.sparql import term_text
 from exsce_dsl.store.writing import WriteReport, bundle_graphs
 
@@ -62,7 +62,8 @@ def replace_run(
 ) -> WriteReport:
     """Write ``document`` (run ``run``, analysed again) in place of what the store holds of that
     run, in one write.  ``replaced`` in the report names the old graphs (dropped or written
-    again), ``added`` the graphs only the new version has.
+    again, and the segment graphs no run drives any more), ``added`` the graphs only the new
+    version has.
 
     Raises :class:`~exsce_dsl.store.base.StoreConflictError`, having written nothing, when a
     graph of the new version is in the store for something else than the old run.
@@ -79,15 +80,17 @@ def replace_run(
     others = sorted(store.existing_graphs([n for n in graphs if n not in old]))
     if others:
         raise StoreConflictError(_conflict(store, run, others), others)
-    writes: dict[str, Sequence[Quad]] = {name: [] for name in old}
+    exsce_run = Namespaces(namespace).fixed[ids.EXSCE] + ids.RUN_ATTR.local
+    orphans = orphan_segment_graphs(store, old, exsce_run, kept={*graphs, *shared})
+    writes: dict[str, Sequence[Quad]] = {name: [] for name in [*old, *orphans]}
     writes.update(graphs)
     for name, quads in shared.items():
         writes.setdefault(name, quads)
-    store.write(GraphSet(writes), replace={*old, *graphs})
+    store.write(GraphSet(writes), replace={*old, *orphans, *graphs})
     return WriteReport(
         location=store.location,
         added=tuple(name for name in graphs if name not in old),
-        replaced=tuple(old),
+        replaced=tuple([*old, *orphans]),
         statements=_count(graphs) + _count(shared),
     )
 

@@ -34,7 +34,7 @@ by :func:`segment_index`; it adds nothing they do not say.
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Collection, Iterable, Mapping, Sequence
 
 from pyoxigraph import Literal, NamedNode, Quad
 
@@ -42,7 +42,7 @@ from exsce_dsl.prov import identifiers as ids
 from exsce_dsl.prov.identifiers import PROV_NAMESPACE
 from exsce_dsl.store.base import Store
 
-__all__ = ["is_index_graph", "segment_index", "segment_iri", "stale_index_graphs"]
+__all__ = ["is_index_graph", "orphan_segment_graphs", "segment_index", "segment_iri", "stale_index_graphs"]
 
 _RDF_TYPE = NamedNode(ids.RDF_TYPE)
 _USED = f"{PROV_NAMESPACE}used"
@@ -56,7 +56,8 @@ _METRIC_TYPE_SUFFIX = f"{_RUNS_PART}{ids.METRIC_TYPE.local}"
 _ATTRIBUTE_ENDINGS = (_METRIC_TYPE_SUFFIX, f"/{ids.RUN_ATTR.local}", f"/{ids.ROBOT_ATTR.local}")
 
 
-_INDEX_GRAPH = re.compile(r"/segments/[^/]+/[^/]+/[^/]+$|/runs/run_[^/]+/[^/]+-task_\d+-subtask_\d+-w_\d+$")
+_ACTION_GRAPH = re.compile(r"/runs/run_[^/]+/[^/]+-task_\d+-subtask_\d+-w_\d+$")
+_INDEX_GRAPH = re.compile(r"/segments/[^/]+/[^/]+/[^/]+$|" + _ACTION_GRAPH.pattern)
 
 
 def is_index_graph(name: str) -> bool:
@@ -132,7 +133,8 @@ def stale_index_graphs(
     store: Store, graphs: Mapping[str, Sequence[Quad]], index: Mapping[str, Sequence[Quad]]
 ) -> list[str]:
     """Index graphs in ``store`` of the runs ``index`` is about that ``graphs`` and ``index`` lack:
-    the actions an older version of a run had (dropped when the run is replaced)."""
+    the actions an older version of a run had, and the segments only they drove (dropped when the
+    run is replaced)."""
     from exsce_dsl.store.sparql import term_text
 
     runs: dict[str, Quad] = {}
@@ -149,7 +151,39 @@ def stale_index_graphs(
         f"GRAPH ?g {{ ?segment {term_text(run_p)} ?run }} }}"
     )
     found = {g.value for (g,) in rows.rows if isinstance(g, NamedNode)}
-    return sorted(found - set(index) - set(graphs))
+    stale = found - set(index) - set(graphs)
+    orphans = orphan_segment_graphs(store, found, run_p.value, kept={*index, *graphs})
+    return sorted(stale | set(orphans))
+
+
+def orphan_segment_graphs(
+    store: Store, rewritten: Collection[str], run_predicate: str, kept: Collection[str] = ()
+) -> list[str]:
+    """The segment graphs that only the action graphs ``rewritten`` observe (graphs a write drops
+    or writes anew): once they are gone, no run drives the segment any more, and its graph would
+    be left behind, an orphan (a run replaced by a version with fewer segments, or with other
+    poses).  ``kept``: the graphs the write holds (a segment the new version still drives);
+    ``run_predicate``: the IRI of ``exsce:run``."""
+    from exsce_dsl.store.sparql import term_text
+
+    actions = sorted(term_text(NamedNode(n)) for n in rewritten if _ACTION_GRAPH.search(n))
+    if not actions:
+        return []
+    run_p = term_text(NamedNode(run_predicate))
+    rows = store.select(
+        f"SELECT DISTINCT ?segment WHERE {{ VALUES ?g {{ {' '.join(actions)} }} "
+        f"GRAPH ?g {{ ?segment {run_p} ?run }} }}"
+    )
+    seen = {s.value for (s,) in rows.rows if isinstance(s, NamedNode)} - set(kept)
+    if not seen:
+        return []
+    segments = " ".join(term_text(NamedNode(name)) for name in sorted(seen))
+    rows = store.select(
+        f"SELECT DISTINCT ?segment WHERE {{ VALUES ?segment {{ {segments} }} "
+        f"GRAPH ?g {{ ?segment {run_p} ?run }} FILTER(?g NOT IN ({', '.join(actions)})) }}"
+    )
+    observed = {s.value for (s,) in rows.rows if isinstance(s, NamedNode)}
+    return sorted(seen - observed)
 
 
 def _local(iri: str) -> str:

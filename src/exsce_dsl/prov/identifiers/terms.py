@@ -207,6 +207,9 @@ COUNTED_FOR = Term(EXSCE, "counted_for")
 SAMPLES_USED = Term(EXSCE, "samples_used")
 SAMPLES_IN_WINDOW = Term(EXSCE, "samples_in_window")
 FEWER_BECAUSE = Term(EXSCE, "fewer_because")
+TF_CHAIN = Term(EXSCE, "tf_chain")
+"""On a sample count whose source is composed from TF: the transforms composed (``map → odom →
+base_link``)."""
 RUN_PROBLEM_TYPE = Term(EXSCE, "run_problem")
 """Something ingestion said of a run (a value it could not compute, and why)."""
 PROBLEM = Term(EXSCE, "problem")

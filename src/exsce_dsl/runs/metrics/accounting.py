@@ -156,17 +156,23 @@ def finish_accounting(
     wall: Callable[[np.ndarray], np.ndarray],
     real: Mapping[str, tuple[str, ...]],
     gaps: Sequence[CoverageGap],
+    chains: Mapping[str, str] | None = None,
 ) -> MetricValue:
     """``value`` with its accounting's window on the wall clock, its sources named as the bag has
-    them (``real``: a series the monitors read → the bag topics it came from), and the coverage
-    findings that touch it: about its metric and robot, on one of its topics (or on none), and
-    overlapping its window."""
+    them (``real``: a series the monitors read → the bag topics it came from; ``chains``: a series
+    composed from TF → the transforms composed), and the coverage findings that touch it: about
+    its metric and robot, on one of its topics (or on none), and overlapping its window."""
     found = value.accounting
     if found is None:
         return value
     start, end = (float(x) for x in wall(np.array([found.start, found.end], dtype=np.float64)))
+    chains = chains or {}
     sources = tuple(
-        replace(c, topics=tuple(dict.fromkeys(r for t in c.topics for r in real.get(t, (t,)))))
+        replace(
+            c,
+            topics=tuple(dict.fromkeys(r for t in c.topics for r in real.get(t, (t,)))),
+            tf_chain=next((chains[t] for t in c.topics if t in chains), c.tf_chain),
+        )
         for c in found.sources
     )
     topics = set(value.topics) | {t for c in sources for t in c.topics}

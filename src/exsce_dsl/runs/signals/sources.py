@@ -97,6 +97,13 @@ class Chosen:
     from_pose: bool = False
     """Estimated from the robot's pose (its source's topics are the pose's), the bag having
     nothing of this signal: a velocity, or a distance travelled."""
+    frames: tuple[str, ...] = ()
+    """For a TF chain once read: the frames its transforms composed, the fixed frame first."""
+
+    @property
+    def tf_chain(self) -> str | None:
+        """``map → odom → base_link``: the transforms a TF chain composed (None: not one)."""
+        return " → ".join(self.frames) if self.frames else None
 
     @property
     def topics(self) -> tuple[str, ...]:
@@ -258,13 +265,21 @@ def signal_topics(robot: RobotSources, data: BagData, problems: list[str] | None
         name = signal_topic(signal, robot.namespace)
         failures: list[tuple[Chosen, str]] = []
         for chosen in first.with_all():
+            topic: Topic | None
             try:
-                topic = _signal(name, signal, chosen, data, found, robot.three_d)
+                if chosen.tf is not None and not chosen.from_pose:
+                    topic, frames = _tf_pose(name, chosen, data)
+                    chosen = replace(chosen, frames=frames)
+                else:
+                    topic = _signal(name, signal, chosen, data, found, robot.three_d)
             except TfError as exc:
                 failures.append((chosen, exc.message))
                 continue
             if topic is not None:
                 found[name] = topic
+                pose = robot.used.get("pose")
+                if chosen.from_pose and pose is not None:  # estimated from the pose: its chain
+                    chosen = replace(chosen, frames=pose.frames)
                 robot.used[signal] = chosen
             break
         if name in found or not failures:
@@ -294,8 +309,6 @@ def _signal(
         if pose is None:
             return None
         return _speed(name, pose, three_d) if signal == "velocity" else _path(name, pose, three_d)
-    if chosen.tf is not None:
-        return _tf_pose(name, chosen, data)
     series = data.series.get(chosen.topic)
     if series is None:
         return None
@@ -344,8 +357,9 @@ def _pose(name: str, series: Series, prefix: tuple[str, ...]) -> Topic:
     return Topic(name, series.t, {**position, "yaw": yaw_from_quaternion(quaternion)})
 
 
-def _tf_pose(name: str, chosen: Chosen, data: BagData) -> Topic:
-    """The pose of the chain's body frame in its fixed frame, at the fastest transform's stamps."""
+def _tf_pose(name: str, chosen: Chosen, data: BagData) -> tuple[Topic, tuple[str, ...]]:
+    """The pose of the chain's body frame in its fixed frame, at the fastest transform's stamps,
+    and the frames the chain composed (the fixed frame first)."""
     assert chosen.tf is not None
     edges: dict[tuple[str, str], EdgeSeries] = {}
     for topic in chosen.tf_topics:
@@ -366,7 +380,9 @@ def _tf_pose(name: str, chosen: Chosen, data: BagData) -> Topic:
         raise TfError(f"no time at which every transform of {fixed} -> {body} is known")
     position = poses.position[keep]
     fields = {"x": position[:, 0], "y": position[:, 1], "z": position[:, 2], "yaw": poses.yaw[keep]}
-    return Topic(name, poses.times[keep], fields)
+    chain = tree.chain(fixed, body)
+    frames = (fixed, *(e.parent for e in chain.up), *(e.child for e in chain.down))
+    return Topic(name, poses.times[keep], fields), frames
 
 
 def _edges(series: Series, static: bool) -> list[EdgeSeries]:

@@ -49,9 +49,11 @@ class ValueAccount:
         return said
 
     def samples_text(self) -> list[str]:
-        """One line per source: ``/odom: 3952 of 3952 samples in the window`` (and why fewer)."""
+        """One line per source: ``/odom: 3952 of 3952 samples in the window`` (and why fewer);
+        a pose from TF names its transforms: ``TF map → odom → base_link on /tf + /tf_static``."""
         return [
-            f"{' + '.join(c.topics)}: {c.used} of {counted(c.in_window, 'sample')} in the window"
+            (f"TF {c.tf_chain} on " if c.tf_chain else "")
+            + f"{' + '.join(c.topics)}: {c.used} of {counted(c.in_window, 'sample')} in the window"
             + (f" ({c.why})" if c.why else "")
             for c in self.sources
         ]
@@ -93,6 +95,7 @@ def value_accounts(
                 int_of(row["used"]),
                 int_of(row["in_window"]),
                 text_of(row["why"]),
+                text_of(row["tf_chain"]),
             )
             counts[entity].append((index, count))
     return [
