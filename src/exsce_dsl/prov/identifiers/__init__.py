@@ -1,6 +1,7 @@
 """Every namespace, prefix and identifier rule of exsce's PROV, in one place: the IRIs and
 vocabulary terms in :mod:`~exsce_dsl.prov.identifiers.terms`, the rules that make local names
 and prefixes in :mod:`~exsce_dsl.prov.identifiers.naming`; both named here.
+Long because: it lists every name twice, one a line (imported, then in ``__all__``), and nothing else.
 
 This package is free of prov and rdflib: it deals in prefix names, IRIs and local names
 (strings), so that every layer can share it.
