@@ -33,8 +33,7 @@ from tests.support.bag_factory import (
     START_NS,
     Topic,
     header,
-    point,
-    quaternion,
+    odometry_at,
     typestore_for,
     write_bag,
 )
@@ -235,20 +234,6 @@ BLIND_EVERY = 4
 """Every fourth scan sees nothing within its range (all beams at infinity)."""
 
 
-def _odometry(store: Any, index: int, time_ns: int, x: float) -> Any:
-    t = store.types
-    body = t["geometry_msgs/msg/Pose"](
-        position=point(store, (x, 0.0, 0.0)), orientation=quaternion(store, 0.0)
-    )
-    zero = t["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=0.0)
-    return t[ODOMETRY](
-        header=header(store, time_ns, "odom", index),
-        child_frame_id="base_link",
-        pose=t["geometry_msgs/msg/PoseWithCovariance"](pose=body, covariance=np.zeros(36)),
-        twist=t["geometry_msgs/msg/TwistWithCovariance"](
-            twist=t["geometry_msgs/msg/Twist"](linear=zero, angular=zero), covariance=np.zeros(36)
-        ),
-    )
 
 
 def _scan(store: Any, index: int, time_ns: int) -> Any:
@@ -274,7 +259,7 @@ def _blind_bag(folder: Path) -> Path:
     odometry = [(START_NS + i * 50_000_000, i) for i in range(201)]
     scans = [(START_NS + i * 100_000_000 + 1_000_000, i) for i in range(100)]
     topics = [
-        Topic("/odom", ODOMETRY, [(ns, _odometry(store, i, ns, i * 0.05)) for ns, i in odometry]),
+        Topic("/odom", ODOMETRY, [(ns, odometry_at(store, i, ns, i * 0.05)) for ns, i in odometry]),
         Topic("/scan", LASER_SCAN, [(ns, _scan(store, i, ns)) for ns, i in scans]),
     ]
     path = folder / "blind.bag"

@@ -11,9 +11,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Any
 
-import numpy as np
 import pytest
 
 from exsce_dsl.lang import load_spec
@@ -24,9 +22,7 @@ from tests.support.bag_factory import (
     ODOMETRY,
     START_NS,
     Topic,
-    header,
-    point,
-    quaternion,
+    odometry_at,
     typestore_for,
     write_bag,
 )
@@ -73,20 +69,6 @@ SHAPES = {
 }
 
 
-def _odometry(store: Any, index: int, stamp_ns: int, x: float) -> Any:
-    t = store.types
-    body = t["geometry_msgs/msg/Pose"](
-        position=point(store, (x, 0.0, 0.0)), orientation=quaternion(store, 0.0)
-    )
-    zero = t["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=0.0)
-    return t[ODOMETRY](
-        header=header(store, stamp_ns, "odom", index),
-        child_frame_id="base_link",
-        pose=t["geometry_msgs/msg/PoseWithCovariance"](pose=body, covariance=np.zeros(36)),
-        twist=t["geometry_msgs/msg/TwistWithCovariance"](
-            twist=t["geometry_msgs/msg/Twist"](linear=zero, angular=zero), covariance=np.zeros(36)
-        ),
-    )
 
 
 def clock_bag(folder: Path, shape: str, fmt: str = "ros1") -> Path:
@@ -99,7 +81,7 @@ def clock_bag(folder: Path, shape: str, fmt: str = "ros1") -> Path:
         s = i / 20
         log = first_log + int(round(s * 1e9))
         stamp = log if first_stamp is None else int(round((first_stamp + s) * 1e9))
-        odom.append((log, _odometry(store, i, stamp, 0.5 * s)))
+        odom.append((log, odometry_at(store, i, stamp, 0.5 * s)))
         if clock and i % 2 == 0:
             sim = stamp * 1e-9
             time = store.types["builtin_interfaces/msg/Time"](

@@ -28,11 +28,8 @@ from tests.support.bag_factory import (
     START_NS,
     TF_MESSAGE,
     Topic,
-    header,
-    point,
-    quaternion,
+    odometry_at,
     typestore_for,
-    vector3,
     write_bag,
 )
 from tests.support.real_shapes import transform_stamped
@@ -93,20 +90,6 @@ def _drive(t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return x, y, np.where(t < 11.0, 0.0, np.pi / 2)
 
 
-def _odometry(store: Any, index: int, stamp_ns: int, x: float, y: float, yaw: float) -> Any:
-    t = store.types
-    body = t["geometry_msgs/msg/Pose"](position=point(store, (x, y, 0.0)), orientation=quaternion(store, yaw))
-    return t[ODOMETRY](
-        header=header(store, stamp_ns, "odom", index),
-        child_frame_id="base_link",
-        pose=t["geometry_msgs/msg/PoseWithCovariance"](pose=body, covariance=np.zeros(36)),
-        twist=t["geometry_msgs/msg/TwistWithCovariance"](
-            twist=t["geometry_msgs/msg/Twist"](
-                linear=vector3(store, (0.0, 0.0, 0.0)), angular=vector3(store, (0.0, 0.0, 0.0))
-            ),
-            covariance=np.zeros(36),
-        ),
-    )
 
 
 def _clock(store: Any, seconds: float) -> Any:
@@ -140,7 +123,7 @@ def tf_bag(folder: Path, fmt: str, reset_at: float | None = None, with_clock: bo
     for i, s in enumerate(fast):
         moved = transform_stamped(store, stamp(s), "odom", "base_link", x[i], y[i], yaw[i])
         tf.append((_log_ns(s), store.types[TF_MESSAGE](transforms=[moved])))
-        odom.append((_log_ns(s), _odometry(store, i, stamp(s), x[i], y[i], yaw[i])))
+        odom.append((_log_ns(s), odometry_at(store, i, stamp(s), x[i], y[i], yaw[i])))
     for s in np.arange(int(DURATION * 10) + 1) / 10:
         moved = transform_stamped(store, stamp(s) + int(POST_DATED * 1e9), "map", "odom", *MAP_TO_ODOM)
         tf.append((_log_ns(s), store.types[TF_MESSAGE](transforms=[moved])))

@@ -8,7 +8,6 @@ cover every message of the recording.  References come from rosbags' deserialisa
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pytest
@@ -23,9 +22,7 @@ from tests.support.bag_factory import (
     ODOMETRY,
     START_NS,
     Topic,
-    header,
-    point,
-    quaternion,
+    odometry_at,
     typestore_for,
     write_bag,
 )
@@ -81,18 +78,6 @@ def _drive(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.interp(t, frames, at[:, 0]), np.interp(t, frames, at[:, 1])
 
 
-def _odometry(store: Any, index: int, time_ns: int, x: float, y: float) -> Any:
-    t = store.types
-    body = t["geometry_msgs/msg/Pose"](position=point(store, (x, y, 0.0)), orientation=quaternion(store, 0.0))
-    zero = t["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=0.0)
-    return t[ODOMETRY](
-        header=header(store, time_ns, "odom", index),
-        child_frame_id="base_link",
-        pose=t["geometry_msgs/msg/PoseWithCovariance"](pose=body, covariance=np.zeros(36)),
-        twist=t["geometry_msgs/msg/TwistWithCovariance"](
-            twist=t["geometry_msgs/msg/Twist"](linear=zero, angular=zero), covariance=np.zeros(36)
-        ),
-    )
 
 
 def _early_bag(folder: Path, fmt: str) -> Path:
@@ -103,7 +88,7 @@ def _early_bag(folder: Path, fmt: str) -> Path:
     messages = []
     for i, s in enumerate(t):
         ns = START_NS + int(round(s * 1e9))
-        messages.append((ns, _odometry(store, i, ns, float(x[i]), float(y[i]))))
+        messages.append((ns, odometry_at(store, i, ns, float(x[i]), float(y[i]))))
     path = folder / (f"early_{fmt}.bag" if fmt == "ros1" else f"early_{fmt}")
     write_bag(path, fmt, [Topic("/odom", ODOMETRY, messages)], store)
     return path

@@ -315,6 +315,22 @@ def odometry(store: Any, index: int, time_ns: int, seed: int = 0, frame_id: str 
     )
 
 
+def odometry_at(store: Any, index: int, stamp_ns: int, x: float, y: float = 0.0, yaw: float = 0.0) -> Any:
+    """An odometry message placing the robot at (``x``, ``y``) facing ``yaw``, its twist zero (the
+    tests that use it read the path, not the odometry's own velocity)."""
+    t = store.types
+    body = t["geometry_msgs/msg/Pose"](position=point(store, (x, y, 0.0)), orientation=quaternion(store, yaw))
+    zero = vector3(store, (0.0, 0.0, 0.0))
+    return t[ODOMETRY](
+        header=header(store, stamp_ns, "odom", index),
+        child_frame_id="base_link",
+        pose=t["geometry_msgs/msg/PoseWithCovariance"](pose=body, covariance=np.zeros(36)),
+        twist=t["geometry_msgs/msg/TwistWithCovariance"](
+            twist=t["geometry_msgs/msg/Twist"](linear=zero, angular=zero), covariance=np.zeros(36)
+        ),
+    )
+
+
 def pose_stamped(store: Any, index: int, time_ns: int, seed: int = 0, frame_id: str = "map") -> Any:
     return store.types[POSE_STAMPED](
         header=header(store, time_ns, frame_id, index), pose=pose(store, _rng(seed, index))
