@@ -180,3 +180,13 @@ def test_bag_info_lists_both_versions_of_a_type(tmp_path: Path) -> None:
     assert len(set(md5s)) == 2
     for topic in bag_info(bag).topics:
         assert topic.definition == f"the bag (2 versions: {', '.join(md5s)})"
+
+
+def test_bag_info_gives_the_rate_of_a_version_rosbags_cannot_read(tmp_path: Path) -> None:
+    """Stumble: ``bag info`` showed "-" for the rate of the topic carrying the version rosbags'
+    one typestore does not hold; a rate is the log times', whatever the bytes."""
+    bag = _ros1_bag(tmp_path / "versions.bag", ("/old", "/new"))
+    rates = {t.name: t.rate for t in bag_info(bag).topics}
+    for version, topic in enumerate(("/old", "/new"), start=1):
+        times = np.array([t for t, _ in _values(version)], dtype=float) / 1e9
+        assert rates[topic] == pytest.approx((len(times) - 1) / (times[-1] - times[0]), rel=1e-6)

@@ -179,11 +179,11 @@ def _read(
             whole = msgtype in _STATUS
             if index >= (TF_SAMPLE if standard_type(msgtype) == _TF else SAMPLE) and not whole:
                 break
+            logs.append(time_ns * 1e-9)  # the rate is the log times': known whatever the bytes
             try:
                 message = reader.deserialize(raw, connection.msgtype)
-            except Exception:  # a type rosbags cannot read: its count and rate are still known
-                break
-            logs.append(time_ns * 1e-9)
+            except Exception:  # a type (or a version of it) rosbags cannot read: no stamp
+                continue
             stamp = _stamp(message)
             if stamp is not None:
                 stamps.append(time_ns * 1e-9 - stamp)
