@@ -19,6 +19,8 @@ from exsce_dsl.model.runs import ActionId, Hotspot, MetricScope, MetricValue
 from exsce_dsl.runs.bags.reading import BagData, Series
 from exsce_dsl.runs.segments.recorded import RecordedAction
 
+from tests.support.reference_path import hold
+
 HOTSPOT_RADIUS = 1.0  # metres: violations closer than this to a hotspot belong to it
 
 
@@ -45,16 +47,6 @@ def robot_topics(ns: str) -> dict[str, str]:
 
 def _window(series: Series, start: float, end: float) -> slice:
     return slice(int(np.searchsorted(series.t, start, "left")), int(np.searchsorted(series.t, end, "right")))
-
-
-def _durations(t: np.ndarray) -> np.ndarray:
-    """How long each sample holds: until the next one (the last holds one median period)."""
-    if len(t) < 2:
-        return np.zeros(len(t))
-    gaps = np.diff(t)
-    period = float(np.median(gaps))
-    held: np.ndarray = np.minimum(np.append(gaps, period), 2 * period)
-    return held
 
 
 @dataclass
@@ -204,12 +196,12 @@ def compute_metrics(
                             "max_velocity", scope, float(speed.max()), (sig.topics["vel"],), robot, aid, "m/s"
                         )
                     )
-        for name, topic, times, hold, over in _safety_signals(sig, limits, start, end):
+        for name, topic, times, held, over in _safety_signals(sig, limits, start, end):
             values.append(
                 MetricValue(
                     "violation_duration",
                     MetricScope.ROBOT,
-                    float(hold[over].sum()),
+                    float(held[over].sum()),
                     (topic,),
                     sig.robot,
                     unit="s",
@@ -220,7 +212,7 @@ def compute_metrics(
                 where = sig.position_at(times[over])
                 hotspots.extend(
                     Hotspot(name, Position(float(c[0]), float(c[1])), n, d, sig.robot)
-                    for c, n, d in _cluster(where, hold[over])
+                    for c, n, d in _cluster(where, held[over])
                 )
         for key in ("pose", "scan", "vel", "distance"):
             if getattr(sig, key) is None and key != "distance":
@@ -252,7 +244,7 @@ def _safety_signals(sig: RobotSignals, limits: SafetyLimits, start: float, end: 
         w = _window(sig.vel, start, end)
         t = sig.vel.t[w]
         found.append(
-            ("max_velocity", sig.topics["vel"], t, _durations(t), sig.speed()[w] > limits.max_velocity)
+            ("max_velocity", sig.topics["vel"], t, hold(t), sig.speed()[w] > limits.max_velocity)
         )
     if sig.scan is not None and len(sig.scan):
         w = _window(sig.scan, start, end)
@@ -263,7 +255,7 @@ def _safety_signals(sig: RobotSignals, limits: SafetyLimits, start: float, end: 
                 "distance_to_obstacles",
                 sig.topics["scan"],
                 t,
-                _durations(t),
+                hold(t),
                 nearest < limits.distance_to_obstacles,
             )
         )
@@ -324,14 +316,14 @@ def _between_robots(
             gap = np.hypot(*(pa - pb).T)
             nearest = min(nearest, float(gap.min()))
             over = gap < limits.distance_between_robots
-            hold = _durations(t)
-            violation += float(hold[over].sum())
+            held = hold(t)
+            violation += float(held[over].sum())
             topics += [a.topics["pose"], b.topics["pose"]]
             if over.any():
                 mid = (pa[over] + pb[over]) / 2
                 hotspots.extend(
                     Hotspot("distance_between_robots", Position(float(c[0]), float(c[1])), n, d)
-                    for c, n, d in _cluster(mid, hold[over])
+                    for c, n, d in _cluster(mid, held[over])
                 )
     if not np.isfinite(nearest):
         return []

@@ -160,11 +160,12 @@ def speeds(t: np.ndarray, *coordinates: np.ndarray) -> np.ndarray:
 
 
 def hold(t: np.ndarray) -> np.ndarray:
-    """How long each sample holds: until the next one, the last one median period, at most two."""
+    """How long each sample holds: until the next one, the last one median period, at most two;
+    the period is the median of the steps that move (samples sharing a time hold nothing)."""
     if len(t) < 2:
         return np.zeros(len(t))
     gaps = np.diff(t)
-    period = float(np.median(gaps))
+    period = float(np.median(gaps[gaps > 0])) if np.any(gaps > 0) else 0.0
     held: np.ndarray = np.minimum(np.append(gaps, period), 2 * period)
     return held
 
