@@ -228,7 +228,8 @@ def prefix_of(document: ProvDocument, iri: str) -> set[str]:
 
 
 def renamed(scenario: Scenario, robot_ids: dict[str, str], scenario_id: str) -> Scenario:
-    robots = tuple(Robot(robot_ids[r.id], r.type, r.namespace, r.start_pose) for r in scenario.robots)
+    """``scenario`` with its robots renamed, each in the namespace of its new id (as the method's are)."""
+    robots = tuple(Robot(robot_ids[r.id], r.type, robot_ids[r.id], r.start_pose) for r in scenario.robots)
     allocation = tuple(Assignment(robot_ids[a.robot], a.task) for a in scenario.mission.allocation)
     mission = Mission(scenario.mission.id, scenario.mission.type, allocation)
     return Scenario(scenario_id, scenario.environment, robots, mission, scenario.tasks)

@@ -47,7 +47,7 @@ def _robot_level(analysed: AnalysedRun) -> dict[tuple[str, str | None], float]:
 def _places(spec: Specification, robot: str) -> list[float]:
     """The positions of a robot's area, its start left out: x, y, x, y..."""
     (env,) = spec.environments
-    area = next(a for a in env.areas if a.id == f"{robot}_places")
+    area = next(a for a in env.areas if a.id == f"{spec.scenario().id}_{robot}_places")
     return [v for p in area.poses if not p.id.endswith("-start") for v in (p.position.x, p.position.y)]
 
 
@@ -84,7 +84,7 @@ def test_a_draft_of_an_executors_bag_checks_and_its_run_has_the_bags_values(
         assert values[("distance_travelled", robot)] == pytest.approx(expected.distance, rel=1e-9)
         assert values[("task_duration", robot)] == pytest.approx(expected.duration, abs=0.05)
     mission = spec.scenario().mission
-    assert [a.task for a in mission.allocation if a.robot == "r2"] == ["r2_goal_1"]
+    assert [a.task for a in mission.allocation if a.robot == "r2"] == [f"{spec.scenario().id}_r2_goal_1"]
     assert mission.type.value == "parallel"
 
 

@@ -157,7 +157,7 @@ def test_store_migrate_moves_an_old_store_to_bag_bundles_named_by_their_run(
     assert done.returncode == 0, done.stderr
     for name, new in moved.items():
         assert f"{name} -> {new}" in done.stdout
-    assert done.stdout.splitlines()[-1].endswith("2 bag bundles named by their run now")
+    assert done.stdout.splitlines()[-1].endswith("bag bundles named by their run: 2")
     with EmbeddedStore(tmp_path / "store") as after:
         assert after.graph_sizes() == current  # as the current code writes it, graph by graph
         assert sorted(runs(after), key=lambda r: r.uuid) == listed  # bags and paths as before

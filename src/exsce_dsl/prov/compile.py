@@ -273,7 +273,7 @@ class _ScenarioCompiler:
         w.member(scenario_id, mission_id)
         w.member(scenario_id, env_ns[scenario.environment.id])
         for robot in scenario.robots:
-            w.member(scenario_id, robot_ns[robot.id])
+            w.member(scenario_id, robot_ns[ids.robot_name(robot)])
         for plan_id, _ in plans:
             w.member(mission_id, plan_id)
 
@@ -282,7 +282,8 @@ class _ScenarioCompiler:
         for robot in scenario.robots:
             if robot.start_pose is None:
                 continue
-            robot_parts = w.of_element(robot.id, names.of_robot(robot.id), "robot")
+            key = ids.robot_name(robot)
+            robot_parts = w.of_element(robot.id, names.of_robot(key), "robot")
             w.derivation(
                 robot_parts[ids.GAZEBO_MODEL],
                 self._pose_id(w, robot.start_pose),
@@ -342,10 +343,11 @@ class _ScenarioCompiler:
         self._write_poses(w, poses.values())
 
     def _robot_bundle(self, robot: Robot) -> None:
-        w = self._bundle(ids.ROBOT, robot.id, f"robot '{robot.id}'", robot.location)
+        key = ids.robot_name(robot)
+        w = self._bundle(ids.ROBOT, key, f"robot '{robot.id}'", robot.location)
         t = w.term
-        robot_id = w.fixed(ids.ROBOT)[robot.id]
-        parts = w.of_element(robot.id, self.names.of_robot(robot.id), "robot")
+        robot_id = w.fixed(ids.ROBOT)[key]
+        parts = w.of_element(robot.id, self.names.of_robot(key), "robot")
         software, hardware = parts[SOFTWARE_CONFIG], parts[HARDWARE_CONFIG]
         model = parts[ids.GAZEBO_MODEL]
         w.entity(robot_id, {PROV_TYPE: t(ids.ROBOT_TYPE_VALUE), t(ids.ROBOT_TYPE): robot.type.id})

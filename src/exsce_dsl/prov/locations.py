@@ -77,9 +77,10 @@ def source_locations(scenario: Scenario, namespace: str = DEFAULT_NAMESPACE) -> 
 
     # Robots, their parts and start poses.
     for robot in scenario.robots:
-        put(fixed[ids.ROBOT] + robot.id, robot.location)
-        put(fixed[ids.ROBOT] + ids.bundle_name(robot.id), robot.location)
-        robot_parts = names.of_robot(robot.id)
+        key = ids.robot_name(robot)
+        put(fixed[ids.ROBOT] + key, robot.location)
+        put(fixed[ids.ROBOT] + ids.bundle_name(key), robot.location)
+        robot_parts = names.of_robot(key)
         for part in (ids.GAZEBO_MODEL, ids.ROBOT_AGENT, ids.SOFTWARE_CONFIG, ids.HARDWARE_CONFIG):
             put(robot_parts + part, robot.location)
         if robot.start_pose is not None:

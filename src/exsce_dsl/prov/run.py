@@ -123,6 +123,7 @@ class _RunCompiler:
         """The run's namespace, declared at document level (it names bundles)."""
         self._pose_names: dict[Pose, str] = {}
         self._robot_ids = {robot.id for robot in scenario.robots}
+        self._robot_names = {robot.id: ids.robot_name(robot) for robot in scenario.robots}
         self._allocated: dict[str, int] = {}
         for assignment in scenario.mission.allocation:
             self._allocated[assignment.robot] = self._allocated.get(assignment.robot, 0) + 1
@@ -135,7 +136,7 @@ class _RunCompiler:
             self._hotspot_bundle()
         write_coverage(self.writer, self.run_parts, (self.run_prefix, self.run_ns_iri), self.run)
         write_problems(self.writer, self.run_parts, (self.run_prefix, self.run_ns_iri), self.run)
-        write_execution(self.writer, self.run, ids.bag_name(self.run.bag.file_name))
+        write_execution(self.writer, self.run, ids.bag_name(self.run.bag.file_name), self._robot_names)
         return self.writer.document
 
     # -- helpers -----------------------------------------------------------
@@ -209,7 +210,7 @@ class _RunCompiler:
                 )
             agent = agents.get(robot)
             if agent is None:
-                robot_parts = w.of_element(robot, names.of_robot(robot), "robot")
+                robot_parts = w.of_element(robot, names.of_robot(self._robot_names[robot]), "robot")
                 agent = agents[robot] = robot_parts[ids.ROBOT_AGENT]
             task_id = parts[ids.task_execution_name(robot, task.allocation)]
             writer.claim(task_id, f"task {task.allocation} of robot '{robot}'")
@@ -217,7 +218,7 @@ class _RunCompiler:
                 task_id,
                 {**task_type, t(ids.SEGMENTED_BY): task.segmented_by} if task.segmented_by else task_type,
             )
-            w.used(task_id, robot_ns[robot])
+            w.used(task_id, robot_ns[self._robot_names[robot]])
             w.associated(task_id, agent, mission_ns[ids.allocation_name(robot, task.allocation)])
             w.informed(run_id, task_id)
             for action in task.actions:

@@ -108,9 +108,12 @@ def _goals(bundle: Mapping[str, Any], activities: Mapping[str, Any]) -> Iterator
         )
 
 
-def write_execution(writer: DocumentWriter, run: Run, bag: str) -> None:
+def write_execution(
+    writer: DocumentWriter, run: Run, bag: str, robot_names: Mapping[str, str]
+) -> None:
     """The bundle of ``run``'s execution (none when the run has no run-time PROV); ``bag``: the
-    local name of the ingested run's bag entity in the run's namespace."""
+    local name of the ingested run's bag entity in the run's namespace; ``robot_names``: each
+    robot id's local name in ``robot:`` (:func:`~exsce_dsl.prov.identifiers.robot_name`)."""
     execution = run.execution
     if execution is None:
         return
@@ -149,7 +152,8 @@ def write_execution(writer: DocumentWriter, run: Run, bag: str) -> None:
             goal_facts[t(ids.ATTEMPTS)] = goal.attempts
         w.activity(goal_id, goal_facts, goal.start, goal.end)
         w.informed(goal_id, activity)
-        robot_parts = w.of_element(goal.robot, names.of_robot(goal.robot), "robot")
+        robot_key = robot_names.get(goal.robot, goal.robot)
+        robot_parts = w.of_element(goal.robot, names.of_robot(robot_key), "robot")
         w.associated(goal_id, robot_parts[ids.ROBOT_AGENT])
         if goal.start_pose is not None:
             w.started(goal_id, pose_ns[goal.start_pose])

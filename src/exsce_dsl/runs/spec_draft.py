@@ -60,7 +60,9 @@ from exsce_dsl.model.acceptance import (
 )
 from exsce_dsl.model.conventions import CONVENTIONS, METHOD, Window
 from exsce_dsl.model.names import KEYWORDS, is_valid_name
+from exsce_dsl.model.runs import run_uuid
 from exsce_dsl.output_folder import existing, write_below
+from exsce_dsl.runs.bag_identity import content_hash
 from exsce_dsl.runs.bag_robots import BagContents, BagRobot, Place, bag_contents
 from exsce_dsl.wording import counted
 
@@ -108,7 +110,8 @@ def draft_spec(bag: Path, out: Path, force: bool = False) -> SpecDraft:
         raise ExportError(f"would overwrite {', '.join(found)}; use --force to replace")
     m = contents.map
     grid = grid_from_ros(m.values, m.width, m.height, m.resolution, m.origin) if m is not None else None
-    drafter = _Drafter(contents, out.name, _name(_file_stem(bag), set(), "bag"), grid=grid)
+    tag = run_uuid(content_hash(bag))[:8]  # the start of the id its run will have
+    drafter = _Drafter(contents, out.name, _name(f"{out.stem}_{tag}", set(), "scenario"), grid=grid)
     document, poses = drafter.document(map_yaml.name if map_yaml else None)
     text = format_document(document, poses, drafter.comments)
     written = _write_map(grid, map_yaml) if grid is not None and map_yaml is not None else ()
@@ -172,6 +175,10 @@ class _Drafter:
     contents: BagContents
     file: str
     scenario: str
+    """The scenario's id: the specification's file name and the first 8 digits of the bag's run
+    id.  Its environment, areas and tasks start with it: a store shares an area or task of one
+    id among its scenarios, so drafts of many bags (each ``recording.mcap``, each robot's
+    ``root_robot_places``) would collide."""
     comments: list[Comment] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     ids: dict[str, BagRobot] = field(default_factory=dict)
@@ -204,6 +211,8 @@ class _Drafter:
             f"Drafted by `exscec init --from-bag` from {c.path.name}: {counted(c.topics, 'topic')}, "
             f"{c.end - c.start:.1f} s, {counted(len(c.robots), 'robot')} found.",
             f"Next: exscec check {self.file}; exscec ingest {c.path.name} --scenario {self.file}",
+            f"Names start with {self.scenario}: the file's name and the start of the bag's run id, "
+            "so drafts of bags that share a file name share a store.",
             *(f"Left out: {why}" for why in c.skipped),  # a name the language could not hold
             "",
         ]
@@ -304,7 +313,7 @@ class _Drafter:
                 )
                 continue
             where = ", ".join(robot.goals_from) or ", ".join(robot.pose_from) or "its path"
-            area = _name(f"{rid}_places", self.taken, "area")
+            area = _name(f"{self.scenario}_{rid}_places", self.taken, "area")
             counted_goals = counted(len(robot.tasks), "goal") if robot.goals_from else "its path"
             area_location = self.at(f"{rid}: {counted_goals}, from {where}", *robot.notes[:5])
             start = self._pose(f"{rid}-start", robot.start, area)
@@ -323,7 +332,7 @@ class _Drafter:
                     declared[place.name or pose.id] = pose
                     poses.append(pose)
                     visits.append(pose)
-                wanted = f"{rid}_goal_{number}" if robot.goals_from else f"{rid}_path"
+                wanted = f"{self.scenario}_{rid}_" + (f"goal_{number}" if robot.goals_from else "path")
                 mine.append(Task(_name(wanted, self.taken, "task"), (Subtask(tuple(visits)),)))
             tasks[rid] = mine
             areas.append(Area(area, tuple(poses), area_location))

@@ -10,6 +10,9 @@ Findings, by kind:
 * ``old bag bundle`` — a run's bag bundle named by the bag's file (``exsce:<bag file>_bundle``,
   the scheme before runs named their bag bundles).  ``--fix`` (and ``store migrate``) renames it
   ``<run>:bag_bundle``.
+* ``old robot name`` — a robot whose namespace is not its id, named by its id alone (the scheme
+  before issue 48; :func:`~exsce_dsl.prov.identifiers.robot_name`).  ``--fix`` (and ``store
+  migrate``) renames it, its parts and its bundle in every graph that names them.
 * ``dangling reference`` — a graph naming something in the runs' namespace that no graph
   describes (a verdict of a metric value gone), or a baseline that learnt from runs the store no
   longer holds.  Not mended: which record is wrong is a judgement (build the baselines again with
@@ -33,12 +36,14 @@ from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, PROV_NAMESPACE, Namesp
 from exsce_dsl.store.base import GraphSet, Store
 from exsce_dsl.store.graph_owners import graph_run
 from exsce_dsl.store.migrating import old_bag_bundles, renamed_graphs
+from exsce_dsl.store.robot_renaming import old_robot_names, renamed_robot_graphs
 from exsce_dsl.store.sparql import term_text
 
 __all__ = ["StoreCheck", "StoreFinding", "check_store"]
 
 ORPHAN = "orphan graph"
 OLD_BAG_BUNDLE = "old bag bundle"
+OLD_ROBOT_NAME = "old robot name"
 DANGLING = "dangling reference"
 NO_SCENARIO = "run without scenario"
 _REBUILD = "build it again: exscec baseline SPEC"
@@ -91,9 +96,10 @@ class StoreCheck:
 
 
 def check_store(store: Store, namespace: str = DEFAULT_NAMESPACE, *, fix: bool = False) -> StoreCheck:
-    """Look for orphan graphs, old-scheme bag bundles, dangling references and runs without their
-    scenario in ``store``; with ``fix``, remove the orphans and rename the bag bundles, in one
-    write (the other findings are left for a person: the module says why)."""
+    """Look for orphan graphs, old-scheme bag bundles and robot names, dangling references and runs
+    without their scenario in ``store``; with ``fix``, remove the orphans and rename the bag
+    bundles in one write, then the robots in another (the other findings are left for a person:
+    the module says why)."""
     names = Namespaces(namespace)
     graphs = sorted(store.graph_names())
     runs = _stored_runs(store, names)
@@ -106,6 +112,13 @@ def check_store(store: Store, namespace: str = DEFAULT_NAMESPACE, *, fix: bool =
         StoreFinding(OLD_BAG_BUNDLE, m.old, f"the bag of run {m.run}, to be named <{m.new}>", fixable=True)
         for m in moves
     ]
+    renames = old_robot_names(store, namespace)
+    findings += [
+        StoreFinding(
+            OLD_ROBOT_NAME, r.old + "_bundle", f"robot <{r.old}>, to be named <{r.new}>", fixable=True
+        )
+        for r in renames
+    ]
     findings += _dangling(store, names, runs)
     findings += _runs_without_scenario(store, names)
     if not fix or not any(f.fixable for f in findings):
@@ -114,6 +127,9 @@ def check_store(store: Store, namespace: str = DEFAULT_NAMESPACE, *, fix: bool =
     writes = renamed_graphs(store, [m for m in moves if m.old not in removed])
     writes.update({name: [] for name in removed})
     store.write(GraphSet(writes), replace=set(writes))
+    robot_writes = renamed_robot_graphs(store, renames)  # the orphans are gone by now
+    if robot_writes:
+        store.write(GraphSet(robot_writes), replace=set(robot_writes))
     return StoreCheck(store.location, tuple(findings), tuple(f for f in findings if f.fixable))
 
 

@@ -25,7 +25,10 @@ def shared_element(graph: str) -> tuple[str, str] | None:
     """(kind, id) when ``graph`` is the bundle of a robot, environment, area or task: named by the
     element's id alone, so every scenario of the store with an element of that id shares it."""
     found = _SHARED_GRAPH.search(graph)
-    return (_SHARED_KINDS[found.group(1)], found.group(2)) if found is not None else None
+    if found is None:
+        return None
+    kind, name = found.groups()
+    return (_SHARED_KINDS[kind], name.split(".", 1)[0] if kind == "robots" else name)
 
 
 def replace_advice(graphs: Sequence[str]) -> str:

@@ -1,4 +1,5 @@
-"""Moving an old store to the current identities: a run's bag bundle named by the run.
+"""Moving an old store to the current identities: a run's bag bundle named by the run, and each
+robot by :func:`~exsce_dsl.prov.identifiers.robot_name` (:mod:`.robot_renaming`).
 
 Before issue 48 a run's bag bundle was named by the bag's file, ``exsce:<bag file>_bundle`` (or,
 for a bag that was a run of a second scenario too, ``<run>:<bag file>_bundle``), so two
@@ -18,6 +19,7 @@ from pyoxigraph import Literal, NamedNode, Quad
 from exsce_dsl.prov import identifiers as ids
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, PROV_NAMESPACE, Namespaces
 from exsce_dsl.store.base import GraphSet, Store
+from exsce_dsl.store.robot_renaming import RobotRename, old_robot_names, renamed_robot_graphs
 from exsce_dsl.store.sparql import term_text
 
 __all__ = ["BagBundleMove", "MigrationReport", "migrate_store", "old_bag_bundles", "renamed_graphs"]
@@ -39,16 +41,21 @@ class MigrationReport:
 
     location: str
     moved: tuple[BagBundleMove, ...] = ()
+    robots: tuple[RobotRename, ...] = ()
+    """The robots renamed (each in every graph that names it)."""
 
     def summary(self) -> str:
-        """One line per graph moved, then a count."""
-        lines = [f"{m.old} -> {m.new}" for m in self.moved]
-        count = len(self.moved)
-        if count:
-            named = "bag bundles named by their run" if count != 1 else "bag bundle named by its run"
-            lines.append(f"{self.location}: {count} {named} now")
+        """One line per graph or robot moved, then a count."""
+        lines = [f"{m.old} -> {m.new}" for m in self.moved] + [f"{r.old} -> {r.new}" for r in self.robots]
+        done = [f"bag bundles named by their run: {len(self.moved)}"] if self.moved else []
+        done += [f"robots named by their declaration: {len(self.robots)}"] if self.robots else []
+        if done:
+            lines.append(f"{self.location}: {'; '.join(done)}")
         else:
-            lines.append(f"{self.location}: nothing to migrate (every bag bundle is named by its run)")
+            lines.append(
+                f"{self.location}: nothing to migrate "
+                "(every bag bundle is named by its run, every robot by its declaration)"
+            )
         return "\n".join(lines)
 
 
@@ -93,9 +100,14 @@ def renamed_graphs(store: Store, moves: Sequence[BagBundleMove]) -> dict[str, li
 
 
 def migrate_store(store: Store, namespace: str = DEFAULT_NAMESPACE) -> MigrationReport:
-    """Rename every old-scheme bag bundle of ``store`` to its run's name, in one write."""
+    """Rename every old-scheme bag bundle of ``store`` to its run's name, in one write, then every
+    robot named the old way (:mod:`.robot_renaming`), in another."""
     moves = old_bag_bundles(store, namespace)
     if moves:
         writes = renamed_graphs(store, moves)
         store.write(GraphSet(writes), replace=set(writes))
-    return MigrationReport(store.location, tuple(moves))
+    renames = old_robot_names(store, namespace)
+    if renames:
+        robot_writes = renamed_robot_graphs(store, renames)
+        store.write(GraphSet(robot_writes), replace=set(robot_writes))
+    return MigrationReport(store.location, tuple(moves), tuple(renames))

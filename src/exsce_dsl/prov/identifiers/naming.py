@@ -8,11 +8,15 @@ where the published rule loses information:
   is exact, and otherwise with Python's shortest round-trip form
   (:func:`format_angle`), so that two different poses never share an id;
 * task ids are the DSL task ids (``task:delivery_a``), not the task file's
-  basename (``task:delivery_a.yaml``), which collides across environments.
+  basename (``task:delivery_a.yaml``), which collides across environments;
+* a robot whose namespace is not its id (``root_robot`` at the root, ``r1`` in
+  ``/lab/r1``) is named by its id and a digest of what its bundle says
+  (:func:`robot_name`), so two scenarios may each have a robot of that id.
 """
 
 from __future__ import annotations
 
+import hashlib
 import re
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
@@ -20,6 +24,7 @@ from urllib.parse import unquote_to_bytes
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model.geometry import Orientation, Pose
+from exsce_dsl.model.robots import Robot
 from exsce_dsl.prov.identifiers.terms import (
     ANGLE,
     COORD,
@@ -180,6 +185,27 @@ def map_entity_name(map_name: str) -> str:
 def obstacle_pose_relation_name(obstacle_id: str) -> str:
     """``<obstacle>-pose``, in the environment's namespace."""
     return f"{obstacle_id}-pose"
+
+
+def robot_name(robot: Robot) -> str:
+    """The local name of ``robot`` in ``robot:`` and its namespace of parts.
+
+    The method names a robot by its id alone (``robot:tiago1``, namespace ``tiago1``): a
+    robot is known by the namespace its topics are under, and that is its id.  So is a robot
+    here whose namespace is its id (``/`` aside).  Any other robot (``root_robot`` at the
+    root, ``r1`` in ``/lab/r1``) is ``<id>.<8 hex digits>``: the sha256 of its namespace, type
+    and hardware, so scenarios that give one id to different robots never share a robot, and
+    those that declare the same robot do.  Ids hold no ``.``, so the id is the part before it.
+    """
+    if robot.namespace.strip("/") == robot.id:
+        return robot.id
+    said = "\n".join((robot.namespace, robot.type.id, robot.type.base or "", str(robot.type.torso)))
+    return f"{robot.id}.{hashlib.sha256(said.encode('utf-8')).hexdigest()[:8]}"
+
+
+def robot_id_of_name(local: str) -> str:
+    """The robot id in a local name :func:`robot_name` made."""
+    return local.split(".", 1)[0]
 
 
 def bundle_name(element_id: str) -> str:
