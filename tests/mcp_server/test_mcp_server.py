@@ -408,7 +408,16 @@ def test_lineage_and_verdicts_are_what_exscec_shows(project: Project) -> None:
     assert scenario_c["ancestors"] == [] and scenario_c["descendants"] == [
         {"scenario": "c_one", "steps": derivation["steps"], "derived": []}
     ]
+    chain = of_run.pop("chain")
     assert of_run == {"run": project.verified, **scenario_c}
+    printed = project.exscec("lineage", project.verified)  # the chain as the command line prints it
+    assert chain["run"] == project.verified and chain["scenario"] == "scenario_c"
+    assert f"bag {chain['bag']}" in printed and chain["bag"].endswith(".bag")
+    assert f"values ({len(chain['values'])})" in printed and len(chain["values"]) > 10
+    assert sum("window" in value for value in chain["values"]) == printed.count("    window: ")
+    assert sorted((v["oracle"], v["outcome"]) for v in chain["verdicts"]) == sorted(
+        (v["oracle"], v["verdict"]) for v in project.verified_json
+    )
     assert "no scenario 'scenario_d'" in unknown and "did you mean 'scenario_c'?" in unknown
     assert "either a scenario or a run" in neither
     assert "remove_robot(reassign=tiago1 robot=tiago2)" in project.exscec("lineage", "c_one")

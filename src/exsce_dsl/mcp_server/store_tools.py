@@ -2,7 +2,9 @@
 
 Both answer what the command line shows, from the same library functions:
 ``lineage`` what ``exscec lineage`` prints (:func:`exsce_dsl.store.queries.lineage`,
-:func:`~exsce_dsl.store.queries.derived_scenarios`), ``run_verdicts`` what the
+:func:`~exsce_dsl.store.queries.derived_scenarios`, and for a run its chain from dispatch to
+verdict, :func:`~exsce_dsl.store.queries.run_chain` with each value's account), ``run_verdicts``
+what the
 store holds of a run's last ``exscec verify``
 (:func:`exsce_dsl.store.queries.results.verdicts`, as ``exscec verify --json``
 writes each verdict).
@@ -10,8 +12,10 @@ writes each verdict).
 
 from __future__ import annotations
 
+import dataclasses
+import datetime
 import json
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import mcp_types as types
@@ -25,13 +29,17 @@ from exsce_dsl.model.verdicts import Outcome
 from exsce_dsl.oracles.report import verdicts_json
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.queries import (
+    RunChain,
     StoredRun,
+    ValueAccount,
     derivation_of,
     derived_scenarios,
     lineage,
     resolve_run,
+    run_chain,
     runs,
     scenario_ids,
+    value_accounts,
 )
 from exsce_dsl.store.queries.results import verdicts
 from exsce_dsl.suggest import did_you_mean
@@ -93,16 +101,47 @@ def _lineage(access: Access, arguments: Mapping[str, Any]) -> dict[str, Any]:
         raise ArgumentError("give either a scenario or a run")
     answer: dict[str, Any] = {}
     with access.store() as store:
+        chain = None
         if run is not None:
             found = stored_run(store, str(run))
             answer["run"] = found.uuid
             scenario = found.scenario
+            chain = (run_chain(store, found.uuid), value_accounts(store, found.uuid))
         scenario = stored_scenario(store, str(scenario))
         ancestry = lineage(store, scenario)
         answer["scenario"] = scenario
         answer["ancestors"] = [derivation_json(d) for d in reversed(ancestry)]
         answer["descendants"] = _descendants(store, scenario, frozenset({scenario}))
+    if chain is not None:
+        answer["chain"] = chain_json(*chain, access.max_rows)
     return answer
+
+
+def chain_json(found: RunChain, values: Sequence[ValueAccount], max_items: int) -> dict[str, Any]:
+    """A run's chain as JSON, as ``exscec lineage RUN`` prints it: execution, goals, bag, values
+    (each with its window and samples), verdicts and baseline runs; at most ``max_items`` goals,
+    values and verdicts each, ``truncated`` naming the lists cut short."""
+    chain = dataclasses.asdict(found)
+    accounts = {(a.metric, a.robot, a.action, a.safety_metric): a for a in values}
+    for value in chain["values"]:
+        account = accounts.get((value["metric"], value["robot"], value["action"], value["safety_metric"]))
+        if account is not None and account.window is not None:
+            value["window"] = account.window_text()
+            value["samples"] = account.samples_text()
+    chain["baselines"] = [{"run": run, "bag_path": path} for run, path in found.baselines]
+    cut = [name for name in ("goals", "values", "verdicts") if len(chain[name]) > max_items]
+    for name in cut:
+        chain[name] = chain[name][:max_items]
+    if cut:
+        chain["truncated"] = {"lists": cut, "shown": max_items}
+    answer: dict[str, Any] = json.loads(json.dumps(chain, default=_json_default))
+    return answer
+
+
+def _json_default(value: object) -> object:
+    if isinstance(value, datetime.datetime):
+        return value.isoformat()
+    raise TypeError(f"{type(value).__name__} is not JSON")
 
 
 def lineage_tool() -> ToolEntry:
@@ -113,7 +152,9 @@ def lineage_tool() -> ToolEntry:
             "Where a scenario (or the scenario of a run) comes from and what was derived from it, as "
             "`exscec lineage` shows: 'ancestors' oldest first, each the derivation of a scenario from "
             "its base with the transformations applied in order; 'descendants' a tree of the scenarios "
-            "derived from it.  Give either scenario or run."
+            "derived from it.  For a run, 'chain' too: the dispatcher's execution and the goals it "
+            "sent, the bag, each value with its window and samples, the verdicts and the baseline "
+            "runs they used.  Give either scenario or run."
         ),
         input_schema=object_schema(
             {
