@@ -81,11 +81,14 @@ def _report(calls: list[tuple[str, str]]) -> None:
     top = [_step(b) for a, b in calls if _step(a) == "runs/analyse" and _step(b) in _STEPS]
     walk = _collapsed(top)
     print("steps the top of runs enters:", " → ".join(s.removeprefix("runs/") for s in walk))
-    print("entries per step:", ", ".join(f"{s.removeprefix('runs/')} {walk.count(s)}" for s in dict.fromkeys(walk)))
+    print(
+        "entries per step:",
+        ", ".join(f"{s.removeprefix('runs/')} {walk.count(s)}" for s in dict.fromkeys(walk)),
+    )
     inside = _collapsed([_step(b) for _, b in calls if _step(b).startswith("runs/")])
     seen: set[str] = set()
     returns = 0
-    for before, after in zip(inside, inside[1:]):
+    for before, after in zip(inside, inside[1:], strict=False):
         seen.add(before)
         returns += after in seen
     files = {f for call in calls for f in call}

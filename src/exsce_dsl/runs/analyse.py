@@ -15,7 +15,7 @@ from exsce_dsl.lang import standard_metrics
 from exsce_dsl.messages.catalogue import Source
 from exsce_dsl.messages.field_check import check_fields
 from exsce_dsl.model import Scenario
-from exsce_dsl.model.conventions import Window
+from exsce_dsl.model.conventions import DISPATCHER_FEEDBACK, DISPATCHER_RESULT, Window
 from exsce_dsl.model.expressions import Field, walk
 from exsce_dsl.model.messages import DISPATCHER, POSE, FieldPath, Fields
 from exsce_dsl.model.metrics import MetricDefinition
@@ -63,8 +63,7 @@ from exsce_dsl.runs.signals.timeline import (
 )
 from exsce_dsl.wording import counted
 
-_FEEDBACK = "/{ns}/waypoint_dispatcher/feedback"
-_RESULT = "/{ns}/waypoint_dispatcher/result"
+_FEEDBACK, _RESULT = DISPATCHER_FEEDBACK, DISPATCHER_RESULT
 
 
 @dataclass(frozen=True)
