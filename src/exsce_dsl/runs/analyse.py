@@ -26,12 +26,10 @@ from exsce_dsl.runs.bag_identity import content_hash
 from exsce_dsl.runs.bags.data import BagData
 from exsce_dsl.runs.bags.names import BagTopics
 from exsce_dsl.runs.bags.reading import (
-    ANY,
     OBJECTS,
     BagError,
     Check,
     Reduce,
-    StatusUpdate,
     Wanted,
     bag_topics,
     read_bag,
@@ -50,7 +48,6 @@ from exsce_dsl.runs.missing import missing_metrics, unread_topics
 from exsce_dsl.runs.plausible_poses import Refused, refuse_implausible, spec_speed_limit
 from exsce_dsl.runs.recorded_execution import recorded_execution
 from exsce_dsl.runs.robots import SERVED, StackRobots, stack_robots
-from exsce_dsl.runs.segments.dispatcher import SUCCEEDED, segments
 from exsce_dsl.runs.segments.recorded import RecordedAction
 from exsce_dsl.runs.segments.sources import DISPATCHER_SOURCE, segment_robot
 from exsce_dsl.runs.signals.detect import Detected, pose_like_topics, with_detected_conventions
@@ -105,14 +102,13 @@ def run_metrics(scenario: Scenario) -> tuple[MetricDefinition, ...]:
 
 
 def wanted_topics(metrics: tuple[MetricDefinition, ...], robots: list[Robot]) -> dict[str, Wanted]:
-    """Topic → its message type (``*`` for the dispatcher's) and the fields the metrics read of it
-    (and of each robot's pose, where hotspots are placed)."""
+    """Topic → its message type (the dispatcher's: kept as message objects) and the fields the
+    metrics read of it (and of each robot's pose, where hotspots are placed)."""
     types: dict[str, str] = {}
     paths: dict[str, dict[FieldPath, None]] = {}
     for robot in robots:
         ns = robot.namespace.strip("/")
-        for pattern, msgtype in [(_FEEDBACK, ANY), (_RESULT, ANY), (POSE_TOPIC, POSE)]:
-            types[expand_topic(pattern, ns)] = msgtype
+        types[expand_topic(POSE_TOPIC, ns)] = POSE
         paths.setdefault(expand_topic(POSE_TOPIC, ns), {}).update(dict.fromkeys(HOTSPOT_PATHS))
         for metric in metrics:
             read_paths = fields_read(metric)
@@ -120,7 +116,7 @@ def wanted_topics(metrics: tuple[MetricDefinition, ...], robots: list[Robot]) ->
                 if read.signal:  # a signal: read from the sources runs/signals chooses
                     continue
                 topic = expand_topic(read.topic, ns)
-                types.setdefault(topic, ANY if read.msgtype in DISPATCHER else read.msgtype)
+                types.setdefault(topic, OBJECTS if read.msgtype in DISPATCHER else read.msgtype)
                 paths.setdefault(topic, {}).update(dict.fromkeys(read_paths.get(read.name, ())))
     return {topic: Wanted(msgtype, tuple(paths.get(topic, {}))) for topic, msgtype in types.items()}
 
@@ -317,19 +313,15 @@ def _segment_robots(path: Path, scenario: Scenario, bag: _Signals) -> _Segmented
     for robot in bag.robots:
         ns = robot.namespace.strip("/")
         feedback, result = expand_topic(_FEEDBACK, ns), expand_topic(_RESULT, ns)
-        updates = data.feedback.get(feedback)
-        dispatched = segments(scenario, robot.id, updates) if updates is not None else None
         # an implausible pose places no arrival; the whole run still spans the recording
         track = stacks.track(robot, bag.refused.usable(bag.topics))
-        found = segment_robot(scenario, robot, data, track, dispatched)
+        found = segment_robot(scenario, robot, data, track)
         bag.problems += found.problems
         out.actions.extend(found.segments)
         if found.source and found.source != DISPATCHER_SOURCE:
             out.segmented_by[robot.id] = found.source
-        if found.succeeded is None and dispatched is not None:
-            out.results[robot.id] = _succeeded(data.results.get(result))
-        else:
-            out.results[robot.id] = found.succeeded
+        out.results[robot.id] = found.succeeded
+        if found.source != DISPATCHER_SOURCE:
             stacks.real_topics[feedback] = stacks.real_topics[result] = (
                 found.topics or stacks.real_topics.get(expand_topic(SERVED["pose"], ns), ())
             )
@@ -396,11 +388,6 @@ def _nothing_of(path: Path, robot: Robot, types: Mapping[str, str]) -> str:
         f"'{robot.namespace or '/'}'); the bag's pose-like topics: {listed}. Say where its pose is "
         'in its robot type (pose on "TOPIC" or pose from tf FIXED -> BODY)'
     )
-
-
-def _succeeded(final: list[StatusUpdate] | None) -> int | None:
-    """Waypoints the dispatcher's results say SUCCEEDED (None: the bag has no result topic)."""
-    return None if final is None else sum(s == SUCCEEDED for u in final for s in u.statuses)
 
 
 def _time(seconds: float) -> dt.datetime:

@@ -14,18 +14,15 @@ from exsce_dsl.messages.catalogue import Source
 from exsce_dsl.model.messages import FieldPath, Fields
 from exsce_dsl.model.runs import MetricValue
 
-ANY = "*"
-"""The expected type of the dispatcher's topics: whatever the bag says, deserialized whole."""
 OBJECTS = "**"
 """The expected type of topics kept as message objects (a navigation stack's goals and statuses:
 few messages, read by attribute): whatever the bag says, in :attr:`BagData.messages`."""
-WHOLE = (ANY, OBJECTS)
 
 
 @dataclass(frozen=True)
 class Wanted:
-    """What is read of one topic: its expected type (``*``: the dispatcher's, read whole) and
-    the field paths the metrics use."""
+    """What is read of one topic: its expected type (:data:`OBJECTS`: kept as message objects)
+    and the field paths the metrics use."""
 
     msgtype: str
     paths: tuple[FieldPath, ...] = ()
@@ -52,16 +49,6 @@ class Series:
         return len(self.t)
 
 
-@dataclass(frozen=True)
-class StatusUpdate:
-    """A dispatcher feedback or result: the status of each waypoint of one goal."""
-
-    t: float
-    goal: str  # the actionlib goal id (may be empty)
-    waypoints: tuple[str, ...]
-    statuses: tuple[int, ...]
-
-
 @dataclass
 class BagData:
     path: Path
@@ -69,8 +56,6 @@ class BagData:
     end: float
     topics: tuple[str, ...]
     series: dict[str, Series] = field(default_factory=dict)
-    feedback: dict[str, list[StatusUpdate]] = field(default_factory=dict)  # topic -> updates
-    results: dict[str, list[StatusUpdate]] = field(default_factory=dict)
     messages: dict[str, list[tuple[float, Any]]] = field(default_factory=dict)
     """Topics wanted as :data:`OBJECTS`: (receive time, rosbags message object), in time order."""
     problems: list[str] = field(default_factory=list)
