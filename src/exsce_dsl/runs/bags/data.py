@@ -4,7 +4,7 @@ whatever the bag's format."""
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -12,7 +12,6 @@ import numpy as np
 
 from exsce_dsl.messages.catalogue import Source
 from exsce_dsl.model.messages import FieldPath, Fields
-from exsce_dsl.model.runs import MetricValue
 
 OBJECTS = "**"
 """The expected type of topics kept as message objects (a navigation stack's goals and statuses:
@@ -61,14 +60,6 @@ class BagData:
     problems: list[str] = field(default_factory=list)
     spellings: dict[str, tuple[str, ...]] = field(default_factory=dict)
     """A wanted name → the bag's topics read for it, as the bag spells them (see ``bags.names``)."""
-
-    def spelt(self, value: MetricValue) -> MetricValue:
-        """``value`` with its topics named as the bag spells them (``groundtruth`` for a
-        specification's ``/groundtruth``)."""
-        if all(self.spellings.get(t, (t,)) == (t,) for t in value.topics):
-            return value
-        named = [real for t in value.topics for real in self.spellings.get(t, (t,))]
-        return replace(value, topics=tuple(dict.fromkeys(named)))
 
 
 Reduce = Callable[[dict[str, np.ndarray]], dict[str, np.ndarray]]
