@@ -34,10 +34,10 @@ from exsce_dsl.codegen.ros_monitor import (
     ros2_monitor_files,
 )
 from exsce_dsl.lang import load_spec, standard_metrics
+from exsce_dsl.model.conventions import DISPATCHER_FEEDBACK, DISPATCHER_RESULT
 from exsce_dsl.monitor_kit import monitor_runtime
 from exsce_dsl.oracles.relations import relation
 from exsce_dsl.resources import package_file
-from exsce_dsl.runs import analyse
 from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
@@ -83,7 +83,7 @@ def test_the_runtime_imports_nothing_of_exsce() -> None:
 def test_the_dispatcher_topics_are_those_ingestion_reads() -> None:
     from exsce_dsl.codegen import ros_monitor
 
-    assert (ros_monitor.FEEDBACK_TOPIC, ros_monitor.RESULT_TOPIC) == (analyse._FEEDBACK, analyse._RESULT)
+    assert (ros_monitor.FEEDBACK_TOPIC, ros_monitor.RESULT_TOPIC) == (DISPATCHER_FEEDBACK, DISPATCHER_RESULT)
 
 
 @pytest.mark.parametrize("ros", [1, 2])

@@ -35,7 +35,7 @@ from exsce_dsl.runs.bags.mcap import mcap_files
 from exsce_dsl.runs.bags.mcap_index import read_topics, schemas
 from exsce_dsl.runs.bags.raw_messages import RawMessages
 from exsce_dsl.runs.bags.reader import UnsupportedBag
-from exsce_dsl.runs.bags.reading import ANY, Wanted, read_bag
+from exsce_dsl.runs.bags.reading import OBJECTS, Wanted, read_bag
 from exsce_dsl.runs.bags.rosbags_fallback import read_with_rosbags
 from exsce_dsl.sim.messages import FEEDBACK
 from exsce_dsl.sim.messages import typestore as sim_typestore
@@ -682,12 +682,20 @@ def _same_data(a: bagdata.BagData, b: bagdata.BagData) -> None:
         assert series.fields.keys() == other.fields.keys()
         for key, values in series.fields.items():
             assert np.array_equal(values, other.fields[key], equal_nan=True), (topic, key)
-    assert a.feedback == b.feedback and a.results == b.results
+    assert _statuses(a) == _statuses(b)
     assert a.problems == b.problems
 
 
+def _statuses(data: bagdata.BagData) -> dict[str, list[tuple[float, list[tuple[str, int]]]]]:
+    """The dispatcher's statuses of each topic kept as message objects, with their times."""
+    return {
+        topic: [(t, [(s.goal_id.id, s.status) for s in m.feedback.goal_status.status_list]) for t, m in found]
+        for topic, found in data.messages.items()
+    }
+
+
 def _dispatcher_bag(tmp_path: Path, written: list[Written]) -> tuple[Path, dict[str, Wanted]]:
-    """The recording with the dispatcher's feedback (read whole: ``*``) on its own topic."""
+    """The recording with the dispatcher's feedback (kept as message objects) on its own topic."""
     store = sim_typestore("mcap")
     types = store.types
     path = tmp_path / "dispatcher"
@@ -720,7 +728,7 @@ def _dispatcher_bag(tmp_path: Path, written: list[Written]) -> tuple[Path, dict[
         "/odom": Wanted("nav_msgs/msg/Odometry", ODOM_PATHS),
         "/pose": Wanted("geometry_msgs/msg/PoseStamped", (path_of("pose", "position", "x"),)),
         "/late": Wanted("nav_msgs/msg/Odometry", ODOM_PATHS),  # the wrong type: a problem
-        "/wd/feedback": Wanted(ANY),
+        "/wd/feedback": Wanted(OBJECTS),
     }
     return path, wanted
 
@@ -731,7 +739,7 @@ def test_read_bag_reads_what_rosbags_reads(tmp_path: Path, written: list[Written
     theirs = read_with_rosbags(bag, wanted, None, None)
     _same_data(ours, theirs)
     assert len(ours.series["/odom"]) == len([w for w in written if w[0] == "/odom"])
-    assert len(ours.feedback["/wd/feedback"]) == (len(written) + 49) // 50
+    assert len(ours.messages["/wd/feedback"]) == (len(written) + 49) // 50
     assert len(ours.problems) == 1 and "/late" in ours.problems[0]  # of the wrong type
     _same_data(read_bag(mcap_of(bag), wanted), theirs)  # the .mcap file itself
 

@@ -243,9 +243,7 @@ def _safety_signals(sig: RobotSignals, limits: SafetyLimits, start: float, end: 
     if sig.vel is not None and len(sig.vel):
         w = _window(sig.vel, start, end)
         t = sig.vel.t[w]
-        found.append(
-            ("max_velocity", sig.topics["vel"], t, hold(t), sig.speed()[w] > limits.max_velocity)
-        )
+        found.append(("max_velocity", sig.topics["vel"], t, hold(t), sig.speed()[w] > limits.max_velocity))
     if sig.scan is not None and len(sig.scan):
         w = _window(sig.scan, start, end)
         t = sig.scan.t[w]
@@ -347,15 +345,17 @@ def metrics_of_bag(path, scenario) -> tuple[list[MetricValue], list[Hotspot]]:  
     from exsce_dsl.runs.analyse import run_metrics, wanted_topics
     from exsce_dsl.runs.bags.reading import read_bag
     from exsce_dsl.runs.segments.dispatcher import SUCCEEDED, segments
+    from exsce_dsl.runs.signals.dispatcher_statuses import dispatcher_statuses
 
     robots = [r for r in scenario.robots if r.start_pose is not None]
     data = read_bag(path, wanted_topics(run_metrics(scenario), robots))
     actions: list[RecordedAction] = []
     results: dict[str, int | None] = {}
     for robot in robots:
-        topics = robot_topics(robot.namespace)
-        actions += segments(scenario, robot.id, data.feedback[topics["feedback"]])
-        final = data.results.get(topics["result"])
+        statuses = dispatcher_statuses(robot.namespace, data)
+        assert statuses.feedback is not None
+        actions += segments(scenario, robot.id, statuses.feedback)
+        final = statuses.result
         results[robot.id] = None if final is None else sum(s == SUCCEEDED for u in final for s in u.statuses)
     signals = [RobotSignals.from_bag(r.id, r.namespace, data) for r in robots]
     return compute_metrics(signals, actions, results, SafetyLimits(), [])

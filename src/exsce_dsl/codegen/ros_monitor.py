@@ -27,6 +27,7 @@ from exsce_dsl.messages.catalogue import MessageTypeError
 from exsce_dsl.messages.user import configured_catalogue
 from exsce_dsl.model import Scenario, Specification
 from exsce_dsl.model.acceptance import BasicRelation
+from exsce_dsl.model.conventions import DISPATCHER_FEEDBACK, DISPATCHER_RESULT
 from exsce_dsl.model.expressions import Field, walk
 from exsce_dsl.model.messages import (
     FEEDBACK,
@@ -47,8 +48,7 @@ from exsce_dsl.resources import package_file
 from exsce_dsl.runs.metrics.monitor_code import monitor_source
 from exsce_dsl.templating import GenerationError, python_name, python_string, render
 
-FEEDBACK_TOPIC = "/{ns}/waypoint_dispatcher/feedback"
-RESULT_TOPIC = "/{ns}/waypoint_dispatcher/result"
+FEEDBACK_TOPIC, RESULT_TOPIC = DISPATCHER_FEEDBACK, DISPATCHER_RESULT
 """The dispatcher's topics, where ingestion takes each robot's windows and successes from."""
 VERDICT_TOPIC = "/exsce/verdicts"
 _ROS_PACKAGE = re.compile(r"[a-z][a-z0-9]*(?:_[a-z0-9]+)*")

@@ -22,7 +22,7 @@ MEANINGS: dict[str, str] = {
     "velocity": '`velocity on "/{ns}/cmd_vel" [TYPE]`: where the robot\'s velocity is (Twist, TwistStamped '
     "or an Odometry's twist); several lines are tried in order. In a metric, `reads vel: robot "
     "velocity` reads it (`vel.linear.x` ... `vel.angular.z`).",
-    "scan": '`scan on "/{ns}/scan" [at 10 Hz]`: the robot\'s laser scan (sensor_msgs/msg/LaserScan); '
+    "scan": '`scan on "/{ns}/base_scan" [at 10 Hz]`: the robot\'s laser scan (sensor_msgs/msg/LaserScan); '
     "`scan at 10 Hz`: the rate it is published at, wherever it is read from (a run that recorded it "
     "at less than half of it is told at ingest).",
     "Hz": "`at 10 Hz`: the rate a robot's signal is published at (pose, velocity, scan or distance); a "

@@ -165,16 +165,32 @@ class Signals:
         return detected.overridden(**said, said=self.said, named=False)
 
 
+METHOD_TOPICS = {
+    "pose": "/{ns}/robot_pose",
+    "velocity": "/{ns}/nav_vel",
+    "scan": "/{ns}/scan",
+    "distance": "/{ns}/distance_travelled",
+    "dispatcher": "/{ns}/waypoint_dispatcher",
+    "feedback": "/{ns}/waypoint_dispatcher/feedback",
+    "result": "/{ns}/waypoint_dispatcher/result",
+}
+"""The method's topic names (patterns with ``{ns}``), by what each carries: the only place they are
+written (``tests/project/test_method_topics.py`` holds it); the simulator, the code generators and
+ingestion take them from here."""
+
 METHOD = Signals(
     convention="method",
-    pose=(TopicSource("/{ns}/robot_pose", POSE_WITH_COVARIANCE),),
-    velocity=(TopicSource("/{ns}/nav_vel", TWIST),),
-    scan=(TopicSource("/{ns}/scan", LASER_SCAN),),
-    distance=(TopicSource("/{ns}/distance_travelled", FLOAT64),),
+    pose=(TopicSource(METHOD_TOPICS["pose"], POSE_WITH_COVARIANCE),),
+    velocity=(TopicSource(METHOD_TOPICS["velocity"], TWIST),),
+    scan=(TopicSource(METHOD_TOPICS["scan"], LASER_SCAN),),
+    distance=(TopicSource(METHOD_TOPICS["distance"], FLOAT64),),
     navigation=Navigation.DISPATCHER,
-    actions=("/{ns}/waypoint_dispatcher",),
+    actions=(METHOD_TOPICS["dispatcher"],),
 )
 """The method's own topics, as its executor and the robots of its published runs publish them."""
+
+DISPATCHER_FEEDBACK, DISPATCHER_RESULT = METHOD_TOPICS["feedback"], METHOD_TOPICS["result"]
+"""The method's waypoint dispatcher's feedback and result topics (patterns with ``{ns}``)."""
 
 NAV2 = Signals(
     convention="nav2",

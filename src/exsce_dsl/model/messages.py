@@ -50,7 +50,7 @@ DISPATCHER = (FEEDBACK, RESULT)
 """Read whole by the run's segmentation; a metric uses them through ``elapsed`` and ``succeeded``."""
 
 POSE = "geometry_msgs/msg/PoseWithCovarianceStamped"
-"""The method's robot pose (``/{ns}/robot_pose``), where hotspots are placed."""
+"""The method's robot pose (its convention's pose topic), where hotspots are placed."""
 
 
 @dataclass(frozen=True)

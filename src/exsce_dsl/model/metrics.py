@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 from exsce_dsl.errors import SourceLocation
+from exsce_dsl.model.conventions import METHOD_TOPICS
 from exsce_dsl.model.expressions import Expression, Field
 
 if TYPE_CHECKING:
@@ -129,19 +130,22 @@ SI_UNIT = {
     Dimension.NUMBER: "",
 }
 
-_FEEDBACK, _RESULT, _POSE = "waypoint_dispatcher/feedback", "waypoint_dispatcher/result", "robot_pose"
+_FEEDBACK, _RESULT, _POSE, _VEL, _SCAN, _DISTANCE = (
+    METHOD_TOPICS[name].removeprefix("/{ns}/")
+    for name in ("feedback", "result", "pose", "velocity", "scan", "distance")
+)
 TOPICS: dict[str, tuple[str, ...]] = {
     "mission_duration": (_FEEDBACK,),
     "task_duration": (_FEEDBACK,),
     "waypoints_visited": (_RESULT,),
-    "distance_travelled": ("distance_travelled",),
-    "distance_to_obstacles": ("scan",),
-    "max_velocity": ("nav_vel",),
+    "distance_travelled": (_DISTANCE,),
+    "distance_to_obstacles": (_SCAN,),
+    "max_velocity": (_VEL,),
     "distance_between_robots": (_POSE,),
-    "violation_duration": ("nav_vel", "scan"),
+    "violation_duration": (_VEL, _SCAN),
 }
-"""The topics each metric is computed from, below a robot's namespace (DESIGN §1; the names
-the standard library declares them with)."""
+"""The topics each metric is computed from, below a robot's namespace (DESIGN §1: the method's,
+from its convention)."""
 
 
 class ComputedFor(enum.Enum):
@@ -154,7 +158,7 @@ class ComputedFor(enum.Enum):
 
 @dataclass(frozen=True)
 class TopicRead:
-    """A topic a metric reads: ``reads vel: geometry_msgs/msg/Twist on "/{ns}/nav_vel"``."""
+    """A topic a metric reads: ``reads vel: geometry_msgs/msg/Twist on "/{ns}/cmd_vel"``."""
 
     name: str
     msgtype: str

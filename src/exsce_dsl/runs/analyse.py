@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import datetime as dt
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from types import ModuleType
 
@@ -15,23 +15,31 @@ from exsce_dsl.lang import standard_metrics
 from exsce_dsl.messages.catalogue import Source
 from exsce_dsl.messages.field_check import check_fields
 from exsce_dsl.model import Scenario
-from exsce_dsl.model.conventions import Window
+from exsce_dsl.model.conventions import DISPATCHER_FEEDBACK, DISPATCHER_RESULT, Window
 from exsce_dsl.model.expressions import Field, walk
 from exsce_dsl.model.messages import DISPATCHER, POSE, FieldPath, Fields
 from exsce_dsl.model.metrics import MetricDefinition
 from exsce_dsl.model.robots import Robot
-from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Bag, Run, RunClock, TaskExecution, run_uuid
+from exsce_dsl.model.runs import (
+    Action,
+    ActionId,
+    ActionStatus,
+    Bag,
+    MetricValue,
+    Run,
+    RunClock,
+    TaskExecution,
+    run_uuid,
+)
 from exsce_dsl.monitor_kit.monitor_core import Compute, Topic, expand_topic, reducer
 from exsce_dsl.runs.bag_identity import content_hash
 from exsce_dsl.runs.bags.data import BagData
 from exsce_dsl.runs.bags.names import BagTopics
 from exsce_dsl.runs.bags.reading import (
-    ANY,
     OBJECTS,
     BagError,
     Check,
     Reduce,
-    StatusUpdate,
     Wanted,
     bag_topics,
     read_bag,
@@ -50,9 +58,9 @@ from exsce_dsl.runs.missing import missing_metrics, unread_topics
 from exsce_dsl.runs.plausible_poses import Refused, refuse_implausible, spec_speed_limit
 from exsce_dsl.runs.recorded_execution import recorded_execution
 from exsce_dsl.runs.robots import SERVED, StackRobots, stack_robots
-from exsce_dsl.runs.segments.dispatcher import SUCCEEDED, segments
 from exsce_dsl.runs.segments.recorded import RecordedAction
 from exsce_dsl.runs.segments.sources import DISPATCHER_SOURCE, segment_robot
+from exsce_dsl.runs.segments.track import Track
 from exsce_dsl.runs.signals.detect import Detected, pose_like_topics, with_detected_conventions
 from exsce_dsl.runs.signals.timeline import (
     Timeline,
@@ -63,8 +71,7 @@ from exsce_dsl.runs.signals.timeline import (
 )
 from exsce_dsl.wording import counted
 
-_FEEDBACK = "/{ns}/waypoint_dispatcher/feedback"
-_RESULT = "/{ns}/waypoint_dispatcher/result"
+_FEEDBACK, _RESULT = DISPATCHER_FEEDBACK, DISPATCHER_RESULT
 
 
 @dataclass(frozen=True)
@@ -106,14 +113,13 @@ def run_metrics(scenario: Scenario) -> tuple[MetricDefinition, ...]:
 
 
 def wanted_topics(metrics: tuple[MetricDefinition, ...], robots: list[Robot]) -> dict[str, Wanted]:
-    """Topic → its message type (``*`` for the dispatcher's) and the fields the metrics read of it
-    (and of each robot's pose, where hotspots are placed)."""
+    """Topic → its message type (the dispatcher's: kept as message objects) and the fields the
+    metrics read of it (and of each robot's pose, where hotspots are placed)."""
     types: dict[str, str] = {}
     paths: dict[str, dict[FieldPath, None]] = {}
     for robot in robots:
         ns = robot.namespace.strip("/")
-        for pattern, msgtype in [(_FEEDBACK, ANY), (_RESULT, ANY), (POSE_TOPIC, POSE)]:
-            types[expand_topic(pattern, ns)] = msgtype
+        types[expand_topic(POSE_TOPIC, ns)] = POSE
         paths.setdefault(expand_topic(POSE_TOPIC, ns), {}).update(dict.fromkeys(HOTSPOT_PATHS))
         for metric in metrics:
             read_paths = fields_read(metric)
@@ -121,7 +127,7 @@ def wanted_topics(metrics: tuple[MetricDefinition, ...], robots: list[Robot]) ->
                 if read.signal:  # a signal: read from the sources runs/signals chooses
                     continue
                 topic = expand_topic(read.topic, ns)
-                types.setdefault(topic, ANY if read.msgtype in DISPATCHER else read.msgtype)
+                types.setdefault(topic, OBJECTS if read.msgtype in DISPATCHER else read.msgtype)
                 paths.setdefault(topic, {}).update(dict.fromkeys(read_paths.get(read.name, ())))
     return {topic: Wanted(msgtype, tuple(paths.get(topic, {}))) for topic, msgtype in types.items()}
 
@@ -201,10 +207,10 @@ def analyse_bag(
         found.results,
         bag.problems,
         found.whole_runs,
-        {**stacks.named(robots), **bag.refused.reasons},
+        {**bag.named, **bag.refused.reasons},
         found.reasons,
     )
-    values = [bag.data.spelt(stacks.with_real_sources(v)) for v in values]
+    values = [_bag_named(stacks.with_real_sources(v), bag.data.spellings) for v in values]
     if strict:
         acting = [r.id for r in robots if scenario.mission.tasks_of(r.id)]
         lacking = missing_metrics(metrics, robots, acting, found.actions, values)
@@ -260,6 +266,12 @@ class _Signals:
     problems: list[str]
     refused: Refused = field(default_factory=Refused)
     """The topics whose poses no robot could make: the monitors do not read them."""
+    named: dict[str, str] = field(default_factory=dict)
+    """How the run's problems name what the monitors read of the robots (:meth:`StackRobots.named`)."""
+    tracks: dict[str, Track] = field(default_factory=dict)
+    """Each robot's pose, for segmentation (an implausible pose is none)."""
+    spans: dict[str, tuple[float, float] | None] = field(default_factory=dict)
+    """Each robot's signals' first and last message (None: it has none)."""
 
 
 def _read_signals(
@@ -292,9 +304,14 @@ def _read_signals(
         topics[name] = Topic(name, served.t, {**served.fields, **read.fields}) if same and read else served
     refused = refuse_implausible(robots, stacks, topics, data, spec_speed_limit(scenario.metrics))
     problems += refused.problems
+    # an implausible pose places no arrival; the whole run still spans the recording
+    usable = refused.usable(topics)
     return _Signals(
-        types, robots, detected, stacks, unread, recorded, timeline, data, topics, problems, refused
-    )
+        types, robots, detected, stacks, unread, recorded, timeline, data, topics, problems, refused,
+        stacks.named(robots),
+        {r.id: stacks.track(r, usable) for r in robots},
+        {r.id: stacks.recorded_span(r, topics) for r in robots},
+    )  # fmt: skip
 
 
 @dataclass
@@ -318,26 +335,20 @@ def _segment_robots(path: Path, scenario: Scenario, bag: _Signals) -> _Segmented
     for robot in bag.robots:
         ns = robot.namespace.strip("/")
         feedback, result = expand_topic(_FEEDBACK, ns), expand_topic(_RESULT, ns)
-        updates = data.feedback.get(feedback)
-        dispatched = segments(scenario, robot.id, updates) if updates is not None else None
-        # an implausible pose places no arrival; the whole run still spans the recording
-        track = stacks.track(robot, bag.refused.usable(bag.topics))
-        found = segment_robot(scenario, robot, data, track, dispatched)
+        found = segment_robot(scenario, robot, data, bag.tracks[robot.id])
         bag.problems += found.problems
         out.actions.extend(found.segments)
         if found.source and found.source != DISPATCHER_SOURCE:
             out.segmented_by[robot.id] = found.source
-        if found.succeeded is None and dispatched is not None:
-            out.results[robot.id] = _succeeded(data.results.get(result))
-        else:
-            out.results[robot.id] = found.succeeded
+        out.results[robot.id] = found.succeeded
+        if found.source != DISPATCHER_SOURCE:
             stacks.real_topics[feedback] = stacks.real_topics[result] = (
                 found.topics or stacks.real_topics.get(expand_topic(SERVED["pose"], ns), ())
             )
         # the whole run is the recording unless recorded goals span it: never an arrival
         recording = robot.signals.window is Window.RECORDING or not found.goals
         if (not found.segments or recording) and scenario.mission.tasks_of(robot.id):
-            span = stacks.recorded_span(robot, bag.topics)
+            span = bag.spans[robot.id]
             if span is None and not found.segments:
                 raise BagError("\n  ".join([_nothing_of(path, robot, bag.types), *bag.unread]))
             if span is not None:
@@ -360,6 +371,14 @@ def _why_recording(robot: Robot, goals: bool, segmented: bool) -> str:
 def _spelt(topics: tuple[str, ...], spellings: Mapping[str, tuple[str, ...]]) -> tuple[str, ...]:
     """``topics`` as the bag spells them."""
     return tuple(dict.fromkeys(s for t in topics for s in spellings.get(t, (t,))))
+
+
+def _bag_named(value: MetricValue, spellings: Mapping[str, tuple[str, ...]]) -> MetricValue:
+    """``value`` with its topics named as the bag spells them (``groundtruth`` for a
+    specification's ``/groundtruth``)."""
+    if all(spellings.get(t, (t,)) == (t,) for t in value.topics):
+        return value
+    return replace(value, topics=_spelt(value.topics, spellings))
 
 
 def _recording(span: tuple[float, float], data: BagData) -> tuple[float, float]:
@@ -397,11 +416,6 @@ def _nothing_of(path: Path, robot: Robot, types: Mapping[str, str]) -> str:
         f"'{robot.namespace or '/'}'); the bag's pose-like topics: {listed}. Say where its pose is "
         'in its robot type (pose on "TOPIC" or pose from tf FIXED -> BODY)'
     )
-
-
-def _succeeded(final: list[StatusUpdate] | None) -> int | None:
-    """Waypoints the dispatcher's results say SUCCEEDED (None: the bag has no result topic)."""
-    return None if final is None else sum(s == SUCCEEDED for u in final for s in u.statuses)
 
 
 def _time(seconds: float) -> dt.datetime:

@@ -26,15 +26,15 @@ import numpy as np
 from exsce_dsl.errors import BagError
 from exsce_dsl.model.conventions import Navigation, Signals
 from exsce_dsl.model.goals import GoalStatus
-from exsce_dsl.model.metrics import expand_topic
 from exsce_dsl.model.names import is_ros_namespace
 from exsce_dsl.model.robots import Robot, RobotType
-from exsce_dsl.runs.bags.reading import ANY, OBJECTS, BagData, Wanted, bag_topics, read_bag
-from exsce_dsl.runs.robots import FEEDBACK, StackRobots
+from exsce_dsl.runs.bags.reading import OBJECTS, BagData, Wanted, bag_topics, read_bag
+from exsce_dsl.runs.robots import StackRobots
 from exsce_dsl.runs.segments.dispatcher import dispatcher_goals
 from exsce_dsl.runs.segments.goals import goal_legs
 from exsce_dsl.runs.segments.track import DEFAULT_TOLERANCE, Track
 from exsce_dsl.runs.signals.detect import Detected, pose_like_topics, robot_namespaces
+from exsce_dsl.runs.signals.dispatcher_statuses import dispatcher_statuses
 from exsce_dsl.runs.signals.navigation_goals import goal_wanted, read_goals
 from exsce_dsl.runs.signals.sources import choose_sources, signals_wanted
 from exsce_dsl.runs.signals.timeline import decide_timeline, on_timeline, stamp_catalogue, with_stamps
@@ -126,8 +126,6 @@ def bag_contents(path: Path) -> BagContents:
     wanted = dict(signals_wanted(sources.values(), ()))
     for model in models:
         wanted.update(goal_wanted(model.signals, model.namespace))
-        if model.signals.navigation is Navigation.DISPATCHER:
-            wanted[expand_topic(FEEDBACK, model.namespace)] = Wanted(ANY)
     grids = sorted(t for t, m in types.items() if m == OCCUPANCY_GRID)
     maps = [t for t in grids if t.lstrip("/") == "map"] or [t for t in grids if "costmap" not in t][:1]
     wanted.update({t: Wanted(OBJECTS) for t in maps})
@@ -180,8 +178,8 @@ def _places(robot: BagRobot, model: Robot, data: BagData, track: Track) -> None:
 
 
 def _dispatched(robot: BagRobot, data: BagData, track: Track) -> None:
-    topic = expand_topic(FEEDBACK, robot.namespace)
-    updates = data.feedback.get(topic) or []
+    statuses = dispatcher_statuses(robot.namespace, data)
+    topic, updates = statuses.topics[0], statuses.feedback or []
     for goal in dispatcher_goals(updates):
         places = []
         for w, waypoint in enumerate(goal[0].waypoints):

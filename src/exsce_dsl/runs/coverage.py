@@ -218,7 +218,7 @@ def read_topics(
 ) -> list[ReadTopic]:
     """The series of ``data`` that ``values`` were computed from, with the robot and the metrics
     that read each (the values name topics as the bag spells them).  A topic only mission values
-    read is its robot's when it is in the robot's namespace (``/tiago1/robot_pose``)."""
+    read is its robot's when it is in the robot's namespace (``/tiago1/odom``)."""
     spaces = {f"/{r.namespace.strip('/')}/": r.id for r in robots if r.namespace.strip("/")}
     metrics: dict[str, dict[str, None]] = {}
     owned: dict[str, set[str]] = {}
@@ -259,7 +259,7 @@ def declared_rates(
     robots: Iterable[Robot], sources: Mapping[str, RobotSources], data: BagData
 ) -> dict[str, float]:
     """Bag topic (as spelt) → the rate its robot type declares for the signal read from it: the
-    source's own (``scan on "/{ns}/scan" at 10 Hz``), else the signal's (``scan at 10 Hz``).  A
+    source's own (``scan on "/{ns}/base_scan" at 10 Hz``), else the signal's (``scan at 10 Hz``).  A
     pose from TF has no rate of its own (``/tf`` carries every frame)."""
     found: dict[str, float] = {}
     for robot in robots:

@@ -1,8 +1,7 @@
 """Runs of robots whose type declares where its signals are (Nav2, move_base, or its own topics).
 
 The standard library's metrics are declared over the method's topics
-(``/{ns}/robot_pose``, ``/{ns}/nav_vel``, ``/{ns}/scan``,
-``/{ns}/distance_travelled``) and its dispatcher's windows.  For a robot whose
+(:data:`~exsce_dsl.model.conventions.METHOD_TOPICS`) and its dispatcher's windows.  For a robot whose
 type says otherwise, ingestion reads the signals from the sources chosen in the
 bag (:mod:`~exsce_dsl.runs.signals.sources`) and serves them to the monitors under
 those names, with the fields the method's types have there; the metrics' sources
@@ -20,7 +19,14 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from exsce_dsl.model.conventions import METHOD, Navigation, TfSource, TopicSource
+from exsce_dsl.model.conventions import (
+    DISPATCHER_FEEDBACK,
+    DISPATCHER_RESULT,
+    METHOD_TOPICS,
+    Navigation,
+    TfSource,
+    TopicSource,
+)
 from exsce_dsl.model.messages import FieldPath
 from exsce_dsl.model.metrics import expand_topic
 from exsce_dsl.model.robots import Robot
@@ -37,14 +43,8 @@ from exsce_dsl.runs.signals.sources import (
     signals_wanted,
 )
 
-FEEDBACK = "/{ns}/waypoint_dispatcher/feedback"
-RESULT = "/{ns}/waypoint_dispatcher/result"
-SERVED = {
-    "pose": METHOD.pose[0].topic,  # type: ignore[union-attr]
-    "velocity": METHOD.velocity[0].topic,
-    "scan": METHOD.scan[0].topic,
-    "distance": METHOD.distance[0].topic,
-}
+FEEDBACK, RESULT = DISPATCHER_FEEDBACK, DISPATCHER_RESULT
+SERVED = {signal: METHOD_TOPICS[signal] for signal in ("pose", "velocity", "scan", "distance")}
 """The method's topic each signal is served under, for the standard library's metrics."""
 
 
@@ -99,7 +99,7 @@ class StackRobots:
         return adapted
 
     def read_from(self, name: str) -> str | None:
-        """The bag topic a served or signal topic (``/{ns}/scan``, ``/{ns}/~scan``) is read from,
+        """The bag topic a served or signal topic (the method's scan, ``/{ns}/~scan``) is read from,
         when it is one topic (not a TF chain) of another name; None otherwise."""
         for robot in self.sources.values():
             for signal, chosen in robot.chosen.items():

@@ -1,8 +1,8 @@
 """The method's topics: what the method's executor and its waypoint dispatcher publish.
 
-Per robot namespace: ``robot_pose`` (PoseWithCovarianceStamped, 50 Hz), ``nav_vel`` (Twist,
-25 Hz), ``distance_travelled`` (Float64, 10 Hz), ``scan`` (LaserScan, 10 Hz) and the dispatcher's
-``waypoint_dispatcher/feedback`` and ``result`` (see :mod:`exsce_dsl.sim.messages`).
+Per robot namespace (names from :data:`~exsce_dsl.model.conventions.METHOD_TOPICS`): the pose
+(PoseWithCovarianceStamped, 50 Hz), velocity (Twist, 25 Hz), distance travelled (Float64, 10 Hz),
+scan (LaserScan, 10 Hz) and the dispatcher's feedback and result (see :mod:`exsce_dsl.sim.messages`).
 """
 
 from __future__ import annotations
@@ -14,6 +14,8 @@ from typing import Any
 import numpy as np
 
 from exsce_dsl.maps.planning import PlanningGrid
+from exsce_dsl.model.conventions import METHOD_TOPICS
+from exsce_dsl.model.metrics import expand_topic
 from exsce_dsl.sim.batches import Batch, stamp_columns
 from exsce_dsl.sim.executor import Execution, GoalStatus
 from exsce_dsl.sim.messages import FEEDBACK, RESULT
@@ -34,20 +36,17 @@ POSE_NOISE, YAW_NOISE = 0.005, 0.002
 
 @dataclass(frozen=True)
 class Topics:
-    """The topic names of one robot namespace (the method's defaults)."""
+    """The topic names of one robot namespace (the method's, from its convention)."""
 
     ns: str
 
-    def __getattr__(self, name: str) -> str:  # pragma: no cover - only the names below are used
-        raise AttributeError(name)
-
-    def _name(self, topic: str) -> str:
+    def _name(self, carries: str) -> str:
         """``/ns/topic``; ``/topic`` for a robot at the root (no namespace)."""
-        return f"/{self.ns}/{topic}" if self.ns else f"/{topic}"
+        return expand_topic(METHOD_TOPICS[carries], self.ns)
 
     @property
     def pose(self) -> str:
-        return self._name("robot_pose")
+        return self._name("pose")
 
     @property
     def scan(self) -> str:
@@ -55,19 +54,19 @@ class Topics:
 
     @property
     def vel(self) -> str:
-        return self._name("nav_vel")
+        return self._name("velocity")
 
     @property
     def distance(self) -> str:
-        return self._name("distance_travelled")
+        return self._name("distance")
 
     @property
     def feedback(self) -> str:
-        return self._name("waypoint_dispatcher/feedback")
+        return self._name("feedback")
 
     @property
     def result(self) -> str:
-        return self._name("waypoint_dispatcher/result")
+        return self._name("result")
 
 
 def method_messages(run: RobotRun) -> Iterator[Message | Batch]:

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any
 from exsce_dsl.errors import SourceLocation
 from exsce_dsl.lang.lexical import quantity_text
 from exsce_dsl.messages.field_check import FieldProblem, field_shape
+from exsce_dsl.model.conventions import METHOD_TOPICS
 from exsce_dsl.model.expressions import (
     AGGREGATES,
     CONDITION_AGGREGATES,
@@ -223,7 +224,7 @@ class ExpressionBuilder:
             which = "feedback" if node.name == "elapsed" else "result"
             raise self._fail(
                 f"'{node.name}' comes from the waypoint dispatcher: read its {which} topic "
-                f'(reads {which}: {needed} on "/{{ns}}/waypoint_dispatcher/{which}")',
+                f'(reads {which}: {needed} on "{METHOD_TOPICS[which]}")',
                 node,
             )
         if node.name == "succeeded" and self.scope.subject is not ComputedFor.ROBOT:

@@ -3,7 +3,7 @@
 ``convention nav2`` takes Nav2's sources; each ``pose``, ``velocity``, ``scan``,
 ``navigation`` or ``arrival`` line replaces the convention's for that signal
 (several ``pose`` lines are a list of preference, tried in order at ingest).  A rate
-(``scan on "/{ns}/scan" at 10 Hz``, or ``scan at 10 Hz`` for the signal wherever it is read
+(``scan on "/{ns}/base_scan" at 10 Hz``, or ``scan at 10 Hz`` for the signal wherever it is read
 from) says how often the topic is published: a run that recorded it at less than half of it
 is told (``runs.coverage``).
 A robot type that names no convention has it detected from each bag at ingest, and its own lines

@@ -4,7 +4,7 @@ whatever the bag's format."""
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -12,20 +12,16 @@ import numpy as np
 
 from exsce_dsl.messages.catalogue import Source
 from exsce_dsl.model.messages import FieldPath, Fields
-from exsce_dsl.model.runs import MetricValue
 
-ANY = "*"
-"""The expected type of the dispatcher's topics: whatever the bag says, deserialized whole."""
 OBJECTS = "**"
 """The expected type of topics kept as message objects (a navigation stack's goals and statuses:
 few messages, read by attribute): whatever the bag says, in :attr:`BagData.messages`."""
-WHOLE = (ANY, OBJECTS)
 
 
 @dataclass(frozen=True)
 class Wanted:
-    """What is read of one topic: its expected type (``*``: the dispatcher's, read whole) and
-    the field paths the metrics use."""
+    """What is read of one topic: its expected type (:data:`OBJECTS`: kept as message objects)
+    and the field paths the metrics use."""
 
     msgtype: str
     paths: tuple[FieldPath, ...] = ()
@@ -52,16 +48,6 @@ class Series:
         return len(self.t)
 
 
-@dataclass(frozen=True)
-class StatusUpdate:
-    """A dispatcher feedback or result: the status of each waypoint of one goal."""
-
-    t: float
-    goal: str  # the actionlib goal id (may be empty)
-    waypoints: tuple[str, ...]
-    statuses: tuple[int, ...]
-
-
 @dataclass
 class BagData:
     path: Path
@@ -69,21 +55,11 @@ class BagData:
     end: float
     topics: tuple[str, ...]
     series: dict[str, Series] = field(default_factory=dict)
-    feedback: dict[str, list[StatusUpdate]] = field(default_factory=dict)  # topic -> updates
-    results: dict[str, list[StatusUpdate]] = field(default_factory=dict)
     messages: dict[str, list[tuple[float, Any]]] = field(default_factory=dict)
     """Topics wanted as :data:`OBJECTS`: (receive time, rosbags message object), in time order."""
     problems: list[str] = field(default_factory=list)
     spellings: dict[str, tuple[str, ...]] = field(default_factory=dict)
     """A wanted name → the bag's topics read for it, as the bag spells them (see ``bags.names``)."""
-
-    def spelt(self, value: MetricValue) -> MetricValue:
-        """``value`` with its topics named as the bag spells them (``groundtruth`` for a
-        specification's ``/groundtruth``)."""
-        if all(self.spellings.get(t, (t,)) == (t,) for t in value.topics):
-            return value
-        named = [real for t in value.topics for real in self.spellings.get(t, (t,))]
-        return replace(value, topics=tuple(dict.fromkeys(named)))
 
 
 Reduce = Callable[[dict[str, np.ndarray]], dict[str, np.ndarray]]

@@ -19,7 +19,7 @@ import numpy as np
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.messages.catalogue import MessageCatalogue, Source, parse_definition, standard_catalogue
 from exsce_dsl.runs.bags.chunk_batches import Messages
-from exsce_dsl.runs.bags.data import OBJECTS, BagData, Check, Reduce, Wanted
+from exsce_dsl.runs.bags.data import BagData, Check, Reduce, Wanted
 from exsce_dsl.runs.bags.mcap_index import IDL_SEPARATOR, Schema, definitions, read_channels, recorded_span
 from exsce_dsl.runs.bags.objects import deserialized, deserializer_for
 from exsce_dsl.runs.bags.reader import BagReader, UnsupportedBag
@@ -92,8 +92,7 @@ class _Mcap(IndexReading):
             store = deserializer_for(catalogue, msgtype)
             order = np.argsort(messages.times, kind="stable")
             read = functools.partial(store.deserialize_cdr, typename=msgtype)
-            lazy = topic if self.wanted_for(topic).msgtype == OBJECTS else None
-            objects = deserialized(read, [messages.raws[i] for i in order.tolist()], lazy)
+            objects = deserialized(read, [messages.raws[i] for i in order.tolist()], topic)
             self.add_whole(topic, messages.times[order] / 1e9, objects)
         return self.data(start / 1e9, end / 1e9, tuple(sorted({topic for topic, _ in found})))
 

@@ -8,8 +8,8 @@ else from the user's ``.msg``/``.idl`` files, else from rosbags' standard
 typestores, per connection: two versions of one type in a bag are decoded each by
 its own.  Several connections on one topic are merged, each message's connection
 kept where there are several (:attr:`Series.publishers`, whose stamps are judged
-apart), and every topic's messages are put in time order.  The dispatcher's few feedback and result
-messages are deserialized by rosbags.
+apart), and every topic's messages are put in time order.  Topics wanted as message objects (a
+navigation stack's few goals and statuses) are deserialized by rosbags.
 
 Each format has its reader (:mod:`~exsce_dsl.runs.bags.reader`), and :data:`READERS` lists
 them in the order they are tried.
@@ -22,14 +22,11 @@ from pathlib import Path
 
 from exsce_dsl.errors import BagError as BagError
 from exsce_dsl.messages.catalogue import MessageTypeError
-from exsce_dsl.runs.bags.data import ANY as ANY
 from exsce_dsl.runs.bags.data import OBJECTS as OBJECTS
-from exsce_dsl.runs.bags.data import WHOLE as WHOLE
 from exsce_dsl.runs.bags.data import BagData as BagData
 from exsce_dsl.runs.bags.data import Check as Check
 from exsce_dsl.runs.bags.data import Reduce as Reduce
 from exsce_dsl.runs.bags.data import Series as Series
-from exsce_dsl.runs.bags.data import StatusUpdate as StatusUpdate
 from exsce_dsl.runs.bags.data import Wanted as Wanted
 from exsce_dsl.runs.bags.decode import DecodeError
 from exsce_dsl.runs.bags.files import check_bag_file

@@ -20,13 +20,11 @@ from exsce_dsl.errors import BagError
 from exsce_dsl.messages.catalogue import MessageCatalogue
 from exsce_dsl.messages.user import configured_user_catalogue
 from exsce_dsl.model.messages import canonical_type, standard_type
-from exsce_dsl.runs.bags.data import OBJECTS, WHOLE, BagData, Check, Reduce, Series, StatusUpdate, Wanted
+from exsce_dsl.runs.bags.data import OBJECTS, BagData, Check, Reduce, Series, Wanted
 from exsce_dsl.runs.bags.decode import TEXTS, decode, decode_slowly, vectorisable
 from exsce_dsl.runs.bags.names import TopicMatch
 from exsce_dsl.runs.bags.objects import deserializer_for
 from exsce_dsl.runs.bags.raw_messages import RawMessages
-
-_PROGRESS = {0: 0, 1: 1}  # PENDING, ACTIVE; every other status is final
 
 
 class _Topic:
@@ -127,7 +125,6 @@ class Reading:
         self.reduce = reduce
         self.check = check
         self.topics: dict[str, _Topic] = {}
-        self.updates: dict[str, list[StatusUpdate]] = {}
         self.objects: dict[str, list[tuple[float, Any]]] = {}
         self.problems: list[str] = []
         self.checked: set[tuple[str, str, int]] = set()
@@ -157,7 +154,7 @@ class Reading:
         """Whether the connection of ``topic`` with ``msgtype`` is read (a problem says why not)."""
         expected = self.wanted_for(topic).msgtype
         msgtype = canonical_type(msgtype)
-        if expected not in WHOLE and standard_type(msgtype) != standard_type(expected):
+        if expected != OBJECTS and standard_type(msgtype) != standard_type(expected):
             problem = f"topic {topic} carries {msgtype}, not {expected}: its metrics are missing"
             if problem not in self.problems:
                 self.problems.append(problem)
@@ -175,7 +172,7 @@ class Reading:
         """Check the fields the metrics read of ``topic`` against the type's definition, once per
         definition (``catalogue``: each version of a type the bag carries is checked)."""
         key = (topic, msgtype, id(catalogue))  # catalogues live as long as the reading
-        if key in self.checked or self.wanted_for(topic).msgtype in WHOLE:
+        if key in self.checked or self.wanted_for(topic).msgtype == OBJECTS:
             return
         lacking = catalogue.missing(msgtype)
         if lacking:
@@ -222,25 +219,15 @@ class Reading:
         return decode_slowly(lambda raw: read(raw, msgtype), raws, wanted.paths, wanted.texts)
 
     def add_whole(self, topic: str, times: np.ndarray, objects: Sequence[Any]) -> None:
-        """Messages of a topic wanted whole (``times`` in seconds): the dispatcher's statuses, or
-        the objects themselves."""
-        if self.wanted_for(topic).msgtype == OBJECTS:
-            for name in self.match.read_for(topic):
-                self.objects.setdefault(name, []).extend(zip(times.tolist(), objects, strict=True))
-        else:
-            updates = [_status_update(m, t, topic) for m, t in zip(objects, times.tolist(), strict=True)]
-            for name in self.match.read_for(topic):
-                self.updates.setdefault(name, []).extend(updates)
+        """Messages of a topic wanted as :data:`OBJECTS` (``times`` in seconds)."""
+        for name in self.match.read_for(topic):
+            self.objects.setdefault(name, []).extend(zip(times.tolist(), objects, strict=True))
 
     def data(self, start: float, end: float, topics: tuple[str, ...]) -> BagData:
         data = BagData(self.path, start, end, topics, problems=self.problems)
         data.spellings = {name: tuple(spelt) for name, spelt in self.spellings.items()}
         for topic, found in sorted(self.topics.items()):
             data.series[topic] = found.series()
-        for topic, updates in sorted(self.updates.items()):
-            # statuses only move forward: updates recorded at the same instant go in that order
-            updates.sort(key=lambda u: (u.t, sum(_PROGRESS.get(s, 2) for s in u.statuses)))
-            (data.results if topic.endswith("/result") else data.feedback)[topic] = updates
         for topic, objects in sorted(self.objects.items()):
             data.messages[topic] = sorted(objects, key=lambda pair: pair[0])
         return data
@@ -291,25 +278,10 @@ class IndexReading(Reading):
         bytes (messages read whole)."""
         if not self.accepts(topic, msgtype):
             return True  # nothing kept
-        if self.wanted_for(topic).msgtype in WHOLE:
+        if self.wanted_for(topic).msgtype == OBJECTS:
             self.keep_whole(topic, msgtype, definition)
             return False
         catalogue = self.catalogue(topic, msgtype, definition)
         self.prepare(topic, msgtype, catalogue)
         self.add(topic, msgtype, times, self.decode(topic, msgtype, catalogue, messages, self.cdr), publisher)
         return True
-
-
-def _status_update(msg: Any, t: float, topic: str) -> StatusUpdate:
-    try:
-        payload = getattr(msg, "feedback", None) or msg.result
-        status_list = payload.goal_status.status_list
-        goal = getattr(getattr(msg, "status", None), "goal_id", None)
-    except AttributeError:
-        raise BagError(f"topic {topic} does not carry the waypoint dispatcher's goal statuses") from None
-    return StatusUpdate(
-        t,
-        getattr(goal, "id", "") or "",
-        tuple(str(s.goal_id.id) for s in status_list),
-        tuple(int(s.status) for s in status_list),
-    )

@@ -30,7 +30,7 @@ from exsce_dsl.messages.catalogue import MessageCatalogue, Source, parse_definit
 from exsce_dsl.model.messages import standard_type
 from exsce_dsl.runs.bags.buffers import Buffer, mapped, release
 from exsce_dsl.runs.bags.chunk_batches import ChunkBatch, Decoder, Gathered, Messages
-from exsce_dsl.runs.bags.data import OBJECTS, BagData, Check, Reduce, Wanted
+from exsce_dsl.runs.bags.data import BagData, Check, Reduce, Wanted
 from exsce_dsl.runs.bags.gather import gather_values
 from exsce_dsl.runs.bags.names import BagTopics
 from exsce_dsl.runs.bags.objects import deserialized, deserializer_for
@@ -243,8 +243,7 @@ class _Ros1(IndexReading):
             store = deserializer_for(catalogue, messages.msgtype)
             order = np.argsort(messages.times, kind="stable")
             read = functools.partial(store.deserialize_ros1, typename=messages.msgtype)
-            lazy = topic if self.wanted_for(topic).msgtype == OBJECTS else None
-            objects = deserialized(read, [messages.raws[i] for i in order.tolist()], lazy)
+            objects = deserialized(read, [messages.raws[i] for i in order.tolist()], topic)
             self.add_whole(topic, messages.times[order] / 1e9, objects)
         return self.data(start / 1e9, end / 1e9, tuple(sorted({topic for topic, _ in found})))
 

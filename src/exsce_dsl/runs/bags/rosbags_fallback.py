@@ -22,7 +22,7 @@ from exsce_dsl.errors import BagError, DecodeError
 from exsce_dsl.messages.catalogue import MessageCatalogue, MessageTypeError, Source, standard_catalogue
 from exsce_dsl.messages.user import configured_user_catalogue
 from exsce_dsl.model.messages import canonical_type
-from exsce_dsl.runs.bags.data import OBJECTS, WHOLE, BagData, Check, Reduce, Wanted
+from exsce_dsl.runs.bags.data import OBJECTS, BagData, Check, Reduce, Wanted
 from exsce_dsl.runs.bags.mcap import schema_catalogue
 from exsce_dsl.runs.bags.mcap_index import Schema
 from exsce_dsl.runs.bags.names import BagTopics
@@ -112,7 +112,7 @@ def _read_connection(
     reader: Any, reading: Reading, conn: Any, catalogue: MessageCatalogue, cdr: bool
 ) -> None:
     topic, msgtype = conn.topic, canonical_type(conn.msgtype)
-    whole = reading.wanted_for(topic).msgtype in WHOLE
+    whole = reading.wanted_for(topic).msgtype == OBJECTS
     if not whole:
         reading.prepare(topic, msgtype, catalogue)
     store = deserializer_for(catalogue, msgtype) if whole else None
@@ -121,9 +121,8 @@ def _read_connection(
         times = np.asarray(stamps, dtype=np.int64)
         if store is not None:
             read = store.deserialize_cdr if cdr else store.deserialize_ros1
-            lazy = topic if reading.wanted_for(topic).msgtype == OBJECTS else None
             reading.add_whole(
-                topic, times / 1e9, deserialized(functools.partial(read, typename=msgtype), raws, lazy)
+                topic, times / 1e9, deserialized(functools.partial(read, typename=msgtype), raws, topic)
             )
         else:
             fields = reading.decode(topic, msgtype, catalogue, RawMessages.join(raws), cdr)

@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from exsce_dsl.model.conventions import METHOD_TOPICS
 from exsce_dsl.model.geometry import Position
 from exsce_dsl.model.messages import path_of
 from exsce_dsl.model.metrics import ComputedFor, MetricDefinition
@@ -28,7 +29,7 @@ from exsce_dsl.runs.metrics.monitor_code import reads_used
 from exsce_dsl.runs.segments.recorded import RecordedAction
 
 HOTSPOT_RADIUS = 1.0  # metres: violations closer than this to a hotspot belong to it
-POSE_TOPIC = "/{ns}/robot_pose"
+POSE_TOPIC = METHOD_TOPICS["pose"]
 """Where hotspots are located: each robot's pose."""
 HOTSPOT_PATHS = (path_of("pose", "pose", "position", "x"), path_of("pose", "pose", "position", "y"))
 """What hotspots read of the pose."""

@@ -13,8 +13,8 @@ from __future__ import annotations
 from exsce_dsl.errors import SegmentError as SegmentError
 from exsce_dsl.model import Pose, Scenario
 from exsce_dsl.model.goals import ACTIONLIB_FINAL, GoalStatus, actionlib_names
-from exsce_dsl.runs.bags.reading import StatusUpdate
 from exsce_dsl.runs.segments.recorded import RecordedAction
+from exsce_dsl.runs.signals.dispatcher_statuses import StatusUpdate
 from exsce_dsl.wording import counted
 
 ACTIVE, SUCCEEDED = GoalStatus.ACTIVE, GoalStatus.SUCCEEDED
@@ -78,6 +78,11 @@ def planned_goals(scenario: Scenario, robot: str) -> list[tuple[int, str, int, t
         for s, subtask in enumerate(task.subtasks, start=1):
             plan.append((allocation, task.id, s, subtask.waypoints))
     return plan
+
+
+def succeeded_waypoints(final: list[StatusUpdate] | None) -> int | None:
+    """Waypoints the dispatcher's results say SUCCEEDED (None: the bag has no result topic)."""
+    return None if final is None else sum(s == SUCCEEDED for u in final for s in u.statuses)
 
 
 def dispatcher_goals(updates: list[StatusUpdate]) -> list[list[StatusUpdate]]:

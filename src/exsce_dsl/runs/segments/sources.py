@@ -12,16 +12,19 @@ Adding a source is one entry here (and its module beside this one).
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.conventions import Navigation
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.runs.bags.reading import BagData
 from exsce_dsl.runs.segments.arrival import arrival_segments
+from exsce_dsl.runs.segments.dispatcher import segments as dispatcher_segments
+from exsce_dsl.runs.segments.dispatcher import succeeded_waypoints
 from exsce_dsl.runs.segments.goals import goal_segments
 from exsce_dsl.runs.segments.recorded import RecordedAction
 from exsce_dsl.runs.segments.track import SUCCEEDED, Track
+from exsce_dsl.runs.signals.dispatcher_statuses import dispatcher_statuses
 from exsce_dsl.runs.signals.navigation_goals import read_goals
 
 DISPATCHER_SOURCE = "the waypoint dispatcher"
@@ -44,15 +47,16 @@ class RobotSegments:
 
 @dataclass
 class SegmentInput:
-    """What a source may look at: the plan, the robot, its bag's data and pose track, its
-    dispatcher's segments (None: the bag has no dispatcher topics), and where to say problems."""
+    """What a source may look at: the plan, the robot, its bag's data and pose track; where to
+    say problems, and what a source could tell without segments (``unsegmented``: the dispatcher's
+    successes, when it recorded goals none of which started)."""
 
     scenario: Scenario
     robot: Robot
     data: BagData
     track: Track
-    dispatcher: list[RecordedAction] | None
     problems: list[str] = field(default_factory=list)
+    unsegmented: RobotSegments | None = None
 
 
 @dataclass(frozen=True)
@@ -64,9 +68,14 @@ class SegmentSource:
 
 
 def _dispatcher(given: SegmentInput) -> RobotSegments | None:
-    if given.dispatcher is None or not _started(given.dispatcher):
+    """The method's waypoint dispatcher's goals, matched in order to the robot's subtasks; the
+    waypoints its results say SUCCEEDED (None: the bag has no result topic)."""
+    statuses = dispatcher_statuses(given.robot.namespace, given.data)
+    if statuses.feedback is None:
         return None
-    return RobotSegments(given.dispatcher, DISPATCHER_SOURCE, None)
+    found = dispatcher_segments(given.scenario, given.robot.id, statuses.feedback)
+    given.unsegmented = RobotSegments([], DISPATCHER_SOURCE, succeeded_waypoints(statuses.result))
+    return replace(given.unsegmented, segments=found) if _started(found) else None
 
 
 def _goals(given: SegmentInput) -> RobotSegments | None:
@@ -105,12 +114,9 @@ SEGMENT_SOURCES: tuple[SegmentSource, ...] = (
 """The sources of a robot's segments, in the order they are tried."""
 
 
-def segment_robot(
-    scenario: Scenario, robot: Robot, data: BagData, track: Track, dispatcher: list[RecordedAction] | None
-) -> RobotSegments:
-    """The robot's segments from the first of :data:`SEGMENT_SOURCES` that gives any;
-    ``dispatcher``: its segments from the method's dispatcher, if its bag has that."""
-    given = SegmentInput(scenario, robot, data, track, dispatcher)
+def segment_robot(scenario: Scenario, robot: Robot, data: BagData, track: Track) -> RobotSegments:
+    """The robot's segments from the first of :data:`SEGMENT_SOURCES` that gives any."""
+    given = SegmentInput(scenario, robot, data, track)
     for source in SEGMENT_SOURCES:
         found = source.find(given)
         if found is not None:
@@ -122,6 +128,8 @@ def segment_robot(
         f"robot '{robot.id}': no path segments (no navigation goals, and no pose that reaches its planned "
         "waypoints): its metrics are of the whole run only"
     )
+    if given.unsegmented is not None:
+        return replace(given.unsegmented, problems=tuple(given.problems))
     return RobotSegments([], "", None, (), tuple(given.problems))
 
 

@@ -4,7 +4,7 @@ A robot type that names no convention gets its signals from what the bag holds u
 namespace, in this order (the first that matches wins), and the lines it does have (a ``pose``
 source, an ``arrival`` tolerance, a ``window``) win over what is detected:
 
-1. the method's waypoint dispatcher (``/{ns}/waypoint_dispatcher/feedback``): ``method``;
+1. the method's waypoint dispatcher (its feedback topic): ``method``;
 2. Nav2's actions (``/{ns}/navigate_to_pose/_action/status``, ``follow_waypoints``,
    ``navigate_through_poses``): ``nav2``;
 3. move_base's actionlib topics (``/{ns}/move_base/status``): ``move_base``;
@@ -14,8 +14,8 @@ source, an ``arrival`` tolerance, a ``window``) win over what is detected:
    first, then any other such as ``/jackal_velocity_controller/odom``), else the namespace's only
    PoseStamped or PoseWithCovarianceStamped topic; the velocity from ``/{ns}/cmd_vel``, else the
    odometry's twist, else another Twist or TwistStamped topic under the namespace or at the root
-   (``/velocity``; else, later, from the poses); the distance along the odometry; the scan on
-   ``/{ns}/scan``, else the namespace's only LaserScan.
+   (``/velocity``; else, later, from the poses); the distance along the odometry; the scan on the
+   method's scan topic, else the namespace's only LaserScan.
 
 "Under the namespace" is every topic below ``/{ns}/`` (every topic, for a robot at the root).
 """
@@ -26,8 +26,10 @@ from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
 from exsce_dsl.model.conventions import (
+    DISPATCHER_FEEDBACK,
     LASER_SCAN,
     METHOD,
+    METHOD_TOPICS,
     MOVE_BASE,
     NAV2,
     ODOMETRY,
@@ -91,7 +93,7 @@ def with_detected_conventions(
 def detect_convention(robot: Robot, types: Mapping[str, str]) -> tuple[Signals, Detected]:
     """The signals of ``robot`` as its bag has them (the rules of this module's docstring)."""
     ns = robot.namespace
-    dispatcher = expand_topic("/{ns}/waypoint_dispatcher/feedback", ns)
+    dispatcher = expand_topic(DISPATCHER_FEEDBACK, ns)
     if dispatcher in types:
         return METHOD, Detected(robot.id, "method", (dispatcher,))
     for action in NAV2.actions:
@@ -129,7 +131,7 @@ def _without_goals(robot: Robot, types: Mapping[str, str]) -> tuple[Signals, Det
     velocity = [TopicSource(cmd_vel)] + [TopicSource(t, ODOMETRY) for t in odometry]
     velocity += [TopicSource(t, types[t]) for t in _twists(types, ns) if t != cmd_vel]
     scans = sorted(t for t, m in mine.items() if m == LASER_SCAN)
-    scan_topic = expand_topic("/{ns}/scan", ns)
+    scan_topic = expand_topic(METHOD_TOPICS["scan"], ns)
     scan = [scan_topic] if scan_topic in scans else scans[:1] if len(scans) == 1 else []
     signals = Signals(
         convention="detected",
@@ -189,7 +191,7 @@ NOT_ROBOTS = frozenset(
         "navigate_to_pose",
         "navigate_through_poses",
         "follow_waypoints",
-        "waypoint_dispatcher",
+        METHOD_TOPICS["dispatcher"].rsplit("/", 1)[-1],
         "tf",
         "tf_static",
         "clock",
@@ -217,7 +219,7 @@ def robot_namespaces(types: Mapping[str, str]) -> list[tuple[str, Signals, Detec
     levels = {t.lstrip("/").split("/")[0] for t in types if "/" in t.lstrip("/")}
     namespaces = sorted(levels - NOT_ROBOTS)
     interfaces = [f"{action}/_action/status" for action in NAV2.actions]
-    interfaces += [f"{MOVE_BASE.actions[0]}/status", "/{ns}/waypoint_dispatcher/feedback"]
+    interfaces += [f"{MOVE_BASE.actions[0]}/status", DISPATCHER_FEEDBACK]
     at_root = any("/" not in t.lstrip("/") and m in _ROBOT_TYPES for t, m in types.items()) or any(
         expand_topic(i, "") in types for i in interfaces
     )

@@ -29,6 +29,7 @@ from exsce_dsl.model.conventions import Navigation, Signals
 from exsce_dsl.model.goals import ACTION_FINAL, ACTIONLIB_FINAL, action_names, actionlib_names
 from exsce_dsl.model.metrics import expand_topic
 from exsce_dsl.runs.bags.reading import OBJECTS, BagData, Wanted
+from exsce_dsl.runs.signals.dispatcher_statuses import dispatcher_wanted
 from exsce_dsl.runs.signals.tf_poses import yaw_from_quaternion
 
 XYYaw = tuple[float, float, float]
@@ -71,7 +72,10 @@ Messages = Sequence[tuple[float, Any]]
 
 def goal_wanted(signals: Signals, namespace: str) -> dict[str, Wanted]:
     """What the robot's navigation goals are read from, all as message objects (few: a status
-    array a second and at each change, a plan per goal or replanning)."""
+    array a second and at each change, a plan per goal or replanning); the method's dispatcher's
+    are its feedback and result (:mod:`~exsce_dsl.runs.signals.dispatcher_statuses`)."""
+    if signals.navigation is Navigation.DISPATCHER:
+        return dispatcher_wanted(namespace)
     actions = [expand_topic(a, namespace) for a in signals.actions]
     if signals.navigation is Navigation.NAV2:
         found = [f"{a}/_action/status" for a in actions]

@@ -51,7 +51,7 @@ from exsce_dsl.messages.catalogue import (
 from exsce_dsl.messages.user import configured_user_catalogue
 from exsce_dsl.model.messages import path_of
 from exsce_dsl.runs.bags.decode import TEXTS
-from exsce_dsl.runs.bags.reading import WHOLE, BagData, Series, StatusUpdate, Wanted
+from exsce_dsl.runs.bags.reading import OBJECTS, BagData, Series, Wanted
 from exsce_dsl.runs.signals.clock_words import describe_clocks, log_time_is_dated
 from exsce_dsl.runs.signals.stamp_tracks import (
     StampTrack,
@@ -193,7 +193,7 @@ def with_stamps(
     ``/clock`` when the bag (``types``: topic → type) recorded it."""
     found = dict(wanted)
     for topic, want in wanted.items():
-        if want.msgtype in WHOLE or any(p in want.paths for p in STAMP_PATHS):
+        if want.msgtype == OBJECTS or any(p in want.paths for p in STAMP_PATHS):
             continue
         if _has_header(types.get(topic, want.msgtype), catalogue):
             found[topic] = replace(want, paths=(*want.paths, *STAMP_PATHS))
@@ -323,7 +323,7 @@ def decide_timeline(data: BagData) -> Timeline:
     stamped_topics = {s.topic for s in stamped}
     for topic in sorted(set(data.series) - stamped_topics - {CLOCK_TOPIC}):
         clocks.append(SourceClock(topic, LOG_TIME, simulated_run))
-    for topic in sorted({*data.feedback, *data.results, *data.messages}):
+    for topic in sorted(data.messages):
         clocks.append(SourceClock(topic, LOG_TIME, simulated_run))
     if not timeline.dated and recorded:  # the recorder logged simulated time: so is every source
         clocks = [replace(c, simulated=True) for c in clocks]
@@ -431,7 +431,7 @@ def _source_clock(series: _Stamped, timeline: Timeline, notes: list[str]) -> Sou
 
 
 def on_timeline(data: BagData, timeline: Timeline) -> BagData:
-    """``data`` with every series, status update and message object timed on ``timeline``."""
+    """``data`` with every series and message object timed on ``timeline``."""
     clocks = {c.topic: c for c in timeline.clocks}
     start, end = timeline.from_log(np.array([data.start, data.end], dtype=np.float64)).tolist()
     messages = {}
@@ -447,15 +447,8 @@ def on_timeline(data: BagData, timeline: Timeline) -> BagData:
             for topic, series in data.series.items()
             if topic != CLOCK_TOPIC
         },
-        feedback={t: _updates_on(u, timeline) for t, u in data.feedback.items()},
-        results={t: _updates_on(u, timeline) for t, u in data.results.items()},
         messages=messages,
     )
-
-
-def _updates_on(updates: list[StatusUpdate], timeline: Timeline) -> list[StatusUpdate]:
-    times = timeline.from_log(np.array([u.t for u in updates], dtype=np.float64)).tolist()
-    return [replace(u, t=t) for u, t in zip(updates, times, strict=True)]
 
 
 def _series_on(series: Series, clock: SourceClock | None, timeline: Timeline) -> Series:

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from exsce_dsl.model.conventions import POSE_TYPES, TfSource
+from exsce_dsl.model.conventions import METHOD_TOPICS, POSE_TYPES, TfSource
 from exsce_dsl.runs.bags.names import topic_key
 from exsce_dsl.runs.bags.reading import bag_topics, read_bag
 from exsce_dsl.runs.signals.sources import (
@@ -27,7 +27,7 @@ from exsce_dsl.runs.signals.sources import (
     signals_wanted,
 )
 
-_PREFERRED = ("robot_pose", "amcl_pose")
+_PREFERRED = (METHOD_TOPICS["pose"].rsplit("/", 1)[-1], "amcl_pose")
 _LAST = ("odom",)
 
 
