@@ -109,7 +109,7 @@ MISSION: tuple[Transformation, ...] = (
         (Parameter("task", "task", False), Parameter("robot", "robot", False)),
         remove_task,
         "take TASK away (from ROBOT, or every robot)",
-        ("remove tasks of {robot}", "remove task {task} [from {robot}]"),
+        ("remove task {task} [from {robot}]", "remove tasks of {robot}"),
         ("task", "robot"),
     ),
     Transformation(
