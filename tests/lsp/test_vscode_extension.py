@@ -27,6 +27,7 @@ from pathlib import Path
 
 import pytest
 
+from exsce_dsl.lang.transformation_syntax import step_words
 from exsce_dsl.model.expressions import FUNCTIONS
 
 from tests.support.cli import run_exscec
@@ -201,7 +202,9 @@ def _tx_text() -> str:
 
 
 def _language_keywords() -> set[str]:
-    return set(re.findall(r"'([A-Za-z_][A-Za-z0-9_]*)'", _tx_text()))
+    """The keywords of grammar/*.tx and those of the derive steps, which the loader adds from
+    the transformations' records."""
+    return set(re.findall(r"'([A-Za-z_][A-Za-z0-9_]*)'", _tx_text())) | step_words()
 
 
 def _rule_alternatives(rule: str) -> list[str]:
