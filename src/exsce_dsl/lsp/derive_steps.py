@@ -114,5 +114,6 @@ def step_meanings() -> dict[str, str]:
     for record in TRANSFORMATIONS.values():
         for phrase in record.phrases:
             head = phrase.split()[0]
-            said.setdefault(head, []).append(f"`{shown_phrase(phrase)}` ({record.name}): {record.help}")
+            text = f"`{shown_phrase(record, phrase)}` ({record.name}): {record.help}"
+            said.setdefault(head, []).append(text)
     return {head: "; ".join(texts) + "." for head, texts in said.items()}

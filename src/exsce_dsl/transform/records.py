@@ -165,13 +165,17 @@ def registry(*tables: tuple[Transformation, ...]) -> dict[str, Transformation]:
 
 def markdown_table(records: Mapping[str, Transformation]) -> str:
     """The table of transformations ``docs/deriving.md`` shows."""
-    rows = ["| transformation | in a `derive` block | what it does |", "|---|---|---|"]
+    rows = ["| in a `derive` block | `exscec derive -t` | what it does |", "|---|---|---|"]
     for record in records.values():
-        written = "<br>".join(f"`{shown_phrase(p)}`" for p in record.phrases)
-        rows.append(f"| `{record.name}` | {written} | {record.help} |")
+        written = "<br>".join(f"`{shown_phrase(record, p)}`" for p in record.phrases)
+        rows.append(f"| {written} | `{record.usage()}` | {record.help} |")
     return "\n".join(rows) + "\n"
 
 
-def shown_phrase(phrase: str) -> str:
+_SHOWN = {"position": "(X, Y[, Z])", "allocation": "{ ROBOT does TASK then TASK ... }"}
+"""How the phrases people read show an argument of these types (others: the parameter's name)."""
+
+
+def shown_phrase(record: Transformation, phrase: str) -> str:
     """A phrase as people read it: ``remove robot ROBOT [reassign to REASSIGN]``."""
-    return re.sub(r"\{(\w+)\}", lambda m: m.group(1).upper(), phrase)
+    return re.sub(r"\{(\w+)\}", lambda m: _SHOWN.get(record.type_of(m.group(1)), m.group(1).upper()), phrase)
