@@ -218,5 +218,6 @@ PROPOSERS: dict[str, Proposer] = {
     "remove_robot": _remove_robot,
     "add_robot": _add_robot,
     "replace_robot": _replace_robot,
-}
-"""The arguments worth trying, per transformation (every transformation has one: a test checks)."""
+} | {name: t.propose for name, t in TRANSFORMATIONS.items() if t.propose is not None}
+"""The arguments worth trying, per transformation (every transformation has one: a test checks);
+a transformation's record may carry its own (``propose``)."""

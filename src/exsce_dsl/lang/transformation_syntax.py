@@ -154,3 +154,13 @@ def step_words() -> frozenset[str]:
             elif isinstance(part, Group):
                 stack.append(part.parts)
     return frozenset(found)
+
+
+def step_heads() -> frozenset[str]:
+    """The words a step starts with."""
+    found: set[str] = set()
+    for rule in step_rules_by_name().values():
+        first = rule.parts[0]
+        if isinstance(first, Word):
+            found.add(first.text)
+    return frozenset(found)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+from exsce_dsl.lang.transformation_syntax import step_heads
 from exsce_dsl.transform.records import Slot, Transformation, Word, phrase_parts, shown_phrase, variants
 from exsce_dsl.transform.transformations import TRANSFORMATIONS
 
@@ -15,13 +16,6 @@ _PLACEHOLDERS = {"count": "n"}
 
 def _variants(record: Transformation) -> list[tuple[Word | Slot, ...]]:
     return [v for phrase in record.phrases for v in variants(phrase_parts(phrase))]
-
-
-def step_heads() -> frozenset[str]:
-    """The words a step starts with."""
-    return frozenset(
-        v[0].text for r in TRANSFORMATIONS.values() for v in _variants(r) if isinstance(v[0], Word)
-    )
 
 
 def _inner_pairs() -> frozenset[tuple[str, str]]:
