@@ -15,10 +15,9 @@ from dataclasses import dataclass
 
 from lsprotocol import types
 
-from exsce_dsl.lang import Continuations, Symbol
+from exsce_dsl.lang import Continuations, Symbol, builtin_metrics
 from exsce_dsl.lsp.derive_steps import current_step, next_types, snippet
 from exsce_dsl.lsp.navigation import Names
-from exsce_dsl.model.metrics import METRICS
 from exsce_dsl.oracles.relations import relation, relation_names
 from exsce_dsl.transform.transformations import TRANSFORMATIONS
 
@@ -255,7 +254,7 @@ def complete(
                 kind = _ITEM_KINDS.get(symbol.kind, types.CompletionItemKind.Text)
                 add(symbol.name, kind, _detail(symbol), "0")
             if wanted.kind == "metric":
-                for name, info in METRICS.items():
+                for name, info in builtin_metrics().items():
                     if not names.symbols("metric", name):
                         add(name, types.CompletionItemKind.Field, f"built-in metric: {info.meaning}", "0")
     for keyword in allowed.keywords:
