@@ -11,20 +11,26 @@ from exsce_dsl.model import Position, Scenario, Task
 from exsce_dsl.model.names import NUMBER
 from exsce_dsl.suggest import did_you_mean
 from exsce_dsl.transform.applied import Applied, pose_of, recorded, robot_of
-from exsce_dsl.transform.records import Arguments, Parameter, Transformation
+from exsce_dsl.transform.records import Arguments, Transformation, transformation
+
+ENVIRONMENT: list[Transformation] = []
+"""This module's transformations, in the order they are declared."""
 
 
+@transformation(ENVIRONMENT, "swap start poses of {robot} and {with}", "robot: robot, with: robot",
+                records="robot to", help="ROBOT and WITH swap start poses")
 def swap_start_poses(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     first, second = robot_of(scenario, a["robot"]), robot_of(scenario, a["with"])
     if first.id == second.id:
         raise ExsceError(f"cannot swap the start pose of '{first.id}' with its own")
     swapped = {first.id: second.start_pose, second.id: first.start_pose}
     robots = tuple(replace(r, start_pose=swapped[r.id]) if r.id in swapped else r for r in scenario.robots)
-    return Applied(
-        replace(scenario, robots=robots), (), (recorded("swap_start_poses", robot=first.id, to=second.id),)
-    )
+    swap = recorded("swap_start_poses", robot=first.id, to=second.id)
+    return Applied(replace(scenario, robots=robots), (), (swap,))
 
 
+@transformation(ENVIRONMENT, "start {robot} at {pose}", "robot: robot, pose: pose",
+                records="robot pose", help="ROBOT (without one) starts at POSE")
 def add_start_pose(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     """Give a robot that has none a start pose (a pose no other robot starts at)."""
     robot = robot_of(scenario, a["robot"])
@@ -41,6 +47,8 @@ def add_start_pose(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) 
     )
 
 
+@transformation(ENVIRONMENT, "remove start pose of {robot}", "robot: robot",
+                records="robot", help="ROBOT (without tasks) loses its start pose")
 def remove_start_pose(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     """Take a robot's start pose away; only a robot without tasks may have none."""
     robot = robot_of(scenario, a["robot"])
@@ -66,6 +74,9 @@ def _coordinates(text: str) -> tuple[float, ...]:
     return tuple(values)
 
 
+@transformation(ENVIRONMENT, "move obstacle {obstacle} to {to}", "obstacle: obstacle, to: position",
+                records="obstacle to",
+                help="OBSTACLE moves to TO: x,y or x,y,z in metres (same heading, model and size)")
 def move_obstacle(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     """The obstacle at another position (``x,y`` or ``x,y,z`` in metres; z is 0 unless given),
     with its heading, model and size.  The step records z only when it is not 0, as the
@@ -85,39 +96,3 @@ def move_obstacle(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -
     environment = replace(env, obstacles=tuple(moved if o.id == obstacle.id else o for o in env.obstacles))
     step = recorded("move_obstacle", obstacle=obstacle.id, to=",".join(written))
     return Applied(replace(scenario, environment=environment), (), (step,))
-
-
-ENVIRONMENT: tuple[Transformation, ...] = (
-    Transformation(
-        "swap_start_poses",
-        (Parameter("robot", "robot"), Parameter("with", "robot")),
-        swap_start_poses,
-        "ROBOT and WITH swap start poses",
-        ("swap start poses of {robot} and {with}",),
-        ("robot", "to"),
-    ),
-    Transformation(
-        "add_start_pose",
-        (Parameter("robot", "robot"), Parameter("pose", "pose")),
-        add_start_pose,
-        "ROBOT (without one) starts at POSE",
-        ("start {robot} at {pose}",),
-        ("robot", "pose"),
-    ),
-    Transformation(
-        "remove_start_pose",
-        (Parameter("robot", "robot"),),
-        remove_start_pose,
-        "ROBOT (without tasks) loses its start pose",
-        ("remove start pose of {robot}",),
-        ("robot",),
-    ),
-    Transformation(
-        "move_obstacle",
-        (Parameter("obstacle", "obstacle"), Parameter("to", "position")),
-        move_obstacle,
-        "OBSTACLE moves to TO: x,y or x,y,z in metres (same heading, model and size)",
-        ("move obstacle {obstacle} to {to}",),
-        ("obstacle", "to"),
-    ),
-)

@@ -9,9 +9,14 @@ from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import Robot, Scenario, Task
 from exsce_dsl.model.names import is_valid_name
 from exsce_dsl.transform.applied import Applied, pose_of, recorded, robot_of, with_allocation
-from exsce_dsl.transform.records import Arguments, Parameter, Transformation
+from exsce_dsl.transform.records import Arguments, Transformation, transformation
+
+FLEET: list[Transformation] = []
+"""This module's transformations, in the order they are declared."""
 
 
+@transformation(FLEET, "remove robot {robot} [reassign to {reassign}]", "robot: robot, reassign: robot?",
+                records="robot reassign", help="drop ROBOT (its tasks go to REASSIGN, or go)")
 def remove_robot(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     """Drop a robot; its tasks are dropped, or reassigned to another robot (``reassign``)."""
     robot = robot_of(scenario, a["robot"]).id
@@ -32,6 +37,10 @@ def remove_robot(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) ->
     return Applied(new, (), (recorded("remove_robot", robot=robot, reassign=heir),))
 
 
+@transformation(FLEET, "add robot {robot} like {like} at {start} [taking over {take_over}]",
+                "robot: new_robot, like: robot, start: pose, take_over: robot?",
+                records="robot like start",
+                help="a robot typed LIKE at START (taking over TAKE_OVER's tasks)")
 def add_robot(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     """A robot like ``like`` (its type) at ``start`` (a pose of the environment), taking over
     the tasks of ``take_over`` (a robot) if given."""
@@ -58,6 +67,9 @@ def add_robot(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Ap
     return applied
 
 
+@transformation(FLEET, "replace robot {robot} by {by} [like {like}] [at {start}]",
+                "robot: robot, by: new_robot, like: robot?, start: pose?",
+                records="", help="BY (typed LIKE) takes ROBOT's tasks, and its place (or starts at START)")
 def replace_robot(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     """Composite: add a robot like ``like`` at the old one's start pose (or at ``start``), taking
     over its tasks, then remove the old one."""
@@ -80,41 +92,3 @@ def replace_robot(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -
     )
     removed = remove_robot(added.scenario, {"robot": old.id}, tasks)
     return added.then(removed)
-
-
-FLEET: tuple[Transformation, ...] = (
-    Transformation(
-        "remove_robot",
-        (Parameter("robot", "robot"), Parameter("reassign", "robot", False)),
-        remove_robot,
-        "drop ROBOT (its tasks go to REASSIGN, or go)",
-        ("remove robot {robot} [reassign to {reassign}]",),
-        ("robot", "reassign"),
-    ),
-    Transformation(
-        "add_robot",
-        (
-            Parameter("robot", "new_robot"),
-            Parameter("like", "robot"),
-            Parameter("start", "pose"),
-            Parameter("take_over", "robot", False),
-        ),
-        add_robot,
-        "a robot typed LIKE at START (taking over TAKE_OVER's tasks)",
-        ("add robot {robot} like {like} at {start} [taking over {take_over}]",),
-        ("robot", "like", "start"),
-    ),
-    Transformation(
-        "replace_robot",
-        (
-            Parameter("robot", "robot"),
-            Parameter("by", "new_robot"),
-            Parameter("like", "robot", False),
-            Parameter("start", "pose", False),
-        ),
-        replace_robot,
-        "BY (typed LIKE) takes ROBOT's tasks, and its place (or starts at START)",
-        ("replace robot {robot} by {by} [like {like}] [at {start}]",),
-        (),
-    ),
-)

@@ -9,9 +9,15 @@ from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import Assignment, Scenario, Task
 from exsce_dsl.suggest import did_you_mean
 from exsce_dsl.transform.applied import Applied, recorded, robot_of, with_allocation
-from exsce_dsl.transform.records import Arguments, Parameter, Transformation
+from exsce_dsl.transform.records import Arguments, Transformation, transformation
+
+MISSION: list[Transformation] = []
+"""This module's transformations, in the order they are declared."""
 
 
+@transformation(MISSION, "add task {task} to {robot} [at {position}]",
+                "robot: robot, task: task, position: count?",
+                records="robot task position", help="give ROBOT the TASK, at POSITION among its tasks")
 def add_task(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     robot, task_id = robot_of(scenario, a["robot"]).id, a["task"]
     if task_id not in tasks and scenario.task(task_id) is None:
@@ -31,6 +37,9 @@ def add_task(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> App
     return Applied(new, (), (recorded("add_task", robot=robot, task=task_id, position=position),))
 
 
+@transformation(MISSION, ("remove task {task} [from {robot}]", "remove tasks of {robot}"),
+                "task: task?, robot: robot?",
+                records="task robot", help="take TASK away (from ROBOT, or every robot)")
 def remove_task(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     task_id, robot = a.get("task"), a.get("robot")
     if task_id is None and robot is None:
@@ -47,6 +56,8 @@ def remove_task(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> 
     return Applied(with_allocation(scenario, kept), (), (recorded("remove_task", task=task_id, robot=robot),))
 
 
+@transformation(MISSION, "substitute task {task} by {with}", "task: task, with: task",
+                records="task by", help="allocate task WITH wherever TASK was")
 def substitute_task(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     old, new_id = a["task"], a["with"]
     if old not in {e.task for e in scenario.mission.allocation}:
@@ -60,6 +71,8 @@ def substitute_task(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task])
     )
 
 
+@transformation(MISSION, "swap tasks of {robot} and {with}", "robot: robot, with: robot",
+                records="robot to", help="ROBOT and WITH swap their tasks")
 def swap_assignment(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     first, second = robot_of(scenario, a["robot"]).id, robot_of(scenario, a["with"]).id
     if first == second:
@@ -71,6 +84,8 @@ def swap_assignment(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task])
     )
 
 
+@transformation(MISSION, "reverse task order [of {robot}]", "robot: robot?",
+                records="robot", help="each robot (or ROBOT) does its tasks in reverse")
 def reverse_task_order(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     robot = a.get("robot")
     robots = [robot_of(scenario, robot).id] if robot else [r.id for r in scenario.robots]
@@ -82,6 +97,9 @@ def reverse_task_order(scenario: Scenario, a: Arguments, tasks: Mapping[str, Tas
     return Applied(with_allocation(scenario, allocation), (), (recorded("reverse_task_order", robot=robot),))
 
 
+@transformation(MISSION, "reallocate {allocation}", "allocation: allocation",
+                records="allocation robot to",
+                help="the mission becomes ALLOCATION: robot:task,robot:task,... in order")
 def substitute_allocation(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     """A whole new allocation: ``robot:task,robot:task,...`` in execution order."""
     entries = []
@@ -93,55 +111,3 @@ def substitute_allocation(scenario: Scenario, a: Arguments, tasks: Mapping[str, 
     extra = {e.task: tasks[e.task] for e in entries if e.task in tasks}
     new = with_allocation(scenario, entries, extra)
     return Applied(new, (), (recorded("substitute_allocation", allocation=a["allocation"].replace(" ", "")),))
-
-
-MISSION: tuple[Transformation, ...] = (
-    Transformation(
-        "add_task",
-        (Parameter("robot", "robot"), Parameter("task", "task"), Parameter("position", "count", False)),
-        add_task,
-        "give ROBOT the TASK, at POSITION among its tasks",
-        ("add task {task} to {robot} [at {position}]",),
-        ("robot", "task", "position"),
-    ),
-    Transformation(
-        "remove_task",
-        (Parameter("task", "task", False), Parameter("robot", "robot", False)),
-        remove_task,
-        "take TASK away (from ROBOT, or every robot)",
-        ("remove task {task} [from {robot}]", "remove tasks of {robot}"),
-        ("task", "robot"),
-    ),
-    Transformation(
-        "substitute_task",
-        (Parameter("task", "task"), Parameter("with", "task")),
-        substitute_task,
-        "allocate task WITH wherever TASK was",
-        ("substitute task {task} by {with}",),
-        ("task", "by"),
-    ),
-    Transformation(
-        "swap_assignment",
-        (Parameter("robot", "robot"), Parameter("with", "robot")),
-        swap_assignment,
-        "ROBOT and WITH swap their tasks",
-        ("swap tasks of {robot} and {with}",),
-        ("robot", "to"),
-    ),
-    Transformation(
-        "reverse_task_order",
-        (Parameter("robot", "robot", False),),
-        reverse_task_order,
-        "each robot (or ROBOT) does its tasks in reverse",
-        ("reverse task order [of {robot}]",),
-        ("robot",),
-    ),
-    Transformation(
-        "substitute_allocation",
-        (Parameter("allocation", "allocation"),),
-        substitute_allocation,
-        "the mission becomes ALLOCATION: robot:task,robot:task,... in order",
-        ("reallocate {allocation}",),
-        ("allocation", "robot", "to"),
-    ),
-)

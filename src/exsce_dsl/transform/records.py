@@ -2,7 +2,8 @@
 the function that applies it, the shape of the step it records, how a ``derive`` block writes it
 (its phrases), and the text editors and the docs show of it.
 
-Everything else is driven by these records, with no per-transformation code: the grammar of
+A transformation's module declares it over its function (:func:`transformation`), so that the
+record and the code it describes are read together.  Everything else is driven by these records, with no per-transformation code: the grammar of
 ``derive`` steps and the builder (:mod:`exsce_dsl.lang.transformation_syntax`), the formatter,
 the language server's completion and hover, ``exscec derive --list``, the table of
 ``docs/deriving.md``.  A parameter's *type* is all they need to know of it (:data:`TYPES`).
@@ -16,7 +17,7 @@ with the first phrase that holds its arguments).
 from __future__ import annotations
 
 import re
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 
 from exsce_dsl.model import Scenario, Task
@@ -112,8 +113,9 @@ class Transformation:
     """One input transformation, all that is known of it."""
 
     name: str
+    """The method's name (``remove_robot``), in code, the DSL's records, the CLI and RDF alike."""
+    apply: Callable[[Scenario, Arguments, Mapping[str, Task]], Applied]
     parameters: tuple[Parameter, ...]
-    apply: Apply
     help: str
     """What it does, in a line: completion, hover, ``derive --list`` and the docs show it;
     parameters in capitals."""
@@ -143,7 +145,33 @@ class Transformation:
         return " ".join([self.name, *arguments])
 
 
-def registry(*tables: tuple[Transformation, ...]) -> dict[str, Transformation]:
+def transformation(
+    table: list[Transformation],
+    phrases: str | tuple[str, ...],
+    parameters: str,
+    *,
+    records: str,
+    help: str,  # noqa: A002 - the record's field
+    propose: Proposer | None = None,
+) -> Callable[[Apply], Apply]:
+    """Declare the function below as a transformation (named as it is) and add its record to
+    ``table``: ``parameters`` are ``name: type`` (``?`` after the type: optional), ``records`` the
+    names its step may record, space-separated."""
+
+    def declare(apply: Apply) -> Apply:
+        declared = []
+        for item in parameters.split(","):
+            name, _, kind = (part.strip() for part in item.partition(":"))
+            declared.append(Parameter(name, kind.rstrip("?"), not kind.endswith("?")))
+        said = (phrases,) if isinstance(phrases, str) else phrases
+        recorded = tuple(records.split())
+        table.append(Transformation(apply.__name__, apply, tuple(declared), help, said, recorded, propose))
+        return apply
+
+    return declare
+
+
+def registry(*tables: Sequence[Transformation]) -> dict[str, Transformation]:
     """The transformations of ``tables`` by name, each checked to be consistent (a phrase
     names only its parameters, each parameter has a known type and is written by a phrase)."""
     found: dict[str, Transformation] = {}

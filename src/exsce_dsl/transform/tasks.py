@@ -11,9 +11,14 @@ from exsce_dsl.model import Orientation, Pose, Position, Scenario, Task
 from exsce_dsl.model.derivation import TaskOrigin
 from exsce_dsl.model.names import is_valid_name
 from exsce_dsl.transform.applied import Applied, pose_of, recorded, with_allocation
-from exsce_dsl.transform.records import Arguments, Parameter, Transformation
+from exsce_dsl.transform.records import Arguments, Transformation, transformation
+
+TASKS: list[Transformation] = []
+"""This module's transformations, in the order they are declared."""
 
 
+@transformation(TASKS, "reverse waypoints of {task} [as {as}]", "task: task, as: new_task?",
+                records="task to", help="a new task AS: TASK's waypoints reversed")
 def reverse_waypoint_order(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     """A new task with the waypoints of ``task`` in reverse order, substituted for it."""
     old = scenario.task(a["task"])
@@ -33,6 +38,19 @@ def reverse_waypoint_order(scenario: Scenario, a: Arguments, tasks: Mapping[str,
     return Applied(new, (reversed_task,), (step,), (TaskOrigin(new_id, old.id, 1),))
 
 
+def _propose_mirrors(s: Scenario, tasks: Mapping[str, Task]) -> Iterator[Arguments]:
+    """Each allocated task about each robot's start pose, where the environment has no map: in
+    a building, a mirrored path runs into walls (there, a mirror is for the user to write)."""
+    if s.environment.map is not None:
+        return
+    starts = list(dict.fromkeys(r.start_pose.id for r in s.robots if r.start_pose is not None))
+    for task in dict.fromkeys(e.task for e in s.mission.allocation):
+        yield from ({"task": task, "about": pose} for pose in starts)
+
+
+@transformation(TASKS, "mirror waypoints of {task} about {about} [as {as}]",
+                "task: task, about: pose, as: new_task?", records="task about to", propose=_propose_mirrors,
+                help="a new task AS: TASK's waypoints mirrored about the line through pose ABOUT")
 def mirror_waypoints(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     """A new task with the waypoints of ``task`` mirrored about the line through pose ``about``
     along its heading (headings mirrored too), substituted for it: where the environment is
@@ -74,34 +92,3 @@ def _mirrored(pose: Pose, axis: Pose, new_id: str) -> Pose:
     o = pose.orientation
     yaw = math.remainder(2 * heading - o.yaw, math.tau)
     return Pose(new_id, Position(x, y, pose.position.z), Orientation(-o.roll, o.pitch, yaw))
-
-
-def _propose_mirrors(s: Scenario, tasks: Mapping[str, Task]) -> Iterator[Arguments]:
-    """Each allocated task about each robot's start pose, where the environment has no map: in
-    a building, a mirrored path runs into walls (there, a mirror is for the user to write)."""
-    if s.environment.map is not None:
-        return
-    starts = list(dict.fromkeys(r.start_pose.id for r in s.robots if r.start_pose is not None))
-    for task in dict.fromkeys(e.task for e in s.mission.allocation):
-        yield from ({"task": task, "about": pose} for pose in starts)
-
-
-TASKS: tuple[Transformation, ...] = (
-    Transformation(
-        "reverse_waypoint_order",
-        (Parameter("task", "task"), Parameter("as", "new_task", False)),
-        reverse_waypoint_order,
-        "a new task AS: TASK's waypoints reversed",
-        ("reverse waypoints of {task} [as {as}]",),
-        ("task", "to"),
-    ),
-    Transformation(
-        "mirror_waypoints",
-        (Parameter("task", "task"), Parameter("about", "pose"), Parameter("as", "new_task", False)),
-        mirror_waypoints,
-        "a new task AS: TASK's waypoints mirrored about the line through pose ABOUT along its heading",
-        ("mirror waypoints of {task} about {about} [as {as}]",),
-        ("task", "about", "to"),
-        _propose_mirrors,
-    ),
-)

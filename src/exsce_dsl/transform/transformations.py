@@ -5,9 +5,10 @@ made (a reversed task is a new task) and the step it records; a precondition tha
 does not hold is an :class:`~exsce_dsl.errors.ExsceError` saying which.  Composite
 transformations (``replace_robot``) are made of basic ones and record those.
 
-A new transformation is a function and its :class:`~exsce_dsl.transform.records.Transformation`
-record, in the module of what it changes (mission, tasks, environment, fleet): the record
-is all the language, the editors and the docs need of it.
+A new transformation is a function declared with its record (``@transformation(TABLE, phrase,
+parameters, records=..., help=...)``, :mod:`exsce_dsl.transform.records`) in the module of what
+it changes (mission, tasks, environment, fleet): the record is all the language, the editors and
+the docs need of it.
 """
 
 from __future__ import annotations
