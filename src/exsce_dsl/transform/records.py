@@ -3,10 +3,11 @@ the function that applies it, the shape of the step it records, how a ``derive``
 (its phrases), and the text editors and the docs show of it.
 
 A transformation's module declares it over its function (:func:`transformation`), so that the
-record and the code it describes are read together.  Everything else is driven by these records, with no per-transformation code: the grammar of
-``derive`` steps and the builder (:mod:`exsce_dsl.lang.transformation_syntax`), the formatter,
-the language server's completion and hover, ``exscec derive --list``, the table of
-``docs/deriving.md``.  A parameter's *type* is all they need to know of it (:data:`TYPES`).
+record and the code it describes are read together.  Everything else is driven by these
+records, with no per-transformation code: the grammar of ``derive`` steps and the builder
+(:mod:`exsce_dsl.lang.transformation_syntax`), the formatter, the language server's completion
+and hover, ``exscec derive --list``, the table of ``docs/deriving.md``, the words the VS Code
+grammar highlights.  A parameter's *type* is all they need to know of it (:data:`TYPES`).
 
 A phrase is the step's words, ``{parameter}`` where an argument goes and ``[...]`` around an
 optional part: ``remove robot {robot} [reassign to {reassign}]``.  A transformation written in
