@@ -40,7 +40,7 @@ RANK = {name: rank for rank, names in enumerate(LAYERS) for name in names}
 STEPS: dict[str, list[set[str]]] = {
     "lang": [
         # the core the other parts share
-        {"locations", "lexical", "chunks", "parser", "loader", "incremental", "stdlib"},
+        {"locations", "lexical", "transformation_syntax", "chunks", "parser", "loader", "incremental", "stdlib"},
         # parse trees to the model; the cache of checked specifications loads through it, and the
         # standard library's metrics are cached in it
         {"build", "spec_cache"},

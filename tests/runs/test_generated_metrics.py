@@ -12,8 +12,7 @@ import math
 
 import pytest
 
-from exsce_dsl.lang import load_spec
-from exsce_dsl.model.metrics import METRICS
+from exsce_dsl.lang import builtin_metrics, load_spec
 from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
@@ -37,7 +36,7 @@ def _keyed(values):
     """Values of the built-in metrics by what they are of (the example's own metrics are elsewhere)."""
     keyed = {}
     for v in values:
-        if v.metric not in METRICS:
+        if v.metric not in builtin_metrics():
             continue
         key = (v.metric, v.scope, v.robot, v.action, v.safety_metric)
         assert key not in keyed, f"two values for {key}"

@@ -3,9 +3,10 @@
 
 The JSON is generated so that its regular expressions are written once, by name
 (NAME, NUMBER, ...), instead of being copied by hand into JSON strings.  After
-changing this file or grammar/common.tx, run
+changing this file, grammar/common.tx or a transformation's record, run (with the
+project's environment: the derive steps' words come from the transformations' records)
 
-    python3 editors/vscode/syntaxes/generate_grammar.py
+    PYTHONPATH=src python3 editors/vscode/syntaxes/generate_grammar.py
 
 and commit both files; tests/lsp/test_vscode_extension.py fails while they disagree.
 
@@ -33,6 +34,7 @@ from __future__ import annotations
 
 import json
 import re
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -74,7 +76,27 @@ MESSAGE_TYPE = r"(?<![\w/])[A-Za-z_][A-Za-z0-9_]*/(?:msg/)?[A-Za-z_][A-Za-z0-9_]
 # Words that start a top-level declaration or a derivation step: a region whose
 # header is still being typed ends before the next one.
 TOP_LEVEL = r"import|robot\s+type|environment|task|scenario|acceptance|derive|metric"
-STEP_VERBS = "remove|add|replace|swap|reverse|substitute|start|move|reallocate"
+STEP_WORDS = (
+    "robot task tasks start pose poses waypoints order obstacle of reassign to like at "
+    "taking over by as from and"
+)
+
+
+def _record_words() -> tuple[str, str]:
+    """The derive steps' first words and their other words, as the transformations' records
+    write them (exsce_dsl/transform): those above, then any a newer record adds, so that the
+    steps of a new transformation are highlighted once this file is run again."""
+    sys.path.insert(0, str(HERE.parents[2] / "src"))
+    from exsce_dsl.lang.transformation_syntax import step_heads, step_words
+
+    verbs = ["remove", "add", "replace", "swap", "reverse", "substitute", "start", "move", "reallocate"]
+    verbs += sorted(step_heads() - set(verbs))
+    others = STEP_WORDS.split()
+    others += sorted(step_words() - set(others) - set(verbs))
+    return "|".join(verbs), " ".join(others)
+
+
+STEP_VERBS, STEP_KEYWORDS = _record_words()
 
 
 def kw(words: str) -> str:
@@ -506,10 +528,7 @@ def repository() -> dict[str, Rule]:
         step("reallocate", kw("reallocate"), (VERB,), [block("reallocate", [include("assignments")])]),
         # A step still being written.
         keywords(STEP_VERBS.replace("|", " "), VERB),
-        keywords(
-            "robot task tasks start pose poses waypoints order obstacle of reassign to like at "
-            "taking over by as from and"
-        ),
+        keywords(STEP_KEYWORDS),
         include("quantity"),
         include("punctuation"),
         name_as("variable.other" + S),

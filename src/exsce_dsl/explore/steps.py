@@ -30,8 +30,10 @@ from itertools import combinations
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import Pose, Robot, Scenario, Task
 from exsce_dsl.model.names import is_valid_name
+from exsce_dsl.transform.applied import Applied
 from exsce_dsl.transform.derivation import Request
-from exsce_dsl.transform.transformations import TRANSFORMATIONS, Applied, Arguments
+from exsce_dsl.transform.records import Arguments
+from exsce_dsl.transform.transformations import TRANSFORMATIONS
 
 MAX_POSES = 6
 ROBOT_STEM = "new_robot"
@@ -216,5 +218,6 @@ PROPOSERS: dict[str, Proposer] = {
     "remove_robot": _remove_robot,
     "add_robot": _add_robot,
     "replace_robot": _replace_robot,
-}
-"""The arguments worth trying, per transformation (every transformation has one: a test checks)."""
+} | {name: t.propose for name, t in TRANSFORMATIONS.items() if t.propose is not None}
+"""The arguments worth trying, per transformation (every transformation has one: a test checks);
+a transformation's record may carry its own (``propose``)."""

@@ -37,7 +37,12 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from exsce_dsl.lang.build.specification import Analysis, analyse, load_spec
-    from exsce_dsl.lang.build.standard_metrics import standard_metrics
+    from exsce_dsl.lang.build.standard_metrics import (
+        builtin_metrics,
+        known_metrics,
+        metric_info,
+        standard_metrics,
+    )
     from exsce_dsl.lang.chunks import declaration_chunks, tokens
     from exsce_dsl.lang.editor.analysis import analyse_for_editor, index_text
     from exsce_dsl.lang.editor.continuations import Continuations, continuations_at
@@ -68,6 +73,9 @@ _WHERE = {
     "Analysis": "build.specification",
     "load_spec_cached": "spec_cache",
     "standard_metrics": "build.standard_metrics",
+    "builtin_metrics": "build.standard_metrics",
+    "metric_info": "build.standard_metrics",
+    "known_metrics": "build.standard_metrics",
     "display_path": "loader",
     "import_target": "loader",
     "ImportScope": "loader",
@@ -120,6 +128,7 @@ __all__ = [
     "acceptance_document",
     "analyse",
     "analyse_for_editor",
+    "builtin_metrics",
     "comments",
     "continuations_at",
     "declaration_chunks",
@@ -139,8 +148,10 @@ __all__ = [
     "import_task_yaml",
     "index_text",
     "is_oracle_yaml",
+    "known_metrics",
     "load_spec",
     "load_spec_cached",
+    "metric_info",
     "scenario_to_yaml",
     "standard_metrics",
     "task_to_yaml",

@@ -11,12 +11,13 @@ import re
 from dataclasses import dataclass
 from typing import Any
 
-from textx import TextXSyntaxError, metamodel_from_file
+from textx import TextXSyntaxError, metamodel_from_str
 
 from exsce_dsl.errors import Diagnostic, ExsceSyntaxError, SourceLocation
 from exsce_dsl.lang.chunks import area_spans, declaration_chunks
 from exsce_dsl.lang.lexical import string_value
 from exsce_dsl.lang.locations import LineIndex
+from exsce_dsl.lang.transformation_syntax import step_rules
 from exsce_dsl.model.metrics import UNITS
 from exsce_dsl.model.names import KEYWORDS
 from exsce_dsl.resources import grammar_file
@@ -49,9 +50,18 @@ internal error)."""
 _NESTING_TOKEN = re.compile(r""""(?:\\.|[^"\\])*"|'(?:\\.|[^'\\])*'|//[^\n]*|/\*.*?\*/|[()]""", re.DOTALL)
 
 
+def grammar_text() -> str:
+    """The whole grammar of the entry file: ``exsce.tx``, then ``derive.tx`` and the rules of the
+    steps, made from the transformations' records (see ``grammar/derive.tx``)."""
+    entry = grammar_file()
+    derive = (entry.parent / "derive.tx").read_text(encoding="utf-8")
+    return "\n".join([entry.read_text(encoding="utf-8"), derive, step_rules()])
+
+
 def new_metamodel() -> Any:
     """A fresh metamodel of the exsce grammar (textX caches nothing across them)."""
-    made = metamodel_from_file(str(grammar_file()), autokwd=True)
+    # the entry file's name, for its imports
+    made = metamodel_from_str(grammar_text(), file_name=str(grammar_file()), autokwd=True)
     made.register_obj_processors({"Quoted": string_value})  # textX's STRING does not unescape
     return made
 

@@ -15,9 +15,9 @@ from dataclasses import dataclass
 
 from lsprotocol import types
 
-from exsce_dsl.lang import Continuations, Symbol
+from exsce_dsl.lang import Continuations, Symbol, builtin_metrics
+from exsce_dsl.lsp.derive_steps import current_step, next_types, snippet
 from exsce_dsl.lsp.navigation import Names
-from exsce_dsl.model.metrics import METRICS
 from exsce_dsl.oracles.relations import relation, relation_names
 from exsce_dsl.transform.transformations import TRANSFORMATIONS
 
@@ -28,10 +28,6 @@ _BLOCK_WORDS = frozenset(
     {"robots", "mission", "scenario", "environment", "area", "task", "subtask", "acceptance", "derive"}
     | {"reallocate", "metric", "robot"}
 )
-_STEP_WORDS = frozenset(
-    {"remove", "add", "replace", "swap", "reverse", "substitute", "move", "reallocate", "start"}
-)
-
 # How each relation of the oracles is written in acceptance criteria.
 _RELATION_PHRASES = {
     "below_max": "stays below ",
@@ -39,24 +35,6 @@ _RELATION_PHRASES = {
     "invariant": "is invariant",
     "increasing": "is increasing",
     "decreasing": "is decreasing",
-}
-
-# Each transformation as a derive step: (snippet, plain text).
-_STEPS = {
-    "remove_robot": ("remove robot ${1:robot}", "remove robot "),
-    "add_robot": ("add robot ${1:new_robot} like ${2:robot} at ${3:pose}", "add robot "),
-    "replace_robot": ("replace robot ${1:robot} by ${2:new_robot}", "replace robot "),
-    "swap_assignment": ("swap tasks of ${1:robot} and ${2:robot}", "swap tasks of "),
-    "swap_start_poses": ("swap start poses of ${1:robot} and ${2:robot}", "swap start poses of "),
-    "reverse_waypoint_order": ("reverse waypoints of ${1:task}", "reverse waypoints of "),
-    "reverse_task_order": ("reverse task order", "reverse task order"),
-    "add_task": ("add task ${1:task} to ${2:robot}", "add task "),
-    "remove_task": ("remove task ${1:task}", "remove task "),
-    "substitute_task": ("substitute task ${1:task} by ${2:task}", "substitute task "),
-    "add_start_pose": ("start ${1:robot} at ${2:pose}", "start "),
-    "remove_start_pose": ("remove start pose of ${1:robot}", "remove start pose of "),
-    "move_obstacle": ("move obstacle ${1:obstacle} to (${2:x}, ${3:y})", "move obstacle "),
-    "substitute_allocation": ("reallocate {\n\t${1:robot} does ${2:task}\n}", "reallocate {"),
 }
 
 _ITEM_KINDS = {
@@ -164,38 +142,20 @@ def _in_derivation(before: Sequence[str], names: Names) -> list[Wanted]:
     if len(before) == 4 and before[-1] == "from":
         return [Wanted("scenario")]
     environment = _environment_of(names, before[3]) if len(before) > 3 else None
-    start = 0
-    for i, token in enumerate(before):
-        if token in _STEP_WORDS and not (token == "start" and i and before[i - 1] in ("swap", "remove")):
-            start = i
-    step = list(before[start:])
-    if not step or step[0] not in _STEP_WORDS:
-        return []
-    head, pair, last, n = step[0], step[:2], step[-1], len(step)
-    task = Wanted("task")
     # the robots the steps add, and the base's (known from the text while this file is not indexed yet)
     robots = [Wanted("robot", derived), Wanted("robot", before[3] if len(before) > 3 else None)]
-    if head == "reallocate":
-        return [task] if last in ("does", "then") else robots
-    if pair in (["add", "task"], ["remove", "task"], ["substitute", "task"]) and n == 2:
-        return [task]
-    if (last == "of" and pair == ["reverse", "waypoints"]) or (last == "by" and head == "substitute"):
-        return [task]
-    if pair == ["move", "obstacle"] and n == 2:
-        return [Wanted("obstacle", environment=environment)]
-    if last == "at" and (pair in (["add", "robot"], ["replace", "robot"]) or head == "start"):
-        return [Wanted("pose", environment=environment)]
-    robot_places = (
-        (pair in (["remove", "robot"], ["replace", "robot"]) and n == 2)
-        or last in ("like", "over")
-        or (last == "to" and ("reassign" in step or pair == ["add", "task"]))
-        or (last == "from" and pair == ["remove", "task"])
-        or (last == "and" and head == "swap")
-        or (head == "start" and n == 1)
-        or (last == "of" and pair in (["swap", "tasks"], ["swap", "start"], ["remove", "tasks"]))
-        or (last == "of" and pair in (["reverse", "task"], ["remove", "start"]))
-    )
-    return robots if robot_places else []
+    by_type = {
+        "robot": robots,
+        "allocation robot": robots,
+        "task": [Wanted("task")],
+        "allocation task": [Wanted("task")],
+        "pose": [Wanted("pose", environment=environment)],
+        "obstacle": [Wanted("obstacle", environment=environment)],
+    }
+    wanted: list[Wanted] = []
+    for kind in sorted(next_types(current_step(before))):
+        wanted.extend(w for w in by_type.get(kind, []) if w not in wanted)
+    return wanted
 
 
 def _environment_of(names: Names, scenario: str) -> str | None:
@@ -294,7 +254,7 @@ def complete(
                 kind = _ITEM_KINDS.get(symbol.kind, types.CompletionItemKind.Text)
                 add(symbol.name, kind, _detail(symbol), "0")
             if wanted.kind == "metric":
-                for name, info in METRICS.items():
+                for name, info in builtin_metrics().items():
                     if not names.symbols("metric", name):
                         add(name, types.CompletionItemKind.Field, f"built-in metric: {info.meaning}", "0")
     for keyword in allowed.keywords:
@@ -306,11 +266,10 @@ def complete(
                 params = ", ".join(sorted(relation(name).parameters))
                 add(name, types.CompletionItemKind.Operator, f"relation {name}({params})", "2", insert=phrase)
     if allowed.declaration == "derive" and "remove" in allowed.keywords:
-        for name, (snippet, plain) in _STEPS.items():
-            if name in TRANSFORMATIONS:
-                kind = types.CompletionItemKind.Snippet
-                help_text = TRANSFORMATIONS[name].help
-                add(name, kind, help_text, "2", insert=snippet if snippets else plain, snippet=snippets)
+        for name, record in TRANSFORMATIONS.items():
+            written, plain = snippet(record)
+            kind = types.CompletionItemKind.Snippet
+            add(name, kind, record.help, "2", insert=written if snippets else plain, snippet=snippets)
     incomplete = len(items) > LIMIT
     items.sort(key=lambda item: item.sort_text or item.label)
     return types.CompletionList(is_incomplete=incomplete, items=items[:LIMIT])

@@ -7,10 +7,10 @@ import re
 from collections.abc import Callable
 
 from exsce_dsl.errors import SourceLocation
-from exsce_dsl.lang import Symbol, declaration_chunks, tokens
+from exsce_dsl.lang import Symbol, builtin_metrics, declaration_chunks, tokens
 from exsce_dsl.lsp.keywords import MEANINGS
 from exsce_dsl.lsp.navigation import Names, Target
-from exsce_dsl.model.metrics import METRICS, SI_UNIT
+from exsce_dsl.model.metrics import SI_UNIT
 
 _WORD = re.compile(r"[A-Za-z_][\w-]*")
 
@@ -39,8 +39,8 @@ def symbol_hover(names: Names, target: Target, source: Callable[[SourceLocation]
     """Markdown about what ``target`` names; ``source`` gives the text at a location."""
     found = names.definitions(target)
     if not found:
-        if target.kind == "metric" and target.name in METRICS:
-            info = METRICS[target.name]
+        if target.kind == "metric" and target.name in builtin_metrics():
+            info = builtin_metrics()[target.name]
             unit = SI_UNIT[info.dimension] or "a count"
             said = "each robot" if info.per_robot else "the mission"
             return f"**metric** `{target.name}` (built-in)\n\n{info.meaning}; of {said}; unit: {unit}"

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
-MEANINGS: dict[str, str] = {
+from exsce_dsl.lsp.derive_steps import step_meanings
+
+_WRITTEN: dict[str, str] = {
     "import": '`import "path.exsce"`: use the declarations of another file (a path relative to this one).',
     "robot": "`robot type NAME { ... }` declares the hardware of a kind of robot; "
     "`each robot` says a clause of every robot of the fleet.",
@@ -113,20 +115,7 @@ MEANINGS: dict[str, str] = {
     "its": "`each robot at its start pose`.",
     "derive": "`derive NEW from BASE { steps }`: a scenario made from another by input transformations, "
     "applied in order (each a step of the generation provenance).",
-    "remove": "`remove robot R [reassign to S]` (remove_robot), `remove task T [from R]` or "
-    "`remove tasks of R` (remove_task), `remove start pose of R` (remove_start_pose).",
-    "add": "`add robot NEW like R at POSE [taking over S]` (add_robot), `add task T to R [at N]` (add_task).",
-    "replace": "`replace robot R by NEW [like S] [at POSE]` (replace_robot): NEW takes R's tasks, and its "
-    "start pose or POSE.",
-    "swap": "`swap tasks of R and S` (swap_assignment), `swap start poses of R and S` (swap_start_poses).",
-    "reverse": "`reverse waypoints of T [as NEW]` (reverse_waypoint_order), `reverse task order [of R]` "
-    "(reverse_task_order).",
-    "substitute": "`substitute task T by U` (substitute_task): U wherever T was allocated.",
     "reassign": "`reassign to R`: the removed robot's tasks go to R.",
-    "move": "`move obstacle O to (x, y[, z])` (move_obstacle): the obstacle elsewhere, same heading and "
-    "size.",
-    "start": "`start R at POSE` (add_start_pose); `swap start poses`; `remove start pose of R`.",
-    "reallocate": "`reallocate { R does T then U }` (substitute_allocation): a whole new allocation.",
     "like": "`like R`: the new robot has R's type.",
     "metric": '`metric NAME for each robot [per segment] { "meaning" unit U reads ... value EXPR }`: '
     "what a monitor computes from a run's topics.",
@@ -142,3 +131,6 @@ MEANINGS: dict[str, str] = {
     "otherwise": "`otherwise EXPR`: computed instead when a topic of the value is not in the bag.",
     "runs": "`when MISSION runs`.",
 }
+
+MEANINGS: dict[str, str] = _WRITTEN | step_meanings()
+"""Every keyword's meaning; the words that start a derive step say their transformations'."""

@@ -1,9 +1,10 @@
 """The metrics exsce computes from a run's bag, and what each one measures.
 
-Acceptance criteria are checked against this table: the metric exists, a robot's
-metric is said of a robot and a mission's of the mission, a quantity has the
-metric's dimension, and only metrics with per-segment values take a time window
-(a window's value combines the values of the segments inside it).
+Acceptance criteria are checked against what a metric is (:class:`MetricInfo`): the metric
+exists, a robot's metric is said of a robot and a mission's of the mission, a quantity has the
+metric's dimension, and only metrics with per-segment values take a time window (a window's
+value combines the values of the segments inside it).  The built-in metrics are declared in the
+standard library (``lang/stdlib/metrics.exsce``), read by ``exsce_dsl.lang.builtin_metrics``.
 """
 
 from __future__ import annotations
@@ -79,27 +80,16 @@ class MetricInfo:
         return self.combine is not None
 
 
-METRICS: dict[str, MetricInfo] = {
-    m.name: m
-    for m in (
-        MetricInfo("mission_duration", Dimension.TIME, False, meaning="first goal active to last goal done"),
-        MetricInfo("task_duration", Dimension.TIME, True, Combine.SUM, meaning="time to complete its tasks"),
-        MetricInfo("waypoints_visited", Dimension.COUNT, True, meaning="goals that succeeded"),
-        MetricInfo("distance_travelled", Dimension.LENGTH, True, Combine.SUM, meaning="metres travelled"),
-        MetricInfo("distance_to_obstacles", Dimension.LENGTH, True, Combine.MIN, meaning="least laser range"),
-        MetricInfo("max_velocity", Dimension.SPEED, True, Combine.MAX, meaning="largest linear speed"),
-        MetricInfo(
-            "distance_between_robots", Dimension.LENGTH, False, meaning="least distance between two robots"
-        ),
-        MetricInfo(
-            "violation_duration",
-            Dimension.TIME,
-            True,
-            also_mission=True,
-            meaning="seconds a safety limit was violated",
-        ),
-    )
-}
+VIOLATION_DURATION = MetricInfo(
+    "violation_duration",
+    Dimension.TIME,
+    True,
+    also_mission=True,
+    meaning="seconds a safety limit was violated",
+)
+"""The one built-in metric the language does not declare: it follows from each metric that is
+``safe below|above`` a limit.  The others are declared once, in the standard library
+(``lang/stdlib/metrics.exsce``); ``exsce_dsl.lang.builtin_metrics`` gives them all."""
 
 UNITS: dict[str, tuple[Dimension, float]] = {
     "s": (Dimension.TIME, 1.0),
@@ -224,23 +214,6 @@ class MetricDefinition:
 
     def topics_of(self, namespaces: tuple[str, ...]) -> tuple[str, ...]:
         return tuple(read.topic_of(ns) for ns in namespaces for read in self.reads)
-
-
-def metric_info(name: str, scenario: Scenario | None = None) -> MetricInfo | None:
-    """What ``name`` measures: a metric the scenario's specification declares, else a built-in one."""
-    if scenario is not None:
-        for definition in scenario.metrics:
-            if definition.name == name:
-                return definition.info()
-    return METRICS.get(name)
-
-
-def known_metrics(scenario: Scenario | None = None) -> dict[str, MetricInfo]:
-    """Every metric a clause may name: the built-in ones and the specification's own."""
-    found = dict(METRICS)
-    if scenario is not None:
-        found.update({d.name: d.info() for d in scenario.metrics})
-    return found
 
 
 def default_topics(scenario: Scenario, metric: str, robot: str | None) -> tuple[str, ...]:

@@ -8,10 +8,10 @@ import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-from exsce_dsl.lang import standard_metrics
+from exsce_dsl.lang import metric_info, standard_metrics
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.acceptance import Moment, Window
-from exsce_dsl.model.metrics import Combine, ComputedFor, metric_info
+from exsce_dsl.model.metrics import Combine, ComputedFor
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.queries import run_metric_values, run_segment_values
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from exsce_dsl.lang import metric_info
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.acceptance import (
     Acceptance,
@@ -19,7 +20,6 @@ from exsce_dsl.model.acceptance import (
     Quantity,
     Window,
 )
-from exsce_dsl.model.metrics import metric_info
 from exsce_dsl.model.oracles import OracleType
 
 

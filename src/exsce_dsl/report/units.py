@@ -10,7 +10,8 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
-from exsce_dsl.model.metrics import METRICS, SI_UNIT, Dimension, MetricDefinition
+from exsce_dsl.lang import builtin_metrics
+from exsce_dsl.model.metrics import SI_UNIT, Dimension, MetricDefinition
 from exsce_dsl.store.queries import MetricReading
 
 COUNTED = {"waypoints_visited": "waypoints"}
@@ -35,7 +36,7 @@ def metric_units(
     A metric the store has values of but neither declares nor gives a unit is a count (the
     store records no unit for counts).
     """
-    units = {name: unit_label(name, info.dimension) for name, info in METRICS.items()}
+    units = {name: unit_label(name, info.dimension) for name, info in builtin_metrics().items()}
     units.update({d.name: unit_label(d.name, d.dimension) for d in definitions})
     for reading in readings:
         if reading.unit:

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from exsce_dsl.model.metrics import METRICS, Combine
+from exsce_dsl.lang import builtin_metrics
+from exsce_dsl.model.metrics import Combine
 from exsce_dsl.similarity.distances import ScenarioFacts, pose_id
 from exsce_dsl.store import queries
 from exsce_dsl.store.base import Store
@@ -27,7 +28,7 @@ def scenario_facts(store: Store, scenario: str) -> ScenarioFacts:
     if not runs:
         return ScenarioFacts(scenario, bases, torsos, segments)
     metrics: dict[str, float] = {}
-    for name, info in METRICS.items():
+    for name, info in builtin_metrics().items():
         if name == "violation_duration":
             continue
         if info.per_robot:

@@ -15,7 +15,8 @@ from exsce_dsl.model.derivation import Derivation
 from exsce_dsl.model.derived import DerivedScenario, Step
 from exsce_dsl.model.names import is_valid_name
 from exsce_dsl.suggest import did_you_mean
-from exsce_dsl.transform.transformations import TRANSFORMATIONS, Applied
+from exsce_dsl.transform.applied import Applied
+from exsce_dsl.transform.transformations import TRANSFORMATIONS
 
 Request = tuple[str, Mapping[str, str]]
 """A transformation's name and its arguments as text."""

@@ -15,6 +15,7 @@ from typing import Any
 from exsce_dsl.errors import SourceLocation
 from exsce_dsl.lang.build.context import Report
 from exsce_dsl.lang.build.references import UnknownNames, not_in_fleet
+from exsce_dsl.lang.build.standard_metrics import known_metrics
 from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.acceptance import (
@@ -32,7 +33,7 @@ from exsce_dsl.model.acceptance import (
     When,
     Window,
 )
-from exsce_dsl.model.metrics import SI_UNIT, UNITS, Dimension, MetricInfo, known_metrics
+from exsce_dsl.model.metrics import SI_UNIT, UNITS, Dimension, MetricInfo
 from exsce_dsl.suggest import did_you_mean
 
 _QUANTITY = re.compile(r"(\S+?)\s*(m/s|cm/s|km/h|rad/s|deg/s|mm|cm|km|ms|min|std|rad|deg|m|s|h|%)?")

@@ -10,75 +10,13 @@ from typing import Any
 from exsce_dsl.errors import ExsceError, SourceLocation
 from exsce_dsl.lang.build.checks import check_environment_map
 from exsce_dsl.lang.build.context import Declared, Report, name_span, report_duplicate
-from exsce_dsl.lang.build.poses import position_of
 from exsce_dsl.lang.build.references import UnknownNames
-from exsce_dsl.lang.lexical import quantity_text
 from exsce_dsl.lang.parser import ParsedFile
+from exsce_dsl.lang.transformation_syntax import step_of, written_arguments
 from exsce_dsl.model import Environment, Scenario, Task
 from exsce_dsl.model.derived import DerivedScenario, Step
 from exsce_dsl.transform.derivation import derive
-
-
-def _name(ref: Any) -> str | None:
-    return None if ref is None else str(ref.name)
-
-
-def step_of(node: Any) -> tuple[str, dict[str, str | None]]:
-    """The transformation a step of the grammar names, with its arguments."""
-    kind = node.__class__.__name__
-    if kind == "RemoveRobot":
-        return "remove_robot", {"robot": _name(node.robot), "reassign": _name(node.heir)}
-    if kind == "AddRobot":
-        return "add_robot", {
-            "robot": node.robot,
-            "like": _name(node.like),
-            "start": _name(node.start),
-            "take_over": _name(node.donor),
-        }
-    if kind == "ReplaceRobot":
-        return "replace_robot", {
-            "robot": _name(node.robot),
-            "by": node.new,
-            "like": _name(node.like),
-            "start": _name(node.start),
-        }
-    if kind in ("SwapTasks", "SwapStartPoses"):
-        name = "swap_assignment" if kind == "SwapTasks" else "swap_start_poses"
-        return name, {"robot": _name(node.robot), "with": _name(node.other)}
-    if kind == "ReverseWaypoints":
-        return "reverse_waypoint_order", {"task": _name(node.task), "as": node.new or None}
-    if kind == "ReverseTaskOrder":
-        return "reverse_task_order", {"robot": _name(node.robot)}
-    if kind == "AddTask":
-        position = str(node.position) if node.position else None
-        return "add_task", {"task": _name(node.task), "robot": _name(node.robot), "position": position}
-    if kind == "RemoveTasksOf":
-        return "remove_task", {"robot": _name(node.robot)}
-    if kind == "RemoveTask":
-        return "remove_task", {"task": _name(node.task), "robot": _name(node.robot)}
-    if kind == "SubstituteTask":
-        return "substitute_task", {"task": _name(node.task), "with": _name(node.other)}
-    if kind == "StartAt":
-        return "add_start_pose", {"robot": _name(node.robot), "pose": _name(node.pose)}
-    if kind == "RemoveStartPose":
-        return "remove_start_pose", {"robot": _name(node.robot)}
-    if kind == "MoveObstacle":
-        p = position_of(node.position)
-        metres = [p.x, p.y] + ([p.z] if p.z != 0.0 else [])  # as move_obstacle records it
-        return "move_obstacle", {"obstacle": _name(node.obstacle), "to": ",".join(repr(v) for v in metres)}
-    assert kind == "Reallocate", kind
-    entries = [f"{a.robot.name}:{t.name}" for a in node.assignments for t in a.tasks]
-    return "substitute_allocation", {"allocation": ",".join(entries)}
-
-
-def written_arguments(node: Any) -> tuple[tuple[str, str], ...]:
-    """The arguments of a step whose text is not their value's (see :attr:`Step.written`)."""
-    if node.__class__.__name__ == "MoveObstacle":
-        texts = [node.position.x, node.position.y] + (
-            [node.position.z] if node.position.z is not None else []
-        )
-        return (("to", ", ".join(quantity_text(t) for t in texts)),)
-    return ()
+from exsce_dsl.transform.transformations import TRANSFORMATIONS
 
 
 def build_derivation(
@@ -105,6 +43,7 @@ def build_derivation(
         steps.append(Step(name, given, pf.span(node), written_arguments(node)))
     done: list[Step] = []
     derived = None
+    environment = base.environment
     for step in steps:  # apply one more step at a time, to place an error at its step
         done.append(step)
         try:
@@ -112,10 +51,10 @@ def build_derivation(
         except ExsceError as exc:
             report(exc.message, step.location)
             return None
-        if step.transformation == "move_obstacle":
-            moved = str(step.argument("obstacle"))
+        for moved in _moved_obstacles(step, environment, derived.scenario.environment):
             for problem in _obstacle_map_problems(derived.scenario.environment, moved, step.location):
                 report(problem, step.location)
+        environment = derived.scenario.environment
     assert derived is not None  # the grammar asks for one step at least
     return DerivedScenario(
         tree.name,
@@ -126,6 +65,15 @@ def build_derivation(
         derived.derivation,
         pf.span(tree),
     )
+
+
+def _moved_obstacles(step: Step, before: Environment, after: Environment) -> list[str]:
+    """The obstacles ``step`` names that it put elsewhere."""
+    record = TRANSFORMATIONS[step.transformation]
+    named = [step.argument(p.name) for p in record.parameters if p.type == "obstacle"]
+    was = {o.id: o.pose.position for o in before.obstacles}
+    now = {o.id: o.pose.position for o in after.obstacles}
+    return [o for o in named if o is not None and o in now and was.get(o) != now[o]]
 
 
 def _obstacle_map_problems(env: Environment, obstacle_id: str, where: SourceLocation | None) -> list[str]:

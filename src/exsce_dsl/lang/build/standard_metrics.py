@@ -11,7 +11,8 @@ import functools
 
 from exsce_dsl.errors import Diagnostic, Severity, SourceLocation, SpecError
 from exsce_dsl.lang.spec_cache import cached_standard_metrics
-from exsce_dsl.model.metrics import METRICS, MetricDefinition
+from exsce_dsl.model.metrics import VIOLATION_DURATION, MetricDefinition, MetricInfo
+from exsce_dsl.model.scenario import Scenario
 
 
 @functools.cache
@@ -43,4 +44,29 @@ def _parse_standard_metrics() -> tuple[MetricDefinition, ...]:
 
 def reserved_metric_names() -> dict[str, str]:
     """Names a user's metric may not take, with why."""
-    return {name: "is one of exsce's built-in metrics" for name in METRICS}
+    return {name: "is one of exsce's built-in metrics" for name in builtin_metrics()}
+
+
+@functools.cache
+def builtin_metrics() -> dict[str, MetricInfo]:
+    """What each built-in metric is: the standard library's, as it declares them, and
+    violation_duration (which follows from the safe ones)."""
+    declared = {m.name: m.info() for m in standard_metrics()}
+    return declared | {VIOLATION_DURATION.name: VIOLATION_DURATION}
+
+
+def metric_info(name: str, scenario: Scenario | None = None) -> MetricInfo | None:
+    """What ``name`` measures: a metric the scenario's specification declares, else a built-in one."""
+    if scenario is not None:
+        for definition in scenario.metrics:
+            if definition.name == name:
+                return definition.info()
+    return builtin_metrics().get(name)
+
+
+def known_metrics(scenario: Scenario | None = None) -> dict[str, MetricInfo]:
+    """Every metric a clause may name: the built-in ones and the specification's own."""
+    found = dict(builtin_metrics())
+    if scenario is not None:
+        found.update({d.name: d.info() for d in scenario.metrics})
+    return found

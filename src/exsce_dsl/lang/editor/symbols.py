@@ -15,10 +15,11 @@ from dataclasses import dataclass
 from typing import Any
 
 from exsce_dsl.errors import SourceLocation
-from exsce_dsl.lang.build.derivation import step_of
 from exsce_dsl.lang.build.poses import position_of
 from exsce_dsl.lang.lexical import quantity_text
 from exsce_dsl.lang.parser import ParsedFile
+from exsce_dsl.lang.transformation_syntax import step_of, step_references
+from exsce_dsl.transform.transformations import TRANSFORMATIONS
 
 # The references each construct of the grammar holds: attribute -> kind of what it names.
 _REFERENCES: dict[str, dict[str, str]] = {
@@ -35,21 +36,11 @@ _REFERENCES: dict[str, dict[str, str]] = {
     "TaskWindow": {"task": "task"},
     "Against": {"scenario": "scenario"},
     "Derivation": {"base": "scenario"},
-    "RemoveRobot": {"robot": "robot", "heir": "robot"},
-    "AddRobot": {"like": "robot", "start": "pose", "donor": "robot"},
-    "ReplaceRobot": {"robot": "robot", "like": "robot"},
-    "SwapTasks": {"robot": "robot", "other": "robot"},
-    "SwapStartPoses": {"robot": "robot", "other": "robot"},
-    "ReverseWaypoints": {"task": "task"},
-    "ReverseTaskOrder": {"robot": "robot"},
-    "AddTask": {"task": "task", "robot": "robot"},
-    "RemoveTasksOf": {"robot": "robot"},
-    "RemoveTask": {"task": "task", "robot": "robot"},
-    "SubstituteTask": {"task": "task", "other": "task"},
-    "StartAt": {"robot": "robot", "pose": "pose"},
-    "RemoveStartPose": {"robot": "robot"},
-    "MoveObstacle": {"obstacle": "obstacle"},
+    **step_references(),  # a derive step's, from its transformation's record
 }
+
+_MADE = {"new_robot": "robot", "new_task": "task"}
+"""What a step's argument of each of these types declares."""
 
 SCOPED_KINDS = frozenset({"robot", "mission"})
 """Kinds whose names are a scenario's own (``scope`` says which scenario)."""
@@ -290,15 +281,13 @@ class _Reader:
             name, arguments = step_of(node)
             given = " ".join(f"{k}={v}" for k, v in arguments.items() if v is not None)
             facts.append((f"step {number}", f"{name} {given}".strip()))
-            if node.__class__.__name__ == "AddRobot":
-                made = [("like", node.like.name), ("starts at", node.start.name)]
-                children.append(self.symbol("robot", node, name=node.robot, scope=decl.name, facts=made))
-            elif node.__class__.__name__ == "ReplaceRobot":
-                made = [("replaces", node.robot.name)]
-                children.append(self.symbol("robot", node, name=node.new, scope=decl.name, facts=made))
-            elif node.__class__.__name__ == "ReverseWaypoints" and node.new:
-                made = [("reverses", node.task.name), ("derived by", decl.name)]
-                children.append(self.symbol("task", node, name=node.new, facts=made))
+            for parameter, made in arguments.items():
+                kind = _MADE.get(TRANSFORMATIONS[name].type_of(parameter))
+                if kind is None or made is None:
+                    continue
+                said = [("made by", name)] + [(k, v) for k, v in arguments.items() if k != parameter and v]
+                scope = decl.name if kind == "robot" else None
+                children.append(self.symbol(kind, node, name=made, scope=scope, facts=said))
         return self.symbol("scenario", decl, facts=facts, children=children)
 
     def _metric(self, decl: Any) -> Symbol:

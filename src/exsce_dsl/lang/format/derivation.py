@@ -1,10 +1,13 @@
-"""The canonical text of ``derive`` blocks (the formatter's part for them)."""
+"""The canonical text of ``derive`` blocks (the formatter's part for them): each step in its
+transformation's phrase, each argument as its type is written."""
 
 from __future__ import annotations
 
 from exsce_dsl.errors import SourceLocation
 from exsce_dsl.lang.lexical import as_written, read_length
 from exsce_dsl.model.derived import DerivedScenario, Step
+from exsce_dsl.transform.records import Slot, Transformation, Word, phrase_parts, variants
+from exsce_dsl.transform.transformations import TRANSFORMATIONS
 
 INDENT = "  "
 Line = tuple[str, SourceLocation | None]
@@ -21,49 +24,46 @@ def derivation_lines(derived: DerivedScenario) -> list[Line]:
 
 
 def step_text(step: Step) -> list[str]:
-    """A step as written (a ``reallocate`` block takes several lines)."""
-    a = step.argument
-    name = step.transformation
-    if name == "remove_robot":
-        return [f"remove robot {a('robot')}" + (f" reassign to {a('reassign')}" if a("reassign") else "")]
-    if name == "add_robot":
-        text = f"add robot {a('robot')} like {a('like')} at {a('start')}"
-        return [text + (f" taking over {a('take_over')}" if a("take_over") else "")]
-    if name == "replace_robot":
-        text = f"replace robot {a('robot')} by {a('by')}" + (f" like {a('like')}" if a("like") else "")
-        return [text + (f" at {a('start')}" if a("start") else "")]
-    if name in ("swap_assignment", "swap_start_poses"):
-        what = "tasks" if name == "swap_assignment" else "start poses"
-        return [f"swap {what} of {a('robot')} and {a('with')}"]
-    if name == "reverse_waypoint_order":
-        return [f"reverse waypoints of {a('task')}" + (f" as {a('as')}" if a("as") else "")]
-    if name == "reverse_task_order":
-        return ["reverse task order" + (f" of {a('robot')}" if a("robot") else "")]
-    if name == "add_task":
-        return [f"add task {a('task')} to {a('robot')}" + (f" at {a('position')}" if a("position") else "")]
-    if name == "remove_task":
-        if a("task") is None:
-            return [f"remove tasks of {a('robot')}"]
-        return [f"remove task {a('task')}" + (f" from {a('robot')}" if a("robot") else "")]
-    if name == "substitute_task":
-        return [f"substitute task {a('task')} by {a('with')}"]
-    if name == "add_start_pose":
-        return [f"start {a('robot')} at {a('pose')}"]
-    if name == "remove_start_pose":
-        return [f"remove start pose of {a('robot')}"]
-    if name == "move_obstacle":  # metres, as x,y[,z]
-        metres = [float(v) for v in (a("to") or "").split(",")]
-        texts = [t for t in dict(step.written).get("to", "").split(",") if t.strip()]
+    """A step as written, in the first phrase of its transformation that holds its arguments
+    (a ``reallocate`` block takes several lines)."""
+    record = TRANSFORMATIONS[step.transformation]
+    given = {k for k, v in step.arguments if v is not None}
+    for phrase in record.phrases:
+        for variant in variants(phrase_parts(phrase)):
+            if {p.parameter for p in variant if isinstance(p, Slot)} == given:
+                return _written(record, variant, step)
+    raise ValueError(f"no phrase of {step.transformation} takes {sorted(given)}")
+
+
+def _written(record: Transformation, variant: tuple[Word | Slot, ...], step: Step) -> list[str]:
+    lines = [""]
+    for part in variant:
+        if isinstance(part, Word):
+            texts = [part.text]
+        else:
+            texts = _argument_text(record.type_of(part.parameter), part.parameter, step)
+        lines[-1] = f"{lines[-1]} {texts[0]}".strip()
+        lines.extend(texts[1:])
+    return lines
+
+
+def _argument_text(kind: str, parameter: str, step: Step) -> list[str]:
+    """An argument as a step writes it: its text, or the lines of a block."""
+    value = step.argument(parameter) or ""
+    if kind == "position":  # metres, as x,y[,z]
+        metres = [float(v) for v in value.split(",")]
+        texts = [t for t in dict(step.written).get(parameter, "").split(",") if t.strip()]
         if len(texts) == 3 and len(metres) == 2:  # a z of 0 written out
             metres.append(0.0)
         shown = as_written(metres, texts, read_length) or [repr(v) for v in metres]
-        return [f"move obstacle {a('obstacle')} to ({', '.join(shown)})"]
-    assert name == "substitute_allocation", name
-    runs: list[tuple[str, list[str]]] = []
-    for entry in (a("allocation") or "").split(","):
-        robot, _, task = (part.strip() for part in entry.partition(":"))
-        if runs and runs[-1][0] == robot:
-            runs[-1][1].append(task)
-        else:
-            runs.append((robot, [task]))
-    return ["reallocate {", *(f"{INDENT}{robot} does {' then '.join(tasks)}" for robot, tasks in runs), "}"]
+        return [f"({', '.join(shown)})"]
+    if kind == "allocation":
+        runs: list[tuple[str, list[str]]] = []
+        for entry in value.split(","):
+            robot, _, task = (part.strip() for part in entry.partition(":"))
+            if runs and runs[-1][0] == robot:
+                runs[-1][1].append(task)
+            else:
+                runs.append((robot, [task]))
+        return ["{", *(f"{INDENT}{robot} does {' then '.join(tasks)}" for robot, tasks in runs), "}"]
+    return [value]

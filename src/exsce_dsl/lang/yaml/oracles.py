@@ -19,6 +19,7 @@ from typing import Any
 import yaml
 
 from exsce_dsl.errors import Diagnostic, ExportError, ImportFormatError, SourceLocation
+from exsce_dsl.lang.build.standard_metrics import known_metrics, metric_info
 from exsce_dsl.lang.format.acceptance import expectation_text
 from exsce_dsl.lang.yaml.located import YamlFile, YamlNode, child_node, node_location
 from exsce_dsl.model import Document, Import, Scenario, Specification
@@ -32,7 +33,7 @@ from exsce_dsl.model.acceptance import (
     Subject,
     When,
 )
-from exsce_dsl.model.metrics import SI_UNIT, Dimension, MetricInfo, default_topics, known_metrics, metric_info
+from exsce_dsl.model.metrics import SI_UNIT, Dimension, MetricInfo, default_topics
 from exsce_dsl.model.names import NUMBER, is_valid_name
 from exsce_dsl.suggest import did_you_mean
 
