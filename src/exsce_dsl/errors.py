@@ -251,6 +251,11 @@ class StoreLockedError(StoreError):
         self.path = path
 
 
+class StoreUnwritableError(StoreError):
+    """The store folder can be read but not opened for writing (read-only mount, no permission,
+    full disk): reads use a read-only view, and a write raises this."""
+
+
 class StoreConflictError(StoreError):
     """A document differs from what the store holds under the same names."""
 
@@ -330,3 +335,36 @@ class UnknownNameWarning(UserWarning):
 class CacheWarning(UserWarning):
     """The user's cache folder cannot be trusted (another user's, or writable by others), so it is
     not used (``user_cache``)."""
+
+
+class NoGoodRuns(ExsceError):
+    """Every stored run of a scenario was left out: there is nothing to learn from."""
+
+
+class NotEnoughRuns(ExsceError):
+    """A baseline was asked for before the scenario had the runs its criteria require."""
+
+
+class IngestFailed(ExsceError):
+    """A bag given to :func:`verify_runs` could not be ingested, so nothing was judged."""
+
+
+class CorruptBag(ExsceError):
+    """Bytes that are not what the bag's own checksums say was recorded: no reader should read them."""
+
+
+class ResourceNotFound(ExsceError):
+    """No resource has the URI asked for."""
+
+
+class OracleFileErrors(ImportFormatError):
+    """Every problem found in one oracle file, reported together (first one as the message)."""
+
+    def __init__(self, problems: Sequence[ImportFormatError]) -> None:
+        found = sorted(problems, key=lambda p: p.location or SourceLocation("", 0, 0))
+        super().__init__(found[0].message, found[0].location)
+        self._diagnostics = tuple(d for p in found for d in p.diagnostics)
+
+    @property
+    def diagnostics(self) -> Sequence[Diagnostic]:
+        return self._diagnostics

@@ -14,7 +14,7 @@ from pathlib import Path
 
 from prov.model import ProvDocument
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import ExsceError, IngestFailed
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.coverage import CoverageGap, TopicRate
 from exsce_dsl.model.document import Specification
@@ -35,10 +35,6 @@ from exsce_dsl.store.writing import WriteReport, add_prov
 
 _BAG_SUFFIXES = (".bag", ".mcap", ".db3")
 """What a bag's name ends with: such a name that is not a file is a missing bag, not a run id."""
-
-
-class IngestFailed(ExsceError):
-    """A bag given to :func:`verify_runs` could not be ingested, so nothing was judged."""
 
 
 @dataclass(frozen=True)

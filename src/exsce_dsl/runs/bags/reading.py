@@ -21,6 +21,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from exsce_dsl.errors import BagError as BagError
+from exsce_dsl.errors import CorruptBag
 from exsce_dsl.messages.catalogue import MessageTypeError
 from exsce_dsl.runs.bags.data import ANY as ANY
 from exsce_dsl.runs.bags.data import OBJECTS as OBJECTS
@@ -34,7 +35,6 @@ from exsce_dsl.runs.bags.data import Wanted as Wanted
 from exsce_dsl.runs.bags.decode import DecodeError
 from exsce_dsl.runs.bags.files import check_bag_file
 from exsce_dsl.runs.bags.mcap import MCAP
-from exsce_dsl.runs.bags.mcap_index import CorruptBag
 from exsce_dsl.runs.bags.names import BagTopics
 from exsce_dsl.runs.bags.objects import LazyMessage as LazyMessage
 from exsce_dsl.runs.bags.reader import BagReader, UnsupportedBag
