@@ -48,10 +48,11 @@ import numpy as np
 from exsce_dsl.errors import CorruptBag
 from exsce_dsl.runs.bags.buffers import mapped, release
 from exsce_dsl.runs.bags.chunk_batches import ChunkBatch, Decoder, Gathered, Messages
+from exsce_dsl.runs.bags.formats import MCAP_FILE
 from exsce_dsl.runs.bags.reader import UnsupportedBag
 from exsce_dsl.wording import counted
 
-MAGIC = b"\x89MCAP0\r\n"
+MAGIC = MCAP_FILE.magic
 OP_HEADER = 0x01
 OP_FOOTER = 0x02
 OP_SCHEMA = 0x03

@@ -31,13 +31,14 @@ from exsce_dsl.model.messages import standard_type
 from exsce_dsl.runs.bags.buffers import Buffer, mapped, release
 from exsce_dsl.runs.bags.chunk_batches import ChunkBatch, Decoder, Gathered, Messages
 from exsce_dsl.runs.bags.data import OBJECTS, BagData, Check, Reduce, Wanted
+from exsce_dsl.runs.bags.formats import ROS1_BAG
 from exsce_dsl.runs.bags.gather import gather_values
 from exsce_dsl.runs.bags.names import BagTopics
 from exsce_dsl.runs.bags.objects import deserialized, deserializer_for
 from exsce_dsl.runs.bags.reader import BagReader, UnsupportedBag
 from exsce_dsl.runs.bags.reading_base import IndexReading
 
-MAGIC = b"#ROSBAG V2.0\n"
+MAGIC = ROS1_BAG.magic
 OP_MSG, OP_BAG, OP_INDEX, OP_CHUNK, OP_CHUNK_INFO, OP_CONN = 0x02, 0x03, 0x04, 0x05, 0x06, 0x07
 
 
@@ -270,8 +271,9 @@ def _topics(path: Path) -> BagTopics:
 
 ROS1 = BagReader(
     "ROS 1",
-    claims=lambda path: path.is_file() and path.suffix == ".bag",
+    claims=lambda path: path.is_file() and path.suffix == ROS1_BAG.suffix,
     read=_read,
     topics=_topics,
+    formats=(ROS1_BAG,),
 )
 """ROS 1 bags (a ``.bag`` file), from the bag's own index."""
