@@ -58,7 +58,8 @@ class StoreFlavour:
     written).  ``own_graphs``: beginnings of the names of the graphs the server keeps for
     itself, never listed, exported or cleared.  ``answers``: how its answers are read when not
     as SPARQL JSON (then graph by graph).  ``ask_column``: the one column of the table it
-    answers an ASK with (a row of 1: true), if it does so.
+    answers an ASK with (a row of 1: true), if it does so.  ``whole_requests``: the write
+    strategy, below.
     """
 
     name: str
@@ -70,6 +71,9 @@ class StoreFlavour:
     own_graphs: tuple[str, ...] = ()
     answers: Answers | None = None
     ask_column: str | None = None
+    whole_requests: bool = True
+    """Whether a request of several operations is one transaction (all or nothing); False: each
+    operation is committed on its own, so a write that replaces graphs drops, then inserts."""
 
 
 SPARQL = StoreFlavour("sparql")
@@ -83,10 +87,11 @@ VIRTUOSO = StoreFlavour(
     own_graphs=virtuoso.OWN_GRAPHS,
     answers=Answers(virtuoso.TURTLE, virtuoso.result_set_rows, virtuoso.graph_triples),
     ask_column="__ASK_RETVAL",
+    whole_requests=False,
 )
 """Virtuoso 7 (:mod:`exsce_dsl.store.virtuoso`): no blank nodes in ``INSERT DATA``, doubles
-exact only in its Turtle, graphs of its own, ASK answered as a table.  Each operation of a
-request is committed on its own (a write that replaces graphs drops them, then inserts)."""
+exact only in its Turtle, graphs of its own, ASK answered as a table, each operation of a
+request committed on its own."""
 
 _BUILT_IN = (
     StoreFlavour("oxigraph", Preset("/query", "/update", "/store", strip=("/query", "/update", "/store"))),
