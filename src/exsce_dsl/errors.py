@@ -15,6 +15,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from enum import Enum
+from http import HTTPStatus
 from pathlib import Path
 from typing import Any
 
@@ -368,3 +369,42 @@ class OracleFileErrors(ImportFormatError):
     @property
     def diagnostics(self) -> Sequence[Diagnostic]:
         return self._diagnostics
+
+
+# -- signals inside the library: each is caught by the caller of what raised it, which says what
+# went wrong in an ExsceError of its own (or answers an HTTP request with it)
+
+
+class Unparsable(Exception):
+    """The text does not parse as SPARQL 1.1 (it may still be Oxigraph's SPARQL)."""
+
+
+class RefusedRequest(Exception):
+    """A request answered with ``status`` and ``message`` (plain text) and these ``headers``."""
+
+    def __init__(self, status: HTTPStatus, message: str, headers: dict[str, str] | None = None) -> None:
+        super().__init__(message)
+        self.status = status
+        self.message = message
+        self.headers = headers or {}
+
+
+class AnswerCut(Exception):
+    """An answer stopped after its headers were sent (over a limit, or the worker failed)."""
+
+
+class FieldProblem(Exception):
+    """What is wrong with a path (the caller knows where it is written)."""
+
+    def __init__(self, message: str) -> None:
+        super().__init__(message)
+        self.message = message
+
+
+class FileProblem(Exception):
+    """What is wrong with one file, in words; :func:`~exsce_dsl.runs.bags.files.check_bag_file`
+    says which bag it is."""
+
+
+class UnsupportedBag(Exception):
+    """This reader cannot read the bag; use the next (rosbags, at the end)."""

@@ -20,8 +20,7 @@ from dataclasses import dataclass
 from pathlib import Path, PurePath
 from typing import Any
 
-from exsce_dsl.errors import BagError, ExsceError
-from exsce_dsl.runs.bags.file_problems import FileProblem
+from exsce_dsl.errors import BagError, ExsceError, FileProblem
 from exsce_dsl.runs.bags.formats import BUILT_IN_FORMATS, MCAP_FILE, ROS1_BAG, ROS2_METADATA, BagFormat
 from exsce_dsl.textfiles import read_text
 

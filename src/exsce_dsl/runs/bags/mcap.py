@@ -3,7 +3,7 @@
 :data:`MCAP` reads an ``.mcap`` file, or a ROS 2 bag folder whose ``metadata.yaml`` says
 ``storage_identifier: mcap``, over :mod:`exsce_dsl.runs.bags.mcap_index` (the file's
 summary, chunks and message indexes), and passes it to the next reader (rosbags') when that
-raises :class:`~exsce_dsl.runs.bags.reader.UnsupportedBag`.  A type's definition comes from
+raises :class:`~exsce_dsl.errors.UnsupportedBag`.  A type's definition comes from
 the channel's schema (``ros2msg`` or ``ros2idl``), else from the user's files, else from
 rosbags' standard typestores.
 """
@@ -16,14 +16,14 @@ from pathlib import Path
 
 import numpy as np
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import ExsceError, UnsupportedBag
 from exsce_dsl.messages.catalogue import MessageCatalogue, Source, parse_definition, standard_catalogue
 from exsce_dsl.runs.bags.chunk_batches import Messages
 from exsce_dsl.runs.bags.data import OBJECTS, BagData, Check, Reduce, Wanted
 from exsce_dsl.runs.bags.formats import MCAP_FILE, ROS2_METADATA
 from exsce_dsl.runs.bags.mcap_index import IDL_SEPARATOR, Schema, definitions, read_channels, recorded_span
 from exsce_dsl.runs.bags.objects import deserialized, deserializer_for
-from exsce_dsl.runs.bags.reader import BagReader, UnsupportedBag
+from exsce_dsl.runs.bags.reader import BagReader
 from exsce_dsl.runs.bags.reading_base import IndexReading
 from exsce_dsl.textfiles import read_text
 

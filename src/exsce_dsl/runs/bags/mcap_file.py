@@ -8,8 +8,9 @@ import mmap
 import struct
 from pathlib import Path
 
+from exsce_dsl.errors import FileProblem
 from exsce_dsl.runs.bags.buffers import u64
-from exsce_dsl.runs.bags.file_problems import FileProblem, unparsed
+from exsce_dsl.runs.bags.file_problems import unparsed
 from exsce_dsl.runs.bags.formats import MCAP_FILE
 from exsce_dsl.runs.bags.mcap_index import (
     DECOMPRESSORS,

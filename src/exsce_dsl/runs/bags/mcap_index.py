@@ -45,11 +45,10 @@ from pathlib import Path
 
 import numpy as np
 
-from exsce_dsl.errors import CorruptBag
+from exsce_dsl.errors import CorruptBag, UnsupportedBag
 from exsce_dsl.runs.bags.buffers import mapped, release
 from exsce_dsl.runs.bags.chunk_batches import ChunkBatch, Decoder, Gathered, Messages
 from exsce_dsl.runs.bags.formats import MCAP_FILE
-from exsce_dsl.runs.bags.reader import UnsupportedBag
 from exsce_dsl.wording import counted
 
 MAGIC = MCAP_FILE.magic

@@ -19,11 +19,6 @@ from exsce_dsl.runs.bags.data import BagData, Check, Reduce, Wanted
 from exsce_dsl.runs.bags.formats import BagFormat
 from exsce_dsl.runs.bags.names import BagTopics
 
-
-class UnsupportedBag(Exception):
-    """This reader cannot read the bag; use the next (rosbags, at the end)."""
-
-
 Read = Callable[[Path, Mapping[str, Wanted], Mapping[str, Reduce] | None, Check | None], BagData]
 """(the bag, the wanted topics, their reductions, the check of their fields) → what was read."""
 

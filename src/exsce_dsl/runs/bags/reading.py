@@ -21,7 +21,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from exsce_dsl.errors import BagError as BagError
-from exsce_dsl.errors import CorruptBag
+from exsce_dsl.errors import CorruptBag, UnsupportedBag
 from exsce_dsl.messages.catalogue import MessageTypeError
 from exsce_dsl.plugins import Registry
 from exsce_dsl.runs.bags.data import ANY as ANY
@@ -39,7 +39,7 @@ from exsce_dsl.runs.bags.formats import BagFormat, is_ros2_folder
 from exsce_dsl.runs.bags.mcap import MCAP
 from exsce_dsl.runs.bags.names import BagTopics
 from exsce_dsl.runs.bags.objects import LazyMessage as LazyMessage
-from exsce_dsl.runs.bags.reader import BagReader, UnsupportedBag
+from exsce_dsl.runs.bags.reader import BagReader
 from exsce_dsl.runs.bags.ros1 import ROS1
 from exsce_dsl.runs.bags.rosbags_fallback import ROSBAGS
 

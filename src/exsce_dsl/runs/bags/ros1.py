@@ -11,7 +11,7 @@ comes from the connection (the bag's own), else from the user's files, else
 from rosbags' ROS 1 typestore.
 
 Uncompressed, bz2 and lz4 chunks are read; anything unexpected raises
-:class:`~exsce_dsl.runs.bags.reader.UnsupportedBag` and :data:`ROS1` passes the
+:class:`~exsce_dsl.errors.UnsupportedBag` and :data:`ROS1` passes the
 bag to the next reader (rosbags').
 """
 
@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from exsce_dsl.errors import UnsupportedBag
 from exsce_dsl.messages.catalogue import MessageCatalogue, Source, parse_definition, standard_ros1_catalogue
 from exsce_dsl.model.messages import standard_type
 from exsce_dsl.runs.bags.buffers import Buffer, mapped, release
@@ -35,7 +36,7 @@ from exsce_dsl.runs.bags.formats import ROS1_BAG
 from exsce_dsl.runs.bags.gather import gather_values
 from exsce_dsl.runs.bags.names import BagTopics
 from exsce_dsl.runs.bags.objects import deserialized, deserializer_for
-from exsce_dsl.runs.bags.reader import BagReader, UnsupportedBag
+from exsce_dsl.runs.bags.reader import BagReader
 from exsce_dsl.runs.bags.reading_base import IndexReading
 
 MAGIC = ROS1_BAG.magic
