@@ -15,6 +15,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from enum import Enum
+from http import HTTPStatus
 from pathlib import Path
 from typing import Any
 
@@ -251,6 +252,11 @@ class StoreLockedError(StoreError):
         self.path = path
 
 
+class StoreUnwritableError(StoreError):
+    """The store folder can be read but not opened for writing (read-only mount, no permission,
+    full disk): reads use a read-only view, and a write raises this."""
+
+
 class StoreConflictError(StoreError):
     """A document differs from what the store holds under the same names."""
 
@@ -330,3 +336,75 @@ class UnknownNameWarning(UserWarning):
 class CacheWarning(UserWarning):
     """The user's cache folder cannot be trusted (another user's, or writable by others), so it is
     not used (``user_cache``)."""
+
+
+class NoGoodRuns(ExsceError):
+    """Every stored run of a scenario was left out: there is nothing to learn from."""
+
+
+class NotEnoughRuns(ExsceError):
+    """A baseline was asked for before the scenario had the runs its criteria require."""
+
+
+class IngestFailed(ExsceError):
+    """A bag given to :func:`verify_runs` could not be ingested, so nothing was judged."""
+
+
+class CorruptBag(ExsceError):
+    """Bytes that are not what the bag's own checksums say was recorded: no reader should read them."""
+
+
+class ResourceNotFound(ExsceError):
+    """No resource has the URI asked for."""
+
+
+class OracleFileErrors(ImportFormatError):
+    """Every problem found in one oracle file, reported together (first one as the message)."""
+
+    def __init__(self, problems: Sequence[ImportFormatError]) -> None:
+        found = sorted(problems, key=lambda p: p.location or SourceLocation("", 0, 0))
+        super().__init__(found[0].message, found[0].location)
+        self._diagnostics = tuple(d for p in found for d in p.diagnostics)
+
+    @property
+    def diagnostics(self) -> Sequence[Diagnostic]:
+        return self._diagnostics
+
+
+# -- signals inside the library: each is caught by the caller of what raised it, which says what
+# went wrong in an ExsceError of its own (or answers an HTTP request with it)
+
+
+class Unparsable(Exception):
+    """The text does not parse as SPARQL 1.1 (it may still be Oxigraph's SPARQL)."""
+
+
+class RefusedRequest(Exception):
+    """A request answered with ``status`` and ``message`` (plain text) and these ``headers``."""
+
+    def __init__(self, status: HTTPStatus, message: str, headers: dict[str, str] | None = None) -> None:
+        super().__init__(message)
+        self.status = status
+        self.message = message
+        self.headers = headers or {}
+
+
+class AnswerCut(Exception):
+    """An answer stopped after its headers were sent (over a limit, or the worker failed)."""
+
+
+class FieldProblem(Exception):
+    """What is wrong with a path (the caller knows where it is written)."""
+
+    def __init__(self, message: str) -> None:
+        super().__init__(message)
+        self.message = message
+
+
+class FileProblem(Exception):
+    """What is wrong with one file, in words; :func:`~exsce_dsl.runs.bags.files.check_bag_file`
+    says which bag it is."""
+
+
+class UnsupportedBag(Exception):
+    """This reader cannot read the bag; use the next (rosbags, at the end)."""

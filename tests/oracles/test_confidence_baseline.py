@@ -12,10 +12,11 @@ from prov.model import ProvDocument
 from pyoxigraph import Literal, NamedNode
 from scipy import stats
 
+from exsce_dsl.errors import NotEnoughRuns
 from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.acceptance import Acceptance
-from exsce_dsl.oracles.baseline import NotEnoughRuns, baseline_oracles
+from exsce_dsl.oracles.baseline import baseline_oracles
 from exsce_dsl.prov.oracle import compile_oracles
 from exsce_dsl.rdf import to_quads
 from exsce_dsl.rdf.shacl import validate

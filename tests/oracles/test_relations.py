@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import math
 import sys
-import textwrap
 from collections.abc import Iterator, Mapping
 from pathlib import Path
 
@@ -23,6 +22,8 @@ from exsce_dsl.oracles.relations import (
     relation,
     relation_names,
 )
+
+from tests.support.plugin_packages import installed_plugins
 
 BUILT_IN = ("above_min", "below_max", "decreasing", "increasing", "invariant")
 
@@ -197,16 +198,7 @@ broken = exsce_test_relations:not_a_relation
 @pytest.fixture
 def plugin(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
     """A distribution installed in ``tmp_path`` that registers three relations."""
-    (tmp_path / "exsce_test_relations.py").write_text(PLUGIN)
-    dist_info = tmp_path / "exsce_test_relations-1.0.dist-info"
-    dist_info.mkdir()
-    (dist_info / "METADATA").write_text("Metadata-Version: 2.1\nName: exsce-test-relations\nVersion: 1.0\n")
-    (dist_info / "entry_points.txt").write_text(textwrap.dedent(ENTRY_POINTS))
-    monkeypatch.syspath_prepend(str(tmp_path))
-    relations._registry.cache_clear()
-    yield
-    relations._registry.cache_clear()
-    sys.modules.pop("exsce_test_relations", None)
+    yield from installed_plugins(tmp_path, monkeypatch, relations.RELATIONS, "exsce_test_relations", PLUGIN, ENTRY_POINTS)
 
 
 @pytest.mark.usefixtures("plugin")

@@ -29,12 +29,12 @@ from rosbags.interfaces import Qos, QosDurability, QosHistory, QosLiveliness, Qo
 from rosbags.rosbag2 import CompressionFormat, CompressionMode, StoragePlugin, Writer
 from rosbags.typesys import Stores, get_typestore
 
+from exsce_dsl.errors import UnsupportedBag
 from exsce_dsl.model.messages import path_of
 from exsce_dsl.runs.bags import reading as bagdata
 from exsce_dsl.runs.bags.mcap import mcap_files
 from exsce_dsl.runs.bags.mcap_index import read_topics, schemas
 from exsce_dsl.runs.bags.raw_messages import RawMessages
-from exsce_dsl.runs.bags.reader import UnsupportedBag
 from exsce_dsl.runs.bags.reading import OBJECTS, Wanted, read_bag
 from exsce_dsl.runs.bags.rosbags_fallback import read_with_rosbags
 from exsce_dsl.sim.messages import FEEDBACK

@@ -8,8 +8,8 @@ import threading
 import pyoxigraph
 import pytest
 
-from exsce_dsl.errors import FederationRefused
-from exsce_dsl.store.federation import Federated, Unparsable, federated_targets, refuse_federation
+from exsce_dsl.errors import FederationRefused, Unparsable
+from exsce_dsl.store.federation import Federated, federated_targets, refuse_federation
 
 REFUSED = [
     "SELECT * WHERE { SERVICE <http://127.0.0.1:9/sparql> { ?s ?p ?o } }",

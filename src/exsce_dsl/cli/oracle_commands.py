@@ -194,8 +194,9 @@ def verify(**given: Any) -> None:
           --required-pass-rate 0.5 --confidence 0.9  # exits 3: 2 runs are too few
     """
     from exsce_dsl.cli.trial_commands import report_trial
+    from exsce_dsl.errors import IngestFailed
     from exsce_dsl.lang import load_spec
-    from exsce_dsl.oracles.judging import IngestFailed, verify_runs
+    from exsce_dsl.oracles.judging import verify_runs
     from exsce_dsl.store.open import open_store
 
     options = _VerifyOptions(**given)

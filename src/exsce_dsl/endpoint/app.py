@@ -27,13 +27,13 @@ from exsce_dsl.endpoint.protocol import (
     MAX_BODY,
     MAX_QUERY_BODY,
     Parameters,
-    RefusedRequest,
     iri,
     one,
     operation,
     read_body,
 )
 from exsce_dsl.endpoint.worker import Job
+from exsce_dsl.errors import RefusedRequest
 from exsce_dsl.store.base import MAX_QUERY
 
 METHODS = ["GET", "HEAD", "POST", "PUT", "DELETE", "PATCH", "OPTIONS"]

@@ -30,9 +30,8 @@ from typing import Any
 
 import anyio.to_thread
 
-from exsce_dsl.endpoint.protocol import RefusedRequest
 from exsce_dsl.endpoint.worker import DATA, END, HEAD, READY, REFUSED, Job, Settings, run_worker
-from exsce_dsl.errors import StoreError
+from exsce_dsl.errors import AnswerCut, RefusedRequest, StoreError
 
 LOGGER = logging.getLogger("exsce_dsl.endpoint")
 FIRST_BUFFER = 4 * 1024 * 1024
@@ -47,10 +46,6 @@ class Answer:
     media: str
     first: bytes
     rest: AsyncIterator[bytes] | None = None
-
-
-class AnswerCut(Exception):
-    """An answer stopped after its headers were sent (over a limit, or the worker failed)."""
 
 
 class Evaluator:
@@ -261,4 +256,4 @@ def _next_message(conn: Connection) -> bytes | None:
         return None
 
 
-__all__ = ["FIRST_BUFFER", "Answer", "AnswerCut", "Evaluator"]
+__all__ = ["FIRST_BUFFER", "Answer", "Evaluator"]

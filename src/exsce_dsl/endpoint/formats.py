@@ -9,7 +9,8 @@ from typing import Any
 
 from pyoxigraph import QueryResultsFormat, RdfFormat
 
-from exsce_dsl.endpoint.protocol import Parameters, RefusedRequest
+from exsce_dsl.endpoint.protocol import Parameters
+from exsce_dsl.errors import RefusedRequest
 
 RESULT_FORMATS = {
     "application/sparql-results+json": QueryResultsFormat.JSON,

@@ -24,7 +24,7 @@ from starlette.responses import PlainTextResponse
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from exsce_dsl import __version__
-from exsce_dsl.endpoint.evaluator import AnswerCut
+from exsce_dsl.errors import AnswerCut
 
 LOGGER = logging.getLogger("exsce_dsl.endpoint")
 WILDCARDS = ("0.0.0.0", "::", "")

@@ -13,6 +13,8 @@ from http import HTTPStatus
 
 from pyoxigraph import NamedNode
 
+from exsce_dsl.errors import RefusedRequest
+
 MAX_BODY = 256 * 1024 * 1024
 """The largest request body accepted with the update token (bytes): a write through the endpoint."""
 MAX_QUERY_BODY = 4 * 1024 * 1024
@@ -20,16 +22,6 @@ MAX_QUERY_BODY = 4 * 1024 * 1024
 
 Parameters = dict[str, list[str]]
 """A query string's or a form's parameters, each with every value given."""
-
-
-class RefusedRequest(Exception):
-    """A request answered with ``status`` and ``message`` (plain text) and these ``headers``."""
-
-    def __init__(self, status: HTTPStatus, message: str, headers: dict[str, str] | None = None) -> None:
-        super().__init__(message)
-        self.status = status
-        self.message = message
-        self.headers = headers or {}
 
 
 async def read_body(length: str | None, stream: AsyncIterator[bytes], cap: int) -> bytes:

@@ -42,8 +42,7 @@ from pyoxigraph import (
 )
 
 from exsce_dsl.endpoint.formats import DATASET_FORMATS, GRAPH_FORMATS, RESULT_FORMATS, negotiate
-from exsce_dsl.endpoint.protocol import RefusedRequest
-from exsce_dsl.errors import FederationRefused, StoreError
+from exsce_dsl.errors import FederationRefused, RefusedRequest, StoreError
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.federation import refuse_federation
 

@@ -17,8 +17,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from exsce_dsl.model.runs import run_name
+from exsce_dsl.runs.bags.formats import ROS1_BAG
 
-BAG, PROV, PARAMETERS = ".bag", ".prov.json", ".rosparams"
+BAG, PROV, PARAMETERS = ROS1_BAG.suffix, ".prov.json", ".rosparams"
 """The extensions of a run's files: its bag, its run-time PROV, its parameter-server dump."""
 
 

@@ -34,7 +34,7 @@ from pathlib import Path
 from typing import NamedTuple
 
 from exsce_dsl.derive.derive_scenario import DerivedSpec, add_derivation, derive_spec
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import ExsceError, IngestFailed
 from exsce_dsl.explore.cover import covering_derivations
 from exsce_dsl.explore.draw import Candidate, draw_derivations
 from exsce_dsl.explore.executors import Executor, bags_in
@@ -54,7 +54,7 @@ from exsce_dsl.model.campaign import (
 )
 from exsce_dsl.model.document import Specification
 from exsce_dsl.model.verdicts import Outcome, Verdict
-from exsce_dsl.oracles.judging import IngestFailed, verify_runs
+from exsce_dsl.oracles.judging import verify_runs
 from exsce_dsl.prov.campaign import compile_campaign, compile_shrinking, compile_trial
 from exsce_dsl.runs.ingest import ingest_bags, stored_bag_run_id
 from exsce_dsl.store.base import Store

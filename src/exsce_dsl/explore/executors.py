@@ -14,8 +14,9 @@ back bags, one per run; the campaign ingests and judges them.  Three kinds:
   scenarios on a live ROS 1 graph against exsce's stand-in robots, faults planted in them
   (:mod:`exsce_dsl.explore.ros1_executor`);
 - a plug-in: a package registers a factory under the entry-point group ``exsce.executors``
-  (called with no arguments, it returns an Executor), chosen by its name.  A built-in name is
-  looked up first: a plug-in of the same name is never chosen.
+  (called with no arguments, it returns an Executor), chosen by its name; the plug-ins are
+  read by :mod:`exsce_dsl.plugins` (a built-in is never replaced, a broken plug-in is left
+  out with a warning).
 
 A command and a plug-in run where the campaign runs, whether or not the campaign's bags are
 analysed on a cluster (``exscec explore --cluster``): exsce does not know what they need.
@@ -31,7 +32,6 @@ import subprocess
 from collections.abc import Callable, Sequence
 from contextlib import AbstractContextManager, nullcontext
 from dataclasses import dataclass
-from importlib.metadata import entry_points
 from pathlib import Path
 from typing import Protocol, runtime_checkable
 
@@ -39,13 +39,13 @@ from exsce_dsl.errors import ExsceError
 from exsce_dsl.execute.stand_in.session import DEFAULT_SPEED_UP
 from exsce_dsl.explore.ros1_executor import ros1_executor
 from exsce_dsl.model import Scenario
+from exsce_dsl.plugins import Registry
+from exsce_dsl.runs.bags.reading import is_bag
 from exsce_dsl.sim.faults import Fault
 from exsce_dsl.sim.run import simulate
 from exsce_dsl.suggest import did_you_mean
 
-ENTRY_POINT_GROUP = "exsce.executors"
 PLACEHOLDERS = ("scenario_file", "scenario", "runs", "seed", "out")
-BAG_SUFFIXES = (".bag", ".mcap", ".db3")
 
 
 @runtime_checkable
@@ -161,13 +161,9 @@ class CommandExecutor:
 
 
 def bags_in(folder: Path) -> list[Path]:
-    """The bags in ``folder``, by name: files of :data:`BAG_SUFFIXES` and rosbag2 folders (not
+    """The bags in ``folder``, by name: files of a bag reader's formats and rosbag2 folders (not
     the ``.prov.json`` or ``.rosparams`` beside them, nor a hidden folder of logs)."""
-    return sorted(p for p in folder.iterdir() if p.suffix in BAG_SUFFIXES or _is_rosbag2_folder(p))
-
-
-def _is_rosbag2_folder(path: Path) -> bool:
-    return path.is_dir() and (path / "metadata.yaml").is_file()
+    return sorted(p for p in folder.iterdir() if is_bag(p))
 
 
 @dataclass(frozen=True)
@@ -183,13 +179,15 @@ class ExecutorOptions:
 
 
 @dataclass(frozen=True)
-class BuiltInExecutor:
-    """An executor exsce ships, chosen by ``name``: ``start(options)`` gives it for a block
-    (what it runs on is started when the block begins and stopped when it ends)."""
+class NamedExecutor:
+    """An executor chosen by ``name`` (a built-in or a plug-in): ``start(options)`` gives it for a
+    block (what it runs on is started when the block begins and stopped when it ends);
+    ``takes_options``: it reads :class:`ExecutorOptions` (a plug-in takes none)."""
 
     name: str
     summary: str
     start: Callable[[ExecutorOptions], AbstractContextManager[Executor]]
+    takes_options: bool = True
 
 
 def _ros1(options: ExecutorOptions) -> AbstractContextManager[Executor]:
@@ -203,28 +201,56 @@ def _ros1(options: ExecutorOptions) -> AbstractContextManager[Executor]:
     )
 
 
-BUILT_IN_EXECUTORS: dict[str, BuiltInExecutor] = {
+BUILT_IN_EXECUTORS: dict[str, NamedExecutor] = {
     e.name: e
-    for e in (
-        BuiltInExecutor("ros1", "a live ROS 1 graph, exsce's stand-in robots serving the goals", _ros1),
-    )
+    for e in (NamedExecutor("ros1", "a live ROS 1 graph, exsce's stand-in robots serving the goals", _ros1),)
 }
-"""The executors chosen by name before the plug-ins."""
+"""The executors exsce ships, chosen by name."""
+
+
+def _plugin(name: str, loaded: object) -> NamedExecutor | None:
+    """A plug-in's factory as a named executor; what it makes is checked when it is chosen."""
+    if not callable(loaded):
+        return None
+    source = f"{getattr(loaded, '__module__', '?')}:{getattr(loaded, '__qualname__', loaded)}"
+    where = f"the executor plug-in '{name}' ({source})"
+    return NamedExecutor(name, "a plug-in", lambda _: nullcontext(_made(where, loaded)), takes_options=False)
+
+
+def _made(where: str, factory: Callable[[], object]) -> Executor:
+    try:
+        made = factory()
+    except Exception as error:  # a third party's package: say which, whatever went wrong
+        raise ExsceError(f"{where} cannot be made: {error!r}") from None
+    if not isinstance(made, Executor):
+        raise ExsceError(f"{where} did not give an Executor")
+    return made
+
+
+EXECUTORS: Registry[NamedExecutor] = Registry(
+    "executor", BUILT_IN_EXECUTORS.items(), _plugin, "an executor factory"
+)
+"""The executors chosen by name: the built-ins, then the plug-ins (:mod:`exsce_dsl.plugins`)."""
 
 
 def named_executor(name: str, options: ExecutorOptions | None = None) -> AbstractContextManager[Executor]:
     """The executor called ``name`` for a block: a built-in one, else a plug-in (which takes
     none of ``options``)."""
     options = options or ExecutorOptions()
-    if name in BUILT_IN_EXECUTORS:
-        return BUILT_IN_EXECUTORS[name].start(options)
-    if options != ExecutorOptions():
-        built_in = ", ".join(BUILT_IN_EXECUTORS)
+    known = EXECUTORS.entries()
+    if name not in known:
+        plugins = ", ".join(n for n in known if n not in BUILT_IN_EXECUTORS) or "none is installed"
+        raise ExsceError(
+            f"no executor '{name}'{did_you_mean(name, list(known))} "
+            f"(built in: {', '.join(BUILT_IN_EXECUTORS)}; plug-ins registered: {plugins})"
+        )
+    chosen = known[name]
+    if options != ExecutorOptions() and not chosen.takes_options:
         raise ExsceError(
             f"--fault, --stand-in, --start-master and --speed-up are for the built-in executors "
-            f"({built_in}), not the plug-in '{name}'"
+            f"({', '.join(BUILT_IN_EXECUTORS)}), not the plug-in '{name}'"
         )
-    return nullcontext(plugin_executor(name))
+    return chosen.start(options)
 
 
 def chosen_executor(
@@ -245,24 +271,3 @@ def chosen_executor(
     if name:
         return named_executor(name, options)
     return nullcontext(SimulatorExecutor.with_faults(options.faults, dask_address=dask_address))
-
-
-def plugin_executor(name: str) -> Executor:
-    """The executor a package registered under ``exsce.executors`` as ``name``."""
-    found = {point.name: point for point in entry_points(group=ENTRY_POINT_GROUP)}
-    if name not in found:
-        known = ", ".join(sorted(found)) or "none is installed"
-        built_in = ", ".join(BUILT_IN_EXECUTORS)
-        raise ExsceError(
-            f"no executor '{name}'{did_you_mean(name, [*BUILT_IN_EXECUTORS, *found])} "
-            f"(built in: {built_in}; plug-ins registered: {known})"
-        )
-    try:
-        made = found[name].load()()
-    except Exception as error:  # a third party's package: say which, whatever went wrong
-        raise ExsceError(
-            f"the executor plug-in '{name}' ({found[name].value}) cannot be loaded: {error!r}"
-        ) from None
-    if not isinstance(made, Executor):
-        raise ExsceError(f"the executor plug-in '{name}' ({found[name].value}) did not give an Executor")
-    return made

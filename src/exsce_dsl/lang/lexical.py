@@ -17,10 +17,6 @@ from exsce_dsl.lang.locations import LineIndex
 _TOKEN = re.compile(r'"(?:\\.|[^"\\])*"|//[^\n]*|/\*.*?\*/', re.DOTALL)
 
 
-def has_comments(text: str) -> bool:
-    return any(not m.group().startswith('"') for m in _TOKEN.finditer(text))
-
-
 @dataclass(frozen=True)
 class Comment:
     file: str

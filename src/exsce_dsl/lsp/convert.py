@@ -131,7 +131,3 @@ def lsp_diagnostic(diagnostic: Diagnostic, lines: TextLines) -> types.Diagnostic
         source="exsce",
         data={"hint": diagnostic.hint} if diagnostic.hint else None,
     )
-
-
-def lsp_location(loc: SourceLocation, lines: TextLines) -> types.Location:
-    return types.Location(uri_of(loc.file), lines.range(loc))

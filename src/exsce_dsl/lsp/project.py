@@ -240,10 +240,6 @@ class Project:
                 found.update(analysis.files)
         return found
 
-    def spec_of(self, path: str) -> Specification | None:
-        analysis = self.roots.get(path)
-        return analysis.spec if analysis is not None else None
-
 
 def _library_index() -> FileIndex:
     source = package_file("lang", "stdlib", "metrics.exsce")

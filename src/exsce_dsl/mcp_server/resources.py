@@ -25,7 +25,7 @@ from typing import Any
 
 import mcp_types as types
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import ExsceError, ResourceNotFound
 from exsce_dsl.mcp_server.access import Access
 from exsce_dsl.mcp_server.arguments import NAME, RUN_ID
 from exsce_dsl.mcp_server.store_tools import derivation_json, stored_run, stored_scenario
@@ -43,7 +43,7 @@ from exsce_dsl.store.queries import (
 )
 from exsce_dsl.store.queries.results import verdicts
 
-__all__ = ["SCHEME", "ResourceNotFound", "list_resources", "read_resource", "resource_templates"]
+__all__ = ["SCHEME", "list_resources", "read_resource", "resource_templates"]
 
 SCHEME = "exsce://"
 SCENARIOS = f"{SCHEME}scenarios"
@@ -53,10 +53,6 @@ PAGE = 500
 """Resources listed per page of ``resources/list``."""
 
 _URI = re.compile(r"exsce://(scenarios|runs)(?:/([^/]*))?")
-
-
-class ResourceNotFound(ExsceError):
-    """No resource has the URI asked for."""
 
 
 def scenario_uri(scenario: str) -> str:

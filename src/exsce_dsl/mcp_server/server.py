@@ -26,14 +26,13 @@ from mcp.shared.exceptions import MCPError
 from mcp_types import INTERNAL_ERROR, INVALID_PARAMS
 
 from exsce_dsl import __version__
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import ExsceError, ResourceNotFound
 from exsce_dsl.mcp_server.access import Access
 from exsce_dsl.mcp_server.answers import ToolEntry, tool_error, tool_result
 from exsce_dsl.mcp_server.arguments import checked_arguments
 from exsce_dsl.mcp_server.check_tool import check_tool
 from exsce_dsl.mcp_server.library_tools import library_tools
 from exsce_dsl.mcp_server.resources import (
-    ResourceNotFound,
     list_resources,
     read_resource,
     resource_templates,

@@ -12,7 +12,7 @@ and ROS 2 packages that rosbags ships (``std``, ``geometry``, ``nav``,
 from __future__ import annotations
 
 import functools
-from collections.abc import Iterable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -196,7 +196,3 @@ def parse_definition(text: str, msgtype: str, kind: str, source: Source) -> Mess
     catalogue = MessageCatalogue()
     catalogue.add(found, source)
     return catalogue
-
-
-def known_types(catalogues: Iterable[MessageCatalogue]) -> list[str]:
-    return sorted({name for c in catalogues for name in c.definitions})

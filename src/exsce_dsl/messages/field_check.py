@@ -15,7 +15,7 @@ element of another would be an array of arrays, which no metric reads.
 
 from __future__ import annotations
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import ExsceError, FieldProblem
 from exsce_dsl.model.messages import (
     FieldPath,
     Fields,
@@ -29,14 +29,6 @@ from exsce_dsl.model.messages import (
 )
 from exsce_dsl.model.metrics import MetricDefinition
 from exsce_dsl.suggest import did_you_mean
-
-
-class FieldProblem(Exception):
-    """What is wrong with a path (the caller knows where it is written)."""
-
-    def __init__(self, message: str) -> None:
-        super().__init__(message)
-        self.message = message
 
 
 def field_shape(tree: Fields, path: FieldPath, read: str, msgtype: str, text: bool = False) -> bool:

@@ -20,7 +20,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import ExsceError, NotEnoughRuns
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.acceptance import Acceptance, BasicRelation
 from exsce_dsl.model.oracles import Oracle
@@ -33,10 +33,6 @@ from exsce_dsl.store.base import Store
 
 PACKAGE = "exsce.metamorphic.relationships"
 """The package the method's YAML names for the built-in relations (kept for its format)."""
-
-
-class NotEnoughRuns(ExsceError):
-    """A baseline was asked for before the scenario had the runs its criteria require."""
 
 
 @dataclass(frozen=True)

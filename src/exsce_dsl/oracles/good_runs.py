@@ -22,7 +22,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import NoGoodRuns
 from exsce_dsl.lang import standard_metrics
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.coverage import CoverageGap, Shortfall
@@ -31,10 +31,6 @@ from exsce_dsl.store.queries import RunDefect, run_coverage, run_defects
 from exsce_dsl.store.queries import runs as stored_runs
 
 __all__ = ["GoodRuns", "NoGoodRuns", "good_runs"]
-
-
-class NoGoodRuns(ExsceError):
-    """Every stored run of a scenario was left out: there is nothing to learn from."""
 
 
 @dataclass(frozen=True)

@@ -14,7 +14,7 @@ from pathlib import Path
 
 from prov.model import ProvDocument
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import ExsceError, IngestFailed
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.coverage import CoverageGap, TopicRate
 from exsce_dsl.model.document import Specification
@@ -25,6 +25,7 @@ from exsce_dsl.oracles.good_runs import GoodRuns
 from exsce_dsl.oracles.verify import judge_runs
 from exsce_dsl.prov.oracle import compile_oracles
 from exsce_dsl.prov.verdicts import compile_verdicts
+from exsce_dsl.runs.bags.reading import names_a_bag
 from exsce_dsl.runs.ingest import ingest_bags
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.queries import oracles as stored_oracles
@@ -33,12 +34,7 @@ from exsce_dsl.store.queries import runs as stored_runs
 from exsce_dsl.store.queries.run_ids import names_a_prefix
 from exsce_dsl.store.writing import WriteReport, add_prov
 
-_BAG_SUFFIXES = (".bag", ".mcap", ".db3")
 """What a bag's name ends with: such a name that is not a file is a missing bag, not a run id."""
-
-
-class IngestFailed(ExsceError):
-    """A bag given to :func:`verify_runs` could not be ingested, so nothing was judged."""
 
 
 @dataclass(frozen=True)
@@ -123,7 +119,7 @@ def verify_runs(
     bags = [Path(r) for r in runs if isinstance(r, Path) or Path(r).exists()]
     given = [str(r) for r in runs if not (isinstance(r, Path) or Path(r).exists())]
     for text in given:
-        if not names_a_prefix(text) and ("/" in text or Path(text).suffix in _BAG_SUFFIXES):  # a path
+        if not names_a_prefix(text) and ("/" in text or names_a_bag(text)):  # a path
             raise ExsceError(f"no bag or bag folder {text} (nor is it a run id)")
     uuids = resolve_runs(store, given)  # prefixes and IRIs as well as whole uuids
     for result in ingest_bags(bags, scenario, store) if bags else []:

@@ -7,26 +7,24 @@ judgements (:func:`all_of`, :func:`any_of`) or aggregate a fleet's values
 (:func:`aggregate`).  What a derived scenario's metrics are expected to do comes from the
 stored runs (:mod:`exsce_dsl.derive.expect`), not from a table of transformations.
 
-Third-party packages add relations through the entry-point group ``exsce.relations``;
-a relation is never imported from a module name found in a data file.
+Third-party packages add relations through the entry-point group ``exsce.relations``
+(:mod:`exsce_dsl.plugins`); a relation is never imported from a module name found in a data file.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import functools
 import math
-import warnings
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from importlib.metadata import entry_points
 
 from exsce_dsl.errors import RelationError as RelationError
+from exsce_dsl.plugins import Registry
 from exsce_dsl.suggest import did_you_mean
 
 __all__ = [
-    "ENTRY_POINT_GROUP",
+    "RELATIONS",
     "Judgement",
     "Relation",
     "RelationError",
@@ -36,9 +34,6 @@ __all__ = [
     "relation",
     "relation_names",
 ]
-
-ENTRY_POINT_GROUP = "exsce.relations"
-
 
 @dataclass(frozen=True)
 class Judgement:
@@ -151,39 +146,27 @@ _BUILT_IN: Mapping[str, Relation] = {
 }
 
 
-@functools.lru_cache(maxsize=1)
-def _registry() -> Mapping[str, Relation]:
-    """The built-ins and the plug-ins' relations, read once; a plug-in that cannot be used is
-    left out with a warning, so that it does not stop every other oracle."""
-    found = dict(_BUILT_IN)
-    for point in entry_points(group=ENTRY_POINT_GROUP):
-        where = f"the plug-in relation '{point.name}' ({point.value})"
-        if point.name in _BUILT_IN:
-            warnings.warn(f"{where} cannot replace exsce's own '{point.name}'; ignored", stacklevel=3)
-            continue
-        try:
-            loaded = point.load()
-            made = loaded if isinstance(loaded, Relation) or not callable(loaded) else loaded()
-        except Exception as exc:  # a broken third-party package
-            warnings.warn(f"{where} cannot be loaded: {exc!r}; ignored", stacklevel=3)
-            continue
-        if not isinstance(made, Relation) or made.name != point.name:
-            warnings.warn(f"{where} is not a Relation named '{point.name}'; ignored", stacklevel=3)
-            continue
-        found[point.name] = made
-    return found
+def _accepted(name: str, loaded: object) -> Relation | None:
+    """A plug-in's relation: the object registered, or what calling it (a class) makes."""
+    made = loaded if isinstance(loaded, Relation) or not callable(loaded) else loaded()
+    return made if isinstance(made, Relation) and made.name == name else None
+
+
+RELATIONS: Registry[Relation] = Registry("relation", _BUILT_IN.items(), _accepted, "a Relation")
+"""The built-ins and the plug-ins' relations (:mod:`exsce_dsl.plugins`: a plug-in that cannot be
+used is left out with a warning, so that it does not stop every other oracle)."""
 
 
 def relation(name: str) -> Relation:
     """The relation called ``name``: a built-in one or a registered plug-in's."""
-    known = _registry()
+    known = RELATIONS.entries()
     if name not in known:
         raise RelationError(f"unknown relation '{name}'{did_you_mean(name, known)}")
     return known[name]
 
 
 def relation_names() -> tuple[str, ...]:
-    return tuple(sorted(_registry()))
+    return tuple(sorted(RELATIONS.entries()))
 
 
 def all_of(*judgements: Judgement) -> Judgement:

@@ -23,7 +23,8 @@ from exsce_dsl.messages.catalogue import standard_catalogue
 from exsce_dsl.messages.user import configured_user_catalogue
 from exsce_dsl.model.goals import action_names, actionlib_names
 from exsce_dsl.model.messages import standard_type
-from exsce_dsl.runs.bags.reading import bag_topics
+from exsce_dsl.runs.bags.formats import MCAP_FILE
+from exsce_dsl.runs.bags.reading import bag_formats, bag_topics
 from exsce_dsl.runs.bags.rosbags_fallback import typestore_for
 from exsce_dsl.runs.plausible_poses import bag_findings
 from exsce_dsl.runs.signals.clock_words import describe_clocks, log_time_is_dated
@@ -152,8 +153,8 @@ def _plausibility(path: Path, types: Mapping[str, str]) -> tuple[str, ...]:
 
 def _format(path: Path) -> str:
     if path.is_file():
-        return {".bag": "ROS 1", ".mcap": "MCAP"}.get(path.suffix, path.suffix)
-    return "ROS 2 (MCAP)" if any(path.glob("*.mcap")) else "ROS 2 (sqlite3)"
+        return next((f.name for f in bag_formats() if f.suffix == path.suffix), path.suffix)
+    return "ROS 2 (MCAP)" if any(path.glob(f"*{MCAP_FILE.suffix}")) else "ROS 2 (sqlite3)"
 
 
 def _read(

@@ -27,6 +27,7 @@ from exsce_dsl.model.conventions import Signals
 from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Run, run_name, run_uuid
 from exsce_dsl.parallel.dask_client import dask_map
 from exsce_dsl.prov.recorder import recorded_prov_json, recorded_run
+from exsce_dsl.runs.bags.formats import ROS1_BAG
 from exsce_dsl.sim.bag import write_bag
 from exsce_dsl.sim.conventions import convention_writer
 from exsce_dsl.sim.executor import Execution, Fault, GoalStatus, execute
@@ -172,7 +173,7 @@ def play_run(plan: RunPlan, index: int, grid: PlanningGrid | None = None) -> Sim
     grid = planning_grid(scenario) if grid is None else grid
     execution = execute(scenario, grid, run_seed, plan.faults)
     name = run_name(start, scenario.id, run_id)
-    bag_name = name + ".bag" if plan.fmt == "ros1" else name
+    bag_name = name + ROS1_BAG.suffix if plan.fmt == "ros1" else name
     partial = plan.out_dir / f".{name}.partial"  # the run's own: a retry clears what a killed try left
     _remove(partial)
     partial.mkdir(parents=True)

@@ -58,9 +58,6 @@ class GraphSet:
 
     graphs: Mapping[str, Sequence[Quad]]
 
-    def triple_count(self) -> int:
-        return sum(len(q) for q in self.graphs.values())
-
 
 Replace = bool | Set[str]
 """Which graphs a write empties first: all of them (True), none (False), or those named."""

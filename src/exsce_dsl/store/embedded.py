@@ -33,6 +33,7 @@ from pathlib import Path
 from pyoxigraph import BlankNode, NamedNode, Quad, QueryBoolean, QuerySolutions, RdfFormat
 from pyoxigraph import Store as OxStore
 
+from exsce_dsl.errors import StoreUnwritableError
 from exsce_dsl.store.base import (
     Bindings,
     GraphSet,
@@ -73,7 +74,7 @@ class EmbeddedStore(Store):
         elif self.path.exists() and not read_only:
             try:
                 self._open()
-            except (StoreLockedError, _UnwritableError):
+            except (StoreLockedError, StoreUnwritableError):
                 pass  # reads use a read-only view; writes say who holds the store, or why not
 
     # -- opening -------------------------------------------------------------
@@ -89,7 +90,7 @@ class EmbeddedStore(Store):
             )
         if self._unwritable is not None:
             said = f"cannot write to the store at {path}: {self._unwritable} (reading it works)"
-            raise _UnwritableError(said)
+            raise StoreUnwritableError(said)
         try:
             path.mkdir(parents=True, exist_ok=True)
             self._store = OxStore(str(path))
@@ -114,7 +115,7 @@ class EmbeddedStore(Store):
         if self.path is not None and self.path.exists():  # made since, or reopened after close()
             try:
                 return self._open()
-            except (StoreLockedError, _UnwritableError):
+            except (StoreLockedError, StoreUnwritableError):
                 return self._read_only_view()
         if self._empty is None:
             self._empty = OxStore()
@@ -159,7 +160,7 @@ class EmbeddedStore(Store):
             self._open()
         except StoreLockedError:
             return True
-        except _UnwritableError:
+        except StoreUnwritableError:
             return False  # read through a view; a write says why it cannot be
         return False
 
@@ -302,11 +303,6 @@ class EmbeddedStore(Store):
         self._store = None
         self._empty = None
         self._view = None
-
-
-class _UnwritableError(StoreError):
-    """The store folder can be read but not opened for writing (read-only mount, no permission,
-    full disk): reads use a read-only view, and a write raises this."""
 
 
 def _with_fresh_blank_nodes(graphs: GraphSet) -> list[Quad]:

@@ -22,9 +22,9 @@ from collections.abc import Collection, Iterator
 from dataclasses import dataclass
 from typing import Any
 
-from exsce_dsl.errors import FederationRefused
+from exsce_dsl.errors import FederationRefused, Unparsable
 
-__all__ = ["Federated", "Unparsable", "federated_targets", "refuse_federation"]
+__all__ = ["Federated", "federated_targets", "refuse_federation"]
 
 
 @dataclass(frozen=True)
@@ -47,10 +47,6 @@ class Federated:
 
 _ESCAPE = re.compile(r"\\u([0-9A-Fa-f]{4})|\\U([0-9A-Fa-f]{8})")
 _KEYWORD = re.compile(r"service|load", re.IGNORECASE)
-
-
-class Unparsable(Exception):
-    """The text does not parse as SPARQL 1.1 (it may still be Oxigraph's SPARQL)."""
 
 
 def federated_targets(text: str, *, update: bool = False) -> list[Federated]:

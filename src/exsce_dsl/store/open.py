@@ -36,7 +36,6 @@ from __future__ import annotations
 import os
 import threading
 import urllib.parse
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -44,14 +43,13 @@ from exsce_dsl.store.base import Store, StoreError
 from exsce_dsl.store.embedded import EmbeddedStore
 
 if TYPE_CHECKING:  # imported when a URL names an endpoint: urllib.request and http.client are slow
+    from exsce_dsl.store.flavours import Preset
     from exsce_dsl.store.remote import RemoteStore
 
 __all__ = [
     "DEFAULT_STORE",
-    "PRESETS",
     "STORE_ENV",
     "TOKEN_ENV",
-    "Preset",
     "StoreOpening",
     "open_store",
     "store_url",
@@ -61,28 +59,6 @@ DEFAULT_STORE = Path(".exsce") / "store"
 """The project's embedded store, relative to the current folder."""
 STORE_ENV = "EXSCE_STORE"
 TOKEN_ENV = "EXSCE_STORE_TOKEN"
-
-
-@dataclass(frozen=True)
-class Preset:
-    """Where an endpoint flavour puts its services, relative to the URL given."""
-
-    query: str
-    update: str
-    gsp: str | None = None
-    form: bool = False
-    strip: tuple[str, ...] = ()
-    """Endpoint suffixes to take off the URL given, to find the base."""
-
-
-PRESETS: dict[str, Preset] = {
-    "oxigraph": Preset("/query", "/update", "/store", strip=("/query", "/update", "/store")),
-    "exsce": Preset("/query", "/update", "/store", strip=("/query", "/update", "/sparql", "/store")),
-    "fuseki": Preset("/query", "/update", "/data", strip=("/query", "/sparql", "/update", "/data")),
-    "graphdb": Preset("", "/statements", "/rdf-graphs/service", strip=("/statements",)),
-    "virtuoso": Preset("/sparql", "/sparql", "/sparql-graph-crud", form=True, strip=("/sparql",)),
-    "neptune": Preset("/sparql", "/sparql", "/sparql/gsp/", form=True, strip=("/sparql",)),
-}
 
 
 def store_url(url: str | None = None) -> str:
@@ -103,12 +79,15 @@ def open_store(
         return EmbeddedStore(None)
     scheme, sep, rest = spec.partition("://")
     if sep and "+" in scheme:
+        from exsce_dsl.store.flavours import FLAVOURS, flavour_named
+
         flavour, _, protocol = scheme.partition("+")
-        preset = PRESETS.get(flavour.lower())
-        if preset is None:
-            known = ", ".join(f"{name}+http://..." for name in PRESETS)
+        named = flavour_named(flavour)
+        if named is None or named.preset is None:
+            presets = [f.name for f in FLAVOURS.entries().values() if f.preset is not None]
+            known = ", ".join(f"{name}+http://..." for name in presets)
             raise StoreError(f"unknown kind of store '{flavour}' in {spec!r}; known: {known}")
-        return _preset_store(preset, f"{protocol}://{rest}", token, timeout)
+        return _preset_store(named.preset, f"{protocol}://{rest}", token, timeout)
     if sep and scheme.lower() in ("http", "https"):
         return _endpoint_store(spec, token, timeout)
     if sep and scheme.lower() != "file":

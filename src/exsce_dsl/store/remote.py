@@ -11,13 +11,10 @@
   write bigger than the endpoint accepts fails, whole, with the endpoint's message.
 * Reading one graph: the Graph Store Protocol (``GET ?graph=``) when a GSP URL
   is known, else a ``CONSTRUCT``.
-* Virtuoso (known by its ``Server`` header) differs: it takes no blank nodes in
-  ``INSERT DATA`` (they are written as Skolem IRIs, SKOLEM, and read back as
-  blank nodes), commits each operation of a request on its own (a write that
-  replaces graphs drops them, then inserts), writes doubles with six digits in
-  its SPARQL results (SELECTs and graphs are read as Turtle,
-  :mod:`exsce_dsl.store.virtuoso`), and holds graphs of its own, which are left
-  out and never dropped.
+* What a kind of server does its own way is its flavour's record
+  (:mod:`exsce_dsl.store.flavours`, told by the ``Server`` header): blank nodes written as
+  Skolem IRIs (read back as blank nodes), answers read as Turtle where SPARQL JSON loses
+  digits (Virtuoso), graphs of the server's own, left out and never dropped.
 
 Authentication: a bearer token (``token``; ``exscec serve`` and
 token-protected gateways), or a user and password (HTTP Basic, sent with
@@ -49,8 +46,8 @@ from pyoxigraph import (
 
 from exsce_dsl import __version__
 from exsce_dsl.prov.identifiers import SKOLEM_BASE
-from exsce_dsl.store import virtuoso
 from exsce_dsl.store.base import Bindings, GraphSet, Replace, Rows, Store, StoreError
+from exsce_dsl.store.flavours import StoreFlavour, ask_columns, server_flavour
 from exsce_dsl.store.sparql import bind, graph_node, query_form, term_text, write_update
 
 RESULTS_JSON = "application/sparql-results+json"
@@ -58,12 +55,10 @@ FORM_QUERY_BYTES = 64 * 1024
 """Queries up to this size go URL-encoded (``query=``), which every SPARQL 1.1 endpoint takes
 (Virtuoso 7 never answers a query sent as an ``application/sparql-query`` body); larger ones
 go as a body, since web servers cap forms (Jetty, under Fuseki, at 200 kB)."""
-ASK_VIRTUOSO = "__ASK_RETVAL"
-"""Virtuoso answers ASK as a table with this one column: one row of 1 when true, none when false."""
 N_TRIPLES = "application/n-triples"
 SKOLEM = SKOLEM_BASE
-"""Where the IRIs that stand for blank nodes on Virtuoso begin (RDF 1.1 Concepts, 3.5): written
-in their place, read back as blank nodes."""
+"""Where the IRIs that stand for blank nodes begin (RDF 1.1 Concepts, 3.5), on a server whose
+flavour writes them in their place: read back as blank nodes."""
 
 
 class RemoteStore(Store):
@@ -201,17 +196,18 @@ class RemoteStore(Store):
     # -- Store ---------------------------------------------------------------
 
     def select(self, query: str, bindings: Bindings | None = None) -> Rows:
-        if self.is_virtuoso():  # exact doubles come in Turtle only (see exsce_dsl.store.virtuoso)
-            if query_form(query) != "SELECT":
-                raise StoreError("not a SELECT query")
-            body, _ = self._post_sparql(self.url, "query", bind(query, bindings), virtuoso.TURTLE)
-            rows = virtuoso.result_set_rows(body, self.label)
-            return Rows(rows.variables, tuple(tuple(_unskolemised(t) for t in row) for row in rows.rows))
-        return self._solutions(query, bindings, None)[0]
+        answers = self.flavour().answers
+        if answers is None:
+            return self._solutions(query, bindings, None)[0]
+        if query_form(query) != "SELECT":
+            raise StoreError("not a SELECT query")
+        body, _ = self._post_sparql(self.url, "query", bind(query, bindings), answers.media_type)
+        rows = answers.rows(body, self.label)
+        return Rows(rows.variables, tuple(tuple(_unskolemised(t) for t in row) for row in rows.rows))
 
     def select_first(self, query: str, most: int, bindings: Bindings | None = None) -> tuple[Rows, bool]:
-        """As the base's, but the solutions of the answer are turned into rows lazily."""
-        if self.is_virtuoso():
+        """As the base's, but SPARQL JSON's solutions are turned into rows lazily."""
+        if self.flavour().answers is not None:
             return super().select_first(query, most, bindings)
         return self._solutions(query, bindings, most)
 
@@ -220,7 +216,7 @@ class RemoteStore(Store):
         result = self._query(query, bindings)
         variables = tuple(v.value for v in result.variables) if isinstance(result, QuerySolutions) else ()
         if not isinstance(result, QuerySolutions) or (
-            variables == (ASK_VIRTUOSO,) and query_form(query) == "ASK"
+            len(variables) == 1 and variables[0] in ask_columns() and query_form(query) == "ASK"
         ):
             raise StoreError("not a SELECT query")
         taken = result if most is None else itertools.islice(result, most + 1)
@@ -231,7 +227,8 @@ class RemoteStore(Store):
 
     def ask(self, query: str, bindings: Bindings | None = None) -> bool:
         result = self._query(query, bindings)
-        if isinstance(result, QuerySolutions) and [v.value for v in result.variables] == [ASK_VIRTUOSO]:
+        columns = [v.value for v in result.variables] if isinstance(result, QuerySolutions) else []
+        if isinstance(result, QuerySolutions) and len(columns) == 1 and columns[0] in ask_columns():
             return any(row[0] is not None and row[0].value not in ("0", "false") for row in result)
         if not isinstance(result, QueryBoolean):
             raise StoreError("not an ASK query")
@@ -241,17 +238,15 @@ class RemoteStore(Store):
         self._post_sparql(self.update_url, "update", bind(update, bindings), None)
 
     def write(self, graphs: GraphSet, *, replace: Replace = False) -> None:
-        text = write_update(graphs, replace, skolem=SKOLEM if self.is_virtuoso() else None)
+        text = write_update(graphs, replace, skolem=self.flavour().skolem)
         if text:
             self._post_sparql(self.update_url, "update", text, None)
 
-    def is_virtuoso(self) -> bool:
-        """Whether the endpoint is Virtuoso (by its ``Server`` header), which takes no blank
-        nodes in ``INSERT DATA`` (see :func:`~exsce_dsl.store.sparql.write_update`) and holds
-        graphs of its own (:data:`~exsce_dsl.store.virtuoso.OWN_GRAPHS`)."""
+    def flavour(self) -> StoreFlavour:
+        """The server's flavour, told by its ``Server`` header (an empty ASK learns it first)."""
         if self._server is None:
             self.ask("ASK {}")
-        return "virtuoso" in (self._server or "").lower()
+        return server_flavour(self._server or "")
 
     def remove_graphs(self, names: Sequence[str]) -> None:
         if names:
@@ -265,29 +260,30 @@ class RemoteStore(Store):
         return {g: n for g, n in super().graph_sizes().items() if not self._servers_own(g)}
 
     def quads(self) -> list[Quad]:
-        if self.is_virtuoso():
+        flavour = self.flavour()
+        if flavour.answers is not None or flavour.own_graphs:  # graph by graph, the server's left out
             return [q for quads in self.graphs(sorted(self.graph_names())).values() for q in quads]
         return super().quads()
 
     def clear(self) -> None:
-        """Remove every graph; on Virtuoso, every graph but the server's own
-        (:data:`~exsce_dsl.store.virtuoso.OWN_GRAPHS`)."""
-        if self.is_virtuoso():
+        """Remove every graph but those the server keeps for itself (its flavour's ``own_graphs``)."""
+        if self.flavour().own_graphs:
             self.remove_graphs(sorted(self.graph_names()))
         else:
             super().clear()
 
     def _servers_own(self, graph: str) -> bool:
-        return self.is_virtuoso() and graph.startswith(virtuoso.OWN_GRAPHS)
+        return graph.startswith(self.flavour().own_graphs)
 
     def graph(self, name: str) -> list[Quad]:
         graph = graph_node(name)
-        if self.is_virtuoso():
+        answers = self.flavour().answers
+        if answers is not None:
             query = f"CONSTRUCT {{ ?s ?p ?o }} WHERE {{ GRAPH {term_text(graph)} {{ ?s ?p ?o }} }}"
-            body, _ = self._post_sparql(self.url, "query", query, virtuoso.TURTLE)
+            body, _ = self._post_sparql(self.url, "query", query, answers.media_type)
             return [
                 Quad(_unskolemised(s), p, _unskolemised(o), graph)
-                for s, p, o in virtuoso.graph_triples(body, self.label)
+                for s, p, o in answers.triples(body, self.label)
             ]
         if self.gsp_url is not None:
             separator = "&" if "?" in self.gsp_url else "?"
@@ -313,7 +309,7 @@ class RemoteStore(Store):
         found: dict[str, list[Quad]] = {name: [] for name in names}
         if not names:
             return found
-        if self.is_virtuoso():  # graph by graph, in Turtle (see exsce_dsl.store.virtuoso)
+        if self.flavour().answers is not None:  # graph by graph, read as the flavour reads them
             return {name: self.graph(name) for name in names}
         values = " ".join(term_text(graph_node(name)) for name in names)
         rows = self.select(f"SELECT ?g ?s ?p ?o WHERE {{ VALUES ?g {{ {values} }} GRAPH ?g {{ ?s ?p ?o }} }}")

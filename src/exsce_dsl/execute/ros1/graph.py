@@ -140,10 +140,6 @@ class Master:
         code, _, uri = answer
         return str(uri) if code == 1 else None
 
-    def topic_types(self) -> dict[str, str]:
-        """Topic → its type, for every topic published now."""
-        return dict(self._call("getTopicTypes"))
-
 
 @dataclass
 class StartedMaster:

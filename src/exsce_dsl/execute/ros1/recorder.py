@@ -31,6 +31,7 @@ from typing import Any
 
 from exsce_dsl.errors import RosGraphError
 from exsce_dsl.execute.ros1.graph import CALLER, INSTALL_HINT, Master, node_environment
+from exsce_dsl.runs.bags.formats import ROS1_BAG
 
 RECORD_PROGRAMS = (Path("/usr/lib/rosbag/record"), Path("/opt/ros/noetic/lib/rosbag/record"))
 """Where ``record`` is: Debian's ``rosbag`` package, ROS Noetic's."""
@@ -68,7 +69,7 @@ class Recorder:
                 f"rosbag record cannot subscribe to {', '.join(repr(t) for t in wrong)}: a topic it records "
                 "is an absolute ROS name (/ns/name: letters, digits and '_')"
             )
-        if bag_path.suffix != ".bag" or ":=" in str(bag_path):
+        if bag_path.suffix != ROS1_BAG.suffix or ":=" in str(bag_path):
             raise RosGraphError(f"rosbag record writes a file named *.bag without ':=', not {bag_path}")
         if not topics:
             raise RosGraphError("rosbag record was given no topic to record")

@@ -39,6 +39,7 @@ from types import TracebackType
 import yaml
 
 from exsce_dsl.errors import ExsceError, RosGraphError
+from exsce_dsl.runs.bags.formats import ROS2_METADATA
 
 STORAGE = "mcap"
 POSITIONAL_TOPICS = frozenset({"foxy", "galactic", "humble", "iron"})
@@ -155,7 +156,7 @@ class Ros2Recorder:
                 f"ros2 bag record did not close {self.output} within {STOP_WAIT:g} s"
             ) from None
         deadline = time.monotonic() + STOP_WAIT
-        while not (self.output / "metadata.yaml").exists():
+        while not (self.output / ROS2_METADATA).exists():
             if time.monotonic() > deadline:
                 raise RosGraphError(
                     f"ros2 bag record left no metadata.yaml in {self.output}: the bag is not closed"

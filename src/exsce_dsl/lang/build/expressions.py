@@ -16,9 +16,9 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from exsce_dsl.errors import SourceLocation
+from exsce_dsl.errors import FieldProblem, SourceLocation
 from exsce_dsl.lang.lexical import quantity_text
-from exsce_dsl.messages.field_check import FieldProblem, field_shape
+from exsce_dsl.messages.field_check import field_shape
 from exsce_dsl.model.conventions import METHOD_TOPICS
 from exsce_dsl.model.expressions import (
     AGGREGATES,

@@ -12,13 +12,13 @@ numbers.  The DSL cannot name topics yet, so a file whose topics are not the def
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 import yaml
 
-from exsce_dsl.errors import Diagnostic, ExportError, ImportFormatError, SourceLocation
+from exsce_dsl.errors import ExportError, ImportFormatError, OracleFileErrors, SourceLocation
 from exsce_dsl.lang.build.standard_metrics import known_metrics, metric_info
 from exsce_dsl.lang.format.acceptance import expectation_text
 from exsce_dsl.lang.yaml.located import YamlFile, YamlNode, child_node, node_location
@@ -58,19 +58,6 @@ _NUMBERS = {
 
 
 # -- import ---------------------------------------------------------------------------------
-
-
-class OracleFileErrors(ImportFormatError):
-    """Every problem found in one oracle file, reported together (first one as the message)."""
-
-    def __init__(self, problems: Sequence[ImportFormatError]) -> None:
-        found = sorted(problems, key=lambda p: p.location or SourceLocation("", 0, 0))
-        super().__init__(found[0].message, found[0].location)
-        self._diagnostics = tuple(d for p in found for d in p.diagnostics)
-
-    @property
-    def diagnostics(self) -> Sequence[Diagnostic]:
-        return self._diagnostics
 
 
 def is_oracle_yaml(path: Path) -> bool:

@@ -12,7 +12,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-from exsce_dsl.runs.bags.reader import UnsupportedBag
+from exsce_dsl.errors import UnsupportedBag
 
 Buffer = bytes | memoryview | mmap.mmap
 

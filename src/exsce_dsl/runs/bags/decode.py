@@ -42,8 +42,9 @@ from typing import Any
 import numpy as np
 
 from exsce_dsl.errors import DecodeError as DecodeError
+from exsce_dsl.errors import FieldProblem
 from exsce_dsl.messages.catalogue import ARRAY, BASE, SEQUENCE, MessageCatalogue
-from exsce_dsl.messages.field_check import FieldProblem, field_shape
+from exsce_dsl.messages.field_check import field_shape
 from exsce_dsl.model.messages import FieldPath, Index, canonical_type
 from exsce_dsl.monitor_kit.monitor_core import PRESENT
 from exsce_dsl.runs.bags.decode_walk import LENGTHS, UNVECTORISED, Request, Walker

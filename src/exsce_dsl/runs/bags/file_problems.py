@@ -1,16 +1,11 @@
-"""What is wrong with a bag file, in words: the error the file checks raise, and why a message
-definition the bag carries does not parse."""
+"""Why a message definition a bag carries does not parse, in words (the file checks raise
+:class:`~exsce_dsl.errors.FileProblem` with it)."""
 
 from __future__ import annotations
 
 from rosbags.typesys import TypesysError, get_types_from_idl, get_types_from_msg
 
 from exsce_dsl.runs.bags.mcap_index import IDL_SEPARATOR
-
-
-class FileProblem(Exception):
-    """What is wrong with one file, in words; :func:`~exsce_dsl.runs.bags.files.check_bag_file`
-    says which bag it is."""
 
 
 def unparsed(msgtype: str, definition: str, topics: list[str], encoding: str) -> str | None:

@@ -15,20 +15,14 @@ from __future__ import annotations
 
 import mmap
 import struct
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path, PurePath
 from typing import Any
 
-from exsce_dsl.errors import BagError, ExsceError
-from exsce_dsl.runs.bags.file_problems import FileProblem
-from exsce_dsl.runs.bags.mcap_file import check_mcap
-from exsce_dsl.runs.bags.mcap_index import MAGIC as MCAP_MAGIC
-from exsce_dsl.runs.bags.ros1 import MAGIC as ROS1_MAGIC
-from exsce_dsl.runs.bags.ros1_file import check_ros1
+from exsce_dsl.errors import BagError, ExsceError, FileProblem
+from exsce_dsl.runs.bags.formats import BUILT_IN_FORMATS, MCAP_FILE, ROS1_BAG, ROS2_METADATA, BagFormat
 from exsce_dsl.textfiles import read_text
-
-SQLITE_MAGIC = b"SQLite format 3\x00"
 
 
 @dataclass(frozen=True)
@@ -51,31 +45,31 @@ WHOLE_FILE = (
 """Whole-file compressions a bag may come in (a bag's own chunks are compressed inside it)."""
 
 
-def check_bag_file(path: Path) -> None:
+def check_bag_file(path: Path, formats: Sequence[BagFormat] = BUILT_IN_FORMATS) -> None:
     """Raise :class:`BagError` if ``path`` is not a bag exsce can read, saying why and what to do.
 
-    ``path`` is a ROS 1 bag (``.bag``), an MCAP file (``.mcap``), a ROS 2 sqlite3
-    file (``.db3``) or a ROS 2 bag folder.  Only headers, indexes and message
-    definitions are read, so the check costs little even for large bags.
+    ``path`` is a file of one of ``formats`` (a ROS 1 bag, an MCAP file, a ROS 2 sqlite3 file)
+    or a ROS 2 bag folder.  Only headers, indexes and message definitions are read, so the
+    check costs little even for large bags.
     """
     if not path.exists():
         raise BagError(f"{path}: no such bag")
     if not path.is_file() and not path.is_dir():
         raise BagError(f"{path}: not a bag: neither a file nor a folder")
-    if path.name == "metadata.yaml":
+    if path.name == ROS2_METADATA:
         raise BagError(f"{path}: the metadata of a ROS 2 bag, not the bag: give its folder, {path.parent}")
     try:
         if path.is_dir():
-            _check_ros2_folder(path)
+            _check_ros2_folder(path, formats)
         else:
-            _check_file(path)
+            _check_file(path, formats)
     except FileProblem as problem:
         raise BagError(f"{path}: {problem}") from None
     except OSError as exc:  # unreadable: permissions, a disk error
         raise BagError(f"{path}: cannot read the bag: {exc.strerror or exc}") from None
 
 
-def _check_file(path: Path) -> None:
+def _check_file(path: Path, formats: Sequence[BagFormat]) -> None:
     size = path.stat().st_size
     if size == 0:
         raise FileProblem("the file is empty (0 bytes): nothing was recorded into it")
@@ -84,21 +78,18 @@ def _check_file(path: Path) -> None:
     for compression in WHOLE_FILE:
         if head.startswith(compression.magic):
             raise FileProblem(_compressed(path, compression))
-    if head.startswith(ROS1_MAGIC):
-        _named(path, ".bag", "a ROS 1 bag")
-        _check_mapped(path, check_ros1)
-    elif head.startswith((b"#ROSRECORD V", b"#ROSBAG V")):
+    for format_ in formats:
+        if head.startswith(format_.magic):
+            _named(path, format_.suffix, format_.what)
+            if format_.check is not None:
+                _check_mapped(path, format_.check)
+            return
+    if head.startswith((b"#ROSRECORD V", b"#ROSBAG V")):
         raise FileProblem(_old_format(path, head))
-    elif head.startswith(MCAP_MAGIC):
-        _named(path, ".mcap", "an MCAP file")
-        _check_mapped(path, check_mcap)
-    elif head.startswith(SQLITE_MAGIC):
-        _named(path, ".db3", "a ROS 2 sqlite3 bag file")
-    else:
-        raise FileProblem(
-            "not a bag: a ROS 1 bag starts with '#ROSBAG V2.0', an MCAP file with MCAP's magic bytes, "
-            "and a ROS 2 bag is a folder holding metadata.yaml"
-        )
+    raise FileProblem(
+        "not a bag: a ROS 1 bag starts with '#ROSBAG V2.0', an MCAP file with MCAP's magic bytes, "
+        "and a ROS 2 bag is a folder holding metadata.yaml"
+    )
 
 
 def _named(path: Path, suffix: str, what: str) -> None:
@@ -124,9 +115,10 @@ def _compressed(path: Path, compression: Compression) -> str:
 def _old_format(path: Path, head: bytes) -> str:
     version = head.split(b"\n", 1)[0].rsplit(b"V", 1)[-1].decode("ascii", "replace")
     if head.startswith(b"#ROSRECORD V"):
+        fixed = path.with_suffix(".v2" + ROS1_BAG.suffix)
         return (
             f"a ROS bag of the old format {version} (ROS before 2010), which exsce does not read (only "
-            f"format 2.0); migrate it with ROS 1's `rosbag fix {path} {path.with_suffix('.v2.bag')}`, "
+            f"format 2.0); migrate it with ROS 1's `rosbag fix {path} {fixed}`, "
             "which writes format 2.0, and ingest the result"
         )
     return f"a ROS bag of format {version}; exsce reads ROS 1 bags of format 2.0 only"
@@ -141,8 +133,8 @@ def _check_mapped(path: Path, check: Callable[[mmap.mmap, Path], None]) -> None:
         raise FileProblem("the file is damaged: a record runs past its end (truncated?)") from None
 
 
-def _check_ros2_folder(folder: Path) -> None:
-    meta = folder / "metadata.yaml"
+def _check_ros2_folder(folder: Path, formats: Sequence[BagFormat]) -> None:
+    meta = folder / ROS2_METADATA
     if not meta.is_file() and not meta.exists():
         inside = sorted(p.name for p in folder.iterdir())
         if not inside:
@@ -150,19 +142,20 @@ def _check_ros2_folder(folder: Path) -> None:
                 f"{folder}: an empty folder, not a ROS 2 bag "
                 "(which holds metadata.yaml and its .db3 or .mcap files)"
             )
-        storage = [name for name in inside if name.endswith((".db3", ".mcap"))]
+        suffixes = tuple(f.suffix for f in formats if f.in_folder)
+        storage = [name for name in inside if name.endswith(suffixes)]
         if not storage:
             raise BagError(f"{folder}: not a bag: a folder without metadata.yaml, .db3 or .mcap files")
         raise BagError(
             f"{folder}: a ROS 2 bag folder without its metadata.yaml (was the recording killed?); rebuild "
             f"it with `ros2 bag reindex {folder}`"
-            + (f", or ingest {folder / storage[0]} itself" if storage[0].endswith(".mcap") else "")
+            + (f", or ingest {folder / storage[0]} itself" if storage[0].endswith(MCAP_FILE.suffix) else "")
         )
     import yaml  # here: only a ROS 2 bag folder needs it
 
     loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml's bounds its nesting (issue 46)
     try:
-        info = _bag_information(yaml.load(read_text(meta, "metadata.yaml"), Loader=loader))
+        info = _bag_information(yaml.load(read_text(meta, ROS2_METADATA), Loader=loader))
     except ExsceError as exc:
         raise BagError(f"{folder}: {exc.message}") from None
     except (yaml.YAMLError, RecursionError) as exc:
@@ -197,7 +190,7 @@ def _check_ros2_folder(folder: Path) -> None:
                 raise BagError(f"{folder}: {file.name}: the file is empty (0 bytes)")
             continue
         try:
-            _check_file(file)
+            _check_file(file, formats)
         except FileProblem as problem:
             raise BagError(f"{folder}: {file.name}: {problem}") from None
     if info.get("message_count") == 0:

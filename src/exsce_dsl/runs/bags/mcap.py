@@ -3,7 +3,7 @@
 :data:`MCAP` reads an ``.mcap`` file, or a ROS 2 bag folder whose ``metadata.yaml`` says
 ``storage_identifier: mcap``, over :mod:`exsce_dsl.runs.bags.mcap_index` (the file's
 summary, chunks and message indexes), and passes it to the next reader (rosbags') when that
-raises :class:`~exsce_dsl.runs.bags.reader.UnsupportedBag`.  A type's definition comes from
+raises :class:`~exsce_dsl.errors.UnsupportedBag`.  A type's definition comes from
 the channel's schema (``ros2msg`` or ``ros2idl``), else from the user's files, else from
 rosbags' standard typestores.
 """
@@ -16,13 +16,14 @@ from pathlib import Path
 
 import numpy as np
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import ExsceError, UnsupportedBag
 from exsce_dsl.messages.catalogue import MessageCatalogue, Source, parse_definition, standard_catalogue
 from exsce_dsl.runs.bags.chunk_batches import Messages
 from exsce_dsl.runs.bags.data import BagData, Check, Reduce, Wanted
+from exsce_dsl.runs.bags.formats import MCAP_FILE, ROS2_METADATA
 from exsce_dsl.runs.bags.mcap_index import IDL_SEPARATOR, Schema, definitions, read_channels, recorded_span
 from exsce_dsl.runs.bags.objects import deserialized, deserializer_for
-from exsce_dsl.runs.bags.reader import BagReader, UnsupportedBag
+from exsce_dsl.runs.bags.reader import BagReader
 from exsce_dsl.runs.bags.reading_base import IndexReading
 from exsce_dsl.textfiles import read_text
 
@@ -32,12 +33,12 @@ def mcap_files(path: Path) -> list[Path] | None:
     folder lists; None if it is not an MCAP bag the index reader can read (another storage, or
     files or messages compressed whole, which only rosbags reads)."""
     if path.is_file():
-        return [path] if path.suffix == ".mcap" else None
+        return [path] if path.suffix == MCAP_FILE.suffix else None
     import yaml  # here: only a ROS 2 bag folder needs it
 
     loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml's: ten times faster
     try:
-        text = read_text(path / "metadata.yaml", "metadata.yaml")  # bounded: never a FIFO's wait
+        text = read_text(path / ROS2_METADATA, ROS2_METADATA)  # bounded: never a FIFO's wait
         info = yaml.load(text, Loader=loader)["rosbag2_bagfile_information"]
         storage, mode = info.get("storage_identifier"), info.get("compression_mode") or ""
         files = [path / str(name) for name in info.get("relative_file_paths") or ()]
@@ -45,7 +46,7 @@ def mcap_files(path: Path) -> list[Path] | None:
         return None
     if storage != "mcap" or str(mode).lower() not in ("", "none") or not files:
         return None
-    if any(f.suffix != ".mcap" or not f.is_file() for f in files):
+    if any(f.suffix != MCAP_FILE.suffix or not f.is_file() for f in files):
         return None
     return files
 
@@ -118,8 +119,9 @@ def _read(
 
 MCAP = BagReader(
     "MCAP",
-    claims=lambda path: path.suffix == ".mcap" if path.is_file() else path.is_dir(),
+    claims=lambda path: path.suffix == MCAP_FILE.suffix if path.is_file() else path.is_dir(),
     read=_read,
+    formats=(MCAP_FILE,),
 )
 """MCAP bags (an ``.mcap`` file, or a ROS 2 bag folder of them), from the files' own index; their
 topics are listed by rosbags."""

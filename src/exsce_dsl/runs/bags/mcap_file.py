@@ -8,8 +8,10 @@ import mmap
 import struct
 from pathlib import Path
 
+from exsce_dsl.errors import FileProblem
 from exsce_dsl.runs.bags.buffers import u64
-from exsce_dsl.runs.bags.file_problems import FileProblem, unparsed
+from exsce_dsl.runs.bags.file_problems import unparsed
+from exsce_dsl.runs.bags.formats import MCAP_FILE
 from exsce_dsl.runs.bags.mcap_index import (
     DECOMPRESSORS,
     MAGIC,
@@ -62,7 +64,7 @@ def check_mcap(data: mmap.mmap, path: Path) -> None:
         raise FileProblem(
             "the MCAP file is truncated: it does not end with MCAP's closing magic bytes (a recording "
             "that was not closed, or an interrupted copy); copy it again, or "
-            + _RECOVER.format(file=path, out=f"{path.stem}.recovered.mcap")
+            + _RECOVER.format(file=path, out=f"{path.stem}.recovered{MCAP_FILE.suffix}")
         )
     at = len(MAGIC)
     if data[at] != OP_HEADER:

@@ -45,13 +45,13 @@ from pathlib import Path
 
 import numpy as np
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import CorruptBag, UnsupportedBag
 from exsce_dsl.runs.bags.buffers import mapped, release
 from exsce_dsl.runs.bags.chunk_batches import ChunkBatch, Decoder, Gathered, Messages
-from exsce_dsl.runs.bags.reader import UnsupportedBag
+from exsce_dsl.runs.bags.formats import MCAP_FILE
 from exsce_dsl.wording import counted
 
-MAGIC = b"\x89MCAP0\r\n"
+MAGIC = MCAP_FILE.magic
 OP_HEADER = 0x01
 OP_FOOTER = 0x02
 OP_SCHEMA = 0x03
@@ -85,10 +85,6 @@ SCHEMA_ENCODINGS = ("ros2msg", "ros2idl")
 """The schema encodings whose text the caller parses (``.msg`` and ``.idl`` forms, as rosbag2 writes).
 An empty schema, which rosbag2 writes when it has no definition, may say any encoding: the caller
 then finds the definition elsewhere."""
-
-
-class CorruptBag(ExsceError):
-    """Bytes that are not what the bag's own checksums say was recorded: no reader should read them."""
 
 
 @dataclass(frozen=True)

@@ -11,8 +11,8 @@ kept where there are several (:attr:`Series.publishers`, whose stamps are judged
 apart), and every topic's messages are put in time order.  Topics wanted as message objects (a
 navigation stack's few goals and statuses) are deserialized by rosbags.
 
-Each format has its reader (:mod:`~exsce_dsl.runs.bags.reader`), and :data:`READERS` lists
-them in the order they are tried.
+Each format has its reader (:mod:`~exsce_dsl.runs.bags.reader`), and :data:`BAG_READERS` holds
+them: exsce's, the plug-ins', rosbags' last (:func:`readers`, in the order they are tried).
 """
 
 from __future__ import annotations
@@ -21,7 +21,9 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from exsce_dsl.errors import BagError as BagError
+from exsce_dsl.errors import CorruptBag, UnsupportedBag
 from exsce_dsl.messages.catalogue import MessageTypeError
+from exsce_dsl.plugins import Registry
 from exsce_dsl.runs.bags.data import OBJECTS as OBJECTS
 from exsce_dsl.runs.bags.data import BagData as BagData
 from exsce_dsl.runs.bags.data import Check as Check
@@ -30,17 +32,46 @@ from exsce_dsl.runs.bags.data import Series as Series
 from exsce_dsl.runs.bags.data import Wanted as Wanted
 from exsce_dsl.runs.bags.decode import DecodeError
 from exsce_dsl.runs.bags.files import check_bag_file
+from exsce_dsl.runs.bags.formats import BagFormat, is_ros2_folder
 from exsce_dsl.runs.bags.mcap import MCAP
-from exsce_dsl.runs.bags.mcap_index import CorruptBag
 from exsce_dsl.runs.bags.names import BagTopics
 from exsce_dsl.runs.bags.objects import LazyMessage as LazyMessage
-from exsce_dsl.runs.bags.reader import BagReader, UnsupportedBag
+from exsce_dsl.runs.bags.reader import BagReader
 from exsce_dsl.runs.bags.ros1 import ROS1
 from exsce_dsl.runs.bags.rosbags_fallback import ROSBAGS
 
-READERS: tuple[BagReader, ...] = (ROS1, MCAP, ROSBAGS)
-"""The bag formats' readers, in the order they are tried: the first that claims a bag reads it,
-and one that raises :class:`UnsupportedBag` passes it on; rosbags', last, reads every bag."""
+
+def _accepted(name: str, loaded: object) -> BagReader | None:
+    made = loaded() if callable(loaded) and not isinstance(loaded, BagReader) else loaded
+    return made if isinstance(made, BagReader) and made.name == name else None
+
+
+BAG_READERS: Registry[BagReader] = Registry(
+    "bag reader", ((r.name, r) for r in (ROS1, MCAP, ROSBAGS)), _accepted, "a BagReader"
+)
+"""exsce's bag readers and the plug-ins' (:mod:`exsce_dsl.plugins`), by name."""
+
+
+def readers() -> tuple[BagReader, ...]:
+    """The readers in the order they are tried: the first that claims a bag reads it, and one
+    that raises :class:`UnsupportedBag` passes it on; rosbags', last, reads every bag."""
+    return (*(r for r in BAG_READERS.entries().values() if r is not ROSBAGS), ROSBAGS)
+
+
+def bag_formats() -> tuple[BagFormat, ...]:
+    """Every file format a reader reads, each once, in the readers' order."""
+    return tuple(dict.fromkeys(f for reader in readers() for f in reader.formats))
+
+
+def is_bag(path: Path) -> bool:
+    """Whether ``path`` is named as a bag is (a reader's format's suffix), or is a ROS 2 bag
+    folder; nothing is read but whether a folder holds a bag's metadata."""
+    return names_a_bag(str(path)) or is_ros2_folder(path)
+
+
+def names_a_bag(text: str) -> bool:
+    """Whether ``text``, a path not looked at, ends in a bag format's suffix."""
+    return Path(text).suffix in {f.suffix for f in bag_formats()}
 
 
 def read_bag(
@@ -60,7 +91,7 @@ def read_bag(
         raise BagError(f"{path}: no such bag")
     _check_once(path)
     try:
-        for reader in READERS:
+        for reader in readers():
             if reader.claims(path):
                 try:
                     return reader.read(path, wanted, reduce, check)
@@ -81,7 +112,7 @@ def bag_topics(path: Path) -> BagTopics:
     if not path.exists():
         raise BagError(f"{path}: no such bag")
     _check_once(path)
-    for reader in READERS:
+    for reader in readers():
         if reader.topics is not None and reader.claims(path):
             try:
                 return reader.topics(path)
@@ -94,12 +125,12 @@ def _check_once(path: Path) -> None:
     """:func:`~exsce_dsl.runs.bags.files.check_bag_file`, once per file as it is (ingest lists a
     bag's topics, then reads it: 80 ms a check on a 100 MB bag)."""
     if not path.is_file():
-        check_bag_file(path)
+        check_bag_file(path, bag_formats())
         return
     status = path.stat()
     key = (str(path.resolve()), status.st_size, status.st_mtime_ns)
     if key not in _CHECKED:
-        check_bag_file(path)
+        check_bag_file(path, bag_formats())
         _CHECKED.add(key)
 
 

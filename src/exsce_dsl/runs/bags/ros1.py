@@ -11,7 +11,7 @@ comes from the connection (the bag's own), else from the user's files, else
 from rosbags' ROS 1 typestore.
 
 Uncompressed, bz2 and lz4 chunks are read; anything unexpected raises
-:class:`~exsce_dsl.runs.bags.reader.UnsupportedBag` and :data:`ROS1` passes the
+:class:`~exsce_dsl.errors.UnsupportedBag` and :data:`ROS1` passes the
 bag to the next reader (rosbags').
 """
 
@@ -26,18 +26,20 @@ from pathlib import Path
 
 import numpy as np
 
+from exsce_dsl.errors import UnsupportedBag
 from exsce_dsl.messages.catalogue import MessageCatalogue, Source, parse_definition, standard_ros1_catalogue
 from exsce_dsl.model.messages import standard_type
 from exsce_dsl.runs.bags.buffers import Buffer, mapped, release
 from exsce_dsl.runs.bags.chunk_batches import ChunkBatch, Decoder, Gathered, Messages
 from exsce_dsl.runs.bags.data import BagData, Check, Reduce, Wanted
+from exsce_dsl.runs.bags.formats import ROS1_BAG
 from exsce_dsl.runs.bags.gather import gather_values
 from exsce_dsl.runs.bags.names import BagTopics
 from exsce_dsl.runs.bags.objects import deserialized, deserializer_for
-from exsce_dsl.runs.bags.reader import BagReader, UnsupportedBag
+from exsce_dsl.runs.bags.reader import BagReader
 from exsce_dsl.runs.bags.reading_base import IndexReading
 
-MAGIC = b"#ROSBAG V2.0\n"
+MAGIC = ROS1_BAG.magic
 OP_MSG, OP_BAG, OP_INDEX, OP_CHUNK, OP_CHUNK_INFO, OP_CONN = 0x02, 0x03, 0x04, 0x05, 0x06, 0x07
 
 
@@ -269,8 +271,9 @@ def _topics(path: Path) -> BagTopics:
 
 ROS1 = BagReader(
     "ROS 1",
-    claims=lambda path: path.is_file() and path.suffix == ".bag",
+    claims=lambda path: path.is_file() and path.suffix == ROS1_BAG.suffix,
     read=_read,
     topics=_topics,
+    formats=(ROS1_BAG,),
 )
 """ROS 1 bags (a ``.bag`` file), from the bag's own index."""

@@ -9,8 +9,9 @@ import struct
 from dataclasses import dataclass
 from pathlib import Path
 
+from exsce_dsl.errors import FileProblem
 from exsce_dsl.runs.bags.buffers import u32
-from exsce_dsl.runs.bags.file_problems import FileProblem, unparsed
+from exsce_dsl.runs.bags.file_problems import unparsed
 from exsce_dsl.runs.bags.ros1 import MAGIC, OP_BAG, OP_CHUNK, OP_CHUNK_INFO, OP_CONN, OP_INDEX, OP_MSG
 
 _OPS = {

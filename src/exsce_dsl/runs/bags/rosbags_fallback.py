@@ -23,6 +23,7 @@ from exsce_dsl.messages.catalogue import MessageCatalogue, MessageTypeError, Sou
 from exsce_dsl.messages.user import configured_user_catalogue
 from exsce_dsl.model.messages import canonical_type
 from exsce_dsl.runs.bags.data import OBJECTS, BagData, Check, Reduce, Wanted
+from exsce_dsl.runs.bags.formats import BUILT_IN_FORMATS, ROS1_BAG, SQLITE3_FILE
 from exsce_dsl.runs.bags.mcap import schema_catalogue
 from exsce_dsl.runs.bags.mcap_index import Schema
 from exsce_dsl.runs.bags.names import BagTopics
@@ -38,7 +39,7 @@ BLOCK = 4096
 def typestore_for(path: Path):  # type: ignore[no-untyped-def]
     from rosbags.typesys import Stores, get_typestore
 
-    ros2 = path.is_dir() or path.suffix in (".db3", ".mcap")
+    ros2 = path.is_dir() or path.suffix in {f.suffix for f in BUILT_IN_FORMATS if f.in_folder}
     return get_typestore(Stores.ROS2_HUMBLE if ros2 else Stores.ROS1_NOETIC)
 
 
@@ -143,7 +144,7 @@ def _blocks(messages: Iterator[tuple[Any, int, bytes]]) -> Iterator[tuple[list[i
 
 
 def _is_ros1(path: Path) -> bool:
-    return path.is_file() and path.suffix == ".bag"
+    return path.is_file() and path.suffix == ROS1_BAG.suffix
 
 
 def _topics(path: Path) -> BagTopics:
@@ -156,5 +157,7 @@ def _topics(path: Path) -> BagTopics:
         raise BagError(f"{path}: cannot read the bag: {type(exc).__name__}: {exc}") from None
 
 
-ROSBAGS = BagReader("rosbags", claims=lambda path: True, read=read_with_rosbags, topics=_topics)
+ROSBAGS = BagReader(
+    "rosbags", claims=lambda path: True, read=read_with_rosbags, topics=_topics, formats=(SQLITE3_FILE,)
+)
 """Every bag, by rosbags' readers: the last of the readers, which says what is broken."""

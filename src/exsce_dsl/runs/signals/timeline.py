@@ -258,10 +258,6 @@ class _Stamped:
     def simulated(self) -> bool:
         return float(np.nanmedian(self.stamps)) < SIMULATED_BEFORE <= float(np.median(self.log))
 
-    @property
-    def other_clock(self) -> bool:
-        return abs(self.offset) > SAME_CLOCK
-
     def coarse(self) -> str:
         """Why the stamps are coarser than the series' rate (empty: they are not): header stamps
         that stay the same while log time goes on, for more than :data:`COARSE_SHARE` of the
