@@ -28,7 +28,7 @@ def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
 LONGEST_FIRST = (
     "execute/test_live_loop.py",
     "cli/test_help_examples_runs.py",
-    "runs/test_timeline.py",
+    "runs/signals/test_timeline.py",
     "runs/test_ros1_graph.py",
     "cli/test_demo_remote.py",
     "explore/test_campaign.py",

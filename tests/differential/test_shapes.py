@@ -4,7 +4,7 @@ ROS 2 sqlite3 and MCAP, against the independent reference of tests/support/refer
 equal to 1e-6 where both compute, missing with a reason exactly where the reference has no
 value.
 
-The bags come from the builders of the tests that found each shape (tests/runs/test_tf_publishers,
+The bags come from the builders of the tests that found each shape (tests/runs/signals/test_tf_publishers,
 test_root_velocity, test_coarse_stamps, test_clock_words, test_whole_run_window, and
 tests/support/real_shapes), each with the specification of its test, and the user functions'
 metrics added where they apply.
@@ -22,19 +22,19 @@ import pytest
 from exsce_dsl.lang import load_spec
 from exsce_dsl.runs.analyse import analyse_bag
 
-from tests.runs.test_clock_words import SPEC as CLOCK_SPEC
-from tests.runs.test_clock_words import clock_bag
-from tests.runs.test_coarse_stamps import SPEC as COARSE_SPEC
-from tests.runs.test_coarse_stamps import _poses as coarse_poses
+from tests.runs.segments.test_whole_run_window import SPEC as EARLY_SPEC
+from tests.runs.segments.test_whole_run_window import _early_bag as early_bag
+from tests.runs.signals.test_clock_words import SPEC as CLOCK_SPEC
+from tests.runs.signals.test_clock_words import clock_bag
+from tests.runs.signals.test_coarse_stamps import SPEC as COARSE_SPEC
+from tests.runs.signals.test_coarse_stamps import _poses as coarse_poses
+from tests.runs.signals.test_root_velocity import SPEC as ROOTED_SPEC
+from tests.runs.signals.test_root_velocity import _messages as rooted_topics
+from tests.runs.signals.test_tf_publishers import SPEC as TF_SPEC
+from tests.runs.signals.test_tf_publishers import tf_bag
 from tests.runs.test_pose_plausibility import SPEC as PLAUSIBILITY_SPEC
 from tests.runs.test_pose_plausibility import _messages as plausibility_topics
-from tests.runs.test_root_velocity import SPEC as ROOTED_SPEC
-from tests.runs.test_root_velocity import _messages as rooted_topics
-from tests.runs.test_tf_publishers import SPEC as TF_SPEC
-from tests.runs.test_tf_publishers import tf_bag
 from tests.runs.test_turtlesim_path import SPEC as TURTLE_SPEC
-from tests.runs.test_whole_run_window import SPEC as EARLY_SPEC
-from tests.runs.test_whole_run_window import _early_bag as early_bag
 from tests.support.bag_factory import (
     LASER_SCAN,
     ODOMETRY,

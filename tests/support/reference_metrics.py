@@ -3,7 +3,7 @@
 exsce now computes the built-in metrics through monitors generated from the
 standard library (``lang/stdlib/metrics.exsce``); this hand-written path is
 kept here, outside the package, only so that tests can check the generated
-path gives the same values (tests/runs/test_generated_metrics.py).
+path gives the same values (tests/runs/metrics/test_generated_metrics.py).
 """
 
 from __future__ import annotations

@@ -31,7 +31,7 @@ from exsce_dsl.sim.run import simulate
 from tests.support.bag_factory import Topic, typestore_for, write_bag
 from tests.support.clock_bags import CLOCK, CLOCK_TYPE, restamp
 
-SPEC = Path(__file__).resolve().parents[2] / "examples" / "brsu_building_c" / "scenario_c.exsce"
+SPEC = Path(__file__).resolve().parents[3] / "examples" / "brsu_building_c" / "scenario_c.exsce"
 DURATIONS = {"task_duration", "mission_duration", "violation_duration"}
 
 
