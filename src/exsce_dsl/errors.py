@@ -47,6 +47,7 @@ __all__ = [
     "StoreConflictError",
     "StoreError",
     "StoreLockedError",
+    "StoreUnwritableError",
     "TfError",
     "TimeLimitError",
     "UnknownNameWarning",
