@@ -13,7 +13,6 @@ from dataclasses import replace
 import pytest
 
 from exsce_dsl.execute.dispatcher import dispatch
-from exsce_dsl.execute.kinematic import ABORT_AFTER, KinematicNavigator
 from exsce_dsl.execute.mission import schedule
 from exsce_dsl.execute.navigator import SimulatedClock
 from exsce_dsl.execute.outcomes import DEFAULT_POLICY, MissionStatus, Outcome, Policy
@@ -21,6 +20,7 @@ from exsce_dsl.lang import load_spec
 from exsce_dsl.maps.planning import planning_grid
 from exsce_dsl.model import MissionType
 
+from tests.support.kinematic_navigator import ABORT_AFTER, KinematicNavigator
 from tests.support.paths import EXAMPLES
 
 # environment.exsce, by hand

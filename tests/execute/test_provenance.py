@@ -18,7 +18,6 @@ from prov.model import ProvActivity, ProvDocument, ProvEnd, ProvStart
 from pyoxigraph import Literal, Quad
 
 from exsce_dsl.execute.dispatcher import dispatch
-from exsce_dsl.execute.kinematic import ABORT_AFTER, KinematicNavigator
 from exsce_dsl.execute.mission import schedule
 from exsce_dsl.execute.navigator import SimulatedClock
 from exsce_dsl.execute.outcomes import DEFAULT_POLICY, MissionStatus, Policy
@@ -30,6 +29,7 @@ from exsce_dsl.prov.run import compile_run
 from exsce_dsl.rdf import to_quads, validate
 from exsce_dsl.sim.run import simulate
 
+from tests.support.kinematic_navigator import ABORT_AFTER, KinematicNavigator
 from tests.support.paths import EXAMPLES
 
 # environment.exsce, by hand
