@@ -4,9 +4,9 @@ The mission core, without middleware: the mission as a schedule of navigation go
 (:mod:`.mission`, with the goal timeouts of the spec or a default from distance and speed
 limit), what a goal's outcome leads to (:mod:`.outcomes`), the dispatcher that drives a schedule
 through any :class:`~.navigator.Navigator` on a clock the caller gives (:mod:`.dispatcher`), the
-run-time PROV of a mission run (:mod:`.provenance`), what a run records (:mod:`.recording`) and
-its files under the method's names (:mod:`.run_files`), and a kinematic navigator on a simulated
-clock for tests (:mod:`.kinematic`).
+run-time PROV of a mission run (:mod:`.provenance`), what a run records (:mod:`.recording`)
+and its files under the method's names (:mod:`.run_files`).  The tests drive the dispatcher with
+a kinematic navigator on a simulated clock (``tests/support/kinematic_navigator.py``).
 
 Adapters: :mod:`.ros1` (rospy's Python runs exsce's nodes — the dispatcher's actionlib clients
 for move_base and the stand-in robot — and this process talks to them and to the master; the

@@ -1,7 +1,7 @@
 """What the dispatcher needs of a robot stack and of time: send goals, cancel them, learn outcomes.
 
-An adapter per middleware (ROS 1 actionlib, ROS 2 actions; not built yet) and the kinematic
-navigator of the tests (:mod:`.kinematic`) implement :class:`Navigator`.  Time comes from a
+An adapter per middleware (ROS 1 actionlib, ROS 2 actions) and the kinematic navigator of the
+tests (``tests/support/kinematic_navigator.py``) implement :class:`Navigator`.  Time comes from a
 :class:`Clock` the caller gives: the ROS clock (simulated time under ``/clock``) or
 :class:`SimulatedClock`, which only moves when a simulated navigator advances it.
 """
