@@ -8,13 +8,13 @@ and passed on.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 
 from prov.model import ProvDocument
 
 from exsce_dsl.derive.derive_scenario import DerivedSpec, StoredDerivation, add_derivation, derive_spec
-from exsce_dsl.derive.expect import SUMMED, ExpectedValue, expected_metric, learning_runs
+from exsce_dsl.derive.expect import RELATIVE_TOLERANCE, SUMMED, ExpectedValue, expected_metric, learning_runs
 from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.document import Specification
@@ -27,7 +27,6 @@ from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import SimulatedRun
 from exsce_dsl.sim.run import simulate as play
 from exsce_dsl.similarity.clustering import Clustering, cluster_stored
-from exsce_dsl.store import open as store_open
 from exsce_dsl.store.base import Store
 from exsce_dsl.transform.derivation import Request
 
@@ -52,10 +51,9 @@ def compile_prov(
     return serialize(document, format) if format is not None else document
 
 
-def open_store(url: str | None = None) -> Store:
-    """The store ``url`` names (default: ``$EXSCE_STORE``, else ``.exsce/store`` here); use it in a
-    ``with`` block, which closes it."""
-    return store_open.open_store(url)
+def prov_text(document: ProvDocument, format: str = "provn") -> str:
+    """A compiled PROV document as text in ``format`` (as :func:`compile_prov` gives it)."""
+    return serialize(document, format)
 
 
 def _scenario(spec: Specification | Scenario, scenario: str | None) -> Scenario:
@@ -72,16 +70,32 @@ def simulate(
     seed: int = 0,
     faults: Sequence[str] = (),
     convention: str | None = None,
+    cmd_vel_stamped: bool = False,
     dask_address: str | None = None,
 ) -> list[SimulatedRun]:
     """``exscec simulate``: play a scenario ``runs`` times with the kinematic executor, one bag per
     run in ``out_dir`` (``faults`` as on the command line: ``overspeed:tiago1``).  With ``dask_address``
     (a Dask scheduler's address) each run is a task on the cluster's workers, which write the bags
     into ``out_dir``: the same path on every worker (a shared filesystem); the same bytes as here."""
+    return list(
+        simulating(
+            spec, out_dir, runs, scenario=scenario, format=format, seed=seed, faults=faults,
+            convention=convention, cmd_vel_stamped=cmd_vel_stamped, dask_address=dask_address,
+        )
+    )  # fmt: skip
+
+
+def simulating(
+    spec: Specification | Scenario, out_dir: str | Path, runs: int = 1, *, scenario: str | None = None,
+    format: str = "ros1", seed: int = 0, faults: Sequence[str] = (), convention: str | None = None,
+    cmd_vel_stamped: bool = False, dask_address: str | None = None,
+) -> Iterator[SimulatedRun]:  # fmt: skip
+    """:func:`simulate`, each run given as soon as its bag is written (``exscec simulate`` says
+    each as it comes); ``cmd_vel_stamped``: nav2's and move_base's cmd_vel as TwistStamped."""
     chosen = _scenario(spec, scenario)
     parsed = tuple(Fault.parse(f) for f in faults)
-    return list(
-        play(chosen, Path(out_dir), runs, format, seed, parsed, convention, dask_address=dask_address)
+    return iter(
+        play(chosen, Path(out_dir), runs, format, seed, parsed, convention, cmd_vel_stamped, dask_address)
     )
 
 
@@ -134,21 +148,26 @@ def derive(
     scenario: str | None = None,
     target: str | Path | None = None,
     expect_from: Store | None = None,
+    tolerance: float = RELATIVE_TOLERANCE,
     include_all: bool = False,
+    source: str | Path | None = None,
 ) -> DerivedSpec:
     """``exscec derive``: a scenario of ``spec`` transformed by ``steps`` in order, e.g.
     ``[("remove_robot", {"robot": "tiago2", "reassign": "tiago1"})]``; the result's ``text`` is
     the new file (write it to ``result.target``).  With ``expect_from``, the file holds the
-    acceptance criteria the good stored runs imply (``exscec derive --expect``; ``include_all``:
-    every stored run, ``--all-runs``)."""
+    acceptance criteria the good stored runs imply (``exscec derive --expect``; ``tolerance``: how
+    far from the expected change a run may be, in percent of it; ``include_all``: every stored
+    run, ``--all-runs``); ``source``: the file ``spec`` was read from, as the user named it
+    (default: its root file)."""
     return derive_spec(
         spec,
-        spec.root,
+        spec.root if source is None else source,
         steps,
         new_id=new_id,
         scenario_id=scenario,
         target=target,
         expect_from=expect_from,
+        tolerance=tolerance,
         include_all=include_all,
     )
 
