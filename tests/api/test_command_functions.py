@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from exsce_dsl import api
-from exsce_dsl.errors import ExsceError, StoreError
+from exsce_dsl.errors import REPLACE_FILES, ExsceError, StoreError
 
 from tests.support.paths import EXAMPLES
 
@@ -141,6 +141,16 @@ def test_export_then_import_the_method_s_yaml(tmp_path: Path) -> None:
 def test_generate_writes_a_target_s_files(tmp_path: Path) -> None:
     paths = api.generate("dispatcher-config", SPEC, tmp_path / "out")
     assert paths and all(p.exists() and tmp_path / "out" in p.parents for p in paths)
+    assert api.generate("dispatcher-config", SPEC, tmp_path / "out", force=True) == paths
+
+
+def test_files_in_the_way_are_said_without_a_flag(tmp_path: Path) -> None:
+    """The library says what to do in words; only the command line names its option (--force)."""
+    api.generate("dispatcher-config", SPEC, tmp_path)
+    with pytest.raises(ExsceError) as refused:
+        api.generate("dispatcher-config", SPEC, tmp_path)
+    assert refused.value.remedy == REPLACE_FILES and "--" not in refused.value.message
+    assert refused.value.message.startswith("would overwrite ")
 
 
 def test_describe_bags_and_prov_text(project: tuple[Path, str, Path]) -> None:
