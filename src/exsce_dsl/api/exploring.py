@@ -38,11 +38,16 @@ class ExploreRequest:
     plugin: str | None = None
     """An executor by name: ``ros1``, or an ``exsce.executors`` plug-in."""
     stand_in: bool = False
+    """With ``plugin="ros1"``: exsce's stand-in robots serve the goals."""
     start_master: bool = False
     speed_up: float | None = None
     jobs: int = 1
+    """Bags analysed in parallel."""
     dask_address: str | None = None
+    """A Dask scheduler whose workers play the simulator's runs and analyse the bags (default:
+    ``$EXSCE_DASK_SCHEDULER``)."""
     output: str | None = None
+    """The campaign's folder (default: ``explore/<campaign id>``)."""
     junit: str | None = None
     """Also write the campaign as JUnit XML to this file."""
     store_url: str | None = None
@@ -162,16 +167,8 @@ def _executor(request: ExploreRequest) -> tuple[AbstractContextManager[Executor]
     given = ExecutorOptions(o.faults, o.stand_in, o.start_master, None, o.speed_up)
     chosen = chosen_executor(o.executor_command, o.plugin, given, address)
     campaign = CampaignOptions(
-        budget=o.budget,
-        seed=o.seed,
-        runs_per_scenario=o.runs_per_scenario,
-        max_steps=o.max_steps,
-        transformations=o.transformations,
-        strategy=o.strategy,
-        tolerance=o.tolerance,
-        shrink=not o.no_shrink,
-        stop_at_violation=o.stop_at_violation,
-        jobs=o.jobs,
-        dask_address=address,
-    )
+        budget=o.budget, seed=o.seed, runs_per_scenario=o.runs_per_scenario, max_steps=o.max_steps,
+        transformations=o.transformations, strategy=o.strategy, tolerance=o.tolerance,
+        shrink=not o.no_shrink, stop_at_violation=o.stop_at_violation, jobs=o.jobs, dask_address=address,
+    )  # fmt: skip
     return chosen, campaign
