@@ -138,6 +138,10 @@ def diagnostic_order(d: Diagnostic) -> tuple[str, int, int, int, str]:
 
 REPLACE_FILES = "ask to replace the files that exist"
 """The remedy of an error that would overwrite files (the command line says it with its option)."""
+MAKE_A_TOKEN = "give no token, and leave EXSCE_STORE_TOKEN unset, to have one made"
+"""The remedy of an update token too short to be a secret."""
+START_A_MASTER = "start roscore and export it, or ask for a roscore of the run's own"
+"""The remedy of a live run without a ROS master to talk to."""
 
 
 class ExsceError(Exception):

@@ -16,7 +16,14 @@ from typing import Any, TypeVar
 
 import click
 
-from exsce_dsl.errors import REPLACE_FILES, Diagnostic, ExsceError, ScenarioChoiceError
+from exsce_dsl.errors import (
+    MAKE_A_TOKEN,
+    REPLACE_FILES,
+    START_A_MASTER,
+    Diagnostic,
+    ExsceError,
+    ScenarioChoiceError,
+)
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -112,9 +119,13 @@ def _scenario_option() -> str:
     return spelt[0] if spelt else "--scenario"
 
 
-REMEDIES = {REPLACE_FILES: "use --force to replace"}
+REMEDIES = {
+    REPLACE_FILES: "{problem}; use --force to replace",
+    MAKE_A_TOKEN: "{problem} (leave --token and EXSCE_STORE_TOKEN unset to have one made)",
+    START_A_MASTER: "{problem}: start roscore and export it, or pass --start-master",
+}
 """Each remedy the library says in words (:attr:`ExsceError.remedy`), as the command line says it:
-with the option that does it."""
+with the option that does it, after the problem."""
 
 
 def _with_options(exc: ExsceError) -> ExsceError:
@@ -123,7 +134,7 @@ def _with_options(exc: ExsceError) -> ExsceError:
     if said is None:
         return exc
     worded = copy.copy(exc)
-    worded.message = f"{exc.problem}; {said}"
+    worded.message = said.format(problem=exc.problem)
     return worded
 
 
