@@ -1,44 +1,47 @@
 """The ``exscec`` commands as Python functions, with typed results.
 
 Each function is what the command of the same name does, minus the printing: the CLI is a thin
-layer over the same library calls.  Functions that read or write runs take the store first (open
-one with :func:`open_store`, a context manager); specifications are loaded once with :func:`load`
-and passed on.
+layer over the same library calls.  Each imports what it needs when called, so that a command
+pays only for its own (``exscec verify`` does not import SciPy for ``cluster``).  Functions that
+read or write runs take the store first (open one with :func:`open_store`, a context manager);
+specifications are loaded once with :func:`load` and passed on.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from prov.model import ProvDocument
-
-from exsce_dsl.derive.derive_scenario import DerivedSpec, StoredDerivation, add_derivation, derive_spec
-from exsce_dsl.derive.expect import RELATIVE_TOLERANCE, SUMMED, ExpectedValue, expected_metric, learning_runs
-from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.document import Specification
-from exsce_dsl.oracles.judging import Baseline, Verification, build_baseline, verify_runs
-from exsce_dsl.prov.spec import compile_spec_scenario
-from exsce_dsl.rdf import serialize
-from exsce_dsl.rdf.spec_check import SpecCheck, check_spec
-from exsce_dsl.runs.ingest import IngestResult, ingest_bags
-from exsce_dsl.sim.executor import Fault
-from exsce_dsl.sim.run import SimulatedRun
-from exsce_dsl.sim.run import simulate as play
-from exsce_dsl.similarity.clustering import Clustering, cluster_stored
-from exsce_dsl.store.base import Store
-from exsce_dsl.transform.derivation import Request
+
+if TYPE_CHECKING:
+    from prov.model import ProvDocument
+
+    from exsce_dsl.derive.derive_scenario import DerivedSpec, StoredDerivation
+    from exsce_dsl.derive.expect import ExpectedValue
+    from exsce_dsl.oracles.judging import Baseline, Verification
+    from exsce_dsl.rdf.spec_check import SpecCheck
+    from exsce_dsl.runs.ingest import IngestResult
+    from exsce_dsl.sim.run import SimulatedRun
+    from exsce_dsl.similarity.clustering import Clustering
+    from exsce_dsl.store.base import Store
+    from exsce_dsl.transform.derivation import Request
 
 
 def load(path: str | Path) -> Specification:
     """Parse, resolve and check a specification (its imports too); a :class:`SpecError` lists
     every error found."""
+    from exsce_dsl.lang import load_spec
+
     return load_spec(path)
 
 
 def check(path: str | Path) -> SpecCheck:
     """``exscec check``: every diagnostic of the language's checks, then of the SHACL shapes."""
+    from exsce_dsl.rdf.spec_check import check_spec
+
     return check_spec(path)
 
 
@@ -47,12 +50,17 @@ def compile_prov(
 ) -> ProvDocument | str:
     """``exscec compile``: the PROV of a scenario (and of its generation, when derived); as text in
     ``format`` (``provn``, ``json``, ``xml``, ``ttl``, ``trig``, ``nq``, ``jsonld``) when given."""
+    from exsce_dsl.prov.spec import compile_spec_scenario
+    from exsce_dsl.rdf import serialize
+
     document = compile_spec_scenario(spec, scenario)
     return serialize(document, format) if format is not None else document
 
 
 def prov_text(document: ProvDocument, format: str = "provn") -> str:
     """A compiled PROV document as text in ``format`` (as :func:`compile_prov` gives it)."""
+    from exsce_dsl.rdf import serialize
+
     return serialize(document, format)
 
 
@@ -92,6 +100,9 @@ def simulating(
 ) -> Iterator[SimulatedRun]:  # fmt: skip
     """:func:`simulate`, each run given as soon as its bag is written (``exscec simulate`` says
     each as it comes); ``cmd_vel_stamped``: nav2's and move_base's cmd_vel as TwistStamped."""
+    from exsce_dsl.sim.executor import Fault
+    from exsce_dsl.sim.run import simulate as play
+
     chosen = _scenario(spec, scenario)
     parsed = tuple(Fault.parse(f) for f in faults)
     return iter(
@@ -109,6 +120,8 @@ def ingest(
     With ``replace``, a bag already stored as a run of the scenario is analysed again and its run
     replaced in one transaction (its verdicts dropped), as ``exscec ingest --replace``;
     ``strict``: a bag whose run would lack a metric value fails (``exscec ingest --strict``)."""
+    from exsce_dsl.runs.ingest import ingest_bags
+
     chosen = _scenario(spec, scenario)
     return ingest_bags(
         [Path(b) for b in bags],
@@ -127,6 +140,8 @@ def baseline(
     """``exscec baseline``: the oracles of a scenario from its acceptance criteria and its good
     stored runs (``include_all``: every run, ``--all-runs``); ``result.runs`` says which runs were
     used and why the others were left out."""
+    from exsce_dsl.oracles.judging import build_baseline
+
     return build_baseline(store, spec, scenario, include_all=include_all)
 
 
@@ -137,6 +152,8 @@ def verify(
     """``exscec verify``: judge runs (stored uuids or unique prefixes of them, or bags, ingested
     first) against every oracle
     of their scenario; the verdicts go to the store unless ``record`` is False."""
+    from exsce_dsl.oracles.judging import verify_runs
+
     return verify_runs(store, _scenario(spec, scenario), runs, record=record)
 
 
@@ -148,7 +165,7 @@ def derive(
     scenario: str | None = None,
     target: str | Path | None = None,
     expect_from: Store | None = None,
-    tolerance: float = RELATIVE_TOLERANCE,
+    tolerance: float | None = None,
     include_all: bool = False,
     source: str | Path | None = None,
 ) -> DerivedSpec:
@@ -156,9 +173,12 @@ def derive(
     ``[("remove_robot", {"robot": "tiago2", "reassign": "tiago1"})]``; the result's ``text`` is
     the new file (write it to ``result.target``).  With ``expect_from``, the file holds the
     acceptance criteria the good stored runs imply (``exscec derive --expect``; ``tolerance``: how
-    far from the expected change a run may be, in percent of it; ``include_all``: every stored
-    run, ``--all-runs``); ``source``: the file ``spec`` was read from, as the user named it
-    (default: its root file)."""
+    far from the expected change a run may be, in percent of it, default 10; ``include_all``:
+    every stored run, ``--all-runs``); ``source``: the file ``spec`` was read from, as the user
+    named it (default: its root file)."""
+    from exsce_dsl.derive.derive_scenario import derive_spec
+    from exsce_dsl.derive.expect import RELATIVE_TOLERANCE
+
     return derive_spec(
         spec,
         spec.root if source is None else source,
@@ -167,7 +187,7 @@ def derive(
         scenario_id=scenario,
         target=target,
         expect_from=expect_from,
-        tolerance=tolerance,
+        tolerance=RELATIVE_TOLERANCE if tolerance is None else tolerance,
         include_all=include_all,
     )
 
@@ -175,6 +195,8 @@ def derive(
 def add_derived(store: Store, derived: DerivedSpec, *, include_all: bool = False) -> StoredDerivation:
     """``exscec derive --add-to-store``: the derived scenario, its generation and its oracles
     (from the base's good runs; ``include_all``: every run)."""
+    from exsce_dsl.derive.derive_scenario import add_derivation
+
     return add_derivation(store, derived, include_all=include_all)
 
 
@@ -183,6 +205,8 @@ def expect(
 ) -> list[ExpectedValue]:
     """``exscec expect``: each robot's expected distance travelled and task duration, and the path
     segments each value comes from, from the good stored runs (``include_all``: every run)."""
+    from exsce_dsl.derive.expect import SUMMED, expected_metric, learning_runs
+
     chosen = _scenario(spec, scenario)
     runs = learning_runs(store, include_all)
     return [
@@ -202,4 +226,6 @@ def cluster(
     weights: Mapping[str, float] | None = None,
 ) -> Clustering:
     """``exscec cluster``: stored scenarios clustered by the method's distances."""
+    from exsce_dsl.similarity.clustering import cluster_stored
+
     return cluster_stored(store, scenarios, method, k, threshold, weights)
