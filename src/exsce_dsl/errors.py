@@ -138,13 +138,30 @@ def diagnostic_order(d: Diagnostic) -> tuple[str, int, int, int, str]:
     return (*where, d.severity.rank, d.message)
 
 
-class ExsceError(Exception):
-    """Base of every error exsce raises on purpose."""
+REPLACE_FILES = "ask to replace the files that exist"
+"""The remedy of an error that would overwrite files (the command line says it with its option)."""
+MAKE_A_TOKEN = "give no token, and leave EXSCE_STORE_TOKEN unset, to have one made"
+"""The remedy of an update token too short to be a secret."""
+START_A_MASTER = "start roscore and export it, or ask for a roscore of the run's own"
+"""The remedy of a live run without a ROS master to talk to."""
 
-    def __init__(self, message: str, location: SourceLocation | None = None) -> None:
-        super().__init__(message)
-        self.message = message
+
+class ExsceError(Exception):
+    """Base of every error exsce raises on purpose.
+
+    ``remedy``: what the user can do about it, in words, after the problem in the message; the
+    library never names an option of the command line, which says a remedy such as
+    :data:`REPLACE_FILES` with its own option (``use --force to replace``)."""
+
+    def __init__(
+        self, message: str, location: SourceLocation | None = None, *, remedy: str | None = None
+    ) -> None:
+        said = f"{message}; {remedy}" if remedy else message
+        super().__init__(said)
+        self.message = said
         self.location = location
+        self.problem = message
+        self.remedy = remedy
 
     @property
     def diagnostics(self) -> Sequence[Diagnostic]:

@@ -565,7 +565,7 @@ def test_exscec_sparql_reads_a_query_from_a_file(store_folder: Path, tmp_path: P
 def test_csv_answers_end_lines_with_crlf_and_quote_as_rfc_4180() -> None:
     from pyoxigraph import Literal, NamedNode
 
-    from exsce_dsl.cli.query_commands import results_csv
+    from exsce_dsl.api import results_csv
     from exsce_dsl.store.base import Rows
 
     rows = Rows(("a", "b"), ((Literal('say "hi", twice'), NamedNode("http://x/y")), (None, Literal("1"))))

@@ -1,45 +1,47 @@
 """The ``exscec`` commands as Python functions, with typed results.
 
 Each function is what the command of the same name does, minus the printing: the CLI is a thin
-layer over the same library calls.  Functions that read or write runs take the store first (open
-one with :func:`open_store`, a context manager); specifications are loaded once with :func:`load`
-and passed on.
+layer over the same library calls.  Each imports what it needs when called, so that a command
+pays only for its own (``exscec verify`` does not import SciPy for ``cluster``).  Functions that
+read or write runs take the store first (open one with :func:`open_store`, a context manager);
+specifications are loaded once with :func:`load` and passed on.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from prov.model import ProvDocument
-
-from exsce_dsl.derive.derive_scenario import DerivedSpec, StoredDerivation, add_derivation, derive_spec
-from exsce_dsl.derive.expect import SUMMED, ExpectedValue, expected_metric, learning_runs
-from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.document import Specification
-from exsce_dsl.oracles.judging import Baseline, Verification, build_baseline, verify_runs
-from exsce_dsl.prov.spec import compile_spec_scenario
-from exsce_dsl.rdf import serialize
-from exsce_dsl.rdf.spec_check import SpecCheck, check_spec
-from exsce_dsl.runs.ingest import IngestResult, ingest_bags
-from exsce_dsl.sim.executor import Fault
-from exsce_dsl.sim.run import SimulatedRun
-from exsce_dsl.sim.run import simulate as play
-from exsce_dsl.similarity.clustering import Clustering, cluster_stored
-from exsce_dsl.store import open as store_open
-from exsce_dsl.store.base import Store
-from exsce_dsl.transform.derivation import Request
+
+if TYPE_CHECKING:
+    from prov.model import ProvDocument
+
+    from exsce_dsl.derive.derive_scenario import DerivedSpec, StoredDerivation
+    from exsce_dsl.derive.expect import ExpectedValue
+    from exsce_dsl.oracles.judging import Baseline, Verification
+    from exsce_dsl.rdf.spec_check import SpecCheck
+    from exsce_dsl.runs.ingest import IngestResult
+    from exsce_dsl.sim.run import SimulatedRun
+    from exsce_dsl.similarity.clustering import Clustering
+    from exsce_dsl.store.base import Store
+    from exsce_dsl.transform.derivation import Request
 
 
 def load(path: str | Path) -> Specification:
     """Parse, resolve and check a specification (its imports too); a :class:`SpecError` lists
     every error found."""
+    from exsce_dsl.lang import load_spec
+
     return load_spec(path)
 
 
 def check(path: str | Path) -> SpecCheck:
     """``exscec check``: every diagnostic of the language's checks, then of the SHACL shapes."""
+    from exsce_dsl.rdf.spec_check import check_spec
+
     return check_spec(path)
 
 
@@ -48,14 +50,18 @@ def compile_prov(
 ) -> ProvDocument | str:
     """``exscec compile``: the PROV of a scenario (and of its generation, when derived); as text in
     ``format`` (``provn``, ``json``, ``xml``, ``ttl``, ``trig``, ``nq``, ``jsonld``) when given."""
+    from exsce_dsl.prov.spec import compile_spec_scenario
+    from exsce_dsl.rdf import serialize
+
     document = compile_spec_scenario(spec, scenario)
     return serialize(document, format) if format is not None else document
 
 
-def open_store(url: str | None = None) -> Store:
-    """The store ``url`` names (default: ``$EXSCE_STORE``, else ``.exsce/store`` here); use it in a
-    ``with`` block, which closes it."""
-    return store_open.open_store(url)
+def prov_text(document: ProvDocument, format: str = "provn") -> str:
+    """A compiled PROV document as text in ``format`` (as :func:`compile_prov` gives it)."""
+    from exsce_dsl.rdf import serialize
+
+    return serialize(document, format)
 
 
 def _scenario(spec: Specification | Scenario, scenario: str | None) -> Scenario:
@@ -72,16 +78,35 @@ def simulate(
     seed: int = 0,
     faults: Sequence[str] = (),
     convention: str | None = None,
+    cmd_vel_stamped: bool = False,
     dask_address: str | None = None,
 ) -> list[SimulatedRun]:
     """``exscec simulate``: play a scenario ``runs`` times with the kinematic executor, one bag per
     run in ``out_dir`` (``faults`` as on the command line: ``overspeed:tiago1``).  With ``dask_address``
     (a Dask scheduler's address) each run is a task on the cluster's workers, which write the bags
     into ``out_dir``: the same path on every worker (a shared filesystem); the same bytes as here."""
+    return list(
+        simulating(
+            spec, out_dir, runs, scenario=scenario, format=format, seed=seed, faults=faults,
+            convention=convention, cmd_vel_stamped=cmd_vel_stamped, dask_address=dask_address,
+        )
+    )  # fmt: skip
+
+
+def simulating(
+    spec: Specification | Scenario, out_dir: str | Path, runs: int = 1, *, scenario: str | None = None,
+    format: str = "ros1", seed: int = 0, faults: Sequence[str] = (), convention: str | None = None,
+    cmd_vel_stamped: bool = False, dask_address: str | None = None,
+) -> Iterator[SimulatedRun]:  # fmt: skip
+    """:func:`simulate`, each run given as soon as its bag is written (``exscec simulate`` says
+    each as it comes); ``cmd_vel_stamped``: nav2's and move_base's cmd_vel as TwistStamped."""
+    from exsce_dsl.sim.executor import Fault
+    from exsce_dsl.sim.run import simulate as play
+
     chosen = _scenario(spec, scenario)
     parsed = tuple(Fault.parse(f) for f in faults)
-    return list(
-        play(chosen, Path(out_dir), runs, format, seed, parsed, convention, dask_address=dask_address)
+    return iter(
+        play(chosen, Path(out_dir), runs, format, seed, parsed, convention, cmd_vel_stamped, dask_address)
     )
 
 
@@ -95,6 +120,8 @@ def ingest(
     With ``replace``, a bag already stored as a run of the scenario is analysed again and its run
     replaced in one transaction (its verdicts dropped), as ``exscec ingest --replace``;
     ``strict``: a bag whose run would lack a metric value fails (``exscec ingest --strict``)."""
+    from exsce_dsl.runs.ingest import ingest_bags
+
     chosen = _scenario(spec, scenario)
     return ingest_bags(
         [Path(b) for b in bags],
@@ -113,6 +140,8 @@ def baseline(
     """``exscec baseline``: the oracles of a scenario from its acceptance criteria and its good
     stored runs (``include_all``: every run, ``--all-runs``); ``result.runs`` says which runs were
     used and why the others were left out."""
+    from exsce_dsl.oracles.judging import build_baseline
+
     return build_baseline(store, spec, scenario, include_all=include_all)
 
 
@@ -123,6 +152,8 @@ def verify(
     """``exscec verify``: judge runs (stored uuids or unique prefixes of them, or bags, ingested
     first) against every oracle
     of their scenario; the verdicts go to the store unless ``record`` is False."""
+    from exsce_dsl.oracles.judging import verify_runs
+
     return verify_runs(store, _scenario(spec, scenario), runs, record=record)
 
 
@@ -134,21 +165,29 @@ def derive(
     scenario: str | None = None,
     target: str | Path | None = None,
     expect_from: Store | None = None,
+    tolerance: float | None = None,
     include_all: bool = False,
+    source: str | Path | None = None,
 ) -> DerivedSpec:
     """``exscec derive``: a scenario of ``spec`` transformed by ``steps`` in order, e.g.
     ``[("remove_robot", {"robot": "tiago2", "reassign": "tiago1"})]``; the result's ``text`` is
     the new file (write it to ``result.target``).  With ``expect_from``, the file holds the
-    acceptance criteria the good stored runs imply (``exscec derive --expect``; ``include_all``:
-    every stored run, ``--all-runs``)."""
+    acceptance criteria the good stored runs imply (``exscec derive --expect``; ``tolerance``: how
+    far from the expected change a run may be, in percent of it, default 10; ``include_all``:
+    every stored run, ``--all-runs``); ``source``: the file ``spec`` was read from, as the user
+    named it (default: its root file)."""
+    from exsce_dsl.derive.derive_scenario import derive_spec
+    from exsce_dsl.derive.expect import RELATIVE_TOLERANCE
+
     return derive_spec(
         spec,
-        spec.root,
+        spec.root if source is None else source,
         steps,
         new_id=new_id,
         scenario_id=scenario,
         target=target,
         expect_from=expect_from,
+        tolerance=RELATIVE_TOLERANCE if tolerance is None else tolerance,
         include_all=include_all,
     )
 
@@ -156,6 +195,8 @@ def derive(
 def add_derived(store: Store, derived: DerivedSpec, *, include_all: bool = False) -> StoredDerivation:
     """``exscec derive --add-to-store``: the derived scenario, its generation and its oracles
     (from the base's good runs; ``include_all``: every run)."""
+    from exsce_dsl.derive.derive_scenario import add_derivation
+
     return add_derivation(store, derived, include_all=include_all)
 
 
@@ -164,6 +205,8 @@ def expect(
 ) -> list[ExpectedValue]:
     """``exscec expect``: each robot's expected distance travelled and task duration, and the path
     segments each value comes from, from the good stored runs (``include_all``: every run)."""
+    from exsce_dsl.derive.expect import SUMMED, expected_metric, learning_runs
+
     chosen = _scenario(spec, scenario)
     runs = learning_runs(store, include_all)
     return [
@@ -183,4 +226,6 @@ def cluster(
     weights: Mapping[str, float] | None = None,
 ) -> Clustering:
     """``exscec cluster``: stored scenarios clustered by the method's distances."""
+    from exsce_dsl.similarity.clustering import cluster_stored
+
     return cluster_stored(store, scenarios, method, k, threshold, weights)

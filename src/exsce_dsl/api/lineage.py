@@ -13,19 +13,23 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from exsce_dsl.errors import AmbiguousRunError, UnknownRunError
-from exsce_dsl.model.derivation import Derivation
+from exsce_dsl.model.derivation import Derivation, TransformationStep
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.queries import (
     RunChain,
     ValueAccount,
+    derivation_of,
+    derived_scenarios,
     dispatched_runs,
     lineage,
     resolve_run,
     run_chain,
+    scenario_ids,
     value_accounts,
 )
+from exsce_dsl.store.queries.run_ids import is_full_uuid, names_a_prefix
 
-__all__ = ["RunLineage", "run_lineage"]
+__all__ = ["RunLineage", "ScenarioLineage", "lineage_of", "run_lineage"]
 
 
 @dataclass(frozen=True)
@@ -111,3 +115,59 @@ def run_lineage(store: Store, run: str) -> RunLineage:
     chain = run_chain(store, uuid)
     ancestry = tuple(lineage(store, chain.scenario)) if chain.scenario else ()
     return RunLineage(chain, ancestry, tuple(value_accounts(store, uuid)))
+
+
+@dataclass(frozen=True)
+class ScenarioLineage:
+    """A stored scenario's derivations: its ancestors' (the oldest first) and its descendants',
+    each with the steps that made it, as a tree."""
+
+    scenario: str
+    ancestry: tuple[Derivation, ...]
+    descendants: tuple[tuple[int, str, tuple[TransformationStep, ...]], ...]
+    """Depth-first: (depth below the scenario, the derived scenario, the steps that made it)."""
+
+    def text(self) -> str:
+        """The ancestors, the scenario, then its descendants as a tree."""
+        lines = []
+        for derivation in self.ancestry:
+            lines.append(derivation.base)
+            lines.append(f"  └─ {' → '.join(_step_text(s) for s in derivation.steps)}")
+        lines.append(f"{self.scenario}  (this one)")
+        for depth, child, steps in self.descendants:
+            made = " → ".join(_step_text(s) for s in steps)
+            lines.append(f"{'    ' * depth}  └─ {made}: {child}")
+        return "\n".join(lines)
+
+
+def _step_text(step: TransformationStep) -> str:
+    arguments = " ".join(f"{k}={v}" for k, v in step.parameters)
+    return f"{step.transformation}({arguments})" if arguments else step.transformation
+
+
+def _descendants(
+    store: Store, parent: str, depth: int, seen: frozenset[str]
+) -> list[tuple[int, str, tuple[TransformationStep, ...]]]:
+    found = []
+    for child in derived_scenarios(store, parent):
+        if child in seen:
+            continue
+        made = derivation_of(store, child)
+        found.append((depth, child, tuple(made.steps) if made else ()))
+        found += _descendants(store, child, depth + 1, seen | {child})
+    return found
+
+
+def lineage_of(store: Store, name: str) -> RunLineage | ScenarioLineage:
+    """``exscec lineage NAME``: a stored scenario's derivations, or, when the store holds no
+    scenario ``name``, the chain of the run it names (:func:`run_lineage`).  A name that is no
+    stored run either is a scenario without derivations, unless it has the shape of a run's id
+    (then an :class:`~exsce_dsl.errors.UnknownRunError`)."""
+    if name not in scenario_ids(store):
+        try:
+            return run_lineage(store, name)
+        except UnknownRunError:
+            if names_a_prefix(name) or is_full_uuid(name):
+                raise  # an id of a run: say the store lacks it
+    ancestry = tuple(reversed(lineage(store, name)))
+    return ScenarioLineage(name, ancestry, tuple(_descendants(store, name, 0, frozenset({name}))))

@@ -47,9 +47,9 @@ def info(bags: tuple[str, ...], fmt: str) -> None:
       exscec simulate examples/brsu_building_c/scenario_c.exsce -o bags/ --convention nav2 --format mcap
       exscec bag info bags/*
     """
-    from exsce_dsl.runs.bag_info import bag_info
+    from exsce_dsl.api import describe_bags
 
-    found = [bag_info(Path(b)) for b in bag_arguments(bags)]
+    found = describe_bags(bag_arguments(bags))
     if not found:
         raise click.UsageError("no bag among the files given")
     if fmt == "json":
@@ -62,7 +62,7 @@ def info(bags: tuple[str, ...], fmt: str) -> None:
 
 
 def _table(info: object) -> str:
-    from exsce_dsl.runs.bag_info import BagInfo
+    from exsce_dsl.api import BagInfo
 
     assert isinstance(info, BagInfo)
     if info.dated:
@@ -129,7 +129,7 @@ def init(bag_path: str, output: str | None, force: bool) -> None:
       exscec init --from-bag nav2_runs/*.bag -o from_bag.exsce
       exscec check from_bag.exsce
     """
-    from exsce_dsl.api.drafts import init_from_bag
+    from exsce_dsl.api import init_from_bag
 
     draft = init_from_bag(Path(bag_path), output, force)
     robots = ", ".join(f"{rid} ({ns or '/'}, {convention})" for rid, ns, convention in draft.robots)

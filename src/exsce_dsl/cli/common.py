@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 import functools
 import os
 import sys
@@ -15,7 +16,14 @@ from typing import Any, TypeVar
 
 import click
 
-from exsce_dsl.errors import Diagnostic, ExsceError, ScenarioChoiceError
+from exsce_dsl.errors import (
+    MAKE_A_TOKEN,
+    REPLACE_FILES,
+    START_A_MASTER,
+    Diagnostic,
+    ExsceError,
+    ScenarioChoiceError,
+)
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -111,6 +119,25 @@ def _scenario_option() -> str:
     return spelt[0] if spelt else "--scenario"
 
 
+REMEDIES = {
+    REPLACE_FILES: "{problem}; use --force to replace",
+    MAKE_A_TOKEN: "{problem} (leave --token and EXSCE_STORE_TOKEN unset to have one made)",
+    START_A_MASTER: "{problem}: start roscore and export it, or pass --start-master",
+}
+"""Each remedy the library says in words (:attr:`ExsceError.remedy`), as the command line says it:
+with the option that does it, after the problem."""
+
+
+def _with_options(exc: ExsceError) -> ExsceError:
+    """``exc`` with its remedy said as the command line's option, when it has one."""
+    said = REMEDIES.get(exc.remedy or "")
+    if said is None:
+        return exc
+    worded = copy.copy(exc)
+    worded.message = said.format(problem=exc.problem)
+    return worded
+
+
 def reports_errors(func: F) -> F:
     """Turn library errors into ``file:line:col: error: message`` and exit status 2 (bad input);
     an unexpected exception is a bug of ours: exit status 70 (see :class:`ExitCode`)."""
@@ -124,6 +151,7 @@ def reports_errors(func: F) -> F:
                 traceback.print_exc()
             if isinstance(exc, ScenarioChoiceError):
                 exc = exc.naming(_scenario_option())
+            exc = _with_options(exc)
             print_diagnostics(exc.diagnostics)
             sys.exit(ExitCode.BAD_INPUT)
         except click.UsageError:  # exit 2, with the usage line

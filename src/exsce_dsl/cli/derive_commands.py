@@ -8,7 +8,6 @@ import click
 
 from exsce_dsl.cli.common import all_runs_option, reports_errors
 from exsce_dsl.cli.store_commands import store_option
-from exsce_dsl.wording import counted
 
 
 def _requests(words: tuple[str, ...]) -> list[tuple[str, dict[str, str]]]:
@@ -101,51 +100,41 @@ def derive(
       exscec derive examples/brsu_building_c/scenario_c.exsce --id c_one \\
           -t remove_robot --robot tiago2 --reassign tiago1 -o c_one.exsce --expect --add-to-store
     """
-    from exsce_dsl.derive.derive_scenario import add_derivation, derive_spec
-    from exsce_dsl.lang import load_spec
-    from exsce_dsl.store.open import open_store
-    from exsce_dsl.transform.transformations import TRANSFORMATIONS
+    from exsce_dsl.api import TRANSFORMATIONS, add_derived, counted, load, open_store
+    from exsce_dsl.api import derive as derive_spec
 
     if list_them:
         for t in TRANSFORMATIONS.values():
             arguments = " ".join([f"--{a} X" for a in t.required] + [f"[--{a} X]" for a in t.optional])
             click.echo(f"{t.name} {arguments}\n    {t.help}")
         return
-    loaded, requests = load_spec(spec), _requests(steps)
+    loaded, requests = load(spec), _requests(steps)
     if with_expectations:
         with open_store(store_url) as store:
             made = derive_spec(
-                loaded, spec, requests, new_id=new_id, scenario_id=scenario_id, target=output,
-                expect_from=store, tolerance=tolerance, include_all=include_all,
+                loaded, requests, new_id=new_id, scenario=scenario_id, target=output,
+                expect_from=store, tolerance=tolerance, include_all=include_all, source=spec,
             )  # fmt: skip
         if made.criteria is None:
             click.echo(
                 "no acceptance criteria: neither safety clauses to copy nor runs to expect from", err=True
             )
     else:
-        made = derive_spec(loaded, spec, requests, new_id=new_id, scenario_id=scenario_id, target=output)
+        made = derive_spec(loaded, requests, new_id=new_id, scenario=scenario_id, target=output, source=spec)
     if output:
         Path(output).write_text(made.text, encoding="utf-8")
-        load_spec(output)  # what we wrote must check clean
+        load(output)  # what we wrote must check clean
         click.echo(f"wrote {output}: scenario {made.scenario.id}", err=True)
     else:
         click.echo(made.text, nl=False)
     if add_to_store:
         with open_store(store_url) as store:
-            stored = add_derivation(store, made, include_all=include_all)
+            stored = add_derived(store, made, include_all=include_all)
         click.echo(stored.scenario.summary(), err=True)
         click.echo(stored.generation.summary(), err=True)
         if stored.oracles_written is not None:
             oracles = counted(len(stored.oracles), "oracle")
             click.echo(f"{oracles}: {stored.oracles_written.summary()}", err=True)
-
-
-def _step_text(step: object) -> str:
-    from exsce_dsl.model.derivation import TransformationStep
-
-    assert isinstance(step, TransformationStep)
-    arguments = " ".join(f"{k}={v}" for k, v in step.parameters)
-    return f"{step.transformation}({arguments})" if arguments else step.transformation
 
 
 @click.command()
@@ -169,38 +158,10 @@ def lineage(scenario: str, store_url: str | None) -> None:
     Example:
       exscec lineage c_one
     """
-    from exsce_dsl.store.open import open_store
-    from exsce_dsl.store.queries import derivation_of, derived_scenarios, scenario_ids
-    from exsce_dsl.store.queries import lineage as ancestry
+    from exsce_dsl.api import lineage_of, open_store
 
     with open_store(store_url) as store:
-        if scenario not in scenario_ids(store):
-            from exsce_dsl.api.lineage import run_lineage
-            from exsce_dsl.errors import UnknownRunError
-            from exsce_dsl.store.queries.run_ids import is_full_uuid, names_a_prefix
-
-            try:
-                click.echo(run_lineage(store, scenario).text())
-                return
-            except UnknownRunError:
-                if names_a_prefix(scenario) or is_full_uuid(scenario):
-                    raise  # an id of a run: say the store lacks it
-        chain = list(reversed(ancestry(store, scenario)))
-        for derivation in chain:
-            click.echo(derivation.base)
-            click.echo(f"  └─ {' → '.join(_step_text(s) for s in derivation.steps)}")
-        click.echo(f"{scenario}  (this one)")
-
-        def descend(parent: str, depth: int, seen: frozenset[str]) -> None:
-            for child in derived_scenarios(store, parent):
-                if child in seen:
-                    continue
-                found = derivation_of(store, child)
-                steps = " → ".join(_step_text(s) for s in found.steps) if found else ""
-                click.echo(f"{'    ' * depth}  └─ {steps}: {child}")
-                descend(child, depth + 1, seen | {child})
-
-        descend(scenario, 0, frozenset({scenario}))
+        click.echo(lineage_of(store, scenario).text())
 
 
 @click.command()
@@ -219,22 +180,18 @@ def expect(spec: str, scenario_id: str | None, include_all: bool, store_url: str
       exscec expect c_one.exsce
       exscec expect examples/brsu_building_c/scenario_c_alone.exsce
     """
-    from exsce_dsl.derive.expect import SUMMED, expected_metric, learning_runs
-    from exsce_dsl.lang import load_spec
-    from exsce_dsl.store.open import open_store
+    from exsce_dsl.api import expect as expected_values
+    from exsce_dsl.api import load, open_store
 
-    scenario = load_spec(spec).scenario(scenario_id)
+    scenario = load(spec).scenario(scenario_id)
     with open_store(store_url) as store:
-        learning = learning_runs(store, include_all)
-        for robot in scenario.robots:
-            for metric in SUMMED:
-                found = expected_metric(store, scenario, robot.id, metric, runs=learning)
-                shown = f"{found.value:.4g}" if found.value is not None else "unknown"
-                click.echo(f"{robot.id} {metric}: {shown}")
-                for part in found.segments:
-                    value = f"{part.value:.4g}" if part.value is not None else "-"
-                    runs = f" ({part.runs} runs)" if part.runs else ""
-                    click.echo(f"  {part.start} → {part.goal}: {value}  {part.how}{runs}")
+        for found in expected_values(store, scenario, include_all=include_all):
+            shown = f"{found.value:.4g}" if found.value is not None else "unknown"
+            click.echo(f"{found.robot} {found.metric}: {shown}")
+            for part in found.segments:
+                value = f"{part.value:.4g}" if part.value is not None else "-"
+                runs = f" ({part.runs} runs)" if part.runs else ""
+                click.echo(f"  {part.start} → {part.goal}: {value}  {part.how}{runs}")
 
 
 COMMANDS = [derive, lineage, expect]

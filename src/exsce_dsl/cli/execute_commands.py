@@ -165,10 +165,10 @@ def execute(**given: Any) -> None:
           --policy retry-once --verify --junit verdicts.xml --server-timeout 1 \\
           -o live/  # exits 2: no robot's move_base answers
     """
-    from exsce_dsl.lang import load_spec
+    from exsce_dsl.api import load
 
     options = _ExecuteOptions(**given)
-    scenario = load_spec(options.spec).scenario(options.scenario_id)
+    scenario = load(options.spec).scenario(options.scenario_id)
     done = _execute_runs(scenario, options)
     for run in done:
         counts = Counter(r.outcome.value for r in run.mission.records)
@@ -182,7 +182,7 @@ def execute(**given: Any) -> None:
 
 def _execute_runs(scenario: Scenario, options: _ExecuteOptions) -> list[ExecutedRun]:
     """The runs on the live graph; interrupted, what was kept is said and the exit status is 130."""
-    from exsce_dsl.api.execution import execute_ros1
+    from exsce_dsl.api import execute_ros1
     from exsce_dsl.errors import ExecutionInterrupted
 
     try:
@@ -210,15 +210,14 @@ def _execute_runs(scenario: Scenario, options: _ExecuteOptions) -> list[Executed
 
 def _judge(scenario: Scenario, bags: list[Path], options: _ExecuteOptions) -> ExitCode:
     """--verify: the bags ingested and judged as exscec verify judges them (several: one trial)."""
-    from exsce_dsl.api.commands import verify
+    from exsce_dsl.api import open_store, verify
     from exsce_dsl.cli.oracle_commands import report_verification
-    from exsce_dsl.store.open import open_store
 
     with open_store(options.store_url) as store:
         verification = verify(store, scenario, bags)
     if options.runs > 1:
+        from exsce_dsl.api import trial_of
         from exsce_dsl.cli.trial_commands import report_trial
-        from exsce_dsl.oracles.trial_runs import trial_of
 
         trial = trial_of(verification, options.required_pass_rate, options.confidence)
         return report_trial(trial, False, options.junit)

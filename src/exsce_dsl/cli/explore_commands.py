@@ -3,49 +3,15 @@
 from __future__ import annotations
 
 import sys
-from contextlib import AbstractContextManager
-from dataclasses import dataclass
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import click
 
 from exsce_dsl.cli.common import ExitCode, Progress, exit_status, reports_errors
 from exsce_dsl.cli.store_commands import store_option
-from exsce_dsl.wording import counted
 
 if TYPE_CHECKING:
-    from exsce_dsl.explore.campaign import CampaignOptions, CampaignResult
-    from exsce_dsl.explore.executors import Executor
-
-
-@dataclass(frozen=True)
-class _ExploreOptions:
-    """``exscec explore``'s arguments and options, as click gives them."""
-
-    spec: str
-    scenario_id: str | None
-    budget: int
-    seed: int
-    runs_per_scenario: int
-    transformations: tuple[str, ...]
-    max_steps: int
-    strategy: str
-    tolerance: float
-    no_shrink: bool
-    stop_at_violation: bool
-    compare_random: bool
-    faults: tuple[str, ...]
-    executor_command: str | None
-    plugin: str | None
-    stand_in: bool
-    start_master: bool
-    speed_up: float | None
-    jobs: int
-    dask_address: str | None
-    output: str | None
-    junit: str | None
-    store_url: str | None
+    from exsce_dsl.api import Exploration, ExploreRequest
 
 
 @click.command(
@@ -196,130 +162,38 @@ def explore(**given: Any) -> None:
         --executor ros1 --stand-in --start-master \\
         --fault deadlock-start:tiago1:classroom_c025-w002 -o explore/live  # exits 1
     """
-    from exsce_dsl.oracles.campaign_junit import campaign_junit
+    from exsce_dsl.api import ExploreRequest
 
-    options = _ExploreOptions(**given)
-    result, random, durations = _run_campaigns(options)
-    _summary(result, random)
-    if options.junit:
-        Path(options.junit).write_text(campaign_junit(result.record, durations), encoding="utf-8")
-    violated = any(t.violated for t in result.record.trials)
-    undecided = any(t.inconclusive for t in result.record.trials)
-    sys.exit(ExitCode.FAILED if violated else ExitCode.INCONCLUSIVE if undecided else ExitCode.PASSED)
+    request = ExploreRequest(**given)
+    found = _run_campaigns(request)
+    for line in found.summary_lines():
+        click.echo(line)
+    undecided = ExitCode.INCONCLUSIVE if found.inconclusive else ExitCode.PASSED
+    sys.exit(ExitCode.FAILED if found.violated else undecided)
 
 
-def _run_campaigns(
-    options: _ExploreOptions,
-) -> tuple[CampaignResult, CampaignResult | None, dict[str, float]]:
-    """The campaign (and its random baseline with --compare-random), each trial said as it ends;
-    with --junit, its runs' durations.  Ctrl-C exits 130: the same command goes on from there."""
+def _run_campaigns(request: ExploreRequest) -> Exploration:
+    """The campaign (and its random baseline with --compare-random), each trial said as it ends.
+    Ctrl-C exits 130: the same command goes on from there."""
+    from exsce_dsl.api import explore
     from exsce_dsl.errors import ExecutionInterrupted
-    from exsce_dsl.explore.campaign import CampaignEvents, run_campaign
-    from exsce_dsl.explore.figures import random_baseline
-    from exsce_dsl.lang import load_spec
     from exsce_dsl.model.campaign import Trial
-    from exsce_dsl.oracles.campaign_junit import run_seconds
-    from exsce_dsl.store.open import open_store
 
-    chosen, campaign = _executor(options)
-    baseline = random_baseline(campaign) if options.compare_random else None
-    parsed = load_spec(options.spec)
-    total = options.budget * (2 if baseline else 1)
-    with chosen as executor, open_store(options.store_url) as store, Progress(total, "Exploring") as progress:
+    with Progress(request.trials, "Exploring") as progress:
 
-        def events(who: str) -> CampaignEvents:
-            def trial_done(trial: Trial, resumed: bool) -> None:
-                shown = trial.violated or trial.inconclusive
-                found = f": {'; '.join(r.text for r in shown)}" if shown else ""
-                done = " (done before)" if resumed else ""
-                budget = options.budget
-                progress.say(
-                    f"{who}trial {trial.number}/{budget} {trial.scenario} {trial.outcome}{found}{done}"
-                )
-                progress.update()
-
-            return CampaignEvents(said=progress.say, trial_done=trial_done)
-
-        def run(plan: CampaignOptions, output: str | None, who: str) -> CampaignResult:
-            return run_campaign(
-                store, parsed, options.spec, plan, executor, output,
-                scenario_id=options.scenario_id, events=events(who),
-            )  # fmt: skip
+        def trial_done(who: str, trial: Trial, resumed: bool) -> None:
+            shown = trial.violated or trial.inconclusive
+            found = f": {'; '.join(r.text for r in shown)}" if shown else ""
+            done = " (done before)" if resumed else ""
+            number = f"{trial.number}/{request.budget}"
+            progress.say(f"{who}trial {number} {trial.scenario} {trial.outcome}{found}{done}")
+            progress.update()
 
         try:
-            result = run(campaign, options.output, "")
-            random = None
-            if baseline is not None:
-                where = f"{options.output.rstrip('/')}-random" if options.output else None
-                random = run(baseline, where, "random: ")
+            return explore(request, progress.say, trial_done)
         except ExecutionInterrupted as stop:  # the campaign goes on where it stopped, run again
             click.echo(f"error: {stop.message}", err=True)
             sys.exit(ExitCode.INTERRUPTED)
-        durations = run_seconds(store, result.record) if options.junit else {}
-    return result, random, durations
-
-
-def _executor(options: _ExploreOptions) -> tuple[AbstractContextManager[Executor], CampaignOptions]:
-    """What runs the scenarios and the campaign's plan, from the options."""
-    from exsce_dsl.explore.campaign import CampaignOptions
-    from exsce_dsl.explore.executors import ExecutorOptions, chosen_executor
-    from exsce_dsl.parallel.dask_client import dask_address as scheduler_address
-
-    o = options
-    address = scheduler_address(o.dask_address)
-    given = ExecutorOptions(o.faults, o.stand_in, o.start_master, None, o.speed_up)
-    chosen = chosen_executor(o.executor_command, o.plugin, given, address)
-    campaign = CampaignOptions(
-        budget=o.budget,
-        seed=o.seed,
-        runs_per_scenario=o.runs_per_scenario,
-        max_steps=o.max_steps,
-        transformations=o.transformations,
-        strategy=o.strategy,
-        tolerance=o.tolerance,
-        shrink=not o.no_shrink,
-        stop_at_violation=o.stop_at_violation,
-        jobs=o.jobs,
-        dask_address=address,
-    )
-    return chosen, campaign
-
-
-def _summary(result: CampaignResult, random: CampaignResult | None) -> None:
-    """What the campaign found, its figures (beside the random baseline's) and its shrinkings."""
-    from exsce_dsl.explore.figures import figures_table, first_failure, per_100
-    from exsce_dsl.oracles.campaign_junit import steps_text
-
-    record, figures = result.record, result.figures
-    violated = {r.text for t in record.trials for r in t.violated}
-    undecided = {r.text for t in record.trials for r in t.inconclusive} - violated
-    tried = len(record.trials)
-    found = f"{counted(tried, 'derivation')} tried, {counted(len(violated), 'relation')} violated"
-    if undecided:
-        found += f", {len(undecided)} inconclusive"
-    click.echo(f"campaign {record.plan.id}: {found}")
-    click.echo(f"  files: {result.folder}")
-    if random is None:
-        inconclusive = f"; {figures.inconclusive} inconclusive" if figures.inconclusive else ""
-        found = counted(figures.counterexamples, "counterexample")
-        click.echo(
-            f"  {counted(figures.executions, 'execution')}, {found}"
-            f" ({per_100(figures)} per 100 executions), first failure after: {first_failure(figures)}"
-            f"{inconclusive}"
-        )
-    else:
-        click.echo(f"  random baseline {random.record.plan.id}: {random.folder}")
-        for line in figures_table([(record.plan.strategy, figures), ("random", random.figures)]):
-            click.echo(f"  {line}")
-    for shrinking in record.shrinkings:
-        file = result.minimal_files.get(shrinking.relation.text)
-        steps = steps_text(shrinking.minimal_steps)
-        click.echo(f"violated: {shrinking.relation.text} (trial {shrinking.trial})")
-        count = len(shrinking.minimal_steps)
-        click.echo(f"  smallest derivation ({counted(count, 'step')}): {steps}")
-        if file is not None:
-            bags = result.folder / "runs" / shrinking.minimal
-            click.echo(f"  reproduce: exscec verify {bags}/*.bag --scenario {file}")
 
 
 COMMANDS = [explore]

@@ -2,12 +2,10 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import click
 
+from exsce_dsl.api import TARGETS, Target
 from exsce_dsl.cli.common import reports_errors
-from exsce_dsl.codegen.targets import TARGETS, Target
 
 EXAMPLE_SPEC = "examples/brsu_building_c/scenario_c.exsce"
 
@@ -68,9 +66,9 @@ def _target_command(target: Target) -> click.Command:
     @click.option("--force", is_flag=True, help="Replace files that exist.")
     @reports_errors
     def command(spec: str, out_dir: str, scenario_id: str | None, force: bool) -> None:
-        from exsce_dsl.lang import load_spec
+        from exsce_dsl.api import generate as generate_files
 
-        for path in target.generate(load_spec(spec), scenario_id, Path(out_dir), force):
+        for path in generate_files(target.name, spec, out_dir, scenario_id, force=force):
             click.echo(f"wrote {path}", err=True)
 
     return command

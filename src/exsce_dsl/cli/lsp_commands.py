@@ -29,9 +29,9 @@ def lsp(tcp: str | None, stdio: bool) -> None:
     Example:
       exscec lsp
     """
-    from exsce_dsl.lsp import serve
+    from exsce_dsl.api import serve_lsp
 
-    serve(_address(tcp) if tcp else None)
+    serve_lsp(_address(tcp) if tcp else None)
 
 
 COMMANDS = [lsp]

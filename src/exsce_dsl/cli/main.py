@@ -15,7 +15,7 @@ from typing import TextIO
 
 import click
 
-from exsce_dsl import __version__
+from exsce_dsl.api import __version__
 from exsce_dsl.cli.common import State, exit_status_table
 
 COMMAND_MODULES: dict[str, str] = {
@@ -107,7 +107,7 @@ def main(debug: bool, msg_paths: tuple[str, ...]) -> None:
     if warnings.showwarning is not _show_warning:
         warnings.showwarning = _show_warning
     if msg_paths:  # in the environment, so that worker processes see them too
-        from exsce_dsl.messages.msg_path import MSG_PATH
+        from exsce_dsl.api import MSG_PATH
 
         folders = [os.path.abspath(p) for p in msg_paths]
         os.environ[MSG_PATH] = os.pathsep.join([*folders, *filter(None, [os.environ.get(MSG_PATH)])])

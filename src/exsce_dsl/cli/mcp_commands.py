@@ -2,13 +2,11 @@
 
 from __future__ import annotations
 
-import os
-
 import click
 
+from exsce_dsl.api import QUERY_TIMEOUT  # the store's: the endpoint's would import http.server
 from exsce_dsl.cli.common import reports_errors
 from exsce_dsl.cli.store_commands import store_option
-from exsce_dsl.store.base import QUERY_TIMEOUT  # not the endpoint: every command would import http.server
 
 
 @click.command(name="mcp")
@@ -73,14 +71,12 @@ def mcp(timeout: float, max_rows: int, root: str | None, store_url: str | None) 
     Try it with the MCP Inspector:
       npx @modelcontextprotocol/inspector exscec mcp
     """
-    from exsce_dsl.mcp_server import Access, serve
-    from exsce_dsl.store import open as store_open
+    from exsce_dsl.api import serve_mcp
 
-    with store_open.open_store(store_url):  # a store URL that cannot work fails now, not at a request
-        pass
-    click.echo(f"exscec mcp: serving {store_open.store_url(store_url)} read-only on stdio", err=True)
-    folder = os.path.abspath(root or os.getcwd())
-    serve(Access(store_url, timeout=timeout, max_rows=max_rows, root=folder))
+    def ready(url: str) -> None:
+        click.echo(f"exscec mcp: serving {url} read-only on stdio", err=True)
+
+    serve_mcp(store_url, timeout=timeout, max_rows=max_rows, root=root, on_ready=ready)
 
 
 COMMANDS = [mcp]

@@ -21,10 +21,9 @@ from exsce_dsl.cli.store_commands import store_option
 from exsce_dsl.cli.trial_commands import trial_options
 
 if TYPE_CHECKING:
+    from exsce_dsl.api import Store, Verification
     from exsce_dsl.model import Scenario
     from exsce_dsl.model.trials import Trial
-    from exsce_dsl.oracles.judging import Verification
-    from exsce_dsl.store.base import Store
 
 
 @click.command(epilog=exit_status(bad_input="bad input: a spec error, too few runs, no acceptance criteria"))
@@ -52,13 +51,11 @@ def baseline(spec: str, scenario_id: str | None, include_all: bool, store_url: s
       exscec baseline examples/brsu_building_c/scenario_c.exsce
       exscec baseline examples/brsu_building_c/scenario_c.exsce --all-runs
     """
-    from exsce_dsl.lang import load_spec
-    from exsce_dsl.oracles.judging import build_baseline
-    from exsce_dsl.store.open import open_store
-    from exsce_dsl.tables import aligned
+    from exsce_dsl.api import aligned, load, open_store
+    from exsce_dsl.api import baseline as build_baseline
 
     with open_store(store_url) as store:
-        built = build_baseline(store, load_spec(spec), scenario_id, include_all=include_all)
+        built = build_baseline(store, load(spec), scenario_id, include_all=include_all)
     scenario, oracles, report = built.scenario, built.oracles, built.written
     rows: list[tuple[str, ...]] = [("oracle", "relation", "value", "limit", "delta", "tolerance", "runs")]
     for o in oracles:
@@ -193,15 +190,13 @@ def verify(**given: Any) -> None:
       exscec verify --scenario examples/brsu_building_c/scenario_c.exsce --repeat 2 --seed 7 \\
           --required-pass-rate 0.5 --confidence 0.9  # exits 3: 2 runs are too few
     """
+    from exsce_dsl.api import IngestFailed, load, open_store
+    from exsce_dsl.api import verify as verify_runs
     from exsce_dsl.cli.trial_commands import report_trial
-    from exsce_dsl.errors import IngestFailed
-    from exsce_dsl.lang import load_spec
-    from exsce_dsl.oracles.judging import verify_runs
-    from exsce_dsl.store.open import open_store
 
     options = _VerifyOptions(**given)
     _check_runs_given(options)
-    scenario = load_spec(options.spec).scenario(options.scenario_id)
+    scenario = load(options.spec).scenario(options.scenario_id)
     runs = options.runs
     bags: list[str | Path] = [Path(r) for r in bag_arguments(runs) if Path(r).exists()]  # files, bag folders
     uuids: list[str | Path] = [r for r in runs if not Path(r).exists()]
@@ -231,7 +226,7 @@ def _check_runs_given(options: _VerifyOptions) -> None:
 
 def _verify_trial(store: Store, scenario: Scenario, runs: list[str | Path], options: _VerifyOptions) -> Trial:
     """The runs (and --repeat N new ones) judged as one trial."""
-    from exsce_dsl.oracles.trial_runs import REPEAT_FOLDER, REPEAT_SEED, verify_trial
+    from exsce_dsl.api import REPEAT_FOLDER, REPEAT_SEED, verify_trial
 
     return verify_trial(
         store,
@@ -250,8 +245,8 @@ def _verify_trial(store: Store, scenario: Scenario, runs: list[str | Path], opti
 def report_verification(verification: Verification, as_json: bool, junit: str | None) -> ExitCode:
     """Print the verdicts (a table, or JSON), write the JUnit report, count them on stderr; the
     exit status they give: 1 if one failed, 3 if one was inconclusive (and none failed), else 0."""
+    from exsce_dsl.api import junit_xml, verdict_table, verdicts_json
     from exsce_dsl.model.verdicts import Outcome
-    from exsce_dsl.oracles.report import junit_xml, verdict_table, verdicts_json
 
     verdicts = list(verification.verdicts)
     for warning in verification.warnings:

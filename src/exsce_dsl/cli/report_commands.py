@@ -2,13 +2,10 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import click
 
 from exsce_dsl.cli.common import Progress, reports_errors
 from exsce_dsl.cli.store_commands import store_option
-from exsce_dsl.wording import counted
 
 
 @click.command()
@@ -43,15 +40,12 @@ def report(output: str, specs: tuple[str, ...], store_url: str | None) -> None:
     Example:
       exscec report -o report --spec examples/brsu_building_c/scenario_c.exsce
     """
-    from exsce_dsl.report.contents import gather
-    from exsce_dsl.report.html import write_report
-    from exsce_dsl.store.open import open_store
+    from exsce_dsl.api import counted, gather_report, write_report
 
-    with open_store(store_url, read_only=True) as store:
-        contents = gather(store, [Path(s) for s in specs])
+    contents = gather_report(store_url, specs)
     runs = sum(len(s.runs) for s in contents.scenarios)
     with Progress(runs, "drawing runs") as progress:
-        index = write_report(contents, Path(output), progress.update)
+        index = write_report(contents, output, progress.update)
     for note in contents.notes:
         click.echo(f"note: {note}", err=True)
     shown = f"{counted(len(contents.scenarios), 'scenario')}, {counted(runs, 'run')}"

@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import sys
-from pathlib import Path
+from typing import TYPE_CHECKING
 
 import click
 
 from exsce_dsl.cli.common import ExitCode, Progress, bag_arguments, exit_status, reports_errors
 from exsce_dsl.model.conventions import CONVENTIONS
+
+if TYPE_CHECKING:
+    from exsce_dsl.api import IngestResult
 
 
 @click.command(epilog=exit_status(bad_input="bad input, or a run that could not be played"))
@@ -114,15 +117,14 @@ def simulate(
       exscec simulate examples/brsu_building_c/scenario_c.exsce --fault overspeed:tiago1 -o runs/faulty/
       exscec simulate examples/brsu_building_c/scenario_c.exsce --convention nav2 --format mcap -o runs/
     """
-    from exsce_dsl.lang import load_spec
-    from exsce_dsl.parallel.dask_client import dask_address as scheduler_address
-    from exsce_dsl.sim.executor import Fault
-    from exsce_dsl.sim.run import simulate as play
+    from exsce_dsl.api import dask_address as scheduler_address
+    from exsce_dsl.api import load, simulating
 
-    scenario = load_spec(spec).scenario(scenario_id)
-    parsed = tuple(Fault.parse(f) for f in faults)
-    address = scheduler_address(dask_address)
-    played = play(scenario, Path(out_dir), runs, fmt, seed, parsed, convention, cmd_vel_stamped, address)
+    scenario = load(spec).scenario(scenario_id)
+    played = simulating(
+        scenario, out_dir, runs, format=fmt, seed=seed, faults=faults, convention=convention,
+        cmd_vel_stamped=cmd_vel_stamped, dask_address=scheduler_address(dask_address),
+    )  # fmt: skip
     with Progress(runs, f"simulating {scenario.id}") as progress:
         for run in played:
             progress.update()
@@ -202,18 +204,14 @@ def ingest(
       exscec ingest --replace runs/*.bag --scenario examples/brsu_building_c/scenario_c.exsce
       exscec ingest runs/*.bag --scenario examples/brsu_building_c/scenario_c.exsce --strict
     """
-    from exsce_dsl.lang import load_spec_cached
-    from exsce_dsl.store.open import StoreOpening
+    from exsce_dsl.api import ingest_files, load_cached
 
-    scenario = load_spec_cached(spec).scenario(scenario_id)
-    paths = [Path(b) for b in bag_arguments(bags)]
+    scenario = load_cached(spec).scenario(scenario_id)
+    paths = bag_arguments(bags)
     if not paths:
         raise click.UsageError("no bag among the files given")
-    opening = StoreOpening(store_url)  # the store opens while what reads the bags is imported
-    from exsce_dsl.runs.ingest import IngestResult, IngestStatus, ingest_bags
-
     said: set[str] = set()
-    with opening.store() as store, Progress(len(paths), "ingesting") as progress:
+    with Progress(len(paths), "ingesting") as progress:
 
         def shown(result: IngestResult) -> None:
             progress.update()
@@ -225,23 +223,13 @@ def ingest(
             for problem in result.problems:
                 progress.say(f"warning: {result.bag}: {problem}")
 
-        results = ingest_bags(
-            paths,
-            scenario,
-            store,
-            jobs,
-            shown,
-            dask_address=dask_address or None,
-            replace=replace,
-            strict=strict,
-        )
-    done = sum(r.status is IngestStatus.INGESTED for r in results)
-    skipped = sum(r.status is IngestStatus.SKIPPED for r in results)
-    failed = sum(r.failed for r in results)
-    replaced = sum(r.status is IngestStatus.REPLACED for r in results)
-    again = f"{replaced} replaced, " if replace else ""
-    click.echo(f"{done} ingested, {again}{skipped} skipped, {failed} failed", err=True)
-    if failed:
+        _, tally = ingest_files(
+            store_url, scenario, paths, jobs=jobs, on_result=shown, dask_address=dask_address,
+            replace=replace, strict=strict,
+        )  # fmt: skip
+    again = f"{tally.replaced} replaced, " if replace else ""
+    click.echo(f"{tally.ingested} ingested, {again}{tally.skipped} skipped, {tally.failed} failed", err=True)
+    if tally.failed:
         sys.exit(ExitCode.BAD_INPUT)
 
 

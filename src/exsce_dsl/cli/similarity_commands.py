@@ -72,8 +72,8 @@ def cluster(
       exscec cluster --k 2 --dendrogram clusters.svg
       exscec cluster -s scenario_c -s c_one -w d4=2 --json
     """
-    from exsce_dsl.similarity.clustering import cluster_stored
-    from exsce_dsl.store.open import open_store
+    from exsce_dsl.api import cluster as cluster_stored
+    from exsce_dsl.api import open_store
 
     if k is not None and threshold is not None:
         raise click.UsageError("give --k or --threshold, not both")
@@ -83,9 +83,10 @@ def cluster(
                 f"'{image}': write the dendrogram to a .png or .svg file", param_hint="--dendrogram"
             )
     with open_store(store_url) as store:
-        result = cluster_stored(store, scenarios, method, k, threshold, dict(_weight(w) for w in weights))
+        weighted = dict(_weight(w) for w in weights)
+        result = cluster_stored(store, scenarios, method=method, k=k, threshold=threshold, weights=weighted)
     if images:
-        from exsce_dsl.similarity.dendrogram import save_dendrogram
+        from exsce_dsl.api import save_dendrogram
 
         for image in images:
             save_dendrogram(result, Path(image))

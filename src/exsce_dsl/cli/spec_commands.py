@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import difflib
 import sys
 from pathlib import Path
 
@@ -36,7 +35,7 @@ def check(specs: tuple[str, ...]) -> None:
       exscec check examples/brsu_building_c/scenario_c.exsce
       exscec check examples      # every .exsce file below the folder
     """
-    from exsce_dsl.rdf.spec_check import check_spec
+    from exsce_dsl.api import check as check_spec
 
     failed = False
     for spec in spec_files(specs):
@@ -93,11 +92,10 @@ def compile_command(
       exscec compile examples/brsu_building_c/scenario_c.exsce -f json -o scenario_c.prov.json
       exscec compile examples/brsu_building_c/scenario_c.exsce --store
     """
-    from exsce_dsl.lang import load_spec
-    from exsce_dsl.prov.spec import compile_spec_scenario
-    from exsce_dsl.rdf import serialize
+    from exsce_dsl.api import compile_prov, load, prov_text
 
-    document = compile_spec_scenario(load_spec(spec), scenario_id)
+    document = compile_prov(load(spec), scenario_id)
+    assert not isinstance(document, str)  # a document: no format given
     if store_url is not None:
         from exsce_dsl.cli.store_commands import add_to_store
 
@@ -109,7 +107,7 @@ def compile_command(
             return
     elif replace:
         raise click.UsageError("--replace goes with --store")
-    text = serialize(document, fmt)
+    text = prov_text(document, fmt)
     write_text(text, output)
 
 
@@ -132,34 +130,20 @@ def fmt(specs: tuple[str, ...], check_only: bool, show_diff: bool) -> None:
       exscec fmt --check examples     # for CI: fails if a file below examples/ would change
       exscec fmt specs/
     """
-    from exsce_dsl.lang import comments, display_path, format_spec_document, load_spec
-    from exsce_dsl.textfiles import read_text
+    from exsce_dsl.api import format_file
 
     changed = []
     for spec_path in spec_files(specs):
-        spec = load_spec(spec_path)
-        original = read_text(spec_path, "specification")
-        path = display_path(spec_path)
-        formatted = format_spec_document(spec, path, comments(original, path))
-        if formatted == original:
+        formatted = format_file(spec_path)
+        if not formatted.changed:
             continue
         changed.append(spec_path)
         if show_diff:
-            click.echo(
-                "".join(
-                    difflib.unified_diff(
-                        original.splitlines(keepends=True),
-                        formatted.splitlines(keepends=True),
-                        fromfile=spec_path,
-                        tofile=f"{spec_path} (formatted)",
-                    )
-                ),
-                nl=False,
-            )
+            click.echo(formatted.diff(), nl=False)
         if check_only or show_diff:  # as black does: --diff shows, it does not write
             click.echo(f"would reformat {spec_path}", err=True)
         else:
-            Path(spec_path).write_text(formatted, encoding="utf-8")
+            formatted.write()
             click.echo(f"reformatted {spec_path}", err=True)
     if check_only and changed:
         sys.exit(ExitCode.FAILED)
@@ -210,37 +194,29 @@ def import_command(
     Example:
       exscec import out/scenarios/scenario_c.yaml -t out/config/tasks -o specs/
     """
-    from exsce_dsl.lang import import_scenario_yaml, is_oracle_yaml, write_documents
+    from exsce_dsl.api import import_scenario_file, is_oracle_file
 
-    if is_oracle_yaml(Path(yaml_file)):
+    if is_oracle_file(yaml_file):
         _import_oracles(Path(yaml_file), spec_path, out_dir, force)
         return
     if spec_path is not None:
         raise click.UsageError("--spec goes with an oracle file; this is a scenario file")
-    documents = import_scenario_yaml(Path(yaml_file), [Path(d) for d in task_dirs])
-    for path in write_documents(documents, Path(out_dir), overwrite=force):
+    for path in import_scenario_file(yaml_file, out_dir, task_dirs, force=force):
         click.echo(f"wrote {path}", err=True)
 
 
 def _import_oracles(yaml_file: Path, spec_path: str | None, out_dir: str, force: bool) -> None:
-    from exsce_dsl.lang import (
-        acceptance_document,
-        format_document,
-        import_oracles,
-        load_spec,
-        write_documents,
-    )
-    from exsce_dsl.model import Document
+    from exsce_dsl.api import import_oracle_file
 
     if spec_path is None:
         raise click.UsageError(f"{yaml_file} holds oracles: name the spec of its scenario with --spec")
-    acceptance = import_oracles(yaml_file, load_spec(spec_path))
     source = click.get_current_context().get_parameter_source("out_dir")
-    if source == click.core.ParameterSource.DEFAULT:
-        click.echo(format_document(Document("", (), (acceptance,)), {}), nl=False)
+    printed = source == click.core.ParameterSource.DEFAULT
+    imported = import_oracle_file(yaml_file, spec_path, None if printed else out_dir, force=force)
+    if isinstance(imported, str):
+        click.echo(imported, nl=False)
         return
-    document = acceptance_document(acceptance, Path(spec_path), Path(out_dir))
-    for path in write_documents([document], Path(out_dir), overwrite=force):
+    for path in imported:
         click.echo(f"wrote {path}", err=True)
 
 
@@ -281,20 +257,9 @@ def export_command(spec: str, target: str, out_dir: str, scenario_id: str | None
       exscec export examples/brsu_building_c/scenario_c.exsce --to gherkin -o features/
       exscec export examples/brsu_building_c/scenario_c.exsce --to oracle-yaml -o out/  # exits 2
     """
-    from exsce_dsl.errors import ExportError
-    from exsce_dsl.lang import export_gherkin, export_oracle_file, export_yaml, load_spec
+    from exsce_dsl.api import export_spec
 
-    loaded = load_spec(spec)
-    if target == "gherkin":
-        written = export_gherkin(loaded, Path(out_dir), scenario_id)
-    elif target == "oracle-yaml":
-        scenario = loaded.scenario(scenario_id)
-        acceptance = loaded.acceptance_of(scenario.id)
-        if acceptance is None:
-            raise ExportError(f"scenario '{scenario.id}' has no acceptance criteria to write as oracles")
-        written = [export_oracle_file(acceptance, scenario, Path(out_dir))]
-    else:
-        written = export_yaml(loaded.scenario(scenario_id), Path(out_dir))
+    written = export_spec(spec, target, out_dir, scenario_id)
     for path in written:
         click.echo(f"wrote {path}", err=True)
 

@@ -78,12 +78,12 @@ def stand_in(
       exscec stand-in examples/brsu_building_c/scenario_c.exsce --ros1 --start-master \\
           --fault overspeed:tiago1 --speed-up 5   # slower: a busy machine's recorder keeps up
     """
-    from exsce_dsl.api.stand_in import stand_in as play
-    from exsce_dsl.lang import load_spec
+    from exsce_dsl.api import load
+    from exsce_dsl.api import stand_in as play
 
     if not ros1:
         raise click.UsageError("say --ros1: the stand-in plays on ROS 1 only (yet)")
-    loaded = load_spec(spec)
+    loaded = load(spec)
 
     def terminated(signum: int, frame: FrameType | None) -> None:
         raise KeyboardInterrupt

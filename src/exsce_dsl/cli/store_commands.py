@@ -26,12 +26,9 @@ def store_option(func: F) -> F:
 
 def add_to_store(document: Any, store_url: str | None, replace: bool) -> None:
     """Add a compiled PROV document to the store and say what changed (on stderr)."""
-    from exsce_dsl.store.open import open_store
-    from exsce_dsl.store.writing import add_prov
+    from exsce_dsl.api import add_to_store as add
 
-    with open_store(store_url) as store:
-        report = add_prov(store, document, replace=replace)
-    click.echo(report.summary(), err=True)
+    click.echo(add(document, store_url, replace=replace).summary(), err=True)
 
 
 @click.group(name="store")
@@ -61,34 +58,15 @@ def info(store_url: str | None) -> None:
       exscec store info
       exscec store info --store memory:
     """
-    from exsce_dsl.store.embedded import EmbeddedStore
-    from exsce_dsl.store.open import open_store
-    from exsce_dsl.store.remote import RemoteStore
-    from exsce_dsl.store.segment_index import is_index_graph
-    from exsce_dsl.store.writing import is_revision
+    from exsce_dsl.api import store_info
 
-    with open_store(store_url, read_only=True) as store:
-        sizes = store.graph_sizes()
-        if isinstance(store, EmbeddedStore):
-            if store.path is None:
-                kind = "embedded Oxigraph, in memory"
-            elif store.path.exists():
-                kind = "embedded Oxigraph"
-            else:
-                kind = "embedded Oxigraph, not created yet (made on the first write)"
-        elif isinstance(store, RemoteStore) and store.served_by is not None:
-            server = f"exscec serve (pid {store.served_by}) at {store.url}"
-            kind = f"embedded Oxigraph, held by {server}, read through it"
-        else:
-            kind = "SPARQL 1.1 endpoint"
-        revisions = sum(1 for name in sizes if is_revision(name))
-        index = sum(1 for name in sizes if is_index_graph(name))
-        click.echo(f"store:      {store.location} ({kind})")
-        click.echo(
-            f"graphs:     {len(sizes) - revisions - index} (+ {revisions} revisions, "
-            f"+ {index} of the segment index)"
-        )
-        click.echo(f"statements: {sum(sizes.values())}")
+    said = store_info(store_url)
+    click.echo(f"store:      {said.location} ({said.kind})")
+    click.echo(
+        f"graphs:     {said.graphs} (+ {said.revisions} revisions, "
+        f"+ {said.index_graphs} of the segment index)"
+    )
+    click.echo(f"statements: {said.statements}")
 
 
 @store_group.command(name="graphs")
@@ -105,14 +83,10 @@ def graphs(store_url: str | None, with_index: bool) -> None:
     Example:
       exscec store graphs
     """
-    from exsce_dsl.store.open import open_store
-    from exsce_dsl.store.segment_index import is_index_graph
+    from exsce_dsl.api import store_graphs
 
-    with open_store(store_url, read_only=True) as store:
-        sizes = store.graph_sizes()
-    hidden = 0 if with_index else sum(1 for name in sizes if is_index_graph(name))
-    if not with_index:
-        sizes = {name: n for name, n in sizes.items() if not is_index_graph(name)}
+    found = store_graphs(store_url, with_index=with_index)
+    sizes, hidden = found.sizes, found.hidden_index
     width = max((len(str(n)) for n in sizes.values()), default=1)
     for name in sorted(sizes):
         click.echo(f"{sizes[name]:>{width}}  {name}")
@@ -144,11 +118,9 @@ def export(store_url: str | None, fmt: str, output: str | None) -> None:
     Example:
       exscec store export -f nq -o store.nq
     """
-    from exsce_dsl.store.open import open_store
+    from exsce_dsl.api import export_store
 
-    with open_store(store_url, read_only=True) as store:
-        data = store.export(fmt)
-    write_text(data.decode("utf-8"), output)
+    write_text(export_store(store_url, fmt), output)
 
 
 @store_group.command(name="clear")
@@ -162,12 +134,11 @@ def clear(store_url: str | None) -> None:
     Example:
       exscec store clear --yes
     """
-    from exsce_dsl.store.open import open_store
+    from exsce_dsl.api import clear_store
 
-    with open_store(store_url) as store:
-        count = len(store.graph_names())
-        store.clear()
-    click.echo(f"{store.location}: removed {count} graph{'s' if count != 1 else ''}", err=True)
+    cleared = clear_store(store_url)
+    count = cleared.removed
+    click.echo(f"{cleared.location}: removed {count} graph{'s' if count != 1 else ''}", err=True)
 
 
 @store_group.command(name="check")
@@ -190,8 +161,7 @@ def check(store_url: str | None, fix: bool) -> None:
       exscec store check
       exscec store check --fix
     """
-    from exsce_dsl.api import check_store
-    from exsce_dsl.store.open import open_store
+    from exsce_dsl.api import check_store, open_store
 
     with open_store(store_url, read_only=not fix) as store:
         result = check_store(store, fix=fix)
@@ -215,8 +185,7 @@ def migrate(store_url: str | None) -> None:
     Example:
       exscec store migrate
     """
-    from exsce_dsl.api import migrate_store
-    from exsce_dsl.store.open import open_store
+    from exsce_dsl.api import migrate_store, open_store
 
     with open_store(store_url) as store:
         report = migrate_store(store)
@@ -308,8 +277,7 @@ def serve(
       exscec serve --bind 127.0.0.1:0     # on a free port, printed first
       exscec serve --allow-federation query.wikidata.org
     """
-    from exsce_dsl.endpoint.server import ServeOptions, allowed_names, is_loopback, servable_store
-    from exsce_dsl.endpoint.server import serve as serve_store
+    from exsce_dsl.api import is_loopback, serve_endpoint
 
     host, port = _parse_bind(bind)
     token = _update_token(token) if allow_updates else None
@@ -323,38 +291,28 @@ def serve(
     def log(line: str) -> None:
         click.echo(line, err=True)
 
-    options = ServeOptions(
-        host,
-        port,
-        token=token,
-        union_default_graph=union_default_graph,
-        query_timeout=query_timeout,
-        max_answer=int(max_answer_mb * 2**20),
-        allowed_hosts=allowed_names(allowed_hosts),
-        federation_hosts=allowed_names(federation_hosts),
-        log=log if log_requests else None,
-    )
-    store_path = servable_store(store_url)
-
-    def ready(url: str) -> None:
+    def ready(url: str, store_path: object) -> None:
         click.echo(f"{url}/")
         mode = "updates with a bearer token" if token else "read-only"
         where = store_path if store_path is not None else "memory:"
         click.echo(f"serving {where} at {url}/ ({mode}); Ctrl-C to stop", err=True)
 
-    serve_store(store_path, options, on_ready=ready)
+    serve_endpoint(
+        store_url, host, port, token=token, union_default_graph=union_default_graph,
+        query_timeout=query_timeout, max_answer_mb=max_answer_mb, allowed_hosts=allowed_hosts,
+        federation_hosts=federation_hosts, log=log if log_requests else None, on_ready=ready,
+    )  # fmt: skip
 
 
 def _update_token(given: str | None) -> str:
     """The token updates need: ``given`` (if long enough), else a new one, printed once."""
-    from exsce_dsl.endpoint.server import check_token, new_token
+    from exsce_dsl.api import update_token
 
-    if given:
-        return check_token(given)
-    token = new_token()
-    shown = f"updates need this bearer token: {token}  (exscec commands: EXSCE_STORE_TOKEN={token})"
-    click.echo(shown, err=True)
-    return token
+    token = update_token(given)
+    if token.minted:
+        shown = f"updates need this bearer token: {token.text}"
+        click.echo(f"{shown}  (exscec commands: EXSCE_STORE_TOKEN={token.text})", err=True)
+    return token.text
 
 
 def _parse_bind(bind: str) -> tuple[str, int]:

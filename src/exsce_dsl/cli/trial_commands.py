@@ -65,10 +65,8 @@ def trial_exit(trial: Trial) -> ExitCode:
 def report_trial(trial: Trial, as_json: bool, junit: str | None) -> ExitCode:
     """Print the trial's pass-rate table (or JSON), write its JUnit report, count the clauses on
     stderr; the exit status they give (:func:`trial_exit`)."""
+    from exsce_dsl.api import counted, pass_rate_table, pass_rates_json, percent, trial_junit_xml
     from exsce_dsl.model.trials import TrialOutcome
-    from exsce_dsl.oracles.trial_report import pass_rate_table, pass_rates_json, trial_junit_xml
-    from exsce_dsl.oracles.trials import percent
-    from exsce_dsl.wording import counted
 
     for warning in trial.warnings:
         click.echo(f"warning: {warning}", err=True)
@@ -85,7 +83,7 @@ def report_trial(trial: Trial, as_json: bool, junit: str | None) -> ExitCode:
 
 
 def _render(clauses: Sequence[ClauseTrial], fmt: str) -> str:
-    from exsce_dsl.oracles.trial_report import pass_rate_table, pass_rates_csv, pass_rates_json
+    from exsce_dsl.api import pass_rate_table, pass_rates_csv, pass_rates_json
 
     if fmt == "json":
         return pass_rates_json(clauses)
@@ -124,8 +122,8 @@ def flaky(
       exscec flaky scenario_c
       exscec flaky --format csv --required-pass-rate 0.9 -o pass_rates.csv
     """
-    from exsce_dsl.oracles.trial_runs import stored_pass_rates
-    from exsce_dsl.store.open import open_store
+    from exsce_dsl.api import flaky as stored_pass_rates
+    from exsce_dsl.api import open_store
 
     with open_store(store_url) as store:
         clauses = stored_pass_rates(

@@ -7,6 +7,7 @@ from collections.abc import Collection, Mapping
 from pathlib import Path
 
 from exsce_dsl.codegen.readback import check_generated
+from exsce_dsl.errors import REPLACE_FILES
 from exsce_dsl.output_folder import existing, relative_parts, write_below
 from exsce_dsl.templating import GenerationError
 
@@ -27,7 +28,7 @@ def write_files(
         check_generated(str(out_dir.joinpath(relative)), text)
     found = sorted(str(out_dir.joinpath(rel)) for rel in files if existing(out_dir, rel))
     if found and not overwrite:
-        raise GenerationError(f"would overwrite {', '.join(found)}; use --force to replace")
+        raise GenerationError(f"would overwrite {', '.join(found)}", remedy=REPLACE_FILES)
     return [
         write_below(out_dir, rel, text.encode("utf-8"), 0o777 if rel in executable else 0o666)
         for rel, text in files.items()

@@ -32,7 +32,7 @@ from exsce_dsl.endpoint.app import make_app
 from exsce_dsl.endpoint.evaluator import Evaluator
 from exsce_dsl.endpoint.guard import HostRule, is_loopback
 from exsce_dsl.endpoint.worker import Settings
-from exsce_dsl.errors import StoreError
+from exsce_dsl.errors import MAKE_A_TOKEN, StoreError
 from exsce_dsl.store.base import QUERY_TIMEOUT
 from exsce_dsl.store.serve_info import ServeInfo, serve_info_path, write_serve_info
 
@@ -73,8 +73,8 @@ def check_token(token: str) -> str:
     """``token``, or a StoreError if it is too short to be a secret."""
     if len(token) < MIN_TOKEN:
         raise StoreError(
-            f"the update token is {len(token)} characters long; it must have at least {MIN_TOKEN} "
-            "(leave --token and EXSCE_STORE_TOKEN unset to have one made)"
+            f"the update token is {len(token)} characters long; it must have at least {MIN_TOKEN}",
+            remedy=MAKE_A_TOKEN,
         )
     return token
 

@@ -27,7 +27,7 @@ import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from exsce_dsl.errors import BagError, ExportError, SourceLocation
+from exsce_dsl.errors import REPLACE_FILES, BagError, ExportError, SourceLocation
 from exsce_dsl.lang import Comment, declared_poses, format_document
 from exsce_dsl.maps.grid import FREE, OccupancyGrid, grid_from_ros, save_occupancy_grid
 from exsce_dsl.model import (
@@ -107,7 +107,7 @@ def draft_spec(bag: Path, out: Path, force: bool = False) -> SpecDraft:
     targets = [out] + ([map_yaml, map_yaml.with_suffix(".pgm")] if map_yaml else [])
     found = [str(t) for t in targets if existing(t.parent, t.name)]  # a link there is refused
     if found and not force:
-        raise ExportError(f"would overwrite {', '.join(found)}; use --force to replace")
+        raise ExportError(f"would overwrite {', '.join(found)}", remedy=REPLACE_FILES)
     m = contents.map
     grid = grid_from_ros(m.values, m.width, m.height, m.resolution, m.origin) if m is not None else None
     tag = run_uuid(content_hash(bag))[:8]  # the start of the id its run will have

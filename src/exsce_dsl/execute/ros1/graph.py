@@ -22,7 +22,7 @@ from types import TracebackType
 from typing import Any
 from urllib.parse import urlparse
 
-from exsce_dsl.errors import RosGraphError
+from exsce_dsl.errors import START_A_MASTER, RosGraphError
 
 ROS_PYTHON_VARIABLE = "EXSCE_ROS_PYTHON"
 DEFAULT_ROS_PYTHON = Path("/usr/bin/python3")
@@ -73,7 +73,7 @@ def master_uri() -> str:
     """``$ROS_MASTER_URI``, as every ROS tool reads it (an error if it is not set)."""
     uri = os.environ.get("ROS_MASTER_URI")
     if not uri:
-        raise RosGraphError("ROS_MASTER_URI is not set: start roscore and export it, or pass --start-master")
+        raise RosGraphError("ROS_MASTER_URI is not set", remedy=START_A_MASTER)
     return uri
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path, PurePosixPath
 
-from exsce_dsl.errors import ExportError
+from exsce_dsl.errors import REPLACE_FILES, ExportError
 from exsce_dsl.lang.format.document import declared_poses, format_document
 from exsce_dsl.model import Document, Environment
 
@@ -21,7 +21,7 @@ def write_documents(documents: Sequence[Document], out_dir: Path, overwrite: boo
     targets = [(doc, _target(out_dir, doc.path)) for doc in documents]
     existing = [str(t) for _, t in targets if t.exists()]
     if existing and not overwrite:
-        raise ExportError(f"would overwrite {', '.join(existing)}; use --force to replace")
+        raise ExportError(f"would overwrite {', '.join(existing)}", remedy=REPLACE_FILES)
     written = []
     for doc, target in targets:
         target.parent.mkdir(parents=True, exist_ok=True)

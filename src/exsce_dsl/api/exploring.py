@@ -1,0 +1,174 @@
+"""``exscec explore``: a metamorphic test campaign on a scenario, and with ``compare_random`` the
+same budget drawn uniformly at random beside it, its figures for comparison."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from contextlib import AbstractContextManager
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from exsce_dsl.model.campaign import Trial
+from exsce_dsl.wording import counted
+
+if TYPE_CHECKING:
+    from exsce_dsl.explore.campaign import CampaignOptions, CampaignResult
+    from exsce_dsl.explore.executors import Executor
+
+
+@dataclass(frozen=True)
+class ExploreRequest:
+    """A campaign, as ``exscec explore``'s arguments and options give it."""
+
+    spec: str
+    budget: int
+    scenario_id: str | None = None
+    seed: int = 0
+    runs_per_scenario: int = 3
+    transformations: tuple[str, ...] = ()
+    max_steps: int = 2
+    strategy: str = "covering"
+    tolerance: float = 25.0
+    no_shrink: bool = False
+    stop_at_violation: bool = False
+    compare_random: bool = False
+    faults: tuple[str, ...] = ()
+    executor_command: str | None = None
+    plugin: str | None = None
+    """An executor by name: ``ros1``, or an ``exsce.executors`` plug-in."""
+    stand_in: bool = False
+    """With ``plugin="ros1"``: exsce's stand-in robots serve the goals."""
+    start_master: bool = False
+    speed_up: float | None = None
+    jobs: int = 1
+    """Bags analysed in parallel."""
+    dask_address: str | None = None
+    """A Dask scheduler whose workers play the simulator's runs and analyse the bags (default:
+    ``$EXSCE_DASK_SCHEDULER``)."""
+    output: str | None = None
+    """The campaign's folder (default: ``explore/<campaign id>``)."""
+    junit: str | None = None
+    """Also write the campaign as JUnit XML to this file."""
+    store_url: str | None = None
+
+    @property
+    def trials(self) -> int:
+        """The trials the campaign (and its random baseline) may draw."""
+        return self.budget * (2 if self.compare_random else 1)
+
+
+@dataclass(frozen=True)
+class Exploration:
+    """A campaign's result, and its random baseline's (``compare_random``)."""
+
+    result: CampaignResult
+    random: CampaignResult | None
+
+    @property
+    def violated(self) -> bool:
+        return any(t.violated for t in self.result.record.trials)
+
+    @property
+    def inconclusive(self) -> bool:
+        return any(t.inconclusive for t in self.result.record.trials)
+
+    def summary_lines(self) -> list[str]:
+        """What the campaign found, its figures (beside the random baseline's) and its shrinkings."""
+        from exsce_dsl.explore.figures import figures_table, first_failure, per_100
+        from exsce_dsl.oracles.campaign_junit import steps_text
+
+        result, random = self.result, self.random
+        record, figures = result.record, result.figures
+        violated = {r.text for t in record.trials for r in t.violated}
+        undecided = {r.text for t in record.trials for r in t.inconclusive} - violated
+        tried = counted(len(record.trials), "derivation")
+        found = f"{tried} tried, {counted(len(violated), 'relation')} violated"
+        if undecided:
+            found += f", {len(undecided)} inconclusive"
+        lines = [f"campaign {record.plan.id}: {found}", f"  files: {result.folder}"]
+        if random is None:
+            inconclusive = f"; {figures.inconclusive} inconclusive" if figures.inconclusive else ""
+            found = counted(figures.counterexamples, "counterexample")
+            lines.append(
+                f"  {counted(figures.executions, 'execution')}, {found}"
+                f" ({per_100(figures)} per 100 executions), first failure after: {first_failure(figures)}"
+                f"{inconclusive}"
+            )
+        else:
+            lines.append(f"  random baseline {random.record.plan.id}: {random.folder}")
+            compared = figures_table([(record.plan.strategy, figures), ("random", random.figures)])
+            lines += [f"  {line}" for line in compared]
+        for shrinking in record.shrinkings:
+            file = result.minimal_files.get(shrinking.relation.text)
+            lines.append(f"violated: {shrinking.relation.text} (trial {shrinking.trial})")
+            count = len(shrinking.minimal_steps)
+            steps = steps_text(shrinking.minimal_steps)
+            lines.append(f"  smallest derivation ({counted(count, 'step')}): {steps}")
+            if file is not None:
+                bags = result.folder / "runs" / shrinking.minimal
+                lines.append(f"  reproduce: exscec verify {bags}/*.bag --scenario {file}")
+        return lines
+
+
+def explore(
+    request: ExploreRequest,
+    said: Callable[[str], None] | None = None,
+    trial_done: Callable[[str, Trial, bool], None] | None = None,
+) -> Exploration:
+    """Run the campaign (and its random baseline); ``said`` gets what the campaign says as it goes,
+    ``trial_done`` each trial as it ends (``"random: "`` first for the baseline's, and whether it
+    was done before: the store is the campaign's state, so the same request goes on where it
+    stopped).  Interrupted, an :class:`~exsce_dsl.errors.ExecutionInterrupted`."""
+    from exsce_dsl.api.store import open_store
+    from exsce_dsl.explore.campaign import CampaignEvents, run_campaign
+    from exsce_dsl.explore.figures import random_baseline
+    from exsce_dsl.lang import load_spec
+    from exsce_dsl.oracles.campaign_junit import campaign_junit, run_seconds
+
+    chosen, campaign = _executor(request)
+    baseline = random_baseline(campaign) if request.compare_random else None
+    parsed = load_spec(request.spec)
+
+    def events(who: str) -> CampaignEvents:
+        def done(trial: Trial, resumed: bool) -> None:
+            if trial_done is not None:
+                trial_done(who, trial, resumed)
+
+        return CampaignEvents(said=said or (lambda line: None), trial_done=done)
+
+    with chosen as executor, open_store(request.store_url) as store:
+
+        def run(plan: CampaignOptions, output: str | None, who: str) -> CampaignResult:
+            return run_campaign(
+                store, parsed, request.spec, plan, executor, output,
+                scenario_id=request.scenario_id, events=events(who),
+            )  # fmt: skip
+
+        result = run(campaign, request.output, "")
+        random = None
+        if baseline is not None:
+            where = f"{request.output.rstrip('/')}-random" if request.output else None
+            random = run(baseline, where, "random: ")
+        durations = run_seconds(store, result.record) if request.junit else {}
+    if request.junit:
+        Path(request.junit).write_text(campaign_junit(result.record, durations), encoding="utf-8")
+    return Exploration(result, random)
+
+
+def _executor(request: ExploreRequest) -> tuple[AbstractContextManager[Executor], CampaignOptions]:
+    """What runs the scenarios and the campaign's plan, from the request."""
+    from exsce_dsl.explore.campaign import CampaignOptions
+    from exsce_dsl.explore.executors import ExecutorOptions, chosen_executor
+    from exsce_dsl.parallel.dask_client import dask_address as scheduler_address
+
+    o = request
+    address = scheduler_address(o.dask_address)
+    given = ExecutorOptions(o.faults, o.stand_in, o.start_master, None, o.speed_up)
+    chosen = chosen_executor(o.executor_command, o.plugin, given, address)
+    campaign = CampaignOptions(
+        budget=o.budget, seed=o.seed, runs_per_scenario=o.runs_per_scenario, max_steps=o.max_steps,
+        transformations=o.transformations, strategy=o.strategy, tolerance=o.tolerance,
+        shrink=not o.no_shrink, stop_at_violation=o.stop_at_violation, jobs=o.jobs, dask_address=address,
+    )  # fmt: skip
+    return chosen, campaign
