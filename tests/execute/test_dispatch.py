@@ -15,7 +15,7 @@ import pytest
 from exsce_dsl.execute.dispatcher import dispatch
 from exsce_dsl.execute.mission import schedule
 from exsce_dsl.execute.navigator import SimulatedClock
-from exsce_dsl.execute.outcomes import DEFAULT_POLICY, MissionStatus, Outcome, Policy
+from exsce_dsl.execute.outcomes import DEFAULT_POLICY, GoalOutcome, MissionStatus, Policy
 from exsce_dsl.lang import load_spec
 from exsce_dsl.maps.planning import planning_grid
 from exsce_dsl.model import MissionType
@@ -33,7 +33,7 @@ P = {
     "c018-w002": (46.25560760498047, 21.586545944213867),
 }
 V = 0.5  # m/s, the speed both robots drive at in these tests
-S, A, T, C = (Outcome.SUCCEEDED, Outcome.ABORTED, Outcome.TIMED_OUT, Outcome.CANCELLED)
+S, A, T, C = (GoalOutcome.SUCCEEDED, GoalOutcome.ABORTED, GoalOutcome.TIMED_OUT, GoalOutcome.CANCELLED)
 FIRST = ("tiago1", "classroom_c022-w001")  # tiago1's first goal: the one the tests make fail
 
 
@@ -280,7 +280,7 @@ def test_a_rejected_goal_is_skipped_by_the_default_policy(open_floor):
     run = dispatch(schedule(scenario), nav, clock)
     t2 = leg("c025-w001", "c018-w001")
     assert _rows(run)[:2] == [
-        ("tiago1", "delivery_a", 1, 1, 1, "c022-w001", 0.0, 0.0, Outcome.REJECTED, 1),
+        ("tiago1", "delivery_a", 1, 1, 1, "c022-w001", 0.0, 0.0, GoalOutcome.REJECTED, 1),
         ("tiago1", "delivery_a", 1, 1, 2, "c018-w001", 0.0, t2, S, 1),
     ]
 

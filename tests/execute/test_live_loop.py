@@ -31,7 +31,7 @@ import pytest
 
 from exsce_dsl import api as exsce
 from exsce_dsl.api.demo import LIVE_STEPS
-from exsce_dsl.execute.outcomes import Outcome
+from exsce_dsl.execute.outcomes import GoalOutcome
 from exsce_dsl.execute.ros1.graph import start_master
 from exsce_dsl.runs.bags.reading import bag_topics
 from exsce_dsl.sim.run import simulate
@@ -136,7 +136,7 @@ def test_a_goal_the_server_aborts_is_an_aborted_segment_and_the_next_goal_goes(t
             faults=["skip-waypoint:tiago1:1"],
         )
     records = [r for r in run.mission.records if r.robot == "tiago1"]
-    assert [r.outcome for r in records] == [Outcome.ABORTED, Outcome.SUCCEEDED, Outcome.SUCCEEDED]
+    assert [r.outcome for r in records] == [GoalOutcome.ABORTED, GoalOutcome.SUCCEEDED, GoalOutcome.SUCCEEDED]
     assert all(r.attempts == 1 for r in records)  # skip-waypoint: not sent again
     assert run.mission.status.value == "completed"
     assert '"exsce:goal_outcome"' not in run.files.prov.read_text()  # aborted by the stack itself

@@ -11,7 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from exsce_dsl.errors import RosGraphError
+from exsce_dsl.cli.common import REMEDIES
+from exsce_dsl.errors import START_A_MASTER, RosGraphError
 from exsce_dsl.execute.ros1.channel import NodeChannel
 from exsce_dsl.execute.ros1.graph import (
     DEFAULT_ROS_PYTHON,
@@ -74,8 +75,10 @@ def test_the_master_uri_comes_from_the_environment(monkeypatch: pytest.MonkeyPat
     monkeypatch.setenv("ROS_MASTER_URI", "http://127.0.0.1:11399")
     assert master_uri() == "http://127.0.0.1:11399"
     monkeypatch.delenv("ROS_MASTER_URI")
-    with pytest.raises(RosGraphError, match="--start-master"):
+    with pytest.raises(RosGraphError, match="ROS_MASTER_URI is not set") as raised:
         master_uri()
+    assert raised.value.remedy == START_A_MASTER  # the command line says it as --start-master
+    assert "--start-master" in REMEDIES[START_A_MASTER]
 
 
 def test_a_python_without_rospy_is_refused_with_how_to_install(monkeypatch: pytest.MonkeyPatch) -> None:

@@ -17,7 +17,7 @@ import pytest
 from exsce_dsl.errors import RosGraphError
 from exsce_dsl.execute.dispatcher import dispatch
 from exsce_dsl.execute.mission import schedule
-from exsce_dsl.execute.outcomes import MissionStatus, Outcome
+from exsce_dsl.execute.outcomes import GoalOutcome, MissionStatus
 from exsce_dsl.execute.ros1.navigator import DispatcherNode, Ros1Navigator, RosClock, move_base_actions
 from exsce_dsl.lang import load_spec
 from exsce_dsl.model import MissionType
@@ -61,7 +61,7 @@ def test_goals_arrive_in_the_schedules_order_with_the_specs_poses(scenario_c, tm
         start_server(graph, log, "tiago1,tiago2", "--duration", "0.3")
         run = run_mission(graph, scenario_c, tmp_path)
     assert run.status is MissionStatus.COMPLETED
-    assert [r.outcome for r in run.records] == [Outcome.SUCCEEDED] * 6
+    assert [r.outcome for r in run.records] == [GoalOutcome.SUCCEEDED] * 6
     goals = [e for e in seen(log) if e["event"] == "goal"]
     for robot, poses in (("tiago1", TIAGO1), ("tiago2", TIAGO2)):
         got = [g for g in goals if g["robot"] == robot]
@@ -86,7 +86,7 @@ def test_a_sequential_mission_has_one_goal_active_at_a_time(scenario_c, tmp_path
     with ros1_graph(tmp_path / "ros", sim_time=False) as graph:
         start_server(graph, log, "tiago1,tiago2", "--duration", "0.2")
         run = run_mission(graph, sequential, tmp_path)
-    assert [r.outcome for r in run.records] == [Outcome.SUCCEEDED] * 6
+    assert [r.outcome for r in run.records] == [GoalOutcome.SUCCEEDED] * 6
     events = [e for e in seen(log) if e["event"] in ("goal", "end")]
     # allocation order: tiago1 delivery_a, tiago2 delivery_b, tiago1 home, tiago2 home
     order = [(g["robot"], g["x"]) for g in events if g["event"] == "goal"]
@@ -103,9 +103,9 @@ def test_an_aborted_goal_is_skipped_and_the_next_one_sent(scenario_c, tmp_path: 
         run = run_mission(graph, scenario_c, tmp_path)
     tiago1 = [(r.pose.id, r.outcome, r.attempts) for r in run.records if r.robot == "tiago1"]
     assert tiago1 == [
-        ("classroom_c022-w001", Outcome.ABORTED, 1),
-        ("classroom_c018-w001", Outcome.SUCCEEDED, 1),
-        ("classroom_c025-w001", Outcome.SUCCEEDED, 1),
+        ("classroom_c022-w001", GoalOutcome.ABORTED, 1),
+        ("classroom_c018-w001", GoalOutcome.SUCCEEDED, 1),
+        ("classroom_c025-w001", GoalOutcome.SUCCEEDED, 1),
     ]
     xs = [g["x"] for g in seen(log) if g["event"] == "goal" and g["robot"] == "tiago1"]
     assert xs == [pytest.approx(P[p][0]) for p in TIAGO1]
@@ -134,9 +134,9 @@ def test_timeouts_run_on_simulated_time(scenario_c, tmp_path: Path) -> None:
         run = run_mission(graph, scenario_c, tmp_path, timeout=30.0)
         took = time.monotonic() - started
     first = next(r for r in run.records if r.robot == "tiago1")
-    assert (first.pose.id, first.outcome) == ("classroom_c022-w001", Outcome.TIMED_OUT)
+    assert (first.pose.id, first.outcome) == ("classroom_c022-w001", GoalOutcome.TIMED_OUT)
     assert first.end - first.start == pytest.approx(30.0, abs=1.0)  # ROS seconds
     assert took < 15  # wall seconds: far less than 30
     cancels = [e for e in seen(log) if e["event"] == "cancel"]
     assert [(c["robot"], c["n"]) for c in cancels] == [("tiago1", 1)]
-    assert sum(r.outcome is Outcome.SUCCEEDED for r in run.records) == 5
+    assert sum(r.outcome is GoalOutcome.SUCCEEDED for r in run.records) == 5

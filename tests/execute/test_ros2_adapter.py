@@ -24,7 +24,7 @@ import yaml
 
 from exsce_dsl.errors import ExsceError, RosGraphError
 from exsce_dsl.execute.mission import schedule
-from exsce_dsl.execute.outcomes import Outcome
+from exsce_dsl.execute.outcomes import GoalOutcome
 from exsce_dsl.execute.ros2 import (
     Ros2Recorder,
     execute_ros2,
@@ -183,27 +183,27 @@ def test_quaternions_of_rotations_worked_out_by_hand() -> None:
 @pytest.mark.parametrize(
     "status, outcome",
     [
-        (4, Outcome.SUCCEEDED),
-        (6, Outcome.ABORTED),
-        (5, Outcome.CANCELLED),
-        (0, Outcome.ABORTED),
+        (4, GoalOutcome.SUCCEEDED),
+        (6, GoalOutcome.ABORTED),
+        (5, GoalOutcome.CANCELLED),
+        (0, GoalOutcome.ABORTED),
         (1, None),
         (2, None),
         (3, None),
     ],
 )
-def test_goal_status_codes_map_onto_the_cores_outcomes(status: int, outcome: Outcome | None) -> None:
+def test_goal_status_codes_map_onto_the_cores_outcomes(status: int, outcome: GoalOutcome | None) -> None:
     assert goal_outcome(status) is outcome
 
 
 def test_a_goal_not_accepted_is_rejected_and_an_unknown_code_is_an_error() -> None:
-    assert goal_outcome(0, accepted=False) is Outcome.REJECTED
+    assert goal_outcome(0, accepted=False) is GoalOutcome.REJECTED
     with pytest.raises(ExsceError, match="7"):
         goal_outcome(7)
 
 
 def test_follow_waypoints_results_map_onto_each_waypoint() -> None:
-    s, a, c = Outcome.SUCCEEDED, Outcome.ABORTED, Outcome.CANCELLED
+    s, a, c = GoalOutcome.SUCCEEDED, GoalOutcome.ABORTED, GoalOutcome.CANCELLED
     # succeeded, waypoint 1 missed (stop_on_failure false): the others were reached
     assert waypoint_outcomes(4, 3, [1], 2) == (s, a, s)
     # aborted at waypoint 1, which is missed: waypoint 0 reached, waypoint 2 never sent

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.execute.mission import DEFAULT_SPEED
 from exsce_dsl.execute.navigator import Finished, SimulatedClock
-from exsce_dsl.execute.outcomes import Outcome
+from exsce_dsl.execute.outcomes import GoalOutcome
 from exsce_dsl.maps.planning import PlanningGrid, Point
 from exsce_dsl.model import Pose, Scenario
 
@@ -37,12 +37,12 @@ class _Drive:
     start: float
     end: float | None
     """None: never answered."""
-    outcome: Outcome
+    outcome: GoalOutcome
 
     def position(self, t: float) -> Point:
         """Where the robot is at ``t`` on this drive (at the start if it does not move)."""
-        if self.outcome is not Outcome.SUCCEEDED or self.end is None or self.end <= self.start:
-            return self.path[0] if self.outcome is not Outcome.SUCCEEDED else self.path[-1]
+        if self.outcome is not GoalOutcome.SUCCEEDED or self.end is None or self.end <= self.start:
+            return self.path[0] if self.outcome is not GoalOutcome.SUCCEEDED else self.path[-1]
         along = min(1.0, max(0.0, (t - self.start) / (self.end - self.start))) * _length(self.path)
         for a, b in zip(self.path, self.path[1:], strict=False):
             step = math.dist(a, b)
@@ -89,16 +89,16 @@ class KinematicNavigator:
         self.sent.append((goal, robot, pose, now))
         name, here = (robot, pose.id), self.where[robot]
         if name in self.silent:
-            self.active[goal] = _Drive(robot, name, (here,), now, None, Outcome.ABORTED)
+            self.active[goal] = _Drive(robot, name, (here,), now, None, GoalOutcome.ABORTED)
         elif name in self.rejects:
-            self.active[goal] = _Drive(robot, name, (here,), now, now, Outcome.REJECTED)
+            self.active[goal] = _Drive(robot, name, (here,), now, now, GoalOutcome.REJECTED)
         elif self.aborts.get(name, 0) > 0:
             self.aborts[name] -= 1
-            self.active[goal] = _Drive(robot, name, (here,), now, now + ABORT_AFTER, Outcome.ABORTED)
+            self.active[goal] = _Drive(robot, name, (here,), now, now + ABORT_AFTER, GoalOutcome.ABORTED)
         else:
             path = tuple(self.grid.plan(here, (pose.position.x, pose.position.y)))
             speed = self.speeds.get(robot, DEFAULT_SPEED)
-            self.active[goal] = _Drive(robot, name, path, now, now + _length(path) / speed, Outcome.SUCCEEDED)
+            self.active[goal] = _Drive(robot, name, path, now, now + _length(path) / speed, GoalOutcome.SUCCEEDED)
 
     def cancel(self, goal: int) -> None:
         drive = self.active.pop(goal, None)

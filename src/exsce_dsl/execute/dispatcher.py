@@ -21,10 +21,10 @@ from exsce_dsl.execute.mission import Goal, Schedule
 from exsce_dsl.execute.navigator import Clock, Navigator
 from exsce_dsl.execute.outcomes import (
     DEFAULT_POLICY,
+    GoalOutcome,
     GoalRecord,
     MissionRun,
     MissionStatus,
-    Outcome,
     Policy,
 )
 
@@ -92,9 +92,9 @@ class _Dispatch:
             if finished is None:
                 self._time_out(self.clock.now())
             elif finished.goal in self.active:  # else: an end after we cancelled it, or reported twice
-                if finished.outcome is Outcome.SUCCEEDED:
+                if finished.outcome is GoalOutcome.SUCCEEDED:
                     done = self.active.pop(finished.goal)
-                    self._record(done, Outcome.SUCCEEDED, finished.time)
+                    self._record(done, GoalOutcome.SUCCEEDED, finished.time)
                     self._next(done.lane)
                 else:
                     self._failed(finished.goal, finished.outcome, finished.time)
@@ -113,7 +113,7 @@ class _Dispatch:
         if self.lanes[lane] and self.status is MissionStatus.COMPLETED:
             self._send(lane, self.lanes[lane].popleft(), None, 1)
 
-    def _record(self, done: _Active, outcome: Outcome, end: float) -> None:
+    def _record(self, done: _Active, outcome: GoalOutcome, end: float) -> None:
         g = done.goal
         self.records.append(
             GoalRecord(
@@ -135,9 +135,9 @@ class _Dispatch:
         for number in late:
             if number in self.active:  # a stop on an earlier one may have cancelled it already
                 self.navigator.cancel(number)
-                self._failed(number, Outcome.TIMED_OUT, now)
+                self._failed(number, GoalOutcome.TIMED_OUT, now)
 
-    def _failed(self, number: int, outcome: Outcome, end: float) -> None:
+    def _failed(self, number: int, outcome: GoalOutcome, end: float) -> None:
         """A goal that did not succeed: aborted, rejected, timed out, or cancelled by another
         client of the robot's stack (preempted): ``policy`` says what comes next."""
         done = self.active.pop(number)
@@ -160,5 +160,5 @@ class _Dispatch:
         now = self.clock.now()
         for number, active in sorted(self.active.items()):
             self.navigator.cancel(number)
-            self._record(active, Outcome.CANCELLED, now)
+            self._record(active, GoalOutcome.CANCELLED, now)
         self.active.clear()

@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Protocol
 
-from exsce_dsl.execute.outcomes import Outcome
+from exsce_dsl.execute.outcomes import GoalOutcome
 from exsce_dsl.model import Pose
 
 
@@ -27,7 +27,7 @@ class Finished:
 
     goal: int
     """The number the dispatcher gave the goal when it sent it."""
-    outcome: Outcome
+    outcome: GoalOutcome
     """SUCCEEDED, ABORTED or REJECTED."""
     time: float
 

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from exsce_dsl.model import Pose
 
 
-class Outcome(enum.Enum):
+class GoalOutcome(enum.Enum):
     SUCCEEDED = "succeeded"
     ABORTED = "aborted"
     REJECTED = "rejected"
@@ -25,7 +25,7 @@ class Outcome(enum.Enum):
     """The mission was cancelled or stopped while the goal was active."""
 
 
-FAILED = frozenset({Outcome.ABORTED, Outcome.REJECTED, Outcome.TIMED_OUT})
+FAILED = frozenset({GoalOutcome.ABORTED, GoalOutcome.REJECTED, GoalOutcome.TIMED_OUT})
 """The outcomes that a :class:`Policy` handles (and CANCELLED when another client of the robot's
 stack cancelled the goal, not the dispatcher)."""
 
@@ -65,7 +65,7 @@ class GoalRecord:
     pose: Pose
     start: float
     end: float
-    outcome: Outcome
+    outcome: GoalOutcome
     attempts: int
 
 

@@ -24,7 +24,7 @@ from __future__ import annotations
 import datetime as dt
 
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.execute.outcomes import GoalRecord, MissionRun, Outcome
+from exsce_dsl.execute.outcomes import GoalOutcome, GoalRecord, MissionRun
 from exsce_dsl.model import Pose, Scenario
 from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Run, RunStatus
 from exsce_dsl.prov.recorder import recorded_prov_json, recorded_run
@@ -56,7 +56,7 @@ def mission_run_record(
                 "action cannot say where it started"
             )
         actions.append(_action(record, before, at(record.start), at(record.end)))
-        if record.outcome is Outcome.SUCCEEDED:
+        if record.outcome is GoalOutcome.SUCCEEDED:
             where[record.robot] = record.pose
     status = RunStatus(mission.status.value)
     return recorded_run(run_id, scenario.id, start, at(mission.end), bag_file_name, actions, status)
@@ -71,7 +71,7 @@ def mission_prov_json(
 
 
 def _action(record: GoalRecord, start_pose: Pose, start: dt.datetime, end: dt.datetime) -> Action:
-    succeeded = record.outcome is Outcome.SUCCEEDED
+    succeeded = record.outcome is GoalOutcome.SUCCEEDED
     return Action(
         ActionId(record.robot, record.task_number, record.subtask, record.waypoint),
         start_pose,
@@ -79,6 +79,6 @@ def _action(record: GoalRecord, start_pose: Pose, start: dt.datetime, end: dt.da
         ActionStatus.SUCCEEDED if succeeded else ActionStatus.ABORTED,
         start,
         end,
-        None if succeeded or record.outcome is Outcome.ABORTED else record.outcome.value,
+        None if succeeded or record.outcome is GoalOutcome.ABORTED else record.outcome.value,
         record.attempts,
     )

@@ -45,7 +45,7 @@ class Navigation(Enum):
     """No goals in the bags: segments come from arrival at the planned waypoints."""
 
 
-class Window(Enum):
+class MetricSpan(Enum):
     """What a robot's whole-run metrics cover."""
 
     GOALS = "goals"
@@ -136,8 +136,8 @@ class Signals:
     actions: tuple[str, ...] = ()
     """The navigation interface's action (or dispatcher) names, patterns with ``{ns}``."""
     tolerance: Tolerance = field(default_factory=Tolerance)
-    window: Window = Window.GOALS
-    """What a robot's whole-run metrics cover (see :class:`Window`)."""
+    window: MetricSpan = MetricSpan.GOALS
+    """What a robot's whole-run metrics cover (see :class:`MetricSpan`)."""
     rates: tuple[tuple[str, float], ...] = ()
     """(signal, Hz) the author declared for a signal wherever it is read from (``scan at 10
     Hz``); a source's own rate (``scan on "/{ns}/scan" at 10 Hz``) wins for that source."""

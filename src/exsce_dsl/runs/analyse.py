@@ -15,7 +15,7 @@ from exsce_dsl.lang import standard_metrics
 from exsce_dsl.messages.catalogue import Source
 from exsce_dsl.messages.field_check import check_fields
 from exsce_dsl.model import Scenario
-from exsce_dsl.model.conventions import DISPATCHER_FEEDBACK, DISPATCHER_RESULT, Window
+from exsce_dsl.model.conventions import DISPATCHER_FEEDBACK, DISPATCHER_RESULT, MetricSpan
 from exsce_dsl.model.expressions import Field, walk
 from exsce_dsl.model.messages import DISPATCHER, POSE, FieldPath, Fields
 from exsce_dsl.model.metrics import MetricDefinition
@@ -346,7 +346,7 @@ def _segment_robots(path: Path, scenario: Scenario, bag: _Signals) -> _Segmented
                 found.topics or stacks.real_topics.get(expand_topic(SERVED["pose"], ns), ())
             )
         # the whole run is the recording unless recorded goals span it: never an arrival
-        recording = robot.signals.window is Window.RECORDING or not found.goals
+        recording = robot.signals.window is MetricSpan.RECORDING or not found.goals
         if (not found.segments or recording) and scenario.mission.tasks_of(robot.id):
             span = bag.spans[robot.id]
             if span is None and not found.segments:
@@ -359,7 +359,7 @@ def _segment_robots(path: Path, scenario: Scenario, bag: _Signals) -> _Segmented
 
 def _why_recording(robot: Robot, goals: bool, segmented: bool) -> str:
     """Why a robot's whole-run window is the recording."""
-    if robot.signals.window is Window.RECORDING:
+    if robot.signals.window is MetricSpan.RECORDING:
         return "the recording (the spec's window whole recording)"
     if not goals:
         return "the recording (no recorded goals" + (

@@ -58,7 +58,7 @@ from exsce_dsl.model.acceptance import (
     Subject,
     When,
 )
-from exsce_dsl.model.conventions import CONVENTIONS, METHOD, Window
+from exsce_dsl.model.conventions import CONVENTIONS, METHOD, MetricSpan
 from exsce_dsl.model.names import KEYWORDS, is_valid_name
 from exsce_dsl.model.runs import run_uuid
 from exsce_dsl.output_folder import existing, write_below
@@ -260,7 +260,8 @@ class _Drafter:
             if key in CONVENTIONS:
                 signals = CONVENTIONS[key]
             else:
-                signals = METHOD.overridden(window=Window.RECORDING, named=False, said=frozenset({"window"}))
+                whole = MetricSpan.RECORDING
+                signals = METHOD.overridden(window=whole, named=False, said=frozenset({"window"}))
                 said.append(
                     "No goals: the convention is detected at each ingest; metrics of the whole recording."
                 )

@@ -37,7 +37,7 @@ from exsce_dsl.sim.passing import Wait, head_on_wait
 
 
 @dataclass
-class Timeline:
+class RobotMotion:
     """A robot's motion and dispatcher events over the whole run."""
 
     robot: str
@@ -281,13 +281,13 @@ class _Play:
         return Execution(trajectories, events, actions, end * DT)
 
 
-def _starting_timelines(scenario: Scenario, rng: random.Random) -> dict[str, Timeline]:
+def _starting_timelines(scenario: Scenario, rng: random.Random) -> dict[str, RobotMotion]:
     """Each robot with a start pose, standing there for half a second to a second."""
-    timelines: dict[str, Timeline] = {}
+    timelines: dict[str, RobotMotion] = {}
     for robot in scenario.robots:
         if robot.start_pose is None:
             continue
-        tl = Timeline(robot.id)
+        tl = RobotMotion(robot.id)
         tl.x, tl.y, tl.yaw = (
             robot.start_pose.position.x,
             robot.start_pose.position.y,
@@ -300,7 +300,7 @@ def _starting_timelines(scenario: Scenario, rng: random.Random) -> dict[str, Tim
 
 def _drive_to(
     grid: PlanningGrid,
-    tl: Timeline,
+    tl: RobotMotion,
     goal: Pose,
     via: tuple[float, float] | None,
     parked: tuple[Point, ...],
@@ -329,7 +329,7 @@ def _drive_to(
 
 
 def _near_collision(
-    scenario: Scenario, timelines: dict[str, Timeline], grid: PlanningGrid, limits: Limits
+    scenario: Scenario, timelines: dict[str, RobotMotion], grid: PlanningGrid, limits: Limits
 ) -> dict[str, list[Trajectory]]:
     """The second robot's first action starts with a drive to the first robot, which waits at its
     start until the second has come close and gone back: the legs, to insert in that action."""

@@ -20,7 +20,7 @@ from typing import Any
 
 from exsce_dsl.errors import RosGraphError
 from exsce_dsl.execute.navigator import Finished
-from exsce_dsl.execute.outcomes import Outcome
+from exsce_dsl.execute.outcomes import GoalOutcome
 from exsce_dsl.execute.recording import PROV_TOPIC
 from exsce_dsl.execute.ros1.channel import Message, NodeChannel
 from exsce_dsl.model import Pose, Scenario
@@ -38,10 +38,10 @@ WAKE = 0.1
 """Wall seconds between two looks at ``interrupted`` while waiting for the node."""
 _NAME = re.compile(r"^(/[A-Za-z][A-Za-z0-9_]*)+$")
 _OUTCOMES = {
-    "succeeded": Outcome.SUCCEEDED,
-    "aborted": Outcome.ABORTED,
-    "rejected": Outcome.REJECTED,
-    "cancelled": Outcome.CANCELLED,
+    "succeeded": GoalOutcome.SUCCEEDED,
+    "aborted": GoalOutcome.ABORTED,
+    "rejected": GoalOutcome.REJECTED,
+    "cancelled": GoalOutcome.CANCELLED,
 }
 
 
@@ -169,5 +169,5 @@ class Ros1Navigator:
 def _finished(message: dict[str, Any]) -> Finished | None:
     if message.get("event") != "finished":
         return None
-    outcome = _OUTCOMES.get(str(message.get("outcome")), Outcome.ABORTED)
+    outcome = _OUTCOMES.get(str(message.get("outcome")), GoalOutcome.ABORTED)
     return Finished(int(message["goal"]), outcome, float(message["time"]))

@@ -27,7 +27,7 @@ from exsce_dsl.errors import RosGraphError
 from exsce_dsl.execute.dispatcher import dispatch
 from exsce_dsl.execute.mission import schedule
 from exsce_dsl.execute.navigator import Finished
-from exsce_dsl.execute.outcomes import DEFAULT_POLICY, MissionRun, Outcome, Policy
+from exsce_dsl.execute.outcomes import DEFAULT_POLICY, GoalOutcome, MissionRun, Policy
 from exsce_dsl.execute.ros2.nav2 import goal_outcome, nav2_actions, stamped_pose
 from exsce_dsl.execute.ros2.recorder import SOURCE_HINT, Ros2Recorder
 from exsce_dsl.model import Pose, Scenario
@@ -131,7 +131,7 @@ class Ros2Navigator:
         self._unanswered.discard(goal)
         handle = future.result()
         if not handle.accepted:
-            self._end(goal, Outcome.REJECTED)
+            self._end(goal, GoalOutcome.REJECTED)
             return
         if goal in self._cancelled:  # cancelled while its acceptance was on the way
             handle.cancel_goal_async()
@@ -151,9 +151,9 @@ class Ros2Navigator:
     def _result(self, goal: int, future: Any) -> None:
         self._handles.pop(goal, None)
         outcome = goal_outcome(int(future.result().status))
-        self._end(goal, Outcome.ABORTED if outcome is None else outcome)
+        self._end(goal, GoalOutcome.ABORTED if outcome is None else outcome)
 
-    def _end(self, goal: int, outcome: Outcome) -> None:
+    def _end(self, goal: int, outcome: GoalOutcome) -> None:
         if goal not in self._cancelled:  # the dispatcher's own cancels are not reported
             self._ended.append(Finished(goal, outcome, self.clock.now()))
 

@@ -14,10 +14,10 @@ A goal's pose is a ``geometry_msgs/PoseStamped`` in the ``map`` frame, its orien
 quaternion of the waypoint's roll, pitch and yaw; the stamp is set when the goal is sent.
 
 Outcomes: an action goal ends with an ``action_msgs/msg/GoalStatus`` code (:func:`goal_outcome`):
-SUCCEEDED (4) is :attr:`Outcome.SUCCEEDED`, ABORTED (6) :attr:`Outcome.ABORTED`, CANCELED (5)
-:attr:`Outcome.CANCELLED` (cancelled by someone else than the dispatcher, whose own cancels are
-not reported), UNKNOWN (0: the server no longer knows the goal) :attr:`Outcome.ABORTED`; a goal
-the server did not accept is :attr:`Outcome.REJECTED`.  ACCEPTED, EXECUTING and CANCELING are not
+SUCCEEDED (4) is :attr:`GoalOutcome.SUCCEEDED`, ABORTED (6) :attr:`GoalOutcome.ABORTED`, CANCELED (5)
+:attr:`GoalOutcome.CANCELLED` (cancelled by someone else than the dispatcher, whose own cancels are
+not reported), UNKNOWN (0: the server no longer knows the goal) :attr:`GoalOutcome.ABORTED`; a goal
+the server did not accept is :attr:`GoalOutcome.REJECTED`.  ACCEPTED, EXECUTING and CANCELING are not
 ends.
 """
 
@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.execute.mission import Goal, Schedule
-from exsce_dsl.execute.outcomes import Outcome
+from exsce_dsl.execute.outcomes import GoalOutcome
 from exsce_dsl.model import Pose, Scenario
 from exsce_dsl.model.conventions import NAV2, Navigation
 from exsce_dsl.model.geometry import quaternion
@@ -50,10 +50,10 @@ STATUS_CANCELED = 5
 STATUS_ABORTED = 6
 
 _ENDS = {
-    STATUS_SUCCEEDED: Outcome.SUCCEEDED,
-    STATUS_ABORTED: Outcome.ABORTED,
-    STATUS_CANCELED: Outcome.CANCELLED,
-    STATUS_UNKNOWN: Outcome.ABORTED,
+    STATUS_SUCCEEDED: GoalOutcome.SUCCEEDED,
+    STATUS_ABORTED: GoalOutcome.ABORTED,
+    STATUS_CANCELED: GoalOutcome.CANCELLED,
+    STATUS_UNKNOWN: GoalOutcome.ABORTED,
 }
 _UNDERWAY = {STATUS_ACCEPTED, STATUS_EXECUTING, STATUS_CANCELING}
 
@@ -153,11 +153,11 @@ def follow_waypoints_goals(scenario: Scenario, schedule: Schedule) -> tuple[Foll
     )
 
 
-def goal_outcome(status: int, accepted: bool = True) -> Outcome | None:
+def goal_outcome(status: int, accepted: bool = True) -> GoalOutcome | None:
     """The outcome of a goal whose result came with ``status`` (a GoalStatus code); None while it
     is underway.  A goal the server did not accept is REJECTED, whatever the status."""
     if not accepted:
-        return Outcome.REJECTED
+        return GoalOutcome.REJECTED
     if status in _UNDERWAY:
         return None
     if status not in _ENDS:
@@ -167,7 +167,7 @@ def goal_outcome(status: int, accepted: bool = True) -> Outcome | None:
 
 def waypoint_outcomes(
     status: int, count: int, missed: Iterable[int], current: int
-) -> tuple[Outcome | None, ...]:
+) -> tuple[GoalOutcome | None, ...]:
     """Each waypoint's outcome of a ``FollowWaypoints`` goal of ``count`` waypoints that ended with
     ``status``, whose result listed the ``missed`` waypoints (indices from 0; Humble's
     ``int32[] missed_waypoints``, or the ``index`` of Jazzy's ``MissedWaypoint``) and whose last
@@ -181,12 +181,12 @@ def waypoint_outcomes(
     missing = set(missed)
     if any(not 0 <= i < count for i in missing):
         raise ExsceError(f"missed waypoints {sorted(missing)} outside the goal's {count} waypoints")
-    ends: list[Outcome | None] = []
+    ends: list[GoalOutcome | None] = []
     for index in range(count):
         if index in missing:
-            ends.append(Outcome.ABORTED)
-        elif outcome is Outcome.SUCCEEDED or index < current:
-            ends.append(Outcome.SUCCEEDED)
+            ends.append(GoalOutcome.ABORTED)
+        elif outcome is GoalOutcome.SUCCEEDED or index < current:
+            ends.append(GoalOutcome.SUCCEEDED)
         elif index == current:
             ends.append(outcome)
         else:

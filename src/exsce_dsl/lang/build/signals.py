@@ -25,13 +25,13 @@ from exsce_dsl.model.conventions import (
     NAV2,
     POSE_TYPES,
     VELOCITY_TYPES,
+    MetricSpan,
     Navigation,
     PoseSource,
     Signals,
     TfSource,
     Tolerance,
     TopicSource,
-    Window,
 )
 from exsce_dsl.model.messages import canonical_type
 from exsce_dsl.model.names import TOPIC_RULE, is_topic_pattern
@@ -119,7 +119,7 @@ def build_signals(
     if "ArrivalFact" in said:
         changes["tolerance"] = _tolerance(said["ArrivalFact"], span, error)
     if "WindowFact" in said:
-        changes["window"] = Window.RECORDING if said["WindowFact"].recording else Window.GOALS
+        changes["window"] = MetricSpan.RECORDING if said["WindowFact"].recording else MetricSpan.GOALS
     location = span(conventions[0] if conventions else mine[0])
     named = bool(conventions) or (base.named and base is not METHOD)
     own = frozenset(changes) - {"actions"}

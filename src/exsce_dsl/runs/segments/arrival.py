@@ -36,9 +36,9 @@ from exsce_dsl.model.conventions import Tolerance
 from exsce_dsl.runs.segments.track import (
     DEFAULT_TOLERANCE,
     SUCCEEDED,
-    Outcome,
     Segmentation,
     Track,
+    WaypointResult,
     angle_between,
     at,
     build_segmentation,
@@ -70,7 +70,7 @@ def arrival_segments(
     away = np.flatnonzero(from_start > tolerance.position)
     if not away.size:
         warnings.append(f"robot {robot} never moved: it stayed within {tolerance.position} m of {at(x0, y0)}")
-        outcomes = [Outcome(None, None, "NOT_STARTED")] * len(plan)
+        outcomes = [WaypointResult(None, None, "NOT_STARTED")] * len(plan)
         return build_segmentation(scenario, robot, plan, outcomes, track, tolerance, warnings)
     departure = int(away[0])
     still = (from_start[:departure] <= STILL_POSITION) & (
@@ -96,8 +96,9 @@ def arrival_segments(
                 f"robot {robot} never reached {planned.label} after {track.times[index]:.3f}"
                 + (f"; it and the {counted(later, 'waypoint')} after it are NOT_REACHED" if later else "")
             )
-            outcomes += [Outcome(None, None, "NOT_REACHED")] * (len(plan) - k)
+            outcomes += [WaypointResult(None, None, "NOT_REACHED")] * (len(plan) - k)
             break
-        outcomes.append(Outcome(float(track.times[index]), float(track.times[index + arrival]), SUCCEEDED))
+        reached = WaypointResult(float(track.times[index]), float(track.times[index + arrival]), SUCCEEDED)
+        outcomes.append(reached)
         index += arrival
     return build_segmentation(scenario, robot, plan, outcomes, track, tolerance, warnings)

@@ -48,10 +48,10 @@ from exsce_dsl.model.conventions import Tolerance
 from exsce_dsl.runs.segments.track import (
     DEFAULT_TOLERANCE,
     SUCCEEDED,
-    Outcome,
     PlannedWaypoint,
     Segmentation,
     Track,
+    WaypointResult,
     at,
     build_segmentation,
     matches,
@@ -86,7 +86,7 @@ def goal_segments(
     if not goals:
         return Segmentation((), (f"robot {robot} has no navigation goals: no segments from goals",))
     legs = goal_legs(goals, track, warnings)
-    outcomes: list[Outcome | None] = [None] * len(plan)
+    outcomes: list[WaypointResult | None] = [None] * len(plan)
     following, last = 0, -1  # the next planned waypoint to look at; the last one matched
     for leg in legs:
         if leg.target is None:
@@ -95,7 +95,7 @@ def goal_segments(
         previous = outcomes[last] if last >= 0 else None
         if previous is not None and previous.status != SUCCEEDED and _matches(plan[last], leg, tolerance):
             start = previous.start if previous.start is not None else leg.start
-            outcomes[last] = Outcome(start, leg.end, leg.status)
+            outcomes[last] = WaypointResult(start, leg.end, leg.status)
             warnings.append(
                 f"{leg.label} retries {plan[last].label} after {previous.status}: "
                 "the segment keeps the first attempt's start"
@@ -112,8 +112,8 @@ def goal_segments(
                 f"{leg.label} went on to {plan[match].label}"
             )
             for j in range(following, match):
-                outcomes[j] = Outcome(None, None, "SKIPPED")
-        outcomes[match] = Outcome(leg.start, leg.end, leg.status)
+                outcomes[j] = WaypointResult(None, None, "SKIPPED")
+        outcomes[match] = WaypointResult(leg.start, leg.end, leg.status)
         following, last = match + 1, match
     if last < 0:
         warnings.append(
@@ -121,7 +121,7 @@ def goal_segments(
             "by pose: no segments from goals"
         )
         return Segmentation((), tuple(warnings))
-    filled = [o if o is not None else Outcome(None, None, "NOT_STARTED") for o in outcomes]
+    filled = [o if o is not None else WaypointResult(None, None, "NOT_STARTED") for o in outcomes]
     return build_segmentation(scenario, robot, plan, filled, track, tolerance, warnings)
 
 

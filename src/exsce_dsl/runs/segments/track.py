@@ -4,7 +4,7 @@ A path segment is one planned waypoint of a robot's mission, from the robot's pr
 waypoint's pose.  The dispatcher's statuses (`segments`) say which waypoint each action was for;
 real stacks do not run the dispatcher, so `goal_segments` matches their navigation goals to the
 planned waypoints by pose and `arrival_segments` watches the robot's pose arrive at them.  Both
-find, for each planned waypoint, an `Outcome` (start, end, status), and `build_segmentation` turns the
+find, for each planned waypoint, an `WaypointResult` (start, end, status), and `build_segmentation` turns the
 outcomes into `RecordedAction`s with the same start-pose rule:
 
 - a segment the robot attempted (one with a start time) starts where it is expected to be: at
@@ -153,7 +153,7 @@ def planned_waypoints(scenario: Scenario, robot: str) -> list[PlannedWaypoint]:
 
 
 @dataclass(frozen=True)
-class Outcome:
+class WaypointResult:
     """What a source found for one planned waypoint."""
 
     start: float | None
@@ -177,7 +177,7 @@ def build_segmentation(
     scenario: Scenario,
     robot: str,
     plan: list[PlannedWaypoint],
-    outcomes: list[Outcome],
+    outcomes: list[WaypointResult],
     track: Track,
     tolerance: Tolerance,
     warnings: list[str],
