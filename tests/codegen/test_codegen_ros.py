@@ -426,7 +426,11 @@ def test_a_robot_at_the_root_reduces_its_topics_without_an_empty_level(
     """A robot with no namespace (a Nav2 TurtleBot's topics sit at the root): ``/{ns}/scan`` is
     ``/scan``, and its scans are reduced there, as for a namespaced robot."""
     package = packages[2]
-    topics = {t.replace("/tiago1/", "/"): s for t, s in package.config.TOPICS.items() if t.startswith("/tiago1/")}
+    topics = {
+        t.replace("/tiago1/", "/"): {**s, "signals": tuple(n.replace("/tiago1/", "/") for n in s.get("signals", ()))}
+        for t, s in package.config.TOPICS.items()
+        if t.startswith("/tiago1/")
+    }
     runtime = package.monitor_runtime.MonitorRuntime(package.monitors, [("tiago1", "")], topics, [])
     runtime.on_message("/waypoint_dispatcher/feedback", 0.0, _feedback("g1", [("w1", 1)]))
     for i, closest in enumerate((3.0, 1.25, 2.0)):

@@ -1,4 +1,5 @@
 """The live side of the metric monitors: messages in, metric values and oracle verdicts out.
+Long because: it is copied as one file into each node package (buffers, windows, runtime).
 
 This module imports only numpy and the standard library, like ``monitor_core`` (``tests/monitor_kit``
 holds them so): ``exscec generate ros1-monitor`` and ``ros2-monitor`` copy it as it is into the node
@@ -208,10 +209,9 @@ class _Column:
         return self.data[: self.n]
 
 
-Reduction = tuple[str, str, Any]
-
-
-def _reductions(entries: Mapping[str, list[Reduction]], names: Sequence[str]) -> list[Reduction]:
+def _reductions(
+    entries: Mapping[str, list[tuple[str, str, Any]]], names: Sequence[str]
+) -> list[tuple[str, str, Any]]:
     """The reductions the monitors ask of a topic under any of its ``names``, each once."""
     return list(dict.fromkeys(r for name in names for r in entries.get(name, [])))
 
