@@ -317,18 +317,25 @@ def _runtime(package: SimpleNamespace) -> Any:
     return package.monitor_runtime.MonitorRuntime(package.monitors, c.ROBOTS, c.TOPICS, c.ORACLES, c.SCENARIO)
 
 
+def fed_a_bag(package: SimpleNamespace, bag: Path) -> tuple[Any, list[tuple[str, float, Any]], Any]:
+    """The package's runtime fed every message of ``bag`` it subscribes to, the messages, and its
+    evaluation at the last one (which found no problem)."""
+    runtime = _runtime(package)
+    messages = _messages(bag, package.config.TOPICS)
+    for topic, t, msg in messages:
+        runtime.on_message(topic, t, msg)
+    evaluation = runtime.evaluate(messages[-1][1])
+    assert evaluation.problems == ()
+    return runtime, messages, evaluation
+
+
 @pytest.mark.parametrize("ros", [1, 2])
 def test_the_runtime_fed_a_bag_computes_what_ingest_computes_and_judges_it(
     packages: dict[int, SimpleNamespace], overspeed: dict[int, tuple[Path, Any]], ros: int
 ) -> None:
     package, (bag, analysed) = packages[ros], overspeed[ros]
-    runtime = _runtime(package)
-    messages = _messages(bag, package.config.TOPICS)
+    runtime, messages, evaluation = fed_a_bag(package, bag)
     assert {topic for topic, _, _ in messages} == set(package.config.TOPICS)
-    for topic, t, msg in messages:
-        runtime.on_message(topic, t, msg)
-    evaluation = runtime.evaluate(messages[-1][1])
-    assert evaluation.problems == ()
 
     compared = 0
     for value in analysed.run.metrics:

@@ -18,7 +18,7 @@ from exsce_dsl.lang import load_spec
 from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.sim.run import simulate
 
-from tests.codegen.test_codegen_ros import BUILDING, PACKAGE, _import_package, _messages, _runtime
+from tests.codegen.test_codegen_ros import BUILDING, PACKAGE, _import_package, fed_a_bag
 
 SIGNAL_METRICS = """
 metric live_east for each robot {
@@ -72,12 +72,7 @@ def test_a_live_monitor_computes_a_signal_metric_as_ingest_does(tmp_path: Path, 
     package = _import_package(out / PACKAGE / "src" if ros == 1 else out / PACKAGE)
     assert package.config.TOPICS["/tiago1/robot_pose"]["signals"] == ("/tiago1/~pose",)
     assert not any("~" in topic for topic in package.config.TOPICS)  # a node subscribes to bag topics
-    runtime = _runtime(package)
-    messages = _messages(run.bag, package.config.TOPICS)
-    for topic, t, msg in messages:
-        runtime.on_message(topic, t, msg)
-    evaluation = runtime.evaluate(messages[-1][1])
-    assert evaluation.problems == ()
+    _, _, evaluation = fed_a_bag(package, run.bag)
     compared = 0
     for value in analysed.run.metrics:
         if value.metric in LIVE and value.action is None:
