@@ -18,7 +18,8 @@ from exsce_dsl.codegen.monitors import monitor_files
 from exsce_dsl.lang import load_spec, standard_metrics
 from exsce_dsl.resources import package_file
 from exsce_dsl.runs.analyse import analyse_bag, run_metrics, wanted_topics
-from exsce_dsl.runs.bags.reading import read_bag
+from exsce_dsl.runs.bags.reading import bag_topics, read_bag
+from exsce_dsl.runs.signals.sources import choose_sources, signal_topic, signal_topics, signals_wanted
 from exsce_dsl.sim.run import simulate
 from exsce_dsl.user_cache import read_cached
 
@@ -66,8 +67,14 @@ def test_generate_writes_a_package_that_passes_ruff_and_computes_what_ingest_com
     scenario = load_spec(SPEC).scenario()
     run = next(iter(simulate(scenario, tmp_path / "runs", runs=1, seed=4)))
     analysed = analyse_bag(run.bag, scenario)
-    data = read_bag(run.bag, wanted_topics(run_metrics(scenario), list(scenario.robots)))
+    robots, types = list(scenario.robots), bag_topics(run.bag)
+    sources = {r.id: choose_sources(r, types) for r in robots}
+    wanted = wanted_topics(run_metrics(scenario), robots)
+    scan_paths = [p for r in robots for p in wanted.pop(signal_topic("scan", r.namespace)).paths]
+    data = read_bag(run.bag, {**wanted, **signals_wanted(sources.values(), scan_paths)})
     topics = {name: core.Topic(name, s.t, s.fields) for name, s in data.series.items()}
+    for mine in sources.values():  # the robots' signals, which the standard library reads
+        topics.update({n: core.Topic(n, s.t, s.fields) for n, s in signal_topics(mine, data).items()})
     for robot in scenario.robots:
         actions = [a for task in analysed.run.tasks if task.robot == robot.id for a in task.actions]
         start, end = min(a.start for a in actions).timestamp(), max(a.end for a in actions).timestamp()

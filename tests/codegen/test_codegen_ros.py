@@ -317,18 +317,25 @@ def _runtime(package: SimpleNamespace) -> Any:
     return package.monitor_runtime.MonitorRuntime(package.monitors, c.ROBOTS, c.TOPICS, c.ORACLES, c.SCENARIO)
 
 
+def fed_a_bag(package: SimpleNamespace, bag: Path) -> tuple[Any, list[tuple[str, float, Any]], Any]:
+    """The package's runtime fed every message of ``bag`` it subscribes to, the messages, and its
+    evaluation at the last one (which found no problem)."""
+    runtime = _runtime(package)
+    messages = _messages(bag, package.config.TOPICS)
+    for topic, t, msg in messages:
+        runtime.on_message(topic, t, msg)
+    evaluation = runtime.evaluate(messages[-1][1])
+    assert evaluation.problems == ()
+    return runtime, messages, evaluation
+
+
 @pytest.mark.parametrize("ros", [1, 2])
 def test_the_runtime_fed_a_bag_computes_what_ingest_computes_and_judges_it(
     packages: dict[int, SimpleNamespace], overspeed: dict[int, tuple[Path, Any]], ros: int
 ) -> None:
     package, (bag, analysed) = packages[ros], overspeed[ros]
-    runtime = _runtime(package)
-    messages = _messages(bag, package.config.TOPICS)
+    runtime, messages, evaluation = fed_a_bag(package, bag)
     assert {topic for topic, _, _ in messages} == set(package.config.TOPICS)
-    for topic, t, msg in messages:
-        runtime.on_message(topic, t, msg)
-    evaluation = runtime.evaluate(messages[-1][1])
-    assert evaluation.problems == ()
 
     compared = 0
     for value in analysed.run.metrics:
@@ -426,7 +433,11 @@ def test_a_robot_at_the_root_reduces_its_topics_without_an_empty_level(
     """A robot with no namespace (a Nav2 TurtleBot's topics sit at the root): ``/{ns}/scan`` is
     ``/scan``, and its scans are reduced there, as for a namespaced robot."""
     package = packages[2]
-    topics = {t.replace("/tiago1/", "/"): s for t, s in package.config.TOPICS.items() if t.startswith("/tiago1/")}
+    topics = {
+        t.replace("/tiago1/", "/"): {**s, "signals": tuple(n.replace("/tiago1/", "/") for n in s.get("signals", ()))}
+        for t, s in package.config.TOPICS.items()
+        if t.startswith("/tiago1/")
+    }
     runtime = package.monitor_runtime.MonitorRuntime(package.monitors, [("tiago1", "")], topics, [])
     runtime.on_message("/waypoint_dispatcher/feedback", 0.0, _feedback("g1", [("w1", 1)]))
     for i, closest in enumerate((3.0, 1.25, 2.0)):

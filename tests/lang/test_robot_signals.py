@@ -273,8 +273,14 @@ def test_a_signal_is_a_robots_not_the_missions(tmp_path: Path) -> None:
         load_spec(path)
 
 
-def test_live_monitors_refuse_a_metric_that_reads_a_signal(tmp_path: Path) -> None:
+def test_live_monitors_read_a_signal_from_the_methods_topic(tmp_path: Path) -> None:
+    """A live node subscribes to the method's pose topic for ``robot pose`` (its values:
+    tests/codegen/test_live_signals.py); a pose's yaw, computed at ingest, it refuses."""
     path = tmp_path / "scene.exsce"
     path.write_text(SCENE.replace("OVERRIDE", "") + SIGNAL_METRIC.replace("SUBJECT", "each robot"))
-    with pytest.raises(ExsceError, match="live monitors subscribe to topics and do not compute signals yet"):
+    files = ros1_monitor_files(load_spec(path), None)
+    config = next(text for name, text in files.items() if str(name).endswith("config.py"))
+    assert '"signals": ("/r1/~pose",)' in config
+    path.write_text(path.read_text().replace("max(pose.x)", "max(pose.yaw)"))
+    with pytest.raises(ExsceError, match="its yaw is computed at ingest only"):
         ros1_monitor_files(load_spec(path), None)

@@ -20,8 +20,9 @@ METHOD_TOPIC = re.compile(
 """The method's topic names as code writes them: a pattern with ``{ns}``, the dispatcher's
 feedback and result, or a quoted name below the namespace."""
 PENDING = {"exsce_dsl/lang/stdlib/metrics.exsce"}
-"""Files still written over the method's topics: the standard library reads them until its
-metrics are written over signals (issue 49, item 1)."""
+"""Files still written over the method's topics: the standard library's mission_duration,
+task_duration and waypoints_visited read the dispatcher's feedback and result until a robot's
+navigation goals are a signal (issue 49, item 1); its other metrics read signals."""
 
 
 def _hits(path: Path) -> list[str]:

@@ -233,3 +233,34 @@ def test_a_metric_reads_a_robots_signal_wherever_its_type_says_it_is(tmp_path: P
     assert sources["fastest_turn"] == ("/r2/cmd_vel",)
     method_sources = {v.metric: v.topics for v in method.run.metrics if v.robot == "r2"}
     assert method_sources["furthest_east"] == ("/r2/robot_pose",)
+
+
+SCAN_METRIC = """
+metric nearest_obstacle for each robot per segment {
+  "least laser range, read from the robot's scan signal"
+  unit m
+  reads laser: robot scan
+  value min(laser.ranges where laser.ranges >= laser.range_min and laser.ranges <= laser.range_max)
+}
+"""
+
+
+@pytest.mark.parametrize("robot_type, convention", [("torso no", "method"), ("convention nav2", "nav2")])
+def test_a_metric_reads_a_robots_scan_signal(tmp_path: Path, robot_type: str, convention: str) -> None:
+    """``reads laser: robot scan`` reads the scan the robot's convention says, wherever it is: its
+    values are the built-in distance_to_obstacles' (which reads the same scan), from the same topic."""
+    path = tmp_path / "scan.exsce"
+    path.write_text(yard_text(robot_type) + SCAN_METRIC)
+    scenario = load_spec(path).scenario()
+    (run,) = simulate(scenario, tmp_path / "bags", fmt="ros1", seed=5, convention=convention)
+    analysed = analyse_bag(run.bag, scenario)
+    values = _values(analysed)
+    compared = [
+        (value, values[("distance_to_obstacles", *key[1:])])
+        for key, value in values.items()
+        if key[0] == "nearest_obstacle"
+    ]
+    assert len(compared) >= 4
+    assert all(ours == builtin for ours, builtin in compared)
+    sources = {v.metric: v.topics for v in analysed.run.metrics if v.robot == "r2"}
+    assert sources["nearest_obstacle"] == sources["distance_to_obstacles"] == ("/r2/scan",)

@@ -339,16 +339,31 @@ def _between_robots(
     ]
 
 
+_READ = {
+    "pose": ("geometry_msgs/msg/PoseWithCovarianceStamped", ("pose.pose.position.x", "pose.pose.position.y")),
+    "scan": ("sensor_msgs/msg/LaserScan", ("ranges", "range_min", "range_max")),
+    "vel": ("geometry_msgs/msg/Twist", ("linear.x", "linear.y", "linear.z", "angular.z")),
+    "distance": ("std_msgs/msg/Float64", ("data",)),
+}
+"""What the hand-written path reads of each of a robot's topics."""
+
+
 def metrics_of_bag(path, scenario) -> tuple[list[MetricValue], list[Hotspot]]:  # type: ignore[no-untyped-def]
     """The hand-written path's values and hotspots for a bag of ``scenario``: the bag read with
     every field kept, the dispatcher's statuses segmented, then :func:`compute_metrics`."""
+    from exsce_dsl.model.messages import path_of
     from exsce_dsl.runs.analyse import run_metrics, wanted_topics
-    from exsce_dsl.runs.bags.reading import read_bag
+    from exsce_dsl.runs.bags.reading import Wanted, read_bag
     from exsce_dsl.runs.segments.dispatcher import SUCCEEDED, segments
     from exsce_dsl.runs.signals.dispatcher_statuses import dispatcher_statuses
 
     robots = [r for r in scenario.robots if r.start_pose is not None]
-    data = read_bag(path, wanted_topics(run_metrics(scenario), robots))
+    wanted = wanted_topics(run_metrics(scenario), robots)
+    for robot in robots:  # the method's topics, named here (the standard library reads signals)
+        topics = robot_topics(robot.namespace)
+        for key, (msgtype, names) in _READ.items():
+            wanted[topics[key]] = Wanted(msgtype, tuple(path_of(*n.split(".")) for n in names))
+    data = read_bag(path, wanted)
     actions: list[RecordedAction] = []
     results: dict[str, int | None] = {}
     for robot in robots:

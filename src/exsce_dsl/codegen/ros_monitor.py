@@ -27,7 +27,7 @@ from exsce_dsl.messages.catalogue import MessageTypeError
 from exsce_dsl.messages.user import configured_catalogue
 from exsce_dsl.model import Scenario, Specification
 from exsce_dsl.model.acceptance import BasicRelation
-from exsce_dsl.model.conventions import DISPATCHER_FEEDBACK, DISPATCHER_RESULT
+from exsce_dsl.model.conventions import DISPATCHER_FEEDBACK, DISPATCHER_RESULT, METHOD
 from exsce_dsl.model.expressions import Field, walk
 from exsce_dsl.model.messages import (
     FEEDBACK,
@@ -40,7 +40,7 @@ from exsce_dsl.model.messages import (
     Step,
     canonical_type,
 )
-from exsce_dsl.model.metrics import ComputedFor, MetricDefinition, expand_topic
+from exsce_dsl.model.metrics import ComputedFor, MetricDefinition, TopicRead, expand_topic
 from exsce_dsl.model.names import ROS_TOPIC_RULE, is_ros_topic
 from exsce_dsl.oracles.plan import PlannedOracle, plan_oracles
 from exsce_dsl.prov.identifiers import oracle_name
@@ -57,6 +57,9 @@ _ROSPY_TIME = {"sec": "secs", "nanosec": "nsecs"}
 """rospy's names of the fields of a time or a duration, which ROS 2 (and exsce's paths) name
 otherwise."""
 _COPIED = ("monitor_core.py", "monitor_runtime.py")
+_POSE_AXES = ("x", "y", "z")
+_POSE_AT = ("pose", "pose", "position")
+"""Where the method's pose (``PoseWithCovarianceStamped``) holds a position."""
 
 
 @dataclass
@@ -68,6 +71,8 @@ class TopicEntry:
     robot: str | None = None
     fields: dict[str, str] = field(default_factory=dict)
     arrays: list[str] = field(default_factory=list)
+    signals: list[str] = field(default_factory=list)
+    """The robot's signals (``/r1/~pose``) the monitors read from this topic, by those names."""
 
     @property
     def python_type(self) -> str:
@@ -144,25 +149,42 @@ def monitor_topics(
                 if not isinstance(node, Field):
                     continue
                 read = reads[node.read]
+                topic, msgtype, path = read.topic_of(ns), canonical_type(read.msgtype), node.path
+                if read.signal:  # live: the method's topic for the signal (its convention's)
+                    topic, msgtype, path = _method_signal(metric, read, path, ns)
+                entry = add(topic, TopicEntry(msgtype), f"metric {metric.name}", read.location)
                 if read.signal:
-                    raise GenerationError(
-                        f"metric '{metric.name}' reads the robot's {read.signal} (its signal, wherever its "
-                        "type says it is): live monitors subscribe to topics and do not compute signals yet; "
-                        "read a topic in this metric to monitor it live",
-                        read.location,
-                    )
-                wanted = TopicEntry(canonical_type(read.msgtype))
-                entry = add(read.topic_of(ns), wanted, f"metric {metric.name}", read.location)
+                    entry.signals = sorted({*entry.signals, read.topic_of(ns)})
                 if entry.msgtype not in trees:
                     trees[entry.msgtype] = _tree(entry.msgtype)
                 key = node.path.key
-                entry.fields[key] = attribute_path(node.path, trees[entry.msgtype]) if ros == 1 else key
+                entry.fields[key] = attribute_path(path, trees[entry.msgtype]) if ros == 1 else path.key
                 if node.arrays and key not in entry.arrays:
                     entry.arrays.append(key)
     for entry in topics.values():
         entry.fields = dict(sorted(entry.fields.items()))
         entry.arrays.sort()
     return dict(sorted(topics.items()))
+
+
+def _method_signal(
+    metric: MetricDefinition, read: TopicRead, path: FieldPath, namespace: str
+) -> tuple[str, str, FieldPath]:
+    """Where a live monitor reads a robot's signal: the topic and type of the method's convention
+    (:data:`~exsce_dsl.model.conventions.METHOD`, which the robots a monitor watches publish), and
+    the field of its message that holds ``path``; a pose's yaw is no field of it: an error."""
+    (source,) = getattr(METHOD, str(read.signal))
+    msgtype = canonical_type(source.msgtype or "")
+    if read.signal != "pose":
+        return expand_topic(source.topic, namespace), msgtype, path
+    if path.picks or len(path.steps) != 1 or path.steps[0] not in _POSE_AXES:
+        raise GenerationError(
+            f"metric '{metric.name}' reads the robot's pose.{path.key}: live monitors read a pose's "
+            f"position ({', '.join('pose.' + a for a in _POSE_AXES)}) from {msgtype}; its yaw is "
+            "computed at ingest only",
+            read.location,
+        )
+    return expand_topic(source.topic, namespace), msgtype, FieldPath((*_POSE_AT, *path.steps), path.length)
 
 
 def attribute_path(path: FieldPath, tree: Fields | None) -> str:

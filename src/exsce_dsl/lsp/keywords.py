@@ -26,7 +26,8 @@ _WRITTEN: dict[str, str] = {
     "velocity` reads it (`vel.linear.x` ... `vel.angular.z`).",
     "scan": '`scan on "/{ns}/base_scan" [at 10 Hz]`: the robot\'s laser scan (sensor_msgs/msg/LaserScan); '
     "`scan at 10 Hz`: the rate it is published at, wherever it is read from (a run that recorded it "
-    "at less than half of it is told at ingest).",
+    "at less than half of it is told at ingest). In a metric, `reads laser: robot scan` reads it "
+    "(`laser.ranges`, `laser.range_min` ...).",
     "Hz": "`at 10 Hz`: the rate a robot's signal is published at (pose, velocity, scan or distance); a "
     "run recorded at less than half of it is reported at ingest, and its clauses are inconclusive.",
     "distance": "`reads odometer: robot distance`: in a metric, the distance the robot has travelled "

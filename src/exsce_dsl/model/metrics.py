@@ -44,6 +44,7 @@ SIGNAL_TYPES = {
     "pose": "exsce_msgs/msg/RobotPose",
     "velocity": "geometry_msgs/msg/Twist",
     "distance": "std_msgs/msg/Float64",
+    "scan": "sensor_msgs/msg/LaserScan",
 }
 """A robot's signals a metric can read, and the type whose fields each has."""
 

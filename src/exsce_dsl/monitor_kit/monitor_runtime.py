@@ -1,4 +1,5 @@
 """The live side of the metric monitors: messages in, metric values and oracle verdicts out.
+Long because: it is copied as one file into each node package (buffers, windows, runtime).
 
 This module imports only numpy and the standard library, like ``monitor_core`` (``tests/monitor_kit``
 holds them so): ``exscec generate ros1-monitor`` and ``ros2-monitor`` copy it as it is into the node
@@ -173,6 +174,12 @@ class TopicSpec:
     fields: Mapping[str, str] = field(default_factory=dict)
     arrays: tuple[str, ...] = ()
     """The fields that hold arrays (one row per message, rows may differ in length)."""
+    signals: tuple[str, ...] = ()
+    """The robot's signals (``/r1/~pose``) the monitors read from this topic, by those names."""
+
+    def names(self, topic: str) -> tuple[str, ...]:
+        """The names the monitors read this topic by: its own and its signals'."""
+        return (topic, *self.signals)
 
 
 class _Column:
@@ -200,6 +207,13 @@ class _Column:
 
     def view(self) -> np.ndarray:
         return self.data[: self.n]
+
+
+def _reductions(
+    entries: Mapping[str, list[tuple[str, str, Any]]], names: Sequence[str]
+) -> list[tuple[str, str, Any]]:
+    """The reductions the monitors ask of a topic under any of its ``names``, each once."""
+    return list(dict.fromkeys(r for name in names for r in entries.get(name, [])))
 
 
 def _padded(rows: Sequence[np.ndarray]) -> np.ndarray:
@@ -393,11 +407,11 @@ class MonitorRuntime:
         for _, namespace in self.robots:
             for pattern, *reduction in monitors.REDUCERS:
                 entries.setdefault(self.core.expand_topic(pattern, namespace), []).append(tuple(reduction))
-        self.buffers = {
-            name: _Buffer(spec, self.core.reducer(entries[name]) if name in entries else None)
-            for name, spec in self.specs.items()
-            if spec.role == "data"
-        }
+        self.buffers: dict[str, _Buffer] = {}
+        for name, spec in self.specs.items():
+            found = _reductions(entries, spec.names(name))
+            if spec.role == "data":
+                self.buffers[name] = _Buffer(spec, self.core.reducer(found) if found else None)
         self.dispatch = {robot: _Dispatch() for robot, _ in self.robots}
         self.succeeded: dict[str, int] = {}
         self.problems: dict[str, None] = {}  # insertion-ordered set
@@ -433,7 +447,12 @@ class MonitorRuntime:
     def evaluate(self, now: float) -> Evaluation:
         """The metrics over each robot's window and the mission's so far, and each oracle's verdict."""
         with self._lock:
-            topics = {name: b.topic(self.core, name) for name, b in self.buffers.items() if b.t.n}
+            topics = {
+                alias: b.topic(self.core, alias)
+                for name, b in self.buffers.items()
+                if b.t.n
+                for alias in self.specs[name].names(name)
+            }
             windows = {robot: self.dispatch[robot].window(now) for robot, _ in self.robots}
             succeeded = dict(self.succeeded)
         problems: dict[str, None] = {}

@@ -124,8 +124,9 @@ def wanted_topics(metrics: tuple[MetricDefinition, ...], robots: list[Robot]) ->
         for metric in metrics:
             read_paths = fields_read(metric)
             for read in metric.reads:
-                if read.signal:  # a signal: read from the sources runs/signals chooses
+                if read.signal and read.signal != "scan":  # read from the sources runs/signals chooses
                     continue
+                # a scan signal keeps the fields the metric reads of it (StackRobots.adapt)
                 topic = expand_topic(read.topic, ns)
                 types.setdefault(topic, OBJECTS if read.msgtype in DISPATCHER else read.msgtype)
                 paths.setdefault(topic, {}).update(dict.fromkeys(read_paths.get(read.name, ())))

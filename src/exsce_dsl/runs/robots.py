@@ -70,6 +70,9 @@ class StackRobots:
         scan_paths: list[FieldPath] = []
         popped: dict[str, Wanted] = {}
         for robot in robots:
+            scan = adapted.pop(signal_topic("scan", robot.namespace), None)
+            if scan is not None:  # a metric's scan signal: what it reads of the chosen scan
+                scan_paths += scan.paths
             if robot.id not in self.serves:
                 continue
             for signal, pattern in SERVED.items():

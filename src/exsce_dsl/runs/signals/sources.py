@@ -317,6 +317,8 @@ def _signal(
     if signal == "velocity":
         prefix = ".".join(_VELOCITY_AT[chosen.msgtype])
         fields = {key: series.fields[f"{prefix}.{key}" if prefix else key] for key in _VELOCITY_KEYS}
+        if not three_d:  # a planar robot's speed is in x-y: max_velocity is the norm of linear
+            fields["linear.z"] = np.zeros(len(series.t))
         return Topic(name, series.t, fields)
     if signal == "distance" and chosen.msgtype != FLOAT64:
         return _distance(name, series, _POSE_AT[chosen.msgtype], three_d)

@@ -17,7 +17,7 @@ from . import monitor_core as core
 
 
 def _reduce_distance_to_obstacles_0_0(topic_0: core.Topic) -> tuple[core.Signal, core.Signal | None]:
-    """The per-message values of min(...) over arrays, for some messages of "/{ns}/scan"."""
+    """The per-message values of min(...) over arrays, for some messages of "/{ns}/~scan"."""
     return (
         topic_0.field("ranges"),
         core.combine(np.logical_and, core.combine(np.greater_equal, topic_0.field("ranges"), topic_0.field("range_min")), core.combine(np.less_equal, topic_0.field("ranges"), topic_0.field("range_max"))),
@@ -25,7 +25,7 @@ def _reduce_distance_to_obstacles_0_0(topic_0: core.Topic) -> tuple[core.Signal,
 
 
 REDUCERS: list[tuple[str, str, str, core.Compute]] = [
-    ("/{ns}/scan", "distance_to_obstacles/0/0", "min", _reduce_distance_to_obstacles_0_0),
+    ("/{ns}/~scan", "distance_to_obstacles/0/0", "min", _reduce_distance_to_obstacles_0_0),
 ]
 """(topic, key, aggregate, values): aggregates over arrays, reduced per message as a bag is read."""
 
@@ -123,7 +123,7 @@ class RobotMetrics:
 
     def _prepare_distance_travelled(self) -> tuple[int, list[core.Prepared]] | None:
         # the value: change(distance.data)
-        topic_0 = self.topic("/{ns}/distance_travelled")
+        topic_0 = self.topic("/{ns}/~distance")
         if topic_0 is not None:
             return 0, [
                 core.prepare(
@@ -132,15 +132,15 @@ class RobotMetrics:
                     None,
                 ),
             ]
-        # otherwise: path_length(pose.pose.pose.position.x, pose.pose.pose.position.y)
-        topic_0 = self.topic("/{ns}/robot_pose")
+        # otherwise: path_length(pose.x, pose.y)
+        topic_0 = self.topic("/{ns}/~pose")
         if topic_0 is not None:
             return 1, [
                 core.prepare(
                     "path_length",
-                    topic_0.field("pose.pose.position.x"),
+                    topic_0.field("x"),
                     None,
-                    topic_0.field("pose.pose.position.y"),
+                    topic_0.field("y"),
                 ),
             ]
         return None
@@ -162,7 +162,7 @@ class RobotMetrics:
 
     def _prepare_distance_to_obstacles(self) -> tuple[int, list[core.Prepared]] | None:
         # the value: min(scan.ranges where scan.ranges >= scan.range_min and scan.ranges <= scan.range_max)
-        topic_0 = self.topic("/{ns}/scan")
+        topic_0 = self.topic("/{ns}/~scan")
         if topic_0 is not None:
             return 0, [
                 core.reduced("min", topic_0, "distance_to_obstacles/0/0", _reduce_distance_to_obstacles_0_0),
@@ -186,7 +186,7 @@ class RobotMetrics:
 
     def _prepare_max_velocity(self) -> tuple[int, list[core.Prepared]] | None:
         # the value: max(norm(vel.linear.x, vel.linear.y, vel.linear.z))
-        topic_0 = self.topic("/{ns}/nav_vel")
+        topic_0 = self.topic("/{ns}/~velocity")
         if topic_0 is not None:
             return 0, [
                 core.prepare(
@@ -326,14 +326,14 @@ class MissionMetrics:
         return core.finite(a[0])
 
     def _prepare_distance_between_robots(self, first: str, second: str) -> tuple[int, list[core.Prepared]] | None:
-        # the value: min(norm(a.pose.pose.pose.position.x - b.pose.pose.pose.position.x, a.pose.pose.pose.position.y - b.pose.pose.pose.position.y))
-        topic_0 = self.topic(first, "/{ns}/robot_pose")
-        topic_1 = self.topic(second, "/{ns}/robot_pose")
+        # the value: min(norm(a.pose.x - b.pose.x, a.pose.y - b.pose.y))
+        topic_0 = self.topic(first, "/{ns}/~pose")
+        topic_1 = self.topic(second, "/{ns}/~pose")
         if topic_0 is not None and topic_1 is not None:
             return 0, [
                 core.prepare(
                     "min",
-                    core.norm(core.combine(np.subtract, topic_0.field("pose.pose.position.x"), topic_1.field("pose.pose.position.x")), core.combine(np.subtract, topic_0.field("pose.pose.position.y"), topic_1.field("pose.pose.position.y"))),
+                    core.norm(core.combine(np.subtract, topic_0.field("x"), topic_1.field("x")), core.combine(np.subtract, topic_0.field("y"), topic_1.field("y"))),
                     None,
                 ),
             ]

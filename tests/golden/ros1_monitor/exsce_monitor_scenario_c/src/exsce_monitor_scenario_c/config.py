@@ -29,6 +29,7 @@ TOPICS: dict[str, dict[str, Any]] = {
             "data": "data",
         },
         "arrays": (),
+        "signals": ("/tiago1/~distance",),
     },
     "/tiago1/nav_vel": {
         "type": "geometry_msgs.msg.Twist",
@@ -41,16 +42,18 @@ TOPICS: dict[str, dict[str, Any]] = {
             "linear.z": "linear.z",
         },
         "arrays": (),
+        "signals": ("/tiago1/~velocity",),
     },
     "/tiago1/robot_pose": {
         "type": "geometry_msgs.msg.PoseWithCovarianceStamped",
         "role": "data",
         "robot": None,
         "fields": {
-            "pose.pose.position.x": "pose.pose.position.x",
-            "pose.pose.position.y": "pose.pose.position.y",
+            "x": "pose.pose.position.x",
+            "y": "pose.pose.position.y",
         },
         "arrays": (),
+        "signals": ("/tiago1/~pose",),
     },
     "/tiago1/scan": {
         "type": "sensor_msgs.msg.LaserScan",
@@ -62,6 +65,7 @@ TOPICS: dict[str, dict[str, Any]] = {
             "ranges": "ranges",
         },
         "arrays": ("ranges",),
+        "signals": ("/tiago1/~scan",),
     },
     "/tiago1/waypoint_dispatcher/feedback": {
         "type": "waypoint_dispatcher.msg.FollowWaypointsActionFeedback",
@@ -85,6 +89,7 @@ TOPICS: dict[str, dict[str, Any]] = {
             "data": "data",
         },
         "arrays": (),
+        "signals": ("/tiago2/~distance",),
     },
     "/tiago2/nav_vel": {
         "type": "geometry_msgs.msg.Twist",
@@ -97,16 +102,18 @@ TOPICS: dict[str, dict[str, Any]] = {
             "linear.z": "linear.z",
         },
         "arrays": (),
+        "signals": ("/tiago2/~velocity",),
     },
     "/tiago2/robot_pose": {
         "type": "geometry_msgs.msg.PoseWithCovarianceStamped",
         "role": "data",
         "robot": None,
         "fields": {
-            "pose.pose.position.x": "pose.pose.position.x",
-            "pose.pose.position.y": "pose.pose.position.y",
+            "x": "pose.pose.position.x",
+            "y": "pose.pose.position.y",
         },
         "arrays": (),
+        "signals": ("/tiago2/~pose",),
     },
     "/tiago2/scan": {
         "type": "sensor_msgs.msg.LaserScan",
@@ -118,6 +125,7 @@ TOPICS: dict[str, dict[str, Any]] = {
             "ranges": "ranges",
         },
         "arrays": ("ranges",),
+        "signals": ("/tiago2/~scan",),
     },
     "/tiago2/waypoint_dispatcher/feedback": {
         "type": "waypoint_dispatcher.msg.FollowWaypointsActionFeedback",
