@@ -39,7 +39,8 @@ from rosbags.rosbag2 import Writer as Writer2
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 from exsce_dsl.model.messages import FieldPath, Index, Select, path_of
-from exsce_dsl.runs.bags.reading import Wanted, read_bag
+from exsce_dsl.runs.bags.data import Wanted
+from exsce_dsl.runs.bags.reading import read_bag
 
 NESTED = {
     "bench_msgs/msg/Item": "string name\nfloat64[] values\nint32 id\n",

@@ -28,7 +28,7 @@ from xml.sax.saxutils import escape
 
 import jinja2
 
-from exsce_dsl.errors import GenerationError as GenerationError
+from exsce_dsl.errors import GenerationError
 from exsce_dsl.resources import resource_dir
 
 _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")

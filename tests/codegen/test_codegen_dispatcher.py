@@ -17,9 +17,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from exsce_dsl.codegen.dispatcher import MISSION_FILE, dispatcher_files, generate_dispatcher_config
+from exsce_dsl.errors import GenerationError
 from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Document, Orientation, Pose, Position, Scenario, Specification, Subtask, Task
-from exsce_dsl.templating import GenerationError
 
 from tests.support.paths import EXAMPLES, FIXTURES
 

@@ -33,6 +33,7 @@ from exsce_dsl.codegen.ros_monitor import (
     ros1_monitor_files,
     ros2_monitor_files,
 )
+from exsce_dsl.errors import GenerationError
 from exsce_dsl.lang import load_spec, standard_metrics
 from exsce_dsl.model.conventions import DISPATCHER_FEEDBACK, DISPATCHER_RESULT
 from exsce_dsl.monitor_kit import monitor_runtime
@@ -41,7 +42,6 @@ from exsce_dsl.resources import package_file
 from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
-from exsce_dsl.templating import GenerationError
 
 from tests.support.cli import exscec_here
 from tests.support.paths import EXAMPLES

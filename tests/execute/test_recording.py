@@ -9,9 +9,10 @@ from pathlib import Path
 import pytest
 
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.execute.recording import ALWAYS, PROV_TOPIC, recorded_topics
+from exsce_dsl.execute.recording import ALWAYS, recorded_topics
 from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
+from exsce_dsl.runs.coverage import PROV_TOPIC
 
 from tests.support.paths import EXAMPLES
 

@@ -16,10 +16,11 @@ from types import SimpleNamespace
 import pytest
 
 from exsce_dsl.codegen.ros_monitor import attribute_path, monitor_topics
+from exsce_dsl.errors import MessageTypeError
 from exsce_dsl.lang import analyse
 from exsce_dsl.lang.format.metrics import expression_text, metric_lines
 from exsce_dsl.lsp.fields import field_hover, offers
-from exsce_dsl.messages.catalogue import MessageTypeError, Source, parse_definition, standard_catalogue
+from exsce_dsl.messages.catalogue import Source, parse_definition, standard_catalogue
 from exsce_dsl.messages.field_check import check_fields
 from exsce_dsl.messages.user import configured_catalogue, user_catalogue
 from exsce_dsl.model.expressions import Aggregate, Field

@@ -6,7 +6,6 @@ Each case writes a small specification, runs the real `exscec check` on it and r
 
 from __future__ import annotations
 
-import importlib
 import re
 from collections.abc import Sequence
 from pathlib import Path
@@ -395,32 +394,6 @@ def test_every_error_class_is_in_the_errors_module() -> None:
     public = {n for n in defined if not n.startswith("_")}
     missing = sorted(n for n in public if n not in errors_module.__all__ or not hasattr(errors_module, n))
     assert missing == [], f"not in exsce_dsl.errors: {missing}"
-
-
-@pytest.mark.parametrize(
-    ("module", "name"),
-    [
-        ("exsce_dsl.templating", "GenerationError"),
-        ("exsce_dsl.lsp.navigation", "RenameError"),
-        ("exsce_dsl.oracles.relations", "RelationError"),
-        ("exsce_dsl.maps.planning", "PlanningError"),
-        ("exsce_dsl.store.base", "StoreError"),
-        ("exsce_dsl.store.base", "StoreLockedError"),
-        ("exsce_dsl.store.base", "StoreConflictError"),
-        ("exsce_dsl.store.queries.run_ids", "UnknownRunError"),
-        ("exsce_dsl.store.queries.run_ids", "AmbiguousRunError"),
-        ("exsce_dsl.messages.catalogue", "MessageTypeError"),
-        ("exsce_dsl.runs.bags.reading", "BagError"),
-        ("exsce_dsl.runs.signals.tf_poses", "TfError"),
-        ("exsce_dsl.runs.bags.decode", "DecodeError"),
-        ("exsce_dsl.runs.segments.dispatcher", "SegmentError"),
-        ("exsce_dsl.mcp_server.access", "TimeLimitError"),
-        ("exsce_dsl.mcp_server.arguments", "ArgumentError"),
-    ],
-)
-def test_an_error_keeps_its_old_name_and_is_the_errors_modules_class(module: str, name: str) -> None:
-    old = getattr(importlib.import_module(module), name)
-    assert old is getattr(errors_module, name)
 
 
 def test_a_broken_file_whose_import_string_no_file_can_have_gives_diagnostics(tmp_path: Path) -> None:

@@ -10,12 +10,11 @@ from pathlib import Path
 
 import pytest
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import ExsceError, RelationError
 from exsce_dsl.oracles import relations
 from exsce_dsl.oracles.relations import (
     Judgement,
     Relation,
-    RelationError,
     aggregate,
     all_of,
     any_of,

@@ -11,13 +11,12 @@ import pytest
 from rosbags.rosbag1 import Reader as Ros1Reader
 from rosbags.rosbag1 import Writer as Ros1Writer
 
+from exsce_dsl.errors import BagError, SegmentError
 from exsce_dsl.lang import load_spec
 from exsce_dsl.maps.planning import planning_grid
 from exsce_dsl.model.runs import MetricScope, MetricValue
 from exsce_dsl.runs.analyse import analyse_bag
-from exsce_dsl.runs.bags.reading import BagError
 from exsce_dsl.runs.ingest import ingest_bags
-from exsce_dsl.runs.segments.dispatcher import SegmentError
 from exsce_dsl.sim.executor import Fault, GoalStatus
 from exsce_dsl.sim.messages import typestore
 from exsce_dsl.sim.run import simulate

@@ -18,7 +18,7 @@ import pytest
 from pyoxigraph import Literal, Quad
 
 from exsce_dsl import api
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import ExsceError, StoreConflictError
 from exsce_dsl.lang import load_spec
 from exsce_dsl.oracles.judging import verify_runs
 from exsce_dsl.prov import DEFAULT_NAMESPACE, compile_scenario
@@ -26,7 +26,7 @@ from exsce_dsl.prov.run import compile_run
 from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.runs.ingest import IngestStatus, ingest_bags
 from exsce_dsl.sim.run import simulate
-from exsce_dsl.store.base import GraphSet, StoreConflictError
+from exsce_dsl.store.base import GraphSet
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.queries import run_metric_values, runs
 from exsce_dsl.store.writing import add_prov

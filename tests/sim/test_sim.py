@@ -214,7 +214,8 @@ def test_any_seed_gives_a_bag_with_valid_stamps(tmp_path):
     """Seed 100001 once started in the year 2300, past what a nanosecond stamp (and ROS 1 time) holds."""
     from exsce_dsl.lang import load_spec
     from exsce_dsl.model.messages import path_of
-    from exsce_dsl.runs.bags.reading import Wanted, read_bag
+    from exsce_dsl.runs.bags.data import Wanted
+    from exsce_dsl.runs.bags.reading import read_bag
     from exsce_dsl.sim.run import EPOCH, simulate
 
     scenario = load_spec(EXAMPLES / "brsu_building_c" / "scenario_c.exsce").scenario("scenario_c")

@@ -16,6 +16,7 @@ import pytest
 from prov.model import ProvDocument
 from pyoxigraph import BlankNode, CanonicalizationAlgorithm, Dataset
 
+from exsce_dsl.errors import StoreError
 from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
 from exsce_dsl.prov import compile_scenario
@@ -23,7 +24,7 @@ from exsce_dsl.prov.run import compile_run
 from exsce_dsl.rdf import to_quads
 from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.sim.run import simulate
-from exsce_dsl.store.base import Store, StoreError
+from exsce_dsl.store.base import Store
 from exsce_dsl.store.batch_writing import RunWriter, Written
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.remote import RemoteStore

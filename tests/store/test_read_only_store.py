@@ -18,7 +18,8 @@ from pathlib import Path
 import pytest
 from pyoxigraph import Literal, NamedNode, Quad
 
-from exsce_dsl.store.base import GraphSet, StoreError
+from exsce_dsl.errors import StoreError
+from exsce_dsl.store.base import GraphSet
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.open import open_store
 

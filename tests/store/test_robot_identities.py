@@ -10,10 +10,10 @@ from pathlib import Path
 
 import pytest
 
+from exsce_dsl.errors import StoreConflictError
 from exsce_dsl.lang import load_spec
 from exsce_dsl.prov import compile_scenario
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE
-from exsce_dsl.store.base import StoreConflictError
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.queries.terms import run_query
 from exsce_dsl.store.writing import add_prov

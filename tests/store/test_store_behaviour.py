@@ -12,7 +12,8 @@ from pathlib import Path
 import pytest
 from pyoxigraph import BlankNode, Literal, NamedNode, Quad
 
-from exsce_dsl.store.base import GraphSet, Store, StoreError
+from exsce_dsl.errors import StoreError
+from exsce_dsl.store.base import GraphSet, Store
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.remote import RemoteStore
 

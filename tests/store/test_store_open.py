@@ -11,7 +11,8 @@ from pathlib import Path
 import pytest
 from pyoxigraph import Literal, NamedNode, Quad
 
-from exsce_dsl.store.base import GraphSet, StoreError, StoreLockedError
+from exsce_dsl.errors import StoreError, StoreLockedError
+from exsce_dsl.store.base import GraphSet
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.open import open_store
 from exsce_dsl.store.remote import RemoteStore

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from exsce_dsl.store.base import StoreError
+from exsce_dsl.errors import StoreError
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.open import StoreOpening
 

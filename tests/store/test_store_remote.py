@@ -11,7 +11,8 @@ from pathlib import Path
 import pytest
 from pyoxigraph import Literal, NamedNode, Quad
 
-from exsce_dsl.store.base import GraphSet, StoreError
+from exsce_dsl.errors import StoreError
+from exsce_dsl.store.base import GraphSet
 from exsce_dsl.store.remote import RemoteStore
 
 from tests.support.store_servers import Server, free_port, oxigraph_server

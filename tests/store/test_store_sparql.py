@@ -5,7 +5,8 @@ from __future__ import annotations
 import pytest
 from pyoxigraph import BlankNode, Literal, NamedNode, Quad, Store
 
-from exsce_dsl.store.base import GraphSet, StoreError
+from exsce_dsl.errors import StoreError
+from exsce_dsl.store.base import GraphSet
 from exsce_dsl.store.sparql import bind, where_group, write_update
 
 

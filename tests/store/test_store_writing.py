@@ -10,10 +10,11 @@ import pytest
 from prov.model import ProvDocument
 from pyoxigraph import Literal, NamedNode, Quad
 
+from exsce_dsl.errors import StoreConflictError, StoreError
 from exsce_dsl.lang import load_spec
 from exsce_dsl.prov import compile_scenario
 from exsce_dsl.rdf import to_quads
-from exsce_dsl.store.base import Store, StoreConflictError, StoreError
+from exsce_dsl.store.base import Store
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.remote import RemoteStore
 from exsce_dsl.store.writing import add_graphs, add_prov, is_revision, revision_name

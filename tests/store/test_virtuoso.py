@@ -18,11 +18,12 @@ from pathlib import Path
 import pytest
 from pyoxigraph import BlankNode, CanonicalizationAlgorithm, Dataset, Literal, NamedNode, Quad
 
+from exsce_dsl.errors import StoreError
 from exsce_dsl.lang import load_spec
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
 from exsce_dsl.store import queries
-from exsce_dsl.store.base import GraphSet, Store, StoreError
+from exsce_dsl.store.base import GraphSet, Store
 from exsce_dsl.store.open import open_store
 from exsce_dsl.store.remote import RemoteStore
 

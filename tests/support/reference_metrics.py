@@ -16,7 +16,7 @@ import numpy as np
 
 from exsce_dsl.model.geometry import Position
 from exsce_dsl.model.runs import ActionId, Hotspot, MetricScope, MetricValue
-from exsce_dsl.runs.bags.reading import BagData, Series
+from exsce_dsl.runs.bags.data import BagData, Series
 from exsce_dsl.runs.segments.recorded import RecordedAction
 
 from tests.support.reference_path import hold
@@ -353,7 +353,8 @@ def metrics_of_bag(path, scenario) -> tuple[list[MetricValue], list[Hotspot]]:  
     every field kept, the dispatcher's statuses segmented, then :func:`compute_metrics`."""
     from exsce_dsl.model.messages import path_of
     from exsce_dsl.runs.analyse import run_metrics, wanted_topics
-    from exsce_dsl.runs.bags.reading import Wanted, read_bag
+    from exsce_dsl.runs.bags.data import Wanted
+    from exsce_dsl.runs.bags.reading import read_bag
     from exsce_dsl.runs.segments.dispatcher import SUCCEEDED, segments
     from exsce_dsl.runs.signals.dispatcher_statuses import dispatcher_statuses
 

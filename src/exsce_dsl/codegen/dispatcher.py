@@ -17,10 +17,11 @@ from typing import Any
 import yaml
 
 from exsce_dsl.codegen.output import write_files
+from exsce_dsl.errors import GenerationError
 from exsce_dsl.lang import scenario_to_yaml, task_to_yaml
 from exsce_dsl.model import Robot, Scenario, Specification, Task
 from exsce_dsl.model.names import is_valid_name
-from exsce_dsl.templating import GenerationError, render
+from exsce_dsl.templating import render
 
 MISSION_FILE = "mission.yaml"
 

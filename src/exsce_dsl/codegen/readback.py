@@ -15,8 +15,7 @@ from pathlib import Path, PurePosixPath
 
 import yaml
 
-from exsce_dsl.errors import SourceLocation
-from exsce_dsl.templating import GenerationError
+from exsce_dsl.errors import GenerationError, SourceLocation
 
 
 def _failed(

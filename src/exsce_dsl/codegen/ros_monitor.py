@@ -21,9 +21,8 @@ from pathlib import Path, PurePosixPath
 from typing import Any
 
 from exsce_dsl.codegen.output import write_files
-from exsce_dsl.errors import SourceLocation
+from exsce_dsl.errors import GenerationError, MessageTypeError, SourceLocation
 from exsce_dsl.lang import expectation_text, standard_metrics
-from exsce_dsl.messages.catalogue import MessageTypeError
 from exsce_dsl.messages.user import configured_catalogue
 from exsce_dsl.model import Scenario, Specification
 from exsce_dsl.model.acceptance import BasicRelation
@@ -46,7 +45,7 @@ from exsce_dsl.oracles.plan import PlannedOracle, plan_oracles
 from exsce_dsl.prov.identifiers import oracle_name
 from exsce_dsl.resources import package_file
 from exsce_dsl.runs.metrics.monitor_code import monitor_source
-from exsce_dsl.templating import GenerationError, python_name, python_string, render
+from exsce_dsl.templating import python_name, python_string, render
 
 FEEDBACK_TOPIC, RESULT_TOPIC = DISPATCHER_FEEDBACK, DISPATCHER_RESULT
 """The dispatcher's topics, where ingestion takes each robot's windows and successes from."""

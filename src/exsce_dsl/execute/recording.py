@@ -33,7 +33,7 @@ from exsce_dsl.model.metrics import expand_topic
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.runs.analyse import run_metrics, wanted_topics
 from exsce_dsl.runs.bags.names import topic_key
-from exsce_dsl.runs.coverage import PROV_TOPIC as PROV_TOPIC
+from exsce_dsl.runs.coverage import PROV_TOPIC
 from exsce_dsl.runs.robots import StackRobots
 
 ALWAYS = ("/tf", "/tf_static", "/clock", PROV_TOPIC)

@@ -8,13 +8,14 @@ import os
 
 from lsprotocol import types
 
+from exsce_dsl.errors import RenameError
 from exsce_dsl.lang import comments, continuations_at, display_path, format_spec_document, import_target
 from exsce_dsl.lsp.actions import quick_fixes
 from exsce_dsl.lsp.completion import complete
 from exsce_dsl.lsp.convert import path_of, uri_of
 from exsce_dsl.lsp.fields import field_hover, offers
 from exsce_dsl.lsp.hover import keyword_hover, symbol_hover, word_at
-from exsce_dsl.lsp.navigation import RENAMEABLE, Names, RenameError, import_at
+from exsce_dsl.lsp.navigation import RENAMEABLE, Names, import_at
 from exsce_dsl.lsp.outline import document_symbol, workspace_symbols
 from exsce_dsl.lsp.server import ExsceLanguageServer, failed, options_of
 

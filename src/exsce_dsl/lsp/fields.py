@@ -14,8 +14,9 @@ import re
 from dataclasses import dataclass
 from typing import Any
 
+from exsce_dsl.errors import MessageTypeError
 from exsce_dsl.lang import declaration_chunks
-from exsce_dsl.messages.catalogue import ARRAY, BASE, NAME, SEQUENCE, MessageCatalogue, MessageTypeError
+from exsce_dsl.messages.catalogue import ARRAY, BASE, NAME, SEQUENCE, MessageCatalogue
 from exsce_dsl.messages.user import configured_catalogue
 from exsce_dsl.model.messages import DISPATCHER, canonical_type
 

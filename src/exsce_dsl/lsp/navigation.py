@@ -13,8 +13,7 @@ import os
 from collections.abc import Collection, Sequence
 from dataclasses import dataclass
 
-from exsce_dsl.errors import RenameError as RenameError
-from exsce_dsl.errors import SourceLocation
+from exsce_dsl.errors import RenameError, SourceLocation
 from exsce_dsl.lang import SCOPED_KINDS, FileIndex, Reference, Symbol
 from exsce_dsl.model.names import is_valid_name
 

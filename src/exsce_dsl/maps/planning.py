@@ -19,8 +19,7 @@ import numpy as np
 from scipy import ndimage
 from scipy.sparse import csr_matrix
 
-from exsce_dsl.errors import ExsceError
-from exsce_dsl.errors import PlanningError as PlanningError
+from exsce_dsl.errors import ExsceError, PlanningError
 from exsce_dsl.maps.grid import OccupancyGrid, load_occupancy_grid
 from exsce_dsl.maps.paths import grid_graph, shortest_path
 from exsce_dsl.model import Scenario

@@ -25,10 +25,10 @@ from typing import TypeVar
 import anyio
 import anyio.to_thread
 
-from exsce_dsl.errors import TimeLimitError as TimeLimitError
+from exsce_dsl.errors import TimeLimitError
 from exsce_dsl.store.base import QUERY_TIMEOUT, Store
 
-__all__ = ["DEFAULT_MAX_ROWS", "Access", "TimeLimitError"]
+__all__ = ["DEFAULT_MAX_ROWS", "Access"]
 
 T = TypeVar("T")
 

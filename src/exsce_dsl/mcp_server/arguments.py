@@ -20,14 +20,13 @@ import re
 from collections.abc import Mapping
 from typing import Any
 
-from exsce_dsl.errors import ArgumentError as ArgumentError
+from exsce_dsl.errors import ArgumentError
 from exsce_dsl.model.names import NAME_PATTERN
 
 __all__ = [
     "NAME",
     "POSE_NAME",
     "RUN_ID",
-    "ArgumentError",
     "checked_arguments",
     "identifier",
     "object_schema",

@@ -26,10 +26,10 @@ from typing import TYPE_CHECKING, Any
 
 import mcp_types as types
 
-from exsce_dsl.errors import Diagnostic, Severity
+from exsce_dsl.errors import ArgumentError, Diagnostic, Severity
 from exsce_dsl.mcp_server.access import Access
 from exsce_dsl.mcp_server.answers import READ_ONLY, ToolEntry
-from exsce_dsl.mcp_server.arguments import ArgumentError, object_schema
+from exsce_dsl.mcp_server.arguments import object_schema
 from exsce_dsl.textfiles import reading_inside
 
 if TYPE_CHECKING:

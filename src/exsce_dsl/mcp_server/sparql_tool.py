@@ -30,10 +30,10 @@ from typing import Any
 
 import mcp_types as types
 
-from exsce_dsl.errors import ExsceError, FederationRefused
+from exsce_dsl.errors import ArgumentError, ExsceError, FederationRefused
 from exsce_dsl.mcp_server.access import Access
 from exsce_dsl.mcp_server.answers import READ_ONLY, ToolEntry, first_rows_json
-from exsce_dsl.mcp_server.arguments import ArgumentError, object_schema
+from exsce_dsl.mcp_server.arguments import object_schema
 from exsce_dsl.store.base import MAX_QUERY
 from exsce_dsl.store.federation import refuse_federation
 from exsce_dsl.store.queries import standard_prefixes

@@ -20,10 +20,10 @@ from typing import Any
 
 import mcp_types as types
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import ArgumentError, ExsceError
 from exsce_dsl.mcp_server.access import Access
 from exsce_dsl.mcp_server.answers import READ_ONLY, ToolEntry
-from exsce_dsl.mcp_server.arguments import NAME, RUN_ID, ArgumentError, identifier, object_schema
+from exsce_dsl.mcp_server.arguments import NAME, RUN_ID, identifier, object_schema
 from exsce_dsl.model.derivation import Derivation
 from exsce_dsl.model.verdicts import Outcome
 from exsce_dsl.oracles.report import verdicts_json

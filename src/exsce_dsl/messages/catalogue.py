@@ -16,7 +16,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from exsce_dsl.errors import MessageTypeError as MessageTypeError
+from exsce_dsl.errors import MessageTypeError
 from exsce_dsl.messages.typestore_cache import standard_fielddefs
 from exsce_dsl.model.messages import Fields, Leaf, MessageArray, Node, canonical_type
 

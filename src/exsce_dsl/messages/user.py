@@ -13,18 +13,10 @@ import functools
 from collections.abc import Iterable
 from pathlib import Path
 
-from exsce_dsl.errors import ExsceError
-from exsce_dsl.messages.catalogue import (
-    MessageCatalogue,
-    MessageTypeError,
-    Source,
-    parse_definition,
-    standard_catalogue,
-)
-from exsce_dsl.messages.msg_path import MSG_PATH as MSG_PATH
+from exsce_dsl.errors import ExsceError, MessageTypeError
+from exsce_dsl.messages.catalogue import MessageCatalogue, Source, parse_definition, standard_catalogue
 from exsce_dsl.messages.msg_path import definition_files as _definition_files
-from exsce_dsl.messages.msg_path import msg_path_files as msg_path_files
-from exsce_dsl.messages.msg_path import msg_path_folders as msg_path_folders
+from exsce_dsl.messages.msg_path import msg_path_folders
 from exsce_dsl.textfiles import read_text
 
 

@@ -19,7 +19,7 @@ from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
-from exsce_dsl.errors import RelationError as RelationError
+from exsce_dsl.errors import RelationError
 from exsce_dsl.plugins import Registry
 from exsce_dsl.suggest import did_you_mean
 
@@ -27,7 +27,6 @@ __all__ = [
     "RELATIONS",
     "Judgement",
     "Relation",
-    "RelationError",
     "aggregate",
     "all_of",
     "any_of",

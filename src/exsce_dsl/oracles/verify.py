@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import ExsceError, RelationError
 from exsce_dsl.lang import standard_metrics
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.acceptance import Window
@@ -15,7 +15,7 @@ from exsce_dsl.model.oracles import Oracle
 from exsce_dsl.model.verdicts import Outcome, Verdict
 from exsce_dsl.oracles.coverage_check import Span, clause_gaps, judge_coverage, learned_rate_gaps
 from exsce_dsl.oracles.observe import RunValues, observe, parse_window, run_values, window_segments
-from exsce_dsl.oracles.relations import RelationError, relation
+from exsce_dsl.oracles.relations import relation
 from exsce_dsl.oracles.sources import ValueSources
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.queries import StoredRun, action_times

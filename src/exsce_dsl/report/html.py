@@ -18,7 +18,7 @@ from pathlib import Path
 import jinja2
 
 from exsce_dsl import __version__
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import BagError, ExsceError
 from exsce_dsl.figures import save_figure
 from exsce_dsl.model.derivation import Derivation
 from exsce_dsl.model.verdicts import Verdict
@@ -29,7 +29,6 @@ from exsce_dsl.output_folder import written_whole
 from exsce_dsl.report.contents import ReportContents, RunContents, ScenarioContents
 from exsce_dsl.report.plots import campaign_figure, metrics_figure, trajectory_figure
 from exsce_dsl.resources import resource_dir
-from exsce_dsl.runs.bags.reading import BagError
 from exsce_dsl.runs.signals.trajectories import Trajectory, trajectories
 from exsce_dsl.similarity.dendrogram import dendrogram_figure
 from exsce_dsl.wording import counted, noun

@@ -10,7 +10,7 @@ from types import ModuleType
 
 import numpy as np
 
-from exsce_dsl.errors import ExsceError, IncompleteRunError
+from exsce_dsl.errors import BagError, ExsceError, IncompleteRunError
 from exsce_dsl.lang import standard_metrics
 from exsce_dsl.messages.catalogue import Source
 from exsce_dsl.messages.field_check import check_fields
@@ -33,17 +33,9 @@ from exsce_dsl.model.runs import (
 )
 from exsce_dsl.monitor_kit.monitor_core import Compute, Topic, expand_topic, reducer
 from exsce_dsl.runs.bag_identity import content_hash
-from exsce_dsl.runs.bags.data import BagData
+from exsce_dsl.runs.bags.data import OBJECTS, BagData, Check, Reduce, Wanted
 from exsce_dsl.runs.bags.names import BagTopics
-from exsce_dsl.runs.bags.reading import (
-    OBJECTS,
-    BagError,
-    Check,
-    Reduce,
-    Wanted,
-    bag_topics,
-    read_bag,
-)
+from exsce_dsl.runs.bags.reading import bag_topics, read_bag
 from exsce_dsl.runs.coverage import (
     PROV_TOPIC,
     Recording,

@@ -28,7 +28,8 @@ from exsce_dsl.model.conventions import Navigation, Signals
 from exsce_dsl.model.goals import GoalStatus
 from exsce_dsl.model.names import is_ros_namespace
 from exsce_dsl.model.robots import Robot, RobotType
-from exsce_dsl.runs.bags.reading import OBJECTS, BagData, Wanted, bag_topics, read_bag
+from exsce_dsl.runs.bags.data import OBJECTS, BagData, Wanted
+from exsce_dsl.runs.bags.reading import bag_topics, read_bag
 from exsce_dsl.runs.robots import StackRobots
 from exsce_dsl.runs.segments.dispatcher import dispatcher_goals
 from exsce_dsl.runs.segments.goals import goal_legs

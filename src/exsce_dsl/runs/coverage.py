@@ -41,7 +41,7 @@ from exsce_dsl.model.coverage import CoverageGap, Shortfall, TopicRate
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import MetricValue, RunStatus
 from exsce_dsl.monitor_kit.monitor_core import expand_topic
-from exsce_dsl.runs.bags.reading import BagData
+from exsce_dsl.runs.bags.data import BagData
 from exsce_dsl.runs.segments.recorded import RecordedAction
 from exsce_dsl.runs.signals.sources import SIGNALS, RobotSources
 from exsce_dsl.runs.signals.timeline import CLOCK_TOPIC, Timeline

@@ -32,7 +32,7 @@ from exsce_dsl.model.metrics import expand_topic
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import MetricValue
 from exsce_dsl.monitor_kit.monitor_core import Topic
-from exsce_dsl.runs.bags.reading import BagData, Wanted
+from exsce_dsl.runs.bags.data import BagData, Wanted
 from exsce_dsl.runs.segments.track import Track
 from exsce_dsl.runs.signals.navigation_goals import goal_wanted
 from exsce_dsl.runs.signals.sources import (

@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from exsce_dsl.model import Pose
-from exsce_dsl.model.goals import GoalStatus as GoalStatus
+from exsce_dsl.model.goals import GoalStatus
 
 
 @dataclass(frozen=True)

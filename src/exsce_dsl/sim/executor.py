@@ -19,7 +19,8 @@ import numpy as np
 from exsce_dsl.errors import ExsceError, PlanningError
 from exsce_dsl.maps.planning import PlanningGrid, Point
 from exsce_dsl.model import MissionType, Pose, Scenario
-from exsce_dsl.sim.actions import GoalEvent, GoalStatus, SimulatedAction
+from exsce_dsl.model.goals import GoalStatus
+from exsce_dsl.sim.actions import GoalEvent, SimulatedAction
 from exsce_dsl.sim.conflicts import MAX_REPAIRS, Leg, Repair, conflict_repairs, meetings
 from exsce_dsl.sim.faults import (
     DEADLOCK_WAIT,

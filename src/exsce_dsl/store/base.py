@@ -23,9 +23,7 @@ from dataclasses import dataclass
 
 from pyoxigraph import BlankNode, Literal, NamedNode, Quad
 
-from exsce_dsl.errors import StoreConflictError as StoreConflictError
-from exsce_dsl.errors import StoreError as StoreError
-from exsce_dsl.errors import StoreLockedError as StoreLockedError
+from exsce_dsl.errors import StoreError
 
 QUERY_TIMEOUT = 60.0
 """Seconds a query may take, evaluation and serialization, by default (``exscec serve``, ``exscec mcp``)."""

@@ -46,9 +46,9 @@ from types import TracebackType
 from prov.model import ProvDocument
 from pyoxigraph import RdfFormat, serialize
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import ExsceError, StoreError
 from exsce_dsl.rdf.prov_o import nquad_lines, quads_of_lines
-from exsce_dsl.store.base import Store, StoreError
+from exsce_dsl.store.base import Store
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.segment_index import segment_index
 from exsce_dsl.store.writing import WriteReport, add_prov

@@ -33,17 +33,8 @@ from pathlib import Path
 from pyoxigraph import BlankNode, NamedNode, Quad, QueryBoolean, QuerySolutions, RdfFormat
 from pyoxigraph import Store as OxStore
 
-from exsce_dsl.errors import StoreUnwritableError
-from exsce_dsl.store.base import (
-    Bindings,
-    GraphSet,
-    Replace,
-    Rows,
-    Store,
-    StoreError,
-    StoreLockedError,
-    replaced_names,
-)
+from exsce_dsl.errors import StoreError, StoreLockedError, StoreUnwritableError
+from exsce_dsl.store.base import Bindings, GraphSet, Replace, Rows, Store, replaced_names
 from exsce_dsl.store.sparql import bind, checked_quads, graph_node, write_update
 
 VIEW_ATTEMPTS = 5

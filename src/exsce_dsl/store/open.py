@@ -39,7 +39,8 @@ import urllib.parse
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from exsce_dsl.store.base import Store, StoreError
+from exsce_dsl.errors import StoreError
+from exsce_dsl.store.base import Store
 from exsce_dsl.store.embedded import EmbeddedStore
 
 if TYPE_CHECKING:  # imported when a URL names an endpoint: urllib.request and http.client are slow

@@ -45,8 +45,9 @@ from pyoxigraph import (
 )
 
 from exsce_dsl import __version__
+from exsce_dsl.errors import StoreError
 from exsce_dsl.prov.identifiers import SKOLEM_BASE
-from exsce_dsl.store.base import Bindings, GraphSet, Replace, Rows, Store, StoreError
+from exsce_dsl.store.base import Bindings, GraphSet, Replace, Rows, Store
 from exsce_dsl.store.flavours import StoreFlavour, ask_columns, server_flavour
 from exsce_dsl.store.sparql import bind, graph_node, query_form, term_text, write_update
 

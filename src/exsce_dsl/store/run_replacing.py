@@ -24,9 +24,10 @@ from collections.abc import Mapping, Sequence
 from prov.model import ProvDocument
 from pyoxigraph import Literal, NamedNode, Quad
 
+from exsce_dsl.errors import StoreConflictError
 from exsce_dsl.prov import identifiers as ids
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, PROV_NAMESPACE, Namespaces
-from exsce_dsl.store.base import GraphSet, Store, StoreConflictError
+from exsce_dsl.store.base import GraphSet, Store
 from exsce_dsl.store.segment_index import orphan_segment_graphs, segment_index
 from exsce_dsl.store.sparql import term_text
 from exsce_dsl.store.writing import WriteReport, bundle_graphs

@@ -14,7 +14,8 @@ from collections.abc import Iterable, Sequence
 
 from pyoxigraph import BlankNode, Literal, NamedNode, Quad
 
-from exsce_dsl.store.base import Bindings, GraphSet, Replace, StoreError, Term, replaced_names
+from exsce_dsl.errors import StoreError
+from exsce_dsl.store.base import Bindings, GraphSet, Replace, Term, replaced_names
 
 _VARIABLE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 

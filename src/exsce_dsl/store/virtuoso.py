@@ -19,8 +19,9 @@ from __future__ import annotations
 
 from pyoxigraph import BlankNode, Literal, NamedNode, RdfFormat, Triple, parse
 
+from exsce_dsl.errors import StoreError
 from exsce_dsl.prov.identifiers import LDP_NAMESPACE, SPARQL_RESULTS_NAMESPACE, XSD_NAMESPACE
-from exsce_dsl.store.base import Rows, StoreError, Term
+from exsce_dsl.store.base import Rows, Term
 
 OWN_GRAPHS = (
     "http://www.openlinksw.com/schemas/virtrdf#",

@@ -52,8 +52,9 @@ from pyoxigraph import (
     Quad,
 )
 
+from exsce_dsl.errors import StoreConflictError, StoreError
 from exsce_dsl.prov.identifiers import PROV_NAMESPACE, RDF_TYPE, ROBOT_SCHEMA, XSD_NAMESPACE
-from exsce_dsl.store.base import GraphSet, Store, StoreConflictError, StoreError
+from exsce_dsl.store.base import GraphSet, Store
 from exsce_dsl.store.graph_owners import replace_advice
 from exsce_dsl.store.literals import INTEGER_TYPES
 from exsce_dsl.store.segment_index import segment_index, stale_index_graphs

@@ -19,12 +19,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from exsce_dsl.errors import UnsupportedBag
+from exsce_dsl.errors import BagError, UnsupportedBag
 from exsce_dsl.lang import load_spec
 from exsce_dsl.prov import compile_scenario
 from exsce_dsl.runs.analyse import analyse_bag
 from exsce_dsl.runs.bags.files import check_bag_file
-from exsce_dsl.runs.bags.reading import BagError
 from exsce_dsl.runs.bags.ros1 import read_topics
 from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.writing import add_prov

@@ -38,7 +38,7 @@ from hypothesis import HealthCheck, given, note, settings
 from hypothesis import strategies as st
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import DecodeError, ExsceError
 from exsce_dsl.messages.catalogue import (
     MessageCatalogue,
     Source,
@@ -47,7 +47,7 @@ from exsce_dsl.messages.catalogue import (
     standard_ros1_catalogue,
 )
 from exsce_dsl.model.messages import FieldPath, Index, Select
-from exsce_dsl.runs.bags.decode import PRESENT, DecodeError, decode
+from exsce_dsl.runs.bags.decode import PRESENT, decode
 from exsce_dsl.runs.bags.raw_messages import RawMessages
 
 from tests.support import bag_factory as factory

@@ -13,11 +13,13 @@ import numpy as np
 import pytest
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
+from exsce_dsl.errors import DecodeError
 from exsce_dsl.messages.catalogue import standard_catalogue, standard_ros1_catalogue
 from exsce_dsl.model.messages import FieldPath, Index, path_of
-from exsce_dsl.runs.bags.decode import TEXTS, DecodeError, decode, decode_slowly
+from exsce_dsl.runs.bags.data import Wanted
+from exsce_dsl.runs.bags.decode import TEXTS, decode, decode_slowly
 from exsce_dsl.runs.bags.raw_messages import RawMessages
-from exsce_dsl.runs.bags.reading import Wanted, read_bag
+from exsce_dsl.runs.bags.reading import read_bag
 
 from tests.support import bag_factory as factory
 

@@ -7,8 +7,8 @@ from __future__ import annotations
 import pytest
 from rosbags.typesys import Stores, get_typestore
 
-from exsce_dsl.runs.bags.objects import deserialized
-from exsce_dsl.runs.bags.reading import BagError, LazyMessage
+from exsce_dsl.errors import BagError
+from exsce_dsl.runs.bags.objects import LazyMessage, deserialized
 
 STORE = get_typestore(Stores.ROS2_HUMBLE)
 

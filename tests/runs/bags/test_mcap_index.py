@@ -32,10 +32,11 @@ from rosbags.typesys import Stores, get_typestore
 from exsce_dsl.errors import UnsupportedBag
 from exsce_dsl.model.messages import path_of
 from exsce_dsl.runs.bags import reading as bagdata
+from exsce_dsl.runs.bags.data import OBJECTS, Wanted
 from exsce_dsl.runs.bags.mcap import mcap_files
 from exsce_dsl.runs.bags.mcap_index import read_topics, schemas
 from exsce_dsl.runs.bags.raw_messages import RawMessages
-from exsce_dsl.runs.bags.reading import OBJECTS, Wanted, read_bag
+from exsce_dsl.runs.bags.reading import read_bag
 from exsce_dsl.runs.bags.rosbags_fallback import read_with_rosbags
 from exsce_dsl.sim.messages import FEEDBACK
 from exsce_dsl.sim.messages import typestore as sim_typestore

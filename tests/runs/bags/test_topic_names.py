@@ -31,7 +31,8 @@ from exsce_dsl.prov import identifiers as ids
 from exsce_dsl.prov import serialize_prov
 from exsce_dsl.prov.run import compile_run
 from exsce_dsl.runs.analyse import analyse_bag
-from exsce_dsl.runs.bags.reading import Wanted, bag_topics, read_bag
+from exsce_dsl.runs.bags.data import Wanted
+from exsce_dsl.runs.bags.reading import bag_topics, read_bag
 from exsce_dsl.runs.ingest import ingest_bags
 from exsce_dsl.runs.signals.trajectories import trajectories
 from exsce_dsl.sim.run import simulate

@@ -13,11 +13,11 @@ from operator import attrgetter
 import numpy as np
 import pytest
 
+from exsce_dsl.errors import SegmentError
 from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Pose, Position, Scenario
 from exsce_dsl.model.conventions import Tolerance
 from exsce_dsl.runs.segments.arrival import arrival_segments
-from exsce_dsl.runs.segments.dispatcher import SegmentError
 from exsce_dsl.runs.segments.goals import goal_segments
 from exsce_dsl.runs.segments.track import Segmentation, Track, near, planned_waypoints
 from exsce_dsl.runs.signals.navigation_goals import Goal

@@ -19,12 +19,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import ExsceError, TfError
 from exsce_dsl.runs.signals.tf_poses import (
     EdgeSeries,
     FrameTree,
     Poses,
-    TfError,
     default_times,
     pose_at,
     yaw_from_quaternion,

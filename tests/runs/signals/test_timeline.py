@@ -24,7 +24,8 @@ from exsce_dsl.model import Scenario
 from exsce_dsl.prov.run import compile_run
 from exsce_dsl.rdf import to_quads, validate
 from exsce_dsl.runs.analyse import AnalysedRun, analyse_bag
-from exsce_dsl.runs.bags.reading import Wanted, bag_topics, read_bag
+from exsce_dsl.runs.bags.data import Wanted
+from exsce_dsl.runs.bags.reading import bag_topics, read_bag
 from exsce_dsl.runs.signals.timeline import decide_timeline, stamp_catalogue, with_stamps
 from exsce_dsl.sim.run import simulate
 

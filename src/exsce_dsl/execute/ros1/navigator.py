@@ -21,12 +21,12 @@ from typing import Any
 from exsce_dsl.errors import RosGraphError
 from exsce_dsl.execute.navigator import Finished
 from exsce_dsl.execute.outcomes import GoalOutcome
-from exsce_dsl.execute.recording import PROV_TOPIC
 from exsce_dsl.execute.ros1.channel import Message, NodeChannel
 from exsce_dsl.model import Pose, Scenario
 from exsce_dsl.model.conventions import Navigation
 from exsce_dsl.model.geometry import quaternion
 from exsce_dsl.model.metrics import expand_topic
+from exsce_dsl.runs.coverage import PROV_TOPIC
 
 MOVE_BASE_ACTION = "/{ns}/move_base"
 STARTUP = 30.0

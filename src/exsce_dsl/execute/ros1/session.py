@@ -33,13 +33,14 @@ from exsce_dsl.execute.dispatcher import dispatch
 from exsce_dsl.execute.mission import Schedule, schedule
 from exsce_dsl.execute.outcomes import DEFAULT_POLICY, MissionRun, MissionStatus, Policy
 from exsce_dsl.execute.provenance import mission_prov_json
-from exsce_dsl.execute.recording import PROV_TOPIC, recorded_topics
+from exsce_dsl.execute.recording import recorded_topics
 from exsce_dsl.execute.ros1.graph import Master
 from exsce_dsl.execute.ros1.navigator import DispatcherNode, Ros1Navigator, RosClock, move_base_actions
 from exsce_dsl.execute.ros1.parameters import dump_parameters, load_scenario
 from exsce_dsl.execute.ros1.recorder import Recorder
 from exsce_dsl.execute.run_files import RunFiles
 from exsce_dsl.model import Scenario
+from exsce_dsl.runs.coverage import PROV_TOPIC
 
 INCOMPLETE = "incomplete"
 """The folder of ``out`` that holds the runs cut short."""

@@ -23,10 +23,10 @@ import re
 from collections.abc import Mapping
 from typing import Any, Protocol
 
-from exsce_dsl.errors import Severity, SourceLocation
+from exsce_dsl.errors import MessageTypeError, Severity, SourceLocation
 from exsce_dsl.lang.build.expressions import ExpressionBuilder, Scope, Typed, read_quantity
 from exsce_dsl.lang.parser import ParsedFile
-from exsce_dsl.messages.catalogue import MessageCatalogue, MessageTypeError
+from exsce_dsl.messages.catalogue import MessageCatalogue
 from exsce_dsl.model.expressions import Aggregate, Expression, WindowValue
 from exsce_dsl.model.messages import DISPATCHER, Fields, canonical_type
 from exsce_dsl.model.metrics import (

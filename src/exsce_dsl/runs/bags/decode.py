@@ -41,8 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from exsce_dsl.errors import DecodeError as DecodeError
-from exsce_dsl.errors import FieldProblem
+from exsce_dsl.errors import DecodeError, FieldProblem
 from exsce_dsl.messages.catalogue import ARRAY, BASE, SEQUENCE, MessageCatalogue
 from exsce_dsl.messages.field_check import field_shape
 from exsce_dsl.model.messages import FieldPath, Index, canonical_type

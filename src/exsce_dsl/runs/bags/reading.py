@@ -20,22 +20,13 @@ from __future__ import annotations
 from collections.abc import Mapping
 from pathlib import Path
 
-from exsce_dsl.errors import BagError as BagError
-from exsce_dsl.errors import CorruptBag, UnsupportedBag
-from exsce_dsl.messages.catalogue import MessageTypeError
+from exsce_dsl.errors import BagError, CorruptBag, DecodeError, MessageTypeError, UnsupportedBag
 from exsce_dsl.plugins import Registry
-from exsce_dsl.runs.bags.data import OBJECTS as OBJECTS
-from exsce_dsl.runs.bags.data import BagData as BagData
-from exsce_dsl.runs.bags.data import Check as Check
-from exsce_dsl.runs.bags.data import Reduce as Reduce
-from exsce_dsl.runs.bags.data import Series as Series
-from exsce_dsl.runs.bags.data import Wanted as Wanted
-from exsce_dsl.runs.bags.decode import DecodeError
+from exsce_dsl.runs.bags.data import BagData, Check, Reduce, Wanted
 from exsce_dsl.runs.bags.files import check_bag_file
 from exsce_dsl.runs.bags.formats import BagFormat, is_ros2_folder
 from exsce_dsl.runs.bags.mcap import MCAP
 from exsce_dsl.runs.bags.names import BagTopics
-from exsce_dsl.runs.bags.objects import LazyMessage as LazyMessage
 from exsce_dsl.runs.bags.reader import BagReader
 from exsce_dsl.runs.bags.ros1 import ROS1
 from exsce_dsl.runs.bags.rosbags_fallback import ROSBAGS

@@ -18,8 +18,8 @@ from typing import Any
 
 import numpy as np
 
-from exsce_dsl.errors import BagError, DecodeError
-from exsce_dsl.messages.catalogue import MessageCatalogue, MessageTypeError, Source, standard_catalogue
+from exsce_dsl.errors import BagError, DecodeError, MessageTypeError
+from exsce_dsl.messages.catalogue import MessageCatalogue, Source, standard_catalogue
 from exsce_dsl.messages.user import configured_user_catalogue
 from exsce_dsl.model.messages import canonical_type
 from exsce_dsl.runs.bags.data import OBJECTS, BagData, Check, Reduce, Wanted

@@ -10,7 +10,7 @@ robot: a bag whose waypoint ids differ is from another scenario.
 
 from __future__ import annotations
 
-from exsce_dsl.errors import SegmentError as SegmentError
+from exsce_dsl.errors import SegmentError
 from exsce_dsl.model import Pose, Scenario
 from exsce_dsl.model.goals import ACTIONLIB_FINAL, GoalStatus, actionlib_names
 from exsce_dsl.runs.segments.recorded import RecordedAction

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field, replace
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.conventions import Navigation
 from exsce_dsl.model.robots import Robot
-from exsce_dsl.runs.bags.reading import BagData
+from exsce_dsl.runs.bags.data import BagData
 from exsce_dsl.runs.segments.arrival import arrival_segments
 from exsce_dsl.runs.segments.dispatcher import segments as dispatcher_segments
 from exsce_dsl.runs.segments.dispatcher import succeeded_waypoints

@@ -31,9 +31,10 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from exsce_dsl.errors import SegmentError
 from exsce_dsl.model import Orientation, Pose, Position, Scenario
 from exsce_dsl.model.conventions import Tolerance
-from exsce_dsl.runs.segments.dispatcher import SegmentError, planned_goals
+from exsce_dsl.runs.segments.dispatcher import planned_goals
 from exsce_dsl.runs.segments.recorded import RecordedAction
 
 Floats = npt.NDArray[np.float64]

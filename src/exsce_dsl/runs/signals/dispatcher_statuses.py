@@ -14,9 +14,10 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from exsce_dsl.errors import BagError
 from exsce_dsl.model.conventions import DISPATCHER_FEEDBACK, DISPATCHER_RESULT
 from exsce_dsl.model.metrics import expand_topic
-from exsce_dsl.runs.bags.reading import OBJECTS, BagData, BagError, Wanted
+from exsce_dsl.runs.bags.data import OBJECTS, BagData, Wanted
 
 _PROGRESS = {0: 0, 1: 1}  # PENDING, ACTIVE; every other status is final
 

@@ -28,7 +28,7 @@ import numpy as np
 from exsce_dsl.model.conventions import Navigation, Signals
 from exsce_dsl.model.goals import ACTION_FINAL, ACTIONLIB_FINAL, action_names, actionlib_names
 from exsce_dsl.model.metrics import expand_topic
-from exsce_dsl.runs.bags.reading import OBJECTS, BagData, Wanted
+from exsce_dsl.runs.bags.data import OBJECTS, BagData, Wanted
 from exsce_dsl.runs.signals.dispatcher_statuses import dispatcher_wanted
 from exsce_dsl.runs.signals.tf_poses import yaw_from_quaternion
 

@@ -28,6 +28,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from exsce_dsl.errors import TfError
 from exsce_dsl.model.conventions import (
     DISTANCE_TYPES,
     FLOAT64,
@@ -46,16 +47,9 @@ from exsce_dsl.model.messages import FieldPath, canonical_type, path_of
 from exsce_dsl.model.metrics import expand_topic, signal_pattern
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.monitor_kit.monitor_core import Signal, Topic, speed
+from exsce_dsl.runs.bags.data import BagData, Series, Wanted
 from exsce_dsl.runs.bags.decode import TEXTS
-from exsce_dsl.runs.bags.reading import BagData, Series, Wanted
-from exsce_dsl.runs.signals.tf_poses import (
-    EdgeSeries,
-    FrameTree,
-    TfError,
-    default_times,
-    pose_at,
-    yaw_from_quaternion,
-)
+from exsce_dsl.runs.signals.tf_poses import EdgeSeries, FrameTree, default_times, pose_at, yaw_from_quaternion
 
 SIGNALS = ("pose", "velocity", "scan", "distance")
 TF_MESSAGE = "tf2_msgs/msg/TFMessage"

@@ -22,8 +22,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from exsce_dsl.runs.bags.data import Series
 from exsce_dsl.runs.bags.decode import TEXTS
-from exsce_dsl.runs.bags.reading import Series
 
 TOGETHER = 1.0
 """Seconds of log time within which publishers going back are one reset (a slow publisher's

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from exsce_dsl.errors import TfError as TfError
+from exsce_dsl.errors import TfError
 from exsce_dsl.suggest import did_you_mean
 
 MAX_EXTRAPOLATION = 0.5

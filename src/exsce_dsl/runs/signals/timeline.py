@@ -42,16 +42,12 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from exsce_dsl.messages.catalogue import (
-    MessageCatalogue,
-    MessageTypeError,
-    standard_catalogue,
-    standard_ros1_catalogue,
-)
+from exsce_dsl.errors import MessageTypeError
+from exsce_dsl.messages.catalogue import MessageCatalogue, standard_catalogue, standard_ros1_catalogue
 from exsce_dsl.messages.user import configured_user_catalogue
 from exsce_dsl.model.messages import path_of
+from exsce_dsl.runs.bags.data import OBJECTS, BagData, Series, Wanted
 from exsce_dsl.runs.bags.decode import TEXTS
-from exsce_dsl.runs.bags.reading import OBJECTS, BagData, Series, Wanted
 from exsce_dsl.runs.signals.clock_words import describe_clocks, log_time_is_dated
 from exsce_dsl.runs.signals.stamp_tracks import (
     StampTrack,
