@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 
 from exsce_dsl.errors import CacheWarning
-from exsce_dsl.lang import load_spec, spec_cache, standard_metrics
+from exsce_dsl.lang import code_cache, load_spec, standard_metrics
 from exsce_dsl.lang.spec_cache import load_spec_cached
 from exsce_dsl.messages import typestore_cache
 from exsce_dsl.runs.metrics import monitor_code
@@ -94,12 +94,12 @@ def test_spec_pickle_swapped_is_not_unpickled(
     entries = sorted((cache / "specs").glob("*.pickle"))
     assert entries
     marker = tmp_path / "marker"
-    payload = spec_cache.FORMAT + pickle.dumps(_Plant(marker))
+    payload = code_cache.FORMAT + pickle.dumps(_Plant(marker))
     for swapped in _swaps(entries[0], payload):
         for entry in entries:
             entry.write_bytes(swapped)
         assert load_spec_cached(spec) == expected
-        assert spec_cache.cached_standard_metrics(lambda: tuple(standard_metrics()))
+        assert code_cache.cached_standard_metrics(lambda: tuple(standard_metrics()))
         assert not marker.exists()
 
 

@@ -16,7 +16,7 @@ from lsprotocol import types
 import exsce_dsl.errors as errors_module
 from exsce_dsl.errors import Diagnostic, Severity, SourceLocation
 from exsce_dsl.lang import analyse
-from exsce_dsl.lang.build.references import UnknownNames, declared_in
+from exsce_dsl.lang.builders.references import UnknownNames, declared_in
 from exsce_dsl.lang.chunks import declared_names
 from exsce_dsl.lang.loader import parse_whole
 from exsce_dsl.lang.parser import ParsedFile

@@ -12,10 +12,11 @@ from pathlib import Path
 import pytest
 
 from exsce_dsl.errors import SpecError
-from exsce_dsl.lang import load_spec, spec_cache
-from exsce_dsl.lang.build import specification as build
-from exsce_dsl.lang.build.standard_metrics import _parse_standard_metrics
-from exsce_dsl.lang.spec_cache import code_fingerprint, load_spec_cached
+from exsce_dsl.lang import code_cache, load_spec, spec_cache
+from exsce_dsl.lang.builders import specification as build
+from exsce_dsl.lang.builders.standard_metrics import _parse_standard_metrics
+from exsce_dsl.lang.code_cache import code_fingerprint
+from exsce_dsl.lang.spec_cache import load_spec_cached
 from exsce_dsl.model import Specification
 from exsce_dsl.model.metrics import MetricDefinition
 from exsce_dsl.user_cache import read_cached
@@ -253,10 +254,10 @@ def test_the_standard_library_is_parsed_once_per_installation(
         made.append(1)
         return _parse_standard_metrics()
 
-    first = spec_cache.cached_standard_metrics(parse)
-    second = spec_cache.cached_standard_metrics(parse)
+    first = code_cache.cached_standard_metrics(parse)
+    second = code_cache.cached_standard_metrics(parse)
     assert made == [1]
     assert first == second and [m.name for m in first] == [m.name for m in _parse_standard_metrics()]
     (entry,) = (cache / "specs").glob("stdlib-metrics-*.pickle")
     content = read_cached(entry)
-    assert content is not None and pickle.loads(content[len(spec_cache.FORMAT) :]) == first
+    assert content is not None and pickle.loads(content[len(code_cache.FORMAT) :]) == first

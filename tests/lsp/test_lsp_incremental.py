@@ -12,7 +12,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from exsce_dsl.lang import ParseCache, continuations_at, declaration_chunks
-from exsce_dsl.lang.build.specification import analyse, analyse_files
+from exsce_dsl.lang.builders.specification import analyse, analyse_files
 from exsce_dsl.lang.editor.symbols import index_file
 from exsce_dsl.lang.loader import load_files, parse_whole
 

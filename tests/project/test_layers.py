@@ -41,9 +41,12 @@ STEPS: dict[str, list[set[str]]] = {
     "lang": [
         # the core the other parts share
         {"locations", "lexical", "transformation_syntax", "chunks", "parser", "loader", "incremental", "stdlib"},
-        # parse trees to the model; the cache of checked specifications loads through it, and the
-        # standard library's metrics are cached in it
-        {"build", "spec_cache"},
+        # values kept while exsce's code is unchanged (the parsed standard library)
+        {"code_cache"},
+        # parse trees to the model
+        {"builders"},
+        # checked specifications kept in the user's cache: loaded through the builders
+        {"spec_cache"},
         {"format"},
         {"yaml"},
         {"registration"},

@@ -3,7 +3,7 @@ after the subpackage of ``src/exsce_dsl/runs/`` whose code its files test, so th
 a module's tests beside where its path says, and a subpackage that moves or is renamed takes its
 tests along (this test fails until it does).
 
-Mirrored so far: ``runs`` only. Not yet: ``tests/lang`` (``lang/build``, ``format``, ``yaml``,
+Mirrored so far: ``runs`` only. Not yet: ``tests/lang`` (``lang/builders``, ``format``, ``yaml``,
 ``editor``: being rearranged under the same issue), and the flat folders of the other packages
 (``store``, ``oracles``, ``execute``, ``explore``, ``derive``...), whose tests still sit in one
 folder per package.  Add a package to :data:`MIRRORED` when its tests are moved."""

@@ -36,8 +36,8 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from exsce_dsl.lang.build.specification import Analysis, analyse, load_spec
-    from exsce_dsl.lang.build.standard_metrics import (
+    from exsce_dsl.lang.builders.specification import Analysis, analyse, load_spec
+    from exsce_dsl.lang.builders.standard_metrics import (
         builtin_metrics,
         known_metrics,
         metric_info,
@@ -68,14 +68,14 @@ if TYPE_CHECKING:
 
 _WHERE = {
     # reading and checking a specification
-    "load_spec": "build.specification",
-    "analyse": "build.specification",
-    "Analysis": "build.specification",
+    "load_spec": "builders.specification",
+    "analyse": "builders.specification",
+    "Analysis": "builders.specification",
     "load_spec_cached": "spec_cache",
-    "standard_metrics": "build.standard_metrics",
-    "builtin_metrics": "build.standard_metrics",
-    "metric_info": "build.standard_metrics",
-    "known_metrics": "build.standard_metrics",
+    "standard_metrics": "builders.standard_metrics",
+    "builtin_metrics": "builders.standard_metrics",
+    "metric_info": "builders.standard_metrics",
+    "known_metrics": "builders.standard_metrics",
     "display_path": "loader",
     "import_target": "loader",
     "ImportScope": "loader",

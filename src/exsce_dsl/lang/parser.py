@@ -1,6 +1,6 @@
 """The textX side of the language: the metamodel and syntax errors in words.
 
-textX objects never leave ``lang``; :mod:`exsce_dsl.lang.build.specification` turns them
+textX objects never leave ``lang``; :mod:`exsce_dsl.lang.builders.specification` turns them
 into the semantic model.
 """
 

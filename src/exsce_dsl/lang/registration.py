@@ -15,7 +15,7 @@ from textx import TextXSemanticError, language
 
 def _check_whole_spec(model: Any, metamodel: Any) -> None:
     """Model processor: run exsce's own checks, which follow imports and resolve names."""
-    from exsce_dsl.lang.build.specification import analyse
+    from exsce_dsl.lang.builders.specification import analyse
 
     path = getattr(model, "_tx_filename", None)
     if not path:

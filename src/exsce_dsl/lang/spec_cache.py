@@ -34,28 +34,19 @@ every class of the semantic model, kept in step with it.
 
 from __future__ import annotations
 
-import functools
 import hashlib
 import os
 import pickle
-import sys
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from dataclasses import fields, is_dataclass
-from importlib.util import find_spec
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
 
+from exsce_dsl.lang.code_cache import FORMAT, add_parts, code_fingerprint
 from exsce_dsl.user_cache import cache_folder, read_cached, write_cached
 
 if TYPE_CHECKING:
     from exsce_dsl.model import Specification
-    from exsce_dsl.model.metrics import MetricDefinition
-
-FORMAT = b"exsce spec cache 1"
-"""Changes whenever what an entry holds changes shape."""
-
-LIBRARIES = ("textx", "arpeggio", "rosbags", "yaml")
-"""Installed packages whose version changes what loading a specification gives."""
 
 T = TypeVar("T")
 Dependencies = tuple[tuple[str, str | None], ...]
@@ -63,18 +54,18 @@ Dependencies = tuple[tuple[str, str | None], ...]
 
 
 def load_spec_cached(path: str | Path) -> Specification:
-    """:func:`~exsce_dsl.lang.build.load_spec`, from the user's cache folder when nothing it
+    """:func:`~exsce_dsl.lang.builders.load_spec`, from the user's cache folder when nothing it
     depends on has changed (see the module's description); raises the same errors."""
     folder = cache_folder()
     if folder is None:
-        from exsce_dsl.lang.build.specification import load_spec
+        from exsce_dsl.lang.builders.specification import load_spec
 
         return load_spec(path)
     entry = folder / "specs" / f"{_entry_name(path)}.pickle"
     found = _valid_entry(read_cached(entry))
     if found is not None:
         return found
-    from exsce_dsl.lang.build.specification import load_spec_reading
+    from exsce_dsl.lang.builders.specification import load_spec_reading
 
     spec, read = load_spec_reading(path)
     dependencies = tuple((p, _digest(p)) for p in [*read, *_map_files(spec)])
@@ -83,59 +74,9 @@ def load_spec_cached(path: str | Path) -> Specification:
     return spec
 
 
-def cached_standard_metrics(make: Callable[[], tuple[MetricDefinition, ...]]) -> tuple[MetricDefinition, ...]:
-    """The standard library's metrics, parsed by ``make`` once per installation of exsce (the
-    library ships in the package, and its types are rosbags')."""
-    return _cached_by_code("stdlib-metrics", make)
-
-
-def _cached_by_code(name: str, make: Callable[[], T]) -> T:
-    folder = cache_folder()
-    if folder is None:
-        return make()
-    entry = folder / "specs" / f"{name}-{code_fingerprint().hex()[:32]}.pickle"
-    data = read_cached(entry)
-    if data is not None and data.startswith(FORMAT):
-        try:
-            value: T = pickle.loads(data[len(FORMAT) :])  # noqa: S301 - read_cached checked its HMAC
-            return value
-        except Exception:  # noqa: BLE001 - a damaged entry is made again
-            pass
-    value = make()
-    write_cached(entry, FORMAT + pickle.dumps(value, pickle.HIGHEST_PROTOCOL))
-    return value
-
-
-@functools.lru_cache(maxsize=1)
-def code_fingerprint() -> bytes:
-    """A digest of exsce's code and resources (each file's path, size and modification time, as
-    Python decides whether a ``.pyc`` is current), exsce's and Python's versions, and where and
-    when the libraries that parsing and checking use were installed."""
-    from exsce_dsl import __version__
-
-    digest = hashlib.sha256()
-    _add(digest, FORMAT, __version__, sys.version)
-    package = Path(__file__).resolve().parents[1]
-    # the grammar ships in the package (a wheel) or beside it (a checkout: see exsce_dsl.resources)
-    for root in (package, package.parents[1] / "grammar"):
-        for dirpath, dirnames, filenames in os.walk(root):
-            dirnames[:] = sorted(d for d in dirnames if d != "__pycache__")
-            for name in sorted(filenames):
-                if name.endswith((".pyc", ".tmp")):
-                    continue
-                stat = os.stat(os.path.join(dirpath, name))
-                _add(digest, os.path.join(dirpath, name), str(stat.st_size), str(stat.st_mtime_ns))
-    for library in LIBRARIES:
-        spec = find_spec(library)
-        origin = spec.origin if spec is not None else None
-        stat_of = os.stat(origin) if origin else None
-        _add(digest, library, str(origin), str(stat_of.st_mtime_ns if stat_of else None))
-    return digest.digest()
-
-
 def _entry_name(path: str | Path) -> str:
     digest = hashlib.sha256()
-    _add(digest, code_fingerprint().hex(), os.getcwd(), str(path), os.path.abspath(path))
+    add_parts(digest, code_fingerprint().hex(), os.getcwd(), str(path), os.path.abspath(path))
     return digest.hexdigest()[:40]
 
 
@@ -203,9 +144,3 @@ def _instances(root: object, kind: type[T]) -> Iterator[T]:
             pending.extend(item)
         elif isinstance(item, dict):
             pending.extend(item.values())
-
-
-def _add(digest: Any, *parts: str | bytes) -> None:
-    for part in parts:
-        data = part.encode("utf-8", "surrogateescape") if isinstance(part, str) else part
-        digest.update(len(data).to_bytes(8, "little") + data)

@@ -1,6 +1,6 @@
 """Metric expressions: a small language over message fields, as a checked tree.
 
-The builder (``lang.build.metrics``) type-checks every node; a tree here is
+The builder (``lang.builders.metrics``) type-checks every node; a tree here is
 known to be well formed: fields exist in their message type, aggregates are
 over numbers, a metric's value is one number per window.  (A field of a type
 exsce does not know is checked later, against the bag's definition, by

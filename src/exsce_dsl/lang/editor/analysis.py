@@ -2,7 +2,7 @@
 
 :func:`analyse_for_editor` reads a root file and its imports through a
 :class:`~exsce_dsl.lang.incremental.ParseCache` (unsaved texts from ``overlay``),
-checks them as :func:`~exsce_dsl.lang.build.analyse` does, and indexes each file
+checks them as :func:`~exsce_dsl.lang.builders.analyse` does, and indexes each file
 (:func:`~exsce_dsl.lang.editor.symbols.index_file`) unless its text was indexed before.
 Parse trees stay in ``lang``; what comes out is plain data.
 """
@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from exsce_dsl.errors import Diagnostic
-from exsce_dsl.lang.build.specification import Analysis, analyse_files
+from exsce_dsl.lang.builders.specification import Analysis, analyse_files
 from exsce_dsl.lang.editor.symbols import FileIndex, index_file
 from exsce_dsl.lang.incremental import ParseCache
 from exsce_dsl.lang.loader import ANYWHERE, ImportScope, parse_whole, read_sources

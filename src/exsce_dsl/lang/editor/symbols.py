@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from exsce_dsl.errors import SourceLocation
-from exsce_dsl.lang.build.poses import position_of
+from exsce_dsl.lang.builders.poses import position_of
 from exsce_dsl.lang.lexical import quantity_text
 from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.lang.transformation_syntax import step_of, step_references

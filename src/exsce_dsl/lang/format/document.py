@@ -17,7 +17,7 @@ import os
 from collections.abc import Iterable, Mapping, Sequence
 
 from exsce_dsl.errors import SourceLocation
-from exsce_dsl.lang.build.expressions import read_quantity
+from exsce_dsl.lang.builders.expressions import read_quantity
 from exsce_dsl.lang.format.acceptance import acceptance_lines
 from exsce_dsl.lang.format.derivation import derivation_lines
 from exsce_dsl.lang.format.metrics import metric_lines

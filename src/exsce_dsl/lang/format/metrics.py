@@ -9,7 +9,7 @@ A field prints as written: ``tf.transforms[child_frame_id == "base_link"].transf
 from __future__ import annotations
 
 from exsce_dsl.errors import SourceLocation
-from exsce_dsl.lang.build.expressions import read_quantity
+from exsce_dsl.lang.builders.expressions import read_quantity
 from exsce_dsl.lang.lexical import as_written
 from exsce_dsl.lang.lexical import number_text as _number
 from exsce_dsl.lang.lexical import string_literal as _string

@@ -19,7 +19,7 @@ from typing import Any
 import yaml
 
 from exsce_dsl.errors import ExportError, ImportFormatError, OracleFileErrors, SourceLocation
-from exsce_dsl.lang.build.standard_metrics import known_metrics, metric_info
+from exsce_dsl.lang.builders.standard_metrics import known_metrics, metric_info
 from exsce_dsl.lang.format.acceptance import expectation_text
 from exsce_dsl.lang.yaml.located import YamlFile, YamlNode, child_node, node_location
 from exsce_dsl.model import Document, Import, Scenario, Specification

@@ -8,9 +8,9 @@ from dataclasses import replace
 from typing import Any
 
 from exsce_dsl.errors import ExsceError, SourceLocation
-from exsce_dsl.lang.build.checks import check_environment_map
-from exsce_dsl.lang.build.context import Declared, Report, name_span, report_duplicate
-from exsce_dsl.lang.build.references import UnknownNames
+from exsce_dsl.lang.builders.checks import check_environment_map
+from exsce_dsl.lang.builders.context import Declared, Report, name_span, report_duplicate
+from exsce_dsl.lang.builders.references import UnknownNames
 from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.lang.transformation_syntax import step_of, written_arguments
 from exsce_dsl.model import Environment, Scenario, Task

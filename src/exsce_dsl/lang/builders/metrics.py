@@ -1,6 +1,6 @@
 """Build metric declarations (``metric NAME for ... { ... }``): what a metric is said of, the
 topics it reads, its unit, safety limit and how its values combine; its expressions are
-checked by :mod:`exsce_dsl.lang.build.expressions`.
+checked by :mod:`exsce_dsl.lang.builders.expressions`.
 
 Every problem is reported at its ``file:line:col``: an unknown topic or field of
 a message type (with a did-you-mean), an aggregate over something that is not a
@@ -24,7 +24,7 @@ from collections.abc import Mapping
 from typing import Any, Protocol
 
 from exsce_dsl.errors import MessageTypeError, Severity, SourceLocation
-from exsce_dsl.lang.build.expressions import ExpressionBuilder, Scope, Typed, read_quantity
+from exsce_dsl.lang.builders.expressions import ExpressionBuilder, Scope, Typed, read_quantity
 from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.messages.catalogue import MessageCatalogue
 from exsce_dsl.model.expressions import Aggregate, Expression, WindowValue

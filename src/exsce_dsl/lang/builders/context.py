@@ -8,7 +8,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from exsce_dsl.errors import Diagnostic, Severity, SourceLocation
-from exsce_dsl.lang.build.references import UnknownNames
+from exsce_dsl.lang.builders.references import UnknownNames
 from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.model import Acceptance, Environment, Pose, RobotType, RosResource, Scenario, Task
 from exsce_dsl.model.derived import DerivedScenario

@@ -16,7 +16,7 @@ from collections.abc import Callable
 from typing import Any
 
 from exsce_dsl.errors import SourceLocation
-from exsce_dsl.lang.build.expressions import read_quantity
+from exsce_dsl.lang.builders.expressions import read_quantity
 from exsce_dsl.model.conventions import (
     CONVENTIONS,
     LASER_SCAN,

@@ -13,9 +13,9 @@ from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
 from exsce_dsl.errors import SourceLocation
-from exsce_dsl.lang.build.context import Report
-from exsce_dsl.lang.build.references import UnknownNames, not_in_fleet
-from exsce_dsl.lang.build.standard_metrics import known_metrics
+from exsce_dsl.lang.builders.context import Report
+from exsce_dsl.lang.builders.references import UnknownNames, not_in_fleet
+from exsce_dsl.lang.builders.standard_metrics import known_metrics
 from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.acceptance import (

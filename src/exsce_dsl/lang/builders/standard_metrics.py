@@ -10,7 +10,7 @@ from __future__ import annotations
 import functools
 
 from exsce_dsl.errors import Diagnostic, Severity, SourceLocation, SpecError
-from exsce_dsl.lang.spec_cache import cached_standard_metrics
+from exsce_dsl.lang.code_cache import cached_standard_metrics
 from exsce_dsl.model.metrics import VIOLATION_DURATION, MetricDefinition, MetricInfo
 from exsce_dsl.model.scenario import Scenario
 
@@ -23,7 +23,7 @@ def standard_metrics() -> tuple[MetricDefinition, ...]:
 
 
 def _parse_standard_metrics() -> tuple[MetricDefinition, ...]:
-    from exsce_dsl.lang.build.metrics import build_metric
+    from exsce_dsl.lang.builders.metrics import build_metric
     from exsce_dsl.lang.parser import parse_text
     from exsce_dsl.messages.catalogue import standard_catalogue
     from exsce_dsl.resources import package_file

@@ -6,8 +6,8 @@ from pathlib import Path
 from typing import Any
 
 from exsce_dsl.errors import SourceLocation
-from exsce_dsl.lang.build.context import BuildContext, Declared, name_span, report_duplicate, ros_resource
-from exsce_dsl.lang.build.poses import orientation_of, position_of
+from exsce_dsl.lang.builders.context import BuildContext, Declared, name_span, report_duplicate, ros_resource
+from exsce_dsl.lang.builders.poses import orientation_of, position_of
 from exsce_dsl.lang.lexical import read_length
 from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.model import Area, Environment, MapModel, Obstacle, Pose, WorldModel

@@ -4,8 +4,8 @@ References are resolved here rather than by textX so that *every* unknown
 name is reported (with a did-you-mean), not only the first one.  Each kind of
 declaration has its builder (:mod:`.environments`, :mod:`.robots`, :mod:`.tasks`,
 :mod:`.scenarios`, :mod:`.metrics`, :mod:`.derivation`, :mod:`.acceptance`), sharing
-one :class:`~exsce_dsl.lang.build.context.BuildContext`; checks that need the whole
-scenario live in :mod:`exsce_dsl.lang.build.checks`.
+one :class:`~exsce_dsl.lang.builders.context.BuildContext`; checks that need the whole
+scenario live in :mod:`exsce_dsl.lang.builders.checks`.
 """
 
 from __future__ import annotations
@@ -16,17 +16,17 @@ from pathlib import Path
 from typing import Any
 
 from exsce_dsl.errors import Diagnostic, Severity, SpecError, diagnostic_order
-from exsce_dsl.lang.build.acceptance import build_all_acceptance
-from exsce_dsl.lang.build.checks import check_environment_map, check_scenario
-from exsce_dsl.lang.build.context import BuildContext
-from exsce_dsl.lang.build.derivation import build_derivations
-from exsce_dsl.lang.build.environments import build_environment
-from exsce_dsl.lang.build.metrics import build_metric
-from exsce_dsl.lang.build.references import UnknownNames
-from exsce_dsl.lang.build.robots import build_robot_type
-from exsce_dsl.lang.build.scenarios import build_scenario
-from exsce_dsl.lang.build.standard_metrics import reserved_metric_names
-from exsce_dsl.lang.build.tasks import build_task, task_pose_candidates
+from exsce_dsl.lang.builders.acceptance import build_all_acceptance
+from exsce_dsl.lang.builders.checks import check_environment_map, check_scenario
+from exsce_dsl.lang.builders.context import BuildContext
+from exsce_dsl.lang.builders.derivation import build_derivations
+from exsce_dsl.lang.builders.environments import build_environment
+from exsce_dsl.lang.builders.metrics import build_metric
+from exsce_dsl.lang.builders.references import UnknownNames
+from exsce_dsl.lang.builders.robots import build_robot_type
+from exsce_dsl.lang.builders.scenarios import build_scenario
+from exsce_dsl.lang.builders.standard_metrics import reserved_metric_names
+from exsce_dsl.lang.builders.tasks import build_task, task_pose_candidates
 from exsce_dsl.lang.loader import ANYWHERE, ImportScope, Parse, read_sources
 from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.model import Document, Import, Specification
@@ -80,7 +80,7 @@ def analyse_files(
 ) -> Analysis:
     """:func:`analyse` of files already parsed (the root first), with the problems found reading
     them; ``broken`` has the text of each file with a syntax error (the names they seem to
-    declare are not reported unknown: see :mod:`exsce_dsl.lang.build.references`), and ``parse``
+    declare are not reported unknown: see :mod:`exsce_dsl.lang.builders.references`), and ``parse``
     reads the files not imported where an unknown name may be declared."""
     diagnostics = list(diagnostics)
     unknown = UnknownNames(files, broken, parse)

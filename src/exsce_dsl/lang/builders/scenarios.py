@@ -6,10 +6,10 @@ from collections.abc import Mapping
 from typing import Any
 
 from exsce_dsl.errors import SourceLocation
-from exsce_dsl.lang.build.context import BuildContext, Declared, name_span
-from exsce_dsl.lang.build.references import not_in_fleet
-from exsce_dsl.lang.build.robots import build_robots
-from exsce_dsl.lang.build.tasks import timeout_of
+from exsce_dsl.lang.builders.context import BuildContext, Declared, name_span
+from exsce_dsl.lang.builders.references import not_in_fleet
+from exsce_dsl.lang.builders.robots import build_robots
+from exsce_dsl.lang.builders.tasks import timeout_of
 from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.model import Assignment, Mission, MissionType, Scenario, Task
 

@@ -5,9 +5,9 @@ from __future__ import annotations
 from typing import Any
 
 from exsce_dsl.errors import SourceLocation
-from exsce_dsl.lang.build.context import BuildContext, Declared, name_span, report_duplicate
-from exsce_dsl.lang.build.signals import build_signals
-from exsce_dsl.lang.build.tasks import pose_use
+from exsce_dsl.lang.builders.context import BuildContext, Declared, name_span, report_duplicate
+from exsce_dsl.lang.builders.signals import build_signals
+from exsce_dsl.lang.builders.tasks import pose_use
 from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.model import Environment, Pose, Robot, RobotType
 from exsce_dsl.model.robots import root_namespace

@@ -5,8 +5,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from exsce_dsl.lang.build.context import BuildContext, Declared, ros_resource
-from exsce_dsl.lang.build.poses import orientation_of, position_of
+from exsce_dsl.lang.builders.context import BuildContext, Declared, ros_resource
+from exsce_dsl.lang.builders.poses import orientation_of, position_of
 from exsce_dsl.lang.lexical import quantity_text, read_duration
 from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.model import Pose, Subtask, Task
