@@ -108,7 +108,7 @@ from exsce_dsl.explore.campaign import (
 from exsce_dsl.explore.executors import SimulatorExecutor
 from exsce_dsl.lang import load_spec
 from exsce_dsl.model import Scenario
-from exsce_dsl.model.campaign import CampaignFigures, CheckedRelation, Request, Shrinking, Trial
+from exsce_dsl.model.campaign import CampaignFigures, CampaignTrial, CheckedRelation, Request, Shrinking
 from exsce_dsl.model.document import Specification
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.open import open_store
@@ -356,12 +356,14 @@ def run_unit(unit: Unit) -> Outcome:
     return outcome
 
 
-def executions_until(trials: Sequence[Trial], number: int) -> int:
+def executions_until(trials: Sequence[CampaignTrial], number: int) -> int:
     """Runs of the trials drawn up to and with trial ``number``."""
     return sum(len(t.runs) for t in trials if t.number <= number)
 
 
-def judge_baseline(outcome: Outcome, violating: Sequence[Trial], fault_free: FaultFree, store: Store) -> None:
+def judge_baseline(
+    outcome: Outcome, violating: Sequence[CampaignTrial], fault_free: FaultFree, store: Store
+) -> None:
     """The first violating trial whose violation the fault caused (trials checked in draw order,
     up to that one: each check runs the derivation fault-free)."""
     for trial in violating:

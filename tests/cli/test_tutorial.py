@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from exsce_dsl.api.demo import STEPS, Step, command_hint, run_steps, set_up, summary_lines
+from exsce_dsl.api.demo import STEPS, DemoStep, command_hint, run_steps, set_up, summary_lines
 from exsce_dsl.cli.demo_commands import run_in_process
 
 from tests.support.paths import ROOT
@@ -52,9 +52,9 @@ def test_a_verdict_other_than_expected_is_reported_and_the_demo_goes_on(tmp_path
     set_up(folder)
     good, missing = "exscec check scenarios/scenario_c.exsce", "exscec check scenarios/missing.exsce"
     steps = (
-        Step("check", good),
-        Step("should fail", good, expected_exit=1, verdict="a good spec"),
-        Step("refused, as it should", missing, expected_exit=2, verdict="no spec"),
+        DemoStep("check", good),
+        DemoStep("should fail", good, expected_exit=1, verdict="a good spec"),
+        DemoStep("refused, as it should", missing, expected_exit=2, verdict="no spec"),
     )
     run = run_steps(folder, run_in_process, steps=steps)
     assert [o.exit_code for o in run.outcomes] == [0, 0, 2]
@@ -71,8 +71,8 @@ def test_a_step_the_next_ones_need_stops_the_demo_when_it_fails(tmp_path: Path) 
     folder = tmp_path / "demo"
     set_up(folder)
     steps = (
-        Step("compile a missing file", "exscec compile scenarios/missing.exsce --store"),
-        Step("never run", "exscec check scenarios/scenario_c.exsce"),
+        DemoStep("compile a missing file", "exscec compile scenarios/missing.exsce --store"),
+        DemoStep("never run", "exscec check scenarios/scenario_c.exsce"),
     )
     run = run_steps(folder, run_in_process, steps=steps)
     assert len(run.outcomes) == 1 and run.stopped == run.outcomes[0] and not run.as_expected
@@ -92,11 +92,11 @@ def test_exscec_demo_exits_1_when_an_outcome_is_not_the_expected_one(
 
     monkeypatch.chdir(tmp_path)
     command = "exscec check scenarios/scenario_c.exsce"
-    monkeypatch.setattr(demo, "STEPS", (Step("verify, as it were", command, verdict="the example"),))
+    monkeypatch.setattr(demo, "STEPS", (DemoStep("verify, as it were", command, verdict="the example"),))
     passed = CliRunner().invoke(main, ["demo", "as-expected"])
     assert passed.exit_code == 0, passed.output
     assert re.search(r"passed, as expected\s+the example", passed.stderr)
-    monkeypatch.setattr(demo, "STEPS", (Step("verify, as it were", command, 1, verdict="the example"),))
+    monkeypatch.setattr(demo, "STEPS", (DemoStep("verify, as it were", command, 1, verdict="the example"),))
     failed = CliRunner().invoke(main, ["demo", "not-as-expected"])
     assert failed.exit_code == 1, failed.output
     assert "[1/1] verify, as it were" in failed.stderr

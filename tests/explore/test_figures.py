@@ -21,7 +21,7 @@ from exsce_dsl.explore.campaign import CampaignOptions, _violations, run_campaig
 from exsce_dsl.explore.executors import SimulatorExecutor
 from exsce_dsl.explore.figures import figures_table, random_baseline
 from exsce_dsl.lang import load_spec
-from exsce_dsl.model.campaign import CampaignFigures, CampaignPlan, CheckedRelation, Trial
+from exsce_dsl.model.campaign import CampaignFigures, CampaignPlan, CampaignTrial, CheckedRelation
 from exsce_dsl.model.verdicts import Outcome, Verdict
 from exsce_dsl.oracles.campaign_junit import campaign_junit
 from exsce_dsl.prov.campaign import compile_campaign, compile_trial
@@ -44,9 +44,9 @@ LONGER = CheckedRelation("task_duration", "tiago1", "increasing")
 
 def _trial(
     number: int, runs: int, violated: tuple[CheckedRelation, ...] = (), inconclusive: tuple[CheckedRelation, ...] = ()
-) -> Trial:
+) -> CampaignTrial:
     uuids = tuple(f"run{number}-{i}" for i in range(runs))
-    return Trial("campaign_x", number, f"s{number}", (), uuids, (SPEED, DURATION), violated, (), inconclusive)
+    return CampaignTrial("campaign_x", number, f"s{number}", (), uuids, (SPEED, DURATION), violated, (), inconclusive)
 
 
 def test_the_figures_of_trials_counted_by_hand() -> None:
@@ -93,7 +93,7 @@ def test_a_relation_neither_failed_nor_passed_in_most_runs_is_inconclusive() -> 
     assert set(judged.checked) == set(runs)
     assert judged.violated == (CheckedRelation("distance_travelled", "tiago1", "invariant"),)
     assert set(judged.inconclusive) == {DURATION, CheckedRelation("distance_travelled", "tiago2", "invariant")}
-    trial = Trial("c", 1, "s", (), ("r0", "r1", "r2"), judged.checked, (), (), judged.inconclusive)
+    trial = CampaignTrial("c", 1, "s", (), ("r0", "r1", "r2"), judged.checked, (), (), judged.inconclusive)
     assert trial.outcome == "inconclusive"  # neither a counterexample nor a pass
     assert CampaignFigures.of([trial]).counterexamples == 0
 
@@ -119,7 +119,7 @@ def test_a_random_campaign_has_no_random_baseline_of_its_own() -> None:
     )
 
 
-def _campaign_in(store_path: Path, strategy: str) -> tuple[str, list[Trial]]:
+def _campaign_in(store_path: Path, strategy: str) -> tuple[str, list[CampaignTrial]]:
     with open_store(str(store_path)) as store:
         (plan,) = [p for p in campaigns(store) if p.strategy == strategy]
         record = campaign_record(store, plan.id)
@@ -127,7 +127,7 @@ def _campaign_in(store_path: Path, strategy: str) -> tuple[str, list[Trial]]:
     return plan.id, list(record.trials)
 
 
-def _counted(trials: list[Trial]) -> dict[str, str]:
+def _counted(trials: list[CampaignTrial]) -> dict[str, str]:
     """The figures of ``trials``, counted here, as the table prints them."""
     executed, first = 0, None
     for trial in trials:

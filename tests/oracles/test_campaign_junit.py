@@ -9,7 +9,7 @@ from dataclasses import replace
 import pytest
 
 from exsce_dsl.lang import load_spec
-from exsce_dsl.model.campaign import CampaignPlan, CampaignRecord, Shrinking, Trial
+from exsce_dsl.model.campaign import CampaignPlan, CampaignRecord, CampaignTrial, Shrinking
 from exsce_dsl.model.runs import Bag, Run
 from exsce_dsl.oracles.campaign_junit import campaign_junit, run_seconds, steps_text
 from exsce_dsl.prov import compile_scenario
@@ -39,7 +39,7 @@ PLAN = CampaignPlan(
 )
 
 
-def _trials() -> list[Trial]:
+def _trials() -> list[CampaignTrial]:
     return list(
         sample_trials((("run1a", "run1b", "run1c"), ("run2a", "run2b", "run2c"), ("run3a", "run3b", "run3c")))
     )

@@ -16,7 +16,7 @@ import pytest
 from test_report import ARTIFACTS, _chromium
 
 from exsce_dsl.lang import load_spec
-from exsce_dsl.model.campaign import CampaignPlan, CampaignRecord, Trial
+from exsce_dsl.model.campaign import CampaignPlan, CampaignRecord, CampaignTrial
 from exsce_dsl.prov import compile_scenario
 from exsce_dsl.prov.campaign import compile_campaign, compile_shrinking, compile_trial
 from exsce_dsl.prov.derivation import compile_derivation
@@ -232,7 +232,7 @@ def test_the_chart_steps_up_once_per_trial_that_found_a_relation(report: tuple[P
 def test_text_from_a_campaign_is_escaped(tmp_path: Path) -> None:
     nasty = '<script>alert("x")</script>'
     plan = CampaignPlan("c_nasty", "s", 2, 1, 1, 1, (), nasty, nasty, False, 5.0)
-    trial = Trial("c_nasty", 1, "s_1", (("remove_robot", {"robot": nasty}),), ("r",), (), ())
+    trial = CampaignTrial("c_nasty", 1, "s_1", (("remove_robot", {"robot": nasty}),), ("r",), (), ())
     contents = ReportContents(
         (), (), None, campaigns=(campaign_contents(CampaignRecord(plan, None, (trial,), ())),)
     )

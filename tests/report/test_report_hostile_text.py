@@ -18,7 +18,7 @@ from hypothesis import given, settings
 from matplotlib.figure import Figure
 
 from exsce_dsl.figures import save_figure
-from exsce_dsl.model.campaign import CampaignPlan, CampaignRecord, CheckedRelation, Trial
+from exsce_dsl.model.campaign import CampaignPlan, CampaignRecord, CampaignTrial, CheckedRelation
 from exsce_dsl.model.geometry import Position
 from exsce_dsl.model.runs import Hotspot
 from exsce_dsl.model.verdicts import Outcome, Verdict
@@ -172,7 +172,7 @@ def test_a_campaigns_relations_with_mathtext_chars_are_drawn_one_per_line(tmp_pa
         CheckedRelation("task_duration", f"r{MATH}", "increasing"),
         CheckedRelation("distance_travelled", "r1", "invariant"),
     )
-    trial = Trial("c", 1, "s_1", (), ("run",), violated, violated)
+    trial = CampaignTrial("c", 1, "s_1", (), ("run",), violated, violated)
     figure = campaign_figure(campaign_contents(CampaignRecord(plan, None, (trial,), ())))
     save_figure(figure, tmp_path / "campaign.svg")
     (label,) = [t for t in _texts(figure) if "task_duration" in t]

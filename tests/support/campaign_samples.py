@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from exsce_dsl.model.campaign import CheckedRelation, Shrinking, ShrinkTry, Trial
+from exsce_dsl.model.campaign import CampaignTrial, CheckedRelation, Shrinking, ShrinkTry
 
 DURATION = CheckedRelation("task_duration", "tiago1", "increasing", "scenario_c")
 DISTANCE = CheckedRelation("distance_travelled", "tiago1", "invariant")
@@ -14,14 +14,14 @@ REMOVE = ("remove_robot", {"robot": "tiago2", "reassign": "tiago1"})
 REVERSE = ("reverse_waypoint_order", {"task": "delivery_a"})
 
 
-def sample_trials(runs: Sequence[tuple[str, str, str]]) -> tuple[Trial, ...]:
+def sample_trials(runs: Sequence[tuple[str, str, str]]) -> tuple[CampaignTrial, ...]:
     """The four trials; ``runs``: the uuids of trials 1, 2 and 3's runs."""
     both = (DURATION, DISTANCE)
     return (
-        Trial("c_explore", 1, "c_explore_0001", (REMOVE,), runs[0], both, (DURATION,)),
-        Trial("c_explore", 2, "c_explore_0002", (REVERSE,), runs[1], both, ()),
-        Trial("c_explore", 3, "c_explore_0003", (REVERSE, REMOVE), runs[2], both, both),
-        Trial("c_explore", 4, "c_explore_0004", (REVERSE,), (), (), ()),
+        CampaignTrial("c_explore", 1, "c_explore_0001", (REMOVE,), runs[0], both, (DURATION,)),
+        CampaignTrial("c_explore", 2, "c_explore_0002", (REVERSE,), runs[1], both, ()),
+        CampaignTrial("c_explore", 3, "c_explore_0003", (REVERSE, REMOVE), runs[2], both, both),
+        CampaignTrial("c_explore", 4, "c_explore_0004", (REVERSE,), (), (), ()),
     )
 
 

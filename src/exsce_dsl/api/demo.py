@@ -31,7 +31,7 @@ CONVENTIONS = ("method", "nav2", "move_base")
 
 
 @dataclass(frozen=True)
-class Step:
+class DemoStep:
     title: str
     command: str
     """As typed in a shell, from the project folder (globs allowed)."""
@@ -40,103 +40,105 @@ class Step:
     """For a verify step: what the runs it judges are (shown in the summary)."""
 
 
-STEPS: tuple[Step, ...] = (
-    Step(
+STEPS: tuple[DemoStep, ...] = (
+    DemoStep(
         "Check the scenario (syntax, references, free space on the map, SHACL)",
         "exscec check scenarios/scenario_c.exsce",
     ),
-    Step(
+    DemoStep(
         "Compile it to PROV and add it to the store",
         "exscec compile scenarios/scenario_c.exsce -f provn -o scenario_c.provn --store",
     ),
-    Step(
+    DemoStep(
         "Simulate three baseline runs (bags and their run-time PROV)",
         "exscec simulate scenarios/scenario_c.exsce --runs 3 --seed 1 -o runs/baseline",
     ),
-    Step(
+    DemoStep(
         "Ingest them: metrics per run and per path segment, one transaction per bag",
         "exscec ingest runs/baseline/*.bag --scenario scenarios/scenario_c.exsce --jobs 2",
     ),
-    Step(
+    DemoStep(
         "Build the baseline oracles from the acceptance criteria and the stored runs",
         "exscec baseline scenarios/scenario_c.exsce",
     ),
-    Step(
+    DemoStep(
         "Simulate a new run, and one where tiago1 drives too fast",
         "exscec simulate scenarios/scenario_c.exsce --runs 1 --seed 7 -o runs/new",
     ),
-    Step(
+    DemoStep(
         "(the faulty run)",
         "exscec simulate scenarios/scenario_c.exsce --runs 1 --seed 8 --fault overspeed:tiago1 "
         "-o runs/faulty",
     ),
-    Step(
+    DemoStep(
         "Verify the new run against every oracle (it passes)",
         "exscec verify runs/new/*.bag --scenario scenarios/scenario_c.exsce --junit verdicts-new.xml",
         verdict="new run of scenario_c",
     ),
-    Step(
+    DemoStep(
         "Verify the faulty run (it fails its safety limits and the baseline: exit 1)",
         "exscec verify runs/faulty/*.bag --scenario scenarios/scenario_c.exsce",
         expected_exit=1,
         verdict="run of scenario_c with the over-speed fault",
     ),
-    Step(
+    DemoStep(
         "Derive a scenario: remove tiago2 and give its tasks to tiago1, with the oracles it must meet",
         "exscec derive scenarios/scenario_c.exsce -t remove_robot --robot tiago2 --reassign tiago1 "
         "--id c_one -o scenarios/c_one.exsce --expect --tolerance 15 --add-to-store",
     ),
-    Step(
+    DemoStep(
         "What its runs should show, and where each number comes from", "exscec expect scenarios/c_one.exsce"
     ),
-    Step(
+    DemoStep(
         "Simulate the derived scenario",
         "exscec simulate scenarios/c_one.exsce --runs 1 --seed 3 -o runs/c_one",
     ),
-    Step(
+    DemoStep(
         "Verify it against its metamorphic oracles (it passes)",
         "exscec verify runs/c_one/*.bag --scenario scenarios/c_one.exsce",
         verdict="run of derived c_one",
     ),
-    Step("Where c_one comes from", "exscec lineage c_one"),
-    Step(
+    DemoStep("Where c_one comes from", "exscec lineage c_one"),
+    DemoStep(
         "Explore derivations with a planted deadlock: found, and shrunk to the one step it needs (exit 1)",
         "exscec explore scenarios/scenario_c.exsce -n 1 -k 1 -t swap_start_poses -t reverse_task_order "
         "--fault deadlock-start:tiago1:classroom_c025-w002 -o explore/deadlock --junit campaign.xml",
         expected_exit=1,
     ),
-    Step("Cluster the stored scenarios, with a dendrogram", "exscec cluster --k 2 --dendrogram clusters.svg"),
-    Step("Write the HTML report", "exscec report -o report --spec scenarios/scenario_c.exsce"),
+    DemoStep(
+        "Cluster the stored scenarios, with a dendrogram", "exscec cluster --k 2 --dendrogram clusters.svg"
+    ),
+    DemoStep("Write the HTML report", "exscec report -o report --spec scenarios/scenario_c.exsce"),
 )
 
 LIVE_SCENARIO = "scenarios/scenario_c.exsce"
-LIVE_STEPS: tuple[Step, ...] = (
-    Step("Check the scenario", f"exscec check {LIVE_SCENARIO}"),
-    Step(
+LIVE_STEPS: tuple[DemoStep, ...] = (
+    DemoStep("Check the scenario", f"exscec check {LIVE_SCENARIO}"),
+    DemoStep(
         "Compile it to PROV and add it to the store",
         f"exscec compile {LIVE_SCENARIO} -f provn -o scenario_c.provn --store",
     ),
-    Step(
+    DemoStep(
         "Execute three baseline runs on the live ROS 1 graph: exsce's stand-in robots serve the move_base "
         "goals, rosbag record records each run",
         f"exscec execute {LIVE_SCENARIO} --ros1 --stand-in --seed 1 --runs 3 -o runs/baseline",
     ),
-    Step("Ingest them", f"exscec ingest runs/baseline/*.bag --scenario {LIVE_SCENARIO} --jobs 2"),
-    Step("Build the baseline oracles", f"exscec baseline {LIVE_SCENARIO}"),
-    Step(
+    DemoStep("Ingest them", f"exscec ingest runs/baseline/*.bag --scenario {LIVE_SCENARIO} --jobs 2"),
+    DemoStep("Build the baseline oracles", f"exscec baseline {LIVE_SCENARIO}"),
+    DemoStep(
         "Execute a new run and judge it (it passes)",
         f"exscec execute {LIVE_SCENARIO} --ros1 --stand-in --seed 7 -o runs/new --verify "
         "--junit verdicts-new.xml",
         verdict="new run of scenario_c on the live graph",
     ),
-    Step(
+    DemoStep(
         "Execute a run where tiago1's stand-in drives too fast, and judge it (it fails: exit 1)",
         f"exscec execute {LIVE_SCENARIO} --ros1 --stand-in --seed 8 --fault overspeed:tiago1 "
         "-o runs/faulty --verify",
         expected_exit=1,
         verdict="live run with the over-speed fault",
     ),
-    Step("Write the HTML report", f"exscec report -o report --spec {LIVE_SCENARIO}"),
+    DemoStep("Write the HTML report", f"exscec report -o report --spec {LIVE_SCENARIO}"),
 )
 """``exscec demo --ros1``: the method's loop on a live ROS 1 graph (a roscore of the demo's own),
 the robots played by the stand-in in move_base's convention; ``docs/live.md`` has the same steps."""
@@ -149,7 +151,7 @@ _ENDINGS = {0: "passed", 1: "failed", 2: "refused (bad input)", 3: "inconclusive
 class StepOutcome:
     """How one step ended."""
 
-    step: Step
+    step: DemoStep
     exit_code: int
 
     @property
@@ -176,7 +178,7 @@ class DemoRun:
 
     folder: Path
     store: str
-    steps: tuple[Step, ...]
+    steps: tuple[DemoStep, ...]
     outcomes: tuple[StepOutcome, ...]
     seconds: float
 
@@ -285,8 +287,8 @@ def run_steps(
     folder: Path,
     run_command: Callable[[list[str]], int],
     store_url: str | None = None,
-    steps: Sequence[Step] | None = None,
-    on_step: Callable[[int, Step], None] | None = None,
+    steps: Sequence[DemoStep] | None = None,
+    on_step: Callable[[int, DemoStep], None] | None = None,
 ) -> DemoRun:
     """Run ``steps`` (default: :data:`STEPS`) in ``folder``, each through ``run_command`` (the
     arguments after ``exscec``; returns the exit status), on ``store_url`` if given.

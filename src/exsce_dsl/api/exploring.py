@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from exsce_dsl.model.campaign import Trial
+from exsce_dsl.model.campaign import CampaignTrial
 from exsce_dsl.wording import counted
 
 if TYPE_CHECKING:
@@ -114,7 +114,7 @@ class Exploration:
 def explore(
     request: ExploreRequest,
     said: Callable[[str], None] | None = None,
-    trial_done: Callable[[str, Trial, bool], None] | None = None,
+    trial_done: Callable[[str, CampaignTrial, bool], None] | None = None,
 ) -> Exploration:
     """Run the campaign (and its random baseline); ``said`` gets what the campaign says as it goes,
     ``trial_done`` each trial as it ends (``"random: "`` first for the baseline's, and whether it
@@ -131,7 +131,7 @@ def explore(
     parsed = load_spec(request.spec)
 
     def events(who: str) -> CampaignEvents:
-        def done(trial: Trial, resumed: bool) -> None:
+        def done(trial: CampaignTrial, resumed: bool) -> None:
             if trial_done is not None:
                 trial_done(who, trial, resumed)
 

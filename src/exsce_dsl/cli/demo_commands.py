@@ -84,7 +84,7 @@ def demo(folder: str, store_url: str | None, setup_only: bool, convention: str, 
     from exsce_dsl.api.demo import (
         LIVE_STEPS,
         STEPS,
-        Step,
+        DemoStep,
         command_hint,
         live_graph,
         run_steps,
@@ -114,7 +114,7 @@ def demo(folder: str, store_url: str | None, setup_only: bool, convention: str, 
     if hint:
         click.echo(f"{hint}, then 'cd {folder}'", err=True)
 
-    def announce(number: int, step: Step) -> None:
+    def announce(number: int, step: DemoStep) -> None:
         click.secho(f"\n[{number}/{len(steps)}] {step.title}", bold=True, err=True)
         click.secho(f"$ {step.command}", fg="cyan", err=True)
         sys.stdout.flush()

@@ -177,11 +177,11 @@ def _run_campaigns(request: ExploreRequest) -> Exploration:
     Ctrl-C exits 130: the same command goes on from there."""
     from exsce_dsl.api import explore
     from exsce_dsl.errors import ExecutionInterrupted
-    from exsce_dsl.model.campaign import Trial
+    from exsce_dsl.model.campaign import CampaignTrial
 
     with Progress(request.trials, "Exploring") as progress:
 
-        def trial_done(who: str, trial: Trial, resumed: bool) -> None:
+        def trial_done(who: str, trial: CampaignTrial, resumed: bool) -> None:
             shown = trial.violated or trial.inconclusive
             found = f": {'; '.join(r.text for r in shown)}" if shown else ""
             done = " (done before)" if resumed else ""

@@ -46,11 +46,11 @@ from exsce_dsl.model.campaign import (
     CampaignFigures,
     CampaignPlan,
     CampaignRecord,
+    CampaignTrial,
     CheckedRelation,
     Request,
     Shrinking,
     ShrinkTry,
-    Trial,
 )
 from exsce_dsl.model.document import Specification
 from exsce_dsl.model.verdicts import Outcome, Verdict
@@ -106,7 +106,7 @@ class CampaignEvents:
     """What a campaign tells its caller as it goes (a progress bar, log lines)."""
 
     said: Callable[[str], None] = lambda line: None
-    trial_done: Callable[[Trial, bool], None] = lambda trial, resumed: None
+    trial_done: Callable[[CampaignTrial, bool], None] = lambda trial, resumed: None
     """After each trial; ``resumed``: it was read back from the store, not run."""
     shrink_try_done: Callable[[ShrinkTry], None] = lambda tried: None
 
@@ -264,10 +264,10 @@ class _Campaign:
         verification = verify_runs(self.store, made.scenario, runs)
         return made, tuple(runs), list(verification.verdicts)
 
-    def trial(self, number: int, candidate: Candidate) -> Trial:
+    def trial(self, number: int, candidate: Candidate) -> CampaignTrial:
         made, runs, verdicts = self.judge(candidate.requests, "scenarios")
         found = _violations(verdicts, len(runs))
-        trial = Trial(
+        trial = CampaignTrial(
             self.plan.id,
             number,
             made.scenario.id,
@@ -281,7 +281,7 @@ class _Campaign:
         add_prov(self.store, compile_trial(trial))
         return trial
 
-    def shrinking(self, number: int, relation: CheckedRelation, trial: Trial) -> Shrinking:
+    def shrinking(self, number: int, relation: CheckedRelation, trial: CampaignTrial) -> Shrinking:
         tries: list[ShrinkTry] = []
 
         def still_fails(requests: tuple[Request, ...]) -> bool:
@@ -335,7 +335,7 @@ def run_campaign(
     if done:
         events.said(f"going on with {plan.id}: {len(done)} trial(s) done already")
     campaign.ensure_base_runs()
-    trials: list[Trial] = []
+    trials: list[CampaignTrial] = []
     for number, candidate in enumerate(draw(spec, base, options), start=1):
         if number in done:
             trial = done[number]

@@ -79,7 +79,7 @@ class CampaignPlan:
 
 
 @dataclass(frozen=True)
-class Trial:
+class CampaignTrial:
     """One derivation tried: its scenario, its runs, and the relations checked and violated."""
 
     campaign: str
@@ -134,7 +134,7 @@ class CampaignFigures:
         return 100 * self.counterexamples / self.executions if self.executions else None
 
     @classmethod
-    def of(cls, trials: Sequence[Trial]) -> CampaignFigures:
+    def of(cls, trials: Sequence[CampaignTrial]) -> CampaignFigures:
         """The figures of ``trials`` in the order they were drawn."""
         executions, first = 0, None
         distinct: list[CheckedRelation] = []
@@ -183,7 +183,7 @@ class CampaignRecord:
 
     plan: CampaignPlan
     started: datetime.datetime | None
-    trials: tuple[Trial, ...]
+    trials: tuple[CampaignTrial, ...]
     shrinkings: tuple[Shrinking, ...]
 
     @property

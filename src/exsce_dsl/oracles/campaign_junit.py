@@ -15,7 +15,7 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from collections.abc import Mapping, Sequence
 
-from exsce_dsl.model.campaign import CampaignRecord, CheckedRelation, Request, Shrinking, Trial
+from exsce_dsl.model.campaign import CampaignRecord, CampaignTrial, CheckedRelation, Request, Shrinking
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.queries import runs as stored_runs
 from exsce_dsl.transform.transformations import TRANSFORMATIONS
@@ -64,7 +64,7 @@ def _shrunk(relation: CheckedRelation, trial: int, shrinkings: Sequence[Shrinkin
     return ["not shrunk"]
 
 
-def _failure(trial: Trial, shrinkings: Sequence[Shrinking]) -> tuple[str, str]:
+def _failure(trial: CampaignTrial, shrinkings: Sequence[Shrinking]) -> tuple[str, str]:
     """A violated trial's failure: its message (each relation and where it was shrunk to) and its
     text (the same, a line per relation, after the scenario and its runs)."""
     found = [(r.text, _shrunk(r, trial.number, shrinkings)) for r in trial.violated]

@@ -30,7 +30,14 @@ from collections.abc import Sequence
 from prov.constants import PROV_TYPE
 from prov.model import ProvDocument
 
-from exsce_dsl.model.campaign import CampaignFigures, CampaignPlan, CheckedRelation, Request, Shrinking, Trial
+from exsce_dsl.model.campaign import (
+    CampaignFigures,
+    CampaignPlan,
+    CampaignTrial,
+    CheckedRelation,
+    Request,
+    Shrinking,
+)
 from exsce_dsl.prov import identifiers as ids
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, Namespaces
 from exsce_dsl.prov.records import Attributes, DocumentWriter
@@ -111,7 +118,7 @@ def compile_campaign(
     return writer.document
 
 
-def compile_trial(trial: Trial, namespace: str = DEFAULT_NAMESPACE) -> ProvDocument:
+def compile_trial(trial: CampaignTrial, namespace: str = DEFAULT_NAMESPACE) -> ProvDocument:
     """One trial's bundle (see the module's docstring)."""
     writer, names, iri = _writer(trial.campaign, namespace)
     parts = writer.element_namespace(trial.campaign, iri, "campaign")

@@ -191,7 +191,7 @@ def _length(gap: CoverageGap) -> float:
 def find_coverage(recording: Recording) -> Coverage:
     """Every gap of ``recording``, and the rate of each topic its metrics read."""
     wall = _wall(recording.timeline)
-    topics = read_topics(recording.data, recording.values, recording.robots)
+    topics = topics_read_by(recording.data, recording.values, recording.robots)
     gaps = _cut_short(recording, wall)
     windows = robot_windows(recording)
     notes: list[str] = []
@@ -213,7 +213,7 @@ def find_coverage(recording: Recording) -> Coverage:
     return Coverage(tuple(gaps), rates, tuple(notes))
 
 
-def read_topics(
+def topics_read_by(
     data: BagData, values: Iterable[MetricValue], robots: Iterable[Robot] = ()
 ) -> list[ReadTopic]:
     """The series of ``data`` that ``values`` were computed from, with the robot and the metrics

@@ -20,7 +20,7 @@ from exsce_dsl.model.conventions import Tolerance
 from exsce_dsl.runs.segments.arrival import arrival_segments
 from exsce_dsl.runs.segments.goals import goal_segments
 from exsce_dsl.runs.segments.track import Segmentation, Track, near, planned_waypoints
-from exsce_dsl.runs.signals.navigation_goals import Goal
+from exsce_dsl.runs.signals.navigation_goals import RecordedGoal
 
 from tests.support.paths import EXAMPLES
 
@@ -66,12 +66,12 @@ def rows(result: Segmentation, *fields: str) -> list[object]:
     return [getter(g) for g in result.segments]
 
 
-def in_order(poses) -> list[Goal]:
+def in_order(poses) -> list[RecordedGoal]:
     _, w1, w2, w3 = poses
     return [
-        Goal("g1", 10.0, 11.0, 30.0, "SUCCEEDED", xyyaw(w1)),
-        Goal("g2", 31.0, 32.0, 50.0, "SUCCEEDED", xyyaw(w2, dx=0.1)),
-        Goal("g3", 51.0, 52.0, 70.0, "SUCCEEDED", xyyaw(w3)),
+        RecordedGoal("g1", 10.0, 11.0, 30.0, "SUCCEEDED", xyyaw(w1)),
+        RecordedGoal("g2", 31.0, 32.0, 50.0, "SUCCEEDED", xyyaw(w2, dx=0.1)),
+        RecordedGoal("g3", 51.0, 52.0, 70.0, "SUCCEEDED", xyyaw(w3)),
     ]
 
 
@@ -119,9 +119,9 @@ def test_a_skipped_waypoint_is_a_skipped_segment_and_a_warning(scenario, poses) 
 def test_a_goal_off_the_plan_is_a_warning_not_a_segment(scenario, poses) -> None:
     g1, g2, g3 = in_order(poses)
     _, _, w2, _ = poses
-    off = Goal("gx", 30.5, 30.6, 30.9, "ABORTED", (0.0, 0.0, 0.0))
-    near = Goal("gnear", 31.0, 31.5, 45.0, "SUCCEEDED", xyyaw(w2, dx=0.5))  # 0.5 m > 0.35 m
-    late = Goal("g2", 46.0, 47.0, 50.0, "SUCCEEDED", g2.target)
+    off = RecordedGoal("gx", 30.5, 30.6, 30.9, "ABORTED", (0.0, 0.0, 0.0))
+    near = RecordedGoal("gnear", 31.0, 31.5, 45.0, "SUCCEEDED", xyyaw(w2, dx=0.5))  # 0.5 m > 0.35 m
+    late = RecordedGoal("g2", 46.0, 47.0, 50.0, "SUCCEEDED", g2.target)
     result = goal_segments(scenario, R, [g1, off, near, late, g3], route(poses), Tolerance())
     assert rows(result, "goal.id", "start", "end", "status") == [
         (W1_ID, 11.0, 30.0, "SUCCEEDED"),
@@ -137,8 +137,8 @@ def test_a_goal_off_the_plan_is_a_warning_not_a_segment(scenario, poses) -> None
 def test_a_retry_replaces_the_aborted_attempt_and_keeps_its_start(scenario, poses) -> None:
     _, g2, g3 = in_order(poses)
     _, w1, _, _ = poses
-    first = Goal("g1a", 10.0, 11.0, 20.0, "ABORTED", xyyaw(w1))
-    retry = Goal("g1b", 21.0, 22.0, 30.0, "SUCCEEDED", xyyaw(w1, dy=-0.2))
+    first = RecordedGoal("g1a", 10.0, 11.0, 20.0, "ABORTED", xyyaw(w1))
+    retry = RecordedGoal("g1b", 21.0, 22.0, 30.0, "SUCCEEDED", xyyaw(w1, dy=-0.2))
     result = goal_segments(scenario, R, [first, retry, g2, g3], route(poses), Tolerance())
     assert rows(result)[:2] == [
         (R, 1, "delivery_a", 1, 1, S_ID, W1_ID, 11.0, 30.0, "SUCCEEDED"),
@@ -151,8 +151,8 @@ def test_a_retry_replaces_the_aborted_attempt_and_keeps_its_start(scenario, pose
 def test_after_a_detour_off_the_plan_the_next_segment_starts_where_the_robot_is(scenario, poses) -> None:
     s, w1, w2, w3 = poses
     g1, _, g3 = in_order(poses)
-    detour = Goal("gx", 30.5, 31.0, 40.0, "SUCCEEDED", (50.0, 35.0, 0.0))
-    g2 = Goal("g2", 41.0, 42.0, 50.0, "SUCCEEDED", xyyaw(w2))
+    detour = RecordedGoal("gx", 30.5, 31.0, 40.0, "SUCCEEDED", (50.0, 35.0, 0.0))
+    g2 = RecordedGoal("g2", 41.0, 42.0, 50.0, "SUCCEEDED", xyyaw(w2))
     trk = track((0, xyyaw(s)), (30, xyyaw(w1)), (40, (50.0, 35.0, 0.0)), (50, xyyaw(w2)), (70, xyyaw(w3)))
     result = goal_segments(scenario, R, [g1, detour, g2, g3], trk, Tolerance())
     assert rows(result, "start_pose.id") == [S_ID, "tiago1@42.000", W2_ID]
@@ -168,7 +168,7 @@ def test_after_an_aborted_goal_the_next_segment_starts_where_the_robot_stopped(s
     stopped = (50.0, 35.0, 1.0)
     trk = track((0, xyyaw(s)), (11, xyyaw(s)), (20, stopped), (22, stopped), (50, xyyaw(w2)), (70, xyyaw(w3)))
     _, _, g3 = in_order(poses)
-    goals = [Goal("g1", 10.0, 11.0, 20.0, "ABORTED", xyyaw(w1)), Goal("g2", 21.0, 22.0, 50.0, "SUCCEEDED", xyyaw(w2))]
+    goals = [RecordedGoal("g1", 10.0, 11.0, 20.0, "ABORTED", xyyaw(w1)), RecordedGoal("g2", 21.0, 22.0, 50.0, "SUCCEEDED", xyyaw(w2))]
     result = goal_segments(scenario, R, [*goals, g3], trk, Tolerance())
     assert rows(result) == [
         (R, 1, "delivery_a", 1, 1, S_ID, W1_ID, 11.0, 20.0, "ABORTED"),
@@ -183,8 +183,8 @@ def test_after_an_aborted_goal_the_next_segment_starts_where_the_robot_stopped(s
 def test_a_goal_back_to_a_reached_waypoint_is_not_a_retry(scenario, poses) -> None:
     g1, _, g3 = in_order(poses)
     _, w1, w2, _ = poses
-    again = Goal("again", 30.5, 30.6, 31.0, "SUCCEEDED", xyyaw(w1))
-    g2 = Goal("g2", 36.0, 37.0, 50.0, "SUCCEEDED", xyyaw(w2))
+    again = RecordedGoal("again", 30.5, 30.6, 31.0, "SUCCEEDED", xyyaw(w1))
+    g2 = RecordedGoal("g2", 36.0, 37.0, 50.0, "SUCCEEDED", xyyaw(w2))
     result = goal_segments(scenario, R, [g1, again, g2, g3], route(poses), Tolerance())
     assert rows(result, "start", "end") == [(11.0, 30.0), (37.0, 50.0), (52.0, 70.0)]
     assert result.warnings == ("goal again to (52.83, 32.56) is not in the plan of robot tiago1",)
@@ -193,8 +193,8 @@ def test_a_goal_back_to_a_reached_waypoint_is_not_a_retry(scenario, poses) -> No
 def test_canceled_and_still_active_goals(scenario, poses) -> None:
     g1, _, _ = in_order(poses)
     _, _, w2, w3 = poses
-    canceled = Goal("g2", 31.0, None, 40.0, "CANCELED", xyyaw(w2))  # never active: starts when accepted
-    active = Goal("g3", 41.0, 42.0, 99.0, "ACTIVE", xyyaw(w3))  # last seen at 99 s, never ended
+    canceled = RecordedGoal("g2", 31.0, None, 40.0, "CANCELED", xyyaw(w2))  # never active: starts when accepted
+    active = RecordedGoal("g3", 41.0, 42.0, 99.0, "ACTIVE", xyyaw(w3))  # last seen at 99 s, never ended
     result = goal_segments(scenario, R, [g1, canceled, active], route(poses), Tolerance())
     assert rows(result) == [
         (R, 1, "delivery_a", 1, 1, S_ID, W1_ID, 11.0, 30.0, "SUCCEEDED"),
@@ -210,9 +210,9 @@ def test_a_goal_without_a_target_is_where_the_robot_was_when_it_succeeded(scenar
     stopped = (50.0, 35.0, 0.0)
     trk = track((0, xyyaw(s)), (11, xyyaw(s)), (30, xyyaw(w1)), (40, stopped), (52, stopped), (70, xyyaw(w3)))
     goals = [
-        Goal("g1", 10.0, 11.0, 30.0, "SUCCEEDED"),  # the track is at W1 at 30 s
-        Goal("g2", 31.0, 32.0, 40.0, "ABORTED"),  # failed somewhere: no telling where it was going
-        Goal("g3", 51.0, 52.0, 70.0, "SUCCEEDED"),  # the track is at W3 at 70 s
+        RecordedGoal("g1", 10.0, 11.0, 30.0, "SUCCEEDED"),  # the track is at W1 at 30 s
+        RecordedGoal("g2", 31.0, 32.0, 40.0, "ABORTED"),  # failed somewhere: no telling where it was going
+        RecordedGoal("g3", 51.0, 52.0, 70.0, "SUCCEEDED"),  # the track is at W3 at 70 s
     ]
     result = goal_segments(scenario, R, goals, trk, Tolerance())
     assert rows(result, "start_pose.id", "goal.id", "start", "end", "status") == [
@@ -232,7 +232,7 @@ def test_a_goal_without_a_target_is_where_the_robot_was_when_it_succeeded(scenar
 )
 def test_heading_tolerance_on_goals(scenario, poses, dyaw: float, heading: float | None, matched: bool) -> None:
     g1, g2, g3 = in_order(poses)
-    turned = Goal("g1", 10.0, 11.0, 30.0, "SUCCEEDED", xyyaw(poses[1], dyaw=dyaw))
+    turned = RecordedGoal("g1", 10.0, 11.0, 30.0, "SUCCEEDED", xyyaw(poses[1], dyaw=dyaw))
     result = goal_segments(scenario, R, [turned, g2, g3], route(poses), Tolerance(heading=heading))
     assert result.segments[0].status == ("SUCCEEDED" if matched else "SKIPPED")
     assert any("goal g1 to" in w for w in result.warnings) is not matched
@@ -251,8 +251,8 @@ def test_a_robot_not_at_its_start_pose_starts_where_it_is(scenario, poses) -> No
 def test_no_goals_or_none_in_the_plan_give_no_segments(scenario, poses) -> None:
     expected = Segmentation((), ("robot tiago1 has no navigation goals: no segments from goals",))
     assert goal_segments(scenario, R, [], route(poses), Tolerance()) == expected
-    timeless = Goal("t", None, None, None, "ACTIVE", xyyaw(poses[1]))
-    elsewhere = Goal("gx", 5.0, 6.0, 7.0, "SUCCEEDED", (1.0, 2.0, 0.0))
+    timeless = RecordedGoal("t", None, None, None, "ACTIVE", xyyaw(poses[1]))
+    elsewhere = RecordedGoal("gx", 5.0, 6.0, 7.0, "SUCCEEDED", (1.0, 2.0, 0.0))
     result = goal_segments(scenario, R, [timeless, elsewhere], route(poses), Tolerance())
     assert result.segments == ()
     assert result.warnings == (
@@ -265,9 +265,9 @@ def test_no_goals_or_none_in_the_plan_give_no_segments(scenario, poses) -> None:
 # --- follow_waypoints -------------------------------------------------------------------------------
 
 
-def follow(poses, progress, status="SUCCEEDED", ended=70.0, targets=True, missed=()) -> Goal:
+def follow(poses, progress, status="SUCCEEDED", ended=70.0, targets=True, missed=()) -> RecordedGoal:
     given = tuple(xyyaw(p) for p in poses[1:]) if targets else ()
-    return Goal("fw", 10.0, 11.0, ended, status, None, tuple(progress), given, tuple(missed))
+    return RecordedGoal("fw", 10.0, 11.0, ended, status, None, tuple(progress), given, tuple(missed))
 
 
 @pytest.mark.parametrize("targets", [True, False], ids=["targets", "track"])

@@ -1,7 +1,7 @@
 """Path segments from a robot's navigation goals, matched to its planned waypoints by pose.
 
 Real stacks (Nav2, move_base, ...) do not say which planned waypoint a goal was for, so the goal's
-target pose says it.  The goals come already read from the bag, as `Goal`s; the rules:
+target pose says it.  The goals come already read from the bag, as `RecordedGoal`s; the rules:
 
 1. **Legs.**  A goal to one pose is one leg: it starts when the goal became active (``started``,
    else ``accepted``), ends at ``ended`` with the goal's ``status`` (``ACTIVE``: never ended, no
@@ -57,7 +57,7 @@ from exsce_dsl.runs.segments.track import (
     matches,
     planned_waypoints,
 )
-from exsce_dsl.runs.signals.navigation_goals import Goal, XYYaw
+from exsce_dsl.runs.signals.navigation_goals import RecordedGoal, XYYaw
 
 
 @dataclass(frozen=True)
@@ -74,7 +74,7 @@ class Leg:
 def goal_segments(
     scenario: Scenario,
     robot: str,
-    goals: Sequence[Goal],
+    goals: Sequence[RecordedGoal],
     track: Track,
     tolerance: Tolerance = DEFAULT_TOLERANCE,
 ) -> Segmentation:
@@ -130,7 +130,7 @@ def _matches(planned: PlannedWaypoint, leg: Leg, tolerance: Tolerance) -> bool:
     return matches(tolerance, planned.pose, *leg.target)
 
 
-def goal_legs(goals: Sequence[Goal], track: Track, warnings: list[str]) -> list[Leg]:
+def goal_legs(goals: Sequence[RecordedGoal], track: Track, warnings: list[str]) -> list[Leg]:
     """The legs of ``goals`` in the order they were first seen, with their targets (rules 1-3)."""
     timed = []
     for goal in goals:
@@ -151,7 +151,7 @@ def goal_legs(goals: Sequence[Goal], track: Track, warnings: list[str]) -> list[
     return legs
 
 
-def _waypoint_legs(goal: Goal, track: Track, warnings: list[str]) -> list[Leg]:
+def _waypoint_legs(goal: RecordedGoal, track: Track, warnings: list[str]) -> list[Leg]:
     """The legs of a follow_waypoints goal: one per waypoint index its feedback reported."""
     progress: list[tuple[int, float]] = []
     for index, t in goal.progress:

@@ -2,7 +2,7 @@
 
 Few messages (a status array a second and at each change), so they are read as
 message objects (:data:`~exsce_dsl.runs.bags.reading.OBJECTS`, each distinct one once)
-and walked here into :class:`Goal`\\ s, in receive
+and walked here into :class:`RecordedGoal`\\ s, in receive
 time.  (A global plan is long, but rosbags deserializes its poses faster than the
 vectorised decoder walks them one element index at a time, for a plan a chunk.)
 
@@ -36,7 +36,7 @@ XYYaw = tuple[float, float, float]
 
 
 @dataclass(frozen=True)
-class Goal:
+class RecordedGoal:
     """One navigation goal of a robot, as read from its bag (times in seconds since the epoch)."""
 
     key: str  # the goal's id (a Nav2 UUID as hex, a move_base goal id string)
@@ -86,11 +86,11 @@ def goal_wanted(signals: Signals, namespace: str) -> dict[str, Wanted]:
     return {}
 
 
-def read_goals(signals: Signals, namespace: str, data: BagData) -> tuple[list[Goal], list[str]]:
+def read_goals(signals: Signals, namespace: str, data: BagData) -> tuple[list[RecordedGoal], list[str]]:
     """The robot's goals from the bag's messages, and the topics they came from."""
     messages = data.messages
     actions = [expand_topic(a, namespace) for a in signals.actions]
-    goals: list[Goal] = []
+    goals: list[RecordedGoal] = []
     used: list[str] = []
     for action in actions:
         if signals.navigation is Navigation.NAV2:
@@ -133,7 +133,7 @@ def _move_base_key(goal_id: Any) -> str:
     return str(goal_id.id)
 
 
-def _nav2_goals(status: Messages, feedback: Messages, plans: Messages) -> list[Goal]:
+def _nav2_goals(status: Messages, feedback: Messages, plans: Messages) -> list[RecordedGoal]:
     progress: dict[str, list[tuple[int, float]]] = {}
     for t, message in feedback:
         current = getattr(message.feedback, "current_waypoint", None)
@@ -154,7 +154,9 @@ def _nav2_goals(status: Messages, feedback: Messages, plans: Messages) -> list[G
     for goal in goals:
         reported = tuple(progress.get(goal.key, ()))
         target = None if reported else _plan_target(plans, goal)
-        found.append(Goal(goal.key, goal.accepted, goal.started, goal.ended, goal.status, target, reported))
+        found.append(
+            RecordedGoal(goal.key, goal.accepted, goal.started, goal.ended, goal.status, target, reported)
+        )
     return found
 
 
@@ -165,7 +167,7 @@ def _statuses(
     final: set[int],
     started_at: set[int],
     targets: Mapping[str, tuple[float, float, float]],
-) -> list[Goal]:
+) -> list[RecordedGoal]:
     """Goals from status arrays: when each was first seen, became active and reached a final status."""
     seen: dict[str, dict[str, Any]] = {}
     for t, message in status:
@@ -178,12 +180,12 @@ def _statuses(
             if code in final and goal["ended"] is None:
                 goal["ended"], goal["status"] = t, names.get(code, str(code))
     return [
-        Goal(key, g["accepted"], g["started"], g["ended"], g["status"], targets.get(key))
+        RecordedGoal(key, g["accepted"], g["started"], g["ended"], g["status"], targets.get(key))
         for key, g in seen.items()
     ]
 
 
-def _plan_target(plans: Messages, goal: Goal) -> tuple[float, float, float] | None:
+def _plan_target(plans: Messages, goal: RecordedGoal) -> tuple[float, float, float] | None:
     """The last pose of the first global plan published while the goal was under way."""
     begin = goal.accepted if goal.accepted is not None else goal.started
     if begin is None:

@@ -50,7 +50,7 @@ class Velocity:
 
 
 @dataclass(frozen=True)
-class Step:
+class ImplausibleStep:
     """One implausible step: when (seconds from the series' first pose), how long, in what time."""
 
     at: float
@@ -70,7 +70,7 @@ class Implausible:
     poses: int
     returns: int
     """Implausible steps followed by one back to where they started."""
-    worst: Step
+    worst: ImplausibleStep
     velocity: Velocity | None = None
 
     @property
@@ -136,5 +136,5 @@ def check_poses(
     with np.errstate(invalid="ignore"):
         returned = jump[:-1] & jump[1:] & (back <= bound * np.maximum(times[2:] - times[:-2], 0.0) + NOISE)
     k = int(np.nanargmax(np.where(jump, length, -np.inf)))
-    worst = Step(float(times[k] - times[0]), float(length[k]), float(seconds[k]))
+    worst = ImplausibleStep(float(times[k] - times[0]), float(length[k]), float(seconds[k]))
     return Implausible(topic, bound, int(jump.sum()), len(times), int(returned.sum()), worst, velocity)

@@ -8,11 +8,11 @@ import json
 from exsce_dsl.model.campaign import (
     CampaignPlan,
     CampaignRecord,
+    CampaignTrial,
     CheckedRelation,
     Request,
     Shrinking,
     ShrinkTry,
-    Trial,
 )
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE
 from exsce_dsl.store.base import Store
@@ -65,10 +65,10 @@ def campaigns(
     return [plan for plan, _ in _plans(store, base, namespace)]
 
 
-def campaign_trials(store: Store, campaign: str, namespace: str = DEFAULT_NAMESPACE) -> list[Trial]:
+def campaign_trials(store: Store, campaign: str, namespace: str = DEFAULT_NAMESPACE) -> list[CampaignTrial]:
     """The trials of ``campaign`` written so far, in the order they were drawn."""
     return [
-        Trial(
+        CampaignTrial(
             campaign,
             int_of(row["order"]),
             text_of(row["scenario"]) or "",
