@@ -251,7 +251,7 @@ class StandIn:
         self.counts[key] = self.counts.get(key, 0) + 1
 
     def run(self) -> None:
-        """Publish every sample up to simulated now, then ``/clock``; TICK wall seconds a round."""
+        """Publish every sample up to simulated now, each after its ``/clock``; TICK wall seconds a round."""
         base_wall, base_sim = time.monotonic(), self.start_ns
         try:
             while self.running and not rospy.is_shutdown():
@@ -266,12 +266,16 @@ class StandIn:
                 if target - published_ns > MAX_LAG_NS:  # behind: simulated time waits for us
                     target = published_ns + MAX_LAG_NS
                     base_wall, base_sim = now, target
-                self.publish_clock(target)
                 last = (target - self.start_ns) // DT_NS
                 with self.lock:
+                    # /clock steps with each sample, so a round that catches up after a stall does
+                    # not reach a recorder as one burst stamped at one time (a gap before it)
                     while self.published < last:
+                        self.publish_clock(self.time_of(self.published + 1))
                         self.publish_sample(self.published + 1)
                         self.published += 1
+                if target > self.time_of(self.published):
+                    self.publish_clock(target)
                 time.sleep(TICK)
         except Exception as e:  # the node is useless without its clock: say why and end
             self.running = False
