@@ -28,7 +28,7 @@ from exsce_dsl.model.conventions import (
     TopicSource,
 )
 from exsce_dsl.model.messages import FieldPath
-from exsce_dsl.model.metrics import expand_topic
+from exsce_dsl.model.metrics import GOALS_READ_AS, expand_topic
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import MetricValue
 from exsce_dsl.monitor_kit.monitor_core import Topic
@@ -181,14 +181,17 @@ class StackRobots:
                     said = f"no {signal} (none detected in the bag)"
                 names = [signal_topic(signal, ns)] + ([served] if robot.id in self.serves else [])
                 found.update(dict.fromkeys(names, said))
-            if signals.navigation is not Navigation.DISPATCHER:
-                actions = ", ".join(expand_topic(a, ns) for a in signals.actions)
-                said = (
-                    f"no navigation goals (looked for {actions})"
-                    if actions
-                    else "no path segments (no navigation goals, and no arrival at its planned waypoints)"
-                )
-                found.update(dict.fromkeys((expand_topic(FEEDBACK, ns), expand_topic(RESULT, ns)), said))
+            goals = [expand_topic(p, ns) for p in GOALS_READ_AS.values()]
+            if signals.navigation is Navigation.DISPATCHER:  # its feedback, its result
+                found.update(zip(goals, (expand_topic(FEEDBACK, ns), expand_topic(RESULT, ns)), strict=True))
+                continue
+            actions = ", ".join(expand_topic(a, ns) for a in signals.actions)
+            said = (
+                f"no navigation goals (looked for {actions})"
+                if actions
+                else "no path segments (no navigation goals, and no arrival at its planned waypoints)"
+            )
+            found.update(dict.fromkeys((*goals, expand_topic(FEEDBACK, ns), expand_topic(RESULT, ns)), said))
         return found
 
     def recorded_span(self, robot: Robot, topics: Mapping[str, Topic]) -> tuple[float, float] | None:

@@ -25,7 +25,7 @@ from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import Accounting, ActionId, Hotspot, MetricScope, MetricValue, SourceCount
 from exsce_dsl.monitor_kit import monitor_core as core
 from exsce_dsl.runs.metrics.accounting import GOALS_SPAN, MISSION_SPAN, SampleCounter, segment_reason
-from exsce_dsl.runs.metrics.monitor_code import reads_used
+from exsce_dsl.runs.metrics.monitor_code import topics_used
 from exsce_dsl.runs.segments.recorded import RecordedAction
 
 HOTSPOT_RADIUS = 1.0  # metres: violations closer than this to a hotspot belong to it
@@ -92,13 +92,12 @@ def compute_metrics(
 
 def _topics(metric: MetricDefinition, alternative: int, namespaces: Sequence[str]) -> tuple[str, ...]:
     """The topics an alternative of ``metric`` read, for robots of these namespaces (in order)."""
-    patterns = {r.name: r.topic for r in metric.reads}
-    used = reads_used(metric, alternative)
+    used = topics_used(metric, alternative)
     found: list[str] = []
     for n, ns in enumerate(namespaces):
-        for whose, read in used:
+        for whose, pattern in used:
             if whose is None or (metric.pair is not None and metric.pair.index(whose) == n):
-                topic = core.expand_topic(patterns[read], ns)
+                topic = core.expand_topic(pattern, ns)
                 if topic not in found:
                     found.append(topic)
     return tuple(found)
