@@ -54,9 +54,6 @@ and no fields; a metric uses it through ``elapsed`` and ``succeeded``."""
 WINDOWS = (*DISPATCHER, GOALS)
 """The types read as windows and successes, never field by field."""
 
-POSE = "geometry_msgs/msg/PoseWithCovarianceStamped"
-"""The method's robot pose (its convention's pose topic), where hotspots are placed."""
-
 
 @dataclass(frozen=True)
 class Index:

@@ -17,7 +17,7 @@ from exsce_dsl.messages.field_check import check_fields
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.conventions import MetricSpan
 from exsce_dsl.model.expressions import Field, walk
-from exsce_dsl.model.messages import DISPATCHER, POSE, FieldPath, Fields
+from exsce_dsl.model.messages import DISPATCHER, FieldPath, Fields
 from exsce_dsl.model.metrics import GOALS_READ_AS, MetricDefinition
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import (
@@ -44,7 +44,7 @@ from exsce_dsl.runs.coverage import (
     recorded_mission_status,
 )
 from exsce_dsl.runs.metrics.accounting import finish_accounting
-from exsce_dsl.runs.metrics.compute import HOTSPOT_PATHS, POSE_TOPIC, compute_metrics
+from exsce_dsl.runs.metrics.compute import compute_metrics
 from exsce_dsl.runs.metrics.monitor_code import load_monitors
 from exsce_dsl.runs.missing import missing_metrics, unread_topics
 from exsce_dsl.runs.plausible_poses import Refused, refuse_implausible, spec_speed_limit
@@ -105,13 +105,11 @@ def run_metrics(scenario: Scenario) -> tuple[MetricDefinition, ...]:
 
 def wanted_topics(metrics: tuple[MetricDefinition, ...], robots: list[Robot]) -> dict[str, Wanted]:
     """Topic → its message type (the dispatcher's: kept as message objects) and the fields the
-    metrics read of it (and of each robot's pose, where hotspots are placed)."""
+    metrics read of it."""
     types: dict[str, str] = {}
     paths: dict[str, dict[FieldPath, None]] = {}
     for robot in robots:
         ns = robot.namespace.strip("/")
-        types[expand_topic(POSE_TOPIC, ns)] = POSE
-        paths.setdefault(expand_topic(POSE_TOPIC, ns), {}).update(dict.fromkeys(HOTSPOT_PATHS))
         for metric in metrics:
             read_paths = fields_read(metric)
             for read in metric.reads:

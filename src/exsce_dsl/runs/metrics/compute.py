@@ -17,10 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from exsce_dsl.model.conventions import METHOD_TOPICS
 from exsce_dsl.model.geometry import Position
-from exsce_dsl.model.messages import path_of
-from exsce_dsl.model.metrics import ComputedFor, MetricDefinition
+from exsce_dsl.model.metrics import ComputedFor, MetricDefinition, signal_pattern
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import Accounting, ActionId, Hotspot, MetricScope, MetricValue, SourceCount
 from exsce_dsl.monitor_kit import monitor_core as core
@@ -29,10 +27,9 @@ from exsce_dsl.runs.metrics.monitor_code import topics_used
 from exsce_dsl.runs.segments.recorded import RecordedAction
 
 HOTSPOT_RADIUS = 1.0  # metres: violations closer than this to a hotspot belong to it
-POSE_TOPIC = METHOD_TOPICS["pose"]
-"""Where hotspots are located: each robot's pose."""
-HOTSPOT_PATHS = (path_of("pose", "pose", "position", "x"), path_of("pose", "pose", "position", "y"))
-"""What hotspots read of the pose."""
+POSE_SIGNAL = signal_pattern("pose")
+"""Where hotspots are located: each robot's pose signal (its ``x`` and ``y``), wherever its
+convention puts it."""
 
 Window = tuple[RecordedAction | None, float, float]
 
@@ -351,17 +348,13 @@ def _pairs_missing(
 
 
 def _pose(topics: Mapping[str, core.Topic], namespace: str) -> core.Topic | None:
-    found = topics.get(core.expand_topic(POSE_TOPIC, namespace))
+    found = topics.get(core.expand_topic(POSE_SIGNAL, namespace))
     return found if found is not None and len(found) else None
 
 
 def _position_at(pose: core.Topic, times: np.ndarray) -> np.ndarray:
-    return np.column_stack(
-        [
-            np.interp(times, pose.t, pose.fields[HOTSPOT_PATHS[0].key]),
-            np.interp(times, pose.t, pose.fields[HOTSPOT_PATHS[1].key]),
-        ]
-    )
+    x, y = (np.interp(times, pose.t, pose.fields[axis]) for axis in ("x", "y"))
+    return np.column_stack([x, y])
 
 
 def group_hotspots(points: np.ndarray, durations: np.ndarray) -> list[tuple[np.ndarray, int, float]]:
