@@ -18,7 +18,7 @@ from exsce_dsl.model import Scenario
 from exsce_dsl.model.conventions import MetricSpan
 from exsce_dsl.model.expressions import Field, walk
 from exsce_dsl.model.messages import DISPATCHER, FieldPath, Fields
-from exsce_dsl.model.metrics import GOALS_READ_AS, MetricDefinition
+from exsce_dsl.model.metrics import MetricDefinition
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import (
     Action,
@@ -54,7 +54,6 @@ from exsce_dsl.runs.segments.recorded import RecordedAction
 from exsce_dsl.runs.segments.sources import DISPATCHER_SOURCE, segment_robot
 from exsce_dsl.runs.segments.track import Track
 from exsce_dsl.runs.signals.detect import Detected, pose_like_topics, with_detected_conventions
-from exsce_dsl.runs.signals.sources import signal_topic
 from exsce_dsl.runs.signals.timeline import (
     Timeline,
     decide_timeline,
@@ -330,10 +329,7 @@ def _segment_robots(path: Path, scenario: Scenario, bag: _Signals) -> _Segmented
         if found.source and found.source != DISPATCHER_SOURCE:
             out.segmented_by[robot.id] = found.source
         out.results[robot.id] = found.succeeded
-        # the goals signal's values name the topics its goals came from (without goals: the pose's)
-        windows = found.topics or stacks.real_topics.get(signal_topic("pose", ns), ())
-        goals, outcomes = (expand_topic(p, ns) for p in GOALS_READ_AS.values())
-        stacks.real_topics[goals], stacks.real_topics[outcomes] = windows, found.outcomes or windows
+        stacks.name_goals(ns, found.topics, found.outcomes, found.source == DISPATCHER_SOURCE)
         # the whole run is the recording unless recorded goals span it: never an arrival
         recording = robot.signals.window is MetricSpan.RECORDING or not found.goals
         if (not found.segments or recording) and scenario.mission.tasks_of(robot.id):

@@ -143,6 +143,20 @@ class StackRobots:
                     self.estimated[name] = "pose"
         return found
 
+    def name_goals(
+        self, namespace: str, windows: tuple[str, ...], outcomes: tuple[str, ...], dispatcher: bool
+    ) -> None:
+        """Say which bag topics the robot's goals signal came from: ``windows`` when its goals were
+        active, ``outcomes`` how they ended (where not ``windows``); without goals, its pose's.
+        A robot not segmented by the dispatcher has its goals served under the dispatcher's names
+        too (a user metric's ``elapsed`` over the dispatcher's feedback)."""
+        windows = windows or self.real_topics.get(signal_topic("pose", namespace), ())
+        goals, results = (expand_topic(p, namespace) for p in GOALS_READ_AS.values())
+        self.real_topics[goals], self.real_topics[results] = windows, outcomes or windows
+        if not dispatcher:
+            self.real_topics[expand_topic(FEEDBACK, namespace)] = windows
+            self.real_topics[expand_topic(RESULT, namespace)] = windows
+
     def with_real_sources(self, value: MetricValue) -> MetricValue:
         """``value`` with the topics it came from named as the bag has them, and what it was
         estimated from where the bag lacked its signal."""
