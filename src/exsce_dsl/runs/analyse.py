@@ -49,7 +49,7 @@ from exsce_dsl.runs.metrics.monitor_code import load_monitors
 from exsce_dsl.runs.missing import missing_metrics, unread_topics
 from exsce_dsl.runs.plausible_poses import Refused, refuse_implausible, spec_speed_limit
 from exsce_dsl.runs.recorded_execution import recorded_execution
-from exsce_dsl.runs.robots import SERVED, StackRobots, stack_robots
+from exsce_dsl.runs.robots import StackRobots, stack_robots
 from exsce_dsl.runs.segments.recorded import RecordedAction
 from exsce_dsl.runs.segments.sources import DISPATCHER_SOURCE, segment_robot
 from exsce_dsl.runs.segments.track import Track
@@ -150,10 +150,10 @@ def field_checker(metrics: tuple[MetricDefinition, ...], robots: list[Robot]) ->
 
 def reductions(monitors: ModuleType, robots: list[Robot], stacks: StackRobots) -> dict[str, Reduce]:
     """Topic → what to reduce of each block of its messages as the bag is read (the monitors'
-    aggregates over arrays), so that no topic's arrays are ever all in memory.  A signal served
-    under another name than its bag topic's (a scan on ``/base_scan`` served as ``/scan``) is
-    reduced as its bag topic is read: the reader keeps no arrays of a topic it reduces, so a
-    reduction keyed by the served name alone left the monitors without the scan's ranges."""
+    aggregates over arrays), so that no topic's arrays are ever all in memory.  A scan signal
+    (``/{ns}/~scan``) is reduced as its bag topic (``/base_scan``) is read: the reader keeps no
+    arrays of a topic it reduces, so a reduction keyed by the signal's name alone left the
+    monitors without the scan's ranges."""
     entries: dict[str, list[tuple[str, str, Compute]]] = {}
     for robot in robots:
         for pattern, key, func, compute in monitors.REDUCERS:
@@ -240,7 +240,7 @@ def analyse_bag(
 @dataclass
 class _Signals:
     """A bag read as a run of a scenario: its robots (conventions detected where their type names
-    none), the stacks serving their signals, every series on the run's one timeline, and the
+    none), where their signals were read from, every series on the run's one timeline, and the
     problems found so far."""
 
     types: BagTopics
@@ -266,15 +266,14 @@ class _Signals:
 def _read_signals(
     path: Path, scenario: Scenario, metrics: tuple[MetricDefinition, ...], monitors: ModuleType
 ) -> _Signals:
-    """Read what the metrics need of the bag at ``path``, put it on one timeline, and serve each
-    robot's signals under the topics the monitors read."""
+    """Read what the metrics need of the bag at ``path``, put it on one timeline, and each
+    robot's signals from the sources its convention names (``/{ns}/~pose``...)."""
     types = bag_topics(path)
     robots, detected = with_detected_conventions(
         [r for r in scenario.robots if r.start_pose is not None], types
     )
-    stacks = stack_robots(robots, types, {r.id for r in robots})
-    serving = [expand_topic(p, r.namespace) for r in robots if r.id in stacks.serves for p in SERVED.values()]
-    unread = unread_topics(scenario.metrics, robots, types, serving)
+    stacks = stack_robots(robots, types)
+    unread = unread_topics(scenario.metrics, robots, types)
     wanted = with_stamps(stacks.adapt(wanted_topics(metrics, robots), robots), types, stamp_catalogue())
     if PROV_TOPIC in types:
         wanted[PROV_TOPIC] = Wanted(OBJECTS)
@@ -285,12 +284,7 @@ def _read_signals(
     for sources in stacks.sources.values():
         problems += sources.notes
     topics = {name: Topic(name, s.t, s.fields) for name, s in data.series.items()}
-    for name, served in stacks.served_topics(data, problems).items():
-        read = topics.get(name)
-        # a signal served under the very topic it was read from keeps every field the bag gave
-        # (a user metric may read more of it than the method's fields: pose.pose.covariance)
-        same = read is not None and len(read) == len(served) and np.array_equal(read.t, served.t)
-        topics[name] = Topic(name, served.t, {**served.fields, **read.fields}) if same and read else served
+    topics.update(stacks.signal_series(data, problems))
     refused = refuse_implausible(robots, stacks, topics, data, spec_speed_limit(scenario.metrics))
     problems += refused.problems
     # an implausible pose places no arrival; the whole run still spans the recording

@@ -13,13 +13,12 @@ from pathlib import Path
 import pytest
 from rosbags.highlevel import AnyReader
 
-from exsce_dsl.lang import analyse, load_spec
+from exsce_dsl.lang import analyse
 from exsce_dsl.model.runs import MetricScope
-from exsce_dsl.runs.analyse import AnalysedRun, analyse_bag
+from exsce_dsl.runs.analyse import AnalysedRun
 from exsce_dsl.sim.executor import Fault
-from exsce_dsl.sim.run import simulate
 
-from tests.sim.test_sim_conventions import YARD
+from tests.support.yard_runs import yard_runs
 
 USER_METRICS = """
 metric goal_time for each robot per segment {
@@ -47,15 +46,7 @@ PREFIXES = {"r1": "", "r2": "/r2"}
 
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[Path, AnalysedRun]]:
-    folder = tmp_path_factory.mktemp("goals")
-    spec = folder / "yard.exsce"
-    spec.write_text(YARD + USER_METRICS, encoding="utf-8")
-    scenario = load_spec(spec).scenario()
-    found = {}
-    for convention in ("method", "nav2", "move_base"):
-        (run,) = simulate(scenario, folder / convention, 1, "ros1", 7, SKIPPED, convention=convention)
-        found[convention] = (run.bag, analyse_bag(run.bag, scenario))
-    return found
+    return yard_runs(tmp_path_factory.mktemp("goals"), USER_METRICS, ("method", "nav2", "move_base"), SKIPPED)
 
 
 def _values(
