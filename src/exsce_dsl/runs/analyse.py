@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import datetime as dt
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from types import ModuleType
@@ -21,46 +21,39 @@ from exsce_dsl.model.messages import DISPATCHER, POSE, FieldPath, Fields
 from exsce_dsl.model.metrics import MetricDefinition
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import (
-    Action,
-    ActionId,
-    ActionStatus,
     Bag,
     MetricValue,
     Run,
     RunClock,
-    TaskExecution,
     run_uuid,
 )
 from exsce_dsl.monitor_kit.monitor_core import Compute, Topic, expand_topic, reducer
 from exsce_dsl.runs.bag_identity import content_hash
 from exsce_dsl.runs.bags.data import OBJECTS, BagData, Check, Reduce, Wanted
 from exsce_dsl.runs.bags.names import BagTopics
-from exsce_dsl.runs.bags.reading import bag_topics, read_bag
+from exsce_dsl.runs.bags.reading import open_bag
 from exsce_dsl.runs.coverage import (
     PROV_TOPIC,
     Recording,
     declared_rates,
     find_coverage,
     recorded_mission_status,
+    with_findings,
 )
-from exsce_dsl.runs.metrics.accounting import finish_accounting
+from exsce_dsl.runs.metrics.accounting import on_wall_clock
 from exsce_dsl.runs.metrics.compute import HOTSPOT_PATHS, POSE_TOPIC, compute_metrics
 from exsce_dsl.runs.metrics.monitor_code import load_monitors
 from exsce_dsl.runs.missing import missing_metrics, unread_topics
 from exsce_dsl.runs.plausible_poses import Refused, refuse_implausible, spec_speed_limit
 from exsce_dsl.runs.recorded_execution import recorded_execution
 from exsce_dsl.runs.robots import SERVED, StackRobots, stack_robots
+from exsce_dsl.runs.segments.executions import task_executions
 from exsce_dsl.runs.segments.recorded import RecordedAction
 from exsce_dsl.runs.segments.sources import DISPATCHER_SOURCE, segment_robot
 from exsce_dsl.runs.segments.track import Track
 from exsce_dsl.runs.signals.detect import Detected, pose_like_topics, with_detected_conventions
-from exsce_dsl.runs.signals.timeline import (
-    Timeline,
-    decide_timeline,
-    on_timeline,
-    stamp_catalogue,
-    with_stamps,
-)
+from exsce_dsl.runs.signals.recording import read_on_timeline
+from exsce_dsl.runs.signals.timeline import Timeline, stamp_catalogue, with_stamps
 from exsce_dsl.wording import counted
 
 _FEEDBACK, _RESULT = DISPATCHER_FEEDBACK, DISPATCHER_RESULT
@@ -189,7 +182,9 @@ def analyse_bag(
     source = scenario.location.file if scenario.location else scenario.id
     monitors = load_monitors(metrics, source)
     bag = _read_signals(path, scenario, metrics, monitors)
+    dated = bag.timeline.dated  # what the run keeps of its timeline, as the signals step ends
     found = _segment_robots(path, scenario, bag)
+    tasks = task_executions(found.actions, found.segmented_by, bag.timeline.to_wall)
     robots, stacks = bag.robots, bag.stacks
     values, hotspots = compute_metrics(
         monitors,
@@ -203,7 +198,11 @@ def analyse_bag(
         {**bag.named, **bag.refused.reasons},
         found.reasons,
     )
-    values = [_bag_named(stacks.with_real_sources(v), bag.data.spellings) for v in values]
+    real = {n: _spelt(stacks.real_topics.get(n, (n,)), bag.data.spellings) for n in bag.topics}
+    values = [
+        on_wall_clock(_bag_named(stacks.with_real_sources(v), bag.data.spellings), bag.timeline.to_wall, real, stacks.real_chains)
+        for v in values
+    ]  # fmt: skip
     if strict:
         acting = [r.id for r in robots if scenario.mission.tasks_of(r.id)]
         lacking = missing_metrics(metrics, robots, acting, found.actions, values)
@@ -217,20 +216,18 @@ def analyse_bag(
         )
     )  # fmt: skip
     bag.problems += covered.said()
-    real = {n: _spelt(stacks.real_topics.get(n, (n,)), bag.data.spellings) for n in bag.topics}
-    chains = stacks.real_chains
-    values = [finish_accounting(v, bag.timeline.to_wall, real, covered.gaps, chains) for v in values]
+    values = [with_findings(v, covered.gaps) for v in values]
     run = Run(
         uuid=run_id or run_uuid(digest),
         scenario=scenario.id,
         start=_time(bag.recorded.start),
         end=_time(bag.recorded.end),
         bag=Bag(path.name, bag.data.topics, str(path.resolve())),
-        tasks=_task_executions(found.actions, found.segmented_by, bag.timeline.to_wall),
+        tasks=tasks,
         metrics=tuple(values),
         hotspots=tuple(hotspots),
         clocks=_run_clocks(bag.timeline, bag.data.spellings),
-        dated=bag.timeline.dated,
+        dated=dated,
         conventions=tuple((d.robot, d.convention, d.evidence) for d in bag.detected),
         status=status,
         coverage=covered.gaps,
@@ -272,7 +269,8 @@ def _read_signals(
 ) -> _Signals:
     """Read what the metrics need of the bag at ``path``, put it on one timeline, and serve each
     robot's signals under the topics the monitors read."""
-    types = bag_topics(path)
+    opened = open_bag(path)
+    types = opened.topics
     robots, detected = with_detected_conventions(
         [r for r in scenario.robots if r.start_pose is not None], types
     )
@@ -282,9 +280,8 @@ def _read_signals(
     wanted = with_stamps(stacks.adapt(wanted_topics(metrics, robots), robots), types, stamp_catalogue())
     if PROV_TOPIC in types:
         wanted[PROV_TOPIC] = Wanted(OBJECTS)
-    recorded = read_bag(path, wanted, reductions(monitors, robots, stacks), field_checker(metrics, robots))
-    timeline = decide_timeline(recorded)
-    data = on_timeline(recorded, timeline)
+    read = read_on_timeline(opened, wanted, reductions(monitors, robots, stacks), field_checker(metrics, robots))
+    recorded, timeline, data = read.recorded, read.timeline, read.data
     problems = unread + list(data.problems) + list(timeline.notes)
     for sources in stacks.sources.values():
         problems += sources.notes
@@ -413,29 +410,3 @@ def _nothing_of(path: Path, robot: Robot, types: Mapping[str, str]) -> str:
 
 def _time(seconds: float) -> dt.datetime:
     return dt.datetime.fromtimestamp(seconds, tz=dt.timezone.utc)
-
-
-def _task_executions(
-    actions: list[RecordedAction], segmented_by: dict[str, str], wall: Callable[[np.ndarray], np.ndarray]
-) -> tuple[TaskExecution, ...]:
-    """The robots' tasks as executed, with their actions' times as the wall clock had them.  A
-    segment that started and ended is an action (its metric values need one): ABORTED when its
-    goal ended other than SUCCEEDED (aborted, or cancelled: PREEMPTED, CANCELED, as the
-    dispatcher cancels a goal that timed out)."""
-    started = [a for a in actions if a.start is not None and a.end is not None]
-    started.sort(key=lambda a: (a.start or 0.0, a.robot))
-    grouped: dict[tuple[str, int], list[Action]] = {}
-    for a in started:
-        grouped.setdefault((a.robot, a.allocation), []).append(
-            Action(
-                ActionId(a.robot, a.allocation, a.subtask, a.waypoint),
-                a.start_pose,
-                a.goal,
-                ActionStatus.SUCCEEDED if a.status == "SUCCEEDED" else ActionStatus.ABORTED,
-                _time(float(wall(np.array([a.start]))[0])),
-                _time(float(wall(np.array([a.end]))[0])),
-            )
-        )
-    return tuple(
-        TaskExecution(robot, n, tuple(acts), segmented_by.get(robot)) for (robot, n), acts in grouped.items()
-    )
