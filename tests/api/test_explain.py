@@ -340,7 +340,8 @@ def test_the_findings_that_touch_a_value_are_its_annotations() -> None:
         ),
         CoverageGap(Shortfall.GAP, "a gap on the pose's own topic", "bot", "/tf", (), _at(150), _at(151)),
     ]
-    shifted = with_findings(on_wall_clock(_value(100.0, 200.0), lambda t: t, {"/served/pose": ("/tf",)}), gaps)
+    (walled,) = on_wall_clock([_value(100.0, 200.0)], lambda t: t, {"/served/pose": ("/tf",)})
+    shifted = with_findings(walled, gaps)
     assert shifted.accounting is not None
     assert shifted.accounting.sources[0].topics == ("/tf",)
     assert shifted.accounting.annotations == (

@@ -151,26 +151,33 @@ def _held(p: core.Prepared, start: float, end: float) -> list[str]:
 
 
 def on_wall_clock(
-    value: MetricValue,
+    values: Sequence[MetricValue],
     wall: Callable[[np.ndarray], np.ndarray],
     real: Mapping[str, tuple[str, ...]],
     chains: Mapping[str, str] | None = None,
-) -> MetricValue:
-    """``value`` with its accounting's window on the wall clock and its sources named as the bag
+) -> list[MetricValue]:
+    """``values`` with their accountings' windows on the wall clock (``wall``: the run's timeline
+    → the recorder's wall clock, called once for every window) and their sources named as the bag
     has them (``real``: a series the monitors read → the bag topics it came from; ``chains``: a
-    series composed from TF → the transforms composed).  The coverage findings that touch it are
-    added once the run's coverage is known (:func:`~exsce_dsl.runs.coverage.with_findings`)."""
-    found = value.accounting
-    if found is None:
-        return value
-    start, end = (float(x) for x in wall(np.array([found.start, found.end], dtype=np.float64)))
+    series composed from TF → the transforms composed).  The coverage findings that touch a value
+    are added once the run's coverage is known (:func:`~exsce_dsl.runs.coverage.with_findings`)."""
+    windows = [(a.start, a.end) for v in values if (a := v.accounting) is not None]
+    walled = iter(wall(np.array(windows, dtype=np.float64).reshape(-1)).tolist() if windows else [])
     chains = chains or {}
-    sources = tuple(
-        replace(
-            c,
-            topics=tuple(dict.fromkeys(r for t in c.topics for r in real.get(t, (t,)))),
-            tf_chain=next((chains[t] for t in c.topics if t in chains), c.tf_chain),
+    found = []
+    for value in values:
+        if value.accounting is None:
+            found.append(value)
+            continue
+        sources = tuple(
+            replace(
+                c,
+                topics=tuple(dict.fromkeys(r for t in c.topics for r in real.get(t, (t,)))),
+                tf_chain=next((chains[t] for t in c.topics if t in chains), c.tf_chain),
+            )
+            for c in value.accounting.sources
         )
-        for c in found.sources
-    )
-    return replace(value, accounting=replace(found, start=start, end=end, sources=sources))
+        start, end = next(walled), next(walled)
+        walled_accounting = replace(value.accounting, start=start, end=end, sources=sources)
+        found.append(replace(value, accounting=walled_accounting))
+    return found
