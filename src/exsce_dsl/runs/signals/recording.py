@@ -32,10 +32,7 @@ class OnTimeline:
 
 
 def read_on_timeline(
-    bag: OpenedBag,
-    wanted: Mapping[str, Wanted],
-    reduce: Mapping[str, Reduce] | None = None,
-    check: Check | None = None,
+    bag: OpenedBag, wanted: Mapping[str, Wanted], reduce: Mapping[str, Reduce], check: Check
 ) -> OnTimeline:
     """Read ``wanted`` of ``bag`` (``reduce`` and ``check`` as
     :func:`~exsce_dsl.runs.bags.reading.read_bag` takes them) and the stamps of its topics that
