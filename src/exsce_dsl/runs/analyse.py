@@ -162,7 +162,7 @@ def analyse_bag(
     source = scenario.location.file if scenario.location else scenario.id
     monitors = load_monitors(metrics, source)
     bag = _read_signals(path, scenario, metrics, monitors)
-    dated = bag.timeline.dated  # what the run keeps of its timeline, as the signals step ends
+    dated = bag.timeline.dated  # taken as the signals step ends: assembling the run enters no step
     found = _segment_robots(path, scenario, bag)
     tasks = task_executions(found.actions, found.segmented_by, bag.timeline.to_wall)
     robots, stacks = bag.robots, bag.stacks
