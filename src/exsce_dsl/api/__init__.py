@@ -94,27 +94,27 @@ if TYPE_CHECKING:
     from exsce_dsl.codegen.targets import TARGETS, Target
     from exsce_dsl.errors import AmbiguousRunError, IngestFailed, RosGraphError, UnknownRunError
     from exsce_dsl.messages.msg_path import MSG_PATH
-    from exsce_dsl.oracles.judging import Verification
-    from exsce_dsl.oracles.report import junit_xml, verdict_table, verdicts_json
-    from exsce_dsl.oracles.trial_report import (
+    from exsce_dsl.oracles import (
+        REPEAT_FOLDER,
+        REPEAT_SEED,
+        Verification,
+        junit_xml,
         pass_rate_table,
         pass_rates_csv,
         pass_rates_json,
+        percent,
         trial_junit_xml,
+        trial_of,
+        verdict_table,
+        verdicts_json,
     )
-    from exsce_dsl.oracles.trial_runs import REPEAT_FOLDER, REPEAT_SEED, trial_of
-    from exsce_dsl.oracles.trials import percent
     from exsce_dsl.parallel.dask_client import dask_address
-    from exsce_dsl.runs.bag_info import BagInfo
-    from exsce_dsl.runs.ingest import IngestResult
+    from exsce_dsl.runs import BagInfo, IngestResult
     from exsce_dsl.similarity.dendrogram import save_dendrogram
-    from exsce_dsl.store.base import QUERY_TIMEOUT, Rows, Store
-    from exsce_dsl.store.checking import check_store
-    from exsce_dsl.store.migrating import migrate_store
-    from exsce_dsl.store.queries.run_ids import resolve_run
+    from exsce_dsl.store import QUERY_TIMEOUT, Rows, Store, check_store, migrate_store, resolve_run
     from exsce_dsl.tables import aligned
     from exsce_dsl.textfiles import read_text
-    from exsce_dsl.transform.transformations import TRANSFORMATIONS
+    from exsce_dsl.transform import TRANSFORMATIONS
     from exsce_dsl.wording import counted
 
 _SESSION: dict[str, str] = {
@@ -144,9 +144,9 @@ _SESSION: dict[str, str] = {
     "verdicts": "api.tables",
     "flaky": "api.trials",
     "verify_trial": "api.trials",
-    "check_store": "store.checking",
-    "migrate_store": "store.migrating",
-    "resolve_run": "store.queries.run_ids",
+    "check_store": "store",
+    "migrate_store": "store",
+    "resolve_run": "store",
     "AmbiguousRunError": "errors",
     "RosGraphError": "errors",
     "UnknownRunError": "errors",
@@ -201,36 +201,36 @@ _COMMAND_LINE: dict[str, str] = {
     "answer_text": "api.answers",
     "results_csv": "api.answers",
     "results_json": "api.answers",
-    "verdict_table": "oracles.report",
-    "verdicts_json": "oracles.report",
-    "junit_xml": "oracles.report",
-    "pass_rate_table": "oracles.trial_report",
-    "pass_rates_csv": "oracles.trial_report",
-    "pass_rates_json": "oracles.trial_report",
-    "trial_junit_xml": "oracles.trial_report",
-    "percent": "oracles.trials",
-    "trial_of": "oracles.trial_runs",
+    "verdict_table": "oracles",
+    "verdicts_json": "oracles",
+    "junit_xml": "oracles",
+    "pass_rate_table": "oracles",
+    "pass_rates_csv": "oracles",
+    "pass_rates_json": "oracles",
+    "trial_junit_xml": "oracles",
+    "percent": "oracles",
+    "trial_of": "oracles",
     "save_dendrogram": "similarity.dendrogram",
     "aligned": "tables",
     "counted": "wording",
     "read_text": "textfiles",
     # the library's tables and constants the commands name in their options and help
     "__version__": "",
-    "BagInfo": "runs.bag_info",
+    "BagInfo": "runs",
     "IngestFailed": "errors",
     "MSG_PATH": "messages.msg_path",
-    "QUERY_TIMEOUT": "store.base",
-    "REPEAT_FOLDER": "oracles.trial_runs",
-    "REPEAT_SEED": "oracles.trial_runs",
+    "QUERY_TIMEOUT": "store",
+    "REPEAT_FOLDER": "oracles",
+    "REPEAT_SEED": "oracles",
     "TARGETS": "codegen.targets",
     "Target": "codegen.targets",
-    "TRANSFORMATIONS": "transform.transformations",
+    "TRANSFORMATIONS": "transform",
     "dask_address": "parallel.dask_client",
     # the types the commands' signatures name
-    "IngestResult": "runs.ingest",
-    "Rows": "store.base",
-    "Store": "store.base",
-    "Verification": "oracles.judging",
+    "IngestResult": "runs",
+    "Rows": "store",
+    "Store": "store",
+    "Verification": "oracles",
 }
 """What ``exscec``'s commands use besides the session's functions: a function per command with
 its typed result, the renderers of answers, verdicts and trials, and the library's tables the

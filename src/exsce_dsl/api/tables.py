@@ -13,13 +13,9 @@ from dataclasses import asdict
 from typing import TYPE_CHECKING, Any
 
 from exsce_dsl.errors import UnknownNameWarning
-from exsce_dsl.store import queries
-from exsce_dsl.store.base import Rows, Store
-from exsce_dsl.store.literals import canonical_rows, literal_value
-from exsce_dsl.store.queries.library import query as library_query
-from exsce_dsl.store.queries.results import pose_positions
-from exsce_dsl.store.queries.results import verdicts as stored_verdicts
-from exsce_dsl.store.queries.stored_names import unknown_names
+from exsce_dsl.store import Rows, Store, canonical_rows, literal_value, pose_positions, queries, unknown_names
+from exsce_dsl.store import query as library_query
+from exsce_dsl.store import verdicts as stored_verdicts
 
 if TYPE_CHECKING:
     import pandas as pd

@@ -6,9 +6,16 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from exsce_dsl.lang.transformation_syntax import step_heads
-from exsce_dsl.transform.records import Slot, Transformation, Word, phrase_parts, shown_phrase, variants
-from exsce_dsl.transform.transformations import TRANSFORMATIONS
+from exsce_dsl.lang import step_heads
+from exsce_dsl.transform import (
+    TRANSFORMATIONS,
+    Slot,
+    Transformation,
+    Word,
+    phrase_parts,
+    shown_phrase,
+    variants,
+)
 
 _PLACEHOLDERS = {"count": "n"}
 """A parameter's placeholder in a snippet, where it is not its type's name."""

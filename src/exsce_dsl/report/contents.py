@@ -23,15 +23,21 @@ from exsce_dsl.model.runs import Hotspot
 from exsce_dsl.model.scenario import Scenario
 from exsce_dsl.model.trials import ClauseTrial
 from exsce_dsl.model.verdicts import Outcome, Verdict
-from exsce_dsl.oracles.trials import clause_trials, lowest_pass_rate_first
+from exsce_dsl.oracles import clause_trials, lowest_pass_rate_first
 from exsce_dsl.report.campaigns import CampaignContents, gather_campaigns
 from exsce_dsl.report.units import metric_units
 from exsce_dsl.similarity.clustering import Clustering, cluster
 from exsce_dsl.similarity.facts import scenario_facts
-from exsce_dsl.store import queries
-from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries import MetricReading, StoredRun, ValueAccount
-from exsce_dsl.store.queries.results import hotspots, pose_positions, verdicts
+from exsce_dsl.store import (
+    MetricReading,
+    Store,
+    StoredRun,
+    ValueAccount,
+    hotspots,
+    pose_positions,
+    queries,
+    verdicts,
+)
 
 _RANK = {Outcome.FAILED: 0, Outcome.PASSED: 2}
 """Where verdicts of each outcome go when failures come first; any other outcome goes between."""

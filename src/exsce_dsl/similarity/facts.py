@@ -5,8 +5,7 @@ from __future__ import annotations
 from exsce_dsl.lang import builtin_metrics
 from exsce_dsl.model.metrics import Combine
 from exsce_dsl.similarity.distances import ScenarioFacts, pose_id
-from exsce_dsl.store import queries
-from exsce_dsl.store.base import Store
+from exsce_dsl.store import Store, queries
 
 
 def _combined(combine: Combine | None, means: list[float]) -> float:
