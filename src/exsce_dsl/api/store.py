@@ -10,7 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from exsce_dsl.store import open as store_open
+from exsce_dsl import store as store_face
 
 if TYPE_CHECKING:
     from prov.model import ProvDocument
@@ -21,12 +21,12 @@ if TYPE_CHECKING:
 def open_store(url: str | None = None, *, read_only: bool = False) -> Store:
     """The store ``url`` names (default: ``$EXSCE_STORE``, else ``.exsce/store`` here); use it in a
     ``with`` block, which closes it.  ``read_only``: an embedded store's folder is only read."""
-    return store_open.open_store(url, read_only=read_only)
+    return store_face.open_store(url, read_only=read_only)
 
 
 def store_url(url: str | None = None) -> str:
     """The store URL ``url`` stands for (the default store's when None)."""
-    return store_open.store_url(url)
+    return store_face.store_url(url)
 
 
 @dataclass(frozen=True)

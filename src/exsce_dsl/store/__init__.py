@@ -14,7 +14,7 @@ if TYPE_CHECKING:
     from exsce_dsl.store.federation import refuse_federation
     from exsce_dsl.store.literals import canonical_rows, literal_text, literal_value
     from exsce_dsl.store.migrating import migrate_store
-    from exsce_dsl.store.open import StoreOpening, open_store
+    from exsce_dsl.store.open import StoreOpening, open_store, store_url
     from exsce_dsl.store.queries import (
         MetricReading,
         MetricSource,
@@ -54,7 +54,11 @@ if TYPE_CHECKING:
     from exsce_dsl.store.queries.library import Query, query
     from exsce_dsl.store.queries.results import hotspots, pose_positions, verdicts
     from exsce_dsl.store.queries.run_ids import is_full_uuid, names_a_prefix, resolve_run
+    from exsce_dsl.store.queries.run_values import violation_duration
+    from exsce_dsl.store.queries.scenarios import path_segments
+    from exsce_dsl.store.queries.segment_stats import mission_metric_over_runs
     from exsce_dsl.store.queries.stored_names import unknown_names
+    from exsce_dsl.store.queries.stored_oracles import hotspot_counts, safety_metrics
     from exsce_dsl.store.remote import RemoteStore
     from exsce_dsl.store.run_replacing import replace_run, verdict_graphs
     from exsce_dsl.store.segment_index import is_index_graph
