@@ -15,7 +15,6 @@ open_store`` imports ``store/open.py`` and not the whole package::
 
 from __future__ import annotations
 
-import ast
 import importlib
 import sys
 from collections.abc import Callable
@@ -24,15 +23,28 @@ from pathlib import Path
 from typing import Any
 
 
-def face_names(source: str) -> dict[str, str]:
-    """Each name a face's source imports under ``if TYPE_CHECKING:``, and the module it is imported from."""
-    names: dict[str, str] = {}
+def face_blocks(source: str) -> list[dict[str, str]]:
+    """Each ``if TYPE_CHECKING:`` block of a face's source (a face may group its names so): the
+    names it imports, and the module each is imported from."""
+    import ast  # only when a face is first asked for a name
+
+    blocks = []
     for node in ast.parse(source).body:
         if isinstance(node, ast.If) and isinstance(node.test, ast.Name) and node.test.id == "TYPE_CHECKING":
-            for statement in node.body:
-                if isinstance(statement, ast.ImportFrom) and statement.module:
-                    names.update({alias.asname or alias.name: statement.module for alias in statement.names})
-    return names
+            blocks.append(
+                {
+                    alias.asname or alias.name: statement.module
+                    for statement in node.body
+                    if isinstance(statement, ast.ImportFrom) and statement.module
+                    for alias in statement.names
+                }
+            )
+    return blocks
+
+
+def face_names(source: str) -> dict[str, str]:
+    """Each name a face's source imports under ``if TYPE_CHECKING:``, and the module it is imported from."""
+    return {name: module for block in face_blocks(source) for name, module in block.items()}
 
 
 def lazy_face(package: str, file: str) -> tuple[Callable[[str], Any], Callable[[], list[str]]]:
