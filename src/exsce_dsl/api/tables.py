@@ -26,7 +26,7 @@ from exsce_dsl.store import (
     unknown_names,
 )
 from exsce_dsl.store import query as library_query
-from exsce_dsl.store import runs as scenario_runs
+from exsce_dsl.store import runs as stored_runs
 from exsce_dsl.store import verdicts as stored_verdicts
 
 if TYPE_CHECKING:
@@ -47,7 +47,7 @@ def _frame(records: Sequence[dict[str, Any]], columns: Sequence[str]) -> pd.Data
 def _runs(store: Store, scenario: str | None, runs: Sequence[str] | None) -> dict[str, str]:
     """Run uuid → its scenario, for the runs asked for (all of ``scenario``'s, or every run; each
     given as its uuid, a unique prefix of it or its IRI)."""
-    known = {r.uuid: r.scenario for r in scenario_runs(store, scenario)}
+    known = {r.uuid: r.scenario for r in stored_runs(store, scenario)}
     return known if runs is None else {r: known.get(r, "") for r in resolve_runs(store, runs)}
 
 

@@ -45,10 +45,10 @@ from exsce_dsl.store import (
     verdicts,
 )
 from exsce_dsl.store import (
-    oracles as scenario_oracles,
+    oracles as stored_oracles,
 )
 from exsce_dsl.store import (
-    runs as scenario_runs,
+    runs as stored_runs,
 )
 
 _RANK = {Outcome.FAILED: 0, Outcome.PASSED: 2}
@@ -231,7 +231,7 @@ def gather(store: Store, specs: Sequence[Path] = ()) -> ReportContents:
             children.setdefault(derivation.base, []).append(scenario_id)
     scenarios = []
     for scenario_id in ids:
-        runs = scenario_runs(store, scenario_id)
+        runs = stored_runs(store, scenario_id)
         uuids = [r.uuid for r in runs]
         spots: dict[str, list[Hotspot]] = {}
         for found in hotspots(store, uuids):
@@ -257,7 +257,7 @@ def gather(store: Store, specs: Sequence[Path] = ()) -> ReportContents:
                     )
                     for r in runs
                 ),
-                oracles=tuple(scenario_oracles(store, scenario_id)),
+                oracles=tuple(stored_oracles(store, scenario_id)),
                 values=tuple(run_metric_values(store, uuids)),
                 waypoints=_waypoints(store, scenario_id),
                 grid=_grid_of(scenario_id, derivations, grids),

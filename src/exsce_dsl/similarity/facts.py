@@ -14,8 +14,8 @@ from exsce_dsl.store import (
     safety_metrics,
     violation_duration,
 )
-from exsce_dsl.store import robots as scenario_robots
-from exsce_dsl.store import runs as scenario_runs
+from exsce_dsl.store import robots as stored_robots
+from exsce_dsl.store import runs as stored_runs
 
 
 def _combined(combine: Combine | None, means: list[float]) -> float:
@@ -30,9 +30,9 @@ def _combined(combine: Combine | None, means: list[float]) -> float:
 def scenario_facts(store: Store, scenario: str) -> ScenarioFacts:
     """The robots, path segments and (if it has runs) metric means, violation time and hotspot
     count of ``scenario``."""
-    robots = scenario_robots(store, scenario)
+    robots = stored_robots(store, scenario)
     segments = tuple((pose_id(s.start), pose_id(s.goal)) for s in path_segments(store, scenario))
-    runs = [r.uuid for r in scenario_runs(store, scenario)]
+    runs = [r.uuid for r in stored_runs(store, scenario)]
     bases, torsos = tuple(r.base for r in robots), tuple(r.torso for r in robots)
     if not runs:
         return ScenarioFacts(scenario, bases, torsos, segments)
