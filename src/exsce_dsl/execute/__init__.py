@@ -30,8 +30,8 @@ if TYPE_CHECKING:
         Options,
         execute_runs,
     )
-    from exsce_dsl.execute.stand_in import StandIn
-    from exsce_dsl.execute.stand_in.session import DEFAULT_SPEED_UP, start_stand_in
+    from exsce_dsl.execute.stand_in import StandIn, start_stand_in
+    from exsce_dsl.execute.stand_in.session import DEFAULT_SPEED_UP
 else:
     from exsce_dsl.faces import lazy_face
 

@@ -15,44 +15,50 @@ if TYPE_CHECKING:
     from exsce_dsl.store.literals import canonical_rows, literal_text, literal_value
     from exsce_dsl.store.migrating import migrate_store
     from exsce_dsl.store.open import StoreOpening, open_store, store_url
-    from exsce_dsl.store.queries.accounting import ValueAccount, run_problems, value_accounts
-    from exsce_dsl.store.queries.campaigns import campaign_record, campaigns
-    from exsce_dsl.store.queries.coverage import run_coverage, run_topic_rates
-    from exsce_dsl.store.queries.library import Parameter, Query, query, query_names, standard_prefixes
-    from exsce_dsl.store.queries.results import hotspots, pose_positions, verdicts
-    from exsce_dsl.store.queries.run_ids import is_full_uuid, names_a_prefix, resolve_run, resolve_runs
-    from exsce_dsl.store.queries.run_lineage import RunChain, dispatched_runs, run_chain
-    from exsce_dsl.store.queries.run_values import (
+    from exsce_dsl.store.queries import (
         MetricReading,
         MetricSource,
+        Parameter,
+        RunChain,
         RunDefect,
         StoredRun,
+        ValueAccount,
+        ValueStats,
         action_times,
-        metric_sources,
-        run_defects,
-        run_metric_values,
-        run_scenarios,
-        run_segment_values,
-        runs,
-        violation_duration,
-    )
-    from exsce_dsl.store.queries.scenarios import (
         derivation_of,
         derived_scenarios,
+        dispatched_runs,
         lineage,
-        path_segments,
-        robots,
-        scenario_ids,
-    )
-    from exsce_dsl.store.queries.segment_stats import (
-        ValueStats,
-        mission_metric_over_runs,
+        metric_sources,
+        oracles,
+        query_names,
+        resolve_runs,
         robot_metric_over_runs,
+        robots,
+        run_chain,
+        run_coverage,
+        run_defects,
+        run_metric_values,
+        run_problems,
+        run_query,
+        run_scenarios,
+        run_segment_values,
+        run_topic_rates,
+        runs,
+        scenario_ids,
         segment_metric_between,
+        standard_prefixes,
+        value_accounts,
     )
+    from exsce_dsl.store.queries.campaigns import campaign_record, campaigns
+    from exsce_dsl.store.queries.library import Query, query
+    from exsce_dsl.store.queries.results import hotspots, pose_positions, verdicts
+    from exsce_dsl.store.queries.run_ids import is_full_uuid, names_a_prefix, resolve_run
+    from exsce_dsl.store.queries.run_values import violation_duration
+    from exsce_dsl.store.queries.scenarios import path_segments
+    from exsce_dsl.store.queries.segment_stats import mission_metric_over_runs
     from exsce_dsl.store.queries.stored_names import unknown_names
-    from exsce_dsl.store.queries.stored_oracles import hotspot_counts, oracles, safety_metrics
-    from exsce_dsl.store.queries.terms import run_query
+    from exsce_dsl.store.queries.stored_oracles import hotspot_counts, safety_metrics
     from exsce_dsl.store.remote import RemoteStore
     from exsce_dsl.store.run_replacing import replace_run, verdict_graphs
     from exsce_dsl.store.segment_index import is_index_graph
