@@ -55,7 +55,9 @@ def _reaches_inside(path: Path, package: str) -> list[str]:
 
 
 def _outsiders(package: str) -> list[Path]:
-    return sorted(p for p in PACKAGE.rglob("*.py") if p.relative_to(PACKAGE).parts[0].removesuffix(".py") != package)
+    return sorted(
+        p for p in PACKAGE.rglob("*.py") if p.relative_to(PACKAGE).parts[0].removesuffix(".py") != package
+    )
 
 
 @pytest.mark.parametrize("package", FACES)
@@ -65,7 +67,9 @@ def test_other_packages_import_only_the_face(package: str) -> None:
         for path in _outsiders(package)
         for where in _reaches_inside(path, package)
     ]
-    assert not found, f"import these from exsce_dsl.{package} (python /work/scripts/faces.py):\n" + "\n".join(found)
+    assert not found, f"import these from exsce_dsl.{package} (python /work/scripts/faces.py):\n" + "\n".join(
+        found
+    )
 
 
 @pytest.mark.parametrize("package", FACES)
