@@ -34,7 +34,7 @@ from exsce_dsl.endpoint.protocol import (
 )
 from exsce_dsl.endpoint.worker import Job
 from exsce_dsl.errors import RefusedRequest
-from exsce_dsl.store.base import MAX_QUERY
+from exsce_dsl.store import MAX_QUERY
 
 METHODS = ["GET", "HEAD", "POST", "PUT", "DELETE", "PATCH", "OPTIONS"]
 
