@@ -15,7 +15,7 @@ PACKAGE = Path(__file__).resolve().parents[2] / "src" / "exsce_dsl"
 
 LAYERS: list[set[str]] = [
     # the base
-    {"errors", "suggest", "resources", "textfiles", "tables", "templating", "figures", "user_cache", "wording",
+    {"errors", "remedies", "suggest", "resources", "textfiles", "tables", "templating", "figures", "user_cache", "wording",
      "output_folder", "plugins"},
     {"model"},
     {"messages", "maps", "monitor_kit", "parallel"},

@@ -15,7 +15,7 @@ element of another would be an array of arrays, which no metric reads.
 
 from __future__ import annotations
 
-from exsce_dsl.errors import ExsceError, FieldProblem
+from exsce_dsl.errors import ExsceError, FieldProblem, Remedied
 from exsce_dsl.model.messages import (
     FieldPath,
     Fields,
@@ -28,6 +28,7 @@ from exsce_dsl.model.messages import (
     canonical_type,
 )
 from exsce_dsl.model.metrics import MetricDefinition
+from exsce_dsl.remedies import DEFINE_THE_BAGS_TYPE
 from exsce_dsl.suggest import did_you_mean
 
 
@@ -57,17 +58,12 @@ def check_fields(
                 continue
             if arrays != f.arrays:
                 shape = "an array" if arrays else "a number"
-                found.append(
-                    ExsceError(
-                        _from(
-                            f"{_text(read.name, f.path)} is {shape} per message by the definition of "
-                            f"{msgtype}, not what metric '{metric.name}' was checked with: give exsce "
-                            "the definition the bag uses (exscec --msg-path, or EXSCE_MSG_PATH)",
-                            source,
-                        ),
-                        f.location,
-                    )
+                wrong = (
+                    f"{_text(read.name, f.path)} is {shape} per message by the definition of "
+                    f"{msgtype}, not what metric '{metric.name}' was checked with"
                 )
+                said = Remedied(wrong, DEFINE_THE_BAGS_TYPE).said()  # ingest prints it in a BagError's text
+                found.append(ExsceError(_from(said, source), f.location))
     return found
 
 

@@ -11,19 +11,21 @@ then it is analysed again and its run replaced in one write
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 import threading
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from enum import Enum
 from pathlib import Path
 from typing import TYPE_CHECKING, cast
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import ExsceError, Remedied
 from exsce_dsl.model import Scenario
 from exsce_dsl.parallel.workers import workers
 from exsce_dsl.prov import DEFAULT_NAMESPACE, compile_scenario
 from exsce_dsl.prov.run import compile_run
+from exsce_dsl.remedies import REPLACE_THE_RUN
 from exsce_dsl.runs.bag_identity import content_hash
 from exsce_dsl.runs.bag_runs import BagRun, bag_runs
 from exsce_dsl.store.base import Store
@@ -67,10 +69,16 @@ class IngestResult:
     """What ingestion picked for the run: conventions detected, a simulated timeline."""
     clocks: tuple[str, ...] = field(default_factory=tuple)
     """Which clock each of the bag's sources was timed by (``exscec ingest -v``)."""
+    remedied: Remedied | None = None
+    """The message as a problem and its remedy, when it has one (:meth:`said`)."""
 
     @property
     def failed(self) -> bool:
         return self.status is IngestStatus.FAILED
+
+    def said(self, wording: Mapping[str, str] | None = None) -> str:
+        """The message, its remedy in ``wording`` (the command line's: ``cli.common.REMEDIES``)."""
+        return self.remedied.said(wording) if self.remedied else self.message
 
 
 def _analyse(args: tuple[Path, Scenario, str | None, str | None, bool]) -> AnalysedRun | ExsceError:
@@ -260,11 +268,10 @@ def _skipped(
         return IngestResult(path, IngestStatus.SKIPPED, message, run.run_id)
     if not run.stored or replace:
         return None
-    message = (
-        f"{path}: already a run of scenario '{scenario_id}' (run {run.run_id}); "
-        "pass --replace to analyse it again under this spec"
+    remedied = Remedied(
+        f"{path}: already a run of scenario '{scenario_id}' (run {run.run_id})", REPLACE_THE_RUN
     )
-    return IngestResult(path, IngestStatus.SKIPPED, message, run.run_id)
+    return IngestResult(path, IngestStatus.SKIPPED, remedied.said(), run.run_id, remedied=remedied)
 
 
 def _result(bag: _Todo, analysed: AnalysedRun | None, done: Written) -> IngestResult:
@@ -272,8 +279,10 @@ def _result(bag: _Todo, analysed: AnalysedRun | None, done: Written) -> IngestRe
     path = bag.path
     if done.error is not None or done.report is None or analysed is None:
         message = done.error.message if done.error is not None else "not written"
-        named = message if str(path) in message else f"{path}: {message}"
-        return IngestResult(path, IngestStatus.FAILED, named)
+        prefix = "" if str(path) in message else f"{path}: "
+        cause = done.error.remedied if done.error is not None else None
+        remedied = dataclasses.replace(cause, problem=prefix + cause.problem) if cause else None
+        return IngestResult(path, IngestStatus.FAILED, prefix + message, remedied=remedied)
     return IngestResult(
         path,
         IngestStatus.REPLACED if bag.replacing else IngestStatus.INGESTED,
@@ -303,7 +312,7 @@ def _what_was_done(bag: _Todo, values: int, report: WriteReport) -> str:
         said = f"analysed again {said}, in place of the stored one"
         dropped = verdict_graphs(report.replaced)
         if dropped:
-            said += "; its verdicts were dropped (exscec verify judges it again)"
+            said += "; its verdicts were dropped (verifying the run judges it again)"
     if bag.run is not None and bag.run.others:
         said += f"; the bag is also a run of scenario {', '.join(repr(s) for s in bag.run.others)}"
     return said
