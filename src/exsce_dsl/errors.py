@@ -36,8 +36,8 @@ __all__ = [
     "IncompleteRunError",
     "MessageTypeError",
     "PlanningError",
-    "Remedied",
     "RelationError",
+    "Remedied",
     "RenameError",
     "RosGraphError",
     "ScenarioChoiceError",
@@ -151,7 +151,7 @@ def diagnostic_order(d: Diagnostic) -> tuple[str, int, int, int, str]:
 
 @dataclass(frozen=True)
 class Remedied:
-    """A problem and what to do about it (a remedy above, in words).
+    """A problem and what to do about it (a remedy of :mod:`exsce_dsl.remedies`, in words).
 
     :meth:`said` puts them together, in a front end's ``wording`` when it has one for the remedy
     (``cli.common.REMEDIES``: the command line's, with its options), else as ``problem; remedy``.
@@ -175,9 +175,10 @@ class Remedied:
 class ExsceError(Exception):
     """Base of every error exsce raises on purpose.
 
-    ``remedy``: what the user can do about it, in words, after the problem in the message; the
-    library never names an option of the command line, which says a remedy such as
-    :data:`REPLACE_FILES` with its own option (``use --force to replace``)."""
+    ``remedy``: what the user can do about it, in words (:mod:`exsce_dsl.remedies`), after the
+    problem in the message; ``about``: what the remedy is about (:class:`Remedied`).  The library
+    never names an option of the command line, which says a remedy such as ``REPLACE_FILES`` with
+    its own option (``use --force to replace``)."""
 
     def __init__(
         self,

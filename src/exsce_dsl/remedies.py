@@ -61,6 +61,10 @@ SELECT_OR_ASK = "ask a SELECT or an ASK query"
 SERVE_A_FOLDER = "it serves an embedded store"
 """A store to serve that is an endpoint already."""
 
+STRICT_STORES_NONE = "a strict ingest stores no run with a missing metric{about}"
+"""A run a strict ingest refuses (``about``: ``:`` and the run's problems, one an indented line,
+or nothing)."""
+
 # baselines, verdicts, campaigns
 LEARN_FROM_EVERY_RUN = "ingest runs that pass, or include every run"
 """Every stored run of a scenario left out of what a baseline learns from."""

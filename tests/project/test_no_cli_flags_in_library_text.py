@@ -22,44 +22,44 @@ PACKAGE = Path(__file__).resolve().parents[2] / "src" / "exsce_dsl"
 FLAG_TEXT = re.compile(r"(?<![\w-])--[a-z][a-z-]+|\bexscec ")
 """A long option (``--msg-path``) or an invocation of the command line (``exscec verify``)."""
 
-_GENERATED = "text generated into files for users, which name the command that made them"
-_OTHER_PROGRAM = "the command line of another program exsce starts (its own options, not exscec's)"
-_TEXTX = "a generator of textX's own command line (`textx generate`), whose options it names"
-_HELP = "help text (like docs/): it tells what the equivalent command is"
-_PROGRAM_NAME = "the name of the running server (exscec serve/mcp), not an invocation to type"
+WHY: dict[str, str] = {
+    "the demo's script: the exscec commands it shows, runs and asks the user to type": "api/demo.py:*",
+    "text generated into files for users, which names the command that made them: the docs table of "
+    "transformations (docs/deriving.md), the comments of a drafted .exsce file, the generated ROS "
+    "monitor package's header and README, the generated monitor code's header": (
+        "transform/records.py:exscec runs/spec_draft.py:* codegen/ros_monitor.py:exscec "
+        "runs/metrics/monitor_code.py:exscec"
+    ),
+    "the command line of another program exsce starts, with its own options, not exscec's: "
+    "`ros2 bag record`, exsce's ROS 1 dispatcher node": (
+        "execute/ros2/recorder.py:* execute/ros1/navigator.py:* execute/ros1/nodes/dispatcher_node.py:*"
+    ),
+    "generators registered with textX, whose own command line (`textx generate`) has these options": (
+        "codegen/registration.py:--scenario rdf/registration.py:--overwrite"
+    ),
+    "help text, like docs/, telling the equivalent command: the language server's hover text, the "
+    "MCP tools' descriptions": (
+        "lsp/keywords.py:* mcp_server/check_tool.py:exscec mcp_server/library_tools.py:exscec "
+        "mcp_server/store_tools.py:exscec"
+    ),
+    "the name of a running server (exscec serve, exscec mcp), not an invocation to type: the prefix "
+    "of its log lines, the endpoint's HTTP authentication realm, the process holding a store": (
+        "mcp_server/server.py:exscec endpoint/server.py:exscec endpoint/worker.py:exscec "
+        "endpoint/app.py:exscec api/store.py:exscec store/open.py:exscec"
+    ),
+    "an executor's name is part of a campaign's identity (hashed into campaign_<digest>, recorded in "
+    "its plan): new words would rename every campaign": "explore/executors.py:--fault explore/ros1_executor.py:*",
+    "issue 49: moved at merge": "runs/analyse.py:--strict",
+}
+"""Why some literals may name the command line → the places: ``module:text`` (the module below
+``src/exsce_dsl``; the text found, ``*`` for any)."""
 
 ALLOWED: dict[tuple[str, str], str] = {
-    ("api/demo.py", "*"): "the demo's script: the exscec commands it shows, runs and asks the user to type",
-    ("transform/records.py", "exscec "): "the header of the docs table of transformations (docs/deriving.md)",
-    ("runs/spec_draft.py", "*"): "comments written into the drafted .exsce file: " + _GENERATED,
-    ("codegen/ros_monitor.py", "exscec "): "the generated ROS monitor package's header and README: " + _GENERATED,
-    ("runs/metrics/monitor_code.py", "exscec "): "the header of the generated monitor code: " + _GENERATED,
-    ("execute/ros2/recorder.py", "*"): "the options of `ros2 bag record`: " + _OTHER_PROGRAM,
-    ("execute/ros1/navigator.py", "*"): "the options of exsce's dispatcher node: " + _OTHER_PROGRAM,
-    ("execute/ros1/nodes/dispatcher_node.py", "*"): "the dispatcher node's own options: " + _OTHER_PROGRAM,
-    ("codegen/registration.py", "--scenario"): _TEXTX,
-    ("rdf/registration.py", "--overwrite"): _TEXTX,
-    ("lsp/keywords.py", "*"): "hover text of the language server: " + _HELP,
-    ("mcp_server/check_tool.py", "exscec "): "an MCP tool's description: " + _HELP,
-    ("mcp_server/library_tools.py", "exscec "): "an MCP tool's description: " + _HELP,
-    ("mcp_server/store_tools.py", "exscec "): "MCP tools' descriptions: " + _HELP,
-    ("mcp_server/server.py", "exscec "): "the prefix of the MCP server's log lines: " + _PROGRAM_NAME,
-    ("endpoint/server.py", "exscec "): "the prefix of the endpoint's log lines: " + _PROGRAM_NAME,
-    ("endpoint/worker.py", "exscec "): "the prefix of the endpoint's log lines: " + _PROGRAM_NAME,
-    ("endpoint/app.py", "exscec "): "the endpoint's HTTP authentication realm: " + _PROGRAM_NAME,
-    ("api/store.py", "exscec "): "names the process holding the store (exscec serve, pid N): " + _PROGRAM_NAME,
-    ("store/open.py", "exscec "): "names the process holding the store (exscec serve, pid N): " + _PROGRAM_NAME,
-    ("explore/executors.py", "--fault"): (
-        "an executor's name is part of a campaign's identity (hashed into campaign_<digest>, recorded "
-        "in its plan): new words would rename every campaign"
-    ),
-    ("explore/ros1_executor.py", "*"): (
-        "an executor's name is part of a campaign's identity (hashed into campaign_<digest>, recorded "
-        "in its plan): new words would rename every campaign"
-    ),
-    ("runs/analyse.py", "--strict"): "issue 49: moved at merge",
+    (module, text): why
+    for why, places in WHY.items()
+    for module, _, text in (p.partition(":") for p in places.split())
 }
-"""(module below ``src/exsce_dsl``, the text found or ``*`` for any) → why it may name it."""
+"""(module, text or ``*``) → why it may name it."""
 
 
 def _docstrings(tree: ast.Module) -> set[int]:
@@ -68,7 +68,9 @@ def _docstrings(tree: ast.Module) -> set[int]:
     return {
         id(node.value)
         for node in ast.walk(tree)
-        if isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant) and isinstance(node.value.value, str)
+        if isinstance(node, ast.Expr)
+        and isinstance(node.value, ast.Constant)
+        and isinstance(node.value.value, str)
     }
 
 
@@ -77,7 +79,7 @@ def _flag_texts(path: Path) -> list[tuple[int, str, str]]:
     tree = ast.parse(path.read_text(encoding="utf-8"))
     docs = _docstrings(tree)
     return [
-        (node.lineno, found.group(0), node.value)
+        (node.lineno, found.group(0).strip(), node.value)
         for node in ast.walk(tree)
         if isinstance(node, ast.Constant) and isinstance(node.value, str) and id(node) not in docs
         for found in FLAG_TEXT.finditer(node.value)
@@ -117,7 +119,7 @@ def test_the_scan_sees_f_strings_and_skips_docstrings(tmp_path: Path) -> None:
         '    return f"{n} found; pass --replace"\n'
         'SAID = "exscec serve"\n'
     )
-    assert sorted((line, text) for line, text, _ in _flag_texts(source)) == [(4, "--replace"), (5, "exscec ")]
+    assert sorted((line, text) for line, text, _ in _flag_texts(source)) == [(4, "--replace"), (5, "exscec")]
 
 
 def test_the_remedies_said_in_words_and_with_the_options() -> None:

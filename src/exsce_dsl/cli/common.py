@@ -55,6 +55,7 @@ from exsce_dsl.remedies import (
     STAND_IN_ONLY,
     START_A_MASTER,
     STORE_THE_SCENARIO,
+    STRICT_STORES_NONE,
     VERIFY_THE_RUN,
 )
 
@@ -164,6 +165,7 @@ REMEDIES = {
     ),
     POINT_MSG_PATH: "{problem}; point EXSCE_MSG_PATH (or exscec --msg-path) at a folder of message packages",
     REPLACE_THE_RUN: "{problem}; pass --replace to analyse it again under this spec",
+    STRICT_STORES_NONE: "{problem}, and --strict stores no run with a missing metric{about}",
     REPLACE_A_STORED_RUN: (
         "{problem}: to analyse the run again and replace it, ingest its bag with replace "
         "(`exscec ingest BAG --scenario SPEC --replace`)"
