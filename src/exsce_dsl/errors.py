@@ -186,7 +186,7 @@ class ExsceError(Exception):
         location: SourceLocation | None = None,
         *,
         remedy: str | None = None,
-        about: str = "",
+        about: str | tuple[str, ...] = "",
     ) -> None:
         self.remedied = Remedied(message, remedy, about) if remedy else None
         said = self.remedied.said() if self.remedied else message

@@ -238,6 +238,12 @@ with the option or command that does it (``str.format`` templates of ``{problem}
 said with these options before it said them in words (issue 49)."""
 
 
+def said_with_options(exc: ExsceError) -> str:
+    """``exc``'s message, its remedy said as the command line's option (for a command that prints
+    an error itself, as ``error: message``)."""
+    return _with_options(exc).message
+
+
 def _with_options(exc: ExsceError) -> ExsceError:
     """``exc`` with its remedy said as the command line's option, when it has one."""
     if exc.remedied is None or exc.remedied.remedy not in REMEDIES:

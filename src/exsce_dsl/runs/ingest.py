@@ -20,7 +20,7 @@ from enum import Enum
 from pathlib import Path
 from typing import TYPE_CHECKING, cast
 
-from exsce_dsl.errors import ExsceError, Remedied
+from exsce_dsl.errors import ExsceError, IngestFailed, Remedied
 from exsce_dsl.model import Scenario
 from exsce_dsl.parallel.workers import workers
 from exsce_dsl.prov import DEFAULT_NAMESPACE, compile_scenario
@@ -79,6 +79,13 @@ class IngestResult:
     def said(self, wording: Mapping[str, str] | None = None) -> str:
         """The message, its remedy in ``wording`` (the command line's: ``cli.common.REMEDIES``)."""
         return self.remedied.said(wording) if self.remedied else self.message
+
+    def failure(self) -> IngestFailed:
+        """This result as the error of what needed its run (with the remedy, if it has one)."""
+        cause = self.remedied
+        if cause is None:
+            return IngestFailed(self.message)
+        return IngestFailed(cause.problem, remedy=cause.remedy, about=cause.about)
 
 
 def _analyse(args: tuple[Path, Scenario, str | None, str | None, bool]) -> AnalysedRun | ExsceError:
