@@ -56,6 +56,7 @@ from exsce_dsl.remedies import (
     START_A_MASTER,
     STORE_THE_SCENARIO,
     STRICT_STORES_NONE,
+    VERIFY_AGAIN,
     VERIFY_THE_RUN,
 )
 
@@ -199,6 +200,7 @@ REMEDIES = {
     LEARN_FROM_EVERY_RUN: "{problem}; ingest runs that pass, or include every run (--all-runs)",
     BUILD_A_BASELINE: "{problem}: build its baseline first (exscec baseline <spec> --scenario-id {about})",
     VERIFY_THE_RUN: "{problem} (exscec verify RUN)",
+    VERIFY_AGAIN: "{problem} (exscec verify judges it again){about}",
     REPRODUCE_IT: "{problem}: exscec verify {about[0]}/*.bag --scenario {about[1]}",
     INSTALL_DASK: "--cluster needs Dask's distributed package: pip install 'exsce[dask]'",
     BUILT_IN_OPTIONS: (

@@ -25,7 +25,7 @@ from exsce_dsl.model import Scenario
 from exsce_dsl.parallel.workers import workers
 from exsce_dsl.prov import DEFAULT_NAMESPACE, compile_scenario
 from exsce_dsl.prov.run import compile_run
-from exsce_dsl.remedies import REPLACE_THE_RUN
+from exsce_dsl.remedies import REPLACE_THE_RUN, VERIFY_AGAIN
 from exsce_dsl.runs.bag_identity import content_hash
 from exsce_dsl.runs.bag_runs import BagRun, bag_runs
 from exsce_dsl.store.base import Store
@@ -290,16 +290,19 @@ def _result(bag: _Todo, analysed: AnalysedRun | None, done: Written) -> IngestRe
         cause = done.error.remedied if done.error is not None else None
         remedied = dataclasses.replace(cause, problem=prefix + cause.problem) if cause else None
         return IngestResult(path, IngestStatus.FAILED, prefix + message, remedied=remedied)
+    said, dropped, others = _what_was_done(bag, len(analysed.run.metrics), done.report)
+    done_text, rest = f"{path}: run {analysed.run.uuid} {said}", others + _uncovered(analysed)
+    remedied = Remedied(done_text, VERIFY_AGAIN, rest) if dropped else None
     return IngestResult(
         path,
         IngestStatus.REPLACED if bag.replacing else IngestStatus.INGESTED,
-        f"{path}: run {analysed.run.uuid} {_what_was_done(bag, len(analysed.run.metrics), done.report)}"
-        + _uncovered(analysed),
+        remedied.said() if remedied else done_text + rest,
         analysed.run.uuid,
         tuple(analysed.problems),
         done.report.statements,
         tuple(analysed.picked()),
         tuple(analysed.clocks()),
+        remedied=remedied,
     )
 
 
@@ -312,14 +315,15 @@ def _uncovered(analysed: AnalysedRun) -> str:
     return f"; its recording does not cover all of it: {counted(len(gaps), 'gap')} ({kinds})"
 
 
-def _what_was_done(bag: _Todo, values: int, report: WriteReport) -> str:
-    """``(51 metric values)``, and what else a reader should know of the run."""
-    said = f"({values} metric values)"
+def _what_was_done(bag: _Todo, values: int, report: WriteReport) -> tuple[str, bool, str]:
+    """``(51 metric values)``; whether a replaced run's verdicts were dropped (the remedy, to
+    verify it again, goes after that); then what else a reader should know of the run."""
+    said, dropped = f"({values} metric values)", False
     if bag.replacing:
         said = f"analysed again {said}, in place of the stored one"
-        dropped = verdict_graphs(report.replaced)
-        if dropped:
-            said += "; its verdicts were dropped (verifying the run judges it again)"
+        if verdict_graphs(report.replaced):
+            said, dropped = f"{said}; its verdicts were dropped", True
+    others = ""
     if bag.run is not None and bag.run.others:
-        said += f"; the bag is also a run of scenario {', '.join(repr(s) for s in bag.run.others)}"
-    return said
+        others = f"; the bag is also a run of scenario {', '.join(repr(s) for s in bag.run.others)}"
+    return said, dropped, others
