@@ -24,7 +24,8 @@ from exsce_dsl.prov.run import compile_run
 from exsce_dsl.rdf.prov_o import to_quads
 from exsce_dsl.rdf.shacl import validate
 from exsce_dsl.runs.analyse import analyse_bag
-from exsce_dsl.runs.metrics.accounting import finish_accounting
+from exsce_dsl.runs.coverage import with_findings
+from exsce_dsl.runs.metrics.accounting import on_wall_clock
 from exsce_dsl.runs.spec_draft import draft_spec
 
 from tests.support.bag_factory import (
@@ -339,7 +340,8 @@ def test_the_findings_that_touch_a_value_are_its_annotations() -> None:
         ),
         CoverageGap(Shortfall.GAP, "a gap on the pose's own topic", "bot", "/tf", (), _at(150), _at(151)),
     ]
-    shifted = finish_accounting(_value(100.0, 200.0), lambda t: t, {"/served/pose": ("/tf",)}, gaps)
+    (walled,) = on_wall_clock([_value(100.0, 200.0)], lambda t: t, {"/served/pose": ("/tf",)})
+    shifted = with_findings(walled, gaps)
     assert shifted.accounting is not None
     assert shifted.accounting.sources[0].topics == ("/tf",)
     assert shifted.accounting.annotations == (

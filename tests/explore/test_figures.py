@@ -23,7 +23,7 @@ from exsce_dsl.explore.figures import figures_table, random_baseline
 from exsce_dsl.lang import load_spec
 from exsce_dsl.model.campaign import CampaignFigures, CampaignPlan, CampaignTrial, CheckedRelation
 from exsce_dsl.model.verdicts import Outcome, Verdict
-from exsce_dsl.oracles.campaign_junit import campaign_junit
+from exsce_dsl.oracles.campaign_junit import campaign_junit_xml
 from exsce_dsl.prov.campaign import compile_campaign, compile_trial
 from exsce_dsl.store.open import open_store
 from exsce_dsl.store.queries.campaigns import campaign_record, campaigns
@@ -228,7 +228,7 @@ def test_an_inconclusive_trial_and_the_figures_read_back_from_the_store() -> Non
     assert (stored["executions"], stored["counterexamples"], stored["to_first_failure"]) == ("6", "1", "4")
     assert (stored["inconclusive_trials"], stored["violated_relations"]) == ("1", "1")
     assert float(stored["per_100_executions"] or "nan") == pytest.approx(100 / 6)
-    suite = ET.fromstring(campaign_junit(record))[0]
+    suite = ET.fromstring(campaign_junit_xml(record))[0]
     first = suite.findall("testcase")[0].find("skipped")
     assert first is not None and str(first.get("message")).startswith("inconclusive: tiago1 task_duration invariant")
     assert (suite.get("failures"), suite.get("skipped")) == ("1", "1")

@@ -6,20 +6,25 @@ import importlib
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
 import exsce_dsl.lang as lang
+from exsce_dsl.faces import face_names
+
+WHERE = face_names(Path(lang.__file__).read_text(encoding="utf-8"))
+"""The face's one list: each entry point and its module (the imports under ``if TYPE_CHECKING:``)."""
 
 
 @pytest.mark.parametrize("name", lang.__all__)
 def test_each_entry_point_is_the_name_its_module_defines(name: str) -> None:
-    module = importlib.import_module(f"exsce_dsl.lang.{lang._WHERE[name]}")
+    module = importlib.import_module(WHERE[name])
     assert getattr(lang, name) is getattr(module, name)
 
 
 def test_every_entry_point_is_listed_once() -> None:
-    assert sorted(lang.__all__) == sorted(lang._WHERE) and len(set(lang.__all__)) == len(lang.__all__)
+    assert lang.__all__ == list(WHERE) and len(set(lang.__all__)) == len(lang.__all__)
 
 
 def test_an_unknown_name_is_an_attribute_error() -> None:

@@ -11,7 +11,7 @@ import pytest
 from exsce_dsl.lang import load_spec
 from exsce_dsl.model.campaign import CampaignPlan, CampaignRecord, CampaignTrial, Shrinking
 from exsce_dsl.model.runs import Bag, Run
-from exsce_dsl.oracles.campaign_junit import campaign_junit, run_seconds, steps_text
+from exsce_dsl.oracles.campaign_junit import campaign_junit_xml, run_seconds, steps_text
 from exsce_dsl.prov import compile_scenario
 from exsce_dsl.prov.campaign import compile_campaign, compile_shrinking, compile_trial
 from exsce_dsl.prov.run import compile_run
@@ -84,7 +84,7 @@ def test_the_campaign_is_one_suite_with_a_case_per_trial_in_order(
     stored: tuple[CampaignRecord, dict[str, float]],
 ) -> None:
     record, _ = stored
-    suite = _suite(campaign_junit(record))
+    suite = _suite(campaign_junit_xml(record))
     assert suite.tag == "testsuite" and suite.get("name") == "campaign c_explore"
     assert (suite.get("tests"), suite.get("failures"), suite.get("errors"), suite.get("skipped")) == (
         "4",
@@ -113,7 +113,7 @@ def test_a_failure_names_the_violated_relations_and_their_minimal_derivations(
     stored: tuple[CampaignRecord, dict[str, float]],
 ) -> None:
     record, _ = stored
-    cases = _suite(campaign_junit(record)).findall("testcase")
+    cases = _suite(campaign_junit_xml(record)).findall("testcase")
     first, third = (cases[i].find("failure") for i in (0, 2))
     assert first is not None and third is not None
     assert first.get("message") == (
@@ -137,22 +137,22 @@ def test_a_failure_names_the_violated_relations_and_their_minimal_derivations(
 def test_times_are_what_the_runs_took_by_the_store(stored: tuple[CampaignRecord, dict[str, float]]) -> None:
     record, durations = stored
     assert durations == {"run1a": 20.0, "run1b": 25.0, "run1c": 30.5}  # the other trials' runs are not stored
-    root = ET.fromstring(campaign_junit(record, durations))
+    root = ET.fromstring(campaign_junit_xml(record, durations))
     suite = root[0]
     assert [c.get("time") for c in suite.findall("testcase")] == ["75.500", "0.000", "0.000", "0.000"]
     assert suite.get("time") == root.get("time") == "75.500"
-    assert ET.fromstring(campaign_junit(record))[0].get("time") == "0.000"  # nothing known: nothing taken
+    assert ET.fromstring(campaign_junit_xml(record))[0].get("time") == "0.000"  # nothing known: nothing taken
 
 
 def test_text_is_escaped_and_the_xml_parses(stored: tuple[CampaignRecord, dict[str, float]]) -> None:
     record, _ = stored
-    xml = campaign_junit(record)
+    xml = campaign_junit_xml(record)
     assert xml.startswith('<?xml version="1.0" encoding="UTF-8"?>\n')
     assert "&lt;c069&gt;" in xml and "&amp; more" in xml and "<c069>" not in xml
 
 
 def test_a_campaign_without_trials_is_an_empty_suite() -> None:
-    suite = _suite(campaign_junit(CampaignRecord(PLAN, None, (), ())))
+    suite = _suite(campaign_junit_xml(CampaignRecord(PLAN, None, (), ())))
     assert (suite.get("tests"), suite.get("failures"), suite.get("time")) == ("0", "0", "0.000")
     assert suite.get("timestamp") is None and not suite.findall("testcase")
 
@@ -181,7 +181,7 @@ def test_a_trial_that_decided_nothing_violated_but_not_everything_is_skipped_as_
     first, second = sorted(record.trials, key=lambda t: t.number)
     assert second.inconclusive == (DURATION,) and second.outcome == "inconclusive"
     assert first.inconclusive == () and first.outcome == "violated"
-    suite = _suite(campaign_junit(record))
+    suite = _suite(campaign_junit_xml(record))
     assert (suite.get("tests"), suite.get("failures"), suite.get("skipped")) == ("2", "1", "1")
     skipped = suite.findall("testcase")[1].find("skipped")
     assert skipped is not None and skipped.get("message") == (

@@ -13,7 +13,7 @@ import pytest
 from rosbags.highlevel import AnyReader
 
 from exsce_dsl.lang import load_spec
-from exsce_dsl.runs.bag_info import bag_info
+from exsce_dsl.runs.bag_info import bag_info_of
 from exsce_dsl.sim.run import simulate
 
 from tests.support.bag_factory import typestore_for, write_bag
@@ -43,7 +43,7 @@ def _counted(bag: Path) -> dict[str, int]:
 
 
 def test_a_simulated_nav2_bag_says_its_topics_clocks_tf_goals_and_conventions(bags: dict[str, Path]) -> None:
-    info = bag_info(bags["simulated"])
+    info = bag_info_of(bags["simulated"])
     topics = {t.name: t for t in info.topics}
     assert {name: t.messages for name, t in topics.items()} == _counted(bags["simulated"])
     assert info.timeline.startswith("simulated time")
@@ -84,7 +84,7 @@ def test_each_tf_edge_has_its_rate_and_static_ones_none(tmp_path: Path) -> None:
     store = typestore_for("mcap")
     bag = tmp_path / "tf_only"
     write_bag(bag, "mcap", SHAPES["tf_only"](store), store)
-    info = bag_info(bag)
+    info = bag_info_of(bag)
     # the shape publishes map -> odom at 10 Hz and odom -> base_link at 30 Hz, the laser mount once
     assert dict(info.tf_rates) == pytest.approx({("map", "odom"): 10.0, ("odom", "base_link"): 30.0})
     assert ("base_link", "base_laser_link", True) in info.tf_edges

@@ -154,6 +154,31 @@ def test_a_silent_scan_is_a_gap_of_the_metrics_that_read_it(
     assert not gap.concerns("distance_to_obstacles", "tiago2")
 
 
+def test_a_silent_scan_is_an_annotation_of_the_scan_values_over_the_silence_only(
+    scenario: Scenario, clean: Path, tmp_path: Path
+) -> None:
+    """Regression (issue 49, the walk): the values' windows go onto the wall clock in the metrics
+    step and the coverage step adds the findings after; the gap still reaches exactly the values
+    that read the scan of its robot over a window that holds it."""
+    bag = drop(clean, tmp_path / "dropped", "mcap", "/tiago1/scan", 30.0, 40.0)
+    times = _log_times(clean, "/tiago1/scan")
+    first = bag_span(clean).start * 1e-9
+    before, after = times[times <= first + 30.0][-1], times[times >= first + 40.0][0]
+    run = analyse_bag(bag, scenario).run
+    (gap,) = run.coverage
+    named: dict[tuple[str, str | None, str | None, bool], set[bool]] = {}
+    for value in run.metrics:
+        if value.accounting is not None:
+            over = value.accounting.start <= after and value.accounting.end >= before
+            key = (value.metric, value.safety_metric, value.robot, over)
+            named.setdefault(key, set()).add(gap.reason in value.accounting.annotations)
+    assert named[("distance_to_obstacles", None, "tiago1", True)] == {True}
+    assert named[("violation_duration", "distance_to_obstacles", "tiago1", True)] == {True}
+    assert named[("distance_to_obstacles", None, "tiago1", False)] == {False}  # segments elsewhere
+    assert named[("distance_to_obstacles", None, "tiago2", True)] == {False}
+    assert named[("max_velocity", None, "tiago1", True)] == {False}
+
+
 def test_a_short_silence_is_no_gap(scenario: Scenario, clean: Path, tmp_path: Path) -> None:
     """Four scans lost (0.4 s at 10 Hz) are under the threshold: max(0.5 s, 10 periods = 1 s)."""
     bag = drop(clean, tmp_path / "hiccup", "mcap", "/tiago1/scan", 30.05, 30.45)

@@ -16,7 +16,7 @@ from rosbags.highlevel import AnyReader
 
 from exsce_dsl.lang import load_spec
 from exsce_dsl.runs.analyse import analyse_bag
-from exsce_dsl.runs.bag_info import bag_info
+from exsce_dsl.runs.bag_info import bag_info_of
 from exsce_dsl.runs.signals.plausibility import Velocity, check_poses, speed_bound
 from exsce_dsl.runs.spec_draft import draft_spec
 
@@ -45,7 +45,7 @@ def _odometry_path(bag: Path, topic: str) -> float:
 
 @pytest.mark.parametrize("name", ALL)
 def test_real_bags_show_no_plausibility_finding(name: str) -> None:
-    assert bag_info(REALBAGS / name).plausibility == ()
+    assert bag_info_of(REALBAGS / name).plausibility == ()
 
 
 @pytest.mark.parametrize("name", sorted(ODOMETRY))

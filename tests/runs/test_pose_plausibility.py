@@ -20,7 +20,7 @@ from rosbags.highlevel import AnyReader
 from exsce_dsl.errors import IncompleteRunError
 from exsce_dsl.lang import load_spec
 from exsce_dsl.runs.analyse import AnalysedRun, analyse_bag
-from exsce_dsl.runs.bag_info import bag_info
+from exsce_dsl.runs.bag_info import bag_info_of
 
 from tests.support.bag_factory import (
     POSE_STAMPED,
@@ -204,7 +204,7 @@ def test_interleaved_tracks_refused_by_strict_ingest(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize("fmt", list(FORMATS))
 def test_interleaved_tracks_shown_by_bag_info(fmt: str, tmp_path: Path) -> None:
-    info = bag_info(_bag(tmp_path, "tracks", fmt))
+    info = bag_info_of(_bag(tmp_path, "tracks", fmt))
     (said,) = info.plausibility
     assert said.startswith("/location alternates between two tracks up to 3.8 m apart"), said
     assert "while /velocity never exceeds 0.31 m/s" in said
@@ -222,7 +222,7 @@ def test_a_teleport_makes_no_distance(tmp_path: Path) -> None:
     (said,) = [p for p in analysed.problems if "its pose makes no distance or speed" in p]
     assert f"/location teleports {steps[k]:.1f} m in {0.037:.3f} s, 15.0 s after its first pose" in said, said
     assert f"; 1 of {len(steps)} steps implies more than 1 m/s while /velocity never exceeds" in said
-    assert bag_info(bag).plausibility
+    assert bag_info_of(bag).plausibility
 
 
 def test_a_clean_drive_whose_speed_matches_its_velocity_is_untouched(tmp_path: Path) -> None:
@@ -234,7 +234,7 @@ def test_a_clean_drive_whose_speed_matches_its_velocity_is_untouched(tmp_path: P
     assert values["distance_travelled"] == pytest.approx(path, rel=1e-6)
     assert values["location_path"] == pytest.approx(path, rel=1e-6)
     assert not [p for p in analysed.problems if "plausible" in p or "distance or speed" in p]
-    assert bag_info(bag).plausibility == ()
+    assert bag_info_of(bag).plausibility == ()
 
 
 def test_interleaved_tracks_refused_by_ingest_strict_command(tmp_path: Path) -> None:

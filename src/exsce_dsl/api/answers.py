@@ -16,12 +16,11 @@ from pyoxigraph import BlankNode, Literal, NamedNode
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.remedies import SELECT_OR_ASK
-from exsce_dsl.store.base import Rows, Term
-from exsce_dsl.store.literals import literal_text
+from exsce_dsl.store import Rows, Term, literal_text
 from exsce_dsl.tables import aligned
 
 if TYPE_CHECKING:
-    from exsce_dsl.store.queries.library import Query
+    from exsce_dsl.store import Query
 
 ANSWER_FORMATS = ("table", "json", "csv")
 _PREFIX_DECLARATION = re.compile(r"^\s*PREFIX\s+([A-Za-z][\w.-]*)?:", re.IGNORECASE | re.MULTILINE)
@@ -33,7 +32,7 @@ _KIND_AFTER_PROLOGUE = re.compile(
 
 def results_json(rows: Rows) -> str:
     """SPARQL 1.1 Query Results JSON."""
-    from exsce_dsl.store.answers import results_json as answer
+    from exsce_dsl.store import results_json as answer
 
     return json.dumps(answer(rows), indent=2) + "\n"
 
@@ -84,7 +83,7 @@ def results_table(rows: Rows, prefixes: Mapping[str, str]) -> str:
 
 def answer_text(rows: Rows, format: str = "table") -> str:
     """A SELECT's answer in one of :data:`ANSWER_FORMATS`."""
-    from exsce_dsl.store.queries import standard_prefixes
+    from exsce_dsl.store import standard_prefixes
 
     if format == "json":
         return results_json(rows)
@@ -95,7 +94,7 @@ def answer_text(rows: Rows, format: str = "table") -> str:
 
 def library_queries() -> list[Query]:
     """The queries of the library, by name, each with what it answers and its parameters."""
-    from exsce_dsl.store.queries import query, query_names
+    from exsce_dsl.store import query, query_names
 
     return [query(name) for name in query_names()]
 
@@ -113,8 +112,7 @@ def answer_query(store_url: str | None, name: str, parameters: Mapping[str, Sequ
     """``exscec query NAME -p k=v``: the library's query ``name``, its parameters bound as RDF
     terms (checked before the store is opened; a run by a unique prefix of its uuid, or its IRI)."""
     from exsce_dsl.api.store import open_store
-    from exsce_dsl.store.queries import query, run_query
-    from exsce_dsl.store.queries.stored_names import unknown_names
+    from exsce_dsl.store import query, run_query, unknown_names
 
     library_query = query(name)
     library_query.bindings(parameters)  # check the parameters before opening the store
@@ -129,8 +127,7 @@ def stored_runs(store_url: str | None, scenario: str | None = None) -> QueryAnsw
     """``exscec runs``: the runs of ``scenario`` (of every scenario when None), oldest first; a
     scenario the store does not hold is a warning."""
     from exsce_dsl.api.store import open_store
-    from exsce_dsl.store.queries import run_query
-    from exsce_dsl.store.queries.stored_names import unknown_names
+    from exsce_dsl.store import run_query, unknown_names
 
     given = {} if scenario is None else {"scenario": scenario}
     with open_store(store_url, read_only=True) as store:
@@ -143,7 +140,7 @@ def answer_sparql(store_url: str | None, text: str) -> Rows | bool:
     """``exscec sparql``: a SELECT's rows or an ASK's answer; the library's prefixes are declared
     unless the query declares them itself.  Other kinds of query are an ExsceError."""
     from exsce_dsl.api.store import open_store
-    from exsce_dsl.store.queries import standard_prefixes
+    from exsce_dsl.store import standard_prefixes
 
     declared = {m.group(1) or "" for m in _PREFIX_DECLARATION.finditer(text)}
     prologue = "".join(

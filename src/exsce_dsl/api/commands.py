@@ -19,15 +19,14 @@ from exsce_dsl.model.document import Specification
 if TYPE_CHECKING:
     from prov.model import ProvDocument
 
-    from exsce_dsl.derive.derive_scenario import DerivedSpec, StoredDerivation
-    from exsce_dsl.derive.expect import ExpectedValue
-    from exsce_dsl.oracles.judging import Baseline, Verification
+    from exsce_dsl.derive import DerivedSpec, ExpectedValue, StoredDerivation
+    from exsce_dsl.oracles import Baseline, Verification
     from exsce_dsl.rdf.spec_check import SpecCheck
-    from exsce_dsl.runs.ingest import IngestResult
+    from exsce_dsl.runs import IngestResult
     from exsce_dsl.sim.run import SimulatedRun
     from exsce_dsl.similarity.clustering import Clustering
-    from exsce_dsl.store.base import Store
-    from exsce_dsl.transform.derivation import Request
+    from exsce_dsl.store import Store
+    from exsce_dsl.transform import Request
 
 
 def load(path: str | Path) -> Specification:
@@ -120,7 +119,7 @@ def ingest(
     With ``replace``, a bag already stored as a run of the scenario is analysed again and its run
     replaced in one transaction (its verdicts dropped), as ``exscec ingest --replace``;
     ``strict``: a bag whose run would lack a metric value fails (``exscec ingest --strict``)."""
-    from exsce_dsl.runs.ingest import ingest_bags
+    from exsce_dsl.runs import ingest_bags
 
     chosen = _scenario(spec, scenario)
     return ingest_bags(
@@ -140,7 +139,7 @@ def baseline(
     """``exscec baseline``: the oracles of a scenario from its acceptance criteria and its good
     stored runs (``include_all``: every run, ``--all-runs``); ``result.runs`` says which runs were
     used and why the others were left out."""
-    from exsce_dsl.oracles.judging import build_baseline
+    from exsce_dsl.oracles import build_baseline
 
     return build_baseline(store, spec, scenario, include_all=include_all)
 
@@ -152,7 +151,7 @@ def verify(
     """``exscec verify``: judge runs (stored uuids or unique prefixes of them, or bags, ingested
     first) against every oracle
     of their scenario; the verdicts go to the store unless ``record`` is False."""
-    from exsce_dsl.oracles.judging import verify_runs
+    from exsce_dsl.oracles import verify_runs
 
     return verify_runs(store, _scenario(spec, scenario), runs, record=record)
 
@@ -176,8 +175,7 @@ def derive(
     far from the expected change a run may be, in percent of it, default 10; ``include_all``:
     every stored run, ``--all-runs``); ``source``: the file ``spec`` was read from, as the user
     named it (default: its root file)."""
-    from exsce_dsl.derive.derive_scenario import derive_spec
-    from exsce_dsl.derive.expect import RELATIVE_TOLERANCE
+    from exsce_dsl.derive import RELATIVE_TOLERANCE, derive_spec
 
     return derive_spec(
         spec,
@@ -195,7 +193,7 @@ def derive(
 def add_derived(store: Store, derived: DerivedSpec, *, include_all: bool = False) -> StoredDerivation:
     """``exscec derive --add-to-store``: the derived scenario, its generation and its oracles
     (from the base's good runs; ``include_all``: every run)."""
-    from exsce_dsl.derive.derive_scenario import add_derivation
+    from exsce_dsl.derive import add_derivation
 
     return add_derivation(store, derived, include_all=include_all)
 
@@ -205,7 +203,7 @@ def expect(
 ) -> list[ExpectedValue]:
     """``exscec expect``: each robot's expected distance travelled and task duration, and the path
     segments each value comes from, from the good stored runs (``include_all``: every run)."""
-    from exsce_dsl.derive.expect import SUMMED, expected_metric, learning_runs
+    from exsce_dsl.derive import SUMMED, expected_metric, learning_runs
 
     chosen = _scenario(spec, scenario)
     runs = learning_runs(store, include_all)

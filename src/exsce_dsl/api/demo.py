@@ -269,7 +269,7 @@ def _inside(folder: Path, store_url: str | None) -> Iterator[None]:
 def live_graph(folder: Path) -> Iterator[str]:
     """A roscore of the demo's own (its logs in ``folder/.exsce-ros``), exported as
     ``$ROS_MASTER_URI`` while the block runs; the master's URI."""
-    from exsce_dsl.execute.ros1.graph import start_master
+    from exsce_dsl.execute import start_master
 
     before = os.environ.get("ROS_MASTER_URI")
     with start_master(folder.absolute() / ".exsce-ros") as master:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from exsce_dsl.runs.spec_draft import SpecDraft, default_spec_path, draft_spec
+from exsce_dsl.runs import SpecDraft, default_spec_path, draft_spec
 
 
 def init_from_bag(bag: str | Path, out: str | Path | None = None, force: bool = False) -> SpecDraft:

@@ -7,19 +7,20 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.execute.outcomes import DEFAULT_POLICY, Policy
-from exsce_dsl.execute.ros1.graph import master_uri as environment_master_uri
-from exsce_dsl.execute.ros1.graph import start_master as start_roscore
-from exsce_dsl.execute.ros1.session import (
+from exsce_dsl.execute import (
+    DEFAULT_POLICY,
     DEFAULT_SERVER_TIMEOUT,
+    DEFAULT_SPEED_UP,
     LOGS,
     ExecutedRun,
     Interruption,
     Options,
+    Policy,
     execute_runs,
+    start_stand_in,
 )
-from exsce_dsl.execute.stand_in import start_stand_in
-from exsce_dsl.execute.stand_in.session import DEFAULT_SPEED_UP
+from exsce_dsl.execute import master_uri as environment_master_uri
+from exsce_dsl.execute import start_master as start_roscore
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.document import Specification
 from exsce_dsl.remedies import STAND_IN_FOR_FAULTS

@@ -12,14 +12,7 @@ import re
 from dataclasses import dataclass
 
 from exsce_dsl.errors import UnknownValueError
-from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries import (
-    ValueAccount,
-    metric_sources,
-    resolve_run,
-    run_problems,
-    value_accounts,
-)
+from exsce_dsl.store import Store, ValueAccount, metric_sources, resolve_run, run_problems, value_accounts
 from exsce_dsl.suggest import did_you_mean
 
 __all__ = ["Explanation", "explain"]

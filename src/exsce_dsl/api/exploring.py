@@ -79,7 +79,7 @@ class Exploration:
         """What the campaign found, its figures (beside the random baseline's) and its shrinkings;
         how to reproduce one in ``wording`` (the command line's, ``cli.common.REMEDIES``) if given."""
         from exsce_dsl.explore.figures import figures_table, first_failure, per_100
-        from exsce_dsl.oracles.campaign_junit import steps_text
+        from exsce_dsl.oracles import steps_text
 
         result, random = self.result, self.random
         record, figures = result.record, result.figures
@@ -127,7 +127,7 @@ def explore(
     from exsce_dsl.explore.campaign import CampaignEvents, run_campaign
     from exsce_dsl.explore.figures import random_baseline
     from exsce_dsl.lang import load_spec
-    from exsce_dsl.oracles.campaign_junit import campaign_junit, run_seconds
+    from exsce_dsl.oracles import campaign_junit_xml, run_seconds
 
     chosen, campaign = _executor(request)
     baseline = random_baseline(campaign) if request.compare_random else None
@@ -155,7 +155,7 @@ def explore(
             random = run(baseline, where, "random: ")
         durations = run_seconds(store, result.record) if request.junit else {}
     if request.junit:
-        Path(request.junit).write_text(campaign_junit(result.record, durations), encoding="utf-8")
+        Path(request.junit).write_text(campaign_junit_xml(result.record, durations), encoding="utf-8")
     return Exploration(result, random)
 
 

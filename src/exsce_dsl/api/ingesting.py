@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from exsce_dsl.model import Scenario
     from exsce_dsl.model.document import Specification
-    from exsce_dsl.runs.ingest import IngestResult
+    from exsce_dsl.runs import IngestResult
 
 
 def load_cached(path: str | Path) -> Specification:
@@ -45,10 +45,10 @@ def ingest_files(
     """``exscec ingest``: each bag's metrics and run PROV, as runs of ``scenario``, into the store
     ``store_url`` names (see :func:`~exsce_dsl.api.ingest`); ``on_result`` gets each bag's result
     as it is done."""
-    from exsce_dsl.store.open import StoreOpening
+    from exsce_dsl.store import StoreOpening
 
     opening = StoreOpening(store_url)  # the store opens while what reads the bags is imported
-    from exsce_dsl.runs.ingest import IngestStatus, ingest_bags
+    from exsce_dsl.runs import IngestStatus, ingest_bags
 
     with opening.store() as store:
         results = ingest_bags(

@@ -16,20 +16,21 @@ from dataclasses import dataclass
 from exsce_dsl.errors import AmbiguousRunError, Remedied, UnknownRunError
 from exsce_dsl.model.derivation import Derivation, TransformationStep
 from exsce_dsl.remedies import VERIFY_THE_RUN
-from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries import (
+from exsce_dsl.store import (
     RunChain,
+    Store,
     ValueAccount,
     derivation_of,
     derived_scenarios,
     dispatched_runs,
+    is_full_uuid,
     lineage,
+    names_a_prefix,
     resolve_run,
     run_chain,
     scenario_ids,
     value_accounts,
 )
-from exsce_dsl.store.queries.run_ids import is_full_uuid, names_a_prefix
 
 __all__ = ["RunLineage", "ScenarioLineage", "lineage_of", "run_lineage"]
 

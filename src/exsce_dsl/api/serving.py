@@ -79,13 +79,13 @@ def serve_mcp(
     """``exscec mcp``: the store (read-only) and the checker for an MCP client on stdio; the
     check tool reads files below ``root`` only (default: the current folder).  The store is
     opened once first, so that a URL that cannot work fails now; ``on_ready`` gets its URL."""
+    from exsce_dsl import store as store_face
     from exsce_dsl.mcp_server import Access, serve
-    from exsce_dsl.store import open as store_open
 
-    with store_open.open_store(store_url):  # a store URL that cannot work fails now, not at a request
+    with store_face.open_store(store_url):  # a store URL that cannot work fails now, not at a request
         pass
     if on_ready is not None:
-        on_ready(store_open.store_url(store_url))
+        on_ready(store_face.store_url(store_url))
     folder = os.path.abspath(root or os.getcwd())
     serve(Access(store_url, timeout=timeout, max_rows=max_rows, root=folder))
 

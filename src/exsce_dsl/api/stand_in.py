@@ -8,10 +8,9 @@ from collections.abc import Iterator, Sequence
 from contextlib import ExitStack, contextmanager
 from pathlib import Path
 
-from exsce_dsl.execute.ros1.graph import master_uri as environment_master_uri
-from exsce_dsl.execute.ros1.graph import start_master as start_roscore
-from exsce_dsl.execute.stand_in import StandIn, start_stand_in
-from exsce_dsl.execute.stand_in.session import DEFAULT_SPEED_UP
+from exsce_dsl.execute import DEFAULT_SPEED_UP, StandIn, start_stand_in
+from exsce_dsl.execute import master_uri as environment_master_uri
+from exsce_dsl.execute import start_master as start_roscore
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.document import Specification
 from exsce_dsl.sim.faults import Fault

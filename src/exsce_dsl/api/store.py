@@ -10,24 +10,23 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from exsce_dsl.store import open as store_open
+from exsce_dsl import store as store_face
 
 if TYPE_CHECKING:
     from prov.model import ProvDocument
 
-    from exsce_dsl.store.base import Store
-    from exsce_dsl.store.writing import WriteReport
+    from exsce_dsl.store import Store, WriteReport
 
 
 def open_store(url: str | None = None, *, read_only: bool = False) -> Store:
     """The store ``url`` names (default: ``$EXSCE_STORE``, else ``.exsce/store`` here); use it in a
     ``with`` block, which closes it.  ``read_only``: an embedded store's folder is only read."""
-    return store_open.open_store(url, read_only=read_only)
+    return store_face.open_store(url, read_only=read_only)
 
 
 def store_url(url: str | None = None) -> str:
     """The store URL ``url`` stands for (the default store's when None)."""
-    return store_open.store_url(url)
+    return store_face.store_url(url)
 
 
 @dataclass(frozen=True)
@@ -46,10 +45,7 @@ class StoreInfo:
 def store_info(url: str | None = None) -> StoreInfo:
     """``exscec store info``: the store's kind (embedded, held by ``exscec serve``, an endpoint)
     and its sizes."""
-    from exsce_dsl.store.embedded import EmbeddedStore
-    from exsce_dsl.store.remote import RemoteStore
-    from exsce_dsl.store.segment_index import is_index_graph
-    from exsce_dsl.store.writing import is_revision
+    from exsce_dsl.store import EmbeddedStore, RemoteStore, is_index_graph, is_revision
 
     with open_store(url, read_only=True) as store:
         sizes = store.graph_sizes()
@@ -83,7 +79,7 @@ class StoreGraphs:
 
 def store_graphs(url: str | None = None, *, with_index: bool = False) -> StoreGraphs:
     """The store's named graphs with their sizes; the segment index's only ``with_index``."""
-    from exsce_dsl.store.segment_index import is_index_graph
+    from exsce_dsl.store import is_index_graph
 
     with open_store(url, read_only=True) as store:
         sizes = store.graph_sizes()
@@ -118,7 +114,7 @@ def clear_store(url: str | None = None) -> ClearedStore:
 def add_to_store(document: ProvDocument, url: str | None = None, *, replace: bool = False) -> WriteReport:
     """``exscec compile --store``: add a compiled PROV document, one graph per bundle; a changed
     scenario is replaced (keeping a revision) only with ``replace``."""
-    from exsce_dsl.store.writing import add_prov
+    from exsce_dsl.store import add_prov
 
     with open_store(url) as store:
         return add_prov(store, document, replace=replace)

@@ -13,13 +13,21 @@ from dataclasses import asdict
 from typing import TYPE_CHECKING, Any
 
 from exsce_dsl.errors import UnknownNameWarning
-from exsce_dsl.store import queries
-from exsce_dsl.store.base import Rows, Store
-from exsce_dsl.store.literals import canonical_rows, literal_value
-from exsce_dsl.store.queries.library import query as library_query
-from exsce_dsl.store.queries.results import pose_positions
-from exsce_dsl.store.queries.results import verdicts as stored_verdicts
-from exsce_dsl.store.queries.stored_names import unknown_names
+from exsce_dsl.store import (
+    Rows,
+    Store,
+    canonical_rows,
+    literal_value,
+    pose_positions,
+    resolve_runs,
+    run_metric_values,
+    run_query,
+    run_segment_values,
+    unknown_names,
+)
+from exsce_dsl.store import query as library_query
+from exsce_dsl.store import runs as stored_runs
+from exsce_dsl.store import verdicts as stored_verdicts
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -39,8 +47,8 @@ def _frame(records: Sequence[dict[str, Any]], columns: Sequence[str]) -> pd.Data
 def _runs(store: Store, scenario: str | None, runs: Sequence[str] | None) -> dict[str, str]:
     """Run uuid → its scenario, for the runs asked for (all of ``scenario``'s, or every run; each
     given as its uuid, a unique prefix of it or its IRI)."""
-    known = {r.uuid: r.scenario for r in queries.runs(store, scenario)}
-    return known if runs is None else {r: known.get(r, "") for r in queries.resolve_runs(store, runs)}
+    known = {r.uuid: r.scenario for r in stored_runs(store, scenario)}
+    return known if runs is None else {r: known.get(r, "") for r in resolve_runs(store, runs)}
 
 
 def metrics(store: Store, scenario: str | None = None, runs: Sequence[str] | None = None) -> pd.DataFrame:
@@ -49,7 +57,7 @@ def metrics(store: Store, scenario: str | None = None, runs: Sequence[str] | Non
     run, scenario, robot (None for the mission's), metric, safety (the safety metric a
     ``violation_duration`` is about), value and unit (None for a count)."""
     scenario_of = _runs(store, scenario, runs)
-    readings = queries.run_metric_values(store, list(scenario_of))
+    readings = run_metric_values(store, list(scenario_of))
     return _frame(
         [
             {"run": r.run, "scenario": scenario_of.get(r.run, ""), "robot": r.robot, "metric": r.metric,
@@ -67,7 +75,7 @@ def segments(store: Store, scenario: str | None = None, runs: Sequence[str] | No
     start_x and start_y (where that pose is, in metres, in the map's frame), goal (the goal pose),
     metric, value and unit (as the store holds it; None for a count)."""
     scenario_of = _runs(store, scenario, runs)
-    readings = queries.run_segment_values(store, list(scenario_of))
+    readings = run_segment_values(store, list(scenario_of))
     where = pose_positions(store, [r.start for r in readings if r.start is not None])
     nowhere = (None, None)
     return _frame(
@@ -115,7 +123,7 @@ def query(store: Store, name: str, **parameters: str | Sequence[str]) -> pd.Data
     the store's closest names (the answer is then empty)."""
     if library_query(name).is_update:
         raise ValueError(f"'{name}' is an update; the Python API runs the library's queries only")
-    rows = queries.run_query(store, name, parameters, check_runs=True)
+    rows = run_query(store, name, parameters, check_runs=True)
     for warning in unknown_names(store, name, parameters):
         warnings.warn(warning, UnknownNameWarning, stacklevel=2)
     return rows_frame(rows)

@@ -14,10 +14,9 @@ from pathlib import Path
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.document import Specification
 from exsce_dsl.model.trials import ClauseTrial, Trial
-from exsce_dsl.oracles.trial_runs import REPEAT_FOLDER, REPEAT_SEED, stored_pass_rates
-from exsce_dsl.oracles.trial_runs import verify_trial as judge
-from exsce_dsl.oracles.trials import CONFIDENCE, REQUIRED_PASS_RATE
-from exsce_dsl.store.base import Store
+from exsce_dsl.oracles import CONFIDENCE, REPEAT_FOLDER, REPEAT_SEED, REQUIRED_PASS_RATE, stored_pass_rates
+from exsce_dsl.oracles import verify_trial as judge
+from exsce_dsl.store import Store
 
 
 def verify_trial(

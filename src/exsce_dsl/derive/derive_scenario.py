@@ -13,13 +13,11 @@ from exsce_dsl.lang import declared_poses, format_document
 from exsce_dsl.model import Acceptance, Scenario
 from exsce_dsl.model.document import Specification
 from exsce_dsl.model.oracles import Oracle
-from exsce_dsl.oracles.baseline import learn_baseline
-from exsce_dsl.oracles.judging import compile_learnt
+from exsce_dsl.oracles import compile_learnt, learn_baseline
 from exsce_dsl.prov import compile_scenario
 from exsce_dsl.prov.derivation import compile_derivation
-from exsce_dsl.store.base import Store
-from exsce_dsl.store.writing import WriteReport, add_prov
-from exsce_dsl.transform.derivation import Derived, Request, derive, derived_document
+from exsce_dsl.store import Store, WriteReport, add_prov
+from exsce_dsl.transform import Derived, Request, derive, derived_document
 
 
 @dataclass(frozen=True)

@@ -40,9 +40,8 @@ from exsce_dsl.model.acceptance import (
     Subject,
     When,
 )
-from exsce_dsl.oracles.good_runs import good_runs
-from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries import ValueStats, robot_metric_over_runs, segment_metric_between
+from exsce_dsl.oracles import good_runs_of
+from exsce_dsl.store import Store, ValueStats, robot_metric_over_runs, segment_metric_between
 
 SUMMED = ("distance_travelled", "task_duration")
 """The metrics a robot's value of is the sum of its segments' values."""
@@ -93,7 +92,7 @@ def robot_path(scenario: Scenario, robot_id: str) -> list[tuple[Pose, Pose]]:
 def learning_runs(store: Store, include_all: bool = False) -> tuple[str, ...]:
     """The runs whose drives expected values and estimates learn from: the good runs of every
     scenario (:mod:`exsce_dsl.oracles.good_runs`), or every stored run with ``include_all``."""
-    return good_runs(store, include_all=include_all).used
+    return good_runs_of(store, include_all=include_all).used
 
 
 def _either_way(
@@ -334,7 +333,7 @@ def metamorphic_acceptance(
             and (e.metric not in PAIRWISE or len(robots) > 1)
         ]
     performance: list[Expectation] = []
-    chosen = good_runs(store, base.id, include_all=include_all, scenario=base)
+    chosen = good_runs_of(store, base.id, include_all=include_all, scenario=base)
     base_runs = list(chosen.require_some(f"'{base.id}' to expect from").used)
     learning = learning_runs(store, include_all)
     for robot in derived.robots:

@@ -35,7 +35,7 @@ from exsce_dsl.endpoint.protocol import (
 from exsce_dsl.endpoint.worker import Job
 from exsce_dsl.errors import RefusedRequest, Remedied
 from exsce_dsl.remedies import READ_ONLY, SEND_THE_TOKEN
-from exsce_dsl.store.base import MAX_QUERY
+from exsce_dsl.store import MAX_QUERY
 
 METHODS = ["GET", "HEAD", "POST", "PUT", "DELETE", "PATCH", "OPTIONS"]
 

@@ -34,8 +34,7 @@ from exsce_dsl.endpoint.guard import HostRule, is_loopback
 from exsce_dsl.endpoint.worker import Settings
 from exsce_dsl.errors import StoreError
 from exsce_dsl.remedies import MAKE_A_TOKEN, SERVE_A_FOLDER
-from exsce_dsl.store.base import QUERY_TIMEOUT
-from exsce_dsl.store.serve_info import ServeInfo, serve_info_path, write_serve_info
+from exsce_dsl.store import QUERY_TIMEOUT, ServeInfo, serve_info_path, write_serve_info
 
 __all__ = ["MAX_ANSWER", "MIN_TOKEN", "ServeOptions", "check_token", "new_token", "serve", "servable_store"]
 
@@ -85,9 +84,7 @@ def check_token(token: str) -> str:
 def servable_store(store_url: str | None) -> Path | None:
     """The folder of the embedded store ``store_url`` names (None: ``memory:``), free to serve;
     a StoreError if it is an endpoint, or served already."""
-    from exsce_dsl.store.embedded import EmbeddedStore
-    from exsce_dsl.store.open import open_store
-    from exsce_dsl.store.remote import RemoteStore
+    from exsce_dsl.store import EmbeddedStore, RemoteStore, open_store
 
     store = open_store(store_url)
     try:

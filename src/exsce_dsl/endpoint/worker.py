@@ -45,8 +45,7 @@ from pyoxigraph import (
 from exsce_dsl.endpoint.formats import DATASET_FORMATS, GRAPH_FORMATS, RESULT_FORMATS, negotiate
 from exsce_dsl.errors import FederationRefused, RefusedRequest, Remedied, StoreError
 from exsce_dsl.remedies import ALLOW_FEDERATION
-from exsce_dsl.store.embedded import EmbeddedStore
-from exsce_dsl.store.federation import refuse_federation
+from exsce_dsl.store import EmbeddedStore, refuse_federation
 
 READY, HEAD, DATA, END, REFUSED = b"R", b"H", b"D", b"E", b"X"
 """The first byte of each reply: the store is open (or REFUSED: it cannot be); an answer's media

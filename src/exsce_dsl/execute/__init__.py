@@ -13,3 +13,26 @@ for move_base and the stand-in robot — and this process talks to them and to t
 real ``rosbag record``; tested on a real roscore) and :mod:`.ros2` (rclpy and Nav2, imported only
 where rclpy exists; not run on a live ROS 2 graph in exsce's CI).
 """
+
+# mypy: implicit-reexport
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from exsce_dsl.execute.outcomes import DEFAULT_POLICY, Policy
+    from exsce_dsl.execute.ros1.graph import master_uri, start_master
+    from exsce_dsl.execute.ros1.session import (
+        DEFAULT_SERVER_TIMEOUT,
+        LOGS,
+        ExecutedRun,
+        Interruption,
+        Options,
+        execute_runs,
+    )
+    from exsce_dsl.execute.stand_in import StandIn, start_stand_in
+    from exsce_dsl.execute.stand_in.session import DEFAULT_SPEED_UP
+else:
+    from exsce_dsl.faces import lazy_face
+
+    __getattr__, __dir__ = lazy_face(__name__, __file__)

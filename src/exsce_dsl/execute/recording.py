@@ -31,10 +31,7 @@ from exsce_dsl.model import Scenario
 from exsce_dsl.model.conventions import CONVENTIONS, Signals, TfSource
 from exsce_dsl.model.metrics import expand_topic
 from exsce_dsl.model.robots import Robot
-from exsce_dsl.runs.analyse import run_metrics, wanted_topics
-from exsce_dsl.runs.bags.names import topic_key
-from exsce_dsl.runs.coverage import PROV_TOPIC
-from exsce_dsl.runs.robots import StackRobots
+from exsce_dsl.runs import PROV_TOPIC, StackRobots, run_metrics, topic_key, wanted_topics
 
 ALWAYS = ("/tf", "/tf_static", "/clock", PROV_TOPIC)
 """Recorded in every run: the global TF tree, simulated time and the run-time PROV."""

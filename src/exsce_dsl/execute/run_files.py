@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from exsce_dsl.model.runs import run_name
-from exsce_dsl.runs.bags.formats import ROS1_BAG
+from exsce_dsl.runs import ROS1_BAG
 
 BAG, PROV, PARAMETERS = ROS1_BAG.suffix, ".prov.json", ".rosparams"
 """The extensions of a run's files: its bag, its run-time PROV, its parameter-server dump."""

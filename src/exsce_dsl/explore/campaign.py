@@ -33,7 +33,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import NamedTuple
 
-from exsce_dsl.derive.derive_scenario import DerivedSpec, add_derivation, derive_spec
+from exsce_dsl.derive import DerivedSpec, add_derivation, derive_spec
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.explore.cover import covering_derivations
 from exsce_dsl.explore.draw import Candidate, draw_derivations
@@ -54,15 +54,12 @@ from exsce_dsl.model.campaign import (
 )
 from exsce_dsl.model.document import Specification
 from exsce_dsl.model.verdicts import Outcome, Verdict
-from exsce_dsl.oracles.judging import verify_runs
+from exsce_dsl.oracles import verify_runs
 from exsce_dsl.prov.campaign import compile_campaign, compile_shrinking, compile_trial
-from exsce_dsl.runs.ingest import ingest_bags, stored_bag_run_id
-from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries import derivation_of
-from exsce_dsl.store.queries import runs as stored_runs
-from exsce_dsl.store.queries.campaigns import campaign_record
-from exsce_dsl.store.writing import add_prov
-from exsce_dsl.transform.derivation import derived_document
+from exsce_dsl.runs import ingest_bags, stored_bag_run_id
+from exsce_dsl.store import Store, add_prov, campaign_record, derivation_of
+from exsce_dsl.store import runs as stored_runs
+from exsce_dsl.transform import derived_document
 
 STRATEGIES = ("covering", "random")
 TOLERANCE = 25.0

@@ -29,8 +29,7 @@ from exsce_dsl.explore.fingerprint import fingerprint
 from exsce_dsl.explore.playable import standing_in_the_way
 from exsce_dsl.explore.steps import ProposedStep, applicable_steps
 from exsce_dsl.model import Scenario, Task
-from exsce_dsl.transform.applied import Applied
-from exsce_dsl.transform.derivation import Request
+from exsce_dsl.transform import Applied, Request
 
 ATTEMPTS = 20
 """Draws per derivation asked for, at most, before the space counts as spent."""

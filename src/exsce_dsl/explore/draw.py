@@ -24,9 +24,7 @@ from exsce_dsl.explore.playable import standing_in_the_way
 from exsce_dsl.explore.steps import ProposedStep, applicable_steps
 from exsce_dsl.model import Scenario, Task
 from exsce_dsl.suggest import did_you_mean
-from exsce_dsl.transform.applied import Applied
-from exsce_dsl.transform.derivation import Request, derive
-from exsce_dsl.transform.transformations import TRANSFORMATIONS
+from exsce_dsl.transform import TRANSFORMATIONS, Applied, Request, derive
 
 
 @dataclass(frozen=True)

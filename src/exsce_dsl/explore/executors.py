@@ -36,12 +36,12 @@ from pathlib import Path
 from typing import Protocol, runtime_checkable
 
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.execute.stand_in.session import DEFAULT_SPEED_UP
+from exsce_dsl.execute import DEFAULT_SPEED_UP
 from exsce_dsl.explore.ros1_executor import ros1_executor
 from exsce_dsl.model import Scenario
 from exsce_dsl.plugins import Registry
 from exsce_dsl.remedies import BUILT_IN_OPTIONS, ONE_EXECUTOR, ROS1_OPTIONS
-from exsce_dsl.runs.bags.reading import is_bag
+from exsce_dsl.runs import is_bag
 from exsce_dsl.sim.faults import Fault
 from exsce_dsl.sim.run import simulate
 from exsce_dsl.suggest import did_you_mean

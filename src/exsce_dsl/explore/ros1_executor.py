@@ -29,10 +29,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.execute.ros1.graph import start_master as start_roscore
-from exsce_dsl.execute.ros1.session import LOGS, Interruption, execute_runs
-from exsce_dsl.execute.stand_in import start_stand_in
-from exsce_dsl.execute.stand_in.session import DEFAULT_SPEED_UP
+from exsce_dsl.execute import DEFAULT_SPEED_UP, LOGS, Interruption, execute_runs, start_stand_in
+from exsce_dsl.execute import start_master as start_roscore
 from exsce_dsl.model import Scenario
 from exsce_dsl.remedies import FAULTS_NEED_THE_STAND_IN, STAND_IN_ONLY
 from exsce_dsl.sim.faults import Fault

@@ -23,8 +23,7 @@ from exsce_dsl.errors import ExsceError
 from exsce_dsl.explore.fingerprint import fingerprint
 from exsce_dsl.explore.playable import standing_in_the_way
 from exsce_dsl.model import Scenario, Task
-from exsce_dsl.transform.derivation import Request, derive
-from exsce_dsl.transform.transformations import TRANSFORMATIONS
+from exsce_dsl.transform import TRANSFORMATIONS, Request, derive
 
 MAX_TRIES = 500
 """Calls of ``still_fails`` a shrink makes at most (each runs a derivation)."""

@@ -30,10 +30,7 @@ from itertools import combinations
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import Pose, Robot, Scenario, Task
 from exsce_dsl.model.names import is_valid_name
-from exsce_dsl.transform.applied import Applied
-from exsce_dsl.transform.derivation import Request
-from exsce_dsl.transform.records import Arguments
-from exsce_dsl.transform.transformations import TRANSFORMATIONS
+from exsce_dsl.transform import TRANSFORMATIONS, Applied, Arguments, Request
 
 MAX_POSES = 6
 ROBOT_STEM = "new_robot"

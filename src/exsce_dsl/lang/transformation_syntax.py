@@ -16,8 +16,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from exsce_dsl.lang.lexical import quantity_text, read_length
-from exsce_dsl.transform.records import Group, Part, Slot, Transformation, Word, phrase_parts
-from exsce_dsl.transform.transformations import TRANSFORMATIONS
+from exsce_dsl.transform import TRANSFORMATIONS, Group, Part, Slot, Transformation, Word, phrase_parts
 
 REFERENCE_TYPES = frozenset({"robot", "task", "pose", "obstacle"})
 """Types whose argument names something declared (the grammar's ``Ref``)."""

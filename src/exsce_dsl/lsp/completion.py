@@ -18,8 +18,8 @@ from lsprotocol import types
 from exsce_dsl.lang import Continuations, Symbol, builtin_metrics
 from exsce_dsl.lsp.derive_steps import current_step, next_types, snippet
 from exsce_dsl.lsp.navigation import Names
-from exsce_dsl.oracles.relations import relation, relation_names
-from exsce_dsl.transform.transformations import TRANSFORMATIONS
+from exsce_dsl.oracles import relation, relation_names
+from exsce_dsl.transform import TRANSFORMATIONS
 
 LIMIT = 300
 """At most this many items; the list is marked incomplete beyond (the client asks again)."""

@@ -5,10 +5,13 @@ what each step's first word means (hover)."""
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
-from exsce_dsl.lang.transformation_syntax import step_heads
-from exsce_dsl.transform.records import Slot, Transformation, Word, phrase_parts, shown_phrase, variants
-from exsce_dsl.transform.transformations import TRANSFORMATIONS
+from exsce_dsl.lang import step_heads
+from exsce_dsl.transform import TRANSFORMATIONS, Slot, Word, phrase_parts, shown_phrase, variants
+
+if TYPE_CHECKING:
+    from exsce_dsl.transform import Transformation
 
 _PLACEHOLDERS = {"count": "n"}
 """A parameter's placeholder in a snippet, where it is not its type's name."""

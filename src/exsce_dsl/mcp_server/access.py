@@ -27,7 +27,7 @@ import anyio.to_thread
 
 from exsce_dsl.errors import TimeLimitError
 from exsce_dsl.remedies import LONGER_TIME_LIMIT
-from exsce_dsl.store.base import QUERY_TIMEOUT, Store
+from exsce_dsl.store import QUERY_TIMEOUT, Store
 
 __all__ = ["DEFAULT_MAX_ROWS", "Access"]
 
@@ -58,7 +58,7 @@ class Access:
     @contextlib.contextmanager
     def store(self) -> Iterator[Store]:
         """The store, open for one request."""
-        from exsce_dsl.store.open import open_store
+        from exsce_dsl.store import open_store
 
         with open_store(self.store_url, timeout=self.timeout) as store:
             yield store

@@ -21,8 +21,7 @@ from typing import Any
 import mcp_types as types
 
 from exsce_dsl.mcp_server.access import Access
-from exsce_dsl.store.answers import results_json
-from exsce_dsl.store.base import Bindings, Store
+from exsce_dsl.store import Bindings, Store, results_json
 
 __all__ = ["READ_ONLY", "ToolEntry", "first_rows_json", "results_json", "tool_error", "tool_result"]
 

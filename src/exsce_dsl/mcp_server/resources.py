@@ -30,8 +30,8 @@ from exsce_dsl.mcp_server.access import Access
 from exsce_dsl.mcp_server.arguments import NAME, RUN_ID
 from exsce_dsl.mcp_server.store_tools import derivation_json, stored_run, stored_scenario
 from exsce_dsl.model.verdicts import Outcome
-from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries import (
+from exsce_dsl.store import (
+    Store,
     StoredRun,
     derivation_of,
     derived_scenarios,
@@ -40,8 +40,8 @@ from exsce_dsl.store.queries import (
     run_metric_values,
     runs,
     scenario_ids,
+    verdicts,
 )
-from exsce_dsl.store.queries.results import verdicts
 
 __all__ = ["SCHEME", "list_resources", "read_resource", "resource_templates"]
 

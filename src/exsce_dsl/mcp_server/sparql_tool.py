@@ -34,10 +34,7 @@ from exsce_dsl.errors import ArgumentError, ExsceError, FederationRefused
 from exsce_dsl.mcp_server.access import Access
 from exsce_dsl.mcp_server.answers import READ_ONLY, ToolEntry, first_rows_json
 from exsce_dsl.mcp_server.arguments import object_schema
-from exsce_dsl.store.base import MAX_QUERY
-from exsce_dsl.store.federation import refuse_federation
-from exsce_dsl.store.queries import standard_prefixes
-from exsce_dsl.store.sparql import declared_prefixes, query_form
+from exsce_dsl.store import MAX_QUERY, declared_prefixes, query_form, refuse_federation, standard_prefixes
 
 __all__ = ["read_only_query", "sparql_tool"]
 

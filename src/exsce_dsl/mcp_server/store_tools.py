@@ -26,11 +26,11 @@ from exsce_dsl.mcp_server.answers import READ_ONLY, ToolEntry
 from exsce_dsl.mcp_server.arguments import NAME, RUN_ID, identifier, object_schema
 from exsce_dsl.model.derivation import Derivation
 from exsce_dsl.model.verdicts import Outcome
-from exsce_dsl.oracles.report import verdicts_json
+from exsce_dsl.oracles import verdicts_json
 from exsce_dsl.remedies import VERIFY_THE_RUN
-from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries import (
+from exsce_dsl.store import (
     RunChain,
+    Store,
     StoredRun,
     ValueAccount,
     derivation_of,
@@ -41,8 +41,8 @@ from exsce_dsl.store.queries import (
     runs,
     scenario_ids,
     value_accounts,
+    verdicts,
 )
-from exsce_dsl.store.queries.results import verdicts
 from exsce_dsl.suggest import did_you_mean
 
 __all__ = ["lineage_tool", "run_verdicts_tool", "stored_run", "stored_scenario"]

@@ -15,7 +15,10 @@ element of another would be an array of arrays, which no metric reads.
 
 from __future__ import annotations
 
-from exsce_dsl.errors import ExsceError, FieldProblem, Remedied
+from collections.abc import Callable
+
+from exsce_dsl.errors import BagError, ExsceError, FieldProblem, Remedied
+from exsce_dsl.messages.catalogue import Source
 from exsce_dsl.model.messages import (
     FieldPath,
     Fields,
@@ -28,6 +31,7 @@ from exsce_dsl.model.messages import (
     canonical_type,
 )
 from exsce_dsl.model.metrics import MetricDefinition
+from exsce_dsl.model.robots import Robot
 from exsce_dsl.remedies import DEFINE_THE_BAGS_TYPE
 from exsce_dsl.suggest import did_you_mean
 
@@ -65,6 +69,25 @@ def check_fields(
                 said = Remedied(wrong, DEFINE_THE_BAGS_TYPE).said()  # ingest prints it in a BagError's text
                 found.append(ExsceError(_from(said, source), f.location))
     return found
+
+
+def field_checker(
+    metrics: tuple[MetricDefinition, ...], robots: list[Robot]
+) -> Callable[[str, str, Fields, Source | None], None]:
+    """Checks what ``metrics`` read of a topic against the definition of the type the bag has for
+    it, before anything is computed: a type unknown when the specification was checked is checked
+    here, with the same messages at the same places (``file:line:col``)."""
+
+    def check(topic: str, msgtype: str, tree: Fields, source: Source | None) -> None:
+        problems: list[ExsceError] = []
+        for metric in metrics:
+            if any(read.topic_of(r.namespace) == topic for read in metric.reads for r in robots):
+                problems += check_fields(metric, msgtype, tree, source.text if source else None)
+        if problems:
+            where = "\n".join(f"  {p}" for p in dict.fromkeys(str(p) for p in problems))
+            raise BagError(f"topic {topic} ({msgtype}) lacks what the metrics read of it:\n{where}")
+
+    return check
 
 
 def describe(node: Node) -> str:

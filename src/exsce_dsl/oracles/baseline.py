@@ -24,12 +24,12 @@ from exsce_dsl.errors import ExsceError, NotEnoughRuns
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.acceptance import Acceptance, BasicRelation
 from exsce_dsl.model.oracles import Oracle
-from exsce_dsl.oracles.good_runs import GoodRuns, good_runs
+from exsce_dsl.oracles.good_runs import GoodRuns, good_runs_of
 from exsce_dsl.oracles.intervals import prediction_half_width
 from exsce_dsl.oracles.observe import RunValues, observe, run_values
 from exsce_dsl.oracles.plan import PlannedOracle, plan_oracles, tolerance_of
 from exsce_dsl.oracles.sources import ValueSources, unread_topics
-from exsce_dsl.store.base import Store
+from exsce_dsl.store import Store
 
 PACKAGE = "exsce.metamorphic.relationships"
 """The package the method's YAML names for the built-in relations (kept for its format)."""
@@ -125,8 +125,8 @@ def learn_baseline(
 def _usable_runs(store: Store, scenario: Scenario | str, include_all: bool = False) -> GoodRuns:
     """The good runs of a scenario (every run with ``include_all``), and those left out with why."""
     if isinstance(scenario, Scenario):
-        return good_runs(store, scenario.id, include_all=include_all, scenario=scenario)
-    return good_runs(store, scenario, include_all=include_all)
+        return good_runs_of(store, scenario.id, include_all=include_all, scenario=scenario)
+    return good_runs_of(store, scenario, include_all=include_all)
 
 
 def _statistics(oracle: PlannedOracle, runs: Sequence[RunValues], scenario: Scenario) -> Statistics | None:

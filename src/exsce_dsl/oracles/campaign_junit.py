@@ -16,12 +16,12 @@ import xml.etree.ElementTree as ET
 from collections.abc import Mapping, Sequence
 
 from exsce_dsl.model.campaign import CampaignRecord, CampaignTrial, CheckedRelation, Request, Shrinking
-from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries import runs as stored_runs
-from exsce_dsl.transform.transformations import TRANSFORMATIONS
+from exsce_dsl.store import Store
+from exsce_dsl.store import runs as stored_runs
+from exsce_dsl.transform import TRANSFORMATIONS
 from exsce_dsl.wording import counted
 
-__all__ = ["campaign_junit", "run_seconds", "step_text", "steps_text"]
+__all__ = ["campaign_junit_xml", "run_seconds", "step_text", "steps_text"]
 
 ARROW = " → "
 """Between the steps of a derivation, as people read it."""
@@ -77,7 +77,7 @@ def _failure(trial: CampaignTrial, shrinkings: Sequence[Shrinking]) -> tuple[str
     return message, "\n".join(lines)
 
 
-def campaign_junit(record: CampaignRecord, durations: Mapping[str, float] | None = None) -> str:
+def campaign_junit_xml(record: CampaignRecord, durations: Mapping[str, float] | None = None) -> str:
     """The campaign as JUnit XML (see the module's docstring).
 
     A test case's ``time`` is what its runs took, from ``durations`` (run uuid → seconds, as

@@ -27,11 +27,10 @@ from exsce_dsl.lang import standard_metrics
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.coverage import CoverageGap, Shortfall
 from exsce_dsl.remedies import LEARN_FROM_EVERY_RUN
-from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries import RunDefect, run_coverage, run_defects
-from exsce_dsl.store.queries import runs as stored_runs
+from exsce_dsl.store import RunDefect, Store, run_coverage, run_defects
+from exsce_dsl.store import runs as stored_runs
 
-__all__ = ["GoodRuns", "NoGoodRuns", "good_runs"]
+__all__ = ["GoodRuns", "NoGoodRuns", "good_runs_of"]
 
 
 @dataclass(frozen=True)
@@ -62,7 +61,7 @@ class GoodRuns:
         )
 
 
-def good_runs(
+def good_runs_of(
     store: Store,
     scenario_id: str | None = None,
     *,

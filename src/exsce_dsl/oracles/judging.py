@@ -25,14 +25,18 @@ from exsce_dsl.oracles.good_runs import GoodRuns
 from exsce_dsl.oracles.verify import judge_runs
 from exsce_dsl.prov.oracle import compile_oracles
 from exsce_dsl.prov.verdicts import compile_verdicts
-from exsce_dsl.runs.bags.reading import names_a_bag
-from exsce_dsl.runs.ingest import ingest_bags
-from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries import oracles as stored_oracles
-from exsce_dsl.store.queries import resolve_runs, run_coverage, run_topic_rates
-from exsce_dsl.store.queries import runs as stored_runs
-from exsce_dsl.store.queries.run_ids import names_a_prefix
-from exsce_dsl.store.writing import WriteReport, add_prov
+from exsce_dsl.runs import ingest_bags, names_a_bag
+from exsce_dsl.store import (
+    Store,
+    WriteReport,
+    add_prov,
+    names_a_prefix,
+    resolve_runs,
+    run_coverage,
+    run_topic_rates,
+)
+from exsce_dsl.store import oracles as stored_oracles
+from exsce_dsl.store import runs as stored_runs
 
 """What a bag's name ends with: such a name that is not a file is a missing bag, not a run id."""
 

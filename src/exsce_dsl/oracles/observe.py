@@ -12,8 +12,7 @@ from exsce_dsl.lang import metric_info, standard_metrics
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.acceptance import Moment, Window
 from exsce_dsl.model.metrics import Combine, ComputedFor
-from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries import run_metric_values, run_segment_values
+from exsce_dsl.store import Store, run_metric_values, run_segment_values
 
 _ACTION = re.compile(r"/(?P<robot>[^/]+)-task_(?P<task>\d+)-subtask_(?P<subtask>\d+)-w_(?P<waypoint>\d+)$")
 _WINDOW = re.compile(

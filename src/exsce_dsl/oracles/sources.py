@@ -15,8 +15,7 @@ from collections.abc import Iterable
 
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.metrics import default_topics
-from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries import MetricSource, metric_sources
+from exsce_dsl.store import MetricSource, Store, metric_sources
 
 __all__ = ["ValueSources", "unread_topics"]
 

@@ -26,9 +26,8 @@ from exsce_dsl.oracles.trials import (
 )
 from exsce_dsl.sim.executor import Fault
 from exsce_dsl.sim.run import simulate
-from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries import scenario_ids
-from exsce_dsl.store.queries.results import verdicts as stored_verdicts
+from exsce_dsl.store import Store, scenario_ids
+from exsce_dsl.store import verdicts as stored_verdicts
 from exsce_dsl.suggest import did_you_mean
 
 REPEAT_SEED = 1

@@ -18,10 +18,9 @@ from exsce_dsl.oracles.observe import RunValues, observe, parse_window, run_valu
 from exsce_dsl.oracles.relations import relation
 from exsce_dsl.oracles.sources import ValueSources
 from exsce_dsl.remedies import BUILD_A_BASELINE
-from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries import StoredRun, action_times
-from exsce_dsl.store.queries import oracles as stored_oracles
-from exsce_dsl.store.queries import runs as stored_runs
+from exsce_dsl.store import Store, StoredRun, action_times
+from exsce_dsl.store import oracles as stored_oracles
+from exsce_dsl.store import runs as stored_runs
 
 
 def judge_runs(

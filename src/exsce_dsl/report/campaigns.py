@@ -12,9 +12,8 @@ import datetime
 from dataclasses import dataclass
 
 from exsce_dsl.model.campaign import CampaignPlan, CampaignRecord, CheckedRelation
-from exsce_dsl.oracles.campaign_junit import steps_text
-from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries.campaigns import campaign_record, campaigns
+from exsce_dsl.oracles import steps_text
+from exsce_dsl.store import Store, campaign_record, campaigns
 
 __all__ = [
     "CampaignContents",

@@ -23,16 +23,34 @@ from exsce_dsl.model.runs import Hotspot
 from exsce_dsl.model.scenario import Scenario
 from exsce_dsl.model.trials import ClauseTrial
 from exsce_dsl.model.verdicts import Outcome, Verdict
-from exsce_dsl.oracles.trials import clause_trials, lowest_pass_rate_first
+from exsce_dsl.oracles import clause_trials, lowest_pass_rate_first
 from exsce_dsl.remedies import ADD_ITS_SPEC, GIVE_THE_SPECS
 from exsce_dsl.report.campaigns import CampaignContents, gather_campaigns
 from exsce_dsl.report.units import metric_units
 from exsce_dsl.similarity.clustering import Clustering, cluster
 from exsce_dsl.similarity.facts import scenario_facts
-from exsce_dsl.store import queries
-from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries import MetricReading, StoredRun, ValueAccount
-from exsce_dsl.store.queries.results import hotspots, pose_positions, verdicts
+from exsce_dsl.store import (
+    MetricReading,
+    Store,
+    StoredRun,
+    ValueAccount,
+    derivation_of,
+    dispatched_runs,
+    hotspots,
+    path_segments,
+    pose_positions,
+    run_metric_values,
+    run_segment_values,
+    scenario_ids,
+    value_accounts,
+    verdicts,
+)
+from exsce_dsl.store import (
+    oracles as stored_oracles,
+)
+from exsce_dsl.store import (
+    runs as stored_runs,
+)
 
 _RANK = {Outcome.FAILED: 0, Outcome.PASSED: 2}
 """Where verdicts of each outcome go when failures come first; any other outcome goes between."""
@@ -200,17 +218,17 @@ def gather(store: Store, specs: Sequence[Path] = ()) -> ReportContents:
     units of the metrics they declare."""
     declared = [scenario for spec in specs for scenario in load_spec(spec).scenarios]
     grids, missing, notes = _grids(declared)
-    ids = queries.scenario_ids(store)
+    ids = scenario_ids(store)
     all_verdicts = verdicts(store)
-    dispatched = dict(queries.dispatched_runs(store, ""))  # every run's dispatcher's id, in one query
-    derivations = {s: queries.derivation_of(store, s) for s in ids}
+    dispatched = dict(dispatched_runs(store, ""))  # every run's dispatcher's id, in one query
+    derivations = {s: derivation_of(store, s) for s in ids}
     children: dict[str, list[str]] = {}
     for scenario_id, derivation in derivations.items():
         if derivation is not None:
             children.setdefault(derivation.base, []).append(scenario_id)
     scenarios = []
     for scenario_id in ids:
-        runs = queries.runs(store, scenario_id)
+        runs = stored_runs(store, scenario_id)
         uuids = [r.uuid for r in runs]
         spots: dict[str, list[Hotspot]] = {}
         for found in hotspots(store, uuids):
@@ -231,13 +249,13 @@ def gather(store: Store, specs: Sequence[Path] = ()) -> ReportContents:
                         failures_first(judged.get(r.uuid, ())),
                         tuple(spots.get(r.uuid, ())),
                         tuple(driven.get(r.uuid, ())),
-                        tuple(queries.value_accounts(store, r.uuid)),
+                        tuple(value_accounts(store, r.uuid)),
                         dispatched.get(r.uuid),
                     )
                     for r in runs
                 ),
-                oracles=tuple(queries.oracles(store, scenario_id)),
-                values=tuple(queries.run_metric_values(store, uuids)),
+                oracles=tuple(stored_oracles(store, scenario_id)),
+                values=tuple(run_metric_values(store, uuids)),
                 waypoints=_waypoints(store, scenario_id),
                 grid=_grid_of(scenario_id, derivations, grids),
                 missing_map=_missing_map(scenario_id, derivations, grids, missing, given=bool(specs)),
@@ -261,7 +279,7 @@ def gather(store: Store, specs: Sequence[Path] = ()) -> ReportContents:
 
 
 def _waypoints(store: Store, scenario_id: str) -> dict[str, tuple[tuple[str, float, float], ...]]:
-    segments = queries.path_segments(store, scenario_id)
+    segments = path_segments(store, scenario_id)
     where = pose_positions(store, [p for s in segments for p in (s.start, s.goal)])
     paths: dict[str, list[str]] = {}
     for segment in segments:
@@ -329,7 +347,7 @@ def _lineage(scenario_id: str, derivations: Mapping[str, Derivation | None]) -> 
 
 def _segments(store: Store, runs: Sequence[str]) -> dict[str, list[RunSegment]]:
     """Run uuid → the path segments its robots drove, by robot then in order, each at its start pose."""
-    readings = queries.run_segment_values(store, runs)
+    readings = run_segment_values(store, runs)
     where = pose_positions(store, [r.start for r in readings if r.start is not None])
     by_action: dict[tuple[str, str], list[MetricReading]] = {}
     for reading in readings:

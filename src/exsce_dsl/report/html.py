@@ -22,14 +22,12 @@ from exsce_dsl.errors import BagError, ExsceError
 from exsce_dsl.figures import save_figure
 from exsce_dsl.model.derivation import Derivation
 from exsce_dsl.model.verdicts import Verdict
-from exsce_dsl.oracles.report import expectation
-from exsce_dsl.oracles.trial_report import interval
-from exsce_dsl.oracles.trials import percent
+from exsce_dsl.oracles import expectation, interval, percent
 from exsce_dsl.output_folder import written_whole
 from exsce_dsl.report.contents import ReportContents, RunContents, ScenarioContents
 from exsce_dsl.report.plots import campaign_figure, metrics_figure, trajectory_figure
 from exsce_dsl.resources import resource_dir
-from exsce_dsl.runs.signals.trajectories import Trajectory, trajectories
+from exsce_dsl.runs import Trajectory, trajectories
 from exsce_dsl.similarity.dendrogram import dendrogram_figure
 from exsce_dsl.wording import counted, noun
 

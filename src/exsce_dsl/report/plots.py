@@ -17,8 +17,8 @@ from exsce_dsl.maps.grid import OccupancyGrid
 from exsce_dsl.model.oracles import Oracle
 from exsce_dsl.report.campaigns import CampaignContents
 from exsce_dsl.report.contents import RunContents, ScenarioContents
-from exsce_dsl.runs.signals.trajectories import Trajectory
-from exsce_dsl.store.queries import MetricReading
+from exsce_dsl.runs import Trajectory
+from exsce_dsl.store import MetricReading
 from exsce_dsl.wording import counted
 
 MARGIN = 2.5

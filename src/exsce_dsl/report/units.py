@@ -12,7 +12,7 @@ from collections.abc import Iterable
 
 from exsce_dsl.lang import builtin_metrics
 from exsce_dsl.model.metrics import SI_UNIT, Dimension, MetricDefinition
-from exsce_dsl.store.queries import MetricReading
+from exsce_dsl.store import MetricReading
 
 COUNTED = {"waypoints_visited": "waypoints"}
 """What a count metric counts, said after its numbers; a count not listed here is a ``(count)``."""

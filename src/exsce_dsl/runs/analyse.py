@@ -3,64 +3,54 @@
 from __future__ import annotations
 
 import datetime as dt
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from types import ModuleType
 
 import numpy as np
 
-from exsce_dsl.errors import BagError, ExsceError, IncompleteRunError
+from exsce_dsl.errors import BagError, IncompleteRunError
 from exsce_dsl.lang import standard_metrics
-from exsce_dsl.messages.catalogue import Source
-from exsce_dsl.messages.field_check import check_fields
+from exsce_dsl.messages.field_check import field_checker
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.conventions import DISPATCHER_FEEDBACK, DISPATCHER_RESULT, MetricSpan
 from exsce_dsl.model.expressions import Field, walk
-from exsce_dsl.model.messages import DISPATCHER, POSE, FieldPath, Fields
+from exsce_dsl.model.messages import DISPATCHER, POSE, FieldPath
 from exsce_dsl.model.metrics import MetricDefinition
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import (
-    Action,
-    ActionId,
-    ActionStatus,
     Bag,
     MetricValue,
     Run,
     RunClock,
-    TaskExecution,
     run_uuid,
 )
 from exsce_dsl.monitor_kit.monitor_core import Compute, Topic, expand_topic, reducer
 from exsce_dsl.runs.bag_identity import content_hash
-from exsce_dsl.runs.bags.data import OBJECTS, BagData, Check, Reduce, Wanted
-from exsce_dsl.runs.bags.names import BagTopics
-from exsce_dsl.runs.bags.reading import bag_topics, read_bag
+from exsce_dsl.runs.bags.data import OBJECTS, BagData, Reduce, Wanted
+from exsce_dsl.runs.bags.reading import OpenedBag, open_bag
 from exsce_dsl.runs.coverage import (
     PROV_TOPIC,
     Recording,
     declared_rates,
     find_coverage,
     recorded_mission_status,
+    with_findings,
 )
-from exsce_dsl.runs.metrics.accounting import finish_accounting
+from exsce_dsl.runs.metrics.accounting import on_wall_clock
 from exsce_dsl.runs.metrics.compute import HOTSPOT_PATHS, POSE_TOPIC, compute_metrics
 from exsce_dsl.runs.metrics.monitor_code import load_monitors
 from exsce_dsl.runs.missing import missing_metrics, unread_topics
 from exsce_dsl.runs.plausible_poses import Refused, refuse_implausible, spec_speed_limit
 from exsce_dsl.runs.recorded_execution import recorded_execution
 from exsce_dsl.runs.robots import SERVED, StackRobots, stack_robots
-from exsce_dsl.runs.segments.recorded import RecordedAction
+from exsce_dsl.runs.segments.recorded import RecordedAction, task_executions
 from exsce_dsl.runs.segments.sources import DISPATCHER_SOURCE, segment_robot
 from exsce_dsl.runs.segments.track import Track
 from exsce_dsl.runs.signals.detect import Detected, pose_like_topics, with_detected_conventions
-from exsce_dsl.runs.signals.timeline import (
-    Timeline,
-    decide_timeline,
-    on_timeline,
-    stamp_catalogue,
-    with_stamps,
-)
+from exsce_dsl.runs.signals.recording import read_on_timeline
+from exsce_dsl.runs.signals.timeline import Timeline
 from exsce_dsl.wording import counted
 
 _FEEDBACK, _RESULT = DISPATCHER_FEEDBACK, DISPATCHER_RESULT
@@ -135,23 +125,6 @@ def fields_read(metric: MetricDefinition) -> dict[str, list[FieldPath]]:
     return found
 
 
-def field_checker(metrics: tuple[MetricDefinition, ...], robots: list[Robot]) -> Check:
-    """Checks what ``metrics`` read of a topic against the definition of the type the bag has for
-    it, before anything is computed: a type unknown when the specification was checked is checked
-    here, with the same messages at the same places (``file:line:col``)."""
-
-    def check(topic: str, msgtype: str, tree: Fields, source: Source | None) -> None:
-        problems: list[ExsceError] = []
-        for metric in metrics:
-            if any(read.topic_of(r.namespace) == topic for read in metric.reads for r in robots):
-                problems += check_fields(metric, msgtype, tree, source.text if source else None)
-        if problems:
-            where = "\n".join(f"  {p}" for p in dict.fromkeys(str(p) for p in problems))
-            raise BagError(f"topic {topic} ({msgtype}) lacks what the metrics read of it:\n{where}")
-
-    return check
-
-
 def reductions(monitors: ModuleType, robots: list[Robot], stacks: StackRobots) -> dict[str, Reduce]:
     """Topic → what to reduce of each block of its messages as the bag is read (the monitors'
     aggregates over arrays), so that no topic's arrays are ever all in memory.  A signal served
@@ -189,7 +162,9 @@ def analyse_bag(
     source = scenario.location.file if scenario.location else scenario.id
     monitors = load_monitors(metrics, source)
     bag = _read_signals(path, scenario, metrics, monitors)
+    dated = bag.timeline.dated  # taken as the signals step ends: assembling the run enters no step
     found = _segment_robots(path, scenario, bag)
+    tasks = task_executions(found.actions, found.segmented_by, bag.timeline.to_wall)
     robots, stacks = bag.robots, bag.stacks
     values, hotspots = compute_metrics(
         monitors,
@@ -204,6 +179,8 @@ def analyse_bag(
         found.reasons,
     )
     values = [_bag_named(stacks.with_real_sources(v), bag.data.spellings) for v in values]
+    real = {n: _spelt(stacks.real_topics.get(n, (n,)), bag.data.spellings) for n in bag.topics}
+    values = on_wall_clock(values, bag.timeline.to_wall, real, stacks.real_chains)
     if strict:
         acting = [r.id for r in robots if scenario.mission.tasks_of(r.id)]
         lacking = missing_metrics(metrics, robots, acting, found.actions, values)
@@ -217,20 +194,18 @@ def analyse_bag(
         )
     )  # fmt: skip
     bag.problems += covered.said()
-    real = {n: _spelt(stacks.real_topics.get(n, (n,)), bag.data.spellings) for n in bag.topics}
-    chains = stacks.real_chains
-    values = [finish_accounting(v, bag.timeline.to_wall, real, covered.gaps, chains) for v in values]
+    values = [with_findings(v, covered.gaps) for v in values]
     run = Run(
         uuid=run_id or run_uuid(digest),
         scenario=scenario.id,
         start=_time(bag.recorded.start),
         end=_time(bag.recorded.end),
         bag=Bag(path.name, bag.data.topics, str(path.resolve())),
-        tasks=_task_executions(found.actions, found.segmented_by, bag.timeline.to_wall),
+        tasks=tasks,
         metrics=tuple(values),
         hotspots=tuple(hotspots),
         clocks=_run_clocks(bag.timeline, bag.data.spellings),
-        dated=bag.timeline.dated,
+        dated=dated,
         conventions=tuple((d.robot, d.convention, d.evidence) for d in bag.detected),
         status=status,
         coverage=covered.gaps,
@@ -247,7 +222,8 @@ class _Signals:
     none), the stacks serving their signals, every series on the run's one timeline, and the
     problems found so far."""
 
-    types: BagTopics
+    opened: OpenedBag
+    """The bag, its topics and their types from its index."""
     robots: list[Robot]
     detected: list[Detected]
     stacks: StackRobots
@@ -272,19 +248,20 @@ def _read_signals(
 ) -> _Signals:
     """Read what the metrics need of the bag at ``path``, put it on one timeline, and serve each
     robot's signals under the topics the monitors read."""
-    types = bag_topics(path)
+    opened = open_bag(path)
+    types = opened.topics
     robots, detected = with_detected_conventions(
         [r for r in scenario.robots if r.start_pose is not None], types
     )
     stacks = stack_robots(robots, types, {r.id for r in robots})
     serving = [expand_topic(p, r.namespace) for r in robots if r.id in stacks.serves for p in SERVED.values()]
     unread = unread_topics(scenario.metrics, robots, types, serving)
-    wanted = with_stamps(stacks.adapt(wanted_topics(metrics, robots), robots), types, stamp_catalogue())
+    wanted = stacks.adapt(wanted_topics(metrics, robots), robots)
     if PROV_TOPIC in types:
         wanted[PROV_TOPIC] = Wanted(OBJECTS)
-    recorded = read_bag(path, wanted, reductions(monitors, robots, stacks), field_checker(metrics, robots))
-    timeline = decide_timeline(recorded)
-    data = on_timeline(recorded, timeline)
+    checked = field_checker(metrics, robots)
+    on_line = read_on_timeline(opened, wanted, reductions(monitors, robots, stacks), checked)
+    recorded, timeline, data = on_line.recorded, on_line.timeline, on_line.data
     problems = unread + list(data.problems) + list(timeline.notes)
     for sources in stacks.sources.values():
         problems += sources.notes
@@ -300,7 +277,7 @@ def _read_signals(
     # an implausible pose places no arrival; the whole run still spans the recording
     usable = refused.usable(topics)
     return _Signals(
-        types, robots, detected, stacks, unread, recorded, timeline, data, topics, problems, refused,
+        opened, robots, detected, stacks, unread, recorded, timeline, data, topics, problems, refused,
         stacks.named(robots),
         {r.id: stacks.track(r, usable) for r in robots},
         {r.id: stacks.recorded_span(r, topics) for r in robots},
@@ -343,7 +320,7 @@ def _segment_robots(path: Path, scenario: Scenario, bag: _Signals) -> _Segmented
         if (not found.segments or recording) and scenario.mission.tasks_of(robot.id):
             span = bag.spans[robot.id]
             if span is None and not found.segments:
-                raise BagError("\n  ".join([_nothing_of(path, robot, bag.types), *bag.unread]))
+                raise BagError("\n  ".join([_nothing_of(path, robot, bag.opened.topics), *bag.unread]))
             if span is not None:
                 out.whole_runs[robot.id] = _recording(span, data)
                 out.reasons[robot.id] = _why_recording(robot, found.goals, bool(found.segments))
@@ -413,29 +390,3 @@ def _nothing_of(path: Path, robot: Robot, types: Mapping[str, str]) -> str:
 
 def _time(seconds: float) -> dt.datetime:
     return dt.datetime.fromtimestamp(seconds, tz=dt.timezone.utc)
-
-
-def _task_executions(
-    actions: list[RecordedAction], segmented_by: dict[str, str], wall: Callable[[np.ndarray], np.ndarray]
-) -> tuple[TaskExecution, ...]:
-    """The robots' tasks as executed, with their actions' times as the wall clock had them.  A
-    segment that started and ended is an action (its metric values need one): ABORTED when its
-    goal ended other than SUCCEEDED (aborted, or cancelled: PREEMPTED, CANCELED, as the
-    dispatcher cancels a goal that timed out)."""
-    started = [a for a in actions if a.start is not None and a.end is not None]
-    started.sort(key=lambda a: (a.start or 0.0, a.robot))
-    grouped: dict[tuple[str, int], list[Action]] = {}
-    for a in started:
-        grouped.setdefault((a.robot, a.allocation), []).append(
-            Action(
-                ActionId(a.robot, a.allocation, a.subtask, a.waypoint),
-                a.start_pose,
-                a.goal,
-                ActionStatus.SUCCEEDED if a.status == "SUCCEEDED" else ActionStatus.ABORTED,
-                _time(float(wall(np.array([a.start]))[0])),
-                _time(float(wall(np.array([a.end]))[0])),
-            )
-        )
-    return tuple(
-        TaskExecution(robot, n, tuple(acts), segmented_by.get(robot)) for (robot, n), acts in grouped.items()
-    )

@@ -119,7 +119,7 @@ class BagInfo:
         }
 
 
-def bag_info(path: Path) -> BagInfo:
+def bag_info_of(path: Path) -> BagInfo:
     """What the bag at ``path`` holds (see the module's docstring)."""
     from rosbags.highlevel import AnyReader
 

@@ -15,8 +15,7 @@ from dataclasses import dataclass
 from exsce_dsl.model.runs import run_uuid
 from exsce_dsl.prov import identifiers as ids
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, Namespaces
-from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries import run_scenarios
+from exsce_dsl.store import Store, run_scenarios
 
 __all__ = ["BagRun", "bag_runs"]
 

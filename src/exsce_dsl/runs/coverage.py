@@ -30,7 +30,7 @@ import datetime as dt
 import json
 from collections import Counter
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -211,6 +211,32 @@ def find_coverage(recording: Recording) -> Coverage:
     gaps += _clock_jumps(recording, wall)
     rates = tuple(_rate(read) for read in topics)
     return Coverage(tuple(gaps), rates, tuple(notes))
+
+
+def with_findings(value: MetricValue, gaps: Iterable[CoverageGap]) -> MetricValue:
+    """``value`` with the findings of ``gaps`` that touch it in its accounting: about its metric
+    and robot, on one of its topics or sources (or on none), and overlapping its window (on the
+    wall clock: :func:`~exsce_dsl.runs.metrics.accounting.on_wall_clock`)."""
+    found = value.accounting
+    if found is None:
+        return value
+    topics = set(value.topics) | {t for c in found.sources for t in c.topics}
+    metric = value.safety_metric or value.metric
+    touching = [
+        g.reason
+        for g in gaps
+        if g.concerns(metric, value.robot)
+        and (g.topic is None or g.topic in topics)
+        and _overlaps(g, found.start, found.end)
+    ]
+    return replace(value, accounting=replace(found, annotations=tuple(dict.fromkeys(touching))))
+
+
+def _overlaps(gap: CoverageGap, start: float, end: float) -> bool:
+    """Whether ``gap`` (open where its start or end is None) meets ``[start, end]`` (wall clock)."""
+    first = gap.start.timestamp() if gap.start is not None else -np.inf
+    last = gap.end.timestamp() if gap.end is not None else np.inf
+    return bool(first <= end and last >= start)
 
 
 def topics_read_by(

@@ -28,10 +28,7 @@ from exsce_dsl.prov.run import compile_run
 from exsce_dsl.remedies import REPLACE_THE_RUN, VERIFY_AGAIN
 from exsce_dsl.runs.bag_identity import content_hash
 from exsce_dsl.runs.bag_runs import BagRun, bag_runs
-from exsce_dsl.store.base import Store
-from exsce_dsl.store.batch_writing import RunWriter, Written
-from exsce_dsl.store.run_replacing import replace_run, verdict_graphs
-from exsce_dsl.store.writing import WriteReport, add_prov
+from exsce_dsl.store import RunWriter, Store, WriteReport, Written, add_prov, replace_run, verdict_graphs
 from exsce_dsl.wording import counted
 
 if TYPE_CHECKING:

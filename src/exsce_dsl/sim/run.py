@@ -28,7 +28,7 @@ from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Run, run_name, 
 from exsce_dsl.parallel.dask_client import dask_map
 from exsce_dsl.prov.recorder import recorded_prov_json, recorded_run
 from exsce_dsl.remedies import CHOOSE_A_CONVENTION
-from exsce_dsl.runs.bags.formats import ROS1_BAG
+from exsce_dsl.runs import ROS1_BAG
 from exsce_dsl.sim.bag import write_bag
 from exsce_dsl.sim.conventions import convention_writer
 from exsce_dsl.sim.executor import Execution, Fault, GoalStatus, execute

@@ -12,8 +12,7 @@ from scipy.spatial.distance import squareform
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.similarity.distances import Distances, Norms, ScenarioFacts, distances
 from exsce_dsl.similarity.facts import scenario_facts
-from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries import scenario_ids
+from exsce_dsl.store import Store, scenario_ids
 
 METHODS = ("average", "complete", "single", "ward")
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 from rosbags.highlevel import AnyReader
 
 from exsce_dsl.model.messages import standard_type
-from exsce_dsl.runs.bag_info import bag_info
+from exsce_dsl.runs.bag_info import bag_info_of
 from exsce_dsl.runs.bags.reading import bag_topics
 
 from tests.runs.test_turtlesim_path import TURTLESIM
@@ -34,7 +34,7 @@ def test_turtlesim_old_tf_edges_are_listed() -> None:
             for transform in reader.deserialize(raw, connection.msgtype).transforms:
                 moving.add((transform.header.frame_id.lstrip("/"), transform.child_frame_id.lstrip("/")))
     assert moving == {("world", "turtle1"), ("world", "turtle2")}
-    info = bag_info(BAG)
+    info = bag_info_of(BAG)
     listed = {(p.lstrip("/"), c.lstrip("/")) for p, c, static in info.tf_edges if not static}
     assert listed == moving
     assert {t.name: t.msgtype for t in info.topics}["/tf"] == "tf/msg/tfMessage"  # shown as recorded

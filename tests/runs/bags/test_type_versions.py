@@ -23,7 +23,7 @@ from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 from exsce_dsl.errors import BagError
 from exsce_dsl.model.messages import path_of
-from exsce_dsl.runs.bag_info import bag_info
+from exsce_dsl.runs.bag_info import bag_info_of
 from exsce_dsl.runs.bags.data import Wanted
 from exsce_dsl.runs.bags.reading import read_bag
 from exsce_dsl.runs.bags.rosbags_fallback import read_with_rosbags
@@ -178,7 +178,7 @@ def test_bag_info_lists_both_versions_of_a_type(tmp_path: Path) -> None:
     with Ros1Reader(bag) as reader:
         md5s = sorted(c.digest[:8] for c in reader.connections)
     assert len(set(md5s)) == 2
-    for topic in bag_info(bag).topics:
+    for topic in bag_info_of(bag).topics:
         assert topic.definition == f"the bag (2 versions: {', '.join(md5s)})"
 
 
@@ -186,7 +186,7 @@ def test_bag_info_gives_the_rate_of_a_version_rosbags_cannot_read(tmp_path: Path
     """Stumble: ``bag info`` showed "-" for the rate of the topic carrying the version rosbags'
     one typestore does not hold; a rate is the log times', whatever the bytes."""
     bag = _ros1_bag(tmp_path / "versions.bag", ("/old", "/new"))
-    rates = {t.name: t.rate for t in bag_info(bag).topics}
+    rates = {t.name: t.rate for t in bag_info_of(bag).topics}
     for version, topic in enumerate(("/old", "/new"), start=1):
         times = np.array([t for t, _ in _values(version)], dtype=float) / 1e9
         assert rates[topic] == pytest.approx((len(times) - 1) / (times[-1] - times[0]), rel=1e-6)

@@ -16,7 +16,7 @@ import pytest
 
 from exsce_dsl.lang import load_spec
 from exsce_dsl.runs.analyse import analyse_bag
-from exsce_dsl.runs.bag_info import bag_info
+from exsce_dsl.runs.bag_info import bag_info_of
 
 from tests.support.bag_factory import (
     ODOMETRY,
@@ -113,7 +113,7 @@ def _ingest_timeline(bag: Path, spec: Path, store: Path) -> tuple[str, str]:
 def test_clocks_described_alike_by_bag_info_and_ingest(shape: str, tmp_path: Path) -> None:
     bag = clock_bag(tmp_path, shape)
     told, _ = _ingest_timeline(bag, _spec(tmp_path), tmp_path / "store")
-    info = bag_info(bag)
+    info = bag_info_of(bag)
     assert told == info.timeline
     table = exscec_here("bag", "info", str(bag))
     assert table.returncode == 0, table.stderr

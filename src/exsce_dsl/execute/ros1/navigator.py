@@ -26,7 +26,7 @@ from exsce_dsl.model import Pose, Scenario
 from exsce_dsl.model.conventions import Navigation
 from exsce_dsl.model.geometry import quaternion
 from exsce_dsl.model.metrics import expand_topic
-from exsce_dsl.runs.coverage import PROV_TOPIC
+from exsce_dsl.runs import PROV_TOPIC
 
 MOVE_BASE_ACTION = "/{ns}/move_base"
 STARTUP = 30.0

@@ -31,7 +31,7 @@ from typing import Any
 
 from exsce_dsl.errors import RosGraphError
 from exsce_dsl.execute.ros1.graph import CALLER, INSTALL_HINT, Master, node_environment
-from exsce_dsl.runs.bags.formats import ROS1_BAG
+from exsce_dsl.runs import ROS1_BAG
 
 RECORD_PROGRAMS = (Path("/usr/lib/rosbag/record"), Path("/opt/ros/noetic/lib/rosbag/record"))
 """Where ``record`` is: Debian's ``rosbag`` package, ROS Noetic's."""

@@ -40,7 +40,7 @@ from exsce_dsl.execute.ros1.parameters import dump_parameters, load_scenario
 from exsce_dsl.execute.ros1.recorder import Recorder
 from exsce_dsl.execute.run_files import RunFiles
 from exsce_dsl.model import Scenario
-from exsce_dsl.runs.coverage import PROV_TOPIC
+from exsce_dsl.runs import PROV_TOPIC
 
 INCOMPLETE = "incomplete"
 """The folder of ``out`` that holds the runs cut short."""

@@ -39,7 +39,7 @@ from types import TracebackType
 import yaml
 
 from exsce_dsl.errors import ExsceError, RosGraphError
-from exsce_dsl.runs.bags.formats import ROS2_METADATA
+from exsce_dsl.runs import ROS2_METADATA
 
 STORAGE = "mcap"
 POSITIONAL_TOPICS = frozenset({"foxy", "galactic", "humble", "iron"})

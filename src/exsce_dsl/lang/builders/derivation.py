@@ -15,8 +15,7 @@ from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.lang.transformation_syntax import step_of, written_arguments
 from exsce_dsl.model import Environment, Scenario, Task
 from exsce_dsl.model.derived import DerivedScenario, Step
-from exsce_dsl.transform.derivation import derive
-from exsce_dsl.transform.transformations import TRANSFORMATIONS
+from exsce_dsl.transform import TRANSFORMATIONS, derive
 
 
 def build_derivation(

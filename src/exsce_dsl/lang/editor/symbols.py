@@ -19,7 +19,7 @@ from exsce_dsl.lang.builders.poses import position_of
 from exsce_dsl.lang.lexical import quantity_text
 from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.lang.transformation_syntax import step_of, step_references
-from exsce_dsl.transform.transformations import TRANSFORMATIONS
+from exsce_dsl.transform import TRANSFORMATIONS
 
 # The references each construct of the grammar holds: attribute -> kind of what it names.
 _REFERENCES: dict[str, dict[str, str]] = {

@@ -6,8 +6,7 @@ from __future__ import annotations
 from exsce_dsl.errors import SourceLocation
 from exsce_dsl.lang.lexical import as_written, read_length
 from exsce_dsl.model.derived import DerivedScenario, Step
-from exsce_dsl.transform.records import Slot, Transformation, Word, phrase_parts, variants
-from exsce_dsl.transform.transformations import TRANSFORMATIONS
+from exsce_dsl.transform import TRANSFORMATIONS, Slot, Transformation, Word, phrase_parts, variants
 
 INDENT = "  "
 Line = tuple[str, SourceLocation | None]

@@ -18,6 +18,7 @@ them: exsce's, the plug-ins', rosbags' last (:func:`readers`, in the order they 
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import dataclass
 from pathlib import Path
 
 from exsce_dsl.errors import BagError, CorruptBag, DecodeError, MessageTypeError, UnsupportedBag
@@ -78,9 +79,14 @@ def read_bag(
     never all held at once; given a ``reduce``, array fields are not kept (what
     is needed of them is reduced).  Without it, every wanted field is kept.
     """
-    if not path.exists():
-        raise BagError(f"{path}: no such bag")
-    _check_once(path)
+    _check_once(_existing(path))
+    return _read(path, wanted, reduce, check)
+
+
+def _read(
+    path: Path, wanted: Mapping[str, Wanted], reduce: Mapping[str, Reduce] | None, check: Check | None
+) -> BagData:
+    """:func:`read_bag` of a bag already checked: the first reader that claims it reads it."""
     try:
         for reader in readers():
             if reader.claims(path):
@@ -97,12 +103,35 @@ def read_bag(
         raise BagError(f"{path}: {exc.message}") from None
 
 
+@dataclass(frozen=True)
+class OpenedBag:
+    """A bag looked at once: checked, its topics and their types known from its own index
+    (nothing decoded); :meth:`read` reads what is wanted of it.  Analysis opens a bag here, in
+    the bags step, and hands it to the signals step, which reads what the robots' conventions and
+    the metrics want: the walk does not come back to the bags step to read."""
+
+    path: Path
+    topics: BagTopics
+
+    def read(
+        self,
+        wanted: Mapping[str, Wanted],
+        reduce: Mapping[str, Reduce] | None = None,
+        check: Check | None = None,
+    ) -> BagData:
+        """:func:`read_bag` of this bag, not checked again."""
+        return _read(self.path, wanted, reduce, check)
+
+
+def open_bag(path: Path) -> OpenedBag:
+    """The bag at ``path``, checked and its topics listed (:func:`bag_topics`)."""
+    return OpenedBag(path, bag_topics(path))
+
+
 def bag_topics(path: Path) -> BagTopics:
     """Topic → its message type (ROS 2 spelling), from the bag's own index (nothing decoded); a
     topic is found by any name that reads it (:mod:`~exsce_dsl.runs.bags.names`)."""
-    if not path.exists():
-        raise BagError(f"{path}: no such bag")
-    _check_once(path)
+    _check_once(_existing(path))
     for reader in readers():
         if reader.topics is not None and reader.claims(path):
             try:
@@ -112,9 +141,17 @@ def bag_topics(path: Path) -> BagTopics:
     raise BagError(f"{path}: no reader lists the bag's topics")  # pragma: no cover (rosbags lists all)
 
 
+def _existing(path: Path) -> Path:
+    """``path``, or a :class:`BagError` saying there is no such bag."""
+    if not path.exists():
+        raise BagError(f"{path}: no such bag")
+    return path
+
+
 def _check_once(path: Path) -> None:
-    """:func:`~exsce_dsl.runs.bags.files.check_bag_file`, once per file as it is (ingest lists a
-    bag's topics, then reads it: 80 ms a check on a 100 MB bag)."""
+    """:func:`~exsce_dsl.runs.bags.files.check_bag_file`, once per file as it is (``bag info`` lists a
+    bag's topics, then reads it: 80 ms a check on a 100 MB bag; an :class:`OpenedBag` is read
+    unchecked, as it was checked when opened)."""
     if not path.is_file():
         check_bag_file(path, bag_formats())
         return

@@ -4,9 +4,9 @@ A monitor reads every sample of its sources inside a value's window; this module
 where the value is made, with ``numpy.searchsorted`` over the very arrays the monitor read, and
 says why a value used fewer: samples outside the span where all the topics it combines have data,
 samples without the array element it reads, samples without a value (NaN, or no element passing
-the metric's condition).  Analysis then names the sources as the bag has them, puts the window on
-the wall clock and adds the run's coverage findings that touch the value
-(:func:`finish_accounting`).
+the metric's condition).  Analysis then names the sources as the bag has them and puts the window
+on the wall clock (:func:`on_wall_clock`); the run's coverage adds the findings that touch the
+value (:func:`~exsce_dsl.runs.coverage.with_findings`).
 """
 
 from __future__ import annotations
@@ -16,7 +16,6 @@ from dataclasses import replace
 
 import numpy as np
 
-from exsce_dsl.model.coverage import CoverageGap
 from exsce_dsl.model.runs import Accounting, MetricValue, SourceCount
 from exsce_dsl.monitor_kit import monitor_core as core
 from exsce_dsl.wording import counted
@@ -151,45 +150,34 @@ def _held(p: core.Prepared, start: float, end: float) -> list[str]:
     return [f"{counted(cut, 'sample')} before a gap held for two median periods, not the whole gap"]
 
 
-def finish_accounting(
-    value: MetricValue,
+def on_wall_clock(
+    values: Sequence[MetricValue],
     wall: Callable[[np.ndarray], np.ndarray],
     real: Mapping[str, tuple[str, ...]],
-    gaps: Sequence[CoverageGap],
     chains: Mapping[str, str] | None = None,
-) -> MetricValue:
-    """``value`` with its accounting's window on the wall clock, its sources named as the bag has
-    them (``real``: a series the monitors read → the bag topics it came from; ``chains``: a series
-    composed from TF → the transforms composed), and the coverage findings that touch it: about
-    its metric and robot, on one of its topics (or on none), and overlapping its window."""
-    found = value.accounting
-    if found is None:
-        return value
-    start, end = (float(x) for x in wall(np.array([found.start, found.end], dtype=np.float64)))
+) -> list[MetricValue]:
+    """``values`` with their accountings' windows on the wall clock (``wall``: the run's timeline
+    → the recorder's wall clock, called once for every window) and their sources named as the bag
+    has them (``real``: a series the monitors read → the bag topics it came from; ``chains``: a
+    series composed from TF → the transforms composed).  The coverage findings that touch a value
+    are added once the run's coverage is known (:func:`~exsce_dsl.runs.coverage.with_findings`)."""
+    windows = [(a.start, a.end) for v in values if (a := v.accounting) is not None]
+    walled = iter(wall(np.array(windows, dtype=np.float64).reshape(-1)).tolist() if windows else [])
     chains = chains or {}
-    sources = tuple(
-        replace(
-            c,
-            topics=tuple(dict.fromkeys(r for t in c.topics for r in real.get(t, (t,)))),
-            tf_chain=next((chains[t] for t in c.topics if t in chains), c.tf_chain),
+    found = []
+    for value in values:
+        if value.accounting is None:
+            found.append(value)
+            continue
+        sources = tuple(
+            replace(
+                c,
+                topics=tuple(dict.fromkeys(r for t in c.topics for r in real.get(t, (t,)))),
+                tf_chain=next((chains[t] for t in c.topics if t in chains), c.tf_chain),
+            )
+            for c in value.accounting.sources
         )
-        for c in found.sources
-    )
-    topics = set(value.topics) | {t for c in sources for t in c.topics}
-    metric = value.safety_metric or value.metric
-    touching = [
-        g.reason
-        for g in gaps
-        if g.concerns(metric, value.robot)
-        and (g.topic is None or g.topic in topics)
-        and _overlaps(g, start, end)
-    ]
-    annotations = tuple(dict.fromkeys(touching))
-    return replace(value, accounting=Accounting(start, end, found.reason, sources, annotations))
-
-
-def _overlaps(gap: CoverageGap, start: float, end: float) -> bool:
-    """Whether ``gap`` (open where its start or end is None) meets ``[start, end]`` (wall clock)."""
-    first = gap.start.timestamp() if gap.start is not None else -np.inf
-    last = gap.end.timestamp() if gap.end is not None else np.inf
-    return bool(first <= end and last >= start)
+        start, end = next(walled), next(walled)
+        walled_accounting = replace(value.accounting, start=start, end=end, sources=sources)
+        found.append(replace(value, accounting=walled_accounting))
+    return found
