@@ -27,6 +27,7 @@ from exsce_dsl.model.conventions import Signals
 from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Run, run_name, run_uuid
 from exsce_dsl.parallel.dask_client import dask_map
 from exsce_dsl.prov.recorder import recorded_prov_json, recorded_run
+from exsce_dsl.remedies import CHOOSE_A_CONVENTION
 from exsce_dsl.runs import ROS1_BAG
 from exsce_dsl.sim.bag import write_bag
 from exsce_dsl.sim.conventions import convention_writer
@@ -231,7 +232,7 @@ def scenario_convention(scenario: Scenario) -> str:
     if len(found) > 1:
         listed = ", ".join(f"{robot}: {name}" for robot, name in named.items())
         raise ExsceError(
-            f"the robots of scenario '{scenario.id}' follow different conventions ({listed}); the "
-            "executor writes one for the whole run: choose it with --convention"
+            f"the robots of scenario '{scenario.id}' follow different conventions ({listed})",
+            remedy=CHOOSE_A_CONVENTION,
         )
     return found[0] if found else "method"

@@ -34,6 +34,7 @@ import numpy as np
 from exsce_dsl.errors import ExsceError, PlanningError
 from exsce_dsl.maps.planning import PlanningGrid, Point
 from exsce_dsl.model import Orientation, Pose, Position, Scenario
+from exsce_dsl.remedies import SIMULATE_IT
 from exsce_dsl.sim.faults import (
     DEADLOCK_WAIT,
     Fault,
@@ -165,7 +166,7 @@ class Fleet:
         simulate --seed SEED`` (their noise is seeded by both too)."""
         check_faults(scenario, faults)
         if any(f.kind == "near-collision" for f in faults):
-            raise ExsceError("the stand-in does not play fault 'near-collision' (exscec simulate does)")
+            raise ExsceError("the stand-in does not play fault 'near-collision'", remedy=SIMULATE_IT)
         self.scenario, self.grid, self.faults = scenario, grid, faults
         self.laser = laser or Laser()
         limits = limits or Limits()

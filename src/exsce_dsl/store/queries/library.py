@@ -37,6 +37,7 @@ from pyoxigraph import Literal, NamedNode
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.prov import identifiers as ids
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, Namespaces
+from exsce_dsl.remedies import LIST_THE_QUERIES
 from exsce_dsl.store.base import Bindings, Term
 from exsce_dsl.suggest import did_you_mean
 
@@ -177,7 +178,7 @@ def query(name: str) -> Query:
     found = _library().get(name)
     if found is None:
         hint = did_you_mean(name, _library())
-        raise ExsceError(f"no query called '{name}'{hint} (`exscec query --list` shows them all)")
+        raise ExsceError(f"no query called '{name}'{hint}", remedy=LIST_THE_QUERIES)
     return found
 
 
