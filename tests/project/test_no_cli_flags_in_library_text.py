@@ -49,7 +49,6 @@ WHY: dict[str, str] = {
     ),
     "an executor's name is part of a campaign's identity (hashed into campaign_<digest>, recorded in "
     "its plan): new words would rename every campaign": "explore/executors.py:--fault explore/ros1_executor.py:*",
-    "issue 49: moved at merge": "runs/analyse.py:--strict",
 }
 """Why some literals may name the command line → the places: ``module:text`` (the module below
 ``src/exsce_dsl``; the text found, ``*`` for any)."""
