@@ -48,10 +48,9 @@ def test_runs_four_steps_have_their_test_folders() -> None:
 
 
 def test_lang_subpackages_have_their_test_folders() -> None:
-    """The language's builders, formatter and YAML import/export each have their tests in
-    ``tests/lang/<subpackage>/`` (``lang/editor`` is tested through the language server, in
-    ``tests/lsp/``)."""
-    parts = ("builders", "format", "yaml")
+    """The language's builders, formatter, YAML import/export and editor support each have their
+    tests in ``tests/lang/<subpackage>/``."""
+    parts = ("builders", "format", "yaml", "editor")
     assert all((SOURCE / "lang" / part / "__init__.py").is_file() for part in parts)
     without = [part for part in parts if not any((TESTS / "lang" / part).glob("test_*.py"))]
     assert not without, f"subpackages of lang/ without tests in tests/lang/<subpackage>/: {without}"
