@@ -31,7 +31,7 @@ STOOD = 3.0
 it stood (when both were waiting for each other, the one that then moved on is met a little
 further on, where nobody can go round it)."""
 
-Leg = tuple[str, int]
+LegId = tuple[str, int]
 """A robot's drive to one waypoint: the robot and the leg's number (from 1, over the run)."""
 
 
@@ -52,7 +52,7 @@ class Timed(Protocol):
 class Repair:
     """Plan ``leg`` again round ``place``."""
 
-    leg: Leg
+    leg: LegId
     place: Point
 
 
@@ -132,7 +132,7 @@ def _repairs_of(
     return repairs
 
 
-def leg_at(actions: Sequence[Timed], robot: str, t: float) -> Leg | None:
+def leg_at(actions: Sequence[Timed], robot: str, t: float) -> LegId | None:
     """The leg ``robot`` drives at ``t`` (or last drove, when it waits between legs)."""
     number, found = 0, None
     for action in actions:

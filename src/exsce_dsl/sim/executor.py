@@ -21,7 +21,7 @@ from exsce_dsl.maps.planning import PlanningGrid, Point
 from exsce_dsl.model import MissionType, Pose, Scenario
 from exsce_dsl.model.goals import GoalStatus
 from exsce_dsl.sim.actions import GoalEvent, SimulatedAction
-from exsce_dsl.sim.conflicts import MAX_REPAIRS, Leg, Repair, conflict_repairs, meetings
+from exsce_dsl.sim.conflicts import MAX_REPAIRS, LegId, Repair, conflict_repairs, meetings
 from exsce_dsl.sim.faults import (
     DEADLOCK_WAIT,
     Fault,
@@ -88,8 +88,8 @@ def execute(
     place where the other was (sim.conflicts).  ``near-collision`` is the fault of not doing so."""
     check_faults(scenario, faults)
     limits = limits or Limits()
-    avoid: dict[Leg, tuple[Point, ...]] = {}
-    waits: dict[Leg, Wait] = {}
+    avoid: dict[LegId, tuple[Point, ...]] = {}
+    waits: dict[LegId, Wait] = {}
     plans: Plans = {}  # the same leg, planned round the same robots, in every replay
     execution = _play(scenario, grid, seed, faults, limits, avoid, plans, waits)
     if any(f.kind == "near-collision" for f in faults):
@@ -115,7 +115,7 @@ def execute(
 
 
 def _can_go_round(
-    repair: Repair, actions: list[SimulatedAction], avoid: dict[Leg, tuple[Point, ...]]
+    repair: Repair, actions: list[SimulatedAction], avoid: dict[LegId, tuple[Point, ...]]
 ) -> bool:
     """The repair would change its leg: the place is not tried yet (nor one near it) and not
     so near the leg's ends that its path cannot go round it."""
@@ -133,9 +133,9 @@ def _play(
     seed: int,
     faults: tuple[Fault, ...],
     limits: Limits,
-    avoid: dict[Leg, tuple[Point, ...]],
+    avoid: dict[LegId, tuple[Point, ...]],
     plans: Plans,
-    waits: dict[Leg, Wait],
+    waits: dict[LegId, Wait],
 ) -> Execution:
     """One playing of ``scenario``: each allocation entry's subtasks dispatched in turn, then the
     robots giving way to each other and all trajectories held to one end."""
@@ -156,9 +156,9 @@ class _Play:
         rng: random.Random,
         faults: tuple[Fault, ...],
         limits: Limits,
-        avoid: dict[Leg, tuple[Point, ...]],
+        avoid: dict[LegId, tuple[Point, ...]],
         plans: Plans,
-        waits: dict[Leg, Wait],
+        waits: dict[LegId, Wait],
     ) -> None:
         self.scenario, self.grid, self.rng, self.faults, self.limits = scenario, grid, rng, faults, limits
         self.avoid, self.plans, self.waits = avoid, plans, waits

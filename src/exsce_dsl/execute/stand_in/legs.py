@@ -78,7 +78,7 @@ class Standing:
 
 
 @dataclass(frozen=True)
-class Leg:
+class StandInLeg:
     """One goal's drive, sample by sample (or a robot's start: one sample, no goal)."""
 
     robot: str
@@ -135,7 +135,7 @@ class Leg:
 
 
 @dataclass
-class Robot:
+class StandInRobot:
     name: str
     namespace: str
     limits: Limits
@@ -144,9 +144,9 @@ class Robot:
     at: Standing
     goals: int = 0
     """How many goals it has had."""
-    legs: dict[str, tuple[Leg, Standing]] = field(default_factory=dict)
+    legs: dict[str, tuple[StandInLeg, Standing]] = field(default_factory=dict)
     """Each goal's leg and where the robot stood before it."""
-    current: Leg | None = None
+    current: StandInLeg | None = None
 
 
 class Fleet:
@@ -174,13 +174,13 @@ class Fleet:
         if unplaced:
             raise ExsceError(f"robot '{unplaced[0]}' has no start pose: the stand-in cannot place it")
         speeds = _executor_speeds(scenario, seed, limits, faults, run)
-        self.robots: dict[str, Robot] = {}
+        self.robots: dict[str, StandInRobot] = {}
         for index, robot in enumerate(scenario.robots):
             start = robot.start_pose
             assert start is not None
             speed = speeds[robot.id]
             rng = np.random.default_rng([seed, index] if run == 0 else [seed, index, run])
-            self.robots[robot.id] = Robot(
+            self.robots[robot.id] = StandInRobot(
                 robot.id,
                 robot.namespace,
                 Limits(speed, limits.max_accel, limits.max_turn_rate),
@@ -193,7 +193,7 @@ class Fleet:
         self.stuck = deadlocked(scenario, faults)
         self.poses = [*scenario.environment.poses(), *(w for t in scenario.tasks for w in t.waypoints())]
 
-    def start_legs(self) -> list[Leg]:
+    def start_legs(self) -> list[StandInLeg]:
         """Each robot standing at its start: a leg of one sample without a goal."""
         legs = []
         for robot in self.robots.values():
@@ -201,7 +201,7 @@ class Fleet:
             legs.append(self._leg(robot, None, True, 0.0, Trajectory.hold(x, y, yaw, 1)))
         return legs
 
-    def leg(self, name: str, goal: str, x: float, y: float, yaw: float, time: float) -> Leg:
+    def leg(self, name: str, goal: str, x: float, y: float, yaw: float, time: float) -> StandInLeg:
         """The leg of goal ``goal`` (target ``x, y, yaw`` in the map) that ``name`` got at ``time``."""
         robot = self.robots.get(name)
         if robot is None:
@@ -235,7 +235,7 @@ class Fleet:
             return found.with_orientation(Orientation(yaw=yaw))
         return Pose("goal", Position(x, y), Orientation(yaw=yaw))
 
-    def _drive(self, robot: Robot, target: Pose) -> tuple[Trajectory, bool]:
+    def _drive(self, robot: StandInRobot, target: Pose) -> tuple[Trajectory, bool]:
         x, y, yaw = robot.at.truth
         parts = []
         if self.stuck and robot.goals == 1:
@@ -265,7 +265,7 @@ class Fleet:
         parts.append(driven if len(driven) else Trajectory.hold(x, y, yaw, 1))
         return Trajectory.concat(parts), True
 
-    def _plan_round(self, robot: Robot, start: Point, goal: Point) -> list[Point]:
+    def _plan_round(self, robot: StandInRobot, start: Point, goal: Point) -> list[Point]:
         """The grid's path, round the robots that stand in its way once their legs are done."""
         path = self.grid.plan(start, goal)
         discs = []
@@ -283,7 +283,7 @@ class Fleet:
         except PlanningError:  # no way round: the plain path
             return path
 
-    def _let_pass(self, robot: Robot, trajectory: Trajectory, time: float) -> Trajectory:
+    def _let_pass(self, robot: StandInRobot, trajectory: Trajectory, time: float) -> Trajectory:
         """``trajectory`` put off until it keeps CLEARANCE from the other robots as they drive their
         legs (by MAX_WAIT at most, then as it is)."""
         x, y, yaw = robot.at.truth
@@ -298,7 +298,7 @@ class Fleet:
         return trajectory
 
     @staticmethod
-    def _where_over(robot: Robot, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def _where_over(robot: StandInRobot, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Where ``robot`` is at each of ``times``: on its leg, else where it stands."""
         leg = robot.current
         if leg is None:
@@ -307,8 +307,8 @@ class Fleet:
         return leg.truth.x[k], leg.truth.y[k]
 
     def _leg(
-        self, robot: Robot, goal: str | None, succeeded: bool, time: float, trajectory: Trajectory
-    ) -> Leg:
+        self, robot: StandInRobot, goal: str | None, succeeded: bool, time: float, trajectory: Trajectory
+    ) -> StandInLeg:
         x, y, yaw = robot.at.truth
         # the leg's frames from where the robot stands (sample 0, dropped): its odometry goes on
         frames = localise(
@@ -331,7 +331,7 @@ class Fleet:
             ROBOT_RADIUS,
             robot.rng,
         )
-        return Leg(
+        return StandInLeg(
             robot.name,
             goal,
             succeeded,
@@ -378,4 +378,4 @@ def _tail(poses: Poses) -> Poses:
     return Poses(poses.x[1:], poses.y[1:], poses.yaw[1:])
 
 
-__all__ = ["FIELDS", "Fleet", "Leg", "Standing"]
+__all__ = ["FIELDS", "Fleet", "StandInLeg", "Standing"]
