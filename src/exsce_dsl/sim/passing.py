@@ -22,7 +22,7 @@ import numpy as np
 
 from exsce_dsl.maps.planning import PlanningGrid, Point
 from exsce_dsl.sim.conflicts import CLEARANCE, STOOD, LegId, Timed, leg_at
-from exsce_dsl.sim.motion import DT, Trajectory
+from exsce_dsl.sim.motion import DT, SampledMotion
 
 ASIDE = CLEARANCE + 0.3
 """Metres between a waiting robot's centre and the other's path: room to pass at clearance."""
@@ -58,7 +58,7 @@ class Wait:
 
 
 def head_on_wait(
-    trajectories: dict[str, Trajectory],
+    trajectories: dict[str, SampledMotion],
     actions: Sequence[Driven],
     order: Sequence[str],
     grid: PlanningGrid,
@@ -97,7 +97,7 @@ def _mid_leg(actions: Sequence[Driven], leg: LegId, point: Point) -> bool:
     return bool(path) and all(math.dist(point, end) > ENDS for end in (path[0], path[-1]))
 
 
-def _stood_since(trajectory: Trajectory, k: int) -> int | None:
+def _stood_since(trajectory: SampledMotion, k: int) -> int | None:
     """The first sample of the stop the robot was in just before sample ``k`` (within STOOD
     seconds of it), or None when it did not stand then."""
     since = max(0, k - int(STOOD / DT))

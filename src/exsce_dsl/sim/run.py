@@ -31,7 +31,7 @@ from exsce_dsl.remedies import CHOOSE_A_CONVENTION
 from exsce_dsl.runs import ROS1_BAG
 from exsce_dsl.sim.bag import write_bag
 from exsce_dsl.sim.conventions import convention_writer
-from exsce_dsl.sim.executor import Execution, Fault, GoalStatus, execute
+from exsce_dsl.sim.executor import Fault, GoalStatus, SimulatedExecution, execute
 
 FORMATS = ("ros1", "ros2", "mcap")
 #: Runs of seed S start at this instant plus S days (modulo SEED_DAYS), one hour apart (no wall clock:
@@ -47,7 +47,7 @@ class SimulatedRun:
     bag: Path
     start: dt.datetime
     seed: int
-    execution: Execution
+    execution: SimulatedExecution
     messages: int
 
 
@@ -204,7 +204,7 @@ def _remove(path: Path) -> None:
 
 
 def _recorded_run(
-    run_id: str, scenario: Scenario, execution: Execution, start: dt.datetime, bag: Path
+    run_id: str, scenario: Scenario, execution: SimulatedExecution, start: dt.datetime, bag: Path
 ) -> Run:
     """What the method's recorder writes during a run: task executions and actions, no metrics."""
 

@@ -46,7 +46,7 @@ from exsce_dsl.sim.faults import (
     speed_factor,
 )
 from exsce_dsl.sim.localisation import Odometry, Poses, localise
-from exsce_dsl.sim.motion import DT, Limits, Trajectory, drive
+from exsce_dsl.sim.motion import DT, Limits, SampledMotion, drive
 from exsce_dsl.sim.scan import ROBOT_RADIUS, SCAN_EVERY, Laser, scan_ranges
 
 MATCH = 0.05
@@ -198,7 +198,7 @@ class Fleet:
         legs = []
         for robot in self.robots.values():
             x, y, yaw = robot.at.truth
-            legs.append(self._leg(robot, None, True, 0.0, Trajectory.hold(x, y, yaw, 1)))
+            legs.append(self._leg(robot, None, True, 0.0, SampledMotion.hold(x, y, yaw, 1)))
         return legs
 
     def leg(self, name: str, goal: str, x: float, y: float, yaw: float, time: float) -> StandInLeg:
@@ -235,12 +235,12 @@ class Fleet:
             return found.with_orientation(Orientation(yaw=yaw))
         return Pose("goal", Position(x, y), Orientation(yaw=yaw))
 
-    def _drive(self, robot: StandInRobot, target: Pose) -> tuple[Trajectory, bool]:
+    def _drive(self, robot: StandInRobot, target: Pose) -> tuple[SampledMotion, bool]:
         x, y, yaw = robot.at.truth
         parts = []
         if self.stuck and robot.goals == 1:
-            parts.append(Trajectory.hold(x, y, yaw, int(round(DEADLOCK_WAIT / DT))))
-        aborted = Trajectory.concat([*parts, Trajectory.hold(x, y, yaw, ABORT_AFTER)])
+            parts.append(SampledMotion.hold(x, y, yaw, int(round(DEADLOCK_WAIT / DT))))
+        aborted = SampledMotion.concat([*parts, SampledMotion.hold(x, y, yaw, ABORT_AFTER)])
         if (robot.name, robot.goals) in self.skip:
             return aborted, False
         goal = (target.position.x, target.position.y)
@@ -252,7 +252,7 @@ class Fleet:
             else:
                 there, on = self.grid.plan((x, y), via), self.grid.plan(via, goal)
                 heading = math.atan2(on[1][1] - on[0][1], on[1][0] - on[0][0]) if len(on) > 1 else yaw
-                driven = Trajectory.concat(
+                driven = SampledMotion.concat(
                     [
                         drive(there, yaw, heading, robot.limits),
                         drive(on, heading, target.orientation.yaw, robot.limits),
@@ -262,8 +262,8 @@ class Fleet:
             return aborted, False
         if self.boxes:
             driven = slow_in_areas(driven, self.boxes)
-        parts.append(driven if len(driven) else Trajectory.hold(x, y, yaw, 1))
-        return Trajectory.concat(parts), True
+        parts.append(driven if len(driven) else SampledMotion.hold(x, y, yaw, 1))
+        return SampledMotion.concat(parts), True
 
     def _plan_round(self, robot: StandInRobot, start: Point, goal: Point) -> list[Point]:
         """The grid's path, round the robots that stand in its way once their legs are done."""
@@ -283,7 +283,7 @@ class Fleet:
         except PlanningError:  # no way round: the plain path
             return path
 
-    def _let_pass(self, robot: StandInRobot, trajectory: Trajectory, time: float) -> Trajectory:
+    def _let_pass(self, robot: StandInRobot, trajectory: SampledMotion, time: float) -> SampledMotion:
         """``trajectory`` put off until it keeps CLEARANCE from the other robots as they drive their
         legs (by MAX_WAIT at most, then as it is)."""
         x, y, yaw = robot.at.truth
@@ -293,7 +293,9 @@ class Fleet:
             others = [self._where_over(o, times) for o in self.robots.values() if o is not robot]
             if all(np.hypot(trajectory.x - ox, trajectory.y - oy).min() >= CLEARANCE for ox, oy in others):
                 return (
-                    Trajectory.concat([Trajectory.hold(x, y, yaw, held), trajectory]) if held else trajectory
+                    SampledMotion.concat([SampledMotion.hold(x, y, yaw, held), trajectory])
+                    if held
+                    else trajectory
                 )
         return trajectory
 
@@ -307,12 +309,12 @@ class Fleet:
         return leg.truth.x[k], leg.truth.y[k]
 
     def _leg(
-        self, robot: StandInRobot, goal: str | None, succeeded: bool, time: float, trajectory: Trajectory
+        self, robot: StandInRobot, goal: str | None, succeeded: bool, time: float, trajectory: SampledMotion
     ) -> StandInLeg:
         x, y, yaw = robot.at.truth
         # the leg's frames from where the robot stands (sample 0, dropped): its odometry goes on
         frames = localise(
-            Trajectory.concat([Trajectory.hold(x, y, yaw, 1), trajectory]), robot.rng, robot.drift
+            SampledMotion.concat([SampledMotion.hold(x, y, yaw, 1), trajectory]), robot.rng, robot.drift
         )
         n = len(trajectory)
         ox, oy, oyaw = robot.at.odom
