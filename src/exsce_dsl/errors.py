@@ -12,7 +12,7 @@ modules that raise them import them from here, so the old names still work
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from enum import Enum
 from http import HTTPStatus
@@ -37,6 +37,7 @@ __all__ = [
     "MessageTypeError",
     "PlanningError",
     "RelationError",
+    "Remedied",
     "RenameError",
     "RosGraphError",
     "ScenarioChoiceError",
@@ -107,6 +108,8 @@ class Diagnostic:
     severity: Severity = Severity.ERROR
     code: str = "exsce"
     hint: str | None = field(default=None, compare=False)
+    remedied: Remedied | None = field(default=None, compare=False)
+    """The message as a problem and its remedy, when it has one (:meth:`said`)."""
 
     def __init__(
         self,
@@ -115,7 +118,9 @@ class Diagnostic:
         severity: Severity | str = Severity.ERROR,
         code: str = "exsce",
         hint: str | None = None,
+        remedied: Remedied | None = None,
     ) -> None:
+        object.__setattr__(self, "remedied", remedied)
         object.__setattr__(self, "message", message)
         object.__setattr__(self, "location", location)
         object.__setattr__(self, "severity", Severity(severity))
@@ -125,6 +130,12 @@ class Diagnostic:
     @property
     def is_error(self) -> bool:
         return self.severity is Severity.ERROR
+
+    def said(self, wording: Mapping[str, str]) -> Diagnostic:
+        """This diagnostic with its remedy in ``wording`` (the command line's)."""
+        if self.remedied is None:
+            return self
+        return Diagnostic(self.remedied.said(wording), self.location, self.severity, self.code, self.hint)
 
     def __str__(self) -> str:
         where = f"{self.location}: " if self.location else ""
@@ -138,25 +149,47 @@ def diagnostic_order(d: Diagnostic) -> tuple[str, int, int, int, str]:
     return (*where, d.severity.rank, d.message)
 
 
-REPLACE_FILES = "ask to replace the files that exist"
-"""The remedy of an error that would overwrite files (the command line says it with its option)."""
-MAKE_A_TOKEN = "give no token, and leave EXSCE_STORE_TOKEN unset, to have one made"
-"""The remedy of an update token too short to be a secret."""
-START_A_MASTER = "start roscore and export it, or ask for a roscore of the run's own"
-"""The remedy of a live run without a ROS master to talk to."""
+@dataclass(frozen=True)
+class Remedied:
+    """A problem and what to do about it (a remedy of :mod:`exsce_dsl.remedies`, in words).
+
+    :meth:`said` puts them together, in a front end's ``wording`` when it has one for the remedy
+    (``cli.common.REMEDIES``: the command line's, with its options), else as ``problem; remedy``.
+    A wording is a ``str.format`` template of ``{problem}`` and ``{about}``: what the remedy is about
+    (a scenario's id, the element a replace would change)."""
+
+    problem: str
+    remedy: str
+    about: str | tuple[str, ...] = ""
+
+    def __str__(self) -> str:
+        return self.said()
+
+    def said(self, wording: Mapping[str, str] | None = None) -> str:
+        template = (wording or {}).get(self.remedy)
+        if template is None:
+            return f"{self.problem}; {self.remedy.format(about=self.about)}"
+        return template.format(problem=self.problem, about=self.about)
 
 
 class ExsceError(Exception):
     """Base of every error exsce raises on purpose.
 
-    ``remedy``: what the user can do about it, in words, after the problem in the message; the
-    library never names an option of the command line, which says a remedy such as
-    :data:`REPLACE_FILES` with its own option (``use --force to replace``)."""
+    ``remedy``: what the user can do about it, in words (:mod:`exsce_dsl.remedies`), after the
+    problem in the message; ``about``: what the remedy is about (:class:`Remedied`).  The library
+    never names an option of the command line, which says a remedy such as ``REPLACE_FILES`` with
+    its own option (``use --force to replace``)."""
 
     def __init__(
-        self, message: str, location: SourceLocation | None = None, *, remedy: str | None = None
+        self,
+        message: str,
+        location: SourceLocation | None = None,
+        *,
+        remedy: str | None = None,
+        about: str | tuple[str, ...] = "",
     ) -> None:
-        said = f"{message}; {remedy}" if remedy else message
+        self.remedied = Remedied(message, remedy, about) if remedy else None
+        said = self.remedied.said() if self.remedied else message
         super().__init__(said)
         self.message = said
         self.location = location
@@ -165,7 +198,7 @@ class ExsceError(Exception):
 
     @property
     def diagnostics(self) -> Sequence[Diagnostic]:
-        return (Diagnostic(self.message, self.location),)
+        return (Diagnostic(self.message, self.location, remedied=self.remedied),)
 
     def __str__(self) -> str:
         return "\n".join(str(d) for d in self.diagnostics)
@@ -191,13 +224,15 @@ class ExsceSyntaxError(SpecError):
 
 
 class ScenarioChoiceError(ExsceError):
-    """A file declares no scenario or several, and none was named: the message names the option
-    that chooses one, which each command spells its own way (``--scenario`` where the file is an
-    argument, ``--scenario-id`` where ``--scenario`` is the file)."""
+    """A file declares no scenario or several, and none was named.  The command line names the
+    option that chooses one (:meth:`naming`), which each command spells its own way
+    (``--scenario`` where the file is an argument, ``--scenario-id`` where ``--scenario`` is the
+    file); the library names none."""
 
-    def __init__(self, root: str, found: Sequence[str], option: str = "--scenario") -> None:
+    def __init__(self, root: str, found: Sequence[str], option: str | None = None) -> None:
         listed = ", ".join(found) or "none"
-        super().__init__(f"{root} declares {len(found)} scenarios ({listed}); name one with {option}")
+        with_option = f" with {option}" if option else ""
+        super().__init__(f"{root} declares {len(found)} scenarios ({listed}); name one{with_option}")
         self.root, self.found, self.option = root, tuple(found), option
 
     def naming(self, option: str) -> ScenarioChoiceError:
@@ -265,8 +300,8 @@ class FederationRefused(StoreError):
 class StoreLockedError(StoreError):
     """An embedded store's folder is open in another process (RocksDB allows one)."""
 
-    def __init__(self, message: str, path: str) -> None:
-        super().__init__(message)
+    def __init__(self, message: str, path: str, *, remedy: str | None = None) -> None:
+        super().__init__(message, remedy=remedy)
         self.path = path
 
 
@@ -278,8 +313,10 @@ class StoreUnwritableError(StoreError):
 class StoreConflictError(StoreError):
     """A document differs from what the store holds under the same names."""
 
-    def __init__(self, message: str, graphs: Sequence[str]) -> None:
-        super().__init__(message)
+    def __init__(
+        self, message: str, graphs: Sequence[str], *, remedy: str | None = None, about: str = ""
+    ) -> None:
+        super().__init__(message, remedy=remedy, about=about)
         self.graphs = tuple(graphs)
         """The names of the graphs that differ."""
 
@@ -287,8 +324,10 @@ class StoreConflictError(StoreError):
 class UnknownRunError(ExsceError):
     """No stored run has this id (``exsce_dsl.store.queries.run_ids``)."""
 
-    def __init__(self, message: str, closest: Sequence[Any] = ()) -> None:
-        super().__init__(message)
+    def __init__(
+        self, message: str, closest: Sequence[Any] = (), *, remedy: str | None = None, about: str = ""
+    ) -> None:
+        super().__init__(message, remedy=remedy, about=about)
         self.closest = tuple(closest)
         """The stored runs whose ids are closest (``RunCandidate``: uuid, scenario, bag)."""
 

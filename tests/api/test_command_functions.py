@@ -14,7 +14,8 @@ from pathlib import Path
 import pytest
 
 from exsce_dsl import api
-from exsce_dsl.errors import REPLACE_FILES, ExsceError, StoreError
+from exsce_dsl.errors import ExsceError, StoreError
+from exsce_dsl.remedies import REPLACE_FILES, SELECT_OR_ASK
 
 from tests.support.paths import EXAMPLES
 
@@ -62,8 +63,9 @@ def test_answer_sparql_asks_and_refuses_a_construct(project: tuple[Path, str, Pa
     _, store, _ = project
     assert api.answer_sparql(store, "ASK { GRAPH ?g { ?r a exsce:run } }") is True
     assert api.answer_sparql(store, "ASK { GRAPH ?g { ?r a exsce:no_such_class } }") is False
-    with pytest.raises(ExsceError, match="SELECT and ASK"):
+    with pytest.raises(ExsceError, match="neither a SELECT nor an ASK query") as refused:
         api.answer_sparql(store, "CONSTRUCT { ?s ?p ?o } WHERE { ?s ?p ?o }")
+    assert refused.value.remedy == SELECT_OR_ASK and "exscec" not in refused.value.message
 
 
 def test_store_info_graphs_and_export_agree(project: tuple[Path, str, Path]) -> None:

@@ -150,6 +150,7 @@ def test_strict_ingest_refuses_a_missing_metric_and_stores_nothing(bag: Path, tm
                        "--strict")  # fmt: skip
     assert done.returncode == 2, done.stderr
     assert f"error: {bag}: 1 metric value would be missing (gt_path of 'bot')" in done.stderr, done.stderr
+    assert "(gt_path of 'bot'), and --strict stores no run with a missing metric:\n  " in done.stderr
     assert "did you mean /groundtruth?" in done.stderr
     assert "0 ingested, 0 skipped, 1 failed" in done.stderr
     assert runs_in(store) == []

@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from exsce_dsl.cli.common import REMEDIES
-from exsce_dsl.errors import START_A_MASTER, RosGraphError
+from exsce_dsl.errors import RosGraphError
 from exsce_dsl.execute.ros1.channel import NodeChannel
 from exsce_dsl.execute.ros1.graph import (
     DEFAULT_ROS_PYTHON,
@@ -25,6 +25,7 @@ from exsce_dsl.execute.ros1.graph import (
     ros_python,
     start_master,
 )
+from exsce_dsl.remedies import START_A_MASTER
 
 from tests.support.ros1_graph import gone, require_ros1
 

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from exsce_dsl.errors import ExsceError
-from exsce_dsl.execute.stand_in.legs import FIELDS, Fleet, Leg
+from exsce_dsl.execute.stand_in.legs import FIELDS, Fleet, StandInLeg
 from exsce_dsl.lang import load_spec
 from exsce_dsl.maps.planning import planning_grid
 from exsce_dsl.model import Scenario
@@ -67,7 +67,7 @@ def fleet(scenario: Scenario, *faults: str) -> Fleet:
     return Fleet(scenario, planning_grid(scenario), seed=3, faults=tuple(Fault.parse(f) for f in faults))
 
 
-def length(leg: Leg, frame: str = "truth") -> float:
+def length(leg: StandInLeg, frame: str = "truth") -> float:
     poses = getattr(leg, frame)
     return float(np.hypot(np.diff(poses.x), np.diff(poses.y)).sum())
 

@@ -15,8 +15,8 @@ PACKAGE = Path(__file__).resolve().parents[2] / "src" / "exsce_dsl"
 
 LAYERS: list[set[str]] = [
     # the base
-    {"errors", "suggest", "resources", "textfiles", "tables", "templating", "figures", "user_cache", "wording",
-     "output_folder", "plugins", "faces"},
+    {"errors", "remedies", "suggest", "resources", "textfiles", "tables", "templating", "figures", "user_cache",
+     "wording", "output_folder", "plugins", "faces"},
     {"model"},
     {"messages", "maps", "monitor_kit", "parallel"},
     {"transform"},

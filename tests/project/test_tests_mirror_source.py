@@ -1,10 +1,9 @@
-"""Tests mirror the source tree (issue 49, item 5): a test folder below ``tests/runs/`` is named
-after the subpackage of ``src/exsce_dsl/runs/`` whose code its files test, so that a reader finds
-a module's tests beside where its path says, and a subpackage that moves or is renamed takes its
-tests along (this test fails until it does).
+"""Tests mirror the source tree (issue 49, item 5): a test folder below ``tests/runs/`` or
+``tests/lang/`` is named after the subpackage of ``src/exsce_dsl/runs/`` or ``lang/`` whose code
+its files test, so that a reader finds a module's tests beside where its path says, and a
+subpackage that moves or is renamed takes its tests along (this test fails until it does).
 
-Mirrored so far: ``runs`` only. Not yet: ``tests/lang`` (``lang/builders``, ``format``, ``yaml``,
-``editor``: being rearranged under the same issue), and the flat folders of the other packages
+Mirrored so far: ``runs`` and ``lang``. Not yet: the flat folders of the other packages
 (``store``, ``oracles``, ``execute``, ``explore``, ``derive``...), whose tests still sit in one
 folder per package.  Add a package to :data:`MIRRORED` when its tests are moved."""
 
@@ -16,7 +15,7 @@ ROOT = Path(__file__).resolve().parents[2]
 TESTS = ROOT / "tests"
 SOURCE = ROOT / "src" / "exsce_dsl"
 
-MIRRORED = ("runs",)
+MIRRORED = ("runs", "lang")
 """Packages whose test folders mirror their subpackages."""
 
 
@@ -46,3 +45,12 @@ def test_runs_four_steps_have_their_test_folders() -> None:
     assert all((SOURCE / "runs" / step / "__init__.py").is_file() for step in steps)
     without = [step for step in steps if not any((TESTS / "runs" / step).glob("test_*.py"))]
     assert not without, f"steps of runs/ without tests in tests/runs/<step>/: {without}"
+
+
+def test_lang_subpackages_have_their_test_folders() -> None:
+    """The language's builders, formatter, YAML import/export and editor support each have their
+    tests in ``tests/lang/<subpackage>/``."""
+    parts = ("builders", "format", "yaml", "editor")
+    assert all((SOURCE / "lang" / part / "__init__.py").is_file() for part in parts)
+    without = [part for part in parts if not any((TESTS / "lang" / part).glob("test_*.py"))]
+    assert not without, f"subpackages of lang/ without tests in tests/lang/<subpackage>/: {without}"

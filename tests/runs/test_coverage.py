@@ -206,7 +206,7 @@ def test_a_thinned_scan_without_a_declared_rate_is_no_gap(
     scenario: Scenario, clean: Path, tmp_path: Path
 ) -> None:
     """Every 5th scan kept (2 Hz): its median period grows with it, so no silence is a gap; only a
-    declared rate says it is low (tests/lang/test_declared_rates)."""
+    declared rate says it is low (tests/lang/builders/test_declared_rates)."""
     bag = thin(clean, tmp_path / "thin", "mcap", "/tiago1/scan", 5)
     analysed = analyse_bag(bag, scenario)
     assert analysed.run.coverage == ()

@@ -20,6 +20,7 @@ import pytest
 from rosbags.highlevel import AnyReader
 
 from exsce_dsl import api
+from exsce_dsl.cli.common import REMEDIES
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.lang import load_spec
 from exsce_dsl.oracles.judging import verify_runs
@@ -191,6 +192,7 @@ def test_a_replaced_run_loses_its_verdicts_and_is_verified_again(bags, project) 
     [replaced] = ingest_bags([bags[0]], spec.scenario(), store, replace=True)
     assert replaced.status is IngestStatus.REPLACED
     assert "its verdicts were dropped" in replaced.message
+    assert "its verdicts were dropped (exscec verify judges it again)" in replaced.said(REMEDIES)  # the CLI's
     assert not any("verdicts_bundle" in g for g in store.graph_names())
     assert len(run_query(store, "verdicts", {})) == 0
     assert run_query(store, "oracles", {"scenario": "scenario_c"})  # the baseline stays

@@ -18,6 +18,7 @@ import pytest
 from pyoxigraph import Literal, Quad
 
 from exsce_dsl import api
+from exsce_dsl.cli.common import REMEDIES
 from exsce_dsl.errors import ExsceError, StoreConflictError
 from exsce_dsl.lang import load_spec
 from exsce_dsl.oracles.judging import verify_runs
@@ -141,6 +142,8 @@ def test_a_run_stored_with_other_content_names_ingest_replace(project: Path) -> 
         add_prov(store, compile_run(run, scenario))
     message = str(raised.value)
     assert f"run {run.uuid} with other content" in message
-    assert "`exscec ingest BAG --scenario SPEC --replace`" in message
-    assert "exscec compile" not in message
+    assert "ingest its bag with replace" in message
+    assert raised.value.remedied is not None  # what the command line says, with its option:
+    assert "`exscec ingest BAG --scenario SPEC --replace`" in raised.value.remedied.said(REMEDIES)
+    assert "exscec compile" not in raised.value.remedied.said(REMEDIES)
     assert isinstance(raised.value, ExsceError)

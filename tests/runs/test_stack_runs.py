@@ -131,7 +131,7 @@ def test_robots_of_two_conventions_need_one_chosen(tmp_path: Path) -> None:
     path = tmp_path / "mixed.exsce"
     path.write_text(text)
     scenario = load_spec(path).scenario()
-    with pytest.raises(ExsceError, match=r"different conventions \(r1: nav2, r2: method\).*--convention"):
+    with pytest.raises(ExsceError, match=r"different conventions \(r1: nav2, r2: method\).*choose it"):
         list(simulate(scenario, tmp_path / "bags"))
     (run,) = simulate(scenario, tmp_path / "bags", convention="method")
     assert "/r2/robot_pose" in bag_topics(run.bag)

@@ -18,8 +18,8 @@ from exsce_dsl.lang import load_spec
 from exsce_dsl.maps.planning import PlanningGrid, planning_grid
 from exsce_dsl.model import Scenario, Task
 from exsce_dsl.sim.conflicts import CLEARANCE, conflict_repairs
-from exsce_dsl.sim.executor import Execution, Fault, execute
-from exsce_dsl.sim.motion import DT, Trajectory
+from exsce_dsl.sim.executor import Fault, SimulatedExecution, execute
+from exsce_dsl.sim.motion import DT, SampledMotion
 from exsce_dsl.transform.derivation import derive
 
 from tests.support.paths import EXAMPLES
@@ -55,7 +55,7 @@ def grid(spec_tasks: tuple[Scenario, dict[str, Task]]) -> PlanningGrid:
     return planning_grid(spec_tasks[0])
 
 
-def closest(execution: Execution) -> float:
+def closest(execution: SimulatedExecution) -> float:
     """The smallest distance between two robots' centres over the run, in metres."""
     tr = execution.trajectories
     return min(
@@ -100,8 +100,8 @@ def test_the_robot_that_drives_into_one_that_stands_goes_round_it() -> None:
     line = np.linspace(0.0, 4.0, n)
     still = np.zeros(n)
     trajectories = {
-        "first": Trajectory(still + 2.0, still + 0.1, still, still, still),  # stands on the way
-        "second": Trajectory(line, still, still, still + 0.5, still),  # drives through it
+        "first": SampledMotion(still + 2.0, still + 0.1, still, still, still),  # stands on the way
+        "second": SampledMotion(line, still, still, still + 0.5, still),  # drives through it
     }
     actions = [Drive("first", 0.0, 0.0), Drive("second", 0.0, n * DT), Drive("second", n * DT, n * DT)]
     [first, *rest] = conflict_repairs(trajectories, actions, ["first", "second"])
@@ -109,7 +109,7 @@ def test_the_robot_that_drives_into_one_that_stands_goes_round_it() -> None:
     assert first.place == pytest.approx((2.0, 0.1))
     assert [r.leg for r in rest] == [("first", 1)]  # the one that stands comes after
 
-    apart = {**trajectories, "first": Trajectory(still + 2.0, still + 2.0, still, still, still)}
+    apart = {**trajectories, "first": SampledMotion(still + 2.0, still + 2.0, still, still, still)}
     assert conflict_repairs(apart, actions, ["first", "second"]) == []
 
 
@@ -119,8 +119,8 @@ def test_a_later_meeting_is_offered_after_the_first() -> None:
     still = np.zeros(n)
     there_and_back = np.concatenate([np.linspace(0.0, 4.0, n // 2), np.linspace(4.0, 0.0, n // 2)])
     trajectories = {
-        "first": Trajectory(still + 2.0, still + 0.1, still, still, still),
-        "second": Trajectory(there_and_back, still, still, still + 0.5, still),  # passes it twice
+        "first": SampledMotion(still + 2.0, still + 0.1, still, still, still),
+        "second": SampledMotion(there_and_back, still, still, still + 0.5, still),  # passes it twice
     }
     actions = [
         Drive("first", 0.0, 0.0),

@@ -16,7 +16,7 @@ import pytest
 from exsce_dsl.maps.planning import PlanningGrid, planning_grid
 from exsce_dsl.model import Scenario, Task
 from exsce_dsl.sim.conflicts import CLEARANCE
-from exsce_dsl.sim.executor import Execution, execute
+from exsce_dsl.sim.executor import SimulatedExecution, execute
 from exsce_dsl.sim.motion import DT
 from exsce_dsl.transform.derivation import derive
 
@@ -40,7 +40,7 @@ def crossing(spec_c: tuple[Scenario, dict[str, Task]]) -> Scenario:
     return derive(base, steps, "crossing", tasks=tasks).scenario
 
 
-def _leg(execution: Execution, robot: str, task: str, waypoint: int) -> tuple[int, int]:
+def _leg(execution: SimulatedExecution, robot: str, task: str, waypoint: int) -> tuple[int, int]:
     """The samples of a robot's drive to a task's waypoint."""
     action = next(
         a for a in execution.actions if (a.robot, a.task, a.waypoint_number) == (robot, task, waypoint)
@@ -48,13 +48,13 @@ def _leg(execution: Execution, robot: str, task: str, waypoint: int) -> tuple[in
     return int(round(action.start / DT)), int(round(action.end / DT))
 
 
-def _driven(execution: Execution, robot: str, samples: tuple[int, int]) -> float:
+def _driven(execution: SimulatedExecution, robot: str, samples: tuple[int, int]) -> float:
     tr = execution.trajectories[robot]
     x, y = tr.x[samples[0] : samples[1] + 1], tr.y[samples[0] : samples[1] + 1]
     return float(np.hypot(np.diff(x), np.diff(y)).sum())
 
 
-def _gap(execution: Execution) -> np.ndarray:
+def _gap(execution: SimulatedExecution) -> np.ndarray:
     a, b = execution.trajectories["tiago1"], execution.trajectories["tiago2"]
     n = min(len(a), len(b))
     return np.hypot(a.x[:n] - b.x[:n], a.y[:n] - b.y[:n])

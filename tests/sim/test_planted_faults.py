@@ -21,7 +21,7 @@ from exsce_dsl.errors import ExsceError
 from exsce_dsl.lang import load_spec
 from exsce_dsl.maps.planning import PlanningGrid, planning_grid
 from exsce_dsl.model import Scenario
-from exsce_dsl.sim.executor import Execution, Fault, GoalStatus, execute
+from exsce_dsl.sim.executor import Fault, GoalStatus, SimulatedExecution, execute
 from exsce_dsl.sim.motion import DT
 from exsce_dsl.sim.run import simulate
 from exsce_dsl.transform.derivation import derive
@@ -65,7 +65,7 @@ def grid(scenario_c: Scenario) -> PlanningGrid:
 
 
 @pytest.fixture(scope="module")
-def plain_runs(scenario_c: Scenario, grid: PlanningGrid) -> dict[int, Execution]:
+def plain_runs(scenario_c: Scenario, grid: PlanningGrid) -> dict[int, SimulatedExecution]:
     return {seed: execute(scenario_c, grid, seed) for seed in SEEDS}
 
 
@@ -75,7 +75,7 @@ def _derived(scenario_c: Scenario, planted: Planted) -> Scenario:
 
 def _played(
     scenario: Scenario, grid: PlanningGrid, planted: Planted, seed: int = 1
-) -> tuple[Execution, Execution]:
+) -> tuple[SimulatedExecution, SimulatedExecution]:
     """``scenario`` played without, then with the planted fault."""
     return execute(scenario, grid, seed), execute(scenario, grid, seed, (Fault.parse(planted.fault),))
 
@@ -83,35 +83,35 @@ def _played(
 # What a run shows, from the robots' positions: distance, speed, when they move.
 
 
-def _steps(execution: Execution, robot: str) -> np.ndarray:
+def _steps(execution: SimulatedExecution, robot: str) -> np.ndarray:
     tr = execution.trajectories[robot]
     return np.hypot(np.diff(tr.x), np.diff(tr.y))
 
 
-def travelled(execution: Execution, robot: str) -> float:
+def travelled(execution: SimulatedExecution, robot: str) -> float:
     return float(_steps(execution, robot).sum())
 
 
-def top_speed(execution: Execution, robot: str) -> float:
+def top_speed(execution: SimulatedExecution, robot: str) -> float:
     return float(_steps(execution, robot).max() / DT)
 
 
-def driving_time(execution: Execution, robot: str) -> float:
+def driving_time(execution: SimulatedExecution, robot: str) -> float:
     """Seconds in which the robot's position changes."""
     return float(np.count_nonzero(_steps(execution, robot) > 1e-9) * DT)
 
 
-def first_move(execution: Execution, robot: str) -> float:
+def first_move(execution: SimulatedExecution, robot: str) -> float:
     return float(np.flatnonzero(_steps(execution, robot) > 1e-9)[0] * DT)
 
 
-def last_move(execution: Execution) -> float:
+def last_move(execution: SimulatedExecution) -> float:
     """When the last robot stops for good: the mission's end."""
     moved = (np.flatnonzero(_steps(execution, r) > 1e-9) for r in execution.trajectories)
     return max(float(m[-1] * DT) for m in moved if len(m))
 
 
-def _same(a: Execution, b: Execution) -> bool:
+def _same(a: SimulatedExecution, b: SimulatedExecution) -> bool:
     fields = ("x", "y", "yaw", "v", "w")
     return (
         a.trajectories.keys() == b.trajectories.keys()
@@ -129,13 +129,19 @@ def _same(a: Execution, b: Execution) -> bool:
 @pytest.mark.parametrize("planted", PLANTED, ids=lambda p: p.fault)
 @pytest.mark.parametrize("seed", SEEDS)
 def test_scenario_c_runs_as_if_the_fault_were_not_there(
-    planted: Planted, seed: int, scenario_c: Scenario, grid: PlanningGrid, plain_runs: dict[int, Execution]
+    planted: Planted,
+    seed: int,
+    scenario_c: Scenario,
+    grid: PlanningGrid,
+    plain_runs: dict[int, SimulatedExecution],
 ) -> None:
     faulty = execute(scenario_c, grid, seed, (Fault.parse(planted.fault),))
     assert _same(faulty, plain_runs[seed])  # identical, so within any run-to-run noise
 
 
-def test_the_seeds_differ_so_identity_is_not_a_blind_comparison(plain_runs: dict[int, Execution]) -> None:
+def test_the_seeds_differ_so_identity_is_not_a_blind_comparison(
+    plain_runs: dict[int, SimulatedExecution],
+) -> None:
     assert not _same(plain_runs[SEEDS[0]], plain_runs[SEEDS[1]])
 
 
@@ -156,7 +162,7 @@ def test_slow_area_shows_when_a_robot_starts_in_the_area(scenario_c: Scenario, g
 
 
 def test_detour_shows_when_delivery_a_is_driven_backwards(
-    scenario_c: Scenario, grid: PlanningGrid, plain_runs: dict[int, Execution]
+    scenario_c: Scenario, grid: PlanningGrid, plain_runs: dict[int, SimulatedExecution]
 ) -> None:
     derived = _derived(scenario_c, DETOUR)
     without, with_fault = _played(derived, grid, DETOUR)
@@ -181,7 +187,7 @@ def test_deadlock_shows_when_the_start_poses_are_swapped(scenario_c: Scenario, g
 
 
 def test_overspeed_shows_when_one_robot_takes_all_tasks(
-    scenario_c: Scenario, grid: PlanningGrid, plain_runs: dict[int, Execution]
+    scenario_c: Scenario, grid: PlanningGrid, plain_runs: dict[int, SimulatedExecution]
 ) -> None:
     derived = _derived(scenario_c, MANY_TASKS)
     without, with_fault = _played(derived, grid, MANY_TASKS)
@@ -193,7 +199,7 @@ def test_overspeed_shows_when_one_robot_takes_all_tasks(
 
 
 def test_overspeed_shows_when_delivery_a_goes_to_the_other_robot(
-    scenario_c: Scenario, grid: PlanningGrid, plain_runs: dict[int, Execution]
+    scenario_c: Scenario, grid: PlanningGrid, plain_runs: dict[int, SimulatedExecution]
 ) -> None:
     derived = _derived(scenario_c, REASSIGNED)
     assert ("tiago2", "delivery_a") in {(e.robot, e.task) for e in derived.mission.allocation}

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pytest
 
+from exsce_dsl.cli.common import REMEDIES
 from exsce_dsl.errors import StoreConflictError
 from exsce_dsl.lang import load_spec
 from exsce_dsl.prov import compile_scenario
@@ -95,7 +96,9 @@ def test_a_plain_named_robot_declared_otherwise_by_another_scenario_is_refused_w
         add(store, tmp_path, "second", "r1", robot="r1", kind="_2")  # another type
     message = str(raised.value)
     assert "robot 'r1' is named by id alone" in message
-    assert "--replace would change the other scenario's too" in message
+    assert "replacing would change the other scenario's too" in message  # the library's words
+    assert raised.value.remedied is not None  # the command line's, with its option:
+    assert "--replace would change the other scenario's too" in raised.value.remedied.said(REMEDIES)
 
 
 def test_a_scenario_edited_in_place_keeps_the_plain_replace_advice(tmp_path: Path) -> None:
@@ -107,6 +110,10 @@ def test_a_scenario_edited_in_place_keeps_the_plain_replace_advice(tmp_path: Pat
     with pytest.raises(StoreConflictError) as raised:
         add_prov(store, compile_scenario(load_spec(path).scenario()))
     message = str(raised.value)
-    assert "`exscec compile SPEC --store --replace`" in message
+    assert "to replace it, add it again with replace" in message
+    assert raised.value.remedied is not None
+    assert "\nto replace it, add it again with replace (`exscec compile SPEC --store --replace`)" in (
+        raised.value.remedied.said(REMEDIES)
+    )
     assert "exsce:only_bundle" in message
     assert "named by id alone" not in message  # the scenario's own graph

@@ -102,7 +102,7 @@ def test_store_check_finds_a_damaged_store_and_fix_removes_the_orphans(project: 
     assert by_kind["orphan graph"] == {ghost, segment, *orphans_of_gone}
     assert by_kind["run without scenario"] == {f"{RUNS}{kept}_bundle"}
     dangling = [f for f in result.findings if f.kind == "dangling reference"]
-    assert any(gone in f.message and "exscec baseline SPEC" in f.message for f in dangling)  # the baseline
+    assert any(gone in f.message and "build it again" in f.message for f in dangling)  # the baseline
     assert not result.clean
     store.close()
 
@@ -111,6 +111,7 @@ def test_store_check_finds_a_damaged_store_and_fix_removes_the_orphans(project: 
     assert done.returncode == 1
     assert f"<{ghost}>: orphan graph: a graph of run 0000ghost, which the store does not hold" in done.stdout
     assert "can be fixed with --fix" in done.stdout
+    assert "(build it again: exscec baseline SPEC)" in done.stdout  # the remedy with its command
 
     fixed = exscec_here(*cli, "--fix")
     assert fixed.returncode == 1, fixed.stderr  # the dangling baseline and the missing scenario stay

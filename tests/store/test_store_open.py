@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 from pyoxigraph import Literal, NamedNode, Quad
 
+from exsce_dsl.cli.common import REMEDIES
 from exsce_dsl.errors import StoreError, StoreLockedError
 from exsce_dsl.store.base import GraphSet
 from exsce_dsl.store.embedded import EmbeddedStore
@@ -185,7 +186,9 @@ def test_a_store_held_by_another_process_is_read_only_and_writing_is_a_clear_err
                 reader.write(one_quad())
         message = str(held.value)
         assert f"the store at {path} is in use" in message
-        assert "one process at a time" in message and "--store" in message
+        assert "one process at a time" in message and "through a SPARQL endpoint" in message
+        assert held.value.remedied is not None  # the command line says it with its option:
+        assert "point --store at a SPARQL endpoint" in held.value.remedied.said(REMEDIES)
         if sys.platform == "linux":
             assert f"pid {holder.pid}" in message
         # a serve.json left by a server that is gone does not redirect anything

@@ -97,7 +97,7 @@ if TYPE_CHECKING:  # what exscec's commands use besides (docs/python.md need not
         store_info,
         store_url,
     )
-    from exsce_dsl.codegen.targets import TARGETS, Target
+    from exsce_dsl.codegen.targets import TARGETS, GenerationTarget
     from exsce_dsl.errors import IngestFailed
     from exsce_dsl.messages.msg_path import MSG_PATH
     from exsce_dsl.oracles import (

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 from pyoxigraph import BlankNode, Literal, NamedNode
 
 from exsce_dsl.errors import ExsceError
+from exsce_dsl.remedies import SELECT_OR_ASK
 from exsce_dsl.store import Rows, Term, literal_text
 from exsce_dsl.tables import aligned
 
@@ -148,7 +149,7 @@ def answer_sparql(store_url: str | None, text: str) -> Rows | bool:
     kind = _KIND_AFTER_PROLOGUE.match(text)
     verb = kind.group(1).upper() if kind else ""
     if verb not in ("SELECT", "ASK"):
-        raise ExsceError("exscec sparql runs SELECT and ASK queries")
+        raise ExsceError("the query is neither a SELECT nor an ASK query", remedy=SELECT_OR_ASK)
     with open_store(store_url, read_only=True) as store:
         if verb == "ASK":
             return store.ask(prologue + text)

@@ -23,6 +23,7 @@ from exsce_dsl.execute import master_uri as environment_master_uri
 from exsce_dsl.execute import start_master as start_roscore
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.document import Specification
+from exsce_dsl.remedies import STAND_IN_FOR_FAULTS
 from exsce_dsl.sim.faults import Fault
 
 __all__ = ["ExecutedRun", "Policy", "execute_ros1"]
@@ -63,7 +64,7 @@ def execute_ros1(
     out = Path(out_dir)
     options = Options(Policy(policy), server_timeout, timeout)
     if not stand_in and (faults or seed):
-        raise ExsceError("faults and a seed are the stand-in's: give stand_in=True (--stand-in) with them")
+        raise ExsceError("faults and a seed are the stand-in's", remedy=STAND_IN_FOR_FAULTS)
     planted = tuple(Fault.parse(f) for f in faults)
     with contextlib.ExitStack() as stack:
         if interrupted is None:

@@ -3,13 +3,15 @@ same budget drawn uniformly at random beside it, its figures for comparison."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from contextlib import AbstractContextManager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from exsce_dsl.errors import Remedied
 from exsce_dsl.model.campaign import CampaignTrial
+from exsce_dsl.remedies import REPRODUCE_IT
 from exsce_dsl.wording import counted
 
 if TYPE_CHECKING:
@@ -73,8 +75,9 @@ class Exploration:
     def inconclusive(self) -> bool:
         return any(t.inconclusive for t in self.result.record.trials)
 
-    def summary_lines(self) -> list[str]:
-        """What the campaign found, its figures (beside the random baseline's) and its shrinkings."""
+    def summary_lines(self, wording: Mapping[str, str] | None = None) -> list[str]:
+        """What the campaign found, its figures (beside the random baseline's) and its shrinkings;
+        how to reproduce one in ``wording`` (the command line's, ``cli.common.REMEDIES``) if given."""
         from exsce_dsl.explore.figures import figures_table, first_failure, per_100
         from exsce_dsl.oracles import steps_text
 
@@ -107,7 +110,7 @@ class Exploration:
             lines.append(f"  smallest derivation ({counted(count, 'step')}): {steps}")
             if file is not None:
                 bags = result.folder / "runs" / shrinking.minimal
-                lines.append(f"  reproduce: exscec verify {bags}/*.bag --scenario {file}")
+                lines.append(Remedied("  reproduce", REPRODUCE_IT, (str(bags), str(file))).said(wording))
         return lines
 
 

@@ -10,10 +10,12 @@ prefix of it, or its IRI), or by the id the dispatcher gave it (what ``exscec si
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
-from exsce_dsl.errors import AmbiguousRunError, UnknownRunError
+from exsce_dsl.errors import AmbiguousRunError, Remedied, UnknownRunError
 from exsce_dsl.model.derivation import Derivation, TransformationStep
+from exsce_dsl.remedies import VERIFY_THE_RUN
 from exsce_dsl.store import (
     RunChain,
     Store,
@@ -42,8 +44,9 @@ class RunLineage:
     ancestry: tuple[Derivation, ...]
     accounts: tuple[ValueAccount, ...]
 
-    def text(self) -> str:
-        """The chain for people, from the scenario to the baseline runs."""
+    def text(self, wording: Mapping[str, str] | None = None) -> str:
+        """The chain for people, from the scenario to the baseline runs; a remedy in ``wording``
+        (the command line's, ``cli.common.REMEDIES``) when given, else in words."""
         chain = self.chain
         lines = [f"run {chain.run}"]
         lines.append(f"scenario {chain.scenario or '(unknown)'}")
@@ -54,7 +57,7 @@ class RunLineage:
         lines.append(f"bag {chain.bag or '(none)'}" + (f"  {chain.bag_path}" if chain.bag_path else ""))
         lines += self._value_lines()
         judged = f"verdicts ({len(chain.verdicts)})"
-        lines.append(judged if chain.verdicts else "verdicts: none (exscec verify RUN)")
+        lines.append(judged if chain.verdicts else Remedied("verdicts: none", VERIFY_THE_RUN).said(wording))
         for verdict in chain.verdicts:
             observed = f" {verdict.observed:.6g}" if verdict.observed is not None else ""
             lines.append(f"  {verdict.outcome:<12} {verdict.oracle} {verdict.relation}{observed}")
@@ -128,8 +131,9 @@ class ScenarioLineage:
     descendants: tuple[tuple[int, str, tuple[TransformationStep, ...]], ...]
     """Depth-first: (depth below the scenario, the derived scenario, the steps that made it)."""
 
-    def text(self) -> str:
-        """The ancestors, the scenario, then its descendants as a tree."""
+    def text(self, wording: Mapping[str, str] | None = None) -> str:
+        """The ancestors, the scenario, then its descendants as a tree (``wording`` as
+        :meth:`RunLineage.text` takes it: this text has no remedy to word)."""
         lines = []
         for derivation in self.ancestry:
             lines.append(derivation.base)

@@ -7,7 +7,7 @@ Each call serves until Ctrl-C or SIGTERM; what the server needs is imported when
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Collection
+from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -42,10 +42,13 @@ def serve_endpoint(
     union_default_graph: bool = False, query_timeout: float = 60.0, max_answer_mb: float = 256.0,
     allowed_hosts: Collection[str] = (), federation_hosts: Collection[str] = (),
     log: Callable[[str], None] | None = None, on_ready: Callable[[str, Path | None], None] | None = None,
+    wording: Mapping[str, str] | None = None,
 ) -> None:  # fmt: skip
     """``exscec serve``: the embedded store ``store_url`` names as a SPARQL 1.1 endpoint on
     ``host:port`` (updates only with ``token``); a StoreError if the store is an endpoint already
-    or served.  ``on_ready`` gets the server's URL and the store's folder (None: in memory)."""
+    or served.  ``on_ready`` gets the server's URL and the store's folder (None: in memory).
+    ``wording``: how the refusals say their remedies (the command line's, which starts it, with
+    its options: ``cli.common.REMEDIES``); in words without it."""
     from exsce_dsl.endpoint.server import ServeOptions, allowed_names, servable_store, serve
 
     options = ServeOptions(
@@ -58,6 +61,7 @@ def serve_endpoint(
         allowed_hosts=allowed_names(allowed_hosts),
         federation_hosts=allowed_names(federation_hosts),
         log=log,
+        wording=dict(wording or {}),
     )
     store_path = servable_store(store_url)
 

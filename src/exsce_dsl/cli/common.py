@@ -16,13 +16,48 @@ from typing import Any, TypeVar
 
 import click
 
-from exsce_dsl.errors import (
+from exsce_dsl.errors import Diagnostic, ExsceError, ScenarioChoiceError
+from exsce_dsl.remedies import (
+    ADD_ITS_SPEC,
+    ALLOW_FEDERATION,
+    ALLOW_THE_HOST,
+    ANOTHER_STORE,
+    BUILD_A_BASELINE,
+    BUILT_IN_OPTIONS,
+    CHOOSE_A_CONVENTION,
+    CLOSEST_RUNS,
+    DEFINE_THE_TYPE,
+    FAULTS_NEED_THE_STAND_IN,
+    FIX_THE_STORE,
+    GIVE_A_RUN_ID,
+    GIVE_THE_SPECS,
+    INSTALL_DASK,
+    LEARN_FROM_EVERY_RUN,
+    LIST_THE_QUERIES,
     MAKE_A_TOKEN,
+    NO_RUNS_AT_ALL,
+    ONE_EXECUTOR,
+    POINT_MSG_PATH,
+    READ_ONLY,
+    REBUILD_THE_BASELINE,
+    REPLACE_A_SHARED_ELEMENT,
+    REPLACE_A_STORED_RUN,
+    REPLACE_A_STORED_SPEC,
     REPLACE_FILES,
+    REPLACE_THE_RUN,
+    REPRODUCE_IT,
+    ROS1_OPTIONS,
+    SELECT_OR_ASK,
+    SEND_THE_TOKEN,
+    SERVE_A_FOLDER,
+    SIMULATE_IT,
+    STAND_IN_FOR_FAULTS,
+    STAND_IN_ONLY,
     START_A_MASTER,
-    Diagnostic,
-    ExsceError,
-    ScenarioChoiceError,
+    STORE_THE_SCENARIO,
+    STRICT_STORES_NONE,
+    VERIFY_AGAIN,
+    VERIFY_THE_RUN,
 )
 
 F = TypeVar("F", bound=Callable[..., Any])
@@ -98,7 +133,7 @@ SHOWN_DIAGNOSTICS = 100
 def print_diagnostics(diagnostics: Iterable[Diagnostic]) -> None:
     found = list(diagnostics)
     for d in found[:SHOWN_DIAGNOSTICS]:
-        click.echo(str(d), err=True)
+        click.echo(str(d.said(REMEDIES)), err=True)
     if len(found) > SHOWN_DIAGNOSTICS:
         hidden = Counter(str(d.severity) for d in found[SHOWN_DIAGNOSTICS:])
         total = sum(hidden.values())
@@ -123,18 +158,100 @@ REMEDIES = {
     REPLACE_FILES: "{problem}; use --force to replace",
     MAKE_A_TOKEN: "{problem} (leave --token and EXSCE_STORE_TOKEN unset to have one made)",
     START_A_MASTER: "{problem}: start roscore and export it, or pass --start-master",
+    SIMULATE_IT: "{problem} (exscec simulate does)",
+    CHOOSE_A_CONVENTION: "{problem}; the executor writes one for the whole run: choose it with --convention",
+    DEFINE_THE_TYPE: (
+        "{problem} (to check them now, give exsce the type's .msg or .idl file: exscec --msg-path DIR, "
+        "or EXSCE_MSG_PATH)"
+    ),
+    POINT_MSG_PATH: "{problem}; point EXSCE_MSG_PATH (or exscec --msg-path) at a folder of message packages",
+    REPLACE_THE_RUN: "{problem}; pass --replace to analyse it again under this spec",
+    STRICT_STORES_NONE: "{problem}, and --strict stores no run with a missing metric{about}",
+    REPLACE_A_STORED_RUN: (
+        "{problem}: to analyse the run again and replace it, ingest its bag with replace "
+        "(`exscec ingest BAG --scenario SPEC --replace`)"
+    ),
+    REPLACE_A_STORED_SPEC: (
+        "{problem}\nto replace it, add it again with replace (`exscec compile SPEC --store --replace`): "
+        "the old version is kept as a revision (prov:wasRevisionOf)"
+    ),
+    REPLACE_A_SHARED_ELEMENT: (
+        "{problem}\nto replace it, add it again with replace (`exscec compile SPEC --store --replace`): "
+        "the old version is kept as a revision (prov:wasRevisionOf); but {about} named by id alone, "
+        "shared by every scenario of the store that names one so: if another scenario declares it "
+        "otherwise, give this scenario's another id (--replace would change the other scenario's too)"
+    ),
+    FIX_THE_STORE: "{problem} ({about} can be fixed with --fix)",
+    REBUILD_THE_BASELINE: "{problem} (build it again: exscec baseline SPEC)",
+    STORE_THE_SCENARIO: "{problem} (add it: exscec compile SPEC --store)",
+    ANOTHER_STORE: (
+        "{problem}: stop that process, or point --store at a SPARQL endpoint "
+        "(for example `exscec serve` over this store)"
+    ),
+    LIST_THE_QUERIES: "{problem} (`exscec query --list` shows them all)",
+    GIVE_A_RUN_ID: (
+        "{problem}: give a run's uuid, a prefix of it ({about} characters at least, as `exscec runs` "
+        "prints them) or its IRI"
+    ),
+    NO_RUNS_AT_ALL: "{problem} (it holds no runs at all: `exscec ingest BAG...` adds them)",
+    CLOSEST_RUNS: "{problem}; the closest ids (`exscec runs` lists every run):\n{about}",
+    SELECT_OR_ASK: "exscec sparql runs SELECT and ASK queries",
+    SERVE_A_FOLDER: "{problem}; exscec serve serves an embedded store",
+    LEARN_FROM_EVERY_RUN: "{problem}; ingest runs that pass, or include every run (--all-runs)",
+    BUILD_A_BASELINE: "{problem}: build its baseline first (exscec baseline <spec> --scenario-id {about})",
+    VERIFY_THE_RUN: "{problem} (exscec verify RUN)",
+    VERIFY_AGAIN: "{problem} (exscec verify judges it again){about}",
+    REPRODUCE_IT: "{problem}: exscec verify {about[0]}/*.bag --scenario {about[1]}",
+    INSTALL_DASK: "--cluster needs Dask's distributed package: pip install 'exsce[dask]'",
+    BUILT_IN_OPTIONS: (
+        "--fault, --stand-in, --start-master and --speed-up are for the built-in executors {about}"
+    ),
+    ONE_EXECUTOR: "give one of --fault (the simulator), --executor-command and --executor",
+    ROS1_OPTIONS: "--stand-in, --start-master and --speed-up go with --executor ros1",
+    FAULTS_NEED_THE_STAND_IN: (
+        "--fault with --executor ros1 plants the fault in exsce's stand-in robots: give --stand-in"
+    ),
+    STAND_IN_ONLY: (
+        "{problem}: give --stand-in (a campaign starts each derived scenario from its own start poses, "
+        "and exsce cannot yet move a real stack's robots there between runs; a script that resets your "
+        "simulator and runs exscec execute --ros1 can be an --executor-command)"
+    ),
+    STAND_IN_FOR_FAULTS: "{problem}: give stand_in=True (--stand-in) with them",
+    READ_ONLY: (
+        "{problem} (exscec serve without --allow-updates): stop the server to write to its store "
+        "directly, or restart it with --allow-updates and send its bearer token (exscec commands: "
+        "EXSCE_STORE_TOKEN)"
+    ),
+    SEND_THE_TOKEN: "{problem}; exscec commands send EXSCE_STORE_TOKEN",
+    ALLOW_THE_HOST: "{problem}: ask it by the address it listens on, or start it with --allowed-host NAME",
+    ALLOW_FEDERATION: "{problem} (exscec serve --allow-federation HOST lets the endpoint reach HOST)",
+    GIVE_THE_SPECS: (
+        "no occupancy grid: no --spec was given: pass the scenarios' files with exscec report --spec "
+        "FILE.exsce to draw paths on their maps"
+    ),
+    ADD_ITS_SPEC: (
+        "no occupancy grid: no file given with --spec declares scenario '{about}' (or one it was derived "
+        "from): add its file to exscec report --spec"
+    ),
 }
-"""Each remedy the library says in words (:attr:`ExsceError.remedy`), as the command line says it:
-with the option that does it, after the problem."""
+"""Each remedy the library says in words (:mod:`exsce_dsl.remedies`), as the command line says it:
+with the option or command that does it (``str.format`` templates of ``{problem}`` and
+``{about}``: :meth:`~exsce_dsl.errors.Remedied.said`).  What the user sees is what the library
+said with these options before it said them in words (issue 49)."""
+
+
+def said_with_options(exc: ExsceError) -> str:
+    """``exc``'s message, its remedy said as the command line's option (for a command that prints
+    an error itself, as ``error: message``)."""
+    return _with_options(exc).message
 
 
 def _with_options(exc: ExsceError) -> ExsceError:
     """``exc`` with its remedy said as the command line's option, when it has one."""
-    said = REMEDIES.get(exc.remedy or "")
-    if said is None:
+    if exc.remedied is None or exc.remedied.remedy not in REMEDIES:
         return exc
     worded = copy.copy(exc)
-    worded.message = said.format(problem=exc.problem)
+    worded.message = exc.remedied.said(REMEDIES)
     return worded
 
 

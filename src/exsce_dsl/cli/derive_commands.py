@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from exsce_dsl.cli.common import all_runs_option, reports_errors
+from exsce_dsl.cli.common import REMEDIES, all_runs_option, reports_errors
 from exsce_dsl.cli.store_commands import store_option
 
 
@@ -161,7 +161,7 @@ def lineage(scenario: str, store_url: str | None) -> None:
     from exsce_dsl.api import lineage_of, open_store
 
     with open_store(store_url) as store:
-        click.echo(lineage_of(store, scenario).text())
+        click.echo(lineage_of(store, scenario).text(REMEDIES))
 
 
 @click.command()

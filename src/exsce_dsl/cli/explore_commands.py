@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
-from exsce_dsl.cli.common import ExitCode, Progress, exit_status, reports_errors
+from exsce_dsl.cli.common import REMEDIES, ExitCode, Progress, exit_status, reports_errors
 from exsce_dsl.cli.store_commands import store_option
 
 if TYPE_CHECKING:
@@ -166,7 +166,7 @@ def explore(**given: Any) -> None:
 
     request = ExploreRequest(**given)
     found = _run_campaigns(request)
-    for line in found.summary_lines():
+    for line in found.summary_lines(REMEDIES):
         click.echo(line)
     undecided = ExitCode.INCONCLUSIVE if found.inconclusive else ExitCode.PASSED
     sys.exit(ExitCode.FAILED if found.violated else undecided)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from exsce_dsl.api import TARGETS, Target
+from exsce_dsl.api import TARGETS, GenerationTarget
 from exsce_dsl.cli.common import reports_errors
 
 EXAMPLE_SPEC = "examples/brsu_building_c/scenario_c.exsce"
@@ -44,7 +44,7 @@ def generate() -> None:
     """
 
 
-def _target_command(target: Target) -> click.Command:
+def _target_command(target: GenerationTarget) -> click.Command:
     @click.command(
         name=target.name,
         short_help=target.description,

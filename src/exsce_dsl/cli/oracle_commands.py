@@ -15,6 +15,7 @@ from exsce_dsl.cli.common import (
     bag_arguments,
     exit_status,
     reports_errors,
+    said_with_options,
     write_text,
 )
 from exsce_dsl.cli.store_commands import store_option
@@ -207,7 +208,7 @@ def verify(**given: Any) -> None:
                 sys.exit(report_trial(judged, options.as_json, options.junit))
             verification = verify_runs(store, scenario, [*uuids, *bags], record=not options.no_record)
         except IngestFailed as exc:
-            click.echo(f"error: {exc.message}", err=True)
+            click.echo(f"error: {said_with_options(exc)}", err=True)
             sys.exit(ExitCode.BAD_INPUT)
     sys.exit(report_verification(verification, options.as_json, options.junit))
 

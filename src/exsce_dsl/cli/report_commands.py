@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from exsce_dsl.cli.common import Progress, reports_errors
+from exsce_dsl.cli.common import REMEDIES, Progress, reports_errors
 from exsce_dsl.cli.store_commands import store_option
 
 
@@ -47,7 +47,7 @@ def report(output: str, specs: tuple[str, ...], store_url: str | None) -> None:
     with Progress(runs, "drawing runs") as progress:
         index = write_report(contents, output, progress.update)
     for note in contents.notes:
-        click.echo(f"note: {note}", err=True)
+        click.echo(f"note: {note if isinstance(note, str) else note.said(REMEDIES)}", err=True)
     shown = f"{counted(len(contents.scenarios), 'scenario')}, {counted(runs, 'run')}"
     click.echo(f"wrote {index} ({shown})", err=True)
 

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 import click
 
-from exsce_dsl.cli.common import ExitCode, Progress, bag_arguments, exit_status, reports_errors
+from exsce_dsl.cli.common import REMEDIES, ExitCode, Progress, bag_arguments, exit_status, reports_errors
 from exsce_dsl.model.conventions import CONVENTIONS
 
 if TYPE_CHECKING:
@@ -215,7 +215,7 @@ def ingest(
 
         def shown(result: IngestResult) -> None:
             progress.update()
-            progress.say(f"{'error: ' if result.failed else ''}{result.message}")
+            progress.say(f"{'error: ' if result.failed else ''}{result.said(REMEDIES)}")
             for line in result.picked + (result.clocks if verbose else ()):
                 if verbose or line not in said:  # what every bag shares is said once
                     progress.say(f"  {line}")

@@ -8,7 +8,7 @@ from typing import Any, TypeVar
 
 import click
 
-from exsce_dsl.cli.common import ExitCode, reports_errors, write_text
+from exsce_dsl.cli.common import REMEDIES, ExitCode, reports_errors, write_text
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -165,7 +165,7 @@ def check(store_url: str | None, fix: bool) -> None:
 
     with open_store(store_url, read_only=not fix) as store:
         result = check_store(store, fix=fix)
-    click.echo(result.summary())
+    click.echo(result.summary(REMEDIES))
     if not result.clean:
         sys.exit(ExitCode.FAILED)
 
@@ -301,6 +301,7 @@ def serve(
         store_url, host, port, token=token, union_default_graph=union_default_graph,
         query_timeout=query_timeout, max_answer_mb=max_answer_mb, allowed_hosts=allowed_hosts,
         federation_hosts=federation_hosts, log=log if log_requests else None, on_ready=ready,
+        wording=REMEDIES,
     )  # fmt: skip
 
 

@@ -7,8 +7,9 @@ from collections.abc import Collection, Mapping
 from pathlib import Path
 
 from exsce_dsl.codegen.readback import check_generated
-from exsce_dsl.errors import REPLACE_FILES, GenerationError
+from exsce_dsl.errors import GenerationError
 from exsce_dsl.output_folder import existing, relative_parts, write_below
+from exsce_dsl.remedies import REPLACE_FILES
 
 
 def write_files(

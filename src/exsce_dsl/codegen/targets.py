@@ -19,7 +19,7 @@ Generate = Callable[[Specification, "str | None", Path, bool], list[Path]]
 
 
 @dataclass(frozen=True)
-class Target:
+class GenerationTarget:
     name: str
     description: str
     module: str
@@ -32,29 +32,29 @@ class Target:
         return func(spec, scenario_id, out_dir, overwrite)
 
 
-TARGETS: dict[str, Target] = {
+TARGETS: dict[str, GenerationTarget] = {
     t.name: t
     for t in (
-        Target(
+        GenerationTarget(
             "monitors",
             "vectorised numpy monitor classes (RobotMetrics, MissionMetrics) for the spec's metrics",
             "exsce_dsl.codegen.monitors",
             "generate_monitors",
         ),
-        Target(
+        GenerationTarget(
             "dispatcher-config",
             "the waypoint files the method's dispatcher reads: the mission, and each robot's task files",
             "exsce_dsl.codegen.dispatcher",
             "generate_dispatcher_config",
         ),
-        Target(
+        GenerationTarget(
             "ros1-monitor",
             "a ROS 1 (catkin, rospy) package of a runtime monitor node: the scenario's metrics live, "
             "its oracles' verdicts as JSON on /exsce/verdicts",
             "exsce_dsl.codegen.ros_monitor",
             "generate_ros1_monitor",
         ),
-        Target(
+        GenerationTarget(
             "ros2-monitor",
             "a ROS 2 (ament_python, rclpy) package of a runtime monitor node: the scenario's metrics live, "
             "its oracles' verdicts as JSON on /exsce/verdicts",

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import hmac
 import urllib.parse
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from http import HTTPStatus
 from importlib.resources import files
@@ -33,7 +33,8 @@ from exsce_dsl.endpoint.protocol import (
     read_body,
 )
 from exsce_dsl.endpoint.worker import Job
-from exsce_dsl.errors import RefusedRequest
+from exsce_dsl.errors import RefusedRequest, Remedied
+from exsce_dsl.remedies import READ_ONLY, SEND_THE_TOKEN
 from exsce_dsl.store import MAX_QUERY
 
 METHODS = ["GET", "HEAD", "POST", "PUT", "DELETE", "PATCH", "OPTIONS"]
@@ -41,20 +42,26 @@ METHODS = ["GET", "HEAD", "POST", "PUT", "DELETE", "PATCH", "OPTIONS"]
 
 @dataclass(frozen=True)
 class Endpoint:
-    """What the routes need: the worker, the update token (None: read-only), the page."""
+    """What the routes need: the worker, the update token (None: read-only), the page, and how
+    refusals say their remedies (:meth:`~exsce_dsl.errors.Remedied.said`)."""
 
     evaluator: Evaluator
     token: str | None
     page: bytes
+    wording: Mapping[str, str] | None = None
 
 
 def make_app(
-    evaluator: Evaluator, rule: HostRule, token: str | None, log: Callable[[str], None] | None = None
+    evaluator: Evaluator,
+    rule: HostRule,
+    token: str | None,
+    log: Callable[[str], None] | None = None,
+    wording: Mapping[str, str] | None = None,
 ) -> Guard:
     """The application: the routes behind the doors of :class:`~exsce_dsl.endpoint.guard.Guard`."""
     page = files("exsce_dsl.endpoint").joinpath("page.html").read_text(encoding="utf-8")
     mode = "enabled, with a bearer token" if token else "read-only"
-    endpoint = Endpoint(evaluator, token, page.replace("MODE", mode).encode("utf-8"))
+    endpoint = Endpoint(evaluator, token, page.replace("MODE", mode).encode("utf-8"), wording)
 
     def route(path: str, handler: Callable[[Endpoint, Request], object]) -> list[Route]:
         async def call(request: Request) -> Response:
@@ -77,7 +84,7 @@ def make_app(
         routes=routes,
         exception_handlers={RefusedRequest: _refused, Exception: _internal_error},  # type: ignore[dict-item]
     )
-    return Guard(app, rule, log)
+    return Guard(app, rule, log, wording)
 
 
 async def _home(endpoint: Endpoint, request: Request) -> Response:
@@ -182,19 +189,18 @@ def _has_token(endpoint: Endpoint, request: Request) -> bool:
 
 def _check_token(endpoint: Endpoint, request: Request) -> None:
     if endpoint.token is None:
-        raise RefusedRequest(
-            HTTPStatus.FORBIDDEN,
-            "this endpoint is read-only (exscec serve without --allow-updates): stop the server to "
-            "write to its store directly, or restart it with --allow-updates and send its bearer "
-            "token (exscec commands: EXSCE_STORE_TOKEN)",
-        )
+        read_only = Remedied("this endpoint is read-only", READ_ONLY)
+        raise RefusedRequest(HTTPStatus.FORBIDDEN, read_only.said(endpoint.wording))
     if not _has_token(endpoint, request):
         scheme = request.headers.get("authorization", "").partition(" ")[0]
         reason = "a wrong bearer token" if scheme.lower() == "bearer" else "no bearer token"
+        lacking = Remedied(
+            f"updates need the endpoint's token (Authorization: Bearer <token>); the request had {reason}",
+            SEND_THE_TOKEN,
+        )
         raise RefusedRequest(
             HTTPStatus.UNAUTHORIZED,
-            "updates need the endpoint's token (Authorization: Bearer <token>); "
-            f"the request had {reason}; exscec commands send EXSCE_STORE_TOKEN",
+            lacking.said(endpoint.wording),
             {"WWW-Authenticate": 'Bearer realm="exscec serve"'},
         )
 

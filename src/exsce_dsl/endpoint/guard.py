@@ -17,14 +17,15 @@ from __future__ import annotations
 
 import ipaddress
 import logging
-from collections.abc import Callable, Collection
+from collections.abc import Callable, Collection, Mapping
 from typing import Any
 
 from starlette.responses import PlainTextResponse
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from exsce_dsl import __version__
-from exsce_dsl.errors import AnswerCut
+from exsce_dsl.errors import AnswerCut, Remedied
+from exsce_dsl.remedies import ALLOW_THE_HOST
 
 LOGGER = logging.getLogger("exsce_dsl.endpoint")
 WILDCARDS = ("0.0.0.0", "::", "")
@@ -92,10 +93,18 @@ def _split_host(header: str) -> tuple[str | None, int | None]:
 class Guard:
     """ASGI middleware: the Host and Origin checks, the common headers, and a log line per request."""
 
-    def __init__(self, app: ASGIApp, rule: HostRule, log: Callable[[str], None] | None = None) -> None:
+    def __init__(
+        self,
+        app: ASGIApp,
+        rule: HostRule,
+        log: Callable[[str], None] | None = None,
+        wording: Mapping[str, str] | None = None,
+    ) -> None:
         self.app = app
         self.rule = rule
         self.log = log
+        self.wording = wording
+        """How refusals say their remedies (:meth:`~exsce_dsl.errors.Remedied.said`)."""
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
         if scope["type"] != "http":
@@ -135,11 +144,8 @@ class Guard:
             )
         host = headers.get("host", "")
         if not self.rule.admits(host):
-            return PlainTextResponse(
-                f"this endpoint does not answer for the host {host[:100]!r}: ask it by the address it "
-                "listens on, or start it with --allowed-host NAME\n",
-                status_code=421,
-            )
+            refused = Remedied(f"this endpoint does not answer for the host {host[:100]!r}", ALLOW_THE_HOST)
+            return PlainTextResponse(refused.said(self.wording) + "\n", status_code=421)
         origin = headers.get("origin")
         if origin is not None and origin.lower() != f"http://{host.lower()}":
             return PlainTextResponse(

@@ -21,7 +21,7 @@ import secrets
 import signal
 import socket
 import threading
-from collections.abc import Callable, Collection, Iterator
+from collections.abc import Callable, Collection, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import FrameType
@@ -32,7 +32,8 @@ from exsce_dsl.endpoint.app import make_app
 from exsce_dsl.endpoint.evaluator import Evaluator
 from exsce_dsl.endpoint.guard import HostRule, is_loopback
 from exsce_dsl.endpoint.worker import Settings
-from exsce_dsl.errors import MAKE_A_TOKEN, StoreError
+from exsce_dsl.errors import StoreError
+from exsce_dsl.remedies import MAKE_A_TOKEN, SERVE_A_FOLDER
 from exsce_dsl.store import QUERY_TIMEOUT, ServeInfo, serve_info_path, write_serve_info
 
 __all__ = ["MAX_ANSWER", "MIN_TOKEN", "ServeOptions", "check_token", "new_token", "serve", "servable_store"]
@@ -61,6 +62,8 @@ class ServeOptions:
     federation_hosts: tuple[str, ...] = ()
     """Hosts that SERVICE and LOAD may reach."""
     log: Callable[[str], None] | None = field(default=None, compare=False)
+    wording: Mapping[str, str] = field(default_factory=dict, compare=False)
+    """How refusals say their remedies (:meth:`~exsce_dsl.errors.Remedied.said`)."""
 
 
 def new_token() -> str:
@@ -88,9 +91,7 @@ def servable_store(store_url: str | None) -> Path | None:
         if isinstance(store, RemoteStore):
             if store.served_by is not None:
                 raise StoreError(f"{store.location}: the store is served already (pid {store.served_by})")
-            raise StoreError(
-                f"{store.location} is a SPARQL endpoint already; exscec serve serves an embedded store"
-            )
+            raise StoreError(f"{store.location} is a SPARQL endpoint already", remedy=SERVE_A_FOLDER)
         assert isinstance(store, EmbeddedStore)
         return store.path
     finally:
@@ -113,7 +114,9 @@ def serve(
     listener = _listen(options.host, options.port)
     port = int(listener.getsockname()[1])
     url = url_of(options.host, port)
-    settings = Settings(store_path, options.union_default_graph, options.federation_hosts, options.max_answer)
+    settings = Settings(
+        store_path, options.union_default_graph, options.federation_hosts, options.max_answer, options.wording
+    )
     evaluator = Evaluator(settings, options.query_timeout, options.log)
     info_path = serve_info_path(store_path) if store_path is not None else None
     try:
@@ -121,9 +124,8 @@ def serve(
         if info_path is not None and store_path is not None:
             info = ServeInfo(url, os.getpid(), str(store_path.resolve()), options.token is not None)
             write_serve_info(info_path, info)
-        app = make_app(
-            evaluator, HostRule(options.host, port, options.allowed_hosts), options.token, options.log
-        )
+        rule = HostRule(options.host, port, options.allowed_hosts)
+        app = make_app(evaluator, rule, options.token, options.log, options.wording)
         config = uvicorn.Config(
             app,
             lifespan="off",

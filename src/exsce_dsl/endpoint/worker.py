@@ -26,7 +26,8 @@ import re
 import signal
 import sys
 import threading
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 from http import HTTPStatus
 from multiprocessing.connection import Connection
 from pathlib import Path
@@ -42,7 +43,8 @@ from pyoxigraph import (
 )
 
 from exsce_dsl.endpoint.formats import DATASET_FORMATS, GRAPH_FORMATS, RESULT_FORMATS, negotiate
-from exsce_dsl.errors import FederationRefused, RefusedRequest, StoreError
+from exsce_dsl.errors import FederationRefused, RefusedRequest, Remedied, StoreError
+from exsce_dsl.remedies import ALLOW_FEDERATION
 from exsce_dsl.store import EmbeddedStore, refuse_federation
 
 READY, HEAD, DATA, END, REFUSED = b"R", b"H", b"D", b"E", b"X"
@@ -70,6 +72,8 @@ class Settings:
     federation_hosts: tuple[str, ...] = ()
     """The hosts SERVICE and LOAD may reach (none by default)."""
     max_answer: int = 256 * 1024 * 1024
+    wording: Mapping[str, str] = field(default_factory=dict)
+    """How refusals say their remedies (:meth:`~exsce_dsl.errors.Remedied.said`)."""
 
 
 @dataclass(frozen=True)
@@ -227,10 +231,8 @@ def _check_federation(job: Job, settings: Settings) -> None:
     try:
         refuse_federation(job.text, settings.federation_hosts, update=job.kind == "update")
     except FederationRefused as exc:
-        raise RefusedRequest(
-            HTTPStatus.FORBIDDEN,
-            f"{exc.message} (exscec serve --allow-federation HOST lets the endpoint reach HOST)",
-        ) from None
+        said = Remedied(exc.message, ALLOW_FEDERATION).said(settings.wording)
+        raise RefusedRequest(HTTPStatus.FORBIDDEN, said) from None
 
 
 def _failed(what: str, exc: BaseException) -> RefusedRequest:

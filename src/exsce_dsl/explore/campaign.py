@@ -34,7 +34,7 @@ from pathlib import Path
 from typing import NamedTuple
 
 from exsce_dsl.derive import DerivedSpec, add_derivation, derive_spec
-from exsce_dsl.errors import ExsceError, IngestFailed
+from exsce_dsl.errors import ExsceError
 from exsce_dsl.explore.cover import covering_derivations
 from exsce_dsl.explore.draw import Candidate, draw_derivations
 from exsce_dsl.explore.executors import Executor, bags_in
@@ -220,7 +220,7 @@ class _Campaign:
             bags, scenario, self.store, self.options.jobs, dask_address=self.options.dask_address
         ):
             if result.failed or result.run_id is None:
-                raise IngestFailed(result.message)
+                raise result.failure()
             uuids.append(result.run_id)
         return uuids
 

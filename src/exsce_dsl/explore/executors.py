@@ -40,6 +40,7 @@ from exsce_dsl.execute import DEFAULT_SPEED_UP
 from exsce_dsl.explore.ros1_executor import ros1_executor
 from exsce_dsl.model import Scenario
 from exsce_dsl.plugins import Registry
+from exsce_dsl.remedies import BUILT_IN_OPTIONS, ONE_EXECUTOR, ROS1_OPTIONS
 from exsce_dsl.runs import is_bag
 from exsce_dsl.sim.faults import Fault
 from exsce_dsl.sim.run import simulate
@@ -247,8 +248,9 @@ def named_executor(name: str, options: ExecutorOptions | None = None) -> Abstrac
     chosen = known[name]
     if options != ExecutorOptions() and not chosen.takes_options:
         raise ExsceError(
-            f"--fault, --stand-in, --start-master and --speed-up are for the built-in executors "
-            f"({', '.join(BUILT_IN_EXECUTORS)}), not the plug-in '{name}'"
+            f"the executor '{name}' is a plug-in",
+            remedy=BUILT_IN_OPTIONS,
+            about=f"({', '.join(BUILT_IN_EXECUTORS)}), not the plug-in '{name}'",
         )
     return chosen.start(options)
 
@@ -263,9 +265,9 @@ def chosen_executor(
     ``name``, else exsce's simulator with ``options.faults`` (on the Dask cluster at
     ``dask_address`` when given).  The options must go together."""
     if command and (options.faults or name):
-        raise ExsceError("give one of --fault (the simulator), --executor-command and --executor")
+        raise ExsceError("a campaign's runs are played by one executor", remedy=ONE_EXECUTOR)
     if (options.stand_in or options.start_master or options.speed_up is not None) and not name:
-        raise ExsceError("--stand-in, --start-master and --speed-up go with --executor ros1")
+        raise ExsceError("no executor was named", remedy=ROS1_OPTIONS)
     if command:
         return nullcontext(CommandExecutor(command))
     if name:

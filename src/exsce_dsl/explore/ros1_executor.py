@@ -32,14 +32,8 @@ from exsce_dsl.errors import ExsceError
 from exsce_dsl.execute import DEFAULT_SPEED_UP, LOGS, Interruption, execute_runs, start_stand_in
 from exsce_dsl.execute import start_master as start_roscore
 from exsce_dsl.model import Scenario
+from exsce_dsl.remedies import FAULTS_NEED_THE_STAND_IN, STAND_IN_ONLY
 from exsce_dsl.sim.faults import Fault
-
-NEEDS_STAND_IN = (
-    "the ros1 executor drives exsce's stand-in robots only, for now: give --stand-in (a campaign "
-    "starts each derived scenario from its own start poses, and exsce cannot yet move a real "
-    "stack's robots there between runs; a script that resets your simulator and runs exscec "
-    "execute --ros1 can be an --executor-command)"
-)
 
 
 @dataclass(frozen=True)
@@ -104,10 +98,12 @@ def ros1_executor(
     must be True (see the module's docstring); ``faults`` as ``exscec simulate --fault``."""
     if faults and not stand_in:
         raise ExsceError(
-            "--fault with --executor ros1 plants the fault in exsce's stand-in robots: give --stand-in"
+            "the ros1 executor plants faults in exsce's stand-in robots", remedy=FAULTS_NEED_THE_STAND_IN
         )
     if not stand_in:
-        raise ExsceError(NEEDS_STAND_IN)
+        raise ExsceError(
+            "the ros1 executor drives exsce's stand-in robots only, for now", remedy=STAND_IN_ONLY
+        )
     planted = tuple(Fault.parse(f) for f in faults)
     checked = Ros1Executor("unused", planted, speed_up)  # wrong options fail before a roscore starts
     with ExitStack() as stack:

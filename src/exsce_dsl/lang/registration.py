@@ -27,7 +27,7 @@ def _check_whole_spec(model: Any, metamodel: Any) -> None:
         raise TextXSemanticError(
             first.message
             + (
-                f" (and {len(analysis.errors) - 1} more; see 'exscec check')"
+                f" (and {len(analysis.errors) - 1} more; exsce's checker lists them all)"
                 if len(analysis.errors) > 1
                 else ""
             ),

@@ -58,7 +58,7 @@ _OFFERED_KINDS = {
 
 
 @dataclass(frozen=True)
-class Wanted:
+class WantedName:
     """A kind of name that fits, said in scenario ``scope`` (robots, missions) or of
     environment ``environment`` (poses, obstacles)."""
 
@@ -67,7 +67,7 @@ class Wanted:
     environment: str | None = None
 
 
-def wanted_names(allowed: Continuations, names: Names) -> list[Wanted]:
+def wanted_names(allowed: Continuations, names: Names) -> list[WantedName]:
     """Which kinds of names fit at the point, from the words before it."""
     before = allowed.before
     if not before:
@@ -76,7 +76,7 @@ def wanted_names(allowed: Continuations, names: Names) -> list[Wanted]:
     if declaration == "scenario":
         return _in_scenario(before, names)
     if declaration == "task":
-        return [Wanted("pose")] if before[-1] in ("visit", ",") else []
+        return [WantedName("pose")] if before[-1] in ("visit", ",") else []
     if declaration == "acceptance":
         return _in_acceptance(before)
     if declaration == "derive":
@@ -95,64 +95,64 @@ def _blocks(before: Sequence[str]) -> list[str]:
     return stack
 
 
-def _in_scenario(before: Sequence[str], names: Names) -> list[Wanted]:
+def _in_scenario(before: Sequence[str], names: Names) -> list[WantedName]:
     last = before[-1]
     name = before[1] if len(before) > 1 else None
     environment = before[3] if len(before) > 3 else None
     if len(before) == 3 and last == "in":
-        return [Wanted("environment")]
+        return [WantedName("environment")]
     blocks = _blocks(before)
     if last == ":" and blocks[-1:] == ["robots"]:
-        return [Wanted("robot type")]
+        return [WantedName("robot type")]
     if last == "at" and before[-2] == "starts":
-        return [Wanted("pose", environment=environment)]
+        return [WantedName("pose", environment=environment)]
     if blocks[-1:] == ["mission"]:
         if last in ("does", "then"):
-            return [Wanted("task")]
-        return [Wanted("robot", name)]
+            return [WantedName("task")]
+        return [WantedName("robot", name)]
     return []
 
 
-def _in_acceptance(before: Sequence[str]) -> list[Wanted]:
+def _in_acceptance(before: Sequence[str]) -> list[WantedName]:
     last, previous = before[-1], before[-2] if len(before) > 1 else ""
     scenario = before[2] if len(before) > 2 else None
     if len(before) == 2 and last == "for":
-        return [Wanted("scenario")]
+        return [WantedName("scenario")]
     table = {
-        "given": [Wanted("robot", scenario)],
-        "when": [Wanted("robot", scenario), Wanted("mission", scenario)],
-        "does": [Wanted("task")],
-        "then": [Wanted("robot", scenario), Wanted("metric")],
-        "and": [Wanted("robot", scenario), Wanted("metric")],
-        "before": [Wanted("robot", scenario), Wanted("task")],
-        "after": [Wanted("robot", scenario), Wanted("task")],
-        "during": [Wanted("task")],
-        "reaches": [Wanted("pose")],
-        "of": [Wanted("scenario")],
+        "given": [WantedName("robot", scenario)],
+        "when": [WantedName("robot", scenario), WantedName("mission", scenario)],
+        "does": [WantedName("task")],
+        "then": [WantedName("robot", scenario), WantedName("metric")],
+        "and": [WantedName("robot", scenario), WantedName("metric")],
+        "before": [WantedName("robot", scenario), WantedName("task")],
+        "after": [WantedName("robot", scenario), WantedName("task")],
+        "during": [WantedName("task")],
+        "reaches": [WantedName("pose")],
+        "of": [WantedName("scenario")],
     }
     if last in table:
         return table[last]
     if previous in ("then", "and") or (last == "robot" and previous == "each"):
-        return [Wanted("metric")]
+        return [WantedName("metric")]
     return []
 
 
-def _in_derivation(before: Sequence[str], names: Names) -> list[Wanted]:
+def _in_derivation(before: Sequence[str], names: Names) -> list[WantedName]:
     derived = before[1] if len(before) > 1 else None
     if len(before) == 4 and before[-1] == "from":
-        return [Wanted("scenario")]
+        return [WantedName("scenario")]
     environment = _environment_of(names, before[3]) if len(before) > 3 else None
     # the robots the steps add, and the base's (known from the text while this file is not indexed yet)
-    robots = [Wanted("robot", derived), Wanted("robot", before[3] if len(before) > 3 else None)]
+    robots = [WantedName("robot", derived), WantedName("robot", before[3] if len(before) > 3 else None)]
     by_type = {
         "robot": robots,
         "allocation robot": robots,
-        "task": [Wanted("task")],
-        "allocation task": [Wanted("task")],
-        "pose": [Wanted("pose", environment=environment)],
-        "obstacle": [Wanted("obstacle", environment=environment)],
+        "task": [WantedName("task")],
+        "allocation task": [WantedName("task")],
+        "pose": [WantedName("pose", environment=environment)],
+        "obstacle": [WantedName("obstacle", environment=environment)],
     }
-    wanted: list[Wanted] = []
+    wanted: list[WantedName] = []
     for kind in sorted(next_types(current_step(before))):
         wanted.extend(w for w in by_type.get(kind, []) if w not in wanted)
     return wanted
@@ -171,7 +171,7 @@ def _environment_of(names: Names, scenario: str) -> str | None:
     return None
 
 
-def candidates(wanted: Wanted, names: Names, all_symbols: Sequence[Symbol]) -> list[Symbol]:
+def candidates(wanted: WantedName, names: Names, all_symbols: Sequence[Symbol]) -> list[Symbol]:
     """The declarations that fit ``wanted``."""
     found = [s for s in all_symbols if s.kind == wanted.kind]
     if wanted.kind in ("robot", "mission"):

@@ -9,7 +9,7 @@ from collections.abc import Callable
 from exsce_dsl.errors import SourceLocation
 from exsce_dsl.lang import Symbol, builtin_metrics, declaration_chunks, tokens
 from exsce_dsl.lsp.keywords import MEANINGS
-from exsce_dsl.lsp.navigation import Names, Target
+from exsce_dsl.lsp.navigation import NameAtPoint, Names
 from exsce_dsl.model.metrics import SI_UNIT
 
 _WORD = re.compile(r"[A-Za-z_][\w-]*")
@@ -35,7 +35,9 @@ def keyword_hover(word: str) -> str | None:
     return f"**{word}** (keyword)\n\n{meaning}" if meaning else None
 
 
-def symbol_hover(names: Names, target: Target, source: Callable[[SourceLocation], str | None]) -> str | None:
+def symbol_hover(
+    names: Names, target: NameAtPoint, source: Callable[[SourceLocation], str | None]
+) -> str | None:
     """Markdown about what ``target`` names; ``source`` gives the text at a location."""
     found = names.definitions(target)
     if not found:

@@ -27,7 +27,7 @@ RENAMEABLE = frozenset(
 
 
 @dataclass(frozen=True)
-class Target:
+class NameAtPoint:
     """A name at a point: what it is, and the occurrence under the point."""
 
     kind: str
@@ -92,15 +92,15 @@ class Names:
             scope = self.base_of(scope)
         return []
 
-    def target_at(self, index: FileIndex, line: int, column: int) -> Target | None:
+    def target_at(self, index: FileIndex, line: int, column: int) -> NameAtPoint | None:
         """The name at 1-based ``line``:``column`` of the file of ``index``."""
         for ref in index.references:
             if _contains(ref.location, line, column):
-                return Target(ref.kind, ref.name, self._declaring_scope(ref), ref.location)
+                return NameAtPoint(ref.kind, ref.name, self._declaring_scope(ref), ref.location)
         for symbol in index.all_symbols():
             if symbol.kind not in NOT_NAMES and _contains(symbol.location, line, column):
                 scope = symbol.scope if symbol.kind in SCOPED_KINDS else None
-                return Target(symbol.kind, symbol.name, scope, symbol.location, symbol)
+                return NameAtPoint(symbol.kind, symbol.name, scope, symbol.location, symbol)
         return None
 
     def _declaring_scope(self, ref: Reference) -> str | None:
@@ -109,14 +109,14 @@ class Names:
         found = self.resolve(ref.kind, ref.name, ref.scope)
         return found[0].scope if found else ref.scope
 
-    def definitions(self, target: Target) -> list[Symbol]:
+    def definitions(self, target: NameAtPoint) -> list[Symbol]:
         if target.declaration is not None:
             return [target.declaration]
         if target.kind in SCOPED_KINDS:
             return [s for s in self.symbols(target.kind, target.name) if s.scope == target.scope]
         return self.nearest(self.resolve(target.kind, target.name))
 
-    def references(self, target: Target, declarations: bool = True) -> list[SourceLocation]:
+    def references(self, target: NameAtPoint, declarations: bool = True) -> list[SourceLocation]:
         """Every place ``target`` is named (its declarations first, with ``declarations``)."""
         found: list[SourceLocation] = []
         if declarations:
@@ -128,7 +128,7 @@ class Names:
                         found.append(ref.location)
         return list(dict.fromkeys(found))
 
-    def rename(self, target: Target, new_name: str, library: FileIndex) -> list[SourceLocation]:
+    def rename(self, target: NameAtPoint, new_name: str, library: FileIndex) -> list[SourceLocation]:
         """The places to write ``new_name`` in; raise :class:`RenameError` when it cannot be done."""
         if target.kind not in RENAMEABLE:
             raise RenameError(f"a {target.kind} cannot be renamed")

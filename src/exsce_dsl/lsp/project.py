@@ -35,7 +35,7 @@ _SCAN_LIMIT = 5000
 
 
 @dataclass(frozen=True)
-class Document:
+class OpenDocument:
     """An open document as the analysis saw it."""
 
     text: str
@@ -78,7 +78,7 @@ class Project:
         self._generation = 0
 
     # ---------------------------------------------------------- analysis thread
-    def roots_to_analyse(self, changed: Iterable[str], documents: Mapping[str, Document]) -> list[str]:
+    def roots_to_analyse(self, changed: Iterable[str], documents: Mapping[str, OpenDocument]) -> list[str]:
         """The open documents to analyse after ``changed`` changed: those first, then those that read them."""
         changed = set(changed)
         roots = sorted(p for p in changed if p in documents)
@@ -87,7 +87,7 @@ class Project:
         )
         return roots
 
-    def analyse(self, root: str, documents: Mapping[str, Document]) -> RootAnalysis:
+    def analyse(self, root: str, documents: Mapping[str, OpenDocument]) -> RootAnalysis:
         """Analyse the open document ``root`` with what it imports (open ones as the editor has them)."""
         overlay = {path: doc.text for path, doc in documents.items()}
         scope = self.import_scope(root)
@@ -128,7 +128,7 @@ class Project:
             return workspace
         return ImportScope.inside(os.path.dirname(os.path.abspath(root)))
 
-    def failed(self, root: str, documents: Mapping[str, Document], error: BaseException) -> RootAnalysis:
+    def failed(self, root: str, documents: Mapping[str, OpenDocument], error: BaseException) -> RootAnalysis:
         """The analysis of ``root`` that raised ``error`` (a bug): one diagnostic at its start
         saying so, in place of what an analysis would have found."""
         kind = type(error).__name__
@@ -150,7 +150,7 @@ class Project:
         self.roots = {**self.roots, root: done}
         return done
 
-    def close(self, path: str, documents: Mapping[str, Document]) -> None:
+    def close(self, path: str, documents: Mapping[str, OpenDocument]) -> None:
         """``path`` is no longer open: it is no longer a root (its analysis is dropped)."""
         roots = dict(self.roots)
         roots.pop(path, None)

@@ -15,7 +15,7 @@ from collections.abc import Callable, Mapping
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
-from exsce_dsl.lsp.project import Document, Project, RootAnalysis
+from exsce_dsl.lsp.project import OpenDocument, Project, RootAnalysis
 
 logger = logging.getLogger(__name__)
 
@@ -27,7 +27,7 @@ class Scheduler:
     def __init__(
         self,
         project: Project,
-        documents: Callable[[], Mapping[str, Document]],
+        documents: Callable[[], Mapping[str, OpenDocument]],
         done: Callable[[list[RootAnalysis]], None],
         delay: float = DEBOUNCE,
     ) -> None:

@@ -21,8 +21,8 @@ from exsce_dsl import __version__
 from exsce_dsl.errors import Diagnostic, ExsceError, SourceLocation
 from exsce_dsl.lang import FileIndex
 from exsce_dsl.lsp.convert import TextLines, lsp_diagnostic, path_of, uri_of
-from exsce_dsl.lsp.navigation import Names, Target
-from exsce_dsl.lsp.project import Document, Project, RootAnalysis
+from exsce_dsl.lsp.navigation import NameAtPoint, Names
+from exsce_dsl.lsp.project import OpenDocument, Project, RootAnalysis
 from exsce_dsl.lsp.scheduler import Scheduler
 from exsce_dsl.lsp.shapes import ShapeChecks
 from exsce_dsl.textfiles import read_text
@@ -43,9 +43,9 @@ class ExsceLanguageServer(LanguageServer):
         self.published: dict[str, list[Diagnostic]] = {}
 
     # --------------------------------------------------------------- documents
-    def open_documents(self) -> dict[str, Document]:
+    def open_documents(self) -> dict[str, OpenDocument]:
         return {
-            path_of(uri): Document(doc.source, doc.version)
+            path_of(uri): OpenDocument(doc.source, doc.version)
             for uri, doc in self.workspace.text_documents.items()
             if uri.startswith("file:")
         }
@@ -120,7 +120,7 @@ class ExsceLanguageServer(LanguageServer):
         lines = self.lines_of(path_of(uri))
         return lines.location(lines.offset(position))
 
-    async def target(self, uri: str, position: types.Position) -> tuple[Names, Target | None]:
+    async def target(self, uri: str, position: types.Position) -> tuple[Names, NameAtPoint | None]:
         """The name at a point, once the latest text is analysed."""
         await self.scheduler.settled()
         path, index = self.index_of(uri)

@@ -26,6 +26,7 @@ import anyio
 import anyio.to_thread
 
 from exsce_dsl.errors import TimeLimitError
+from exsce_dsl.remedies import LONGER_TIME_LIMIT
 from exsce_dsl.store import QUERY_TIMEOUT, Store
 
 __all__ = ["DEFAULT_MAX_ROWS", "Access"]
@@ -78,8 +79,8 @@ class Access:
                 )
         except TimeoutError:
             raise TimeLimitError(
-                f"the request ran over the server's time limit of {self.timeout:g} s "
-                "(ask for less: LIMIT, fewer runs; or start exscec mcp with a larger --timeout)"
+                f"the request ran over the server's time limit of {self.timeout:g} s",
+                remedy=LONGER_TIME_LIMIT,
             ) from None
 
     @property

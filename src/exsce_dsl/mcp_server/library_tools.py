@@ -20,7 +20,7 @@ import mcp_types as types
 from exsce_dsl.mcp_server.access import Access
 from exsce_dsl.mcp_server.answers import READ_ONLY, ToolEntry, results_json
 from exsce_dsl.mcp_server.arguments import MAX_TEXT, MAX_VALUES, NAME, POSE_NAME, RUN_ID, object_schema
-from exsce_dsl.store import Parameter, Query, query, query_names, run_query
+from exsce_dsl.store import Query, QueryParameter, query, query_names, run_query
 
 __all__ = ["library_tools", "parameter_schema", "query_tool"]
 
@@ -44,7 +44,7 @@ _KIND_SCHEMAS: dict[str, dict[str, Any]] = {
 still made an RDF term by the library."""
 
 
-def parameter_schema(parameter: Parameter) -> dict[str, Any]:
+def parameter_schema(parameter: QueryParameter) -> dict[str, Any]:
     """The JSON schema of a query parameter: its kind's, a list of those for a ``+`` kind."""
     one = dict(_KIND_SCHEMAS.get(parameter.kind, {"type": "string"}))
     if one["type"] == "string":

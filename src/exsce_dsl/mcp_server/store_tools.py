@@ -20,13 +20,14 @@ from typing import Any
 
 import mcp_types as types
 
-from exsce_dsl.errors import ArgumentError, ExsceError
+from exsce_dsl.errors import ArgumentError, ExsceError, Remedied
 from exsce_dsl.mcp_server.access import Access
 from exsce_dsl.mcp_server.answers import READ_ONLY, ToolEntry
 from exsce_dsl.mcp_server.arguments import NAME, RUN_ID, identifier, object_schema
 from exsce_dsl.model.derivation import Derivation
 from exsce_dsl.model.verdicts import Outcome
 from exsce_dsl.oracles import verdicts_json
+from exsce_dsl.remedies import VERIFY_THE_RUN
 from exsce_dsl.store import (
     RunChain,
     Store,
@@ -181,7 +182,9 @@ def _run_verdicts(access: Access, arguments: Mapping[str, Any]) -> dict[str, Any
         "verdicts": json.loads(verdicts_json(found)),
     }
     if not found:
-        answer["note"] = "the store holds no verdicts of this run: it was not verified (exscec verify RUN)"
+        answer["note"] = Remedied(
+            "the store holds no verdicts of this run: it was not verified", VERIFY_THE_RUN
+        ).said()
     return answer
 
 

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from exsce_dsl.errors import BagError, ExsceError, FieldProblem
+from exsce_dsl.errors import BagError, ExsceError, FieldProblem, Remedied
 from exsce_dsl.messages.catalogue import Source
 from exsce_dsl.model.messages import (
     FieldPath,
@@ -32,6 +32,7 @@ from exsce_dsl.model.messages import (
 )
 from exsce_dsl.model.metrics import MetricDefinition
 from exsce_dsl.model.robots import Robot
+from exsce_dsl.remedies import DEFINE_THE_BAGS_TYPE
 from exsce_dsl.suggest import did_you_mean
 
 
@@ -61,17 +62,12 @@ def check_fields(
                 continue
             if arrays != f.arrays:
                 shape = "an array" if arrays else "a number"
-                found.append(
-                    ExsceError(
-                        _from(
-                            f"{_text(read.name, f.path)} is {shape} per message by the definition of "
-                            f"{msgtype}, not what metric '{metric.name}' was checked with: give exsce "
-                            "the definition the bag uses (exscec --msg-path, or EXSCE_MSG_PATH)",
-                            source,
-                        ),
-                        f.location,
-                    )
+                wrong = (
+                    f"{_text(read.name, f.path)} is {shape} per message by the definition of "
+                    f"{msgtype}, not what metric '{metric.name}' was checked with"
                 )
+                said = Remedied(wrong, DEFINE_THE_BAGS_TYPE).said()  # ingest prints it in a BagError's text
+                found.append(ExsceError(_from(said, source), f.location))
     return found
 
 

@@ -26,6 +26,7 @@ from exsce_dsl.errors import NoGoodRuns
 from exsce_dsl.lang import standard_metrics
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.coverage import CoverageGap, Shortfall
+from exsce_dsl.remedies import LEARN_FROM_EVERY_RUN
 from exsce_dsl.store import RunDefect, Store, run_coverage, run_defects
 from exsce_dsl.store import runs as stored_runs
 
@@ -55,8 +56,8 @@ class GoodRuns:
         if self.used or not self.left_out:
             return self
         raise NoGoodRuns(
-            f"no good run of {what} to learn from: every stored run was left out: {self.reasons()}; "
-            "ingest runs that pass, or include every run (--all-runs)"
+            f"no good run of {what} to learn from: every stored run was left out: {self.reasons()}",
+            remedy=LEARN_FROM_EVERY_RUN,
         )
 
 

@@ -14,7 +14,7 @@ from pathlib import Path
 
 from prov.model import ProvDocument
 
-from exsce_dsl.errors import ExsceError, IngestFailed
+from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.coverage import CoverageGap, TopicRate
 from exsce_dsl.model.document import Specification
@@ -128,7 +128,7 @@ def verify_runs(
     uuids = resolve_runs(store, given)  # prefixes and IRIs as well as whole uuids
     for result in ingest_bags(bags, scenario, store) if bags else []:
         if result.failed or result.run_id is None:
-            raise IngestFailed(result.message)
+            raise result.failure()
         uuids.append(result.run_id)
     judged = tuple(dict.fromkeys(uuids))
     if coverage is None:

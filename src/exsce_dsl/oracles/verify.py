@@ -17,6 +17,7 @@ from exsce_dsl.oracles.coverage_check import Span, clause_gaps, judge_coverage, 
 from exsce_dsl.oracles.observe import RunValues, observe, parse_window, run_values, window_segments
 from exsce_dsl.oracles.relations import relation
 from exsce_dsl.oracles.sources import ValueSources
+from exsce_dsl.remedies import BUILD_A_BASELINE
 from exsce_dsl.store import Store, StoredRun, action_times
 from exsce_dsl.store import oracles as stored_oracles
 from exsce_dsl.store import runs as stored_runs
@@ -50,8 +51,9 @@ def judge_runs(
     oracles = stored_oracles(store, scenario.id)
     if not oracles:
         raise ExsceError(
-            f"scenario '{scenario.id}' has no oracles in the store: build its baseline first "
-            f"(exscec baseline <spec> --scenario-id {scenario.id})"
+            f"scenario '{scenario.id}' has no oracles in the store",
+            remedy=BUILD_A_BASELINE,
+            about=scenario.id,
         )
     values = run_values(store, list(runs))
     times = _action_spans(store, runs)

@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from exsce_dsl.errors import ExsceError
+from exsce_dsl.remedies import INSTALL_DASK
 
 DASK_SCHEDULER_ENV = "EXSCE_DASK_SCHEDULER"
 """The environment variable ``--cluster`` defaults to: the scheduler's address."""
@@ -53,7 +54,7 @@ def dask_map(address: str) -> Iterator[Callable[[Callable[[Any], Any], Iterable[
     try:
         from distributed import Client
     except ImportError:
-        raise ExsceError("--cluster needs Dask's distributed package: pip install 'exsce[dask]'") from None
+        raise ExsceError("a Dask cluster needs Dask's distributed package", remedy=INSTALL_DASK) from None
     try:
         client = Client(address, timeout=CONNECT_SECONDS, set_as_default=False)  # type: ignore[no-untyped-call]
     except (OSError, TimeoutError, ValueError) as exc:

@@ -13,7 +13,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import ExsceError, Remedied
 from exsce_dsl.lang import load_spec
 from exsce_dsl.maps.grid import OccupancyGrid, load_occupancy_grid
 from exsce_dsl.model.derivation import Derivation
@@ -24,6 +24,7 @@ from exsce_dsl.model.scenario import Scenario
 from exsce_dsl.model.trials import ClauseTrial
 from exsce_dsl.model.verdicts import Outcome, Verdict
 from exsce_dsl.oracles import clause_trials, lowest_pass_rate_first
+from exsce_dsl.remedies import ADD_ITS_SPEC, GIVE_THE_SPECS
 from exsce_dsl.report.campaigns import CampaignContents, gather_campaigns
 from exsce_dsl.report.units import metric_units
 from exsce_dsl.similarity.clustering import Clustering, cluster
@@ -121,12 +122,6 @@ class RunContents:
         return "failed" if self.failed else "inconclusive" if self.inconclusive else "passed"
 
 
-NO_SPEC = (
-    "no --spec was given: pass the scenarios' files with exscec report --spec FILE.exsce "
-    "to draw paths on their maps"
-)
-
-
 @dataclass(frozen=True)
 class MissingMap:
     """Why a scenario's paths are drawn without a map: ``kind`` is ``no_spec`` (no --spec given),
@@ -140,10 +135,11 @@ class MissingMap:
     detail: str = ""
 
     @property
-    def text(self) -> str:
-        """What to tell the user, and what to do about it."""
+    def text(self) -> str | Remedied:
+        """What to tell the user, and what to do about it (a remedy the command line says with
+        its options: :meth:`~exsce_dsl.errors.Remedied.said`)."""
         if self.kind == "no_spec":
-            return f"no occupancy grid: {NO_SPEC}"
+            return Remedied("no occupancy grid: no specification was given", GIVE_THE_SPECS)
         if self.kind == "no_map":
             return (
                 f"no occupancy grid: scenario '{self.scenario}' has no map: its environment "
@@ -151,10 +147,11 @@ class MissingMap:
             )
         if self.kind == "unreadable":
             return f"no occupancy grid: cannot read the map of scenario '{self.scenario}': {self.detail}"
-        return (
-            f"no occupancy grid: no file given with --spec declares scenario '{self.scenario}' "
-            "(or one it was derived from): add its file to exscec report --spec"
+        problem = (
+            f"no occupancy grid: no file given declares scenario '{self.scenario}' "
+            "(or one it was derived from)"
         )
+        return Remedied(problem, ADD_ITS_SPEC, self.scenario)
 
 
 @dataclass(frozen=True)
@@ -192,8 +189,8 @@ class ReportContents:
     """Every run's last verdicts, failed first."""
     clustering: Clustering | None
     """Of all scenarios (None with fewer than two)."""
-    notes: tuple[str, ...] = field(default=())
-    """What could not be shown, and why."""
+    notes: tuple[str | Remedied, ...] = field(default=())
+    """What could not be shown, and why (a remedy in words; ``str()`` of one says it so)."""
     units: Mapping[str, str] = field(default_factory=dict)
     """Metric name → the unit its numbers are shown with (see :mod:`.units`)."""
     campaigns: tuple[CampaignContents, ...] = field(default=())
@@ -295,13 +292,13 @@ def _waypoints(store: Store, scenario_id: str) -> dict[str, tuple[tuple[str, flo
 
 def _grids(
     scenarios: Sequence[Scenario],
-) -> tuple[dict[str, OccupancyGrid], dict[str, MissingMap], list[str]]:
+) -> tuple[dict[str, OccupancyGrid], dict[str, MissingMap], list[str | Remedied]]:
     """Scenario id → the occupancy grid of its environment, for every one of ``scenarios``; for
     those without one, scenario id → why; and the notes the report prints."""
     grids: dict[str, OccupancyGrid] = {}
     missing: dict[str, MissingMap] = {}
     loaded: dict[str, OccupancyGrid] = {}
-    notes: list[str] = []
+    notes: list[str | Remedied] = []
     for scenario in scenarios:
         map_model = scenario.environment.map
         if map_model is None or map_model.file is None:

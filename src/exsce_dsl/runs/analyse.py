@@ -25,6 +25,7 @@ from exsce_dsl.model.runs import (
     run_uuid,
 )
 from exsce_dsl.monitor_kit.monitor_core import Compute, Topic, expand_topic, reducer
+from exsce_dsl.remedies import STRICT_STORES_NONE
 from exsce_dsl.runs.bag_identity import content_hash
 from exsce_dsl.runs.bags.data import OBJECTS, BagData, Reduce, Wanted
 from exsce_dsl.runs.bags.reading import OpenedBag, open_bag
@@ -179,7 +180,8 @@ def analyse_bag(
         acting = [r.id for r in robots if scenario.mission.tasks_of(r.id)]
         lacking = missing_metrics(metrics, robots, acting, found.actions, values)
         if lacking:
-            raise IncompleteRunError(_incomplete(path, lacking, bag.problems))
+            problem, why = _incomplete(path, lacking, bag.problems)
+            raise IncompleteRunError(problem, remedy=STRICT_STORES_NONE, about=why)
     status = recorded_mission_status(path, bag.data.messages.get(PROV_TOPIC, ()))
     covered = find_coverage(
         Recording(
@@ -352,14 +354,12 @@ def _run_clocks(timeline: Timeline, spellings: Mapping[str, tuple[str, ...]]) ->
     return tuple(found.values())
 
 
-def _incomplete(path: Path, lacking: list[str], problems: list[str]) -> str:
-    """Why ``--strict`` refuses a run: the values it would lack, then the run's problems."""
+def _incomplete(path: Path, lacking: list[str], problems: list[str]) -> tuple[str, str]:
+    """Why a strict ingest refuses a run: the values it would lack, and (what its remedy,
+    :data:`~exsce_dsl.remedies.STRICT_STORES_NONE`, is about) the run's problems."""
     why = "".join(f"\n  {p}" for p in dict.fromkeys(problems))
     values = counted(len(lacking), "metric value")
-    return (
-        f"{path}: {values} would be missing ({'; '.join(lacking)}), and --strict stores no run "
-        "with a missing metric" + (f":{why}" if why else "")
-    )
+    return f"{path}: {values} would be missing ({'; '.join(lacking)})", (f":{why}" if why else "")
 
 
 def _nothing_of(path: Path, robot: Robot, types: Mapping[str, str]) -> str:

@@ -11,19 +11,21 @@ then it is analysed again and its run replaced in one write
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 import threading
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from enum import Enum
 from pathlib import Path
 from typing import TYPE_CHECKING, cast
 
-from exsce_dsl.errors import ExsceError
+from exsce_dsl.errors import ExsceError, IngestFailed, Remedied
 from exsce_dsl.model import Scenario
 from exsce_dsl.parallel.workers import workers
 from exsce_dsl.prov import DEFAULT_NAMESPACE, compile_scenario
 from exsce_dsl.prov.run import compile_run
+from exsce_dsl.remedies import REPLACE_THE_RUN, VERIFY_AGAIN
 from exsce_dsl.runs.bag_identity import content_hash
 from exsce_dsl.runs.bag_runs import BagRun, bag_runs
 from exsce_dsl.store import RunWriter, Store, WriteReport, Written, add_prov, replace_run, verdict_graphs
@@ -64,10 +66,23 @@ class IngestResult:
     """What ingestion picked for the run: conventions detected, a simulated timeline."""
     clocks: tuple[str, ...] = field(default_factory=tuple)
     """Which clock each of the bag's sources was timed by (``exscec ingest -v``)."""
+    remedied: Remedied | None = None
+    """The message as a problem and its remedy, when it has one (:meth:`said`)."""
 
     @property
     def failed(self) -> bool:
         return self.status is IngestStatus.FAILED
+
+    def said(self, wording: Mapping[str, str] | None = None) -> str:
+        """The message, its remedy in ``wording`` (the command line's: ``cli.common.REMEDIES``)."""
+        return self.remedied.said(wording) if self.remedied else self.message
+
+    def failure(self) -> IngestFailed:
+        """This result as the error of what needed its run (with the remedy, if it has one)."""
+        cause = self.remedied
+        if cause is None:
+            return IngestFailed(self.message)
+        return IngestFailed(cause.problem, remedy=cause.remedy, about=cause.about)
 
 
 def _analyse(args: tuple[Path, Scenario, str | None, str | None, bool]) -> AnalysedRun | ExsceError:
@@ -257,11 +272,10 @@ def _skipped(
         return IngestResult(path, IngestStatus.SKIPPED, message, run.run_id)
     if not run.stored or replace:
         return None
-    message = (
-        f"{path}: already a run of scenario '{scenario_id}' (run {run.run_id}); "
-        "pass --replace to analyse it again under this spec"
+    remedied = Remedied(
+        f"{path}: already a run of scenario '{scenario_id}' (run {run.run_id})", REPLACE_THE_RUN
     )
-    return IngestResult(path, IngestStatus.SKIPPED, message, run.run_id)
+    return IngestResult(path, IngestStatus.SKIPPED, remedied.said(), run.run_id, remedied=remedied)
 
 
 def _result(bag: _Todo, analysed: AnalysedRun | None, done: Written) -> IngestResult:
@@ -269,18 +283,23 @@ def _result(bag: _Todo, analysed: AnalysedRun | None, done: Written) -> IngestRe
     path = bag.path
     if done.error is not None or done.report is None or analysed is None:
         message = done.error.message if done.error is not None else "not written"
-        named = message if str(path) in message else f"{path}: {message}"
-        return IngestResult(path, IngestStatus.FAILED, named)
+        prefix = "" if str(path) in message else f"{path}: "
+        cause = done.error.remedied if done.error is not None else None
+        remedied = dataclasses.replace(cause, problem=prefix + cause.problem) if cause else None
+        return IngestResult(path, IngestStatus.FAILED, prefix + message, remedied=remedied)
+    said, dropped, others = _what_was_done(bag, len(analysed.run.metrics), done.report)
+    done_text, rest = f"{path}: run {analysed.run.uuid} {said}", others + _uncovered(analysed)
+    remedied = Remedied(done_text, VERIFY_AGAIN, rest) if dropped else None
     return IngestResult(
         path,
         IngestStatus.REPLACED if bag.replacing else IngestStatus.INGESTED,
-        f"{path}: run {analysed.run.uuid} {_what_was_done(bag, len(analysed.run.metrics), done.report)}"
-        + _uncovered(analysed),
+        remedied.said() if remedied else done_text + rest,
         analysed.run.uuid,
         tuple(analysed.problems),
         done.report.statements,
         tuple(analysed.picked()),
         tuple(analysed.clocks()),
+        remedied=remedied,
     )
 
 
@@ -293,14 +312,15 @@ def _uncovered(analysed: AnalysedRun) -> str:
     return f"; its recording does not cover all of it: {counted(len(gaps), 'gap')} ({kinds})"
 
 
-def _what_was_done(bag: _Todo, values: int, report: WriteReport) -> str:
-    """``(51 metric values)``, and what else a reader should know of the run."""
-    said = f"({values} metric values)"
+def _what_was_done(bag: _Todo, values: int, report: WriteReport) -> tuple[str, bool, str]:
+    """``(51 metric values)``; whether a replaced run's verdicts were dropped (the remedy, to
+    verify it again, goes after that); then what else a reader should know of the run."""
+    said, dropped = f"({values} metric values)", False
     if bag.replacing:
         said = f"analysed again {said}, in place of the stored one"
-        dropped = verdict_graphs(report.replaced)
-        if dropped:
-            said += "; its verdicts were dropped (exscec verify judges it again)"
+        if verdict_graphs(report.replaced):
+            said, dropped = f"{said}; its verdicts were dropped", True
+    others = ""
     if bag.run is not None and bag.run.others:
-        said += f"; the bag is also a run of scenario {', '.join(repr(s) for s in bag.run.others)}"
-    return said
+        others = f"; the bag is also a run of scenario {', '.join(repr(s) for s in bag.run.others)}"
+    return said, dropped, others

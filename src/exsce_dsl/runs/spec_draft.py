@@ -27,7 +27,7 @@ import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from exsce_dsl.errors import REPLACE_FILES, BagError, ExportError, SourceLocation
+from exsce_dsl.errors import BagError, ExportError, SourceLocation
 from exsce_dsl.lang import Comment, declared_poses, format_document
 from exsce_dsl.maps.grid import FREE, OccupancyGrid, grid_from_ros, save_occupancy_grid
 from exsce_dsl.model import (
@@ -62,6 +62,7 @@ from exsce_dsl.model.conventions import CONVENTIONS, METHOD, MetricSpan
 from exsce_dsl.model.names import KEYWORDS, is_valid_name
 from exsce_dsl.model.runs import run_uuid
 from exsce_dsl.output_folder import existing, write_below
+from exsce_dsl.remedies import REPLACE_FILES
 from exsce_dsl.runs.bag_identity import content_hash
 from exsce_dsl.runs.bag_robots import BagContents, BagRobot, Place, bag_contents
 from exsce_dsl.wording import counted

@@ -21,7 +21,7 @@ from exsce_dsl.model import Scenario
 from exsce_dsl.model.conventions import Signals
 from exsce_dsl.sim.batches import Batch
 from exsce_dsl.sim.conventions import convention_writer
-from exsce_dsl.sim.executor import Execution
+from exsce_dsl.sim.executor import SimulatedExecution
 from exsce_dsl.sim.scan import Laser
 from exsce_dsl.sim.writing import RobotRun
 
@@ -44,7 +44,7 @@ def write_bag(
     path: Path,
     fmt: str,
     scenario: Scenario,
-    execution: Execution,
+    execution: SimulatedExecution,
     grid: PlanningGrid,
     start_ns: int,
     seed: int,

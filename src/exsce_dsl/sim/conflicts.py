@@ -17,7 +17,7 @@ from typing import Protocol
 import numpy as np
 
 from exsce_dsl.maps.planning import Point
-from exsce_dsl.sim.motion import DT, Trajectory
+from exsce_dsl.sim.motion import DT, SampledMotion
 
 CLEARANCE = 0.7
 """Metres between two robots' centres below which they touch (two 0.3 m robots, 0.1 m apart)."""
@@ -31,7 +31,7 @@ STOOD = 3.0
 it stood (when both were waiting for each other, the one that then moved on is met a little
 further on, where nobody can go round it)."""
 
-Leg = tuple[str, int]
+LegId = tuple[str, int]
 """A robot's drive to one waypoint: the robot and the leg's number (from 1, over the run)."""
 
 
@@ -52,12 +52,12 @@ class Timed(Protocol):
 class Repair:
     """Plan ``leg`` again round ``place``."""
 
-    leg: Leg
+    leg: LegId
     place: Point
 
 
 def conflict_repairs(
-    trajectories: Mapping[str, Trajectory],
+    trajectories: Mapping[str, SampledMotion],
     actions: Sequence[Timed],
     order: Sequence[str],
     clearance: float = CLEARANCE,
@@ -78,7 +78,7 @@ def conflict_repairs(
 
 
 def meetings(
-    trajectories: Mapping[str, Trajectory], order: Sequence[str], clearance: float = CLEARANCE
+    trajectories: Mapping[str, SampledMotion], order: Sequence[str], clearance: float = CLEARANCE
 ) -> list[tuple[int, str, str]]:
     """Each time two robots come closer than ``clearance``: its first sample and the two robots
     (in ``order``), earliest first."""
@@ -96,7 +96,7 @@ def meetings(
 
 
 def _positions(
-    trajectories: Mapping[str, Trajectory], robots: Sequence[str]
+    trajectories: Mapping[str, SampledMotion], robots: Sequence[str]
 ) -> tuple[np.ndarray, np.ndarray]:
     """The robots' x and y, one row each, over the samples they all have."""
     n = min(len(trajectories[r]) for r in robots)
@@ -132,7 +132,7 @@ def _repairs_of(
     return repairs
 
 
-def leg_at(actions: Sequence[Timed], robot: str, t: float) -> Leg | None:
+def leg_at(actions: Sequence[Timed], robot: str, t: float) -> LegId | None:
     """The leg ``robot`` drives at ``t`` (or last drove, when it waits between legs)."""
     number, found = 0, None
     for action in actions:

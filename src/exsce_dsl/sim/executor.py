@@ -21,7 +21,7 @@ from exsce_dsl.maps.planning import PlanningGrid, Point
 from exsce_dsl.model import MissionType, Pose, Scenario
 from exsce_dsl.model.goals import GoalStatus
 from exsce_dsl.sim.actions import GoalEvent, SimulatedAction
-from exsce_dsl.sim.conflicts import MAX_REPAIRS, Leg, Repair, conflict_repairs, meetings
+from exsce_dsl.sim.conflicts import MAX_REPAIRS, LegId, Repair, conflict_repairs, meetings
 from exsce_dsl.sim.faults import (
     DEADLOCK_WAIT,
     Fault,
@@ -33,7 +33,7 @@ from exsce_dsl.sim.faults import (
     speed_factor,
 )
 from exsce_dsl.sim.give_way import distance_to_polyline, give_way
-from exsce_dsl.sim.motion import DT, Limits, Trajectory, drive
+from exsce_dsl.sim.motion import DT, Limits, SampledMotion, drive
 from exsce_dsl.sim.passing import Wait, head_on_wait
 
 
@@ -42,13 +42,13 @@ class RobotMotion:
     """A robot's motion and dispatcher events over the whole run."""
 
     robot: str
-    parts: list[Trajectory] = field(default_factory=list)
+    parts: list[SampledMotion] = field(default_factory=list)
     samples: int = 0
     yaw: float = 0.0
     x: float = 0.0
     y: float = 0.0
 
-    def append(self, part: Trajectory) -> None:
+    def append(self, part: SampledMotion) -> None:
         if len(part):
             self.parts.append(part)
             self.samples += len(part)
@@ -56,7 +56,7 @@ class RobotMotion:
 
     def wait_until(self, sample: int) -> None:
         if sample > self.samples:
-            self.append(Trajectory.hold(self.x, self.y, self.yaw, sample - self.samples))
+            self.append(SampledMotion.hold(self.x, self.y, self.yaw, sample - self.samples))
 
     @property
     def now(self) -> float:
@@ -64,10 +64,10 @@ class RobotMotion:
 
 
 @dataclass(frozen=True)
-class Execution:
+class SimulatedExecution:
     """What the executor did: trajectories on one clock, events and ground truth."""
 
-    trajectories: dict[str, Trajectory]
+    trajectories: dict[str, SampledMotion]
     events: list[GoalEvent]
     actions: list[SimulatedAction]
     duration: float
@@ -79,7 +79,7 @@ def execute(
     seed: int,
     faults: tuple[Fault, ...] = (),
     limits: Limits | None = None,
-) -> Execution:
+) -> SimulatedExecution:
     """Play ``scenario``; where two robots would still touch after giving way, the whole run is
     played again (as a fleet manager repairs a plan), at most MAX_REPAIRS times: when they had
     stopped facing each other, the one with less right of way drives by way of a place beside the
@@ -88,8 +88,8 @@ def execute(
     place where the other was (sim.conflicts).  ``near-collision`` is the fault of not doing so."""
     check_faults(scenario, faults)
     limits = limits or Limits()
-    avoid: dict[Leg, tuple[Point, ...]] = {}
-    waits: dict[Leg, Wait] = {}
+    avoid: dict[LegId, tuple[Point, ...]] = {}
+    waits: dict[LegId, Wait] = {}
     plans: Plans = {}  # the same leg, planned round the same robots, in every replay
     execution = _play(scenario, grid, seed, faults, limits, avoid, plans, waits)
     if any(f.kind == "near-collision" for f in faults):
@@ -115,7 +115,7 @@ def execute(
 
 
 def _can_go_round(
-    repair: Repair, actions: list[SimulatedAction], avoid: dict[Leg, tuple[Point, ...]]
+    repair: Repair, actions: list[SimulatedAction], avoid: dict[LegId, tuple[Point, ...]]
 ) -> bool:
     """The repair would change its leg: the place is not tried yet (nor one near it) and not
     so near the leg's ends that its path cannot go round it."""
@@ -133,10 +133,10 @@ def _play(
     seed: int,
     faults: tuple[Fault, ...],
     limits: Limits,
-    avoid: dict[Leg, tuple[Point, ...]],
+    avoid: dict[LegId, tuple[Point, ...]],
     plans: Plans,
-    waits: dict[Leg, Wait],
-) -> Execution:
+    waits: dict[LegId, Wait],
+) -> SimulatedExecution:
     """One playing of ``scenario``: each allocation entry's subtasks dispatched in turn, then the
     robots giving way to each other and all trajectories held to one end."""
     play = _Play(scenario, grid, random.Random(seed), faults, limits, avoid, plans, waits)
@@ -156,9 +156,9 @@ class _Play:
         rng: random.Random,
         faults: tuple[Fault, ...],
         limits: Limits,
-        avoid: dict[Leg, tuple[Point, ...]],
+        avoid: dict[LegId, tuple[Point, ...]],
         plans: Plans,
-        waits: dict[Leg, Wait],
+        waits: dict[LegId, Wait],
     ) -> None:
         self.scenario, self.grid, self.rng, self.faults, self.limits = scenario, grid, rng, faults, limits
         self.avoid, self.plans, self.waits = avoid, plans, waits
@@ -174,7 +174,7 @@ class _Play:
         self.task_numbers: dict[str, int] = {}
         self.waypoint_counts: dict[str, int] = {}
         self.near_collision = any(f.kind == "near-collision" for f in faults)
-        self.approach: dict[str, list[Trajectory]] = {}
+        self.approach: dict[str, list[SampledMotion]] = {}
         if self.near_collision:
             self.approach = _near_collision(scenario, self.timelines, grid, limits)
         self.slow_boxes = area_boxes(scenario, faults)
@@ -203,9 +203,9 @@ class _Play:
         ids = tuple(w.id for w in waypoints)
         key = f"{robot}-task_{self.task_numbers[robot]:02d}-subtask_{s_number:03d}"
         statuses = [GoalStatus.PENDING] * len(ids)
-        tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, 5))
+        tl.append(SampledMotion.hold(tl.x, tl.y, tl.yaw, 5))
         self.events.append(GoalEvent(tl.now, robot, key, ids, tuple(statuses), False))  # goal accepted
-        tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, 5))  # the dispatcher activates its first waypoint
+        tl.append(SampledMotion.hold(tl.x, tl.y, tl.yaw, 5))  # the dispatcher activates its first waypoint
         for w_number, goal in enumerate(waypoints, start=1):
             statuses[w_number - 1] = GoalStatus.ACTIVE
             start_t = tl.now
@@ -233,7 +233,7 @@ class _Play:
             )
             last = w_number == len(ids)
             self.events.append(GoalEvent(tl.now, robot, key, ids, tuple(statuses), last))
-            tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, int(self.rng.uniform(0.2, 0.6) * 50)))
+            tl.append(SampledMotion.hold(tl.x, tl.y, tl.yaw, int(self.rng.uniform(0.2, 0.6) * 50)))
 
     def advance(self, robot: str, goal: Pose) -> tuple[list[Point], GoalStatus]:
         """The robot's next leg, to ``goal``: driven (by way of a detour or a head-on wait when
@@ -243,12 +243,12 @@ class _Play:
         self.waypoint_counts[robot] = count = self.waypoint_counts.get(robot, 0) + 1
         leg = (robot, count)
         if self.stuck and count == 1:  # deadlock-start: every robot waits
-            tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, int(round(DEADLOCK_WAIT / DT))))
+            tl.append(SampledMotion.hold(tl.x, tl.y, tl.yaw, int(round(DEADLOCK_WAIT / DT))))
         keep_clear = _standing(self.parked, self.avoid.get(leg, ()))
         if leg in self.skip:
             target = (goal.position.x, goal.position.y)
             path = _plan_around(self.grid, (tl.x, tl.y), target, keep_clear, self.plans)
-            tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, 25))
+            tl.append(SampledMotion.hold(tl.x, tl.y, tl.yaw, 25))
             return path, GoalStatus.ABORTED
         for part in self.approach.pop(robot, []):  # the near-collision fault, inside the mission
             tl.append(part)
@@ -264,22 +264,22 @@ class _Play:
         self.last_pose[robot] = goal
         return path, GoalStatus.SUCCEEDED
 
-    def finish(self) -> Execution:
+    def finish(self) -> SimulatedExecution:
         """The robots give way to each other (unless the near-collision fault forbids it) and
         every trajectory is held to one end, a second after the last robot stops."""
-        trajectories = {r: Trajectory.concat(t.parts) for r, t in self.timelines.items()}
+        trajectories = {r: SampledMotion.concat(t.parts) for r, t in self.timelines.items()}
         events, actions = self.events, self.actions
         if not self.near_collision:
             trajectories, events, actions = give_way(self.scenario, trajectories, events, actions)
         end = max(len(t) for t in trajectories.values()) + 50
         trajectories = {
-            r: Trajectory.concat(
-                [t, Trajectory.hold(float(t.x[-1]), float(t.y[-1]), float(t.yaw[-1]), end - len(t))]
+            r: SampledMotion.concat(
+                [t, SampledMotion.hold(float(t.x[-1]), float(t.y[-1]), float(t.yaw[-1]), end - len(t))]
             )
             for r, t in trajectories.items()
         }
         events.sort(key=lambda e: (e.t, e.robot))
-        return Execution(trajectories, events, actions, end * DT)
+        return SimulatedExecution(trajectories, events, actions, end * DT)
 
 
 def _starting_timelines(scenario: Scenario, rng: random.Random) -> dict[str, RobotMotion]:
@@ -294,7 +294,7 @@ def _starting_timelines(scenario: Scenario, rng: random.Random) -> dict[str, Rob
             robot.start_pose.position.y,
             robot.start_pose.orientation.yaw,
         )
-        tl.append(Trajectory.hold(tl.x, tl.y, tl.yaw, int(rng.uniform(0.5, 1.0) * 50)))
+        tl.append(SampledMotion.hold(tl.x, tl.y, tl.yaw, int(rng.uniform(0.5, 1.0) * 50)))
         timelines[robot.id] = tl
     return timelines
 
@@ -308,7 +308,7 @@ def _drive_to(
     limits: Limits,
     plans: Plans,
     until: int | None = None,
-) -> tuple[list[tuple[float, float]], Trajectory]:
+) -> tuple[list[tuple[float, float]], SampledMotion]:
     """The path from where ``tl`` stands to ``goal`` (by way of ``via``, stopping there to turn:
     the detour fault; and waiting there until sample ``until``: a head-on wait) and the drive
     along it."""
@@ -323,15 +323,15 @@ def _drive_to(
     second = drive(on, heading, goal.orientation.yaw, limits)
     parts = [first, second]
     if until is not None and until > tl.samples + len(first):
-        end = first if len(first) else Trajectory.hold(tl.x, tl.y, heading, 1)
+        end = first if len(first) else SampledMotion.hold(tl.x, tl.y, heading, 1)
         x, y, yaw = float(end.x[-1]), float(end.y[-1]), float(end.yaw[-1])
-        parts.insert(1, Trajectory.hold(x, y, yaw, until - tl.samples - len(first)))
-    return there + on[1:], Trajectory.concat(parts)
+        parts.insert(1, SampledMotion.hold(x, y, yaw, until - tl.samples - len(first)))
+    return there + on[1:], SampledMotion.concat(parts)
 
 
 def _near_collision(
     scenario: Scenario, timelines: dict[str, RobotMotion], grid: PlanningGrid, limits: Limits
-) -> dict[str, list[Trajectory]]:
+) -> dict[str, list[SampledMotion]]:
     """The second robot's first action starts with a drive to the first robot, which waits at its
     start until the second has come close and gone back: the legs, to insert in that action."""
     robots = [r for r in scenario.robots if r.id in timelines]
@@ -401,4 +401,4 @@ def _standing(parked: dict[str, Point], avoid: tuple[Point, ...]) -> tuple[Point
     return tuple(parked.values()) + avoid
 
 
-__all__ = ["SimulatedAction", "Execution", "Fault", "GoalEvent", "GoalStatus", "execute", "np"]
+__all__ = ["SimulatedAction", "SimulatedExecution", "Fault", "GoalEvent", "GoalStatus", "execute", "np"]

@@ -50,7 +50,7 @@ import numpy as np
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import Pose, Scenario
-from exsce_dsl.sim.motion import DT, Trajectory
+from exsce_dsl.sim.motion import DT, SampledMotion
 from exsce_dsl.suggest import did_you_mean
 
 OVERSPEED = 1.0 / 0.6 * 1.4 / 0.95
@@ -268,7 +268,7 @@ def area_boxes(scenario: Scenario, faults: tuple[Fault, ...]) -> list[tuple[floa
     return boxes
 
 
-def slow_in_areas(leg: Trajectory, boxes: list[tuple[float, float, float, float]]) -> Trajectory:
+def slow_in_areas(leg: SampledMotion, boxes: list[tuple[float, float, float, float]]) -> SampledMotion:
     """``leg`` driven at SLOW_AREA of its speed from the first sample inside one of ``boxes``
     to its end (the same path, more samples); unchanged if it never enters one."""
     inside = np.zeros(len(leg), dtype=bool)
@@ -292,7 +292,7 @@ def slow_in_areas(leg: Trajectory, boxes: list[tuple[float, float, float, float]
     k1 = np.minimum(k + 1, last)
     f = at - k
     scale = np.asarray(rates)
-    return Trajectory(
+    return SampledMotion(
         leg.x[k] + f * (leg.x[k1] - leg.x[k]),
         leg.y[k] + f * (leg.y[k1] - leg.y[k]),
         leg.yaw[k] + f * (leg.yaw[k1] - leg.yaw[k]),

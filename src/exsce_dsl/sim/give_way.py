@@ -16,7 +16,7 @@ import numpy as np
 from exsce_dsl.model import Scenario
 from exsce_dsl.sim.actions import GoalEvent, SimulatedAction
 from exsce_dsl.sim.conflicts import CLEARANCE
-from exsce_dsl.sim.motion import DT, Trajectory
+from exsce_dsl.sim.motion import DT, SampledMotion
 
 SAFE_DISTANCE = 1.5  # metres between robot centres that robots keep when they can
 MAX_WAIT = 10.0  # seconds a robot waits before it goes on (a real planner would detour)
@@ -29,10 +29,10 @@ STEP = DT / RAMP  # the most a robot's rate changes in one sample
 
 def give_way(
     scenario: Scenario,
-    trajectories: dict[str, Trajectory],
+    trajectories: dict[str, SampledMotion],
     events: list[GoalEvent],
     actions: list[SimulatedAction],
-) -> tuple[dict[str, Trajectory], list[GoalEvent], list[SimulatedAction]]:
+) -> tuple[dict[str, SampledMotion], list[GoalEvent], list[SimulatedAction]]:
     """Right of way by fleet order, replayed on the trajectories (paths unchanged, clocks warped).
 
     Each robot advances along its own trajectory at a rate between -1 (backing up
@@ -65,7 +65,7 @@ class _Replay:
     trajectory (a fractional sample index), at what rate it advances, and how long it has waited."""
 
     def __init__(
-        self, trajectories: dict[str, Trajectory], order: list[str], actions: list[SimulatedAction]
+        self, trajectories: dict[str, SampledMotion], order: list[str], actions: list[SimulatedAction]
     ) -> None:
         self.trajectories, self.order = trajectories, order
         # plain floats: at() runs a million times a replay, and numpy scalars cost thrice as much
@@ -193,7 +193,7 @@ class _Replay:
         return (xs[k] + f * (xs[k1] - xs[k]), ys[k] + f * (ys[k1] - ys[k]))
 
 
-def _warped(tr: Trajectory, p: np.ndarray) -> tuple[Trajectory, np.ndarray]:
+def _warped(tr: SampledMotion, p: np.ndarray) -> tuple[SampledMotion, np.ndarray]:
     """``tr`` resampled at the fractional positions ``p`` the replay showed, and for each of its
     original samples the first new sample that reached it."""
     last = len(tr) - 1
@@ -201,7 +201,7 @@ def _warped(tr: Trajectory, p: np.ndarray) -> tuple[Trajectory, np.ndarray]:
     k1 = np.minimum(k + 1, last)
     f = p - k
     speed_scale = np.diff(p, prepend=0.0)  # progress per sample: -1..1
-    warped = Trajectory(
+    warped = SampledMotion(
         tr.x[k] + f * (tr.x[k1] - tr.x[k]),
         tr.y[k] + f * (tr.y[k1] - tr.y[k]),
         tr.yaw[k] + f * (tr.yaw[k1] - tr.yaw[k]),
@@ -212,7 +212,7 @@ def _warped(tr: Trajectory, p: np.ndarray) -> tuple[Trajectory, np.ndarray]:
     return warped, np.minimum(first, len(p))
 
 
-def _last_move(trajectory: Trajectory) -> int:
+def _last_move(trajectory: SampledMotion) -> int:
     """The last sample at which the robot is still moving (0 if it never moves)."""
     moved = np.flatnonzero((np.abs(np.diff(trajectory.x)) > 1e-9) | (np.abs(np.diff(trajectory.y)) > 1e-9))
     return int(moved[-1]) + 1 if len(moved) else 0

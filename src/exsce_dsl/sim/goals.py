@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from exsce_dsl.model import Pose
-from exsce_dsl.sim.executor import Execution, GoalStatus
+from exsce_dsl.sim.executor import GoalStatus, SimulatedExecution
 from exsce_dsl.sim.motion import DT
 
 
@@ -51,7 +51,9 @@ class NavigationGoal:
         return Phase.EXECUTING if sample < self.ended else self.outcome
 
 
-def navigation_goals(execution: Execution, robot: str, rng: np.random.Generator) -> list[NavigationGoal]:
+def navigation_goals(
+    execution: SimulatedExecution, robot: str, rng: np.random.Generator
+) -> list[NavigationGoal]:
     """The goals of ``robot``, in order; each gets its UUID from ``rng``."""
     goals = []
     actions = sorted((a for a in execution.actions if a.robot == robot), key=lambda a: a.start)

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from exsce_dsl.sim.motion import DT, Trajectory
+from exsce_dsl.sim.motion import DT, SampledMotion
 
 SCALE_ERROR = (0.01, 0.03)
 """Odometry's distance scale error, a fraction (its sign is seeded too)."""
@@ -93,7 +93,9 @@ class Localisation:
     drift: Odometry
 
 
-def localise(trajectory: Trajectory, rng: np.random.Generator, drift: Odometry | None = None) -> Localisation:
+def localise(
+    trajectory: SampledMotion, rng: np.random.Generator, drift: Odometry | None = None
+) -> Localisation:
     """The odometry, estimate and correction of a robot that drove ``trajectory`` (seeded);
     ``drift``: its odometry's, else drawn from ``rng`` (a robot driving leg after leg keeps one)."""
     drift = Odometry.seeded(rng) if drift is None else drift

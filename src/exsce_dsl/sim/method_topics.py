@@ -17,7 +17,7 @@ from exsce_dsl.maps.planning import PlanningGrid
 from exsce_dsl.model.conventions import METHOD_TOPICS
 from exsce_dsl.model.metrics import expand_topic
 from exsce_dsl.sim.batches import Batch, stamp_columns
-from exsce_dsl.sim.executor import Execution, GoalStatus
+from exsce_dsl.sim.executor import GoalStatus, SimulatedExecution
 from exsce_dsl.sim.messages import FEEDBACK, RESULT
 from exsce_dsl.sim.scan import Laser, laser_scans
 from exsce_dsl.sim.values import (
@@ -82,7 +82,7 @@ def robot_messages(
     store: Any,
     robot: str,
     topics: Topics,
-    execution: Execution,
+    execution: SimulatedExecution,
     grid: PlanningGrid,
     laser: Laser,
     rng: np.random.Generator,
@@ -151,7 +151,7 @@ def robot_messages(
 
 
 def dispatcher_messages(
-    store: Any, robot: str, topics: Topics, execution: Execution, start_ns: int
+    store: Any, robot: str, topics: Topics, execution: SimulatedExecution, start_ns: int
 ) -> Iterator[Message]:
     T = store.types
     last_change: dict[tuple[str, int], int] = {}

@@ -23,7 +23,7 @@ class Limits:
 
 
 @dataclass(frozen=True)
-class Trajectory:
+class SampledMotion:
     """Samples every DT seconds from ``t0``: position, heading, speed, turn rate."""
 
     x: np.ndarray
@@ -36,26 +36,26 @@ class Trajectory:
         return len(self.x)
 
     @staticmethod
-    def hold(x: float, y: float, yaw: float, samples: int) -> Trajectory:
+    def hold(x: float, y: float, yaw: float, samples: int) -> SampledMotion:
         z = np.zeros(samples)
-        return Trajectory(z + x, z + y, z + yaw, z.copy(), z.copy())
+        return SampledMotion(z + x, z + y, z + yaw, z.copy(), z.copy())
 
     @staticmethod
-    def concat(parts: list[Trajectory]) -> Trajectory:
-        return Trajectory(
+    def concat(parts: list[SampledMotion]) -> SampledMotion:
+        return SampledMotion(
             *(np.concatenate([getattr(p, f) for p in parts]) for f in ("x", "y", "yaw", "v", "w"))
         )
 
 
-def _turn(x: float, y: float, yaw0: float, yaw1: float, limits: Limits) -> Trajectory:
+def _turn(x: float, y: float, yaw0: float, yaw1: float, limits: Limits) -> SampledMotion:
     delta = math.atan2(math.sin(yaw1 - yaw0), math.cos(yaw1 - yaw0))
     n = int(math.ceil(abs(delta) / (limits.max_turn_rate * DT)))
     if n == 0:
-        return Trajectory.hold(x, y, yaw0, 0)
+        return SampledMotion.hold(x, y, yaw0, 0)
     yaw = yaw0 + delta * np.arange(1, n + 1) / n
     w = np.full(n, delta / (n * DT))
     z = np.zeros(n)
-    return Trajectory(z + x, z + y, yaw, z, w)
+    return SampledMotion(z + x, z + y, yaw, z, w)
 
 
 def _speed_profile(length: float, limits: Limits) -> np.ndarray:
@@ -84,7 +84,7 @@ def _speed_profile(length: float, limits: Limits) -> np.ndarray:
     return profile
 
 
-def drive(path: list[tuple[float, float]], yaw0: float, goal_yaw: float, limits: Limits) -> Trajectory:
+def drive(path: list[tuple[float, float]], yaw0: float, goal_yaw: float, limits: Limits) -> SampledMotion:
     """From ``path[0]`` heading ``yaw0`` along ``path`` to ``path[-1]``, ending at ``goal_yaw``."""
     pts = np.asarray(path, dtype=np.float64)
     seg = np.diff(pts, axis=0)
@@ -118,6 +118,6 @@ def drive(path: list[tuple[float, float]], yaw0: float, goal_yaw: float, limits:
     v = (s - prev_s) / DT
     prev_yaw = np.concatenate([[float(headings[0])], yaw[:-1]])
     w = (yaw - prev_yaw) / DT
-    moving = Trajectory(x, y, yaw, v, w)
+    moving = SampledMotion(x, y, yaw, v, w)
     last = _turn(float(x[-1]), float(y[-1]), float(yaw[-1]), goal_yaw, limits)
-    return Trajectory.concat([first, moving, last])
+    return SampledMotion.concat([first, moving, last])

@@ -21,8 +21,8 @@ from typing import Protocol
 import numpy as np
 
 from exsce_dsl.maps.planning import PlanningGrid, Point
-from exsce_dsl.sim.conflicts import CLEARANCE, STOOD, Leg, Timed, leg_at
-from exsce_dsl.sim.motion import DT, Trajectory
+from exsce_dsl.sim.conflicts import CLEARANCE, STOOD, LegId, Timed, leg_at
+from exsce_dsl.sim.motion import DT, SampledMotion
 
 ASIDE = CLEARANCE + 0.3
 """Metres between a waiting robot's centre and the other's path: room to pass at clearance."""
@@ -52,13 +52,13 @@ class Wait:
     """Drive ``leg`` by way of ``place`` and wait there until ``until`` (seconds on the run's
     clock; None: do not wait) before driving on to its goal."""
 
-    leg: Leg
+    leg: LegId
     place: Point
     until: float | None
 
 
 def head_on_wait(
-    trajectories: dict[str, Trajectory],
+    trajectories: dict[str, SampledMotion],
     actions: Sequence[Driven],
     order: Sequence[str],
     grid: PlanningGrid,
@@ -90,14 +90,14 @@ def head_on_wait(
     return Wait(leg, place, until) if until - mover_stop * DT <= LONGEST else None
 
 
-def _mid_leg(actions: Sequence[Driven], leg: Leg, point: Point) -> bool:
+def _mid_leg(actions: Sequence[Driven], leg: LegId, point: Point) -> bool:
     """``point`` is on the way: farther than ENDS from both ends of the leg's path."""
     robot, number = leg
     path = [x for x in actions if x.robot == robot][number - 1].path
     return bool(path) and all(math.dist(point, end) > ENDS for end in (path[0], path[-1]))
 
 
-def _stood_since(trajectory: Trajectory, k: int) -> int | None:
+def _stood_since(trajectory: SampledMotion, k: int) -> int | None:
     """The first sample of the stop the robot was in just before sample ``k`` (within STOOD
     seconds of it), or None when it did not stand then."""
     since = max(0, k - int(STOOD / DT))
@@ -112,7 +112,7 @@ def _stood_since(trajectory: Trajectory, k: int) -> int | None:
     return int(moves[-1]) + 1 if len(moves) else 0
 
 
-def _path_ahead(actions: Sequence[Driven], leg: Leg, at: Point) -> np.ndarray:
+def _path_ahead(actions: Sequence[Driven], leg: LegId, at: Point) -> np.ndarray:
     """The other robot's path from ``at`` to the end of its leg, and its next leg's."""
     robot, number = leg
     own = [x for x in actions if x.robot == robot]

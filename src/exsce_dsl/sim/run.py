@@ -27,10 +27,11 @@ from exsce_dsl.model.conventions import Signals
 from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Run, run_name, run_uuid
 from exsce_dsl.parallel.dask_client import dask_map
 from exsce_dsl.prov.recorder import recorded_prov_json, recorded_run
+from exsce_dsl.remedies import CHOOSE_A_CONVENTION
 from exsce_dsl.runs import ROS1_BAG
 from exsce_dsl.sim.bag import write_bag
 from exsce_dsl.sim.conventions import convention_writer
-from exsce_dsl.sim.executor import Execution, Fault, GoalStatus, execute
+from exsce_dsl.sim.executor import Fault, GoalStatus, SimulatedExecution, execute
 
 FORMATS = ("ros1", "ros2", "mcap")
 #: Runs of seed S start at this instant plus S days (modulo SEED_DAYS), one hour apart (no wall clock:
@@ -46,7 +47,7 @@ class SimulatedRun:
     bag: Path
     start: dt.datetime
     seed: int
-    execution: Execution
+    execution: SimulatedExecution
     messages: int
 
 
@@ -203,7 +204,7 @@ def _remove(path: Path) -> None:
 
 
 def _recorded_run(
-    run_id: str, scenario: Scenario, execution: Execution, start: dt.datetime, bag: Path
+    run_id: str, scenario: Scenario, execution: SimulatedExecution, start: dt.datetime, bag: Path
 ) -> Run:
     """What the method's recorder writes during a run: task executions and actions, no metrics."""
 
@@ -231,7 +232,7 @@ def scenario_convention(scenario: Scenario) -> str:
     if len(found) > 1:
         listed = ", ".join(f"{robot}: {name}" for robot, name in named.items())
         raise ExsceError(
-            f"the robots of scenario '{scenario.id}' follow different conventions ({listed}); the "
-            "executor writes one for the whole run: choose it with --convention"
+            f"the robots of scenario '{scenario.id}' follow different conventions ({listed})",
+            remedy=CHOOSE_A_CONVENTION,
         )
     return found[0] if found else "method"

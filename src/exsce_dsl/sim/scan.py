@@ -14,7 +14,7 @@ import numpy as np
 
 from exsce_dsl.maps.planning import PlanningGrid
 from exsce_dsl.sim.batches import Batch, stamp_columns
-from exsce_dsl.sim.executor import Execution
+from exsce_dsl.sim.executor import SimulatedExecution
 from exsce_dsl.sim.motion import DT
 from exsce_dsl.sim.values import header_at
 
@@ -132,7 +132,7 @@ def laser_scans(
     topic: str,
     frame: str,
     robot: str,
-    execution: Execution,
+    execution: SimulatedExecution,
     grid: PlanningGrid,
     laser: Laser,
     rng: np.random.Generator,

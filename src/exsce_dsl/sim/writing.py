@@ -1,6 +1,6 @@
 """What a convention's writer is given for one robot, and what it gives back.
 
-A writer turns one robot's part of an :class:`~exsce_dsl.sim.executor.Execution` into
+A writer turns one robot's part of an :class:`~exsce_dsl.sim.executor.SimulatedExecution` into
 messages, ``(topic, type, stamp in ns, message value)``, in any order: the bag writer sorts them.
 """
 
@@ -14,7 +14,7 @@ import numpy as np
 
 from exsce_dsl.maps.planning import PlanningGrid
 from exsce_dsl.sim.batches import Batch
-from exsce_dsl.sim.executor import Execution
+from exsce_dsl.sim.executor import SimulatedExecution
 from exsce_dsl.sim.scan import Laser
 
 Message = tuple[str, str, int, Any]
@@ -30,7 +30,7 @@ class RobotRun:
     robot: str
     namespace: str
     """Without slashes; ``""``: the robot's topics are at the root."""
-    execution: Execution
+    execution: SimulatedExecution
     grid: PlanningGrid
     laser: Laser
     rng: np.random.Generator

@@ -18,7 +18,7 @@ if TYPE_CHECKING:
     from exsce_dsl.store.queries import (
         MetricReading,
         MetricSource,
-        Parameter,
+        QueryParameter,
         RunChain,
         RunDefect,
         StoredRun,

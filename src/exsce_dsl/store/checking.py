@@ -26,13 +26,15 @@ revisions go with the run.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 from pyoxigraph import Literal, NamedNode
 
+from exsce_dsl.errors import Remedied
 from exsce_dsl.prov import identifiers as ids
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, PROV_NAMESPACE, Namespaces
+from exsce_dsl.remedies import FIX_THE_STORE, REBUILD_THE_BASELINE, STORE_THE_SCENARIO
 from exsce_dsl.store.base import GraphSet, Store
 from exsce_dsl.store.graph_owners import graph_run
 from exsce_dsl.store.migrating import old_bag_bundles, renamed_graphs
@@ -46,7 +48,6 @@ OLD_BAG_BUNDLE = "old bag bundle"
 OLD_ROBOT_NAME = "old robot name"
 DANGLING = "dangling reference"
 NO_SCENARIO = "run without scenario"
-_REBUILD = "build it again: exscec baseline SPEC"
 
 
 @dataclass(frozen=True)
@@ -58,11 +59,14 @@ class StoreFinding:
     """The graph it is in (or is)."""
     message: str
     fixable: bool = False
-    """Whether ``--fix`` mends it."""
+    """Whether ``check_store(fix=True)`` mends it."""
+    remedied: Remedied | None = field(default=None, compare=False)
+    """The message as a problem and its remedy, when it has one."""
 
-    def line(self) -> str:
-        """``<graph>: kind: message``."""
-        return f"<{self.graph}>: {self.kind}: {self.message}"
+    def line(self, wording: Mapping[str, str] | None = None) -> str:
+        """``<graph>: kind: message``, its remedy in ``wording`` (the command line's) if given."""
+        message = self.remedied.said(wording) if self.remedied else self.message
+        return f"<{self.graph}>: {self.kind}: {message}"
 
 
 @dataclass(frozen=True)
@@ -78,20 +82,22 @@ class StoreCheck:
         """Nothing is left to mend: no finding, or every one fixed."""
         return len(self.fixed) == len(self.findings)
 
-    def summary(self) -> str:
-        """One line per finding (``fixed:`` before those mended), then a count."""
+    def summary(self, wording: Mapping[str, str] | None = None) -> str:
+        """One line per finding (``fixed:`` before those mended), then a count; remedies in
+        ``wording`` (the command line's, ``cli.common.REMEDIES``) when given, else in words."""
         fixed = set(self.fixed)
-        lines = [("fixed: " if f in fixed else "") + f.line() for f in self.findings]
+        lines = [("fixed: " if f in fixed else "") + f.line(wording) for f in self.findings]
         count = len(self.findings)
         if not count:
             lines.append(f"{self.location}: no problem found")
             return "\n".join(lines)
-        tail = f"{count} problem{'s' if count != 1 else ''} found"
+        tail = f"{self.location}: {count} problem{'s' if count != 1 else ''} found"
         if self.fixed:
             tail += f", {len(self.fixed)} fixed"
         elif any(f.fixable for f in self.findings):
-            tail += f" ({sum(f.fixable for f in self.findings)} can be fixed with --fix)"
-        lines.append(f"{self.location}: {tail}")
+            fixable = str(sum(f.fixable for f in self.findings))
+            tail = Remedied(tail, FIX_THE_STORE, fixable).said(wording)
+        lines.append(tail)
         return "\n".join(lines)
 
 
@@ -229,8 +235,10 @@ def _dangling(store: Store, names: Namespaces, runs: set[str]) -> list[StoreFind
         missing = sorted({r for r in listed.value.split() if r not in runs})
         if missing:
             shown = ", ".join(missing[:3]) + (f" and {len(missing) - 3} more" if len(missing) > 3 else "")
-            message = f"learnt from run {shown}, which the store does not hold ({_REBUILD})"
-            found.append(StoreFinding(DANGLING, graph.value, message))
+            remedied = Remedied(
+                f"learnt from run {shown}, which the store does not hold", REBUILD_THE_BASELINE
+            )
+            found.append(StoreFinding(DANGLING, graph.value, remedied.said(), remedied=remedied))
     return sorted(set(found), key=lambda f: (f.graph, f.message))
 
 
@@ -250,9 +258,7 @@ def _runs_without_scenario(store: Store, names: Namespaces) -> list[StoreFinding
         assert graph is not None and run is not None and scenario is not None
         if "/" in scenario.value[len(base) :]:
             continue  # not a scenario's entity
-        message = (
-            f"run {run.value} is a run of <{scenario.value}>, which the store does not hold "
-            "(add it: exscec compile SPEC --store)"
-        )
-        found.append(StoreFinding(NO_SCENARIO, graph.value, message))
+        problem = f"run {run.value} is a run of <{scenario.value}>, which the store does not hold"
+        remedied = Remedied(problem, STORE_THE_SCENARIO)
+        found.append(StoreFinding(NO_SCENARIO, graph.value, remedied.said(), remedied=remedied))
     return found

@@ -34,6 +34,7 @@ from pyoxigraph import BlankNode, NamedNode, Quad, QueryBoolean, QuerySolutions,
 from pyoxigraph import Store as OxStore
 
 from exsce_dsl.errors import StoreError, StoreLockedError, StoreUnwritableError
+from exsce_dsl.remedies import ANOTHER_STORE
 from exsce_dsl.store.base import Bindings, GraphSet, Replace, Rows, Store, replaced_names
 from exsce_dsl.store.sparql import bind, checked_quads, graph_node, write_update
 
@@ -87,7 +88,7 @@ class EmbeddedStore(Store):
             self._store = OxStore(str(path))
         except OSError as exc:
             if "lock" in str(exc).lower():
-                raise StoreLockedError(_locked_message(path, exc), str(path)) from None
+                raise StoreLockedError(_locked_message(path, exc), str(path), remedy=ANOTHER_STORE) from None
             reason = next((r for r in UNWRITABLE if r in str(exc)), None)
             if reason is not None and (path / "CURRENT").exists():
                 self._unwritable = reason.lower()
@@ -330,11 +331,7 @@ def _locked_message(path: Path, exc: OSError) -> str:
         who = f"it is open in {holder}"
     else:
         who = "another process has it open"
-    return (
-        f"the store at {path} is in use: {who}.  An embedded store can be opened by one "
-        "process at a time: stop that process, or point --store at a SPARQL endpoint "
-        "(for example `exscec serve` over this store)"
-    )
+    return f"the store at {path} is in use: {who}.  An embedded store can be opened by one process at a time"
 
 
 def lock_holder(path: Path) -> str | None:

@@ -8,6 +8,8 @@ from __future__ import annotations
 import re
 from collections.abc import Sequence
 
+from exsce_dsl.remedies import REPLACE_A_SHARED_ELEMENT, REPLACE_A_STORED_RUN, REPLACE_A_STORED_SPEC
+
 __all__ = ["graph_run", "replace_advice", "shared_element"]
 
 _SHARED_GRAPH = re.compile(r"/(robots|environments|tasks)/([^/?]+)_bundle$")
@@ -31,28 +33,18 @@ def shared_element(graph: str) -> tuple[str, str] | None:
     return (_SHARED_KINDS[kind], name.split(".", 1)[0] if kind == "robots" else name)
 
 
-def replace_advice(graphs: Sequence[str]) -> str:
-    """What to run to replace conflicting ``graphs``: ``ingest --replace`` for a run's (a run is
-    analysed again from its bag), ``compile --store --replace`` for a spec's, with a warning for
-    graphs every scenario with an element of that id shares (another scenario's robot is
-    replaced too)."""
+def replace_advice(graphs: Sequence[str]) -> tuple[str, str, str]:
+    """How to replace conflicting ``graphs``, as the last line of the problem (or nothing), the
+    remedy and what it is about: ingest again for a run's (a run is analysed again from its bag),
+    add again for a spec's, with a warning for graphs every scenario with an element of that id
+    shares (another scenario's robot is replaced too).  ``cli.common.REMEDIES`` says each with
+    the command that does it (``ingest --replace``, ``compile --store --replace``)."""
     runs = sorted({run for g in graphs if (run := graph_run(g)) is not None})
     if runs:
         which = ", ".join(runs[:3]) + (f" and {len(runs) - 3} more" if len(runs) > 3 else "")
-        return (
-            f"the store holds run {which} with other content: to analyse the run again and replace "
-            "it, ingest its bag with replace (`exscec ingest BAG --scenario SPEC --replace`)"
-        )
-    advice = (
-        "to replace it, add it again with replace (`exscec compile SPEC --store --replace`): "
-        "the old version is kept as a revision (prov:wasRevisionOf)"
-    )
+        return f"the store holds run {which} with other content", REPLACE_A_STORED_RUN, ""
     shared = sorted({found for g in graphs if (found := shared_element(g)) is not None})
     if shared:
         which = ", ".join(f"{kind} '{element}'" for kind, element in shared[:3])
-        advice += (
-            f"; but {which} {'is' if len(shared) == 1 else 'are'} named by id alone, shared by every "
-            "scenario of the store that names one so: if another scenario declares it otherwise, "
-            "give this scenario's another id (--replace would change the other scenario's too)"
-        )
-    return advice
+        return "", REPLACE_A_SHARED_ELEMENT, f"{which} {'is' if len(shared) == 1 else 'are'}"
+    return "", REPLACE_A_STORED_SPEC, ""

@@ -189,9 +189,8 @@ def add_graphs(
     for name in names:
         plan.compare(name, stored.get(name, []), list(graphs[name]), derived=name in derived)
     if plan.conflicts and not replace:
-        raise StoreConflictError(
-            _conflict_message(store, graphs, plan.conflicts, prefixes), [c.graph for c in plan.conflicts]
-        )
+        problem, remedy, about = _conflict_message(store, graphs, plan.conflicts, prefixes)
+        raise StoreConflictError(problem, [c.graph for c in plan.conflicts], remedy=remedy, about=about)
     revisions = _revisions(store, plan.conflicts, stored) if plan.conflicts else {}
     writes = {**plan.to_add, **plan.to_replace, **revisions, **plan.derived_changes}
     if writes:
@@ -420,7 +419,8 @@ def _conflict_message(
     graphs: Mapping[str, Sequence[Quad]],
     conflicts: Sequence[_Difference],
     prefixes: Mapping[str, str],
-) -> str:
+) -> tuple[str, str, str]:
+    """What differs, one line per graph, then the remedy and what it is about (:func:`replace_advice`)."""
     what = _what(graphs, prefixes)
     count = len(conflicts)
     lines = [
@@ -443,8 +443,8 @@ def _conflict_message(
         if not details:
             details.append("blank-node statements differ")
         lines.append(f"  {compact(c.graph, prefixes)}: {'; '.join(details)}")
-    lines.append(replace_advice([c.graph for c in conflicts]))
-    return "\n".join(lines)
+    last, remedy, about = replace_advice([c.graph for c in conflicts])
+    return "\n".join([*lines, last] if last else lines), remedy, about
 
 
 def _what(graphs: Mapping[str, Sequence[Quad]], prefixes: Mapping[str, str]) -> str:

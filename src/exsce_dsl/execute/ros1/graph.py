@@ -22,7 +22,8 @@ from types import TracebackType
 from typing import Any
 from urllib.parse import urlparse
 
-from exsce_dsl.errors import START_A_MASTER, RosGraphError
+from exsce_dsl.errors import RosGraphError
+from exsce_dsl.remedies import START_A_MASTER
 
 ROS_PYTHON_VARIABLE = "EXSCE_ROS_PYTHON"
 DEFAULT_ROS_PYTHON = Path("/usr/bin/python3")

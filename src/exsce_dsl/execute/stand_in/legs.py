@@ -34,6 +34,7 @@ import numpy as np
 from exsce_dsl.errors import ExsceError, PlanningError
 from exsce_dsl.maps.planning import PlanningGrid, Point
 from exsce_dsl.model import Orientation, Pose, Position, Scenario
+from exsce_dsl.remedies import SIMULATE_IT
 from exsce_dsl.sim.faults import (
     DEADLOCK_WAIT,
     Fault,
@@ -45,7 +46,7 @@ from exsce_dsl.sim.faults import (
     speed_factor,
 )
 from exsce_dsl.sim.localisation import Odometry, Poses, localise
-from exsce_dsl.sim.motion import DT, Limits, Trajectory, drive
+from exsce_dsl.sim.motion import DT, Limits, SampledMotion, drive
 from exsce_dsl.sim.scan import ROBOT_RADIUS, SCAN_EVERY, Laser, scan_ranges
 
 MATCH = 0.05
@@ -77,7 +78,7 @@ class Standing:
 
 
 @dataclass(frozen=True)
-class Leg:
+class StandInLeg:
     """One goal's drive, sample by sample (or a robot's start: one sample, no goal)."""
 
     robot: str
@@ -134,7 +135,7 @@ class Leg:
 
 
 @dataclass
-class Robot:
+class StandInRobot:
     name: str
     namespace: str
     limits: Limits
@@ -143,9 +144,9 @@ class Robot:
     at: Standing
     goals: int = 0
     """How many goals it has had."""
-    legs: dict[str, tuple[Leg, Standing]] = field(default_factory=dict)
+    legs: dict[str, tuple[StandInLeg, Standing]] = field(default_factory=dict)
     """Each goal's leg and where the robot stood before it."""
-    current: Leg | None = None
+    current: StandInLeg | None = None
 
 
 class Fleet:
@@ -165,7 +166,7 @@ class Fleet:
         simulate --seed SEED`` (their noise is seeded by both too)."""
         check_faults(scenario, faults)
         if any(f.kind == "near-collision" for f in faults):
-            raise ExsceError("the stand-in does not play fault 'near-collision' (exscec simulate does)")
+            raise ExsceError("the stand-in does not play fault 'near-collision'", remedy=SIMULATE_IT)
         self.scenario, self.grid, self.faults = scenario, grid, faults
         self.laser = laser or Laser()
         limits = limits or Limits()
@@ -173,13 +174,13 @@ class Fleet:
         if unplaced:
             raise ExsceError(f"robot '{unplaced[0]}' has no start pose: the stand-in cannot place it")
         speeds = _executor_speeds(scenario, seed, limits, faults, run)
-        self.robots: dict[str, Robot] = {}
+        self.robots: dict[str, StandInRobot] = {}
         for index, robot in enumerate(scenario.robots):
             start = robot.start_pose
             assert start is not None
             speed = speeds[robot.id]
             rng = np.random.default_rng([seed, index] if run == 0 else [seed, index, run])
-            self.robots[robot.id] = Robot(
+            self.robots[robot.id] = StandInRobot(
                 robot.id,
                 robot.namespace,
                 Limits(speed, limits.max_accel, limits.max_turn_rate),
@@ -192,15 +193,15 @@ class Fleet:
         self.stuck = deadlocked(scenario, faults)
         self.poses = [*scenario.environment.poses(), *(w for t in scenario.tasks for w in t.waypoints())]
 
-    def start_legs(self) -> list[Leg]:
+    def start_legs(self) -> list[StandInLeg]:
         """Each robot standing at its start: a leg of one sample without a goal."""
         legs = []
         for robot in self.robots.values():
             x, y, yaw = robot.at.truth
-            legs.append(self._leg(robot, None, True, 0.0, Trajectory.hold(x, y, yaw, 1)))
+            legs.append(self._leg(robot, None, True, 0.0, SampledMotion.hold(x, y, yaw, 1)))
         return legs
 
-    def leg(self, name: str, goal: str, x: float, y: float, yaw: float, time: float) -> Leg:
+    def leg(self, name: str, goal: str, x: float, y: float, yaw: float, time: float) -> StandInLeg:
         """The leg of goal ``goal`` (target ``x, y, yaw`` in the map) that ``name`` got at ``time``."""
         robot = self.robots.get(name)
         if robot is None:
@@ -234,12 +235,12 @@ class Fleet:
             return found.with_orientation(Orientation(yaw=yaw))
         return Pose("goal", Position(x, y), Orientation(yaw=yaw))
 
-    def _drive(self, robot: Robot, target: Pose) -> tuple[Trajectory, bool]:
+    def _drive(self, robot: StandInRobot, target: Pose) -> tuple[SampledMotion, bool]:
         x, y, yaw = robot.at.truth
         parts = []
         if self.stuck and robot.goals == 1:
-            parts.append(Trajectory.hold(x, y, yaw, int(round(DEADLOCK_WAIT / DT))))
-        aborted = Trajectory.concat([*parts, Trajectory.hold(x, y, yaw, ABORT_AFTER)])
+            parts.append(SampledMotion.hold(x, y, yaw, int(round(DEADLOCK_WAIT / DT))))
+        aborted = SampledMotion.concat([*parts, SampledMotion.hold(x, y, yaw, ABORT_AFTER)])
         if (robot.name, robot.goals) in self.skip:
             return aborted, False
         goal = (target.position.x, target.position.y)
@@ -251,7 +252,7 @@ class Fleet:
             else:
                 there, on = self.grid.plan((x, y), via), self.grid.plan(via, goal)
                 heading = math.atan2(on[1][1] - on[0][1], on[1][0] - on[0][0]) if len(on) > 1 else yaw
-                driven = Trajectory.concat(
+                driven = SampledMotion.concat(
                     [
                         drive(there, yaw, heading, robot.limits),
                         drive(on, heading, target.orientation.yaw, robot.limits),
@@ -261,10 +262,10 @@ class Fleet:
             return aborted, False
         if self.boxes:
             driven = slow_in_areas(driven, self.boxes)
-        parts.append(driven if len(driven) else Trajectory.hold(x, y, yaw, 1))
-        return Trajectory.concat(parts), True
+        parts.append(driven if len(driven) else SampledMotion.hold(x, y, yaw, 1))
+        return SampledMotion.concat(parts), True
 
-    def _plan_round(self, robot: Robot, start: Point, goal: Point) -> list[Point]:
+    def _plan_round(self, robot: StandInRobot, start: Point, goal: Point) -> list[Point]:
         """The grid's path, round the robots that stand in its way once their legs are done."""
         path = self.grid.plan(start, goal)
         discs = []
@@ -282,7 +283,7 @@ class Fleet:
         except PlanningError:  # no way round: the plain path
             return path
 
-    def _let_pass(self, robot: Robot, trajectory: Trajectory, time: float) -> Trajectory:
+    def _let_pass(self, robot: StandInRobot, trajectory: SampledMotion, time: float) -> SampledMotion:
         """``trajectory`` put off until it keeps CLEARANCE from the other robots as they drive their
         legs (by MAX_WAIT at most, then as it is)."""
         x, y, yaw = robot.at.truth
@@ -292,12 +293,14 @@ class Fleet:
             others = [self._where_over(o, times) for o in self.robots.values() if o is not robot]
             if all(np.hypot(trajectory.x - ox, trajectory.y - oy).min() >= CLEARANCE for ox, oy in others):
                 return (
-                    Trajectory.concat([Trajectory.hold(x, y, yaw, held), trajectory]) if held else trajectory
+                    SampledMotion.concat([SampledMotion.hold(x, y, yaw, held), trajectory])
+                    if held
+                    else trajectory
                 )
         return trajectory
 
     @staticmethod
-    def _where_over(robot: Robot, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def _where_over(robot: StandInRobot, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Where ``robot`` is at each of ``times``: on its leg, else where it stands."""
         leg = robot.current
         if leg is None:
@@ -306,12 +309,12 @@ class Fleet:
         return leg.truth.x[k], leg.truth.y[k]
 
     def _leg(
-        self, robot: Robot, goal: str | None, succeeded: bool, time: float, trajectory: Trajectory
-    ) -> Leg:
+        self, robot: StandInRobot, goal: str | None, succeeded: bool, time: float, trajectory: SampledMotion
+    ) -> StandInLeg:
         x, y, yaw = robot.at.truth
         # the leg's frames from where the robot stands (sample 0, dropped): its odometry goes on
         frames = localise(
-            Trajectory.concat([Trajectory.hold(x, y, yaw, 1), trajectory]), robot.rng, robot.drift
+            SampledMotion.concat([SampledMotion.hold(x, y, yaw, 1), trajectory]), robot.rng, robot.drift
         )
         n = len(trajectory)
         ox, oy, oyaw = robot.at.odom
@@ -330,7 +333,7 @@ class Fleet:
             ROBOT_RADIUS,
             robot.rng,
         )
-        return Leg(
+        return StandInLeg(
             robot.name,
             goal,
             succeeded,
@@ -377,4 +380,4 @@ def _tail(poses: Poses) -> Poses:
     return Poses(poses.x[1:], poses.y[1:], poses.yaw[1:])
 
 
-__all__ = ["FIELDS", "Fleet", "Leg", "Standing"]
+__all__ = ["FIELDS", "Fleet", "StandInLeg", "Standing"]

@@ -7,7 +7,7 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import Any
 
-from exsce_dsl.errors import Diagnostic, Severity, SourceLocation
+from exsce_dsl.errors import Diagnostic, Remedied, Severity, SourceLocation
 from exsce_dsl.lang.builders.references import UnknownNames
 from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.model import Acceptance, Environment, Pose, RobotType, RosResource, Scenario, Task
@@ -101,9 +101,13 @@ class BuildContext:
         self.diagnostics.append(Diagnostic(message, location, Severity.WARNING, code=code))
 
     def metric_problem(
-        self, message: str, location: SourceLocation | None, severity: Severity = Severity.ERROR
+        self,
+        message: str,
+        location: SourceLocation | None,
+        severity: Severity = Severity.ERROR,
+        remedied: Remedied | None = None,
     ) -> None:
-        self.diagnostics.append(Diagnostic(message, location, severity, code="metric"))
+        self.diagnostics.append(Diagnostic(message, location, severity, code="metric", remedied=remedied))
 
     def unknown_name(self, kind: str, name: str, at: SourceLocation, known: Iterable[str]) -> None:
         """Report that no file read declares ``name`` (unless a file with a syntax error may)."""

@@ -23,7 +23,7 @@ import re
 from collections.abc import Mapping
 from typing import Any, Protocol
 
-from exsce_dsl.errors import MessageTypeError, Severity, SourceLocation
+from exsce_dsl.errors import MessageTypeError, Remedied, Severity, SourceLocation
 from exsce_dsl.lang.builders.expressions import ExpressionBuilder, Scope, Typed, read_quantity
 from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.messages.catalogue import MessageCatalogue
@@ -42,6 +42,7 @@ from exsce_dsl.model.metrics import (
     signal_pattern,
 )
 from exsce_dsl.model.names import ROS_TOPIC_RULE, TOPIC_RULE, is_ros_topic, is_topic_pattern
+from exsce_dsl.remedies import DEFINE_THE_TYPE
 from exsce_dsl.suggest import did_you_mean
 
 
@@ -49,7 +50,12 @@ class Report(Protocol):
     """Where problems go: an error (the metric is not built) or a warning."""
 
     def __call__(
-        self, message: str, location: SourceLocation | None, severity: Severity = Severity.ERROR, /
+        self,
+        message: str,
+        location: SourceLocation | None,
+        severity: Severity = Severity.ERROR,
+        remedied: Remedied | None = None,
+        /,
     ) -> None: ...
 
 
@@ -117,8 +123,8 @@ class _MetricBuilder:
             where = self.name_location
         self.report(message, where)
 
-    def warning(self, message: str, node: Any) -> None:
-        self.report(message, self.pf.span(node), Severity.WARNING)
+    def warning(self, message: str, node: Any, remedied: Remedied | None = None) -> None:
+        self.report(message, self.pf.span(node), Severity.WARNING, remedied)
 
     def catalogue(self) -> MessageCatalogue:
         if self._catalogue is None:
@@ -238,13 +244,13 @@ class _MetricBuilder:
             if msgtype in catalogue:  # known, but it needs a type that is not
                 self.warning(f"{exc.message}: the fields of {read.name} are checked when a bag is read", read)
                 return None
-        self.warning(
+        remedied = Remedied(
             f"exsce does not know the message type {read.msgtype}"
             f"{did_you_mean(msgtype, catalogue.definitions)}: the fields of {read.name} are checked when "
-            "a bag is read, against the bag's definition (to check them now, give exsce the type's "
-            ".msg or .idl file: exscec --msg-path DIR, or EXSCE_MSG_PATH)",
-            read,
+            "a bag is read, against the bag's definition",
+            DEFINE_THE_TYPE,
         )
+        self.warning(remedied.said(), read, remedied)
         return None
 
     def _dimension(self, tree: Any, value: Typed | None) -> Dimension | None:

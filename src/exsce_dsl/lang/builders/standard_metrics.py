@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import functools
 
-from exsce_dsl.errors import Diagnostic, Severity, SourceLocation, SpecError
+from exsce_dsl.errors import Diagnostic, Remedied, Severity, SourceLocation, SpecError
 from exsce_dsl.lang.code_cache import cached_standard_metrics
 from exsce_dsl.model.metrics import VIOLATION_DURATION, MetricDefinition, MetricInfo
 from exsce_dsl.model.scenario import Scenario
@@ -32,8 +32,13 @@ def _parse_standard_metrics() -> tuple[MetricDefinition, ...]:
     pf = parse_text(source.read_text(encoding="utf-8"), str(source))
     problems: list[Diagnostic] = []
 
-    def report(message: str, at: SourceLocation | None, severity: Severity = Severity.ERROR) -> None:
-        problems.append(Diagnostic(message, at, severity))
+    def report(
+        message: str,
+        at: SourceLocation | None,
+        severity: Severity = Severity.ERROR,
+        remedied: Remedied | None = None,
+    ) -> None:
+        problems.append(Diagnostic(message, at, severity, remedied=remedied))
 
     types = standard_catalogue()  # the method's types only, whatever the user defines
     built = [build_metric(pf, tree, report, standard=True, catalogue=types) for tree in pf.tree.declarations]

@@ -85,7 +85,7 @@ class Reference:
 
 
 @dataclass(frozen=True)
-class Import:
+class IndexedImport:
     path: str
     """As written."""
     location: SourceLocation
@@ -98,7 +98,7 @@ class FileIndex:
     symbols: tuple[Symbol, ...]
     """The top-level declarations, each with its children."""
     references: tuple[Reference, ...]
-    imports: tuple[Import, ...] = ()
+    imports: tuple[IndexedImport, ...] = ()
 
     def all_symbols(self) -> Iterator[Symbol]:
         for symbol in self.symbols:
@@ -109,7 +109,7 @@ def index_file(pf: ParsedFile) -> FileIndex:
     """The declarations and references of one parsed file."""
     reader = _Reader(pf)
     symbols = tuple(s for decl in pf.tree.declarations if (s := reader.declaration(decl)) is not None)
-    imports = tuple(Import(i.path, pf.span(i)) for i in pf.tree.imports)
+    imports = tuple(IndexedImport(i.path, pf.span(i)) for i in pf.tree.imports)
     return FileIndex(pf.path, symbols, tuple(reader.references), imports)
 
 

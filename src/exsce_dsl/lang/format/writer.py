@@ -5,9 +5,10 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path, PurePosixPath
 
-from exsce_dsl.errors import REPLACE_FILES, ExportError
+from exsce_dsl.errors import ExportError
 from exsce_dsl.lang.format.document import declared_poses, format_document
 from exsce_dsl.model import Document, Environment
+from exsce_dsl.remedies import REPLACE_FILES
 
 
 def write_documents(documents: Sequence[Document], out_dir: Path, overwrite: bool = False) -> list[Path]:

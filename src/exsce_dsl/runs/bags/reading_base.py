@@ -20,6 +20,7 @@ from exsce_dsl.errors import BagError
 from exsce_dsl.messages.catalogue import MessageCatalogue
 from exsce_dsl.messages.user import configured_user_catalogue
 from exsce_dsl.model.messages import canonical_type, standard_type
+from exsce_dsl.remedies import POINT_MSG_PATH
 from exsce_dsl.runs.bags.data import OBJECTS, BagData, Check, Reduce, Series, Wanted
 from exsce_dsl.runs.bags.decode import TEXTS, decode, decode_slowly, vectorisable
 from exsce_dsl.runs.bags.names import TopicMatch
@@ -178,8 +179,8 @@ class Reading:
         if lacking:
             raise BagError(
                 f"{self.path}: no definition of {', '.join(lacking)} (topic {topic}): the bag carries none "
-                "and no .msg/.idl file gives it; point EXSCE_MSG_PATH (or exscec --msg-path) at a folder "
-                "of message packages"
+                "and no .msg/.idl file gives it",
+                remedy=POINT_MSG_PATH,
             )
         if self.check is not None:
             tree, source = catalogue.tree(msgtype), catalogue.source_of(msgtype)

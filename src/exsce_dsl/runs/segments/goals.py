@@ -61,7 +61,7 @@ from exsce_dsl.runs.signals.navigation_goals import RecordedGoal, XYYaw
 
 
 @dataclass(frozen=True)
-class Leg:
+class GoalLeg:
     """One leg of a robot's goals: to one pose, from ``start`` to ``end`` with a final ``status``."""
 
     label: str
@@ -125,12 +125,12 @@ def goal_segments(
     return build_segmentation(scenario, robot, plan, filled, track, tolerance, warnings)
 
 
-def _matches(planned: PlannedWaypoint, leg: Leg, tolerance: Tolerance) -> bool:
+def _matches(planned: PlannedWaypoint, leg: GoalLeg, tolerance: Tolerance) -> bool:
     assert leg.target is not None
     return matches(tolerance, planned.pose, *leg.target)
 
 
-def goal_legs(goals: Sequence[RecordedGoal], track: Track, warnings: list[str]) -> list[Leg]:
+def goal_legs(goals: Sequence[RecordedGoal], track: Track, warnings: list[str]) -> list[GoalLeg]:
     """The legs of ``goals`` in the order they were first seen, with their targets (rules 1-3)."""
     timed = []
     for goal in goals:
@@ -139,7 +139,7 @@ def goal_legs(goals: Sequence[RecordedGoal], track: Track, warnings: list[str]) 
         else:
             timed.append(goal)
     timed.sort(key=lambda g: g.first_seen or 0.0)  # stable: goals seen at once keep their order
-    legs: list[Leg] = []
+    legs: list[GoalLeg] = []
     for goal in timed:
         if goal.follows_waypoints:
             legs.extend(_waypoint_legs(goal, track, warnings))
@@ -147,11 +147,11 @@ def goal_legs(goals: Sequence[RecordedGoal], track: Track, warnings: list[str]) 
         start = goal.started if goal.started is not None else goal.accepted
         end = None if goal.status == "ACTIVE" else goal.ended
         target = goal.target or _reached_at(track, goal.status, end)
-        legs.append(Leg(f"goal {goal.key}", start, end, goal.status, target))
+        legs.append(GoalLeg(f"goal {goal.key}", start, end, goal.status, target))
     return legs
 
 
-def _waypoint_legs(goal: RecordedGoal, track: Track, warnings: list[str]) -> list[Leg]:
+def _waypoint_legs(goal: RecordedGoal, track: Track, warnings: list[str]) -> list[GoalLeg]:
     """The legs of a follow_waypoints goal: one per waypoint index its feedback reported."""
     progress: list[tuple[int, float]] = []
     for index, t in goal.progress:
@@ -165,7 +165,7 @@ def _waypoint_legs(goal: RecordedGoal, track: Track, warnings: list[str]) -> lis
     if not progress:
         warnings.append(f"goal {goal.key} ({goal.status}) never reported a current waypoint: ignored")
         return []
-    legs: list[Leg] = []
+    legs: list[GoalLeg] = []
     for k, (index, t) in enumerate(progress):
         final = k == len(progress) - 1
         if final:
@@ -189,7 +189,7 @@ def _waypoint_legs(goal: RecordedGoal, track: Track, warnings: list[str]) -> lis
             given = goal.targets[j] if j < len(goal.targets) else None
             # the track knows only where the robot was when the last of these was done
             target = given or (_reached_at(track, status, end) if j == reached[-1] else None)
-            legs.append(Leg(f"goal {goal.key}[{j}]", t if j == index else end, end, status, target))
+            legs.append(GoalLeg(f"goal {goal.key}[{j}]", t if j == index else end, end, status, target))
     return legs
 
 

@@ -16,7 +16,14 @@ from __future__ import annotations
 
 from exsce_dsl.store.queries.accounting import ValueAccount, run_problems, value_accounts
 from exsce_dsl.store.queries.coverage import run_coverage, run_topic_rates
-from exsce_dsl.store.queries.library import KINDS, Parameter, Query, query, query_names, standard_prefixes
+from exsce_dsl.store.queries.library import (
+    KINDS,
+    Query,
+    QueryParameter,
+    query,
+    query_names,
+    standard_prefixes,
+)
 from exsce_dsl.store.queries.run_ids import (
     MIN_PREFIX,
     AmbiguousRunError,
@@ -108,7 +115,7 @@ __all__ = [
     "KINDS",
     "MetricReading",
     "MetricSource",
-    "Parameter",
+    "QueryParameter",
     "PathSegment",
     "Query",
     "RobotFacts",

@@ -37,10 +37,11 @@ from pyoxigraph import Literal, NamedNode
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.prov import identifiers as ids
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, Namespaces
+from exsce_dsl.remedies import LIST_THE_QUERIES
 from exsce_dsl.store.base import Bindings, Term
 from exsce_dsl.suggest import did_you_mean
 
-__all__ = ["KINDS", "Parameter", "Query", "query", "query_names", "standard_prefixes"]
+__all__ = ["KINDS", "QueryParameter", "Query", "query", "query_names", "standard_prefixes"]
 
 _XSD_DOUBLE = NamedNode(ids.XSD_NAMESPACE + "double")
 
@@ -83,7 +84,7 @@ from it with a look-up, where the uuid literal is one of every run entity's), an
 
 
 @dataclass(frozen=True)
-class Parameter:
+class QueryParameter:
     name: str
     kind: str
     many: bool = False
@@ -102,14 +103,14 @@ class Query:
     description: str
     text: str
     """The SPARQL as written (comments included), without the prologue."""
-    parameters: tuple[Parameter, ...]
+    parameters: tuple[QueryParameter, ...]
     is_update: bool
 
     def sparql(self, namespace: str = DEFAULT_NAMESPACE) -> str:
         """The text to run: the prologue of prefixes, then the query."""
         return prologue(namespace) + self.text
 
-    def parameter(self, name: str) -> Parameter:
+    def parameter(self, name: str) -> QueryParameter:
         for p in self.parameters:
             if p.name == name:
                 return p
@@ -149,7 +150,7 @@ def _parse(name: str, text: str, is_update: bool) -> Query:
             pname, kind, mark, about = match.groups(default="")
             if kind not in KINDS:
                 raise ExsceError(f"query '{name}': parameter ?{pname} has an unknown kind '{kind}'")
-            parameters.append(Parameter(pname, kind, mark in ("+", "*"), mark in ("?", "*"), about))
+            parameters.append(QueryParameter(pname, kind, mark in ("+", "*"), mark in ("?", "*"), about))
         elif not description and stripped.lstrip("#").strip():
             description = stripped.lstrip("#").strip()
     return Query(name, description, text, tuple(parameters), is_update)
@@ -177,7 +178,7 @@ def query(name: str) -> Query:
     found = _library().get(name)
     if found is None:
         hint = did_you_mean(name, _library())
-        raise ExsceError(f"no query called '{name}'{hint} (`exscec query --list` shows them all)")
+        raise ExsceError(f"no query called '{name}'{hint}", remedy=LIST_THE_QUERIES)
     return found
 
 

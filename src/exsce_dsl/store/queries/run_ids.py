@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 from exsce_dsl.errors import AmbiguousRunError, ExsceError, UnknownRunError
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE
+from exsce_dsl.remedies import CLOSEST_RUNS, GIVE_A_RUN_ID, NO_RUNS_AT_ALL
 from exsce_dsl.store.base import Store, Term
 from exsce_dsl.store.queries.library import query
 
@@ -76,10 +77,7 @@ def run_id_text(given: str) -> str:
     in lower case; an :class:`ExsceError` for anything else, or a prefix that is too short."""
     text = _without_iri(given).lower()
     if not _ID_CHARACTERS.fullmatch(text):
-        raise ExsceError(
-            f"'{given}' is not a run id: give a run's uuid, a prefix of it ({MIN_PREFIX} characters "
-            "at least, as `exscec runs` prints them) or its IRI"
-        )
+        raise ExsceError(f"'{given}' is not a run id", remedy=GIVE_A_RUN_ID, about=str(MIN_PREFIX))
     if len(text) < MIN_PREFIX:
         raise ExsceError(
             f"run id '{given}' is too short: give at least {MIN_PREFIX} characters of the uuid "
@@ -119,13 +117,9 @@ def resolve_run(store: Store, given: str, namespace: str = DEFAULT_NAMESPACE) ->
         )
     closest = _closest(store, prefix, namespace)
     if not closest:
-        raise UnknownRunError(
-            f"the store holds no run {given} (it holds no runs at all: `exscec ingest BAG...` adds them)"
-        )
+        raise UnknownRunError(f"the store holds no run {given}", remedy=NO_RUNS_AT_ALL)
     raise UnknownRunError(
-        f"the store holds no run {given}; the closest ids (`exscec runs` lists every run):\n"
-        + _listed(closest),
-        closest,
+        f"the store holds no run {given}", closest, remedy=CLOSEST_RUNS, about=_listed(closest)
     )
 
 

@@ -13,7 +13,7 @@ from collections.abc import Sequence
 from exsce_dsl.errors import UnknownNameWarning
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE
 from exsce_dsl.store.base import Store
-from exsce_dsl.store.queries.library import Parameter, query
+from exsce_dsl.store.queries.library import QueryParameter, query
 from exsce_dsl.store.queries.terms import Given, run_query
 from exsce_dsl.suggest import closest_several
 
@@ -31,7 +31,7 @@ SHOWN = 8
 """Names listed at most when none is close."""
 
 
-def named_by(parameter: Parameter) -> str | None:
+def named_by(parameter: QueryParameter) -> str | None:
     """What ``parameter``'s values name (``metric``, ``robot``, ``scenario``), if one of these."""
     found = NAMED.get(parameter.kind)
     if found is None and parameter.kind == "id" and parameter.name in ("scenario", "base"):

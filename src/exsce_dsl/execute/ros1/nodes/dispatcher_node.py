@@ -89,7 +89,7 @@ class Dispatcher:
         if missing:
             fail(
                 "no move_base action server answered within %g s at %s" % (timeout, ", ".join(missing))
-                + ": start the robots' navigation stacks (or exscec stand-in) first"
+                + ": start the robots' navigation stacks (or exsce's stand-in) first"
             )
 
     def handle(self, command):

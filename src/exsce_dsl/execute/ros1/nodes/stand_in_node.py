@@ -59,7 +59,7 @@ def set_yaw(q: Any, yaw: float) -> None:
     q.x, q.y, q.z, q.w = 0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)
 
 
-class Leg:
+class StandInLeg:
     """A leg the venv computed: FIELDS values per sample, a scan every SCAN_EVERY samples."""
 
     def __init__(self, command: Dict[str, Any]) -> None:
@@ -82,12 +82,12 @@ class Leg:
         return self.scans[j * self.beams : (j + 1) * self.beams]
 
 
-class Robot:
+class StandInRobot:
     def __init__(self, name: str, ns: str) -> None:
         self.name, self.ns = name, ns
         self.held = [0.0] * FIELDS  # where it stands between goals
         self.held_scan: Any = None
-        self.leg: Optional[Leg] = None
+        self.leg: Optional[StandInLeg] = None
         self.active: Any = None  # the goal handle being driven (or awaiting its leg)
         self.active_id: Optional[str] = None
         self.awaiting: Optional[float] = None  # wall time since when its goal awaits its leg
@@ -95,10 +95,10 @@ class Robot:
         self.pubs: Dict[str, Any] = {}
 
 
-class StandIn:
+class StandInNode:
     def __init__(self) -> None:
         self.lock = threading.RLock()
-        self.robots: Dict[str, Robot] = {}
+        self.robots: Dict[str, StandInRobot] = {}
         self.setup_done = threading.Event()
         self.running = True
         self.speed_up = 10.0
@@ -117,9 +117,9 @@ class StandIn:
             self.speed_up = float(command["speed_up"])
             self.laser = command["laser"]
             for r in command["robots"]:
-                self.robots[r["name"]] = Robot(r["name"], r["ns"])
+                self.robots[r["name"]] = StandInRobot(r["name"], r["ns"])
         elif kind == "leg":
-            self.take_leg(Leg(command), command["robot"])
+            self.take_leg(StandInLeg(command), command["robot"])
         elif kind == "stats":
             with self.lock:
                 now_ns = self.time_of(self.published)
@@ -133,7 +133,7 @@ class StandIn:
         else:
             emit("warning", message="unknown command %r" % kind)
 
-    def take_leg(self, leg: Leg, name: str) -> None:
+    def take_leg(self, leg: StandInLeg, name: str) -> None:
         with self.lock:
             robot = self.robots[name]
             if leg.goal is None:  # where the robot stands at the start
@@ -162,7 +162,7 @@ class StandIn:
             else:
                 self.on_cancel(robot, handle)
 
-    def on_goal(self, robot: Robot, handle: Any) -> None:
+    def on_goal(self, robot: StandInRobot, handle: Any) -> None:
         with self.lock:
             if robot.active is not None:  # move_base: a new goal preempts the active one
                 self.stop(robot, "preempted by a new goal")
@@ -182,12 +182,12 @@ class StandIn:
                 time=self.time_of(self.published) / 1e9,
             )
 
-    def on_cancel(self, robot: Robot, handle: Any) -> None:
+    def on_cancel(self, robot: StandInRobot, handle: Any) -> None:
         with self.lock:
             if robot.active is not None and robot.active_id == handle.get_goal_id().id:
                 self.stop(robot, "cancelled")
 
-    def stop(self, robot: Robot, why: str) -> None:
+    def stop(self, robot: StandInRobot, why: str) -> None:
         """Stop ``robot`` where it is now, its goal canceled (preempted)."""
         leg, k = robot.leg, -1
         if leg is not None:
@@ -245,7 +245,7 @@ class StandIn:
         self.clock_pub.publish(Clock(clock=stamp_of(ns)))
         self.counts["/clock"] = self.counts.get("/clock", 0) + 1
 
-    def publish(self, robot: Robot, name: str, message: Any) -> None:
+    def publish(self, robot: StandInRobot, name: str, message: Any) -> None:
         robot.pubs[name].publish(message)
         key = topic(robot.ns, name)
         self.counts[key] = self.counts.get(key, 0) + 1
@@ -308,7 +308,7 @@ class StandIn:
             if leg is not None and k == leg.samples - 1:
                 self.finish(robot, leg, values, scan, t)
 
-    def finish(self, robot: Robot, leg: Leg, values: List[float], scan: Any, t: int) -> None:
+    def finish(self, robot: StandInRobot, leg: StandInLeg, values: List[float], scan: Any, t: int) -> None:
         robot.held = values[:9] + [0.0, 0.0, 0.0, 0.0]
         robot.held_scan = scan
         handle, goal_id = robot.active, robot.active_id
@@ -321,7 +321,7 @@ class StandIn:
             )
         emit("finished", robot=robot.name, goal=goal_id, outcome=leg.outcome, time=t / 1e9)
 
-    def publish_state(self, robot: Robot, n: int, t: int, v: List[float], scan: Any, k: int) -> None:
+    def publish_state(self, robot: StandInRobot, n: int, t: int, v: List[float], scan: Any, k: int) -> None:
         stamp = stamp_of(t)
         if n % STATIC_EVERY == 0:  # latched, and again: a recorder started later gets it on its clock
             self.publish_static(robot, t)
@@ -371,7 +371,7 @@ class StandIn:
             if robot.active.get_goal_status().status == GoalStatus.ACTIVE:
                 robot.active.publish_feedback(MoveBaseFeedback(base_position=position))
 
-    def publish_static(self, robot: Robot, t: int) -> None:
+    def publish_static(self, robot: StandInRobot, t: int) -> None:
         stamp = stamp_of(t)
         transforms = [
             transform(stamp, "base_link", "base_footprint", 0.0, 0.0, 0.0, -FOOTPRINT_HEIGHT),
@@ -403,7 +403,7 @@ AMCL_COVARIANCE = diagonal(
 
 
 def main() -> None:
-    node = StandIn()
+    node = StandInNode()
 
     def closed() -> None:
         node.running = False

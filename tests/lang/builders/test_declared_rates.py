@@ -20,7 +20,7 @@ from exsce_dsl.sim.run import simulate
 
 from tests.support.bag_surgery import thin
 
-EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "brsu_building_c"
+EXAMPLE = Path(__file__).resolve().parents[3] / "examples" / "brsu_building_c"
 RATED = """\
 robot type rover {
   base diff_drive

@@ -15,6 +15,7 @@ from types import SimpleNamespace
 
 import pytest
 
+from exsce_dsl.cli.common import REMEDIES
 from exsce_dsl.codegen.ros_monitor import attribute_path, monitor_topics
 from exsce_dsl.errors import MessageTypeError
 from exsce_dsl.lang import analyse
@@ -230,7 +231,9 @@ def test_a_type_exsce_does_not_know_is_a_warning_at_its_read(tmp_path):
     assert warning.severity == "warning"
     assert (warning.location.line, warning.location.column) == (2, 3)
     assert warning.message.startswith("exsce does not know the message type turtlesim/msg/Pose: the fields of ")
-    assert "exscec --msg-path DIR, or EXSCE_MSG_PATH" in warning.message
+    assert "in a folder EXSCE_MSG_PATH names, to check them now" in warning.message  # the library's words
+    assert warning.remedied is not None  # what `exscec check` says, with its option:
+    assert "exscec --msg-path DIR, or EXSCE_MSG_PATH" in warning.said(REMEDIES).message
     (metric,) = analysis.spec.metrics
     assert [(f.path.key, f.arrays, f.location.column) for f in metric.reads[0].fields] == [
         ("x", False, 13),
@@ -497,3 +500,16 @@ def test_hover_shows_a_field_s_type_and_a_read_s():
     at = text.index("tf.transforms[")
     assert field_hover(text, at, at + 2) == "**topic** `tf`: `tf2_msgs/msg/TFMessage` on `/{ns}/tf`"
     assert field_hover(text, text.index("max"), text.index("max") + 3) is None
+
+
+def test_check_says_the_unknown_type_s_remedy_with_its_option(tmp_path, monkeypatch):
+    """The library says the remedy in words; `exscec check` says it with its option (issue 49)."""
+    monkeypatch.delenv("EXSCE_MSG_PATH", raising=False)
+    (tmp_path / "m.exsce").write_text(TURTLE)
+    done = exscec_here("check", "m.exsce", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert (
+        "m.exsce:2:3: warning: exsce does not know the message type turtlesim/msg/Pose: the fields of "
+        "turtle are checked when a bag is read, against the bag's definition (to check them now, give "
+        "exsce the type's .msg or .idl file: exscec --msg-path DIR, or EXSCE_MSG_PATH)"
+    ) in done.stderr

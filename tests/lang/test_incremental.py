@@ -1,5 +1,5 @@
-"""What the language server parses with: declaration-by-declaration parsing (lang.incremental),
-the index of names (lang.editor.symbols) and what the grammar expects at a point (lang.editor.continuations)."""
+"""Declaration-by-declaration parsing (lang.incremental), what the language server parses with:
+the same model at the same places as a whole parse, and only what an edit touched re-parsed."""
 
 from __future__ import annotations
 
@@ -13,7 +13,6 @@ from hypothesis import strategies as st
 
 from exsce_dsl.lang import ParseCache, continuations_at, declaration_chunks
 from exsce_dsl.lang.builders.specification import analyse, analyse_files
-from exsce_dsl.lang.editor.symbols import index_file
 from exsce_dsl.lang.loader import load_files, parse_whole
 
 from tests.support.paths import EXAMPLES
@@ -143,51 +142,6 @@ def test_declarations_start_only_after_a_closed_one() -> None:
     ]
 
 
-def test_the_index_holds_declarations_and_references_with_places() -> None:
-    path = EXAMPLES / "brsu_building_c" / "scenario_c_alone.exsce"
-    pf, _ = parse_whole(path.read_text(), "alone.exsce")
-    assert pf is not None
-    index = index_file(pf)
-    (derived,) = index.symbols
-    assert (derived.kind, derived.name, derived.fact("derived from")) == (
-        "scenario",
-        "scenario_c_alone",
-        "scenario_c",
-    )
-    assert [(r.kind, r.name, r.scope, r.location.line, r.location.column) for r in index.references] == [
-        ("scenario", "scenario_c", None, 5, 30),
-        ("task", "delivery_a", None, 7, 24),
-        ("robot", "tiago2", "scenario_c_alone", 6, 16),
-        ("robot", "tiago1", "scenario_c_alone", 6, 35),
-    ]
-
-
-@pytest.mark.parametrize(
-    ("text", "keywords", "name"),
-    [
-        ("", {"import", "task", "scenario", "environment", "robot", "metric", "derive", "acceptance"}, False),
-        ("task t {\n  visit ", set(), True),
-        ("scenario s in e {\n  robots {\n    r1: tiago ", {"namespace", "starts"}, True),
-        (
-            "derive d from s {\n  ",
-            {"remove", "add", "replace", "swap", "reverse", "substitute", "start"},
-            False,
-        ),
-        ('acceptance for s {\n  scenario "x" {\n    then each robot max_velocity ', {"stays", "is"}, False),
-    ],
-)
-def test_what_the_grammar_expects_at_the_end(text: str, keywords: set[str], name: bool) -> None:
-    expected = continuations_at(text, len(text))
-    assert expected is not None and expected.known
-    assert keywords <= set(expected.keywords)
-    assert expected.name is name
-
-
-def test_nothing_is_expected_inside_a_comment_or_a_string() -> None:
-    assert continuations_at("task t { // visit ", 18) is None
-    assert continuations_at('acceptance for s { scenario "moves sa', 37) is None
-
-
 def test_completion_in_a_long_environment_parses_only_the_area_it_is_in() -> None:
     text = environment_text(30, 12)
     at = text.index("    pose room_25-w04")
@@ -197,22 +151,6 @@ def test_completion_in_a_long_environment_parses_only_the_area_it_is_in() -> Non
     assert expected.before[:8] == ("environment", "big", "{", "map", "big", "area", "room_25", "{")
     assert "room_24" not in expected.before  # the areas before are left out
     assert expected.before[-1] == "0.5" and expected.before.count("pose") == 4
-
-
-def test_lsp_columns_count_code_units_of_the_agreed_encoding() -> None:
-    from lsprotocol import types
-
-    from exsce_dsl.errors import SourceLocation
-    from exsce_dsl.lsp.convert import TextLines
-
-    text = "a\n/* 🤖 é */ visit x\n"
-    where = SourceLocation("f", 2, 17, 2, 18)  # the x: the 17th character of line 2
-    assert TextLines(text).range(where) == types.Range(types.Position(1, 17), types.Position(1, 18))  # 🤖: 2
-    assert TextLines(text, "utf-8").range(where).start == types.Position(1, 20)  # 🤖: 4 bytes, é: 2
-    assert TextLines(text, "utf-32").range(where).start == types.Position(1, 16)
-    for encoding in ("utf-8", "utf-16", "utf-32"):
-        lines = TextLines(text, encoding)
-        assert lines.offset(lines.range(where).start) == text.index("x")
 
 
 _WORDS = ["task", "}", "{", "visit", ",", "scenario", "robot type", '"', "//", "area", "import", "(", "at"]

@@ -157,7 +157,7 @@ def test_the_formatter_prints_what_parses_back_to_the_same_model(tmp_path: Path,
 
 def test_the_bags_pages_robot_types_check(tmp_path: Path) -> None:
     """The robot types docs/bags.md shows are valid, with the sources the page says."""
-    page = (Path(__file__).resolve().parents[2] / "docs" / "bags.md").read_text()
+    page = (Path(__file__).resolve().parents[3] / "docs" / "bags.md").read_text()
     section = page[page.index("## Conventions") :]
     block = section.split("```")[1].removeprefix("exsce\n")
     robot_types = _types(tmp_path, block)

@@ -43,7 +43,7 @@ from exsce_dsl.model import (
     WorldModel,
 )
 
-MODELS = Path(__file__).parents[1] / "fixtures" / "hbrs-sesame-models"
+MODELS = Path(__file__).parents[2] / "fixtures" / "hbrs-sesame-models"
 SCENARIOS = MODELS / "scenarios"
 TASKS = MODELS / "tasks" / "brsu_building_c_with_doors"
 
