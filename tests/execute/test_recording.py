@@ -60,13 +60,13 @@ def test_every_run_records_tf_the_clock_and_the_prov() -> None:
 
 
 def test_scenario_c_in_the_methods_convention() -> None:
-    # its own metrics (fast_driving_time, mean_turn_rate) read /{ns}/nav_vel, recorded already
+    # its own metrics (fast_driving_time, mean_turn_rate) read the velocity signal: /{ns}/nav_vel
     expected = sorted(EVERY_RUN + method_topics("tiago1") + method_topics("tiago2"))
     assert recorded_topics(scenario_c(), "method") == expected
 
 
 def test_scenario_c_on_move_base_does_not_record_what_ingestion_serves_from_signals() -> None:
-    # nav_vel, robot_pose, distance_travelled are served from cmd_vel, TF, odom at ingestion
+    # the metrics read the signals (velocity, pose, distance) from cmd_vel, TF, odom: no nav_vel
     expected = sorted(EVERY_RUN + move_base_topics("tiago1") + move_base_topics("tiago2"))
     assert recorded_topics(scenario_c(), "move_base") == expected
 
@@ -107,7 +107,7 @@ metric battery_low for each robot {
 metric mean_turn_rate for each robot {
   "mean absolute angular velocity"
   unit rad/s
-  reads vel: geometry_msgs/msg/Twist on "/{ns}/nav_vel"
+  reads vel: robot velocity
   value mean(abs(vel.angular.z))
 }
 

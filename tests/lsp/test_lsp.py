@@ -302,7 +302,7 @@ async def test_completion_of_a_metric_s_fields_follows_the_path_before_the_point
     assert linear.text_edit.range.end.character - linear.text_edit.range.start.character == len("lin")
     assert set(await items("vel.angular.")) == {"x", "y", "z"}
     reads = await items("value mean(abs(")
-    assert reads["vel"].detail == "geometry_msgs/msg/Twist on /{ns}/nav_vel"
+    assert reads["vel"].detail == "the robot's velocity (geometry_msgs/msg/Twist)"
     close_document(client, uri)
 
 

@@ -353,7 +353,7 @@ def metrics_of_bag(path, scenario) -> tuple[list[MetricValue], list[Hotspot]]:  
     every field kept, the dispatcher's statuses segmented, then :func:`compute_metrics`."""
     from exsce_dsl.model.messages import path_of
     from exsce_dsl.runs.analyse import run_metrics, wanted_topics
-    from exsce_dsl.runs.bags.data import Wanted
+    from exsce_dsl.runs.bags.data import OBJECTS, Wanted
     from exsce_dsl.runs.bags.reading import read_bag
     from exsce_dsl.runs.segments.dispatcher import SUCCEEDED, segments
     from exsce_dsl.runs.signals.dispatcher_statuses import dispatcher_statuses
@@ -364,6 +364,7 @@ def metrics_of_bag(path, scenario) -> tuple[list[MetricValue], list[Hotspot]]:  
         topics = robot_topics(robot.namespace)
         for key, (msgtype, names) in _READ.items():
             wanted[topics[key]] = Wanted(msgtype, tuple(path_of(*n.split(".")) for n in names))
+        wanted[topics["feedback"]] = wanted[topics["result"]] = Wanted(OBJECTS)  # the dispatcher's goals
     data = read_bag(path, wanted)
     actions: list[RecordedAction] = []
     results: dict[str, int | None] = {}

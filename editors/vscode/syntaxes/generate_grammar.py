@@ -601,7 +601,12 @@ def repository() -> dict[str, Rule]:
                 _3="punctuation.separator.colon" + S,
             ),
             # reads pose: robot pose (a signal of the robot, wherever its type says it is)
-            match(r"(?<=:)\s*(robot)\s+(pose|velocity|distance)" + AFTER, None, _1=KEYWORD, _2=KEYWORD),
+            match(
+                r"(?<=:)\s*(robot)\s+(pose|velocity|distance|scan|goals)" + AFTER,
+                None,
+                _1=KEYWORD,
+                _2=KEYWORD,
+            ),
             match(MESSAGE_TYPE, "support.type.message" + S),
             metric_kw("on value otherwise safe below above unit reads"),
             include("topic-strings"),

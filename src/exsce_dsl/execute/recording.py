@@ -9,9 +9,8 @@ before there is one:
 - its navigation goals: the method's dispatcher's ``feedback`` and ``result``, move_base's
   ``goal``, ``status`` and ``result``, Nav2's action ``status`` (``follow_waypoints``' feedback
   too) and the planner's ``plan``;
-- every topic a metric reads (the standard library's and the specification's), except those
-  ingestion serves itself from a robot's signals (the method's ``robot_pose``, ``nav_vel``... of a
-  robot in another convention);
+- every topic a metric reads by name (a signal it reads, ``robot pose``..., is among the
+  sources above);
 - and :data:`ALWAYS`: ``/tf``, ``/tf_static``, ``/clock`` (which decides the run's clock) and
   :data:`PROV_TOPIC`, where the dispatcher publishes the run-time PROV.
 
@@ -50,7 +49,7 @@ def recorded_topics(scenario: Scenario, convention: str | None = None) -> list[s
         for signals in _candidates(robot, convention):
             stack = replace(robot, declared_signals=signals)
             found.update(_signal_topics(signals, robot.namespace))
-            read = StackRobots({}, {robot.id}).adapt(wanted_topics(metrics, [stack]), [stack])
+            read = StackRobots({}).adapt(wanted_topics(metrics, [stack]), [stack])
             found.update(read)
     return sorted({topic_key(topic) for topic in found})
 

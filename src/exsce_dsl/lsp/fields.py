@@ -18,7 +18,8 @@ from exsce_dsl.errors import MessageTypeError
 from exsce_dsl.lang import declaration_chunks
 from exsce_dsl.messages.catalogue import ARRAY, BASE, NAME, SEQUENCE, MessageCatalogue
 from exsce_dsl.messages.user import configured_catalogue
-from exsce_dsl.model.messages import DISPATCHER, canonical_type
+from exsce_dsl.model.messages import WINDOWS, canonical_type
+from exsce_dsl.model.metrics import SIGNAL_TYPES
 
 _WORD = r"[A-Za-z_][A-Za-z0-9_]*"
 _PART = rf"{_WORD}(?:\s*\[[^\[\]\n]*\])*"
@@ -27,6 +28,7 @@ _AFTER_DOT = re.compile(rf"({_PATH})\s*\.\s*\Z")
 _IN_SELECTION = re.compile(rf"({_PATH})\s*\[\s*((?:{_WORD}\s*\.\s*)*)\Z")
 _STEPS = re.compile(rf"{_WORD}|\[[^\[\]\n]*\]")
 _READ = re.compile(rf"\breads\s+({_WORD})\s*:\s*({_WORD}/(?:msg/)?{_WORD})(?:\s+on\s+(\"[^\"\n]*\"))?")
+_SIGNAL_READ = re.compile(rf"\breads\s+({_WORD})\s*:\s*robot\s+({'|'.join(SIGNAL_TYPES)})\b")
 _PAIR = re.compile(rf"\bpair\s+of\s+robots\s*\(\s*({_WORD})\s*,\s*({_WORD})\s*\)")
 _TYPE_BEFORE = re.compile(r"[\w/]*\Z")
 _BEFORE = 400
@@ -57,10 +59,19 @@ class Offer:
 
 @dataclass(frozen=True)
 class MetricText:
-    """What a metric's text says about names: its reads (name → type, topic) and pair binders."""
+    """What a metric's text says about names: its reads (name → type, topic; a signal's topic is
+    ``robot velocity``...) and pair binders."""
 
     reads: dict[str, tuple[str, str]]
     pair: tuple[str, ...]
+
+    def source(self, name: str) -> str:
+        """Where a read is: ``geometry_msgs/msg/Twist on /{ns}/cmd_vel``, ``the robot's velocity
+        (geometry_msgs/msg/Twist)``."""
+        msgtype, topic = self.reads[name]
+        if topic.startswith("robot "):
+            return f"the robot's {topic.removeprefix('robot ')} ({msgtype})"
+        return f"{msgtype} on {topic}"
 
 
 def metric_text(text: str, offset: int) -> tuple[int, MetricText] | None:
@@ -70,6 +81,7 @@ def metric_text(text: str, offset: int) -> tuple[int, MetricText] | None:
         return None
     body = text[chunk.start : chunk.end]
     reads = {m[1]: (canonical_type(m[2]), (m[3] or '""')[1:-1]) for m in _READ.finditer(body)}
+    reads |= {m[1]: (SIGNAL_TYPES[m[2]], f"robot {m[2]}") for m in _SIGNAL_READ.finditer(body)}
     pair = _PAIR.search(body)
     return chunk.start, MetricText(reads, (pair[1], pair[2]) if pair else ())
 
@@ -89,7 +101,7 @@ def offers(text: str, offset: int, word_start: int, message_type: bool) -> Offer
     before = text[max(start, word_start - _BEFORE) : word_start]
     path = _path_before(before)
     if path is None:
-        items = [(name, "read", f"{msgtype} on {topic}") for name, (msgtype, topic) in metric.reads.items()]
+        items = [(name, "read", metric.source(name)) for name in metric.reads]
         items += [(name, "robot", "a robot of the pair") for name in metric.pair]
         return Offer(word_start, items) if _at_field_start(before) else None
     fields = _fields_at(catalogue, metric, path)
@@ -110,6 +122,8 @@ def field_hover(text: str, start: int, end: int) -> str | None:
     if path is None:
         if word in metric.reads and not re.search(r"\breads\s*\Z", before):
             msgtype, topic = metric.reads[word]
+            if topic.startswith("robot "):
+                return f"**signal** `{word}`: the robot's {topic.removeprefix('robot ')} (`{msgtype}`)"
             return f"**topic** `{word}`: `{msgtype}` on `{topic}`"
         return None
     catalogue = configured_catalogue()
@@ -151,7 +165,7 @@ def _fields_at(catalogue: MessageCatalogue, metric: MetricText, path: list[str])
     if not path or path[0] not in metric.reads:
         return None
     msgtype = metric.reads[path[0]][0]
-    if msgtype in DISPATCHER:
+    if msgtype in WINDOWS:
         return None
     desc: Any = (NAME, msgtype)
     try:

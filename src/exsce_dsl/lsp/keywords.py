@@ -32,6 +32,10 @@ _WRITTEN: dict[str, str] = {
     "run recorded at less than half of it is reported at ingest, and its clauses are inconclusive.",
     "distance": "`reads odometer: robot distance`: in a metric, the distance the robot has travelled "
     "so far (`odometer.data`, m), wherever its type says it is.",
+    "goals": "`reads goals: robot goals`: in a metric, the robot's navigation goals, read as windows "
+    "(`elapsed`, `succeeded`) from whatever recorded them (the dispatcher, Nav2, move_base, else arrival "
+    "at its planned waypoints). `window goals`: whole-run metrics from its first goal's start to its "
+    "last goal's end.",
     "navigation": '`navigation dispatcher|nav2|move_base|none [on "/{ns}/ACTION", ...]`: the '
     "navigation interface whose goals make the path segments; `none`: segments by arrival at the "
     "planned waypoints.",

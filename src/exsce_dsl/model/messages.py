@@ -12,9 +12,9 @@ array of messages whose field has a value (``transforms[child_frame_id ==
 "base_link"]``), or the length of an array (``len(status_list)``).  Its
 :attr:`FieldPath.key` is the one text by which the bag reader, the monitors
 and the formatter know it.  ROS 1 and ROS 2 names of a type are one
-(``geometry_msgs/Twist`` is ``geometry_msgs/msg/Twist``).  The waypoint
-dispatcher's feedback and result are read as windows and successes
-(``elapsed``, ``succeeded``), not field by field.
+(``geometry_msgs/Twist`` is ``geometry_msgs/msg/Twist``).  A robot's goals
+signal, and the waypoint dispatcher's feedback and result read as topics, are
+read as windows and successes (``elapsed``, ``succeeded``), not field by field.
 """
 
 from __future__ import annotations
@@ -48,9 +48,11 @@ FEEDBACK = "waypoint_dispatcher/msg/FollowWaypointsActionFeedback"
 RESULT = "waypoint_dispatcher/msg/FollowWaypointsActionResult"
 DISPATCHER = (FEEDBACK, RESULT)
 """Read whole by the run's segmentation; a metric uses them through ``elapsed`` and ``succeeded``."""
-
-POSE = "geometry_msgs/msg/PoseWithCovarianceStamped"
-"""The method's robot pose (its convention's pose topic), where hotspots are placed."""
+GOALS = "exsce_msgs/msg/RobotGoals"
+"""What a robot's goals signal (``reads goals: robot goals``) is taken for: no message of any bag,
+and no fields; a metric uses it through ``elapsed`` and ``succeeded``."""
+WINDOWS = (*DISPATCHER, GOALS)
+"""The types read as windows and successes, never field by field."""
 
 
 @dataclass(frozen=True)

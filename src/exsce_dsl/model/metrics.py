@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 from exsce_dsl.errors import SourceLocation
 from exsce_dsl.model.conventions import METHOD_TOPICS
 from exsce_dsl.model.expressions import Expression, Field
+from exsce_dsl.model.messages import GOALS
 
 if TYPE_CHECKING:
     from exsce_dsl.model.scenario import Scenario
@@ -45,13 +46,21 @@ SIGNAL_TYPES = {
     "velocity": "geometry_msgs/msg/Twist",
     "distance": "std_msgs/msg/Float64",
     "scan": "sensor_msgs/msg/LaserScan",
+    "goals": GOALS,
 }
-"""A robot's signals a metric can read, and the type whose fields each has."""
+"""A robot's signals a metric can read, and the type whose fields each has (goals: none, they are
+read as windows)."""
 
 
 def signal_pattern(signal: str) -> str:
     """The topic name a robot's signal goes under among a run's topics (``~`` is in no bag's)."""
     return f"/{{ns}}/~{signal}"
+
+
+GOALS_READ_AS = {"elapsed": signal_pattern("goals"), "succeeded": signal_pattern("goals") + "/outcomes"}
+"""What ``elapsed`` and ``succeeded`` read of a robot's goals signal, as a run's values name it: when
+its goals were active, and how they ended; a stack may record the two on different topics (the
+method's dispatcher: its feedback and its result)."""
 
 
 def expand_topic(pattern: str, namespace: str) -> str:
@@ -160,8 +169,9 @@ class TopicRead:
     """Every field the metric reads of the topic, where it is written: what the bag reader
     decodes, and what ``messages.field_check`` checks against the bag's definition."""
     signal: str | None = None
-    """A robot's signal (``pose``, ``velocity``, ``distance``) rather than a topic: ``topic`` is
-    then the name ingestion gives the signal (``/{ns}/~pose``), ``msgtype`` the signal's fields'."""
+    """A robot's signal (``pose``, ``velocity``, ``scan``, ``distance``, ``goals``) rather than a
+    topic: ``topic`` is then the name ingestion gives the signal (``/{ns}/~pose``), ``msgtype`` the
+    signal's fields'."""
 
     def topic_of(self, namespace: str) -> str:
         return expand_topic(self.topic, namespace)

@@ -8,15 +8,13 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from types import ModuleType
 
-import numpy as np
-
 from exsce_dsl.errors import BagError, IncompleteRunError
 from exsce_dsl.lang import standard_metrics
 from exsce_dsl.messages.field_check import field_checker
 from exsce_dsl.model import Scenario
-from exsce_dsl.model.conventions import DISPATCHER_FEEDBACK, DISPATCHER_RESULT, MetricSpan
+from exsce_dsl.model.conventions import MetricSpan
 from exsce_dsl.model.expressions import Field, walk
-from exsce_dsl.model.messages import DISPATCHER, POSE, FieldPath
+from exsce_dsl.model.messages import DISPATCHER, FieldPath
 from exsce_dsl.model.metrics import MetricDefinition
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import (
@@ -40,12 +38,12 @@ from exsce_dsl.runs.coverage import (
     with_findings,
 )
 from exsce_dsl.runs.metrics.accounting import on_wall_clock
-from exsce_dsl.runs.metrics.compute import HOTSPOT_PATHS, POSE_TOPIC, compute_metrics
+from exsce_dsl.runs.metrics.compute import compute_metrics
 from exsce_dsl.runs.metrics.monitor_code import load_monitors
 from exsce_dsl.runs.missing import missing_metrics, unread_topics
 from exsce_dsl.runs.plausible_poses import Refused, refuse_implausible, spec_speed_limit
 from exsce_dsl.runs.recorded_execution import recorded_execution
-from exsce_dsl.runs.robots import SERVED, StackRobots, stack_robots
+from exsce_dsl.runs.robots import StackRobots, stack_robots
 from exsce_dsl.runs.segments.recorded import RecordedAction, task_executions
 from exsce_dsl.runs.segments.sources import DISPATCHER_SOURCE, segment_robot
 from exsce_dsl.runs.segments.track import Track
@@ -53,8 +51,6 @@ from exsce_dsl.runs.signals.detect import Detected, pose_like_topics, with_detec
 from exsce_dsl.runs.signals.recording import read_on_timeline
 from exsce_dsl.runs.signals.timeline import Timeline
 from exsce_dsl.wording import counted
-
-_FEEDBACK, _RESULT = DISPATCHER_FEEDBACK, DISPATCHER_RESULT
 
 
 @dataclass(frozen=True)
@@ -97,13 +93,11 @@ def run_metrics(scenario: Scenario) -> tuple[MetricDefinition, ...]:
 
 def wanted_topics(metrics: tuple[MetricDefinition, ...], robots: list[Robot]) -> dict[str, Wanted]:
     """Topic → its message type (the dispatcher's: kept as message objects) and the fields the
-    metrics read of it (and of each robot's pose, where hotspots are placed)."""
+    metrics read of it."""
     types: dict[str, str] = {}
     paths: dict[str, dict[FieldPath, None]] = {}
     for robot in robots:
         ns = robot.namespace.strip("/")
-        types[expand_topic(POSE_TOPIC, ns)] = POSE
-        paths.setdefault(expand_topic(POSE_TOPIC, ns), {}).update(dict.fromkeys(HOTSPOT_PATHS))
         for metric in metrics:
             read_paths = fields_read(metric)
             for read in metric.reads:
@@ -128,10 +122,10 @@ def fields_read(metric: MetricDefinition) -> dict[str, list[FieldPath]]:
 
 def reductions(monitors: ModuleType, robots: list[Robot], stacks: StackRobots) -> dict[str, Reduce]:
     """Topic → what to reduce of each block of its messages as the bag is read (the monitors'
-    aggregates over arrays), so that no topic's arrays are ever all in memory.  A signal served
-    under another name than its bag topic's (a scan on ``/base_scan`` served as ``/scan``) is
-    reduced as its bag topic is read: the reader keeps no arrays of a topic it reduces, so a
-    reduction keyed by the served name alone left the monitors without the scan's ranges."""
+    aggregates over arrays), so that no topic's arrays are ever all in memory.  A scan signal
+    (``/{ns}/~scan``) is reduced as its bag topic (``/base_scan``) is read: the reader keeps no
+    arrays of a topic it reduces, so a reduction keyed by the signal's name alone left the
+    monitors without the scan's ranges."""
     entries: dict[str, list[tuple[str, str, Compute]]] = {}
     for robot in robots:
         for pattern, key, func, compute in monitors.REDUCERS:
@@ -221,7 +215,7 @@ def analyse_bag(
 @dataclass
 class _Signals:
     """A bag read as a run of a scenario: its robots (conventions detected where their type names
-    none), the stacks serving their signals, every series on the run's one timeline, and the
+    none), where their signals were read from, every series on the run's one timeline, and the
     problems found so far."""
 
     opened: OpenedBag
@@ -248,16 +242,15 @@ class _Signals:
 def _read_signals(
     path: Path, scenario: Scenario, metrics: tuple[MetricDefinition, ...], monitors: ModuleType
 ) -> _Signals:
-    """Read what the metrics need of the bag at ``path``, put it on one timeline, and serve each
-    robot's signals under the topics the monitors read."""
+    """Read what the metrics need of the bag at ``path``, put it on one timeline, and each
+    robot's signals from the sources its convention names (``/{ns}/~pose``...)."""
     opened = open_bag(path)
     types = opened.topics
     robots, detected = with_detected_conventions(
         [r for r in scenario.robots if r.start_pose is not None], types
     )
-    stacks = stack_robots(robots, types, {r.id for r in robots})
-    serving = [expand_topic(p, r.namespace) for r in robots if r.id in stacks.serves for p in SERVED.values()]
-    unread = unread_topics(scenario.metrics, robots, types, serving)
+    stacks = stack_robots(robots, types)
+    unread = unread_topics(scenario.metrics, robots, types)
     wanted = stacks.adapt(wanted_topics(metrics, robots), robots)
     if PROV_TOPIC in types:
         wanted[PROV_TOPIC] = Wanted(OBJECTS)
@@ -268,12 +261,7 @@ def _read_signals(
     for sources in stacks.sources.values():
         problems += sources.notes
     topics = {name: Topic(name, s.t, s.fields) for name, s in data.series.items()}
-    for name, served in stacks.served_topics(data, problems).items():
-        read = topics.get(name)
-        # a signal served under the very topic it was read from keeps every field the bag gave
-        # (a user metric may read more of it than the method's fields: pose.pose.covariance)
-        same = read is not None and len(read) == len(served) and np.array_equal(read.t, served.t)
-        topics[name] = Topic(name, served.t, {**served.fields, **read.fields}) if same and read else served
+    topics.update(stacks.signal_series(data, problems))
     refused = refuse_implausible(robots, stacks, topics, data, spec_speed_limit(scenario.metrics))
     problems += refused.problems
     # an implausible pose places no arrival; the whole run still spans the recording
@@ -306,17 +294,13 @@ def _segment_robots(path: Path, scenario: Scenario, bag: _Signals) -> _Segmented
     stacks, data, out = bag.stacks, bag.data, _Segmented()
     for robot in bag.robots:
         ns = robot.namespace.strip("/")
-        feedback, result = expand_topic(_FEEDBACK, ns), expand_topic(_RESULT, ns)
         found = segment_robot(scenario, robot, data, bag.tracks[robot.id])
         bag.problems += found.problems
         out.actions.extend(found.segments)
         if found.source and found.source != DISPATCHER_SOURCE:
             out.segmented_by[robot.id] = found.source
         out.results[robot.id] = found.succeeded
-        if found.source != DISPATCHER_SOURCE:
-            stacks.real_topics[feedback] = stacks.real_topics[result] = (
-                found.topics or stacks.real_topics.get(expand_topic(SERVED["pose"], ns), ())
-            )
+        stacks.name_goals(ns, found.topics, found.outcomes, found.source == DISPATCHER_SOURCE)
         # the whole run is the recording unless recorded goals span it: never an arrival
         recording = robot.signals.window is MetricSpan.RECORDING or not found.goals
         if (not found.segments or recording) and scenario.mission.tasks_of(robot.id):

@@ -132,9 +132,9 @@ def bag_contents(path: Path) -> BagContents:
     wanted.update({t: Wanted(OBJECTS) for t in maps})
     recorded = read_bag(path, with_stamps(wanted, types, stamp_catalogue()))
     data = on_timeline(recorded, decide_timeline(recorded))
-    stacks = StackRobots(sources, set())
+    stacks = StackRobots(sources)
     problems: list[str] = []
-    topics = stacks.served_topics(data, problems)
+    topics = stacks.signal_series(data, problems)
     for robot, model in zip(robots, models, strict=True):
         robot.scan = choose_sources(model, types).chosen.get("scan") is not None
         used = sources[model.id].used.get("pose")

@@ -47,15 +47,13 @@ def unread_topics(
     metrics: Iterable[MetricDefinition],
     robots: Sequence[Robot],
     bag: Mapping[str, str],
-    served: Iterable[str] = (),
 ) -> list[str]:
     """One warning per topic that ``metrics`` (the specification's own, not the standard
-    library's) or the robots' types name but ``bag`` (topic → type) lacks; ``served``: the topic
-    names ingestion serves itself (a robot's signals under the method's names)."""
+    library's) or the robots' types name but ``bag`` (topic → type) lacks."""
     found: dict[str, Unread] = {}
 
     def lacks(topic: str, types: tuple[str, ...], kind: str, reader: str) -> None:
-        if topic in bag or topic in skipped:
+        if topic in bag:
             return
         before = found.get(topic, Unread(topic, types, kind, ()))
         more = tuple(t for t in types if t not in before.types)
@@ -63,7 +61,6 @@ def unread_topics(
         readers = before.readers + (reader,) * (reader not in before.readers)
         found[topic] = Unread(topic, before.types + more, kind, readers)
 
-    skipped = set(served)
     for robot in robots:
         _robot_sources(robot, bag, lacks)
     for metric in metrics:

@@ -31,7 +31,7 @@ from exsce_dsl.model.robots import Robot
 from exsce_dsl.monitor_kit.monitor_core import Topic
 from exsce_dsl.runs.bags.data import BagData, Series, Wanted
 from exsce_dsl.runs.bags.reading import read_bag
-from exsce_dsl.runs.robots import SERVED, StackRobots
+from exsce_dsl.runs.robots import StackRobots
 from exsce_dsl.runs.signals.detect import robot_namespaces, under_namespace
 from exsce_dsl.runs.signals.plausibility import (
     Implausible,
@@ -81,7 +81,7 @@ def refuse_implausible(
     data: BagData,
     limit: float | None,
 ) -> Refused:
-    """What the monitors may not read of ``topics`` (the signals served and the bag's series),
+    """What the monitors may not read of ``topics`` (the robots' signals and the bag's series),
     each robot's pose measured against ``limit`` (:func:`spec_speed_limit`) and its velocity."""
     refused = Refused()
     bound = speed_bound(limit)
@@ -102,7 +102,7 @@ def refuse_implausible(
         refused.findings.append(found)
         said = found.describe()
         refused.problems.append(f"robot '{robot.id}': its pose makes no distance or speed: {said}")
-        names = _refused_names(robot, mine, stacks.serves)
+        names = _refused_names(robot, mine)
         refused.reasons.update(dict.fromkeys(names, f"no plausible pose ({said})"))
     for name, series in data.series.items():
         if name in checked:
@@ -151,10 +151,10 @@ def _own_velocity(mine: RobotSources, topics: Mapping[str, Topic], three_d: bool
     return velocity_peak(", ".join(used.topics), axes)
 
 
-def _refused_names(robot: Robot, mine: RobotSources, serves: set[str]) -> list[str]:
+def _refused_names(robot: Robot, mine: RobotSources) -> list[str]:
     """The topics the monitors read of a robot's implausible pose: the pose, its velocity and
-    distance where they come from it, under the robot's own names and the method's, and the bag
-    topic itself (a user metric may read it)."""
+    distance where they come from it, under the robot's own names, and the bag topic itself (a
+    user metric may read it)."""
     pose = mine.used["pose"]
     refused = ["pose"]
     for signal in ("velocity", "distance"):
@@ -163,8 +163,6 @@ def _refused_names(robot: Robot, mine: RobotSources, serves: set[str]) -> list[s
         if used is not None and (used.from_pose or (along and used.topics == pose.topics)):
             refused.append(signal)
     names = [signal_topic(s, robot.namespace) for s in refused]
-    if robot.id in serves:
-        names += [expand_topic(SERVED[s], robot.namespace) for s in refused]
     return names + ([pose.topic] if pose.tf is None else [])
 
 

@@ -161,7 +161,7 @@ ERRORS = [
     ("value mean(speed.linear.x)", 3, 14, "unknown topic 'speed'"),
     ("value first(vel.linear.x where vel.linear.x and 1)", 3, 51, "'and' joins conditions"),
     ("value duration where vel.linear.x", 3, 9, "needs a condition per message"),
-    ("value succeeded", 3, 9, "comes from the waypoint dispatcher: read its result topic"),
+    ("value succeeded", 3, 9, "counts the robot's goals that succeeded: read them (reads goals: robot goals)"),
     ("value abs(1, 2)", 3, 9, "abs(...) takes one value"),
     ("value max(derivate(vel.linear.x))", 3, 13, "unknown function 'derivate'; did you mean 'derivative'? (the "
      "functions: min, max, mean, sum, first, last, integral, change, path_length, norm, abs, sqrt, speed, "

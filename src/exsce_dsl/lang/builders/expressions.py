@@ -19,7 +19,6 @@ from typing import TYPE_CHECKING, Any
 from exsce_dsl.errors import FieldProblem, SourceLocation
 from exsce_dsl.lang.lexical import quantity_text
 from exsce_dsl.messages.field_check import field_shape
-from exsce_dsl.model.conventions import METHOD_TOPICS
 from exsce_dsl.model.expressions import (
     AGGREGATES,
     CONDITION_AGGREGATES,
@@ -37,7 +36,7 @@ from exsce_dsl.model.expressions import (
     WindowValue,
     expression_depth,
 )
-from exsce_dsl.model.messages import DISPATCHER, FEEDBACK, RESULT, FieldPath, Fields, Index, Select, Step
+from exsce_dsl.model.messages import FEEDBACK, GOALS, RESULT, WINDOWS, FieldPath, Fields, Index, Select, Step
 from exsce_dsl.model.metrics import UNITS, ComputedFor, Dimension, TopicRead
 from exsce_dsl.suggest import did_you_mean
 
@@ -48,6 +47,7 @@ _QUANTITY = re.compile(r"(\S+?)\s*([a-z/]+)?")
 _NUMERIC = (Kind.CONSTANT, Kind.NUMBERS, Kind.ARRAYS, Kind.VALUE)
 _PER_MESSAGE = (Kind.NUMBERS, Kind.ARRAYS, Kind.CONDITIONS, Kind.ARRAY_CONDITIONS)
 _CONDITIONS = (Kind.CONDITIONS, Kind.ARRAY_CONDITIONS)
+
 
 @dataclass(frozen=True)
 class Typed:
@@ -219,14 +219,14 @@ class ExpressionBuilder:
         return Typed(Number(quantity[0], written, self.pf.span(node)), Kind.CONSTANT)
 
     def _windowvalue(self, node: Any) -> Typed:
-        needed = FEEDBACK if node.name == "elapsed" else RESULT
-        if not any(r.msgtype == needed for r in self.scope.reads.values()):
-            which = "feedback" if node.name == "elapsed" else "result"
-            raise self._fail(
-                f"'{node.name}' comes from the waypoint dispatcher: read its {which} topic "
-                f'(reads {which}: {needed} on "{METHOD_TOPICS[which]}")',
-                node,
+        needed = FEEDBACK if node.name == "elapsed" else RESULT  # or the dispatcher's topic itself
+        if not any(r.msgtype in (needed, GOALS) for r in self.scope.reads.values()):
+            what = (
+                "measures the robot's goals"
+                if node.name == "elapsed"
+                else "counts the robot's goals that succeeded"
             )
+            raise self._fail(f"'{node.name}' {what}: read them (reads goals: robot goals)", node)
         if node.name == "succeeded" and self.scope.subject is not ComputedFor.ROBOT:
             raise self._fail("'succeeded' counts the waypoints of one robot: use it 'for each robot'", node)
         return Typed(WindowValue(node.name, self.pf.span(node)), Kind.VALUE)
@@ -260,10 +260,9 @@ class ExpressionBuilder:
         if read is None:
             raise self._fail(f"unknown topic '{first.name}'{did_you_mean(first.name, self.scope.reads)}", at)
         self._not_an_array(first, f"'{read.name}' is a topic")
-        if read.msgtype in DISPATCHER:
-            raise self._fail(
-                f"the dispatcher's {read.msgtype} is read as windows: use 'elapsed' or 'succeeded'", at
-            )
+        if read.msgtype in WINDOWS:
+            whose = "robot's goals are" if read.signal else f"dispatcher's {read.msgtype} is"
+            raise self._fail(f"the {whose} read as windows: use 'elapsed' or 'succeeded'", at)
         path = FieldPath(tuple(step for part in parts[1:] for step in _steps(part)), length)
         arrays = False
         tree = self.scope.trees.get(read.name)

@@ -28,7 +28,7 @@ from exsce_dsl.lang.builders.expressions import ExpressionBuilder, Scope, Typed,
 from exsce_dsl.lang.parser import ParsedFile
 from exsce_dsl.messages.catalogue import MessageCatalogue
 from exsce_dsl.model.expressions import Aggregate, Expression, WindowValue
-from exsce_dsl.model.messages import DISPATCHER, Fields, canonical_type
+from exsce_dsl.model.messages import WINDOWS, Fields, canonical_type
 from exsce_dsl.model.metrics import (
     SI_UNIT,
     SIGNAL_TYPES,
@@ -223,18 +223,19 @@ class _MetricBuilder:
         if self.pair is not None and read.name in self.pair:
             self.error(f"'{read.name}' names a robot of the pair; give the signal another name", read)
             return
-        if self.subject is ComputedFor.MISSION:
+        if self.subject is ComputedFor.MISSION and read.signal != "goals":  # a mission's: every robot's
             self.error(f"the robot's {read.signal} is read for each robot or each pair of robots", read)
             return
         msgtype = SIGNAL_TYPES[read.signal]
         topic = signal_pattern(read.signal)
         self.reads[read.name] = TopicRead(read.name, msgtype, topic, self.pf.span(read), signal=read.signal)
-        self.trees[read.name] = self.catalogue().tree(msgtype)
+        if msgtype not in WINDOWS:
+            self.trees[read.name] = self.catalogue().tree(msgtype)
         self.broken_reads.discard(read.name)
 
     def _tree(self, read: Any, msgtype: str) -> Fields | None:
         """The fields of ``msgtype``; None (and a warning) for a type the catalogue lacks."""
-        if msgtype in DISPATCHER:
+        if msgtype in WINDOWS:
             return None
         catalogue = self.catalogue()
         try:

@@ -19,20 +19,18 @@ import numpy as np
 
 from exsce_dsl.model.conventions import METHOD_TOPICS
 from exsce_dsl.model.geometry import Position
-from exsce_dsl.model.messages import path_of
-from exsce_dsl.model.metrics import ComputedFor, MetricDefinition
+from exsce_dsl.model.metrics import SIGNAL_TYPES, ComputedFor, MetricDefinition, signal_pattern
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import Accounting, ActionId, Hotspot, MetricScope, MetricValue, SourceCount
 from exsce_dsl.monitor_kit import monitor_core as core
 from exsce_dsl.runs.metrics.accounting import GOALS_SPAN, MISSION_SPAN, SampleCounter, segment_reason
-from exsce_dsl.runs.metrics.monitor_code import reads_used
+from exsce_dsl.runs.metrics.monitor_code import topics_used
 from exsce_dsl.runs.segments.recorded import RecordedAction
 
 HOTSPOT_RADIUS = 1.0  # metres: violations closer than this to a hotspot belong to it
-POSE_TOPIC = METHOD_TOPICS["pose"]
-"""Where hotspots are located: each robot's pose."""
-HOTSPOT_PATHS = (path_of("pose", "pose", "position", "x"), path_of("pose", "pose", "position", "y"))
-"""What hotspots read of the pose."""
+POSE_SIGNAL = signal_pattern("pose")
+"""Where hotspots are located: each robot's pose signal (its ``x`` and ``y``), wherever its
+convention puts it."""
 
 Window = tuple[RecordedAction | None, float, float]
 
@@ -54,7 +52,7 @@ def compute_metrics(
     segments' (a robot without segments, or whose window is its whole recording);
     ``named``: a topic the monitors read → how the run's problems name it: the bag's topics it was
     read from, or the sources looked for (a robot's signals are read where its convention puts
-    them, not from the method's topics the metrics are declared over); ``reasons``: robot → why
+    them); ``reasons``: robot → why
     its ``whole_runs`` span is its whole-run window (the recording, and why).  Each value carries
     its accounting: window, reason, and the samples of each source it used."""
     named = named or {}
@@ -92,13 +90,12 @@ def compute_metrics(
 
 def _topics(metric: MetricDefinition, alternative: int, namespaces: Sequence[str]) -> tuple[str, ...]:
     """The topics an alternative of ``metric`` read, for robots of these namespaces (in order)."""
-    patterns = {r.name: r.topic for r in metric.reads}
-    used = reads_used(metric, alternative)
+    used = topics_used(metric, alternative)
     found: list[str] = []
     for n, ns in enumerate(namespaces):
-        for whose, read in used:
+        for whose, pattern in used:
             if whose is None or (metric.pair is not None and metric.pair.index(whose) == n):
-                topic = core.expand_topic(patterns[read], ns)
+                topic = core.expand_topic(pattern, ns)
                 if topic not in found:
                     found.append(topic)
     return tuple(found)
@@ -117,9 +114,25 @@ def _missing(
     what = f"{metric.name} of '{robot.id}'" + (" and its violation duration" if metric.safety else "")
     verb = "are" if metric.safety else "is"
     if absent:
-        return f"{_absent(absent, named)}: {what} {verb} missing"
+        return f"{_absent(absent, named)}: {what} {verb} missing{_signal_hint(absent, [robot.namespace])}"
     outside = _outside(wanted, topics, start, end, named)
     return f"{what} {verb} missing" + (f": {outside}" if outside else "")
+
+
+def _signal_hint(absent: Sequence[str], namespaces: Sequence[str]) -> str:
+    """Where a metric reads one of the method's topics by name and the bag lacks it: the signal
+    that reads it wherever the robot's type says it is (a topic read by name is the bag's)."""
+    said = [
+        f"`robot {signal}`"
+        for signal in SIGNAL_TYPES
+        if signal in METHOD_TOPICS
+        and any(core.expand_topic(METHOD_TOPICS[signal], ns) in absent for ns in namespaces)
+    ]
+    return (
+        f" (to read it wherever the robot's type says it is, read the signal {' or '.join(said)})"
+        if said
+        else ""
+    )
 
 
 def _absent(absent: Sequence[str], named: Mapping[str, str]) -> str:
@@ -337,7 +350,7 @@ def _pairs_missing(
     monitor: Any, metric: MetricDefinition, start: float, end: float, named: Mapping[str, str]
 ) -> str:
     """Why a metric over pairs of robots is missing: the pairs that have no value."""
-    lacking = []
+    lacking, hint = [], ""
     for first, second in monitor.pairs():
         if getattr(monitor, f"_{metric.name}")(start, end, first, second) is not None:
             continue
@@ -347,22 +360,19 @@ def _pairs_missing(
         lacked = "; ".join(s if s.startswith("no ") else f"no {s}" for s in said)
         why = lacked if absent else _outside(read, monitor.topics, start, end, named)
         lacking.append(f"{first[0]} and {second[0]}" + (f" ({why})" if why else ""))
+        hint = hint or _signal_hint(absent, [first[1], second[1]])
     what = f"{metric.name} of the mission" + (" and its violation duration are" if metric.safety else " is")
-    return f"{what} missing: no value for {'; '.join(lacking)}"
+    return f"{what} missing: no value for {'; '.join(lacking)}{hint}"
 
 
 def _pose(topics: Mapping[str, core.Topic], namespace: str) -> core.Topic | None:
-    found = topics.get(core.expand_topic(POSE_TOPIC, namespace))
+    found = topics.get(core.expand_topic(POSE_SIGNAL, namespace))
     return found if found is not None and len(found) else None
 
 
 def _position_at(pose: core.Topic, times: np.ndarray) -> np.ndarray:
-    return np.column_stack(
-        [
-            np.interp(times, pose.t, pose.fields[HOTSPOT_PATHS[0].key]),
-            np.interp(times, pose.t, pose.fields[HOTSPOT_PATHS[1].key]),
-        ]
-    )
+    x, y = (np.interp(times, pose.t, pose.fields[axis]) for axis in ("x", "y"))
+    return np.column_stack([x, y])
 
 
 def group_hotspots(points: np.ndarray, durations: np.ndarray) -> list[tuple[np.ndarray, int, float]]:

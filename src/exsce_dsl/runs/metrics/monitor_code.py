@@ -41,8 +41,8 @@ from exsce_dsl.model.expressions import (
     is_constant,
     walk,
 )
-from exsce_dsl.model.messages import FEEDBACK, RESULT
-from exsce_dsl.model.metrics import Combine, ComputedFor, MetricDefinition
+from exsce_dsl.model.messages import FEEDBACK, GOALS, RESULT
+from exsce_dsl.model.metrics import GOALS_READ_AS, Combine, ComputedFor, MetricDefinition
 from exsce_dsl.user_cache import cache_folder, read_cached, write_cached
 
 GENERATOR = "exscec generate monitors"
@@ -251,17 +251,20 @@ def _inputs_digest(metrics: Sequence[MetricDefinition], source: str) -> str:
     return digest.hexdigest()
 
 
-def reads_used(metric: MetricDefinition, alternative: int) -> list[tuple[str | None, str]]:
-    """The (pair robot or None, read name) an alternative reads, dispatcher topics included."""
+def topics_used(metric: MetricDefinition, alternative: int) -> list[tuple[str | None, str]]:
+    """The (pair robot or None, topic pattern) an alternative reads: its fields' topics, and what
+    ``elapsed`` and ``succeeded`` read (of a robot's goals signal: :data:`GOALS_READ_AS`)."""
     expr = metric.value if alternative == 0 else metric.fallback
     assert expr is not None
+    reads = {r.name: r for r in metric.reads}
     used: list[tuple[str | None, str]] = []
     for node in walk(expr):
-        if isinstance(node, Field) and (node.robot, node.read) not in used:
-            used.append((node.robot, node.read))
+        if isinstance(node, Field) and (node.robot, reads[node.read].topic) not in used:
+            used.append((node.robot, reads[node.read].topic))
         elif isinstance(node, WindowValue):
             wanted = RESULT if node.name == "succeeded" else FEEDBACK
             for read in metric.reads:
-                if read.msgtype == wanted and (None, read.name) not in used:
-                    used.append((None, read.name))
+                topic = GOALS_READ_AS[node.name] if read.msgtype == GOALS else read.topic
+                if read.msgtype in (wanted, GOALS) and (None, topic) not in used:
+                    used.append((None, topic))
     return used

@@ -43,6 +43,8 @@ class RobotSegments:
     goals: bool = True
     """Whether the segments are recorded goals, whose span may stand for the robot's whole run;
     arrival's are not: an arrival cuts segments, never the run (the run is then its recording)."""
+    outcomes: tuple[str, ...] = ()
+    """The bag's topics ``succeeded`` came from, where not ``topics`` (the dispatcher's result)."""
 
 
 @dataclass
@@ -74,7 +76,9 @@ def _dispatcher(given: SegmentInput) -> RobotSegments | None:
     if statuses.feedback is None:
         return None
     found = dispatcher_segments(given.scenario, given.robot.id, statuses.feedback)
-    given.unsegmented = RobotSegments([], DISPATCHER_SOURCE, succeeded_waypoints(statuses.result))
+    feedback, result = statuses.topics
+    succeeded = succeeded_waypoints(statuses.result)
+    given.unsegmented = RobotSegments([], DISPATCHER_SOURCE, succeeded, (feedback,), outcomes=(result,))
     return replace(given.unsegmented, segments=found) if _started(found) else None
 
 
@@ -121,9 +125,7 @@ def segment_robot(scenario: Scenario, robot: Robot, data: BagData, track: Track)
         found = source.find(given)
         if found is not None:
             problems = tuple(given.problems)
-            return RobotSegments(
-                found.segments, found.source, found.succeeded, found.topics, problems, found.goals
-            )
+            return replace(found, problems=problems)
     given.problems.append(
         f"robot '{robot.id}': no path segments (no navigation goals, and no pose that reaches its planned "
         "waypoints): its metrics are of the whole run only"

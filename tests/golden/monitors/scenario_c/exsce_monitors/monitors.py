@@ -214,7 +214,7 @@ class RobotMetrics:
 
     def _prepare_fast_driving_time(self) -> tuple[int, list[core.Prepared]] | None:
         # the value: duration where norm(vel.linear.x, vel.linear.y) > 0.8 m/s
-        topic_0 = self.topic("/{ns}/nav_vel")
+        topic_0 = self.topic("/{ns}/~velocity")
         if topic_0 is not None:
             return 0, [
                 core.prepare(
@@ -242,7 +242,7 @@ class RobotMetrics:
 
     def _prepare_mean_turn_rate(self) -> tuple[int, list[core.Prepared]] | None:
         # the value: mean(abs(vel.angular.z))
-        topic_0 = self.topic("/{ns}/nav_vel")
+        topic_0 = self.topic("/{ns}/~velocity")
         if topic_0 is not None:
             return 0, [
                 core.prepare(
