@@ -96,7 +96,7 @@ def test_a_spec_file_name_cannot_break_out_of_the_generated_comment(tmp_path):
 
 
 def test_ingest_keeps_the_rendered_monitors_in_the_cache_folder(tmp_path, monkeypatch):
-    from exsce_dsl.runs.metrics import monitor_code
+    from exsce_dsl import monitor_code
 
     metrics = tuple(standard_metrics()) + load_spec(SPEC).metrics
     monkeypatch.setenv("EXSCE_CACHE", str(tmp_path / "cache"))

@@ -20,7 +20,7 @@ from exsce_dsl.errors import ExsceError, GenerationError
 from exsce_dsl.lang import load_spec, standard_metrics
 from exsce_dsl.model.expressions import Number, Unary
 from exsce_dsl.model.metrics import MetricDefinition
-from exsce_dsl.runs.metrics.monitor_code import load_monitors, monitor_source
+from exsce_dsl.monitor_code import load_monitors, monitor_source
 
 from tests.support.cli import exscec_here
 from tests.support.hostile_specs import (

@@ -15,11 +15,11 @@ from pathlib import Path
 
 import pytest
 
+from exsce_dsl import monitor_code
 from exsce_dsl.errors import CacheWarning
 from exsce_dsl.lang import code_cache, load_spec, standard_metrics
 from exsce_dsl.lang.spec_cache import load_spec_cached
 from exsce_dsl.messages import typestore_cache
-from exsce_dsl.runs.metrics import monitor_code
 from exsce_dsl.user_cache import KEY_NAME, MAGIC, cache_folder, read_cached, write_cached
 
 from tests.support.cli import run_exscec

@@ -21,6 +21,7 @@ LAYERS: list[set[str]] = [
     {"messages", "maps", "monitor_kit", "parallel"},
     {"transform"},
     {"lang"},
+    {"monitor_code"},
     {"prov"},
     {"rdf"},
     {"store"},

@@ -28,7 +28,7 @@ WHY: dict[str, str] = {
     "transformations (docs/deriving.md), the comments of a drafted .exsce file, the generated ROS "
     "monitor package's header and README, the generated monitor code's header": (
         "transform/records.py:exscec runs/spec_draft.py:* codegen/ros_monitor.py:exscec "
-        "runs/metrics/monitor_code.py:exscec"
+        "monitor_code.py:exscec"
     ),
     "the command line of another program exsce starts, with its own options, not exscec's: "
     "`ros2 bag record`, exsce's ROS 1 dispatcher node": (

@@ -14,8 +14,8 @@ from pathlib import Path
 from exsce_dsl.codegen.output import write_files
 from exsce_dsl.lang import standard_metrics
 from exsce_dsl.model import Specification
+from exsce_dsl.monitor_code import GENERATOR, monitor_source
 from exsce_dsl.resources import package_file
-from exsce_dsl.runs import GENERATOR, monitor_source
 from exsce_dsl.templating import python_string
 
 PACKAGE = "exsce_monitors"

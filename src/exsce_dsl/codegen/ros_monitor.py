@@ -41,10 +41,10 @@ from exsce_dsl.model.messages import (
 )
 from exsce_dsl.model.metrics import ComputedFor, MetricDefinition, TopicRead, expand_topic
 from exsce_dsl.model.names import ROS_TOPIC_RULE, is_ros_topic
+from exsce_dsl.monitor_code import monitor_source
 from exsce_dsl.oracles import PlannedOracle, plan_oracles
 from exsce_dsl.prov.identifiers import oracle_name
 from exsce_dsl.resources import package_file
-from exsce_dsl.runs import monitor_source
 from exsce_dsl.templating import python_name, python_string, render
 
 FEEDBACK_TOPIC, RESULT_TOPIC = DISPATCHER_FEEDBACK, DISPATCHER_RESULT

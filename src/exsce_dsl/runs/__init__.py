@@ -13,7 +13,6 @@ if TYPE_CHECKING:
     from exsce_dsl.runs.bags.reading import is_bag, names_a_bag
     from exsce_dsl.runs.coverage import PROV_TOPIC
     from exsce_dsl.runs.ingest import IngestResult, IngestStatus, ingest_bags, stored_bag_run_id
-    from exsce_dsl.runs.metrics.monitor_code import GENERATOR, monitor_source
     from exsce_dsl.runs.robots import StackRobots
     from exsce_dsl.runs.signals.trajectories import Trajectory, trajectories
     from exsce_dsl.runs.spec_draft import SpecDraft, default_spec_path, draft_spec

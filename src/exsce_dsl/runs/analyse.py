@@ -24,6 +24,7 @@ from exsce_dsl.model.runs import (
     RunClock,
     run_uuid,
 )
+from exsce_dsl.monitor_code import load_monitors
 from exsce_dsl.monitor_kit.monitor_core import Compute, Topic, expand_topic, reducer
 from exsce_dsl.remedies import STRICT_STORES_NONE
 from exsce_dsl.runs.bag_identity import content_hash
@@ -39,7 +40,6 @@ from exsce_dsl.runs.coverage import (
 )
 from exsce_dsl.runs.metrics.accounting import on_wall_clock
 from exsce_dsl.runs.metrics.compute import compute_metrics
-from exsce_dsl.runs.metrics.monitor_code import load_monitors
 from exsce_dsl.runs.missing import missing_metrics, unread_topics
 from exsce_dsl.runs.plausible_poses import Refused, refuse_implausible, spec_speed_limit
 from exsce_dsl.runs.recorded_execution import recorded_execution

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 from exsce_dsl.lang import expression_text, load_spec
 from exsce_dsl.lang.lexical import number_text, string_literal
-from exsce_dsl.runs.metrics.monitor_code import monitor_source
+from exsce_dsl.monitor_code import monitor_source
 
 HEADER = """metric m for each robot {{
   reads vel: geometry_msgs/msg/Twist on "/{{ns}}/nav_vel"

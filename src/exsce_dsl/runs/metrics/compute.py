@@ -2,7 +2,7 @@
 
 Windows come from the waypoint dispatcher (the mission, each robot's part of
 it, each path segment); the values inside them from ``RobotMetrics`` and
-``MissionMetrics`` (:mod:`exsce_dsl.runs.metrics.monitor_code`).  A metric that is
+``MissionMetrics`` (:mod:`exsce_dsl.monitor_code`).  A metric that is
 ``safe below|above`` a limit also gets its ``violation_duration`` and its
 hotspots, from the per-message values its monitor prepared.  A metric whose
 topics are missing from the bag is *missing* (no value, and a problem is
@@ -22,9 +22,9 @@ from exsce_dsl.model.geometry import Position
 from exsce_dsl.model.metrics import SIGNAL_TYPES, ComputedFor, MetricDefinition, signal_pattern
 from exsce_dsl.model.robots import Robot
 from exsce_dsl.model.runs import Accounting, ActionId, Hotspot, MetricScope, MetricValue, SourceCount
+from exsce_dsl.monitor_code import topics_used
 from exsce_dsl.monitor_kit import monitor_core as core
 from exsce_dsl.runs.metrics.accounting import GOALS_SPAN, MISSION_SPAN, SampleCounter, segment_reason
-from exsce_dsl.runs.metrics.monitor_code import topics_used
 from exsce_dsl.runs.segments.recorded import RecordedAction
 
 HOTSPOT_RADIUS = 1.0  # metres: violations closer than this to a hotspot belong to it
