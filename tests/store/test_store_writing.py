@@ -10,6 +10,7 @@ import pytest
 from prov.model import ProvDocument
 from pyoxigraph import Literal, NamedNode, Quad
 
+from exsce_dsl.cli.common import REMEDIES
 from exsce_dsl.errors import StoreConflictError, StoreError
 from exsce_dsl.lang import load_spec
 from exsce_dsl.prov import compile_scenario
@@ -127,7 +128,8 @@ def test_a_changed_scenario_is_refused_with_what_differs(
     assert "another version of scenario exsce:scenario_c" in message
     assert "exsce:scenario_c_bundle: mission:mission_c differs" in message
     assert "mission_c:tiago2-task_02 only in the store" in message
-    assert "--replace" in message
+    assert "to replace it, add it again with replace" in message  # the library's words
+    assert "--replace" in refused.value.remedied.said(REMEDIES)  # the command line's
     assert snapshot(store) == before
 
 

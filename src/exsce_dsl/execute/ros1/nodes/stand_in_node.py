@@ -40,7 +40,9 @@ STATIC_EVERY = 50  # samples: 1 Hz
 SCAN_EVERY, CORRECTION_EVERY, AMCL_EVERY, FEEDBACK_EVERY = 5, 5, 25, 10  # samples: 10, 10, 2, 5 Hz
 CMD_VEL_PERIOD_NS = 50_000_000  # 20 Hz
 TICK = 0.01  # wall seconds between publishing rounds
-MAX_LAG_NS = 500_000_000  # simulated time runs no further ahead of what was published
+MAX_LAG_NS = 200_000_000  # simulated time runs no further ahead of what was published: a round after
+# a stall of the node (whose recorder likely stalled with it) moves the clock 0.2 s at most, not
+# speed_up times the stall (0.5 s let a 20 Hz topic stamped on receipt show a gap of 0.56 s)
 QUEUE = 2000
 LEG_WAIT = 10.0  # wall seconds simulated time waits for a leg at most
 LOCALISATION_NOISE, LOCALISATION_YAW_NOISE = 0.02, 0.01
