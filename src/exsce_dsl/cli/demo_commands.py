@@ -71,7 +71,7 @@ def demo(folder: str, store_url: str | None, setup_only: bool, convention: str, 
     played by exsce's stand-in in move_base's convention, each run's mission
     dispatched as move_base goals and recorded by rosbag record, baseline
     runs ingested, a new run and one with tiago1 driving too fast executed
-    and judged: exscec demo live-demo --ros1 (about two minutes; the test
+    and judged: exscec demo live-demo --ros1 (about three minutes; the test
     suite runs it in tests/execute/test_live_loop.py).
     Exits 0 when every step ended as expected (the faulty run failing, the
     others passing), 1 otherwise.

@@ -116,7 +116,7 @@ class _ExecuteOptions:
 @click.option(
     "--speed-up",
     type=click.FloatRange(min=0, min_open=True),
-    default=10.0,  # execute.stand_in.session.DEFAULT_SPEED_UP (a test holds them equal)
+    default=5.0,  # execute.stand_in.session.DEFAULT_SPEED_UP (a test holds them equal)
     show_default=True,
     help="With --stand-in: simulated time runs this many times faster than wall time.",
 )

@@ -27,7 +27,7 @@ from exsce_dsl.cli.common import exit_status, reports_errors
 )
 @click.option(
     "--speed-up",
-    default=10.0,  # execute.stand_in.session.DEFAULT_SPEED_UP (a test holds them equal)
+    default=5.0,  # execute.stand_in.session.DEFAULT_SPEED_UP (a test holds them equal)
     show_default=True,
     type=click.FloatRange(min=0.0, min_open=True),
     help="Simulated time (/clock) runs this many times faster than wall time.",

@@ -158,13 +158,14 @@ class StandIn:
             self._reader.join(5.0)
 
 
-DEFAULT_SPEED_UP = 10.0
+DEFAULT_SPEED_UP = 5.0
 """How many times faster than wall time simulated time runs by default (``execute``,
-``stand-in`` and ``explore --executor ros1`` alike): 8.9x reached on a loaded 2-core machine
-(bench/execute.py; planning stops the clock, so the factor stays below it).  At 20 (13x
-reached) ``rosbag record`` lost messages there: it queues 100 per topic, a tenth of a second of
-odometry at 20x, and a recorder kept off a core longer than that leaves a gap that makes the
-run inconclusive."""
+``stand-in`` and ``explore --executor ros1`` alike).  ``rosbag record`` stamps a topic without
+a header (``cmd_vel``) when it receives it, on the simulated clock: a recorder kept off a core
+for 50 ms shows a gap of speed-up × 50 ms, and a gap over 0.5 s makes the run inconclusive.  At
+10 (8.9x reached on a loaded 2-core machine, bench/execute.py) a test suite beside it gave gaps
+of 0.53-0.77 s; at 5 the live demo passes with two busy loops on both cores.  At 20 the
+recorder lost messages (it queues 100 per topic)."""
 
 
 @contextmanager
