@@ -85,7 +85,7 @@ if TYPE_CHECKING:
 @click.option(
     "--speed-up", type=click.FloatRange(0, min_open=True),
     help="With --executor ros1: the stand-in's simulated time runs this many times faster "
-    "than wall time [default: 10].",
+    "than wall time [default: 5].",
 )  # fmt: skip
 @click.option(
     "--jobs", "-j", default=1, show_default=True, type=click.IntRange(1), help="Bags analysed in parallel."

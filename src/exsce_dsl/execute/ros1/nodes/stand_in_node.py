@@ -103,7 +103,7 @@ class StandInNode:
         self.robots: Dict[str, StandInRobot] = {}
         self.setup_done = threading.Event()
         self.running = True
-        self.speed_up = 10.0
+        self.speed_up = 5.0  # until the setup command says (DEFAULT_SPEED_UP)
         self.laser: Dict[str, float] = {}
         self.start_ns = 0
         self.published = 0  # the last global sample published
