@@ -19,7 +19,8 @@ from exsce_dsl.sim.run import simulate
 
 from tests.support.paths import ROOT
 
-RUNS = ROOT / "src" / "exsce_dsl" / "runs"
+RUNS = Path(analyse_bag.__code__.co_filename).resolve().parent
+"""Where ``runs`` is imported from: ``src/`` in a checkout, site-packages where exsce is installed."""
 STEPS = ("bags", "signals", "segments", "metrics", "coverage", "recorded_execution")
 """The steps of ``runs``, bottom to top; every other module of ``runs`` is its top."""
 
