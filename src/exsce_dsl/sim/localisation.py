@@ -36,25 +36,25 @@ NOISE_TIME = 1.0
 
 
 @dataclass(frozen=True)
-class Poses:
+class PlanarPoses:
     """Planar poses, one per sample: the pose of a child frame in a parent frame."""
 
     x: np.ndarray
     y: np.ndarray
     yaw: np.ndarray
 
-    def compose(self, other: Poses) -> Poses:
+    def compose(self, other: PlanarPoses) -> PlanarPoses:
         """``self ∘ other``: ``other``'s poses (given in ``self``'s child frame) in ``self``'s parent."""
         c, s = np.cos(self.yaw), np.sin(self.yaw)
-        return Poses(
+        return PlanarPoses(
             self.x + c * other.x - s * other.y,
             self.y + s * other.x + c * other.y,
             _wrap(self.yaw + other.yaw),
         )
 
-    def inverse(self) -> Poses:
+    def inverse(self) -> PlanarPoses:
         c, s = np.cos(self.yaw), np.sin(self.yaw)
-        return Poses(-(c * self.x + s * self.y), s * self.x - c * self.y, _wrap(-self.yaw))
+        return PlanarPoses(-(c * self.x + s * self.y), s * self.x - c * self.y, _wrap(-self.yaw))
 
 
 @dataclass(frozen=True)
@@ -78,13 +78,13 @@ class Odometry:
 class Localisation:
     """A robot's frames, sample by sample."""
 
-    truth: Poses
+    truth: PlanarPoses
     """``map → base_link`` as the robot really is."""
-    odom: Poses
+    odom: PlanarPoses
     """``odom → base_link``, the odometry."""
-    estimate: Poses
+    estimate: PlanarPoses
     """``map → base_link`` as the localiser has it."""
-    correction: Poses
+    correction: PlanarPoses
     """``map → odom``."""
     v: np.ndarray
     """Forward speed as odometry measures it (m/s)."""
@@ -99,9 +99,9 @@ def localise(
     """The odometry, estimate and correction of a robot that drove ``trajectory`` (seeded);
     ``drift``: its odometry's, else drawn from ``rng`` (a robot driving leg after leg keeps one)."""
     drift = Odometry.seeded(rng) if drift is None else drift
-    truth = Poses(trajectory.x, trajectory.y, trajectory.yaw)
+    truth = PlanarPoses(trajectory.x, trajectory.y, trajectory.yaw)
     odom = _odometry(truth, drift)
-    estimate = Poses(
+    estimate = PlanarPoses(
         truth.x + _wandering(rng, LOCALISATION_NOISE, len(truth.x)),
         truth.y + _wandering(rng, LOCALISATION_NOISE, len(truth.x)),
         _wrap(truth.yaw + _wandering(rng, LOCALISATION_YAW_NOISE, len(truth.x))),
@@ -117,7 +117,7 @@ def localise(
     )
 
 
-def _odometry(truth: Poses, drift: Odometry) -> Poses:
+def _odometry(truth: PlanarPoses, drift: Odometry) -> PlanarPoses:
     """Integrate each step's motion, measured in the body frame with the drift's errors, from zero."""
     dx, dy = np.diff(truth.x), np.diff(truth.y)
     c, s = np.cos(truth.yaw[:-1]), np.sin(truth.yaw[:-1])
@@ -129,7 +129,7 @@ def _odometry(truth: Poses, drift: Odometry) -> Poses:
     f, lat = forward * (1.0 + drift.scale), lateral * (1.0 + drift.scale)
     x = np.concatenate([[0.0], np.cumsum(oc * f - os_ * lat)])
     y = np.concatenate([[0.0], np.cumsum(os_ * f + oc * lat)])
-    return Poses(x, y, _wrap(yaw))
+    return PlanarPoses(x, y, _wrap(yaw))
 
 
 def _wandering(rng: np.random.Generator, sigma: float, samples: int) -> np.ndarray:

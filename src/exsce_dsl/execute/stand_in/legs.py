@@ -45,7 +45,7 @@ from exsce_dsl.sim.faults import (
     slow_in_areas,
     speed_factor,
 )
-from exsce_dsl.sim.localisation import Odometry, Poses, localise
+from exsce_dsl.sim.localisation import Odometry, PlanarPoses, localise
 from exsce_dsl.sim.motion import DT, Limits, SampledMotion, drive
 from exsce_dsl.sim.scan import ROBOT_RADIUS, SCAN_EVERY, Laser, scan_ranges
 
@@ -86,10 +86,10 @@ class StandInLeg:
     succeeded: bool
     start: float
     """Simulated seconds when the goal came."""
-    truth: Poses
-    odom: Poses
-    estimate: Poses
-    correction: Poses
+    truth: PlanarPoses
+    odom: PlanarPoses
+    estimate: PlanarPoses
+    correction: PlanarPoses
     v: np.ndarray
     w: np.ndarray
     command_v: np.ndarray
@@ -318,7 +318,7 @@ class Fleet:
         )
         n = len(trajectory)
         ox, oy, oyaw = robot.at.odom
-        standing = Poses(np.full(n, ox), np.full(n, oy), np.full(n, oyaw))
+        standing = PlanarPoses(np.full(n, ox), np.full(n, oy), np.full(n, oyaw))
         odom = standing.compose(_tail(frames.odom))
         estimate = _tail(frames.estimate)
         idx = np.arange(0, n, SCAN_EVERY)
@@ -338,7 +338,7 @@ class Fleet:
             goal,
             succeeded,
             time,
-            Poses(trajectory.x, trajectory.y, trajectory.yaw),
+            PlanarPoses(trajectory.x, trajectory.y, trajectory.yaw),
             odom,
             estimate,
             estimate.compose(odom.inverse()),
@@ -376,8 +376,8 @@ def _distance_to(path: np.ndarray, point: Point) -> float:
     return float(np.hypot(*(nearest - np.asarray(point)).T).min())
 
 
-def _tail(poses: Poses) -> Poses:
-    return Poses(poses.x[1:], poses.y[1:], poses.yaw[1:])
+def _tail(poses: PlanarPoses) -> PlanarPoses:
+    return PlanarPoses(poses.x[1:], poses.y[1:], poses.yaw[1:])
 
 
 __all__ = ["FIELDS", "Fleet", "StandInLeg", "Standing"]
