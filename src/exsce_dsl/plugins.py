@@ -22,6 +22,7 @@ T = TypeVar("T")
 GROUPS: Mapping[str, str] = {
     "relation": "exsce.relations",
     "executor": "exsce.executors",
+    "simulator": "exsce.simulators",
     "bag reader": "exsce.bag_readers",
     "store flavour": "exsce.store_flavours",
 }

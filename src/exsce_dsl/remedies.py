@@ -14,6 +14,8 @@ REPLACE_FILES = "ask to replace the files that exist"
 """The remedy of an error that would overwrite files."""
 SIMULATE_IT = "the simulator plays it"
 """A fault the stand-in does not play."""
+INSTALL_IRSIM = "install exsce's irsim extra, which brings IR-SIM (ir-sim on PyPI)"
+"""IR-SIM was asked for and is not installed."""
 CHOOSE_A_CONVENTION = "the executor writes one for the whole run: choose it"
 """Robots of one run that follow different conventions."""
 DEFINE_THE_TYPE = (

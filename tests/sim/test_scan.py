@@ -12,7 +12,8 @@ import pytest
 
 from exsce_dsl.maps.grid import load_occupancy_grid
 from exsce_dsl.maps.planning import PlanningGrid
-from exsce_dsl.sim.scan import MARCHED_AT_ONCE, Laser, scan_ranges
+from exsce_dsl.sim.laser import Laser
+from exsce_dsl.sim.scan import MARCHED_AT_ONCE, scan_ranges
 
 from tests.support.map_files import write_map
 

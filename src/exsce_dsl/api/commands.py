@@ -79,8 +79,12 @@ def simulate(
     convention: str | None = None,
     cmd_vel_stamped: bool = False,
     dask_address: str | None = None,
+    simulator: str = "kinematic",
+    behaviour: str | None = None,
+    scans: str | None = None,
 ) -> list[SimulatedRun]:
-    """``exscec simulate``: play a scenario ``runs`` times with the kinematic executor, one bag per
+    """``exscec simulate``: play a scenario ``runs`` times with ``simulator`` (``kinematic``, exsce's
+    own executor, or ``irsim``, IR-SIM with ``behaviour`` and ``scans``), one bag per
     run in ``out_dir`` (``faults`` as on the command line: ``overspeed:tiago1``).  With ``dask_address``
     (a Dask scheduler's address) each run is a task on the cluster's workers, which write the bags
     into ``out_dir``: the same path on every worker (a shared filesystem); the same bytes as here."""
@@ -88,6 +92,7 @@ def simulate(
         simulating(
             spec, out_dir, runs, scenario=scenario, format=format, seed=seed, faults=faults,
             convention=convention, cmd_vel_stamped=cmd_vel_stamped, dask_address=dask_address,
+            simulator=simulator, behaviour=behaviour, scans=scans,
         )
     )  # fmt: skip
 
@@ -95,18 +100,24 @@ def simulate(
 def simulating(
     spec: Specification | Scenario, out_dir: str | Path, runs: int = 1, *, scenario: str | None = None,
     format: str = "ros1", seed: int = 0, faults: Sequence[str] = (), convention: str | None = None,
-    cmd_vel_stamped: bool = False, dask_address: str | None = None,
+    cmd_vel_stamped: bool = False, dask_address: str | None = None, simulator: str = "kinematic",
+    behaviour: str | None = None, scans: str | None = None,
 ) -> Iterator[SimulatedRun]:  # fmt: skip
     """:func:`simulate`, each run given as soon as its bag is written (``exscec simulate`` says
     each as it comes); ``cmd_vel_stamped``: nav2's and move_base's cmd_vel as TwistStamped."""
     from exsce_dsl.sim.executor import Fault
     from exsce_dsl.sim.run import simulate as play
+    from exsce_dsl.sim.simulators import simulator_named
 
     chosen = _scenario(spec, scenario)
     parsed = tuple(Fault.parse(f) for f in faults)
+    player = simulator_named(simulator, behaviour, scans)
     return iter(
-        play(chosen, Path(out_dir), runs, format, seed, parsed, convention, cmd_vel_stamped, dask_address)
-    )
+        play(
+            chosen, Path(out_dir), runs, format, seed, parsed, convention, cmd_vel_stamped, dask_address,
+            player,
+        )
+    )  # fmt: skip
 
 
 def ingest(

@@ -32,6 +32,7 @@ from exsce_dsl.remedies import (
     GIVE_A_RUN_ID,
     GIVE_THE_SPECS,
     INSTALL_DASK,
+    INSTALL_IRSIM,
     LEARN_FROM_EVERY_RUN,
     LIST_THE_QUERIES,
     MAKE_A_TOKEN,
@@ -159,6 +160,7 @@ REMEDIES = {
     MAKE_A_TOKEN: "{problem} (leave --token and EXSCE_STORE_TOKEN unset to have one made)",
     START_A_MASTER: "{problem}: start roscore and export it, or pass --start-master",
     SIMULATE_IT: "{problem} (exscec simulate does)",
+    INSTALL_IRSIM: "{problem}: pip install 'exsce[irsim]' (or, in a clone, pip install -e '.[irsim]')",
     CHOOSE_A_CONVENTION: "{problem}; the executor writes one for the whole run: choose it with --convention",
     DEFINE_THE_TYPE: (
         "{problem} (to check them now, give exsce the type's .msg or .idl file: exscec --msg-path DIR, "
@@ -377,3 +379,33 @@ all_runs_option = click.option(
     "a safety limit (measured at ingest).",
 )
 """The option of the commands that learn from stored runs (baselines, expected values)."""
+
+
+def simulator_options(func: F) -> F:
+    """``--simulator``, ``--behaviour`` and ``--scans``: what plays simulated runs."""
+    for option in reversed(
+        (
+            click.option(
+                "--simulator",
+                default="kinematic",
+                show_default=True,
+                metavar="NAME",
+                help="What plays the runs: kinematic (exsce's own executor) or irsim (IR-SIM, "
+                "pip install 'exsce[irsim]'), or a simulator plug-in.",
+            ),
+            click.option(
+                "--behaviour",
+                type=click.Choice(["dash", "rvo", "orca", "sfm"]),
+                help="irsim: IR-SIM's behaviour between the path's points [default: rvo] (orca "
+                "needs pyrvo).",
+            ),
+            click.option(
+                "--scans",
+                type=click.Choice(["exsce", "irsim", "none"]),
+                help="irsim: who measures the scans: exsce's laser model on IR-SIM's robot poses, "
+                "IR-SIM's lidar2d (slow on a building's map), or none [default: exsce].",
+            ),
+        )
+    ):
+        func = option(func)
+    return func

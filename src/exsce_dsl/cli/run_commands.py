@@ -7,7 +7,15 @@ from typing import TYPE_CHECKING
 
 import click
 
-from exsce_dsl.cli.common import REMEDIES, ExitCode, Progress, bag_arguments, exit_status, reports_errors
+from exsce_dsl.cli.common import (
+    REMEDIES,
+    ExitCode,
+    Progress,
+    bag_arguments,
+    exit_status,
+    reports_errors,
+    simulator_options,
+)
 from exsce_dsl.model.conventions import CONVENTIONS
 
 if TYPE_CHECKING:
@@ -68,6 +76,7 @@ if TYPE_CHECKING:
     "bags into --output themselves, so --output (and the map files) must be the same path on every "
     "worker (a shared filesystem).  The same bags as without.  Default: $EXSCE_DASK_SCHEDULER.",
 )
+@simulator_options
 @reports_errors
 def simulate(
     spec: str,
@@ -80,11 +89,18 @@ def simulate(
     convention: str | None,
     cmd_vel_stamped: bool,
     dask_address: str | None,
+    simulator: str,
+    behaviour: str | None,
+    scans: str | None,
 ) -> None:
-    """Play a scenario with the kinematic executor and write one bag per run.
+    """Play a scenario in a simulator and write one bag per run.
 
-    Robots plan around the occupied cells of the environment's map, drive
-    with bounded speed and acceleration and seeded noise.  Per robot
+    The kinematic executor (the default) plans around the occupied cells of
+    the environment's map and drives with bounded speed and acceleration and
+    seeded noise.  --simulator irsim plays each run in IR-SIM: the map as
+    its obstacle grid, each leg's path planned by exsce, the driving,
+    collisions and (with --scans irsim) the scans IR-SIM's (docs/irsim.md);
+    it plays the speed faults and skip-waypoint.  Per robot
     namespace the bag holds, by --convention:
 
     \b
@@ -116,6 +132,7 @@ def simulate(
       exscec simulate examples/brsu_building_c/scenario_c.exsce --runs 3 -o runs/
       exscec simulate examples/brsu_building_c/scenario_c.exsce --fault overspeed:tiago1 -o runs/faulty/
       exscec simulate examples/brsu_building_c/scenario_c.exsce --convention nav2 --format mcap -o runs/
+      exscec simulate examples/brsu_building_c/scenario_c.exsce --simulator irsim -o runs/irsim/
     """
     from exsce_dsl.api import dask_address as scheduler_address
     from exsce_dsl.api import load, simulating
@@ -124,6 +141,7 @@ def simulate(
     played = simulating(
         scenario, out_dir, runs, format=fmt, seed=seed, faults=faults, convention=convention,
         cmd_vel_stamped=cmd_vel_stamped, dask_address=scheduler_address(dask_address),
+        simulator=simulator, behaviour=behaviour, scans=scans,
     )  # fmt: skip
     with Progress(runs, f"simulating {scenario.id}") as progress:
         for run in played:

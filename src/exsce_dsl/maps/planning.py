@@ -119,6 +119,11 @@ class PlanningGrid:
 
     def plan(self, start: Point, goal: Point, robot_radius: float = 0.3) -> list[Point]:
         """A collision-free polyline from start to goal (both included)."""
+        return self._shortcut(self.cell_path(start, goal), robot_radius)
+
+    def cell_path(self, start: Point, goal: Point) -> list[Point]:
+        """The planned path from start to goal (both included) through the centres of its cells,
+        before corners are cut: it keeps to the middle of doorways and corridors."""
         source, target = self._nearest_free(start), self._nearest_free(goal)
         if source is None or target is None:
             bad = start if source is None else goal
@@ -131,8 +136,7 @@ class PlanningGrid:
                 f"no path from ({start[0]:.2f}, {start[1]:.2f}) to ({goal[0]:.2f}, {goal[1]:.2f})"
             )
         cells = [(n // width, n % width) for n in nodes]
-        path = [start] + [self.centre(c) for c in cells[1:-1]] + [goal]
-        return self._shortcut(path, robot_radius)
+        return [start] + [self.centre(c) for c in cells[1:-1]] + [goal]
 
     def _nearest_free(self, p: Point) -> tuple[int, int] | None:
         r, c = self.cell_of(p)

@@ -35,6 +35,16 @@ class DispatchedGoal:
 
 
 @dataclass(frozen=True)
+class SimulatorInfo:
+    """The software that played a simulated run: its name (``kinematic``, ``irsim``), its version
+    and the settings that decided how it played (``behaviour=rvo``)."""
+
+    name: str
+    version: str
+    settings: tuple[tuple[str, str], ...] = ()
+
+
+@dataclass(frozen=True)
 class Execution:
     """The execution of a run's mission, as its dispatcher recorded it."""
 
@@ -51,3 +61,5 @@ class Execution:
     """``cancelled`` or ``stopped`` when the mission did not complete."""
     goals: tuple[DispatchedGoal, ...] = ()
     """In the order they were sent."""
+    simulator: SimulatorInfo | None = None
+    """What played the run, when a simulator did (its run-time PROV names it)."""

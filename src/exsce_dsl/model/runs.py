@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model.coverage import CoverageGap, TopicRate
-from exsce_dsl.model.executions import Execution
+from exsce_dsl.model.executions import Execution, SimulatorInfo
 from exsce_dsl.model.geometry import Pose, Position
 from exsce_dsl.model.names import NAME_PATTERN
 
@@ -264,6 +264,9 @@ class Run:
     simulated time (they are then seconds after 1970 of simulated time, and no date is written)."""
     execution: Execution | None = None
     """What the dispatcher did, as the run-time PROV recorded with the bag says (None without it)."""
+    simulator: SimulatorInfo | None = None
+    """What played the run, in the run-time PROV a simulator writes (ingestion reads it back
+    into :attr:`execution`)."""
 
     def actions(self) -> Iterator[Action]:
         for task in self.tasks:

@@ -80,7 +80,7 @@ from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, Namespaces
 from exsce_dsl.prov.records import Attributes, BundleWriter, DocumentWriter
 from exsce_dsl.prov.run_accounting import accounting_facts, write_problems, write_sample_counts
 from exsce_dsl.prov.run_coverage import write_coverage
-from exsce_dsl.prov.run_execution import write_execution
+from exsce_dsl.prov.run_execution import write_execution, write_simulator
 
 __all__ = ["compile_run"]
 
@@ -183,6 +183,8 @@ class _RunCompiler:
             run_facts[t(ids.MISSION_STATUS)] = run.status.value
         dated = run.dated  # a run on simulated log time has no date (not one of 1970)
         w.activity(run_id, run_facts, run.start if dated else None, run.end if dated else None)
+        if run.simulator is not None:
+            write_simulator(w, parts[ids.SIMULATOR_AGENT], run_id, run.simulator)
         parameters = parts[ids.PARAMETER_SERVER]
         writer.claim(parameters, "the run's parameter server")
         parameter_facts: Attributes = {PROV_TYPE: t(ids.ROS_PARAMETER_SERVER)}

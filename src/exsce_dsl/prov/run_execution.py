@@ -34,12 +34,12 @@ from typing import Any
 
 from prov.constants import PROV_ROLE, PROV_TYPE
 
-from exsce_dsl.model.executions import DispatchedGoal, Execution
+from exsce_dsl.model.executions import DispatchedGoal, Execution, SimulatorInfo
 from exsce_dsl.model.runs import Run
 from exsce_dsl.prov import identifiers as ids
-from exsce_dsl.prov.records import Attributes, DocumentWriter
+from exsce_dsl.prov.records import Attributes, BundleWriter, DocumentWriter
 
-__all__ = ["parse_document", "read_execution", "write_execution"]
+__all__ = ["parse_document", "read_execution", "write_execution", "write_simulator"]
 
 _ACTION = re.compile(r"^(?P<robot>.+)-task_\d+-subtask_\d+-w_\d+$")
 _RUN_TYPE = "exsce:run"
@@ -80,8 +80,42 @@ def read_execution(document: object, source: str, scenario: str) -> Execution | 
             end=_time(run.get("prov:endTime")),
             mission_status=_text(run.get("exsce:mission_status")),
             goals=tuple(_goals(bundle, activities)),
+            simulator=_simulator(bundle, run_name),
         )
     return None
+
+
+def _simulator(bundle: Mapping[str, Any], run_name: str) -> SimulatorInfo | None:
+    """The software agent the run was associated with that names a simulator (None: none)."""
+    agents = _records(bundle, "agent")
+    for association in _records(bundle, "wasAssociatedWith").values():
+        if association.get("prov:activity") != run_name:
+            continue
+        facts = agents.get(str(association.get("prov:agent")))
+        name = _text(facts.get("exsce:simulator")) if isinstance(facts, Mapping) else None
+        if name is None or not isinstance(facts, Mapping):
+            continue
+        said = _text(facts.get("exsce:simulator_settings")) or ""
+        pairs = tuple(
+            (k.strip(), v.strip()) for k, _, v in (p.partition("=") for p in said.split(";")) if k.strip()
+        )
+        return SimulatorInfo(name, _text(facts.get("exsce:simulator_version")) or "", pairs)
+    return None
+
+
+def write_simulator(w: BundleWriter, agent: Any, activity: Any, simulator: SimulatorInfo) -> None:
+    """``agent``, the software that played the run, and ``wasAssociatedWith(activity, agent)``."""
+    t = w.term
+    w.agent(
+        agent,
+        {
+            PROV_TYPE: t(ids.PROV_SOFTWARE_AGENT),
+            t(ids.SIMULATOR): simulator.name,
+            t(ids.SIMULATOR_VERSION): simulator.version,
+            t(ids.SIMULATOR_SETTINGS): "; ".join(f"{k}={v}" for k, v in simulator.settings),
+        },
+    )
+    w.associated(activity, agent)
 
 
 def _goals(bundle: Mapping[str, Any], activities: Mapping[str, Any]) -> Iterator[DispatchedGoal]:
@@ -133,6 +167,8 @@ def write_execution(
         facts[t(ids.MISSION_STATUS)] = execution.mission_status
     w.activity(activity, facts, execution.start, execution.end)
     w.used(activity, w.fixed(ids.EXSCE)[run.scenario])
+    if execution.simulator is not None:
+        write_simulator(w, dispatched[ids.SIMULATOR_AGENT], activity, execution.simulator)
     recorded = dispatched[execution.bag_name or bag]
     w.entity(recorded, {})
     w.generated(recorded, activity)

@@ -22,7 +22,7 @@ from exsce_dsl.model.conventions import Signals
 from exsce_dsl.sim.batches import Batch
 from exsce_dsl.sim.conventions import convention_writer
 from exsce_dsl.sim.executor import SimulatedExecution
-from exsce_dsl.sim.scan import Laser
+from exsce_dsl.sim.laser import Laser
 from exsce_dsl.sim.writing import RobotRun
 
 _FOREVER = QosTime(9223372036, 854775807)

@@ -33,6 +33,7 @@ from exsce_dsl.sim.faults import (
     speed_factor,
 )
 from exsce_dsl.sim.give_way import distance_to_polyline, give_way
+from exsce_dsl.sim.laser import RecordedScans
 from exsce_dsl.sim.motion import DT, Limits, SampledMotion, drive
 from exsce_dsl.sim.passing import Wait, head_on_wait
 
@@ -71,6 +72,9 @@ class SimulatedExecution:
     events: list[GoalEvent]
     actions: list[SimulatedAction]
     duration: float
+    scans: dict[str, RecordedScans] | None = None
+    """What the executor's own sensors measured, per robot; None: it has none (the bag writer
+    ray-marches scans on the map)."""
 
 
 def execute(

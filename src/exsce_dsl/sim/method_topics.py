@@ -18,8 +18,9 @@ from exsce_dsl.model.conventions import METHOD_TOPICS
 from exsce_dsl.model.metrics import expand_topic
 from exsce_dsl.sim.batches import Batch, stamp_columns
 from exsce_dsl.sim.executor import GoalStatus, SimulatedExecution
+from exsce_dsl.sim.laser import Laser
 from exsce_dsl.sim.messages import FEEDBACK, RESULT
-from exsce_dsl.sim.scan import Laser, laser_scans
+from exsce_dsl.sim.scan import laser_scans
 from exsce_dsl.sim.values import (
     header,
     header_at,
@@ -145,7 +146,7 @@ def robot_messages(
         {"data": travelled[at]},
     )
     # scan: LaserScan against the map and the other robots
-    yield laser_scans(
+    yield from laser_scans(
         store, topics.scan, f"{topics.ns}/base_laser_link", robot, execution, grid, laser, rng, stamps
     )
 

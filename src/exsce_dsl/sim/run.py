@@ -24,6 +24,7 @@ from exsce_dsl.errors import ExsceError
 from exsce_dsl.maps.planning import PlanningGrid, planning_grid
 from exsce_dsl.model import Scenario
 from exsce_dsl.model.conventions import Signals
+from exsce_dsl.model.executions import SimulatorInfo
 from exsce_dsl.model.runs import Action, ActionId, ActionStatus, Run, run_name, run_uuid
 from exsce_dsl.parallel.dask_client import dask_map
 from exsce_dsl.prov.recorder import recorded_prov_json, recorded_run
@@ -31,7 +32,8 @@ from exsce_dsl.remedies import CHOOSE_A_CONVENTION
 from exsce_dsl.runs import ROS1_BAG
 from exsce_dsl.sim.bag import write_bag
 from exsce_dsl.sim.conventions import convention_writer
-from exsce_dsl.sim.executor import Fault, GoalStatus, SimulatedExecution, execute
+from exsce_dsl.sim.executor import Fault, GoalStatus, SimulatedExecution
+from exsce_dsl.sim.simulators import KINEMATIC, Simulator
 
 FORMATS = ("ros1", "ros2", "mcap")
 #: Runs of seed S start at this instant plus S days (modulo SEED_DAYS), one hour apart (no wall clock:
@@ -62,6 +64,7 @@ class RunPlan:
     faults: tuple[Fault, ...]
     convention: Signals | str
     twist_stamped: bool
+    simulator: Simulator = KINEMATIC
 
     @classmethod
     def of(
@@ -73,19 +76,30 @@ class RunPlan:
         faults: Sequence[Fault] = (),
         convention: Signals | str | None = None,
         twist_stamped: bool = False,
+        simulator: Simulator = KINEMATIC,
     ) -> RunPlan:
         """The plan of ``simulate``'s arguments: the format checked, the convention chosen."""
         if fmt not in FORMATS:
             raise ExsceError(f"unknown bag format '{fmt}'; use one of {', '.join(FORMATS)}")
         chosen = convention or scenario_convention(scenario)
-        return cls(scenario, out_dir, fmt, seed, tuple(faults), chosen, twist_stamped)
+        return cls(scenario, out_dir, fmt, seed, tuple(faults), chosen, twist_stamped, simulator)
 
     @property
     def variant(self) -> str:
         """What the run ids of another convention than the method's add, so that their bags can
         share a folder with the method's."""
         written = convention_writer(self.convention).name
-        return "" if written == "method" else f"/{written}" + ("/stamped" if self.twist_stamped else "")
+        stamped = "/stamped" if self.twist_stamped else ""
+        return self.played_by + ("" if written == "method" else f"/{written}{stamped}")
+
+    @property
+    def played_by(self) -> str:
+        """What the run ids of another simulator than the kinematic executor add: its name and
+        settings (a run of IR-SIM is never one of the kinematic executor)."""
+        sim = self.simulator
+        if sim.name == KINEMATIC.name:
+            return ""
+        return f"/{sim.name}" + "".join(f"/{k}={v}" for k, v in sim.settings.items())
 
 
 def simulate(
@@ -98,13 +112,15 @@ def simulate(
     convention: Signals | str | None = None,
     twist_stamped: bool = False,
     dask_address: str | None = None,
+    simulator: Simulator = KINEMATIC,
 ) -> Iterator[SimulatedRun]:
     """Play ``scenario`` ``runs`` times and write one bag per run into ``out_dir``, in run order.
 
     ``convention`` (a name or a robot type's :class:`Signals`) says which topics the robots
     publish: the method's, Nav2's or move_base's; None: the one the robots' types name (the
     method's if they name none); ``twist_stamped`` makes the
-    navigation stacks' ``cmd_vel`` a TwistStamped (Nav2 from Jazzy on).  Runs in another
+    navigation stacks' ``cmd_vel`` a TwistStamped (Nav2 from Jazzy on).  ``simulator`` plays
+    each run (:mod:`exsce_dsl.sim.simulators`): the kinematic executor unless told.  Runs in another
     convention than the method's get other run ids, so their bags can share a folder.
 
     With ``dask_address`` (a Dask scheduler's address) each run is one task on the cluster's workers,
@@ -115,10 +131,10 @@ def simulate(
     names each failed run by its index."""
     if dask_address is not None:
         shared = _with_absolute_map(scenario)
-        plan = RunPlan.of(shared, out_dir.absolute(), fmt, seed, faults, convention, twist_stamped)
+        plan = RunPlan.of(shared, out_dir.absolute(), fmt, seed, faults, convention, twist_stamped, simulator)
         plan.out_dir.mkdir(parents=True, exist_ok=True)
         return _on_dask(dask_address, plan, runs, out_dir)
-    plan = RunPlan.of(scenario, out_dir, fmt, seed, faults, convention, twist_stamped)
+    plan = RunPlan.of(scenario, out_dir, fmt, seed, faults, convention, twist_stamped, simulator)
     out_dir.mkdir(parents=True, exist_ok=True)
     return _here(plan, runs)
 
@@ -172,7 +188,7 @@ def play_run(plan: RunPlan, index: int, grid: PlanningGrid | None = None) -> Sim
     faults = ",".join(f.identity for f in plan.faults)
     run_id = run_uuid("simulated", f"{scenario.id}/{plan.seed}/{index}/{faults}{plan.variant}")
     grid = planning_grid(scenario) if grid is None else grid
-    execution = execute(scenario, grid, run_seed, plan.faults)
+    execution = plan.simulator.play(scenario, grid, run_seed, plan.faults)
     name = run_name(start, scenario.id, run_id)
     bag_name = name + ROS1_BAG.suffix if plan.fmt == "ros1" else name
     partial = plan.out_dir / f".{name}.partial"  # the run's own: a retry clears what a killed try left
@@ -186,6 +202,7 @@ def play_run(plan: RunPlan, index: int, grid: PlanningGrid | None = None) -> Sim
             plan.convention, plan.twist_stamped,
         )  # fmt: skip
         recorder = _recorded_run(run_id, scenario, execution, start, bag)
+        recorder = replace(recorder, simulator=_info(plan.simulator))
         recorded = partial / (name + ".prov.json")
         recorded.write_text(recorded_prov_json(recorder, scenario), encoding="utf-8")
         os.replace(recorded, plan.out_dir / recorded.name)
@@ -194,6 +211,10 @@ def play_run(plan: RunPlan, index: int, grid: PlanningGrid | None = None) -> Sim
     finally:
         _remove(partial)
     return SimulatedRun(run_id, bag, start, run_seed, execution, count)
+
+
+def _info(simulator: Simulator) -> SimulatorInfo:
+    return SimulatorInfo(simulator.name, simulator.version, tuple(simulator.settings.items()))
 
 
 def _remove(path: Path) -> None:

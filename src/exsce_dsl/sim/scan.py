@@ -7,7 +7,7 @@ scans of a robot are marched together as one numpy array.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -15,28 +15,11 @@ import numpy as np
 from exsce_dsl.maps.planning import PlanningGrid
 from exsce_dsl.sim.batches import Batch, stamp_columns
 from exsce_dsl.sim.executor import SimulatedExecution
+from exsce_dsl.sim.laser import SCAN_EVERY, Laser, RecordedScans
 from exsce_dsl.sim.motion import DT
 from exsce_dsl.sim.values import header_at
 
-SCAN_EVERY = 5  # samples of the 50 Hz clock: 10 Hz
 ROBOT_RADIUS = 0.3  # other robots are discs of this radius
-
-
-@dataclass(frozen=True)
-class Laser:
-    beams: int = 720
-    angle_min: float = -2.356194490192345  # -135°
-    angle_max: float = 2.356194490192345
-    range_min: float = 0.05
-    range_max: float = 10.0
-    noise: float = 0.01
-
-    @property
-    def angle_increment(self) -> float:
-        return (self.angle_max - self.angle_min) / (self.beams - 1)
-
-    def angles(self) -> np.ndarray:
-        return self.angle_min + self.angle_increment * np.arange(self.beams)
 
 
 def scan_ranges(
@@ -137,15 +120,27 @@ def laser_scans(
     laser: Laser,
     rng: np.random.Generator,
     stamps: np.ndarray,
-) -> Batch:
-    """``sensor_msgs/LaserScan`` messages of ``robot`` every SCAN_EVERY samples (stamps: one per
-    sample), against the map and the other robots."""
-    T = store.types
+) -> Iterator[Batch]:
+    """``sensor_msgs/LaserScan`` messages of ``robot`` (stamps: one per sample): those the
+    executor's own sensor recorded, else ray-marched every SCAN_EVERY samples against the map and
+    the other robots; none when the executor recorded scans but not this robot's (no sensor)."""
+    if execution.scans is not None:
+        recorded = execution.scans.get(robot)
+        if recorded is not None:
+            yield _scan_batch(store, topic, frame, recorded, stamps)
+        return
     tr = execution.trajectories[robot]
     idx = np.arange(0, len(tr), SCAN_EVERY)
     others = [(o.x[idx], o.y[idx]) for r, o in execution.trajectories.items() if r != robot]
     ranges = scan_ranges(grid, laser, tr.x[idx], tr.y[idx], tr.yaw[idx], others, ROBOT_RADIUS, rng)
+    yield _scan_batch(store, topic, frame, RecordedScans(laser, idx, ranges), stamps)
+
+
+def _scan_batch(store: Any, topic: str, frame: str, scans: RecordedScans, stamps: np.ndarray) -> Batch:
+    T = store.types
+    laser = scans.laser
     empty = np.zeros(0, dtype=np.float32)
+    every = int(scans.samples[1] - scans.samples[0]) if len(scans.samples) > 1 else SCAN_EVERY
 
     def scan(sec: int, nanosec: int, seq: int, ranges: np.ndarray) -> Any:
         return T["sensor_msgs/msg/LaserScan"](
@@ -154,13 +149,14 @@ def laser_scans(
             angle_max=laser.angle_max,
             angle_increment=laser.angle_increment,
             time_increment=0.0,
-            scan_time=SCAN_EVERY * DT,
+            scan_time=every * DT,
             range_min=laser.range_min,
             range_max=laser.range_max,
             ranges=ranges,
             intensities=empty,
         )
 
-    seq = np.arange(len(idx)).astype("<u4")
-    columns = {**stamp_columns(stamps[idx]), "seq": seq, "ranges": ranges.astype("<f4")}
-    return Batch(topic, "sensor_msgs/msg/LaserScan", stamps[idx], scan, columns)
+    at = stamps[scans.samples]
+    seq = np.arange(len(at)).astype("<u4")
+    columns = {**stamp_columns(at), "seq": seq, "ranges": scans.ranges.astype("<f4")}
+    return Batch(topic, "sensor_msgs/msg/LaserScan", at, scan, columns)

@@ -72,7 +72,7 @@ def stack_messages(run: RobotRun, frames: Localisation, stamps: np.ndarray) -> I
     yield _odometry(run, frames, stamps)
     yield from _amcl_pose(run, frames, stamps)
     yield from _cmd_vel(run, stamps)
-    yield laser_scans(
+    yield from laser_scans(
         run.store, run.topic("scan"), LASER, run.robot, run.execution, run.grid, run.laser, run.rng, stamps
     )
 

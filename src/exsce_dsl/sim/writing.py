@@ -15,7 +15,7 @@ import numpy as np
 from exsce_dsl.maps.planning import PlanningGrid
 from exsce_dsl.sim.batches import Batch
 from exsce_dsl.sim.executor import SimulatedExecution
-from exsce_dsl.sim.scan import Laser
+from exsce_dsl.sim.laser import Laser
 
 Message = tuple[str, str, int, Any]
 """(topic, message type, stamp in ns, message value built in the run's typestore)."""

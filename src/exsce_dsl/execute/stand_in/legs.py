@@ -45,9 +45,10 @@ from exsce_dsl.sim.faults import (
     slow_in_areas,
     speed_factor,
 )
+from exsce_dsl.sim.laser import SCAN_EVERY, Laser
 from exsce_dsl.sim.localisation import Odometry, PlanarPoses, localise
 from exsce_dsl.sim.motion import DT, Limits, SampledMotion, drive
-from exsce_dsl.sim.scan import ROBOT_RADIUS, SCAN_EVERY, Laser, scan_ranges
+from exsce_dsl.sim.scan import ROBOT_RADIUS, scan_ranges
 
 MATCH = 0.05
 """Metres: a goal this close to a pose of the scenario is that pose."""

@@ -292,6 +292,13 @@ DISPATCHED_RUN = Term(EXSCE, "dispatched_run")
 """On an execution: the dispatcher's uuid of the run."""
 RUN_TIME_PROV = Term(EXSCE, "run_time_prov")
 """On an execution: where its run-time PROV was read (``/exsce/prov`` or the ``.prov.json``)."""
+SIMULATOR = Term(EXSCE, "simulator")
+"""On the agent that played a simulated run (``<run>:simulator``): the simulator's name."""
+SIMULATOR_VERSION = Term(EXSCE, "simulator_version")
+SIMULATOR_SETTINGS = Term(EXSCE, "simulator_settings")
+"""``name=value`` pairs joined by ``; ``, in the order the simulator gives them."""
+SIMULATOR_AGENT = "simulator"
+"""``<run>:simulator``, the software agent that played the run."""
 
 # The segment index (written by the store beside a run's bundles, see exsce_dsl.store.segment_index).
 PATH_SEGMENT = Term(EXSCE, "PathSegment")
