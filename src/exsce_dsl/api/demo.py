@@ -20,7 +20,7 @@ import sys
 import time
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from exsce_dsl.errors import ExsceError
@@ -281,6 +281,18 @@ def live_graph(folder: Path) -> Iterator[str]:
                 os.environ.pop("ROS_MASTER_URI", None)
             else:
                 os.environ["ROS_MASTER_URI"] = before
+
+
+def simulated_by(
+    steps: Sequence[DemoStep], simulator: str, behaviour: str | None = None
+) -> tuple[DemoStep, ...]:
+    """``steps`` with every ``exscec simulate`` played by ``simulator`` (with IR-SIM's ``behaviour``
+    when given): the same method on runs another simulator played."""
+    added = f" --simulator {simulator}" + (f" --behaviour {behaviour}" if behaviour else "")
+    return tuple(
+        replace(step, command=step.command + added) if step.command.startswith("exscec simulate ") else step
+        for step in steps
+    )
 
 
 def run_steps(

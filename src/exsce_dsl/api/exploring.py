@@ -36,6 +36,12 @@ class ExploreRequest:
     stop_at_violation: bool = False
     compare_random: bool = False
     faults: tuple[str, ...] = ()
+    simulator: str = "kinematic"
+    """What plays the runs when no other executor is named: ``kinematic`` or ``irsim``."""
+    behaviour: str | None = None
+    """``irsim``: IR-SIM's behaviour."""
+    scans: str | None = None
+    """``irsim``: who measures the scans."""
     executor_command: str | None = None
     plugin: str | None = None
     """An executor by name: ``ros1``, or an ``exsce.executors`` plug-in."""
@@ -167,7 +173,9 @@ def _executor(request: ExploreRequest) -> tuple[AbstractContextManager[Executor]
 
     o = request
     address = scheduler_address(o.dask_address)
-    given = ExecutorOptions(o.faults, o.stand_in, o.start_master, None, o.speed_up)
+    given = ExecutorOptions(
+        o.faults, o.stand_in, o.start_master, None, o.speed_up, o.simulator, o.behaviour, o.scans
+    )
     chosen = chosen_executor(o.executor_command, o.plugin, given, address)
     campaign = CampaignOptions(
         budget=o.budget, seed=o.seed, runs_per_scenario=o.runs_per_scenario, max_steps=o.max_steps,

@@ -53,8 +53,27 @@ def run_in_process(argv: Sequence[str]) -> int:
     "serving move_base goals, exscec execute recording and judging each run (needs ROS 1: "
     "sh scripts/install-ros1).",
 )
+@click.option(
+    "--simulator",
+    default="kinematic",
+    show_default=True,
+    help="What plays the simulated runs: kinematic, or irsim (IR-SIM, pip install 'exsce[irsim]').",
+)
+@click.option(
+    "--behaviour",
+    type=click.Choice(["dash", "rvo", "orca", "sfm"]),
+    help="irsim: IR-SIM's behaviour [default: rvo].",
+)
 @reports_errors
-def demo(folder: str, store_url: str | None, setup_only: bool, convention: str, ros1: bool) -> None:
+def demo(
+    folder: str,
+    store_url: str | None,
+    setup_only: bool,
+    convention: str,
+    ros1: bool,
+    simulator: str,
+    behaviour: str | None,
+) -> None:
     """Run the whole method on the shipped example, in a new FOLDER.
 
     Copies the example (building C of the method, scenario_c with two TIAGo
@@ -80,6 +99,7 @@ def demo(folder: str, store_url: str | None, setup_only: bool, convention: str, 
     Example:
       exscec demo exsce-demo
       exscec demo my-project --setup-only   # only copy the example, to follow docs/tutorial.md
+      exscec demo irsim-demo --simulator irsim   # the runs played by IR-SIM
     """
     from exsce_dsl.api.demo import (
         LIVE_STEPS,
@@ -89,11 +109,14 @@ def demo(folder: str, store_url: str | None, setup_only: bool, convention: str, 
         live_graph,
         run_steps,
         set_up,
+        simulated_by,
         summary_lines,
     )
 
     if ros1 and convention != "method":
         raise click.UsageError("--ros1 plays the robots in move_base's convention: leave out --convention")
+    if ros1 and (simulator != "kinematic" or behaviour):
+        raise click.UsageError("--ros1 plays exsce's stand-in robots: leave out --simulator and --behaviour")
     target = Path(folder)
     set_up(target, "move_base" if ros1 else convention)
     hint = command_hint(Path.cwd())
@@ -102,14 +125,20 @@ def demo(folder: str, store_url: str | None, setup_only: bool, convention: str, 
         if hint:
             click.echo(hint, err=True)
         return
-    steps = LIVE_STEPS if ros1 else STEPS
+    steps = (
+        LIVE_STEPS
+        if ros1
+        else simulated_by(STEPS, simulator, behaviour)
+        if simulator != "kinematic"
+        else STEPS
+    )
     shown = (
         " on a live ROS 1 graph"
         if ros1
         else ""
         if convention == "method"
         else f" (robots on {convention}'s topics)"
-    )
+    ) + ("" if simulator == "kinematic" else f", runs played by {simulator}")
     click.secho(f"exsce demo in {target.resolve()}{shown}", bold=True, err=True)
     if hint:
         click.echo(f"{hint}, then 'cd {folder}'", err=True)

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
-from exsce_dsl.cli.common import REMEDIES, ExitCode, Progress, exit_status, reports_errors
+from exsce_dsl.cli.common import REMEDIES, ExitCode, Progress, exit_status, reports_errors, simulator_options
 from exsce_dsl.cli.store_commands import store_option
 
 if TYPE_CHECKING:
@@ -62,6 +62,7 @@ if TYPE_CHECKING:
     help="Plant a fault in the simulator, or in the stand-in robots of --executor ros1 --stand-in "
     "(repeatable), as exscec simulate --fault: to try a campaign.",
 )  # fmt: skip
+@simulator_options
 @click.option(
     "--executor-command",
     help="Run scenarios with this program instead of the simulator; placeholders {scenario_file} "
@@ -158,6 +159,7 @@ def explore(**given: Any) -> None:
       exscec explore examples/brsu_building_c/scenario_c.exsce -n 2 -k 1 --max-steps 1 --no-shrink \\
         -t swap_start_poses -t reverse_task_order --fault deadlock-start:tiago1:classroom_c025-w002 \\
         --compare-random -o explore/compared  # exits 1
+      exscec explore examples/irsim_crossing/crossing.exsce -n 4 -k 1 --simulator irsim  # exits 1
       exscec explore examples/brsu_building_c/scenario_c.exsce -n 1 -k 1 -t swap_start_poses \\
         --executor ros1 --stand-in --start-master \\
         --fault deadlock-start:tiago1:classroom_c025-w002 -o explore/live  # exits 1

@@ -44,6 +44,7 @@ from exsce_dsl.remedies import BUILT_IN_OPTIONS, ONE_EXECUTOR, ROS1_OPTIONS
 from exsce_dsl.runs import is_bag
 from exsce_dsl.sim.faults import Fault
 from exsce_dsl.sim.run import simulate
+from exsce_dsl.sim.simulators import KINEMATIC, Simulator, simulator_named
 from exsce_dsl.suggest import did_you_mean
 
 PLACEHOLDERS = ("scenario_file", "scenario", "runs", "seed", "out")
@@ -75,25 +76,38 @@ class SimulatorExecutor:
     faults: tuple[Fault, ...] = ()
     format: str = "ros1"
     dask_address: str | None = None
+    simulator: Simulator = KINEMATIC
 
     @classmethod
     def with_faults(
-        cls, faults: Sequence[str], format: str = "ros1", dask_address: str | None = None
+        cls,
+        faults: Sequence[str],
+        format: str = "ros1",
+        dask_address: str | None = None,
+        simulator: Simulator = KINEMATIC,
     ) -> SimulatorExecutor:
-        return cls(tuple(Fault.parse(f) for f in faults), format, dask_address)
+        return cls(tuple(Fault.parse(f) for f in faults), format, dask_address, simulator)
 
     @property
     def name(self) -> str:
-        """The faults, not where the runs were played: a cluster writes the same bags."""
+        """The simulator (unless the kinematic executor) and the faults, not where the runs were
+        played: a cluster writes the same bags."""
+        sim = self.simulator
+        played = (
+            ""
+            if sim.name == KINEMATIC.name
+            else " " + " ".join([f"--simulator {sim.name}"] + [f"{k}={v}" for k, v in sim.settings.items()])
+        )
         planted = " ".join(f"--fault {f.identity}" for f in self.faults)
-        return f"simulator {planted}".strip()
+        return f"simulator{played} {planted}".strip()
 
     def execute(
         self, scenario: Scenario, scenario_file: Path, out_dir: Path, runs: int, seed: int
     ) -> list[Path]:
         played = simulate(
-            scenario, out_dir, runs, self.format, seed, self.faults, dask_address=self.dask_address
-        )
+            scenario, out_dir, runs, self.format, seed, self.faults, dask_address=self.dask_address,
+            simulator=self.simulator,
+        )  # fmt: skip
         return [run.bag for run in played]
 
 
@@ -177,6 +191,9 @@ class ExecutorOptions:
     start_master: bool = False
     master_uri: str | None = None
     speed_up: float | None = None
+    simulator: str = "kinematic"
+    behaviour: str | None = None
+    scans: str | None = None
 
 
 @dataclass(frozen=True)
@@ -264,12 +281,21 @@ def chosen_executor(
     """What plays a campaign's scenarios: another program (``command``), the executor called
     ``name``, else exsce's simulator with ``options.faults`` (on the Dask cluster at
     ``dask_address`` when given).  The options must go together."""
-    if command and (options.faults or name):
+    simulated = options.simulator != KINEMATIC.name or options.behaviour or options.scans
+    if command and (options.faults or name or simulated):
         raise ExsceError("a campaign's runs are played by one executor", remedy=ONE_EXECUTOR)
+    if name and simulated:
+        raise ExsceError(
+            f"the executor '{name}' plays its own robots; a simulator is chosen for the campaigns "
+            "exsce's simulators play"
+        )
     if (options.stand_in or options.start_master or options.speed_up is not None) and not name:
         raise ExsceError("no executor was named", remedy=ROS1_OPTIONS)
     if command:
         return nullcontext(CommandExecutor(command))
     if name:
         return named_executor(name, options)
-    return nullcontext(SimulatorExecutor.with_faults(options.faults, dask_address=dask_address))
+    simulator = simulator_named(options.simulator, options.behaviour, options.scans)
+    return nullcontext(
+        SimulatorExecutor.with_faults(options.faults, dask_address=dask_address, simulator=simulator)
+    )
