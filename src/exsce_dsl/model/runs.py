@@ -93,7 +93,8 @@ class Action:
     """When the goal reached its final status."""
     outcome: str | None = None
     """Why an ABORTED goal ended when its stack did not abort it: ``rejected``, ``timed out`` (the
-    dispatcher cancelled it) or ``cancelled`` (the mission was); None otherwise."""
+    dispatcher cancelled it) or ``cancelled`` (the mission was); in a simulated run, what the
+    simulator saw: ``collided``, ``no progress`` (the progress checker gave up); None otherwise."""
     attempts: int = 1
     """How many times the goal was sent (a retried goal: 2)."""
 

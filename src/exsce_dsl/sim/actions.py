@@ -27,6 +27,9 @@ class SimulatedAction:
     path: tuple[tuple[float, float], ...] = ()
     """The planned path, from where the robot was at ``start`` to the goal (a skipped waypoint's
     too: it is planned, then not driven)."""
+    outcome: str | None = None
+    """Why an ABORTED goal ended, when the simulator says: ``collided``, ``no progress``,
+    ``timed out``."""
 
 
 @dataclass(frozen=True)

@@ -234,7 +234,7 @@ class _Lockstep:
             self.actions.append(
                 SimulatedAction(
                     robot, task_number, task_id, s_number, w_number, self.last_pose[robot], goal,
-                    start, self.now, leg.status, driven, tuple(leg.path),
+                    start, self.now, leg.status, driven, tuple(leg.path), leg.outcome,
                 )  # fmt: skip
             )
             self.last_pose[robot] = goal
@@ -251,8 +251,10 @@ class _Lockstep:
         if (leg.robot, leg.count) in self.skip or obj.stop_flag:
             yield from self._hold(0.5 if not obj.stop_flag else 0.0)
             leg.status = GoalStatus.ABORTED
+            leg.outcome = "collided" if obj.stop_flag else None
             return
-        obj.set_goal([[x, y, leg.goal.orientation.yaw] for x, y in leg.path[1:]])
+        ahead = leg.path[1:] or leg.path[-1:]  # the robot may stand on its goal already
+        obj.set_goal([[x, y, leg.goal.orientation.yaw] for x, y in ahead])
         timeout = self.k + int((2.0 * leg.length / max(float(obj.vel_max[0, 0]), 0.05) + 60.0) / DT)
         anchor, since = here, self.k
         while True:
@@ -263,8 +265,10 @@ class _Lockstep:
                 break
             if math.dist(at, anchor) >= PROGRESS_RADIUS:
                 anchor, since = at, self.k
-            if obj.stop_flag or (self.k - since) * DT > PROGRESS_TIME or self.k > timeout:
+            stuck = (self.k - since) * DT > PROGRESS_TIME
+            if obj.stop_flag or stuck or self.k > timeout:
                 leg.status = GoalStatus.ABORTED
+                leg.outcome = "collided" if obj.stop_flag else "no progress" if stuck else "timed out"
                 break
         obj.set_goal(None)
 
@@ -280,6 +284,7 @@ class _Leg:
         self.path: list[Point] = []
         self.count = 0
         self.status = GoalStatus.PENDING
+        self.outcome: str | None = None
 
     @property
     def length(self) -> float:

@@ -240,6 +240,7 @@ def _recorded_run(
             ActionStatus.SUCCEEDED if a.status == GoalStatus.SUCCEEDED else ActionStatus.ABORTED,
             at(a.start),
             at(a.end),
+            a.outcome if a.status != GoalStatus.SUCCEEDED else None,
         )
         for a in execution.actions
     )
