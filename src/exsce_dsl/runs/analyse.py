@@ -172,6 +172,7 @@ def analyse_bag(
         found.whole_runs,
         {**bag.named, **bag.refused.reasons},
         found.reasons,
+        [r.id for r in robots if not scenario.mission.tasks_of(r.id)],
     )
     values = [_bag_named(stacks.with_real_sources(v), bag.data.spellings) for v in values]
     real = {n: _spelt(stacks.real_topics.get(n, (n,)), bag.data.spellings) for n in bag.topics}
@@ -303,18 +304,21 @@ def _segment_robots(path: Path, scenario: Scenario, bag: _Signals) -> _Segmented
         stacks.name_goals(ns, found.topics, found.outcomes, found.source == DISPATCHER_SOURCE)
         # the whole run is the recording unless recorded goals span it: never an arrival
         recording = robot.signals.window is MetricSpan.RECORDING or not found.goals
-        if (not found.segments or recording) and scenario.mission.tasks_of(robot.id):
+        tasked = bool(scenario.mission.tasks_of(robot.id))
+        if not found.segments or recording:
             span = bag.spans[robot.id]
-            if span is None and not found.segments:
+            if span is None and not found.segments and tasked:
                 raise BagError("\n  ".join([_nothing_of(path, robot, bag.opened.topics), *bag.unread]))
-            if span is not None:
+            if span is not None:  # a robot with no tasks stands by: its signals still measure it
                 out.whole_runs[robot.id] = _recording(span, data)
-                out.reasons[robot.id] = _why_recording(robot, found.goals, bool(found.segments))
+                out.reasons[robot.id] = _why_recording(robot, found.goals, bool(found.segments), tasked)
     return out
 
 
-def _why_recording(robot: Robot, goals: bool, segmented: bool) -> str:
+def _why_recording(robot: Robot, goals: bool, segmented: bool, tasked: bool = True) -> str:
     """Why a robot's whole-run window is the recording."""
+    if not tasked:
+        return "the recording (no tasks: the robot stands by)"
     if robot.signals.window is MetricSpan.RECORDING:
         return "the recording (the spec's window whole recording)"
     if not goals:

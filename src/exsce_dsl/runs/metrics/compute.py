@@ -11,7 +11,7 @@ reported), never 0.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from types import ModuleType
 from typing import Any
 
@@ -46,6 +46,7 @@ def compute_metrics(
     whole_runs: Mapping[str, tuple[float, float]] | None = None,
     named: Mapping[str, str] | None = None,
     reasons: Mapping[str, str] | None = None,
+    standing: Collection[str] = (),
 ) -> tuple[list[MetricValue], list[Hotspot]]:
     """Every metric of ``metrics`` for a run. ``results``: robot → waypoints SUCCEEDED (None: no topic);
     ``whole_runs``: robot → the span its whole-run values cover, where it is not its path
@@ -53,7 +54,10 @@ def compute_metrics(
     ``named``: a topic the monitors read → how the run's problems name it: the bag's topics it was
     read from, or the sources looked for (a robot's signals are read where its convention puts
     them); ``reasons``: robot → why
-    its ``whole_runs`` span is its whole-run window (the recording, and why).  Each value carries
+    its ``whole_runs`` span is its whole-run window (the recording, and why); ``standing``: the
+    robots given no tasks, measured standing by over their recording (what they were given no goals
+    for, such as ``task_duration``, is not computed, and said so) and left out of the mission's
+    values, as before they were measured.  Each value carries
     its accounting: window, reason, and the samples of each source it used."""
     named = named or {}
     values: list[MetricValue] = []
@@ -72,7 +76,10 @@ def compute_metrics(
         why = (reasons or {}).get(robot.id, "the recording") if whole is not None else GOALS_SPAN
         monitor = monitors.RobotMetrics(robot.id, robot.namespace, topics, results.get(robot.id))
         counter = SampleCounter(topics)
-        for metric in by_subject[ComputedFor.ROBOT]:
+        measured = by_subject[ComputedFor.ROBOT]
+        if robot.id in standing:
+            measured = _standing_by(robot, measured, problems)
+        for metric in measured:
             windows = [(None, start, end), *mine]
             values += _robot_values(monitor, metric, robot, windows, problems, named, (counter, why))
             if metric.safety is not None:
@@ -82,10 +89,29 @@ def compute_metrics(
         fleet = [(r.id, r.namespace) for r in robots]
         monitor = monitors.MissionMetrics(fleet, topics)
         # a robot without goals (a derivation took its tasks) adds nothing to what the mission read
-        acting = [r for r in robots if any(a.robot == r.id for a, _, _ in done) or r.id in (whole_runs or {})]
+        acting = [
+            r
+            for r in robots
+            if any(a.robot == r.id for a, _, _ in done) or (r.id in (whole_runs or {}) and r.id not in standing)
+        ]
         for metric in by_subject[ComputedFor.MISSION] + by_subject[ComputedFor.PAIRS]:
             values += _mission_values(monitor, metric, acting, start, end, topics, hotspots, problems, named)
     return values, hotspots
+
+
+def _standing_by(
+    robot: Robot, metrics: Sequence[MetricDefinition], problems: list[str]
+) -> list[MetricDefinition]:
+    """The metrics of a robot given no tasks: those that do not read its goals (it has none to
+    time or count), the others said in ``problems``."""
+    kept = [m for m in metrics if not any(r.signal == "goals" for r in m.reads)]
+    left = [m.name for m in metrics if m not in kept]
+    if left:
+        problems.append(
+            f"robot '{robot.id}' has no tasks: {', '.join(left)} not measured (it was given no goals); "
+            "its other metrics are of the recording, standing by"
+        )
+    return kept
 
 
 def _topics(metric: MetricDefinition, alternative: int, namespaces: Sequence[str]) -> tuple[str, ...]:
