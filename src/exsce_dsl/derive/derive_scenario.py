@@ -64,7 +64,8 @@ def derive_spec(
     path = Path(spec_path)
     where = Path(target) if target is not None else path.with_name(f"{derived.scenario.id}.exsce")
     document = derived_document(derived, path, where)
-    criteria, notes = None, ()
+    criteria: Acceptance | None = None
+    notes: tuple[str, ...] = ()
     if expect_from is not None:
         found = derived_criteria(
             expect_from,

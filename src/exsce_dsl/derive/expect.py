@@ -28,6 +28,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 from exsce_dsl.derive.grid_lengths import grid_lengths
+from exsce_dsl.derive.kept_clauses import safety_clauses, standing_note
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import Pose, Scenario
 from exsce_dsl.model.acceptance import (
@@ -284,10 +285,6 @@ OBSERVED_DISTANCE = 10.0
 a path hardly varies, but a robot may go round another (the simulator's repairs add up to a few
 metres to a leg, a real planner as much)."""
 
-PAIRWISE = frozenset({"distance_between_robots"})
-"""Mission metrics that need two robots at least."""
-
-
 @dataclass(frozen=True)
 class DerivedCriteria:
     """A derived scenario's acceptance criteria, and a note for each clause the base would give it
@@ -340,20 +337,21 @@ def derived_criteria(
     new robot is caught, and there is nothing of the base to relate it to.  Without an expected
     value, or for a robot the base's runs do not show, there is no performance clause.  A robot
     given no tasks (``add_robot ... taking over``, ``remove_task``) has no performance clause,
-    and a note says why (:func:`_standing_note`); the safety clauses judge it standing by.
+    and a note says why (:func:`~exsce_dsl.derive.kept_clauses.standing_note`); the safety
+    clauses judge it standing by.
 
     E and B come from good runs only (every stored run with ``include_all``): a run that failed,
     was inconclusive, did not complete its mission or broke a safety limit would teach the
     expectation its fault (:mod:`exsce_dsl.oracles.good_runs`)."""
-    safety = _safety_clauses(derived, base_acceptance)
+    safety, notes = safety_clauses(derived, base_acceptance)
     chosen = good_runs_of(store, base.id, include_all=include_all, scenario=base)
     base_runs = list(chosen.require_some(f"'{base.id}' to expect from").used)
     learning = learning_runs(store, include_all)
     performance: list[Expectation] = []
-    notes: list[str] = []
     for robot in derived.robots:
         if not derived.mission.tasks_of(robot.id):
-            notes.append(_standing_note(robot.id, derived.id))
+            if robot.start_pose is not None:  # one without is in no run: its note is said above
+                notes.append(standing_note(robot.id, derived.id))
             continue
         subject = Subject(Quantifier.ROBOT, robot.id)
         in_base = base.robot(robot.id) is not None
@@ -380,37 +378,6 @@ def derived_criteria(
     if performance:
         criteria.append(Criterion(f"as expected from {base.id}", (), when, tuple(performance)))
     return DerivedCriteria(Acceptance(derived.id, tuple(criteria)), tuple(notes))
-
-
-def _safety_clauses(derived: Scenario, base_acceptance: Acceptance | None) -> list[Expectation]:
-    """The base's safety clauses that apply to ``derived`` (see :func:`derived_criteria`)."""
-    if base_acceptance is None:
-        return []
-    robots = {r.id for r in derived.robots}
-    return [
-        e
-        for c in base_acceptance.criteria
-        if c.when is None or c.when.robot is None  # a task's criteria look at a part of the run
-        for e in c.expectations
-        if e.relation in (BasicRelation.BELOW_MAX, BasicRelation.ABOVE_MIN)
-        and e.window is None
-        and (e.subject.robot is None or e.subject.robot in robots)
-        and (e.metric not in PAIRWISE or len(robots) > 1)
-    ]
-
-
-def _standing_note(robot: str, scenario: str) -> str:
-    """Why a robot given no tasks has no performance clause.  It is expected to visit no
-    waypoints, but a run records no goals for a robot given none (``waypoints_visited`` counts
-    goals that succeeded: it has no value, and a value from a missing one is missing, never 0);
-    it has no path to expect a distance or a duration from.  Standing by is still measured: its
-    velocity, scans and distance are recorded, so the safety clauses judge it."""
-    return (
-        f"{robot} has no tasks in {scenario}: no waypoints_visited, distance_travelled or "
-        "task_duration clause (it is expected to visit no waypoint, but a run records no goals "
-        "for a robot given none, so waypoints_visited has no value; and it has no path to expect "
-        "a distance or a duration from); the safety clauses judge it standing by, over its recording"
-    )
 
 
 def _allowance(expected: ExpectedValue, tolerance_percent: float) -> float:

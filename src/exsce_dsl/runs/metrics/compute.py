@@ -56,14 +56,15 @@ def compute_metrics(
     them); ``reasons``: robot → why
     its ``whole_runs`` span is its whole-run window (the recording, and why); ``standing``: the
     robots given no tasks, measured standing by over their recording (what they were given no goals
-    for, such as ``task_duration``, is not computed, and said so) and left out of the mission's
-    values, as before they were measured.  Each value carries
+    for, such as ``task_duration``, is not computed, and said so); the mission's values count them
+    (a robot standing in a corridor is one the others must keep away from) over the mission's
+    window, which their recordings do not widen.  Each value carries
     its accounting: window, reason, and the samples of each source it used."""
     named = named or {}
     values: list[MetricValue] = []
     hotspots: list[Hotspot] = []
     done = [(a, a.start, a.end) for a in actions if a.start is not None and a.end is not None]
-    spans = [(s, e) for _, s, e in done] + list((whole_runs or {}).values())
+    spans = [(s, e) for _, s, e in done] + [w for r, w in (whole_runs or {}).items() if r not in standing]
     by_subject = {s: [m for m in metrics if m.subject is s] for s in ComputedFor}
     for robot in robots:
         mine: list[Window] = [(a, s, e) for a, s, e in done if a.robot == robot.id]
@@ -88,12 +89,8 @@ def compute_metrics(
         start, end = min(s for s, _ in spans), max(e for _, e in spans)
         fleet = [(r.id, r.namespace) for r in robots]
         monitor = monitors.MissionMetrics(fleet, topics)
-        # a robot without goals (a derivation took its tasks) adds nothing to what the mission read
-        acting = [
-            r
-            for r in robots
-            if any(a.robot == r.id for a, _, _ in done) or (r.id in (whole_runs or {}) and r.id not in standing)
-        ]
+        # a robot not in the recording (no goals, no signals) adds nothing to what the mission read
+        acting = [r for r in robots if any(a.robot == r.id for a, _, _ in done) or r.id in (whole_runs or {})]
         for metric in by_subject[ComputedFor.MISSION] + by_subject[ComputedFor.PAIRS]:
             values += _mission_values(monitor, metric, acting, start, end, topics, hotspots, problems, named)
     return values, hotspots
