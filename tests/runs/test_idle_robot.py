@@ -1,5 +1,6 @@
 """A robot left without tasks (a derivation handed them to another) is still a robot of the
-scenario: its run ingests, and the mission's metrics read only the robots that drove."""
+scenario: its run ingests, the mission's metrics over goals read only the robots that drove, and
+standing by it is still measured (tests/derive/test_standing_robot.py)."""
 
 from __future__ import annotations
 

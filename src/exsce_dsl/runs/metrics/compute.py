@@ -56,9 +56,9 @@ def compute_metrics(
     them); ``reasons``: robot → why
     its ``whole_runs`` span is its whole-run window (the recording, and why); ``standing``: the
     robots given no tasks, measured standing by over their recording (what they were given no goals
-    for, such as ``task_duration``, is not computed, and said so); the mission's values count them
-    (a robot standing in a corridor is one the others must keep away from) over the mission's
-    window, which their recordings do not widen.  Each value carries
+    for, such as ``task_duration``, is not computed, and said so); the mission's values that do not
+    read goals count them (a robot standing in a corridor is one the others must keep away from)
+    over the mission's window, which their recordings do not widen.  Each value carries
     its accounting: window, reason, and the samples of each source it used."""
     named = named or {}
     values: list[MetricValue] = []
@@ -92,7 +92,8 @@ def compute_metrics(
         # a robot not in the recording (no goals, no signals) adds nothing to what the mission read
         acting = [r for r in robots if any(a.robot == r.id for a, _, _ in done) or r.id in (whole_runs or {})]
         for metric in by_subject[ComputedFor.MISSION] + by_subject[ComputedFor.PAIRS]:
-            values += _mission_values(monitor, metric, acting, start, end, topics, hotspots, problems, named)
+            reading = [r for r in acting if r.id not in standing] if _reads_goals(metric) else acting
+            values += _mission_values(monitor, metric, reading, start, end, topics, hotspots, problems, named)
     return values, hotspots
 
 
@@ -101,7 +102,7 @@ def _standing_by(
 ) -> list[MetricDefinition]:
     """The metrics of a robot given no tasks: those that do not read its goals (it has none to
     time or count), the others said in ``problems``."""
-    kept = [m for m in metrics if not any(r.signal == "goals" for r in m.reads)]
+    kept = [m for m in metrics if not _reads_goals(m)]
     left = [m.name for m in metrics if m not in kept]
     if left:
         problems.append(
@@ -109,6 +110,11 @@ def _standing_by(
             "its other metrics are of the recording, standing by"
         )
     return kept
+
+
+def _reads_goals(metric: MetricDefinition) -> bool:
+    """Whether ``metric`` reads a robot's navigation goals (a robot given no tasks has none)."""
+    return any(r.signal == "goals" for r in metric.reads)
 
 
 def _topics(metric: MetricDefinition, alternative: int, namespaces: Sequence[str]) -> tuple[str, ...]:
