@@ -57,9 +57,10 @@ def compute_metrics(
     its ``whole_runs`` span is its whole-run window (the recording, and why); ``standing``: the
     robots given no tasks that have no path segments, measured standing by over their recording
     (what they were given no goals for, such as ``task_duration``, is not computed, and said so);
-    the mission's values that do not read goals count them (a robot standing in a corridor is one the others must keep away from)
-    over the mission's window, which their recordings do not widen.  Each value carries
-    its accounting: window, reason, and the samples of each source it used."""
+    the mission's values that do not read goals count them (a robot standing in a corridor is one
+    the others must keep away from) over the mission's window, which their recordings do not
+    widen.  Each value carries its accounting: window, reason, and the samples of each source it
+    used."""
     named = named or {}
     values: list[MetricValue] = []
     hotspots: list[Hotspot] = []
