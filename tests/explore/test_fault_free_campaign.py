@@ -18,7 +18,7 @@ from pathlib import Path
 
 import pytest
 
-from exsce_dsl.model.campaign import CheckedRelation
+from exsce_dsl.model.campaign import CampaignTrial, CheckedRelation
 from exsce_dsl.store.open import open_store
 from exsce_dsl.store.queries.campaigns import campaign_record, campaigns
 
@@ -61,17 +61,21 @@ def test_fault_free_campaign_with_a_robot_left_without_tasks_exits_0(
     assert explored.returncode == 0, explored.stdout + explored.stderr
     assert explored.stdout.splitlines()[0].endswith(": 1 derivation tried, 0 relations violated")
     assert "inconclusive" not in explored.stdout
-    with open_store(str(project / "store")) as store:
-        (plan,) = campaigns(store)
-        record = campaign_record(store, plan.id)
-    assert record is not None
-    (trial,) = record.trials
+    trial = _the_trial(project)
     assert trial.steps == TAKE_OVER  # the derivation that was inconclusive
     assert trial.outcome == "passed"
     # standing by, tiago1 is still judged by the base's limits; it has no waypoint count to judge
     assert {CheckedRelation("max_velocity", "tiago1", "below_max"),
             CheckedRelation("distance_to_obstacles", "tiago1", "above_min")} <= set(trial.checked)  # fmt: skip
     assert not any(r.robot == "tiago1" and r.metric == "waypoints_visited" for r in trial.checked)
+
+
+def _the_trial(project: Path) -> CampaignTrial:
+    """The one trial of the one campaign in the project's store."""
+    with open_store(str(project / "store")) as store:
+        (record,) = [campaign_record(store, plan.id) for plan in campaigns(store)]
+    assert record is not None and len(record.trials) == 1
+    return record.trials[0]
 
 
 def test_the_clauses_a_robot_without_tasks_has_not_are_said_in_a_note(

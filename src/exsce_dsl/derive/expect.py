@@ -285,6 +285,7 @@ OBSERVED_DISTANCE = 10.0
 a path hardly varies, but a robot may go round another (the simulator's repairs add up to a few
 metres to a leg, a real planner as much)."""
 
+
 @dataclass(frozen=True)
 class DerivedCriteria:
     """A derived scenario's acceptance criteria, and a note for each clause the base would give it
@@ -292,21 +293,6 @@ class DerivedCriteria:
 
     acceptance: Acceptance
     notes: tuple[str, ...] = ()
-
-
-def metamorphic_acceptance(
-    store: Store,
-    base: Scenario,
-    derived: Scenario,
-    base_acceptance: Acceptance | None,
-    tolerance_percent: float = RELATIVE_TOLERANCE,
-    *,
-    include_all: bool = False,
-) -> Acceptance:
-    """The acceptance criteria of :func:`derived_criteria`, without its notes."""
-    return derived_criteria(
-        store, base, derived, base_acceptance, tolerance_percent, include_all=include_all
-    ).acceptance
 
 
 def derived_criteria(
