@@ -63,7 +63,8 @@ def _verdicts(folder: Path, bags: list[Path]) -> tuple[int, list[dict[str, objec
 def test_the_derived_scenario_says_what_its_runs_should_show(project: Path) -> None:
     text = (project / "c" / "c_one.exsce").read_text()
     assert "tiago1 does delivery_a then delivery_b then navigate_home_1 then navigate_home_2" in text
-    assert "distance_between_robots" not in text  # one robot left: nothing between robots to judge
+    assert "distance_between_robots stays" not in text  # one robot left: nothing between robots to judge
+    assert "// note: distance_between_robots: no clause, fewer than two robots are in the runs of c_one" in text
     assert "tiago1 waypoints_visited is invariant around 6 within 0 %" in text
     assert "tiago1 waypoints_visited is increasing by 3 within 0 of scenario_c" in text
     expected = exscec_here("expect", "c/c_one.exsce", cwd=project)

@@ -130,7 +130,7 @@ def test_a_segment_with_no_neighbour_data_falls_back_to_the_robot_s_rate_per_met
 
 
 def test_the_derived_scenario_s_criteria_follow_from_the_expected_change() -> None:
-    from exsce_dsl.derive.expect import metamorphic_acceptance
+    from exsce_dsl.derive.expect import derived_criteria
     from exsce_dsl.lang import expectation_text
     from exsce_dsl.model.acceptance import (
         Acceptance,
@@ -148,7 +148,7 @@ def test_the_derived_scenario_s_criteria_follow_from_the_expected_change() -> No
         add_prov(store, compile_run(run(uuid, a_to_b), BASE))
     speed = Expectation(Subject(Quantifier.EACH_ROBOT), "max_velocity", BasicRelation.BELOW_MAX, limit=Quantity(1.0, "m/s", "1.0"))
     base_criteria = Acceptance("base", (Criterion("safe", (), None, (speed,)),))
-    made = metamorphic_acceptance(store, BASE, LONGER, base_criteria)
+    made = derived_criteria(store, BASE, LONGER, base_criteria).acceptance
     assert made.scenario == "longer"
     assert [c.title for c in made.criteria] == ["as safe as base", "as expected from base"]
     assert [expectation_text(e) for e in made.expectations()] == [
@@ -160,14 +160,14 @@ def test_the_derived_scenario_s_criteria_follow_from_the_expected_change() -> No
     ]
     # 16 m of the 22 are observed (a→b, b→c): they allow 10 % at most whatever the tolerance;
     # c→d (6 m) is estimated and allows the whole tolerance: 1.6 + 6 × 80 % = 6.4 m, 29.091 % of 22
-    small = metamorphic_acceptance(store, BASE, LONGER, None, tolerance_percent=80.0)
+    small = derived_criteria(store, BASE, LONGER, None, tolerance_percent=80.0).acceptance
     assert [expectation_text(e) for e in small.expectations()] == [
         "r1 distance_travelled is invariant around 22 m within 29.091 %",
         # a change (6 m) within the allowance (6.4 m): runs may be 6.4 m either side of 22 m, so
         # up to 6 + 6.4 m from the base's 16 m
         "r1 distance_travelled is invariant within 12.4 m of base",
     ]
-    wide = metamorphic_acceptance(store, BASE, LONGER, None, tolerance_percent=30.0)
+    wide = derived_criteria(store, BASE, LONGER, None, tolerance_percent=30.0).acceptance
     assert [expectation_text(e) for e in wide.expectations()][0] == (
         "r1 distance_travelled is invariant around 22 m within 15.455 %"  # (1.6 + 1.8 m) / 22 m
     )
@@ -200,7 +200,7 @@ def test_a_segment_is_read_whatever_heading_its_poses_were_driven_with() -> None
 
 
 def test_a_clause_between_robots_is_not_copied_to_a_scenario_of_one_robot() -> None:
-    from exsce_dsl.derive.expect import metamorphic_acceptance
+    from exsce_dsl.derive.expect import derived_criteria
     from exsce_dsl.model.acceptance import (
         Acceptance,
         BasicRelation,
@@ -212,7 +212,7 @@ def test_a_clause_between_robots_is_not_copied_to_a_scenario_of_one_robot() -> N
     )
 
     apart = Expectation(Subject(Quantifier.MISSION), "distance_between_robots", BasicRelation.ABOVE_MIN, limit=Quantity(0.1, "m", "0.1"))
-    made = metamorphic_acceptance(EmbeddedStore(None), BASE, LONGER, Acceptance("base", (Criterion("apart", (), None, (apart,)),)))
+    made = derived_criteria(EmbeddedStore(None), BASE, LONGER, Acceptance("base", (Criterion("apart", (), None, (apart,)),))).acceptance
     assert made.criteria == ()  # one robot: nothing between robots to judge, and no runs to expect from
 
 
@@ -220,7 +220,7 @@ def test_derive_expect_keeps_a_user_safety_clause_on_mean_speed() -> None:
     """Issue 48, item 6: ``derive --expect`` dropped ``mean_speed stays below`` (a limit on a mean,
     which it took for a clause about the base's own mission) from the derived "as safe as"
     criteria; every limit the user wrote is carried, on any metric, below or above."""
-    from exsce_dsl.derive.expect import metamorphic_acceptance
+    from exsce_dsl.derive.expect import derived_criteria
     from exsce_dsl.lang import expectation_text
     from exsce_dsl.model.acceptance import (
         Acceptance,
@@ -243,7 +243,7 @@ def test_derive_expect_keeps_a_user_safety_clause_on_mean_speed() -> None:
         limit("mean_clearance", BasicRelation.ABOVE_MIN, 0.3, "m"),
     )
     base_criteria = Acceptance("base", (Criterion("moves safely", (), None, clauses),))
-    made = metamorphic_acceptance(EmbeddedStore(None), BASE, LONGER, base_criteria)
+    made = derived_criteria(EmbeddedStore(None), BASE, LONGER, base_criteria).acceptance
     [safe] = [c for c in made.criteria if c.title == "as safe as base"]
     assert [expectation_text(e) for e in safe.expectations] == [
         "each robot max_velocity stays below 1.0 m/s",

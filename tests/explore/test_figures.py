@@ -105,9 +105,10 @@ def test_the_table_puts_each_campaign_in_a_column() -> None:
                              executions_to_first_failure=None)  # fmt: skip
     lines = figures_table([("covering", found), ("random", missed)])
     assert lines[0].split() == ["covering", "random"]
-    rows = {line[:19].strip(): line[19:].split() for line in lines[1:]}
+    rows = {line[:22].strip(): line[22:].split() for line in lines[1:]}
     assert rows["per 100 executions"] == ["33.3", "0.0"]  # 100 × 2 / 6
     assert rows["to first failure"] == ["2", "none", "in", "6"]
+    assert rows["relations inconclusive"] == ["0", "0"]
     assert rows["inconclusive trials"] == ["0", "1"]
 
 

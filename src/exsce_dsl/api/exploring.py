@@ -89,15 +89,15 @@ class Exploration:
 
         result, random = self.result, self.random
         record, figures = result.record, result.figures
-        violated = {r.text for t in record.trials for r in t.violated}
-        undecided = {r.text for t in record.trials for r in t.inconclusive} - violated
-        tried = counted(len(record.trials), "derivation")
-        found = f"{tried} tried, {counted(len(violated), 'relation')} violated"
-        if undecided:
-            found += f", {len(undecided)} inconclusive"
+        # relations on the first line, trials on the second: one meaning per number, said with it
+        tried = counted(figures.trials, "derivation")
+        found = f"{tried} tried, {counted(figures.violated_relations, 'relation')} violated"
+        if figures.inconclusive_relations:
+            found += f", {counted(figures.inconclusive_relations, 'relation')} inconclusive"
         lines = [f"campaign {record.plan.id}: {found}", f"  files: {result.folder}"]
         if random is None:
-            inconclusive = f"; {figures.inconclusive} inconclusive" if figures.inconclusive else ""
+            trials = counted(figures.inconclusive, "trial")
+            inconclusive = f"; {trials} inconclusive" if figures.inconclusive else ""
             found = counted(figures.counterexamples, "counterexample")
             lines.append(
                 f"  {counted(figures.executions, 'execution')}, {found}"

@@ -115,6 +115,8 @@ def derive(
                 loaded, requests, new_id=new_id, scenario=scenario_id, target=output,
                 expect_from=store, tolerance=tolerance, include_all=include_all, source=spec,
             )  # fmt: skip
+        for note in made.notes:
+            click.echo(f"note: {note}", err=True)
         if made.criteria is None:
             click.echo(
                 "no acceptance criteria: neither safety clauses to copy nor runs to expect from", err=True

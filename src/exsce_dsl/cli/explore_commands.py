@@ -121,6 +121,10 @@ def explore(**given: Any) -> None:
     derivations), counterexamples (trials that violated a relation), their
     rate per 100 executions and the executions to the first failure; trials
     neither violated nor passed (verdicts inconclusive) are counted apart.
+    Its first line counts relations (distinct checks violated, and
+    inconclusive but never violated), its second trials.  What a derived
+    scenario's criteria leave out (a robot given no tasks has no performance
+    clause) is said in a note as its trial starts.
     --compare-random runs the same budget with uniform random draws as well
     and prints both campaigns' figures in one table.
 

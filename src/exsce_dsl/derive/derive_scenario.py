@@ -8,7 +8,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from exsce_dsl.derive.expect import RELATIVE_TOLERANCE, metamorphic_acceptance
+from exsce_dsl.derive.expect import RELATIVE_TOLERANCE, derived_criteria
 from exsce_dsl.lang import declared_poses, format_document
 from exsce_dsl.model import Acceptance, Scenario
 from exsce_dsl.model.document import Specification
@@ -32,6 +32,9 @@ class DerivedSpec:
     """The new ``.exsce`` file, formatted."""
     criteria: Acceptance | None
     """Its acceptance criteria, when asked for and the store gave any."""
+    notes: tuple[str, ...] = ()
+    """What its criteria leave out and why (a robot given no tasks has no performance clause); the
+    text has them as comments before its acceptance block."""
 
     @property
     def scenario(self) -> Scenario:
@@ -61,9 +64,10 @@ def derive_spec(
     path = Path(spec_path)
     where = Path(target) if target is not None else path.with_name(f"{derived.scenario.id}.exsce")
     document = derived_document(derived, path, where)
-    criteria = None
+    criteria: Acceptance | None = None
+    notes: tuple[str, ...] = ()
     if expect_from is not None:
-        found = metamorphic_acceptance(
+        found = derived_criteria(
             expect_from,
             base,
             derived.scenario,
@@ -71,11 +75,23 @@ def derive_spec(
             tolerance,
             include_all=include_all,
         )
-        if found.criteria:
-            criteria = found
-            document = replace(document, declarations=(*document.declarations, found))
-    text = format_document(document, declared_poses(spec.environments))
-    return DerivedSpec(base, derived, where, text, criteria)
+        notes = found.notes
+        if found.acceptance.criteria:
+            criteria = found.acceptance
+            document = replace(document, declarations=(*document.declarations, criteria))
+    text = with_notes(format_document(document, declared_poses(spec.environments)), notes, criteria)
+    return DerivedSpec(base, derived, where, text, criteria, notes)
+
+
+def with_notes(text: str, notes: Sequence[str], criteria: Acceptance | None) -> str:
+    """``text`` with each note as a comment before its acceptance block (at its end without one)."""
+    if not notes:
+        return text
+    comments = "".join(f"// note: {n}\n" for n in notes)
+    block = f"acceptance for {criteria.scenario} {{\n" if criteria is not None else None
+    if block is None or block not in text:
+        return f"{text}\n{comments}"
+    return text.replace(block, comments + block, 1)
 
 
 @dataclass(frozen=True)

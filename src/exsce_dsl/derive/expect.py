@@ -28,6 +28,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 from exsce_dsl.derive.grid_lengths import grid_lengths
+from exsce_dsl.derive.kept_clauses import safety_clauses, standing_note
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import Pose, Scenario
 from exsce_dsl.model.acceptance import (
@@ -284,11 +285,17 @@ OBSERVED_DISTANCE = 10.0
 a path hardly varies, but a robot may go round another (the simulator's repairs add up to a few
 metres to a leg, a real planner as much)."""
 
-PAIRWISE = frozenset({"distance_between_robots"})
-"""Mission metrics that need two robots at least."""
+
+@dataclass(frozen=True)
+class DerivedCriteria:
+    """A derived scenario's acceptance criteria, and a note for each clause the base would give it
+    that they leave out, saying why (nothing is left out silently)."""
+
+    acceptance: Acceptance
+    notes: tuple[str, ...] = ()
 
 
-def metamorphic_acceptance(
+def derived_criteria(
     store: Store,
     base: Scenario,
     derived: Scenario,
@@ -296,7 +303,7 @@ def metamorphic_acceptance(
     tolerance_percent: float = RELATIVE_TOLERANCE,
     *,
     include_all: bool = False,
-) -> Acceptance:
+) -> DerivedCriteria:
     """The acceptance criteria of a derived scenario, as the method's Listing 35 makes them: the
     base's safety clauses (every limit the user wrote, ``stays below`` or ``stays above``, on any
     metric: a peak, a mean, a total; over the whole run, about robots it still has; a clause
@@ -314,29 +321,24 @@ def metamorphic_acceptance(
     runs observed: see :func:`_allowance`); waypoints are counted, so exactly.  A robot the base does not
     have (``add_robot``, ``replace_robot``) gets its own-baseline clauses only: a slow-down of the
     new robot is caught, and there is nothing of the base to relate it to.  Without an expected
-    value, or for a robot the base's runs do not show, there is no performance clause.
+    value, or for a robot the base's runs do not show, there is no performance clause.  A robot
+    given no tasks (``add_robot ... taking over``, ``remove_task``) has no performance clause,
+    and a note says why (:func:`~exsce_dsl.derive.kept_clauses.standing_note`); the safety
+    clauses judge it standing by.
 
     E and B come from good runs only (every stored run with ``include_all``): a run that failed,
     was inconclusive, did not complete its mission or broke a safety limit would teach the
     expectation its fault (:mod:`exsce_dsl.oracles.good_runs`)."""
-    safety = []
-    if base_acceptance is not None:
-        robots = {r.id for r in derived.robots}
-        safety = [
-            e
-            for c in base_acceptance.criteria
-            if c.when is None or c.when.robot is None  # a task's criteria look at a part of the run
-            for e in c.expectations
-            if e.relation in (BasicRelation.BELOW_MAX, BasicRelation.ABOVE_MIN)
-            and e.window is None
-            and (e.subject.robot is None or e.subject.robot in robots)
-            and (e.metric not in PAIRWISE or len(robots) > 1)
-        ]
-    performance: list[Expectation] = []
+    safety, notes = safety_clauses(derived, base_acceptance)
     chosen = good_runs_of(store, base.id, include_all=include_all, scenario=base)
     base_runs = list(chosen.require_some(f"'{base.id}' to expect from").used)
     learning = learning_runs(store, include_all)
+    performance: list[Expectation] = []
     for robot in derived.robots:
+        if not derived.mission.tasks_of(robot.id):
+            if robot.start_pose is not None:  # one without is in no run: its note is said above
+                notes.append(standing_note(robot.id, derived.id))
+            continue
         subject = Subject(Quantifier.ROBOT, robot.id)
         in_base = base.robot(robot.id) is not None
         for metric in SUMMED:
@@ -361,7 +363,7 @@ def metamorphic_acceptance(
         criteria.append(Criterion(f"as safe as {base.id}", (), when, tuple(safety)))
     if performance:
         criteria.append(Criterion(f"as expected from {base.id}", (), when, tuple(performance)))
-    return Acceptance(derived.id, tuple(criteria))
+    return DerivedCriteria(Acceptance(derived.id, tuple(criteria)), tuple(notes))
 
 
 def _allowance(expected: ExpectedValue, tolerance_percent: float) -> float:

@@ -240,6 +240,8 @@ class _Campaign:
         )
         if not self.options.relations:
             made = _safety_only(made, self.spec, self.spec_path)
+        for note in made.notes:
+            self.events.said(f"{scenario_id}: note: {note}")
         target.parent.mkdir(parents=True, exist_ok=True)
         target.write_text(made.text, encoding="utf-8")
         # a scenario drawn again by other steps keeps the derivation that made it first
@@ -441,9 +443,9 @@ def _safety_only(made: DerivedSpec, spec: Specification, spec_path: Path) -> Der
         if (kept := tuple(e for e in c.expectations if e.relation in limits))
     )
     if not criteria:
-        return replace(made, criteria=None, text=_text(made, spec, spec_path, None))
+        return replace(made, criteria=None, text=_text(made, spec, spec_path, None), notes=())
     safety = Acceptance(made.criteria.scenario, criteria)
-    return replace(made, criteria=safety, text=_text(made, spec, spec_path, safety))
+    return replace(made, criteria=safety, text=_text(made, spec, spec_path, safety), notes=())
 
 
 def _text(made: DerivedSpec, spec: Specification, spec_path: Path, criteria: Acceptance | None) -> str:

@@ -48,6 +48,7 @@ def figures_table(columns: Sequence[tuple[str, CampaignFigures]]) -> list[str]:
         ("per 100 executions", per_100),
         ("to first failure", first_failure),
         ("relations violated", lambda f: str(f.violated_relations)),
+        ("relations inconclusive", lambda f: str(f.inconclusive_relations)),
         ("inconclusive trials", lambda f: str(f.inconclusive)),
     ]
     cells = [[show(figures) for _, figures in columns] for _, show in rows]

@@ -9,7 +9,7 @@ derivation, whose scenario has another id.
 from __future__ import annotations
 
 import datetime
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
 Request = tuple[str, Mapping[str, str]]
@@ -127,6 +127,10 @@ class CampaignFigures:
     (their runs were executed) but neither as counterexamples nor as passes."""
     executions_to_first_failure: int | None
     """Executions in draw order up to and with the first violating trial's; None when none violated."""
+    inconclusive_relations: int = 0
+    """Distinct relations inconclusive in some trial and violated in none, counted as
+    ``violated_relations`` is (one per check): a trial may leave several undecided, so this is
+    not ``inconclusive`` (trials)."""
 
     @property
     def per_100_executions(self) -> float | None:
@@ -137,22 +141,34 @@ class CampaignFigures:
     def of(cls, trials: Sequence[CampaignTrial]) -> CampaignFigures:
         """The figures of ``trials`` in the order they were drawn."""
         executions, first = 0, None
-        distinct: list[CheckedRelation] = []
         for trial in trials:
             executions += len(trial.runs)
             if trial.violated and first is None:
                 first = executions
-            for relation in trial.violated:
-                if not any(relation.same_check(known) for known in distinct):
-                    distinct.append(relation)
+        violated = _distinct(r for t in trials for r in t.violated)
+        undecided = [
+            r
+            for r in _distinct(r for t in trials for r in t.inconclusive)
+            if not any(r.same_check(known) for known in violated)
+        ]
         return cls(
             trials=len(trials),
             executions=executions,
             counterexamples=sum(bool(t.violated) for t in trials),
-            violated_relations=len(distinct),
+            violated_relations=len(violated),
             inconclusive=sum(t.outcome == "inconclusive" for t in trials),
             executions_to_first_failure=first,
+            inconclusive_relations=len(undecided),
         )
+
+
+def _distinct(relations: Iterable[CheckedRelation]) -> list[CheckedRelation]:
+    """``relations`` one per check (:meth:`CheckedRelation.same_check`), first seen first."""
+    distinct: list[CheckedRelation] = []
+    for relation in relations:
+        if not any(relation.same_check(known) for known in distinct):
+            distinct.append(relation)
+    return distinct
 
 
 @dataclass(frozen=True)

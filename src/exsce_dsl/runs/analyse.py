@@ -172,6 +172,7 @@ def analyse_bag(
         found.whole_runs,
         {**bag.named, **bag.refused.reasons},
         found.reasons,
+        found.standing,
     )
     values = [_bag_named(stacks.with_real_sources(v), bag.data.spellings) for v in values]
     real = {n: _spelt(stacks.real_topics.get(n, (n,)), bag.data.spellings) for n in bag.topics}
@@ -287,6 +288,9 @@ class _Segmented:
     segmented_by: dict[str, str] = field(default_factory=dict)
     reasons: dict[str, str] = field(default_factory=dict)
     """Robot → why its whole-run window is the recording."""
+    standing: list[str] = field(default_factory=list)
+    """The robots given no tasks and with no path segments, whose signals are in the bag: they
+    stand by, and their whole run is the recording."""
 
 
 def _segment_robots(path: Path, scenario: Scenario, bag: _Signals) -> _Segmented:
@@ -303,8 +307,13 @@ def _segment_robots(path: Path, scenario: Scenario, bag: _Signals) -> _Segmented
         stacks.name_goals(ns, found.topics, found.outcomes, found.source == DISPATCHER_SOURCE)
         # the whole run is the recording unless recorded goals span it: never an arrival
         recording = robot.signals.window is MetricSpan.RECORDING or not found.goals
-        if (not found.segments or recording) and scenario.mission.tasks_of(robot.id):
-            span = bag.spans[robot.id]
+        span = bag.spans[robot.id]
+        if not scenario.mission.tasks_of(robot.id):
+            if not found.segments and span is not None:  # it stands by: its signals still measure it
+                out.whole_runs[robot.id] = _recording(span, data)
+                out.reasons[robot.id] = "the recording (no tasks: the robot stands by)"
+                out.standing.append(robot.id)
+        elif not found.segments or recording:
             if span is None and not found.segments:
                 raise BagError("\n  ".join([_nothing_of(path, robot, bag.opened.topics), *bag.unread]))
             if span is not None:

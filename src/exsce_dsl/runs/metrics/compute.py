@@ -11,7 +11,7 @@ reported), never 0.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from types import ModuleType
 from typing import Any
 
@@ -46,6 +46,7 @@ def compute_metrics(
     whole_runs: Mapping[str, tuple[float, float]] | None = None,
     named: Mapping[str, str] | None = None,
     reasons: Mapping[str, str] | None = None,
+    standing: Collection[str] = (),
 ) -> tuple[list[MetricValue], list[Hotspot]]:
     """Every metric of ``metrics`` for a run. ``results``: robot → waypoints SUCCEEDED (None: no topic);
     ``whole_runs``: robot → the span its whole-run values cover, where it is not its path
@@ -53,13 +54,18 @@ def compute_metrics(
     ``named``: a topic the monitors read → how the run's problems name it: the bag's topics it was
     read from, or the sources looked for (a robot's signals are read where its convention puts
     them); ``reasons``: robot → why
-    its ``whole_runs`` span is its whole-run window (the recording, and why).  Each value carries
-    its accounting: window, reason, and the samples of each source it used."""
+    its ``whole_runs`` span is its whole-run window (the recording, and why); ``standing``: the
+    robots given no tasks that have no path segments, measured standing by over their recording
+    (what they were given no goals for, such as ``task_duration``, is not computed, and said so);
+    the mission's values that do not read goals count them (a robot standing in a corridor is one
+    the others must keep away from) over the mission's window, which their recordings do not
+    widen.  Each value carries its accounting: window, reason, and the samples of each source it
+    used."""
     named = named or {}
     values: list[MetricValue] = []
     hotspots: list[Hotspot] = []
     done = [(a, a.start, a.end) for a in actions if a.start is not None and a.end is not None]
-    spans = [(s, e) for _, s, e in done] + list((whole_runs or {}).values())
+    spans = [(s, e) for _, s, e in done] + [w for r, w in (whole_runs or {}).items() if r not in standing]
     by_subject = {s: [m for m in metrics if m.subject is s] for s in ComputedFor}
     for robot in robots:
         mine: list[Window] = [(a, s, e) for a, s, e in done if a.robot == robot.id]
@@ -72,7 +78,10 @@ def compute_metrics(
         why = (reasons or {}).get(robot.id, "the recording") if whole is not None else GOALS_SPAN
         monitor = monitors.RobotMetrics(robot.id, robot.namespace, topics, results.get(robot.id))
         counter = SampleCounter(topics)
-        for metric in by_subject[ComputedFor.ROBOT]:
+        measured = by_subject[ComputedFor.ROBOT]
+        if robot.id in standing:
+            measured = _standing_by(robot, measured, problems)
+        for metric in measured:
             windows = [(None, start, end), *mine]
             values += _robot_values(monitor, metric, robot, windows, problems, named, (counter, why))
             if metric.safety is not None:
@@ -81,11 +90,32 @@ def compute_metrics(
         start, end = min(s for s, _ in spans), max(e for _, e in spans)
         fleet = [(r.id, r.namespace) for r in robots]
         monitor = monitors.MissionMetrics(fleet, topics)
-        # a robot without goals (a derivation took its tasks) adds nothing to what the mission read
+        # a robot not in the recording (no goals, no signals) adds nothing to what the mission read
         acting = [r for r in robots if any(a.robot == r.id for a, _, _ in done) or r.id in (whole_runs or {})]
         for metric in by_subject[ComputedFor.MISSION] + by_subject[ComputedFor.PAIRS]:
-            values += _mission_values(monitor, metric, acting, start, end, topics, hotspots, problems, named)
+            reading = [r for r in acting if r.id not in standing] if _reads_goals(metric) else acting
+            values += _mission_values(monitor, metric, reading, start, end, topics, hotspots, problems, named)
     return values, hotspots
+
+
+def _standing_by(
+    robot: Robot, metrics: Sequence[MetricDefinition], problems: list[str]
+) -> list[MetricDefinition]:
+    """The metrics of a robot given no tasks: those that do not read its goals (it has none to
+    time or count), the others said in ``problems``."""
+    kept = [m for m in metrics if not _reads_goals(m)]
+    left = [m.name for m in metrics if m not in kept]
+    if left:
+        problems.append(
+            f"robot '{robot.id}' has no tasks: {', '.join(left)} not measured (it was given no goals); "
+            "its other metrics are of the recording, standing by"
+        )
+    return kept
+
+
+def _reads_goals(metric: MetricDefinition) -> bool:
+    """Whether ``metric`` reads a robot's navigation goals (a robot given no tasks has none)."""
+    return any(r.signal == "goals" for r in metric.reads)
 
 
 def _topics(metric: MetricDefinition, alternative: int, namespaces: Sequence[str]) -> tuple[str, ...]:

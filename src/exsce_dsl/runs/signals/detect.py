@@ -27,6 +27,7 @@ from dataclasses import dataclass, replace
 
 from exsce_dsl.model.conventions import (
     DISPATCHER_FEEDBACK,
+    FLOAT64,
     LASER_SCAN,
     METHOD,
     METHOD_TOPICS,
@@ -138,10 +139,19 @@ def _without_goals(robot: Robot, types: Mapping[str, str]) -> tuple[Signals, Det
         pose=tuple(poses),
         velocity=tuple(velocity),
         scan=tuple(TopicSource(t, LASER_SCAN) for t in scan),
-        distance=tuple(TopicSource(t, ODOMETRY) for t in odometry[:1]),
+        distance=_distance(mine, ns, odometry),
         navigation=Navigation.NONE,
     )
     return signals, Detected(robot.id, "none (no navigation goals)", tuple(evidence))
+
+
+def _distance(mine: Mapping[str, str], ns: str, odometry: list[str]) -> tuple[TopicSource, ...]:
+    """The method's distance so far when the robot has it (a robot of a method bag that was given
+    no tasks has no dispatcher, but its distance is there), else its first odometry's path."""
+    method = expand_topic(METHOD_TOPICS["distance"], ns)
+    if mine.get(method) == FLOAT64:
+        return (TopicSource(method, FLOAT64),)
+    return tuple(TopicSource(t, ODOMETRY) for t in odometry[:1])
 
 
 def _twists(types: Mapping[str, str], ns: str) -> list[str]:
