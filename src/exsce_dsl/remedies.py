@@ -77,6 +77,14 @@ VERIFY_THE_RUN = "verify the run"
 VERIFY_AGAIN = "verifying the run judges it again{about}"
 """A replaced run whose verdicts were dropped (``about``: what follows in the message, or nothing)."""
 REPRODUCE_IT = "verify the runs {about[0]}/*.bag against {about[1]}"
+REPLAY_IT = "simulate {about[0]} again with seed {about[1]} ({about[2]} runs): the same bags"
+"""A campaign's smallest violating derivation, played again by its seed by the kinematic executor
+(``about``: its file, the seed, the runs)."""
+REPLAY_IN_IRSIM = (
+    "simulate {about[0]} again in IR-SIM with seed {about[1]} ({about[2]} runs, behaviour {about[3]}, "
+    "scans by {about[4]}): the same bags"
+)
+"""The same, played by IR-SIM (``about``: its file, the seed, the runs, the behaviour, the scans)."""
 """A campaign's smallest violating derivation (``about``: its bags' folder, its file)."""
 INSTALL_DASK = "pip install 'exsce[dask]'"
 """A Dask cluster without Dask's distributed package."""

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 
 from exsce_dsl.errors import Remedied
 from exsce_dsl.model.campaign import CampaignTrial
-from exsce_dsl.remedies import REPRODUCE_IT
+from exsce_dsl.remedies import REPLAY_IN_IRSIM, REPLAY_IT, REPRODUCE_IT
 from exsce_dsl.wording import counted
 
 if TYPE_CHECKING:
@@ -72,6 +72,9 @@ class Exploration:
 
     result: CampaignResult
     random: CampaignResult | None
+    replay: tuple[str, ...] | None = None
+    """How a finding's runs are played again by its seed: ``()`` by the kinematic executor, IR-SIM's
+    (behaviour, scans) by IR-SIM; None: they cannot be (another executor, or faults planted)."""
 
     @property
     def violated(self) -> bool:
@@ -84,6 +87,7 @@ class Exploration:
     def summary_lines(self, wording: Mapping[str, str] | None = None) -> list[str]:
         """What the campaign found, its figures (beside the random baseline's) and its shrinkings;
         how to reproduce one in ``wording`` (the command line's, ``cli.common.REMEDIES``) if given."""
+        from exsce_dsl.explore.campaign import scenario_seed
         from exsce_dsl.explore.figures import figures_table, first_failure, per_100
         from exsce_dsl.oracles import steps_text
 
@@ -117,6 +121,11 @@ class Exploration:
             if file is not None:
                 bags = result.folder / "runs" / shrinking.minimal
                 lines.append(Remedied("  reproduce", REPRODUCE_IT, (str(bags), str(file))).said(wording))
+                if self.replay is not None:
+                    seed = scenario_seed(record.plan.seed, shrinking.minimal)
+                    played = (str(file), str(seed), str(record.plan.runs_per_scenario), *self.replay)
+                    remedy = REPLAY_IN_IRSIM if self.replay else REPLAY_IT
+                    lines.append(Remedied("  replay", remedy, played).said(wording))
         return lines
 
 
@@ -162,7 +171,22 @@ def explore(
         durations = run_seconds(store, result.record) if request.junit else {}
     if request.junit:
         Path(request.junit).write_text(campaign_junit_xml(result.record, durations), encoding="utf-8")
-    return Exploration(result, random)
+    return Exploration(result, random, _replay(request))
+
+
+def _replay(request: ExploreRequest) -> tuple[str, ...] | None:
+    """How the campaign's runs are played again by a seed, when exsce's simulators played them."""
+    if request.executor_command or request.plugin or request.faults:
+        return None
+    if request.simulator == "kinematic":
+        return ()
+    if request.simulator == "irsim":
+        from exsce_dsl.sim.simulators import IrsimSimulator
+
+        default = IrsimSimulator()
+        chosen = IrsimSimulator(request.behaviour or default.behaviour, request.scans or default.scans)
+        return (chosen.behaviour, chosen.scans)
+    return None
 
 
 def _executor(request: ExploreRequest) -> tuple[AbstractContextManager[Executor], CampaignOptions]:

@@ -46,6 +46,8 @@ from exsce_dsl.remedies import (
     REPLACE_A_STORED_SPEC,
     REPLACE_FILES,
     REPLACE_THE_RUN,
+    REPLAY_IN_IRSIM,
+    REPLAY_IT,
     REPRODUCE_IT,
     ROS1_OPTIONS,
     SELECT_OR_ASK,
@@ -204,6 +206,11 @@ REMEDIES = {
     VERIFY_THE_RUN: "{problem} (exscec verify RUN)",
     VERIFY_AGAIN: "{problem} (exscec verify judges it again){about}",
     REPRODUCE_IT: "{problem}: exscec verify {about[0]}/*.bag --scenario {about[1]}",
+    REPLAY_IT: "{problem}: exscec simulate {about[0]} --seed {about[1]} --runs {about[2]} -o DIR",
+    REPLAY_IN_IRSIM: (
+        "{problem}: exscec simulate {about[0]} --seed {about[1]} --runs {about[2]} --simulator irsim "
+        "--behaviour {about[3]} --scans {about[4]} -o DIR"
+    ),
     INSTALL_DASK: "--cluster needs Dask's distributed package: pip install 'exsce[dask]'",
     BUILT_IN_OPTIONS: (
         "--fault, --stand-in, --start-master and --speed-up are for the built-in executors {about}"

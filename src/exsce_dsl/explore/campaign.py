@@ -72,6 +72,13 @@ SHRINK_TRIES = 40
 """Derivations a shrinking runs at most."""
 
 
+def scenario_seed(campaign_seed: int, scenario: str) -> int:
+    """The seed a campaign gives the runs of ``scenario``: its own, the same in every call, so
+    that a finding is played again by it."""
+    text = f"{campaign_seed}/{scenario}".encode()
+    return int(hashlib.sha256(text).hexdigest()[:5], 16)  # the executor wants seed × 1000 < 2³¹
+
+
 @dataclass(frozen=True)
 class CampaignOptions:
     budget: int
@@ -191,9 +198,7 @@ class _Campaign:
         self.executions = 0
 
     def seed_of(self, scenario: str) -> int:
-        """Each scenario's runs get a seed of their own, the same in every call."""
-        text = f"{self.plan.seed}/{scenario}".encode()
-        return int(hashlib.sha256(text).hexdigest()[:5], 16)  # the executor wants seed × 1000 < 2³¹
+        return scenario_seed(self.plan.seed, scenario)
 
     def ensure_base_runs(self) -> None:
         have = len(stored_runs(self.store, self.base.id))
