@@ -75,6 +75,9 @@ class SimulatedExecution:
     scans: dict[str, RecordedScans] | None = None
     """What the executor's own sensors measured, per robot; None: it has none (the bag writer
     ray-marches scans on the map)."""
+    dt: float = DT
+    """Seconds between two samples of the trajectories (the kinematic executor's DT; a
+    simulator's own step)."""
 
 
 def execute(

@@ -58,7 +58,7 @@ def navigation_goals(
     goals = []
     actions = sorted((a for a in execution.actions if a.robot == robot), key=lambda a: a.start)
     for number, action in enumerate(actions, start=1):
-        accepted, ended = _sample(action.start), _sample(action.end)
+        accepted, ended = _sample(action.start, execution.dt), _sample(action.end, execution.dt)
         goals.append(
             NavigationGoal(
                 number,
@@ -84,12 +84,14 @@ def status_samples(goals: list[NavigationGoal], samples: int, every: int) -> lis
     return sorted(s for s in changes.union(periodic) if s < samples)
 
 
-def listed(goals: list[NavigationGoal], sample: int, keep: float) -> list[tuple[NavigationGoal, Phase]]:
+def listed(
+    goals: list[NavigationGoal], sample: int, keep: float, dt: float = DT
+) -> list[tuple[NavigationGoal, Phase]]:
     """The goals in the status list at ``sample``, with their phases: accepted ones, and finished
-    ones for ``keep`` seconds after they ended."""
-    kept = int(round(keep / DT))
+    ones for ``keep`` seconds after they ended (samples ``dt`` apart)."""
+    kept = int(round(keep / dt))
     return [(g, phase) for g in goals if (phase := g.phase(sample)) is not None and sample <= g.ended + kept]
 
 
-def _sample(seconds: float) -> int:
-    return int(round(seconds / DT))
+def _sample(seconds: float, dt: float) -> int:
+    return int(round(seconds / dt))

@@ -11,8 +11,9 @@ the robot on a collision, when it has not moved :data:`PROGRESS_RADIUS` in
 
 What is IR-SIM's: the motion between the path's points (its behaviour: ``dash``, ``rvo``,
 ``orca``, ``sfm``), the kinematics and their limits, the collisions (robot–robot and robot–map,
-``collision_mode: stop``), the scans (its ``lidar2d``) and the clock (a step of DT, the bags'
-50 Hz).  Every step of IR-SIM is one sample of the run: nothing is interpolated.
+``collision_mode: stop``), the scans (with ``scans="irsim"``: its ``lidar2d``) and the clock (its
+fixed step, :data:`STEP` unless told: IR-SIM's own default).  Every step of IR-SIM is one sample of
+the run, and the bag's topics are written at the step's rate at most: nothing is interpolated.
 """
 
 from __future__ import annotations
@@ -37,9 +38,10 @@ from exsce_dsl.remedies import INSTALL_IRSIM
 from exsce_dsl.sim.actions import GoalEvent, SimulatedAction
 from exsce_dsl.sim.executor import SimulatedExecution
 from exsce_dsl.sim.faults import Fault, check_faults, speed_factor
-from exsce_dsl.sim.irsim_world import world_file
-from exsce_dsl.sim.laser import SCAN_EVERY, Laser, RecordedScans
-from exsce_dsl.sim.motion import DT, Limits, SampledMotion
+from exsce_dsl.sim.irsim_world import STEP, world_file
+from exsce_dsl.sim.laser import SCAN_PERIOD, Laser, RecordedScans
+from exsce_dsl.sim.motion import Limits, SampledMotion
+from exsce_dsl.sim.values import samples_per
 
 PROGRESS_RADIUS = 0.5
 PROGRESS_TIME = 10.0
@@ -83,6 +85,7 @@ def play_in_irsim(
     behaviour: str = "rvo",
     scans: str = "exsce",
     limits: Limits | None = None,
+    step: float = STEP,
 ) -> SimulatedExecution:
     """Play ``scenario`` once in IR-SIM.  ``scans`` (:data:`SCAN_SOURCES`): who measures the
     robots' scans."""
@@ -104,10 +107,10 @@ def play_in_irsim(
         for r in scenario.robots
     }
     with tempfile.TemporaryDirectory(prefix="exsce-irsim-") as folder:
-        world = world_file(scenario, grid, Path(folder), behaviour, speeds, laser, limits)
+        world = world_file(scenario, grid, Path(folder), behaviour, speeds, laser, limits, step)
         env = irsim.make(str(world), display=False, headless=True, seed=seed, log_level="CRITICAL")
     try:
-        played = _Lockstep(env, scenario, grid, rng, faults, laser).run()
+        played = _Lockstep(env, scenario, grid, rng, faults, laser, step).run()
         return played if scans == "irsim" else replace(played, scans=None if scans == "exsce" else {})
     finally:
         env.end(0)
@@ -125,8 +128,11 @@ class _Lockstep:
         rng: random.Random,
         faults: tuple[Fault, ...],
         laser: Laser | None,
+        step: float,
     ) -> None:
         self.env, self.scenario, self.grid, self.rng, self.laser = env, scenario, grid, rng, laser
+        self.dt = step
+        self.scan_every = samples_per(SCAN_PERIOD, step)
         self.robots = {obj.name: obj for obj in env.robot_list}
         for found in env.objects:
             if found.shape == "map":  # static: its geometry is indexed once, not at each test
@@ -147,7 +153,7 @@ class _Lockstep:
 
     @property
     def now(self) -> float:
-        return self.k * DT
+        return self.k * self.dt
 
     def run(self) -> SimulatedExecution:
         programs = {name: self._program(name) for name in self.robots}
@@ -157,18 +163,18 @@ class _Lockstep:
                     del programs[name]
             if programs:
                 self._step()
-        for _ in range(int(1.0 / DT)):  # a second after the last robot is done
+        for _ in range(int(round(1.0 / self.dt))):  # a second after the last robot is done
             self._step()
         trajectories = {name: _motion(rows) for name, rows in self.samples.items()}
         self.events.sort(key=lambda e: (e.t, e.robot))
         return SimulatedExecution(
-            trajectories, self.events, self.actions, len(self.samples[next(iter(self.samples))]) * DT,
-            self._recorded_scans(),
+            trajectories, self.events, self.actions, len(self.samples[next(iter(self.samples))]) * self.dt,
+            self._recorded_scans(), self.dt,
         )  # fmt: skip
 
     def _step(self) -> None:
         self.k += 1
-        scanning = self.laser is not None and self.k % SCAN_EVERY == 0
+        scanning = self.laser is not None and self.k % self.scan_every == 0
         for name, obj in self.robots.items():
             obj.sensors = self.sensors[name] if scanning else []
         self.env.step()
@@ -196,7 +202,7 @@ class _Lockstep:
         }
 
     def _hold(self, seconds: float) -> Iterator[bool]:
-        for _ in range(int(round(seconds / DT))):
+        for _ in range(int(round(seconds / self.dt))):
             yield True
 
     def _program(self, robot: str) -> Iterator[bool]:
@@ -255,7 +261,7 @@ class _Lockstep:
             return
         ahead = leg.path[1:] or leg.path[-1:]  # the robot may stand on its goal already
         obj.set_goal([[x, y, leg.goal.orientation.yaw] for x, y in ahead])
-        timeout = self.k + int((2.0 * leg.length / max(float(obj.vel_max[0, 0]), 0.05) + 60.0) / DT)
+        timeout = self.k + int((2.0 * leg.length / max(float(obj.vel_max[0, 0]), 0.05) + 60.0) / self.dt)
         anchor, since = here, self.k
         while True:
             yield True
@@ -265,7 +271,7 @@ class _Lockstep:
                 break
             if math.dist(at, anchor) >= PROGRESS_RADIUS:
                 anchor, since = at, self.k
-            stuck = (self.k - since) * DT > PROGRESS_TIME
+            stuck = (self.k - since) * self.dt > PROGRESS_TIME
             if obj.stop_flag or stuck or self.k > timeout:
                 leg.status = GoalStatus.ABORTED
                 leg.outcome = "collided" if obj.stop_flag else "no progress" if stuck else "timed out"

@@ -26,13 +26,16 @@ from exsce_dsl.errors import ExsceError
 from exsce_dsl.maps.planning import PlanningGrid
 from exsce_dsl.model import Robot, Scenario
 from exsce_dsl.sim.laser import Laser
-from exsce_dsl.sim.motion import DT, Limits
+from exsce_dsl.sim.motion import Limits
 
 BEHAVIOURS = ("dash", "rvo", "orca", "sfm")
 """IR-SIM's behaviours exsce offers: ``dash`` drives straight at the next goal; ``rvo``
 (reciprocal velocity obstacles) and ``sfm`` (social forces) avoid the other robots; ``orca`` is
 the group behaviour of pyrvo's ORCA (``pip install pyrvo``)."""
 
+STEP = 0.1
+"""Seconds of IR-SIM's step (its ``step_time``; 0.1 s is IR-SIM's default): the run's sample
+period, so odometry, TF and poses are at 10 Hz."""
 GOAL_TOLERANCE = 0.2
 """Metres from a goal at which IR-SIM counts it reached (Nav2's default is 0.25)."""
 
@@ -65,10 +68,11 @@ def world_file(
     speeds: dict[str, float],
     laser: Laser | None,
     limits: Limits | None = None,
+    step: float = STEP,
 ) -> Path:
     """Write ``scenario`` as an IR-SIM world into ``folder`` (the world file and its map image)
     and return the world file's path.  ``speeds``: each robot's top speed; ``laser``: each robot's
-    ``lidar2d`` (None: no sensor)."""
+    ``lidar2d`` (None: no sensor); ``step``: IR-SIM's step, in seconds."""
     limits = limits or Limits()
     flying = [r.id for r in scenario.robots if r.type.motion != "planar"]
     if flying:
@@ -83,7 +87,7 @@ def world_file(
             "width": width * grid.map_resolution,
             "height": height * grid.map_resolution,
             "offset": [float(grid.origin[0]), float(grid.origin[1])],
-            "step_time": DT,
+            "step_time": step,
             "obstacle_map": str(image),
             "collision_mode": "stop",
         },

@@ -11,7 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-SCAN_EVERY = 5  # samples of the 50 Hz clock: 10 Hz
+SCAN_PERIOD = 0.1  # seconds: scans at 10 Hz
+SCAN_EVERY = 5  # samples of the kinematic executor's 50 Hz clock: SCAN_PERIOD
 
 
 @dataclass(frozen=True)

@@ -94,17 +94,18 @@ class Localisation:
 
 
 def localise(
-    trajectory: SampledMotion, rng: np.random.Generator, drift: Odometry | None = None
+    trajectory: SampledMotion, rng: np.random.Generator, drift: Odometry | None = None, dt: float = DT
 ) -> Localisation:
-    """The odometry, estimate and correction of a robot that drove ``trajectory`` (seeded);
-    ``drift``: its odometry's, else drawn from ``rng`` (a robot driving leg after leg keeps one)."""
+    """The odometry, estimate and correction of a robot that drove ``trajectory`` (seeded, its
+    samples ``dt`` apart); ``drift``: its odometry's, else drawn from ``rng`` (a robot driving leg
+    after leg keeps one)."""
     drift = Odometry.seeded(rng) if drift is None else drift
     truth = PlanarPoses(trajectory.x, trajectory.y, trajectory.yaw)
     odom = _odometry(truth, drift)
     estimate = PlanarPoses(
-        truth.x + _wandering(rng, LOCALISATION_NOISE, len(truth.x)),
-        truth.y + _wandering(rng, LOCALISATION_NOISE, len(truth.x)),
-        _wrap(truth.yaw + _wandering(rng, LOCALISATION_YAW_NOISE, len(truth.x))),
+        truth.x + _wandering(rng, LOCALISATION_NOISE, len(truth.x), dt),
+        truth.y + _wandering(rng, LOCALISATION_NOISE, len(truth.x), dt),
+        _wrap(truth.yaw + _wandering(rng, LOCALISATION_YAW_NOISE, len(truth.x), dt)),
     )
     return Localisation(
         truth,
@@ -132,9 +133,10 @@ def _odometry(truth: PlanarPoses, drift: Odometry) -> PlanarPoses:
     return PlanarPoses(x, y, _wrap(yaw))
 
 
-def _wandering(rng: np.random.Generator, sigma: float, samples: int) -> np.ndarray:
-    """A first-order Gauss–Markov process: standard deviation ``sigma``, correlation ``NOISE_TIME``."""
-    a = math.exp(-DT / NOISE_TIME)
+def _wandering(rng: np.random.Generator, sigma: float, samples: int, dt: float = DT) -> np.ndarray:
+    """A first-order Gauss–Markov process: standard deviation ``sigma``, correlation ``NOISE_TIME``
+    (samples ``dt`` apart)."""
+    a = math.exp(-dt / NOISE_TIME)
     white = rng.normal(0.0, sigma, samples + 1)
     # the first value already has the stationary spread: a·e₀ + √(1−a²)·n₁ with e₀ ~ N(0, σ²)
     # y[n] = √(1−a²)·e[n] + a·y[n−1], as a plain loop: the very bits of scipy.signal.lfilter

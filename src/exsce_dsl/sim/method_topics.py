@@ -28,10 +28,11 @@ from exsce_dsl.sim.values import (
     planar_rotation,
     ros_time,
     sample_stamps,
+    samples_per,
 )
 from exsce_dsl.sim.writing import Message, RobotRun
 
-POSE_EVERY, VEL_EVERY, DIST_EVERY = 1, 2, 5  # samples of the 50 Hz clock
+POSE_PERIOD, VEL_PERIOD, DIST_PERIOD = 0.02, 0.04, 0.1  # seconds: 50, 25 and 10 Hz
 POSE_NOISE, YAW_NOISE = 0.005, 0.002
 
 
@@ -91,7 +92,7 @@ def robot_messages(
 ) -> Iterator[Message | Batch]:
     tr = execution.trajectories[robot]
     n = len(tr)
-    stamps = sample_stamps(start_ns, n)
+    stamps = sample_stamps(start_ns, n, execution.dt)
     T = store.types
     # robot_pose: PoseWithCovarianceStamped, with measurement noise
     px = tr.x + rng.normal(0, POSE_NOISE, n)
@@ -110,7 +111,7 @@ def robot_messages(
             pose=T["geometry_msgs/msg/PoseWithCovariance"](pose=pose, covariance=covariance),
         )
 
-    at = np.arange(0, n, POSE_EVERY)
+    at = np.arange(0, n, samples_per(POSE_PERIOD, execution.dt))
     yield Batch(
         topics.pose,
         pose_type,
@@ -132,12 +133,12 @@ def robot_messages(
             angular=T["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=w),
         )
 
-    at = np.arange(0, n, VEL_EVERY)
+    at = np.arange(0, n, samples_per(VEL_PERIOD, execution.dt))
     yield Batch(topics.vel, "geometry_msgs/msg/Twist", stamps[at], velocity, {"v": tr.v[at], "w": tr.w[at]})
     # distance_travelled: Float64, cumulative
     step = np.concatenate([[0.0], np.hypot(np.diff(tr.x), np.diff(tr.y))])
     travelled = np.cumsum(step)
-    at = np.arange(0, n, DIST_EVERY)
+    at = np.arange(0, n, samples_per(DIST_PERIOD, execution.dt))
     yield Batch(
         topics.distance,
         "std_msgs/msg/Float64",

@@ -24,7 +24,7 @@ from exsce_dsl.sim.executor import GoalStatus
 from exsce_dsl.sim.goals import NavigationGoal, Phase, listed, navigation_goals, status_samples
 from exsce_dsl.sim.localisation import Localisation, localise
 from exsce_dsl.sim.stack_topics import MAP, stack_messages
-from exsce_dsl.sim.values import header, pose_stamped, ros_time, sample_stamps
+from exsce_dsl.sim.values import header, pose_stamped, ros_time, sample_stamps, samples_per
 from exsce_dsl.sim.writing import Message, RobotRun
 
 ACTION = "move_base"
@@ -43,7 +43,7 @@ TEXTS = {
     Phase.ABORTED: "Failed to find a valid control. Even after executing recovery behaviors.",
 }
 """What move_base says when a goal ends."""
-STATUS_EVERY, FEEDBACK_EVERY = 10, 10  # samples of the 50 Hz clock: 5 Hz (actionlib's status_frequency)
+STATUS_PERIOD, FEEDBACK_PERIOD = 0.2, 0.2  # seconds: 5 Hz (actionlib's status_frequency)
 STATUS_LIST_TIMEOUT = 5.0
 """Seconds a finished goal stays in the status list (actionlib's default)."""
 LATCHED = ("tf_static",)
@@ -52,8 +52,8 @@ LATCHED = ("tf_static",)
 def move_base_messages(run: RobotRun) -> Iterator[Message | Batch]:
     """Every message of one robot driven by move_base."""
     tr = run.execution.trajectories[run.robot]
-    stamps = sample_stamps(run.start_ns, len(tr))
-    frames = localise(tr, run.rng)
+    stamps = sample_stamps(run.start_ns, len(tr), run.execution.dt)
+    frames = localise(tr, run.rng, dt=run.execution.dt)
     yield from stack_messages(run, frames, stamps)
     goals = navigation_goals(run.execution, run.robot, run.rng)
     ids = {goal.number: goal_id(run, goal, stamps) for goal in goals}
@@ -80,10 +80,10 @@ def _status(
     run: RobotRun, goals: list[NavigationGoal], ids: dict[int, Any], stamps: np.ndarray
 ) -> Iterator[Message]:
     T, store = run.store.types, run.store
-    for seq, sample in enumerate(status_samples(goals, len(stamps), STATUS_EVERY)):
-        status_list = [
-            _status_of(run, ids[g.number], phase) for g, phase in listed(goals, sample, STATUS_LIST_TIMEOUT)
-        ]
+    every = samples_per(STATUS_PERIOD, run.execution.dt)
+    for seq, sample in enumerate(status_samples(goals, len(stamps), every)):
+        shown = listed(goals, sample, STATUS_LIST_TIMEOUT, run.execution.dt)
+        status_list = [_status_of(run, ids[g.number], phase) for g, phase in shown]
         msg = T[STATUS](header=header(store, int(stamps[sample]), "", seq), status_list=status_list)
         yield run.topic(f"{ACTION}/status"), STATUS, int(stamps[sample]), msg
 
@@ -114,7 +114,7 @@ def _feedback(
 ) -> Iterator[Message]:
     T, store = run.store.types, run.store
     estimate = frames.estimate
-    for i in range(goal.executing, goal.ended, FEEDBACK_EVERY):
+    for i in range(goal.executing, goal.ended, samples_per(FEEDBACK_PERIOD, run.execution.dt)):
         position = pose_stamped(store, int(stamps[i]), MAP, estimate.x[i], estimate.y[i], estimate.yaw[i])
         msg = T[FEEDBACK](
             header=header(store, int(stamps[i]), ""),

@@ -24,9 +24,8 @@ from exsce_dsl.model.goals import ActionGoalStatus
 from exsce_dsl.sim.batches import Batch
 from exsce_dsl.sim.goals import NavigationGoal, Phase, listed, navigation_goals, status_samples
 from exsce_dsl.sim.localisation import Localisation, localise
-from exsce_dsl.sim.motion import DT
 from exsce_dsl.sim.stack_topics import MAP, stack_messages
-from exsce_dsl.sim.values import duration, header, pose, ros_time, sample_stamps
+from exsce_dsl.sim.values import duration, header, pose, ros_time, sample_stamps, samples_per
 from exsce_dsl.sim.writing import Message, RobotRun
 
 ACTION = "navigate_to_pose"
@@ -40,7 +39,7 @@ CODES = {
     Phase.ABORTED: ActionGoalStatus.ABORTED,
 }
 """action_msgs/GoalStatus values (CANCELED is never reached: the executor cancels nothing)."""
-STATUS_EVERY, FEEDBACK_EVERY = 50, 10  # samples of the 50 Hz clock: 1 Hz, 5 Hz
+STATUS_PERIOD, FEEDBACK_PERIOD = 1.0, 0.2  # seconds: 1 Hz, 5 Hz
 RESULT_TIMEOUT = 900.0
 """Seconds a finished goal stays in the status list (rcl_action's default result timeout)."""
 PLAN_SPACING = 0.05  # metres between the poses of a published plan (a grid planner's cell)
@@ -50,8 +49,8 @@ LATCHED = ("tf_static", f"{ACTION}/_action/status")
 def nav2_messages(run: RobotRun) -> Iterator[Message | Batch]:
     """Every message of one robot driven by Nav2."""
     tr = run.execution.trajectories[run.robot]
-    stamps = sample_stamps(run.start_ns, len(tr))
-    frames = localise(tr, run.rng)
+    stamps = sample_stamps(run.start_ns, len(tr), run.execution.dt)
+    frames = localise(tr, run.rng, dt=run.execution.dt)
     yield from stack_messages(run, frames, stamps)
     goals = navigation_goals(run.execution, run.robot, run.rng)
     yield from _status(run, goals, stamps)
@@ -80,7 +79,7 @@ def plan(run: RobotRun, goal: NavigationGoal, stamps: np.ndarray) -> Any:
 def _status(run: RobotRun, goals: list[NavigationGoal], stamps: np.ndarray) -> Iterator[Message]:
     T, store = run.store.types, run.store
     topic = run.topic(f"{ACTION}/_action/status")
-    for sample in status_samples(goals, len(stamps), STATUS_EVERY):
+    for sample in status_samples(goals, len(stamps), samples_per(STATUS_PERIOD, run.execution.dt)):
         status_list = [
             T["action_msgs/msg/GoalStatus"](
                 goal_info=T["action_msgs/msg/GoalInfo"](
@@ -88,7 +87,7 @@ def _status(run: RobotRun, goals: list[NavigationGoal], stamps: np.ndarray) -> I
                 ),
                 status=CODES[phase],
             )
-            for goal, phase in listed(goals, sample, RESULT_TIMEOUT)
+            for goal, phase in listed(goals, sample, RESULT_TIMEOUT, run.execution.dt)
         ]
         yield topic, STATUS, int(stamps[sample]), T[STATUS](status_list=status_list)
 
@@ -98,7 +97,7 @@ def _feedback(
 ) -> Iterator[Message]:
     T, store = run.store.types, run.store
     kind, fields = stored_name(store, FEEDBACK), stored_name(store, FEEDBACK_FIELDS)
-    samples = np.arange(goal.executing, goal.ended, FEEDBACK_EVERY)
+    samples = np.arange(goal.executing, goal.ended, samples_per(FEEDBACK_PERIOD, run.execution.dt))
     if not len(samples):
         return
     estimate = frames.estimate
@@ -111,7 +110,7 @@ def _feedback(
                 header=header(store, int(stamps[i]), MAP),
                 pose=pose(store, estimate.x[i], estimate.y[i], estimate.yaw[i]),
             ),
-            navigation_time=duration(store, (i - goal.accepted) * DT),
+            navigation_time=duration(store, (i - goal.accepted) * run.execution.dt),
             estimated_time_remaining=duration(store, eta),
             number_of_recoveries=0,
             distance_remaining=left,

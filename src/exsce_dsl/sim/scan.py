@@ -15,9 +15,8 @@ import numpy as np
 from exsce_dsl.maps.planning import PlanningGrid
 from exsce_dsl.sim.batches import Batch, stamp_columns
 from exsce_dsl.sim.executor import SimulatedExecution
-from exsce_dsl.sim.laser import SCAN_EVERY, Laser, RecordedScans
-from exsce_dsl.sim.motion import DT
-from exsce_dsl.sim.values import header_at
+from exsce_dsl.sim.laser import SCAN_PERIOD, Laser, RecordedScans
+from exsce_dsl.sim.values import header_at, samples_per
 
 ROBOT_RADIUS = 0.3  # other robots are discs of this radius
 
@@ -127,20 +126,22 @@ def laser_scans(
     if execution.scans is not None:
         recorded = execution.scans.get(robot)
         if recorded is not None:
-            yield _scan_batch(store, topic, frame, recorded, stamps)
+            yield _scan_batch(store, topic, frame, recorded, stamps, execution.dt)
         return
     tr = execution.trajectories[robot]
-    idx = np.arange(0, len(tr), SCAN_EVERY)
+    idx = np.arange(0, len(tr), samples_per(SCAN_PERIOD, execution.dt))
     others = [(o.x[idx], o.y[idx]) for r, o in execution.trajectories.items() if r != robot]
     ranges = scan_ranges(grid, laser, tr.x[idx], tr.y[idx], tr.yaw[idx], others, ROBOT_RADIUS, rng)
-    yield _scan_batch(store, topic, frame, RecordedScans(laser, idx, ranges), stamps)
+    yield _scan_batch(store, topic, frame, RecordedScans(laser, idx, ranges), stamps, execution.dt)
 
 
-def _scan_batch(store: Any, topic: str, frame: str, scans: RecordedScans, stamps: np.ndarray) -> Batch:
+def _scan_batch(
+    store: Any, topic: str, frame: str, scans: RecordedScans, stamps: np.ndarray, dt: float
+) -> Batch:
     T = store.types
     laser = scans.laser
     empty = np.zeros(0, dtype=np.float32)
-    every = int(scans.samples[1] - scans.samples[0]) if len(scans.samples) > 1 else SCAN_EVERY
+    apart = scans.samples[1] - scans.samples[0] if len(scans.samples) > 1 else samples_per(SCAN_PERIOD, dt)
 
     def scan(sec: int, nanosec: int, seq: int, ranges: np.ndarray) -> Any:
         return T["sensor_msgs/msg/LaserScan"](
@@ -149,7 +150,7 @@ def _scan_batch(store: Any, topic: str, frame: str, scans: RecordedScans, stamps
             angle_max=laser.angle_max,
             angle_increment=laser.angle_increment,
             time_increment=0.0,
-            scan_time=every * DT,
+            scan_time=int(apart) * dt,
             range_min=laser.range_min,
             range_max=laser.range_max,
             ranges=ranges,

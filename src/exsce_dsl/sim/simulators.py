@@ -29,6 +29,7 @@ from exsce_dsl.model import Scenario
 from exsce_dsl.plugins import Registry
 from exsce_dsl.sim.executor import SimulatedExecution, execute
 from exsce_dsl.sim.faults import Fault
+from exsce_dsl.sim.irsim_world import STEP
 from exsce_dsl.suggest import did_you_mean
 
 
@@ -88,6 +89,8 @@ class IrsimSimulator:
     behaviour: str = "rvo"
     scans: str = "exsce"
     name: str = "irsim"
+    step: float = STEP
+    """IR-SIM's step in seconds (its default): the run's sample period."""
 
     def __post_init__(self) -> None:
         from exsce_dsl.sim.irsim_play import SCAN_SOURCES
@@ -111,12 +114,10 @@ class IrsimSimulator:
     def settings(self) -> Mapping[str, str]:
         from exsce_dsl.sim.irsim_play import PATH_SPACING, PROGRESS_RADIUS, PROGRESS_TIME
         from exsce_dsl.sim.irsim_world import GOAL_TOLERANCE
-        from exsce_dsl.sim.motion import DT
-
         return {
             "behaviour": self.behaviour,
             "scans": self.scans,
-            "step_time": f"{DT}",
+            "step_time": f"{self.step}",
             "collision_mode": "stop",
             "goal_tolerance": f"{GOAL_TOLERANCE}",
             "path_spacing": f"{PATH_SPACING}",
@@ -128,7 +129,7 @@ class IrsimSimulator:
     ) -> SimulatedExecution:
         from exsce_dsl.sim.irsim_play import play_in_irsim
 
-        return play_in_irsim(scenario, grid, seed, faults, self.behaviour, self.scans)
+        return play_in_irsim(scenario, grid, seed, faults, self.behaviour, self.scans, step=self.step)
 
 
 KINEMATIC = KinematicSimulator()

@@ -30,7 +30,6 @@ import numpy as np
 
 from exsce_dsl.sim.batches import Batch, stamp_columns
 from exsce_dsl.sim.localisation import LOCALISATION_NOISE, LOCALISATION_YAW_NOISE, Localisation
-from exsce_dsl.sim.motion import DT
 from exsce_dsl.sim.scan import laser_scans
 from exsce_dsl.sim.values import (
     header,
@@ -38,6 +37,7 @@ from exsce_dsl.sim.values import (
     heading_columns,
     planar_rotation,
     pose,
+    samples_per,
     transform,
     transform_at,
     twist,
@@ -45,11 +45,11 @@ from exsce_dsl.sim.values import (
 from exsce_dsl.sim.writing import Message, RobotRun
 
 MAP, ODOM, BASE, FOOTPRINT, LASER = "map", "odom", "base_link", "base_footprint", "base_laser_link"
-ODOM_EVERY, CORRECTION_EVERY, AMCL_EVERY = 1, 5, 25  # samples of the 50 Hz clock: 50, 10, 2 Hz
+ODOM_PERIOD, CORRECTION_PERIOD, AMCL_PERIOD = 0.02, 0.1, 0.5  # seconds: 50, 10, 2 Hz (at most the run's rate)
 CMD_VEL_PERIOD_NS = 50_000_000  # 20 Hz: Nav2's default controller_frequency
 FOOTPRINT_HEIGHT = 0.1  # base_footprint: on the floor, below base_link
 LASER_HEIGHT = 0.2  # base_laser_link: above base_link's origin, where the executor's scans start
-JOINTS_PER_SAMPLE = 2  # robot_state_publisher at 100 Hz: twice per sample of the 50 Hz clock
+JOINTS_PERIOD = 0.01  # robot_state_publisher at 100 Hz
 WHEELS = (
     ("wheel_left_link", 0.0, 0.2, 0.0985),
     ("wheel_right_link", 0.0, -0.2, 0.0985),
@@ -86,8 +86,8 @@ def _tf(run: RobotRun, frames: Localisation, stamps: np.ndarray) -> Iterator[Mes
     ]
     yield run.topic(TF_STATIC), kind, int(stamps[0]), T[kind](transforms=static)
     for parent, child, poses, every in (
-        (ODOM, BASE, frames.odom, ODOM_EVERY),
-        (MAP, ODOM, frames.correction, CORRECTION_EVERY),
+        (ODOM, BASE, frames.odom, samples_per(ODOM_PERIOD, run.execution.dt)),
+        (MAP, ODOM, frames.correction, samples_per(CORRECTION_PERIOD, run.execution.dt)),
     ):
 
         def moved(
@@ -119,12 +119,13 @@ def _joints(run: RobotRun, frames: Localisation, stamps: np.ndarray) -> Batch:
     contact point rolled, at twice the clock's rate (angles interpolated between samples)."""
     T, store = run.store.types, run.store
     kind = "tf2_msgs/msg/TFMessage"
-    times = np.arange(len(stamps) * JOINTS_PER_SAMPLE) / JOINTS_PER_SAMPLE
+    per_sample = samples_per(run.execution.dt, JOINTS_PERIOD)  # joint states between two samples
+    times = np.arange(len(stamps) * per_sample) / per_sample
     joint_stamps = np.interp(times, np.arange(len(stamps)), stamps.astype(float)).astype(np.int64)
     columns = stamp_columns(joint_stamps)
     for number, (_, _, y, radius) in enumerate(WHEELS):
         speed = frames.v - frames.w * y  # the wheel's forward speed: the body's, less the turn's share
-        rolled = np.concatenate([[0.0], np.cumsum(speed[:-1] * DT)])
+        rolled = np.concatenate([[0.0], np.cumsum(speed[:-1] * run.execution.dt)])
         half = (np.interp(times, np.arange(len(stamps)), rolled / radius) / 2).tolist()
         columns[f"sin{number}"] = np.array([math.sin(a) for a in half], dtype="<f8")
         columns[f"cos{number}"] = np.array([math.cos(a) for a in half], dtype="<f8")
@@ -168,7 +169,7 @@ def _odometry(run: RobotRun, frames: Localisation, stamps: np.ndarray) -> Batch:
             ),
         )
 
-    at = np.arange(0, len(stamps), ODOM_EVERY)
+    at = np.arange(0, len(stamps), samples_per(ODOM_PERIOD, run.execution.dt))
     columns = {
         **stamp_columns(stamps[at]),
         "seq": np.arange(len(at)).astype("<u4"),
@@ -185,7 +186,7 @@ def _amcl_pose(run: RobotRun, frames: Localisation, stamps: np.ndarray) -> Itera
     T, store = run.store.types, run.store
     kind = "geometry_msgs/msg/PoseWithCovarianceStamped"
     estimate = frames.estimate
-    for seq, i in enumerate(range(0, len(stamps), AMCL_EVERY)):
+    for seq, i in enumerate(range(0, len(stamps), samples_per(AMCL_PERIOD, run.execution.dt))):
         msg = T[kind](
             header=header(store, int(stamps[i]), MAP, seq),
             pose=T["geometry_msgs/msg/PoseWithCovariance"](

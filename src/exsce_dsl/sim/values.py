@@ -14,10 +14,16 @@ import numpy as np
 from exsce_dsl.sim.motion import DT
 
 
-def sample_stamps(start_ns: int, samples: int) -> np.ndarray:
-    """The stamp (ns) of each sample of the executor's clock."""
-    stamps: np.ndarray = start_ns + (np.arange(samples) * DT * 1e9).astype(np.int64)
+def sample_stamps(start_ns: int, samples: int, dt: float = DT) -> np.ndarray:
+    """The stamp (ns) of each sample of the executor's clock (``dt`` seconds apart)."""
+    stamps: np.ndarray = start_ns + (np.arange(samples) * dt * 1e9).astype(np.int64)
     return stamps
+
+
+def samples_per(period: float, dt: float) -> int:
+    """How many samples ``dt`` apart make a topic's ``period`` (at least one: a topic is never
+    published faster than the run is sampled)."""
+    return max(1, int(round(period / dt)))
 
 
 def ros_time(store: Any, ns: int) -> Any:
