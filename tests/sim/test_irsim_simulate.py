@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -44,7 +45,8 @@ def _odometry_path(bag: Path, robot: str) -> float:
         executing: dict[bytes, int] = {}
         ended: dict[bytes, int] = {}
         for connection, stamp, raw in reader.messages(connections=status):
-            for goal in reader.deserialize(raw, connection.msgtype).status_list:
+            status_array: Any = reader.deserialize(raw, connection.msgtype)
+            for goal in status_array.status_list:
                 key = bytes(goal.goal_info.goal_id.uuid)
                 if goal.status == EXECUTING:
                     executing.setdefault(key, stamp)
@@ -52,11 +54,11 @@ def _odometry_path(bag: Path, robot: str) -> float:
                     ended.setdefault(key, stamp)
         first, last = min(executing.values()), max(ended.values())
         odom = [c for c in reader.connections if c.topic == f"/{robot}/odom"]
-        xy = [
-            (msg.pose.pose.position.x, msg.pose.pose.position.y)
-            for connection, stamp, raw in reader.messages(connections=odom)
-            if first <= stamp <= last and (msg := reader.deserialize(raw, connection.msgtype))
-        ]
+        xy = []
+        for connection, stamp, raw in reader.messages(connections=odom):
+            if first <= stamp <= last:
+                msg: Any = reader.deserialize(raw, connection.msgtype)
+                xy.append((msg.pose.pose.position.x, msg.pose.pose.position.y))
     points = np.array(xy)
     return float(np.hypot(*np.diff(points, axis=0).T).sum())
 
