@@ -68,8 +68,12 @@ def test_one_library_query_returns_the_dispatchers_goals_the_bag_the_values_and_
     project, run, recorded = judged
     chain = rows("query", "run_lineage", "-p", f"run={run}", cwd=project)
     parts = [row["part"] for row in chain]
-    assert parts == sorted(parts, key=["execution", "goal", "bag", "value", "verdict", "baseline"].index)
+    assert parts == sorted(
+        parts, key=["execution", "simulator", "goal", "bag", "value", "verdict", "baseline"].index
+    )
     (execution,) = [r for r in chain if r["part"] == "execution"]
+    (simulator,) = [r for r in chain if r["part"] == "simulator"]  # the run-time PROV names what played it
+    assert (simulator["item"], simulator["detail"]) == ("kinematic", "")
     assert execution["item"] == dispatched_id(recorded)
     assert execution["detail"].endswith(".prov.json")  # simulate records it beside the bag
     goals = [r for r in chain if r["part"] == "goal"]

@@ -109,3 +109,13 @@ def test_the_runs_prov_names_irsim_its_version_and_settings(played: tuple[Simula
             "prov:wasAssociatedWith ?agent . ?agent exsce:simulator ?name ; exsce:simulator_version ?version } }",
         )
     assert found.to_dict("records") == [{"name": "irsim", "version": irsim_version()}]
+
+
+def test_the_runs_lineage_says_what_played_it(played: tuple[SimulatedRun, str]) -> None:
+    _, store = played
+    listed = api.stored_runs(store, "scenario_c").rows
+    assert listed is not None
+    [run] = list(listed)
+    with api.open_store(store, read_only=True) as opened:
+        text = api.run_lineage(opened, _text(run["run"])).text()
+    assert f"  played by irsim {irsim_version()} (behaviour=rvo; scans=exsce; step_time=0.1;" in text

@@ -90,6 +90,9 @@ def _execution_lines(chain: RunChain) -> list[str]:
     if execution.mission_status:
         said += f"; mission {execution.mission_status}"
     lines = [said]
+    if chain.simulator is not None:
+        name, version, settings = chain.simulator
+        lines.append(f"  played by {name} {version}" + (f" ({settings})" if settings else ""))
     for goal in chain.goals:
         outcome = f" ({goal.outcome})" if goal.outcome else ""
         attempts = f", {goal.attempts} attempts" if goal.attempts > 1 else ""

@@ -92,6 +92,8 @@ class RunChain:
     values: tuple[ChainValue, ...] = ()
     verdicts: tuple[ChainVerdict, ...] = ()
     baselines: tuple[tuple[str, str | None], ...] = field(default_factory=tuple)
+    simulator: tuple[str, str, str] | None = None
+    """What played the run, when a simulator did: its name, version and settings."""
 
 
 def run_chain(store: Store, run: str, *, namespace: str = DEFAULT_NAMESPACE) -> RunChain:
@@ -114,6 +116,13 @@ def run_chain(store: Store, run: str, *, namespace: str = DEFAULT_NAMESPACE) -> 
         tuple(_value(r) for r in parts.get("value", ())),
         tuple(_verdict(r) for r in parts.get("verdict", ())),
         tuple((text_of(r["item"]) or "", text_of(r["path"])) for r in parts.get("baseline", ())),
+        next(
+            (
+                (text_of(r["item"]) or "", text_of(r["status"]) or "", text_of(r["detail"]) or "")
+                for r in parts.get("simulator", ())
+            ),
+            None,
+        ),
     )
 
 
