@@ -82,3 +82,37 @@ def test_a_missing_irsim_is_said_with_its_remedy(monkeypatch: pytest.MonkeyPatch
     assert "IR-SIM is not installed: pip install 'exsce[irsim]'" in result.output
     assert "Traceback" not in result.output
     assert not list(tmp_path.iterdir())  # nothing half-way
+
+
+def _variant(tmp_path: Path, mission: str, allocation: str) -> Scenario:
+    spec = tmp_path / "variant.exsce"
+    spec.write_text(
+        f'import "{SPEC}"\n'
+        "scenario variant in three_rooms {\n"
+        "  robots {\n    robot_w: pmb2 starts at west-desk\n    robot_e: pmb2 starts at east-desk\n  }\n"
+        f"  mission variant_mission {mission} {{\n{allocation}  }}\n}}\n",
+        encoding="utf-8",
+    )
+    return api.load(spec).scenario("variant")
+
+
+def test_a_sequential_mission_runs_one_robot_at_a_time(tmp_path: Path) -> None:
+    scenario = _variant(tmp_path, "sequential", "    robot_w does sort_west\n    robot_e does sort_east\n")
+    [run] = api.simulate(scenario, tmp_path / "runs", 1, simulator="irsim")
+    west = [a for a in run.execution.actions if a.robot == "robot_w"]
+    east = [a for a in run.execution.actions if a.robot == "robot_e"]
+    assert len(west) == len(east) == 3
+    assert all(a.status.name == "SUCCEEDED" for a in west + east)
+    assert min(a.start for a in east) > max(a.end for a in west)  # robot_e waited for robot_w's entry
+
+
+def test_robots_that_collide_in_irsim_abort_their_goals_and_say_so(tmp_path: Path) -> None:
+    # dash does not avoid: the two robots cross the hall head-on, on one line
+    scenario = _variant(tmp_path, "parallel", "    robot_w does sort_east\n    robot_e does sort_west\n")
+    [run] = api.simulate(scenario, tmp_path / "runs", 1, simulator="irsim", behaviour="dash")
+    outcomes = {(a.robot, a.waypoint_number): (a.status.name, a.outcome) for a in run.execution.actions}
+    assert outcomes[("robot_w", 1)] == ("ABORTED", "collided")
+    assert outcomes[("robot_e", 1)] == ("ABORTED", "collided")
+    [recorded] = list(run.bag.parent.glob("*.prov.json"))
+    prov = recorded.read_text()
+    assert prov.count('"exsce:goal_outcome": "collided"') == 6  # the later goals of a stopped robot too

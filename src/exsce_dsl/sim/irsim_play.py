@@ -134,6 +134,8 @@ class _Lockstep:
         self.dt = step
         self.scan_every = samples_per(SCAN_PERIOD, step)
         self.robots = {obj.name: obj for obj in env.robot_list}
+        for obj in self.robots.values():  # IR-SIM gives a robot with no goal a default one: none
+            obj.set_goal(None)
         for found in env.objects:
             if found.shape == "map":  # static: its geometry is indexed once, not at each test
                 import shapely
