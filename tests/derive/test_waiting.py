@@ -13,24 +13,10 @@ from dataclasses import replace
 
 import pytest
 
+from exsce_dsl import model as m
 from exsce_dsl.derive.expect import derived_criteria
 from exsce_dsl.derive.waiting import GIVE_WAY, Waiting, others_in_runs, waiting_for
 from exsce_dsl.lang import expectation_text
-from exsce_dsl.model import (
-    Area,
-    Assignment,
-    Environment,
-    Mission,
-    MissionType,
-    Orientation,
-    Pose,
-    Position,
-    Robot,
-    RobotType,
-    Scenario,
-    Subtask,
-    Task,
-)
 from exsce_dsl.model.runs import Action, ActionId, Bag, MetricScope, MetricValue, Run, TaskExecution
 from exsce_dsl.oracles import relation
 from exsce_dsl.prov import compile_scenario
@@ -39,22 +25,22 @@ from exsce_dsl.store.embedded import EmbeddedStore
 from exsce_dsl.store.writing import add_prov
 
 A, B, C = (
-    Pose(f"room-{n}", Position(x, y), Orientation(), "room")
+    m.Pose(f"room-{n}", m.Position(x, y), m.Orientation(), "room")
     for n, x, y in (("a", 0, 0), ("b", 3, 4), ("c", 6, 8))
 )
-ROOM = Environment("house", areas=(Area("room", (A, B, C)),))
-TIAGO = RobotType("tiago", base="pmb2", torso=True)
+ROOM = m.Environment("house", areas=(m.Area("room", (A, B, C)),))
+TIAGO = m.RobotType("tiago", base="pmb2", torso=True)
 TOPICS = ("/r1/distance_travelled", "/r1/waypoint_dispatcher/feedback")
 
 
-def scenario(name: str, *waypoints: Pose, r2: Pose | None = None) -> Scenario:
-    task = Task(f"{name}_task", (Subtask(waypoints),))
-    robots = (Robot("r1", TIAGO, "r1", start_pose=A), Robot("r2", TIAGO, "r2", start_pose=r2))
-    return Scenario(
+def scenario(name: str, *waypoints: m.Pose, r2: m.Pose | None = None) -> m.Scenario:
+    task = m.Task(f"{name}_task", (m.Subtask(waypoints),))
+    robots = (m.Robot("r1", TIAGO, "r1", start_pose=A), m.Robot("r2", TIAGO, "r2", start_pose=r2))
+    return m.Scenario(
         name,
         ROOM,
         robots,
-        Mission(f"{name}_m", MissionType.PARALLEL, (Assignment("r1", task.id),)),
+        m.Mission(f"{name}_m", m.MissionType.PARALLEL, (m.Assignment("r1", task.id),)),
         (task,),
     )
 
@@ -71,16 +57,21 @@ def run(uuid: str, metres: tuple[float, ...], home: bool = False) -> Run:
     actions = tuple(Action(ActionId("r1", 1, 1, i), s, g) for i, (s, g, _, _) in enumerate(legs, 1))
     metrics = []
     for action, (_, _, metre, seconds) in zip(actions, legs, strict=True):
-        metrics.append(MetricValue("distance_travelled", MetricScope.SEGMENT, metre, TOPICS, action=action.id))
+        metrics.append(
+            MetricValue("distance_travelled", MetricScope.SEGMENT, metre, TOPICS, action=action.id)
+        )
         metrics.append(MetricValue("task_duration", MetricScope.SEGMENT, seconds, TOPICS, action=action.id))
-    totals = (("distance_travelled", sum(leg[2] for leg in legs)), ("task_duration", sum(leg[3] for leg in legs)))
+    totals = (
+        ("distance_travelled", sum(leg[2] for leg in legs)),
+        ("task_duration", sum(leg[3] for leg in legs)),
+    )
     metrics += [MetricValue(m, MetricScope.ROBOT, v, TOPICS, robot="r1") for m, v in totals]
     start = datetime.datetime(2024, 7, 1, 9)
     return Run(uuid, "base", start, start + datetime.timedelta(minutes=1), Bag(f"{uuid}.bag", TOPICS),
                (TaskExecution("r1", 1, actions),), tuple(metrics))  # fmt: skip
 
 
-def stored(*runs: tuple[float, float], base: Scenario = BASE) -> EmbeddedStore:
+def stored(*runs: tuple[float, float], base: m.Scenario = BASE) -> EmbeddedStore:
     store = EmbeddedStore(None)
     add_prov(store, compile_scenario(base))
     for i, metres in enumerate(runs):
@@ -96,7 +87,7 @@ def test_a_robot_alone_waits_for_nobody_and_one_with_company_for_each_other() ->
     assert waiting_for(paired, "r1", "task_duration") == GIVE_WAY
     # giving way changes when a robot drives, never where
     assert waiting_for(paired, "r1", "distance_travelled") == 0.0
-    three = replace(paired, robots=(*paired.robots, Robot("r3", TIAGO, "r3", start_pose=B)))
+    three = replace(paired, robots=(*paired.robots, m.Robot("r3", TIAGO, "r3", start_pose=B)))
     assert waiting_for(three, "r1", "task_duration", give_way=7.0) == 14.0
 
 

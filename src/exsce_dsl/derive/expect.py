@@ -350,7 +350,8 @@ def derived_criteria(
                 continue
             before = robot_metric_over_runs(store, metric, robot.id, base_runs) if in_base else None
             unit = "m" if metric == "distance_travelled" else "s"
-            waiting = Waiting(expected, _allowance(estimate, tolerance_percent), waiting_for(derived, robot.id, metric))
+            allowance = _allowance(estimate, tolerance_percent)
+            waiting = Waiting(expected, allowance, waiting_for(derived, robot.id, metric))
             if waiting.waiting:
                 waits[robot.id] = waiting.waiting
             performance.extend(
