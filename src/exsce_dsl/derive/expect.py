@@ -325,7 +325,10 @@ def derived_criteria(
     value, or for a robot the base's runs do not show, there is no performance clause.  A robot
     given no tasks (``add_robot ... taking over``, ``remove_task``) has no performance clause,
     and a note says why (:func:`~exsce_dsl.derive.kept_clauses.standing_note`); the safety
-    clauses judge it standing by.
+    clauses judge it standing by.  A robot that shares the derived scenario's runs with other
+    robots may give way to them: its task_duration clauses allow that time more, on the slow
+    side only, and a note says so (:mod:`exsce_dsl.derive.waiting`).  A tolerance is written
+    rounded up past the rounding of the change it goes with.
 
     E and B come from good runs only (every stored run with ``include_all``): a run that failed,
     was inconclusive, did not complete its mission or broke a safety limit would teach the
