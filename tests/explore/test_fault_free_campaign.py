@@ -11,6 +11,7 @@ a note says why."""
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -18,7 +19,9 @@ from pathlib import Path
 
 import pytest
 
+from exsce_dsl.derive.waiting import GIVE_WAY
 from exsce_dsl.model.campaign import CampaignTrial, CheckedRelation
+from exsce_dsl.store import robot_metric_over_runs
 from exsce_dsl.store.open import open_store
 from exsce_dsl.store.queries.campaigns import campaign_record, campaigns
 
@@ -97,3 +100,39 @@ def test_the_clauses_a_robot_without_tasks_has_not_are_said_in_a_note(
     assert derived.returncode == 0, derived.stderr
     assert f"note: {NOTE.format('c_standing')}" in derived.stderr
     assert f"// note: {NOTE.format('c_standing')}" in (project / "derived.exsce").read_text()
+
+
+SWAPPED = (
+    ("reverse_task_order", {"robot": "tiago2"}),
+    ("swap_start_poses", {"robot": "tiago1", "with": "tiago2"}),
+)
+
+
+def test_fault_free_campaign_where_tiago2_gives_way_to_tiago1_exits_0(tmp_path: Path) -> None:
+    """``explore SPEC -n 8 -k 1 --no-shrink`` exited 1: its trial 8, reverse_task_order(tiago2) →
+    swap_start_poses(tiago1, tiago2), sends tiago2 home to where tiago1 starts, then after tiago1
+    down the same corridor; it waits for tiago1 and took 102.5 s against an expected 79.7 ± 19.9 s
+    (its distance as expected).  Its clauses now allow the time it may give way to tiago1 on the
+    slow side (exsce_dsl.derive.waiting).  Seed 2 draws that derivation first."""
+    shutil.copytree(ROOT / "examples", tmp_path / "examples")
+    explored = _exscec(
+        tmp_path, "explore", SPEC, "-n", "1", "-k", "1", "--no-shrink", "--seed", "2",
+        "-t", "reverse_task_order", "-t", "swap_start_poses", "-o", "c",
+    )  # fmt: skip
+    assert explored.returncode == 0, explored.stdout + explored.stderr
+    trial = _the_trial(tmp_path)
+    assert trial.steps == SWAPPED and trial.outcome == "passed"
+    assert CheckedRelation("task_duration", "tiago2", "invariant") in trial.checked
+    (written,) = (tmp_path / "c" / "scenarios").glob("*.exsce")
+    text = written.read_text()
+    note = f"// note: task_duration: a robot's expected duration drives its path as stored runs drove it; in {written.stem}"
+    assert note in text
+    # the run waited: beyond what tiago2's clause allowed before, within the time it may give way
+    found = re.search(r"tiago2 task_duration is invariant around ([0-9.]+) s within ([0-9.]+) %", text)
+    assert found is not None, text
+    centre, percent = float(found.group(1)), float(found.group(2))
+    expected, allowance = centre - GIVE_WAY / 2, centre * percent / 100 - GIVE_WAY / 2
+    with open_store(str(tmp_path / "store")) as store:
+        measured = robot_metric_over_runs(store, "task_duration", "tiago2", list(trial.runs))
+    assert measured is not None
+    assert expected + allowance < measured.mean <= expected + allowance + GIVE_WAY

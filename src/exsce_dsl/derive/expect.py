@@ -29,6 +29,7 @@ from dataclasses import dataclass, replace
 
 from exsce_dsl.derive.grid_lengths import grid_lengths
 from exsce_dsl.derive.kept_clauses import safety_clauses, standing_note
+from exsce_dsl.derive.waiting import Waiting, waiting_for, waiting_note
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.model import Pose, Scenario
 from exsce_dsl.model.acceptance import (
@@ -324,7 +325,10 @@ def derived_criteria(
     value, or for a robot the base's runs do not show, there is no performance clause.  A robot
     given no tasks (``add_robot ... taking over``, ``remove_task``) has no performance clause,
     and a note says why (:func:`~exsce_dsl.derive.kept_clauses.standing_note`); the safety
-    clauses judge it standing by.
+    clauses judge it standing by.  A robot that shares the derived scenario's runs with other
+    robots may give way to them: its task_duration clauses allow that time more, on the slow
+    side only, and a note says so (:mod:`exsce_dsl.derive.waiting`).  A tolerance is written
+    rounded up past the rounding of the change it goes with.
 
     E and B come from good runs only (every stored run with ``include_all``): a run that failed,
     was inconclusive, did not complete its mission or broke a safety limit would teach the
@@ -334,6 +338,7 @@ def derived_criteria(
     base_runs = list(chosen.require_some(f"'{base.id}' to expect from").used)
     learning = learning_runs(store, include_all)
     performance: list[Expectation] = []
+    waits: dict[str, float] = {}
     for robot in derived.robots:
         if not derived.mission.tasks_of(robot.id):
             if robot.start_pose is not None:  # one without is in no run: its note is said above
@@ -349,7 +354,12 @@ def derived_criteria(
             before = robot_metric_over_runs(store, metric, robot.id, base_runs) if in_base else None
             unit = "m" if metric == "distance_travelled" else "s"
             allowance = _allowance(estimate, tolerance_percent)
-            performance.extend(_expected_clauses(subject, metric, expected, before, allowance, unit, base.id))
+            waiting = Waiting(expected, allowance, waiting_for(derived, robot.id, metric))
+            if waiting.waiting:
+                waits[robot.id] = waiting.waiting
+            performance.extend(
+                _expected_clauses(subject, metric, waiting.centre, before, waiting.half_width, unit, base.id)
+            )
         waypoints = len(robot_path(derived, robot.id))
         before = robot_metric_over_runs(store, "waypoints_visited", robot.id, base_runs) if in_base else None
         if in_base and before is None:
@@ -357,6 +367,8 @@ def derived_criteria(
         performance.extend(
             _expected_clauses(subject, "waypoints_visited", waypoints, before, 0.0, None, base.id)
         )
+    if waits:
+        notes.append(waiting_note(derived, waits))
     when = When(mission=derived.mission.id)  # empty criteria are left out: an empty block is an error
     criteria = []
     if safety:
@@ -395,6 +407,13 @@ def _expected_clauses(
     def quantity(value: float) -> Quantity:
         return Quantity(round(value, 3), unit)
 
+    def allowing(value: float, written: float = 0.0) -> Quantity:
+        """A tolerance as written: what rounding ``written`` (the clause's other value) to 3
+        decimals takes off it added, rounded up (a run within the allowance of the unrounded
+        value must not fail by a rounding: with an allowance of 0 m it did)."""
+        slack = abs(written - round(written, 3))
+        return Quantity(math.ceil(round((value + slack) * 1000.0, 6)) / 1000.0, unit)
+
     own = Expectation(
         subject,
         metric,
@@ -412,12 +431,17 @@ def _expected_clauses(
             subject,
             metric,
             BasicRelation.INVARIANT,
-            tolerance=quantity(allowance + abs(change)),
+            tolerance=allowing(allowance + abs(change)),
             against=base,
         )
         return [own, same]
     direction = BasicRelation.INCREASING if change > 0 else BasicRelation.DECREASING
     moved = Expectation(
-        subject, metric, direction, delta=quantity(abs(change)), tolerance=quantity(allowance), against=base
+        subject,
+        metric,
+        direction,
+        delta=quantity(abs(change)),
+        tolerance=allowing(allowance, abs(change)),
+        against=base,
     )
     return [own, moved]
