@@ -16,6 +16,22 @@ import click
 from exsce_dsl.cli.common import ExitCode, exit_status, reports_errors
 
 
+def _refuse_with_ros1(ros1: bool, convention: bool, simulator: bool) -> None:
+    """--ros1 plays exsce's stand-in in move_base's convention: no other convention or simulator."""
+    if ros1 and convention:
+        raise click.UsageError("--ros1 plays the robots in move_base's convention: leave out --convention")
+    if ros1 and simulator:
+        raise click.UsageError("--ros1 plays exsce's stand-in robots: leave out --simulator and --behaviour")
+
+
+def _where(ros1: bool, convention: str, simulator: str) -> str:
+    """What the demo's heading says of where its runs are played."""
+    if ros1:
+        return " on a live ROS 1 graph"
+    robots = "" if convention == "method" else f" (robots on {convention}'s topics)"
+    return robots + ("" if simulator == "kinematic" else f", runs played by {simulator}")
+
+
 def run_in_process(argv: Sequence[str]) -> int:
     """Run one exscec command line (the arguments after `exscec`) in this process; its exit status."""
     from exsce_dsl.cli.main import main
@@ -113,10 +129,7 @@ def demo(
         summary_lines,
     )
 
-    if ros1 and convention != "method":
-        raise click.UsageError("--ros1 plays the robots in move_base's convention: leave out --convention")
-    if ros1 and (simulator != "kinematic" or behaviour):
-        raise click.UsageError("--ros1 plays exsce's stand-in robots: leave out --simulator and --behaviour")
+    _refuse_with_ros1(ros1, convention != "method", simulator != "kinematic" or behaviour is not None)
     target = Path(folder)
     set_up(target, "move_base" if ros1 else convention)
     hint = command_hint(Path.cwd())
@@ -125,21 +138,10 @@ def demo(
         if hint:
             click.echo(hint, err=True)
         return
-    steps = (
-        LIVE_STEPS
-        if ros1
-        else simulated_by(STEPS, simulator, behaviour)
-        if simulator != "kinematic"
-        else STEPS
-    )
-    shown = (
-        " on a live ROS 1 graph"
-        if ros1
-        else ""
-        if convention == "method"
-        else f" (robots on {convention}'s topics)"
-    ) + ("" if simulator == "kinematic" else f", runs played by {simulator}")
-    click.secho(f"exsce demo in {target.resolve()}{shown}", bold=True, err=True)
+    steps = LIVE_STEPS if ros1 else STEPS
+    if simulator != "kinematic":
+        steps = simulated_by(steps, simulator, behaviour)
+    click.secho(f"exsce demo in {target.resolve()}{_where(ros1, convention, simulator)}", bold=True, err=True)
     if hint:
         click.echo(f"{hint}, then 'cd {folder}'", err=True)
 
@@ -154,14 +156,17 @@ def demo(
             run = run_steps(target, run_in_process, store_url, steps, on_step=announce)
     else:
         run = run_steps(target, run_in_process, store_url, steps, on_step=announce)
-    lines = summary_lines(run, "docs/live.md" if ros1 else "docs/tutorial.md")
+    _say_summary(summary_lines(run, "docs/live.md" if ros1 else "docs/tutorial.md"), hint)
+    if not run.as_expected:
+        sys.exit(ExitCode.FAILED)
+
+
+def _say_summary(lines: list[str], hint: str | None) -> None:
     click.secho(f"\n{lines[0]}", bold=True, err=True)
     for line in lines[1:]:
         click.echo(line, err=True)
     if hint:
         click.echo(f"  {hint}", err=True)
-    if not run.as_expected:
-        sys.exit(ExitCode.FAILED)
 
 
 COMMANDS = [demo]

@@ -96,7 +96,7 @@ class SimulatorExecutor:
         played = (
             ""
             if sim.name == KINEMATIC.name
-            else " " + " ".join([f"--simulator {sim.name}"] + [f"{k}={v}" for k, v in sim.settings.items()])
+            else " " + " ".join([sim.name] + [f"{k}={v}" for k, v in sim.settings.items()])
         )
         planted = " ".join(f"--fault {f.identity}" for f in self.faults)
         return f"simulator{played} {planted}".strip()
