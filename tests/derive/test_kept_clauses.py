@@ -85,3 +85,33 @@ def test_the_standing_note_names_the_robot_the_scenario_and_the_clauses() -> Non
         "tiago1 has no tasks in c_x: no waypoints_visited, distance_travelled or task_duration"
     )
     assert "the safety clauses judge it standing by" in note
+
+
+def test_a_robot_that_drives_nowhere_keeps_its_peaks_not_its_means_or_totals() -> None:
+    """A fault-free campaign on scenario_c failed ``remove_task(delivery_a)``: tiago1, left with
+    navigate_home_1 from its own home, only turns on the spot for a second, and its mean turn rate
+    over that second (0.6–0.9 rad/s) broke the base's 0.5 rad/s, a limit written for a mission."""
+    scenario, base = _derived(("remove_task", {"task": "delivery_a"}))
+    clauses, notes = safety_clauses(scenario, base)
+    said = _said(clauses)
+    assert ("each robot", "max_velocity", "below_max") in said  # peaks judge every robot
+    assert ("each robot", "distance_to_obstacles", "above_min") in said
+    assert ("tiago2", "mean_turn_rate", "below_max") in said and (
+        "tiago2",
+        "fast_driving_time",
+        "below_max",
+    ) in said
+    assert not any(
+        who in ("tiago1", "each robot") and m in ("mean_turn_rate", "fast_driving_time") for who, m, _ in said
+    )
+    assert notes == [
+        f"tiago1 drives nowhere in {scenario.id} (every waypoint of its tasks is where it starts: it only "
+        "turns on the spot): no fast_driving_time, mean_turn_rate clause for it, a limit on a mean or a "
+        "total is about a mission that drives; the base's other limits judge it"
+    ]
+
+
+def test_a_robot_that_drives_keeps_every_limit() -> None:
+    scenario, base = _derived(("remove_task", {"task": "navigate_home_1"}))
+    clauses, notes = safety_clauses(scenario, base)
+    assert _said(clauses) == SCENARIO_C_LIMITS and notes == []

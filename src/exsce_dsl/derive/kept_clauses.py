@@ -4,19 +4,26 @@ each clause they leave out, saying why: nothing is left out silently.
 A robot given no tasks stands by: its runs measure it (velocity, scans, distance), so the base's
 safety limits judge it, but it has no performance clause (:func:`standing_note`).  A robot without a
 start pose is in no run, so no clause can judge it: an ``each robot`` limit is written for each
-robot that is in the runs instead, and a limit between robots needs two of them.
+robot that is in the runs instead, and a limit between robots needs two of them.  A robot whose
+tasks take it nowhere (every waypoint where it starts: it only turns on the spot) is judged by
+the base's limits on peaks, not by its limits on a mean or a total (:func:`is_mean_or_total`):
+a mean turn rate over a second of turning on the spot is not the mean of a mission.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import replace
 
 from exsce_dsl.model import Acceptance, Scenario
 from exsce_dsl.model.acceptance import BasicRelation, Expectation, Quantifier, Subject
+from exsce_dsl.model.expressions import Aggregate
 
 PAIRWISE = frozenset({"distance_between_robots"})
 """Mission metrics that need two robots at least."""
+IN_PLACE = 0.3
+"""Metres: a waypoint this close to where a robot starts takes it nowhere."""
 
 
 def safety_clauses(
@@ -44,6 +51,22 @@ def safety_clauses(
     notes = []
     if absent:
         clauses = [one for e in clauses for one in _each_of(e, placed)]
+    still = [r for r in placed if drives_nowhere(derived, r)]
+    averaged = sorted({e.metric for e in clauses if is_mean_or_total(e.metric, derived)})
+    if still and averaged:
+        moving = [r for r in placed if r not in still]
+        clauses = [
+            one
+            for e in clauses
+            for one in (_each_of(e, moving) if e.metric in averaged else [e])
+            if one.subject.robot not in still or one.metric not in averaged
+        ]
+        notes += [
+            f"{robot} drives nowhere in {derived.id} (every waypoint of its tasks is where it starts: "
+            f"it only turns on the spot): no {', '.join(averaged)} clause for it, a limit on a mean or "
+            "a total is about a mission that drives; the base's other limits judge it"
+            for robot in still
+        ]
     for robot in absent:
         notes.append(
             f"{robot} has no start pose in {derived.id}: it is in none of its runs, so no clause "
@@ -53,6 +76,27 @@ def safety_clauses(
         names = ", ".join(sorted({e.metric for e in pairs}))
         notes.append(f"{names}: no clause, fewer than two robots are in the runs of {derived.id}")
     return clauses, notes
+
+
+def drives_nowhere(scenario: Scenario, robot: str) -> bool:
+    """Whether ``robot`` has tasks and every waypoint of them is within IN_PLACE of its start."""
+    start = next((r.start_pose for r in scenario.robots if r.id == robot), None)
+    tasks = [scenario.task(e.task) for e in scenario.mission.allocation if e.robot == robot]
+    waypoints = [w for t in tasks if t is not None for w in t.waypoints()]
+    if start is None or not waypoints:
+        return False
+    x, y = start.position.x, start.position.y
+    return all(math.hypot(w.position.x - x, w.position.y - y) <= IN_PLACE for w in waypoints)
+
+
+def is_mean_or_total(metric: str, scenario: Scenario) -> bool:
+    """Whether ``metric`` (one of the scenario's own) is a mean or a total over the run (an
+    aggregate other than ``max`` and ``min``, with no safety limit declared); the built-in
+    metrics are peaks, or the time a peak was broken."""
+    definition = next((m for m in scenario.metrics if m.name == metric), None)
+    if definition is None or definition.safety is not None:
+        return False
+    return isinstance(definition.value, Aggregate) and definition.value.func not in ("max", "min")
 
 
 def _each_of(clause: Expectation, robots: Sequence[str]) -> list[Expectation]:
