@@ -17,6 +17,7 @@ from exsce_dsl.explore.executors import EXECUTORS, ExecutorOptions, named_execut
 from exsce_dsl.oracles.relations import RELATIONS
 from exsce_dsl.plugins import GROUPS, Registry
 from exsce_dsl.runs.bags.reading import BAG_READERS
+from exsce_dsl.sim.simulators import SIMULATORS
 from exsce_dsl.store.flavours import FLAVOURS
 
 from tests.support.plugin_packages import installed_plugins
@@ -99,7 +100,7 @@ def test_a_plugin_executor_is_chosen_by_its_name(tmp_path: Path) -> None:
 
 
 def test_every_kind_has_its_group_and_its_registry() -> None:
-    kinds = {registry.kind for registry in (RELATIONS, EXECUTORS, BAG_READERS, FLAVOURS)}
+    kinds = {registry.kind for registry in (RELATIONS, EXECUTORS, SIMULATORS, BAG_READERS, FLAVOURS)}
     assert kinds == set(GROUPS)
     assert {registry.group for registry in plugins.registries()} == set(GROUPS.values())
 
