@@ -14,7 +14,10 @@ from click.testing import CliRunner
 from exsce_dsl import api
 from exsce_dsl.cli.main import main
 from exsce_dsl.errors import ExsceError
+from exsce_dsl.maps.planning import planning_grid
 from exsce_dsl.model import Scenario
+from exsce_dsl.sim.irsim_play import play_in_irsim
+from exsce_dsl.sim.simulators import IrsimSimulator
 
 from tests.support.paths import EXAMPLES
 
@@ -73,6 +76,14 @@ def test_an_unknown_behaviour_is_refused(scenario: Scenario, tmp_path: Path) -> 
         main, ["simulate", str(SPEC), "--simulator", "irsim", "--behaviour", "rvp", "-o", str(tmp_path)]
     )
     assert result.exit_code == 2 and "rvp" in result.output
+
+
+def test_an_unknown_behaviour_or_scan_source_is_refused_by_the_library(scenario: Scenario) -> None:
+    grid = planning_grid(scenario)
+    with pytest.raises(ExsceError, match="IR-SIM has no behaviour 'rvp'.*rvo"):
+        play_in_irsim(scenario, grid, 0, behaviour="rvp")
+    with pytest.raises(ExsceError, match="unknown scan source 'lidar'"):
+        IrsimSimulator("rvo", "lidar")
 
 
 def test_a_missing_irsim_is_said_with_its_remedy(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:

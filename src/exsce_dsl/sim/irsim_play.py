@@ -38,7 +38,7 @@ from exsce_dsl.remedies import INSTALL_IRSIM
 from exsce_dsl.sim.actions import GoalEvent, SimulatedAction
 from exsce_dsl.sim.executor import SimulatedExecution
 from exsce_dsl.sim.faults import Fault, check_faults, speed_factor
-from exsce_dsl.sim.irsim_world import STEP, world_file
+from exsce_dsl.sim.irsim_world import STEP, check_settings, world_file
 from exsce_dsl.sim.laser import SCAN_PERIOD, Laser, RecordedScans
 from exsce_dsl.sim.motion import Limits, SampledMotion
 from exsce_dsl.sim.values import samples_per
@@ -51,11 +51,6 @@ PATH_SPACING = 0.3
 """Metres between the points of a leg's global path that IR-SIM is given as goals: the planned
 path through the middle of the free space, not one cut short at corners (IR-SIM's behaviours turn
 wide, and a corner cut at the planner's clearance leaves them none)."""
-SCAN_SOURCES = ("exsce", "irsim", "none")
-"""Who measures the scans: ``exsce``'s laser model, ray-marched on the same grid against the
-robots where IR-SIM put them (fast); IR-SIM's own ``lidar2d`` (exact on IR-SIM's geometry, but
-each scan casts every beam against every segment of the map, about 0.1 s a scan on scenario_c's
-building); or nobody (no scan topics)."""
 FAULTS_PLAYED = ("overspeed", "slow", "overspeed-many-tasks", "overspeed-reassigned", "skip-waypoint")
 """The deliberate faults IR-SIM plays: those of a robot's speed limit (its ``vel_max``) and the
 dispatcher's skipped waypoint; the others are planted in the kinematic executor's own driving."""
@@ -87,8 +82,8 @@ def play_in_irsim(
     limits: Limits | None = None,
     step: float = STEP,
 ) -> SimulatedExecution:
-    """Play ``scenario`` once in IR-SIM.  ``scans`` (:data:`SCAN_SOURCES`): who measures the
-    robots' scans."""
+    """Play ``scenario`` once in IR-SIM.  ``scans``
+    (:data:`~exsce_dsl.sim.irsim_world.SCAN_SOURCES`): who measures the robots' scans."""
     irsim = irsim_module()
     check_faults(scenario, faults)
     refused = sorted({f.kind for f in faults} - set(FAULTS_PLAYED))
@@ -97,8 +92,7 @@ def play_in_irsim(
             f"IR-SIM does not play the fault(s) {', '.join(refused)} (it plays {', '.join(FAULTS_PLAYED)}); "
             "the others are planted in exsce's kinematic executor"
         )
-    if scans not in SCAN_SOURCES:
-        raise ExsceError(f"unknown scan source '{scans}'; use one of {', '.join(SCAN_SOURCES)}")
+    check_settings(behaviour, scans)
     laser = Laser(noise=0.0) if scans == "irsim" else None
     limits = limits or Limits()
     rng = random.Random(seed)

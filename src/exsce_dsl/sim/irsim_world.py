@@ -27,6 +27,7 @@ from exsce_dsl.maps.planning import PlanningGrid
 from exsce_dsl.model import Robot, Scenario
 from exsce_dsl.sim.laser import Laser
 from exsce_dsl.sim.motion import Limits
+from exsce_dsl.suggest import did_you_mean
 
 BEHAVIOURS = ("dash", "rvo", "orca", "sfm")
 """IR-SIM's behaviours exsce offers: ``dash`` drives straight at the next goal; ``rvo``
@@ -50,10 +51,28 @@ class Body:
 
 BODIES: dict[str, Body] = {
     "pmb2": Body("diff", 0.275),  # PAL's PMB2 (TIAGo's base): differential drive, 0.275 m radius
-    "omni_base": Body("omni", 0.3),
 }
+"""Only differential drives: the run's samples are (x, y, heading, speed, turn rate), and an omni
+base's IR-SIM velocity is (vx, vy); such a base is played as a differential drive for now."""
 DEFAULT_BODY = Body("diff", 0.3)
 """A base exsce knows nothing of: a differential drive as big as the planner assumes."""
+
+
+SCAN_SOURCES = ("exsce", "irsim", "none")
+"""Who measures the scans: ``exsce``'s laser model, ray-marched on the same grid against the
+robots where IR-SIM put them (fast); IR-SIM's own ``lidar2d`` (exact on IR-SIM's geometry, but
+each scan casts every beam against every segment of the map, about 0.1 s a scan on scenario_c's
+building); or nobody (no scan topics)."""
+
+
+def check_settings(behaviour: str, scans: str) -> None:
+    """An :class:`ExsceError` unless ``behaviour`` is one of :data:`BEHAVIOURS` and ``scans`` one
+    of :data:`SCAN_SOURCES`."""
+    if behaviour not in BEHAVIOURS:
+        hint = did_you_mean(behaviour, list(BEHAVIOURS))
+        raise ExsceError(f"IR-SIM has no behaviour '{behaviour}'{hint}; use one of {', '.join(BEHAVIOURS)}")
+    if scans not in SCAN_SOURCES:
+        raise ExsceError(f"unknown scan source '{scans}'; use one of {', '.join(SCAN_SOURCES)}")
 
 
 def body_of(robot: Robot) -> Body:

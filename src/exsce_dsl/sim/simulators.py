@@ -29,7 +29,7 @@ from exsce_dsl.model import Scenario
 from exsce_dsl.plugins import Registry
 from exsce_dsl.sim.executor import SimulatedExecution, execute
 from exsce_dsl.sim.faults import Fault
-from exsce_dsl.sim.irsim_world import STEP
+from exsce_dsl.sim.irsim_world import STEP, check_settings
 from exsce_dsl.suggest import did_you_mean
 
 
@@ -84,7 +84,7 @@ class KinematicSimulator:
 @dataclass(frozen=True)
 class IrsimSimulator:
     """IR-SIM, with one of its behaviours and a source of scans
-    (:data:`~exsce_dsl.sim.irsim_play.SCAN_SOURCES`)."""
+    (:data:`~exsce_dsl.sim.irsim_world.SCAN_SOURCES`)."""
 
     behaviour: str = "rvo"
     scans: str = "exsce"
@@ -93,16 +93,7 @@ class IrsimSimulator:
     """IR-SIM's step in seconds (its default): the run's sample period."""
 
     def __post_init__(self) -> None:
-        from exsce_dsl.sim.irsim_play import SCAN_SOURCES
-        from exsce_dsl.sim.irsim_world import BEHAVIOURS
-
-        if self.behaviour not in BEHAVIOURS:
-            hint = did_you_mean(self.behaviour, list(BEHAVIOURS))
-            raise ExsceError(
-                f"IR-SIM has no behaviour '{self.behaviour}'{hint}; use one of {', '.join(BEHAVIOURS)}"
-            )
-        if self.scans not in SCAN_SOURCES:
-            raise ExsceError(f"unknown scan source '{self.scans}'; use one of {', '.join(SCAN_SOURCES)}")
+        check_settings(self.behaviour, self.scans)
 
     @property
     def version(self) -> str:
