@@ -51,8 +51,20 @@ def demo(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
     folder = tmp_path_factory.mktemp("live") / "live-demo"
     done = run_exscec("demo", str(folder), "--ros1", timeout=600)
     assert "Traceback" not in done.stderr
-    assert done.returncode == 0, done.stderr[-4000:]
+    assert done.returncode == 0, done.stderr[-3000:] + _failed_verdicts(folder / "verdicts-new.xml")
     return folder, done.stderr
+
+
+def _failed_verdicts(junit: Path) -> str:
+    """The new run's failed oracles, from its JUnit file, to say which clause a live run broke."""
+    if not junit.is_file():
+        return ""
+    failed = [
+        f"{case.get('name')}: {(case.find('failure').get('message') or '')[:200]}"  # type: ignore[union-attr]
+        for case in ET.parse(junit).getroot().iter("testcase")
+        if case.find("failure") is not None
+    ]
+    return "\nfailed in the new run: " + "; ".join(failed)
 
 
 def test_the_new_run_passes_and_the_over_speed_run_fails(demo: tuple[Path, str]) -> None:
