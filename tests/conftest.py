@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 import shutil
 import tempfile
+from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -92,3 +93,16 @@ def spec_c() -> tuple[Scenario, dict[str, Task]]:
 
     spec = load_spec(EXAMPLES / "brsu_building_c" / "scenario_c.exsce")
     return spec.scenario("scenario_c"), {t.id: t for t in spec.tasks}
+
+
+@pytest.fixture
+def ros2_env(monkeypatch: pytest.MonkeyPatch) -> Iterator[dict[str, str]]:
+    """A ROS 2 domain of this test's own (``tests.support.ros2_graph``), set in ``os.environ``
+    too: for rclpy in the test's process and the processes it starts."""
+    from tests.support.ros2_graph import ros2_domain
+
+    with ros2_domain() as env:
+        for name, value in env.items():
+            monkeypatch.setenv(name, value)
+        monkeypatch.delenv("ROS_LOCALHOST_ONLY", raising=False)
+        yield env

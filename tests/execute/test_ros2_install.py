@@ -11,8 +11,6 @@ from pathlib import Path
 
 from rosbags.typesys import Stores, get_typestore
 
-from tests.support.ros2_graph import ros2_env  # noqa: F401  # the fixture
-
 SERVER = textwrap.dedent(
     """
     import sys, time, rclpy
@@ -55,8 +53,8 @@ def test_nav2_goal_crosses_processes_on_fast_dds(ros2_env: dict[str, str]) -> No
     """A NavigateToPose goal sent from this process reaches a server in another, with its feedback
     and result coming back: rclpy, Fast DDS and the built nav2_msgs on loopback."""
     import rclpy
-    from rclpy.action import ActionClient
     from nav2_msgs.action import NavigateToPose
+    from rclpy.action import ActionClient
 
     server = subprocess.Popen(
         [sys.executable, "-c", SERVER], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True
@@ -73,7 +71,9 @@ def test_nav2_goal_crosses_processes_on_fast_dds(ros2_env: dict[str, str]) -> No
             goal = NavigateToPose.Goal()
             goal.pose.header.frame_id = "map"
             goal.pose.pose.position.x = 3.25
-            sent = client.send_goal_async(goal, feedback_callback=lambda m: feedback.append(m.feedback.distance_remaining))
+            sent = client.send_goal_async(
+                goal, feedback_callback=lambda m: feedback.append(m.feedback.distance_remaining)
+            )
             executor = rclpy.executors.SingleThreadedExecutor(context=context)
             executor.add_node(node)
             executor.spin_until_future_complete(sent, timeout_sec=10.0)

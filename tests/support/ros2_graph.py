@@ -14,8 +14,6 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-import pytest
-
 DOMAINS = range(1, 101)
 LOCKS = Path(tempfile.gettempdir()) / "exsce-ros2-domains"
 
@@ -55,14 +53,3 @@ def _stale(lock: Path) -> bool:
     except PermissionError:
         return False
     return False
-
-
-@pytest.fixture
-def ros2_env(monkeypatch: pytest.MonkeyPatch) -> Iterator[dict[str, str]]:
-    """This test's domain, set in ``os.environ`` too (for rclpy in the test's own process and the
-    processes it starts)."""
-    with ros2_domain() as env:
-        for name, value in env.items():
-            monkeypatch.setenv(name, value)
-        monkeypatch.delenv("ROS_LOCALHOST_ONLY", raising=False)
-        yield env
