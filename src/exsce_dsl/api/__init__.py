@@ -41,7 +41,7 @@ if TYPE_CHECKING:  # the functions of a Python session, as docs/python.md walks 
     from exsce_dsl.api.execution import execute_ros1
     from exsce_dsl.api.explain import explain
     from exsce_dsl.api.lineage import run_lineage
-    from exsce_dsl.api.stand_in import stand_in
+    from exsce_dsl.api.stand_in import stand_in, stand_in_ros2
     from exsce_dsl.api.store import open_store
     from exsce_dsl.api.tables import metrics, query, rows_frame, segments, sparql, verdicts
     from exsce_dsl.api.trials import flaky, verify_trial

@@ -1,4 +1,4 @@
-"""``exscec stand-in`` from Python: the kinematic executor as live ROS 1 robots."""
+"""``exscec stand-in`` from Python: the kinematic executor as live ROS 1 or ROS 2 robots."""
 
 from __future__ import annotations
 
@@ -9,6 +9,7 @@ from contextlib import ExitStack, contextmanager
 from pathlib import Path
 
 from exsce_dsl.execute import DEFAULT_SPEED_UP, StandIn, start_stand_in
+from exsce_dsl.execute.ros2.stand_in import Ros2StandIn
 from exsce_dsl.execute import master_uri as environment_master_uri
 from exsce_dsl.execute import start_master as start_roscore
 from exsce_dsl.model import Scenario
@@ -51,3 +52,25 @@ def stand_in(
         raise
     if log_dir is None:  # stopped cleanly: nothing there to read
         shutil.rmtree(logs, ignore_errors=True)
+
+
+@contextmanager
+def stand_in_ros2(
+    spec: Specification | Scenario,
+    *,
+    scenario: str | None = None,
+    seed: int = 0,
+    faults: Sequence[str] = (),
+    speed_up: float = DEFAULT_SPEED_UP,
+    run: int = 0,
+) -> Iterator[Ros2StandIn]:
+    """``exscec stand-in --ros2``: the scenario's robots as Nav2 robots (``NavigateToPose`` servers,
+    odometry, TF, AMCL's pose, scans, velocity commands, ``/clock``) on the ROS 2 graph of this
+    process's environment (``ROS_DOMAIN_ID``), with ``faults`` as on the command line, simulated
+    time ``speed_up`` times faster than wall time; run ``run`` drives as run ``run`` of ``exscec
+    simulate --seed SEED``.  Up when the block starts, stopped when it ends."""
+    chosen = spec if isinstance(spec, Scenario) else spec.scenario(scenario)
+    parsed = tuple(Fault.parse(f) for f in faults)
+    with Ros2StandIn(chosen, seed=seed, faults=parsed, speed_up=speed_up, run=run) as running:
+        yield running
+        running.check()

@@ -1,7 +1,8 @@
-"""``exscec stand-in``: the kinematic executor as live ROS 1 robots, until stopped."""
+"""``exscec stand-in``: the kinematic executor as live ROS 1 or ROS 2 robots, until stopped."""
 
 from __future__ import annotations
 
+import os
 import signal
 from types import FrameType
 
@@ -12,7 +13,12 @@ from exsce_dsl.cli.common import exit_status, reports_errors
 
 @click.command("stand-in", epilog=exit_status(passed="stopped with Ctrl-C or SIGTERM"))
 @click.argument("spec", type=click.Path(dir_okay=False))
-@click.option("--ros1", is_flag=True, help="On a ROS 1 graph (the only one the stand-in plays on yet).")
+@click.option("--ros1", is_flag=True, help="On a ROS 1 graph, as move_base robots.")
+@click.option(
+    "--ros2",
+    is_flag=True,
+    help="On the ROS 2 graph of $ROS_DOMAIN_ID, as Nav2 robots (needs ROS 2: sh scripts/install-ros2).",
+)
 @click.option("--scenario", "scenario_id", help="Which scenario, when the file declares several.")
 @click.option("--seed", default=0, show_default=True, type=int, help="Seeds the speeds, drift and noise.")
 @click.option(
@@ -35,19 +41,20 @@ from exsce_dsl.cli.common import exit_status, reports_errors
 @click.option(
     "--start-master",
     is_flag=True,
-    help="Start a roscore of its own on a free port (printed first), stopped at the end; "
-    "else the one at $ROS_MASTER_URI.",
+    help="With --ros1: start a roscore of its own on a free port (printed first), stopped at the "
+    "end; else the one at $ROS_MASTER_URI.",
 )
 @click.option(
     "--log-dir",
     type=click.Path(file_okay=False),
-    help="Folder for the node's log (and the roscore's) [default: a new temporary folder, removed "
-    "when the stand-in stops cleanly].",
+    help="With --ros1: folder for the node's log (and the roscore's) [default: a new temporary "
+    "folder, removed when the stand-in stops cleanly].",
 )
 @reports_errors
 def stand_in(
     spec: str,
     ros1: bool,
+    ros2: bool,
     scenario_id: str | None,
     seed: int,
     faults: tuple[str, ...],
@@ -55,7 +62,7 @@ def stand_in(
     start_master: bool,
     log_dir: str | None,
 ) -> None:
-    """Play a scenario's robots on a live ROS 1 graph, as move_base robots.
+    """Play a scenario's robots on a live ROS 1 or ROS 2 graph, as move_base or Nav2 robots.
 
     Per robot namespace: a move_base_msgs/MoveBaseAction server on
     move_base (a goal is planned on the environment's occupancy grid from
@@ -72,17 +79,30 @@ def stand_in(
     The first line on stdout is ROS_MASTER_URI=URI; it runs until Ctrl-C
     or SIGTERM.  Drive it with any actionlib client, or exscec execute.
 
+    With --ros2 the robots are Nav2's: per namespace a
+    nav2_msgs/action/NavigateToPose server on navigate_to_pose (feedback
+    with current_pose and distance_remaining; a new goal preempts the
+    active one, which aborts; a cancel stops the robot), odom, tf,
+    tf_static (transient local), amcl_pose, scan and cmd_vel (Twist), and
+    /clock for the graph: start the nodes that use it with use_sim_time.
+    The first line on stdout is ROS_DOMAIN_ID=N, the domain of the
+    environment (0 when unset).  Drive it with any rclpy or rclcpp action
+    client, or exscec execute --ros2.
+
     \b
     Example:
       exscec stand-in examples/brsu_building_c/scenario_c.exsce --ros1 --start-master
       exscec stand-in examples/brsu_building_c/scenario_c.exsce --ros1 --start-master \\
           --fault overspeed:tiago1 --speed-up 5   # slower: a busy machine's recorder keeps up
+      exscec stand-in examples/brsu_building_c/scenario_c.exsce --ros2 --fault overspeed:tiago1
     """
     from exsce_dsl.api import load
     from exsce_dsl.api import stand_in as play
 
-    if not ros1:
-        raise click.UsageError("say --ros1: the stand-in plays on ROS 1 only (yet)")
+    if ros1 == ros2:
+        raise click.UsageError("say --ros1 or --ros2: the graph the stand-in plays on")
+    if ros2 and (start_master or log_dir is not None):
+        raise click.UsageError("--start-master and --log-dir go with --ros1")
     loaded = load(spec)
 
     def terminated(signum: int, frame: FrameType | None) -> None:
@@ -90,6 +110,9 @@ def stand_in(
 
     previous = signal.signal(signal.SIGTERM, terminated)
     try:
+        if ros2:
+            _play_ros2(loaded, scenario_id, seed, faults, speed_up)
+            return
         with play(
             loaded, scenario=scenario_id, start_master=start_master, seed=seed, faults=faults,
             speed_up=speed_up, log_dir=log_dir,
@@ -103,6 +126,21 @@ def stand_in(
                 click.echo("stand-in: stopping", err=True)
     finally:
         signal.signal(signal.SIGTERM, previous)
+
+
+def _play_ros2(loaded: object, scenario_id: str | None, seed: int, faults: tuple[str, ...], speed_up: float) -> None:
+    from exsce_dsl.api import stand_in_ros2
+
+    with stand_in_ros2(
+        loaded, scenario=scenario_id, seed=seed, faults=faults, speed_up=speed_up  # type: ignore[arg-type]
+    ) as running:
+        click.echo(f"ROS_DOMAIN_ID={os.environ.get('ROS_DOMAIN_ID') or 0}")
+        servers = ", ".join(f"{robot} ({action})" for robot, action in running.actions.items())
+        click.echo(f"stand-in: {servers} at {speed_up:g}x wall time; Ctrl-C to stop", err=True)
+        try:
+            running.wait()
+        except KeyboardInterrupt:
+            click.echo("stand-in: stopping", err=True)
 
 
 COMMANDS = [stand_in]

@@ -110,9 +110,9 @@ class StandInLeg:
             previous,
         )
 
-    def command(self) -> dict[str, Any]:
-        """The node's ``leg`` command: the arrays base64-encoded, little-endian."""
-        values = np.column_stack(
+    def rows(self) -> np.ndarray:
+        """One row of :data:`FIELDS` values per sample (little-endian float64)."""
+        return np.column_stack(
             [
                 *(getattr(self.odom, a) for a in ("x", "y", "yaw")),
                 *(getattr(self.estimate, a) for a in ("x", "y", "yaw")),
@@ -123,6 +123,10 @@ class StandInLeg:
                 self.command_w,
             ]
         ).astype("<f8")
+
+    def command(self) -> dict[str, Any]:
+        """The ROS 1 node's ``leg`` command: the arrays base64-encoded, little-endian."""
+        values = self.rows()
         return {
             "command": "leg",
             "robot": self.robot,
