@@ -4,7 +4,8 @@ ROS 2 teams run scenarios with scenario_execution (OpenSCENARIO DSL 2 and py_tre
 the mission in its terms, with the actions of its ``osc.ros`` and ``osc.nav2`` libraries:
 
 - each robot an actor of type ``differential_drive_robot``, named by its namespace (by its id
-  when its topics are at the root), whose ``namespace`` field is the robot's;
+  when its topics are at the root or its namespace is no OSC2 name), whose ``namespace`` field is
+  the robot's;
 - ``bag_record`` of the topics a run's metrics read (:func:`~exsce_dsl.execute.recording.
   recorded_topics`, for robots whose type names no convention: Nav2's), first, so that the
   mission starts only once every one of them is recorded; exsce's PROV topic is left out, as no
@@ -17,8 +18,9 @@ the mission in its terms, with the actions of its ``osc.ros`` and ``osc.nav2`` l
   speed), and the scenario's, the longest lane's sum plus :data:`STARTUP`;
 - a comment block naming the acceptance clauses that judge the bag, and the exsce commands.
 
-A spec is data: ids and namespaces become OSC2 names only when they are OSC2 identifiers (else a
-located :class:`~exsce_dsl.errors.ExportError`); every other text is an escaped string literal or
+A spec is data: ids and namespaces become OSC2 names only when they are OSC2 identifiers (a
+scenario id or a robot id needed as a name that is not one is a located
+:class:`~exsce_dsl.errors.ExportError`); every other text is an escaped string literal or
 a one-line comment (:mod:`exsce_dsl.templating`).
 """
 
@@ -26,6 +28,7 @@ from __future__ import annotations
 
 import math
 import re
+import shlex
 from dataclasses import dataclass
 from decimal import Decimal
 from pathlib import Path
@@ -104,12 +107,18 @@ class Osc2Scenario:
     timeout: float
     oracles: tuple[str, ...]
     source: str
+    """The spec file, as its name is shown."""
+
+    @property
+    def source_argument(self) -> str:
+        """The spec file as a shell word, for the commands the comments show."""
+        return shlex.quote(self.source)
 
 
 def osc2_name(name: str, what: str, location: SourceLocation | None) -> str:
     """``name`` if it can name ``what`` in OSC2: an identifier that is no keyword nor a library
     name the export uses; a located :class:`ExportError` otherwise (never rewritten)."""
-    if not _IDENTIFIER.fullmatch(name) or name in OSC2_KEYWORDS or name in USED_NAMES:
+    if not _is_osc2_name(name):
         raise ExportError(
             f"{what} {name!r} cannot name it in OSC2: it must be an identifier (a letter or '_', "
             "then letters, digits or '_') that is not an OSC2 keyword (units such as 'm' and 's' "
@@ -181,12 +190,16 @@ def export_osc2(spec: Specification, out: Path, scenario_id: str | None = None) 
 
 
 def _actor(robot: str, namespace: str, start: Pose | None, location: SourceLocation | None) -> Actor:
+    """The robot's actor: named by its namespace, or by its id when the namespace is the root or
+    no OSC2 name (``/fleet/tiago1``); its ``namespace`` field says the namespace in either case."""
     bare = namespace.strip("/")
-    if bare:
-        name = osc2_name(bare, f"namespace of robot '{robot}'", location)
-    else:
-        name = osc2_name(robot, "robot id (its topics are at the root)", location)
-    return Actor(name, namespace, robot, start)
+    if bare and _is_osc2_name(bare):
+        return Actor(bare, namespace, robot, start)
+    return Actor(osc2_name(robot, "robot id", location), namespace, robot, start)
+
+
+def _is_osc2_name(name: str) -> bool:
+    return bool(_IDENTIFIER.fullmatch(name)) and name not in OSC2_KEYWORDS and name not in USED_NAMES
 
 
 def _steps(lane: tuple[Goal, ...], actor_of: dict[str, str]) -> tuple[Step, ...]:
