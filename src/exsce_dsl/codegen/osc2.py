@@ -115,14 +115,14 @@ class Osc2Scenario:
         return shlex.quote(self.source)
 
 
-def osc2_name(name: str, what: str, location: SourceLocation | None) -> str:
-    """``name`` if it can name ``what`` in OSC2: an identifier that is no keyword nor a library
+def osc2_name(name: str, what: str, location: SourceLocation | None, remedy: str = "") -> str:
+    """``name`` if it can be ``what``'s name in OSC2: an identifier that is no keyword nor a library
     name the export uses; a located :class:`ExportError` otherwise (never rewritten)."""
     if not _is_osc2_name(name):
         raise ExportError(
-            f"{what} {name!r} cannot name it in OSC2: it must be an identifier (a letter or '_', "
+            f"{what} {name!r} is no OSC2 name: an OSC2 name is an identifier (a letter or '_', "
             "then letters, digits or '_') that is not an OSC2 keyword (units such as 'm' and 's' "
-            f"are) nor one of {', '.join(sorted(USED_NAMES))}",
+            f"are) nor one of {', '.join(sorted(USED_NAMES))}{remedy}",
             location,
         )
     return name
@@ -195,7 +195,8 @@ def _actor(robot: str, namespace: str, start: Pose | None, location: SourceLocat
     bare = namespace.strip("/")
     if bare and _is_osc2_name(bare):
         return Actor(bare, namespace, robot, start)
-    return Actor(osc2_name(robot, "robot id", location), namespace, robot, start)
+    remedy = "; a robot's actor is named by its namespace, else by its id: give it a namespace that is one"
+    return Actor(osc2_name(robot, "robot id", location, remedy), namespace, robot, start)
 
 
 def _is_osc2_name(name: str) -> bool:
