@@ -41,7 +41,7 @@ def _code(text: str) -> list[str]:
 def _actors(lines: list[str]) -> dict[str, str]:
     """Actor name -> the namespace its ``keep`` says."""
     found = {}
-    for line, after in zip(lines, lines[1:]):
+    for line, after in zip(lines, lines[1:], strict=False):
         if m := re.fullmatch(r" {4}(\w+): differential_drive_robot with:", line):
             namespace = re.fullmatch(r" {8}keep\(it\.namespace == (\".*\")\)", after)
             assert namespace, after
@@ -114,9 +114,10 @@ def test_scenario_c_says_the_spec(tmp_path: Path) -> None:
     assert [s.split(".")[0].strip() for s in starts] == ["tiago1", "tiago2"]
     assert "44.80387496948242m, y: 37.15502166748047m" in starts[0]  # classroom_c025-w001
     scenario_timeout = _TIMEOUT.search(lines[lines.index("scenario scenario_c:") + 1])
-    assert scenario_timeout and float(scenario_timeout["seconds"]) == max(
-        sum(a[3] for a in lane) for lane in lanes
-    ) + STARTUP
+    assert (
+        scenario_timeout
+        and float(scenario_timeout["seconds"]) == max(sum(a[3] for a in lane) for lane in lanes) + STARTUP
+    )
     acceptance = spec.acceptance_of("scenario_c")
     assert acceptance is not None
     for criterion in acceptance.criteria:
@@ -173,13 +174,17 @@ def test_name_that_osc2_cannot_take_is_refused_where_written(
     assert exscec_here("check", str(spec)).returncode == 0  # a valid exsce spec
     done = exscec_here("export", str(spec), "--to", "osc2", "-o", str(tmp_path / "out"))
     assert done.returncode == 2, done.stdout + done.stderr
-    assert re.search(rf"names\.exsce:{_line_of(spec, where)}:\d+: .*{re.escape(said)}", done.stderr), done.stderr
+    assert re.search(rf"names\.exsce:{_line_of(spec, where)}:\d+: .*{re.escape(said)}", done.stderr), (
+        done.stderr
+    )
     assert "Traceback" not in done.stderr
     assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())
 
 
 def test_namespace_that_is_no_osc2_name_names_the_actor_by_robot_id(tmp_path: Path) -> None:
-    spec = _hostile(tmp_path, **{'namespace "r1"': 'namespace "fleet/r1"', "r2: rover": 'r2: rover namespace "s"'})
+    spec = _hostile(
+        tmp_path, **{'namespace "r1"': 'namespace "fleet/r1"', "r2: rover": 'r2: rover namespace "s"'}
+    )
     actors = _actors(_code(_export(spec, tmp_path)))
     assert actors == {"r1": "fleet/r1", "r2": "s"}  # 's' (seconds) is an OSC2 keyword
 

@@ -226,6 +226,7 @@ def _oracles(spec: Specification, scenario: Scenario) -> tuple[str, ...]:
         return ()
     clauses = []
     for criterion in acceptance.criteria:
-        when = f" when {criterion.when.text()}" if criterion.when is not None and not criterion.when.mission else ""
+        part = criterion.when is not None and not criterion.when.mission
+        when = f" when {criterion.when.text()}" if part and criterion.when is not None else ""
         clauses += [f'"{criterion.title}"{when}: {expectation_text(e)}' for e in criterion.expectations]
     return tuple(clauses)
