@@ -35,8 +35,7 @@ from pathlib import Path
 
 from exsce_dsl.codegen.output import write_files
 from exsce_dsl.errors import ExportError, SourceLocation
-from exsce_dsl.execute.mission import Goal, schedule
-from exsce_dsl.execute.recording import recorded_topics
+from exsce_dsl.execute import Goal, recorded_topics, schedule
 from exsce_dsl.lang import display_path, expectation_text
 from exsce_dsl.model import MissionType, Pose, Scenario, Specification
 from exsce_dsl.runs import PROV_TOPIC
