@@ -69,42 +69,52 @@ USED_NAMES = frozenset(
 """The library names the exported text uses, which a robot's actor may not hide."""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Actor:
     """A robot as an OSC2 actor."""
 
     name: str
     namespace: str
+    """The robot's, as the spec writes it (``""``: the root)."""
     robot: str
     start: Pose | None
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Step:
     """One allocation entry: a robot visits its task's waypoints with one navigation action."""
 
     actor: str
+    """The name of the actor of the robot."""
     task: str
     poses: tuple[Pose, ...]
+    """The task's waypoints, its subtasks one after the other."""
     timeout: float
+    """Seconds: the sum of its goals' timeouts, rounded up."""
 
     @property
     def action(self) -> str:
         return "follow_waypoints" if len(self.poses) > 1 else "nav_to_pose"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Osc2Scenario:
     """What the OSC2 file says, before it is written."""
 
     name: str
+    """The scenario's id, which names the OSC2 scenario."""
     mission: str
     parallel: bool
+    """A ``parallel`` mission (one lane per robot), else ``sequential`` (one lane)."""
     actors: tuple[Actor, ...]
     lanes: tuple[tuple[Step, ...], ...]
+    """What runs side by side; each lane's steps one after the other."""
     topics: tuple[str, ...]
+    """What ``bag_record`` records: absolute names, sorted."""
     timeout: float
+    """Seconds the whole scenario may take."""
     oracles: tuple[str, ...]
+    """The acceptance clauses that judge its bag, worded as the DSL words them."""
     source: str
     """The spec file, as its name is shown."""
 
