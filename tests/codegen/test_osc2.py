@@ -189,6 +189,15 @@ def test_namespace_that_is_no_osc2_name_names_the_actor_by_robot_id(tmp_path: Pa
     assert actors == {"r1": "fleet/r1", "r2": "s"}  # 's' (seconds) is an OSC2 keyword
 
 
+def test_robot_without_start_pose_is_not_started(tmp_path: Path) -> None:
+    """As in exsce's runs, a robot with no start pose (and so no task) takes no part."""
+    spec = _hostile(tmp_path, **{"r2: rover starts at yard-d": "r2: rover", "    r2 does round_2\n": ""})
+    lines = _code(_export(spec, tmp_path))
+    assert set(_actors(lines)) == {"r1", "r2"}
+    assert [line.split(".")[0].strip() for line in lines if ".init_nav2(" in line] == ["r1"]
+    assert _mission(lines)[1] == [[("r1", "nav_to_pose", 1, 60.0)]]
+
+
 def test_export_to_a_file_or_a_folder(tmp_path: Path) -> None:
     to_file = exscec_here("export", str(SCENARIO_C), "--to", "osc2", "-o", str(tmp_path / "c.osc"))
     assert to_file.returncode == 0, to_file.stderr

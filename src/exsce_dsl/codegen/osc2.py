@@ -10,12 +10,14 @@ the mission in its terms, with the actions of its ``osc.ros`` and ``osc.nav2`` l
   recorded_topics`, for robots whose type names no convention: Nav2's), first, so that the
   mission starts only once every one of them is recorded; exsce's PROV topic is left out, as no
   exsce dispatcher runs;
-- ``init_nav2`` of every robot at its start pose, side by side;
+- ``init_nav2`` of every robot at its start pose, side by side (a robot without one has no task
+  and, as in exsce's runs, takes no part);
 - per allocation entry, ``follow_waypoints`` (several waypoints) or ``nav_to_pose`` (one), in the
   mission's order: a ``parallel`` mission runs one ``serial`` block per robot side by side, a
-  ``sequential`` one a single ``serial`` block; each with a timeout, the sum of its goals' (whole seconds, up)
-  (:func:`~exsce_dsl.execute.mission.schedule`: the task's, the mission's, or one from distance and
-  speed), and the scenario's, the longest lane's sum plus :data:`STARTUP`;
+  ``sequential`` one a single ``serial`` block; each with a timeout, the sum of its goals'
+  (:func:`~exsce_dsl.execute.mission.schedule`: the task's, the mission's, or one from distance
+  and speed) in whole seconds, rounded up, and the scenario's, the longest lane's plus
+  :data:`STARTUP`;
 - a comment block naming the acceptance clauses that judge the bag, and the exsce commands.
 
 A spec is data: ids and namespaces become OSC2 names only when they are OSC2 identifiers (a
@@ -235,7 +237,7 @@ def _oracles(spec: Specification, scenario: Scenario) -> tuple[str, ...]:
         return ()
     clauses = []
     for criterion in acceptance.criteria:
-        part = criterion.when is not None and not criterion.when.mission
-        when = f" when {criterion.when.text()}" if part and criterion.when is not None else ""
-        clauses += [f'"{criterion.title}"{when}: {expectation_text(e)}' for e in criterion.expectations]
+        when = criterion.when
+        part = f" when {when.text()}" if when is not None and not when.mission else ""
+        clauses += [f'"{criterion.title}"{part}: {expectation_text(e)}' for e in criterion.expectations]
     return tuple(clauses)
