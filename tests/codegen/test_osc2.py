@@ -11,7 +11,8 @@ from pathlib import Path
 import pytest
 
 from exsce_dsl.api import export_spec
-from exsce_dsl.codegen.osc2 import STARTUP
+from exsce_dsl.codegen.osc2 import STARTUP, osc2_number
+from exsce_dsl.errors import ExportError
 from exsce_dsl.lang import load_spec
 from exsce_dsl.model import MissionType, Scenario
 
@@ -196,6 +197,36 @@ def test_robot_without_start_pose_is_not_started(tmp_path: Path) -> None:
     assert set(_actors(lines)) == {"r1", "r2"}
     assert [line.split(".")[0].strip() for line in lines if ".init_nav2(" in line] == ["r1"]
     assert _mission(lines)[1] == [[("r1", "nav_to_pose", 1, 60.0)]]
+
+
+def test_two_robots_one_actor_name_is_refused(tmp_path: Path) -> None:
+    """r2's namespace is r1's id, at the root (r1's own namespace is no OSC2 name)."""
+    spec = _hostile(
+        tmp_path, **{'namespace "r1"': 'namespace "fleet/r1"', "r2: rover": 'r2: rover namespace "r1"'}
+    )
+    done = exscec_here("export", str(spec), "--to", "osc2", "-o", str(tmp_path / "out"))
+    assert done.returncode == 2
+    assert f"names.exsce:{_line_of(spec, 'r2: rover')}:" in done.stderr
+    assert "robots 'r1' and 'r2' would both be the OSC2 actor 'r1'" in done.stderr
+
+
+@pytest.mark.parametrize(
+    ("value", "written"),
+    [
+        (1e-05, "0.00001"),
+        (-2.5, "-2.5"),
+        (3.0, "3.0"),
+        (1e20, "100000000000000000000.0"),
+        (0.1 + 0.2, "0.30000000000000004"),
+    ],
+)
+def test_numbers_are_decimal_literals(value: float, written: str) -> None:
+    assert osc2_number(value) == written
+
+
+def test_a_number_that_is_not_finite_is_refused() -> None:
+    with pytest.raises(ExportError, match="not a finite number"):
+        osc2_number(float("nan"))
 
 
 def test_export_to_a_file_or_a_folder(tmp_path: Path) -> None:
