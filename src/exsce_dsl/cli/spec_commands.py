@@ -248,12 +248,13 @@ def export_command(spec: str, target: str, out_dir: str, scenario_id: str | None
     each scenario to Gherkin (<scenario>.feature), or its mission to an OSC2 scenario
     for scenario_execution (<scenario>.osc).
 
-    The OSC2 scenario drives each robot's Nav2 (actor named by its namespace):
-    bag_record of the topics the metrics read, init_nav2 at the start poses, then
-    follow_waypoints or nav_to_pose per task in the mission's order, with the
-    spec's timeouts; its comments name the clauses that judge the bag, and the
-    ingest and verify commands to run on it.  A robot namespace or scenario id
-    that is not an OSC2 identifier is an error.
+    The OSC2 scenario drives each robot's Nav2 (an actor named by its
+    namespace, else by its id): bag_record of the topics the metrics read,
+    init_nav2 at the start poses, then follow_waypoints or nav_to_pose per task
+    in the mission's order, with the spec's timeouts; its comments name the
+    clauses that judge the bag, and the ingest and verify commands to run on
+    it.  A scenario id, or a robot id that must name an actor, that is not an
+    OSC2 identifier is an error.
 
     An oracle file holds numbers: a clause that expects the mean of stored runs
     (no 'around' or 'from' value) cannot be written without a baseline, nor can
