@@ -3,10 +3,10 @@
 It sits beside :mod:`exsce_dsl.resources` because two layers render templates:
 ``runs`` (the monitors that ingestion runs) and ``codegen`` (files for users).
 
-Generated code is Python and YAML (and, in the ROS packages, XML, CMake and
+Generated code is Python, YAML and OSC2 (and, in the ROS packages, XML, CMake and
 Markdown).  Nothing from a user's file is pasted into it raw: identifiers go
 through :func:`python_name` (checked, never rewritten), strings through
-:func:`python_string` or :func:`yaml_string` (quoted by the target's own
+:func:`python_string`, :func:`yaml_string` or :func:`osc2_string` (quoted by the target's own
 rules), and numbers through :func:`python_number` or :func:`yaml_number`.
 Text that only informs a reader (comments) goes through :func:`comment_text`,
 which leaves it on one line, and then through :func:`xml_comment_text`,
@@ -102,6 +102,13 @@ def markdown_text(text: str) -> str:
     return escape(comment_text(text))
 
 
+def osc2_string(text: str) -> str:
+    """An OSC2 string literal of ``text`` (scenario_execution reads a literal's body with Python's
+    ``unicode_escape``), on one line and in ASCII: :func:`_double_quoted`, and ``'`` escaped too,
+    which OSC2's lexer does not take bare inside a string."""
+    return _double_quoted(text).replace("'", "\\'")
+
+
 def python_number(value: float | int) -> str:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise GenerationError(f"{value!r} is not a number")
@@ -153,6 +160,7 @@ def environment() -> jinja2.Environment:
         yamlstr=yaml_string,
         pynum=python_number,
         yamlnum=yaml_number,
+        oscstr=osc2_string,
         unwrap=unwrap,
         comment=comment_text,
         docstring=docstring_text,

@@ -93,19 +93,23 @@ def import_oracle_file(
     return write_documents([document], Path(out_dir), overwrite=force)
 
 
-EXPORTS = ("yaml", "oracle-yaml", "gherkin")
-"""What :func:`export_spec` writes: the method's scenario and task files, its oracle file, or
-Gherkin features."""
+EXPORTS = ("yaml", "oracle-yaml", "gherkin", "osc2")
+"""What :func:`export_spec` writes: the method's scenario and task files, its oracle file,
+Gherkin features, or an OSC2 scenario for scenario_execution."""
 
 
 def export_spec(
     spec: str | Path, target: str, out_dir: str | Path, scenario: str | None = None
 ) -> list[Path]:
     """``exscec export --to TARGET``: a scenario of ``spec`` as one of :data:`EXPORTS`, in
-    ``out_dir``; the files written."""
+    ``out_dir`` (for ``osc2``, a ``.osc`` file may be named instead); the files written."""
     from exsce_dsl.lang import export_gherkin, export_oracle_file, export_yaml, load_spec
 
     loaded = load_spec(spec)
+    if target == "osc2":
+        from exsce_dsl.codegen.osc2 import export_osc2
+
+        return export_osc2(loaded, Path(out_dir), scenario)
     if target == "gherkin":
         return export_gherkin(loaded, Path(out_dir), scenario)
     if target == "oracle-yaml":

@@ -225,26 +225,36 @@ def _import_oracles(yaml_file: Path, spec_path: str | None, out_dir: str, force:
 @click.option(
     "--to",
     "target",
-    type=click.Choice(["yaml", "oracle-yaml", "gherkin"]),
+    type=click.Choice(["yaml", "oracle-yaml", "gherkin", "osc2"]),
     default="yaml",
     show_default=True,
-    help="The format to write: the method's scenario and task files, its oracle file, or Gherkin features.",
+    help="The format to write: the method's scenario and task files, its oracle file, Gherkin "
+    "features, or a scenario_execution OSC2 scenario.",
 )
 @click.option(
     "-o",
     "--output",
     "out_dir",
-    type=click.Path(file_okay=False),
+    type=click.Path(),
     default=".",
     show_default=True,
-    help="Folder to write to.",
+    help="Folder to write to (with --to osc2, a .osc file may be named instead).",
 )
 @click.option("--scenario", "scenario_id", help="Which scenario, when the file declares several.")
 @reports_errors
 def export_command(spec: str, target: str, out_dir: str, scenario_id: str | None) -> None:
     """Export a scenario to the method's YAML scenario and task files, its acceptance
-    criteria to the method's oracle file (oracles/<scenario>.yaml), or the criteria of
-    each scenario to Gherkin (<scenario>.feature).
+    criteria to the method's oracle file (oracles/<scenario>.yaml), the criteria of
+    each scenario to Gherkin (<scenario>.feature), or its mission to an OSC2 scenario
+    for scenario_execution (<scenario>.osc).
+
+    The OSC2 scenario drives each robot's Nav2 (an actor named by its
+    namespace, else by its id): bag_record of the topics the metrics read,
+    init_nav2 at the start poses, then follow_waypoints or nav_to_pose per task
+    in the mission's order, with the spec's timeouts; its comments name the
+    clauses that judge the bag, and the ingest and verify commands to run on
+    it.  A scenario id, or a robot id that must name an actor, that is not an
+    OSC2 identifier is an error.
 
     An oracle file holds numbers: a clause that expects the mean of stored runs
     (no 'around' or 'from' value) cannot be written without a baseline, nor can
@@ -256,8 +266,12 @@ def export_command(spec: str, target: str, out_dir: str, scenario_id: str | None
       exscec export examples/brsu_building_c/scenario_c.exsce --to yaml -o out/
       exscec export examples/brsu_building_c/scenario_c.exsce --to gherkin -o features/
       exscec export examples/brsu_building_c/scenario_c.exsce --to oracle-yaml -o out/  # exits 2
+      exscec export examples/brsu_building_c/scenario_c.exsce --to osc2 -o scenario_c.osc
     """
     from exsce_dsl.api import export_spec
+
+    if target != "osc2" and Path(out_dir).is_file():
+        raise click.BadParameter(f"{out_dir} is a file; --to {target} writes to a folder", param_hint="-o")
 
     written = export_spec(spec, target, out_dir, scenario_id)
     for path in written:

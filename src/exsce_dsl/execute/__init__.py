@@ -20,7 +20,9 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    from exsce_dsl.execute.mission import Goal, schedule
     from exsce_dsl.execute.outcomes import DEFAULT_POLICY, Policy
+    from exsce_dsl.execute.recording import recorded_topics
     from exsce_dsl.execute.ros1.graph import master_uri, start_master
     from exsce_dsl.execute.ros1.session import (
         DEFAULT_SERVER_TIMEOUT,
