@@ -8,8 +8,7 @@ from collections.abc import Iterator, Sequence
 from contextlib import ExitStack, contextmanager
 from pathlib import Path
 
-from exsce_dsl.execute import DEFAULT_SPEED_UP, StandIn, start_stand_in
-from exsce_dsl.execute.ros2.stand_in import Ros2StandIn
+from exsce_dsl.execute import DEFAULT_SPEED_UP, Ros2StandIn, StandIn, start_stand_in
 from exsce_dsl.execute import master_uri as environment_master_uri
 from exsce_dsl.execute import start_master as start_roscore
 from exsce_dsl.model import Scenario

@@ -5,10 +5,14 @@ from __future__ import annotations
 import os
 import signal
 from types import FrameType
+from typing import TYPE_CHECKING
 
 import click
 
 from exsce_dsl.cli.common import exit_status, reports_errors
+
+if TYPE_CHECKING:
+    from exsce_dsl.model.document import Specification
 
 
 @click.command("stand-in", epilog=exit_status(passed="stopped with Ctrl-C or SIGTERM"))
@@ -128,12 +132,12 @@ def stand_in(
         signal.signal(signal.SIGTERM, previous)
 
 
-def _play_ros2(loaded: object, scenario_id: str | None, seed: int, faults: tuple[str, ...], speed_up: float) -> None:
+def _play_ros2(
+    loaded: Specification, scenario_id: str | None, seed: int, faults: tuple[str, ...], speed_up: float
+) -> None:
     from exsce_dsl.api import stand_in_ros2
 
-    with stand_in_ros2(
-        loaded, scenario=scenario_id, seed=seed, faults=faults, speed_up=speed_up  # type: ignore[arg-type]
-    ) as running:
+    with stand_in_ros2(loaded, scenario=scenario_id, seed=seed, faults=faults, speed_up=speed_up) as running:
         click.echo(f"ROS_DOMAIN_ID={os.environ.get('ROS_DOMAIN_ID') or 0}")
         servers = ", ".join(f"{robot} ({action})" for robot, action in running.actions.items())
         click.echo(f"stand-in: {servers} at {speed_up:g}x wall time; Ctrl-C to stop", err=True)

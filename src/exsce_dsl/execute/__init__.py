@@ -11,7 +11,8 @@ a kinematic navigator on a simulated clock (``tests/support/kinematic_navigator.
 Adapters: :mod:`.ros1` (rospy's Python runs exsce's nodes — the dispatcher's actionlib clients
 for move_base and the stand-in robot — and this process talks to them and to the master; the
 real ``rosbag record``; tested on a real roscore) and :mod:`.ros2` (rclpy and Nav2, imported only
-where rclpy exists; not run on a live ROS 2 graph in exsce's CI).
+where rclpy exists: the dispatcher's Nav2 action clients and the stand-in's Nav2 robots; tested on
+a live ROS 2 graph of PyPI's Jazzy wheels, ``scripts/install-ros2``).
 """
 
 # mypy: implicit-reexport
@@ -32,6 +33,7 @@ if TYPE_CHECKING:
         Options,
         execute_runs,
     )
+    from exsce_dsl.execute.ros2.stand_in import Ros2StandIn
     from exsce_dsl.execute.stand_in import StandIn, start_stand_in
     from exsce_dsl.execute.stand_in.session import DEFAULT_SPEED_UP
 else:

@@ -24,11 +24,14 @@ from exsce_dsl.sim.laser import SCAN_EVERY, Laser
 DT_NS = 20_000_000
 """The 50 Hz sample clock."""
 STATIC_EVERY, CORRECTION_EVERY, AMCL_EVERY, FEEDBACK_EVERY = 50, 5, 25, 10
-"""Samples between two: ``tf_static`` (1 Hz), ``map → odom`` (10 Hz), ``amcl_pose`` (2 Hz), feedback (5 Hz)."""
+"""Samples between two: ``tf_static`` (1 Hz), ``map → odom`` (10 Hz), ``amcl_pose`` (2 Hz),
+feedback (5 Hz)."""
 CMD_VEL_PERIOD_NS = 50_000_000
 """20 Hz."""
 LOCALISATION_NOISE, LOCALISATION_YAW_NOISE = 0.02, 0.01
 FOOTPRINT_HEIGHT, LASER_HEIGHT = 0.1, 0.2
+Row = Sequence[float] | np.ndarray
+"""A sample's values (see the module's docstring)."""
 TOPICS = ("odom", "tf", "tf_static", "amcl_pose", "cmd_vel", "scan")
 
 
@@ -40,7 +43,9 @@ def diagonal(values: Sequence[float]) -> list[float]:
 
 
 ODOM_COVARIANCE = diagonal([1e-3, 1e-3, 1e6, 1e6, 1e6, 1e-3])
-AMCL_COVARIANCE = diagonal([LOCALISATION_NOISE**2, LOCALISATION_NOISE**2, 0.0, 0.0, 0.0, LOCALISATION_YAW_NOISE**2])
+AMCL_COVARIANCE = diagonal(
+    [LOCALISATION_NOISE**2, LOCALISATION_NOISE**2, 0.0, 0.0, 0.0, LOCALISATION_YAW_NOISE**2]
+)
 
 
 class RobotMessages:
@@ -55,7 +60,7 @@ class RobotMessages:
     def clock(self, ns: int) -> Any:
         return self.msgs["rosgraph_msgs"].Clock(clock=self.stamp(ns))
 
-    def sample(self, n: int, t: int, v: Sequence[float], scan: np.ndarray | None) -> list[tuple[str, Any]]:
+    def sample(self, n: int, t: int, v: Row, scan: np.ndarray | None) -> list[tuple[str, Any]]:
         """The messages of global sample ``n`` at ``t`` ns: (topic's last level, message)."""
         stamp = self.stamp(t)
         out: list[tuple[str, Any]] = []
@@ -77,7 +82,7 @@ class RobotMessages:
             out.append(("scan", self.scan(stamp, scan)))
         return out
 
-    def odometry(self, stamp: Any, v: Sequence[float]) -> Any:
+    def odometry(self, stamp: Any, v: Row) -> Any:
         odom = self.msgs["nav_msgs"].Odometry()
         odom.header.stamp, odom.header.frame_id, odom.child_frame_id = stamp, "odom", "base_link"
         odom.pose.pose.position.x, odom.pose.pose.position.y = float(v[0]), float(v[1])
@@ -87,7 +92,7 @@ class RobotMessages:
         odom.twist.covariance = ODOM_COVARIANCE
         return odom
 
-    def amcl(self, stamp: Any, v: Sequence[float]) -> Any:
+    def amcl(self, stamp: Any, v: Row) -> Any:
         amcl = self.msgs["geometry_msgs"].PoseWithCovarianceStamped()
         amcl.header.stamp, amcl.header.frame_id = stamp, "map"
         amcl.pose.pose.position.x, amcl.pose.pose.position.y = float(v[3]), float(v[4])
@@ -95,7 +100,7 @@ class RobotMessages:
         amcl.pose.covariance = AMCL_COVARIANCE
         return amcl
 
-    def where(self, stamp: Any, v: Sequence[float]) -> Any:
+    def where(self, stamp: Any, v: Row) -> Any:
         """The robot's estimated pose in the map (Nav2's feedback ``current_pose``)."""
         pose = self.msgs["geometry_msgs"].PoseStamped()
         pose.header.stamp, pose.header.frame_id = stamp, "map"
@@ -126,7 +131,9 @@ class RobotMessages:
             ]
         )
 
-    def transform(self, stamp: Any, parent: str, child: str, x: float, y: float, yaw: float, z: float = 0.0) -> Any:
+    def transform(
+        self, stamp: Any, parent: str, child: str, x: float, y: float, yaw: float, z: float = 0.0
+    ) -> Any:
         moved = self.msgs["geometry_msgs"].TransformStamped()
         moved.header.stamp, moved.header.frame_id, moved.child_frame_id = stamp, parent, child
         moved.transform.translation.x, moved.transform.translation.y = float(x), float(y)

@@ -42,7 +42,14 @@ from exsce_dsl.sim.faults import Fault
 from exsce_dsl.sim.laser import SCAN_EVERY
 
 NODE = "exsce_stand_in"
-MESSAGE_PACKAGES = ("builtin_interfaces", "rosgraph_msgs", "nav_msgs", "geometry_msgs", "sensor_msgs", "tf2_msgs")
+MESSAGE_PACKAGES = (
+    "builtin_interfaces",
+    "rosgraph_msgs",
+    "nav_msgs",
+    "geometry_msgs",
+    "sensor_msgs",
+    "tf2_msgs",
+)
 TICK = 0.01
 """Wall seconds between two publishing rounds."""
 MAX_LAG_NS = 200_000_000
@@ -94,7 +101,9 @@ class Ros2StandIn:
             raise ExsceError(f"the stand-in's speed-up must be above 0, not {speed_up:g}")
         self.scenario, self.speed_up = scenario, speed_up
         self.fleet = Fleet(scenario, planning_grid(scenario), seed, tuple(faults), run=run)
-        self.actions = {r.id: nav2_actions(r).navigate_to_pose for r in scenario.robots if r.id in self.fleet.robots}
+        self.actions = {
+            r.id: nav2_actions(r).navigate_to_pose for r in scenario.robots if r.id in self.fleet.robots
+        }
         self.lock = threading.RLock()
         self.planning = threading.Lock()
         self.robots: dict[str, PlayedRobot] = {}
@@ -132,7 +141,9 @@ class Ros2StandIn:
         rclpy.init(context=self._context, signal_handler_options=_no_signal_handlers(rclpy))
         self.node = rclpy.create_node(NODE, context=self._context)
         self._create_endpoints(modules, msgs)
-        executor = modules.executors.MultiThreadedExecutor(num_threads=2 + len(self.robots), context=self._context)
+        executor = modules.executors.MultiThreadedExecutor(
+            num_threads=2 + len(self.robots), context=self._context
+        )
         executor.add_node(self.node)
         self._executor = executor
         self.start_ns = int(time.time()) * 1_000_000_000
@@ -169,7 +180,9 @@ class Ros2StandIn:
     def _create_endpoints(self, modules: Ros2Modules, msgs: dict[str, ModuleType]) -> None:
         qos = importlib.import_module("rclpy.qos")
         latched = qos.QoSProfile(
-            depth=1, reliability=qos.ReliabilityPolicy.RELIABLE, durability=qos.DurabilityPolicy.TRANSIENT_LOCAL
+            depth=1,
+            reliability=qos.ReliabilityPolicy.RELIABLE,
+            durability=qos.DurabilityPolicy.TRANSIENT_LOCAL,
         )
         types = {
             "odom": msgs["nav_msgs"].Odometry,
@@ -259,7 +272,9 @@ class Ros2StandIn:
         with self.lock:
             if robot.handle is handle:
                 robot.leg, robot.rows, robot.start = leg, leg.rows(), self.published + 1
-                steps = np.hypot(np.diff(leg.truth.x, prepend=leg.truth.x[0]), np.diff(leg.truth.y, prepend=leg.truth.y[0]))
+                steps = np.hypot(
+                    np.diff(leg.truth.x, prepend=leg.truth.x[0]), np.diff(leg.truth.y, prepend=leg.truth.y[0])
+                )
                 robot.remaining = np.cumsum(steps[::-1])[::-1] - steps
             robot.planning = False
         return self._await_end(robot, handle, goal)
@@ -369,6 +384,13 @@ class Ros2StandIn:
         feedback.distance_remaining = remaining
         feedback.navigation_time.sec, feedback.navigation_time.nanosec = divmod(k * DT_NS, 1_000_000_000)
         robot.handle.publish_feedback(feedback)
+
+
+def _distance_left(leg: StandInLeg) -> np.ndarray:
+    """Metres the leg's path goes on after each of its samples."""
+    x, y = leg.truth.x, leg.truth.y
+    steps = np.hypot(np.diff(x, prepend=x[0]), np.diff(y, prepend=y[0]))
+    return np.asarray(np.cumsum(steps[::-1])[::-1] - steps)
 
 
 def _standing(row: np.ndarray) -> np.ndarray:

@@ -1,0 +1,156 @@
+"""``exscec stand-in --ros2`` on a live ROS 2 graph: a process of its own serving Nav2 goals, driven
+by an rclpy action client in the test's process (a domain of the test's own)."""
+
+from __future__ import annotations
+
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from tests.support.paths import EXAMPLES
+
+SCENARIO_C = EXAMPLES / "brsu_building_c" / "scenario_c.exsce"
+GOAL_WAIT = 120.0
+
+
+@contextmanager
+def stand_in(*options: str) -> Iterator[subprocess.Popen[str]]:
+    """``exscec stand-in scenario_c --ros2 OPTIONS`` until the block ends (SIGTERM: exit 0)."""
+    process = subprocess.Popen(
+        [str(Path(sys.executable).with_name("exscec")), "stand-in", str(SCENARIO_C), "--ros2", *options],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
+    try:
+        assert process.stdout is not None
+        first = process.stdout.readline().strip()
+        assert first == f"ROS_DOMAIN_ID={os.environ['ROS_DOMAIN_ID']}", (
+            first,
+            process.stderr and process.stderr.read(),
+        )
+        yield process
+    finally:
+        if process.poll() is None:
+            os.killpg(process.pid, signal.SIGTERM)
+        _, err = process.communicate(timeout=30)
+    assert process.returncode == 0, err
+    assert "Traceback" not in err and "terminate called" not in err, err
+
+
+class Client:
+    """An rclpy node with a NavigateToPose client per robot, and what it hears of ``/tiago1/odom``."""
+
+    def __init__(self) -> None:
+        import rclpy
+        from nav2_msgs.action import NavigateToPose
+        from nav_msgs.msg import Odometry
+        from rclpy.action import ActionClient
+        from rclpy.executors import SingleThreadedExecutor
+
+        self.rclpy, self.action = rclpy, NavigateToPose
+        self.context = rclpy.Context()
+        rclpy.init(context=self.context)
+        self.node = rclpy.create_node("exsce_test_client", context=self.context)
+        self.clients = {
+            r: ActionClient(self.node, NavigateToPose, f"/{r}/navigate_to_pose") for r in ("tiago1", "tiago2")
+        }
+        self.odom: list[Any] = []
+        self.node.create_subscription(Odometry, "/tiago1/odom", self.odom.append, 100)
+        self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor.add_node(self.node)
+        for client in self.clients.values():
+            assert client.wait_for_server(timeout_sec=30.0)
+
+    def send(self, robot: str, x: float, y: float, feedback: list[float] | None = None) -> Any:
+        goal = self.action.Goal()
+        goal.pose.header.frame_id = "map"
+        goal.pose.pose.position.x, goal.pose.pose.position.y = x, y
+        heard = None if feedback is None else (lambda m: feedback.append(m.feedback.distance_remaining))
+        sent = self.clients[robot].send_goal_async(goal, feedback_callback=heard)
+        self.executor.spin_until_future_complete(sent, timeout_sec=10.0)
+        handle = sent.result()
+        assert handle is not None and handle.accepted
+        return handle
+
+    def result(self, handle: Any) -> int:
+        future = handle.get_result_async()
+        self.executor.spin_until_future_complete(future, timeout_sec=GOAL_WAIT)
+        assert future.done()
+        return int(future.result().status)
+
+    def close(self) -> None:
+        self.executor.shutdown()
+        self.node.destroy_node()
+        self.context.try_shutdown()
+
+
+@pytest.fixture
+def client(ros2_env: dict[str, str]) -> Iterator[Client]:
+    made: list[Client] = []
+    with stand_in("--speed-up", "10"):
+        made.append(Client())
+        try:
+            yield made[0]
+        finally:
+            made[0].close()
+
+
+def test_a_goal_is_driven_to_its_pose_with_feedback_then_a_cancel_stops_the_robot(
+    client: Client, spec_c: Any
+) -> None:
+    """tiago1 reaches the first waypoint of its task (SUCCEEDED), its feedback's distance left
+    falling to nothing and its odometry on simulated time; a second goal cancelled on the way is
+    CANCELED, and the odometry stops moving."""
+    scenario, _ = spec_c
+    task = next(t for t in scenario.tasks if t.id == "delivery_a")
+    target = next(iter(task.waypoints())).position
+    feedback: list[float] = []
+    handle = client.send("tiago1", target.x, target.y, feedback)
+    assert client.result(handle) == 4  # SUCCEEDED
+    assert len(feedback) > 5 and feedback[0] > 1.0 and feedback[-1] < 0.3
+    assert all(a >= b - 1e-6 for a, b in zip(feedback, feedback[1:], strict=False))
+    stamps = [m.header.stamp.sec + m.header.stamp.nanosec / 1e9 for m in client.odom]
+    assert len(stamps) > 50 and all(
+        b - a == pytest.approx(0.02, abs=1e-6) for a, b in zip(stamps, stamps[1:], strict=False)
+    )
+
+    start = scenario.robot("tiago1").start_pose.position
+    going = client.send("tiago1", start.x, start.y)
+    deadline = time.monotonic() + 0.5
+    while time.monotonic() < deadline:
+        client.executor.spin_once(timeout_sec=0.05)
+    cancelled = going.cancel_goal_async()
+    client.executor.spin_until_future_complete(cancelled, timeout_sec=10.0)
+    assert client.result(going) == 5  # CANCELED
+    client.odom.clear()
+    deadline = time.monotonic() + 2.0
+    while time.monotonic() < deadline:
+        client.executor.spin_once(timeout_sec=0.05)
+    poses = [(m.pose.pose.position.x, m.pose.pose.position.y) for m in client.odom]
+    assert len(poses) > 10 and math.dist(poses[0], poses[-1]) < 1e-9  # standing still
+
+
+def test_a_planted_skip_waypoint_fault_aborts_the_robots_first_goal(
+    ros2_env: dict[str, str], spec_c: Any
+) -> None:
+    """``--fault skip-waypoint:tiago2`` aborts tiago2's first goal (ABORTED) and not tiago1's."""
+    scenario, _ = spec_c
+    target = next(iter(next(t for t in scenario.tasks if t.id == "delivery_b").waypoints())).position
+    with stand_in("--fault", "skip-waypoint:tiago2", "--speed-up", "10"):
+        client = Client()
+        try:
+            assert client.result(client.send("tiago2", target.x, target.y)) == 6  # ABORTED
+            assert client.result(client.send("tiago2", target.x, target.y)) == 4
+        finally:
+            client.close()
