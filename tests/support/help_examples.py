@@ -353,6 +353,9 @@ def _mcp(example: Example, cwd: Path, env: dict[str, str]) -> None:
 
 
 def _stand_in(example: Example, cwd: Path, env: dict[str, str]) -> None:
+    if "--ros2" in example.line:
+        _stand_in_ros2(example, cwd, env)
+        return
     process = _start(example.line, cwd, env)
     try:
         first = _Reader(process).until(b"\n").decode().strip()  # ROS_MASTER_URI=...
@@ -365,3 +368,37 @@ def _stand_in(example: Example, cwd: Path, env: dict[str, str]) -> None:
         if process.poll() is None:
             os.killpg(process.pid, signal.SIGINT)  # Ctrl-C, as the help says
     _stopped(process, example)
+
+
+def _stand_in_ros2(example: Example, cwd: Path, env: dict[str, str]) -> None:
+    """The ROS 2 stand-in, in a domain of its own: its first line names it, and a node of this
+    process sees its clock and each robot's NavigateToPose action on the graph."""
+    import rclpy
+
+    from tests.support.ros2_graph import ros2_domain
+
+    with ros2_domain() as domain:
+        process = _start(example.line, cwd, {**env, **domain})
+        context = rclpy.Context()
+        try:
+            first = _Reader(process).until(b"\n").decode().strip()
+            assert first == f"ROS_DOMAIN_ID={domain['ROS_DOMAIN_ID']}", first
+            rclpy.init(context=context, domain_id=int(domain["ROS_DOMAIN_ID"]))
+            node = rclpy.create_node("exsce_help_examples", context=context)
+            wanted = {
+                "/clock",
+                "/tiago1/navigate_to_pose/_action/status",
+                "/tiago2/navigate_to_pose/_action/status",
+            }
+            deadline = time.monotonic() + 20.0
+            while True:
+                seen = {name for name, _ in node.get_topic_names_and_types()}
+                if wanted <= seen or time.monotonic() > deadline:
+                    break
+                time.sleep(0.2)
+            assert wanted <= seen, sorted(seen)
+        finally:
+            context.try_shutdown()
+            if process.poll() is None:
+                os.killpg(process.pid, signal.SIGINT)  # Ctrl-C, as the help says
+        _stopped(process, example)

@@ -21,6 +21,9 @@ from exsce_dsl.runs import ROS1_BAG
 
 BAG, PROV, PARAMETERS = ROS1_BAG.suffix, ".prov.json", ".rosparams"
 """The extensions of a run's files: its bag, its run-time PROV, its parameter-server dump."""
+ROS2_BAG, ROS2_PARAMETERS = "", ".params.yaml"
+"""A ROS 2 run's: its bag is a rosbag2 folder named as the run, its parameters the dispatcher
+node's, as ``ros2 param dump`` writes them."""
 
 
 @dataclass(frozen=True)
@@ -29,17 +32,21 @@ class RunFiles:
 
     folder: Path
     name: str
+    ros2: bool = False
+    """A ROS 2 run: the bag a folder ``name/``, the parameters ``name.params.yaml``."""
 
     @classmethod
-    def of(cls, folder: Path, scenario: str, run_id: str, start: datetime.datetime) -> RunFiles:
+    def of(
+        cls, folder: Path, scenario: str, run_id: str, start: datetime.datetime, ros2: bool = False
+    ) -> RunFiles:
         """The files of run ``run_id`` (a uuid) of ``scenario``, started at ``start`` (with a time
         zone), in ``folder``; an :class:`~exsce_dsl.errors.ExsceError` for a scenario id that is
         not file-safe, a run id that is not a uuid or a start without a time zone."""
-        return cls(folder, run_name(start, scenario, run_id))
+        return cls(folder, run_name(start, scenario, run_id), ros2)
 
     @property
     def bag(self) -> Path:
-        return self.folder / (self.name + BAG)
+        return self.folder / (self.name + (ROS2_BAG if self.ros2 else BAG))
 
     @property
     def prov(self) -> Path:
@@ -47,7 +54,7 @@ class RunFiles:
 
     @property
     def rosparams(self) -> Path:
-        return self.folder / (self.name + PARAMETERS)
+        return self.folder / (self.name + (ROS2_PARAMETERS if self.ros2 else PARAMETERS))
 
     def all(self) -> tuple[Path, Path, Path]:
         """The three files, in the order they are put in place (the bag last)."""
@@ -63,16 +70,18 @@ class RunFiles:
         is removed)."""
         self.discard_staged()
         self.staging.mkdir(parents=True)
-        return RunFiles(self.staging, self.name)
+        return RunFiles(self.staging, self.name, self.ros2)
 
     def put_in_place(self) -> list[Path]:
         """Move the staged files that exist into :attr:`folder` (each replacing a file of the same
         name), the bag last: a bag in its place is a whole run.  The hidden folder is removed.
         Returns the files put in place."""
-        staged = RunFiles(self.staging, self.name)
+        staged = RunFiles(self.staging, self.name, self.ros2)
         placed = []
         for source, target in zip(staged.all(), self.all(), strict=True):
             if source.exists():
+                if target.is_dir():  # a ROS 2 bag of an earlier try: os.replace takes empty folders only
+                    shutil.rmtree(target)
                 os.replace(source, target)
                 placed.append(target)
         self.discard_staged()
