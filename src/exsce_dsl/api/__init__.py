@@ -38,7 +38,7 @@ if TYPE_CHECKING:  # the functions of a Python session, as docs/python.md walks 
         verify,
     )
     from exsce_dsl.api.drafts import init_from_bag
-    from exsce_dsl.api.execution import execute_ros1
+    from exsce_dsl.api.execution import execute_ros1, execute_ros2
     from exsce_dsl.api.explain import explain
     from exsce_dsl.api.lineage import run_lineage
     from exsce_dsl.api.stand_in import stand_in, stand_in_ros2

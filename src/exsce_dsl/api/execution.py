@@ -1,4 +1,4 @@
-"""``exscec execute --ros1``: a scenario's mission on a live ROS 1 graph, as a Python function."""
+"""``exscec execute --ros1|--ros2``: a scenario's mission on a live ROS graph, as Python functions."""
 
 from __future__ import annotations
 
@@ -16,7 +16,9 @@ from exsce_dsl.execute import (
     Interruption,
     Options,
     Policy,
+    Ros2StandIn,
     execute_runs,
+    execute_runs_ros2,
     start_stand_in,
 )
 from exsce_dsl.execute import master_uri as environment_master_uri
@@ -26,7 +28,7 @@ from exsce_dsl.model.document import Specification
 from exsce_dsl.remedies import STAND_IN_FOR_FAULTS
 from exsce_dsl.sim.faults import Fault
 
-__all__ = ["ExecutedRun", "Policy", "execute_ros1"]
+__all__ = ["ExecutedRun", "Policy", "execute_ros1", "execute_ros2"]
 
 
 def execute_ros1(
@@ -83,3 +85,44 @@ def execute_ros1(
                 )
 
         return execute_runs(chosen, uri, out, runs, options, interrupted, around_run)
+
+
+def execute_ros2(
+    spec: Specification | Scenario,
+    out_dir: str | Path,
+    runs: int = 1,
+    *,
+    scenario: str | None = None,
+    policy: Policy | str = DEFAULT_POLICY,
+    server_timeout: float = DEFAULT_SERVER_TIMEOUT,
+    timeout: float | None = None,
+    interrupted: Callable[[], bool] | None = None,
+    stand_in: bool = False,
+    seed: int = 0,
+    faults: Sequence[str] = (),
+    speed_up: float = DEFAULT_SPEED_UP,
+    use_sim_time: bool | None = None,
+) -> list[ExecutedRun]:
+    """``exscec execute --ros2``: run the scenario's mission ``runs`` times on the live ROS 2 graph
+    of this process's environment (``ROS_DOMAIN_ID``) through each robot's Nav2
+    (``NavigateToPose``), each run leaving the rosbag2 MCAP folder ``<date>_<scenario>_run-<id>``,
+    ``.prov.json`` and ``.params.yaml`` in ``out_dir``.  ``use_sim_time``: None uses ``/clock``
+    when something publishes it.  Policies, timeouts, interruption and a missing action server
+    as :func:`execute_ros1`; ``stand_in``: exsce's Nav2 stand-in robots (``exscec stand-in
+    --ros2``) serve the goals, started afresh for each run in this process, with ``faults``."""
+    chosen = spec if isinstance(spec, Scenario) else spec.scenario(scenario)
+    out = Path(out_dir)
+    options = Options(Policy(policy), server_timeout, timeout)
+    if not stand_in and (faults or seed):
+        raise ExsceError("faults and a seed are the stand-in's", remedy=STAND_IN_FOR_FAULTS)
+    planted = tuple(Fault.parse(f) for f in faults)
+    with contextlib.ExitStack() as stack:
+        if interrupted is None:
+            interrupted = stack.enter_context(Interruption())
+        around_run = None
+        if stand_in:
+
+            def around_run(run: int) -> contextlib.AbstractContextManager[object]:
+                return Ros2StandIn(chosen, seed=seed, faults=planted, speed_up=speed_up, run=run)
+
+        return execute_runs_ros2(chosen, out, runs, options, interrupted, around_run, use_sim_time)

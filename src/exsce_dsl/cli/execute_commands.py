@@ -28,6 +28,7 @@ class _ExecuteOptions:
 
     spec: str
     ros1: bool
+    ros2: bool
     scenario_id: str | None
     runs: int
     out_dir: str
@@ -57,7 +58,12 @@ class _ExecuteOptions:
     )
 )
 @click.argument("spec", type=click.Path(dir_okay=False))
-@click.option("--ros1", is_flag=True, required=True, help="Run on a ROS 1 graph (rospy, actionlib, rosbag).")
+@click.option("--ros1", is_flag=True, help="Run on a ROS 1 graph (rospy, actionlib, rosbag).")
+@click.option(
+    "--ros2",
+    is_flag=True,
+    help="Run on the ROS 2 graph of $ROS_DOMAIN_ID (rclpy, Nav2's NavigateToPose, a rosbag2 MCAP bag).",
+)
 @click.option("--scenario", "scenario_id", help="Which scenario, when the file declares several.")
 @click.option("--runs", "-n", default=1, show_default=True, type=click.IntRange(1), help="How many runs.")
 @click.option(
@@ -67,9 +73,12 @@ class _ExecuteOptions:
     type=click.Path(file_okay=False),
     default="runs",
     show_default=True,
-    help="Folder for each run's .bag, .prov.json and .rosparams.",
+    help="Folder for each run's .bag, .prov.json and .rosparams (--ros2: bag folder, .prov.json and "
+    ".params.yaml).",
 )
-@click.option("--start-master", is_flag=True, help="Start a roscore of our own (else: $ROS_MASTER_URI).")
+@click.option(
+    "--start-master", is_flag=True, help="With --ros1: start a roscore of our own (else: $ROS_MASTER_URI)."
+)
 @click.option(
     "--policy",
     type=click.Choice(POLICIES),
@@ -157,6 +166,14 @@ def execute(**given: Any) -> None:
     robots (exscec stand-in: move_base servers, odometry, TF, scans, on
     simulated time), started afresh for each run, with --fault planted.
 
+    With --ros2 the goals go to each robot's Nav2
+    (nav2_msgs/action/NavigateToPose on /<namespace>/navigate_to_pose), from
+    a node exsce_dispatcher that holds the scenario as its parameters;
+    exsce's recorder subscribes to the same topics and writes a rosbag2 MCAP
+    folder (metadata.yaml with each topic's QoS and type hash); /clock, when
+    something publishes it, is the clock (use_sim_time).  Each run leaves the
+    bag folder <date>_<scenario>_run-<id>, .prov.json and .params.yaml.
+
     \b
     Examples:
       exscec execute examples/brsu_building_c/scenario_c.exsce --ros1 --start-master --stand-in \\
@@ -164,10 +181,15 @@ def execute(**given: Any) -> None:
       exscec execute examples/brsu_building_c/scenario_c.exsce --ros1 --start-master --runs 3 \\
           --policy retry-once --verify --junit verdicts.xml --server-timeout 1 \\
           -o live/  # exits 2: no robot's move_base answers
+      exscec execute examples/brsu_building_c/scenario_c.exsce --ros2 --stand-in --verify -o live-ros2/
     """
     from exsce_dsl.api import load
 
     options = _ExecuteOptions(**given)
+    if options.ros1 == options.ros2:
+        raise click.UsageError("say --ros1 or --ros2: the graph to run on")
+    if options.ros2 and options.start_master:
+        raise click.UsageError("--start-master goes with --ros1 (a ROS 2 graph has no master)")
     scenario = load(options.spec).scenario(options.scenario_id)
     done = _execute_runs(scenario, options)
     for run in done:
@@ -182,10 +204,23 @@ def execute(**given: Any) -> None:
 
 def _execute_runs(scenario: Scenario, options: _ExecuteOptions) -> list[ExecutedRun]:
     """The runs on the live graph; interrupted, what was kept is said and the exit status is 130."""
-    from exsce_dsl.api import execute_ros1
+    from exsce_dsl.api import execute_ros1, execute_ros2
     from exsce_dsl.errors import ExecutionInterrupted
 
     try:
+        if options.ros2:
+            return execute_ros2(
+                scenario,
+                options.out_dir,
+                options.runs,
+                policy=options.policy,
+                server_timeout=options.server_timeout,
+                timeout=options.goal_timeout,
+                stand_in=options.stand_in,
+                seed=options.seed,
+                faults=options.faults,
+                speed_up=options.speed_up,
+            )
         return execute_ros1(
             scenario,
             options.out_dir,

@@ -33,6 +33,7 @@ if TYPE_CHECKING:
         Options,
         execute_runs,
     )
+    from exsce_dsl.execute.ros2.session import execute_runs_ros2
     from exsce_dsl.execute.ros2.stand_in import Ros2StandIn
     from exsce_dsl.execute.stand_in import StandIn, start_stand_in
     from exsce_dsl.execute.stand_in.session import DEFAULT_SPEED_UP

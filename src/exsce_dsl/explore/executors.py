@@ -12,7 +12,8 @@ back bags, one per run; the campaign ingests and judges them.  Three kinds:
   a user's own simulator, or a script that drives a real robot;
 - a built-in executor chosen by its name (:data:`BUILT_IN_EXECUTORS`): ``ros1`` runs the
   scenarios on a live ROS 1 graph against exsce's stand-in robots, faults planted in them
-  (:mod:`exsce_dsl.explore.ros1_executor`);
+  (:mod:`exsce_dsl.explore.ros1_executor`), ``ros2`` on a live ROS 2 graph against the Nav2
+  stand-in robots (:mod:`exsce_dsl.explore.ros2_executor`);
 - a plug-in: a package registers a factory under the entry-point group ``exsce.executors``
   (called with no arguments, it returns an Executor), chosen by its name; the plug-ins are
   read by :mod:`exsce_dsl.plugins` (a built-in is never replaced, a broken plug-in is left
@@ -38,6 +39,7 @@ from typing import Protocol, runtime_checkable
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.execute import DEFAULT_SPEED_UP
 from exsce_dsl.explore.ros1_executor import ros1_executor
+from exsce_dsl.explore.ros2_executor import ros2_executor
 from exsce_dsl.model import Scenario
 from exsce_dsl.plugins import Registry
 from exsce_dsl.remedies import BUILT_IN_OPTIONS, ONE_EXECUTOR, ROS1_OPTIONS
@@ -219,9 +221,19 @@ def _ros1(options: ExecutorOptions) -> AbstractContextManager[Executor]:
     )
 
 
+def _ros2(options: ExecutorOptions) -> AbstractContextManager[Executor]:
+    if options.start_master or options.master_uri:
+        raise ExsceError("a ROS 2 graph has no master: --start-master goes with the ros1 executor")
+    speed_up = DEFAULT_SPEED_UP if options.speed_up is None else options.speed_up
+    return ros2_executor(stand_in=options.stand_in, faults=options.faults, speed_up=speed_up)
+
+
 BUILT_IN_EXECUTORS: dict[str, NamedExecutor] = {
     e.name: e
-    for e in (NamedExecutor("ros1", "a live ROS 1 graph, exsce's stand-in robots serving the goals", _ros1),)
+    for e in (
+        NamedExecutor("ros1", "a live ROS 1 graph, exsce's stand-in robots serving the goals", _ros1),
+        NamedExecutor("ros2", "a live ROS 2 graph, exsce's Nav2 stand-in robots serving the goals", _ros2),
+    )
 }
 """The executors exsce ships, chosen by name."""
 
