@@ -27,7 +27,7 @@ from rosbags.typesys import Stores, get_typestore
 
 from exsce_dsl.errors import ExsceError, RosGraphError
 from exsce_dsl.execute.ros2 import RECORDER_NODE, Ros2Recorder
-from exsce_dsl.execute.ros2.record_node import partial_folder
+from exsce_dsl.execute.ros2.recorder import partial_folder
 from exsce_dsl.runs import PROV_TOPIC
 
 from tests.support.paths import ROOT
@@ -86,7 +86,13 @@ PUBLISHER = textwrap.dedent(
         odom.publish(message)
 
     print("ready", flush=True)
-    sys.stdin.readline()
+    recorders = int(sys.stdin.readline())
+    # discovery is matched on each side on its own: publish once this side sees the recorders
+    # (on simulated time, their clocks' subscriptions to /clock too)
+    needed = [(odom, recorders)] + ([(clock, 2 * recorders)] if mode == "sim" else [])
+    end = time.monotonic() + 10.0
+    while time.monotonic() < end and any(p.get_subscription_count() < n for p, n in needed):
+        rclpy.spin_once(node, timeout_sec=0.01)
     if mode == "wall":
         for i in range(count):
             publish_odom(i)
@@ -133,15 +139,29 @@ class Publisher:
         assert self.process.stdout is not None
         return self.process.stdout.readline().strip()
 
-    def publish(self) -> None:
+    def publish(self, recorders: int = 1) -> None:
+        """Publish once ``recorders`` recorders are matched to the publisher; return when done."""
         assert self.process.stdin is not None
-        self.process.stdin.write("go\n")
+        self.process.stdin.write(f"{recorders}\n")
         self.process.stdin.flush()
         assert self.line() == "done"
 
     def close(self) -> None:
         self.process.kill()
         self.process.wait()
+
+
+def record_run(bag: Path, mode: str, count: int, use_sim_time: bool = False) -> Ros2Recorder:
+    """The publisher's run (``mode``, ``count`` messages) recorded into ``bag``; the stopped recorder."""
+    publisher = Publisher(mode, count)
+    try:
+        with Ros2Recorder(bag, TOPICS, use_sim_time=use_sim_time) as recorder:
+            recorder.wait_subscribed(20.0, published=PUBLISHED)
+            publisher.publish()
+            recorder.stop()
+    finally:
+        publisher.close()
+    return recorder
 
 
 def built_hash(package: str, kind: str, name: str) -> str:
@@ -173,17 +193,10 @@ def metadata(bag: Path) -> dict[str, object]:
 def test_a_run_on_a_live_graph_is_recorded_whole(ros2_env: dict[str, str], tmp_path: Path) -> None:
     """Every message published while recording is in the bag with its values, and the latched
     tf_static and PROV published before the recorder started are there too."""
-    publisher = Publisher("wall", 50)
     bag = tmp_path / "runs" / "run_1"
-    try:
-        before = time.time_ns()
-        with Ros2Recorder(bag, TOPICS) as recorder:
-            recorder.wait_subscribed(20.0, published=PUBLISHED)
-            publisher.publish()
-            written = recorder.stop()
-        after = time.time_ns()
-    finally:
-        publisher.close()
+    before = time.time_ns()
+    written = record_run(bag, "wall", 50).written
+    after = time.time_ns()
     assert not partial_folder(bag).exists()
     messages = read_bag(bag)
     odom = messages["/tiago1/odom"]
@@ -210,14 +223,8 @@ def test_a_run_on_a_live_graph_is_recorded_whole(ros2_env: dict[str, str], tmp_p
 
 def test_the_bags_metadata_is_as_rosbag2_writes_it(ros2_env: dict[str, str], tmp_path: Path) -> None:
     """metadata.yaml: MCAP, version 9, each topic's offered QoS (the publishers') and type hash."""
-    publisher = Publisher("wall", 3)
     bag = tmp_path / "run_2"
-    try:
-        with Ros2Recorder(bag, TOPICS) as recorder:
-            recorder.wait_subscribed(20.0, published=PUBLISHED)
-            publisher.publish()
-    finally:
-        publisher.close()
+    record_run(bag, "wall", 3)
     info = metadata(bag)
     assert (info["storage_identifier"], info["version"]) == ("mcap", 9)
     assert [Path(f).suffix for f in info["relative_file_paths"]] == [".mcap"]  # type: ignore[attr-defined]
@@ -247,14 +254,8 @@ def test_the_bags_metadata_is_as_rosbag2_writes_it(ros2_env: dict[str, str], tmp
 
 
 def test_exscec_bag_info_reads_the_recorded_bag(ros2_env: dict[str, str], tmp_path: Path) -> None:
-    publisher = Publisher("wall", 20)
     bag = tmp_path / "run_3"
-    try:
-        with Ros2Recorder(bag, TOPICS) as recorder:
-            recorder.wait_subscribed(20.0, published=PUBLISHED)
-            publisher.publish()
-    finally:
-        publisher.close()
+    record_run(bag, "wall", 20)
     done = subprocess.run(
         [Path(sys.executable).with_name("exscec"), "bag", "info", "--format", "json", str(bag)],
         capture_output=True,
@@ -272,15 +273,8 @@ def test_on_sim_time_the_log_times_are_the_clocks(ros2_env: dict[str, str], tmp_
     """Log time is /clock's: each odometry at the clock published before it; nothing before the
     first /clock (the odometry published then is dropped and counted), but the latched
     tf_static received before it is written at its time."""
-    publisher = Publisher("sim", 8)
     bag = tmp_path / "run_4"
-    try:
-        with Ros2Recorder(bag, TOPICS, use_sim_time=True) as recorder:
-            recorder.wait_subscribed(20.0, published=PUBLISHED)
-            publisher.publish()
-            recorder.stop()
-    finally:
-        publisher.close()
+    recorder = record_run(bag, "sim", 8, use_sim_time=True)
     messages = read_bag(bag)
     ticks = [(1000 + i) * 10**9 + 500 for i in range(8)]
     odom = messages["/tiago1/odom"]
@@ -302,7 +296,7 @@ def test_a_killed_recorder_leaves_no_bag_and_a_terminated_one_a_whole_bag(
         with first, second:
             first.wait_subscribed(20.0, published=PUBLISHED)
             second.wait_subscribed(20.0, published=PUBLISHED)
-            publisher.publish()
+            publisher.publish(recorders=2)
             assert first.process is not None and second.process is not None
             assert partial_folder(killed).is_dir()  # it writes there, beside the bag's name
             os.killpg(first.process.pid, signal.SIGKILL)

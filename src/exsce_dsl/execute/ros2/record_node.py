@@ -1,20 +1,20 @@
 """The ROS 2 recorder's process: an rclpy node that writes a rosbag2 MCAP bag, without rosbag2.
 
 Run as ``python -m exsce_dsl.execute.ros2.record_node CONFIG`` (CONFIG: JSON, see
-:func:`config`) by :class:`~exsce_dsl.execute.ros2.recorder.Ros2Recorder`, which reads the
-events it prints.  Its node, :data:`NODE_NAME`, subscribes with serialized (raw) subscriptions to
-exactly the topics it is given, each once a publisher of it shows on the graph (looked for every
-:data:`POLL` seconds; hidden ``_action`` topics included), with the type the graph names, the
-QoS its publishers offer (:mod:`.record_types`) and that type's definition and hash.  Each
-message is written as it is received, at the node's clock's time: the wall clock, or ``/clock``
-with ``use_sim_time``, when nothing is written before the first ``/clock`` message (a latched
-topic's messages received before it are held and written at its time; others are dropped and
-counted).
+:func:`~.recorder.config`) by :class:`~.recorder.Ros2Recorder`, which reads the events it
+prints.  Its node, :data:`~.recorder.RECORDER_NODE`, subscribes with serialized (raw)
+subscriptions to exactly the topics it is given, each once a publisher of it shows on the graph
+(looked for every :data:`POLL` seconds; hidden ``_action`` topics included), with the type the
+graph names, the QoS its publishers offer (:mod:`.record_types`) and that type's definition and
+hash.  Each message is written as it is received, at the node's clock's time: the wall clock, or
+``/clock`` with ``use_sim_time``, when nothing is written before the first ``/clock`` message (a
+latched topic's messages received before it are held and written at its time; others are
+dropped and counted).
 
-The bag is written into :func:`partial_folder`, a hidden sibling of the bag, and moved to the
-bag's name only once the writer has closed it (on SIGINT or SIGTERM): a recorder killed on the
-way leaves nothing under the bag's name.  A topic it cannot record (a type it cannot describe,
-several types on one topic) stops it with an error naming the topic, and no bag.
+The bag is written into :func:`~.recorder.partial_folder`, a hidden sibling of the bag, and moved
+to the bag's name only once the writer has closed it (on SIGINT or SIGTERM): a recorder killed
+on the way leaves nothing under the bag's name.  A topic it cannot record (a type it cannot
+describe, several types on one topic) stops it with an error naming the topic, and no bag.
 
 Events, one JSON object a line on stdout: ``ready``; ``status`` (``published``: the topics that
 have a publisher; ``subscribed``: those whose every publisher is matched to the recorder) when it
@@ -36,23 +36,14 @@ from pathlib import Path
 from types import FrameType
 from typing import Any
 
-NODE_NAME = "exsce_recorder"
+from exsce_dsl.execute.ros2.recorder import RECORDER_NODE, partial_folder
+
 POLL = 0.1
 """Seconds between two looks at the graph for new publishers."""
 SPIN = 0.02
 """Longest wait for a message in one turn of the loop."""
 DRAIN = 2.0
 """Longest time spent writing what has arrived when asked to stop."""
-
-
-def partial_folder(bag: Path) -> Path:
-    """The hidden folder the bag is written in, beside where it is moved when closed."""
-    return bag.with_name(f".{bag.name}.recording")
-
-
-def config(bag: Path, topics: Sequence[str], use_sim_time: bool) -> str:
-    """The process's one argument."""
-    return json.dumps({"bag": str(bag), "topics": list(topics), "use_sim_time": use_sim_time})
 
 
 def emit(event: str, **fields: Any) -> None:
@@ -66,7 +57,7 @@ def ros(module: str) -> Any:
 
 
 def log(text: str) -> None:
-    print(f"[{NODE_NAME}] {text}", file=sys.stderr, flush=True)
+    print(f"[{RECORDER_NODE}] {text}", file=sys.stderr, flush=True)
 
 
 class Recording:
@@ -192,13 +183,13 @@ def record(bag: Path, topics: Sequence[str], use_sim_time: bool) -> int:
     rclpy.init(context=context, signal_handler_options=ros("rclpy.signals").SignalHandlerOptions.NO)
     try:
         sim_time = ros("rclpy.parameter").Parameter("use_sim_time", value=use_sim_time)
-        node = rclpy.create_node(NODE_NAME, context=context, parameter_overrides=[sim_time])
+        node = rclpy.create_node(RECORDER_NODE, context=context, parameter_overrides=[sim_time])
         executor = ros("rclpy.executors").SingleThreadedExecutor(context=context)
         executor.add_node(node)
         writer.open()
         recording = Recording(node, writer, topics, use_sim_time)
         try:
-            emit("ready", node=NODE_NAME)
+            emit("ready", node=RECORDER_NODE)
             _loop(executor, recording, stop)
             writer.close()
         except BaseException as error:

@@ -19,6 +19,7 @@ lines (read here) and its log to ``log`` (``<bag>.record.log`` unless given).
 
 from __future__ import annotations
 
+import contextlib
 import importlib.util
 import json
 import os
@@ -37,10 +38,9 @@ from typing import IO, Any
 import yaml
 
 from exsce_dsl.errors import ExsceError, RosGraphError
-from exsce_dsl.execute.ros2.record_node import NODE_NAME, config, partial_folder
 from exsce_dsl.runs import ROS2_METADATA
 
-RECORDER_NODE = NODE_NAME
+RECORDER_NODE = "exsce_recorder"
 """The recorder's node name on the graph."""
 PROGRAM = "exsce_dsl.execute.ros2.record_node"
 """The module the recorder's process runs."""
@@ -52,6 +52,16 @@ STOP_WAIT = 30.0
 POLL = 0.02
 
 _TOPIC = re.compile(r"(/[A-Za-z_][A-Za-z0-9_]*)+")
+
+
+def partial_folder(bag: Path) -> Path:
+    """The hidden folder the bag is written in, beside where it is moved when closed."""
+    return bag.with_name(f".{bag.name}.recording")
+
+
+def config(bag: Path, topics: Sequence[str], use_sim_time: bool) -> str:
+    """The recorder process's one argument."""
+    return json.dumps({"bag": str(bag), "topics": list(topics), "use_sim_time": use_sim_time})
 
 
 def check_topics(topics: Sequence[str]) -> None:
@@ -191,16 +201,12 @@ class Ros2Recorder:
         process = self.process
         if process is None:
             raise RosGraphError("the ROS 2 recorder was not started")
-        if process.poll() is None:
-            _signal_group(process, signal.SIGINT)
-            try:
-                process.wait(timeout)
-            except subprocess.TimeoutExpired:
-                self._kill()
-                raise RosGraphError(
-                    f"the ROS 2 recorder did not close {self.output.name} within {timeout:g} s and was "
-                    f"killed: the recording is lost: see {self.log}"
-                ) from None
+        if process.poll() is None and not _interrupted(process, timeout):
+            self._kill()
+            raise RosGraphError(
+                f"the ROS 2 recorder did not close {self.output.name} within {timeout:g} s and was "
+                f"killed: the recording is lost: see {self.log}"
+            )
         self._kill()
         if process.returncode != 0 or not (self.output / ROS2_METADATA).is_file():
             raise RosGraphError(
@@ -216,11 +222,10 @@ class Ros2Recorder:
         if self.process is None:
             return
         self._ended = True
-        _signal_group(self.process, signal.SIGKILL)
-        try:
+        with contextlib.suppress(ProcessLookupError, PermissionError):
+            os.killpg(self.process.pid, signal.SIGKILL)  # its group: anything it started too
+        with contextlib.suppress(subprocess.TimeoutExpired):
             self.process.wait(5.0)
-        except subprocess.TimeoutExpired:
-            pass
         if self._reader is not None:
             self._reader.join(1.0)
         if self.process.stdout is not None:
@@ -252,8 +257,12 @@ def bag_counts(bag: Path) -> dict[str, int]:
     }
 
 
-def _signal_group(process: subprocess.Popen[str], sig: int) -> None:
+def _interrupted(process: subprocess.Popen[str], timeout: float) -> bool:
+    """Interrupt the process's group as Ctrl-C would; whether it ended within ``timeout`` s."""
+    with contextlib.suppress(ProcessLookupError, PermissionError):
+        os.killpg(process.pid, signal.SIGINT)
     try:
-        os.killpg(process.pid, sig)
-    except (ProcessLookupError, PermissionError):
-        pass
+        process.wait(timeout)
+    except subprocess.TimeoutExpired:
+        return False
+    return True
