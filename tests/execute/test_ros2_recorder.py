@@ -23,10 +23,12 @@ from pathlib import Path
 import pytest
 import yaml
 from rosbags.highlevel import AnyReader
+from rosbags.interfaces import Qos, QosDurability, QosHistory, QosLiveliness, QosReliability, QosTime
 from rosbags.typesys import Stores, get_typestore
 
 from exsce_dsl.errors import ExsceError, RosGraphError
 from exsce_dsl.execute.ros2 import RECORDER_NODE, Ros2Recorder
+from exsce_dsl.execute.ros2.record_types import adapted_qos
 from exsce_dsl.execute.ros2.recorder import partial_folder
 from exsce_dsl.runs import PROV_TOPIC
 
@@ -254,6 +256,7 @@ def test_the_bags_metadata_is_as_rosbag2_writes_it(ros2_env: dict[str, str], tmp
 
 
 def test_exscec_bag_info_reads_the_recorded_bag(ros2_env: dict[str, str], tmp_path: Path) -> None:
+    """exsce's own bag reading decodes every topic from the definitions the recorder wrote."""
     bag = tmp_path / "run_3"
     record_run(bag, "wall", 20)
     done = subprocess.run(
@@ -265,8 +268,11 @@ def test_exscec_bag_info_reads_the_recorded_bag(ros2_env: dict[str, str], tmp_pa
     )
     assert done.returncode == 0, done.stderr
     [info] = json.loads(done.stdout)
-    text = json.dumps(info)
-    assert "/tiago1/odom" in text and "nav_msgs/msg/Odometry" in text and FEEDBACK in text
+    assert info["format"] == "ROS 2 (MCAP)"
+    topics = {t["name"]: (t["msgtype"], t["messages"], t["definition"]) for t in info["topics"]}
+    assert topics["/tiago1/odom"] == ("nav_msgs/msg/Odometry", 20, "the bag")
+    assert topics[FEEDBACK] == ("nav2_msgs/action/NavigateToPose_FeedbackMessage", 3, "the bag")
+    assert topics["/tiago1/tf_static"] == ("tf2_msgs/msg/TFMessage", 1, "the bag")
 
 
 def test_on_sim_time_the_log_times_are_the_clocks(ros2_env: dict[str, str], tmp_path: Path) -> None:
@@ -371,6 +377,35 @@ def test_a_type_the_typestore_lacks_is_described_from_its_installed_msg(
     assert "definition from its installed .msg files" in recorder.log.read_text()
     [(_, message)] = read_bag(bag)["/tiago1/goals"]
     assert [g.pose.position.y for g in message.goals] == [4.5]
+
+
+def test_the_qos_asked_for_is_what_every_publisher_offers() -> None:
+    """rosbag2's adaptive QoS: one best-effort publisher makes the subscription best effort (a
+    reliable one would not match it), one volatile publisher makes it volatile."""
+
+    def offered(reliability: QosReliability, durability: QosDurability) -> Qos:
+        forever = QosTime(9223372036, 854775807)
+        return Qos(
+            QosHistory.UNKNOWN,
+            0,
+            reliability,
+            durability,
+            forever,
+            forever,
+            QosLiveliness.AUTOMATIC,
+            forever,
+            False,
+        )
+
+    reliable_latched = offered(QosReliability.RELIABLE, QosDurability.TRANSIENT_LOCAL)
+    best_effort = offered(QosReliability.BEST_EFFORT, QosDurability.VOLATILE)
+    assert adapted_qos([reliable_latched, reliable_latched]) == (True, True)
+    assert adapted_qos([reliable_latched, best_effort]) == (False, False)
+    assert adapted_qos([offered(QosReliability.RELIABLE, QosDurability.VOLATILE), reliable_latched]) == (
+        True,
+        False,
+    )
+    assert adapted_qos([]) == (False, False)
 
 
 def test_the_recorder_refuses_names_it_cannot_record_and_an_existing_bag(tmp_path: Path) -> None:
