@@ -416,3 +416,48 @@ def test_the_recorder_refuses_names_it_cannot_record_and_an_existing_bag(tmp_pat
     with pytest.raises(RosGraphError, match="exists"):
         Ros2Recorder(tmp_path / "bag", ["/tf"]).start()
     assert RECORDER_NODE == "exsce_recorder"
+
+
+def test_without_rclpy_the_recorder_says_how_to_get_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setitem(sys.modules, "rclpy", None)  # not importable, as in a Python without ROS 2
+    with pytest.raises(RosGraphError, match=r"needs rclpy.*scripts/install-ros2.*setup\.bash"):
+        Ros2Recorder(tmp_path / "runs" / "run_1", ["/tf"]).start()
+    assert list(tmp_path.iterdir()) == []  # nothing started, nothing written
+
+
+ORPHANED = textwrap.dedent(
+    """
+    import sys, time
+    from pathlib import Path
+    from exsce_dsl.execute.ros2 import Ros2Recorder
+    recorder = Ros2Recorder(Path(sys.argv[1]), ["/tiago1/odom"])
+    recorder.start()
+    print("started", flush=True)
+    time.sleep(60)
+    """
+)
+
+
+def test_a_recorder_whose_starter_died_closes_its_bag_and_ends(
+    ros2_env: dict[str, str], tmp_path: Path
+) -> None:
+    """exscec killed (SIGKILL: no chance to stop the recorder): the recorder, in a session of its
+    own, notices it is orphaned, closes a whole bag and ends, rather than record for ever."""
+    bag = tmp_path / "run_7"
+    starter = subprocess.Popen(
+        [sys.executable, "-c", ORPHANED, str(bag)],
+        stdout=subprocess.PIPE,
+        text=True,
+        env={**os.environ, "PYTHONPATH": str(ROOT / "src")},
+    )
+    assert starter.stdout is not None and starter.stdout.readline().strip() == "started"
+    starter.kill()
+    starter.wait()
+    deadline = time.monotonic() + 10.0
+    while not (bag / "metadata.yaml").exists():
+        assert time.monotonic() < deadline, "the orphaned recorder did not close its bag"
+        time.sleep(0.05)
+    assert metadata(bag)["message_count"] == 0 and not partial_folder(bag).exists()
+    assert "the process that started the recorder is gone" in (tmp_path / "run_7.record.log").read_text()

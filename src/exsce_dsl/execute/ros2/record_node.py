@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import importlib
 import json
+import os
 import shutil
 import signal
 import sys
@@ -150,6 +151,10 @@ class Recording:
                 self._write(early, now, message)
         self._write(topic, now, data)
 
+    def received(self) -> int:
+        """Messages received so far."""
+        return sum(self.written.values()) + sum(self.dropped.values()) + len(self.held)
+
     def _write(self, topic: str, stamp: int, data: bytes) -> None:
         self.writer.write(self.connections[topic], stamp, data)
         self.written[topic] += 1
@@ -215,20 +220,27 @@ def record(bag: Path, topics: Sequence[str], use_sim_time: bool) -> int:
 
 
 def _loop(executor: Any, recording: Recording, stop: Stop) -> None:
-    """Spin, looking at the graph every :data:`POLL` seconds, until asked to stop; then write
-    what has arrived (until a turn brings nothing, at most :data:`DRAIN` seconds)."""
+    """Spin, looking at the graph every :data:`POLL` seconds, until asked to stop or orphaned
+    (the process that started it is gone: a recorder is never left running on its own); then
+    write what has arrived (until a turn brings nothing, at most :data:`DRAIN` seconds)."""
+    parent = os.getppid()
     next_poll = 0.0
     while not stop.asked:
         if time.monotonic() >= next_poll:
+            if os.getppid() != parent:
+                log("the process that started the recorder is gone: closing the bag")
+                break
             recording.poll()
             next_poll = time.monotonic() + POLL
         executor.spin_once(timeout_sec=SPIN)
     end = time.monotonic() + DRAIN
     while time.monotonic() < end:
-        before = sum(recording.written.values()) + sum(recording.dropped.values()) + len(recording.held)
+        before = recording.received()
         executor.spin_once(timeout_sec=SPIN)
-        if sum(recording.written.values()) + sum(recording.dropped.values()) + len(recording.held) == before:
+        if recording.received() == before:
             break
+    for topic, _ in recording.held:  # /clock never came
+        recording.dropped[topic] += 1
 
 
 def main(argv: Sequence[str] | None = None) -> int:
