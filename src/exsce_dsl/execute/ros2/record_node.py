@@ -37,6 +37,10 @@ from pathlib import Path
 from types import FrameType
 from typing import Any
 
+from rosbags.rosbag2 import StoragePlugin, Writer
+
+from exsce_dsl.errors import RosGraphError
+from exsce_dsl.execute.ros2.record_types import DEPTH, adapted_qos, describe_type, message_class, offered_qos
 from exsce_dsl.execute.ros2.recorder import RECORDER_NODE, partial_folder
 
 POLL = 0.1
@@ -94,15 +98,7 @@ class Recording:
             emit("status", published=published, subscribed=subscribed)
 
     def subscribe(self, topic: str, types: Sequence[str]) -> None:
-        from exsce_dsl.errors import RosGraphError
-        from exsce_dsl.execute.ros2.record_types import (
-            DEPTH,
-            adapted_qos,
-            describe_type,
-            message_class,
-            offered_qos,
-        )
-
+        """Subscribe to ``topic`` (published with ``types``) and add its connection to the bag."""
         if len(types) != 1:
             raise RosGraphError(f"{topic} is published with several types, {sorted(types)}: not recorded")
         msgtype = types[0]
@@ -175,14 +171,33 @@ class Stop:
 def record(bag: Path, topics: Sequence[str], use_sim_time: bool) -> int:
     """Record until SIGINT or SIGTERM; the exit status (0: the bag is closed at ``bag``)."""
     stop = Stop()
-    from rosbags.rosbag2 import StoragePlugin, Writer
-
-    from exsce_dsl.errors import RosGraphError
-
     partial = partial_folder(bag)
     shutil.rmtree(partial, ignore_errors=True)  # an earlier, killed recorder's
     partial.mkdir(parents=True)
-    writer = Writer(partial / bag.name, version=9, storage_plugin=StoragePlugin.MCAP)
+    try:
+        recording = _record_into(partial / bag.name, topics, use_sim_time, stop)
+    except BaseException as error:
+        shutil.rmtree(partial, ignore_errors=True)  # no half-written bag anywhere
+        if not isinstance(error, RosGraphError):
+            raise
+        log(f"error: {error.message}")
+        emit("error", message=error.message)
+        return 2
+    if bag.exists():
+        shutil.rmtree(partial, ignore_errors=True)
+        emit("error", message=f"{bag} appeared while recording (not by the recorder): recording dropped")
+        return 2
+    (partial / bag.name).rename(bag)
+    partial.rmdir()
+    log(f"closed {bag}: {sum(recording.written.values())} messages")
+    emit("closed", written=dict(recording.written), dropped=dict(recording.dropped))
+    return 0
+
+
+def _record_into(path: Path, topics: Sequence[str], use_sim_time: bool, stop: Stop) -> Recording:
+    """The node, recording into the bag ``path`` until stopped; the bag closed (or aborted, on
+    an error)."""
+    writer = Writer(path, version=9, storage_plugin=StoragePlugin.MCAP)
     rclpy = ros("rclpy")
     context = ros("rclpy.context").Context()
     rclpy.init(context=context, signal_handler_options=ros("rclpy.signals").SignalHandlerOptions.NO)
@@ -191,32 +206,20 @@ def record(bag: Path, topics: Sequence[str], use_sim_time: bool) -> int:
         node = rclpy.create_node(RECORDER_NODE, context=context, parameter_overrides=[sim_time])
         executor = ros("rclpy.executors").SingleThreadedExecutor(context=context)
         executor.add_node(node)
-        writer.open()
         recording = Recording(node, writer, topics, use_sim_time)
+        writer.open()
         try:
             emit("ready", node=RECORDER_NODE)
             _loop(executor, recording, stop)
-            writer.close()
-        except BaseException as error:
+        except BaseException:
             writer.abort()
-            shutil.rmtree(partial, ignore_errors=True)  # no half-written bag anywhere
-            if not isinstance(error, RosGraphError):
-                raise
-            log(f"error: {error.message}")
-            emit("error", message=error.message)
-            return 2
+            raise
+        writer.close()
         executor.shutdown()
         node.destroy_node()
+        return recording
     finally:
         context.try_shutdown()
-    if bag.exists():
-        emit("error", message=f"{bag} appeared while recording: the bag is left in {partial}")
-        return 2
-    (partial / bag.name).rename(bag)
-    partial.rmdir()
-    log(f"closed {bag}: {sum(recording.written.values())} messages")
-    emit("closed", written=dict(recording.written), dropped=dict(recording.dropped))
-    return 0
 
 
 def _loop(executor: Any, recording: Recording, stop: Stop) -> None:
