@@ -30,7 +30,7 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from types import TracebackType
 from typing import IO, Any
@@ -142,7 +142,7 @@ class Ros2Recorder:
         with self._lock:
             return next((e for e in reversed(self.events) if e.get("event") == kind), None)
 
-    def _wait(self, done: Any, timeout: float, what: str) -> None:
+    def _wait(self, done: Callable[[], bool], timeout: float, what: str) -> None:
         deadline = time.monotonic() + timeout
         while not done():
             self.check_running()
