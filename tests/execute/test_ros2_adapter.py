@@ -1,39 +1,31 @@
-"""The ROS 2 adapter without ROS 2: what it sends to Nav2, how it records, and how it says rclpy is
+"""The ROS 2 adapter without ROS 2: what it sends to Nav2, and how it says rclpy is
 missing.  No live ROS 2 graph runs here (rclpy cannot be installed on this machine): the live
 part (execute/ros2/live.py) is checked only for its refusal without rclpy.
 
 Reference values are written by hand: scenario_c's poses from examples/brsu_building_c
 (environment.exsce, tasks/*.exsce), quaternions of rotations worked out on paper, GoalStatus codes
 from action_msgs/msg/GoalStatus.msg (UNKNOWN 0, ACCEPTED 1, EXECUTING 2, CANCELING 3, SUCCEEDED 4,
-CANCELED 5, ABORTED 6), and ``ros2 bag record``'s arguments as Humble's and Jazzy's ros2bag
-declare them (ros2bag/verb/record.py, restated below as argparse parsers)."""
+CANCELED 5, ABORTED 6).  The recorder is tested on a live graph in test_ros2_recorder.py."""
 
 from __future__ import annotations
 
-import argparse
 import math
-import os
 import subprocess
 import sys
-import time
 from dataclasses import replace
 from pathlib import Path
 
 import pytest
-import yaml
 
 from exsce_dsl.errors import ExsceError, RosGraphError
 from exsce_dsl.execute.mission import schedule
 from exsce_dsl.execute.outcomes import GoalOutcome
 from exsce_dsl.execute.ros2 import (
-    Ros2Recorder,
     execute_ros2,
     follow_waypoints_goals,
     goal_outcome,
     nav2_actions,
     navigate_to_pose_goals,
-    qos_overrides,
-    record_command,
     waypoint_outcomes,
 )
 from exsce_dsl.lang import load_spec
@@ -214,149 +206,3 @@ def test_follow_waypoints_results_map_onto_each_waypoint() -> None:
         waypoint_outcomes(2, 3, [], 1)
     with pytest.raises(ExsceError, match="outside"):
         waypoint_outcomes(4, 3, [3], 2)
-
-
-def _humble_parser() -> argparse.ArgumentParser:
-    """Humble's ``ros2 bag record`` arguments that the command uses (ros2bag 0.15): topics are positional."""
-    parser = argparse.ArgumentParser(exit_on_error=False)
-    parser.add_argument("topics", nargs="*", default=None)
-    parser.add_argument("-o", "--output")
-    parser.add_argument("-s", "--storage", default="sqlite3")
-    parser.add_argument("--include-hidden-topics", action="store_true")
-    parser.add_argument("--qos-profile-overrides-path", type=argparse.FileType("r"))
-    parser.add_argument("--use-sim-time", action="store_true")
-    return parser
-
-
-def _jazzy_parser() -> argparse.ArgumentParser:
-    """Jazzy's (ros2bag 0.26): positional topics deprecated, beside ``--topics``."""
-    parser = argparse.ArgumentParser(exit_on_error=False)
-    parser.add_argument("-o", "--output")
-    parser.add_argument("-s", "--storage", choices=["sqlite3", "mcap"], default="mcap")
-    group = parser.add_mutually_exclusive_group()
-    group.add_argument("topics_positional", nargs="*", default=[])
-    group.add_argument("--topics", nargs="+", default=[])
-    parser.add_argument("--include-hidden-topics", action="store_true")
-    parser.add_argument("--qos-profile-overrides-path", type=argparse.FileType("r"))
-    parser.add_argument("--use-sim-time", action="store_true")
-    return parser
-
-
-def test_the_recorder_command_for_jazzy(tmp_path: Path) -> None:
-    overrides = tmp_path / "qos.yaml"
-    overrides.write_text("{}\n")
-    command = record_command(tmp_path / "bag", TOPICS, "jazzy", overrides=overrides)
-    assert command == (
-        "ros2", "bag", "record", "-s", "mcap", "-o", str(tmp_path / "bag"),
-        "--include-hidden-topics", "--qos-profile-overrides-path", str(overrides), "--topics", *TOPICS,
-    )  # fmt: skip
-    args = _jazzy_parser().parse_args(command[3:])
-    assert (args.topics, args.topics_positional, args.storage) == (TOPICS, [], "mcap")
-    assert args.include_hidden_topics and not args.use_sim_time
-    args.qos_profile_overrides_path.close()
-
-
-def test_the_recorder_command_for_humble_takes_its_topics_as_arguments(tmp_path: Path) -> None:
-    command = record_command(tmp_path / "bag", ["/tf", "/tiago1/scan"], "humble", use_sim_time=True)
-    assert command == (
-        "ros2", "bag", "record", "-s", "mcap", "-o", str(tmp_path / "bag"), "--use-sim-time", "/tf", "/tiago1/scan",
-    )  # fmt: skip
-    args = _humble_parser().parse_args(command[3:])
-    assert (args.topics, args.output, args.storage) == (
-        ["/tf", "/tiago1/scan"],
-        str(tmp_path / "bag"),
-        "mcap",
-    )
-    assert args.use_sim_time and not args.include_hidden_topics
-    # the same distro names, as ROS_DISTRO may spell them
-    assert record_command(tmp_path / "bag", ["/tf"], "Humble")[-1] == "/tf"
-    assert record_command(tmp_path / "bag", ["/tf"], "kilted")[-2:] == ("--topics", "/tf")
-
-
-def test_latched_topics_are_recorded_transient_local() -> None:
-    latched = {
-        "history": "keep_last",
-        "depth": 100,
-        "reliability": "reliable",
-        "durability": "transient_local",
-    }
-    assert qos_overrides(["/tf", "/tf_static", "/tiago1/tf_static", "/tiago1/tf_static_x"]) == {
-        "/tf_static": latched,
-        "/tiago1/tf_static": latched,
-    }
-    assert qos_overrides(["/tf", "/odom"]) == {}
-
-
-@pytest.mark.parametrize("topics", [[], ["tf"], ["/a b"], ["/{ns}/odom"], ["/tiago1/"], ["/1st"]])
-def test_recorded_topics_must_be_absolute_ros2_names(topics: list[str], tmp_path: Path) -> None:
-    with pytest.raises(ExsceError):
-        record_command(tmp_path / "bag", topics, "jazzy")
-
-
-def test_the_recorder_without_ros2_says_to_source_a_distro(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    monkeypatch.setenv("PATH", str(tmp_path))
-    monkeypatch.delenv("ROS_DISTRO", raising=False)
-    with pytest.raises(RosGraphError, match="source a ROS 2 distro's setup"):
-        Ros2Recorder(tmp_path / "bag", TOPICS).start()
-    assert not (tmp_path / "bag").exists()
-
-
-STAND_IN_ROS2 = """\
-#!/bin/sh
-# A stand-in for `ros2 bag record` (ROS 2 cannot be installed here): it makes the bag folder,
-# and on SIGINT writes metadata.yaml and exits, as rosbag2 closes a bag.
-while [ "$1" != "-o" ]; do shift; done
-mkdir "$2"
-trap 'echo "rosbag2_bagfile_information: {}" > "$2/metadata.yaml"; exit 0' INT
-echo "$@" > "$2.args"
-while :; do sleep 0.05; done
-"""
-
-
-def test_the_recorder_stops_with_sigint_and_waits_for_the_closed_bag(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    """The process handling only, against a stand-in shell script for ``ros2`` (not rosbag2)."""
-    tools = tmp_path / "bin"
-    tools.mkdir()
-    (tools / "ros2").write_text(STAND_IN_ROS2)
-    (tools / "ros2").chmod(0o755)
-    monkeypatch.setenv("PATH", f"{tools}{os.pathsep}{os.environ['PATH']}")
-    monkeypatch.setenv("ROS_DISTRO", "jazzy")
-    bag = tmp_path / "runs" / "run_1"
-    with Ros2Recorder(bag, TOPICS) as recorder:
-        process = recorder.process
-        assert process is not None and process.poll() is None
-        deadline = time.monotonic() + 10.0
-        while not (tmp_path / "runs" / "run_1.args").exists():  # its trap is set: SIGINT is caught
-            assert time.monotonic() < deadline, "the stand-in did not start"
-            time.sleep(0.05)
-        assert "--topics /clock /tf /tf_static" in (tmp_path / "runs" / "run_1.args").read_text()
-    assert process.returncode == 0
-    assert (bag / "metadata.yaml").read_text().startswith("rosbag2_bagfile_information")
-    overrides = yaml.safe_load((tmp_path / "runs" / "run_1.qos.yaml").read_text())
-    assert overrides == qos_overrides(TOPICS) and list(overrides) == ["/tf_static"]
-    with pytest.raises(RosGraphError, match="exists"):
-        Ros2Recorder(bag, TOPICS).start()
-
-
-def test_a_recorder_that_fails_to_start_is_named_with_its_log(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    """A stand-in ``ros2`` that fails as Humble's does without the MCAP storage plugin."""
-    tools = tmp_path / "bin"
-    tools.mkdir()
-    (tools / "ros2").write_text("#!/bin/sh\necho \"storage plugin 'mcap' is not available\" >&2\nexit 1\n")
-    (tools / "ros2").chmod(0o755)
-    monkeypatch.setenv("PATH", f"{tools}{os.pathsep}{os.environ['PATH']}")
-    monkeypatch.setenv("ROS_DISTRO", "humble")
-    recorder = Ros2Recorder(tmp_path / "run_1", ["/tf"])
-    recorder.start()
-    assert recorder.process is not None and recorder.process.wait(10) == 1
-    with pytest.raises(RosGraphError, match=r"not running \(exit 1\).*run_1\.record\.log"):
-        recorder.check_running()
-    assert "'mcap' is not available" in recorder.log.read_text()
-    with pytest.raises(RosGraphError, match="ended early"):
-        recorder.stop()

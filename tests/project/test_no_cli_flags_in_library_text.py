@@ -31,9 +31,7 @@ WHY: dict[str, str] = {
         "monitor_code.py:exscec"
     ),
     "the command line of another program exsce starts, with its own options, not exscec's: "
-    "`ros2 bag record`, exsce's ROS 1 dispatcher node": (
-        "execute/ros2/recorder.py:* execute/ros1/navigator.py:* execute/ros1/nodes/dispatcher_node.py:*"
-    ),
+    "exsce's ROS 1 dispatcher node": "execute/ros1/navigator.py:* execute/ros1/nodes/dispatcher_node.py:*",
     "generators registered with textX, whose own command line (`textx generate`) has these options": (
         "codegen/registration.py:--scenario rdf/registration.py:--overwrite"
     ),

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import importlib
 import time
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from types import TracebackType
 from typing import Any
@@ -118,6 +118,10 @@ class Ros2DispatcherNode:
             if time.monotonic() > deadline:
                 raise RosGraphError(f"no time on /clock after {timeout:g} s: is the simulator running?")
             self.executor.spin_once(timeout_sec=WAIT_SLICE)
+
+    def published(self, topics: Sequence[str]) -> list[str]:
+        """Those of ``topics`` that the node sees a publisher of."""
+        return [t for t in topics if self.node.count_publishers(t) > 0]
 
     def navigator(self) -> Ros2Navigator:
         return Ros2Navigator(self.modules, self.executor, self.clients, self.clock)

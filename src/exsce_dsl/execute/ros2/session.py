@@ -86,8 +86,9 @@ def _one_run(
             node.wait_for_servers(options.server_timeout)
             node.wait_for_clock(CLOCK_WAIT)
             log = out / LOGS / f"record-{run_id[:8]}.log"
-            with Ros2Recorder(staged.bag, recorded_topics(scenario), node.use_sim_time, log=log) as recorder:
-                recorder.wait_subscribed(options.server_timeout)
+            topics = recorded_topics(scenario)
+            with Ros2Recorder(staged.bag, topics, node.use_sim_time, log=log) as recorder:
+                recorder.wait_subscribed(options.server_timeout, node.published(topics))
                 navigator = node.navigator()
                 try:
                     mission = dispatch(plan, navigator, node.clock, options.policy, interrupted)
