@@ -29,7 +29,7 @@ from rosbags.typesys import Stores, get_typestore
 from exsce_dsl.errors import ExsceError, RosGraphError
 from exsce_dsl.execute.ros2 import RECORDER_NODE, Ros2Recorder
 from exsce_dsl.execute.ros2.record_types import adapted_qos
-from exsce_dsl.execute.ros2.recorder import partial_folder
+from exsce_dsl.execute.ros2.recorder import DISCOVERY, partial_folder
 from exsce_dsl.runs import PROV_TOPIC
 
 from tests.support.paths import ROOT
@@ -461,3 +461,17 @@ def test_a_recorder_whose_starter_died_closes_its_bag_and_ends(
         time.sleep(0.05)
     assert metadata(bag)["message_count"] == 0 and not partial_folder(bag).exists()
     assert "the process that started the recorder is gone" in (tmp_path / "run_7.record.log").read_text()
+
+
+def test_without_the_published_topics_the_recorder_is_given_time_to_discover_the_graph(
+    ros2_env: dict[str, str], tmp_path: Path
+) -> None:
+    """Just started, the recorder may not see the graph's publishers yet: a caller that does not
+    say which topics are published does not get an answer before DISCOVERY seconds."""
+    with Ros2Recorder(tmp_path / "run_8", ["/tiago1/odom"]) as recorder:
+        with pytest.raises(RosGraphError, match="not started"):
+            Ros2Recorder(tmp_path / "run_9", ["/tf"]).wait_subscribed()
+        started = time.monotonic()
+        recorder.wait_subscribed(20.0)
+        assert time.monotonic() - started >= DISCOVERY - 0.1  # from when it was ready, a moment before
+    assert recorder.written == {"/tiago1/odom": 0}

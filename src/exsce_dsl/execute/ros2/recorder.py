@@ -50,6 +50,9 @@ START_WAIT = 30.0
 STOP_WAIT = 30.0
 """Seconds the recorder may take to close its bag after SIGINT."""
 POLL = 0.02
+DISCOVERY = 1.0
+"""Seconds :meth:`Ros2Recorder.wait_subscribed` gives the recorder's discovery of the graph when
+the caller does not say which topics are published."""
 
 _TOPIC = re.compile(r"(/[A-Za-z_][A-Za-z0-9_]*)+")
 
@@ -95,6 +98,7 @@ class Ros2Recorder:
         self._reader: threading.Thread | None = None
         self._lock = threading.Lock()
         self._ended = False
+        self._ready_at: float | None = None
 
     def start(self, timeout: float = START_WAIT) -> None:
         """Start the recorder; return once its node is up and its bag open."""
@@ -127,6 +131,7 @@ class Ros2Recorder:
         except BaseException:
             self._kill()
             raise
+        self._ready_at = time.monotonic()
 
     def _read(self, stream: IO[str]) -> None:
         for line in stream:
@@ -161,16 +166,20 @@ class Ros2Recorder:
 
     def wait_subscribed(self, timeout: float = 10.0, published: Sequence[str] = ()) -> None:
         """Return once every topic with a publisher (``published``: those the caller sees,
-        which the recorder's own view of the graph may not hold yet) reaches the recorder;
+        which the recorder's own view of the graph may not hold yet; without them, the recorder
+        is given :data:`DISCOVERY` seconds to see the graph first) reaches the recorder;
         :class:`RosGraphError` naming those that do not within ``timeout`` seconds."""
         unknown = sorted(set(published) - set(self.topics))
         if unknown:
             raise RosGraphError(f"the ROS 2 recorder does not record {unknown}")
+        if self._ready_at is None:
+            raise RosGraphError("the ROS 2 recorder was not started")
+        settled = self._ready_at + (0.0 if published else DISCOVERY)
         deadline = time.monotonic() + timeout
         while True:
             self.check_running()
             missing = self.unsubscribed(published)
-            if not missing and self._last("status") is not None:
+            if not missing and self._last("status") is not None and time.monotonic() >= settled:
                 return
             if time.monotonic() > deadline:
                 raise RosGraphError(
