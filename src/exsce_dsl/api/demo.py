@@ -143,6 +143,20 @@ LIVE_STEPS: tuple[DemoStep, ...] = (
 """``exscec demo --ros1``: the method's loop on a live ROS 1 graph (a roscore of the demo's own),
 the robots played by the stand-in in move_base's convention; ``docs/live.md`` has the same steps."""
 
+
+def _on_ros2(step: DemoStep) -> DemoStep:
+    """A live step on ROS 2: Nav2's goals and exsce's recorder, each run's bag a folder."""
+    title = step.title.replace("live ROS 1 graph", "live ROS 2 graph").replace("move_base", "Nav2")
+    title = title.replace("rosbag record records", "exsce's recorder records")
+    command = step.command.replace("--ros1", "--ros2").replace("runs/baseline/*.bag", "runs/baseline/*/")
+    return replace(step, title=title, command=command)
+
+
+LIVE_ROS2_STEPS: tuple[DemoStep, ...] = tuple(_on_ros2(step) for step in LIVE_STEPS)
+"""``exscec demo --ros2``: the same loop on the live ROS 2 graph of ``$ROS_DOMAIN_ID``, the robots
+played by the Nav2 stand-in (the example's robot types on Nav2's convention), each run recorded by
+exsce's recorder into a rosbag2 MCAP folder."""
+
 _ENDINGS = {0: "passed", 1: "failed", 2: "refused (bad input)", 3: "inconclusive"}
 """What a verify step's exit status says of the runs it judged (the codes of ``exscec --help``)."""
 

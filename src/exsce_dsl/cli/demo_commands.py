@@ -7,6 +7,7 @@ command line runs in-process, and what happens is printed.
 
 from __future__ import annotations
 
+import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -16,18 +17,24 @@ import click
 from exsce_dsl.cli.common import ExitCode, exit_status, reports_errors
 
 
-def _refuse_with_ros1(ros1: bool, convention: bool, simulator: bool) -> None:
-    """--ros1 plays exsce's stand-in in move_base's convention: no other convention or simulator."""
-    if ros1 and convention:
-        raise click.UsageError("--ros1 plays the robots in move_base's convention: leave out --convention")
-    if ros1 and simulator:
-        raise click.UsageError("--ros1 plays exsce's stand-in robots: leave out --simulator and --behaviour")
+def _refuse_with_ros1(ros1: bool, convention: bool, simulator: bool, ros2: bool = False) -> None:
+    """--ros1 (--ros2) plays exsce's stand-in in move_base's (Nav2's) convention: no other
+    convention or simulator."""
+    if ros1 and ros2:
+        raise click.UsageError("--ros1 or --ros2: one live graph")
+    flag = "--ros2" if ros2 else "--ros1"
+    if (ros1 or ros2) and convention:
+        raise click.UsageError(f"{flag} plays the robots in its own convention: leave out --convention")
+    if (ros1 or ros2) and simulator:
+        raise click.UsageError(f"{flag} plays exsce's stand-in robots: leave out --simulator and --behaviour")
 
 
-def _where(ros1: bool, convention: str, simulator: str) -> str:
+def _where(ros1: bool, convention: str, simulator: str, ros2: bool = False) -> str:
     """What the demo's heading says of where its runs are played."""
     if ros1:
         return " on a live ROS 1 graph"
+    if ros2:
+        return f" on the live ROS 2 graph of domain {os.environ.get('ROS_DOMAIN_ID') or 0}"
     robots = "" if convention == "method" else f" (robots on {convention}'s topics)"
     return robots + ("" if simulator == "kinematic" else f", runs played by {simulator}")
 
@@ -70,6 +77,13 @@ def run_in_process(argv: Sequence[str]) -> int:
     "sh scripts/install-ros1).",
 )
 @click.option(
+    "--ros2",
+    is_flag=True,
+    help="The loop on the live ROS 2 graph of $ROS_DOMAIN_ID instead: exsce's Nav2 stand-in robots "
+    "serving NavigateToPose goals, exscec execute --ros2 recording and judging each run (needs "
+    "ROS 2: pip install 'exsce[ros2]' && sh scripts/install-ros2).",
+)
+@click.option(
     "--simulator",
     default="kinematic",
     show_default=True,
@@ -87,6 +101,7 @@ def demo(
     setup_only: bool,
     convention: str,
     ros1: bool,
+    ros2: bool,
     simulator: str,
     behaviour: str | None,
 ) -> None:
@@ -107,7 +122,10 @@ def demo(
     dispatched as move_base goals and recorded by rosbag record, baseline
     runs ingested, a new run and one with tiago1 driving too fast executed
     and judged: exscec demo live-demo --ros1 (about three minutes; the test
-    suite runs it in tests/execute/test_live_loop.py).
+    suite runs it in tests/execute/test_live_loop.py).  With --ros2 the same
+    loop runs on a live ROS 2 graph: the stand-in's robots are Nav2's
+    (NavigateToPose), exsce's recorder writes each run's rosbag2 MCAP folder
+    (tests/execute/test_ros2_live_loop.py).
     Exits 0 when every step ended as expected (the faulty run failing, the
     others passing), 1 otherwise.
 
@@ -116,8 +134,10 @@ def demo(
       exscec demo exsce-demo
       exscec demo my-project --setup-only   # only copy the example, to follow docs/tutorial.md
       exscec demo irsim-demo --simulator irsim   # the runs played by IR-SIM
+      exscec demo ros2-demo --ros2   # on a live ROS 2 graph (ROS 2 Jazzy's wheels)
     """
     from exsce_dsl.api.demo import (
+        LIVE_ROS2_STEPS,
         LIVE_STEPS,
         STEPS,
         DemoStep,
@@ -129,19 +149,21 @@ def demo(
         summary_lines,
     )
 
-    _refuse_with_ros1(ros1, convention != "method", simulator != "kinematic" or behaviour is not None)
+    simulated = simulator != "kinematic" or behaviour is not None
+    _refuse_with_ros1(ros1, convention != "method", simulated, ros2)
     target = Path(folder)
-    set_up(target, "move_base" if ros1 else convention)
+    set_up(target, "move_base" if ros1 else "nav2" if ros2 else convention)
     hint = command_hint(Path.cwd())
     if setup_only:
         click.echo(f"copied the example scenarios into {target / 'scenarios'}", err=True)
         if hint:
             click.echo(hint, err=True)
         return
-    steps = LIVE_STEPS if ros1 else STEPS
+    steps = LIVE_STEPS if ros1 else LIVE_ROS2_STEPS if ros2 else STEPS
     if simulator != "kinematic":
         steps = simulated_by(steps, simulator, behaviour)
-    click.secho(f"exsce demo in {target.resolve()}{_where(ros1, convention, simulator)}", bold=True, err=True)
+    where = _where(ros1, convention, simulator, ros2)
+    click.secho(f"exsce demo in {target.resolve()}{where}", bold=True, err=True)
     if hint:
         click.echo(f"{hint}, then 'cd {folder}'", err=True)
 
@@ -156,7 +178,7 @@ def demo(
             run = run_steps(target, run_in_process, store_url, steps, on_step=announce)
     else:
         run = run_steps(target, run_in_process, store_url, steps, on_step=announce)
-    _say_summary(summary_lines(run, "docs/live.md" if ros1 else "docs/tutorial.md"), hint)
+    _say_summary(summary_lines(run, "docs/live.md" if ros1 or ros2 else "docs/tutorial.md"), hint)
     if not run.as_expected:
         sys.exit(ExitCode.FAILED)
 

@@ -25,9 +25,13 @@ def workers(jobs: int, tasks: int, dask_address: str | None = None) -> Iterator[
     if jobs <= 1 or tasks <= 1:
         yield map
         return
+    import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
-    with ProcessPoolExecutor(max_workers=min(jobs, tasks, os.cpu_count() or 1)) as pool:
+    # forkserver, not fork: this process may hold threads (rclpy's and Fast DDS's after a live run
+    # in the same process, as the demo's steps are), and a child forked from them can crash
+    context = multiprocessing.get_context("forkserver")
+    with ProcessPoolExecutor(max_workers=min(jobs, tasks, os.cpu_count() or 1), mp_context=context) as pool:
         yield pool.map
 
 

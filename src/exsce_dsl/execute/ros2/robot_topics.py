@@ -28,6 +28,8 @@ STATIC_EVERY, CORRECTION_EVERY, AMCL_EVERY, FEEDBACK_EVERY = 50, 5, 25, 10
 feedback (5 Hz)."""
 CMD_VEL_PERIOD_NS = 50_000_000
 """20 Hz."""
+PLAN_SPACING = 0.05
+"""Metres between two poses of a published global plan (a grid planner's cell)."""
 LOCALISATION_NOISE, LOCALISATION_YAW_NOISE = 0.02, 0.01
 FOOTPRINT_HEIGHT, LASER_HEIGHT = 0.1, 0.2
 Row = Sequence[float] | np.ndarray
@@ -122,6 +124,25 @@ class RobotMessages:
         )
         message.header.stamp, message.header.frame_id = stamp, "base_laser_link"
         return message
+
+    def plan(self, stamp: Any, x: np.ndarray, y: np.ndarray, yaw: float) -> Any:
+        """The global plan (nav_msgs/Path in ``map``) along ``x, y``: a pose every
+        :data:`PLAN_SPACING` metres facing along it, the last one the target with its heading
+        ``yaw``, as Nav2's planner publishes on ``plan`` when a goal comes."""
+        steps = np.hypot(np.diff(x), np.diff(y))
+        along = np.concatenate([[0.0], np.cumsum(steps)])
+        at = np.append(np.arange(0.0, along[-1], PLAN_SPACING), along[-1])
+        px, py = np.interp(at, along, x), np.interp(at, along, y)
+        headings = np.append(np.arctan2(np.diff(py), np.diff(px)), yaw)
+        path = self.msgs["nav_msgs"].Path()
+        path.header.stamp, path.header.frame_id = stamp, "map"
+        for px_i, py_i, heading in zip(px, py, headings, strict=True):
+            pose = self.msgs["geometry_msgs"].PoseStamped()
+            pose.header.stamp, pose.header.frame_id = stamp, "map"
+            pose.pose.position.x, pose.pose.position.y = float(px_i), float(py_i)
+            set_yaw(pose.pose.orientation, float(heading))
+            path.poses.append(pose)
+        return path
 
     def static(self, stamp: Any) -> Any:
         return self.msgs["tf2_msgs"].TFMessage(

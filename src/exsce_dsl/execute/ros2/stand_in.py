@@ -196,6 +196,8 @@ class Ros2StandIn:
         group = importlib.import_module("rclpy.callback_groups").ReentrantCallbackGroup()
         self.servers = []
         for robot in self.robots.values():
+            plan = expand_topic("/{ns}/plan", robot.namespace)
+            robot.publishers["plan"] = self.node.create_publisher(msgs["nav_msgs"].Path, plan, DEPTH)
             for name in TOPICS:
                 depth = latched if name == "tf_static" else DEPTH
                 topic = expand_topic("/{ns}/" + name, robot.namespace)
@@ -261,7 +263,8 @@ class Ros2StandIn:
                 self._stop(robot)
                 robot.ends[id(preempted)] = "aborted"
             robot.handle, robot.goal, robot.planning = handle, goal, True
-            when = self._time_of(self.published) / 1e9
+            when_ns = self._time_of(self.published)
+            when = when_ns / 1e9
         try:
             with self.planning:
                 leg = self.fleet.leg(robot.name, goal, target.position.x, target.position.y, yaw, when)
@@ -269,6 +272,10 @@ class Ros2StandIn:
             with self.lock:
                 robot.handle, robot.planning = None, False
             return self._end(robot, handle, goal, "aborted", when)
+        if leg.succeeded:  # Nav2's planner publishes the global plan of a goal it can reach
+            path = self.topics.plan(self.topics.stamp(when_ns), leg.truth.x, leg.truth.y, yaw)
+            with self.lock:
+                self._publish(robot, "plan", path)
         with self.lock:
             if robot.handle is handle:
                 robot.leg, robot.rows, robot.start = leg, leg.rows(), self.published + 1
