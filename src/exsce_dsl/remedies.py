@@ -76,7 +76,7 @@ VERIFY_THE_RUN = "verify the run"
 """A run without verdicts."""
 VERIFY_AGAIN = "verifying the run judges it again{about}"
 """A replaced run whose verdicts were dropped (``about``: what follows in the message, or nothing)."""
-REPRODUCE_IT = "verify the runs {about[0]}/*.bag against {about[1]}"
+REPRODUCE_IT = "verify the runs {about[0]} against {about[1]}"
 REPLAY_IT = "simulate {about[0]} again with seed {about[1]} ({about[2]} runs): the same bags"
 """A campaign's smallest violating derivation, played again by its seed by the kinematic executor
 (``about``: its file, the seed, the runs)."""

@@ -21,7 +21,6 @@ from exsce_dsl.errors import ExsceError, RosGraphError
 from exsce_dsl.execute.mission import schedule
 from exsce_dsl.execute.outcomes import GoalOutcome
 from exsce_dsl.execute.ros2 import (
-    execute_ros2,
     follow_waypoints_goals,
     goal_outcome,
     nav2_actions,
@@ -43,7 +42,6 @@ C022_W002 = (54.497589111328125, 31.52023696899414, 2.269)
 C018_W002 = (46.25560760498047, 21.586545944213867, -0.641)
 C025_W002 = (43.432926177978516, 38.493873596191406, 0.925)
 
-TOPICS = ["/clock", "/tf", "/tf_static", "/tiago1/odom", "/tiago1/navigate_to_pose/_action/status"]
 
 
 @pytest.fixture(scope="module")
@@ -75,12 +73,16 @@ def test_importing_the_adapter_needs_no_rclpy() -> None:
 def test_the_live_entry_point_says_rclpy_is_missing_and_how_to_get_it(
     scenario_c, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    monkeypatch.setitem(sys.modules, "rclpy", None)  # not importable (as here), even where ROS 2 is sourced
+    """Where rclpy cannot be imported, execute --ros2 says how to get it, before anything starts."""
+    from exsce_dsl.api import execute_ros2
+
+    monkeypatch.setitem(sys.modules, "rclpy", None)  # not importable, as on a machine without ROS 2
     with pytest.raises(RosGraphError) as raised:
-        execute_ros2(scenario_c, tmp_path / "run", TOPICS)
+        execute_ros2(scenario_c, tmp_path / "run")
     message = str(raised.value)
-    assert "rclpy" in message and "source" in message and "setup.bash" in message
-    assert list(tmp_path.iterdir()) == []  # nothing started, nothing written
+    assert "rclpy" in message and "exsce[ros2]" in message and "scripts/install-ros2" in message
+    assert [p.name for p in tmp_path.iterdir()] in ([], ["run"])
+    assert not list(tmp_path.rglob("*.prov.json")) and not list(tmp_path.rglob("metadata.yaml"))
 
 
 def test_scenario_c_sends_one_navigate_to_pose_goal_per_waypoint_in_each_robots_namespace(scenario_c) -> None:

@@ -120,7 +120,9 @@ class Exploration:
             lines.append(f"  smallest derivation ({counted(count, 'step')}): {steps}")
             if file is not None:
                 bags = result.folder / "runs" / shrinking.minimal
-                lines.append(Remedied("  reproduce", REPRODUCE_IT, (str(bags), str(file))).said(wording))
+                # ROS 1 bags are files; ROS 2 bags (--executor ros2) folders
+                pattern = f"{bags}/*.bag" if any(bags.glob("*.bag")) else f"{bags}/*/"
+                lines.append(Remedied("  reproduce", REPRODUCE_IT, (pattern, str(file))).said(wording))
                 if self.replay is not None:
                     seed = scenario_seed(record.plan.seed, shrinking.minimal)
                     played = (str(file), str(seed), str(record.plan.runs_per_scenario), *self.replay)

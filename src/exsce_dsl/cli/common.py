@@ -205,7 +205,7 @@ REMEDIES = {
     BUILD_A_BASELINE: "{problem}: build its baseline first (exscec baseline <spec> --scenario-id {about})",
     VERIFY_THE_RUN: "{problem} (exscec verify RUN)",
     VERIFY_AGAIN: "{problem} (exscec verify judges it again){about}",
-    REPRODUCE_IT: "{problem}: exscec verify {about[0]}/*.bag --scenario {about[1]}",
+    REPRODUCE_IT: "{problem}: exscec verify {about[0]} --scenario {about[1]}",
     REPLAY_IT: "{problem}: exscec simulate {about[0]} --seed {about[1]} --runs {about[2]} -o DIR",
     REPLAY_IN_IRSIM: (
         "{problem}: exscec simulate {about[0]} --seed {about[1]} --runs {about[2]} --simulator irsim "

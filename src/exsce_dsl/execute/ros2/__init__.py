@@ -5,13 +5,14 @@ and maps their ends onto the core's outcomes; :mod:`.recorder` starts and stops 
 :mod:`.record_node` (an rclpy node writing a rosbag2 MCAP bag with rosbags: no rosbag2), which
 describes each topic's type and QoS with :mod:`.record_types`.
 
-:mod:`.live` is the part that talks to a live graph (:func:`~.live.execute_ros2`,
-:class:`~.live.Ros2Navigator`, :class:`~.live.Ros2Clock`): it imports rclpy only when called and
-raises :class:`~exsce_dsl.errors.RosGraphError` saying how to get it when it is missing.  It is
-not run on a live ROS 2 graph in this project's CI.
+:mod:`.live` (:class:`~.live.Ros2Navigator`, :class:`~.live.Ros2Clock`), :mod:`.dispatcher_node`
+and :mod:`.session` (:func:`~.session.execute_runs_ros2`) talk to a live graph, as do the Nav2
+stand-in robots (:mod:`.stand_in`, :mod:`.robot_topics`): they import rclpy only when called and
+raise :class:`~exsce_dsl.errors.RosGraphError` saying how to get it when it is missing.  The tests
+run them on a live ROS 2 graph of PyPI's Jazzy wheels (``scripts/install-ros2``).
 """
 
-from exsce_dsl.execute.ros2.live import Ros2Clock, Ros2Navigator, execute_ros2, require_rclpy
+from exsce_dsl.execute.ros2.live import Ros2Clock, Ros2Navigator, require_rclpy
 from exsce_dsl.execute.ros2.nav2 import (
     FOLLOW_WAYPOINTS,
     NAVIGATE_TO_POSE,
@@ -39,7 +40,6 @@ __all__ = [
     "Ros2Recorder",
     "StampedPose",
     "bag_counts",
-    "execute_ros2",
     "follow_waypoints_goals",
     "goal_outcome",
     "nav2_actions",

@@ -1,11 +1,12 @@
 """The live ROS 2 part: Nav2 action clients behind the core's ``Navigator`` and ``Clock``.
 
-NOT RUN IN THIS PROJECT'S CI: rclpy cannot be installed here (it comes with a ROS 2 distro, built
-for that distro's Python), so nothing below has met a live ROS 2 graph; what it sends is built
-and tested in :mod:`.nav2`, how the bag is recorded in :mod:`.recorder`.  rclpy and nav2_msgs are
-imported inside :func:`require_rclpy` only, so that importing this module works without them.
+rclpy and nav2_msgs come from ROS 2 Jazzy's wheels (the ``ros2`` extra and
+``scripts/install-ros2``, which builds nav2_msgs) or a sourced ROS 2 distro; they are imported
+inside :func:`require_rclpy` only, so that importing this module works without them.  The node
+that holds the clients is :class:`~.dispatcher_node.Ros2DispatcherNode`; a run is
+:func:`~.session.execute_runs_ros2`.
 
-One rclpy node (``exsce_dispatcher``) holds a ``NavigateToPose`` action client per robot.  It is
+The dispatcher node holds a ``NavigateToPose`` action client per robot.  It is
 spun in the dispatcher's own thread, a slice at a time while :meth:`Ros2Navigator.next_finished`
 waits: goals are sent, and their acceptances and results handled, in that one thread.  (An
 executor spinning on a thread of its own would race ``send_goal_async``, which in Humble's
@@ -17,28 +18,20 @@ from __future__ import annotations
 
 import time
 from collections import deque
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass
-from pathlib import Path
 from types import ModuleType
 from typing import Any
 
 from exsce_dsl.errors import RosGraphError
-from exsce_dsl.execute.dispatcher import dispatch
-from exsce_dsl.execute.mission import schedule
 from exsce_dsl.execute.navigator import Finished
-from exsce_dsl.execute.outcomes import DEFAULT_POLICY, GoalOutcome, MissionRun, Policy
-from exsce_dsl.execute.ros2.nav2 import goal_outcome, nav2_actions, stamped_pose
-from exsce_dsl.execute.ros2.recorder import SOURCE_HINT, Ros2Recorder
-from exsce_dsl.model import Pose, Scenario
+from exsce_dsl.execute.outcomes import GoalOutcome
+from exsce_dsl.execute.ros2.nav2 import goal_outcome, stamped_pose
+from exsce_dsl.execute.ros2.recorder import SOURCE_HINT
+from exsce_dsl.model import Pose
 
-NODE_NAME = "exsce_dispatcher"
-SERVER_WAIT = 10.0
-"""Seconds an action server has to show up before the run fails naming it."""
 CANCEL_WAIT = 2.0
 """Wall seconds a run that stops on an error waits for goals still unanswered, to cancel them."""
-RECORDER_NODE = "rosbag2_recorder"
-"""The node name of ``ros2 bag record``'s recorder (its default)."""
 WAIT_SLICE = 0.05
 """Wall seconds between two looks at the clock while waiting for a goal to end."""
 
@@ -71,8 +64,9 @@ def require_rclpy() -> Ros2Modules:
     except ImportError as exc:
         raise RosGraphError(
             f"the ROS 2 adapter needs rclpy and nav2_msgs, which this Python cannot import ({exc}): "
-            f"{SOURCE_HINT} in the shell that runs exscec, with a Python of the distro's version "
-            "(3.10 for Humble, 3.12 for Jazzy); rclpy is not installed with pip"
+            "install ROS 2 Jazzy's wheels into exscec's environment (pip install 'exsce[ros2]', then "
+            f"sh scripts/install-ros2 from exsce's repository), or {SOURCE_HINT} in the shell that runs "
+            "exscec, with a Python of the distro's version (3.12 for Jazzy)"
         ) from None
     return Ros2Modules(rclpy, context, action, executors, parameter, nav2)
 
@@ -156,85 +150,3 @@ class Ros2Navigator:
     def _end(self, goal: int, outcome: GoalOutcome) -> None:
         if goal not in self._cancelled:  # the dispatcher's own cancels are not reported
             self._ended.append(Finished(goal, outcome, self.clock.now()))
-
-
-def wait_for_clock(executor: Any, clock: Ros2Clock, timeout: float = SERVER_WAIT) -> None:
-    """Spin until ``clock`` has a time (under ``use_sim_time``: the first ``/clock`` message)."""
-    deadline = time.monotonic() + timeout
-    while clock.now() <= 0:
-        if time.monotonic() > deadline:
-            raise RosGraphError(f"no time on /clock after {timeout:g} s: is the simulator running?")
-        executor.spin_once(timeout_sec=WAIT_SLICE)
-
-
-def wait_for_recorder(node: Any, executor: Any, recorder: Ros2Recorder, timeout: float = SERVER_WAIT) -> None:
-    """Spin until the recorder (node :data:`RECORDER_NODE`) subscribes to every topic it records
-    that has a publisher, so that it misses nothing of the first goal; an error if it stopped."""
-    deadline = time.monotonic() + timeout
-    while True:
-        recorder.check_running()
-        published = [t for t in recorder.topics if node.count_publishers(t) > 0]
-        missing = [
-            t
-            for t in published
-            if not any(i.node_name == RECORDER_NODE for i in node.get_subscriptions_info_by_topic(t))
-        ]
-        if not missing:
-            return
-        if time.monotonic() > deadline:
-            raise RosGraphError(f"ros2 bag record did not subscribe to {missing} within {timeout:g} s")
-        executor.spin_once(timeout_sec=WAIT_SLICE)
-
-
-def execute_ros2(
-    scenario: Scenario,
-    bag: Path,
-    topics: Sequence[str],
-    policy: Policy = DEFAULT_POLICY,
-    timeout: float | None = None,
-    speeds: Mapping[str, float] | None = None,
-    use_sim_time: bool = False,
-    cancelled: Callable[[], bool] | None = None,
-) -> MissionRun:
-    """Run ``scenario``'s mission on a live ROS 2 graph through each robot's Nav2, with
-    ``ros2 bag record`` of ``topics`` into the MCAP bag folder ``bag`` from before the first goal
-    to after the last.  Raises :class:`RosGraphError` when rclpy is missing (before anything
-    starts) or a robot's ``navigate_to_pose`` server does not answer within :data:`SERVER_WAIT`."""
-    modules = require_rclpy()
-    plan = schedule(scenario, speeds, timeout)
-    robots = {r.id: r for r in scenario.robots}
-    actions = {robot: nav2_actions(robots[robot]).navigate_to_pose for robot in {g.robot for g in plan.goals}}
-    rclpy = modules.rclpy
-    context = modules.context.Context()
-    rclpy.init(context=context)
-    try:
-        sim_time = modules.parameter.Parameter("use_sim_time", value=use_sim_time)
-        node = rclpy.create_node(NODE_NAME, context=context, parameter_overrides=[sim_time])
-        executor = modules.executors.SingleThreadedExecutor(context=context)
-        executor.add_node(node)
-        try:
-            clients = {
-                robot: modules.action.ActionClient(node, modules.nav2.NavigateToPose, name)
-                for robot, name in sorted(actions.items())
-            }
-            for robot, client in clients.items():
-                if not client.wait_for_server(timeout_sec=SERVER_WAIT):
-                    raise RosGraphError(
-                        f"no NavigateToPose action server at {actions[robot]} (robot '{robot}') "
-                        f"after {SERVER_WAIT:g} s: is Nav2 running in that namespace?"
-                    )
-            clock = Ros2Clock(node)
-            wait_for_clock(executor, clock)
-            navigator = Ros2Navigator(modules, executor, clients, clock)
-            with Ros2Recorder(bag, topics, use_sim_time) as recorder:
-                wait_for_recorder(node, executor, recorder)
-                try:
-                    return dispatch(plan, navigator, clock, policy, cancelled)
-                except BaseException:
-                    navigator.cancel_active()  # no robot drives on after we stop
-                    raise
-        finally:
-            executor.shutdown()
-            node.destroy_node()
-    finally:
-        context.try_shutdown()
