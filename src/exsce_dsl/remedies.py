@@ -94,7 +94,10 @@ BUILT_IN_OPTIONS = (
 """Options given to a plug-in executor (``about``: the built-ins and the plug-in)."""
 ONE_EXECUTOR = "give one of faults (the simulator), an executor command and an executor"
 """Several ways of playing a campaign's runs at once."""
-ROS1_OPTIONS = "the stand-in, a master of its own and a speed-up go with the ros1 executor"
+ROS1_OPTIONS = (
+    "the stand-in, a master of its own and a speed-up go with the ros1 executor "
+    "(the stand-in and a speed-up with ros2 too)"
+)
 """Options of the ros1 executor without it."""
 FAULTS_NEED_THE_STAND_IN = "ask for the stand-in"
 """Faults planted by the ros1 executor, which plants them in the stand-in."""

@@ -177,8 +177,9 @@ def test_a_campaign_on_the_live_graph_finds_and_shrinks_the_planted_deadlock(tmp
             "--executor", "ros2", "--stand-in", "--fault", "deadlock-start:tiago1:classroom_c025-w002",
             "-o", "c", cwd=tmp_path, env=_environment(domain, tmp_path / "store"),
         )  # fmt: skip
-    assert done.returncode == 1, done.stderr[-3000:]
-    assert "smallest derivation (1 step): swap_start_poses(robot=tiago1, with=tiago2)" in done.stderr
-    assert "/*/ --scenario" in done.stderr  # the runs to verify again are bag folders
+    said = done.stdout + done.stderr
+    assert done.returncode == 1, said[-3000:]
+    assert "smallest derivation (1 step): swap_start_poses(robot=tiago1, with=tiago2)" in said
+    assert "/*/ --scenario" in said  # the runs to verify again are bag folders
     bags = [p for p in (tmp_path / "c" / "runs").rglob("metadata.yaml")]
     assert bags

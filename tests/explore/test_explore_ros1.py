@@ -48,9 +48,13 @@ def _exscec(project: Path, *args: str) -> subprocess.CompletedProcess[str]:
         (["--executor", "ros1"], "drives exsce's stand-in robots only, for now: give --stand-in"),
         (
             ["--stand-in", "--fault", DEADLOCK],
-            "--stand-in, --start-master and --speed-up go with --executor ros1",
+            "--stand-in, --start-master and --speed-up go with --executor ros1",  # (ros2 too)
         ),
-        (["--executor", "ros2"], "no executor 'ros2'; did you mean 'ros1'?"),
+        (
+            ["--executor", "ros2"],
+            "the ros2 executor drives exsce's stand-in robots only, for now: give --stand-in",
+        ),
+        (["--executor", "ros3"], "no executor 'ros3'; did you mean"),
     ],
 )
 def test_the_ros1_executor_without_its_stand_in_is_refused_before_anything_runs(

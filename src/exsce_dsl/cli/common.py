@@ -216,7 +216,8 @@ REMEDIES = {
         "--fault, --stand-in, --start-master and --speed-up are for the built-in executors {about}"
     ),
     ONE_EXECUTOR: "give one of --fault (the simulator), --executor-command and --executor",
-    ROS1_OPTIONS: "--stand-in, --start-master and --speed-up go with --executor ros1",
+    ROS1_OPTIONS: "--stand-in, --start-master and --speed-up go with --executor ros1 (--stand-in and "
+    "--speed-up with ros2 too)",
     FAULTS_NEED_THE_STAND_IN: (
         "--fault with --executor ros1 plants the fault in exsce's stand-in robots: give --stand-in"
     ),
@@ -403,8 +404,7 @@ def simulator_options(func: F) -> F:
             click.option(
                 "--behaviour",
                 type=click.Choice(["dash", "rvo", "orca", "sfm"]),
-                help="irsim: IR-SIM's behaviour between the path's points [default: rvo] (orca "
-                "needs pyrvo).",
+                help="irsim: IR-SIM's behaviour between the path's points [default: rvo] (orca needs pyrvo).",
             ),
             click.option(
                 "--scans",

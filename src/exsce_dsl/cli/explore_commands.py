@@ -20,7 +20,8 @@ if TYPE_CHECKING:
         failed="a metamorphic relation was violated",
         inconclusive="none was violated, but one was inconclusive: runs that could not judge it "
         "(cut short, not covered by their recordings) could have violated it",
-        interrupted="Ctrl-C (and SIGTERM with --executor ros1): the same command goes on where it stopped",
+        interrupted="Ctrl-C (and SIGTERM with --executor ros1 or ros2): the same command goes on where it "
+        "stopped",
     )
 )
 @click.argument("spec", type=click.Path(dir_okay=False, exists=True))
@@ -59,7 +60,7 @@ if TYPE_CHECKING:
 )  # fmt: skip
 @click.option(
     "--fault", "faults", multiple=True,
-    help="Plant a fault in the simulator, or in the stand-in robots of --executor ros1 --stand-in "
+    help="Plant a fault in the simulator, or in the stand-in robots of --executor ros1|ros2 --stand-in "
     "(repeatable), as exscec simulate --fault: to try a campaign.",
 )  # fmt: skip
 @simulator_options
@@ -70,12 +71,13 @@ if TYPE_CHECKING:
 )
 @click.option(
     "--executor", "plugin",
-    help="Run scenarios with this executor: ros1 (built in: a live ROS 1 graph, with --stand-in) "
+    help="Run scenarios with this executor: ros1 or ros2 (built in: a live ROS 1 or ROS 2 graph, "
+    "with --stand-in) "
     "or an exsce.executors plug-in.",
 )  # fmt: skip
 @click.option(
     "--stand-in", is_flag=True,
-    help="With --executor ros1: exsce's stand-in robots serve the goals, started for each run "
+    help="With --executor ros1|ros2: exsce's stand-in robots serve the goals, started for each run "
     "(the only robots it drives for now).",
 )  # fmt: skip
 @click.option(
@@ -85,7 +87,7 @@ if TYPE_CHECKING:
 )  # fmt: skip
 @click.option(
     "--speed-up", type=click.FloatRange(0, min_open=True),
-    help="With --executor ros1: the stand-in's simulated time runs this many times faster "
+    help="With --executor ros1|ros2: the stand-in's simulated time runs this many times faster "
     "than wall time [default: 5].",
 )  # fmt: skip
 @click.option(
@@ -154,6 +156,11 @@ def explore(**given: Any) -> None:
     stack's robots to each derived scenario's start poses between runs (a
     script that resets your simulator and runs exscec execute --ros1 can
     be an --executor-command).
+
+    With --executor ros2 --stand-in the runs are played on the live ROS 2
+    graph of $ROS_DOMAIN_ID as exscec execute --ros2 --stand-in plays them:
+    Nav2 NavigateToPose goals, exsce's recorder writing each run's rosbag2
+    MCAP folder, exsce's Nav2 stand-in robots serving the goals.
 
     \b
     Examples:

@@ -34,6 +34,7 @@ __all__ = [
     "relation_names",
 ]
 
+
 @dataclass(frozen=True)
 class Judgement:
     passed: bool
