@@ -37,6 +37,7 @@ per run, run ``i`` driving as run ``i`` of ``exscec simulate --seed S``), and it
     python bench/execute.py                       # 3 runs at speed-up 10 and 20 (about 2 min)
     python bench/execute.py --quick               # 1 run at the default speed-up (10)
     python bench/execute.py --runs 3 --speed-up 10 20 40
+    python bench/execute.py --ros2                # and the same on a live ROS 2 graph (bench/execute_ros2.py)
 
 Needs ROS 1 for ``/usr/bin/python3`` (``sh scripts/install-ros1``).  Prints figures; never a
 unit test.
@@ -46,6 +47,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import statistics
 import tempfile
 import time
@@ -385,6 +387,11 @@ def main() -> None:
     )  # fmt: skip
     parser.add_argument("--seed", type=int, default=0, help="the stand-in's seed (default 0)")
     parser.add_argument("--quick", action="store_true", help="1 run at the default speed-up")
+    parser.add_argument(
+        "--ros2",
+        action="store_true",
+        help="also on a live ROS 2 graph (ROS 2 Jazzy's wheels: scripts/install-ros2)",
+    )
     options = parser.parse_args()
     speed_ups = sorted({DEFAULT_SPEED_UP, *options.speed_up})
     if options.quick:
@@ -404,8 +411,33 @@ def main() -> None:
                     scenario, master.uri, folder, options.runs, speed_up, options.seed
                 )
                 print(f"  speed-up {speed_up:g}: {options.runs} run(s) done", flush=True)
+        if options.ros2:
+            ros2 = _ros2_figures(scenario, folder, options.runs, speed_ups, options.seed)
     report(figures)
+    if options.ros2:
+        from execute_ros2 import report_ros2
+
+        rtf = statistics.median(r.rtf for r in figures)
+        for text, met in report_ros2(ros2, rtf, [x for r in figures for x in r.latencies]):
+            print(f"  {'PASS' if met else 'FAIL'}  {text}")
     print(f"\nwall time {time.perf_counter() - began:.0f} s")
+
+
+def _ros2_figures(
+    scenario: Scenario, folder: Path, runs: int, speed_ups: list[float], seed: int
+) -> list[Any]:
+    """The same runs on a live ROS 2 graph, in a DDS domain of their own."""
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from execute_ros2 import execute_ros2_speed_up
+
+    domain = int(os.environ.get("ROS_DOMAIN_ID") or 91)  # not the default 0: a graph of the benchmark's own
+    found: list[Any] = []
+    for speed_up in speed_ups:
+        found += execute_ros2_speed_up(scenario, folder, runs, speed_up, seed, domain)
+        print(f"  ROS 2 (domain {domain}), speed-up {speed_up:g}: {runs} run(s) done", flush=True)
+    return found
 
 
 if __name__ == "__main__":
