@@ -53,23 +53,27 @@ class Client:
 
     def __init__(self) -> None:
         import rclpy
-        from nav2_msgs.action import NavigateToPose
+        from nav2_msgs.action import FollowWaypoints, NavigateToPose
         from nav_msgs.msg import Odometry
         from rclpy.action import ActionClient
         from rclpy.executors import SingleThreadedExecutor
 
-        self.rclpy, self.action = rclpy, NavigateToPose
+        self.rclpy, self.action, self.follow_action = rclpy, NavigateToPose, FollowWaypoints
         self.context = rclpy.Context()
         rclpy.init(context=self.context)
         self.node = rclpy.create_node("exsce_test_client", context=self.context)
         self.clients = {
             r: ActionClient(self.node, NavigateToPose, f"/{r}/navigate_to_pose") for r in ("tiago1", "tiago2")
         }
+        self.followers = {
+            r: ActionClient(self.node, FollowWaypoints, f"/{r}/follow_waypoints")
+            for r in ("tiago1", "tiago2")
+        }
         self.odom: list[Any] = []
         self.node.create_subscription(Odometry, "/tiago1/odom", self.odom.append, 100)
         self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.node)
-        for client in self.clients.values():
+        for client in [*self.clients.values(), *self.followers.values()]:
             assert client.wait_for_server(timeout_sec=30.0)
 
     def send(self, robot: str, x: float, y: float, feedback: list[float] | None = None) -> Any:
@@ -83,11 +87,31 @@ class Client:
         assert handle is not None and handle.accepted
         return handle
 
+    def follow(self, robot: str, points: list[tuple[float, float]], feedback: list[int]) -> Any:
+        goal = self.follow_action.Goal()
+        from geometry_msgs.msg import PoseStamped
+
+        for x, y in points:
+            stamped = PoseStamped()
+            stamped.header.frame_id = "map"
+            stamped.pose.position.x, stamped.pose.position.y = x, y
+            goal.poses.append(stamped)
+        sent = self.followers[robot].send_goal_async(
+            goal, lambda m: feedback.append(m.feedback.current_waypoint)
+        )
+        self.executor.spin_until_future_complete(sent, timeout_sec=10.0)
+        handle = sent.result()
+        assert handle is not None and handle.accepted
+        return handle
+
     def result(self, handle: Any) -> int:
+        return int(self.outcome(handle).status)
+
+    def outcome(self, handle: Any) -> Any:
         future = handle.get_result_async()
         self.executor.spin_until_future_complete(future, timeout_sec=GOAL_WAIT)
         assert future.done()
-        return int(future.result().status)
+        return future.result()
 
     def close(self) -> None:
         self.executor.shutdown()
@@ -152,5 +176,32 @@ def test_a_planted_skip_waypoint_fault_aborts_the_robots_first_goal(
         try:
             assert client.result(client.send("tiago2", target.x, target.y)) == 6  # ABORTED
             assert client.result(client.send("tiago2", target.x, target.y)) == 4
+        finally:
+            client.close()
+
+
+def test_a_follow_waypoints_goal_drives_its_poses_in_order_and_a_failed_one_is_missed(
+    ros2_env: dict[str, str], spec_c: Any
+) -> None:
+    """tiago1 follows delivery_a's waypoints (SUCCEEDED, feedback current_waypoint 0, 1, 2, no
+    waypoint missed); with ``skip-waypoint:tiago2`` planted, tiago2's FollowWaypoints goal stops at
+    its first waypoint: ABORTED, that waypoint in missed_waypoints."""
+    scenario, _ = spec_c
+    points = {
+        task.id: [(w.position.x, w.position.y) for w in task.waypoints()]
+        for task in scenario.tasks
+        if task.id in ("delivery_a", "delivery_b")
+    }
+    with stand_in("--fault", "skip-waypoint:tiago2", "--speed-up", "10"):
+        client = Client()
+        try:
+            heard: list[int] = []
+            done = client.outcome(client.follow("tiago1", points["delivery_a"], heard))
+            assert done.status == 4 and list(done.result.missed_waypoints) == []
+            assert sorted(set(heard)) == list(range(len(points["delivery_a"])))
+            assert heard == sorted(heard)
+            failed = client.outcome(client.follow("tiago2", points["delivery_b"], []))
+            assert failed.status == 6
+            assert [m.index for m in failed.result.missed_waypoints] == [0]
         finally:
             client.close()

@@ -86,7 +86,9 @@ def stand_in(
     With --ros2 the robots are Nav2's: per namespace a
     nav2_msgs/action/NavigateToPose server on navigate_to_pose (feedback
     with current_pose and distance_remaining; a new goal preempts the
-    active one, which aborts; a cancel stops the robot), odom, tf,
+    active one, which aborts; a cancel stops the robot) and a
+    FollowWaypoints server on follow_waypoints (a failed waypoint stops the
+    goal, missed), the global plan on plan when a goal comes, odom, tf,
     tf_static (transient local), amcl_pose, scan and cmd_vel (Twist), and
     /clock for the graph: start the nodes that use it with use_sim_time.
     The first line on stdout is ROS_DOMAIN_ID=N, the domain of the

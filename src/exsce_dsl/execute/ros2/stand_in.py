@@ -1,7 +1,8 @@
 """exsce's stand-in robots on a live ROS 2 graph: Nav2-like robots on simulated time.
 
-Per robot namespace a ``nav2_msgs/action/NavigateToPose`` server (on the name the robot's
-convention gives, ``/{ns}/navigate_to_pose`` by default) and the topics of :mod:`.robot_topics`;
+Per robot namespace a ``nav2_msgs/action/NavigateToPose`` and a ``FollowWaypoints`` server (on
+the names the robot's convention gives, ``/{ns}/navigate_to_pose`` and ``/{ns}/follow_waypoints``
+by default) and the topics of :mod:`.robot_topics`;
 ``/clock`` for the whole graph, ``speed_up`` times faster than wall time.  A goal is answered with a
 leg of :class:`~exsce_dsl.execute.stand_in.legs.Fleet` (planned on the scenario's occupancy grid
 from where the robot stands, driven with its limits and the executor's faults, the same legs as
@@ -22,7 +23,7 @@ import importlib
 import math
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from types import ModuleType, TracebackType
 from typing import Any
@@ -58,7 +59,10 @@ clock 0.2 s at most, not ``speed_up`` times the stall)."""
 DEPTH = 100
 WAIT = 0.005
 """Wall seconds between two looks of a goal's thread at its end."""
-ERROR_NONE, ERROR_UNKNOWN = 0, 9000
+ERROR_NONE, ERROR_UNKNOWN, ERROR_WAYPOINT = 0, 9000, 600
+"""Nav2's error codes: none; NavigateToPose's UNKNOWN; FollowWaypoints' UNKNOWN."""
+Feedback = Callable[[int, np.ndarray, float, int], None]
+"""Publishes a goal's feedback at a sample: (ns, row, metres left, the leg's sample)."""
 
 
 @dataclass
@@ -81,6 +85,7 @@ class PlayedRobot:
     start: int = 0
     """The global sample of the leg's first one."""
     planning: bool = False
+    feedback: Feedback | None = None
     ends: dict[int, str] = field(default_factory=dict)
     """Goals ended by the clock: id of their handle → ``succeeded`` | ``aborted``."""
 
@@ -101,9 +106,9 @@ class Ros2StandIn:
             raise ExsceError(f"the stand-in's speed-up must be above 0, not {speed_up:g}")
         self.scenario, self.speed_up = scenario, speed_up
         self.fleet = Fleet(scenario, planning_grid(scenario), seed, tuple(faults), run=run)
-        self.actions = {
-            r.id: nav2_actions(r).navigate_to_pose for r in scenario.robots if r.id in self.fleet.robots
-        }
+        played = [r for r in scenario.robots if r.id in self.fleet.robots]
+        self.actions = {r.id: nav2_actions(r).navigate_to_pose for r in played}
+        self.waypoint_actions = {r.id: nav2_actions(r).follow_waypoints for r in played}
         self.lock = threading.RLock()
         self.planning = threading.Lock()
         self.robots: dict[str, PlayedRobot] = {}
@@ -202,17 +207,23 @@ class Ros2StandIn:
                 depth = latched if name == "tf_static" else DEPTH
                 topic = expand_topic("/{ns}/" + name, robot.namespace)
                 robot.publishers[name] = self.node.create_publisher(types[name], topic, depth)
-            self.servers.append(
-                modules.action.ActionServer(
-                    self.node,
-                    modules.nav2.NavigateToPose,
-                    self.actions[robot.name],
-                    execute_callback=lambda handle, r=robot: self._execute(r, handle),
-                    cancel_callback=lambda request: modules.action.CancelResponse.ACCEPT,
-                    callback_group=group,
-                )
+            served = (
+                (modules.nav2.NavigateToPose, self.actions[robot.name], self._execute),
+                (modules.nav2.FollowWaypoints, self.waypoint_actions[robot.name], self._follow),
             )
+            for action, name, execute in served:
+                self.servers.append(
+                    modules.action.ActionServer(
+                        self.node,
+                        action,
+                        name,
+                        execute_callback=lambda handle, r=robot, run=execute: run(r, handle),
+                        cancel_callback=lambda request: modules.action.CancelResponse.ACCEPT,
+                        callback_group=group,
+                    )
+                )
         self.nav2 = modules.nav2
+        self.missed_type = importlib.import_module("nav2_msgs.msg").MissedWaypoint
 
     def _guarded(self, target: Any) -> Any:
         def run() -> None:
@@ -253,25 +264,67 @@ class Ros2StandIn:
     # -- goals, on the executor's threads ------------------------------------------------------
 
     def _execute(self, robot: PlayedRobot, handle: Any) -> Any:
-        target = handle.request.pose.pose
+        """A ``NavigateToPose`` goal: driven to its pose, with Nav2's feedback on the way."""
+        goal = bytes(handle.goal_id.uuid).hex()
+
+        def feedback(t: int, row: np.ndarray, remaining: float, k: int) -> None:
+            message = self.nav2.NavigateToPose.Feedback()
+            message.current_pose = self.topics.where(self.topics.stamp(t), row)
+            message.distance_remaining = remaining
+            message.navigation_time.sec, message.navigation_time.nanosec = divmod(k * DT_NS, 1_000_000_000)
+            handle.publish_feedback(message)
+
+        outcome, when = self._drive(robot, handle, goal, handle.request.pose.pose, feedback)
+        self._end(robot, handle, goal, outcome, when)
+        return self.nav2.NavigateToPose.Result(
+            error_code=ERROR_NONE if outcome == "succeeded" else ERROR_UNKNOWN
+        )
+
+    def _follow(self, robot: PlayedRobot, handle: Any) -> Any:
+        """A ``FollowWaypoints`` goal: its poses driven in order, ``current_waypoint`` as feedback;
+        a waypoint that fails stops the goal (ABORTED, the waypoint missed), as Nav2's waypoint
+        follower does by default (``stop_on_failure``)."""
+        goal = bytes(handle.goal_id.uuid).hex()
+        action = self.nav2.FollowWaypoints
+        missed, outcome, when = [], "succeeded", self._time_of(self.published) / 1e9
+        for index, stamped in enumerate(handle.request.poses):
+
+            def feedback(t: int, row: np.ndarray, remaining: float, k: int, index: int = index) -> None:
+                handle.publish_feedback(action.Feedback(current_waypoint=index))
+
+            outcome, when = self._drive(robot, handle, f"{goal}-{index}", stamped.pose, feedback)
+            if outcome != "succeeded":
+                if outcome == "aborted":
+                    missed.append(self.missed_type(index=index, goal=stamped, error_code=ERROR_WAYPOINT))
+                break
+        self._end(robot, handle, goal, outcome, when)
+        return action.Result(
+            missed_waypoints=missed, error_code=ERROR_NONE if outcome == "succeeded" else ERROR_WAYPOINT
+        )
+
+    def _drive(
+        self, robot: PlayedRobot, handle: Any, goal: str, target: Any, feedback: Feedback
+    ) -> tuple[str, float]:
+        """Drive ``robot`` to ``target`` (a geometry_msgs/Pose) for ``handle``: the leg planned
+        (simulated time standing still meanwhile) and played; how it ended and when."""
         q = target.orientation
         yaw = math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z))
-        goal = bytes(handle.goal_id.uuid).hex()
         with self.lock:
             preempted = robot.handle
-            if preempted is not None:  # Nav2: a new goal preempts the active one
+            if preempted is not None and preempted is not handle:  # Nav2: a new goal preempts
                 self._stop(robot)
                 robot.ends[id(preempted)] = "aborted"
-            robot.handle, robot.goal, robot.planning = handle, goal, True
+            robot.handle, robot.goal, robot.planning, robot.feedback = handle, goal, True, feedback
             when_ns = self._time_of(self.published)
-            when = when_ns / 1e9
         try:
             with self.planning:
-                leg = self.fleet.leg(robot.name, goal, target.position.x, target.position.y, yaw, when)
+                leg = self.fleet.leg(
+                    robot.name, goal, target.position.x, target.position.y, yaw, when_ns / 1e9
+                )
         except ExsceError:
             with self.lock:
                 robot.handle, robot.planning = None, False
-            return self._end(robot, handle, goal, "aborted", when)
+            return "aborted", when_ns / 1e9
         if leg.succeeded:  # Nav2's planner publishes the global plan of a goal it can reach
             path = self.topics.plan(self.topics.stamp(when_ns), leg.truth.x, leg.truth.y, yaw)
             with self.lock:
@@ -279,14 +332,11 @@ class Ros2StandIn:
         with self.lock:
             if robot.handle is handle:
                 robot.leg, robot.rows, robot.start = leg, leg.rows(), self.published + 1
-                steps = np.hypot(
-                    np.diff(leg.truth.x, prepend=leg.truth.x[0]), np.diff(leg.truth.y, prepend=leg.truth.y[0])
-                )
-                robot.remaining = np.cumsum(steps[::-1])[::-1] - steps
+                robot.remaining = _distance_left(leg)
             robot.planning = False
-        return self._await_end(robot, handle, goal)
+        return self._await_end(robot, handle)
 
-    def _await_end(self, robot: PlayedRobot, handle: Any, goal: str) -> Any:
+    def _await_end(self, robot: PlayedRobot, handle: Any) -> tuple[str, float]:
         while True:
             with self.lock:
                 outcome = robot.ends.pop(id(handle), None)
@@ -299,10 +349,10 @@ class Ros2StandIn:
                         robot.handle = None
                 now = self._time_of(self.published) / 1e9
             if outcome is not None:
-                return self._end(robot, handle, goal, outcome, now)
+                return outcome, now
             time.sleep(WAIT)
 
-    def _end(self, robot: PlayedRobot, handle: Any, goal: str, outcome: str, when: float) -> Any:
+    def _end(self, robot: PlayedRobot, handle: Any, goal: str, outcome: str, when: float) -> None:
         if outcome == "succeeded":
             handle.succeed()
         elif outcome == "canceled":
@@ -311,8 +361,6 @@ class Ros2StandIn:
             handle.abort()
         with self.lock:
             self.ended.append(GoalEnd(robot.name, goal, outcome, when))
-        code = ERROR_NONE if outcome == "succeeded" else ERROR_UNKNOWN
-        return self.nav2.NavigateToPose.Result(error_code=code)
 
     def _stop(self, robot: PlayedRobot) -> None:
         """Stop ``robot`` where it is now (holding :attr:`lock`)."""
@@ -378,19 +426,12 @@ class Ros2StandIn:
                 self._publish(robot, name, message)
             if leg is None or k < 0:
                 continue
-            if k % FEEDBACK_EVERY == 0 and robot.remaining is not None:
-                self._feedback(robot, t, row, float(robot.remaining[k]), k)
+            if k % FEEDBACK_EVERY == 0 and robot.remaining is not None and robot.feedback is not None:
+                robot.feedback(t, row, float(robot.remaining[k]), k)
             if k == len(leg) - 1:
                 robot.held, robot.held_scan = _standing(row), scan
                 robot.ends[id(robot.handle)] = "succeeded" if leg.succeeded else "aborted"
                 robot.handle, robot.leg, robot.rows, robot.remaining = None, None, None, None
-
-    def _feedback(self, robot: PlayedRobot, t: int, row: np.ndarray, remaining: float, k: int) -> None:
-        feedback = self.nav2.NavigateToPose.Feedback()
-        feedback.current_pose = self.topics.where(self.topics.stamp(t), row)
-        feedback.distance_remaining = remaining
-        feedback.navigation_time.sec, feedback.navigation_time.nanosec = divmod(k * DT_NS, 1_000_000_000)
-        robot.handle.publish_feedback(feedback)
 
 
 def _distance_left(leg: StandInLeg) -> np.ndarray:
