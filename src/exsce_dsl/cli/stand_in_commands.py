@@ -43,6 +43,19 @@ if TYPE_CHECKING:
     help="Simulated time (/clock) runs this many times faster than wall time.",
 )
 @click.option(
+    "--simulator",
+    type=click.Choice(["kinematic", "irsim"]),
+    default="kinematic",
+    show_default=True,
+    help="With --ros2: what drives each goal's leg: the kinematic executor's motion, or IR-SIM "
+    "(pip install 'exsce[irsim]').",
+)
+@click.option(
+    "--behaviour",
+    type=click.Choice(["dash", "rvo", "orca", "sfm"]),
+    help="With --simulator irsim: IR-SIM's behaviour [default: rvo].",
+)
+@click.option(
     "--start-master",
     is_flag=True,
     help="With --ros1: start a roscore of its own on a free port (printed first), stopped at the "
@@ -63,6 +76,8 @@ def stand_in(
     seed: int,
     faults: tuple[str, ...],
     speed_up: float,
+    simulator: str,
+    behaviour: str | None,
     start_master: bool,
     log_dir: str | None,
 ) -> None:
@@ -93,7 +108,9 @@ def stand_in(
     /clock for the graph: start the nodes that use it with use_sim_time.
     The first line on stdout is ROS_DOMAIN_ID=N, the domain of the
     environment (0 when unset).  Drive it with any rclpy or rclcpp action
-    client, or exscec execute --ros2.
+    client, or exscec execute --ros2.  --simulator irsim drives each
+    goal's leg in IR-SIM (its behaviour, kinematics and avoidance of the
+    robots standing in the world) instead of the kinematic executor.
 
     \b
     Example:
@@ -101,6 +118,7 @@ def stand_in(
       exscec stand-in examples/brsu_building_c/scenario_c.exsce --ros1 --start-master \\
           --fault overspeed:tiago1 --speed-up 5   # slower: a busy machine's recorder keeps up
       exscec stand-in examples/brsu_building_c/scenario_c.exsce --ros2 --fault overspeed:tiago1
+      exscec stand-in examples/irsim_crossing/crossing.exsce --ros2 --simulator irsim
     """
     from exsce_dsl.api import load
     from exsce_dsl.api import stand_in as play
@@ -109,6 +127,8 @@ def stand_in(
         raise click.UsageError("say --ros1 or --ros2: the graph the stand-in plays on")
     if ros2 and (start_master or log_dir is not None):
         raise click.UsageError("--start-master and --log-dir go with --ros1")
+    if ros1 and (simulator != "kinematic" or behaviour is not None):
+        raise click.UsageError("--simulator and --behaviour go with --ros2")
     loaded = load(spec)
 
     def terminated(signum: int, frame: FrameType | None) -> None:
@@ -117,7 +137,7 @@ def stand_in(
     previous = signal.signal(signal.SIGTERM, terminated)
     try:
         if ros2:
-            _play_ros2(loaded, scenario_id, seed, faults, speed_up)
+            _play_ros2(loaded, scenario_id, seed, faults, speed_up, simulator, behaviour)
             return
         with play(
             loaded, scenario=scenario_id, start_master=start_master, seed=seed, faults=faults,
@@ -135,11 +155,20 @@ def stand_in(
 
 
 def _play_ros2(
-    loaded: Specification, scenario_id: str | None, seed: int, faults: tuple[str, ...], speed_up: float
+    loaded: Specification,
+    scenario_id: str | None,
+    seed: int,
+    faults: tuple[str, ...],
+    speed_up: float,
+    simulator: str,
+    behaviour: str | None,
 ) -> None:
     from exsce_dsl.api import stand_in_ros2
 
-    with stand_in_ros2(loaded, scenario=scenario_id, seed=seed, faults=faults, speed_up=speed_up) as running:
+    with stand_in_ros2(
+        loaded, scenario=scenario_id, seed=seed, faults=faults, speed_up=speed_up, simulator=simulator,
+        behaviour=behaviour,
+    ) as running:  # fmt: skip
         click.echo(f"ROS_DOMAIN_ID={os.environ.get('ROS_DOMAIN_ID') or 0}")
         servers = ", ".join(f"{robot} ({action})" for robot, action in running.actions.items())
         click.echo(f"stand-in: {servers} at {speed_up:g}x wall time; Ctrl-C to stop", err=True)

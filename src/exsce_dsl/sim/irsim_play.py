@@ -259,7 +259,7 @@ class _Lockstep:
         obj = self.robots[leg.robot]
         here = (float(obj.state[0, 0]), float(obj.state[1, 0]))
         target = (leg.goal.position.x, leg.goal.position.y)
-        leg.path = _spaced(self.grid.cell_path(here, target))
+        leg.path = spaced(self.grid.cell_path(here, target))
         leg.count = self._count(leg.robot)
         if (leg.robot, leg.count) in self.skip or obj.stop_flag:
             yield from self._hold(0.5 if not obj.stop_flag else 0.0)
@@ -304,7 +304,7 @@ class _Leg:
         return sum(math.dist(a, b) for a, b in zip(self.path, self.path[1:], strict=False))
 
 
-def _spaced(path: list[Point]) -> list[Point]:
+def spaced(path: list[Point]) -> list[Point]:
     """The path's points PATH_SPACING apart along it, its ends kept."""
     kept, since = [path[0]], 0.0
     for a, b in zip(path, path[1:], strict=False):

@@ -129,6 +129,8 @@ class RobotMessages:
         """The global plan (nav_msgs/Path in ``map``) along ``x, y``: a pose every
         :data:`PLAN_SPACING` metres facing along it, the last one the target with its heading
         ``yaw``, as Nav2's planner publishes on ``plan`` when a goal comes."""
+        keep = np.concatenate([[True], np.hypot(np.diff(x), np.diff(y)) > 0])  # a robot standing: one point
+        x, y = x[keep], y[keep]
         steps = np.hypot(np.diff(x), np.diff(y))
         along = np.concatenate([[0.0], np.cumsum(steps)])
         at = np.append(np.arange(0.0, along[-1], PLAN_SPACING), along[-1])

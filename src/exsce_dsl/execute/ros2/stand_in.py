@@ -34,6 +34,7 @@ from exsce_dsl.errors import ExsceError, RosGraphError
 from exsce_dsl.execute.ros2.live import Ros2Modules, require_rclpy
 from exsce_dsl.execute.ros2.nav2 import nav2_actions
 from exsce_dsl.execute.ros2.robot_topics import DT_NS, FEEDBACK_EVERY, TOPICS, RobotMessages
+from exsce_dsl.execute.stand_in.irsim_legs import IrsimFleet
 from exsce_dsl.execute.stand_in.legs import Fleet, StandInLeg
 from exsce_dsl.execute.stand_in.session import DEFAULT_SPEED_UP, GoalEnd, Stats
 from exsce_dsl.maps.planning import planning_grid
@@ -101,11 +102,24 @@ class Ros2StandIn:
         faults: Sequence[Fault] = (),
         speed_up: float = DEFAULT_SPEED_UP,
         run: int = 0,
+        simulator: str = "kinematic",
+        behaviour: str | None = None,
     ) -> None:
+        """``simulator``: what drives the legs, ``kinematic`` (the kinematic executor's motion) or
+        ``irsim`` (IR-SIM, with ``behaviour``, default ``rvo``)."""
         if not speed_up > 0:
             raise ExsceError(f"the stand-in's speed-up must be above 0, not {speed_up:g}")
         self.scenario, self.speed_up = scenario, speed_up
-        self.fleet = Fleet(scenario, planning_grid(scenario), seed, tuple(faults), run=run)
+        grid = planning_grid(scenario)
+        if simulator == "irsim":
+            self.fleet: Fleet = IrsimFleet(scenario, grid, seed, tuple(faults), behaviour or "rvo", run=run)
+        elif simulator == "kinematic" and behaviour is None:
+            self.fleet = Fleet(scenario, grid, seed, tuple(faults), run=run)
+        else:
+            raise ExsceError(
+                f"the stand-in's legs are driven by 'kinematic' or 'irsim' (a behaviour with irsim only), "
+                f"not {simulator!r}" + (f" with behaviour {behaviour!r}" if behaviour else "")
+            )
         played = [r for r in scenario.robots if r.id in self.fleet.robots]
         self.actions = {r.id: nav2_actions(r).navigate_to_pose for r in played}
         self.waypoint_actions = {r.id: nav2_actions(r).follow_waypoints for r in played}
@@ -165,6 +179,9 @@ class Ros2StandIn:
     def close(self) -> None:
         """Stop the clock, end the goals still driven (aborted), then the executor and the node."""
         self.running = False
+        if isinstance(self.fleet, IrsimFleet):
+            with self.planning:
+                self.fleet.close()
         clock, spinner = self._threads if self._threads else (None, None)
         if clock is not None:
             clock.join(5.0)
@@ -326,7 +343,9 @@ class Ros2StandIn:
                 robot.handle, robot.planning = None, False
             return "aborted", when_ns / 1e9
         if leg.succeeded:  # Nav2's planner publishes the global plan of a goal it can reach
-            path = self.topics.plan(self.topics.stamp(when_ns), leg.truth.x, leg.truth.y, yaw)
+            # the path ends at the goal's pose, as a planner's does (a leg ends within tolerance of it)
+            xs, ys = np.append(leg.truth.x, target.position.x), np.append(leg.truth.y, target.position.y)
+            path = self.topics.plan(self.topics.stamp(when_ns), xs, ys, yaw)
             with self.lock:
                 self._publish(robot, "plan", path)
         with self.lock:
