@@ -235,6 +235,8 @@ BLIND_EVERY = 4
 """Every fourth scan sees nothing within its range (all beams at infinity)."""
 
 
+
+
 def _scan(store: Any, index: int, time_ns: int) -> Any:
     blind = index % BLIND_EVERY == 0
     ranges = np.full(9, np.inf if blind else 2.0 + 0.01 * index, dtype=np.float32)

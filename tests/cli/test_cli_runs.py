@@ -30,20 +30,7 @@ def test_simulate_ingest_and_query(in_tmp: Path) -> None:
     rows = json.loads(listed.stdout)["results"]["bindings"]
     assert len(rows) == 2 and {r["scenario_id"]["value"] for r in rows} == {"scenario_d"}
     run_id = rows[0]["run"]["value"]
-    value = exscec_here(
-        "query",
-        "run_metric",
-        "-p",
-        f"run={run_id}",
-        "-p",
-        "metric=waypoints_visited",
-        "-p",
-        "robot=tiago1",
-        "--format",
-        "csv",
-    )
+    value = exscec_here("query", "run_metric", "-p", f"run={run_id}", "-p", "metric=waypoints_visited",
+                        "-p", "robot=tiago1", "--format", "csv")
     assert value.returncode == 0, value.stderr
-    assert value.stdout.splitlines() == [
-        "value,unit",
-        "5,",
-    ]  # scenario_d visits 5 waypoints; a count has no unit
+    assert value.stdout.splitlines() == ["value,unit", "5,"]  # scenario_d visits 5 waypoints; a count has no unit

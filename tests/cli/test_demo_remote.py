@@ -19,7 +19,9 @@ from tests.support.store_servers import oxigraph_server
 def test_the_demo_on_nav2_runs_unchanged_against_a_remote_sparql_endpoint(tmp_path: Path) -> None:
     with oxigraph_server(tmp_path / "oxigraph") as server:
         store = ("--store", f"{server.url}/query")
-        done = run_exscec("demo", "remote-demo", *store, "--convention", "nav2", cwd=tmp_path, timeout=600)
+        done = run_exscec(
+            "demo", "remote-demo", *store, "--convention", "nav2", cwd=tmp_path, timeout=600
+        )
         check_stack_demo(done, tmp_path / "remote-demo", "nav2", *store)
         listed = run_exscec("runs", *store, "-f", "csv", cwd=tmp_path)
     summary = done.stderr[done.stderr.index("Summary") :]

@@ -130,9 +130,7 @@ def test_a_misspelt_topic_warns_with_did_you_mean_and_the_bags_topics_of_its_typ
     said = [line for line in done.stderr.splitlines() if "did you mean" in line]
     assert len(said) == 1, done.stderr  # once for the bag and the topic, not once per reader
     (line,) = said
-    assert line.startswith(
-        f"warning: {bag}: topic /ground_truth, read for the pose of 'bot', metric gt_path,"
-    )
+    assert line.startswith(f"warning: {bag}: topic /ground_truth, read for the pose of 'bot', metric gt_path,")
     assert "did you mean /groundtruth?" in line
     topics = odometry_topics(bag)
     assert topics == ["/groundtruth", "/odom"]
@@ -164,9 +162,7 @@ def test_strict_ingest_refuses_a_missing_metric_and_stores_nothing(bag: Path, tm
     (row,) = runs_in(store)
     table = exscec_here("query", "run_metric", "-p", f"run={row['run']['value']}", "-p", "metric=gt_path", "-p",
                         "robot=bot", "-f", "csv", "--store", store)  # fmt: skip
-    assert float(table.stdout.splitlines()[1].split(",")[0]) == pytest.approx(
-        ground_truth_path(bag), rel=1e-9
-    )
+    assert float(table.stdout.splitlines()[1].split(",")[0]) == pytest.approx(ground_truth_path(bag), rel=1e-9)
 
 
 def test_strict_is_the_apis_too(bag: Path, tmp_path: Path) -> None:
@@ -226,16 +222,12 @@ def test_a_misspelt_metric_parameter_warns_with_did_you_mean(
 def test_a_misspelt_parameter_warns_through_the_api(stored: tuple[str, str]) -> None:
     store_path, run = stored
     with exsce.open_store(store_path) as store:
-        with pytest.warns(
-            UnknownNameWarning, match=r"no metric 'distance_travelld'; did you mean 'distance_travelled'\?"
-        ):
+        with pytest.warns(UnknownNameWarning, match=r"no metric 'distance_travelld'; did you mean 'distance_travelled'\?"):
             table = exsce.query(store, "run_metric", run=run, metric="distance_travelld", robot="bot")
         assert table.empty
         with warnings.catch_warnings():
             warnings.simplefilter("error")
-            assert (
-                len(exsce.query(store, "run_metric", run=run, metric="distance_travelled", robot="bot")) == 1
-            )
+            assert len(exsce.query(store, "run_metric", run=run, metric="distance_travelled", robot="bot")) == 1
 
 
 def test_a_misspelt_metric_parameter_warns_on_virtuoso_too(bag: Path, tmp_path: Path) -> None:

@@ -108,18 +108,8 @@ def by_rosbags(bag: Path) -> dict[str, float]:
 
 
 def stored(run: str, metric: str) -> float:
-    table = ok(
-        "query",
-        "run_metric",
-        "-p",
-        f"run={run}",
-        "-p",
-        f"metric={metric}",
-        "-p",
-        "robot=bot",
-        "--format",
-        "csv",
-    )
+    table = ok("query", "run_metric", "-p", f"run={run}", "-p", f"metric={metric}", "-p", "robot=bot",
+               "--format", "csv")
     return float(table.splitlines()[1].split(",")[0])
 
 
@@ -138,32 +128,13 @@ def test_a_nav2_robot_at_the_root_goes_through_the_whole_method(in_tmp: Path) ->
     runs = json.loads(ok("runs", "--format", "json"))["results"]["bindings"]
     for row in runs:
         expected = by_rosbags(Path(row["path"]["value"]))
-        for metric in (
-            "waypoints_visited",
-            "max_velocity",
-            "mean_speed",
-            "distance_travelled",
-            "distance_to_obstacles",
-        ):
+        for metric in ("waypoints_visited", "max_velocity", "mean_speed", "distance_travelled",
+                       "distance_to_obstacles"):
             assert stored(row["run"]["value"], metric) == pytest.approx(expected[metric], rel=1e-9), metric
         # the goals' ends are their statuses' log times; the executor publishes a transition at once
-        assert stored(row["run"]["value"], "task_duration") == pytest.approx(
-            expected["task_duration"], abs=0.05
-        )
-    ok(
-        "derive",
-        "at_root.exsce",
-        "--id",
-        "at_root_rev",
-        "-t",
-        "reverse_waypoint_order",
-        "--task",
-        "delivery_a",
-        "-o",
-        "at_root_rev.exsce",
-        "--expect",
-        "--add-to-store",
-    )
+        assert stored(row["run"]["value"], "task_duration") == pytest.approx(expected["task_duration"], abs=0.05)
+    ok("derive", "at_root.exsce", "--id", "at_root_rev", "-t", "reverse_waypoint_order", "--task", "delivery_a",
+       "-o", "at_root_rev.exsce", "--expect", "--add-to-store")
     derived = Path("at_root_rev.exsce").read_text()
     assert 'namespace ""' in derived and "bot distance_travelled is" in derived
     ok("check", "at_root_rev.exsce")

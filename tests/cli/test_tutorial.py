@@ -112,12 +112,8 @@ def test_the_demo_says_how_to_type_its_commands_when_exscec_is_not_on_path(tmp_p
     elsewhere = [p for p in os.environ["PATH"].split(os.pathsep) if Path(p).absolute() != here]
     for folder, path in (("without", elsewhere), ("with", [str(exscec.parent), *elsewhere])):
         done = subprocess.run(
-            [str(exscec), "demo", folder, "--setup-only"],
-            cwd=tmp_path,
-            capture_output=True,
-            text=True,
-            env={**os.environ, "PATH": os.pathsep.join(path)},
-            timeout=120,
+            [str(exscec), "demo", folder, "--setup-only"], cwd=tmp_path, capture_output=True, text=True,
+            env={**os.environ, "PATH": os.pathsep.join(path)}, timeout=120,
         )
         assert done.returncode == 0, done.stderr
         hinted = f"first run '. {here}/activate'" in done.stderr

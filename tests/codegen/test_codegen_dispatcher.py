@@ -179,7 +179,9 @@ def test_a_task_given_twice_is_one_file_listed_twice() -> None:
     assert tiago1 == ["tiago1/delivery_a.yaml", "tiago1/navigate_home_1.yaml", "tiago1/delivery_a.yaml"]
 
 
-@pytest.mark.parametrize("namespace", ["../evil", "/fleet/tiago1", "tiago 1", "tiago1/", ".hidden", "1tiago"])
+@pytest.mark.parametrize(
+    "namespace", ["../evil", "/fleet/tiago1", "tiago 1", "tiago1/", ".hidden", "1tiago"]
+)
 def test_a_namespace_that_is_not_a_plain_ros_name_is_refused(tmp_path: Path, namespace: str) -> None:
     scenario = _scenario_c()
     robots = (dataclasses.replace(scenario.robots[0], namespace=namespace), *scenario.robots[1:])

@@ -185,9 +185,7 @@ def test_generate_of_a_500_term_sum_is_an_error_at_the_metric(tmp_path: Path) ->
     """Issue 46, item 9: it passed check, and generate exited 70 (a RecursionError)."""
     spec = tmp_path / "sum.exsce"
     terms = " + ".join(["max(v.data)"] * 500)
-    spec.write_text(
-        f'metric m for each robot {{\n  reads v: std_msgs/msg/Float64 on "/{{ns}}/v"\n  value {terms}\n}}\n'
-    )
+    spec.write_text(f'metric m for each robot {{\n  reads v: std_msgs/msg/Float64 on "/{{ns}}/v"\n  value {terms}\n}}\n')
     done = exscec_here("generate", "monitors", str(spec), "-o", str(tmp_path / "out"))
     assert done.returncode == 2 and done.stderr.startswith(f"{spec}:"), done.stderr  # refused where it is
     assert not (tmp_path / "out").exists()

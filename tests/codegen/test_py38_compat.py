@@ -21,10 +21,8 @@ _BUILTIN_GENERICS = {"list", "tuple", "dict", "set", "frozenset", "type"}
 
 
 def _sources() -> list[tuple[str, str]]:
-    found = [
-        (f"monitor_kit/{name}", package_file("monitor_kit", name).read_text())
-        for name in ("monitor_core.py", "monitor_runtime.py")
-    ]
+    found = [(f"monitor_kit/{name}", package_file("monitor_kit", name).read_text()) for name in
+             ("monitor_core.py", "monitor_runtime.py")]
     for folder in ("monitors", "ros1_monitor", "ros2_monitor"):
         for path in sorted((GOLDEN / folder).rglob("*")):
             if path.is_file() and (path.suffix == ".py" or path.name == "exsce_monitor_node"):
@@ -40,10 +38,7 @@ def _annotations(tree: ast.AST) -> set[int]:
         if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
             args = node.args
             roots += [a.annotation for a in args.args + args.kwonlyargs + args.posonlyargs]
-            roots += [
-                args.vararg.annotation if args.vararg else None,
-                args.kwarg.annotation if args.kwarg else None,
-            ]
+            roots += [args.vararg.annotation if args.vararg else None, args.kwarg.annotation if args.kwarg else None]
             roots.append(node.returns)
         elif isinstance(node, ast.AnnAssign):
             roots.append(node.annotation)
@@ -77,30 +72,19 @@ def test_runs_on_python_3_8(name, source):
     for node in ast.walk(tree):
         if id(node) in skip:
             continue
-        if (
-            isinstance(node, ast.BinOp)
-            and isinstance(node.op, ast.BitOr)
-            and (_is_type(node.left) and _is_type(node.right))
+        if isinstance(node, ast.BinOp) and isinstance(node.op, ast.BitOr) and (
+            _is_type(node.left) and _is_type(node.right)
         ):
             problems.append(f"line {node.lineno}: X | Y of types")
-        if (
-            isinstance(node, ast.Subscript)
-            and isinstance(node.value, ast.Name)
-            and (node.value.id in _BUILTIN_GENERICS)
+        if isinstance(node, ast.Subscript) and isinstance(node.value, ast.Name) and (
+            node.value.id in _BUILTIN_GENERICS
         ):
             problems.append(f"line {node.lineno}: {node.value.id}[...] at run time")
-        if (
-            isinstance(node, ast.Call)
-            and isinstance(node.func, ast.Name)
-            and node.func.id == "zip"
-            and any(k.arg == "strict" for k in node.keywords)
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id == "zip" and any(
+            k.arg == "strict" for k in node.keywords
         ):
             problems.append(f"line {node.lineno}: zip(strict=...)")
-        if (
-            isinstance(node, ast.Subscript)
-            and isinstance(node.value, ast.Name)
-            and node.value.id in abc_names
-        ):
+        if isinstance(node, ast.Subscript) and isinstance(node.value, ast.Name) and node.value.id in abc_names:
             problems.append(f"line {node.lineno}: collections.abc.{node.value.id}[...] at run time")
         if isinstance(node, ast.Attribute) and node.attr in ("removeprefix", "removesuffix"):
             problems.append(f"line {node.lineno}: {node.attr}")

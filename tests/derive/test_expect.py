@@ -146,12 +146,7 @@ def test_the_derived_scenario_s_criteria_follow_from_the_expected_change() -> No
     add_prov(store, compile_scenario(BASE))
     for uuid, a_to_b in (("u1", 10.0), ("u2", 12.0)):
         add_prov(store, compile_run(run(uuid, a_to_b), BASE))
-    speed = Expectation(
-        Subject(Quantifier.EACH_ROBOT),
-        "max_velocity",
-        BasicRelation.BELOW_MAX,
-        limit=Quantity(1.0, "m/s", "1.0"),
-    )
+    speed = Expectation(Subject(Quantifier.EACH_ROBOT), "max_velocity", BasicRelation.BELOW_MAX, limit=Quantity(1.0, "m/s", "1.0"))
     base_criteria = Acceptance("base", (Criterion("safe", (), None, (speed,)),))
     made = derived_criteria(store, BASE, LONGER, base_criteria).acceptance
     assert made.scenario == "longer"
@@ -191,32 +186,16 @@ def test_a_segment_is_read_whatever_heading_its_poses_were_driven_with() -> None
     add_prov(
         store,
         compile_run(
-            Run(
-                "u9",
-                "base",
-                start,
-                start + datetime.timedelta(minutes=1),
-                Bag("u9.bag", DIST),
-                (TaskExecution("r1", 1, actions),),
-                metrics,
-            ),
+            Run("u9", "base", start, start + datetime.timedelta(minutes=1), Bag("u9.bag", DIST),
+                (TaskExecution("r1", 1, actions),), metrics),
             base,
         ),
     )
     ab = expected_metric(store, scenario("plain", B), "r1", "distance_travelled").segments[0]
     assert (ab.value, ab.how, ab.runs) == (7.5, "observed", 1)
-    ba = expected_metric(
-        store,
-        Scenario(
-            "back",
-            ROOM,
-            (Robot("r1", TIAGO, "r1", start_pose=B),),
-            Mission("back_m", MissionType.SEQUENTIAL, (Assignment("r1", "t"),)),
-            (Task("t", (Subtask((A,)),)),),
-        ),
-        "r1",
-        "distance_travelled",
-    ).segments[0]
+    ba = expected_metric(store, Scenario("back", ROOM, (Robot("r1", TIAGO, "r1", start_pose=B),),
+                                         Mission("back_m", MissionType.SEQUENTIAL, (Assignment("r1", "t"),)),
+                                         (Task("t", (Subtask((A,)),)),)), "r1", "distance_travelled").segments[0]
     assert (ba.value, ba.how) == (7.5, "observed the other way")
 
 
@@ -232,15 +211,8 @@ def test_a_clause_between_robots_is_not_copied_to_a_scenario_of_one_robot() -> N
         Subject,
     )
 
-    apart = Expectation(
-        Subject(Quantifier.MISSION),
-        "distance_between_robots",
-        BasicRelation.ABOVE_MIN,
-        limit=Quantity(0.1, "m", "0.1"),
-    )
-    made = derived_criteria(
-        EmbeddedStore(None), BASE, LONGER, Acceptance("base", (Criterion("apart", (), None, (apart,)),))
-    ).acceptance
+    apart = Expectation(Subject(Quantifier.MISSION), "distance_between_robots", BasicRelation.ABOVE_MIN, limit=Quantity(0.1, "m", "0.1"))
+    made = derived_criteria(EmbeddedStore(None), BASE, LONGER, Acceptance("base", (Criterion("apart", (), None, (apart,)),))).acceptance
     assert made.criteria == ()  # one robot: nothing between robots to judge, and no runs to expect from
 
 

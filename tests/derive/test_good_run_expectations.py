@@ -51,9 +51,7 @@ def project(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[str], 
     clean = [run.bag for run in simulate(base, folder / "clean", 3, seed=1)]
     overspeed = (Fault.parse("overspeed:tiago1"),)
     [fast] = [run.bag for run in simulate(base, folder / "fast", 1, seed=7, faults=overspeed)]
-    ingested = exscec_here(
-        "ingest", *map(str, [*clean, fast]), "--scenario", "c/scenario_c.exsce", cwd=folder
-    )
+    ingested = exscec_here("ingest", *map(str, [*clean, fast]), "--scenario", "c/scenario_c.exsce", cwd=folder)
     assert ingested.returncode == 0, ingested.stderr
     said = ingested.stdout + ingested.stderr
 

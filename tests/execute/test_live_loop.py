@@ -82,9 +82,7 @@ def test_the_new_run_passes_and_the_over_speed_run_fails(demo: tuple[Path, str])
     assert outcomes["tiago1-max_velocity"] == "failed" and outcomes["tiago2-max_velocity"] == "passed"
     # the runs are move_base's: its goal topics in the bags, max_velocity read from cmd_vel
     (new_bag,) = (folder / "runs" / "new").glob("*.bag")
-    assert "/tiago1/move_base/status" in bag_topics(new_bag) and "/tiago1/robot_pose" not in bag_topics(
-        new_bag
-    )
+    assert "/tiago1/move_base/status" in bag_topics(new_bag) and "/tiago1/robot_pose" not in bag_topics(new_bag)
     sources = run_exscec(
         "query", "metric_sources", "-p", f"run={faulty_run}", "-p", "metric=max_velocity", "-f", "csv",
         cwd=folder,

@@ -43,6 +43,7 @@ C018_W002 = (46.25560760498047, 21.586545944213867, -0.641)
 C025_W002 = (43.432926177978516, 38.493873596191406, 0.925)
 
 
+
 @pytest.fixture(scope="module")
 def scenario_c():
     return load_spec(EXAMPLES / "brsu_building_c" / "scenario_c.exsce").scenario("scenario_c")

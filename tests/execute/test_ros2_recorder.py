@@ -20,6 +20,7 @@ import textwrap
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 from rosbags.highlevel import AnyReader
@@ -475,3 +476,71 @@ def test_without_the_published_topics_the_recorder_is_given_time_to_discover_the
         recorder.wait_subscribed(20.0)
         assert time.monotonic() - started >= DISCOVERY - 0.1  # from when it was ready, a moment before
     assert recorder.written == {"/tiago1/odom": 0}
+
+
+TICKING = textwrap.dedent(
+    """
+    import sys, time, rclpy
+    from builtin_interfaces.msg import Time
+    from nav_msgs.msg import Odometry
+    from rosgraph_msgs.msg import Clock
+
+    rclpy.init()
+    node = rclpy.create_node("exsce_test_ticker")
+    odom = node.create_publisher(Odometry, "/tiago1/odom", 1000)  # room for what waits on a stalled reader
+    clock = node.create_publisher(Clock, "/clock", 1000)
+    print("ready", flush=True)
+    sys.stdin.readline()
+    end = time.monotonic() + 10.0
+    while time.monotonic() < end and (odom.get_subscription_count() < 1 or clock.get_subscription_count() < 2):
+        rclpy.spin_once(node, timeout_sec=0.01)
+    print("publishing", flush=True)
+    for i in range(100):  # a tick of 50 ms of simulated time every 10 ms of wall time: 5x
+        stamp = Time(sec=2000 + i // 20, nanosec=(i % 20) * 50_000_000)
+        clock.publish(Clock(clock=stamp))
+        message = Odometry()
+        message.header.stamp = stamp
+        odom.publish(message)
+        time.sleep(0.01)
+    print("done", flush=True)
+    sys.stdin.readline()
+    """
+)
+
+
+def test_a_stalled_recorder_puts_no_gap_into_a_run_on_sim_time(
+    ros2_env: dict[str, str], tmp_path: Path
+) -> None:
+    """The recorder stopped (SIGSTOP) for 0.6 s of wall time while odometry is published every
+    50 ms of simulated time, 5x faster than wall time: every message is in the bag at the
+    simulated time it was sent (the /clock sent before it), 50 ms apart, no gap of the 3 s of
+    simulated time that the stall lasted (what a time of receipt would show)."""
+    bag = tmp_path / "runs" / "stalled"
+    ticker = subprocess.Popen(
+        [sys.executable, "-c", TICKING], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True
+    )
+    try:
+        assert ticker.stdout is not None and ticker.stdin is not None
+        assert ticker.stdout.readline().strip() == "ready"
+        with Ros2Recorder(bag, ["/clock", "/tiago1/odom"], use_sim_time=True) as recorder:
+            recorder.wait_subscribed(20.0, published=["/clock", "/tiago1/odom"])
+            ticker.stdin.write("go\n")
+            ticker.stdin.flush()
+            assert ticker.stdout.readline().strip() == "publishing"
+            assert recorder.process is not None
+            time.sleep(0.25)
+            os.kill(recorder.process.pid, signal.SIGSTOP)
+            time.sleep(0.6)
+            os.kill(recorder.process.pid, signal.SIGCONT)
+            assert ticker.stdout.readline().strip() == "done"
+            time.sleep(0.5)
+            recorder.stop()
+    finally:
+        ticker.kill()
+        ticker.wait()
+    odometry = read_bag(bag)["/tiago1/odom"]
+    assert len(odometry) == 100
+    stamps = [stamp for stamp, _ in odometry]
+    sent = [m.header.stamp.sec * 1_000_000_000 + m.header.stamp.nanosec for _, m in odometry]
+    assert stamps == sent  # each at the /clock sent just before it: the time it was published
+    assert set(np.diff(stamps)) == {50_000_000}

@@ -16,16 +16,11 @@ def test_the_areas_a_scenario_drives_in(spec_c: tuple[Scenario, dict[str, Task]]
     base, tasks = spec_c
     assert areas_driven(base) == ROOMS_C
     elsewhere = derive(
-        base,
-        [("replace_robot", {"robot": "tiago2", "by": "tiago3", "start": "classroom_c069-w001"})],
-        tasks=tasks,
+        base, [("replace_robot", {"robot": "tiago2", "by": "tiago3", "start": "classroom_c069-w001"})], tasks=tasks
     ).scenario
     assert areas_driven(elsewhere) == ROOMS_C | {"classroom_c069"}
-    idle = derive(
-        base,
-        [("add_robot", {"robot": "tiago3", "like": "tiago1", "start": "classroom_c069-w001"})],
-        tasks=tasks,
-    ).scenario
+    idle = derive(base, [("add_robot", {"robot": "tiago3", "like": "tiago1", "start": "classroom_c069-w001"})],
+                  tasks=tasks).scenario
     assert areas_driven(idle) == ROOMS_C  # a robot without tasks drives nowhere
 
 

@@ -43,15 +43,10 @@ LONGER = CheckedRelation("task_duration", "tiago1", "increasing")
 
 
 def _trial(
-    number: int,
-    runs: int,
-    violated: tuple[CheckedRelation, ...] = (),
-    inconclusive: tuple[CheckedRelation, ...] = (),
+    number: int, runs: int, violated: tuple[CheckedRelation, ...] = (), inconclusive: tuple[CheckedRelation, ...] = ()
 ) -> CampaignTrial:
     uuids = tuple(f"run{number}-{i}" for i in range(runs))
-    return CampaignTrial(
-        "campaign_x", number, f"s{number}", (), uuids, (SPEED, DURATION), violated, (), inconclusive
-    )
+    return CampaignTrial("campaign_x", number, f"s{number}", (), uuids, (SPEED, DURATION), violated, (), inconclusive)
 
 
 def test_the_figures_of_trials_counted_by_hand() -> None:
@@ -97,10 +92,7 @@ def test_a_relation_neither_failed_nor_passed_in_most_runs_is_inconclusive() -> 
     judged = _violations(verdicts, 3)
     assert set(judged.checked) == set(runs)
     assert judged.violated == (CheckedRelation("distance_travelled", "tiago1", "invariant"),)
-    assert set(judged.inconclusive) == {
-        DURATION,
-        CheckedRelation("distance_travelled", "tiago2", "invariant"),
-    }
+    assert set(judged.inconclusive) == {DURATION, CheckedRelation("distance_travelled", "tiago2", "invariant")}
     trial = CampaignTrial("c", 1, "s", (), ("r0", "r1", "r2"), judged.checked, (), (), judged.inconclusive)
     assert trial.outcome == "inconclusive"  # neither a counterexample nor a pass
     assert CampaignFigures.of([trial]).counterexamples == 0
@@ -239,7 +231,5 @@ def test_an_inconclusive_trial_and_the_figures_read_back_from_the_store() -> Non
     assert float(stored["per_100_executions"] or "nan") == pytest.approx(100 / 6)
     suite = ET.fromstring(campaign_junit_xml(record))[0]
     first = suite.findall("testcase")[0].find("skipped")
-    assert first is not None and str(first.get("message")).startswith(
-        "inconclusive: tiago1 task_duration invariant"
-    )
+    assert first is not None and str(first.get("message")).startswith("inconclusive: tiago1 task_duration invariant")
     assert (suite.get("failures"), suite.get("skipped")) == ("1", "1")

@@ -59,10 +59,8 @@ def test_map_image_that_is_a_fifo_does_not_block(tmp_path: Path) -> None:
     _map_yaml(tmp_path, "m.pgm")
     (tmp_path / "env.exsce").write_text(ENVIRONMENT.format(map="m.yaml"), encoding="utf-8")
     done = run_exscec("check", "env.exsce", cwd=tmp_path, timeout=30)
-    assert (
-        done.returncode == 2
-        and "env.exsce:2:3: error: " in done.stderr
-        and "m.pgm is not a regular file" in (done.stderr)
+    assert done.returncode == 2 and "env.exsce:2:3: error: " in done.stderr and "m.pgm is not a regular file" in (
+        done.stderr
     )
 
 
@@ -76,9 +74,7 @@ def test_import_too_large_refused(tmp_path: Path, monkeypatch: pytest.MonkeyPatc
     analysis = analyse(tmp_path / "main.exsce")
     (error,) = analysis.errors
     assert error.location is not None and (error.location.line, error.location.column) == (2, 1)
-    assert (
-        error.message.startswith("imported file: ") and "big.exsce is larger than 1048 bytes" in error.message
-    )
+    assert error.message.startswith("imported file: ") and "big.exsce is larger than 1048 bytes" in error.message
     assert "EXSCE_MAX_FILE_MB" in error.message
     monkeypatch.setenv("EXSCE_MAX_FILE_MB", "1")
     assert analyse(tmp_path / "main.exsce").errors == []
@@ -110,15 +106,11 @@ def test_spec_with_bom_checks(tmp_path: Path) -> None:
     (bom,) = analyse(tmp_path / "bom.exsce").errors
     assert "unknown pose 'nowhere'" in bom.message
     assert plain.location is not None and bom.location is not None
-    assert (
-        (bom.location.line, bom.location.column, bom.location.end_column)
-        == (
-            plain.location.line,
-            plain.location.column,
-            plain.location.end_column,
-        )
-        == (1, 16, 23)
-    )
+    assert (bom.location.line, bom.location.column, bom.location.end_column) == (
+        plain.location.line,
+        plain.location.column,
+        plain.location.end_column,
+    ) == (1, 16, 23)
     (tmp_path / "bom_ok.exsce").write_bytes(b"\xef\xbb\xbfrobot type r {\n}\n")
     done = run_exscec("check", "bom_ok.exsce", cwd=tmp_path)
     assert done.returncode == 0, done.stderr

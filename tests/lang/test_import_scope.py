@@ -25,10 +25,7 @@ def test_import_of_non_exsce_file_not_quoted(tmp_path: Path) -> None:
     assert SECRET not in done.stdout + done.stderr
     lines = done.stderr.splitlines()
     assert "spec.exsce:1:1: error: only .exsce files are imported: 'secret.txt' is not read" in lines
-    assert (
-        f"spec.exsce:2:1: error: only .exsce files are imported: '{tmp_path / 'secret.txt'}' is not read"
-        in lines
-    )
+    assert f"spec.exsce:2:1: error: only .exsce files are imported: '{tmp_path / 'secret.txt'}' is not read" in lines
 
 
 def test_a_syntax_error_in_an_imported_exsce_file_is_still_shown(tmp_path: Path) -> None:

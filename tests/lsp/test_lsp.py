@@ -272,10 +272,7 @@ async def test_completion_of_transformations_in_a_derive_block(
     )
     assert isinstance(result, types.CompletionList)
     poses = {item.label for item in result.items}
-    assert {
-        "classroom_c069-w001",
-        "classroom_c025-w002",
-    } <= poses and "tiago1" not in poses  # where it starts
+    assert {"classroom_c069-w001", "classroom_c025-w002"} <= poses and "tiago1" not in poses  # where it starts
     close_document(client, uri)
 
 

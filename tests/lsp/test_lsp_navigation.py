@@ -60,6 +60,8 @@ def apply(text: str, edits: list[types.TextEdit]) -> str:
     return text
 
 
+
+
 # ------------------------------------------------------------------- definition
 async def test_go_to_a_definition_in_an_imported_file(client: LanguageClient, workspace: Path) -> None:
     path = workspace / "scenario_c.exsce"
@@ -317,7 +319,5 @@ async def test_a_built_in_metric_cannot_be_renamed(client: LanguageClient, works
     uri = open_document(client, path)
     at = position(text, "max_velocity", 2)
     with pytest.raises(JsonRpcException, match="'max_velocity' is one of exsce's built-in metrics"):
-        await client.text_document_rename_async(
-            types.RenameParams(types.TextDocumentIdentifier(uri), at, "speed")
-        )
+        await client.text_document_rename_async(types.RenameParams(types.TextDocumentIdentifier(uri), at, "speed"))
     close_document(client, uri)

@@ -60,9 +60,7 @@ def test_a_cache_that_cannot_be_written_is_not_kept(tmp_path: Path, monkeypatch:
     assert not (blocker / "cache").exists()
 
 
-def test_the_definitions_go_where_every_cache_entry_goes(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def test_the_definitions_go_where_every_cache_entry_goes(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.delenv("EXSCE_CACHE", raising=False)
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
     typestore_cache.standard_fielddefs("ros2_humble")

@@ -192,7 +192,9 @@ def test_a_run_cut_short_is_never_passed(yard: tuple[Path, dict[str, Path]], tmp
         tuple(report.get(k) for k in counts) == tuple(suite.get(k) for k in counts) == ("11", "0", "0", "11")
     )
     messages = [case.find("skipped").get("message", "") for case in suite.findall("testcase")]  # type: ignore[union-attr]
-    assert all(m.startswith("inconclusive: ") and "mission was cancelled" in m for m in messages)
+    assert all(
+        m.startswith("inconclusive: ") and "mission was cancelled" in m for m in messages
+    )
     assert not report.findall(".//error") and not report.findall(".//failure")
     judged = run_exscec("verify", str(fast_cut), "--scenario", "spec.exsce", *store, "--json", cwd=folder)
     assert judged.returncode == ExitCode.FAILED, judged.stdout + judged.stderr

@@ -197,9 +197,7 @@ broken = exsce_test_relations:not_a_relation
 @pytest.fixture
 def plugin(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
     """A distribution installed in ``tmp_path`` that registers three relations."""
-    yield from installed_plugins(
-        tmp_path, monkeypatch, relations.RELATIONS, "exsce_test_relations", PLUGIN, ENTRY_POINTS
-    )
+    yield from installed_plugins(tmp_path, monkeypatch, relations.RELATIONS, "exsce_test_relations", PLUGIN, ENTRY_POINTS)
 
 
 @pytest.mark.usefixtures("plugin")

@@ -63,7 +63,8 @@ BLOCKS = [b for page in PAGES for b in _blocks(page)]
 
 def _of(language: str, excerpt: bool | None = None) -> list[Block]:
     return [
-        b for b in BLOCKS if b.language == language and (excerpt is None or ("from" in b.info) == excerpt)
+        b for b in BLOCKS
+        if b.language == language and (excerpt is None or ("from" in b.info) == excerpt)
     ]
 
 
@@ -124,7 +125,7 @@ def _resolve(words: list[str]) -> tuple[click.Command, list[str], str]:
 )
 def test_every_exscec_line_parses(block: Block, words: list[str]) -> None:
     leading = [w for w in words[:1] if w.startswith("--")]  # options of the group (--debug)
-    command, rest, name = _resolve(words[len(leading) :])
+    command, rest, name = _resolve(words[len(leading):])
     context = click.Context(command, info_name=name, **command.context_settings)
     try:  # the options exist and take what is given (files need not exist here)
         values, _, _ = command.make_parser(context).parse_args(list(rest))
@@ -134,9 +135,7 @@ def test_every_exscec_line_parses(block: Block, words: list[str]) -> None:
         given = values.get(param.name)
         if isinstance(param.type, click.Choice) and given is not None:
             for value in given if isinstance(given, (list, tuple)) else [given]:
-                assert value in param.type.choices, (
-                    f"{block}: {param.name}={value!r} is not one of {param.type.choices}"
-                )
+                assert value in param.type.choices, f"{block}: {param.name}={value!r} is not one of {param.type.choices}"
 
 
 def test_the_readmes_start_from_your_bag_runs_as_written(tmp_path: Path) -> None:
@@ -145,7 +144,7 @@ def test_the_readmes_start_from_your_bag_runs_as_written(tmp_path: Path) -> None
     from exsce_dsl.sim.run import simulate
 
     readme = (ROOT / "README.md").read_text(encoding="utf-8")
-    section = readme[readme.index("## Start from your bag") :]
+    section = readme[readme.index("## Start from your bag"):]
     section = section[: section.index("\n## ", 3)]  # up to the next section
     [block] = [b for b in _blocks(ROOT / "README.md") if b.language == "sh" and b.text in section]
     spec = load_spec(EXAMPLES / "brsu_building_c" / "scenario_a.exsce")
@@ -154,14 +153,8 @@ def test_the_readmes_start_from_your_bag_runs_as_written(tmp_path: Path) -> None
     env = {**os.environ, "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}"}
     env.pop("EXSCE_STORE", None)
     for line in block.text.splitlines():
-        done = subprocess.run(
-            shlex.split(line, comments=True),
-            cwd=tmp_path,
-            env=env,
-            capture_output=True,
-            text=True,
-            timeout=300,
-        )
+        done = subprocess.run(shlex.split(line, comments=True), cwd=tmp_path, env=env,
+                              capture_output=True, text=True, timeout=300)
         assert done.returncode == 0, f"{line}\n{done.stdout}\n{done.stderr}"
         assert "Traceback" not in done.stderr
     assert (tmp_path / "report" / "index.html").is_file()
@@ -180,9 +173,7 @@ def test_every_link_between_pages_finds_its_page_and_heading(page: Path) -> None
         assert linked.is_file(), f"{page.name}: no page {target}"
         if anchor:
             headings = re.findall(r"^#+ (.+)$", linked.read_text(encoding="utf-8"), flags=re.M)
-            assert anchor in {_anchor(h) for h in headings}, (
-                f"{page.name}: no heading #{anchor} in {linked.name}"
-            )
+            assert anchor in {_anchor(h) for h in headings}, f"{page.name}: no heading #{anchor} in {linked.name}"
 
 
 def test_the_readme_is_short_and_starts_where_users_start() -> None:
@@ -202,7 +193,7 @@ def test_the_language_page_lists_every_function_with_its_arguments() -> None:
     from exsce_dsl.model.expressions import CONDITION_AGGREGATES, FUNCTIONS, WINDOW_VALUES
 
     page = (ROOT / "docs" / "language.md").read_text(encoding="utf-8")
-    section = page[page.index("## Every function") :]
+    section = page[page.index("## Every function"):]
     rows = re.findall(r"^\| (.+?) \| (.+?) \| (.+?) \|$", section, flags=re.M)
     named = {name for cell, _, _ in rows for name in re.findall(r"`(\w+)[( ]", cell + " ")}
     missing = (set(FUNCTIONS) | set(CONDITION_AGGREGATES)) - named

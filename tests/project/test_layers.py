@@ -15,21 +15,8 @@ PACKAGE = Path(__file__).resolve().parents[2] / "src" / "exsce_dsl"
 
 LAYERS: list[set[str]] = [
     # the base
-    {
-        "errors",
-        "remedies",
-        "suggest",
-        "resources",
-        "textfiles",
-        "tables",
-        "templating",
-        "figures",
-        "user_cache",
-        "wording",
-        "output_folder",
-        "plugins",
-        "faces",
-    },
+    {"errors", "remedies", "suggest", "resources", "textfiles", "tables", "templating", "figures", "user_cache",
+     "wording", "output_folder", "plugins", "faces"},
     {"model"},
     {"messages", "maps", "monitor_kit", "parallel"},
     {"transform"},
@@ -54,16 +41,7 @@ RANK = {name: rank for rank, names in enumerate(LAYERS) for name in names}
 STEPS: dict[str, list[set[str]]] = {
     "lang": [
         # the core the other parts share
-        {
-            "locations",
-            "lexical",
-            "transformation_syntax",
-            "chunks",
-            "parser",
-            "loader",
-            "incremental",
-            "stdlib",
-        },
+        {"locations", "lexical", "transformation_syntax", "chunks", "parser", "loader", "incremental", "stdlib"},
         # values kept while exsce's code is unchanged (the parsed standard library)
         {"code_cache"},
         # parse trees to the model
@@ -82,17 +60,7 @@ STEPS: dict[str, list[set[str]]] = {
         {"metrics"},
         {"coverage"},
         {"recorded_execution"},
-        {
-            "analyse",
-            "ingest",
-            "robots",
-            "bag_identity",
-            "bag_info",
-            "bag_robots",
-            "bag_runs",
-            "missing",
-            "plausible_poses",
-        },
+        {"analyse", "ingest", "robots", "bag_identity", "bag_info", "bag_robots", "bag_runs", "missing", "plausible_poses"},
         {"spec_draft"},
     ],
 }

@@ -23,7 +23,6 @@ MOST_CLASS_LINES = 300
 REASON = "Long because:"
 """How a module's or class's docstring says why it is longer (in its first paragraph)."""
 
-
 def _package_modules() -> Iterator[tuple[str, Path]]:
     for path in sorted(PACKAGE.rglob("*.py")):
         yield path.relative_to(PACKAGE).as_posix(), path

@@ -162,7 +162,7 @@ def test_an_action_written_out_by_hand(scenario_c: Scenario) -> None:
     action = "run_30af607a:tiago1-task_01-subtask_001-w_002"
     lines = {r.get_provn() for r in bundle.get_records() if action in r.get_provn().split(",")[0]}
     assert lines == {
-        f'activity({action}, -, -, [prov:type=\'exsce:action\', exsce:run="{UUID}", exsce:status="SUCCEEDED"])',
+        f"activity({action}, -, -, [prov:type='exsce:action', exsce:run=\"{UUID}\", exsce:status=\"SUCCEEDED\"])",
         f"wasEndedBy({action}, pose:classroom_c018-w001-R0.00_P0.00_Y-0.641, -, -, "
         f'[prov:role="goal", exsce:run="{UUID}"])',
         f"wasStartedBy({action}, pose:classroom_c022-w001-R0.00_P0.00_Y2.269, -, -)",
@@ -184,19 +184,12 @@ def run_with_metrics(scenario: Scenario) -> Run:
         scenario,
         bag=Bag(BAG, (T1_DISTANCE, T1_NAV_VEL)),
         metrics=(
-            MetricValue(
-                "distance_travelled", MetricScope.ROBOT, 49.5234, (T1_DISTANCE,), robot="tiago1", unit="m"
-            ),
+            MetricValue("distance_travelled", MetricScope.ROBOT, 49.5234, (T1_DISTANCE,), robot="tiago1", unit="m"),
             MetricValue("distance_travelled", MetricScope.SEGMENT, 10.2956, (T1_DISTANCE,), action=SEGMENT_1),
             MetricValue("distance_travelled", MetricScope.SEGMENT, 19.5078, (T1_DISTANCE,), action=SEGMENT_2),
             MetricValue("mission_duration", MetricScope.MISSION, 97.606, ()),
             MetricValue(
-                "violation_duration",
-                MetricScope.ROBOT,
-                1.5,
-                (T1_NAV_VEL,),
-                robot="tiago1",
-                safety_metric="max_velocity",
+                "violation_duration", MetricScope.ROBOT, 1.5, (T1_NAV_VEL,), robot="tiago1", safety_metric="max_velocity"
             ),
         ),
         hotspots=(Hotspot("max_velocity", Position(44.5, 37.25), 3, 1.5, robot="tiago1"),),
@@ -224,7 +217,7 @@ def test_a_metric_bundle_written_out_by_hand(scenario_c: Scenario) -> None:
     document = compile_run(run_with_metrics(scenario_c), scenario_c)
     run = f"run:run_{UUID}"
     topics = "run_30af607a:tiago1-distance_travelled-topics"
-    common = f'prov:type=\'exsce:output_metric\', run:metricType="distance_travelled", exsce:run="{UUID}"'
+    common = f"prov:type='exsce:output_metric', run:metricType=\"distance_travelled\", exsce:run=\"{UUID}\""
     w1 = "run_30af607a:tiago1-task_01-subtask_001-w_001"
     w2 = "run_30af607a:tiago1-task_01-subtask_001-w_002"
     assert bundle_lines(document, "distance_travelled_bundle") == {
@@ -258,7 +251,7 @@ def test_hotspots_written_out_by_hand(scenario_c: Scenario) -> None:
     document = compile_run(run_with_metrics(scenario_c), scenario_c)
     hotspot = "run_30af607a:tiago1-max_velocity-hotspot_001"
     assert bundle_lines(document, "hotspots_bundle") == {
-        f'entity({hotspot}, [prov:type=\'exsce:hotspot\', hotspot:type="max_velocity", exsce:run="{UUID}", '
+        f"entity({hotspot}, [prov:type='exsce:hotspot', hotspot:type=\"max_velocity\", exsce:run=\"{UUID}\", "
         'coord:x="44.5" %% xsd:double, coord:y="37.25" %% xsd:double, coord:z="0.0" %% xsd:double, '
         'exsce:violations=3, exsce:duration="1.5" %% xsd:double, exsce:robot="tiago1"])',
         f"wasGeneratedBy({hotspot}, run:run_{UUID}, -)",
@@ -274,7 +267,7 @@ def test_action_times_and_status_are_written(scenario_c: Scenario) -> None:
     lines = {r.get_provn() for b in compile_run(run, scenario_c).bundles for r in b.get_records()}
     assert (
         "activity(run_30af607a:tiago1-task_01-subtask_001-w_001, 2023-06-26T21:47:10, 2023-06-26T21:48:00, "
-        f'[prov:type=\'exsce:action\', exsce:run="{UUID}", exsce:status="ABORTED"])'
+        f"[prov:type='exsce:action', exsce:run=\"{UUID}\", exsce:status=\"ABORTED\"])"
     ) in lines
 
 
@@ -305,34 +298,18 @@ def test_metric_values_say_what_they_cover() -> None:
     [
         ({"scenario": "scenario_d"}, "is a run of 'scenario_d', not of 'scenario_c'"),
         ({"uuid": "a b"}, "run uuid 'a b' cannot be part of an identifier"),
-        (
-            {"tasks": (TaskExecution("tiago9", 1, ()),)},
-            "robot 'tiago9', which is not in scenario 'scenario_c'",
-        ),
+        ({"tasks": (TaskExecution("tiago9", 1, ()),)}, "robot 'tiago9', which is not in scenario 'scenario_c'"),
         ({"tasks": (TaskExecution("tiago1", 3, ()),)}, "allocates it 2 task"),
         (
-            {
-                "metrics": (
-                    MetricValue("max_velocity", MetricScope.ROBOT, 1.0, (T1_NAV_VEL,), robot="tiago1"),
-                )
-            },
+            {"metrics": (MetricValue("max_velocity", MetricScope.ROBOT, 1.0, (T1_NAV_VEL,), robot="tiago1"),)},
             "comes from topic '/tiago1/nav_vel', which bag .* does not hold",
         ),
         (
-            {
-                "metrics": (
-                    MetricValue("max_velocity", MetricScope.SEGMENT, 1.0, action=ActionId("tiago1", 1, 1, 9)),
-                )
-            },
+            {"metrics": (MetricValue("max_velocity", MetricScope.SEGMENT, 1.0, action=ActionId("tiago1", 1, 1, 9)),)},
             "tiago1-task_01-subtask_001-w_009, which run .* does not have",
         ),
         (
-            {
-                "metrics": (
-                    MetricValue("m", MetricScope.MISSION, 1.0),
-                    MetricValue("m", MetricScope.MISSION, 2.0),
-                )
-            },
+            {"metrics": (MetricValue("m", MetricScope.MISSION, 1.0), MetricValue("m", MetricScope.MISSION, 2.0))},
             "the value of 'm' of the mission twice",
         ),
     ],
@@ -409,27 +386,10 @@ FEEDBACK = ("/tiago1/waypoint_dispatcher/feedback", "/tiago2/waypoint_dispatcher
 
 def test_oracles_written_out_by_hand() -> None:
     oracles = [
+        Oracle("mission_duration", None, "invariant", BASELINE, "scenario_x", FEEDBACK, value=141.195, tolerance=0.0),
         Oracle(
-            "mission_duration",
-            None,
-            "invariant",
-            BASELINE,
-            "scenario_x",
-            FEEDBACK,
-            value=141.195,
-            tolerance=0.0,
-        ),
-        Oracle(
-            "mission_duration",
-            None,
-            "increasing",
-            METAMORPHIC,
-            "scenario_c",
-            FEEDBACK,
-            value=141.195,
-            delta=43.5891,
-            tolerance=0.0,
-            package="exsce.metamorphic.relationships",
+            "mission_duration", None, "increasing", METAMORPHIC, "scenario_c", FEEDBACK,
+            value=141.195, delta=43.5891, tolerance=0.0, package="exsce.metamorphic.relationships",
         ),
         Oracle("max_velocity", "tiago1", "below_max", BASELINE, "scenario_x", (T1_NAV_VEL,), limit=1.0),
     ]

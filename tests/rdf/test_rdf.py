@@ -323,9 +323,7 @@ def test_every_term_of_the_identifiers_module_is_in_the_vocabulary() -> None:
     names = Namespaces()
     terms = {k: t for k, t in vars(identifiers).items() if isinstance(t, identifiers.Term)}
     assert len(terms) > 40
-    missing = {
-        k: str(t) for k, t in terms.items() if t.prefix != "prov" and URIRef(names.iri(t)) not in known
-    }
+    missing = {k: str(t) for k, t in terms.items() if t.prefix != "prov" and URIRef(names.iri(t)) not in known}
     assert missing == {}
 
 
@@ -335,38 +333,14 @@ def test_the_method_s_run_oracle_and_transformation_terms_are_in_the_vocabulary(
     runs, oracle = Namespace(DEFAULT_NAMESPACE + "runs/"), Namespace(DEFAULT_NAMESPACE + "oracles/")
     ros = Namespace("http://wiki.ros.org/")
     assert {
-        EXSCE.run,
-        EXSCE.task_execution,
-        EXSCE.action,
-        ros.Bags,
-        ros.Topics,
-        EXSCE.topic,
-        EXSCE.output_metric,
-        EXSCE.oracle,
-        EXSCE.transform,
-        EXSCE.generation,
-        EXSCE.hotspot,
+        EXSCE.run, EXSCE.task_execution, EXSCE.action, ros.Bags, ros.Topics, EXSCE.topic,
+        EXSCE.output_metric, EXSCE.oracle, EXSCE.transform, EXSCE.generation, EXSCE.hotspot,
         ros.Parameter_Server,
     } <= classes
     assert {
-        runs.metricType,
-        EXSCE.run,
-        EXSCE.runs,
-        EXSCE.robot,
-        EXSCE.file_path,
-        EXSCE.metric,
-        oracle.metric,
-        oracle.robot,
-        oracle.relationship,
-        oracle.package,
-        oracle.type,
-        oracle.value,
-        oracle.limit,
-        oracle.delta,
-        oracle.tolerance,
-        EXSCE.transform,
-        EXSCE.pkg,
-        EXSCE.allocation_order,
+        runs.metricType, EXSCE.run, EXSCE.runs, EXSCE.robot, EXSCE.file_path, EXSCE.metric,
+        oracle.metric, oracle.robot, oracle.relationship, oracle.package, oracle.type, oracle.value,
+        oracle.limit, oracle.delta, oracle.tolerance, EXSCE.transform, EXSCE.pkg, EXSCE.allocation_order,
     } <= properties
 
 

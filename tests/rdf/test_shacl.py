@@ -114,9 +114,7 @@ SUBTASK = iri("tasks/patrol-subtask_001")
 Quads = list[Quad]
 
 
-def without(
-    predicate: str, subject: NamedNode | None = None, obj: NamedNode | None = None
-) -> Callable[[Quads], Quads]:
+def without(predicate: str, subject: NamedNode | None = None, obj: NamedNode | None = None) -> Callable[[Quads], Quads]:
     def plant(quads: Quads) -> Quads:
         return [
             q
@@ -164,81 +162,21 @@ def two_maps() -> list[tuple[NamedNode, NamedNode, NamedNode | Literal]]:
 # (what is planted, the plant, where it must be reported, words of the message)
 MATRIX: list[tuple[str, Callable[[Quads], Quads], tuple[int, int], str]] = [
     ("a point without x", without("coord:x", POINT_W002), (8, 10), "exactly one x coordinate"),
-    (
-        "a point with two x",
-        added((POINT_W002, term("coord:x"), Literal("4.0", datatype=NamedNode(XSD + "double")))),
-        (8, 10),
-        "exactly one x coordinate",
-    ),
-    (
-        "a misspelt mission type",
-        changed("exsce:missionType", iri("missions/m1"), Literal("parallell")),
-        (24, 11),
-        '"parallel" or "sequential"',
-    ),
-    (
-        "a scenario without mission",
-        without("prov:hadMember", iri("demo"), iri("missions/m1")),
-        (20, 10),
-        "exactly one mission",
-    ),
-    (
-        "a pose with two points",
-        added((POSE_W002, HAD_MEMBER, iri("tasks/points/room-w001"))),
-        (8, 10),
-        "exactly one point",
-    ),
-    (
-        "a pose without orientation",
-        without("prov:hadMember", POSE_W001, iri("tasks/orientation/R0.00_P0.00_Y0.00")),
-        (7, 10),
-        "exactly one orientation",
-    ),
-    (
-        "a yaw that is text",
-        changed("angle:yaw", YAW_05, Literal("half a radian")),
-        (16, 11),
-        "exactly one yaw",
-    ),
+    ("a point with two x", added((POINT_W002, term("coord:x"), Literal("4.0", datatype=NamedNode(XSD + "double")))), (8, 10), "exactly one x coordinate"),
+    ("a misspelt mission type", changed("exsce:missionType", iri("missions/m1"), Literal("parallell")), (24, 11), '"parallel" or "sequential"'),
+    ("a scenario without mission", without("prov:hadMember", iri("demo"), iri("missions/m1")), (20, 10), "exactly one mission"),
+    ("a pose with two points", added((POSE_W002, HAD_MEMBER, iri("tasks/points/room-w001"))), (8, 10), "exactly one point"),
+    ("a pose without orientation", without("prov:hadMember", POSE_W001, iri("tasks/orientation/R0.00_P0.00_Y0.00")), (7, 10), "exactly one orientation"),
+    ("a yaw that is text", changed("angle:yaw", YAW_05, Literal("half a radian")), (16, 11), "exactly one yaw"),
     ("a plan not derived from its task", without("prov:hadPrimarySource", PLAN), (25, 13), "allocated plan"),
-    (
-        "a subtask without waypoints",
-        without("prov:wasDerivedFrom", SUBTASK),
-        (14, 3),
-        "derived from at least one waypoint",
-    ),
-    (
-        "a robot without software configuration",
-        without("prov:hadMember", ROBOT, iri("robots/r1/software-config")),
-        (22, 5),
-        "software configuration",
-    ),
-    (
-        "a hardware configuration with a word for a torso",
-        changed("exsce:torso", iri("robots/r1/hardware-config"), Literal("maybe")),
-        (22, 5),
-        "torso",
-    ),
-    (
-        "an invalid ROS namespace",
-        changed("ros:namespace", iri("robots/r1/software-config"), Literal("1 bad")),
-        (22, 5),
-        "ROS namespace",
-    ),
+    ("a subtask without waypoints", without("prov:wasDerivedFrom", SUBTASK), (14, 3), "derived from at least one waypoint"),
+    ("a robot without software configuration", without("prov:hadMember", ROBOT, iri("robots/r1/software-config")), (22, 5), "software configuration"),
+    ("a hardware configuration with a word for a torso", changed("exsce:torso", iri("robots/r1/hardware-config"), Literal("maybe")), (22, 5), "torso"),
+    ("an invalid ROS namespace", changed("ros:namespace", iri("robots/r1/software-config"), Literal("1 bad")), (22, 5), "ROS namespace"),
     ("a start pose from no pose", without("prov:entity", START), (22, 40), "from exactly one pose"),
     ("an environment with two maps", added(*two_maps()), (3, 13), "at most one map"),
-    (
-        "a map without occupancy grid",
-        without("prov:hadMember", MAP, iri("environments/lab/occupancy_grid")),
-        (4, 3),
-        "occupancy grid",
-    ),
-    (
-        "an obstacle from two poses",
-        added((OBSTACLE, term("prov:wasDerivedFrom"), POSE_W001)),
-        (10, 12),
-        "exactly one pose",
-    ),
+    ("a map without occupancy grid", without("prov:hadMember", MAP, iri("environments/lab/occupancy_grid")), (4, 3), "occupancy grid"),
+    ("an obstacle from two poses", added((OBSTACLE, term("prov:wasDerivedFrom"), POSE_W001)), (10, 12), "exactly one pose"),
     ("an obstacle of odd size", changed("exsce:size", OBSTACLE, Literal("big")), (10, 12), "size"),
     ("a map file without its package", without("ros:pkg", MAP), (4, 3), "exactly one package"),
 ]
@@ -289,14 +227,7 @@ def test_a_message_names_the_node_the_property_and_the_shape(demo: Scenario) -> 
 
 def test_a_node_without_location_falls_back_to_the_scenario(demo: Scenario) -> None:
     stray = NamedNode("https://example.org/stray-point")
-    (found,) = diagnostics_of(
-        demo,
-        added(
-            (stray, RDF_TYPE, term("geom:Point")),
-            (stray, term("coord:y"), Literal("1.0", datatype=NamedNode(XSD + "double"))),
-            (stray, term("coord:z"), Literal("1.0", datatype=NamedNode(XSD + "double"))),
-        ),
-    )
+    (found,) = diagnostics_of(demo, added((stray, RDF_TYPE, term("geom:Point")), (stray, term("coord:y"), Literal("1.0", datatype=NamedNode(XSD + "double"))), (stray, term("coord:z"), Literal("1.0", datatype=NamedNode(XSD + "double")))))
     assert found.location is not None
     assert (found.location.line, found.location.column) == (20, 10)
     assert "<https://example.org/stray-point> coord:x" in found.message
@@ -375,11 +306,7 @@ def oracle_document(**usage: object) -> ProvDocument:
     oracle = scenario["tiago1-max_velocity"]
     bundle.activity(
         oracle,
-        other_attributes={
-            "prov:type": exsce["oracle"],
-            "oracle:metric": "max_velocity",
-            "oracle:robot": "tiago1",
-        },
+        other_attributes={"prov:type": exsce["oracle"], "oracle:metric": "max_velocity", "oracle:robot": "tiago1"},
     )
     relation = {"oracle:relationship": "below_max", "oracle:type": "baseline", "oracle:limit": 1.0}
     relation.update({f"oracle:{k}": v for k, v in usage.items()})
@@ -403,13 +330,7 @@ def shacl_messages(quads: Quads) -> list[str]:
         {},
         {"relationship": "invariant", "limit": None, "value": 97.606, "tolerance": 5.0},
         {"relationship": "invariant", "limit": None, "value": 3},
-        {
-            "relationship": "increasing",
-            "type": "metamorphic",
-            "limit": None,
-            "value": 141.195,
-            "delta": 43.59,
-        },
+        {"relationship": "increasing", "type": "metamorphic", "limit": None, "value": 141.195, "delta": 43.59},
     ],
 )
 def test_oracles_in_the_method_s_shape_conform(relation: dict[str, object]) -> None:
@@ -539,9 +460,7 @@ def test_shapes_for_another_base_namespace_are_named_in_it() -> None:
     document = compile_scenario(scenario, base)
     quads = [q for q in to_quads(document) if q.predicate.value != base + "missionType"]
     prefixes = {**prefixes_of(document), "exsce-sh": base + "shapes/"}
-    found = violation_diagnostics(
-        validate(quads, namespace=base), source_locations(scenario, base), None, prefixes
-    )
+    found = violation_diagnostics(validate(quads, namespace=base), source_locations(scenario, base), None, prefixes)
     assert [d.message for d in found] == [
         "mission:mission_c exsce:missionType: a mission has exactly one type (exsce:missionType) "
         "(SHACL shape exsce-sh:MissionShape)"

@@ -44,11 +44,7 @@ def project(tmp_path_factory: pytest.TempPathFactory) -> Path:
     [run] = simulate(scenario, folder / "runs", 1, seed=4)
     done = exscec_here("ingest", str(run.bag), "--scenario", "c/scenario_c.exsce", cwd=folder)
     assert done.returncode == 0, done.stderr
-    for output, specs in (
-        ("out", ["c/scenario_c.exsce"]),
-        ("plain", []),
-        ("nomap", ["nomap/scenario_c.exsce"]),
-    ):
+    for output, specs in (("out", ["c/scenario_c.exsce"]), ("plain", []), ("nomap", ["nomap/scenario_c.exsce"])):
         made = exscec_here("report", "-o", output, *[a for s in specs for a in ("--spec", s)], cwd=folder)
         assert made.returncode == 0, made.stderr
         (folder / f"{output}.stderr").write_text(made.stderr, encoding="utf-8")
@@ -131,9 +127,7 @@ def test_segment_boundaries_are_marked_on_paths(project: Path) -> None:
     figure = trajectory_figure(scenario, run, trajectories(Path(run.run.path)))
     FigureCanvasAgg(figure).draw()
     [axes] = figure.axes
-    marks = {
-        c.get_gid(): c.get_offsets()[0] for c in axes.collections if str(c.get_gid()).startswith("segment")
-    }
+    marks = {c.get_gid(): c.get_offsets()[0] for c in axes.collections if str(c.get_gid()).startswith("segment")}
     assert sorted(marks) == sorted(f"segment-start-{i}" for i in range(1, len(stored) + 1))
     for i, (x, y) in enumerate(table.where, start=1):
         assert tuple(marks[f"segment-start-{i}"]) == pytest.approx((x, y))

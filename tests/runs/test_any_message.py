@@ -94,14 +94,10 @@ def _rewrite(source: Path, target: Path, fmt: str, namespace: str) -> None:
         messages = [(c, t, raw) for c, t, raw in reader.messages()]
         msgtypes = {c.topic: c.msgtype for c in reader.connections}
         velocity = [
-            (t, reader.deserialize(raw, c.msgtype))
-            for c, t, raw in messages
-            if c.topic == f"{prefix}/nav_vel"
+            (t, reader.deserialize(raw, c.msgtype)) for c, t, raw in messages if c.topic == f"{prefix}/nav_vel"
         ]
         poses = [
-            (t, reader.deserialize(raw, c.msgtype))
-            for c, t, raw in messages
-            if c.topic == f"{prefix}/robot_pose"
+            (t, reader.deserialize(raw, c.msgtype)) for c, t, raw in messages if c.topic == f"{prefix}/robot_pose"
         ]
         store.register({k: v for k, v in reader.typestore.fielddefs.items() if k not in store.fielddefs})
     assert poses and velocity
@@ -123,15 +119,10 @@ def _rewrite(source: Path, target: Path, fmt: str, namespace: str) -> None:
         turtle = T[TURTLE](
             x=p.x, y=p.y, theta=0.0, linear_velocity=float(twist.linear.x) * (-1) ** n, angular_velocity=0.0
         )
-        written += [
-            (t, f"{prefix}/odom", odom, "nav_msgs/msg/Odometry"),
-            (t, f"{prefix}/turtle", turtle, TURTLE),
-        ]
+        written += [(t, f"{prefix}/odom", odom, "nav_msgs/msg/Odometry"), (t, f"{prefix}/turtle", turtle, TURTLE)]
     if ros1:
         with Writer1(target) as writer:
-            conns = {
-                topic: writer.add_connection(topic, msgtypes[topic], typestore=store) for topic in msgtypes
-            }
+            conns = {topic: writer.add_connection(topic, msgtypes[topic], typestore=store) for topic in msgtypes}
             for topic, msgtype in [(f"{prefix}/odom", "nav_msgs/msg/Odometry"), (f"{prefix}/turtle", TURTLE)]:
                 conns[topic] = writer.add_connection(topic, msgtype, typestore=store)
             _write(writer, conns, messages, written, lambda m, ty: store.serialize_ros1(m, ty))
@@ -164,12 +155,8 @@ def _reference(bag: Path, namespace: str, start: float, end: float) -> dict[str,
     with AnyReader([bag], default_typestore=store) as reader:
         odom = [c for c in reader.connections if c.topic == f"{prefix}/odom"]
         turtle = [c for c in reader.connections if c.topic == f"{prefix}/turtle"]
-        odoms = [
-            (t / 1e9, reader.deserialize(raw, c.msgtype)) for c, t, raw in reader.messages(connections=odom)
-        ]
-        turtles = [
-            (t / 1e9, reader.deserialize(raw, c.msgtype)) for c, t, raw in reader.messages(connections=turtle)
-        ]
+        odoms = [(t / 1e9, reader.deserialize(raw, c.msgtype)) for c, t, raw in reader.messages(connections=odom)]
+        turtles = [(t / 1e9, reader.deserialize(raw, c.msgtype)) for c, t, raw in reader.messages(connections=turtle)]
     odoms = [(t, m) for t, m in odoms if start <= t <= end]
     turtles = [(t, m) for t, m in turtles if start <= t <= end]
     path = 0.0
@@ -187,9 +174,7 @@ def test_metrics_over_odometry_and_a_type_known_only_from_the_bag(
     tmp_path: Path, fmt: str, namespace: str
 ) -> None:
     spec = _spec(tmp_path, namespace)
-    result = exscec_here(
-        "simulate", str(spec), "--runs", "1", "-o", str(tmp_path / "runs"), "--format", fmt, cwd=tmp_path
-    )
+    result = exscec_here("simulate", str(spec), "--runs", "1", "-o", str(tmp_path / "runs"), "--format", fmt, cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     (source,) = [p for p in (tmp_path / "runs").iterdir() if not p.name.endswith(".prov.json")]
     target = tmp_path / ("rewritten.bag" if fmt == "ros1" else "rewritten")

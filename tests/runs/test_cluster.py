@@ -53,15 +53,7 @@ def yard(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[Path], Pa
     scenario = load_spec(folder / "spec.exsce").scenario()
     bags = [run.bag for run in simulate(scenario, folder / "runs", BAGS, seed=3)]
     done = run_exscec(
-        "ingest",
-        *map(str, bags),
-        "--scenario",
-        "spec.exsce",
-        "--jobs",
-        "1",
-        "--store",
-        "reference",
-        cwd=folder,
+        "ingest", *map(str, bags), "--scenario", "spec.exsce", "--jobs", "1", "--store", "reference", cwd=folder
     )
     assert done.returncode == 0, done.stderr
     return folder, bags, folder / "reference"

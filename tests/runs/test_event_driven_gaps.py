@@ -21,9 +21,7 @@ from tests.runs.test_turtlesim_path import TURTLESIM
 from tests.support.bag_factory import ODOMETRY, START_NS, Topic, odometry, typestore_for, write_bag
 from tests.support.yard_spec import FAR_YARD
 
-SPEC = (
-    FAR_YARD
-    + """
+SPEC = FAR_YARD + """
 scenario holes in yard {
   robots {
     tb: bot namespace "" starts at start
@@ -33,7 +31,6 @@ scenario holes in yard {
   }
 }
 """
-)
 PERIOD_NS = 50_000_000  # 20 Hz
 
 

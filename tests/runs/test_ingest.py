@@ -296,9 +296,7 @@ def test_a_topic_of_an_unexpected_type_is_reported(scenario_c, runs_c, tmp_path:
     estimated = [v for v in analysed.run.metrics if v.metric == "max_velocity" and v.robot == "tiago1"]
     assert estimated and all(v.estimated_from == "pose" for v in estimated)
     assert all(v.topics == ("/tiago1/robot_pose",) for v in estimated)
-    assert any("/tiago1/nav_vel, which carries std_msgs/msg/String" in p for p in analysed.problems), (
-        analysed.problems
-    )
+    assert any("/tiago1/nav_vel, which carries std_msgs/msg/String" in p for p in analysed.problems), analysed.problems
 
 
 def test_statuses_in_the_bag_are_the_executors(runs_c) -> None:

@@ -37,9 +37,7 @@ from tests.support.bag_factory import (
 from tests.support.cli import exscec_here
 from tests.support.yard_spec import FAR_YARD
 
-SPEC = (
-    FAR_YARD
-    + """
+SPEC = FAR_YARD + """
 metric location_path for each robot {
   unit m
   reads loc: geometry_msgs/msg/PoseStamped on "/{ns}/location"
@@ -60,7 +58,6 @@ acceptance for rooted {
   }
 }
 """
-)
 HZ = 27.0
 SECONDS = 30.0
 GAP = 3.8

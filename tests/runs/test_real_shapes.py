@@ -548,7 +548,9 @@ def test_the_shapes_through_exscec(
     for shape in REFERENCES:
         store = str(folder / f"store_{shape}")
         paths = [str(bags[(shape, fmt)]) for fmt in FORMATS]
-        done = exscec_here("ingest", *paths, "--scenario", str(scenarios[shape][0]), "--store", store)
+        done = exscec_here(
+            "ingest", *paths, "--scenario", str(scenarios[shape][0]), "--store", store
+        )
         assert done.returncode == 0, f"{shape}:\n{done.stdout}\n{done.stderr}"
         assert "Traceback" not in done.stderr and "convention" in done.stderr, done.stderr
         listed = exscec_here("runs", "-f", "json", "--store", store)

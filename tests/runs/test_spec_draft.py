@@ -203,9 +203,7 @@ def test_a_draft_never_overwrites_unless_forced(tmp_path: Path) -> None:
     write_bag(bag, "ros1", SHAPES["jackal"](store), store)
     target = tmp_path / "mine.exsce"
     target.write_text("// the user's own\n")
-    with pytest.raises(
-        ExportError, match="would overwrite .*mine.exsce; ask to replace the files that exist"
-    ):
+    with pytest.raises(ExportError, match="would overwrite .*mine.exsce; ask to replace the files that exist"):
         draft_spec(bag, target)
     assert target.read_text() == "// the user's own\n"
     draft_spec(bag, target, force=True)

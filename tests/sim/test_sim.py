@@ -220,7 +220,5 @@ def test_any_seed_gives_a_bag_with_valid_stamps(tmp_path):
 
     scenario = load_spec(EXAMPLES / "brsu_building_c" / "scenario_c.exsce").scenario("scenario_c")
     (run,) = simulate(scenario, tmp_path, 1, seed=100_001)
-    data = read_bag(
-        run.bag, {"/tiago1/nav_vel": Wanted("geometry_msgs/msg/Twist", (path_of("linear", "x"),))}
-    )
+    data = read_bag(run.bag, {"/tiago1/nav_vel": Wanted("geometry_msgs/msg/Twist", (path_of("linear", "x"),))})
     assert EPOCH.timestamp() <= data.start < 2**32 and run.start.year < 2106

@@ -120,9 +120,7 @@ def test_a_worker_killed_in_the_middle_of_a_run_loses_no_bag(
     folder, reference = yard
     scenario = load_spec(folder / "spec.exsce").scenario()
     with a_worker_killed_while_running(cluster, "_play_task") as killed:
-        played = list(
-            simulate(scenario, tmp_path / "runs", RUNS, seed=SEED, dask_address=cluster.scheduler_address)
-        )
+        played = list(simulate(scenario, tmp_path / "runs", RUNS, seed=SEED, dask_address=cluster.scheduler_address))
     assert killed, "no worker was seen playing a run"
     assert [r.bag.name for r in played] == sorted(n for n in reference if n.endswith(".bag"))
     assert hashes(tmp_path / "runs") == reference  # each bag once and whole, nothing half-written left
@@ -144,10 +142,7 @@ def test_a_campaign_explored_on_the_cluster_is_the_campaign_explored_here(
             shutil.copy(folder / name, project / name)
         env = {k: v for k, v in os.environ.items() if not k.startswith("EXSCE_") or k == "EXSCE_CACHE"}
         on_cluster = ["--cluster", cluster.scheduler_address] if where == "there" else []
-        with (
-            Client(cluster.scheduler_address, set_as_default=False) as watcher,
-            get_task_stream(watcher) as ran,
-        ):
+        with Client(cluster.scheduler_address, set_as_default=False) as watcher, get_task_stream(watcher) as ran:
             outcomes[where] = subprocess.run(
                 [EXSCEC, *arguments, *on_cluster, "--store", str(project / "store")],
                 cwd=project, capture_output=True, text=True, timeout=300, env=env,

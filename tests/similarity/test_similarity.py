@@ -28,9 +28,7 @@ from tests.support.paths import EXAMPLES
 
 
 def facts(id_, bases=("pmb2",), torsos=(True,), segments=(), metrics=None, violation=None, hotspots=None):
-    return ScenarioFacts(
-        id_, tuple(bases), tuple(torsos), tuple(segments), metrics or {}, violation, hotspots
-    )
+    return ScenarioFacts(id_, tuple(bases), tuple(torsos), tuple(segments), metrics or {}, violation, hotspots)
 
 
 def test_d1_d2_d3_count_robots_base_types_and_torsos_over_the_largest_fleet():
@@ -114,9 +112,8 @@ def test_facts_come_from_the_store(project):
 
 def test_clustering_groups_the_scenarios_that_differ_only_by_waypoint_order(project):
     with EmbeddedStore(project / ".exsce" / "store") as store:
-        found = cluster(
-            [scenario_facts(store, s) for s in ("scenario_c", "c_reversed", "c_one", "c_one_reversed")], k=2
-        )
+        found = cluster([scenario_facts(store, s) for s in ("scenario_c", "c_reversed", "c_one", "c_one_reversed")],
+                        k=2)
     assert found.clusters["scenario_c"] == found.clusters["c_reversed"]
     assert found.clusters["c_one"] == found.clusters["c_one_reversed"]
     assert found.clusters["scenario_c"] != found.clusters["c_one"]
@@ -133,11 +130,7 @@ def test_cli_cluster_prints_the_table_and_the_json(project):
     data = json.loads(out.stdout)
     assert data["scenarios"] == ["scenario_c", "c_one"] and data["pairs"][0]["d1"] == 0.5
     unknown = exscec_here("cluster", "-s", "nope", "-s", "c_one", cwd=project)
-    assert (
-        unknown.returncode == 2
-        and "not in the store: nope" in unknown.stderr
-        and "Traceback" not in unknown.stderr
-    )
+    assert unknown.returncode == 2 and "not in the store: nope" in unknown.stderr and "Traceback" not in unknown.stderr
     bad = exscec_here("cluster", "-w", "d9=1", cwd=project)
     assert bad.returncode == 2 and "write NAME=W" in bad.stderr
 
@@ -149,12 +142,8 @@ def test_facts_of_a_scenario_with_runs_have_metric_means_violations_and_hotspots
 
     scenario = load_spec(EXAMPLES / "brsu_building_c" / "scenario_c.exsce").scenario()
     bags = [run.bag for run in simulate(scenario, tmp_path / "runs", runs=1, seed=2)]
-    bags += [
-        run.bag
-        for run in simulate(
-            scenario, tmp_path / "fast", runs=1, seed=2, faults=(Fault.parse("overspeed:tiago1"),)
-        )
-    ]
+    bags += [run.bag for run in simulate(scenario, tmp_path / "fast", runs=1, seed=2,
+                                         faults=(Fault.parse("overspeed:tiago1"),))]
     with EmbeddedStore(tmp_path / "store") as store:
         assert not any(r.failed for r in ingest_bags(bags, scenario, store))
         found = scenario_facts(store, "scenario_c")

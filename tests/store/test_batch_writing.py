@@ -87,9 +87,7 @@ def test_group_commits_store_what_one_add_prov_per_run_stores(
 def test_the_blank_nodes_of_two_runs_stay_apart(documents: list[ProvDocument]) -> None:
     store = EmbeddedStore()
     _write_all(store, documents)
-    own = [
-        {t for q in to_quads(d) for t in (q.subject, q.object) if isinstance(t, BlankNode)} for d in documents
-    ]
+    own = [{t for q in to_quads(d) for t in (q.subject, q.object) if isinstance(t, BlankNode)} for d in documents]
     stored = {t for q in store.quads() for t in (q.subject, q.object) if isinstance(t, BlankNode)}
     assert min(map(len, own)) > 0
     assert len(stored) == sum(map(len, own))  # one label per document would merge them
@@ -131,9 +129,7 @@ def test_a_sparql_endpoint_gets_one_write_per_run(
     for document in documents[:2]:
         add_prov(embedded, document)
     with oxigraph_server(tmp_path / "served") as server:
-        remote = _with_scenario(
-            RemoteStore(f"{server.url}/query", update_url=f"{server.url}/update"), scenario
-        )
+        remote = _with_scenario(RemoteStore(f"{server.url}/query", update_url=f"{server.url}/update"), scenario)
         told = _write_all(remote, documents[:2])
         assert all(w.report is not None and w.report.added for w in told)
         assert _canonical(remote) == _canonical(embedded)
@@ -173,9 +169,7 @@ def test_a_writer_killed_at_random_points_leaves_each_run_wholly_or_not_at_all(
         with EmbeddedStore(folder) as store:
             _with_scenario(store, scenario)
         writer = subprocess.Popen(
-            [sys.executable, "-c", WRITER, str(given), str(folder), str(bulk_from)],
-            stdout=subprocess.PIPE,
-            text=True,
+            [sys.executable, "-c", WRITER, str(given), str(folder), str(bulk_from)], stdout=subprocess.PIPE, text=True
         )
         assert writer.stdout is not None and writer.stdout.readline() == "ready\n"
         # five runs take a tenth of a second or a few to write: kill anywhere in that time

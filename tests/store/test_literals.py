@@ -64,19 +64,12 @@ def test_a_date_time_reads_back_aware_of_its_zone() -> None:
     assert isinstance(moment, datetime.datetime) and moment.tzinfo is not None
     naive = literal_value(typed("2026-01-04T01:02:04", "dateTime"))
     assert isinstance(naive, datetime.datetime) and naive.tzinfo is None
-    assert (
-        literal_text(typed("2026-01-04T01:02:04", "dateTime")) == "2026-01-04T01:02:04.000"
-    )  # no zone made up
+    assert literal_text(typed("2026-01-04T01:02:04", "dateTime")) == "2026-01-04T01:02:04.000"  # no zone made up
 
 
 def test_what_is_not_a_number_is_left_as_written() -> None:
     assert literal_text(typed("seven", "double")) == "seven"
     assert literal_text(Literal("7")) == "7" and literal_text(Literal("7.0", language="en")) == "7.0"
-    assert [number_text(x) for x in (float("nan"), float("inf"), -float("inf"), -0.0)] == [
-        "NaN",
-        "INF",
-        "-INF",
-        "0",
-    ]
+    assert [number_text(x) for x in (float("nan"), float("inf"), -float("inf"), -0.0)] == ["NaN", "INF", "-INF", "0"]
     rows = canonical_rows(Rows(("n",), ((typed("3", "long"),), (None,))))
     assert rows.rows == ((typed("3", "integer"),), (None,))

@@ -18,14 +18,7 @@ from exsce_dsl.store.writing import add_prov
 
 from tests.support.scenario_builders import C022_W001, C025_W001, scenario_c
 
-ODD_TOPICS = (
-    "groundtruth",
-    "ORB-SLAM",
-    "/tiago1/my scan",
-    "/50%@x",
-    "/r\u00e9seau/\u20ac",
-    "/tiago1/nav_vel",
-)
+ODD_TOPICS = ("groundtruth", "ORB-SLAM", "/tiago1/my scan", "/50%@x", "/r\u00e9seau/\u20ac", "/tiago1/nav_vel")
 BAG_NAME = "run #1 (copy) 50%.bag"
 UUID = "0d7c6f0e-0000-4000-8000-000000000001"
 
@@ -52,9 +45,7 @@ def test_odd_names_make_valid_run_graphs() -> None:
 
 def test_the_store_gives_back_the_bags_names() -> None:
     scenario = scenario_c()
-    oracle = Oracle(
-        "max_velocity", "tiago1", "below_max", OracleType.BASELINE, "scenario_c", ODD_TOPICS, limit=1.0
-    )
+    oracle = Oracle("max_velocity", "tiago1", "below_max", OracleType.BASELINE, "scenario_c", ODD_TOPICS, limit=1.0)
     with EmbeddedStore(None) as store:
         add_prov(store, compile_scenario(scenario))
         add_prov(store, compile_run(odd_run(), scenario))

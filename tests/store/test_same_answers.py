@@ -89,13 +89,9 @@ def stores(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Stores]:
             both.output(store, "baseline", "spec.exsce")
             both.output(store, "derive", "spec.exsce", "--id", "yard_reversed", "-t", "reverse_waypoint_order",
                         "--task", "patrol_1", "-o", "reversed.exsce", "--expect", "--add-to-store")  # fmt: skip
-        judged = exscec_here(
-            "verify", bags[-1], "--scenario", "spec.exsce", "--store", both.embedded, cwd=folder
-        )
+        judged = exscec_here("verify", bags[-1], "--scenario", "spec.exsce", "--store", both.embedded, cwd=folder)
         assert judged.returncode == 1 and "2 failed" in judged.stderr  # the run over speed
-        both.output(
-            both.embedded, "explore", "spec.exsce", "-n", "1", "-k", "1", "-t", "reverse_waypoint_order"
-        )
+        both.output(both.embedded, "explore", "spec.exsce", "-n", "1", "-k", "1", "-t", "reverse_waypoint_order")
         with open_store(both.embedded) as here, open_store(both.virtuoso, timeout=60) as there:
             missing = sorted(here.graph_names() - there.graph_names())
             assert any("validation" in name or "verdict" in name for name in missing), missing
@@ -164,13 +160,7 @@ def _commands(stores: Stores) -> dict[str, tuple[str, ...]]:
         "value_accounting": ("-p", f"run={runs[0]}", *distance),
         "segment_metric": (*distance, *poses, *every_run),
         "segment_metric_any": (*distance, *poses),
-        "segment_metric_between": (
-            *distance,
-            "-p",
-            f"from={start.split('-R')[0]}",
-            "-p",
-            f"to={goal.split('-R')[0]}",
-        ),
+        "segment_metric_between": (*distance, "-p", f"from={start.split('-R')[0]}", "-p", f"to={goal.split('-R')[0]}"),
         "segment_metric_of_scenario": (*distance, *poses, "-p", "scenario=yard_run"),
         "verdicts": (),
         "violation_duration_stats": speeding,
@@ -193,9 +183,7 @@ def test_every_query_prints_the_same_from_oxigraph_and_virtuoso(stores: Stores) 
             if fmt == "json" and name not in EMPTY_HERE:
                 assert json.loads(here)["results"]["bindings"], f"{name} found nothing to compare"
             if not _same(here, there):
-                lines = difflib.unified_diff(
-                    here.splitlines(), there.splitlines(), "oxigraph", "virtuoso", n=0
-                )
+                lines = difflib.unified_diff(here.splitlines(), there.splitlines(), "oxigraph", "virtuoso", n=0)
                 different.append(f"{name} -f {fmt}:\n" + "\n".join(list(lines)[:8]))
     assert not different, "\n\n".join(different)
 
@@ -245,8 +233,4 @@ def test_the_stumbles_values_print_in_one_form(stores: Stores) -> None:
                                      "-f", "json"))["results"]["bindings"][0]  # fmt: skip
     # r2 drives field-d (8, 1) to field-c (8, 8) in the open yard: 7 m in each of the five runs
     assert (stats["count"]["value"], stats["mean"]["value"], stats["variance"]["value"]) == ("5", "7", "0")
-    assert (
-        stats["mean"]["datatype"]
-        == stats["variance"]["datatype"]
-        == "http://www.w3.org/2001/XMLSchema#double"
-    )
+    assert stats["mean"]["datatype"] == stats["variance"]["datatype"] == "http://www.w3.org/2001/XMLSchema#double"

@@ -59,13 +59,11 @@ def test_a_placeholder_says_where_a_parameter_is_bound() -> None:
     )
     text = bind(query, {"s": [NamedNode("http://a"), NamedNode("http://b")], "o": Literal("x")})
     inner = text.index("{ SELECT ?s WHERE {")
-    assert text.index("VALUES ?s { <http://a> <http://b> }") > inner  # in the subquery, as placed
+    assert text.index('VALUES ?s { <http://a> <http://b> }') > inner  # in the subquery, as placed
     assert text.index('VALUES (?o) { ("x") }') < inner  # no placeholder: at the top of WHERE
     assert "UNDEF" not in text.split("#")[0] and text.count("UNDEF") == 1  # the comment's stays
     store = Store()
-    store.update(
-        'INSERT DATA { <http://a> <http://p> "x" . <http://a> <http://q> "x" . <http://c> <http://p> "x" . <http://c> <http://q> "x" }'
-    )
+    store.update('INSERT DATA { <http://a> <http://p> "x" . <http://a> <http://q> "x" . <http://c> <http://p> "x" . <http://c> <http://q> "x" }')
     assert [str(s["s"]) for s in store.query(text)] == ["<http://a>"]  # type: ignore[union-attr]
     assert len(list(store.query(query))) == 2  # unbound, the placeholder leaves ?s free  # type: ignore[arg-type]
 

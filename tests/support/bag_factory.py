@@ -194,9 +194,7 @@ def _write_ros1(
                 )
             )
         for i, time_ns, message in _in_order(topics, order):
-            writer.write(
-                connections[i], time_ns, _serialised(message, store.serialize_ros1, topics[i].msgtype)
-            )
+            writer.write(connections[i], time_ns, _serialised(message, store.serialize_ros1, topics[i].msgtype))
 
 
 def _serialised(message: Any, serialise: Callable[[Any, str], Any], msgtype: str) -> Any:
@@ -238,9 +236,7 @@ def _write_ros2(
             for topic in topics
         ]
         for i, time_ns, message in _in_order(topics, order):
-            writer.write(
-                connections[i], time_ns, _serialised(message, store.serialize_cdr, topics[i].msgtype)
-            )
+            writer.write(connections[i], time_ns, _serialised(message, store.serialize_cdr, topics[i].msgtype))
             storage = writer.storage
             if (
                 chunk_bytes is not None

@@ -98,9 +98,7 @@ class KinematicNavigator:
         else:
             path = tuple(self.grid.plan(here, (pose.position.x, pose.position.y)))
             speed = self.speeds.get(robot, DEFAULT_SPEED)
-            self.active[goal] = _Drive(
-                robot, name, path, now, now + _length(path) / speed, GoalOutcome.SUCCEEDED
-            )
+            self.active[goal] = _Drive(robot, name, path, now, now + _length(path) / speed, GoalOutcome.SUCCEEDED)
 
     def cancel(self, goal: int) -> None:
         drive = self.active.pop(goal, None)

@@ -202,9 +202,7 @@ def map_to_odom_shift(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return 0.5 + 0.01 * t, -0.3 + 0.005 * t
 
 
-def transform_stamped(
-    store: Any, stamp_ns: int, parent: str, child: str, x: float, y: float, yaw: float
-) -> Any:
+def transform_stamped(store: Any, stamp_ns: int, parent: str, child: str, x: float, y: float, yaw: float) -> Any:
     t = store.types
     return t["geometry_msgs/msg/TransformStamped"](
         header=header(store, stamp_ns, parent),
@@ -231,9 +229,7 @@ def tf_only(store: Any) -> list[Topic]:
     bx = c * (at["x"] - ox) - s_ * (at["y"] - oy)
     by = s_ * (at["x"] - ox) + c * (at["y"] - oy)
     for i, s in enumerate(fast):
-        moved = transform_stamped(
-            store, ns_of(s), "odom", "base_link", bx[i], by[i], at["yaw"][i] - MAP_TO_ODOM_YAW
-        )
+        moved = transform_stamped(store, ns_of(s), "odom", "base_link", bx[i], by[i], at["yaw"][i] - MAP_TO_ODOM_YAW)
         messages.append((ns_of(s), store.types[TF_MESSAGE](transforms=[moved])))
     messages.sort(key=lambda m: m[0])
     mount = transform_stamped(store, ns_of(0.0), "base_link", "base_laser_link", 0.2, 0.0, 0.0)

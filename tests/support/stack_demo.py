@@ -13,9 +13,7 @@ from exsce_dsl.runs.bags.reading import bag_topics
 from tests.support.cli import run_exscec
 
 
-def check_stack_demo(
-    done: subprocess.CompletedProcess[str], project: Path, convention: str, *store: str
-) -> None:
+def check_stack_demo(done: subprocess.CompletedProcess[str], project: Path, convention: str, *store: str) -> None:
     """``done``: the demo's run; ``project``: its folder; ``store``: the ``--store URL`` it was given."""
     assert done.returncode == 0, done.stderr[-3000:]
     summary = done.stderr[done.stderr.index("Summary") :]
@@ -30,15 +28,7 @@ def check_stack_demo(
     listed = run_exscec("runs", *store, "--format", "json", cwd=project)
     run = json.loads(listed.stdout)["results"]["bindings"][0]["run"]["value"]
     sources = run_exscec(
-        "query",
-        "metric_sources",
-        *store,
-        "-p",
-        f"run={run}",
-        "-p",
-        "metric=max_velocity",
-        "-f",
-        "csv",
+        "query", "metric_sources", *store, "-p", f"run={run}", "-p", "metric=max_velocity", "-f", "csv",
         cwd=project,
     )
     assert sources.returncode == 0, sources.stderr

@@ -31,10 +31,7 @@ def allocation(scenario: Scenario) -> list[tuple[str, str]]:
 
 
 BASE_ALLOCATION = [
-    ("tiago1", "delivery_a"),
-    ("tiago2", "delivery_b"),
-    ("tiago1", "navigate_home_1"),
-    ("tiago2", "navigate_home_2"),
+    ("tiago1", "delivery_a"), ("tiago2", "delivery_b"), ("tiago1", "navigate_home_1"), ("tiago2", "navigate_home_2")
 ]
 
 
@@ -49,66 +46,34 @@ def test_the_base_is_what_the_tests_expect(base: Scenario) -> None:
         (
             "remove_robot",
             {"robot": "tiago2", "reassign": "tiago1"},
-            [
-                ("tiago1", "delivery_a"),
-                ("tiago1", "delivery_b"),
-                ("tiago1", "navigate_home_1"),
-                ("tiago1", "navigate_home_2"),
-            ],
+            [("tiago1", "delivery_a"), ("tiago1", "delivery_b"), ("tiago1", "navigate_home_1"), ("tiago1", "navigate_home_2")],
         ),
         (
             "swap_assignment",
             {"robot": "tiago1", "with": "tiago2"},
-            [
-                ("tiago2", "delivery_a"),
-                ("tiago1", "delivery_b"),
-                ("tiago2", "navigate_home_1"),
-                ("tiago1", "navigate_home_2"),
-            ],
+            [("tiago2", "delivery_a"), ("tiago1", "delivery_b"), ("tiago2", "navigate_home_1"), ("tiago1", "navigate_home_2")],
         ),
         (
             "reverse_task_order",
             {"robot": "tiago1"},
-            [
-                ("tiago1", "navigate_home_1"),
-                ("tiago2", "delivery_b"),
-                ("tiago1", "delivery_a"),
-                ("tiago2", "navigate_home_2"),
-            ],
+            [("tiago1", "navigate_home_1"), ("tiago2", "delivery_b"), ("tiago1", "delivery_a"), ("tiago2", "navigate_home_2")],
         ),
-        (
-            "remove_task",
-            {"task": "delivery_b"},
-            [("tiago1", "delivery_a"), ("tiago1", "navigate_home_1"), ("tiago2", "navigate_home_2")],
-        ),
+        ("remove_task", {"task": "delivery_b"}, [("tiago1", "delivery_a"), ("tiago1", "navigate_home_1"), ("tiago2", "navigate_home_2")]),
         ("remove_task", {"robot": "tiago1"}, [("tiago2", "delivery_b"), ("tiago2", "navigate_home_2")]),
         (
             "add_task",
             {"robot": "tiago2", "task": "delivery_a", "position": "2"},
             # tiago2's 2nd task: just before its former 2nd
-            [
-                ("tiago1", "delivery_a"),
-                ("tiago2", "delivery_b"),
-                ("tiago1", "navigate_home_1"),
-                ("tiago2", "delivery_a"),
-                ("tiago2", "navigate_home_2"),
-            ],
+            [("tiago1", "delivery_a"), ("tiago2", "delivery_b"), ("tiago1", "navigate_home_1"), ("tiago2", "delivery_a"), ("tiago2", "navigate_home_2")],
         ),
         (
             "substitute_task",
             {"task": "delivery_b", "with": "delivery_a"},
-            [
-                ("tiago1", "delivery_a"),
-                ("tiago2", "delivery_a"),
-                ("tiago1", "navigate_home_1"),
-                ("tiago2", "navigate_home_2"),
-            ],
+            [("tiago1", "delivery_a"), ("tiago2", "delivery_a"), ("tiago1", "navigate_home_1"), ("tiago2", "navigate_home_2")],
         ),
     ],
 )
-def test_each_allocation_transformation(
-    base: Scenario, name: str, arguments: dict[str, str], expected: list[tuple[str, str]]
-) -> None:
+def test_each_allocation_transformation(base: Scenario, name: str, arguments: dict[str, str], expected: list[tuple[str, str]]) -> None:
     derived = derive(base, [(name, arguments)], "new_one")
     assert allocation(derived.scenario) == expected
     assert derived.scenario.id == "new_one" and derived.scenario.mission.id == "new_one_mission"
@@ -136,10 +101,7 @@ def test_the_generation_prov_says_which_step_made_a_task_from_which(base: Scenar
     step and derived from the old one."""
     derived = derive(
         base,
-        [
-            ("remove_robot", {"robot": "tiago2", "reassign": "tiago1"}),
-            ("reverse_waypoint_order", {"task": "delivery_b"}),
-        ],
+        [("remove_robot", {"robot": "tiago2", "reassign": "tiago1"}), ("reverse_waypoint_order", {"task": "delivery_b"})],
         "rev",
     )
     provn = compile_derivation(derived.derivation).get_provn()
@@ -149,55 +111,27 @@ def test_the_generation_prov_says_which_step_made_a_task_from_which(base: Scenar
     assert f"wasDerivedFrom(task:delivery_b_reversed, task:delivery_b, {step}, -, -)" in provn
     assert "rev:step_01-remove_robot, task:" not in provn  # the other step made no task
     records = [r for b in compile_derivation(derived.derivation).bundles for r in b.get_records()]
-    assert (
-        sum(1 for r in records if r.get_type().localpart == "Derivation") == 2
-    )  # the scenario's, the task's
+    assert sum(1 for r in records if r.get_type().localpart == "Derivation") == 2  # the scenario's, the task's
 
 
 def test_start_pose_and_robot_transformations(base: Scenario) -> None:
     swapped = derive(base, [("swap_start_poses", {"robot": "tiago1", "with": "tiago2"})], "swapped").scenario
-    assert [r.start_pose.id for r in swapped.robots if r.start_pose] == [
-        "classroom_c025-w002",
-        "classroom_c025-w001",
-    ]
-    added = derive(
-        base,
-        [
-            (
-                "add_robot",
-                {"robot": "tiago3", "like": "tiago1", "start": "classroom_c022-w001", "take_over": "tiago2"},
-            )
-        ],
-        "three",
-    ).scenario
+    assert [r.start_pose.id for r in swapped.robots if r.start_pose] == ["classroom_c025-w002", "classroom_c025-w001"]
+    added = derive(base, [("add_robot", {"robot": "tiago3", "like": "tiago1", "start": "classroom_c022-w001",
+                                          "take_over": "tiago2"})], "three").scenario
     assert [r.id for r in added.robots] == ["tiago1", "tiago2", "tiago3"]
-    assert ("tiago3", "delivery_b") in allocation(added) and not any(
-        r == "tiago2" for r, _ in allocation(added)
-    )
+    assert ("tiago3", "delivery_b") in allocation(added) and not any(r == "tiago2" for r, _ in allocation(added))
     replaced = derive(base, [("replace_robot", {"robot": "tiago2", "by": "tiago9"})], "replaced")
     assert [r.id for r in replaced.scenario.robots] == ["tiago1", "tiago9"]
     assert replaced.scenario.robot("tiago9").start_pose.id == "classroom_c025-w002"  # type: ignore[union-attr]
-    assert [s.transformation for s in replaced.derivation.steps] == [
-        "add_robot",
-        "substitute_allocation",
-        "remove_robot",
-    ]
-    elsewhere = derive(
-        base,
-        [("replace_robot", {"robot": "tiago2", "by": "tiago9", "start": "classroom_c069-w001"})],
-        "elsewhere",
-    ).scenario
+    assert [s.transformation for s in replaced.derivation.steps] == ["add_robot", "substitute_allocation", "remove_robot"]
+    elsewhere = derive(base, [("replace_robot", {"robot": "tiago2", "by": "tiago9", "start": "classroom_c069-w001"})],
+                       "elsewhere").scenario
     assert [(r.id, r.start_pose.id) for r in elsewhere.robots if r.start_pose] == [
-        ("tiago1", "classroom_c025-w001"),
-        ("tiago9", "classroom_c069-w001"),
-    ]
+        ("tiago1", "classroom_c025-w001"), ("tiago9", "classroom_c069-w001")]
     assert ("tiago9", "delivery_b") in allocation(elsewhere)
     with pytest.raises(ExsceError, match="'classroom_c025-w001' is another robot's start pose"):
-        derive(
-            base,
-            [("replace_robot", {"robot": "tiago2", "by": "tiago9", "start": "classroom_c025-w001"})],
-            "x",
-        )
+        derive(base, [("replace_robot", {"robot": "tiago2", "by": "tiago9", "start": "classroom_c025-w001"})], "x")
 
 
 def test_start_pose_and_allocation_transformations(base: Scenario) -> None:
@@ -225,14 +159,9 @@ def test_start_pose_and_allocation_transformations(base: Scenario) -> None:
 
 
 def test_compositions_of_two_and_three_apply_in_order(base: Scenario) -> None:
-    two = derive(
-        base, [("remove_robot", {"robot": "tiago2", "reassign": "tiago1"}), ("reverse_task_order", {})], "two"
-    )
+    two = derive(base, [("remove_robot", {"robot": "tiago2", "reassign": "tiago1"}), ("reverse_task_order", {})], "two")
     assert allocation(two.scenario) == [
-        ("tiago1", "navigate_home_2"),
-        ("tiago1", "navigate_home_1"),
-        ("tiago1", "delivery_b"),
-        ("tiago1", "delivery_a"),
+        ("tiago1", "navigate_home_2"), ("tiago1", "navigate_home_1"), ("tiago1", "delivery_b"), ("tiago1", "delivery_a")
     ]
     three = derive(
         base,
@@ -242,23 +171,11 @@ def test_compositions_of_two_and_three_apply_in_order(base: Scenario) -> None:
             ("remove_task", {"task": "navigate_home_2"}),
         ],
     )
-    assert allocation(three.scenario) == [
-        ("tiago2", "delivery_a_reversed"),
-        ("tiago1", "delivery_b"),
-        ("tiago2", "navigate_home_1"),
-    ]
-    assert (
-        three.scenario.id.startswith("scenario_c_")
-        and three.scenario.id
-        == derive(
-            base,
-            [
-                ("reverse_waypoint_order", {"task": "delivery_a"}),
-                ("swap_assignment", {"robot": "tiago1", "with": "tiago2"}),
-                ("remove_task", {"task": "navigate_home_2"}),
-            ],
-        ).scenario.id
-    )  # deterministic
+    assert allocation(three.scenario) == [("tiago2", "delivery_a_reversed"), ("tiago1", "delivery_b"), ("tiago2", "navigate_home_1")]
+    assert three.scenario.id.startswith("scenario_c_") and three.scenario.id == derive(
+        base, [("reverse_waypoint_order", {"task": "delivery_a"}), ("swap_assignment", {"robot": "tiago1", "with": "tiago2"}),
+               ("remove_task", {"task": "navigate_home_2"})]
+    ).scenario.id  # deterministic
     provn = compile_derivation(three.derivation).get_provn()
     for n, name in enumerate(("reverse_waypoint_order", "swap_assignment", "remove_task"), start=1):
         assert f"step_{n:02d}-{name}" in provn
@@ -277,14 +194,8 @@ def test_compositions_of_two_and_three_apply_in_order(base: Scenario) -> None:
         ([("remove_robot", {})], "remove_robot needs robot"),
         ([("remove_robot", {"robot": "tiago2", "colour": "red"})], "takes no colour"),
         ([("add_task", {"robot": "tiago1", "task": "delivery_a", "position": "9"})], "position 1 to 3"),
-        (
-            [
-                ("remove_task", {"task": "delivery_a"}),
-                ("remove_task", {"task": "navigate_home_1"}),
-                ("remove_task", {"robot": "tiago2"}),
-            ],
-            "would allocate no task",
-        ),
+        ([("remove_task", {"task": "delivery_a"}), ("remove_task", {"task": "navigate_home_1"}),
+          ("remove_task", {"robot": "tiago2"})], "would allocate no task"),
     ],
 )
 def test_preconditions_fail_with_clear_errors(base: Scenario, requests: list, words: str) -> None:  # type: ignore[type-arg]
@@ -295,22 +206,8 @@ def test_preconditions_fail_with_clear_errors(base: Scenario, requests: list, wo
 def test_exscec_derive_writes_a_file_that_checks_clean_and_stores_the_generation(in_tmp: Path) -> None:
     shutil.copytree(EXAMPLES / "brsu_building_c", in_tmp / "c")
     made = exscec_here(
-        "derive",
-        "c/scenario_c.exsce",
-        "-t",
-        "remove_robot",
-        "--robot",
-        "tiago2",
-        "--reassign",
-        "tiago1",
-        "-t",
-        "reverse_waypoint_order",
-        "--task",
-        "delivery_a",
-        "--id",
-        "c_alone",
-        "-o",
-        "c/c_alone.exsce",
+        "derive", "c/scenario_c.exsce", "-t", "remove_robot", "--robot", "tiago2", "--reassign", "tiago1",
+        "-t", "reverse_waypoint_order", "--task", "delivery_a", "--id", "c_alone", "-o", "c/c_alone.exsce",
         "--add-to-store",
     )
     assert made.returncode == 0, made.stderr
@@ -322,17 +219,8 @@ def test_exscec_derive_writes_a_file_that_checks_clean_and_stores_the_generation
     lineage = exscec_here("query", "derivation", "-p", "scenario=c_alone", "--format", "csv")
     assert lineage.returncode == 0, lineage.stderr
     assert "remove_robot" in lineage.stdout and "reverse_waypoint_order" in lineage.stdout
-    again = exscec_here(
-        "derive",
-        "c/c_alone.exsce",
-        "-t",
-        "reverse_task_order",
-        "--id",
-        "c_alone_rev",
-        "-o",
-        "c/c_alone_rev.exsce",
-        "--add-to-store",
-    )
+    again = exscec_here("derive", "c/c_alone.exsce", "-t", "reverse_task_order", "--id", "c_alone_rev",
+                        "-o", "c/c_alone_rev.exsce", "--add-to-store")
     assert again.returncode == 0, again.stderr
     tree = exscec_here("lineage", "c_alone")
     assert tree.returncode == 0, tree.stderr
@@ -346,26 +234,14 @@ def test_exscec_derive_writes_a_file_that_checks_clean_and_stores_the_generation
     assert expected.returncode == 0, expected.stderr
     lines = expected.stdout.splitlines()
     assert lines[0] == "tiago1 distance_travelled: unknown"
-    assert (
-        lines[1]
-        == "  classroom_c025-w001 → classroom_c018-w001: -  no data, nor for classroom_c025-w002 and classroom_c018-w002 near its ends"
-    )
-    criteria = exscec_here(
-        "derive", "c/scenario_c.exsce", "-t", "reverse_task_order", "--id", "c_expect", "--expect"
-    )
+    assert lines[1] == "  classroom_c025-w001 → classroom_c018-w001: -  no data, nor for classroom_c025-w002 and classroom_c018-w002 near its ends"
+    criteria = exscec_here("derive", "c/scenario_c.exsce", "-t", "reverse_task_order", "--id", "c_expect", "--expect")
     assert criteria.returncode == 0, criteria.stderr  # no runs stored: only the safety clauses are copied
-    assert (
-        "acceptance for c_expect {" in criteria.stdout
-        and 'scenario "as safe as scenario_c" {' in criteria.stdout
-    )
+    assert "acceptance for c_expect {" in criteria.stdout and 'scenario "as safe as scenario_c" {' in criteria.stdout
     assert "then each robot max_velocity stays below 1.0 m/s" in criteria.stdout
     assert "0.8 m/s" not in criteria.stdout  # that limit was for a part of a run only
     bad = exscec_here("derive", "c/scenario_c.exsce", "-t", "remove_robot", "--robot", "tiago5")
-    assert (
-        bad.returncode == 2
-        and "has no robot 'tiago5'; did you mean" in bad.stderr
-        and "Traceback" not in bad.stderr
-    )
+    assert bad.returncode == 2 and "has no robot 'tiago5'; did you mean" in bad.stderr and "Traceback" not in bad.stderr
 
 
 def test_a_reversed_task_and_its_generation_validate_together(base: Scenario) -> None:

@@ -50,10 +50,7 @@ def test_a_chain_then_its_inverse_is_the_base(chain: list[tuple[str, dict[str, s
 def test_reversing_a_task_s_waypoints_twice_visits_them_as_before(task: str) -> None:
     twice = derive(
         BASE,
-        [
-            ("reverse_waypoint_order", {"task": task}),
-            ("reverse_waypoint_order", {"task": f"{task}_reversed", "as": "again"}),
-        ],
+        [("reverse_waypoint_order", {"task": task}), ("reverse_waypoint_order", {"task": f"{task}_reversed", "as": "again"})],
         "twice",
     )
     original, again = BASE.task(task), twice.scenario.task("again")

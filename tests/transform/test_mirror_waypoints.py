@@ -76,9 +76,7 @@ def _reflect(x: float, y: float, x0: float, y0: float, heading: float) -> tuple[
     return x0 + m.real, y0 + m.imag
 
 
-def test_waypoints_and_headings_are_mirrored_about_the_pose_s_line(
-    base: Scenario, spec: Specification
-) -> None:
+def test_waypoints_and_headings_are_mirrored_about_the_pose_s_line(base: Scenario, spec: Specification) -> None:
     tasks = {t.id: t for t in spec.tasks}
     derived = derive(base, [("mirror_waypoints", {"task": "patrol", "about": "north"})], "yard_n", tasks)
     (task,) = derived.new_tasks
@@ -92,16 +90,12 @@ def test_waypoints_and_headings_are_mirrored_about_the_pose_s_line(
     assert (corner.position.x, corner.position.y) == pytest.approx((0.0, -1.0), abs=1e-12)
     assert [w.id for w in task.waypoints()] == ["patrol_mirrored-w001", "patrol_mirrored-w002"]
     assert derived.derivation.steps == (
-        TransformationStep(
-            "mirror_waypoints", (("task", "patrol"), ("about", "north"), ("to", "patrol_mirrored"))
-        ),
+        TransformationStep("mirror_waypoints", (("task", "patrol"), ("about", "north"), ("to", "patrol_mirrored"))),
     )
     assert derived.derivation.origins == (TaskOrigin("patrol_mirrored", "patrol", 1),)
 
 
-def test_about_a_slanted_pose_the_reflection_is_the_plain_formula(
-    base: Scenario, spec: Specification
-) -> None:
+def test_about_a_slanted_pose_the_reflection_is_the_plain_formula(base: Scenario, spec: Specification) -> None:
     tasks = {t.id: t for t in spec.tasks}
     derived = derive(base, [("mirror_waypoints", {"task": "patrol", "about": "gate"})], "yard_g", tasks)
     mirrored = [c for w in derived.new_tasks[0].waypoints() for c in (w.position.x, w.position.y)]
@@ -121,9 +115,7 @@ def test_mirroring_twice_about_one_pose_gives_the_waypoints_back(base: Scenario,
     (original,) = [t for t in spec.tasks if t.id == "patrol"]
     for back, first in zip(again.waypoints(), original.waypoints(), strict=True):
         assert back.position.distance_to(first.position) < 1e-9
-        assert math.remainder(back.orientation.yaw - first.orientation.yaw, math.tau) == pytest.approx(
-            0.0, abs=1e-12
-        )
+        assert math.remainder(back.orientation.yaw - first.orientation.yaw, math.tau) == pytest.approx(0.0, abs=1e-12)
 
 
 @pytest.mark.parametrize(
@@ -158,7 +150,7 @@ def test_a_derive_block_builds_prints_back_and_records_the_step(in_tmp: Path, sp
     assert format_spec_document(loaded) == DERIVED
     assert block.derivation is not None
     document = compile_derivation(block.derivation)
-    assert "mirror_waypoints" in document.get_provn()
+    assert 'mirror_waypoints' in document.get_provn()
 
 
 def test_an_unknown_pose_in_a_block_is_reported_at_its_step(in_tmp: Path, spec: Specification) -> None:

@@ -135,10 +135,7 @@ def test_other_transformations_keep_the_environment_and_its_id(base: Scenario) -
 def test_moved_there_and_back_is_the_base_environment_again(base: Scenario) -> None:
     derived = derive(
         base,
-        [
-            ("move_obstacle", {"obstacle": "mast", "to": "4,2.5"}),
-            ("move_obstacle", {"obstacle": "mast", "to": "3,3"}),
-        ],
+        [("move_obstacle", {"obstacle": "mast", "to": "4,2.5"}), ("move_obstacle", {"obstacle": "mast", "to": "3,3"})],
         "back",
     )
     assert derived.scenario.environment == base.environment and not derived.environment_changed
@@ -147,10 +144,7 @@ def test_moved_there_and_back_is_the_base_environment_again(base: Scenario) -> N
 @pytest.mark.parametrize(
     ("arguments", "words"),
     [
-        (
-            {"obstacle": "mats", "to": "4,2.5"},
-            "environment 'yard' has no obstacle 'mats'; did you mean 'mast'?",
-        ),
+        ({"obstacle": "mats", "to": "4,2.5"}, "environment 'yard' has no obstacle 'mats'; did you mean 'mast'?"),
         ({"obstacle": "mast", "to": "3,3"}, r"obstacle 'mast' is at \(3.0, 3.0\) already"),
         ({"obstacle": "mast", "to": "3.0,3.0,0.0"}, "already"),
         ({"obstacle": "mast", "to": "4"}, "'4' is not a position: write x,y or x,y,z in metres"),
@@ -222,36 +216,18 @@ def test_the_canonical_text_is_how_it_is_written(folder: Path) -> None:
 @pytest.mark.parametrize(
     ("written", "line", "column", "words"),
     [
-        (
-            "move obstacle mats to (4.0, 2.5)",
-            4,
-            3,
-            "environment 'yard' has no obstacle 'mats'; did you mean 'mast'?",
-        ),
+        ("move obstacle mats to (4.0, 2.5)", 4, 3, "environment 'yard' has no obstacle 'mats'; did you mean 'mast'?"),
         ("move obstacle mast to (3.0, 3.0)", 4, 3, "obstacle 'mast' is at (3.0, 3.0) already"),
-        (
-            "move obstacle mast to (7.0, 2.0)",
-            4,
-            3,
-            "obstacle 'mast' is outside the map 'yard_map' (x from 0.00 to 5.00",
-        ),
-        (
-            "move obstacle mast to (4.0, 2.5)\n  move obstacle mast to (2.0, -1.0)",
-            5,
-            3,
-            "obstacle 'mast' is outside",
-        ),
+        ("move obstacle mast to (7.0, 2.0)", 4, 3, "obstacle 'mast' is outside the map 'yard_map' (x from 0.00 to 5.00"),
+        ("move obstacle mast to (4.0, 2.5)\n  move obstacle mast to (2.0, -1.0)", 5, 3, "obstacle 'mast' is outside"),
     ],
 )
-def test_a_move_that_cannot_apply_is_reported_at_its_line(
-    folder: Path, written: str, line: int, column: int, words: str
-) -> None:
+def test_a_move_that_cannot_apply_is_reported_at_its_line(folder: Path, written: str, line: int, column: int, words: str) -> None:
     (folder / "moved.exsce").write_text(MOVED.replace("move obstacle mast to (4.0, 2.5)", written))
     analysis = analyse(folder / "moved.exsce")
     found = [(d.location, d.message) for d in analysis.errors]
     at = [
-        m
-        for loc, m in found
+        m for loc, m in found
         if loc is not None and loc.file.endswith("moved.exsce") and (loc.line, loc.column) == (line, column)
     ]
     assert analysis.spec is None and any(words in m for m in at) and len(found) == 1, found
@@ -278,9 +254,7 @@ def test_the_generation_prov_has_the_step_and_its_arguments(base: Scenario) -> N
     }
 
 
-def test_the_derived_document_is_a_derive_block_when_the_environment_changed(
-    folder: Path, base: Scenario
-) -> None:
+def test_the_derived_document_is_a_derive_block_when_the_environment_changed(folder: Path, base: Scenario) -> None:
     target = folder / "sub" / "moved.exsce"
     moved = derive(
         base,
@@ -299,28 +273,17 @@ def test_the_derived_document_is_a_derive_block_when_the_environment_changed(
         "}\n"
     )
     still = derive(base, [("reverse_waypoint_order", {"task": "hop"})], "reversed")
-    assert [
-        type(d).__name__ for d in derived_document(still, folder / "yard.exsce", target).declarations
-    ] == ["Task", "Scenario"]
+    assert [type(d).__name__ for d in derived_document(still, folder / "yard.exsce", target).declarations] == [
+        "Task", "Scenario"
+    ]
 
 
 def test_exscec_derive_writes_a_derive_block_that_checks_and_compiles(in_tmp: Path) -> None:
     write_map(in_tmp, "yard")
     (in_tmp / "yard.exsce").write_text(YARD)
     made = exscec_here(
-        "derive",
-        "yard.exsce",
-        "-t",
-        "move_obstacle",
-        "--obstacle",
-        "mast",
-        "--to",
-        "4,2.5",
-        "--id",
-        "yard_moved",
-        "-o",
-        "new.exsce",
-        "--add-to-store",
+        "derive", "yard.exsce", "-t", "move_obstacle", "--obstacle", "mast", "--to", "4,2.5",
+        "--id", "yard_moved", "-o", "new.exsce", "--add-to-store",
     )
     assert made.returncode == 0, made.stderr
     assert (in_tmp / "new.exsce").read_text() == MOVED
@@ -329,9 +292,7 @@ def test_exscec_derive_writes_a_derive_block_that_checks_and_compiles(in_tmp: Pa
     compiled = exscec_here("compile", "new.exsce", "-f", "provn")
     assert compiled.returncode == 0, compiled.stderr
     assert "hadMember(exsce:yard_moved, env:yard_moved_environment)" in compiled.stdout
-    assert (
-        'exsce:to="4.0,2.5"' in compiled.stdout and "bundle yard_moved:scenario_generation" in compiled.stdout
-    )
+    assert 'exsce:to="4.0,2.5"' in compiled.stdout and "bundle yard_moved:scenario_generation" in compiled.stdout
     bad = exscec_here("derive", "yard.exsce", "-t", "move_obstacle", "--obstacle", "mats", "--to", "4,2.5")
     assert bad.returncode == 2 and "has no obstacle 'mats'; did you mean 'mast'?" in bad.stderr
     assert "Traceback" not in bad.stderr

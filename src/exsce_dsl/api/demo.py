@@ -24,6 +24,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from exsce_dsl.errors import ExsceError
+from exsce_dsl.runs import ROS1_BAG
 
 EXAMPLE = "brsu_building_c"
 SCENARIOS = "scenarios"
@@ -148,7 +149,7 @@ def _on_ros2(step: DemoStep) -> DemoStep:
     """A live step on ROS 2: Nav2's goals and exsce's recorder, each run's bag a folder."""
     title = step.title.replace("live ROS 1 graph", "live ROS 2 graph").replace("move_base", "Nav2")
     title = title.replace("rosbag record records", "exsce's recorder records")
-    command = step.command.replace("--ros1", "--ros2").replace("runs/baseline/*.bag", "runs/baseline/*/")
+    command = step.command.replace("--ros1", "--ros2").replace(f"/*{ROS1_BAG.suffix} ", "/*/ ")
     return replace(step, title=title, command=command)
 
 

@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 from exsce_dsl.errors import Remedied
 from exsce_dsl.model.campaign import CampaignTrial
 from exsce_dsl.remedies import REPLAY_IN_IRSIM, REPLAY_IT, REPRODUCE_IT
+from exsce_dsl.runs import ROS1_BAG
 from exsce_dsl.wording import counted
 
 if TYPE_CHECKING:
@@ -121,7 +122,8 @@ class Exploration:
             if file is not None:
                 bags = result.folder / "runs" / shrinking.minimal
                 # ROS 1 bags are files; ROS 2 bags (--executor ros2) folders
-                pattern = f"{bags}/*.bag" if any(bags.glob("*.bag")) else f"{bags}/*/"
+                ros1 = f"*{ROS1_BAG.suffix}"
+                pattern = f"{bags}/{ros1}" if any(bags.glob(ros1)) else f"{bags}/*/"
                 lines.append(Remedied("  reproduce", REPRODUCE_IT, (pattern, str(file))).said(wording))
                 if self.replay is not None:
                     seed = scenario_seed(record.plan.seed, shrinking.minimal)

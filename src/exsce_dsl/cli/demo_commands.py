@@ -9,12 +9,16 @@ from __future__ import annotations
 
 import os
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import click
 
 from exsce_dsl.cli.common import ExitCode, exit_status, reports_errors
+
+if TYPE_CHECKING:
+    from exsce_dsl.api.demo import DemoStep
 
 
 def _refuse_with_ros1(ros1: bool, convention: bool, simulator: bool, ros2: bool = False) -> None:
@@ -140,7 +144,6 @@ def demo(
         LIVE_ROS2_STEPS,
         LIVE_STEPS,
         STEPS,
-        DemoStep,
         command_hint,
         live_graph,
         run_steps,
@@ -166,12 +169,7 @@ def demo(
     click.secho(f"exsce demo in {target.resolve()}{where}", bold=True, err=True)
     if hint:
         click.echo(f"{hint}, then 'cd {folder}'", err=True)
-
-    def announce(number: int, step: DemoStep) -> None:
-        click.secho(f"\n[{number}/{len(steps)}] {step.title}", bold=True, err=True)
-        click.secho(f"$ {step.command}", fg="cyan", err=True)
-        sys.stdout.flush()
-
+    announce = _announcer(len(steps))
     if ros1:
         with live_graph(target) as uri:
             click.echo(f"ROS_MASTER_URI={uri}", err=True)
@@ -181,6 +179,17 @@ def demo(
     _say_summary(summary_lines(run, "docs/live.md" if ros1 or ros2 else "docs/tutorial.md"), hint)
     if not run.as_expected:
         sys.exit(ExitCode.FAILED)
+
+
+def _announcer(count: int) -> Callable[[int, DemoStep], None]:
+    """What says each step as it starts: its number, title and command."""
+
+    def announce(number: int, step: DemoStep) -> None:
+        click.secho(f"\n[{number}/{count}] {step.title}", bold=True, err=True)
+        click.secho(f"$ {step.command}", fg="cyan", err=True)
+        sys.stdout.flush()
+
+    return announce
 
 
 def _say_summary(lines: list[str], hint: str | None) -> None:

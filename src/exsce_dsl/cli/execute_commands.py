@@ -181,7 +181,8 @@ def execute(**given: Any) -> None:
       exscec execute examples/brsu_building_c/scenario_c.exsce --ros1 --start-master --runs 3 \\
           --policy retry-once --verify --junit verdicts.xml --server-timeout 1 \\
           -o live/  # exits 2: no robot's move_base answers
-      exscec execute examples/brsu_building_c/scenario_c.exsce --ros2 --stand-in --verify -o live-ros2/
+      exscec execute examples/brsu_building_c/scenario_c.exsce --ros2 --stand-in --fault overspeed:tiago1 \\
+          -o live-ros2/
     """
     from exsce_dsl.api import load
 

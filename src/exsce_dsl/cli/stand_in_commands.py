@@ -5,7 +5,7 @@ from __future__ import annotations
 import os
 import signal
 from types import FrameType
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import click
 
@@ -123,12 +123,9 @@ def stand_in(
     from exsce_dsl.api import load
     from exsce_dsl.api import stand_in as play
 
-    if ros1 == ros2:
-        raise click.UsageError("say --ros1 or --ros2: the graph the stand-in plays on")
-    if ros2 and (start_master or log_dir is not None):
-        raise click.UsageError("--start-master and --log-dir go with --ros1")
-    if ros1 and (simulator != "kinematic" or behaviour is not None):
-        raise click.UsageError("--simulator and --behaviour go with --ros2")
+    _check_graph(
+        ros1, ros2, start_master or log_dir is not None, simulator != "kinematic" or behaviour is not None
+    )
     loaded = load(spec)
 
     def terminated(signum: int, frame: FrameType | None) -> None:
@@ -144,14 +141,28 @@ def stand_in(
             speed_up=speed_up, log_dir=log_dir,
         ) as running:  # fmt: skip
             click.echo(f"ROS_MASTER_URI={running.master_uri}")
-            servers = ", ".join(f"{robot} ({action})" for robot, action in running.actions.items())
-            click.echo(f"stand-in: {servers} at {speed_up:g}x wall time; Ctrl-C to stop", err=True)
-            try:
-                running.wait()
-            except KeyboardInterrupt:
-                click.echo("stand-in: stopping", err=True)
+            _serve(running, speed_up)
     finally:
         signal.signal(signal.SIGTERM, previous)
+
+
+def _check_graph(ros1: bool, ros2: bool, ros1_options: bool, ros2_options: bool) -> None:
+    if ros1 == ros2:
+        raise click.UsageError("say --ros1 or --ros2: the graph the stand-in plays on")
+    if ros2 and ros1_options:
+        raise click.UsageError("--start-master and --log-dir go with --ros1")
+    if ros1 and ros2_options:
+        raise click.UsageError("--simulator and --behaviour go with --ros2")
+
+
+def _serve(running: Any, speed_up: float) -> None:
+    """Say what is served, then serve until Ctrl-C or SIGTERM."""
+    servers = ", ".join(f"{robot} ({action})" for robot, action in running.actions.items())
+    click.echo(f"stand-in: {servers} at {speed_up:g}x wall time; Ctrl-C to stop", err=True)
+    try:
+        running.wait()
+    except KeyboardInterrupt:
+        click.echo("stand-in: stopping", err=True)
 
 
 def _play_ros2(
@@ -170,12 +181,7 @@ def _play_ros2(
         behaviour=behaviour,
     ) as running:  # fmt: skip
         click.echo(f"ROS_DOMAIN_ID={os.environ.get('ROS_DOMAIN_ID') or 0}")
-        servers = ", ".join(f"{robot} ({action})" for robot, action in running.actions.items())
-        click.echo(f"stand-in: {servers} at {speed_up:g}x wall time; Ctrl-C to stop", err=True)
-        try:
-            running.wait()
-        except KeyboardInterrupt:
-            click.echo("stand-in: stopping", err=True)
+        _serve(running, speed_up)
 
 
 COMMANDS = [stand_in]

@@ -223,7 +223,7 @@ def _ros1(options: ExecutorOptions) -> AbstractContextManager[Executor]:
 
 def _ros2(options: ExecutorOptions) -> AbstractContextManager[Executor]:
     if options.start_master or options.master_uri:
-        raise ExsceError("a ROS 2 graph has no master: --start-master goes with the ros1 executor")
+        raise ExsceError("a ROS 2 graph has no master: a master of its own goes with the ros1 executor")
     speed_up = DEFAULT_SPEED_UP if options.speed_up is None else options.speed_up
     return ros2_executor(stand_in=options.stand_in, faults=options.faults, speed_up=speed_up)
 

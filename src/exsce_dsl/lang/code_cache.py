@@ -34,7 +34,6 @@ FORMAT = b"exsce spec cache 1"
 LIBRARIES = ("textx", "arpeggio", "rosbags", "yaml")
 """Installed packages whose version changes what loading a specification gives."""
 
-
 def cached_standard_metrics(make: Callable[[], tuple[MetricDefinition, ...]]) -> tuple[MetricDefinition, ...]:
     """The standard library's metrics, parsed by ``make`` once per installation of exsce (the
     library ships in the package, and its types are rosbags')."""

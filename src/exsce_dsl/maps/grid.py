@@ -120,7 +120,9 @@ def load_occupancy_grid(yaml_path: Path) -> OccupancyGrid:
         resolution = float(meta["resolution"])
         thresholds = float(meta.get("occupied_thresh", 0.65)), float(meta.get("free_thresh", 0.196))
     except (TypeError, ValueError):  # the value is not quoted: the file may be anything
-        raise ExsceError(f"map file {yaml_path}: resolution, origin and thresholds must be numbers") from None
+        raise ExsceError(
+            f"map file {yaml_path}: resolution, origin and thresholds must be numbers"
+        ) from None
     return OccupancyGrid(
         cells=_read_pgm(image),
         resolution=resolution,

@@ -34,7 +34,6 @@ __all__ = [
     "relation_names",
 ]
 
-
 @dataclass(frozen=True)
 class Judgement:
     passed: bool

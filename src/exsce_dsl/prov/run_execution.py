@@ -142,7 +142,9 @@ def _goals(bundle: Mapping[str, Any], activities: Mapping[str, Any]) -> Iterator
         )
 
 
-def write_execution(writer: DocumentWriter, run: Run, bag: str, robot_names: Mapping[str, str]) -> None:
+def write_execution(
+    writer: DocumentWriter, run: Run, bag: str, robot_names: Mapping[str, str]
+) -> None:
     """The bundle of ``run``'s execution (none when the run has no run-time PROV); ``bag``: the
     local name of the ingested run's bag entity in the run's namespace; ``robot_names``: each
     robot id's local name in ``robot:`` (:func:`~exsce_dsl.prov.identifiers.robot_name`)."""

@@ -235,19 +235,8 @@ class _Lockstep:
             driven = leg.length if leg.status is GoalStatus.SUCCEEDED else 0.0
             self.actions.append(
                 SimulatedAction(
-                    robot,
-                    task_number,
-                    task_id,
-                    s_number,
-                    w_number,
-                    self.last_pose[robot],
-                    goal,
-                    start,
-                    self.now,
-                    leg.status,
-                    driven,
-                    tuple(leg.path),
-                    leg.outcome,
+                    robot, task_number, task_id, s_number, w_number, self.last_pose[robot], goal,
+                    start, self.now, leg.status, driven, tuple(leg.path), leg.outcome,
                 )  # fmt: skip
             )
             self.last_pose[robot] = goal

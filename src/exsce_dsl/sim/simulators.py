@@ -105,7 +105,6 @@ class IrsimSimulator:
     def settings(self) -> Mapping[str, str]:
         from exsce_dsl.sim.irsim_play import PATH_SPACING, PROGRESS_RADIUS, PROGRESS_TIME
         from exsce_dsl.sim.irsim_world import GOAL_TOLERANCE
-
         return {
             "behaviour": self.behaviour,
             "scans": self.scans,

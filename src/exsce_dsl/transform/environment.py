@@ -17,13 +17,8 @@ ENVIRONMENT: list[Transformation] = []
 """This module's transformations, in the order they are declared."""
 
 
-@transformation(
-    ENVIRONMENT,
-    "swap start poses of {robot} and {with}",
-    "robot: robot, with: robot",
-    records="robot to",
-    help="ROBOT and WITH swap start poses",
-)
+@transformation(ENVIRONMENT, "swap start poses of {robot} and {with}", "robot: robot, with: robot",
+                records="robot to", help="ROBOT and WITH swap start poses")
 def swap_start_poses(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     first, second = robot_of(scenario, a["robot"]), robot_of(scenario, a["with"])
     if first.id == second.id:
@@ -34,13 +29,8 @@ def swap_start_poses(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]
     return Applied(replace(scenario, robots=robots), (), (swap,))
 
 
-@transformation(
-    ENVIRONMENT,
-    "start {robot} at {pose}",
-    "robot: robot, pose: pose",
-    records="robot pose",
-    help="ROBOT (without one) starts at POSE",
-)
+@transformation(ENVIRONMENT, "start {robot} at {pose}", "robot: robot, pose: pose",
+                records="robot pose", help="ROBOT (without one) starts at POSE")
 def add_start_pose(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     """Give a robot that has none a start pose (a pose no other robot starts at)."""
     robot = robot_of(scenario, a["robot"])
@@ -57,13 +47,8 @@ def add_start_pose(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) 
     )
 
 
-@transformation(
-    ENVIRONMENT,
-    "remove start pose of {robot}",
-    "robot: robot",
-    records="robot",
-    help="ROBOT (without tasks) loses its start pose",
-)
+@transformation(ENVIRONMENT, "remove start pose of {robot}", "robot: robot",
+                records="robot", help="ROBOT (without tasks) loses its start pose")
 def remove_start_pose(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     """Take a robot's start pose away; only a robot without tasks may have none."""
     robot = robot_of(scenario, a["robot"])
@@ -89,13 +74,9 @@ def _coordinates(text: str) -> tuple[float, ...]:
     return tuple(values)
 
 
-@transformation(
-    ENVIRONMENT,
-    "move obstacle {obstacle} to {to}",
-    "obstacle: obstacle, to: position",
-    records="obstacle to",
-    help="OBSTACLE moves to TO: x,y or x,y,z in metres (same heading, model and size)",
-)
+@transformation(ENVIRONMENT, "move obstacle {obstacle} to {to}", "obstacle: obstacle, to: position",
+                records="obstacle to",
+                help="OBSTACLE moves to TO: x,y or x,y,z in metres (same heading, model and size)")
 def move_obstacle(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     """The obstacle at another position (``x,y`` or ``x,y,z`` in metres; z is 0 unless given),
     with its heading, model and size.  The step records z only when it is not 0, as the

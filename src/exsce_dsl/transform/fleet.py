@@ -15,13 +15,8 @@ FLEET: list[Transformation] = []
 """This module's transformations, in the order they are declared."""
 
 
-@transformation(
-    FLEET,
-    "remove robot {robot} [reassign to {reassign}]",
-    "robot: robot, reassign: robot?",
-    records="robot reassign",
-    help="drop ROBOT (its tasks go to REASSIGN, or go)",
-)
+@transformation(FLEET, "remove robot {robot} [reassign to {reassign}]", "robot: robot, reassign: robot?",
+                records="robot reassign", help="drop ROBOT (its tasks go to REASSIGN, or go)")
 def remove_robot(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     """Drop a robot; its tasks are dropped, or reassigned to another robot (``reassign``)."""
     robot = robot_of(scenario, a["robot"]).id
@@ -42,13 +37,10 @@ def remove_robot(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) ->
     return Applied(new, (), (recorded("remove_robot", robot=robot, reassign=heir),))
 
 
-@transformation(
-    FLEET,
-    "add robot {robot} like {like} at {start} [taking over {take_over}]",
-    "robot: new_robot, like: robot, start: pose, take_over: robot?",
-    records="robot like start",
-    help="a robot typed LIKE at START (taking over TAKE_OVER's tasks)",
-)
+@transformation(FLEET, "add robot {robot} like {like} at {start} [taking over {take_over}]",
+                "robot: new_robot, like: robot, start: pose, take_over: robot?",
+                records="robot like start",
+                help="a robot typed LIKE at START (taking over TAKE_OVER's tasks)")
 def add_robot(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     """A robot like ``like`` (its type) at ``start`` (a pose of the environment), taking over
     the tasks of ``take_over`` (a robot) if given."""
@@ -75,13 +67,9 @@ def add_robot(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Ap
     return applied
 
 
-@transformation(
-    FLEET,
-    "replace robot {robot} by {by} [like {like}] [at {start}]",
-    "robot: robot, by: new_robot, like: robot?, start: pose?",
-    records="",
-    help="BY (typed LIKE) takes ROBOT's tasks, and its place (or starts at START)",
-)
+@transformation(FLEET, "replace robot {robot} by {by} [like {like}] [at {start}]",
+                "robot: robot, by: new_robot, like: robot?, start: pose?",
+                records="", help="BY (typed LIKE) takes ROBOT's tasks, and its place (or starts at START)")
 def replace_robot(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     """Composite: add a robot like ``like`` at the old one's start pose (or at ``start``), taking
     over its tasks, then remove the old one."""

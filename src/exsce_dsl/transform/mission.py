@@ -15,13 +15,9 @@ MISSION: list[Transformation] = []
 """This module's transformations, in the order they are declared."""
 
 
-@transformation(
-    MISSION,
-    "add task {task} to {robot} [at {position}]",
-    "robot: robot, task: task, position: count?",
-    records="robot task position",
-    help="give ROBOT the TASK, at POSITION among its tasks",
-)
+@transformation(MISSION, "add task {task} to {robot} [at {position}]",
+                "robot: robot, task: task, position: count?",
+                records="robot task position", help="give ROBOT the TASK, at POSITION among its tasks")
 def add_task(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     robot, task_id = robot_of(scenario, a["robot"]).id, a["task"]
     if task_id not in tasks and scenario.task(task_id) is None:
@@ -41,13 +37,9 @@ def add_task(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> App
     return Applied(new, (), (recorded("add_task", robot=robot, task=task_id, position=position),))
 
 
-@transformation(
-    MISSION,
-    ("remove task {task} [from {robot}]", "remove tasks of {robot}"),
-    "task: task?, robot: robot?",
-    records="task robot",
-    help="take TASK away (from ROBOT, or every robot)",
-)
+@transformation(MISSION, ("remove task {task} [from {robot}]", "remove tasks of {robot}"),
+                "task: task?, robot: robot?",
+                records="task robot", help="take TASK away (from ROBOT, or every robot)")
 def remove_task(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     task_id, robot = a.get("task"), a.get("robot")
     if task_id is None and robot is None:
@@ -64,13 +56,8 @@ def remove_task(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> 
     return Applied(with_allocation(scenario, kept), (), (recorded("remove_task", task=task_id, robot=robot),))
 
 
-@transformation(
-    MISSION,
-    "substitute task {task} by {with}",
-    "task: task, with: task",
-    records="task by",
-    help="allocate task WITH wherever TASK was",
-)
+@transformation(MISSION, "substitute task {task} by {with}", "task: task, with: task",
+                records="task by", help="allocate task WITH wherever TASK was")
 def substitute_task(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     old, new_id = a["task"], a["with"]
     if old not in {e.task for e in scenario.mission.allocation}:
@@ -84,13 +71,8 @@ def substitute_task(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task])
     )
 
 
-@transformation(
-    MISSION,
-    "swap tasks of {robot} and {with}",
-    "robot: robot, with: robot",
-    records="robot to",
-    help="ROBOT and WITH swap their tasks",
-)
+@transformation(MISSION, "swap tasks of {robot} and {with}", "robot: robot, with: robot",
+                records="robot to", help="ROBOT and WITH swap their tasks")
 def swap_assignment(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     first, second = robot_of(scenario, a["robot"]).id, robot_of(scenario, a["with"]).id
     if first == second:
@@ -102,13 +84,8 @@ def swap_assignment(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task])
     )
 
 
-@transformation(
-    MISSION,
-    "reverse task order [of {robot}]",
-    "robot: robot?",
-    records="robot",
-    help="each robot (or ROBOT) does its tasks in reverse",
-)
+@transformation(MISSION, "reverse task order [of {robot}]", "robot: robot?",
+                records="robot", help="each robot (or ROBOT) does its tasks in reverse")
 def reverse_task_order(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     robot = a.get("robot")
     robots = [robot_of(scenario, robot).id] if robot else [r.id for r in scenario.robots]
@@ -120,13 +97,9 @@ def reverse_task_order(scenario: Scenario, a: Arguments, tasks: Mapping[str, Tas
     return Applied(with_allocation(scenario, allocation), (), (recorded("reverse_task_order", robot=robot),))
 
 
-@transformation(
-    MISSION,
-    "reallocate {allocation}",
-    "allocation: allocation",
-    records="allocation robot to",
-    help="the mission becomes ALLOCATION: robot:task,robot:task,... in order",
-)
+@transformation(MISSION, "reallocate {allocation}", "allocation: allocation",
+                records="allocation robot to",
+                help="the mission becomes ALLOCATION: robot:task,robot:task,... in order")
 def substitute_allocation(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     """A whole new allocation: ``robot:task,robot:task,...`` in execution order."""
     entries = []

@@ -17,13 +17,8 @@ TASKS: list[Transformation] = []
 """This module's transformations, in the order they are declared."""
 
 
-@transformation(
-    TASKS,
-    "reverse waypoints of {task} [as {as}]",
-    "task: task, as: new_task?",
-    records="task to",
-    help="a new task AS: TASK's waypoints reversed",
-)
+@transformation(TASKS, "reverse waypoints of {task} [as {as}]", "task: task, as: new_task?",
+                records="task to", help="a new task AS: TASK's waypoints reversed")
 def reverse_waypoint_order(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     """A new task with the waypoints of ``task`` in reverse order, substituted for it."""
     old = scenario.task(a["task"])
@@ -53,14 +48,9 @@ def _propose_mirrors(s: Scenario, tasks: Mapping[str, Task]) -> Iterator[Argumen
         yield from ({"task": task, "about": pose} for pose in starts)
 
 
-@transformation(
-    TASKS,
-    "mirror waypoints of {task} about {about} [as {as}]",
-    "task: task, about: pose, as: new_task?",
-    records="task about to",
-    propose=_propose_mirrors,
-    help="a new task AS: TASK's waypoints mirrored about the line through pose ABOUT",
-)
+@transformation(TASKS, "mirror waypoints of {task} about {about} [as {as}]",
+                "task: task, about: pose, as: new_task?", records="task about to", propose=_propose_mirrors,
+                help="a new task AS: TASK's waypoints mirrored about the line through pose ABOUT")
 def mirror_waypoints(scenario: Scenario, a: Arguments, tasks: Mapping[str, Task]) -> Applied:
     """A new task with the waypoints of ``task`` mirrored about the line through pose ``about``
     along its heading (headings mirrored too), substituted for it: where the environment is

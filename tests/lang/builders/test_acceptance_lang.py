@@ -104,10 +104,7 @@ def test_the_criteria_build_to_the_model_in_si_units(spec_folder: Path) -> None:
     r1 = Subject(Quantifier.ROBOT, "r1")
     duration, distance, speed = faster.expectations
     assert (duration.subject, duration.metric, duration.relation, duration.against) == (
-        r1,
-        "task_duration",
-        BasicRelation.DECREASING,
-        "s1",
+        r1, "task_duration", BasicRelation.DECREASING, "s1"
     )
     assert duration.delta == Quantity(0.5, "ms") and duration.tolerance == Quantity(1.0, "s")
     assert distance.relation is BasicRelation.INVARIANT and distance.tolerance == Quantity(10.0, "%")
@@ -119,9 +116,7 @@ def test_the_criteria_build_to_the_model_in_si_units(spec_folder: Path) -> None:
     assert visited.value == Quantity(1.0, None) and visited.tolerance == Quantity(0.0, None)
     assert mission.subject.quantifier is Quantifier.MISSION
     assert (mission.relation, mission.value, mission.delta) == (
-        BasicRelation.INCREASING,
-        Quantity(60.0, "min"),
-        Quantity(6.0, "s"),
+        BasicRelation.INCREASING, Quantity(60.0, "min"), Quantity(6.0, "s")
     )
     assert mission.against is None
 
@@ -147,77 +142,23 @@ def test_fmt_diff_shows_and_writes_nothing(spec_folder: Path) -> None:
 # (id, text to replace, replacement, line, column, words the message must hold)
 CASES = [
     ("unknown-scenario", "acceptance for s2", "acceptance for s3", 43, 16, "unknown scenario 's3'"),
-    (
-        "wrong-mission",
-        "when m2 runs",
-        "when m1 runs",
-        47,
-        10,
-        "the mission of scenario 's2' is 'm2', not 'm1'",
-    ),
-    (
-        "robot-not-in-fleet",
-        "then r1 task_duration",
-        "then r2 task_duration",
-        48,
-        10,
-        "robot 'r2' is not in the fleet",
-    ),
-    (
-        "unknown-metric",
-        "r1 distance_travelled",
-        "r1 distance_travel",
-        49,
-        13,
-        "unknown metric 'distance_travel'; did you mean",
-    ),
-    (
-        "wrong-dimension",
-        "below 90 cm/s",
-        "below 90 cm",
-        50,
-        10,
-        "'max_velocity' is a speed, in m/s; '90 cm' is a length",
-    ),
+    ("wrong-mission", "when m2 runs", "when m1 runs", 47, 10, "the mission of scenario 's2' is 'm2', not 'm1'"),
+    ("robot-not-in-fleet", "then r1 task_duration", "then r2 task_duration", 48, 10, "robot 'r2' is not in the fleet"),
+    ("unknown-metric", "r1 distance_travelled", "r1 distance_travel", 49, 13, "unknown metric 'distance_travel'; did you mean"),
+    ("wrong-dimension", "below 90 cm/s", "below 90 cm", 50, 10, "'max_velocity' is a speed, in m/s; '90 cm' is a length"),
     ("relative-limit", "below 90 cm/s", "below 1 std", 50, 10, "'1 std' is relative"),
     ("mission-metric-of-robot", "and mission_duration", "and r1 mission_duration", 56, 10, "drop 'r1'"),
-    (
-        "robot-metric-of-mission",
-        "and r1 waypoints_visited",
-        "and waypoints_visited",
-        55,
-        10,
-        "measured per robot",
-    ),
+    ("robot-metric-of-mission", "and r1 waypoints_visited", "and waypoints_visited", 55, 10, "measured per robot"),
     ("own-scenario-as-base", "within 10 % of s1", "within 10 % of s2", 49, 60, "'of baseline', not 'of s2'"),
     ("changing-without-base", "within 1 s of s1", "within 1 s", 48, 10, "add 'of <scenario>'"),
-    (
-        "task-not-of-robot",
-        "when r1 does go_p3",
-        "when r1 does go_p1x",
-        53,
-        18,
-        "does not give task 'go_p1x' to 'r1'",
-    ),
+    ("task-not-of-robot", "when r1 does go_p3", "when r1 does go_p1x", 53, 18, "does not give task 'go_p1x' to 'r1'"),
     ("pose-never-reached", "reaches room-p3", "reaches room-p2", 50, 64, "'r1' never goes to 'room-p2'"),
     ("window-on-mission-metric", "by 6 s", "by 6 s during go_p3", 56, 59, "no value per path segment"),
     ("no-baseline-runs", "at least 5 baseline", "at least 0 baseline", 45, 11, "at least 1 run"),
-    (
-        "duplicate-title",
-        '"on the way"',
-        '"faster alone"',
-        52,
-        3,
-        'two acceptance scenarios are called "faster alone"',
-    ),
-    (
-        "when-task-of-other-robot",
-        "r1 distance_to_obstacles stays above 0.2 m during go_p3",
-        "each robot distance_to_obstacles stays above 0.2 m",
-        54,
-        10,
-        "'when r1 does go_p3' looks at r1's task",
-    ),
+    ("duplicate-title", '"on the way"', '"faster alone"', 52, 3, 'two acceptance scenarios are called "faster alone"'),
+    ("when-task-of-other-robot", "r1 distance_to_obstacles stays above 0.2 m during go_p3",
+     "each robot distance_to_obstacles stays above 0.2 m", 54, 10,
+     "'when r1 does go_p3' looks at r1's task"),
     ("syntax", "stays above 0.2 m", "stays over 0.2 m", 54, 41, "expected 'below' or 'above', found 'over'"),
 ]
 

@@ -53,33 +53,19 @@ def test_every_step_form_builds_and_prints_back(folder: Path) -> None:
     every = spec.scenario("every_step")
     assert [r.id for r in every.robots] == ["tiago2", "tiago4"]  # tiago2 gave its tasks to tiago3
     assert every.robot("tiago4").start_pose.id == "classroom_c069-w001"  # type: ignore[union-attr]
-    assert [(a.robot, a.task) for a in every.mission.allocation] == [
-        ("tiago4", "delivery_a_back"),
-        ("tiago4", "delivery_b"),
-    ]
+    assert [(a.robot, a.task) for a in every.mission.allocation] == [("tiago4", "delivery_a_back"), ("tiago4", "delivery_b")]
     derived = {d.id: d for d in spec.derived}
     assert derived["every_step"].derivation is not None
     recorded = [s.transformation for s in derived["every_step"].derivation.steps]
     assert recorded == [
-        "add_robot",
-        "substitute_allocation",
-        "swap_assignment",
-        "swap_start_poses",
-        "reverse_waypoint_order",
-        "reverse_task_order",
-        "add_task",
-        "remove_task",
-        "substitute_task",
-        "add_robot",
-        "substitute_allocation",
-        "remove_robot",  # replace_robot, as its basic steps
-        "remove_robot",
-        "substitute_allocation",
+        "add_robot", "substitute_allocation", "swap_assignment", "swap_start_poses", "reverse_waypoint_order",
+        "reverse_task_order", "add_task", "remove_task", "substitute_task",
+        "add_robot", "substitute_allocation", "remove_robot",  # replace_robot, as its basic steps
+        "remove_robot", "substitute_allocation",
     ]
     from_derived = spec.scenario("from_derived")
     assert [(a.robot, a.task) for a in from_derived.mission.allocation] == [
-        ("tiago4", "delivery_a_back"),
-        ("tiago4", "delivery_b"),
+        ("tiago4", "delivery_a_back"), ("tiago4", "delivery_b")
     ]
     assert [(r.id, r.start_pose) for r in from_derived.robots][2] == ("tiago5", None)
     text = format_spec_document(spec)
@@ -92,34 +78,16 @@ def test_every_step_form_builds_and_prints_back(folder: Path) -> None:
     ("old", "new", "line", "column", "words"),
     [
         ("from scenario_c {", "from scenario_x {", 3, 24, "unknown scenario 'scenario_x'"),
-        (
-            "remove robot tiago3 reassign to tiago4",
-            "remove robot tiago3 reassign to tiago9",
-            13,
-            3,
-            "has no robot 'tiago9'",
-        ),
-        (
-            "add task delivery_a to tiago1 at 1",
-            "add task delivery_a to tiago1 at 7",
-            9,
-            3,
-            "a new one goes at position 1 to",
-        ),
+        ("remove robot tiago3 reassign to tiago4", "remove robot tiago3 reassign to tiago9", 13, 3, "has no robot 'tiago9'"),
+        ("add task delivery_a to tiago1 at 1", "add task delivery_a to tiago1 at 7", 9, 3, "a new one goes at position 1 to"),
         ("derive from_derived", "derive every_step", 19, 8, "duplicate scenario 'every_step'"),
     ],
 )
-def test_a_step_that_cannot_apply_is_reported_at_its_line(
-    folder: Path, old: str, new: str, line: int, column: int, words: str
-) -> None:
+def test_a_step_that_cannot_apply_is_reported_at_its_line(folder: Path, old: str, new: str, line: int, column: int, words: str) -> None:
     (folder / "derived.exsce").write_text(DERIVED.replace(old, new, 1))
     analysis = analyse(folder / "derived.exsce")
     found = [(d.location, d.message) for d in analysis.errors]
-    at = [
-        m
-        for loc, m in found
-        if loc is not None and loc.file.endswith("derived.exsce") and (loc.line, loc.column) == (line, column)
-    ]
+    at = [m for loc, m in found if loc is not None and loc.file.endswith("derived.exsce") and (loc.line, loc.column) == (line, column)]
     assert analysis.spec is None and any(words in m for m in at), found
 
 

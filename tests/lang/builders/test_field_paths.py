@@ -120,9 +120,7 @@ def test_the_kind_decides_what_applies(tmp_path):
     assert picked.errors == []
     counted = _analysis(tmp_path, READS + "  value mean(len(tf.transforms) + len(scan.ranges) * 0)\n}\n")
     assert counted.errors == []
-    mixed = _analysis(
-        tmp_path, READS + "  value max(tf.transforms.transform.translation.x - scan.ranges)\n}\n"
-    )
+    mixed = _analysis(tmp_path, READS + "  value max(tf.transforms.transform.translation.x - scan.ranges)\n}\n")
     assert [(e.location.line, e.location.column) for e in mixed.errors] == [(7, 53)]
     assert "arrays cannot be aligned in time" in mixed.errors[0].message
 
@@ -150,109 +148,50 @@ def test_a_pair_metric_says_whose_topic_before_the_path(tmp_path):
     assert expression_text(metric.value) == text.split("value ")[1].split("\n")[0]
     assert {f.robot for f in metric.reads[0].fields} == {"a", "b"}
     unsaid = _analysis(tmp_path, text.replace("a.tf.transforms", "tf.transforms", 1))
-    assert (
-        'say whose topic this is: a.tf.transforms[child_frame_id == "base_link"]' in unsaid.errors[0].message
-    )
+    assert 'say whose topic this is: a.tf.transforms[child_frame_id == "base_link"]' in unsaid.errors[0].message
 
 
 # A line-number matrix: each planted mistake is reported at its line and column.
 ERRORS = [
-    (
-        "max(tf.transforms[0].transfrom.x)",
-        7,
-        13,
-        "tf.transforms[0] (tf2_msgs/msg/TFMessage.transforms[0]) has no field 'transfrom'; did you mean 'transform'?",
-    ),
+    ("max(tf.transforms[0].transfrom.x)", 7, 13,
+     "tf.transforms[0] (tf2_msgs/msg/TFMessage.transforms[0]) has no field 'transfrom'; did you mean 'transform'?"),
     ("max(odom.pose.pose.postion.x)", 7, 13, "has no field 'postion'; did you mean 'position'?"),
-    (
-        "max(tf.transforms[0].transform)",
-        7,
-        13,
-        "tf.transforms[0].transform is a message (translation, rotation), not a number: name one of its fields",
-    ),
-    (
-        "max(tf.transforms)",
-        7,
-        13,
-        "tf.transforms is an array of messages (header, child_frame_id, transform), not a number: name a field "
-        "of its elements (tf.transforms.header) or pick one (tf.transforms[0])",
-    ),
+    ("max(tf.transforms[0].transform)", 7, 13,
+     "tf.transforms[0].transform is a message (translation, rotation), not a number: name one of its fields"),
+    ("max(tf.transforms)", 7, 13,
+     "tf.transforms is an array of messages (header, child_frame_id, transform), not a number: name a field "
+     "of its elements (tf.transforms.header) or pick one (tf.transforms[0])"),
     ("max(tf.transforms[0].child_frame_id)", 7, 13, "tf.transforms[0].child_frame_id is text, not a number"),
     ("max(diag.status_list.goal_id.id)", 7, 13, "diag.status_list.goal_id.id is text, not a number"),
-    (
-        "max(tf.transforms[child_frame_id == 3].transform.translation.x)",
-        7,
-        13,
-        'child_frame_id is text: compare it to a quoted string (child_frame_id == "...")',
-    ),
-    (
-        'max(diag.status_list[status == "3"].status)',
-        7,
-        13,
-        "status is a number: compare it to a number, not to text",
-    ),
+    ("max(tf.transforms[child_frame_id == 3].transform.translation.x)", 7, 13,
+     'child_frame_id is text: compare it to a quoted string (child_frame_id == "...")'),
+    ('max(diag.status_list[status == "3"].status)', 7, 13,
+     "status is a number: compare it to a number, not to text"),
     ("max(scan.angle_min[0])", 7, 13, "scan.angle_min is a number, not an array: [0] picks an element"),
     ("max(odom.pose[1].pose.position.x)", 7, 13, "odom.pose is a message (pose, covariance), not an array"),
-    (
-        "max(scan.ranges[x == 1])",
-        7,
-        13,
-        "scan.ranges is an array of numbers: [x == ...] picks an element of an array of messages by one of its "
-        "fields; pick a position instead: scan.ranges[0]",
-    ),
-    (
-        'max(scan.header[frame_id == "map"].stamp.sec)',
-        7,
-        13,
-        "scan.header is a message (stamp, frame_id), not an array of messages",
-    ),
-    (
-        'max(tf.transforms[child_frame == "a"].transform.translation.x)',
-        7,
-        13,
-        "an element of tf.transforms has no field 'child_frame'; did you mean 'child_frame_id'?",
-    ),
-    (
-        'max(tf.transforms[header.frame == "a"].transform.translation.x)',
-        7,
-        13,
-        "header in an element of tf.transforms has no field 'frame'; did you mean 'frame_id'?",
-    ),
-    (
-        "max(tf.transforms[header.stamp == 1].transform.translation.x)",
-        7,
-        13,
-        "header.stamp in an element of tf.transforms is a message (sec, nanosec): a selection compares",
-    ),
-    (
-        "max(len(scan.angle_min))",
-        7,
-        13,
-        "len(...) counts the elements of an array, but scan.angle_min is a number",
-    ),
+    ("max(scan.ranges[x == 1])", 7, 13,
+     "scan.ranges is an array of numbers: [x == ...] picks an element of an array of messages by one of its "
+     "fields; pick a position instead: scan.ranges[0]"),
+    ('max(scan.header[frame_id == "map"].stamp.sec)', 7, 13,
+     "scan.header is a message (stamp, frame_id), not an array of messages"),
+    ('max(tf.transforms[child_frame == "a"].transform.translation.x)', 7, 13,
+     "an element of tf.transforms has no field 'child_frame'; did you mean 'child_frame_id'?"),
+    ('max(tf.transforms[header.frame == "a"].transform.translation.x)', 7, 13,
+     "header in an element of tf.transforms has no field 'frame'; did you mean 'frame_id'?"),
+    ("max(tf.transforms[header.stamp == 1].transform.translation.x)", 7, 13,
+     "header.stamp in an element of tf.transforms is a message (sec, nanosec): a selection compares"),
+    ("max(len(scan.angle_min))", 7, 13,
+     "len(...) counts the elements of an array, but scan.angle_min is a number"),
     ("max(len(odom.pose))", 7, 13, "len(...) counts the elements of an array, but odom.pose is a message"),
-    (
-        "max(mk.markers.points.x)",
-        7,
-        13,
-        "mk.markers.points is an array of messages (x, y, z) in each element of mk.markers, an array of arrays: "
-        "pick one element of mk.markers, e.g. mk.markers[0].points.x",
-    ),
+    ("max(mk.markers.points.x)", 7, 13,
+     "mk.markers.points is an array of messages (x, y, z) in each element of mk.markers, an array of arrays: "
+     "pick one element of mk.markers, e.g. mk.markers[0].points.x"),
     ("max(len(mk.markers.points))", 7, 13, "pick one element of mk.markers, e.g. len(mk.markers[0].points)"),
     ("max(mk.markers.colors[0].r)", 7, 13, "e.g. mk.markers[0].colors[0].r"),
     ("max(scan.ranges.x)", 7, 13, "scan.ranges is an array of numbers: it has no field 'x'"),
-    (
-        "max(scan[0].ranges)",
-        7,
-        17,
-        "'scan' is a topic, not an array: [...] picks an element of an array field",
-    ),
-    (
-        "mean(diag.status_list[0].status) - len(diag.status_list)",
-        7,
-        44,
-        "mixes one number per window with values per message",
-    ),
+    ("max(scan[0].ranges)", 7, 17, "'scan' is a topic, not an array: [...] picks an element of an array field"),
+    ("mean(diag.status_list[0].status) - len(diag.status_list)", 7, 44,
+     "mixes one number per window with values per message"),
 ]
 
 
@@ -291,9 +230,7 @@ def test_a_type_exsce_does_not_know_is_a_warning_at_its_read(tmp_path):
     (warning,) = analysis.diagnostics
     assert warning.severity == "warning"
     assert (warning.location.line, warning.location.column) == (2, 3)
-    assert warning.message.startswith(
-        "exsce does not know the message type turtlesim/msg/Pose: the fields of "
-    )
+    assert warning.message.startswith("exsce does not know the message type turtlesim/msg/Pose: the fields of ")
     assert "in a folder EXSCE_MSG_PATH names, to check them now" in warning.message  # the library's words
     assert warning.remedied is not None  # what `exscec check` says, with its option:
     assert "exscec --msg-path DIR, or EXSCE_MSG_PATH" in warning.said(REMEDIES).message
@@ -339,9 +276,7 @@ def test_ingest_says_when_the_bag_makes_an_assumed_number_an_array(tmp_path):
     bag = parse_definition("float32[] x\n", "turtlesim/msg/Pose", "msg", Source("the bag"))
     (error,) = check_fields(metric, "turtlesim/msg/Pose", bag.tree("turtlesim/msg/Pose"))
     assert (error.location.line, error.location.column) == (3, 13)
-    assert error.message.startswith(
-        "turtle.x is an array per message by the definition of turtlesim/msg/Pose"
-    )
+    assert error.message.startswith("turtle.x is an array per message by the definition of turtlesim/msg/Pose")
 
 
 def test_ingest_gives_the_builder_s_own_messages(tmp_path, monkeypatch):
@@ -350,9 +285,7 @@ def test_ingest_gives_the_builder_s_own_messages(tmp_path, monkeypatch):
     (folder / "turtlesim" / "msg").mkdir(parents=True)
     (folder / "turtlesim" / "msg" / "Pose.msg").write_text(TURTLE_MSG)
     (metric,) = _analysis(tmp_path, TURTLE).spec.metrics
-    (at_ingest,) = check_fields(
-        metric, "turtlesim/msg/Pose", user_catalogue([folder]).tree("turtlesim/msg/Pose")
-    )
+    (at_ingest,) = check_fields(metric, "turtlesim/msg/Pose", user_catalogue([folder]).tree("turtlesim/msg/Pose"))
     monkeypatch.setenv("EXSCE_MSG_PATH", str(folder))
     (at_check,) = _analysis(tmp_path, TURTLE).diagnostics
     assert (at_check.severity, at_check.message, at_check.location) == (
@@ -444,10 +377,7 @@ def test_msg_path_goes_in_front_of_the_environment_s_folders(tmp_path, monkeypat
     (tmp_path / "m.exsce").write_text(TURTLE)
     monkeypatch.setenv("EXSCE_MSG_PATH", str(tmp_path / "b"))
     from_b = exscec_here("check", "m.exsce", cwd=tmp_path)
-    assert (
-        from_b.returncode == 2
-        and "m.exsce:3:29: error: turtle (turtlesim/msg/Pose) has no field" in from_b.stderr
-    )
+    assert from_b.returncode == 2 and "m.exsce:3:29: error: turtle (turtlesim/msg/Pose) has no field" in from_b.stderr
     from_a = exscec_here("--msg-path", "a", "check", "m.exsce", cwd=tmp_path)
     assert from_a.returncode == 0 and "warning" not in from_a.stderr, from_a.stderr
     helped = exscec_here("--help")
@@ -471,15 +401,10 @@ def test_every_path_prints_back_to_the_same_metric(tmp_path):
 # ------------------------------------------------------------------ the live runtime
 def _message() -> SimpleNamespace:
     def transform(child: str, x: float) -> SimpleNamespace:
-        return SimpleNamespace(
-            child_frame_id=child,
-            header=SimpleNamespace(frame_id="map"),
-            transform=SimpleNamespace(translation=SimpleNamespace(x=x)),
-        )
+        return SimpleNamespace(child_frame_id=child, header=SimpleNamespace(frame_id="map"),
+                               transform=SimpleNamespace(translation=SimpleNamespace(x=x)))
 
-    return SimpleNamespace(
-        transforms=[transform("odom", 1.0), transform("base_link", 2.0)], ranges=(3.0, 4.0, 5.0)
-    )
+    return SimpleNamespace(transforms=[transform("odom", 1.0), transform("base_link", 2.0)], ranges=(3.0, 4.0, 5.0))
 
 
 @pytest.mark.parametrize(
@@ -502,9 +427,7 @@ def test_the_runtime_reads_paths_from_message_objects(written, value, present):
 
 def test_the_runtime_keeps_a_mask_of_the_messages_with_the_picked_element():
     key = 'transforms[child_frame_id == "base_link"].transform.translation.x'
-    spec = monitor_runtime.TopicSpec(
-        "tf2_msgs.msg.TFMessage", fields={key: key, "len(ranges)": "len(ranges)"}
-    )
+    spec = monitor_runtime.TopicSpec("tf2_msgs.msg.TFMessage", fields={key: key, "len(ranges)": "len(ranges)"})
     monitors = SimpleNamespace(core=SimpleNamespace(Topic=lambda name, t, fields: fields), REDUCERS=[])
     runtime = monitor_runtime.MonitorRuntime(monitors, [], {"/tf": spec}, [])
     runtime.on_message("/tf", 1.0, _message())
@@ -521,9 +444,7 @@ def test_rospy_names_a_time_s_fields_its_own_way_along_any_path():
     assert attribute_path(path, tree) == "transforms[header.stamp.secs == 3].header.stamp.nsecs"
     plain = FieldPath(("transforms", Index(0), "transform", "translation", "x"))
     assert attribute_path(plain, tree) == plain.key
-    assert (
-        attribute_path(FieldPath(("header", "stamp", "sec")), None) == "header.stamp.secs"
-    )  # a type unknown
+    assert attribute_path(FieldPath(("header", "stamp", "sec")), None) == "header.stamp.secs"  # a type unknown
 
 
 def test_a_node_subscribes_with_the_keys_and_attributes_of_every_path(tmp_path):

@@ -62,9 +62,7 @@ def _robot_window(analysed, robot: str) -> tuple[float, float]:
 
 
 def _value(analysed, metric: str, robot: str) -> float:
-    (found,) = [
-        v for v in analysed.run.metrics if v.metric == metric and v.robot == robot and v.action is None
-    ]
+    (found,) = [v for v in analysed.run.metrics if v.metric == metric and v.robot == robot and v.action is None]
     return found.value
 
 
@@ -131,19 +129,13 @@ def test_oracles_on_user_metrics_pass_a_calm_run_and_fail_an_overspeed_one(tmp_p
     assert ingested.returncode == 0, ingested.stderr
     built = exscec_here("baseline", "spec.exsce", cwd=tmp_path)
     assert built.returncode == 0, built.stderr
-    judged = exscec_here(
-        "verify", *map(str, bags.values()), "--scenario", "spec.exsce", "--json", cwd=tmp_path
-    )
+    judged = exscec_here("verify", *map(str, bags.values()), "--scenario", "spec.exsce", "--json", cwd=tmp_path)
     assert judged.returncode == 1, judged.stderr
     verdicts = json.loads(judged.stdout)
     listed = json.loads(exscec_here("runs", "--format", "json", cwd=tmp_path).stdout)["results"]["bindings"]
     case = {row["run"]["value"]: Path(row["bag"]["value"]).parent.name for row in listed}
-    case |= {
-        row["run"]["value"]: name
-        for row in listed
-        for name, bag in bags.items()
-        if Path(row["bag"]["value"]).name == bag.name
-    }
+    case |= {row["run"]["value"]: name for row in listed for name, bag in bags.items()
+             if Path(row["bag"]["value"]).name == bag.name}
     table = {(case[v["run"]], v["oracle"]): v["verdict"] for v in verdicts}
     assert table == {
         ("clean", "tiago1-fast_driving_time"): "passed",
@@ -169,42 +161,19 @@ ERRORS = [
     ("value mean(speed.linear.x)", 3, 14, "unknown topic 'speed'"),
     ("value first(vel.linear.x where vel.linear.x and 1)", 3, 51, "'and' joins conditions"),
     ("value duration where vel.linear.x", 3, 9, "needs a condition per message"),
-    (
-        "value succeeded",
-        3,
-        9,
-        "counts the robot's goals that succeeded: read them (reads goals: robot goals)",
-    ),
+    ("value succeeded", 3, 9, "counts the robot's goals that succeeded: read them (reads goals: robot goals)"),
     ("value abs(1, 2)", 3, 9, "abs(...) takes one value"),
-    (
-        "value max(derivate(vel.linear.x))",
-        3,
-        13,
-        "unknown function 'derivate'; did you mean 'derivative'? (the "
-        "functions: min, max, mean, sum, first, last, integral, change, path_length, norm, abs, sqrt, speed, "
-        "derivative)",
-    ),
+    ("value max(derivate(vel.linear.x))", 3, 13, "unknown function 'derivate'; did you mean 'derivative'? (the "
+     "functions: min, max, mean, sum, first, last, integral, change, path_length, norm, abs, sqrt, speed, "
+     "derivative)"),
     ("value max(speed(vel.linear.x))", 3, 13, "speed(...) takes two or three coordinates (x, y[, z]), not 1"),
     ("value max(derivative(vel.linear.x, vel.linear.y))", 3, 13, "derivative(...) takes one value, not 2"),
-    (
-        "value max(derivative(2))",
-        3,
-        13,
-        "derivative(...) is over a number per message, in time, but this is a constant",
-    ),
-    (
-        "value derivative(max(vel.linear.x))",
-        3,
-        9,
-        "derivative(...) is over a number per message, in time, but this is one number per window",
-    ),
+    ("value max(derivative(2))", 3, 13, "derivative(...) is over a number per message, in time, but this is a "
+     "constant"),
+    ("value derivative(max(vel.linear.x))", 3, 9, "derivative(...) is over a number per message, in time, but "
+     "this is one number per window"),
     ("value 2 * max(norml(vel.linear.x))", 3, 17, "unknown function 'norml'; did you mean 'norm'?"),
-    (
-        "value count(vel.linear.x > 1)",
-        3,
-        9,
-        "'count' is written without parentheses: count where <condition>",
-    ),
+    ("value count(vel.linear.x > 1)", 3, 9, "'count' is written without parentheses: count where <condition>"),
 ]
 
 
@@ -220,69 +189,26 @@ def test_type_errors_are_reported_at_their_line_and_column(tmp_path, value, line
 
 
 DECLARATION_ERRORS = [
-    (
-        'metric max_velocity for each robot {\n  reads v: std_msgs/Float64 on "/{ns}/v"\n  value max(v.data)\n}\n',
-        1,
-        8,
-        "one of exsce's built-in metrics",
-    ),
-    (
-        'metric bad-name for each robot {\n  reads v: std_msgs/Float64 on "/{ns}/v"\n  value max(v.data)\n}\n',
-        1,
-        8,
-        "must be letters, digits and '_'",
-    ),
-    (
-        'metric m for each robot {\n  reads v: std_msgs/Float64 on "/{ns}/v\\"; x"\n  value max(v.data)\n}\n',
-        2,
-        3,
-        "is not a ROS topic name",
-    ),
-    (
-        'metric m for each robot per segment {\n  reads v: std_msgs/Float64 on "/{ns}/v"\n  value mean(v.data)\n}\n',
-        1,
-        8,
-        "so that its values over path segments make one value",
-    ),
-    (
-        'metric m for each robot {\n  unit cm\n  reads v: std_msgs/Float64 on "/{ns}/v"\n  value max(v.data)\n}\n',
-        1,
-        8,
-        "write 'm', not 'cm'",
-    ),
-    (
-        'metric m for each robot {\n  unit m/s\n  safe below 1 m\n  reads v: std_msgs/Float64 on "/{ns}/v"\n'
-        "  value max(v.data)\n}\n",
-        3,
-        3,
-        "the limit is a length, but 'm' is a speed",
-    ),
-    (
-        'metric m for each robot {\n  safe above 1\n  reads v: std_msgs/Float64 on "/{ns}/v"\n  value max(v.data)\n}\n',
-        2,
-        3,
-        "is the min(...) of its values",
-    ),
-    (
-        'metric m for mission {\n  reads p: std_msgs/Float64 on "/{ns}/p"\n  value max(p.data)\n}\n',
-        3,
-        13,
-        "a mission metric reads every robot's topics",
-    ),
-    (
-        'metric m for each pair of robots (a, b) {\n  reads p: std_msgs/Float64 on "/{ns}/p"\n'
-        "  value min(p.data)\n}\n",
-        3,
-        13,
-        "say whose topic this is: a.p.data or b.p.data",
-    ),
-    (
-        'metric m for each pair of robots (a, b) {\n  reads p: sensor_msgs/LaserScan on "/{ns}/p"\n'
-        "  value min(a.p.ranges - b.p.ranges)\n}\n",
-        3,
-        26,
-        "arrays cannot be aligned in time",
-    ),
+    ('metric max_velocity for each robot {\n  reads v: std_msgs/Float64 on "/{ns}/v"\n  value max(v.data)\n}\n',
+     1, 8, "one of exsce's built-in metrics"),
+    ('metric bad-name for each robot {\n  reads v: std_msgs/Float64 on "/{ns}/v"\n  value max(v.data)\n}\n',
+     1, 8, "must be letters, digits and '_'"),
+    ('metric m for each robot {\n  reads v: std_msgs/Float64 on "/{ns}/v\\"; x"\n  value max(v.data)\n}\n',
+     2, 3, "is not a ROS topic name"),
+    ('metric m for each robot per segment {\n  reads v: std_msgs/Float64 on "/{ns}/v"\n  value mean(v.data)\n}\n',
+     1, 8, "so that its values over path segments make one value"),
+    ('metric m for each robot {\n  unit cm\n  reads v: std_msgs/Float64 on "/{ns}/v"\n  value max(v.data)\n}\n',
+     1, 8, "write 'm', not 'cm'"),
+    ('metric m for each robot {\n  unit m/s\n  safe below 1 m\n  reads v: std_msgs/Float64 on "/{ns}/v"\n'
+     "  value max(v.data)\n}\n", 3, 3, "the limit is a length, but 'm' is a speed"),
+    ('metric m for each robot {\n  safe above 1\n  reads v: std_msgs/Float64 on "/{ns}/v"\n  value max(v.data)\n}\n',
+     2, 3, "is the min(...) of its values"),
+    ('metric m for mission {\n  reads p: std_msgs/Float64 on "/{ns}/p"\n  value max(p.data)\n}\n',
+     3, 13, "a mission metric reads every robot's topics"),
+    ('metric m for each pair of robots (a, b) {\n  reads p: std_msgs/Float64 on "/{ns}/p"\n'
+     "  value min(p.data)\n}\n", 3, 13, "say whose topic this is: a.p.data or b.p.data"),
+    ('metric m for each pair of robots (a, b) {\n  reads p: sensor_msgs/LaserScan on "/{ns}/p"\n'
+     "  value min(a.p.ranges - b.p.ranges)\n}\n", 3, 26, "arrays cannot be aligned in time"),
 ]
 
 
@@ -315,10 +241,8 @@ def test_check_names_an_unknown_function_at_its_place_with_the_functions_there_a
 
 
 def test_a_clause_on_a_user_metric_checks_its_unit_and_scope(tmp_path):
-    text = (
-        (BUILDING / "scenario_c.exsce")
-        .read_text()
-        .replace("fast_driving_time stays below 2 s", "fast_driving_time stays below 2 m")
+    text = (BUILDING / "scenario_c.exsce").read_text().replace(
+        "fast_driving_time stays below 2 s", "fast_driving_time stays below 2 m"
     )
     for name in ("environment.exsce", "robots.exsce", "metrics.exsce"):
         (tmp_path / name).write_text((BUILDING / name).read_text())

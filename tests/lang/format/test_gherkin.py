@@ -88,14 +88,8 @@ def test_a_title_and_several_givens_stay_one_line_each() -> None:
         'two\nlines and a "quote"',
         (AtStartPose(Subject(Quantifier.ROBOT, "tiago1")), AtStartPose(Subject(Quantifier.ROBOT, "tiago2"))),
         When(robot="tiago2", task="delivery_b"),
-        (
-            Expectation(
-                Subject(Quantifier.MISSION),
-                "mission_duration",
-                BasicRelation.INVARIANT,
-                value=Quantity(97.606, "s", "97.606"),
-            ),
-        ),
+        (Expectation(Subject(Quantifier.MISSION), "mission_duration", BasicRelation.INVARIANT,
+                     value=Quantity(97.606, "s", "97.606")),),
     )
     text = gherkin_features(Acceptance("scenario_c", (criterion,)), spec.scenario("scenario_c"))
     assert steps(parsed(text)) == {

@@ -71,9 +71,7 @@ def _per_message(depth: int, fields: st.SearchStrategy[str]) -> st.SearchStrateg
 
 
 def _condition(depth: int, fields: st.SearchStrategy[str]) -> st.SearchStrategy[str]:
-    compare = st.tuples(
-        _per_message(depth, fields), st.sampled_from(["<", "<=", ">", ">=", "==", "!="]), numbers
-    )
+    compare = st.tuples(_per_message(depth, fields), st.sampled_from(["<", "<=", ">", ">=", "==", "!="]), numbers)
     single = compare.map(" ".join)
     return st.one_of(
         single,
@@ -85,24 +83,18 @@ def _condition(depth: int, fields: st.SearchStrategy[str]) -> st.SearchStrategy[
 
 def _value(depth: int, fields: st.SearchStrategy[str]) -> st.SearchStrategy[str]:
     aggregate = st.one_of(
-        st.tuples(
-            st.sampled_from(["min", "max", "mean", "sum", "first", "last", "integral", "change"]),
-            _per_message(depth, fields),
-        ).map(lambda p: f"{p[0]}({p[1]})"),
-        st.tuples(st.sampled_from(["min", "max"]), _per_message(depth, fields), _condition(1, fields)).map(
-            lambda p: f"{p[0]}({p[1]} where {p[2]})"
-        ),
-        st.tuples(st.sampled_from(["duration", "count"]), _condition(depth, fields)).map(
-            lambda p: f"({p[0]} where {p[1]})"
-        ),
+        st.tuples(st.sampled_from(["min", "max", "mean", "sum", "first", "last", "integral", "change"]),
+                  _per_message(depth, fields)).map(lambda p: f"{p[0]}({p[1]})"),
+        st.tuples(st.sampled_from(["min", "max"]), _per_message(depth, fields), _condition(1, fields))
+        .map(lambda p: f"{p[0]}({p[1]} where {p[2]})"),
+        st.tuples(st.sampled_from(["duration", "count"]), _condition(depth, fields))
+        .map(lambda p: f"({p[0]} where {p[1]})"),
         st.just("min(scan.ranges where scan.ranges >= scan.range_min)"),
         st.just("elapsed"),
     )
     return st.one_of(
         aggregate,
-        st.tuples(aggregate, st.sampled_from(["+", "-", "*", "/"]), st.one_of(aggregate, numbers)).map(
-            " ".join
-        ),
+        st.tuples(aggregate, st.sampled_from(["+", "-", "*", "/"]), st.one_of(aggregate, numbers)).map(" ".join),
         st.tuples(aggregate, aggregate).map(lambda p: f"norm({p[0]}, {p[1]}) - sqrt({p[1]})"),
     )
 

@@ -101,31 +101,21 @@ def test_the_method_file_imports_as_these_criteria(scenario_c: Scenario) -> None
     assert (criterion.title, criterion.givens, criterion.when) == ("baseline", (), When(mission="mission_c"))
     t1 = [e for e in criterion.expectations if e.subject == TIAGO1]
     assert criterion.expectations[:2] == (
-        Expectation(
-            MISSION, "mission_duration", BasicRelation.INVARIANT, value=s(97.606, ""), tolerance=s(10.0, "")
-        ),
+        Expectation(MISSION, "mission_duration", BasicRelation.INVARIANT, value=s(97.606, ""), tolerance=s(10.0, "")),
         Expectation(MISSION, "distance_between_robots", BasicRelation.ABOVE_MIN, limit=m(0.1, "")),
     )
     assert t1 == [
-        Expectation(
-            TIAGO1, "task_duration", BasicRelation.INVARIANT, value=s(97.606, ""), tolerance=s(5.0, "")
-        ),
+        Expectation(TIAGO1, "task_duration", BasicRelation.INVARIANT, value=s(97.606, ""), tolerance=s(5.0, "")),
         Expectation(TIAGO1, "waypoints_visited", BasicRelation.INVARIANT, value=Quantity(3.0)),
         Expectation(
-            TIAGO1,
-            "distance_travelled",
-            BasicRelation.INVARIANT,
-            value=m(50.702942669287076, ""),
-            tolerance=m(2.0, ""),
+            TIAGO1, "distance_travelled", BasicRelation.INVARIANT, value=m(50.702942669287076, ""), tolerance=m(2.0, "")
         ),
         Expectation(TIAGO1, "distance_to_obstacles", BasicRelation.ABOVE_MIN, limit=m(0.1, "")),
         Expectation(TIAGO1, "max_velocity", BasicRelation.BELOW_MAX, limit=Quantity(1.0, "m/s")),
     ]
     assert len(criterion.expectations) == 12
     # the numbers are written as the file writes them
-    assert "tiago1 distance_travelled is invariant around 50.702942669287076 m within 2.0 m" in dsl_text(
-        acceptance
-    )
+    assert "tiago1 distance_travelled is invariant around 50.702942669287076 m within 2.0 m" in dsl_text(acceptance)
     assert "tiago1 waypoints_visited is invariant around 3\n" in dsl_text(acceptance)
 
 
@@ -170,21 +160,11 @@ def test_a_metamorphic_section_compares_with_the_base_scenario(tmp_path: Path) -
     (criterion,) = acceptance.criteria
     assert criterion.title == "against scenario_b"
     assert criterion.expectations == (
-        Expectation(
-            TIAGO1,
-            "distance_travelled",
-            BasicRelation.INCREASING,
-            value=m(50.7, ""),
-            delta=m(47.5, ""),
-            tolerance=m(0.0, ""),
-            against="scenario_b",
-        ),
+        Expectation(TIAGO1, "distance_travelled", BasicRelation.INCREASING, value=m(50.7, ""), delta=m(47.5, ""),
+                    tolerance=m(0.0, ""), against="scenario_b"),
     )
     text = dsl_text(acceptance)
-    assert (
-        "then tiago1 distance_travelled is increasing from 50.7 m by 47.5 m within 0.0 m of scenario_b"
-        in text
-    )
+    assert "then tiago1 distance_travelled is increasing from 50.7 m by 47.5 m within 0.0 m of scenario_b" in text
     (folder / "both.exsce").write_text('import "scenario_c.exsce"\nimport "scenario_b.exsce"\n\n' + text)
     assert load_spec(folder / "both.exsce").acceptance_of("scenario_c") == acceptance
     exported = yaml.safe_load(export_oracle_yaml(acceptance, spec.scenario("scenario_c")))
@@ -229,82 +209,22 @@ baseline:
 IMPORT_ERRORS = [
     (1, "scenario_c", "scenario_b", "1:5", "these are oracles of scenario 'scenario_b', not of 'scenario_c'"),
     (3, "scenario_c", "scenario c", "3:18", "scenario id 'scenario c'"),
-    (
-        5,
-        "mission_duration",
-        "mission_durration",
-        "5:5",
-        "unknown metric 'mission_durration'; did you mean 'mission_duration'?",
-    ),
-    (
-        5,
-        "mission_duration",
-        "tiago2",
-        "5:5",
-        "unknown metric 'tiago2'; 'tiago2' is a robot: put it under 'robots'",
-    ),
+    (5, "mission_duration", "mission_durration", "5:5", "unknown metric 'mission_durration'; did you mean 'mission_duration'?"),
+    (5, "mission_duration", "tiago2", "5:5", "unknown metric 'tiago2'; 'tiago2' is a robot: put it under 'robots'"),
     (5, "mission_duration", "task_duration", "5:5", "'task_duration' is measured per robot"),
-    (
-        17,
-        "max_velocity",
-        "distance_between_robots",
-        "17:7",
-        "'distance_between_robots' is measured for the whole mission",
-    ),
-    (
-        16,
-        "tiago1",
-        "tiago3",
-        "16:5",
-        "robot 'tiago3' is not in the fleet of scenario 'scenario_c'; did you mean 'tiago1'?",
-    ),
-    (
-        23,
-        "exsce.metamorphic.relationships",
-        "my_lab.relations",
-        "23:20",
-        "never from module names in data files",
-    ),
-    (
-        24,
-        "below_max",
-        "below_maximum",
-        "24:17",
-        "unknown relationship 'below_maximum'; did you mean 'below_max'?",
-    ),
-    (
-        24,
-        "below_max",
-        "equal",
-        "24:17",
-        "unknown relationship 'equal'; the method's relations are below_max, above_min, invariant, increasing, decreasing",
-    ),
+    (17, "max_velocity", "distance_between_robots", "17:7", "'distance_between_robots' is measured for the whole mission"),
+    (16, "tiago1", "tiago3", "16:5", "robot 'tiago3' is not in the fleet of scenario 'scenario_c'; did you mean 'tiago1'?"),
+    (23, "exsce.metamorphic.relationships", "my_lab.relations", "23:20", "never from module names in data files"),
+    (24, "below_max", "below_maximum", "24:17", "unknown relationship 'below_maximum'; did you mean 'below_max'?"),
+    (24, "below_max", "equal", "24:17", "unknown relationship 'equal'; the method's relations are below_max, above_min, invariant, increasing, decreasing"),
     (10, "value", "mean", "10:9", "'invariant' needs a value: add 'value: <number>'"),
     (10, "value", "mean", "10:9", "'mean' does not go with 'invariant', which takes value and tolerance"),
     (21, "limit", "value", "21:11", "'below_max' needs a limit"),
     (10, "97.606", "fast", "10:16", "should be a number, not str 'fast'"),
     (11, "10.0", "-1.0", "11:20", "a tolerance cannot be negative (-1.0)"),
-    (
-        19,
-        "nav_vel",
-        "cmd_vel",
-        "19:11",
-        "topic '/tiago1/cmd_vel' is not one exsce computes max_velocity of 'tiago1' from (/tiago1/nav_vel); the DSL cannot override a metric's topics yet",
-    ),
-    (
-        8,
-        "tiago2",
-        "tiago1",
-        "7:9",
-        "the topics of mission_duration of the mission lack /tiago2/waypoint_dispatcher/feedback",
-    ),
-    (
-        8,
-        "tiago2",
-        "tiago3",
-        "8:11",
-        "topic '/tiago3/waypoint_dispatcher/feedback' is not one exsce computes mission_duration of the mission from",
-    ),
+    (19, "nav_vel", "cmd_vel", "19:11", "topic '/tiago1/cmd_vel' is not one exsce computes max_velocity of 'tiago1' from (/tiago1/nav_vel); the DSL cannot override a metric's topics yet"),
+    (8, "tiago2", "tiago1", "7:9", "the topics of mission_duration of the mission lack /tiago2/waypoint_dispatcher/feedback"),
+    (8, "tiago2", "tiago3", "8:11", "topic '/tiago3/waypoint_dispatcher/feedback' is not one exsce computes mission_duration of the mission from"),
     (2, "baseline", "baselines", "2:1", "unknown section 'baselines'; did you mean 'baseline'?"),
     (15, "robots", "robot", "15:3", "unknown key 'robot' in baseline; did you mean 'robots'?"),
 ]
@@ -350,9 +270,7 @@ def test_every_import_error_is_reported_at_once(scenario_c: Scenario, tmp_path: 
 def test_a_relationship_package_is_never_imported(
     scenario_c: Scenario, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    (tmp_path / "planted_relations.py").write_text(
-        "import pathlib\npathlib.Path(__file__).with_name('ran').touch()\n"
-    )
+    (tmp_path / "planted_relations.py").write_text("import pathlib\npathlib.Path(__file__).with_name('ran').touch()\n")
     monkeypatch.syspath_prepend(str(tmp_path))
     oracles = tmp_path / "scenario_c.yaml"
     oracles.write_text(ORACLE_FILE.replace("exsce.metamorphic.relationships", "planted_relations"))
@@ -370,8 +288,7 @@ def criteria(*expectations: Expectation, when: When | None = None) -> Acceptance
 
 def test_each_robot_is_every_robot_in_fleet_order(scenario_c: Scenario) -> None:
     data = oracles_to_yaml(
-        criteria(Expectation(EACH, "max_velocity", BasicRelation.BELOW_MAX, limit=Quantity(1.0, "m/s"))),
-        scenario_c,
+        criteria(Expectation(EACH, "max_velocity", BasicRelation.BELOW_MAX, limit=Quantity(1.0, "m/s"))), scenario_c
     )
     assert data == {
         "id": "scenario_c",
@@ -400,16 +317,11 @@ def test_a_clause_without_value_takes_the_baseline(
 ) -> None:
     clause = Expectation(MISSION, "mission_duration", BasicRelation.INVARIANT, tolerance=tolerance)
     data = oracles_to_yaml(criteria(clause), scenario_c, {("mission_duration", None): (100.0, 4.0)})
-    assert data["baseline"]["mission"]["mission_duration"]["baseline"] == {
-        "value": 100.0,
-        "tolerance": expected,
-    }
+    assert data["baseline"]["mission"]["mission_duration"]["baseline"] == {"value": 100.0, "tolerance": expected}
 
 
 def test_a_change_without_value_starts_from_the_base_mean(scenario_c: Scenario) -> None:
-    clause = Expectation(
-        TIAGO1, "waypoints_visited", BasicRelation.INCREASING, delta=Quantity(2.0), against="scenario_b"
-    )
+    clause = Expectation(TIAGO1, "waypoints_visited", BasicRelation.INCREASING, delta=Quantity(2.0), against="scenario_b")
     data = oracles_to_yaml(criteria(clause), scenario_c, {("waypoints_visited", "tiago1"): (3.0, 0.0)})
     assert data["metamorphic"]["base_scenario"] == "scenario_b"
     entry = data["metamorphic"]["robots"]["tiago1"]["waypoints_visited"]
@@ -435,42 +347,24 @@ def test_a_clause_without_value_and_no_baseline_cannot_be_written(scenario_c: Sc
     ("acceptance", "message"),
     [
         (
-            criteria(
-                Expectation(
-                    TIAGO1,
-                    "max_velocity",
-                    BasicRelation.BELOW_MAX,
-                    limit=Quantity(0.8, "m/s"),
-                    window=Window(Moment.AFTER, "tiago1", pose="classroom_c022-w001"),
-                )
-            ),
+            criteria(Expectation(TIAGO1, "max_velocity", BasicRelation.BELOW_MAX, limit=Quantity(0.8, "m/s"),
+                                 window=Window(Moment.AFTER, "tiago1", pose="classroom_c022-w001"))),
             "'tiago1 max_velocity stays below 0.8 m/s after tiago1 reaches classroom_c022-w001' looks at part "
             "of a run",
         ),
         (
-            criteria(
-                Expectation(TIAGO1, "max_velocity", BasicRelation.BELOW_MAX, limit=Quantity(0.8, "m/s")),
-                when=When(robot="tiago1", task="delivery_a"),
-            ),
+            criteria(Expectation(TIAGO1, "max_velocity", BasicRelation.BELOW_MAX, limit=Quantity(0.8, "m/s")),
+                     when=When(robot="tiago1", task="delivery_a")),
             "looks at part of a run (during delivery_a, as 'when tiago1 does delivery_a' says)",
         ),
         (
-            criteria(
-                Expectation(EACH, "max_velocity", BasicRelation.BELOW_MAX, limit=Quantity(1.0, "m/s")),
-                Expectation(TIAGO1, "max_velocity", BasicRelation.BELOW_MAX, limit=Quantity(0.8, "m/s")),
-            ),
+            criteria(Expectation(EACH, "max_velocity", BasicRelation.BELOW_MAX, limit=Quantity(1.0, "m/s")),
+                     Expectation(TIAGO1, "max_velocity", BasicRelation.BELOW_MAX, limit=Quantity(0.8, "m/s"))),
             "are both about max_velocity of tiago1",
         ),
         (
-            criteria(
-                Expectation(
-                    MISSION,
-                    "mission_duration",
-                    BasicRelation.INVARIANT,
-                    value=s(97.6, "97.6"),
-                    tolerance=Quantity(1.0, "std"),
-                )
-            ),
+            criteria(Expectation(MISSION, "mission_duration", BasicRelation.INVARIANT, value=s(97.6, "97.6"),
+                                 tolerance=Quantity(1.0, "std"))),
             "'mission_duration is invariant around 97.6 s within 1 std' needs the standard deviation of stored "
             "runs of mission_duration of the mission, and no baseline was given: write a tolerance in the "
             "metric's unit",
@@ -485,13 +379,8 @@ def test_clauses_the_method_cannot_hold_are_refused(
 
 
 def test_default_topics_follow_the_robot_namespaces(scenario_c: Scenario) -> None:
-    assert default_topics(scenario_c, "distance_between_robots", None) == (
-        "/tiago1/robot_pose",
-        "/tiago2/robot_pose",
-    )
-    assert default_topics(scenario_c, "waypoints_visited", "tiago2") == (
-        "/tiago2/waypoint_dispatcher/result",
-    )
+    assert default_topics(scenario_c, "distance_between_robots", None) == ("/tiago1/robot_pose", "/tiago2/robot_pose")
+    assert default_topics(scenario_c, "waypoints_visited", "tiago2") == ("/tiago2/waypoint_dispatcher/result",)
 
 
 finite = st.floats(min_value=-1e6, max_value=1e6, allow_nan=False)
@@ -503,23 +392,10 @@ def test_export_then_import_gives_the_same_criteria(value: float, tolerance: flo
     scenario = load_spec(EXAMPLE / "scenario_c.exsce").scenario("scenario_c")
     acceptance = Acceptance(
         "scenario_c",
-        (
-            Criterion(
-                "baseline",
-                (),
-                When(mission="mission_c"),
-                (
-                    Expectation(
-                        MISSION,
-                        "mission_duration",
-                        BasicRelation.INVARIANT,
-                        value=s(value, ""),
-                        tolerance=s(tolerance, ""),
-                    ),
-                    Expectation(TIAGO1, "distance_to_obstacles", BasicRelation.ABOVE_MIN, limit=m(limit, "")),
-                ),
-            ),
-        ),
+        (Criterion("baseline", (), When(mission="mission_c"), (
+            Expectation(MISSION, "mission_duration", BasicRelation.INVARIANT, value=s(value, ""), tolerance=s(tolerance, "")),
+            Expectation(TIAGO1, "distance_to_obstacles", BasicRelation.ABOVE_MIN, limit=m(limit, "")),
+        )),),
     )
     with tempfile.TemporaryDirectory() as folder:
         oracles = Path(folder) / "scenario_c.yaml"
@@ -535,25 +411,15 @@ def test_cli_imports_and_exports_an_oracle_file(tmp_path: Path) -> None:
     spec = example_without_acceptance(tmp_path / "example")
     printed = exscec_here("import", str(ORACLES), "--spec", str(spec))
     assert printed.returncode == 0, printed.stderr
-    assert printed.stdout.startswith(
-        'acceptance for scenario_c {\n  scenario "baseline" {\n    when mission_c runs\n'
-    )
+    assert printed.stdout.startswith('acceptance for scenario_c {\n  scenario "baseline" {\n    when mission_c runs\n')
 
     written = exscec_here("import", str(ORACLES), "--spec", str(spec), "-o", str(tmp_path / "specs"))
     assert written.returncode == 0, written.stderr
     criteria_file = tmp_path / "specs" / "scenario_c_acceptance.exsce"
     assert criteria_file.read_text().startswith('import "../example/scenario_c.exsce"\n\nacceptance for')
 
-    exported = exscec_here(
-        "export",
-        str(criteria_file),
-        "--to",
-        "oracle-yaml",
-        "--scenario",
-        "scenario_c",
-        "-o",
-        str(tmp_path / "out"),
-    )
+    exported = exscec_here("export", str(criteria_file), "--to", "oracle-yaml", "--scenario", "scenario_c",
+                           "-o", str(tmp_path / "out"))
     assert exported.returncode == 0, exported.stderr
     data = yaml.safe_load((tmp_path / "out" / "oracles" / "scenario_c.yaml").read_text())
     assert as_floats(data) == as_floats(yaml.safe_load(ORACLES.read_text()))
@@ -564,13 +430,10 @@ def test_cli_oracle_import_needs_the_spec_and_export_says_which_clause(tmp_path:
     assert no_spec.returncode == 2
     assert "name the spec of its scenario with --spec" in no_spec.stderr
 
-    no_baseline = exscec_here(
-        "export", str(EXAMPLE / "scenario_c.exsce"), "--to", "oracle-yaml", "-o", str(tmp_path)
-    )
+    no_baseline = exscec_here("export", str(EXAMPLE / "scenario_c.exsce"), "--to", "oracle-yaml", "-o", str(tmp_path))
     assert no_baseline.returncode == 2
-    assert (
-        "scenario_c.exsce:35:10: error: 'each robot task_duration is invariant within 3 std' needs the mean"
-        in (no_baseline.stderr)
+    assert "scenario_c.exsce:35:10: error: 'each robot task_duration is invariant within 3 std' needs the mean" in (
+        no_baseline.stderr
     )
     assert not (tmp_path / "oracles").exists()
 
@@ -589,10 +452,7 @@ def test_the_file_s_values_reach_the_oracle_prov_through_exscec_baseline(scenari
     mission = oracles["mission_duration"]
     assert (mission.relation, mission.value, mission.tolerance) == ("invariant", 97.606, 10.0)
     assert mission.topics == ("/tiago1/waypoint_dispatcher/feedback", "/tiago2/waypoint_dispatcher/feedback")
-    assert (oracles["tiago1-max_velocity"].relation, oracles["tiago1-max_velocity"].limit) == (
-        "below_max",
-        1.0,
-    )
+    assert (oracles["tiago1-max_velocity"].relation, oracles["tiago1-max_velocity"].limit) == ("below_max", 1.0)
     assert oracles["tiago1-distance_travelled"].value == 50.702942669287076
     provn = compile_oracles("scenario_c", list(oracles.values())).get_provn()
     assert 'oracle:value="97.606" %% xsd:double' in provn and 'oracle:tolerance="10.0" %% xsd:double' in provn

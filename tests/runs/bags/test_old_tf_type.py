@@ -20,9 +20,7 @@ BAG = TURTLESIM / "example.bag"
 
 
 def test_old_tf_type_is_tf() -> None:
-    assert (
-        standard_type("tf/tfMessage") == standard_type("tf2_msgs/msg/TFMessage") == "tf2_msgs/msg/TFMessage"
-    )
+    assert standard_type("tf/tfMessage") == standard_type("tf2_msgs/msg/TFMessage") == "tf2_msgs/msg/TFMessage"
     assert standard_type("geometry_msgs/Twist") == "geometry_msgs/msg/Twist"
     assert bag_topics(BAG)["/tf"] == "tf2_msgs/msg/TFMessage"
 

@@ -18,9 +18,7 @@ from exsce_dsl.runs.analyse import analyse_bag
 from tests.support.bag_factory import IMU, ODOMETRY, START_NS, Topic, series, typestore_for, write_bag
 from tests.support.yard_spec import FAR_YARD
 
-SPEC = (
-    FAR_YARD
-    + """
+SPEC = FAR_YARD + """
 scenario span in yard {
   robots {
     tb: bot namespace "" starts at start
@@ -30,7 +28,6 @@ scenario span in yard {
   }
 }
 """
-)
 
 
 @pytest.mark.parametrize("fmt", ["ros1", "ros1-lz4", "sqlite3", "mcap"])
@@ -54,7 +51,4 @@ def test_whole_run_spans_topics_not_read(fmt: str, tmp_path: Path) -> None:
         if v.scope in (MetricScope.ROBOT, MetricScope.MISSION) and v.metric.endswith("_duration")
         and v.safety_metric is None
     }  # fmt: skip
-    assert durations == {
-        "task_duration": pytest.approx(recording),
-        "mission_duration": pytest.approx(recording),
-    }
+    assert durations == {"task_duration": pytest.approx(recording), "mission_duration": pytest.approx(recording)}

@@ -113,9 +113,7 @@ def extra_messages(fmt: str, start_ns: int) -> list[tuple[str, str, int, bytes]]
         found.append((topic, ODOMETRY, time_ns, serialize(odometry(store, i, time_ns, seed=7), ODOMETRY)))
     for i in range(10):
         time_ns = start_ns + 1_000_000_000 * (i + 1)
-        found.append(
-            ("ORB-SLAM", POSE_STAMPED, time_ns, serialize(pose_stamped(store, i, time_ns), POSE_STAMPED))
-        )
+        found.append(("ORB-SLAM", POSE_STAMPED, time_ns, serialize(pose_stamped(store, i, time_ns), POSE_STAMPED)))
     return found
 
 
@@ -125,19 +123,11 @@ def copy_ros1(source: Path, target: Path) -> None:
         out = {}
         for conn in reader.connections:
             out[conn.id] = writer.add_connection(
-                renamed(conn.topic),
-                conn.msgtype,
-                msgdef=conn.msgdef.data,
-                md5sum=conn.digest,
-                callerid=conn.ext.callerid,
-                latching=conn.ext.latching,
+                renamed(conn.topic), conn.msgtype, msgdef=conn.msgdef.data, md5sum=conn.digest,
+                callerid=conn.ext.callerid, latching=conn.ext.latching,
             )
         extra = {}
-        for topic, msgtype in (
-            ("groundtruth", ODOMETRY),
-            ("/groundtruth", ODOMETRY),
-            ("ORB-SLAM", POSE_STAMPED),
-        ):
+        for topic, msgtype in (("groundtruth", ODOMETRY), ("/groundtruth", ODOMETRY), ("ORB-SLAM", POSE_STAMPED)):
             msgdef, md5sum = store.generate_msgdef(msgtype)
             extra[topic] = writer.add_connection(topic, msgtype, msgdef=msgdef, md5sum=md5sum)
         messages = [(t, out[c.id], raw) for c, t, raw in reader.messages()]
@@ -153,20 +143,13 @@ def copy_ros2(source: Path, target: Path, fmt: str) -> None:
         out = {}
         for conn in reader.connections:
             out[conn.id] = writer.add_connection(
-                renamed(conn.topic),
-                conn.msgtype,
-                msgdef=conn.msgdef.data,
-                rihs01=conn.digest,
+                renamed(conn.topic), conn.msgtype, msgdef=conn.msgdef.data, rihs01=conn.digest,
                 serialization_format=conn.ext.serialization_format,
                 offered_qos_profiles=conn.ext.offered_qos_profiles,
             )
         extra = {
             topic: writer.add_connection(topic, msgtype, typestore=store)
-            for topic, msgtype in (
-                ("groundtruth", ODOMETRY),
-                ("/groundtruth", ODOMETRY),
-                ("ORB-SLAM", POSE_STAMPED),
-            )
+            for topic, msgtype in (("groundtruth", ODOMETRY), ("/groundtruth", ODOMETRY), ("ORB-SLAM", POSE_STAMPED))
         }
         messages = [(t, out[c.id], raw) for c, t, raw in reader.messages()]
         messages += [(t, extra[topic], raw) for topic, _, t, raw in extra_messages(fmt, reader.start_time)]
@@ -175,9 +158,7 @@ def copy_ros2(source: Path, target: Path, fmt: str) -> None:
 
 
 @pytest.fixture(scope="module", params=list(FORMATS))
-def bags(
-    request: pytest.FixtureRequest, scenario: Scenario, tmp_path_factory: pytest.TempPathFactory
-) -> tuple[Path, Path]:
+def bags(request: pytest.FixtureRequest, scenario: Scenario, tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
     """The executor's bag as it wrote it, and its copy with the names of a real ROS 1 recording."""
     fmt = request.param
     folder = tmp_path_factory.mktemp(f"bags_{fmt}")
@@ -206,14 +187,10 @@ def broken_copy(bag: Path) -> Path:
 
 def ground_truth_x(path: Path) -> np.ndarray:
     """The ground truth's x on both spellings, as rosbags deserialises it."""
-    with AnyReader(
-        [path], default_typestore=typestore_for("ros1" if path.suffix == ".bag" else "sqlite3")
-    ) as reader:
+    with AnyReader([path], default_typestore=typestore_for("ros1" if path.suffix == ".bag" else "sqlite3")) as reader:
         conns = [c for c in reader.connections if c.topic in ("groundtruth", "/groundtruth")]
         assert {c.topic for c in conns} == {"groundtruth", "/groundtruth"}
-        return np.array(
-            [reader.deserialize(raw, c.msgtype).pose.pose.position.x for c, _, raw in reader.messages(conns)]
-        )
+        return np.array([reader.deserialize(raw, c.msgtype).pose.pose.position.x for c, _, raw in reader.messages(conns)])
 
 
 def whole(run: Run, metric: str) -> tuple[float, tuple[str, ...]]:
@@ -232,23 +209,16 @@ def test_a_bag_of_relative_and_odd_names_ingests(bags: tuple[Path, Path], scenar
     assert mean == pytest.approx(float(np.mean(x)), rel=1e-12)
     assert set(topics) == {"groundtruth", "/groundtruth"}  # the specification's "groundtruth" read both
     top, topics = whole(run, "ground_x_max")
-    assert top == pytest.approx(float(np.max(x)), rel=1e-12) and set(topics) == {
-        "groundtruth",
-        "/groundtruth",
-    }
+    assert top == pytest.approx(float(np.max(x)), rel=1e-12) and set(topics) == {"groundtruth", "/groundtruth"}
     assert whole(run, "max_velocity")[1] == ("cmd_vel",)  # the bag's spelling, not /cmd_vel
     assert {"cmd_vel", "groundtruth", "/groundtruth"} <= set(run.bag.topics)
     # the names change nothing else: every built-in value is the executor's bag's
     before = {(v.metric, v.robot, v.action): v.value for v in analyse_bag(written, scenario).run.metrics}
-    after = {
-        (v.metric, v.robot, v.action): v.value for v in run.metrics if not v.metric.startswith("ground_x")
-    }
+    after = {(v.metric, v.robot, v.action): v.value for v in run.metrics if not v.metric.startswith("ground_x")}
     assert after == pytest.approx(before, rel=1e-9)
 
 
-def test_the_run_prov_and_the_store_name_topics_as_the_bag_does(
-    bags: tuple[Path, Path], scenario: Scenario
-) -> None:
+def test_the_run_prov_and_the_store_name_topics_as_the_bag_does(bags: tuple[Path, Path], scenario: Scenario) -> None:
     real = bags[1]
     run = analyse_bag(real, scenario).run
     provn = serialize_prov(compile_run(run, scenario), "provn")
@@ -283,9 +253,7 @@ def test_a_ros1_name_that_is_not_utf8_does_not_stop_the_bag(tmp_path: Path) -> N
     store = typestore_for("ros1")
     bag = tmp_path / "odd.bag"
     odom = series(store, ODOMETRY, 5)
-    write_bag(
-        bag, "ros1", [Topic("/odom", ODOMETRY, odom), Topic("gt\u00e9", ODOMETRY, series(store, ODOMETRY, 5))]
-    )
+    write_bag(bag, "ros1", [Topic("/odom", ODOMETRY, odom), Topic("gt\u00e9", ODOMETRY, series(store, ODOMETRY, 5))])
     raw = bag.read_bytes()
     assert raw.count("gt\u00e9".encode()) > 0
     bag.write_bytes(raw.replace("gt\u00e9".encode(), b"gt\xff\xfe"))  # as long: the records stay whole

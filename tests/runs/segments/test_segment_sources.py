@@ -27,18 +27,7 @@ from tests.support.paths import EXAMPLES
 R = "tiago1"
 S_ID = W3_ID = "classroom_c025-w001"
 W1_ID, W2_ID = "classroom_c022-w001", "classroom_c018-w001"
-ROW = (
-    "robot",
-    "allocation",
-    "task",
-    "subtask",
-    "waypoint",
-    "start_pose.id",
-    "goal.id",
-    "start",
-    "end",
-    "status",
-)
+ROW = ("robot", "allocation", "task", "subtask", "waypoint", "start_pose.id", "goal.id", "start", "end", "status")
 
 
 @pytest.fixture(scope="module")
@@ -179,10 +168,7 @@ def test_after_an_aborted_goal_the_next_segment_starts_where_the_robot_stopped(s
     stopped = (50.0, 35.0, 1.0)
     trk = track((0, xyyaw(s)), (11, xyyaw(s)), (20, stopped), (22, stopped), (50, xyyaw(w2)), (70, xyyaw(w3)))
     _, _, g3 = in_order(poses)
-    goals = [
-        RecordedGoal("g1", 10.0, 11.0, 20.0, "ABORTED", xyyaw(w1)),
-        RecordedGoal("g2", 21.0, 22.0, 50.0, "SUCCEEDED", xyyaw(w2)),
-    ]
+    goals = [RecordedGoal("g1", 10.0, 11.0, 20.0, "ABORTED", xyyaw(w1)), RecordedGoal("g2", 21.0, 22.0, 50.0, "SUCCEEDED", xyyaw(w2))]
     result = goal_segments(scenario, R, [*goals, g3], trk, Tolerance())
     assert rows(result) == [
         (R, 1, "delivery_a", 1, 1, S_ID, W1_ID, 11.0, 20.0, "ABORTED"),
@@ -207,9 +193,7 @@ def test_a_goal_back_to_a_reached_waypoint_is_not_a_retry(scenario, poses) -> No
 def test_canceled_and_still_active_goals(scenario, poses) -> None:
     g1, _, _ = in_order(poses)
     _, _, w2, w3 = poses
-    canceled = RecordedGoal(
-        "g2", 31.0, None, 40.0, "CANCELED", xyyaw(w2)
-    )  # never active: starts when accepted
+    canceled = RecordedGoal("g2", 31.0, None, 40.0, "CANCELED", xyyaw(w2))  # never active: starts when accepted
     active = RecordedGoal("g3", 41.0, 42.0, 99.0, "ACTIVE", xyyaw(w3))  # last seen at 99 s, never ended
     result = goal_segments(scenario, R, [g1, canceled, active], route(poses), Tolerance())
     assert rows(result) == [
@@ -246,9 +230,7 @@ def test_a_goal_without_a_target_is_where_the_robot_was_when_it_succeeded(scenar
     ("dyaw", "heading", "matched"),
     [(1.0, None, True), (1.0, 0.3, False), (0.2, 0.3, True), (2 * math.pi - 0.1, 0.3, True)],  # yaw wraps
 )
-def test_heading_tolerance_on_goals(
-    scenario, poses, dyaw: float, heading: float | None, matched: bool
-) -> None:
+def test_heading_tolerance_on_goals(scenario, poses, dyaw: float, heading: float | None, matched: bool) -> None:
     g1, g2, g3 = in_order(poses)
     turned = RecordedGoal("g1", 10.0, 11.0, 30.0, "SUCCEEDED", xyyaw(poses[1], dyaw=dyaw))
     result = goal_segments(scenario, R, [turned, g2, g3], route(poses), Tolerance(heading=heading))
@@ -340,9 +322,7 @@ def test_follow_waypoints_jump_without_targets_places_only_the_last_jumped_over(
         "goal fw[0] (SUCCEEDED) has no target: cannot tell its waypoint; ignored",
     )
     assert result.warnings[2].startswith("robot tiago1 skipped classroom_c022-w001")
-    assert result.warnings[3].startswith(
-        "robot tiago1 was at (48.26, 24.62) at 50.000, 13.01 m from its start pose"
-    )
+    assert result.warnings[3].startswith("robot tiago1 was at (48.26, 24.62) at 50.000, 13.01 m from its start pose")
     assert len(result.warnings) == 4
 
 
@@ -363,15 +343,12 @@ def test_follow_waypoints_aborted_on_the_way(scenario, poses) -> None:
 def wander(poses, still: tuple[float, float, float] = (0.005, 0.0, 0.0)) -> Track:
     s, w1, w2, w3 = poses
     return track(
-        (0, xyyaw(s)),
-        (1, xyyaw(s, *still)),
+        (0, xyyaw(s)), (1, xyyaw(s, *still)),
         (2, xyyaw(s, dx=1.0)),  # set off
         (3, xyyaw(w2)),  # W2 before W1: does not count
         (4, xyyaw(w1, dx=0.3)),  # passing within 0.3 m of W1: arrived
-        (5, xyyaw(w1, dx=2.0)),
-        (6, xyyaw(w2, dy=0.5)),  # 0.5 m from W2: not yet
-        (7, xyyaw(w2, dy=0.2)),
-        (8, (47.0, 30.0, 0.0)),
+        (5, xyyaw(w1, dx=2.0)), (6, xyyaw(w2, dy=0.5)),  # 0.5 m from W2: not yet
+        (7, xyyaw(w2, dy=0.2)), (8, (47.0, 30.0, 0.0)),
         (9, xyyaw(w3, dx=0.1, dy=0.1)),  # 0.14 m
     )
 

@@ -78,6 +78,8 @@ def _drive(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.interp(t, frames, at[:, 0]), np.interp(t, frames, at[:, 1])
 
 
+
+
 def _early_bag(folder: Path, fmt: str) -> Path:
     store = typestore_for(fmt)
     legs = float(np.sum(np.hypot(*np.diff(CORNERS, axis=0).T))) / SPEED

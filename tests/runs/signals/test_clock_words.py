@@ -69,6 +69,8 @@ SHAPES = {
 }
 
 
+
+
 def clock_bag(folder: Path, shape: str, fmt: str = "ros1") -> Path:
     """12 s of odometry at 20 Hz (driving 0.5 m/s along x) and, where the shape has it, /clock
     at 10 Hz."""

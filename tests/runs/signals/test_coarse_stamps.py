@@ -23,9 +23,7 @@ from exsce_dsl.runs.signals.timeline import LOG_TIME
 from tests.support.bag_factory import POSE_STAMPED, START_NS, Topic, header, typestore_for, write_bag
 from tests.support.yard_spec import FAR_YARD
 
-SPEC = (
-    FAR_YARD
-    + """
+SPEC = FAR_YARD + """
 metric far_out_time for each robot {
   unit s
   reads loc: geometry_msgs/msg/PoseStamped on "/location"
@@ -40,7 +38,6 @@ scenario coarse in yard {
   }
 }
 """
-)
 COUNT = 300
 PERIOD_NS = 37_037_037  # 27 Hz
 SPEED = 0.25  # m/s along x

@@ -30,9 +30,7 @@ from tests.support.bag_factory import (
 )
 from tests.support.yard_spec import FAR_YARD
 
-SPEC = (
-    FAR_YARD
-    + """
+SPEC = FAR_YARD + """
 scenario rooted in yard {
   robots {
     tb: bot namespace "" starts at start
@@ -42,7 +40,6 @@ scenario rooted in yard {
   }
 }
 """
-)
 COUNT = 200
 PERIOD_NS = 37_000_000  # 27 Hz
 

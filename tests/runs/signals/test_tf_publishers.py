@@ -90,6 +90,8 @@ def _drive(t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return x, y, np.where(t < 11.0, 0.0, np.pi / 2)
 
 
+
+
 def _clock(store: Any, seconds: float) -> Any:
     sec = int(np.floor(seconds))
     time = store.types["builtin_interfaces/msg/Time"](sec=sec, nanosec=int(round((seconds - sec) * 1e9)))

@@ -6,10 +6,11 @@ prints.  Its node, :data:`~.recorder.RECORDER_NODE`, subscribes with serialized 
 subscriptions to exactly the topics it is given, each once a publisher of it shows on the graph
 (looked for every :data:`POLL` seconds; hidden ``_action`` topics included), with the type the
 graph names, the QoS its publishers offer (:mod:`.record_types`) and that type's definition and
-hash.  Each message is written as it is received, at the node's clock's time: the wall clock, or
-``/clock`` with ``use_sim_time``, when nothing is written before the first ``/clock`` message (a
-latched topic's messages received before it are held and written at its time; others are
-dropped and counted).
+hash.  Each message is written as it is received, at the wall clock's time; with
+``use_sim_time``, at the simulated time it was sent (:mod:`.record_timeline`: a recorder that
+falls behind puts no gap into the recording), nothing before the first ``/clock`` message (a
+latched topic's messages sent before it are written at its time; others are dropped and
+counted).
 
 The bag is written into :func:`~.recorder.partial_folder`, a hidden sibling of the bag, and moved
 to the bag's name only once the writer has closed it (on SIGINT or SIGTERM): a recorder killed
@@ -40,6 +41,7 @@ from typing import Any
 from rosbags.rosbag2 import StoragePlugin, Writer
 
 from exsce_dsl.errors import RosGraphError
+from exsce_dsl.execute.ros2.record_timeline import SimTimeline
 from exsce_dsl.execute.ros2.record_types import DEPTH, adapted_qos, describe_type, message_class, offered_qos
 from exsce_dsl.execute.ros2.recorder import RECORDER_NODE, partial_folder
 
@@ -76,6 +78,8 @@ class Recording:
         self.latched: set[str] = set()
         self.held: list[tuple[str, bytes]] = []
         """Latched messages received before the first ``/clock`` (on simulated time)."""
+        self.timeline = SimTimeline() if use_sim_time else None
+        """On ``/clock``: each message placed by when it was sent (:mod:`.record_timeline`)."""
         self.written: Counter[str] = Counter()
         self.dropped: Counter[str] = Counter()
         self.status: tuple[list[str], list[str]] | None = None
@@ -126,14 +130,19 @@ class Recording:
         if latched:
             self.latched.add(topic)
         self.subscriptions[topic] = self.node.create_subscription(
-            cls, topic, lambda data, topic=topic: self.receive(topic, data), qos, raw=True
+            cls, topic, lambda data, info, topic=topic: self.receive(topic, data, info), qos, raw=True
         )
         kind = f"{'reliable' if reliable else 'best effort'}, {'transient local' if latched else 'volatile'}"
         log(f"subscribed to {topic} ({msgtype}, {kind}; its definition from {source})")
 
-    def receive(self, topic: str, data: bytes) -> None:
-        """Write a message at the time it is received (nothing before the first ``/clock`` on
-        simulated time: a latched topic's messages wait for it, others are dropped)."""
+    def receive(self, topic: str, data: bytes, info: Any = None) -> None:
+        """Write a message: on the wall clock at the time it is received; on ``/clock`` at the
+        simulated time it was sent, once known (nothing before the first ``/clock``: a latched
+        topic's messages go at its time, others are dropped)."""
+        if self.timeline is not None:
+            self.timeline.add(topic, data, int(info["source_timestamp"]))
+            self.write_ready()
+            return
         now = int(self.node.get_clock().now().nanoseconds)
         if self.use_sim_time and now <= 0:
             if topic in self.latched:
@@ -147,9 +156,22 @@ class Recording:
                 self._write(early, now, message)
         self._write(topic, now, data)
 
+    def write_ready(self, final: bool = False) -> None:
+        """Write the messages whose simulated time is known (``final``: every one left)."""
+        assert self.timeline is not None
+        for topic, data, stamp in self.timeline.ready(final):
+            first = self.timeline.first
+            if stamp is None and topic in self.latched and first is not None:
+                stamp = first
+            if stamp is None:
+                self.dropped[topic] += 1
+            else:
+                self._write(topic, stamp, data)
+
     def received(self) -> int:
         """Messages received so far."""
-        return sum(self.written.values()) + sum(self.dropped.values()) + len(self.held)
+        waiting = self.timeline.waiting if self.timeline is not None else 0
+        return sum(self.written.values()) + sum(self.dropped.values()) + len(self.held) + waiting
 
     def _write(self, topic: str, stamp: int, data: bytes) -> None:
         self.writer.write(self.connections[topic], stamp, data)
@@ -244,6 +266,8 @@ def _loop(executor: Any, recording: Recording, stop: Stop) -> None:
             break
     for topic, _ in recording.held:  # /clock never came
         recording.dropped[topic] += 1
+    if recording.timeline is not None:
+        recording.write_ready(final=True)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -57,7 +57,9 @@ TICK = 0.01
 MAX_LAG_NS = 200_000_000
 """Simulated time runs no further ahead of what was published (a round after a stall moves the
 clock 0.2 s at most, not ``speed_up`` times the stall)."""
-DEPTH = 100
+DEPTH = 2000
+"""Messages each publisher keeps for a reader that falls behind (a recorder stalled a moment: at
+5x, 2000 odometry messages are 8 s of wall time), as the ROS 1 stand-in's queues."""
 WAIT = 0.005
 """Wall seconds between two looks of a goal's thread at its end."""
 ERROR_NONE, ERROR_UNKNOWN, ERROR_WAYPOINT = 0, 9000, 600
@@ -92,7 +94,10 @@ class PlayedRobot:
 
 
 class Ros2StandIn:
-    """The scenario's robots on the ROS 2 graph of this process's environment (``ROS_DOMAIN_ID``)."""
+    """The scenario's robots on the ROS 2 graph of this process's environment (``ROS_DOMAIN_ID``).
+    Long because: the goals' threads (what each goal drives) and the clock's (what each sample
+    publishes) share the robots' playing state under one lock; split in two, each half would
+    reach into the other's state."""
 
     def __init__(
         self,

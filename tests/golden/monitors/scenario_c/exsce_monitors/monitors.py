@@ -20,11 +20,7 @@ def _reduce_distance_to_obstacles_0_0(topic_0: core.Topic) -> tuple[core.Signal,
     """The per-message values of min(...) over arrays, for some messages of "/{ns}/~scan"."""
     return (
         topic_0.field("ranges"),
-        core.combine(
-            np.logical_and,
-            core.combine(np.greater_equal, topic_0.field("ranges"), topic_0.field("range_min")),
-            core.combine(np.less_equal, topic_0.field("ranges"), topic_0.field("range_max")),
-        ),
+        core.combine(np.logical_and, core.combine(np.greater_equal, topic_0.field("ranges"), topic_0.field("range_min")), core.combine(np.less_equal, topic_0.field("ranges"), topic_0.field("range_max"))),
     )
 
 
@@ -37,15 +33,7 @@ REDUCERS: list[tuple[str, str, str, core.Compute]] = [
 class RobotMetrics:
     """The metrics of one robot over a window of a run: task_duration, waypoints_visited, distance_travelled, distance_to_obstacles, max_velocity, fast_driving_time, mean_turn_rate."""
 
-    METRICS: tuple[str, ...] = (
-        "task_duration",
-        "waypoints_visited",
-        "distance_travelled",
-        "distance_to_obstacles",
-        "max_velocity",
-        "fast_driving_time",
-        "mean_turn_rate",
-    )
+    METRICS: tuple[str, ...] = ("task_duration", "waypoints_visited", "distance_travelled", "distance_to_obstacles", "max_velocity", "fast_driving_time", "mean_turn_rate", )
 
     def __init__(
         self, robot_id: str, namespace: str, topics: Mapping[str, core.Topic], succeeded: int | None = None
@@ -203,9 +191,7 @@ class RobotMetrics:
             return 0, [
                 core.prepare(
                     "max",
-                    core.norm(
-                        topic_0.field("linear.x"), topic_0.field("linear.y"), topic_0.field("linear.z")
-                    ),
+                    core.norm(topic_0.field("linear.x"), topic_0.field("linear.y"), topic_0.field("linear.z")),
                     None,
                 ),
             ]
@@ -234,9 +220,7 @@ class RobotMetrics:
                 core.prepare(
                     "duration",
                     None,
-                    core.combine(
-                        np.greater, core.norm(topic_0.field("linear.x"), topic_0.field("linear.y")), 0.8
-                    ),
+                    core.combine(np.greater, core.norm(topic_0.field("linear.x"), topic_0.field("linear.y")), 0.8),
                 ),
             ]
         return None
@@ -273,10 +257,7 @@ class RobotMetrics:
 class MissionMetrics:
     """The metrics of the mission over a window of a run: mission_duration, distance_between_robots."""
 
-    METRICS: tuple[str, ...] = (
-        "mission_duration",
-        "distance_between_robots",
-    )
+    METRICS: tuple[str, ...] = ("mission_duration", "distance_between_robots", )
 
     def __init__(self, robots: Sequence[tuple[str, str]], topics: Mapping[str, core.Topic]) -> None:
         """``robots``: (robot id, namespace) of each robot, in fleet order."""
@@ -344,9 +325,7 @@ class MissionMetrics:
             return None
         return core.finite(a[0])
 
-    def _prepare_distance_between_robots(
-        self, first: str, second: str
-    ) -> tuple[int, list[core.Prepared]] | None:
+    def _prepare_distance_between_robots(self, first: str, second: str) -> tuple[int, list[core.Prepared]] | None:
         # the value: min(norm(a.pose.x - b.pose.x, a.pose.y - b.pose.y))
         topic_0 = self.topic(first, "/{ns}/~pose")
         topic_1 = self.topic(second, "/{ns}/~pose")
@@ -354,10 +333,7 @@ class MissionMetrics:
             return 0, [
                 core.prepare(
                     "min",
-                    core.norm(
-                        core.combine(np.subtract, topic_0.field("x"), topic_1.field("x")),
-                        core.combine(np.subtract, topic_0.field("y"), topic_1.field("y")),
-                    ),
+                    core.norm(core.combine(np.subtract, topic_0.field("x"), topic_1.field("x")), core.combine(np.subtract, topic_0.field("y"), topic_1.field("y"))),
                     None,
                 ),
             ]
