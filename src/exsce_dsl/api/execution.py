@@ -62,12 +62,9 @@ def execute_ros1(
     ``stand_in``: exsce's stand-in robots (``exscec stand-in``) serve the goals, started afresh
     for each run on simulated time ``speed_up`` times faster than wall time, run ``i`` driving as
     run ``i`` of ``exscec simulate --seed SEED`` does, with ``faults`` as on the command line."""
-    chosen = spec if isinstance(spec, Scenario) else spec.scenario(scenario)
-    out = Path(out_dir)
-    options = Options(Policy(policy), server_timeout, timeout)
-    if not stand_in and (faults or seed):
-        raise ExsceError("faults and a seed are the stand-in's", remedy=STAND_IN_FOR_FAULTS)
-    planted = tuple(Fault.parse(f) for f in faults)
+    chosen, out, options, planted = _prepared(
+        spec, scenario, out_dir, (policy, server_timeout, timeout), stand_in, faults, seed
+    )
     with contextlib.ExitStack() as stack:
         if interrupted is None:
             interrupted = stack.enter_context(Interruption())
@@ -110,12 +107,9 @@ def execute_ros2(
     when something publishes it.  Policies, timeouts, interruption and a missing action server
     as :func:`execute_ros1`; ``stand_in``: exsce's Nav2 stand-in robots (``exscec stand-in
     --ros2``) serve the goals, started afresh for each run in this process, with ``faults``."""
-    chosen = spec if isinstance(spec, Scenario) else spec.scenario(scenario)
-    out = Path(out_dir)
-    options = Options(Policy(policy), server_timeout, timeout)
-    if not stand_in and (faults or seed):
-        raise ExsceError("faults and a seed are the stand-in's", remedy=STAND_IN_FOR_FAULTS)
-    planted = tuple(Fault.parse(f) for f in faults)
+    chosen, out, options, planted = _prepared(
+        spec, scenario, out_dir, (policy, server_timeout, timeout), stand_in, faults, seed
+    )
     with contextlib.ExitStack() as stack:
         if interrupted is None:
             interrupted = stack.enter_context(Interruption())
@@ -126,3 +120,26 @@ def execute_ros2(
                 return Ros2StandIn(chosen, seed=seed, faults=planted, speed_up=speed_up, run=run)
 
         return execute_runs_ros2(chosen, out, runs, options, interrupted, around_run, use_sim_time)
+
+
+def _prepared(
+    spec: Specification | Scenario,
+    scenario: str | None,
+    out_dir: str | Path,
+    how: tuple[Policy | str, float, float | None],
+    stand_in: bool,
+    faults: Sequence[str],
+    seed: int,
+) -> tuple[Scenario, Path, Options, tuple[Fault, ...]]:
+    """What either graph's execution starts from: the scenario, the output folder, the options
+    (``how``: policy, server timeout, goal timeout) and the faults, checked before anything runs."""
+    chosen = spec if isinstance(spec, Scenario) else spec.scenario(scenario)
+    policy, server_timeout, timeout = how
+    if not stand_in and (faults or seed):
+        raise ExsceError("faults and a seed are the stand-in's", remedy=STAND_IN_FOR_FAULTS)
+    return (
+        chosen,
+        Path(out_dir),
+        Options(Policy(policy), server_timeout, timeout),
+        tuple(Fault.parse(f) for f in faults),
+    )

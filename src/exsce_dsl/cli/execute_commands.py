@@ -208,32 +208,24 @@ def _execute_runs(scenario: Scenario, options: _ExecuteOptions) -> list[Executed
     from exsce_dsl.api import execute_ros1, execute_ros2
     from exsce_dsl.errors import ExecutionInterrupted
 
+    common = {
+        "policy": options.policy,
+        "server_timeout": options.server_timeout,
+        "timeout": options.goal_timeout,
+        "stand_in": options.stand_in,
+        "seed": options.seed,
+        "faults": options.faults,
+        "speed_up": options.speed_up,
+    }
     try:
         if options.ros2:
-            return execute_ros2(
-                scenario,
-                options.out_dir,
-                options.runs,
-                policy=options.policy,
-                server_timeout=options.server_timeout,
-                timeout=options.goal_timeout,
-                stand_in=options.stand_in,
-                seed=options.seed,
-                faults=options.faults,
-                speed_up=options.speed_up,
-            )
+            return execute_ros2(scenario, options.out_dir, options.runs, **common)  # type: ignore[arg-type]
         return execute_ros1(
             scenario,
             options.out_dir,
             options.runs,
             start_master=options.start_master,
-            policy=options.policy,
-            server_timeout=options.server_timeout,
-            timeout=options.goal_timeout,
-            stand_in=options.stand_in,
-            seed=options.seed,
-            faults=options.faults,
-            speed_up=options.speed_up,
+            **common,  # type: ignore[arg-type]
         )
     except ExecutionInterrupted as stop:
         click.echo(f"error: {stop.message}", err=True)

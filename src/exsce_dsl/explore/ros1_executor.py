@@ -53,8 +53,7 @@ class Ros1Executor:
     def name(self) -> str:
         """Where the runs were played and what was planted; not the master's address nor the
         speed-up, which give the same runs (simulated time)."""
-        planted = " ".join(f"--fault {f.identity}" for f in self.faults)
-        return f"ros1 --stand-in {planted}".strip()
+        return stand_in_name("ros1", self.faults)
 
     def execute(
         self, scenario: Scenario, scenario_file: Path, out_dir: Path, runs: int, seed: int
@@ -81,6 +80,12 @@ class Ros1Executor:
                 scenario, self.master_uri, out_dir, runs, None, interruption, around_run=around_run
             )
         return [run.files.bag for run in done]
+
+
+def stand_in_name(graph: str, faults: Sequence[Fault]) -> str:
+    """A live executor's name: its graph, the stand-in, and what was planted in it."""
+    planted = " ".join(f"--fault {f.identity}" for f in faults)
+    return f"{graph} --stand-in {planted}".strip()
 
 
 @contextmanager

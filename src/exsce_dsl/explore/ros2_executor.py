@@ -20,6 +20,7 @@ from pathlib import Path
 
 from exsce_dsl.errors import ExsceError
 from exsce_dsl.execute import DEFAULT_SPEED_UP, Interruption, Ros2StandIn, execute_runs_ros2
+from exsce_dsl.explore.ros1_executor import stand_in_name
 from exsce_dsl.model import Scenario
 from exsce_dsl.remedies import FAULTS_NEED_THE_STAND_IN, STAND_IN_ONLY
 from exsce_dsl.sim.faults import Fault
@@ -40,8 +41,7 @@ class Ros2Executor:
     @property
     def name(self) -> str:
         """Where the runs were played and what was planted (not the speed-up: simulated time)."""
-        planted = " ".join(f"--fault {f.identity}" for f in self.faults)
-        return f"ros2 --stand-in {planted}".strip()
+        return stand_in_name("ros2", self.faults)
 
     def execute(
         self, scenario: Scenario, scenario_file: Path, out_dir: Path, runs: int, seed: int

@@ -124,16 +124,44 @@ def execute_runs(
     logs.mkdir(parents=True, exist_ok=True)
     plan = schedule(scenario, options.speeds, options.timeout)
     move_base_actions(scenario)  # a robot ROS 1 cannot send goals to: before anything starts
+    return run_each(
+        runs, interrupted, around_run, lambda: _one_run(scenario, master, out, plan, options, interrupted)
+    )
+
+
+def run_each(
+    runs: int,
+    interrupted: Callable[[], bool] | None,
+    around_run: Callable[[int], AbstractContextManager[object]] | None,
+    one_run: Callable[[], ExecutedRun],
+) -> list[ExecutedRun]:
+    """``runs`` runs of ``one_run``, each inside ``around_run(i)`` when given; a run cut short
+    (or an interruption between two) raises :class:`ExecutionInterrupted`, the whole runs before
+    it named.  The loop of either graph's session."""
     done: list[ExecutedRun] = []
     for _ in range(runs):
         if interrupted is not None and interrupted():
             raise ExecutionInterrupted(None, [r.files.bag for r in done])
         with around_run(len(done)) if around_run is not None else nullcontext():
-            run = _one_run(scenario, master, out, plan, options, interrupted)
+            run = one_run()
         done.append(run)
         if not run.complete:
             raise ExecutionInterrupted(run.files.bag, [r.files.bag for r in done[:-1]])
     return done
+
+
+def placed(run_id: str, files: RunFiles, staged: RunFiles, mission: MissionRun, out: Path) -> ExecutedRun:
+    """The run's staged files moved into place, or into ``out/incomplete`` when it was cut short."""
+    if mission.status is MissionStatus.CANCELLED:
+        kept = RunFiles(out / INCOMPLETE, files.name, files.ros2)
+        kept.folder.mkdir(parents=True, exist_ok=True)
+        for source, target in zip(staged.all(), kept.all(), strict=True):
+            if source.exists():
+                os.replace(source, target)
+        files.discard_staged()
+        return ExecutedRun(run_id, kept, mission)
+    files.put_in_place()
+    return ExecutedRun(run_id, files, mission)
 
 
 def _one_run(
@@ -172,13 +200,4 @@ def _one_run(
     except BaseException:
         files.discard_staged()
         raise
-    if mission.status is MissionStatus.CANCELLED:
-        kept = RunFiles(out / INCOMPLETE, files.name)
-        kept.folder.mkdir(parents=True, exist_ok=True)
-        for source, target in zip(staged.all(), kept.all(), strict=True):
-            if source.exists():
-                os.replace(source, target)
-        files.discard_staged()
-        return ExecutedRun(run_id, kept, mission)
-    files.put_in_place()
-    return ExecutedRun(run_id, files, mission)
+    return placed(run_id, files, staged, mission, out)

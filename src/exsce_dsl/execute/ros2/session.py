@@ -14,19 +14,16 @@ last.  Interrupted, the run goes to ``out/incomplete/`` (its PROV says cancelled
 from __future__ import annotations
 
 import datetime as dt
-import os
 import uuid
 from collections.abc import Callable
-from contextlib import AbstractContextManager, nullcontext
+from contextlib import AbstractContextManager
 from pathlib import Path
 
-from exsce_dsl.errors import ExecutionInterrupted
 from exsce_dsl.execute.dispatcher import dispatch
 from exsce_dsl.execute.mission import Schedule, schedule
-from exsce_dsl.execute.outcomes import MissionStatus
 from exsce_dsl.execute.provenance import mission_prov_json
 from exsce_dsl.execute.recording import recorded_topics
-from exsce_dsl.execute.ros1.session import INCOMPLETE, LOGS, PROV_SETTLE, ExecutedRun, Options
+from exsce_dsl.execute.ros1.session import LOGS, PROV_SETTLE, ExecutedRun, Options, placed, run_each
 from exsce_dsl.execute.ros2.dispatcher_node import Ros2DispatcherNode
 from exsce_dsl.execute.ros2.nav2 import nav2_actions
 from exsce_dsl.execute.ros2.recorder import Ros2Recorder
@@ -56,16 +53,12 @@ def execute_runs_ros2(
     plan = schedule(scenario, options.speeds, options.timeout)
     robots = {g.robot for g in plan.goals}
     actions = {r.id: nav2_actions(r).navigate_to_pose for r in scenario.robots if r.id in robots}
-    done: list[ExecutedRun] = []
-    for _ in range(runs):
-        if interrupted is not None and interrupted():
-            raise ExecutionInterrupted(None, [r.files.bag for r in done])
-        with around_run(len(done)) if around_run is not None else nullcontext():
-            run = _one_run(scenario, out, plan, actions, options, interrupted, use_sim_time)
-        done.append(run)
-        if not run.complete:
-            raise ExecutionInterrupted(run.files.bag, [r.files.bag for r in done[:-1]])
-    return done
+    return run_each(
+        runs,
+        interrupted,
+        around_run,
+        lambda: _one_run(scenario, out, plan, actions, options, interrupted, use_sim_time),
+    )
 
 
 def _one_run(
@@ -104,13 +97,4 @@ def _one_run(
     except BaseException:
         files.discard_staged()
         raise
-    if mission.status is MissionStatus.CANCELLED:
-        kept = RunFiles(out / INCOMPLETE, files.name, ros2=True)
-        kept.folder.mkdir(parents=True, exist_ok=True)
-        for source, target in zip(staged.all(), kept.all(), strict=True):
-            if source.exists():
-                os.replace(source, target)
-        files.discard_staged()
-        return ExecutedRun(run_id, kept, mission)
-    files.put_in_place()
-    return ExecutedRun(run_id, files, mission)
+    return placed(run_id, files, staged, mission, out)
