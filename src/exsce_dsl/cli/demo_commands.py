@@ -128,8 +128,9 @@ def demo(
     and judged: exscec demo live-demo --ros1 (about three minutes; the test
     suite runs it in tests/execute/test_live_loop.py).  With --ros2 the same
     loop runs on a live ROS 2 graph: the stand-in's robots are Nav2's
-    (NavigateToPose), exsce's recorder writes each run's rosbag2 MCAP folder
-    (tests/execute/test_ros2_live_loop.py).
+    (NavigateToPose), exsce's recorder writes each run's rosbag2 MCAP folder:
+    exscec demo ros2-demo --ros2 (about two and a half minutes; the test
+    suite runs it in tests/execute/test_ros2_live_loop.py).
     Exits 0 when every step ended as expected (the faulty run failing, the
     others passing), 1 otherwise.
 
@@ -138,7 +139,6 @@ def demo(
       exscec demo exsce-demo
       exscec demo my-project --setup-only   # only copy the example, to follow docs/tutorial.md
       exscec demo irsim-demo --simulator irsim   # the runs played by IR-SIM
-      exscec demo ros2-demo --ros2   # on a live ROS 2 graph (ROS 2 Jazzy's wheels)
     """
     from exsce_dsl.api.demo import (
         LIVE_ROS2_STEPS,
