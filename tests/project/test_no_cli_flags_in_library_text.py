@@ -46,7 +46,7 @@ WHY: dict[str, str] = {
         "endpoint/app.py:exscec api/store.py:exscec store/open.py:exscec"
     ),
     "an executor's name is part of a campaign's identity (hashed into campaign_<digest>, recorded in "
-    "its plan): new words would rename every campaign": "explore/executors.py:--fault explore/ros1_executor.py:* explore/ros2_executor.py:*",
+    "its plan): new words would rename every campaign": "explore/executors.py:--fault explore/ros1_executor.py:*",
 }
 """Why some literals may name the command line → the places: ``module:text`` (the module below
 ``src/exsce_dsl``; the text found, ``*`` for any)."""

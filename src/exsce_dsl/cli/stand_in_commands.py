@@ -132,7 +132,7 @@ def stand_in(
         raise KeyboardInterrupt
 
     previous = signal.signal(signal.SIGTERM, terminated)
-    try:
+    try:  # a stop that comes at any point, the first line printed or not, is a stop (exit 0)
         if ros2:
             _play_ros2(loaded, scenario_id, seed, faults, speed_up, simulator, behaviour)
             return
@@ -142,6 +142,8 @@ def stand_in(
         ) as running:  # fmt: skip
             click.echo(f"ROS_MASTER_URI={running.master_uri}")
             _serve(running, speed_up)
+    except KeyboardInterrupt:
+        click.echo("stand-in: stopping", err=True)
     finally:
         signal.signal(signal.SIGTERM, previous)
 
@@ -156,13 +158,10 @@ def _check_graph(ros1: bool, ros2: bool, ros1_options: bool, ros2_options: bool)
 
 
 def _serve(running: Any, speed_up: float) -> None:
-    """Say what is served, then serve until Ctrl-C or SIGTERM."""
+    """Say what is served, then serve until Ctrl-C or SIGTERM (KeyboardInterrupt)."""
     servers = ", ".join(f"{robot} ({action})" for robot, action in running.actions.items())
     click.echo(f"stand-in: {servers} at {speed_up:g}x wall time; Ctrl-C to stop", err=True)
-    try:
-        running.wait()
-    except KeyboardInterrupt:
-        click.echo("stand-in: stopping", err=True)
+    running.wait()
 
 
 def _play_ros2(
