@@ -132,7 +132,7 @@ def stand_in(
         raise KeyboardInterrupt
 
     previous = signal.signal(signal.SIGTERM, terminated)
-    try:  # a stop that comes at any point, the first line printed or not, is a stop (exit 0)
+    try:  # a stop before the stand-in serves (while it starts) is a stop too (exit 0)
         if ros2:
             _play_ros2(loaded, scenario_id, seed, faults, speed_up, simulator, behaviour)
             return
@@ -158,10 +158,14 @@ def _check_graph(ros1: bool, ros2: bool, ros1_options: bool, ros2_options: bool)
 
 
 def _serve(running: Any, speed_up: float) -> None:
-    """Say what is served, then serve until Ctrl-C or SIGTERM (KeyboardInterrupt)."""
-    servers = ", ".join(f"{robot} ({action})" for robot, action in running.actions.items())
-    click.echo(f"stand-in: {servers} at {speed_up:g}x wall time; Ctrl-C to stop", err=True)
-    running.wait()
+    """Say what is served, then serve until Ctrl-C or SIGTERM: a stop inside the stand-in's block
+    ends it cleanly (its temporary logs removed)."""
+    try:
+        servers = ", ".join(f"{robot} ({action})" for robot, action in running.actions.items())
+        click.echo(f"stand-in: {servers} at {speed_up:g}x wall time; Ctrl-C to stop", err=True)
+        running.wait()
+    except KeyboardInterrupt:
+        click.echo("stand-in: stopping", err=True)
 
 
 def _play_ros2(
