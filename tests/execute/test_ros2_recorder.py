@@ -96,6 +96,13 @@ PUBLISHER = textwrap.dedent(
     end = time.monotonic() + 10.0
     while time.monotonic() < end and any(p.get_subscription_count() < n for p, n in needed):
         rclpy.spin_once(node, timeout_sec=0.01)
+    # the action's feedback and status writers are the server's own: wait until this node sees the
+    # recorders' readers of them, then give the writers a moment to match (a CI run under load
+    # once recorded one feedback of three)
+    action = "/tiago1/navigate_to_pose/_action/"
+    while time.monotonic() < end and any(node.count_subscribers(action + t) < recorders for t in ("feedback", "status")):
+        rclpy.spin_once(node, timeout_sec=0.01)
+    spin(0.5)
     if mode == "wall":
         for i in range(count):
             publish_odom(i)

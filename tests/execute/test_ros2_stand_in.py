@@ -73,8 +73,10 @@ class Client:
 
         self.odom: list[Any] = []
         self.amcl: list[Any] = []
-        self.node.create_subscription(Odometry, "/tiago1/odom", self.odom.append, 100)
-        self.node.create_subscription(PoseWithCovarianceStamped, "/tiago1/amcl_pose", self.amcl.append, 100)
+        # deep queues: this process takes messages only while it waits for a goal's answer (a CI
+        # run under load once lost odometry from a queue of 100 before the test took it)
+        self.node.create_subscription(Odometry, "/tiago1/odom", self.odom.append, 20000)
+        self.node.create_subscription(PoseWithCovarianceStamped, "/tiago1/amcl_pose", self.amcl.append, 1000)
         self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.node)
         for client in [*self.clients.values(), *self.followers.values()]:
