@@ -5,8 +5,10 @@ from __future__ import annotations
 import pytest
 from pyoxigraph import BlankNode, Literal, NamedNode, Quad, Store
 
-from exsce_dsl.errors import StoreError
+from exsce_dsl.errors import ExsceError, StoreError
+from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, Namespaces
 from exsce_dsl.store.base import GraphSet
+from exsce_dsl.store.queries import library
 from exsce_dsl.store.sparql import bind, where_group, write_update
 
 
@@ -66,6 +68,32 @@ def test_a_placeholder_says_where_a_parameter_is_bound() -> None:
     store.update('INSERT DATA { <http://a> <http://p> "x" . <http://a> <http://q> "x" . <http://c> <http://p> "x" . <http://c> <http://q> "x" }')
     assert [str(s["s"]) for s in store.query(text)] == ["<http://a>"]  # type: ignore[union-attr]
     assert len(list(store.query(query))) == 2  # unbound, the placeholder leaves ?s free  # type: ignore[arg-type]
+
+
+def test_each_branch_of_a_union_gets_the_values_of_its_placeholder() -> None:
+    """run_lineage starts every branch from the run's bundle: one placeholder per branch."""
+    query = (
+        "SELECT ?s ?o WHERE { { VALUES ?s { UNDEF } ?s <http://p> ?o }"
+        " UNION { VALUES ?s { UNDEF } ?s <http://q> ?o } }"
+    )
+    text = bind(query, {"s": [NamedNode("http://a")]})
+    assert text.count("VALUES ?s { <http://a> }") == 2 and "UNDEF" not in text
+    store = Store()
+    store.update("INSERT DATA { <http://a> <http://p> 1 . <http://a> <http://q> 2 . <http://c> <http://p> 3 }")
+    found = sorted(int(s["o"].value) for s in store.query(text))  # type: ignore[union-attr]
+    assert found == [1, 2]
+
+
+def test_a_query_that_names_its_runs_bundles_is_bound_to_them_not_to_the_uuids() -> None:
+    """The runs given to a query with a run_bundle parameter are bound as their bundles (graphs);
+    the uuids are read there (bound beside them, they were joined to every row)."""
+    lineage = library.query("run_lineage")
+    uuid = "0d1e8a5c-1111-4a2b-9c3d-123456789abc"
+    bound = lineage.bindings({"run": [uuid]})
+    assert set(bound) == {"bundle"}
+    assert bound["bundle"] == NamedNode(f"{Namespaces(DEFAULT_NAMESPACE).fixed['run']}run_{uuid}_bundle")
+    with pytest.raises(ExsceError, match="run uuid"):
+        lineage.bindings({"run": ["not a <uuid>"]})
 
 
 def test_one_update_drops_the_replaced_graphs_then_inserts_everything() -> None:

@@ -64,13 +64,16 @@ def bind(query: str, bindings: Bindings | None) -> str:
     A query may say where a parameter's values go instead, with ``VALUES ?name { UNDEF }``
     (valid SPARQL on its own: the variable left free) in the group that should start from
     them, a subquery for instance: Oxigraph evaluates a subquery first and joins the rest
-    to its few solutions, where it would otherwise join a list given at the top last.
+    to its few solutions, where it would otherwise join a list given at the top last.  Each
+    such placeholder gets the values (a query whose branches of a ``UNION`` each start from them).
     """
     if not bindings:
         return query
     placed = _placeholders(query)
-    for name in sorted(set(placed) & set(bindings), key=lambda n: -placed[n][0]):
-        start, end = placed[name]
+    spans = sorted(
+        ((span, name) for name, found in placed.items() if name in bindings for span in found), reverse=True
+    )
+    for (start, end), name in spans:
         query = f"{query[:start]}{values_block({name: bindings[name]})}{query[end:]}"
     rest = {name: value for name, value in bindings.items() if name not in placed}
     if not rest:
@@ -81,10 +84,10 @@ def bind(query: str, bindings: Bindings | None) -> str:
     return f"{query[: at + 1]} {values_block(rest)}\n{query[at + 1 :]}"
 
 
-def _placeholders(query: str) -> dict[str, tuple[int, int]]:
-    """Where the query holds ``VALUES ?name { UNDEF }``: variable name -> (start, end)."""
+def _placeholders(query: str) -> dict[str, list[tuple[int, int]]]:
+    """Where the query holds ``VALUES ?name { UNDEF }``: variable name -> each (start, end)."""
     tokens = [t for t in _TOKEN.finditer(query) if not (t.lastgroup == "other" and t.group().isspace())]
-    found = {}
+    found: dict[str, list[tuple[int, int]]] = {}
     for i in range(len(tokens) - 4):
         values, variable, opening, undef, closing = tokens[i : i + 5]
         if (
@@ -93,7 +96,7 @@ def _placeholders(query: str) -> dict[str, tuple[int, int]]:
             and opening.lastgroup == "open" and undef.group().upper() == "UNDEF"
             and closing.lastgroup == "close"
         ):  # fmt: skip
-            found[variable.group()[1:]] = (values.start(), closing.end())
+            found.setdefault(variable.group()[1:], []).append((values.start(), closing.end()))
     return found
 
 

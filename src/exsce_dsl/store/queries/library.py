@@ -68,6 +68,7 @@ KINDS: Mapping[str, Callable[[Namespaces, str], Term]] = {
     "id": lambda names, text: Literal(text),
     "run": lambda names, text: Literal(text),
     "run_activity": lambda names, text: _iri(names, ids.RUN, ids.run_local_name(text), "run uuid"),
+    "run_bundle": lambda names, text: _iri(names, ids.RUN, f"{ids.run_local_name(text)}_bundle", "run uuid"),
     "robot": lambda names, text: Literal(text),
     "metric": lambda names, text: Literal(text),
     "metric_property": lambda names, text: _iri(names, ids.METRIC, text, "metric"),
@@ -79,7 +80,9 @@ KINDS: Mapping[str, Callable[[Namespaces, str], Term]] = {
 (the position of every heading of the pose), ``double`` → an ``xsd:double``,
 ``metric_property`` → ``metric:<name>`` (the segment index's property for the metric),
 ``run_activity`` → ``run:run_<uuid>`` (the run's activity, given by its uuid: a query starts
-from it with a look-up, where the uuid literal is one of every run entity's), and ``id``,
+from it with a look-up, where the uuid literal is one of every run entity's), ``run_bundle`` →
+``run:run_<uuid>_bundle`` (the run's bundle, a graph: a ``GRAPH ?bundle`` block bound to it reads
+that graph's indexes alone, the fastest start a query has), and ``id``,
 ``run`` (a uuid), ``robot``, ``metric``, ``string`` → a plain literal."""
 
 
@@ -121,7 +124,7 @@ class Query:
         """Terms for parameters given as text (name → values), checked against the declarations."""
         names = Namespaces(namespace)
         found: dict[str, Term | Sequence[Term]] = {}
-        for name, values in given.items():
+        for name, values in self._derived(given).items():
             parameter = self.parameter(name)
             if not parameter.many and len(values) > 1:
                 raise ExsceError(f"parameter '{name}' of query '{self.name}' takes one value")
@@ -131,6 +134,19 @@ class Query:
         if missing:
             raise ExsceError(f"query '{self.name}' needs {', '.join(missing)} (give each with -p NAME=VALUE)")
         return found
+
+    def _derived(self, given: Mapping[str, Sequence[str]]) -> dict[str, Sequence[str]]:
+        """The parameters given, with the runs given to a query that names their bundles
+        (``run_bundle``) bound as those bundles instead: the query starts from them, and
+        reads each run's uuid there (a list of uuids bound beside them would be joined to
+        every row)."""
+        bundles = [p.name for p in self.parameters if p.kind == "run_bundle"]
+        runs = [p.name for p in self.parameters if p.kind == "run" and p.name in given]
+        if not bundles or not runs:
+            return dict(given)
+        derived = {name: values for name, values in given.items() if name not in runs}
+        derived.update((name, given[runs[0]]) for name in bundles)
+        return derived
 
 
 _PARAMETER_LINE = re.compile(r"#\s*\?([A-Za-z_][A-Za-z0-9_]*)\s+([a-z_]+)([+?*]?)(?:\s+(.*))?")
