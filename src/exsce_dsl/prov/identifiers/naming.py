@@ -218,6 +218,11 @@ def bundle_name(element_id: str) -> str:
 _SAFE_NAME = re.compile(r"[A-Za-z0-9_](?:[A-Za-z0-9_.\-]*[A-Za-z0-9_\-])?")
 
 
+def is_name(name: str) -> bool:
+    """Whether ``name`` can be a local name and a part of an IRI as it is."""
+    return _SAFE_NAME.fullmatch(name) is not None
+
+
 def check_name(name: str, what: str) -> str:
     """``name`` if it can be a local name and a part of an IRI as it is; else an ExsceError."""
     if not _SAFE_NAME.fullmatch(name):

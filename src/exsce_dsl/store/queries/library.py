@@ -142,8 +142,8 @@ class Query:
         every row)."""
         bundles = [p.name for p in self.parameters if p.kind == "run_bundle"]
         runs = [p.name for p in self.parameters if p.kind == "run" and p.name in given]
-        if not bundles or not runs:
-            return dict(given)
+        if not bundles or not runs or not all(map(ids.is_name, given[runs[0]])):
+            return dict(given)  # (a value that is no run id is bound as given, and found nowhere)
         derived = {name: values for name, values in given.items() if name not in runs}
         derived.update((name, given[runs[0]]) for name in bundles)
         return derived
