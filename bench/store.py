@@ -208,8 +208,8 @@ def library_parameters(name: str, scenario: Scenario, some_runs: list[str]) -> t
     given: dict[str, object] = {}
     scope = "the store"
     for parameter in library_query(name).parameters:
-        if parameter.kind == "run_bundle":
-            continue  # the query's own, from its runs
+        if parameter.from_runs:
+            continue  # bound from the runs given
         if parameter.kind in ("run", "run_activity"):
             given[parameter.name] = some_runs if parameter.many else some_runs[0]
             scope = f"{len(some_runs)} runs" if parameter.many else "1 run"

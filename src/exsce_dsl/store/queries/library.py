@@ -69,6 +69,7 @@ KINDS: Mapping[str, Callable[[Namespaces, str], Term]] = {
     "run": lambda names, text: Literal(text),
     "run_activity": lambda names, text: _iri(names, ids.RUN, ids.run_local_name(text), "run uuid"),
     "run_bundle": lambda names, text: _iri(names, ids.RUN, f"{ids.run_local_name(text)}_bundle", "run uuid"),
+    "run_part": lambda names, text: _iri(names, ids.RUN, f"{ids.run_local_name(text)}/", "run uuid"),
     "robot": lambda names, text: Literal(text),
     "metric": lambda names, text: Literal(text),
     "metric_property": lambda names, text: _iri(names, ids.METRIC, text, "metric"),
@@ -82,7 +83,8 @@ KINDS: Mapping[str, Callable[[Namespaces, str], Term]] = {
 ``run_activity`` → ``run:run_<uuid>`` (the run's activity, given by its uuid: a query starts
 from it with a look-up, where the uuid literal is one of every run entity's), ``run_bundle`` →
 ``run:run_<uuid>_bundle`` (the run's bundle, a graph: a ``GRAPH ?bundle`` block bound to it reads
-that graph's indexes alone, the fastest start a query has), and ``id``,
+that graph's indexes alone, the fastest start a query has), ``run_part`` → the run's graph
+named like the parameter (``?hotspots_bundle`` → ``run:run_<uuid>/hotspots_bundle``), and ``id``,
 ``run`` (a uuid), ``robot``, ``metric``, ``string`` → a plain literal."""
 
 
@@ -94,8 +96,17 @@ class QueryParameter:
     optional: bool = False
     description: str = ""
 
+    @property
+    def from_runs(self) -> bool:
+        """Whether the parameter is bound from the runs given to the query (a run's graph), never
+        given itself."""
+        return self.kind in ("run_bundle", "run_part")
+
     def term(self, text: str, names: Namespaces) -> Term:
-        return KINDS[self.kind](names, text)
+        made = KINDS[self.kind](names, text)
+        # run_part: the run's parts' namespace, then the part named like the parameter (a name
+        # of letters, digits and '_')
+        return NamedNode(made.value + self.name) if self.kind == "run_part" else made
 
 
 @dataclass(frozen=True)
@@ -137,10 +148,10 @@ class Query:
 
     def _derived(self, given: Mapping[str, Sequence[str]]) -> dict[str, Sequence[str]]:
         """The parameters given, with the runs given to a query that names their bundles
-        (``run_bundle``) bound as those bundles instead: the query starts from them, and
+        (``run_bundle``, ``run_part``) bound as those bundles instead: the query starts from them, and
         reads each run's uuid there (a list of uuids bound beside them would be joined to
         every row)."""
-        bundles = [p.name for p in self.parameters if p.kind == "run_bundle"]
+        bundles = [p.name for p in self.parameters if p.from_runs]
         runs = [p.name for p in self.parameters if p.kind == "run" and p.name in given]
         if not bundles or not runs or not all(map(ids.is_name, given[runs[0]])):
             return dict(given)  # (a value that is no run id is bound as given, and found nowhere)
