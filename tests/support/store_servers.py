@@ -125,33 +125,8 @@ def exscec_serve(*args: str, cwd: Path | None = None, env: dict[str, str] | None
         stop(server.process)
 
 
-VIRTUOSO_INI = """\
-[Database]
-DatabaseFile = {dir}/virtuoso.db
-ErrorLogFile = {dir}/virtuoso.log
-LockFile = {dir}/virtuoso.lck
-TransactionFile = {dir}/virtuoso.trx
-xa_persistent_file = {dir}/virtuoso.pxa
-TempStorage = TempDatabase
-[TempDatabase]
-DatabaseFile = {dir}/virtuoso-temp.db
-TransactionFile = {dir}/virtuoso-temp.trx
-[Parameters]
-ServerPort = {sql_port}
-DisableUnixSocket = 1
-DirsAllowed = .
-NumberOfBuffers = 10000
-MaxDirtyBuffers = 6000
-ThreadsPerQuery = 2
-[HTTPServer]
-ServerPort = {http_port}
-ServerRoot = {dir}
-ServerThreads = 10
-Charset = UTF-8
-[SPARQL]
-ResultSetMaxRows = 1000000
-MaxQueryExecutionTime = 60
-"""
+VIRTUOSO_INI = Path(__file__).parents[1] / "fixtures" / "virtuoso" / "virtuoso.ini"
+"""Debian's default ``virtuoso.ini`` (``tests/fixtures/virtuoso/SOURCES.md``)."""
 VIRTUOSO_STARTUP_SECONDS = 90.0
 """A new database takes ~11 s to make on this machine; more on a loaded one."""
 
@@ -189,13 +164,31 @@ def virtuoso_server(location: Path) -> Iterator[Server]:
         stop(process)
 
 
+def debian_ini(location: Path, sql_port: int, http_port: int) -> str:
+    """Debian's ``virtuoso.ini`` with only its paths and ports changed: the database in
+    LOCATION, the SQL server at SQL_PORT, the HTTP server at HTTP_PORT."""
+    text = VIRTUOSO_INI.read_text()
+    changes = [
+        ("/var/lib/virtuoso-opensource-7/db/", f"{location}/"),
+        ("/var/lib/virtuoso-opensource-7/vsp", str(location)),
+        ("ServerPort\t\t\t= 1111", f"ServerPort\t\t\t= {sql_port}"),
+        ("ServerPort\t\t\t= 8890", f"ServerPort\t\t\t= {http_port}"),
+        ("localhost:8890", f"localhost:{http_port}"),
+    ]
+    for old, new in changes:
+        if old not in text:
+            raise RuntimeError(f"Debian's virtuoso.ini no longer holds {old!r}")
+        text = text.replace(old, new)
+    return text
+
+
 def _start_virtuoso(location: Path) -> tuple[subprocess.Popen[str], str, int]:
     """Virtuoso started on a new database in LOCATION at two free ports: the process, its HTTP
     URL and its SQL port."""
     sql_port, http_port = free_port(), free_port()
     location.mkdir(parents=True, exist_ok=True)
     ini = location / "virtuoso.ini"
-    ini.write_text(VIRTUOSO_INI.format(dir=location, sql_port=sql_port, http_port=http_port))
+    ini.write_text(debian_ini(location, sql_port, http_port))
     process = subprocess.Popen(
         ["virtuoso-t", "+foreground", "+configfile", str(ini)],
         cwd=location,

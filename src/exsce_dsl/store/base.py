@@ -55,6 +55,10 @@ class GraphSet:
     """Named graphs to write together: graph IRI → its quads (in that graph)."""
 
     graphs: Mapping[str, Sequence[Quad]]
+    commit: frozenset[str] = frozenset()
+    """Graphs written in the write's last operation, after every other graph of the set is whole
+    (and dropped first when replaced), on a server that cannot write the set in one transaction:
+    readers that start from them never see half a write.  Elsewhere the write is one transaction."""
 
 
 Replace = bool | Set[str]

@@ -19,8 +19,19 @@ from exsce_dsl.plugins import Registry
 from exsce_dsl.prov.identifiers import SKOLEM_BASE
 from exsce_dsl.store import virtuoso
 from exsce_dsl.store.base import Rows, Term
+from exsce_dsl.store.write_strategy import WriteStrategy
 
-__all__ = ["FLAVOURS", "SPARQL", "Answers", "Preset", "StoreFlavour", "flavour_named", "server_flavour"]
+__all__ = [
+    "FLAVOURS",
+    "SPARQL",
+    "Answers",
+    "Preset",
+    "RowLimit",
+    "StoreFlavour",
+    "WriteStrategy",
+    "flavour_named",
+    "server_flavour",
+]
 
 
 @dataclass(frozen=True)
@@ -48,6 +59,16 @@ class Answers:
 
 
 @dataclass(frozen=True)
+class RowLimit:
+    """How a server says that it cut an answer at a row limit of its configuration."""
+
+    header: str
+    """The answer's header that holds the limit when the answer may be cut at it."""
+    setting: str
+    """The setting, as its administrator knows it (said in the error)."""
+
+
+@dataclass(frozen=True)
 class StoreFlavour:
     """One kind of SPARQL server; the defaults are SPARQL 1.1's, what every endpoint does.
 
@@ -58,8 +79,8 @@ class StoreFlavour:
     written).  ``own_graphs``: beginnings of the names of the graphs the server keeps for
     itself, never listed, exported or cleared.  ``answers``: how its answers are read when not
     as SPARQL JSON (then graph by graph).  ``ask_column``: the one column of the table it
-    answers an ASK with (a row of 1: true), if it does so.  ``whole_requests``: the write
-    strategy, below.
+    answers an ASK with (a row of 1: true), if it does so.  ``writes``: how it takes a write
+    (:class:`~exsce_dsl.store.write_strategy.WriteStrategy`).
     """
 
     name: str
@@ -71,9 +92,15 @@ class StoreFlavour:
     own_graphs: tuple[str, ...] = ()
     answers: Answers | None = None
     ask_column: str | None = None
-    whole_requests: bool = True
-    """Whether a request of several operations is one transaction (all or nothing); False: each
-    operation is committed on its own, so a write that replaces graphs drops, then inserts."""
+    writes: WriteStrategy = WriteStrategy()
+    row_limit: RowLimit | None = None
+    """How the server says it cut an answer (then exsce refuses the answer, never a wrong number)."""
+
+    @property
+    def whole_requests(self) -> bool:
+        """Whether a request of several operations is one transaction (all or nothing); False: each
+        operation is committed on its own, so a write goes in steps."""
+        return self.writes.whole_requests
 
 
 SPARQL = StoreFlavour("sparql")
@@ -87,11 +114,18 @@ VIRTUOSO = StoreFlavour(
     own_graphs=virtuoso.OWN_GRAPHS,
     answers=Answers(virtuoso.TURTLE, virtuoso.result_set_rows, virtuoso.graph_triples),
     ask_column="__ASK_RETVAL",
-    whole_requests=False,
+    writes=WriteStrategy(
+        whole_requests=False,
+        statements=virtuoso.INSERT_DATA_TRIPLES,
+        request_bytes=virtuoso.GRAPH_POST_BYTES,
+        graph_post=True,
+    ),
+    row_limit=RowLimit(virtuoso.MAX_ROWS_HEADER, "[SPARQL] ResultSetMaxRows in its virtuoso.ini"),
 )
 """Virtuoso 7 (:mod:`exsce_dsl.store.virtuoso`): no blank nodes in ``INSERT DATA``, doubles
 exact only in its Turtle, graphs of its own, ASK answered as a table, each operation of a
-request committed on its own."""
+request committed on its own and no ``INSERT DATA`` of more than ~1,400 triples: a write goes
+graph by graph through its Graph Store Protocol, its commit graphs last."""
 
 _BUILT_IN = (
     StoreFlavour("oxigraph", Preset("/query", "/update", "/store", strip=("/query", "/update", "/store"))),

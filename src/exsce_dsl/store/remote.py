@@ -7,8 +7,9 @@
   :meth:`RemoteStore.write` is *one* update request (``DROP SILENT GRAPH`` for
   each replaced graph, then one ``INSERT DATA`` with a ``GRAPH`` block per
   graph), so it is all or nothing wherever the endpoint runs a request in one
-  transaction (Oxigraph, Fuseki, GraphDB, Neptune).  Writes are never split: a
-  write bigger than the endpoint accepts fails, whole, with the endpoint's message.
+  transaction (Oxigraph, Fuseki, GraphDB, Neptune).  On a server whose flavour's
+  write strategy says it commits each operation on its own (Virtuoso), the write
+  goes in steps, its commit graphs last (:mod:`exsce_dsl.store.write_strategy`).
 * Reading one graph: the Graph Store Protocol (``GET ?graph=``) when a GSP URL
   is known, else a ``CONSTRUCT``.
 * What a kind of server does its own way is its flavour's record
@@ -50,6 +51,7 @@ from exsce_dsl.prov.identifiers import SKOLEM_BASE
 from exsce_dsl.store.base import Bindings, GraphSet, Replace, Rows, Store
 from exsce_dsl.store.flavours import StoreFlavour, ask_columns, server_flavour
 from exsce_dsl.store.sparql import bind, graph_node, query_form, term_text, write_update
+from exsce_dsl.store.write_strategy import write_in_steps
 
 RESULTS_JSON = "application/sparql-results+json"
 FORM_QUERY_BYTES = 64 * 1024
@@ -116,6 +118,8 @@ class RemoteStore(Store):
         self._opener = urllib.request.build_opener(*handlers)
         self._server: str | None = None
         """The endpoint's ``Server`` header, once it has answered."""
+        self._headers_seen: dict[str, str] = {}
+        """The headers of the endpoint's last answer."""
 
     # -- HTTP ----------------------------------------------------------------
 
@@ -140,6 +144,7 @@ class RemoteStore(Store):
         try:
             with self._opener.open(request, timeout=self.timeout) as answer:
                 self._server = answer.headers.get("Server", "")
+                self._headers_seen = {k.lower(): v for k, v in answer.headers.items()}
                 return answer.read(), answer.headers.get("Content-Type", "")
         except urllib.error.HTTPError as exc:
             if missing_ok and exc.code == 404:
@@ -169,7 +174,7 @@ class RemoteStore(Store):
                 "or put user:password@ in the store URL"
             )
         elif exc.code == 413:
-            message += "; the request is larger than the endpoint accepts (writes are never split)"
+            message += "; the request is larger than the endpoint accepts"
         return message
 
     def _post_sparql(self, url: str, kind: str, text: str, accept: str | None) -> tuple[bytes, str]:
@@ -204,6 +209,7 @@ class RemoteStore(Store):
             raise StoreError("not a SELECT query")
         body, _ = self._post_sparql(self.url, "query", bind(query, bindings), answers.media_type)
         rows = answers.rows(body, self.label)
+        self._check_whole(len(rows))
         return Rows(rows.variables, tuple(tuple(_unskolemised(t) for t in row) for row in rows.rows))
 
     def select_first(self, query: str, most: int, bindings: Bindings | None = None) -> tuple[Rows, bool]:
@@ -222,9 +228,21 @@ class RemoteStore(Store):
             raise StoreError("not a SELECT query")
         taken = result if most is None else itertools.islice(result, most + 1)
         rows = tuple(tuple(_unskolemised(solution[v]) for v in variables) for solution in taken)
+        self._check_whole(len(rows))
         if most is not None and len(rows) > most:
             return Rows(variables, rows[:most]), True
         return Rows(variables, rows), False
+
+    def _check_whole(self, count: int) -> None:
+        """A StoreError if the last answer, of ``count`` rows, says the server cut it at a row
+        limit of its configuration (its flavour's ``row_limit``): a cut answer is a wrong one."""
+        limit = self.flavour().row_limit
+        said = self._headers_seen.get(limit.header.lower(), "") if limit is not None else ""
+        if limit is not None and said.strip().isdigit() and count >= int(said):
+            raise StoreError(
+                f"{self.label} cut its answer at {said} rows ({limit.setting}), so it would be wrong; "
+                "raise that limit on the server"
+            )
 
     def ask(self, query: str, bindings: Bindings | None = None) -> bool:
         result = self._query(query, bindings)
@@ -239,9 +257,27 @@ class RemoteStore(Store):
         self._post_sparql(self.update_url, "update", bind(update, bindings), None)
 
     def write(self, graphs: GraphSet, *, replace: Replace = False) -> None:
-        text = write_update(graphs, replace, skolem=self.flavour().skolem)
+        """One request where the server makes one request a transaction; else in steps, the
+        set's commit graphs last (its flavour's write strategy says which)."""
+        flavour = self.flavour()
+        if flavour.writes.in_steps:
+            write_in_steps(self, graphs, replace, flavour.writes, skolem=flavour.skolem)
+            return
+        text = write_update(graphs, replace, skolem=flavour.skolem)
         if text:
             self._post_sparql(self.update_url, "update", text, None)
+
+    def can_post_graphs(self) -> bool:
+        """Whether graphs can be written through the Graph Store Protocol (its URL is known)."""
+        return self.gsp_url is not None
+
+    def post_graph(self, name: str, n_triples: bytes) -> None:
+        """Add N-Triples to the graph ``name`` (Graph Store Protocol ``POST ?graph=``)."""
+        if self.gsp_url is None:
+            raise StoreError(f"no Graph Store Protocol URL is known for {self.label}")
+        separator = "&" if "?" in self.gsp_url else "?"
+        url = f"{self.gsp_url}{separator}{urllib.parse.urlencode({'graph': graph_node(name).value})}"
+        self._request(url, data=n_triples, content_type=N_TRIPLES, method="POST")
 
     def flavour(self) -> StoreFlavour:
         """The server's flavour, told by its ``Server`` header (an empty ASK learns it first)."""
@@ -279,12 +315,12 @@ class RemoteStore(Store):
     def graph(self, name: str) -> list[Quad]:
         graph = graph_node(name)
         answers = self.flavour().answers
-        if answers is not None:
-            query = f"CONSTRUCT {{ ?s ?p ?o }} WHERE {{ GRAPH {term_text(graph)} {{ ?s ?p ?o }} }}"
-            body, _ = self._post_sparql(self.url, "query", query, answers.media_type)
+        if answers is not None:  # a SELECT: a server may cut a CONSTRUCT at a row limit unsaid
+            rows = self.select(f"SELECT ?s ?p ?o WHERE {{ GRAPH {term_text(graph)} {{ ?s ?p ?o }} }}")
             return [
-                Quad(_unskolemised(s), p, _unskolemised(o), graph)
-                for s, p, o in answers.triples(body, self.label)
+                Quad(s, p, o, graph)
+                for s, p, o in rows.rows
+                if isinstance(s, (NamedNode, BlankNode)) and isinstance(p, NamedNode) and o is not None
             ]
         if self.gsp_url is not None:
             separator = "&" if "?" in self.gsp_url else "?"

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import re
 import uuid
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 
 from pyoxigraph import BlankNode, Literal, NamedNode, Quad
 
@@ -202,32 +202,49 @@ def checked_quads(quads: Iterable[object], name: str) -> list[Quad]:
     return checked
 
 
+class Skolemiser:
+    """Terms in N-Triples syntax, each blank node label of one write made one fresh IRI starting
+    with ``skolem`` (RDF 1.1 Concepts, 3.5 "Replacing Blank Nodes with IRIs"), the same in every
+    graph and every request of the write; with ``skolem`` None, blank nodes are left as they are."""
+
+    def __init__(self, skolem: str | None) -> None:
+        self.skolem = skolem
+        self.minted: dict[str, str] = {}  # blank node label -> its Skolem IRI, in N-Triples syntax
+
+    def __call__(self, term: object) -> str:
+        if self.skolem is not None and isinstance(term, BlankNode):
+            return self.minted.setdefault(term.value, f"<{self.skolem}{uuid.uuid4().hex}>")
+        return str(term)
+
+
 def write_update(graphs: GraphSet, replace: Replace, *, skolem: str | None = None) -> str:
     """One SPARQL Update that writes ``graphs``: ``DROP SILENT GRAPH`` for each replaced
     graph, then one ``INSERT DATA`` with a ``GRAPH`` block per graph.
 
     One request, so one transaction wherever the endpoint makes a request atomic.  Terms are
     written in N-Triples syntax by pyoxigraph.  With ``skolem`` (for Virtuoso, which refuses
-    blank nodes in ``INSERT DATA``), each blank node label of this write becomes one fresh IRI
-    starting with ``skolem`` (RDF 1.1 Concepts, 3.5 "Replacing Blank Nodes with IRIs"), the
-    same in every graph of the write, so the write stays one ``INSERT DATA``.
+    blank nodes in ``INSERT DATA``), blank nodes are written as Skolem IRIs (:class:`Skolemiser`),
+    so the write stays one ``INSERT DATA``.
     """
-    parts = [f"DROP SILENT GRAPH {graph_node(name)} ;\n" for name in replaced_names(graphs, replace)]
-    blocks: list[str] = []
-    minted: dict[str, str] = {}  # blank node label -> its Skolem IRI, in N-Triples syntax
+    parts = [f"DROP SILENT GRAPH {graph_node(name)}" for name in replaced_names(graphs, replace)]
+    inserted = insert_data({name: checked_quads(quads, name) for name, quads in graphs.graphs.items()},
+                           Skolemiser(skolem))  # fmt: skip
+    if inserted:
+        parts.append(inserted.removesuffix("\n"))
+    return "".join(f"{part} ;\n" for part in parts[:-1]) + (f"{parts[-1]}\n" if parts else "")
 
-    def text(term: object) -> str:
-        if skolem is not None and isinstance(term, BlankNode):
-            return minted.setdefault(term.value, f"<{skolem}{uuid.uuid4().hex}>")
-        return str(term)
 
-    for name, quads in graphs.graphs.items():
-        checked = checked_quads(quads, name)
-        lines = [f"{text(q.subject)} {q.predicate} {text(q.object)} .\n" for q in checked]
-        if lines:
-            blocks.append(f"GRAPH {graph_node(name)} {{\n{''.join(lines)}}}\n")
-    if blocks:
-        parts.append(f"INSERT DATA {{\n{''.join(blocks)}}} ;\n")
-    if parts:
-        parts[-1] = parts[-1].removesuffix(" ;\n") + "\n"
-    return "".join(parts)
+def insert_data(graphs: Mapping[str, Sequence[Quad]], skolemise: Skolemiser) -> str:
+    """One ``INSERT DATA`` with a ``GRAPH`` block per graph that holds quads ('' if none does)."""
+    blocks = [
+        f"GRAPH {graph_node(name)} {{\n{''.join(triple_lines(quads, skolemise))}}}\n"
+        for name, quads in graphs.items()
+        if quads
+    ]
+    return f"INSERT DATA {{\n{''.join(blocks)}}}\n" if blocks else ""
+
+
+def triple_lines(quads: Iterable[Quad], skolemise: Skolemiser) -> Iterator[str]:
+    """Each quad's triple as a line of N-Triples (blank nodes as ``skolemise`` writes them)."""
+    for q in quads:
+        yield f"{skolemise(q.subject)} {q.predicate} {skolemise(q.object)} .\n"

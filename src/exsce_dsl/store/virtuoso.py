@@ -34,6 +34,23 @@ listed, exported or cleared (dropping ``virtrdf#`` breaks the server)."""
 
 TURTLE = "text/turtle"
 
+INSERT_DATA_TRIPLES = 1000
+"""The most triples exsce puts in one ``INSERT DATA`` for Virtuoso.  Virtuoso 7.2.5 compiles an
+``INSERT DATA`` to SQL and refuses one of more SQL than it allows (``SP031 ... The length of
+generated SQL text has exceeded 10000 lines of code``): measured with Debian's default
+configuration, 1,421 triples go and 1,429 do not, whatever the terms (IRIs, plain, typed or
+language-tagged literals).  Two operations of 1,000 in one request are compiled together (3.6 s),
+ten are refused (``SQ199 Maximum size (32767) of a code vector exceeded``): one per request."""
+GRAPH_POST_BYTES = 8 * 1024 * 1024
+"""The most bytes of N-Triples exsce posts to Virtuoso's Graph Store Protocol in one request.
+Virtuoso took a 43 MB post of 500,000 triples in 12 s (its limit, if any, was not reached); the
+parts keep each request short.  10^5 triples go in ~2 s this way, ~27 s as INSERT DATA."""
+MAX_ROWS_HEADER = "X-SPARQL-MaxRows"
+"""The header Virtuoso sends with a SPARQL JSON answer cut at ``[SPARQL] ResultSetMaxRows``
+(Debian's default: 10,000).  Its Turtle result sets, which exsce reads, are not cut (measured:
+100,000 rows); its ``CONSTRUCT`` answers and Graph Store ``GET`` are, without the header: so
+exsce reads a Virtuoso graph with a SELECT."""
+
 _RES = SPARQL_RESULTS_NAMESPACE
 _XSD = XSD_NAMESPACE
 _DECIMAL, _DOUBLE = NamedNode(_XSD + "decimal"), NamedNode(_XSD + "double")
