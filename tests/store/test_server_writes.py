@@ -261,3 +261,22 @@ def test_exscec_ingest_of_scenario_c_into_debians_virtuoso_succeeds(
     assert virtuoso_graphs == embedded_graphs
     for name in embedded_graphs:
         assert canonical(there[name]) == canonical(here[name]), name
+
+
+def test_more_rows_than_result_set_max_rows_are_read_whole_and_a_cut_answer_is_refused(
+    virtuoso: Server,
+) -> None:
+    """Debian's ``ResultSetMaxRows = 10000``: Virtuoso cuts a SPARQL JSON answer there (saying so
+    in ``X-SPARQL-MaxRows``) and a CONSTRUCT without a word; exsce reads its Turtle result sets,
+    which are whole, and refuses a cut answer rather than count from it."""
+    store = open_store(f"virtuoso+{virtuoso.url}", timeout=60)
+    assert isinstance(store, RemoteStore)
+    written = run_graphs("rows", [30_000])
+    store.write(written)
+    graph = f"{EX}rows/g0"
+    query = f"SELECT ?s ?o WHERE {{ GRAPH <{graph}> {{ ?s {VALUE} ?o }} }}"
+    assert len(store.select(query)) == 15_000
+    assert len(store.graph(graph)) == 30_000
+    with pytest.raises(StoreError, match=r"cut its answer at 10000 rows \(\[SPARQL\] ResultSetMaxRows"):
+        store._solutions(query, None, None)  # the SPARQL JSON answer, as for a server of no known flavour
+    store.remove_graphs(sorted(written.graphs))
