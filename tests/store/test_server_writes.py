@@ -130,6 +130,21 @@ def test_a_write_refused_at_its_commit_removes_what_it_wrote(virtuoso: Server) -
     assert sizes_of(store, sorted(written.graphs)) == dict.fromkeys(written.graphs, 0)
 
 
+def test_a_replacing_write_refused_at_its_commit_leaves_no_mixed_run(virtuoso: Server) -> None:
+    """A run written whole, then replaced by a write whose commit graph Virtuoso refuses: the old
+    summary went first, the new graphs are dropped again; no summary is left over graphs of
+    another version (the run is absent, as after a kill before the commit)."""
+    store = open_store(f"virtuoso+{virtuoso.url}", timeout=60)
+    written = run_graphs("replaced", [2_000, 2_000])
+    store.write(written)
+    assert sizes_of(store, sorted(written.graphs)) == {n: len(q) for n, q in written.graphs.items()}
+    summary = next(iter(written.commit))
+    bad = Quad(NamedNode(f"{EX}replaced"), P, Literal("abc", datatype=INTEGER), NamedNode(summary))
+    with pytest.raises(StoreError, match=r"SR341.*removed what it wrote"):
+        store.write(GraphSet({**written.graphs, summary: [bad]}, commit=written.commit), replace=True)
+    assert sizes_of(store, sorted(written.graphs)) == dict.fromkeys(written.graphs, 0)
+
+
 def test_a_commit_graph_larger_than_one_operation_is_refused_before_anything_is_written(
     virtuoso: Server,
 ) -> None:
