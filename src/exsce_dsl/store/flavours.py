@@ -4,9 +4,9 @@ A flavour owns where the server puts its services (:class:`Preset`, for ``virtuo
 store URLs), how its Server header tells it, how it wants blank nodes written (``skolem``), the
 graphs it keeps for itself, how its answers are read when SPARQL JSON would lose digits
 (:class:`Answers`), how it takes a write (:class:`~exsce_dsl.store.write_strategy.WriteStrategy`)
-and how it says that it cut an answer (:class:`RowLimit`).  :class:`~exsce_dsl.store.remote.RemoteStore` asks its server's flavour
-and never names a server.  Packages add flavours under the entry-point group
-``exsce.store_flavours`` (:mod:`exsce_dsl.plugins`).
+and how it says that it cut an answer (:class:`RowLimit`).
+:class:`~exsce_dsl.store.remote.RemoteStore` asks its server's flavour and never names a server.
+Packages add flavours under the entry-point group ``exsce.store_flavours`` (:mod:`exsce_dsl.plugins`).
 """
 
 from __future__ import annotations
