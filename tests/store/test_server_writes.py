@@ -295,3 +295,16 @@ def test_more_rows_than_result_set_max_rows_are_read_whole_and_a_cut_answer_is_r
     with pytest.raises(StoreError, match=r"cut its answer at 10000 rows \(\[SPARQL\] ResultSetMaxRows"):
         store._solutions(query, None, None)  # the SPARQL JSON answer, as for a server of no known flavour
     store.remove_graphs(sorted(written.graphs))
+
+
+def test_debians_virtuoso_keeps_its_dav_and_service_description_graphs_to_itself(virtuoso: Server) -> None:
+    """Debian's ``[URIQA] DefaultHost`` makes graphs ``http://localhost:PORT/DAV/`` and
+    ``.../sparql``: not exsce's, so neither listed nor cleared."""
+    store = open_store(f"virtuoso+{virtuoso.url}", timeout=60)
+    port = virtuoso.url.rsplit(":", 1)[1]
+    own = [f"http://localhost:{port}/DAV/", f"http://localhost:{port}/sparql"]
+    assert store.existing_graphs(own) == set(own)
+    assert not set(own) & store.graph_names()
+    assert not set(own) & set(store.graph_sizes())
+    store.clear()
+    assert store.existing_graphs(own) == set(own)

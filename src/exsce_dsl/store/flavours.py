@@ -11,6 +11,7 @@ Packages add flavours under the entry-point group ``exsce.store_flavours`` (:mod
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -90,11 +91,23 @@ class StoreFlavour:
     ``name+http://`` does not set the flavour, the server's answer does."""
     skolem: str | None = None
     own_graphs: tuple[str, ...] = ()
+    own_graph_names: tuple[str, ...] = ()
+    """Regular expressions matching the whole names of more graphs the server keeps for itself,
+    names that hold its host, so that no beginning tells them."""
     answers: Answers | None = None
     ask_column: str | None = None
     writes: WriteStrategy = WriteStrategy()
     row_limit: RowLimit | None = None
     """How the server says it cut an answer (then exsce refuses the answer, never a wrong number)."""
+
+    def owns(self, graph: str) -> bool:
+        """Whether ``graph`` is one the server keeps for itself (``own_graphs``, ``own_graph_names``)."""
+        return graph.startswith(self.own_graphs) or any(re.fullmatch(p, graph) for p in self.own_graph_names)
+
+    @property
+    def keeps_graphs(self) -> bool:
+        """Whether the server keeps graphs of its own."""
+        return bool(self.own_graphs or self.own_graph_names)
 
     @property
     def whole_requests(self) -> bool:
@@ -112,6 +125,7 @@ VIRTUOSO = StoreFlavour(
     server="virtuoso",
     skolem=SKOLEM_BASE,
     own_graphs=virtuoso.OWN_GRAPHS,
+    own_graph_names=virtuoso.OWN_GRAPH_NAMES,
     answers=Answers(virtuoso.TURTLE, virtuoso.result_set_rows, virtuoso.graph_triples),
     ask_column="__ASK_RETVAL",
     writes=WriteStrategy(

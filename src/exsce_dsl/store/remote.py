@@ -298,19 +298,19 @@ class RemoteStore(Store):
 
     def quads(self) -> list[Quad]:
         flavour = self.flavour()
-        if flavour.answers is not None or flavour.own_graphs:  # graph by graph, the server's left out
+        if flavour.answers is not None or flavour.keeps_graphs:  # graph by graph, the server's left out
             return [q for quads in self.graphs(sorted(self.graph_names())).values() for q in quads]
         return super().quads()
 
     def clear(self) -> None:
-        """Remove every graph but those the server keeps for itself (its flavour's ``own_graphs``)."""
-        if self.flavour().own_graphs:
+        """Remove every graph but those the server keeps for itself (its flavour's ``owns``)."""
+        if self.flavour().keeps_graphs:
             self.remove_graphs(sorted(self.graph_names()))
         else:
             super().clear()
 
     def _servers_own(self, graph: str) -> bool:
-        return graph.startswith(self.flavour().own_graphs)
+        return self.flavour().owns(graph)
 
     def graph(self, name: str) -> list[Quad]:
         graph = graph_node(name)

@@ -31,6 +31,10 @@ OWN_GRAPHS = (
 )
 """Graphs a new Virtuoso database holds for itself (its RDF views, LDP): not exsce's, so not
 listed, exported or cleared (dropping ``virtrdf#`` breaks the server)."""
+OWN_GRAPH_NAMES = (r"https?://[^/]+/DAV/", r"https?://[^/]+/sparql")
+"""Graphs named after the host of ``[URIQA] DefaultHost`` (Debian's ``virtuoso.ini``:
+``localhost:8890``): ``http://HOST/DAV/`` (its WebDAV folder's metadata) and ``http://HOST/sparql``
+(the endpoint's SPARQL 1.1 Service Description)."""
 
 TURTLE = "text/turtle"
 
