@@ -105,8 +105,9 @@ def _undone(sender: Sender, names: Sequence[str], error: StoreError) -> str:
     try:
         _drop(sender, names)
     except StoreError as again:
-        return f"{error}; the write stopped half-way and could not remove what it wrote: {again}"
-    return f"{error}; the write stopped half-way and removed what it wrote (nothing of it is stored)"
+        left = f"could not remove what it wrote ({again.message})"
+        return f"{error.message}; the write stopped half-way and {left}"
+    return f"{error.message}; the write stopped half-way and removed what it wrote (nothing of it is stored)"
 
 
 def _write_graph(sender: Sender, name: str, quads: Sequence[Quad], strategy: WriteStrategy,
