@@ -171,15 +171,20 @@ from tests.store.test_server_writes import KILL_SIZES, run_graphs
 store = open_store(sys.argv[1], timeout=60)
 graphs = run_graphs(sys.argv[2], KILL_SIZES)
 store.flavour()
+replacing = sys.argv[3:] == ["replace"]
+if replacing:
+    store.write(graphs)
 print("writing", flush=True)
-store.write(graphs)
+store.write(run_graphs(sys.argv[2], KILL_SIZES), replace=replacing)
 print("written", flush=True)
 """
 
 
-def _writer(url: str, run: str) -> subprocess.Popen[str]:
+def _writer(url: str, run: str, *replace: str) -> subprocess.Popen[str]:
+    """A process writing the run ``run`` (KILL_SIZES) once it has said "writing"; with "replace",
+    writing it again, replacing its graphs, once the first write is whole."""
     process = subprocess.Popen(
-        [sys.executable, "-c", WRITER, url, run], cwd=ROOT, stdout=subprocess.PIPE, text=True
+        [sys.executable, "-c", WRITER, url, run, *replace], cwd=ROOT, stdout=subprocess.PIPE, text=True
     )
     assert process.stdout is not None
     assert process.stdout.readline().strip() == "writing"
@@ -309,3 +314,32 @@ def test_debians_virtuoso_keeps_its_dav_and_service_description_graphs_to_itself
     assert not set(own) & set(store.graph_sizes())
     store.clear()
     assert store.existing_graphs(own) == set(own)
+
+
+def test_a_writer_killed_while_replacing_a_run_leaves_its_summary_only_over_whole_graphs(
+    virtuoso: Server,
+) -> None:
+    """A run written whole, then written again with ``replace``, killed at a quarter, a half and
+    three quarters of that write: the old summary goes first and the new one comes last, so after
+    the kill the summary is there only over whole graphs, never over dropped or half-written ones."""
+    url = f"virtuoso+{virtuoso.url}"
+    reader = open_store(url, timeout=60)
+    timed = _writer(url, "timed", "replace")
+    started = time.monotonic()
+    assert timed.wait(timeout=120) == 0
+    took = time.monotonic() - started
+    states = []
+    for attempt, moment in enumerate([0.25, 0.5, 0.75]):
+        run = f"replaced{attempt}"
+        wanted = {name: len(quads) for name, quads in run_graphs(run, KILL_SIZES).graphs.items()}
+        writer = _writer(url, run, "replace")
+        time.sleep(moment * took)
+        writer.send_signal(signal.SIGKILL)
+        writer.wait(timeout=30)
+        after = sizes_of(reader, sorted(wanted))
+        committed = after[f"{EX}{run}/summary"] > 0
+        assert not committed or after == wanted, (moment, after)
+        states.append((moment, committed, sum(after.values())))
+    total = sum(wanted.values())
+    print("replacing write took", took, "s; (moment, committed, triples stored) per kill:", states)
+    assert any(not committed and 0 < stored < total for _, committed, stored in states), (took, states)

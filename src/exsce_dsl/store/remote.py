@@ -293,6 +293,17 @@ class RemoteStore(Store):
         rows = self.select("SELECT DISTINCT ?g WHERE { GRAPH ?g { ?s ?p ?o } }")
         return {g.value for (g,) in rows.rows if isinstance(g, NamedNode) and not self._servers_own(g.value)}
 
+    def existing_graphs(self, names: Sequence[str]) -> set[str]:
+        """As the base's, asked with ``FILTER EXISTS``: Virtuoso keeps the plan of a query text, and
+        the base's join, planned while a run's graphs were empty, took 11 s once they held 4*10^4
+        triples (the filter: 14 ms)."""
+        if not names:
+            return set()
+        values = " ".join(term_text(graph_node(name)) for name in dict.fromkeys(names))
+        held = "FILTER EXISTS { GRAPH ?g { ?s ?p ?o } }"
+        rows = self.select(f"SELECT ?g WHERE {{ VALUES ?g {{ {values} }} {held} }}")
+        return {g.value for (g,) in rows.rows if isinstance(g, NamedNode)}
+
     def graph_sizes(self) -> dict[str, int]:
         return {g: n for g, n in super().graph_sizes().items() if not self._servers_own(g)}
 
