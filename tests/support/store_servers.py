@@ -1,4 +1,5 @@
-"""Real SPARQL servers for the store tests: ``oxigraph serve`` and ``exscec serve``.
+"""Real SPARQL servers for the store tests: ``oxigraph serve``, ``exscec serve`` and Virtuoso 7
+(on Debian's default ``virtuoso.ini``, only its paths and ports changed).
 
 Each runs as a child process on 127.0.0.1 at a free port, is waited for until
 it answers, and is stopped (SIGTERM, then SIGKILL) afterwards.
