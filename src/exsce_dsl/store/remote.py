@@ -209,7 +209,7 @@ class RemoteStore(Store):
             raise StoreError("not a SELECT query")
         body, _ = self._post_sparql(self.url, "query", bind(query, bindings), answers.media_type)
         rows = answers.rows(body, self.label)
-        self._check_whole(len(rows))
+        _check_whole(self.flavour(), self._headers_seen, len(rows), self.label)
         return Rows(rows.variables, tuple(tuple(_unskolemised(t) for t in row) for row in rows.rows))
 
     def select_first(self, query: str, most: int, bindings: Bindings | None = None) -> tuple[Rows, bool]:
@@ -228,21 +228,10 @@ class RemoteStore(Store):
             raise StoreError("not a SELECT query")
         taken = result if most is None else itertools.islice(result, most + 1)
         rows = tuple(tuple(_unskolemised(solution[v]) for v in variables) for solution in taken)
-        self._check_whole(len(rows))
+        _check_whole(self.flavour(), self._headers_seen, len(rows), self.label)
         if most is not None and len(rows) > most:
             return Rows(variables, rows[:most]), True
         return Rows(variables, rows), False
-
-    def _check_whole(self, count: int) -> None:
-        """A StoreError if the last answer, of ``count`` rows, says the server cut it at a row
-        limit of its configuration (its flavour's ``row_limit``): a cut answer is a wrong one."""
-        limit = self.flavour().row_limit
-        said = self._headers_seen.get(limit.header.lower(), "") if limit is not None else ""
-        if limit is not None and said.strip().isdigit() and count >= int(said):
-            raise StoreError(
-                f"{self.label} cut its answer at {said} rows ({limit.setting}), so it would be wrong; "
-                "raise that limit on the server"
-            )
 
     def ask(self, query: str, bindings: Bindings | None = None) -> bool:
         result = self._query(query, bindings)
@@ -367,6 +356,19 @@ class RemoteStore(Store):
             if isinstance(s, (NamedNode, BlankNode)):
                 found.setdefault(g.value, []).append(Quad(s, p, o, g))
         return found
+
+
+def _check_whole(flavour: StoreFlavour, headers: dict[str, str], count: int, label: str) -> None:
+    """A StoreError if an answer of ``count`` rows, with these ``headers`` (lower-case names), says
+    the server cut it at a row limit of its configuration (the flavour's ``row_limit``): a cut
+    answer is a wrong one."""
+    limit = flavour.row_limit
+    said = headers.get(limit.header.lower(), "") if limit is not None else ""
+    if limit is not None and said.strip().isdigit() and count >= int(said):
+        raise StoreError(
+            f"{label} cut its answer at {said} rows ({limit.setting}), so it would be wrong; "
+            "raise that limit on the server"
+        )
 
 
 def _unskolemised(term: Any) -> Any:
