@@ -28,6 +28,7 @@ from exsce_dsl.store import queries
 from exsce_dsl.store.base import GraphSet, Store
 from exsce_dsl.store.open import open_store
 from exsce_dsl.store.remote import RemoteStore
+from exsce_dsl.store.run_commit import run_graph_set
 from exsce_dsl.store.virtuoso import INSERT_DATA_TRIPLES
 
 from tests.store.test_virtuoso import canonical
@@ -146,19 +147,26 @@ def test_a_replacing_write_refused_at_its_commit_leaves_no_mixed_run(virtuoso: S
     assert sizes_of(store, sorted(written.graphs)) == dict.fromkeys(written.graphs, 0)
 
 
-def test_a_commit_graph_larger_than_one_operation_is_refused_before_anything_is_written(
+def test_a_commit_graph_larger_than_one_operation_is_written_whole_with_its_last_quads_last(
     virtuoso: Server,
 ) -> None:
+    """A run's bundle (the commit graph of a real run) may hold more than one INSERT DATA carries:
+    its lead goes first, its last quads (the run's type: what listings start from) in the last
+    operation.  A last operation refused leaves nothing of the write."""
     store = open_store(f"virtuoso+{virtuoso.url}", timeout=60)
-    written = run_graphs("too-big", [10])
-    summary = f"{EX}too-big/summary"
+    written = run_graphs("big-commit", [10])
+    summary = f"{EX}big-commit/summary"
     big = [
         Quad(NamedNode(f"{EX}s{i}"), P, Literal(str(i)), NamedNode(summary))
-        for i in range(INSERT_DATA_TRIPLES + 1)
+        for i in range(2 * INSERT_DATA_TRIPLES + 7)
     ]
-    with pytest.raises(StoreError, match="commit graphs hold 1001 triples"):
-        store.write(GraphSet({**written.graphs, summary: big}, commit=written.commit))
-    assert sizes_of(store, sorted(written.graphs)) == dict.fromkeys(written.graphs, 0)
+    refused = Quad(NamedNode(f"{EX}marker"), P, Literal("abc", datatype=INTEGER), NamedNode(summary))
+    with pytest.raises(StoreError, match=r"SR341.*removed what it wrote"):
+        store.write(GraphSet({**written.graphs, summary: [*big, refused]}, commit=frozenset({summary})))
+    assert sizes_of(store, [*sorted(written.graphs), summary]) == dict.fromkeys([*written.graphs, summary], 0)
+    store.write(GraphSet({**written.graphs, summary: big}, commit=frozenset({summary})))
+    assert sizes_of(store, [summary]) == {summary: len(big)}
+    store.remove_graphs([*written.graphs, summary])
 
 
 KILL_SIZES = [5_000] * 8
@@ -343,3 +351,19 @@ def test_a_writer_killed_while_replacing_a_run_leaves_its_summary_only_over_whol
     total = sum(wanted.values())
     print("replacing write took", took, "s; (moment, committed, triples stored) per kill:", states)
     assert any(not committed and 0 < stored < total for _, committed, stored in states), (took, states)
+
+
+def test_a_runs_bundle_is_its_writes_commit_graph_with_the_runs_type_last() -> None:
+    """What makes a run visible to every query that finds runs comes last on Virtuoso."""
+    runs = "https://www.sesame-project.org/scenarios/runs/"
+    bundle, bag = f"{runs}run_1234abcd_bundle", f"{runs}run_1234abcd/bag_bundle"
+    activity = NamedNode(f"{runs}run_1234abcd")
+    rdf_type = NamedNode("http://www.w3.org/1999/02/22-rdf-syntax-ns#type")
+    typed = Quad(
+        activity, rdf_type, NamedNode("https://www.sesame-project.org/scenarios/run"), NamedNode(bundle)
+    )
+    other = Quad(activity, P, Literal("x"), NamedNode(bundle))
+    written = run_graph_set({bundle: [typed, other], bag: [Quad(activity, P, Literal("y"), NamedNode(bag))]})
+    assert written.commit == frozenset({bundle})
+    assert list(written.graphs[bundle]) == [other, typed]
+    assert run_graph_set({f"{bundle}?revision=1": [typed]}).commit == frozenset()  # a revision is no run

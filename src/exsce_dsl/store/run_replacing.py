@@ -27,7 +27,8 @@ from pyoxigraph import Literal, NamedNode, Quad
 from exsce_dsl.errors import StoreConflictError
 from exsce_dsl.prov import identifiers as ids
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, PROV_NAMESPACE, Namespaces
-from exsce_dsl.store.base import GraphSet, Store
+from exsce_dsl.store.base import Store
+from exsce_dsl.store.run_commit import run_graph_set
 from exsce_dsl.store.segment_index import orphan_segment_graphs, segment_index
 from exsce_dsl.store.sparql import term_text
 from exsce_dsl.store.writing import WriteReport, bundle_graphs
@@ -87,7 +88,7 @@ def replace_run(
     writes.update(graphs)
     for name, quads in shared.items():
         writes.setdefault(name, quads)
-    store.write(GraphSet(writes), replace={*old, *orphans, *graphs})
+    store.write(run_graph_set(writes), replace={*old, *orphans, *graphs})
     return WriteReport(
         location=store.location,
         added=tuple(name for name in graphs if name not in old),

@@ -5,8 +5,9 @@ A write that one transactional request can carry is one request (:func:`~exsce_d
 write_update`): all or nothing.  Where that is not possible (Virtuoso commits each operation of a
 request on its own, and compiles no ``INSERT DATA`` of more than ~1,400 triples), a write goes in
 order so that readers never see half of it: the graphs the :class:`~exsce_dsl.store.base.GraphSet`
-names in ``commit`` (a run's summary graph, where every query that lists runs starts) are dropped
-first when replaced and written last, in one operation, after every other graph is whole.  A write
+names in ``commit`` (a run's bundle, where every query that finds runs starts:
+:mod:`exsce_dsl.store.run_commit`) are dropped first when replaced and written last, their last
+statements in one operation, after every other graph is whole.  A write
 that fails half-way removes the graphs it wrote (best effort) and says the server's error.
 """
 
@@ -64,19 +65,13 @@ class Sender(Protocol):
 def write_in_steps(sender: Sender, graphs: GraphSet, replace: Replace, strategy: WriteStrategy, *,
                    skolem: str | None) -> None:  # fmt: skip
     """Write ``graphs`` in order: replaced commit graphs dropped first, then the other replaced
-    graphs, then every other graph (in parts within ``strategy``'s limits), then the commit graphs
-    in one ``INSERT DATA``.  On failure the graphs written are dropped again (best effort) and a
-    StoreError says the server's error."""
+    graphs, then every other graph (in parts within ``strategy``'s limits), then the commit graphs,
+    their last quads in one ``INSERT DATA`` (:func:`_commit_split`).  On failure the graphs written
+    are dropped again (best effort) and a StoreError says the server's error."""
     skolemise = Skolemiser(skolem)
     checked = {name: checked_quads(quads, name) for name, quads in graphs.graphs.items()}
     commit = [name for name in checked if name in graphs.commit and checked[name]]
-    commit_text = insert_data({name: checked[name] for name in commit}, skolemise)
-    in_commit = sum(len(checked[name]) for name in commit)
-    if strategy.statements is not None and in_commit > strategy.statements:
-        raise StoreError(
-            f"cannot write to {sender.label}: its commit graphs hold {in_commit} triples, more than the "
-            f"{strategy.statements} one operation may carry there ({', '.join(commit)})"
-        )
+    lead, last = _commit_split(checked, commit, strategy.statements)
     replaced = replaced_names(graphs, replace)
     fresh = set(replaced) | (set(checked) - sender.existing_graphs(list(checked)))
     first = [name for name in replaced if name in graphs.commit]
@@ -84,15 +79,32 @@ def write_in_steps(sender: Sender, graphs: GraphSet, replace: Replace, strategy:
     _drop(sender, [name for name in replaced if name not in graphs.commit])
     written: list[str] = []
     try:
-        for name, quads in checked.items():
-            if name not in commit and quads:
+        for name, quads in [*((n, q) for n, q in checked.items() if n not in commit), *lead.items()]:
+            if quads:
                 written.append(name)
                 _write_graph(sender, name, quads, strategy, skolemise)
-        if commit_text:
-            written.extend(commit)
-            sender.update(commit_text)
+        if last:
+            written.extend(last)
+            sender.update(insert_data(last, skolemise))
     except StoreError as exc:
         raise StoreError(_undone(sender, [n for n in written if n in fresh], exc)) from None
+
+
+def _commit_split(
+    checked: dict[str, list[Quad]], commit: Sequence[str], most: int | None
+) -> tuple[dict[str, list[Quad]], dict[str, list[Quad]]]:
+    """The commit graphs' quads written before the last operation, and those of the last one: the
+    last commit graph's final ``most`` quads (a writer puts what makes its data visible there:
+    a run's type, where every query that lists runs starts), or every commit graph when they fit
+    in one operation."""
+    if most is None or sum(len(checked[name]) for name in commit) <= most:
+        return {}, {name: checked[name] for name in commit}
+    *others, final = commit
+    quads = checked[final]
+    lead = {name: checked[name] for name in others}
+    if len(quads) > most:
+        lead[final] = quads[:-most]
+    return lead, {final: quads[-most:]}
 
 
 def _drop(sender: Sender, names: Sequence[str]) -> None:

@@ -54,9 +54,10 @@ from pyoxigraph import (
 
 from exsce_dsl.errors import StoreConflictError, StoreError
 from exsce_dsl.prov.identifiers import PROV_NAMESPACE, RDF_TYPE, ROBOT_SCHEMA, XSD_NAMESPACE
-from exsce_dsl.store.base import GraphSet, Store
+from exsce_dsl.store.base import Store
 from exsce_dsl.store.graph_owners import replace_advice
 from exsce_dsl.store.literals import INTEGER_TYPES
+from exsce_dsl.store.run_commit import run_graph_set
 from exsce_dsl.store.segment_index import segment_index, stale_index_graphs
 
 __all__ = [
@@ -195,7 +196,7 @@ def add_graphs(
     writes = {**plan.to_add, **plan.to_replace, **revisions, **plan.derived_changes}
     if writes:
         store.write(
-            GraphSet(writes), replace=set(plan.to_replace) | set(revisions) | set(plan.derived_changes)
+            run_graph_set(writes), replace=set(plan.to_replace) | set(revisions) | set(plan.derived_changes)
         )
     return WriteReport(
         location=store.location,
