@@ -12,16 +12,16 @@ transactional store writes the set in one step and needs no order.
 from __future__ import annotations
 
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 
 from pyoxigraph import NamedNode, Quad
 
 from exsce_dsl.prov import identifiers as ids
 from exsce_dsl.store.base import GraphSet
 
-__all__ = ["run_graph_set"]
+__all__ = ["run_graph_set", "unfinished_run_graphs"]
 
-_RUN_BUNDLE = re.compile(r"/runs/run_[^/?]+_bundle$")
+_RUN_BUNDLE = re.compile(r"/runs/(run_[^/?]+)_bundle$")
 _RUN_TYPE_ENDING = f"/{ids.RUN_TYPE.local}"
 
 
@@ -45,3 +45,13 @@ def _type_last(quads: Sequence[Quad]) -> list[Quad]:
         )
 
     return [q for q in quads if not marks_the_run(q)] + [q for q in quads if marks_the_run(q)]
+
+
+def unfinished_run_graphs(names: Collection[str], existing: Collection[str]) -> set[str]:
+    """Of the graphs ``existing`` of a write of ``names``, those a write of the same run left when
+    it stopped before its last step (its bundle absent): not stored, to be written over.  Only a
+    store that commits in steps can hold them (and ``exscec store check --fix`` removes them)."""
+    runs = {m.group(1) for name in names if (m := _RUN_BUNDLE.search(name)) and name not in existing}
+    if not runs:
+        return set()
+    return {name for name in existing if any(f"/runs/{run}/" in name for run in runs)}

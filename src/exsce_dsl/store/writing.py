@@ -57,7 +57,7 @@ from exsce_dsl.prov.identifiers import PROV_NAMESPACE, RDF_TYPE, ROBOT_SCHEMA, X
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.graph_owners import replace_advice
 from exsce_dsl.store.literals import INTEGER_TYPES
-from exsce_dsl.store.run_commit import run_graph_set
+from exsce_dsl.store.run_commit import run_graph_set, unfinished_run_graphs
 from exsce_dsl.store.segment_index import segment_index, stale_index_graphs
 
 __all__ = [
@@ -185,6 +185,8 @@ def add_graphs(
     derived = frozenset(derived)
     names = list(graphs)
     existing = store.existing_graphs(names)
+    unfinished = unfinished_run_graphs(names, existing)  # left by a write that stopped: written over
+    existing -= unfinished
     stored = store.graphs([name for name in names if name in existing]) if existing else {}
     plan = _WritePlan()
     for name in names:
@@ -195,9 +197,8 @@ def add_graphs(
     revisions = _revisions(store, plan.conflicts, stored) if plan.conflicts else {}
     writes = {**plan.to_add, **plan.to_replace, **revisions, **plan.derived_changes}
     if writes:
-        store.write(
-            run_graph_set(writes), replace=set(plan.to_replace) | set(revisions) | set(plan.derived_changes)
-        )
+        replaced = {*plan.to_replace, *revisions, *plan.derived_changes, *(unfinished & set(writes))}
+        store.write(run_graph_set(writes), replace=replaced)
     return WriteReport(
         location=store.location,
         added=tuple(plan.added),
