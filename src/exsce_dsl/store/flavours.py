@@ -99,6 +99,12 @@ class StoreFlavour:
     writes: WriteStrategy = WriteStrategy()
     row_limit: RowLimit | None = None
     """How the server says it cut an answer (then exsce refuses the answer, never a wrong number)."""
+    advice: tuple[tuple[str, str], ...] = ()
+    """Known refusals of the server: (text its answer holds, what to do), said after its message."""
+
+    def advice_for(self, answer: str) -> str | None:
+        """What to do about a refusal whose answer says ``answer``, if the refusal is a known one."""
+        return next((what for said, what in self.advice if said in answer), None)
 
     def owns(self, graph: str) -> bool:
         """Whether ``graph`` is one the server keeps for itself (``own_graphs``, ``own_graph_names``)."""
@@ -135,6 +141,7 @@ VIRTUOSO = StoreFlavour(
         graph_post=True,
     ),
     row_limit=RowLimit(virtuoso.MAX_ROWS_HEADER, "[SPARQL] ResultSetMaxRows in its virtuoso.ini"),
+    advice=virtuoso.ADVICE,
 )
 """Virtuoso 7 (:mod:`exsce_dsl.store.virtuoso`): no blank nodes in ``INSERT DATA``, doubles
 exact only in its Turtle, graphs of its own, ASK answered as a table, each operation of a

@@ -175,6 +175,8 @@ class RemoteStore(Store):
             )
         elif exc.code == 413:
             message += "; the request is larger than the endpoint accepts"
+        elif advice := server_flavour(self._server or exc.headers.get("Server", "") or "").advice_for(body):
+            message += f"; {advice}"
         return message
 
     def _post_sparql(self, url: str, kind: str, text: str, accept: str | None) -> tuple[bytes, str]:

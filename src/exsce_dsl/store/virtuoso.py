@@ -50,6 +50,16 @@ GRAPH_POST_BYTES = 8 * 1024 * 1024
 Virtuoso took a 43 MB post of 500,000 triples in 12 s (its limit, if any, was not reached); the
 parts keep each request short.  10^5 triples go in ~2 s this way, ~27 s as INSERT DATA."""
 MAX_ROWS_HEADER = "X-SPARQL-MaxRows"
+ADVICE = (
+    (
+        "The estimated execution time",
+        "Virtuoso's cost estimate refused the query before running it, a known fault of its "
+        'MaxQueryCostEstimationTime (openlink/virtuoso-opensource#246: "0 (sec) exceeds the limit"); '
+        "OpenLink's advice is to comment that setting out of the [SPARQL] section of virtuoso.ini "
+        "(Debian's sets it to 400) and restart the server",
+    ),
+)
+"""Refusals of Virtuoso that say nothing of what to do, and what to do (see :class:`StoreFlavour`)."""
 """The header Virtuoso sends with a SPARQL JSON answer cut at ``[SPARQL] ResultSetMaxRows``
 (Debian's default: 10,000).  Its Turtle result sets, which exsce reads, are not cut (measured:
 100,000 rows); its ``CONSTRUCT`` answers and Graph Store ``GET`` are, without the header: so
