@@ -117,7 +117,7 @@ if TYPE_CHECKING:  # what exscec's commands use besides (docs/python.md need not
     from exsce_dsl.parallel.dask_client import dask_address
     from exsce_dsl.runs import BagInfo, IngestResult
     from exsce_dsl.similarity.dendrogram import save_dendrogram
-    from exsce_dsl.store import QUERY_TIMEOUT, Rows, Store
+    from exsce_dsl.store import QUERY_TIMEOUT, QueryTimes, Rows, Store, timing_queries
     from exsce_dsl.tables import aligned
     from exsce_dsl.textfiles import read_text
     from exsce_dsl.transform import TRANSFORMATIONS

@@ -11,6 +11,8 @@ from __future__ import annotations
 import importlib
 import os
 import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import TextIO
 
 import click
@@ -73,6 +75,12 @@ class LazyGroup(click.Group):
 @click.version_option(__version__, prog_name="exscec")
 @click.option("--debug", is_flag=True, help="Show Python tracebacks for errors.")
 @click.option(
+    "--timings",
+    is_flag=True,
+    help="At the command's end, print to stderr each store query it ran: how many times, total and "
+    "longest time, rows; the slowest first (see which question is slow on your store).",
+)
+@click.option(
     "--msg-path",
     "msg_paths",
     multiple=True,
@@ -82,7 +90,7 @@ class LazyGroup(click.Group):
     "before the standard ROS packages; repeatable, the first wins.  Added in front of the "
     "folders of $EXSCE_MSG_PATH (separated by the system's path separator).",
 )
-def main(debug: bool, msg_paths: tuple[str, ...]) -> None:
+def main(debug: bool, timings: bool, msg_paths: tuple[str, ...]) -> None:
     """exsce: executable scenarios for robot testing.
 
     Write scenarios in the exsce language, check them, and compile them to
@@ -98,12 +106,17 @@ def main(debug: bool, msg_paths: tuple[str, ...]) -> None:
     a copy of the project's examples/ (check, compile, export and import
     first, then simulate, ingest, baseline, verify, derive, the queries...).
 
+    `exscec --timings CMD` prints, at CMD's end, the time of each store query
+    it ran.
+
     \b
     Example:
       exscec check examples/brsu_building_c
       exscec compile examples/brsu_building_c/scenario_c.exsce -f provn
     """
     State.debug = debug
+    if timings:
+        click.get_current_context().with_resource(_printed_timings())
     if warnings.showwarning is not _show_warning:
         warnings.showwarning = _show_warning
     if msg_paths:  # in the environment, so that worker processes see them too
@@ -111,6 +124,23 @@ def main(debug: bool, msg_paths: tuple[str, ...]) -> None:
 
         folders = [os.path.abspath(p) for p in msg_paths]
         os.environ[MSG_PATH] = os.pathsep.join([*folders, *filter(None, [os.environ.get(MSG_PATH)])])
+
+
+@contextmanager
+def _printed_timings() -> Iterator[None]:
+    """Time the store queries of the command, and print them to stderr at its end (also when it fails)."""
+    from exsce_dsl.api import timing_queries
+
+    with timing_queries() as times:
+        try:
+            yield
+        finally:
+            if times.calls:
+                click.echo("timings: the store queries of this command, slowest first", err=True)
+                for line in times.lines():
+                    click.echo(f"  {line}", err=True)
+            else:
+                click.echo("timings: no store query", err=True)
 
 
 _python_show_warning = warnings.showwarning

@@ -148,8 +148,9 @@ def runs_command(scenario: str | None, fmt: str, output: str | None, store_url: 
     """List the runs of SCENARIO (of every scenario without one), oldest first.
 
     \b
-    Example:
+    Examples:
       exscec runs scenario_c
+      exscec --timings runs scenario_c   # and how long the store took to answer
     """
     from exsce_dsl.api import answer_text, stored_runs
 

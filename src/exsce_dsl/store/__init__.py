@@ -64,6 +64,7 @@ if TYPE_CHECKING:
     from exsce_dsl.store.segment_index import is_index_graph
     from exsce_dsl.store.serve_info import ServeInfo, serve_info_path, write_serve_info
     from exsce_dsl.store.sparql import declared_prefixes, query_form
+    from exsce_dsl.store.timing import QueryTimes, timing_queries
     from exsce_dsl.store.writing import WriteReport, add_prov, is_revision
 else:
     from exsce_dsl.faces import lazy_face

@@ -51,6 +51,7 @@ from exsce_dsl.prov.identifiers import SKOLEM_BASE
 from exsce_dsl.store.base import Bindings, GraphSet, Replace, Rows, Store
 from exsce_dsl.store.flavours import StoreFlavour, ask_columns, server_flavour
 from exsce_dsl.store.sparql import bind, graph_node, query_form, term_text, write_update
+from exsce_dsl.store.timing import measured, none, one
 from exsce_dsl.store.write_strategy import write_in_steps
 
 RESULTS_JSON = "application/sparql-results+json"
@@ -204,6 +205,9 @@ class RemoteStore(Store):
     # -- Store ---------------------------------------------------------------
 
     def select(self, query: str, bindings: Bindings | None = None) -> Rows:
+        return measured(query, lambda: self._select(query, bindings), len)
+
+    def _select(self, query: str, bindings: Bindings | None) -> Rows:
         answers = self.flavour().answers
         if answers is None:
             return self._solutions(query, bindings, None)[0]
@@ -222,6 +226,13 @@ class RemoteStore(Store):
 
     def _solutions(self, query: str, bindings: Bindings | None, most: int | None) -> tuple[Rows, bool]:
         """The rows of a SELECT's answer (the first ``most``) and whether it has more."""
+        return measured(
+            query, lambda: self._solutions_untimed(query, bindings, most), lambda found: len(found[0])
+        )
+
+    def _solutions_untimed(
+        self, query: str, bindings: Bindings | None, most: int | None
+    ) -> tuple[Rows, bool]:
         result = self._query(query, bindings)
         variables = tuple(v.value for v in result.variables) if isinstance(result, QuerySolutions) else ()
         if not isinstance(result, QuerySolutions) or (
@@ -236,6 +247,9 @@ class RemoteStore(Store):
         return Rows(variables, rows), False
 
     def ask(self, query: str, bindings: Bindings | None = None) -> bool:
+        return measured(query, lambda: self._ask(query, bindings), one)
+
+    def _ask(self, query: str, bindings: Bindings | None) -> bool:
         result = self._query(query, bindings)
         columns = [v.value for v in result.variables] if isinstance(result, QuerySolutions) else []
         if isinstance(result, QuerySolutions) and len(columns) == 1 and columns[0] in ask_columns():
@@ -245,7 +259,9 @@ class RemoteStore(Store):
         return bool(result)
 
     def update(self, update: str, bindings: Bindings | None = None) -> None:
-        self._post_sparql(self.update_url, "update", bind(update, bindings), None)
+        measured(
+            update, lambda: self._post_sparql(self.update_url, "update", bind(update, bindings), None), none
+        )
 
     def write(self, graphs: GraphSet, *, replace: Replace = False) -> None:
         """One request where the server makes one request a transaction; else in steps, the

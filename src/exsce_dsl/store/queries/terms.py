@@ -13,6 +13,7 @@ from exsce_dsl.store.base import Rows, Store, Term
 from exsce_dsl.store.literals import canonical_rows, literal_value, parse_datetime
 from exsce_dsl.store.queries.library import Query, query
 from exsce_dsl.store.queries.run_ids import names_a_prefix, resolve_run
+from exsce_dsl.store.timing import measured, none
 
 Given = Mapping[str, str | Sequence[str]]
 """Parameters as text: name → one value or several."""
@@ -33,10 +34,11 @@ def run_query(
     bindings = q.bindings(as_lists, namespace)  # the parameters checked before any look-up
     if any(q.parameter(name).kind in RUN_KINDS for name in as_lists):
         bindings = q.bindings(_runs_resolved(store, q, as_lists, namespace, check_runs), namespace)
+    text = q.sparql(namespace)
     if q.is_update:
-        store.update(q.sparql(namespace), bindings)
+        measured(text, lambda: store.update(text, bindings), none, name)
         return Rows((), ())
-    return canonical_rows(store.select(q.sparql(namespace), bindings))
+    return canonical_rows(measured(text, lambda: store.select(text, bindings), len, name))
 
 
 RUN_KINDS = ("run", "run_activity")
