@@ -74,10 +74,19 @@ def _parameters(store: object, runs: list[str]) -> dict[str, list[str]]:
 
     segment = queries.path_segments(store, "scenario_c")[0]  # type: ignore[arg-type]
     return {
-        "scenario": ["scenario_c"], "base": ["scenario_c"], "robot": ["tiago1"], "run": runs,
-        "start": [segment.start], "goal": [segment.goal], "pose": [segment.start, segment.goal],
-        "point": [segment.start.rsplit("-R", 1)[0]], "a": [segment.start], "b": [segment.goal],
-        "distance": ["1.0"], "radius": ["1.0"], "tolerance": ["1.0"],
+        "scenario": ["scenario_c"],
+        "base": ["scenario_c"],
+        "robot": ["tiago1"],
+        "run": runs,
+        "start": [segment.start],
+        "goal": [segment.goal],
+        "pose": [segment.start, segment.goal],
+        "point": [segment.start.rsplit("-R", 1)[0]],
+        "a": [segment.start],
+        "b": [segment.goal],
+        "distance": ["1.0"],
+        "radius": ["1.0"],
+        "tolerance": ["1.0"],
     }
 
 
@@ -174,9 +183,11 @@ def main() -> None:
         seconds = {}
         for jobs in jobs_list:
             seconds[jobs] = ingest(bags, folder / f"store-{jobs}", jobs)
-            print(f"ingest with {jobs} job{'s' if jobs > 1 else ''}: {seconds[jobs]:6.1f} s  "
-                  f"{len(bags) / seconds[jobs]:5.2f} bags/s  {size / seconds[jobs]:5.1f} MB/s  "
-                  f"speed-up {seconds[1] / seconds[jobs]:.2f}×")
+            print(
+                f"ingest with {jobs} job{'s' if jobs > 1 else ''}: {seconds[jobs]:6.1f} s  "
+                f"{len(bags) / seconds[jobs]:5.2f} bags/s  {size / seconds[jobs]:5.1f} MB/s  "
+                f"speed-up {seconds[1] / seconds[jobs]:.2f}×"
+            )
         largest = folder / f"store-{jobs_list[-1]}"
         print(f"\nthe query library against the store of {len(bags)} runs (20 runs each):")
         print(f"{'query':32} {'p50 ms':>8} {'p95 ms':>8} {'rows':>7}")

@@ -161,7 +161,9 @@ def _first_good(runs: list[Run], scenario: Scenario, keep: GraphFilter | None) -
         others = [(n, r) for n, r in enumerate(runs) if n not in (i, i + 1)]
         if all(_same(template, run, n, scenario, keep) for n, run in others):
             return template
-    raise SystemExit(f"no template for runs with {shape(runs[0])} hotspots: the synthetic fill cannot be used")
+    raise SystemExit(
+        f"no template for runs with {shape(runs[0])} hotspots: the synthetic fill cannot be used"
+    )
 
 
 def _same(template: Template, run: Run, number: int, scenario: Scenario, keep: GraphFilter | None) -> bool:
@@ -172,12 +174,17 @@ def _normalised(text: str) -> list[str]:
     return sorted(re.sub(r"_:\w+", "_:b", line) for line in text.splitlines())
 
 
-def check_templates(templates: dict[int, Template], scenario: Scenario, runs: Iterable[tuple[int, Run]]) -> int:
+def check_templates(
+    templates: dict[int, Template], scenario: Scenario, runs: Iterable[tuple[int, Run]]
+) -> int:
     """Assert that each run's templated N-Quads are the real conversion's (blank nodes aside); the
     number of runs checked."""
     checked = 0
     for number, run in runs:
-        made, real = _normalised(templates[shape(run)].fill(run, number)), _normalised(real_nquads(run, scenario))
+        made, real = (
+            _normalised(templates[shape(run)].fill(run, number)),
+            _normalised(real_nquads(run, scenario)),
+        )
         if made != real:
             wrong = sorted(set(made) ^ set(real))[:6]
             raise AssertionError(f"the synthetic fill differs from compile_run for run {number}: {wrong}")
@@ -219,13 +226,23 @@ def _worker(worker: int, jobs: int, count: int, seed: int, folder: str, full: in
     queue.put(None)  # type: ignore[attr-defined]
 
 
+DROPPED = re.compile(
+    r"/run_[0-9a-f-]+/(task_duration|distance_travelled|distance_to_obstacles|max_velocity|bag)_bundle$"
+)
+"""The graphs a partial run leaves out: the bag's bundle and the value bundles of the four metrics
+measured per path segment (1,206 of a run's 1,900 quads).  No scenario-wide query of the library
+reads them (the segment index holds their segment values); bench/store.py checks which answers a
+store of partial runs changes, and says so beside their figures."""
+
+
 def scenario_wide_graph(name: str) -> bool:
-    """The graphs of a run kept past ``--full-runs``: all but the value bundles of each metric, the
-    bag's and the hotspots' (set by what the scenario-wide queries read; see bench/store.py)."""
-    return not re.search(r"/run_[0-9a-f-]+/\w+_bundle$", name)
+    """Whether a partial run keeps graph ``name``."""
+    return not DROPPED.search(name)
 
 
-def synthetic_fill(store: EmbeddedStore, count: int, seed: int = 1, jobs: int = 2, full: int | None = None) -> Fill:
+def synthetic_fill(
+    store: EmbeddedStore, count: int, seed: int = 1, jobs: int = 2, full: int | None = None
+) -> Fill:
     """Write runs 0..count-1 of ``synthetic_runs(seed)`` into ``store``: templated N-Quads written by
     ``jobs`` worker processes, bulk-loaded by this one as they come.  Runs from ``full`` on hold
     only the graphs :func:`scenario_wide_graph` keeps."""
@@ -236,7 +253,8 @@ def synthetic_fill(store: EmbeddedStore, count: int, seed: int = 1, jobs: int = 
     with tempfile.TemporaryDirectory(prefix="exsce-fill-", dir=Path(store.location).parent) as folder:
         queue = context.Queue(maxsize=WAITING)
         workers = [
-            context.Process(target=_worker, args=(w, jobs, count, seed, folder, full, queue)) for w in range(jobs)
+            context.Process(target=_worker, args=(w, jobs, count, seed, folder, full, queue))
+            for w in range(jobs)
         ]
         for process in workers:
             process.start()
