@@ -25,13 +25,23 @@ AD_HOC_WORDS = 6
 
 @dataclass
 class QueryTime:
-    """One query's calls: how many, their total and longest time (seconds), the rows they answered."""
+    """One query's calls: the seconds each took, and the rows they answered in all."""
 
     name: str
-    calls: int = 0
-    total: float = 0.0
-    longest: float = 0.0
+    seconds: list[float] = field(default_factory=list)
     rows: int = 0
+
+    @property
+    def calls(self) -> int:
+        return len(self.seconds)
+
+    @property
+    def total(self) -> float:
+        return sum(self.seconds)
+
+    @property
+    def longest(self) -> float:
+        return max(self.seconds, default=0.0)
 
 
 @dataclass
@@ -45,9 +55,7 @@ class QueryTimes:
         found = self.by_name.get(name)
         if found is None:
             found = self.by_name[name] = QueryTime(name)
-        found.calls += 1
-        found.total += seconds
-        found.longest = max(found.longest, seconds)
+        found.seconds.append(seconds)
         found.rows += rows
 
     def slowest_first(self) -> list[QueryTime]:
