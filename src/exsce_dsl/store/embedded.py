@@ -37,7 +37,7 @@ from exsce_dsl.errors import StoreError, StoreLockedError, StoreUnwritableError
 from exsce_dsl.remedies import ANOTHER_STORE
 from exsce_dsl.store.base import Bindings, GraphSet, Replace, Rows, Store, replaced_names
 from exsce_dsl.store.sparql import bind, checked_quads, graph_node, write_update
-from exsce_dsl.store.timing import measured, none, one
+from exsce_dsl.store.timing import none, one, timed_query
 
 VIEW_ATTEMPTS = 5
 """Times a read-only view is opened before a writer's compaction racing it is an error."""
@@ -190,8 +190,9 @@ class EmbeddedStore(Store):
         except (OSError, RuntimeError, ValueError) as exc:
             raise StoreError(f"cannot write to the store at {self.location}: {exc}") from None
 
+    @timed_query(none)
     def update(self, update: str, bindings: Bindings | None = None) -> None:
-        measured(update, lambda: self._run_update(self._writer(), bind(update, bindings)), none)
+        self._run_update(self._writer(), bind(update, bindings))
 
     def _run_update(self, store: OxStore, text: str) -> None:
         try:
@@ -228,15 +229,9 @@ class EmbeddedStore(Store):
     def select_first(self, query: str, most: int, bindings: Bindings | None = None) -> tuple[Rows, bool]:
         return self._solutions(query, bindings, most)
 
+    @timed_query(lambda found: len(found[0]))
     def _solutions(self, query: str, bindings: Bindings | None, most: int | None) -> tuple[Rows, bool]:
         """The rows of a SELECT (the first ``most``, pulled lazily) and whether there were more."""
-        return measured(
-            query, lambda: self._solutions_untimed(query, bindings, most), lambda found: len(found[0])
-        )
-
-    def _solutions_untimed(
-        self, query: str, bindings: Bindings | None, most: int | None
-    ) -> tuple[Rows, bool]:
         result = self.query(query, bindings)
         if not isinstance(result, QuerySolutions):
             raise StoreError("not a SELECT query")
@@ -250,10 +245,8 @@ class EmbeddedStore(Store):
             return Rows(variables, rows[:most]), True
         return Rows(variables, rows), False
 
+    @timed_query(one)
     def ask(self, query: str, bindings: Bindings | None = None) -> bool:
-        return measured(query, lambda: self._ask(query, bindings), one)
-
-    def _ask(self, query: str, bindings: Bindings | None) -> bool:
         result = self.query(query, bindings)
         if not isinstance(result, QueryBoolean):
             raise StoreError("not an ASK query")

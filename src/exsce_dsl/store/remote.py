@@ -51,7 +51,7 @@ from exsce_dsl.prov.identifiers import SKOLEM_BASE
 from exsce_dsl.store.base import Bindings, GraphSet, Replace, Rows, Store
 from exsce_dsl.store.flavours import StoreFlavour, ask_columns, server_flavour
 from exsce_dsl.store.sparql import bind, graph_node, query_form, term_text, write_update
-from exsce_dsl.store.timing import measured, none, one
+from exsce_dsl.store.timing import none, one, timed_query
 from exsce_dsl.store.write_strategy import write_in_steps
 
 RESULTS_JSON = "application/sparql-results+json"
@@ -204,10 +204,8 @@ class RemoteStore(Store):
 
     # -- Store ---------------------------------------------------------------
 
+    @timed_query(len)
     def select(self, query: str, bindings: Bindings | None = None) -> Rows:
-        return measured(query, lambda: self._select(query, bindings), len)
-
-    def _select(self, query: str, bindings: Bindings | None) -> Rows:
         answers = self.flavour().answers
         if answers is None:
             return self._solutions(query, bindings, None)[0]
@@ -224,15 +222,9 @@ class RemoteStore(Store):
             return super().select_first(query, most, bindings)
         return self._solutions(query, bindings, most)
 
+    @timed_query(lambda found: len(found[0]))
     def _solutions(self, query: str, bindings: Bindings | None, most: int | None) -> tuple[Rows, bool]:
         """The rows of a SELECT's answer (the first ``most``) and whether it has more."""
-        return measured(
-            query, lambda: self._solutions_untimed(query, bindings, most), lambda found: len(found[0])
-        )
-
-    def _solutions_untimed(
-        self, query: str, bindings: Bindings | None, most: int | None
-    ) -> tuple[Rows, bool]:
         result = self._query(query, bindings)
         variables = tuple(v.value for v in result.variables) if isinstance(result, QuerySolutions) else ()
         if not isinstance(result, QuerySolutions) or (
@@ -246,10 +238,8 @@ class RemoteStore(Store):
             return Rows(variables, rows[:most]), True
         return Rows(variables, rows), False
 
+    @timed_query(one)
     def ask(self, query: str, bindings: Bindings | None = None) -> bool:
-        return measured(query, lambda: self._ask(query, bindings), one)
-
-    def _ask(self, query: str, bindings: Bindings | None) -> bool:
         result = self._query(query, bindings)
         columns = [v.value for v in result.variables] if isinstance(result, QuerySolutions) else []
         if isinstance(result, QuerySolutions) and len(columns) == 1 and columns[0] in ask_columns():
@@ -258,10 +248,9 @@ class RemoteStore(Store):
             raise StoreError("not an ASK query")
         return bool(result)
 
+    @timed_query(none)
     def update(self, update: str, bindings: Bindings | None = None) -> None:
-        measured(
-            update, lambda: self._post_sparql(self.update_url, "update", bind(update, bindings), None), none
-        )
+        self._post_sparql(self.update_url, "update", bind(update, bindings), None)
 
     def write(self, graphs: GraphSet, *, replace: Replace = False) -> None:
         """One request where the server makes one request a transaction; else in steps, the

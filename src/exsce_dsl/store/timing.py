@@ -9,15 +9,17 @@ queries and are not timed here.
 
 from __future__ import annotations
 
+import functools
 import re
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
 from dataclasses import dataclass, field
-from typing import TypeVar
+from typing import Any, TypeVar, cast
 
 Answer = TypeVar("Answer")
+Method = TypeVar("Method", bound=Callable[..., Any])
 
 AD_HOC_WORDS = 6
 """Words of an ad-hoc query's text that name it in the table."""
@@ -121,6 +123,19 @@ def measured(
         seconds = time.perf_counter() - started
         times._running = False
         times.add(name or ad_hoc_name(text), seconds, answered)
+
+
+def timed_query(rows: Callable[[Any], int]) -> Callable[[Method], Method]:
+    """A store's method ``(self, text, ...)`` that runs query ``text``, timed by :func:`measured`."""
+
+    def decorate(method: Method) -> Method:
+        @functools.wraps(method)
+        def timed(self: object, text: str, *args: Any, **kwargs: Any) -> Any:
+            return measured(text, lambda: method(self, text, *args, **kwargs), rows)
+
+        return cast(Method, timed)
+
+    return decorate
 
 
 def one(_: object) -> int:
