@@ -8,6 +8,7 @@ SQL text has exceeded 10000 lines of code``) and cuts ``CONSTRUCT`` answers at 1
 
 from __future__ import annotations
 
+import functools
 import random
 import shutil
 import signal
@@ -15,7 +16,7 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
@@ -200,12 +201,16 @@ def _writer(url: str, run: str, *replace: str) -> subprocess.Popen[str]:
     return process
 
 
-def _poll(reader: Store, summary: str, wanted: dict[str, int], stop: threading.Event,
+def _exists(reader: Store, graph: str) -> bool:
+    return bool(reader.existing_graphs([graph]))
+
+
+def _poll(reader: Store, seen: Callable[[], bool], wanted: dict[str, int], stop: threading.Event,
           broken: list[dict[str, int]]) -> None:  # fmt: skip
-    """Until ``stop``: once the summary graph is seen, the sizes of the run's graphs, kept in
-    ``broken`` unless each is whole (as ``wanted``)."""
+    """Until ``stop``: once the run is ``seen`` (its commit graph, or a query finds it), the sizes
+    of the run's graphs, kept in ``broken`` unless each is whole (as ``wanted``)."""
     while not stop.is_set():
-        if reader.existing_graphs([summary]):  # committed: every graph must be whole from now on
+        if seen():  # committed: every graph must be whole from now on
             found = sizes_of(reader, sorted(wanted))
             if found != wanted:
                 broken.append(found)
@@ -236,7 +241,8 @@ def test_a_writer_killed_during_a_write_leaves_no_commit_graph_unless_every_grap
         broken: list[dict[str, int]] = []
         stop = threading.Event()
 
-        poller = threading.Thread(target=_poll, args=(reader, summary, wanted, stop, broken))
+        seen = functools.partial(_exists, reader, summary)
+        poller = threading.Thread(target=_poll, args=(reader, seen, wanted, stop, broken))
         poller.start()
         writer = _writer(url, run)
         time.sleep(moment * took)
@@ -429,18 +435,6 @@ def _found(reader: Store, uuid: str) -> bool:
     return any(run.uuid == uuid for run in queries.runs(reader, "scenario_c"))
 
 
-def _visible_runs(reader: Store, uuid: str, expected: dict[str, int], stop: threading.Event,
-                  broken: list[object]) -> None:  # fmt: skip
-    """Until ``stop``: once a library query finds the run, its graphs must be whole."""
-    while not stop.is_set():
-        if _found(reader, uuid):
-            found = sizes_of(reader, sorted(expected))
-            if found != expected:
-                broken.append(found)
-            return
-        time.sleep(0.05)
-
-
 def test_a_real_run_killed_while_written_to_virtuoso_is_never_seen_half_and_is_written_again(
     virtuoso: Server, scenario_c_bags: tuple[Path, list[Path]]
 ) -> None:
@@ -476,9 +470,10 @@ def test_a_real_run_killed_while_written_to_virtuoso_is_never_seen_half_and_is_w
     reader.remove_graphs(run_graph_names)
     states = []
     for moment in [0.15, 0.3, 0.5, 0.7, 0.9, random.uniform(0.1, 0.9), None]:
-        broken: list[object] = []
+        broken: list[dict[str, int]] = []
         stop = threading.Event()
-        poller = threading.Thread(target=_visible_runs, args=(reader, uuid, expected, stop, broken))
+        found_it = functools.partial(_found, reader, uuid)
+        poller = threading.Thread(target=_poll, args=(reader, found_it, expected, stop, broken))
         poller.start()
         _write_run(url, source, None if moment is None else moment * took)
         stop.set()
