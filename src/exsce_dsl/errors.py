@@ -314,11 +314,11 @@ class StoreConflictError(StoreError):
     """A document differs from what the store holds under the same names."""
 
     def __init__(
-        self, message: str, graphs: Sequence[str], *, remedy: str | None = None, about: str = ""
+        self, message: str, graphs: Sequence[str] = (), *, remedy: str | None = None, about: str = ""
     ) -> None:
         super().__init__(message, remedy=remedy, about=about)
         self.graphs = tuple(graphs)
-        """The names of the graphs that differ."""
+        """The names of the graphs that differ (a copy gets them with the rest of its state)."""
 
 
 class UnknownRunError(ExsceError):

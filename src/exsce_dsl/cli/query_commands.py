@@ -89,7 +89,7 @@ def query_command(
         lines = []
         for q in library_queries():
             lines.append(f"{q.name}{' (update)' if q.is_update else ''}: {q.description}")
-            for p in q.parameters:
+            for p in (p for p in q.parameters if not p.from_runs):  # those are bound from the runs
                 mark = (" (one or more)" if p.many else "") + (" (optional)" if p.optional else "")
                 lines.append(f"    -p {p.name}=<{p.kind}>{mark}  {p.description}")
         write_text("\n".join(lines) + "\n", output)

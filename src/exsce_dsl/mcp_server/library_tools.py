@@ -40,7 +40,8 @@ _KIND_SCHEMAS: dict[str, dict[str, Any]] = {
     "double": {"type": "number"},
 }
 """The JSON schema of one value of each parameter kind of the library
-(:data:`exsce_dsl.store.queries.KINDS`); a kind missing here is a plain string,
+(:data:`exsce_dsl.store.queries.KINDS`) but those bound from the runs given, never offered
+(:data:`~exsce_dsl.store.queries.library.FROM_RUNS`); a kind missing here is a plain string,
 still made an RDF term by the library."""
 
 
@@ -63,8 +64,9 @@ def parameter_schema(parameter: QueryParameter) -> dict[str, Any]:
 
 def query_tool(q: Query) -> types.Tool:
     """The tool of library query ``q``."""
-    properties = {p.name: parameter_schema(p) for p in q.parameters}
-    required = tuple(p.name for p in q.parameters if not p.optional)
+    given = [p for p in q.parameters if not p.from_runs]  # the others are bound from the runs
+    properties = {p.name: parameter_schema(p) for p in given}
+    required = tuple(p.name for p in given if not p.optional)
     return types.Tool(
         name=q.name,
         title=q.name.replace("_", " "),

@@ -41,7 +41,7 @@ from exsce_dsl.remedies import LIST_THE_QUERIES
 from exsce_dsl.store.base import Bindings, Term
 from exsce_dsl.suggest import did_you_mean
 
-__all__ = ["KINDS", "QueryParameter", "Query", "query", "query_names", "standard_prefixes"]
+__all__ = ["FROM_RUNS", "KINDS", "QueryParameter", "Query", "query", "query_names", "standard_prefixes"]
 
 _XSD_DOUBLE = NamedNode(ids.XSD_NAMESPACE + "double")
 
@@ -88,6 +88,10 @@ named like the parameter (``?hotspots_bundle`` → ``run:run_<uuid>/hotspots_bun
 ``run`` (a uuid), ``robot``, ``metric``, ``string`` → a plain literal."""
 
 
+FROM_RUNS = frozenset({"run_bundle", "run_part"})
+"""The kinds bound from the runs given to the query (a run's graphs), never given themselves."""
+
+
 @dataclass(frozen=True)
 class QueryParameter:
     name: str
@@ -100,7 +104,7 @@ class QueryParameter:
     def from_runs(self) -> bool:
         """Whether the parameter is bound from the runs given to the query (a run's graph), never
         given itself."""
-        return self.kind in ("run_bundle", "run_part")
+        return self.kind in FROM_RUNS
 
     def term(self, text: str, names: Namespaces) -> Term:
         made = KINDS[self.kind](names, text)
