@@ -134,9 +134,10 @@ def test_the_tools_are_the_library_queries_typed_from_their_metadata(project: Pr
         schema = tool.input_schema
         assert q.description in (tool.description or "")
         assert schema["type"] == "object" and schema["additionalProperties"] is False
-        assert set(schema["properties"]) == {p.name for p in q.parameters}
-        assert set(schema.get("required", [])) == {p.name for p in q.parameters if not p.optional}
-        for p in q.parameters:
+        given = [p for p in q.parameters if not p.from_runs]  # a run's graphs: bound from its run
+        assert set(schema["properties"]) == {p.name for p in given}
+        assert set(schema.get("required", [])) == {p.name for p in given if not p.optional}
+        for p in given:
             prop = schema["properties"][p.name]
             assert p.description in prop["description"]
             assert prop["type"] == ("array" if p.many else "number" if p.kind == "double" else "string")
