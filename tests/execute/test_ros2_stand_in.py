@@ -163,6 +163,11 @@ def test_a_goal_is_driven_to_its_pose_with_feedback_then_a_cancel_stops_the_robo
     cancelled = going.cancel_goal_async()
     client.executor.spin_until_future_complete(cancelled, timeout_sec=10.0)
     assert client.result(going) == 5  # CANCELED
+    # odometry sent before the cancel may still be on its way under load (CI saw 7 mm of it after
+    # the clear): a second to take it in, then two in which the robot must stand still
+    deadline = time.monotonic() + 1.0
+    while time.monotonic() < deadline:
+        client.executor.spin_once(timeout_sec=0.05)
     client.odom.clear()
     deadline = time.monotonic() + 2.0
     while time.monotonic() < deadline:
