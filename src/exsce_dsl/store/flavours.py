@@ -15,12 +15,10 @@ import re
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from pyoxigraph import NamedNode
-
 from exsce_dsl.plugins import Registry
 from exsce_dsl.prov.identifiers import SKOLEM_BASE
 from exsce_dsl.store import virtuoso
-from exsce_dsl.store.base import Rows, Term
+from exsce_dsl.store.base import Rows
 from exsce_dsl.store.write_strategy import WriteStrategy
 
 __all__ = [
@@ -49,14 +47,12 @@ class Preset:
 
 @dataclass(frozen=True)
 class Answers:
-    """How SELECT answers and graphs are asked for (``media_type``) and read, when a server's
-    SPARQL JSON loses what was written."""
+    """How SELECT answers are asked for (``media_type``) and read, when a server's SPARQL JSON
+    loses what was written (a graph is read by a SELECT too)."""
 
     media_type: str
     rows: Callable[[bytes, str], Rows]
     """(the answer, the store's label for errors) → the rows of a SELECT."""
-    triples: Callable[[bytes, str], list[tuple[Term, NamedNode, Term]]]
-    """(the answer, the store's label) → the triples of a graph."""
 
 
 @dataclass(frozen=True)
@@ -132,7 +128,7 @@ VIRTUOSO = StoreFlavour(
     skolem=SKOLEM_BASE,
     own_graphs=virtuoso.OWN_GRAPHS,
     own_graph_names=virtuoso.OWN_GRAPH_NAMES,
-    answers=Answers(virtuoso.TURTLE, virtuoso.result_set_rows, virtuoso.graph_triples),
+    answers=Answers(virtuoso.TURTLE, virtuoso.result_set_rows),
     ask_column="__ASK_RETVAL",
     writes=WriteStrategy(
         whole_requests=False,

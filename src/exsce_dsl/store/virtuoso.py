@@ -105,11 +105,6 @@ def result_set_rows(body: bytes, source: str) -> Rows:
     return Rows(tuple(variables), tuple(rows))
 
 
-def graph_triples(body: bytes, source: str) -> list[tuple[Term, NamedNode, Term]]:
-    """The triples of a graph answered as Turtle, decimals read as doubles."""
-    return [(_retyped(t.subject), t.predicate, _retyped(t.object)) for t in _parsed(body, source)]
-
-
 def _parsed(body: bytes, source: str) -> list[Triple]:
     try:
         return list(parse(body, format=RdfFormat.TURTLE))
