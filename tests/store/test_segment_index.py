@@ -166,11 +166,12 @@ def test_store_graphs_and_info_set_the_index_apart(tmp_path: Path) -> None:
         and "w_001" not in listed.stdout
         and "run_u-1_bundle" in listed.stdout
     )
-    assert "and 5 graphs of the segment index: --index lists them" in listed.stderr  # 2 segments, 3 actions
+    # 2 segments, 3 actions; the run's summary, the keys of its scenario and its one metric
+    assert "and 8 graphs of its indexes: --index lists them" in listed.stderr
     everything = exscec_here("store", "graphs", "--index", cwd=tmp_path)
     assert everything.stdout.count("/segments/corridor_runs/") == 2 and everything.stdout.count("-w_00") == 3
     info = exscec_here("store", "info", cwd=tmp_path)
-    assert "+ 5 of the segment index)" in info.stdout
+    assert "+ 8 of its indexes)" in info.stdout
 
 
 def test_the_values_of_runs_whole_and_by_action() -> None:

@@ -64,14 +64,14 @@ def info(store_url: str | None) -> None:
     click.echo(f"store:      {said.location} ({said.kind})")
     click.echo(
         f"graphs:     {said.graphs} (+ {said.revisions} revisions, "
-        f"+ {said.index_graphs} of the segment index)"
+        f"+ {said.index_graphs} of its indexes)"
     )
     click.echo(f"statements: {said.statements}")
 
 
 @store_group.command(name="graphs")
 @store_option
-@click.option("--index", "with_index", is_flag=True, help="List the graphs of the segment index too.")
+@click.option("--index", "with_index", is_flag=True, help="List the graphs of the store's indexes too (segment index, run summaries).")
 @reports_errors
 def graphs(store_url: str | None, with_index: bool) -> None:
     """List the named graphs with their number of statements.
@@ -92,7 +92,7 @@ def graphs(store_url: str | None, with_index: bool) -> None:
         click.echo(f"{sizes[name]:>{width}}  {name}")
     shown = f"{len(sizes)} graph{'s' if len(sizes) != 1 else ''}, {sum(sizes.values())} statements"
     if hidden:
-        shown += f" (and {hidden} graphs of the segment index: --index lists them)"
+        shown += f" (and {hidden} graphs of its indexes: --index lists them)"
     click.echo(shown, err=True)
 
 

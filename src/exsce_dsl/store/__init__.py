@@ -61,7 +61,7 @@ if TYPE_CHECKING:
     from exsce_dsl.store.queries.stored_oracles import hotspot_counts, safety_metrics
     from exsce_dsl.store.remote import RemoteStore
     from exsce_dsl.store.run_replacing import replace_run, verdict_graphs
-    from exsce_dsl.store.segment_index import is_index_graph
+    from exsce_dsl.store.indexes import is_index_graph
     from exsce_dsl.store.serve_info import ServeInfo, serve_info_path, write_serve_info
     from exsce_dsl.store.sparql import declared_prefixes, query_form
     from exsce_dsl.store.timing import QueryTimes, timing_queries

@@ -50,7 +50,7 @@ from exsce_dsl.errors import ExsceError, StoreError
 from exsce_dsl.rdf.prov_o import nquad_lines, quads_of_lines
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.embedded import EmbeddedStore
-from exsce_dsl.store.segment_index import segment_index
+from exsce_dsl.store.indexes import index_graphs
 from exsce_dsl.store.writing import WriteReport, add_prov
 
 __all__ = ["BULK_FROM", "MAX_GROUP_QUADS", "RunWriter", "Written"]
@@ -170,7 +170,7 @@ class RunWriter:
         lines = nquad_lines(document, blank_prefix=f"b{uuid.uuid4().hex}x")
         quads = quads_of_lines(lines)
         bundles = [b.identifier.uri for b in document.bundles if b.identifier is not None and b.records]
-        index = segment_index({"": quads})
+        index = index_graphs({"": quads})
         with self._lock:
             in_flight = set(self._in_flight)
         existing = self._store.existing_graphs([*bundles, *index]) | (in_flight & {*bundles, *index})

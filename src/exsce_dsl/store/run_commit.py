@@ -3,9 +3,10 @@ them last (:class:`~exsce_dsl.store.base.GraphSet` ``commit``).
 
 Every query that finds runs (the runs of a scenario, a run id's prefix, a run's lineage) starts
 from the run's activity, typed ``exsce:run`` in the run's bundle ``run:run_<uuid>_bundle``.  So the
-bundle is the write's commit graph, and its ``rdf:type exsce:run`` statements its last: on
-Virtuoso, which commits each operation on its own (:mod:`exsce_dsl.store.write_strategy`), a run
-becomes visible with the last operation of its write, once every other graph of it is whole.  A
+bundle is the write's commit graph, and its ``rdf:type exsce:run`` statements its last, together
+with the run's summary, where the scenario-wide queries start (:mod:`.run_summary`): on Virtuoso,
+which commits each operation on its own (:mod:`exsce_dsl.store.write_strategy`), a run becomes
+visible with the last operation of its write, once every other graph of it is whole.  A
 transactional store writes the set in one step and needs no order.
 """
 
@@ -22,13 +23,15 @@ from exsce_dsl.store.base import GraphSet
 __all__ = ["run_graph_set", "unfinished_run_graphs"]
 
 _RUN_BUNDLE = re.compile(r"/runs/(run_[^/?]+)_bundle$")
+_RUN_SUMMARY = re.compile(rf"/runs/run_[^/?]+/(?:{ids.RUN_SUMMARY}|{ids.VERDICTS_SUMMARY})$")
 _RUN_TYPE_ENDING = f"/{ids.RUN_TYPE.local}"
 
 
 def run_graph_set(graphs: Mapping[str, Sequence[Quad]]) -> GraphSet:
-    """``graphs`` to write together, a run's bundle among them committed last, its run's type
-    last of all."""
-    commit = frozenset(name for name in graphs if _RUN_BUNDLE.search(name))
+    """``graphs`` to write together, a run's bundle and summary among them committed last, its
+    run's type in the last operation (with the summary, which the scenario-wide queries read:
+    :mod:`exsce_dsl.store.run_summary`)."""
+    commit = frozenset(name for name in graphs if _RUN_BUNDLE.search(name) or _RUN_SUMMARY.search(name))
     if not commit:
         return GraphSet(graphs)
     ordered = {name: _type_last(quads) if name in commit else quads for name, quads in graphs.items()}

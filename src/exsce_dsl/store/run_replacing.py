@@ -29,7 +29,8 @@ from exsce_dsl.prov import identifiers as ids
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, PROV_NAMESPACE, Namespaces
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.run_commit import run_graph_set
-from exsce_dsl.store.segment_index import orphan_segment_graphs, segment_index
+from exsce_dsl.store.indexes import index_graphs
+from exsce_dsl.store.segment_index import orphan_segment_graphs
 from exsce_dsl.store.sparql import term_text
 from exsce_dsl.store.writing import WriteReport, bundle_graphs
 
@@ -73,7 +74,7 @@ def replace_run(
     graphs = bundle_graphs(document)
     own_prefix = Namespaces(namespace).of_run(run)
     shared: dict[str, list[Quad]] = {}
-    for name, quads in segment_index(graphs).items():
+    for name, quads in index_graphs(graphs).items():
         if name.startswith(own_prefix):
             graphs.setdefault(name, quads)  # an action graph: the run's own
         else:

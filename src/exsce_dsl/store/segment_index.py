@@ -42,7 +42,7 @@ from exsce_dsl.prov import identifiers as ids
 from exsce_dsl.prov.identifiers import PROV_NAMESPACE
 from exsce_dsl.store.base import Store
 
-__all__ = ["is_index_graph", "orphan_segment_graphs", "segment_index", "segment_iri", "stale_index_graphs"]
+__all__ = ["is_segment_index_graph", "orphan_segment_graphs", "segment_index", "segment_iri", "stale_index_graphs"]
 
 _RDF_TYPE = NamedNode(ids.RDF_TYPE)
 _USED = f"{PROV_NAMESPACE}used"
@@ -60,7 +60,7 @@ _ACTION_GRAPH = re.compile(r"/runs/run_[^/]+/[^/]+-task_\d+-subtask_\d+-w_\d+$")
 _INDEX_GRAPH = re.compile(r"/segments/[^/]+/[^/]+/[^/]+$|" + _ACTION_GRAPH.pattern)
 
 
-def is_index_graph(name: str) -> bool:
+def is_segment_index_graph(name: str) -> bool:
     """True for the name of a graph of the segment index (a segment's or an action's)."""
     return _INDEX_GRAPH.search(name) is not None
 

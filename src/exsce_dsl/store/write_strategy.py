@@ -93,18 +93,23 @@ def write_in_steps(sender: Sender, graphs: GraphSet, replace: Replace, strategy:
 def _commit_split(
     checked: dict[str, list[Quad]], commit: Sequence[str], most: int | None
 ) -> tuple[dict[str, list[Quad]], dict[str, list[Quad]]]:
-    """The commit graphs' quads written before the last operation, and those of the last one: the
-    last commit graph's final ``most`` quads (a writer puts what makes its data visible there:
-    a run's type, where every query that lists runs starts), or every commit graph when they fit
-    in one operation."""
+    """The commit graphs' quads written before the last operation, and those of the last one:
+    every commit graph when they fit in one operation; else the largest one's final quads (a
+    writer puts what makes its data visible there: a run's type, where every query that lists
+    runs starts) with the others whole when they fit beside them (a run's summary), or alone."""
     if most is None or sum(len(checked[name]) for name in commit) <= most:
         return {}, {name: checked[name] for name in commit}
-    *others, final = commit
+    final = max(commit, key=lambda name: len(checked[name]))
+    others = [name for name in commit if name != final]
+    beside = sum(len(checked[name]) for name in others)
+    room = most - beside if beside < most else most
     quads = checked[final]
-    lead = {name: checked[name] for name in others}
-    if len(quads) > most:
-        lead[final] = quads[:-most]
-    return lead, {final: quads[-most:]}
+    lead = {} if beside < most else {name: checked[name] for name in others}
+    last = {name: checked[name] for name in others} if beside < most else {}
+    if len(quads) > room:
+        lead[final] = quads[:-room]
+    last[final] = quads[-room:]
+    return lead, last
 
 
 def _drop(sender: Sender, names: Sequence[str]) -> None:

@@ -58,7 +58,8 @@ from exsce_dsl.store.base import Store
 from exsce_dsl.store.graph_owners import replace_advice
 from exsce_dsl.store.literals import INTEGER_TYPES
 from exsce_dsl.store.run_commit import run_graph_set, unfinished_run_graphs
-from exsce_dsl.store.segment_index import segment_index, stale_index_graphs
+from exsce_dsl.store.indexes import index_graphs
+from exsce_dsl.store.segment_index import stale_index_graphs
 
 __all__ = [
     "WriteReport",
@@ -124,12 +125,13 @@ class WriteReport:
 def add_prov(store: Store, document: ProvDocument, *, replace: bool = False) -> WriteReport:
     """Add a PROV document, one named graph per bundle, in one write (see the module's rules).
 
-    A run's segment index (:mod:`exsce_dsl.store.segment_index`) goes in the same write.
+    A run's index graphs (its segment index and summary: :mod:`exsce_dsl.store.indexes`) go in
+    the same write.
     """
     from exsce_dsl.rdf import prefixes_of
 
     graphs = bundle_graphs(document)
-    index = segment_index(graphs)
+    index = index_graphs(graphs)
     if replace and index:
         for stale in stale_index_graphs(store, graphs, index):
             index[stale] = []  # an action the new version of a run no longer has
@@ -162,7 +164,7 @@ def stored_graphs(document: ProvDocument) -> dict[str, list[Quad]]:
     """What :func:`add_prov` writes of a document into an empty store: its bundles and, for a
     run, its segment index (for comparisons with other stores)."""
     graphs = bundle_graphs(document)
-    for name, quads in segment_index(graphs).items():
+    for name, quads in index_graphs(graphs).items():
         graphs.setdefault(name, quads)
     return graphs
 

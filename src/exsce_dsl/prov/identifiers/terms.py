@@ -306,6 +306,36 @@ START_POSE = Term(EXSCE, "startPose")
 GOAL_POSE = Term(EXSCE, "goalPose")
 SEGMENT_OF = Term(EXSCE, "segmentOf")
 
+# The run summaries (written by the store beside a run's bundles and verdicts, see
+# exsce_dsl.store.run_summary): what the scenario-wide questions read, one range of an index each.
+SCENARIO_RUNS = Term(EXSCE, "ScenarioRuns")
+VIOLATION_SERIES = Term(EXSCE, "ViolationSeries")
+HOTSPOT_SERIES = Term(EXSCE, "HotspotSeries")
+METRIC_VALUES = Term(EXSCE, "MetricValues")
+RUN_DEFECT = Term(EXSCE, "RunDefect")
+SUMMARY_OF = Term(EXSCE, "summaryOf")
+SUMMARY_METRIC = Term(EXSCE, "summaryMetric")
+SUMMARY_ROBOT = Term(EXSCE, "summaryRobot")
+SUMMARY_RUN = Term(EXSCE, "summaryRun")
+SUMMARY_START = Term(EXSCE, "summaryStart")
+SUMMARY_END = Term(EXSCE, "summaryEnd")
+SUMMARY_STATUS = Term(EXSCE, "summaryStatus")
+SUMMARY_BAG = Term(EXSCE, "summaryBag")
+SUMMARY_BAG_PATH = Term(EXSCE, "summaryBagPath")
+VIOLATION_SECONDS = Term(EXSCE, "violationSeconds")
+HOTSPOT_COUNT = Term(EXSCE, "hotspotCount")
+DEFECT = Term(EXSCE, "defect")
+DEFECT_KIND = Term(EXSCE, "defectKind")
+DEFECT_SUBJECT = Term(EXSCE, "defectSubject")
+DEFECT_RELATION = Term(EXSCE, "defectRelation")
+DEFECT_ROBOT = Term(EXSCE, "defectRobot")
+DEFECT_SECONDS = Term(EXSCE, "defectSeconds")
+DEFECT_HOTSPOT = Term(EXSCE, "defectHotspot")
+RUN_SUMMARY = "summary"
+"""``<run>:summary``: the run's summary graph (its ingest's facts)."""
+VERDICTS_SUMMARY = "verdicts_summary"
+"""``<run>:verdicts_summary``: the summary of the run's last verification (its defects)."""
+
 PARAMETER_SERVER = "parameter-server"
 """``<run>:parameter-server``, the saved parameters the run used."""
 GOAL_ROLE = "goal"
