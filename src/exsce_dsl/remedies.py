@@ -57,6 +57,8 @@ GIVE_A_RUN_ID = "give a run's uuid, a prefix of it ({about} characters at least)
 NO_RUNS_AT_ALL = "it holds no runs at all: ingesting bags adds them"
 """A run asked of a store without runs."""
 CLOSEST_RUNS = "the closest ids:\n{about}"
+MIGRATE_THE_STORE = "migrate the store: that writes them from its runs' own statements"
+"""A store written before the run summaries (the scenario-wide queries read them)."""
 """A run the store lacks (``about``: the closest ids, one a line)."""
 SELECT_OR_ASK = "ask a SELECT or an ASK query"
 """A query whose answer is a graph, where rows or a truth are wanted."""

@@ -36,6 +36,7 @@ from exsce_dsl.remedies import (
     LEARN_FROM_EVERY_RUN,
     LIST_THE_QUERIES,
     MAKE_A_TOKEN,
+    MIGRATE_THE_STORE,
     NO_RUNS_AT_ALL,
     ONE_EXECUTOR,
     POINT_MSG_PATH,
@@ -198,6 +199,7 @@ REMEDIES = {
         "prints them) or its IRI"
     ),
     NO_RUNS_AT_ALL: "{problem} (it holds no runs at all: `exscec ingest BAG...` adds them)",
+    MIGRATE_THE_STORE: "{problem}: `exscec store migrate` writes them from its runs' own statements",
     CLOSEST_RUNS: "{problem}; the closest ids (`exscec runs` lists every run):\n{about}",
     SELECT_OR_ASK: "exscec sparql runs SELECT and ASK queries",
     SERVE_A_FOLDER: "{problem}; exscec serve serves an embedded store",

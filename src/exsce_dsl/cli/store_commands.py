@@ -71,7 +71,12 @@ def info(store_url: str | None) -> None:
 
 @store_group.command(name="graphs")
 @store_option
-@click.option("--index", "with_index", is_flag=True, help="List the graphs of the store's indexes too (segment index, run summaries).")
+@click.option(
+    "--index",
+    "with_index",
+    is_flag=True,
+    help="List the graphs of the store's indexes too (segment index, run summaries).",
+)
 @reports_errors
 def graphs(store_url: str | None, with_index: bool) -> None:
     """List the named graphs with their number of statements.

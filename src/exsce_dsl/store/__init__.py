@@ -12,6 +12,7 @@ if TYPE_CHECKING:
     from exsce_dsl.store.checking import check_store
     from exsce_dsl.store.embedded import EmbeddedStore
     from exsce_dsl.store.federation import refuse_federation
+    from exsce_dsl.store.indexes import is_index_graph
     from exsce_dsl.store.literals import canonical_rows, literal_text, literal_value
     from exsce_dsl.store.migrating import migrate_store
     from exsce_dsl.store.open import StoreOpening, open_store, store_url
@@ -61,7 +62,6 @@ if TYPE_CHECKING:
     from exsce_dsl.store.queries.stored_oracles import hotspot_counts, safety_metrics
     from exsce_dsl.store.remote import RemoteStore
     from exsce_dsl.store.run_replacing import replace_run, verdict_graphs
-    from exsce_dsl.store.indexes import is_index_graph
     from exsce_dsl.store.serve_info import ServeInfo, serve_info_path, write_serve_info
     from exsce_dsl.store.sparql import declared_prefixes, query_form
     from exsce_dsl.store.timing import QueryTimes, timing_queries

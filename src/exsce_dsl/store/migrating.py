@@ -21,6 +21,7 @@ from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, PROV_NAMESPACE, Namesp
 from exsce_dsl.store.base import GraphSet, Store
 from exsce_dsl.store.robot_renaming import RobotRename, old_robot_names, renamed_robot_graphs
 from exsce_dsl.store.sparql import term_text
+from exsce_dsl.store.summary_migration import runs_without_summary, write_summaries
 
 __all__ = ["BagBundleMove", "MigrationReport", "migrate_store", "old_bag_bundles", "renamed_graphs"]
 
@@ -43,18 +44,22 @@ class MigrationReport:
     moved: tuple[BagBundleMove, ...] = ()
     robots: tuple[RobotRename, ...] = ()
     """The robots renamed (each in every graph that names it)."""
+    summarised: int = 0
+    """The runs given the summary the scenario-wide queries read (:mod:`.run_summary`)."""
 
     def summary(self) -> str:
         """One line per graph or robot moved, then a count."""
         lines = [f"{m.old} -> {m.new}" for m in self.moved] + [f"{r.old} -> {r.new}" for r in self.robots]
         done = [f"bag bundles named by their run: {len(self.moved)}"] if self.moved else []
         done += [f"robots named by their declaration: {len(self.robots)}"] if self.robots else []
+        done += [f"runs given their summary: {self.summarised}"] if self.summarised else []
         if done:
             lines.append(f"{self.location}: {'; '.join(done)}")
         else:
             lines.append(
                 f"{self.location}: nothing to migrate "
-                "(every bag bundle is named by its run, every robot by its declaration)"
+                "(every bag bundle is named by its run, every robot by its declaration, every run has "
+                "its summary)"
             )
         return "\n".join(lines)
 
@@ -101,7 +106,8 @@ def renamed_graphs(store: Store, moves: Sequence[BagBundleMove]) -> dict[str, li
 
 def migrate_store(store: Store, namespace: str = DEFAULT_NAMESPACE) -> MigrationReport:
     """Rename every old-scheme bag bundle of ``store`` to its run's name, in one write, then every
-    robot named the old way (:mod:`.robot_renaming`), in another."""
+    robot named the old way (:mod:`.robot_renaming`), in another, then write the run summaries
+    the store lacks (:mod:`.summary_migration`), a batch of runs a write."""
     moves = old_bag_bundles(store, namespace)
     if moves:
         writes = renamed_graphs(store, moves)
@@ -110,4 +116,6 @@ def migrate_store(store: Store, namespace: str = DEFAULT_NAMESPACE) -> Migration
     if renames:
         robot_writes = renamed_robot_graphs(store, renames)
         store.write(GraphSet(robot_writes), replace=set(robot_writes))
-    return MigrationReport(store.location, tuple(moves), tuple(renames))
+    names = store.graph_names()
+    summarised = write_summaries(store, runs_without_summary(names), names, namespace)
+    return MigrationReport(store.location, tuple(moves), tuple(renames), summarised)

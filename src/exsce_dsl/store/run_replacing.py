@@ -28,8 +28,8 @@ from exsce_dsl.errors import StoreConflictError
 from exsce_dsl.prov import identifiers as ids
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, PROV_NAMESPACE, Namespaces
 from exsce_dsl.store.base import Store
-from exsce_dsl.store.run_commit import run_graph_set
 from exsce_dsl.store.indexes import index_graphs
+from exsce_dsl.store.run_commit import run_graph_set
 from exsce_dsl.store.segment_index import orphan_segment_graphs
 from exsce_dsl.store.sparql import term_text
 from exsce_dsl.store.writing import WriteReport, bundle_graphs

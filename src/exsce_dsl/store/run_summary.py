@@ -281,7 +281,7 @@ class _Summariser:
         ours = {activity} | {
             a for a, p in s.facts.items() if any(o.value == uuid for o in p.get(run_attr, ()))
         }
-        found = set()
+        found: set[str] = set()
         for subject, facts in s.facts.items():
             if metric_type in facts and (
                 subject in ours or any(o.value in ours for o in facts.get(_GENERATED_BY, ()))

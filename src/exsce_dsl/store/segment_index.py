@@ -42,7 +42,13 @@ from exsce_dsl.prov import identifiers as ids
 from exsce_dsl.prov.identifiers import PROV_NAMESPACE
 from exsce_dsl.store.base import Store
 
-__all__ = ["is_segment_index_graph", "orphan_segment_graphs", "segment_index", "segment_iri", "stale_index_graphs"]
+__all__ = [
+    "is_segment_index_graph",
+    "orphan_segment_graphs",
+    "segment_index",
+    "segment_iri",
+    "stale_index_graphs",
+]
 
 _RDF_TYPE = NamedNode(ids.RDF_TYPE)
 _USED = f"{PROV_NAMESPACE}used"

@@ -56,9 +56,9 @@ from exsce_dsl.errors import StoreConflictError, StoreError
 from exsce_dsl.prov.identifiers import PROV_NAMESPACE, RDF_TYPE, ROBOT_SCHEMA, XSD_NAMESPACE
 from exsce_dsl.store.base import Store
 from exsce_dsl.store.graph_owners import replace_advice
+from exsce_dsl.store.indexes import index_graphs
 from exsce_dsl.store.literals import INTEGER_TYPES
 from exsce_dsl.store.run_commit import run_graph_set, unfinished_run_graphs
-from exsce_dsl.store.indexes import index_graphs
 from exsce_dsl.store.segment_index import stale_index_graphs
 
 __all__ = [

@@ -44,6 +44,7 @@ from exsce_dsl.suggest import did_you_mean
 __all__ = ["FROM_RUNS", "KINDS", "QueryParameter", "Query", "query", "query_names", "standard_prefixes"]
 
 _XSD_DOUBLE = NamedNode(ids.XSD_NAMESPACE + "double")
+_SUMMARY_TERMS = tuple(f"exsce:{t.local}" for t in (ids.SUMMARY_OF, ids.SUMMARY_RUN, ids.SUMMARY_METRIC))
 
 
 def _iri(names: Namespaces, prefix: str, local: str, what: str) -> NamedNode:
@@ -123,6 +124,12 @@ class Query:
     """The SPARQL as written (comments included), without the prologue."""
     parameters: tuple[QueryParameter, ...]
     is_update: bool
+
+    @property
+    def reads_summaries(self) -> bool:
+        """Whether the query reads the run summaries (:mod:`exsce_dsl.store.run_summary`), which
+        a store written by an earlier exsce lacks."""
+        return any(term in self.text for term in _SUMMARY_TERMS)
 
     def sparql(self, namespace: str = DEFAULT_NAMESPACE) -> str:
         """The text to run: the prologue of prefixes, then the query."""

@@ -22,6 +22,7 @@ from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE
 from exsce_dsl.remedies import CLOSEST_RUNS, GIVE_A_RUN_ID, NO_RUNS_AT_ALL
 from exsce_dsl.store.base import Store, Term
 from exsce_dsl.store.queries.library import query
+from exsce_dsl.store.summary_migration import require_summaries
 from exsce_dsl.store.timing import measured
 
 __all__ = [
@@ -137,6 +138,7 @@ def _rows(store: Store, name: str, given: dict[str, list[str]], namespace: str) 
     """The runs library query ``name`` answers (run_query resolves run ids with this module, so
     the query is run without it)."""
     library = query(name)
+    require_summaries(store, namespace)
     text, bindings = library.sparql(namespace), library.bindings(given, namespace)
     rows = measured(text, lambda: store.select(text, bindings), len, name)
     return [

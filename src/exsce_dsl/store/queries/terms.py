@@ -13,6 +13,7 @@ from exsce_dsl.store.base import Rows, Store, Term
 from exsce_dsl.store.literals import canonical_rows, literal_value, parse_datetime
 from exsce_dsl.store.queries.library import Query, query
 from exsce_dsl.store.queries.run_ids import names_a_prefix, resolve_run
+from exsce_dsl.store.summary_migration import require_summaries
 from exsce_dsl.store.timing import measured, none
 
 Given = Mapping[str, str | Sequence[str]]
@@ -35,6 +36,8 @@ def run_query(
     if any(q.parameter(name).kind in RUN_KINDS for name in as_lists):
         bindings = q.bindings(_runs_resolved(store, q, as_lists, namespace, check_runs), namespace)
     text = q.sparql(namespace)
+    if q.reads_summaries:
+        require_summaries(store, namespace)
     if q.is_update:
         measured(text, lambda: store.update(text, bindings), none, name)
         return Rows((), ())
