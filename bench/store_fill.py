@@ -39,11 +39,14 @@ from exsce_dsl.model import Scenario
 from exsce_dsl.model.runs import Run
 from exsce_dsl.prov.run import compile_run
 from exsce_dsl.store.embedded import EmbeddedStore
+from exsce_dsl.store.run_summary import RUN_ID_BUCKET
 from exsce_dsl.store.writing import stored_graphs
 
 XSD_INT = "http://www.w3.org/2001/XMLSchema#int"
 BLANK = -1
 """The slot of a blank node's label."""
+BUCKET = -2
+"""The slot of the run-id bucket's key (``summaries/run-ids/<the uuid's first characters>``)."""
 CHUNK = 250
 """Runs per N-Quads file (about 120 MB)."""
 WAITING = 2
@@ -100,8 +103,9 @@ class Template:
         assert len(tokens) == self.tokens, "a run of another shape than its template's"
         blank = f"_:r{number}x"
         parts = [self.chunks[0]]
+        bucket = f"run-ids/{run.uuid[:RUN_ID_BUCKET]}>"
         for slot, chunk in zip(self.slots, self.chunks[1:], strict=True):
-            parts.append(blank if slot == BLANK else tokens[slot])
+            parts.append(blank if slot == BLANK else bucket if slot == BUCKET else tokens[slot])
             parts.append(chunk)
         return "".join(parts)
 
@@ -125,12 +129,14 @@ def make_template(one: Run, other: Run, scenario: Scenario, keep: GraphFilter | 
         else:
             index[token] = i
     keys = sorted(index, key=len, reverse=True)
-    pattern = re.compile("|".join([*map(re.escape, keys), r"_:"]))
+    bucket = f"run-ids/{one.uuid[:RUN_ID_BUCKET]}>"  # a part of the uuid: a slot of its own
+    pattern = re.compile("|".join([re.escape(bucket), *map(re.escape, keys), r"_:"]))
     text = real_nquads(one, scenario, keep)
     chunks, slots, at = [], [], 0
     for found in pattern.finditer(text):
         chunks.append(text[at : found.start()])
-        slots.append(BLANK if found.group() == "_:" else index[found.group()])
+        kind = found.group()
+        slots.append(BLANK if kind == "_:" else BUCKET if kind == bucket else index[kind])
         at = found.end()
     chunks.append(text[at:])
     return Template(len(tokens), tuple(chunks), tuple(slots))

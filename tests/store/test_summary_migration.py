@@ -60,6 +60,9 @@ def test_a_store_from_before_the_summaries_is_refused_until_migrated_and_then_an
     assert "without the run summaries" in refused.stderr and "exscec store migrate" in refused.stderr
     assert "Traceback" not in refused.stderr
 
+    found = exscec_here("store", "check", "--store", str(store), cwd=tmp_path)
+    assert found.returncode != 0 and found.stdout.count("run without summary") == 5, found.stdout
+
     migrated = exscec_here("store", "migrate", "--store", str(store), cwd=tmp_path)
     assert migrated.returncode == 0, migrated.stderr
     assert "runs given their summary: 5" in migrated.stdout

@@ -13,6 +13,9 @@ Findings, by kind:
 * ``old robot name`` — a robot whose namespace is not its id, named by its id alone (the scheme
   before issue 48; :func:`~exsce_dsl.prov.identifiers.robot_name`).  ``--fix`` (and ``store
   migrate``) renames it, its parts and its bundle in every graph that names them.
+* ``run without summary`` — a run whose summary graph (:mod:`.run_summary`) is missing: written
+  by an exsce before the summaries, the scenario-wide queries do not see it.  ``--fix`` (and
+  ``store migrate``) writes it from the run's own statements.
 * ``dangling reference`` — a graph naming something in the runs' namespace that no graph
   describes (a verdict of a metric value gone), or a baseline that learnt from runs the store no
   longer holds.  Not mended: which record is wrong is a judgement (build the baselines again with
@@ -40,6 +43,7 @@ from exsce_dsl.store.graph_owners import graph_run
 from exsce_dsl.store.migrating import old_bag_bundles, renamed_graphs
 from exsce_dsl.store.robot_renaming import old_robot_names, renamed_robot_graphs
 from exsce_dsl.store.sparql import term_text
+from exsce_dsl.store.summary_migration import runs_without_summary, write_summaries
 
 __all__ = ["StoreCheck", "StoreFinding", "check_store"]
 
@@ -48,6 +52,7 @@ OLD_BAG_BUNDLE = "old bag bundle"
 OLD_ROBOT_NAME = "old robot name"
 DANGLING = "dangling reference"
 NO_SCENARIO = "run without scenario"
+NO_SUMMARY = "run without summary"
 
 
 @dataclass(frozen=True)
@@ -125,6 +130,16 @@ def check_store(store: Store, namespace: str = DEFAULT_NAMESPACE, *, fix: bool =
         )
         for r in renames
     ]
+    unsummarised = [run for run in runs_without_summary(graphs) if run in runs]
+    findings += [
+        StoreFinding(
+            NO_SUMMARY,
+            names.of_run(run)[:-1] + "_bundle",
+            f"run {run}, which the scenario-wide questions do not see",
+            fixable=True,
+        )
+        for run in unsummarised
+    ]
     findings += _dangling(store, names, runs)
     findings += _runs_without_scenario(store, names)
     if not fix or not any(f.fixable for f in findings):
@@ -136,6 +151,8 @@ def check_store(store: Store, namespace: str = DEFAULT_NAMESPACE, *, fix: bool =
     robot_writes = renamed_robot_graphs(store, renames)  # the orphans are gone by now
     if robot_writes:
         store.write(GraphSet(robot_writes), replace=set(robot_writes))
+    if unsummarised:
+        write_summaries(store, unsummarised, store.graph_names(), namespace)
     return StoreCheck(store.location, tuple(findings), tuple(f for f in findings if f.fixable))
 
 

@@ -262,9 +262,12 @@ class _Summariser:
 
     def _defects(self, graph: NamedNode, key: NamedNode, run: Literal,
                  defects: Sequence[Mapping[ids.Term, NamedNode | Literal]]) -> list[Quad]:  # fmt: skip
-        """The defects as resources ``<run>:<graph's name>-defect-<n>``, in a fixed order."""
+        """The defects as resources ``<run>:<graph's name>-defect-<n>``, in an order of what they
+        are about, never of their seconds (the same defects of two runs get the same names)."""
         quads: list[Quad] = []
-        ordered = sorted(defects, key=lambda d: sorted((t.local, v.value) for t, v in d.items()))
+        ordered = sorted(
+            defects, key=lambda d: sorted((t.local, v.value) for t, v in d.items() if t != ids.DEFECT_SECONDS)
+        )
         for number, defect in enumerate(ordered):
             node = NamedNode(f"{graph.value}-defect-{number}")
             quads += [Quad(key, self.p(ids.DEFECT), node, graph),

@@ -32,22 +32,20 @@ BATCH = 100
 """Runs summarised per write."""
 
 _RUN_BUNDLE = re.compile(r"/runs/run_([^/?]+)_bundle$")
-_VERDICTS = re.compile(rf"/runs/run_([^/?]+)/{ids.VERDICTS_BUNDLE}$")
 
 
 def runs_without_summary(names: Iterable[str]) -> list[str]:
-    """The runs (uuids) among the graph ``names`` whose run or verdicts bundle has no summary
-    graph beside it, sorted.  (A verification without defects has an empty summary, which a store
-    does not keep: such a run is found again, and :func:`write_summaries` writes nothing for it.)"""
+    """The runs (uuids) among the graph ``names`` whose bundle has no summary graph beside it,
+    sorted.  Their verdicts' summaries are written with theirs (a verification without defects has
+    an empty one, which a store does not keep, so a missing one says nothing)."""
     names = set(names)
     runs = set()
     for name in names:
-        found = _RUN_BUNDLE.search(name) or _VERDICTS.search(name)
-        if found is None:
-            continue
-        summary = ids.RUN_SUMMARY if _RUN_BUNDLE.search(name) else ids.VERDICTS_SUMMARY
-        run_part = name[: found.start()] + f"/runs/run_{found.group(1)}/"
-        if run_part + summary not in names:
+        found = _RUN_BUNDLE.search(name)
+        if (
+            found is not None
+            and f"{name[: found.start()]}/runs/run_{found.group(1)}/{ids.RUN_SUMMARY}" not in names
+        ):
             runs.add(found.group(1))
     return sorted(runs)
 
