@@ -39,6 +39,7 @@ from exsce_dsl.prov import identifiers as ids
 from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, Namespaces
 from exsce_dsl.remedies import LIST_THE_QUERIES
 from exsce_dsl.store.base import Bindings, Term
+from exsce_dsl.store.run_summary import RUN_ID_BUCKET, run_id_bucket
 from exsce_dsl.suggest import did_you_mean
 
 __all__ = ["FROM_RUNS", "KINDS", "QueryParameter", "Query", "query", "query_names", "standard_prefixes"]
@@ -71,6 +72,8 @@ KINDS: Mapping[str, Callable[[Namespaces, str], Term]] = {
     "run_activity": lambda names, text: _iri(names, ids.RUN, ids.run_local_name(text), "run uuid"),
     "run_bundle": lambda names, text: _iri(names, ids.RUN, f"{ids.run_local_name(text)}_bundle", "run uuid"),
     "run_part": lambda names, text: _iri(names, ids.RUN, f"{ids.run_local_name(text)}/", "run uuid"),
+    "run_prefix": lambda names, text: Literal(text),
+    "run_id_bucket": lambda names, text: NamedNode(run_id_bucket(names.fixed[ids.EXSCE], text)),
     "robot": lambda names, text: Literal(text),
     "metric": lambda names, text: Literal(text),
     "metric_property": lambda names, text: _iri(names, ids.METRIC, text, "metric"),
@@ -85,12 +88,16 @@ KINDS: Mapping[str, Callable[[Namespaces, str], Term]] = {
 from it with a look-up, where the uuid literal is one of every run entity's), ``run_bundle`` →
 ``run:run_<uuid>_bundle`` (the run's bundle, a graph: a ``GRAPH ?bundle`` block bound to it reads
 that graph's indexes alone, the fastest start a query has), ``run_part`` → the run's graph
-named like the parameter (``?hotspots_bundle`` → ``run:run_<uuid>/hotspots_bundle``), and ``id``,
+named like the parameter (``?hotspots_bundle`` → ``run:run_<uuid>/hotspots_bundle``),
+``run_id_bucket`` → the run summaries' key of the runs whose uuid starts like the ``run_prefix``
+given (:func:`~exsce_dsl.store.run_summary.run_id_bucket`: a look-up, where a ``STRSTARTS`` reads
+every run's uuid), and ``id``, ``run_prefix`` (the start of a run's uuid),
 ``run`` (a uuid), ``robot``, ``metric``, ``string`` → a plain literal."""
 
 
-FROM_RUNS = frozenset({"run_bundle", "run_part"})
-"""The kinds bound from the runs given to the query (a run's graphs), never given themselves."""
+FROM_RUNS = frozenset({"run_bundle", "run_part", "run_id_bucket"})
+"""The kinds bound from the runs given to the query (a run's graphs, the key of a run id's
+prefix), never given themselves."""
 
 
 @dataclass(frozen=True)
@@ -161,8 +168,15 @@ class Query:
         """The parameters given, with the runs given to a query that names their bundles
         (``run_bundle``, ``run_part``) bound as those bundles instead: the query starts from them, and
         reads each run's uuid there (a list of uuids bound beside them would be joined to
-        every row)."""
-        bundles = [p.name for p in self.parameters if p.from_runs]
+        every row); and a run id's prefix as its key too (``run_id_bucket``)."""
+        derived = dict(given)
+        prefixes = [p.name for p in self.parameters if p.kind == "run_prefix" and p.name in given]
+        for bucket in (p.name for p in self.parameters if p.kind == "run_id_bucket"):
+            # (a prefix too short for a key of its own is looked for among every run's uuid)
+            if prefixes and all(len(v) >= RUN_ID_BUCKET and ids.is_name(v) for v in given[prefixes[0]]):
+                derived[bucket] = given[prefixes[0]]
+        given = derived
+        bundles = [p.name for p in self.parameters if p.kind in ("run_bundle", "run_part")]
         runs = [p.name for p in self.parameters if p.kind == "run" and p.name in given]
         if not bundles or not runs or not all(map(ids.is_name, given[runs[0]])):
             return dict(given)  # (a value that is no run id is bound as given, and found nowhere)
