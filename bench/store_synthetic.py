@@ -36,6 +36,8 @@ from exsce_dsl.model.runs import (
 )
 
 ROBOTS = ("tiago1", "tiago2")
+HOTSPOT_FREE = 0.9
+"""The share of runs that keep to every safety limit (no hotspot, no violation)."""
 WAYPOINTS_PER_TASK = 5
 TASKS_PER_ROBOT = 2
 SEGMENT_METRICS = ("task_duration", "distance_travelled", "distance_to_obstacles", "max_velocity")
@@ -79,7 +81,21 @@ def synthetic_scenario() -> Scenario:
 
 
 def synthetic_run(scenario: Scenario, rng: random.Random, number: int) -> Run:
+    """Run ``number`` of the bench: most runs keep to the safety limits; one in ten has one to
+    three hotspots of max_velocity (the first robot's, then the second's), and violated that limit
+    as long as they last; a run with three violated the mission's distance between the robots too."""
     start = datetime.datetime(2024, 1, 1) + datetime.timedelta(minutes=10 * number)
+    hotspots = tuple(
+        Hotspot(
+            "max_velocity",
+            Position(rng.uniform(0, 6), rng.uniform(0, 4)),
+            rng.randint(1, 5),
+            rng.uniform(0.1, 3.0),
+            robot=ROBOTS[i % 2],
+        )
+        for i in range(0 if rng.random() < HOTSPOT_FREE else rng.randint(1, 3))
+    )
+    violated = {robot: sum(h.duration for h in hotspots if h.robot == robot) for robot in ROBOTS}
     tasks: list[TaskExecution] = []
     metrics: list[MetricValue] = []
     clock = start
@@ -125,7 +141,7 @@ def synthetic_run(scenario: Scenario, rng: random.Random, number: int) -> Run:
                 MetricValue(
                     metric,
                     MetricScope.ROBOT,
-                    rng.uniform(0.0, 100.0),
+                    violated[robot.id] if metric == "violation_duration" else rng.uniform(0.0, 100.0),
                     robot_topics[metric],
                     robot=robot.id,
                     safety_metric="max_velocity" if metric == "violation_duration" else None,
@@ -136,21 +152,13 @@ def synthetic_run(scenario: Scenario, rng: random.Random, number: int) -> Run:
             MetricValue(
                 metric,
                 MetricScope.MISSION,
-                rng.uniform(0.0, 300.0),
+                (rng.uniform(0.5, 5.0) if len(hotspots) == 3 else 0.0)
+                if metric == "violation_duration"
+                else rng.uniform(0.0, 300.0),
                 tuple(f"/{r}/{topic}" for r in ROBOTS),
                 safety_metric="distance_between_robots" if metric == "violation_duration" else None,
             )
         )
-    hotspots = tuple(
-        Hotspot(
-            "max_velocity",
-            Position(rng.uniform(0, 6), rng.uniform(0, 4)),
-            rng.randint(1, 5),
-            rng.uniform(0.1, 3.0),
-            robot=ROBOTS[i % 2],
-        )
-        for i in range(rng.randint(0, 3))
-    )
     run_uuid = str(uuid.UUID(int=rng.getrandbits(128), version=4))
     bag = Bag(f"{start:%Y-%m-%dT%H-%M-%S}_bench_run-{run_uuid[:8]}.bag", tuple(topics))
     return Run(run_uuid, scenario.id, start, clock, bag, tuple(tasks), tuple(metrics), hotspots)

@@ -12,6 +12,7 @@ from exsce_dsl.prov.identifiers import DEFAULT_NAMESPACE, pose_name
 from exsce_dsl.store.base import Rows, Store, Term
 from exsce_dsl.store.literals import canonical_rows, literal_value, parse_datetime
 from exsce_dsl.store.queries.library import Query, query
+from exsce_dsl.store.queries.ordering import sorted_rows, without_order
 from exsce_dsl.store.queries.run_ids import names_a_prefix, resolve_run
 from exsce_dsl.store.summary_migration import require_summaries
 from exsce_dsl.store.timing import measured, none
@@ -41,7 +42,11 @@ def run_query(
     if q.is_update:
         measured(text, lambda: store.update(text, bindings), none, name)
         return Rows((), ())
-    return canonical_rows(measured(text, lambda: store.select(text, bindings), len, name))
+    unordered = without_order(text)
+    if unordered is None:
+        return canonical_rows(measured(text, lambda: store.select(text, bindings), len, name))
+    asked, keys = unordered
+    return measured(text, lambda: sorted_rows(canonical_rows(store.select(asked, bindings)), keys), len, name)
 
 
 RUN_KINDS = ("run", "run_activity")
