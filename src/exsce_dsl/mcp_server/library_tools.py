@@ -36,6 +36,7 @@ _KIND_SCHEMAS: dict[str, dict[str, Any]] = {
     "pose": {"type": "string", "pattern": POSE_NAME},
     "run": {"type": "string", "pattern": RUN_ID},
     "run_activity": {"type": "string", "pattern": RUN_ID},  # given as its uuid, like "run"
+    "run_prefix": {"type": "string", "pattern": RUN_ID},  # the start of a run's uuid (4 characters or more)
     "string": {"type": "string"},
     "double": {"type": "number"},
 }

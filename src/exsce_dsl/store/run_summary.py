@@ -23,7 +23,9 @@ once in a graph of its own name (idempotent: every run writes the same):
         summary:run-ids/5e1a exsce:summaryRun "<uuid>" .          # the uuid's first four characters
         summary:scenario/S exsce:defect run:run_<uuid>/defect-0 .   # one per defect (none: good run)
         run:run_<uuid>/defect-0 a exsce:RunDefect ; exsce:summaryRun "<uuid>" ; exsce:defectKind ... }
-    GRAPH run:run_<uuid>/verdicts_summary { ... the verdicts' defects, as above }
+    GRAPH run:run_<uuid>/verdicts_summary {         # its last verification's
+        run:run_<uuid>/validation exsce:baselineRun "<uuid>" .  # a run its expectations came from
+        ... its defects, as above }
 
 "The mean violation time of max_velocity per robot" is then the key's values, one range of
 the subject index (``GRAPH ?g { <key> exsce:violationSeconds ?s }``); "the runs a baseline may
@@ -308,7 +310,17 @@ class _Summariser:
                 {ids.DEFECT_KIND: outcome[0], ids.DEFECT_RELATION: relation[0], ids.DEFECT_SUBJECT: subject}
             )
         key = self._describe(f"{self.keys}scenario/{scenario}", ids.SCENARIO_RUNS, scenario)
-        self.out[graph.value] = self._defects(graph, key, Literal(uuid), defects)
+        # the runs its expectations came from, one statement each (oracle:runs is one text)
+        runs = sorted(
+            {
+                r
+                for v in s.generated_by(validation)
+                for o in s.values(v, iri(ids.ORACLE_RUNS))
+                for r in o.value.split()
+            }
+        )
+        baseline = [Quad(NamedNode(validation), self.p(ids.BASELINE_RUN), Literal(r), graph) for r in runs]
+        self.out[graph.value] = baseline + self._defects(graph, key, Literal(uuid), defects)
 
 
 def _verdict_subject(verdict: str, relation: str) -> str:

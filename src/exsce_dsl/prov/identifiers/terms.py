@@ -331,6 +331,7 @@ DEFECT_RELATION = Term(EXSCE, "defectRelation")
 DEFECT_ROBOT = Term(EXSCE, "defectRobot")
 DEFECT_SECONDS = Term(EXSCE, "defectSeconds")
 DEFECT_HOTSPOT = Term(EXSCE, "defectHotspot")
+BASELINE_RUN = Term(EXSCE, "baselineRun")
 RUN_SUMMARY = "summary"
 """``<run>:summary``: the run's summary graph (its ingest's facts)."""
 VERDICTS_SUMMARY = "verdicts_summary"
