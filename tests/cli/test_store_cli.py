@@ -34,7 +34,7 @@ def test_compile_adds_to_the_project_store_and_store_commands_show_it(in_tmp: Pa
     assert info.returncode == 0, info.stderr
     assert info.stdout.splitlines() == [
         "store:      .exsce/store (embedded Oxigraph)",
-        "graphs:     14 (+ 0 revisions, + 0 of the segment index)",
+        "graphs:     14 (+ 0 revisions, + 0 of its indexes)",
         "statements: 377",
     ]
     graphs = exscec_here("store", "graphs")
@@ -74,7 +74,7 @@ def test_compile_to_a_sparql_endpoint_refuses_a_changed_scenario_then_replaces_i
     assert replaced.returncode == 0, replaced.stderr
     assert "replaced 1 graph" in replaced.stderr and "exsce:scenario_c_bundle?revision=1" in replaced.stderr
     info = exscec_here("store", "info", "--store", url)
-    assert "graphs:     14 (+ 1 revisions, + 0 of the segment index)" in info.stdout and "SPARQL 1.1 endpoint" in info.stdout
+    assert "graphs:     14 (+ 1 revisions, + 0 of its indexes)" in info.stdout and "SPARQL 1.1 endpoint" in info.stdout
 
 
 def test_an_unreachable_endpoint_is_named(in_tmp: Path) -> None:

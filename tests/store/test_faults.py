@@ -3,7 +3,7 @@
 In each case the store holds every run wholly or not at all: its graphs are
 compared, graph by graph and quad count by quad count, with the states of a
 store into which the same bags were ingested undisturbed, one after another
-(runs share the graphs of the segment index, so a run is not a set of graphs
+(runs share the graphs of the store's indexes, so a run is not a set of graphs
 of its own).
 """
 
