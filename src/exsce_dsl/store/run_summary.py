@@ -61,6 +61,24 @@ _STARTED = f"{PROV_NAMESPACE}startedAtTime"
 _ENDED = f"{PROV_NAMESPACE}endedAtTime"
 _VALUE = f"{PROV_NAMESPACE}value"
 _DEFECT_OUTCOMES = ("failed", "inconclusive", "unjudged")
+_READ = (
+    *(
+        f"/{t.local}"
+        for t in (ids.RUN_ATTR, ids.METRIC_ATTR, ids.ROBOT_ATTR, ids.FILE_PATH, ids.MISSION_STATUS)
+    ),
+    *(
+        f"/{t.local}"
+        for t in (ids.METRIC_TYPE, ids.HOTSPOT_TYPE, ids.ORACLE_OUTCOME, ids.ORACLE_RELATIONSHIP)
+    ),
+    *(f"/{t.local}" for t in (ids.ORACLE_RUNS, ids.SCENARIO_ATTR)),
+    _RDF_TYPE,
+    _USED,
+    _GENERATED_BY,
+    _STARTED,
+    _ENDED,
+    _VALUE,
+)
+"""The endings of the predicates a summary reads."""
 
 
 def is_summary_graph(name: str) -> bool:
@@ -85,16 +103,24 @@ class _Subjects:
     facts: dict[str, dict[str, list[NamedNode | Literal]]] = field(default_factory=dict)
     graphs: dict[tuple[str, str, str], set[str]] = field(default_factory=dict)
     """Where each ``rdf:type`` and ``prov:wasGeneratedBy`` statement is: (s, p, o) → graph names."""
+    by_type: dict[str, list[str]] = field(default_factory=dict)
+    by_generator: dict[str, list[str]] = field(default_factory=dict)
 
     @classmethod
     def of(cls, quads: Iterable[Quad]) -> _Subjects:
+        """The statements a summary is made of (a third of a run's: its predicates end so)."""
         found = cls()
         for quad in quads:
-            s, o = quad.subject, quad.object
-            if isinstance(s, NamedNode) and isinstance(o, NamedNode | Literal):
-                found.facts.setdefault(s.value, {}).setdefault(quad.predicate.value, []).append(o)
-                if quad.predicate.value in (_RDF_TYPE, _GENERATED_BY):
-                    key = (s.value, quad.predicate.value, o.value)
+            s, o, predicate = quad.subject, quad.object, quad.predicate.value
+            if not predicate.endswith(_READ) or not isinstance(s, NamedNode):
+                continue
+            if isinstance(o, NamedNode | Literal):
+                found.facts.setdefault(s.value, {}).setdefault(predicate, []).append(o)
+                if predicate == _RDF_TYPE or predicate == _GENERATED_BY:
+                    key = (s.value, predicate, o.value)
+                    if key not in found.graphs:
+                        index = found.by_type if predicate == _RDF_TYPE else found.by_generator
+                        index.setdefault(o.value, []).append(s.value)
                     found.graphs.setdefault(key, set()).add(str(quad.graph_name))
         return found
 
@@ -106,12 +132,10 @@ class _Subjects:
         return found[0].value if found else None
 
     def typed(self, iri: str) -> list[str]:
-        return [s for s, p in self.facts.items() if any(o.value == iri for o in p.get(_RDF_TYPE, ()))]
+        return self.by_type.get(iri, [])
 
     def generated_by(self, activity: str) -> list[str]:
-        return [
-            s for s, p in self.facts.items() if any(o.value == activity for o in p.get(_GENERATED_BY, ()))
-        ]
+        return self.by_generator.get(activity, [])
 
 
 def run_summary(graphs: Mapping[str, Sequence[Quad]]) -> dict[str, list[Quad]]:
