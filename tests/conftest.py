@@ -27,30 +27,41 @@ def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
 
 
 LONGEST_FIRST = (
-    "execute/test_live_loop.py",
+    "explore/test_explore_ros2.py",  # live
     "cli/test_help_examples_runs.py",
-    "runs/signals/test_timeline.py",
-    "runs/test_ros1_graph.py",
-    "cli/test_demo_remote.py",
-    "explore/test_campaign.py",
-    "cli/test_help_examples_explore.py",
-    "cli/test_init_from_bag.py",
-    "execute/test_ros1_execute.py",
-    "report/test_report.py",
     "api/test_python_api.py",
-    "cli/test_help_examples_live.py",
+    "runs/test_ros1_graph.py",  # live
+    "execute/test_ros1_execute.py",
+    "execute/test_live_loop.py",  # live
     "mcp_server/test_mcp_server.py",
+    "cli/test_root_namespace_nav2.py",
+    "runs/signals/test_timeline.py",
+    "explore/test_figures.py",
+    "cli/test_init_from_bag.py",
+    "cli/test_demo_remote.py",
+    "report/test_report.py",
     "store/test_same_answers.py",
     "execute/test_stand_in.py",
+    "project/test_docs_examples.py",
     "project/test_static_checks.py",
-    "cli/test_root_namespace_nav2.py",
-    "explore/test_figures.py",
+    "explore/test_campaign.py",
+    "cli/test_help_examples_live.py",  # live
+    "cli/test_help_examples_explore.py",  # live
+    "cli/test_help_examples_language.py",
+    "execute/test_ros2_live_loop.py",  # live
+    "store/test_server_writes.py",
 )
-"""Test files that take longest (30-120 s each on two cores), roughly longest first, a file on
-a live ROS graph after one or two that are not, so that live ones seldom share the cores: xdist
-hands out files in collection order (``--no-loadscope-reorder``; its default puts the files with
-most tests first, and so these, of one or two tests each, last, where one worker went on alone
-for a minute after the others had finished)."""
+"""Test files that take longest (20-270 s each on two cores under the suite's load), handed out
+first: xdist hands out files in collection order (``--no-loadscope-reorder``; its default puts
+the files with most tests first, and so these, of one or two tests each, last, where one worker
+went on alone for a minute after the others had finished).  A worker whose file has two tests or
+fewer left is sent the next file at once, so the order is not simply longest first: this one was
+found by replaying xdist's scheduling with each test's seconds in a whole run (three workers),
+for the files on a live ROS graph (``# live``) to run one after another, mostly on one worker,
+while the other two take the rest.  Two live files at once had the recorders of both off the
+cores for long enough to leave gaps over 0.5 s in their runs (an inconclusive run, a baseline
+refused); with the ROS 2 live loop (~200 s, not listed before) at the start beside the ROS 1 one,
+the live files overlapped for ~600 s of a run, in the order before it ~250 s, in this one none."""
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
