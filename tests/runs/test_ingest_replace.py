@@ -160,8 +160,12 @@ def test_ingest_again_after_a_new_metric_keeps_the_old_run_until_replace(bags, p
         start, end = min(a.start for a in actions).timestamp(), max(a.end for a in actions).timestamp()
         expected = _mean_forward_speed(bag, robot, start, end)
         assert after[("mean_forward_speed", robot, None)] == pytest.approx(expected, rel=1e-9)
-    # nothing but the run changed: the other run, the scenario, the shared segment graphs
-    assert _contents(store, but=run) == untouched
+    # nothing but the run changed: the other run, the scenario, the shared segment graphs; the
+    # run summaries' key of the new metric is new (every run with values of it shares it)
+    now = _contents(store, but=run)
+    key = "https://www.sesame-project.org/scenarios/summaries/metric/mean_forward_speed"
+    assert set(now) - set(untouched) == {key} and "mean_forward_speed" in " ".join(now[key])
+    assert {name: statements for name, statements in now.items() if name != key} == untouched
     assert {r.uuid for r in runs(store)} == {run, first[1].run_id}
 
 

@@ -61,11 +61,13 @@ def test_a_placeholder_says_where_a_parameter_is_bound() -> None:
     )
     text = bind(query, {"s": [NamedNode("http://a"), NamedNode("http://b")], "o": Literal("x")})
     inner = text.index("{ SELECT ?s WHERE {")
-    assert text.index('VALUES ?s { <http://a> <http://b> }') > inner  # in the subquery, as placed
+    assert text.index("VALUES ?s { <http://a> <http://b> }") > inner  # in the subquery, as placed
     assert text.index('VALUES (?o) { ("x") }') < inner  # no placeholder: at the top of WHERE
     assert "UNDEF" not in text.split("#")[0] and text.count("UNDEF") == 1  # the comment's stays
     store = Store()
-    store.update('INSERT DATA { <http://a> <http://p> "x" . <http://a> <http://q> "x" . <http://c> <http://p> "x" . <http://c> <http://q> "x" }')
+    store.update(
+        'INSERT DATA { <http://a> <http://p> "x" . <http://a> <http://q> "x" . <http://c> <http://p> "x" . <http://c> <http://q> "x" }'
+    )
     assert [str(s["s"]) for s in store.query(text)] == ["<http://a>"]  # type: ignore[union-attr]
     assert len(list(store.query(query))) == 2  # unbound, the placeholder leaves ?s free  # type: ignore[arg-type]
 
@@ -79,7 +81,9 @@ def test_each_branch_of_a_union_gets_the_values_of_its_placeholder() -> None:
     text = bind(query, {"s": [NamedNode("http://a")]})
     assert text.count("VALUES ?s { <http://a> }") == 2 and "UNDEF" not in text
     store = Store()
-    store.update("INSERT DATA { <http://a> <http://p> 1 . <http://a> <http://q> 2 . <http://c> <http://p> 3 }")
+    store.update(
+        "INSERT DATA { <http://a> <http://p> 1 . <http://a> <http://q> 2 . <http://c> <http://p> 3 }"
+    )
     found = sorted(int(s["o"].value) for s in store.query(text))  # type: ignore[union-attr]
     assert found == [1, 2]
 
@@ -90,8 +94,10 @@ def test_a_query_that_names_its_runs_bundles_is_bound_to_them_not_to_the_uuids()
     lineage = library.query("run_lineage")
     uuid = "0d1e8a5c-1111-4a2b-9c3d-123456789abc"
     bound = lineage.bindings({"run": [uuid]})
-    assert set(bound) == {"bundle"}
-    assert bound["bundle"] == NamedNode(f"{Namespaces(DEFAULT_NAMESPACE).fixed['run']}run_{uuid}_bundle")
+    assert set(bound) == {"bundle", "execution_bundle", "verdicts_bundle", "verdicts_summary"}
+    runs = Namespaces(DEFAULT_NAMESPACE).fixed["run"]
+    assert bound["bundle"] == NamedNode(f"{runs}run_{uuid}_bundle")
+    assert bound["verdicts_summary"] == NamedNode(f"{runs}run_{uuid}/verdicts_summary")
     # a value that is no run id stays a literal (found nowhere): never part of an IRI
     assert set(lineage.bindings({"run": ['x" } UNION { ?s ?p ?o']})) == {"run"}
 
